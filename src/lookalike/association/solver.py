@@ -1,0 +1,101 @@
+"""The assignment solver contract, with scipy's ``linear_sum_assignment`` behind it.
+
+``assign(cost, max_cost)`` matches rows (e.g. tracks) to columns (e.g. detections) so that no
+pair costs more than ``max_cost``: ``inf`` (or anything above ``max_cost``) forbids a pair.
+Rectangular, empty and all-forbidden matrices are legal.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+
+@dataclass(frozen=True)
+class Assignment:
+    """Result of an assignment.
+
+    Attributes:
+        matches: ``(k, 2)`` int array of ``(row, col)`` pairs, sorted by row.
+        unmatched_rows: ``(r,)`` sorted row indices without a match.
+        unmatched_cols: ``(c,)`` sorted column indices without a match.
+    """
+
+    matches: np.ndarray
+    unmatched_rows: np.ndarray
+    unmatched_cols: np.ndarray
+
+    def __iter__(self):  # allows ``matches, rows, cols = assign(...)``
+        return iter((self.matches, self.unmatched_rows, self.unmatched_cols))
+
+
+def _result(rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> Assignment:
+    order = np.argsort(rows, kind="stable")
+    rows, cols = rows[order], cols[order]
+    matches = np.stack([rows, cols], axis=1).astype(int) if rows.size else np.zeros((0, 2), dtype=int)
+    return Assignment(
+        matches=matches,
+        unmatched_rows=np.setdiff1d(np.arange(shape[0]), rows).astype(int),
+        unmatched_cols=np.setdiff1d(np.arange(shape[1]), cols).astype(int),
+    )
+
+
+def _check(cost: np.ndarray) -> np.ndarray:
+    c = np.asarray(cost, dtype=float)
+    if c.ndim != 2:
+        raise ValueError(f"cost: expected a 2-D matrix, got shape {c.shape}")
+    if np.isnan(c).any():
+        row, col = np.argwhere(np.isnan(c))[0]
+        raise ValueError(f"cost: NaN at row {row}, column {col}; use inf to forbid a pair")
+    if np.isneginf(c).any():
+        row, col = np.argwhere(np.isneginf(c))[0]
+        raise ValueError(f"cost: -inf at row {row}, column {col}")
+    return c
+
+
+def assign(cost: np.ndarray, max_cost: float = np.inf) -> Assignment:
+    """Minimum-cost assignment where pairs costing more than ``max_cost`` (or ``inf``) are forbidden.
+
+    With a finite ``max_cost``, leaving a row unmatched costs as much as a pair at ``max_cost``
+    (deep SORT's convention). With ``max_cost = inf`` the solver first maximises the number of
+    allowed pairs, then minimises their total cost.
+    """
+    c = _check(cost)
+    if c.size == 0:
+        return _result(np.zeros(0, int), np.zeros(0, int), c.shape)
+    allowed = np.isfinite(c) & (c <= max_cost)
+    if not allowed.any():
+        return _result(np.zeros(0, int), np.zeros(0, int), c.shape)
+    if np.isfinite(max_cost):
+        # Clip forbidden pairs to just above the limit; they are dropped after solving.
+        scale = max(abs(max_cost - float(c[allowed].min())), 1.0)
+        work = np.where(allowed, c, max_cost + 1e-6 * scale)
+        # Rescale when values are so large that sums could overflow.
+        big = max(abs(float(work.max())), abs(float(work.min())))
+        if big * min(c.shape) > 1e300:
+            work = work / big
+    else:
+        low = float(c[allowed].min())
+        work = np.where(allowed, c - low, 0.0)
+        top = float(work.max())
+        if top > 0 and top * min(c.shape) > 1e290:
+            work = work / top
+            top = 1.0
+        penalty = (top + 1.0) * (min(c.shape) + 1)
+        work = np.where(allowed, work, penalty)
+    rows, cols = linear_sum_assignment(work)
+    keep = allowed[rows, cols]
+    return _result(rows[keep], cols[keep], c.shape)
+
+
+def max_weight_complete(weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns of a maximum-weight complete matching (no gating), as SORT solves it.
+
+    The caller filters the pairs afterwards; this is the reference SORT's "solve then gate" order.
+    """
+    w = _check(weight)
+    if w.size == 0:
+        return np.zeros(0, int), np.zeros(0, int)
+    return linear_sum_assignment(-w)

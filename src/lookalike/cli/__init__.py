@@ -1,0 +1,17 @@
+"""The ``lookalike`` command line (typer). Each command lives in its own module of this package."""
+
+from __future__ import annotations
+
+from lookalike.cli.app import app
+
+# Importing the command modules registers their commands on ``app``.
+from lookalike.cli import track as _track  # noqa: E402,F401
+from lookalike.cli import demo as _demo  # noqa: E402,F401
+
+
+def main() -> None:
+    """Entry point of the ``lookalike`` script."""
+    app()
+
+
+__all__ = ["app", "main"]

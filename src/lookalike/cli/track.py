@@ -1,0 +1,102 @@
+"""``lookalike track`` and ``lookalike trackers``."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any, Optional
+
+import typer
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from lookalike.cli.app import app, console, fail
+from lookalike.io import find_sequences, frames_from_table, read_mot, tracks_to_rows, write_mot
+from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
+from lookalike.trackers.registry import parse_parameter
+
+
+def build_tracker(name: str, settings: list[str]) -> Any:
+    """A tracker from its name and ``KEY=VALUE`` settings, failing with a readable message."""
+    if name not in tracker_names():
+        fail(f"unknown tracker {name!r}; choose one of: {', '.join(tracker_names())}")
+    try:
+        params = dict(parse_parameter(name, s) for s in settings)
+        return make_tracker(name, **params)
+    except (ValueError, TypeError) as exc:
+        fail(str(exc))
+
+
+@app.command()
+def track(
+    path: Path = typer.Argument(..., help="det.txt, a sequence folder, or a folder of sequences."),
+    output: Path = typer.Option(..., "-o", "--output", help="Result file (single det.txt) or folder."),
+    tracker: str = typer.Option("sort", "--tracker", "-t", help="Registered tracker name."),
+    set_: Optional[list[str]] = typer.Option(
+        None, "--set", "-s", help="Tracker parameter KEY=VALUE (repeatable); see `lookalike trackers`."
+    ),
+    min_score: float = typer.Option(float("-inf"), help="Drop detections with a lower score."),
+) -> None:
+    """Run a tracker over MOTChallenge detections and write MOTChallenge results."""
+    try:
+        sequences = [s for s in find_sequences(path) if s.det_path is not None]
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
+    if not sequences:
+        fail(f"{path}: no det/det.txt found")
+    single_file = path.is_file()
+    trk = build_tracker(tracker, set_ or [])
+    loaded = []
+    for seq in sequences:
+        try:
+            table = read_mot(seq.det_path)
+        except ValueError as exc:
+            fail(str(exc))
+        loaded.append((seq, table))
+    total_frames, total_time = 0, 0.0
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    with Progress(*columns, console=console, transient=True) as progress:
+        overall = progress.add_task("sequences", total=len(loaded))
+        for seq, table in loaded:
+            trk.reset()
+            frames = list(frames_from_table(table, seq.length, seq.frame_rate, min_score))
+            task = progress.add_task(seq.name, total=len(frames))
+            rows = []
+            for frame in frames:
+                t0 = time.perf_counter()
+                tracks = trk.update(frame)
+                total_time += time.perf_counter() - t0
+                rows.append(tracks_to_rows(frame.index, tracks))
+                progress.advance(task)
+            target = output if single_file else output / f"{seq.name}.txt"
+            write_mot(target, rows)
+            total_frames += len(frames)
+            progress.remove_task(task)
+            progress.advance(overall)
+    fps = total_frames / total_time if total_time > 0 else float("inf")
+    where = output if single_file else f"{output}/<sequence>.txt"
+    console.print(
+        f"[green]{tracker}[/]: {len(loaded)} sequence(s), {total_frames} frames, "
+        f"{fps:,.0f} frames/s (tracker only) → {where}"
+    )
+
+
+@app.command()
+def trackers(
+    names: bool = typer.Option(False, "--names", help="Print only the names, one per line."),
+) -> None:
+    """List registered trackers and their parameters with defaults."""
+    if names:
+        for name in tracker_names():
+            typer.echo(name)
+        return
+    for name in tracker_names():
+        table = Table(title=f"[bold]{name}[/]", title_justify="left", show_lines=False)
+        table.add_column("parameter")
+        table.add_column("type")
+        table.add_column("default")
+        table.add_column("meaning")
+        for p in tracker_parameters(name):
+            table.add_row(p.name, p.type, repr(p.default), p.doc)
+        console.print(table)
+    console.print("Set any parameter with [bold]--set KEY=VALUE[/] on `lookalike track`.")

@@ -1,0 +1,70 @@
+"""Box format conversions and the vectorised IoU matrix.
+
+Formats are named by their columns: ``xywh`` (left, top, width, height), ``xyxy`` (left, top,
+right, bottom), ``cxcywh`` (centre x, centre y, width, height) and ``xysr`` (centre x, centre y,
+area, aspect ratio width/height, as in SORT). All in pixels; arrays are ``(n, 4)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def xywh_to_xyxy(xywh: np.ndarray) -> np.ndarray:
+    """``(n, 4)`` left/top/width/height to left/top/right/bottom."""
+    b = np.asarray(xywh, dtype=float)
+    out = b.copy()
+    out[..., 2:] += b[..., :2]
+    return out
+
+
+def xyxy_to_xywh(xyxy: np.ndarray) -> np.ndarray:
+    """``(n, 4)`` left/top/right/bottom to left/top/width/height."""
+    b = np.asarray(xyxy, dtype=float)
+    out = b.copy()
+    out[..., 2:] -= b[..., :2]
+    return out
+
+
+def xywh_to_cxcywh(xywh: np.ndarray) -> np.ndarray:
+    """``(n, 4)`` left/top/width/height to centre x/centre y/width/height."""
+    b = np.asarray(xywh, dtype=float)
+    out = b.copy()
+    out[..., :2] += b[..., 2:] / 2.0
+    return out
+
+
+def xywh_to_xysr(xywh: np.ndarray) -> np.ndarray:
+    """``(n, 4)`` left/top/width/height to SORT's centre/area/aspect ``[u, v, s, r]``."""
+    b = np.asarray(xywh, dtype=float)
+    w, h = b[..., 2], b[..., 3]
+    return np.stack([b[..., 0] + w / 2.0, b[..., 1] + h / 2.0, w * h, w / h], axis=-1)
+
+
+def xysr_to_xywh(xysr: np.ndarray) -> np.ndarray:
+    """``(n, 4)`` SORT's ``[u, v, s, r]`` to left/top/width/height (NaN where s·r < 0)."""
+    z = np.asarray(xysr, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        w = np.sqrt(z[..., 2] * z[..., 3])
+        h = z[..., 2] / w
+    return np.stack([z[..., 0] - w / 2.0, z[..., 1] - h / 2.0, w, h], axis=-1)
+
+
+def iou_matrix(xywh_a: np.ndarray, xywh_b: np.ndarray) -> np.ndarray:
+    """Intersection over union of every box in ``a`` with every box in ``b``: ``(n, m)``.
+
+    Boxes of zero area that do not overlap anything give 0, never NaN.
+    """
+    a = np.asarray(xywh_a, dtype=float).reshape(-1, 4)
+    b = np.asarray(xywh_b, dtype=float).reshape(-1, 4)
+    ax1, ay1 = a[:, 0:1], a[:, 1:2]
+    ax2, ay2 = ax1 + a[:, 2:3], ay1 + a[:, 3:4]
+    bx1, by1 = b[:, 0], b[:, 1]
+    bx2, by2 = bx1 + b[:, 2], by1 + b[:, 3]
+    iw = np.clip(np.minimum(ax2, bx2) - np.maximum(ax1, bx1), 0.0, None)
+    ih = np.clip(np.minimum(ay2, by2) - np.maximum(ay1, by1), 0.0, None)
+    inter = iw * ih
+    union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
+    with np.errstate(invalid="ignore", divide="ignore"):
+        iou = np.where(union > 0, inter / union, 0.0)
+    return iou

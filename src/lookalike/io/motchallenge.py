@@ -1,0 +1,168 @@
+"""MOTChallenge text files: ``frame, id, left, top, width, height, conf, x, y, z[, ...]``.
+
+Frames and ids are 1-based in files; in memory ``MotTable.frame`` keeps the file's 1-based
+numbers and :func:`frames_from_table` yields 0-based :class:`Frame` objects.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable, Iterator, Sequence
+
+import numpy as np
+
+from lookalike.types import Detections, Frame, TrackSnapshot
+
+
+@dataclass(frozen=True, eq=False)
+class MotTable:
+    """A MOTChallenge file as columns (one row per box).
+
+    Attributes:
+        frame: ``(n,)`` 1-based frame numbers.
+        track_id: ``(n,)`` ids (-1 in detection files).
+        xywh: ``(n, 4)`` boxes in pixels.
+        conf: ``(n,)`` detector score, or the ground truth's consider flag.
+        extra: ``(n, k)`` the remaining columns (world xyz, or class and visibility in MOT16+ gt).
+        path: the file it came from, if any.
+    """
+
+    frame: np.ndarray
+    track_id: np.ndarray
+    xywh: np.ndarray
+    conf: np.ndarray
+    extra: np.ndarray
+    path: Path | None = None
+
+    def __len__(self) -> int:
+        return int(self.frame.shape[0])
+
+
+def read_mot(path: str | os.PathLike[str], min_columns: int = 6) -> MotTable:
+    """Read a MOTChallenge text file.
+
+    Raises ``ValueError`` naming the file and 1-based line number of a malformed line (too few
+    columns, a non-number, NaN or infinity, a negative size, a frame number below 1).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    text = path.read_text()
+    lines = text.splitlines()
+    rows = [(i + 1, ln) for i, ln in enumerate(lines) if ln.strip()]
+    if not rows:
+        return _table(np.zeros((0, 7)), path)
+    try:
+        data = np.array([ln.split(",") for _, ln in rows], dtype=float)
+    except ValueError:
+        data = None
+    if data is None or data.ndim != 2 or data.shape[1] < min_columns:
+        data = _parse_slowly(path, rows, min_columns)
+    bad = ~np.isfinite(data[:, :6]).all(axis=1) | (data[:, 4:6] < 0).any(axis=1) | (data[:, 0] < 1)
+    if bad.any():
+        line_no, line = rows[int(np.flatnonzero(bad)[0])]
+        raise ValueError(
+            f"{path}:{line_no}: invalid box (NaN/inf, negative size or frame < 1): {line.strip()!r}"
+        )
+    return _table(data, path)
+
+
+def _parse_slowly(path: Path, rows: list[tuple[int, str]], min_columns: int) -> np.ndarray:
+    parsed: list[list[float]] = []
+    width = None
+    for line_no, line in rows:
+        fields = [f.strip() for f in line.split(",")]
+        if len(fields) < min_columns:
+            raise ValueError(
+                f"{path}:{line_no}: expected at least {min_columns} comma-separated columns, "
+                f"got {len(fields)}: {line.strip()!r}"
+            )
+        try:
+            values = [float(f) for f in fields]
+        except ValueError:
+            raise ValueError(f"{path}:{line_no}: not a number in {line.strip()!r}") from None
+        width = len(values) if width is None else min(width, len(values))
+        parsed.append(values)
+    return np.array([v[:width] for v in parsed], dtype=float)
+
+
+def _table(data: np.ndarray, path: Path | None) -> MotTable:
+    n = data.shape[0]
+    conf = data[:, 6] if data.shape[1] > 6 else np.ones(n)
+    extra = data[:, 7:] if data.shape[1] > 7 else np.zeros((n, 0))
+    return MotTable(
+        frame=data[:, 0].astype(int),
+        track_id=data[:, 1].astype(int),
+        xywh=data[:, 2:6].copy(),
+        conf=conf.copy(),
+        extra=extra.copy(),
+        path=path,
+    )
+
+
+def frames_from_table(
+    table: MotTable, length: int | None = None, frame_rate: float = 30.0, min_score: float = -np.inf
+) -> Iterator[Frame]:
+    """Yield one :class:`Frame` per frame ``0 .. length-1`` (file frame ``k`` is index ``k-1``).
+
+    Frames without boxes are yielded empty; ``time = index / frame_rate``. Boxes whose score is
+    below ``min_score`` are dropped.
+    """
+    if frame_rate <= 0:
+        raise ValueError(f"frame_rate must be positive, got {frame_rate}")
+    keep = table.conf >= min_score
+    frames = table.frame[keep]
+    last = int(frames.max()) if len(frames) else 0
+    if length is None:
+        length = last
+    order = np.argsort(frames, kind="stable")
+    frames = frames[order]
+    xywh, conf = table.xywh[keep][order], table.conf[keep][order]
+    bounds = np.searchsorted(frames, np.arange(1, length + 2))
+    for index in range(length):
+        lo, hi = bounds[index], bounds[index + 1]
+        yield Frame(
+            index=index,
+            time=index / frame_rate,
+            detections=Detections(xywh=xywh[lo:hi], score=conf[lo:hi]),
+        )
+
+
+def tracks_to_rows(frame_index: int, tracks: Sequence[TrackSnapshot]) -> np.ndarray:
+    """MOTChallenge result rows ``(k, 10)`` for the boxed tracks of one 0-based frame index."""
+    boxed = [t for t in tracks if t.xywh is not None]
+    rows = np.full((len(boxed), 10), -1.0)
+    for r, t in enumerate(boxed):
+        rows[r, 0] = frame_index + 1
+        rows[r, 1] = t.track_id
+        rows[r, 2:6] = t.xywh
+        rows[r, 6] = 1.0 if t.identity_prob is None else t.identity_prob
+    return rows
+
+
+def write_mot(path: str | os.PathLike[str], rows: Iterable[np.ndarray] | np.ndarray) -> Path:
+    """Write result rows ``(n, 10)`` atomically: a failure never leaves a half-written file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data = np.asarray(rows, dtype=float) if isinstance(rows, np.ndarray) else _stack(rows)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w") as fh:
+            for row in data:
+                fh.write(
+                    f"{int(row[0])},{int(row[1])},{row[2]:.3f},{row[3]:.3f},{row[4]:.3f},"
+                    f"{row[5]:.3f},{row[6]:g},{row[7]:g},{row[8]:g},{row[9]:g}\n"
+                )
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _stack(chunks: Iterable[np.ndarray]) -> np.ndarray:
+    parts = [np.asarray(c, dtype=float).reshape(-1, 10) for c in chunks]
+    return np.vstack(parts) if parts else np.zeros((0, 10))

@@ -1,0 +1,42 @@
+"""Motion models: transition ``F(dt)`` and process noise ``Q(dt)`` for any dimension.
+
+The state is ordered by derivative: positions of all dimensions first, then velocities, then
+(for constant acceleration) accelerations, e.g. ``[x, y, vx, vy]``. ``dt`` is in seconds and the
+noise intensity ``q`` is the spectral density of the white-noise highest derivative (units²/s^k).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def _kinematic(dim: int, order: int, dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
+    if dim < 1:
+        raise ValueError(f"dim must be at least 1, got {dim}")
+    if not (dt >= 0 and math.isfinite(dt)):
+        raise ValueError(f"dt must be a finite non-negative number of seconds, got {dt}")
+    n = order + 1
+    f1 = np.zeros((n, n))
+    for i in range(n):
+        for j in range(i, n):
+            f1[i, j] = dt ** (j - i) / math.factorial(j - i)
+    # Continuous white noise on the highest derivative, integrated exactly over dt.
+    q1 = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            p = (n - 1 - i) + (n - 1 - j) + 1
+            q1[i, j] = q * dt**p / (p * math.factorial(n - 1 - i) * math.factorial(n - 1 - j))
+    eye = np.eye(dim)
+    return np.kron(f1, eye), np.kron(q1, eye)
+
+
+def constant_velocity(dim: int, dt: float, q: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """``(F, Q)`` for constant velocity in ``dim`` dimensions; state ``[p (dim), v (dim)]``."""
+    return _kinematic(dim, 1, dt, q)
+
+
+def constant_acceleration(dim: int, dt: float, q: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """``(F, Q)`` for constant acceleration; state ``[p (dim), v (dim), a (dim)]``."""
+    return _kinematic(dim, 2, dt, q)

@@ -1,0 +1,25 @@
+"""Trackers: the protocol, the registry by name and the implementations."""
+
+from lookalike.trackers.base import Tracker
+from lookalike.trackers.registry import (
+    ParameterInfo,
+    make_tracker,
+    register_tracker,
+    tracker_class,
+    tracker_names,
+    tracker_parameters,
+)
+from lookalike.trackers.sort import Sort
+from lookalike.types.tracks import TrackStatus
+
+__all__ = [
+    "ParameterInfo",
+    "Sort",
+    "TrackStatus",
+    "Tracker",
+    "make_tracker",
+    "register_tracker",
+    "tracker_class",
+    "tracker_names",
+    "tracker_parameters",
+]

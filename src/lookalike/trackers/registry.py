@@ -1,0 +1,108 @@
+"""Trackers registered by name, so that the CLI and benchmarks can build them from strings."""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+from dataclasses import dataclass
+from typing import Any, Callable
+
+_REGISTRY: dict[str, type] = {}
+
+
+@dataclass(frozen=True)
+class ParameterInfo:
+    """One tracker parameter: name, type name, default value and description."""
+
+    name: str
+    type: str
+    default: Any
+    doc: str
+
+
+def register_tracker(name: str) -> Callable[[type], type]:
+    """Class decorator: register a tracker class (which has a ``Config`` dataclass) under ``name``."""
+
+    def decorate(cls: type) -> type:
+        if name in _REGISTRY and _REGISTRY[name] is not cls:
+            raise ValueError(f"a tracker named {name!r} is already registered")
+        if not dataclasses.is_dataclass(getattr(cls, "Config", None)):
+            raise TypeError(f"tracker {name!r} needs a dataclass attribute 'Config'")
+        cls.name = name
+        _REGISTRY[name] = cls
+        return cls
+
+    return decorate
+
+
+def tracker_names() -> list[str]:
+    """Names of all registered trackers, sorted."""
+    _load_builtin()
+    return sorted(_REGISTRY)
+
+
+def tracker_class(name: str) -> type:
+    """The class registered under ``name``; unknown names raise ``KeyError`` listing the known ones."""
+    _load_builtin()
+    try:
+        return _REGISTRY[name]
+    except KeyError:
+        raise KeyError(f"unknown tracker {name!r}; registered: {', '.join(sorted(_REGISTRY))}") from None
+
+
+def tracker_parameters(name: str) -> list[ParameterInfo]:
+    """The parameters of tracker ``name`` with their defaults and descriptions."""
+    config_cls = tracker_class(name).Config
+    hints = typing.get_type_hints(config_cls)
+    out = []
+    for f in dataclasses.fields(config_cls):
+        default = f.default if f.default is not dataclasses.MISSING else f.default_factory()  # type: ignore[misc]
+        type_name = getattr(hints[f.name], "__name__", str(hints[f.name]))
+        out.append(ParameterInfo(f.name, type_name, default, f.metadata.get("doc", "")))
+    return out
+
+
+def make_tracker(name: str, **params: Any) -> Any:
+    """Build tracker ``name`` with config overrides; unknown parameters raise ``ValueError``."""
+    cls = tracker_class(name)
+    known = {f.name for f in dataclasses.fields(cls.Config)}
+    unknown = sorted(set(params) - known)
+    if unknown:
+        raise ValueError(f"tracker {name!r} has no parameter(s) {unknown}; known: {sorted(known)}")
+    return cls(cls.Config(**params))
+
+
+def parse_parameter(name: str, assignment: str) -> tuple[str, Any]:
+    """Parse ``KEY=VALUE`` for tracker ``name``, converting VALUE to the parameter's type."""
+    if "=" not in assignment:
+        raise ValueError(f"expected KEY=VALUE, got {assignment!r}")
+    key, text = (part.strip() for part in assignment.split("=", 1))
+    params = {p.name: p for p in tracker_parameters(name)}
+    if key not in params:
+        raise ValueError(f"tracker {name!r} has no parameter {key!r}; known: {sorted(params)}")
+    hint = typing.get_type_hints(tracker_class(name).Config)[key]
+    return key, _convert(key, text, hint)
+
+
+def _convert(key: str, text: str, hint: Any) -> Any:
+    args = [a for a in typing.get_args(hint) if a is not type(None)]
+    if args and text.lower() in ("none", "null"):
+        return None
+    target = args[0] if args else hint
+    try:
+        if target is bool:
+            if text.lower() in ("1", "true", "yes", "on"):
+                return True
+            if text.lower() in ("0", "false", "no", "off"):
+                return False
+            raise ValueError(text)
+        if target in (int, float, str):
+            return target(text)
+    except ValueError:
+        raise ValueError(f"parameter {key!r}: cannot read {text!r} as {target.__name__}") from None
+    raise ValueError(f"parameter {key!r} of type {hint} cannot be set from text")
+
+
+def _load_builtin() -> None:
+    # Importing the tracker modules registers them.
+    import lookalike.trackers  # noqa: F401

@@ -1,0 +1,35 @@
+"""Frame clock: converts frame time stamps into motion-model steps."""
+
+from __future__ import annotations
+
+import math
+
+
+class FrameClock:
+    """Turns time stamps (seconds) into a number of nominal frame intervals.
+
+    Per-frame models (SORT's noise is defined per frame) use ``steps(t)``: 1.0 for a regular
+    frame, 2.0 after a skipped frame. The nominal interval is given, or the smallest positive
+    step seen so far (1.0 s until a second frame arrives).
+    """
+
+    def __init__(self, interval_s: float | None = None) -> None:
+        self._fixed = interval_s
+        self.interval = interval_s or 1.0
+        self._last: float | None = None
+        self._seen_step = False
+
+    def steps(self, time_s: float) -> float:
+        """Nominal intervals elapsed since the previous call (1.0 on the first call)."""
+        last, self._last = self._last, float(time_s)
+        if last is None:
+            return 1.0
+        dt = self._last - last
+        if not math.isfinite(dt) or dt < 0:
+            raise ValueError(f"frame time went backwards: {last} s then {time_s} s")
+        if dt == 0:
+            return 0.0
+        if self._fixed is None and (not self._seen_step or dt < self.interval):
+            self.interval = dt
+        self._seen_step = True
+        return dt / self.interval

@@ -1,0 +1,8 @@
+"""Data types at every boundary: detections, beacons, frames and track snapshots."""
+
+from lookalike.types.detections import Detections
+from lookalike.types.beacons import Beacons
+from lookalike.types.frame import Frame
+from lookalike.types.tracks import TrackSnapshot, TrackStatus
+
+__all__ = ["Beacons", "Detections", "Frame", "TrackSnapshot", "TrackStatus"]

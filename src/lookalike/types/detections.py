@@ -1,0 +1,111 @@
+"""``Detections``: one frame's detections as a columnar batch of equal-length arrays."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+
+from lookalike.types._validate import as_column, reject_unknown, require_finite
+
+_OPTIONAL = ("position", "heading", "heading_std", "feature", "label")
+
+
+@dataclass(frozen=True, eq=False)
+class Detections:
+    """A frame's detections; every array has one row per detection.
+
+    Attributes:
+        xywh: ``(n, 4)`` boxes, left/top/width/height in pixels. May be omitted for
+            world-only detections (then all zeros).
+        score: ``(n,)`` detector confidence, default 1.
+        position: ``(n, 2)`` ground-plane position in metres (observer frame: x forward,
+            y left), or None.
+        heading: ``(n,)`` absolute visual heading in radians, or None.
+        heading_std: ``(n,)`` spread of the visual heading in radians, or None.
+        feature: ``(n, d)`` appearance features, or None.
+        label: ``(n,)`` integer labels (agent id, -1 for false positive), or None.
+    """
+
+    xywh: np.ndarray | None = None
+    score: np.ndarray | None = None
+    position: np.ndarray | None = None
+    heading: np.ndarray | None = None
+    heading_std: np.ndarray | None = None
+    feature: np.ndarray | None = None
+    label: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        n = _infer_length(self)
+        own = "Detections"
+        xywh = np.zeros((n, 4)) if self.xywh is None else self.xywh
+        xywh = as_column(own, "xywh", xywh, n, 4)
+        require_finite(own, "xywh", xywh)
+        negative = (xywh[:, 2:] < 0).any(axis=1)
+        if negative.any():
+            row = int(np.flatnonzero(negative)[0])
+            raise ValueError(f"{own}.xywh: row {row} has a negative width or height ({xywh[row]!r})")
+        score = as_column(own, "score", np.ones(n) if self.score is None else self.score, n, None)
+        require_finite(own, "score", score)
+        object.__setattr__(self, "xywh", xywh)
+        object.__setattr__(self, "score", score)
+        if self.position is not None:
+            pos = as_column(own, "position", self.position, n, 2)
+            require_finite(own, "position", pos)
+            object.__setattr__(self, "position", pos)
+        for name in ("heading", "heading_std"):
+            value = getattr(self, name)
+            if value is not None:
+                arr = as_column(own, name, value, n, None)
+                require_finite(own, name, arr)
+                object.__setattr__(self, name, arr)
+        if self.feature is not None:
+            feat = np.asarray(self.feature, dtype=float)
+            if feat.ndim != 2:
+                if feat.size == 0:
+                    feat = feat.reshape(0, 0)
+                else:
+                    raise ValueError(f"{own}.feature: expected shape (n, d), got {feat.shape}")
+            feat = as_column(own, "feature", feat, n, feat.shape[1])
+            require_finite(own, "feature", feat)
+            object.__setattr__(self, "feature", feat)
+        if self.label is not None:
+            object.__setattr__(self, "label", as_column(own, "label", self.label, n, None, int))
+
+    def __len__(self) -> int:
+        return int(self.xywh.shape[0])  # type: ignore[union-attr]
+
+    @classmethod
+    def empty(cls) -> "Detections":
+        """A batch with no detections."""
+        return cls(xywh=np.zeros((0, 4)))
+
+    @classmethod
+    def from_dict(cls, columns: Mapping[str, Any]) -> "Detections":
+        """Build from a mapping of column name to values; unknown names raise ``ValueError``."""
+        reject_unknown("Detections", dict(columns), tuple(f.name for f in dataclasses.fields(cls)))
+        return cls(**columns)
+
+    def select(self, index: np.ndarray | slice | list[int]) -> "Detections":
+        """Rows ``index`` as a new batch (boolean mask or integer indices)."""
+        values = {}
+        for f in dataclasses.fields(self):
+            col = getattr(self, f.name)
+            values[f.name] = None if col is None else col[index]
+        return Detections(**values)
+
+    def replace(self, **changes: Any) -> "Detections":
+        """A copy with some columns replaced (validated again)."""
+        reject_unknown("Detections", changes, tuple(f.name for f in dataclasses.fields(self)))
+        return dataclasses.replace(self, **changes)
+
+
+def _infer_length(det: Detections) -> int:
+    for name in ("xywh", "position", "score") + _OPTIONAL:
+        value = getattr(det, name)
+        if value is not None:
+            arr = np.asarray(value)
+            return int(arr.shape[0]) if arr.ndim > 0 else 0
+    return 0
