@@ -113,11 +113,10 @@ def frames_from_table(
     """
     if frame_rate <= 0:
         raise ValueError(f"frame_rate must be positive, got {frame_rate}")
+    if length is None:
+        length = int(table.frame.max()) if len(table) else 0
     keep = table.conf >= min_score
     frames = table.frame[keep]
-    last = int(frames.max()) if len(frames) else 0
-    if length is None:
-        length = last
     order = np.argsort(frames, kind="stable")
     frames = frames[order]
     xywh, conf = table.xywh[keep][order], table.conf[keep][order]

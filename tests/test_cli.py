@@ -1,0 +1,63 @@
+from pathlib import Path
+
+import numpy as np
+from typer.testing import CliRunner
+
+from lookalike.cli import app
+from lookalike.io import read_mot, write_mot
+from lookalike.sim import BoxSceneConfig, simulate_boxes
+
+runner = CliRunner()
+
+
+def _det_file(tmp_path: Path) -> Path:
+    scene = simulate_boxes(BoxSceneConfig(frames=30, seed=3))
+    rows = []
+    for f in scene.frames:
+        for box, score in zip(f.detections.xywh, f.detections.score):
+            rows.append([f.index + 1, -1, *box, score, -1, -1, -1])
+    return write_mot(tmp_path / "seq" / "det" / "det.txt", np.array(rows))
+
+
+def test_track_single_file(tmp_path):
+    det = _det_file(tmp_path)
+    out = tmp_path / "tracks.txt"
+    result = runner.invoke(app, ["track", str(det), "-o", str(out), "--set", "min_hits=1"])
+    assert result.exit_code == 0, result.output
+    assert "frames/s" in result.output
+    assert len(read_mot(out)) > 0
+
+
+def test_track_folder_of_sequences(tmp_path):
+    _det_file(tmp_path / "all")
+    result = runner.invoke(app, ["track", str(tmp_path / "all"), "-o", str(tmp_path / "res")])
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "res" / "seq.txt").is_file()
+
+
+def test_track_errors_are_readable(tmp_path):
+    det = _det_file(tmp_path)
+    r = runner.invoke(app, ["track", str(det), "-o", str(tmp_path / "o.txt"), "--tracker", "nope"])
+    assert r.exit_code == 2 and "unknown tracker" in r.output
+    r = runner.invoke(app, ["track", str(det), "-o", str(tmp_path / "o.txt"), "--set", "max_age=lots"])
+    assert r.exit_code == 2 and "cannot read 'lots' as int" in r.output
+    r = runner.invoke(app, ["track", str(det), "-o", str(tmp_path / "o.txt"), "--set", "colour=3"])
+    assert r.exit_code == 2 and "no parameter 'colour'" in r.output
+    bad = tmp_path / "bad" / "det.txt"
+    bad.parent.mkdir()
+    bad.write_text("1,-1,1,1,1,1,1\n2,-1,oops\n")
+    r = runner.invoke(app, ["track", str(bad), "-o", str(tmp_path / "o.txt")])
+    assert r.exit_code == 2 and "det.txt:2" in r.output
+
+
+def test_trackers_listing():
+    r = runner.invoke(app, ["trackers", "--names"])
+    assert r.exit_code == 0 and "sort" in r.output.split()
+    r = runner.invoke(app, ["trackers"])
+    assert r.exit_code == 0 and "max_age" in r.output and "iou_threshold" in r.output
+
+
+def test_demo_runs(tmp_path):
+    r = runner.invoke(app, ["demo", "-o", str(tmp_path / "demo")])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "demo").is_dir()

@@ -1,0 +1,118 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lookalike.io import find_sequences, frames_from_table, read_mot, read_seqinfo, tracks_to_rows, write_mot
+from lookalike.types import TrackSnapshot, TrackStatus
+
+
+def _write(path: Path, text: str) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return path
+
+
+def test_read_detection_file(tmp_path):
+    p = _write(tmp_path / "det.txt", "1,-1,10,20,30,40,0.9,-1,-1,-1\n\n3,-1,1,2,3,4,0.5,-1,-1,-1\n")
+    t = read_mot(p)
+    assert t.frame.tolist() == [1, 3]
+    assert t.xywh.tolist() == [[10, 20, 30, 40], [1, 2, 3, 4]]
+    frames = list(frames_from_table(t, length=4, frame_rate=10))
+    assert [len(f.detections) for f in frames] == [1, 0, 1, 0]
+    assert frames[2].index == 2 and frames[2].time == pytest.approx(0.2)
+    assert len(list(frames_from_table(t, min_score=0.6))[2].detections) == 0
+
+
+def test_read_gt_with_class_and_visibility(tmp_path):
+    p = _write(tmp_path / "gt.txt", "1,1,10,20,30,40,1,1,0.8\n1,2,0,0,5,5,0,7,1.0\n")
+    t = read_mot(p)
+    assert t.conf.tolist() == [1, 0]
+    assert t.extra.tolist() == [[1, 0.8], [7, 1.0]]
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("1,-1,10,20,30,40,0.9\n1,-1,10,20\n", ":2: expected at least 6"),
+        ("1,-1,10,20,30,40,0.9\n2,-1,10,x,30,40,0.9\n", ":2: not a number"),
+        ("1,-1,10,20,30,40,0.9\n\n2,-1,10,nan,30,40,0.9\n", ":3: invalid box"),
+        ("1,-1,10,20,-30,40,0.9\n", ":1: invalid box"),
+        ("0,-1,10,20,30,40,0.9\n", ":1: invalid box"),
+    ],
+)
+def test_malformed_lines_name_file_and_line(tmp_path, text, message):
+    p = _write(tmp_path / "bad.txt", text)
+    with pytest.raises(ValueError, match=f"bad.txt{message}"):
+        read_mot(p)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nope.txt"):
+        read_mot(tmp_path / "nope.txt")
+
+
+def test_empty_file_is_empty_table(tmp_path):
+    assert len(read_mot(_write(tmp_path / "e.txt", ""))) == 0
+
+
+def test_write_round_trip_and_atomicity(tmp_path):
+    snaps = [TrackSnapshot(track_id=3, status=TrackStatus.CONFIRMED, xywh=np.array([1.5, 2, 3, 4]))]
+    rows = [tracks_to_rows(0, snaps), tracks_to_rows(4, snaps)]
+    out = write_mot(tmp_path / "res" / "seq.txt", rows)
+    t = read_mot(out)
+    assert t.frame.tolist() == [1, 5] and t.track_id.tolist() == [3, 3]
+    np.testing.assert_allclose(t.xywh[0], [1.5, 2, 3, 4])
+
+    def broken():
+        yield tracks_to_rows(0, snaps)
+        raise RuntimeError("tracker crashed")
+
+    with pytest.raises(RuntimeError):
+        write_mot(out, broken())
+    assert read_mot(out).frame.tolist() == [1, 5]  # the earlier file is intact
+    assert [p.name for p in out.parent.iterdir()] == ["seq.txt"]  # no temporary left behind
+
+
+def _make_sequence(root: Path, name: str, length: int = 5) -> Path:
+    seq = root / name
+    _write(seq / "seqinfo.ini", f"[Sequence]\nname={name}\nframeRate=10\nseqLength={length}\nimWidth=64\nimHeight=48\n")
+    _write(seq / "det" / "det.txt", "1,-1,1,1,5,5,1\n")
+    _write(seq / "gt" / "gt.txt", "1,1,1,1,5,5,1\n")
+    return seq
+
+
+def test_find_sequences_in_all_three_forms(tmp_path):
+    a = _make_sequence(tmp_path, "A")
+    _make_sequence(tmp_path, "B")
+    (tmp_path / "notes").mkdir()
+    both = find_sequences(tmp_path)
+    assert [s.name for s in both] == ["A", "B"]
+    one = find_sequences(a)[0]
+    assert one.frame_rate == 10 and one.length == 5 and one.image_size == (64, 48)
+    assert one.gt_path == a / "gt" / "gt.txt"
+    from_file = find_sequences(a / "det" / "det.txt")[0]
+    assert from_file.name == "A" and from_file.length == 5
+    bare = find_sequences(_write(tmp_path / "x" / "mydets.txt", "1,-1,1,1,5,5,1\n"))[0]
+    assert bare.name == "mydets" and bare.length is None
+
+
+def test_find_sequences_errors(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        find_sequences(tmp_path / "missing")
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match="neither a sequence folder"):
+        find_sequences(tmp_path / "empty")
+    _write(tmp_path / "s" / "seqinfo.ini", "[Sequence]\nframeRate=fast\n")
+    with pytest.raises(ValueError, match="seqinfo.ini"):
+        find_sequences(tmp_path / "s")
+    with pytest.raises(ValueError, match="no \\[Sequence\\]"):
+        read_seqinfo(_write(tmp_path / "bad.ini", "[Other]\na=1\n"))
+
+
+def test_real_sequences_load(shared_data):
+    seqs = find_sequences(shared_data / "mot15")
+    assert len(seqs) == 7
+    for s in seqs:
+        t = read_mot(s.det_path)
+        assert len(t) > 0 and t.frame.max() <= s.length

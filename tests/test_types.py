@@ -1,0 +1,82 @@
+import numpy as np
+import pytest
+
+from lookalike import Beacons, Detections, Frame, TrackSnapshot, TrackStatus
+
+
+def test_detections_valid_and_readonly():
+    det = Detections(xywh=[[0, 0, 10, 20], [5, 5, 1, 1]], score=[0.9, 0.5], heading=[0.1, -3.0])
+    assert len(det) == 2
+    assert det.xywh.shape == (2, 4)
+    with pytest.raises(ValueError):
+        det.xywh[0, 0] = 3.0  # read-only
+
+
+def test_empty_is_valid_everywhere():
+    assert len(Detections.empty()) == 0
+    assert len(Detections(xywh=np.zeros((0, 4)))) == 0
+    assert len(Detections(xywh=[])) == 0
+    assert len(Beacons.empty()) == 0
+    frame = Frame(index=0, time=0.0)
+    assert len(frame.detections) == 0 and len(frame.beacons) == 0
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"xywh": [[0, 0, 1, 1], [0, np.nan, 1, 1]]}, "xywh: row 1"),
+        ({"xywh": [[0, 0, 1, 1], [0, 0, np.inf, 1]]}, "xywh: row 1"),
+        ({"xywh": [[0, 0, 1, 1], [0, 0, 1, -2]]}, "xywh: row 1 has a negative"),
+        ({"xywh": [[0, 0, 1, 1]], "score": [0.5, 0.5]}, "score: has 2 rows"),
+        ({"xywh": [[0, 0, 1]]}, "xywh: expected shape (n, 4)"),
+        ({"xywh": [[0, 0, 1, 1]], "position": [[np.nan, 0]]}, "position: row 0"),
+        ({"xywh": [[0, 0, 1, 1]], "heading": [np.nan]}, "heading: row 0"),
+    ],
+)
+def test_detections_reject_bad_columns(kwargs, message):
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        Detections(**kwargs)
+
+
+def test_unknown_fields_are_named():
+    with pytest.raises(ValueError, match="unknown field.*'colour'"):
+        Detections.from_dict({"xywh": [[0, 0, 1, 1]], "colour": [1]})
+    with pytest.raises(ValueError, match="unknown field.*'speed'"):
+        Beacons.from_dict({"agent_id": [0], "t_sent": [0], "t_received": [0], "heading": [0], "speed": [1]})
+
+
+def test_world_only_detections_get_zero_boxes():
+    det = Detections(position=[[1.0, 2.0], [3.0, 4.0]])
+    assert det.xywh.shape == (2, 4) and not det.xywh.any()
+    assert np.all(det.score == 1.0)
+
+
+def test_select_keeps_columns_together():
+    det = Detections(xywh=[[0, 0, 1, 1], [1, 1, 2, 2], [3, 3, 1, 1]], label=[4, 5, 6])
+    sub = det.select(np.array([True, False, True]))
+    assert sub.label.tolist() == [4, 6]
+    assert sub.xywh[:, 0].tolist() == [0, 3]
+
+
+def test_beacons_validate():
+    with pytest.raises(ValueError, match="agent_id: row 0 is negative"):
+        Beacons(agent_id=[-1], t_sent=[0], t_received=[0], heading=[0])
+    with pytest.raises(ValueError, match="heading: has 1 rows but the batch has 2"):
+        Beacons(agent_id=[0, 1], t_sent=[0, 0], t_received=[0, 0], heading=[0])
+    with pytest.raises(ValueError, match="t_received: row 0"):
+        Beacons(agent_id=[0], t_sent=[0], t_received=[np.nan], heading=[0])
+
+
+def test_frame_validates():
+    with pytest.raises(ValueError, match="Frame.index"):
+        Frame(index=-1, time=0.0)
+    with pytest.raises(ValueError, match="Frame.time"):
+        Frame(index=0, time=float("nan"))
+    with pytest.raises(ValueError, match="Frame.detections"):
+        Frame(index=0, time=0.0, detections=[[0, 0, 1, 1]])  # type: ignore[arg-type]
+
+
+def test_track_snapshot_is_frozen():
+    snap = TrackSnapshot(track_id=1, status=TrackStatus.CONFIRMED, xywh=np.zeros(4))
+    with pytest.raises(AttributeError):
+        snap.track_id = 2  # type: ignore[misc]
