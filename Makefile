@@ -22,9 +22,16 @@ demo: venv
 test: venv
 	$(PY) -m pytest -q
 
-bench:
-	$(MAKE) venv EXTRAS=test,vision,viz,bench
-	@for script in benchmarks/*.py; do echo "== $$script"; $(PY) $$script || exit 1; done
+# The peers need numpy < 2, so benchmarks run in their own environment.
+BENCH_VENV := .venv-bench
+$(BENCH_VENV)/.installed: pyproject.toml constraints-bench.txt
+	$(PYTHON) -m venv $(BENCH_VENV)
+	$(BENCH_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt -e ".[vision,viz,bench]"
+	touch $@
+
+bench: $(BENCH_VENV)/.installed
+	@for script in benchmarks/[a-z]*.py; do echo "== $$script"; $(BENCH_VENV)/bin/python $$script || exit 1; done
 
 clean:
-	rm -rf $(VENV) demo-out .pytest_cache
+	rm -rf $(VENV) $(BENCH_VENV) demo-out .pytest_cache

@@ -44,10 +44,15 @@ def xywh_to_xysr(xywh: np.ndarray) -> np.ndarray:
 def xysr_to_xywh(xysr: np.ndarray) -> np.ndarray:
     """``(n, 4)`` SORT's ``[u, v, s, r]`` to left/top/width/height (NaN where s·r < 0)."""
     z = np.asarray(xysr, dtype=float)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        w = np.sqrt(z[..., 2] * z[..., 3])
-        h = z[..., 2] / w
-    return np.stack([z[..., 0] - w / 2.0, z[..., 1] - h / 2.0, w, h], axis=-1)
+    area = z[..., 2] * z[..., 3]
+    w = np.sqrt(area, out=np.full_like(area, np.nan), where=area >= 0)
+    h = np.divide(z[..., 2], w, out=np.full_like(area, np.nan), where=w > 0)
+    out = np.empty(z.shape)
+    out[..., 0] = z[..., 0] - w / 2.0
+    out[..., 1] = z[..., 1] - h / 2.0
+    out[..., 2] = w
+    out[..., 3] = h
+    return out
 
 
 def iou_matrix(xywh_a: np.ndarray, xywh_b: np.ndarray) -> np.ndarray:
@@ -65,6 +70,4 @@ def iou_matrix(xywh_a: np.ndarray, xywh_b: np.ndarray) -> np.ndarray:
     ih = np.clip(np.minimum(ay2, by2) - np.maximum(ay1, by1), 0.0, None)
     inter = iw * ih
     union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
-    with np.errstate(invalid="ignore", divide="ignore"):
-        iou = np.where(union > 0, inter / union, 0.0)
-    return iou
+    return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)

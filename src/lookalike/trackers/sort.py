@@ -74,9 +74,7 @@ class Sort:
         steps = self._clock.steps(frame.time)
         self._frame_count += 1
         det_xywh = frame.detections.xywh
-        self._predict(steps)
-
-        pred_xywh = xysr_to_xywh(self._mean[:, :4])
+        pred_xywh = self._predict(steps)
         matches = self._associate(det_xywh, pred_xywh)
         det_of_track = np.full(len(self._ids), -1, dtype=int)
         if len(matches):
@@ -86,7 +84,9 @@ class Sort:
             self._since_update[t] = 0
             self._hit_streak[t] += 1
             det_of_track[t] = d
-        new = np.setdiff1d(np.arange(len(det_xywh)), matches[:, 0] if len(matches) else [])
+        unmatched = np.ones(len(det_xywh), dtype=bool)
+        unmatched[matches[:, 0]] = False
+        new = np.flatnonzero(unmatched)
         if len(new):
             self._birth(xywh_to_xysr(det_xywh[new]))
             det_of_track = np.concatenate([det_of_track, new])
@@ -99,18 +99,22 @@ class Sort:
 
     # -- steps -------------------------------------------------------------------------------
 
-    def _predict(self, steps: float) -> None:
+    def _predict(self, steps: float) -> np.ndarray:
+        """Predict every track; drop those whose box became invalid; return boxes ``(k, 4)``."""
         if not len(self._ids):
-            return
+            return np.zeros((0, 4))
         mean = self._mean
         # Keep the predicted area positive, as the reference does.
         mean[mean[:, 6] + mean[:, 2] <= 0, 6] = 0.0
         self._mean, self._cov = kalman.predict(mean, self._cov, _transition(steps), _Q * steps)
         self._hit_streak[self._since_update > 0] = 0
         self._since_update += 1
-        valid = np.isfinite(xysr_to_xywh(self._mean[:, :4])).all(axis=1)
+        boxes = xysr_to_xywh(self._mean[:, :4])
+        valid = np.isfinite(boxes).all(axis=1)
         if not valid.all():
             self._keep(valid)
+            boxes = boxes[valid]
+        return boxes
 
     def _associate(self, det_xywh: np.ndarray, trk_xywh: np.ndarray) -> np.ndarray:
         """``(k, 2)`` matched ``(detection, track)`` index pairs."""
