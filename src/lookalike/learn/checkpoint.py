@@ -1,0 +1,154 @@
+"""Exported network weights: a ``.npz`` of arrays plus a JSON metadata file beside it.
+
+``model.npz`` holds ``layer{i}.w_ih``, ``layer{i}.w_hh``, ``layer{i}.b_ih``, ``layer{i}.b_hh``
+(PyTorch's gate order: LSTM ``i, f, g, o``; GRU ``r, z, n``), ``head.weight``, ``head.bias``,
+``input_mean`` and ``input_std``. ``model.json`` records the format version, cell type, sizes,
+the encoding version and free-form training information.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookalike.learn.encoding import ENCODING_VERSION, EncodingSpec
+
+FORMAT_VERSION = 1
+GATES = {"lstm": 4, "gru": 3}
+
+
+class CheckpointError(ValueError):
+    """A weights file that is corrupt, of another version, or does not fit the requested set-up."""
+
+
+@dataclass(frozen=True, eq=False)
+class NetworkWeights:
+    """Weights and metadata of a trained association network."""
+
+    spec: EncodingSpec
+    cell: str
+    hidden: int
+    layers: list[dict[str, np.ndarray]]
+    head_weight: np.ndarray
+    head_bias: np.ndarray
+    input_mean: np.ndarray
+    input_std: np.ndarray
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        _check_shapes(self, "weights")
+
+
+def _check_shapes(w: NetworkWeights, source: str) -> None:
+    if w.cell not in GATES:
+        raise CheckpointError(f"{source}: unknown cell type {w.cell!r} (expected 'lstm' or 'gru')")
+    g, h, n_in = GATES[w.cell], w.hidden, w.spec.n_inputs
+    expected_out = w.spec.n_slots * w.spec.n_classes
+    for i, layer in enumerate(w.layers):
+        width = n_in if i == 0 else h
+        shapes = {"w_ih": (g * h, width), "w_hh": (g * h, h), "b_ih": (g * h,), "b_hh": (g * h,)}
+        for name, shape in shapes.items():
+            got = np.shape(layer.get(name))
+            if got != shape:
+                raise CheckpointError(f"{source}: layer{i}.{name} has shape {got}, expected {shape}")
+    checks = {
+        "head.weight": (w.head_weight, (expected_out, h)),
+        "head.bias": (w.head_bias, (expected_out,)),
+        "input_mean": (w.input_mean, (n_in,)),
+        "input_std": (w.input_std, (n_in,)),
+    }
+    for name, (arr, shape) in checks.items():
+        if np.shape(arr) != shape:
+            raise CheckpointError(f"{source}: {name} has shape {np.shape(arr)}, expected {shape}")
+        if not np.isfinite(arr).all():
+            raise CheckpointError(f"{source}: {name} holds NaN or infinity")
+    if (w.input_std <= 0).any():
+        raise CheckpointError(f"{source}: input_std must be positive")
+
+
+def save_weights(weights: NetworkWeights, path: str | os.PathLike[str]) -> Path:
+    """Write ``path`` (``.npz``) and its ``.json`` metadata; returns the ``.npz`` path."""
+    path = Path(path).with_suffix(".npz")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    arrays = {"head.weight": weights.head_weight, "head.bias": weights.head_bias,
+              "input_mean": weights.input_mean, "input_std": weights.input_std}
+    for i, layer in enumerate(weights.layers):
+        for name, arr in layer.items():
+            arrays[f"layer{i}.{name}"] = arr
+    tmp = path.with_name(path.name + ".tmp.npz")
+    np.savez(tmp, **{k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()})
+    os.replace(tmp, path)
+    meta = {
+        "format": "lookalike-association-net",
+        "format_version": FORMAT_VERSION,
+        "encoding_version": ENCODING_VERSION,
+        "cell": weights.cell,
+        "hidden": weights.hidden,
+        "num_layers": len(weights.layers),
+        "n_agents": weights.spec.n_agents,
+        "n_slots": weights.spec.n_slots,
+        "max_age_s": weights.spec.max_age_s,
+        "info": weights.info,
+    }
+    path.with_suffix(".json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    return path
+
+
+def load_weights(
+    path: str | os.PathLike[str], n_agents: int | None = None, n_slots: int | None = None
+) -> NetworkWeights:
+    """Load weights saved by :func:`save_weights`, refusing files that do not fit.
+
+    Raises :class:`CheckpointError` naming the file when the metadata is missing or of another
+    version, when N or M differ from the requested ``n_agents``/``n_slots``, or when an array
+    has the wrong shape.
+    """
+    path = Path(path).with_suffix(".npz")
+    meta_path = path.with_suffix(".json")
+    if not path.is_file() or not meta_path.is_file():
+        raise CheckpointError(f"{path}: expected {path.name} and {meta_path.name} side by side")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except json.JSONDecodeError as exc:
+        raise CheckpointError(f"{meta_path}: not valid JSON ({exc})") from None
+    if meta.get("format") != "lookalike-association-net":
+        raise CheckpointError(f"{meta_path}: not a lookalike association network")
+    for key, current in (("format_version", FORMAT_VERSION), ("encoding_version", ENCODING_VERSION)):
+        if meta.get(key) != current:
+            raise CheckpointError(
+                f"{meta_path}: {key} {meta.get(key)} is not supported (this lookalike reads {current})"
+            )
+    for key, wanted in (("n_agents", n_agents), ("n_slots", n_slots)):
+        if wanted is not None and meta.get(key) != wanted:
+            raise CheckpointError(f"{meta_path}: trained for {key}={meta.get(key)}, but {wanted} was requested")
+    try:
+        with np.load(path) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (OSError, ValueError) as exc:
+        raise CheckpointError(f"{path}: cannot read the weights ({exc})") from None
+    try:
+        spec = EncodingSpec(int(meta["n_agents"]), int(meta["n_slots"]), float(meta["max_age_s"]))
+        layers = [
+            {name: arrays.get(f"layer{i}.{name}") for name in ("w_ih", "w_hh", "b_ih", "b_hh")}
+            for i in range(int(meta["num_layers"]))
+        ]
+        return NetworkWeights(
+            spec=spec,
+            cell=str(meta["cell"]),
+            hidden=int(meta["hidden"]),
+            layers=layers,
+            head_weight=arrays.get("head.weight"),
+            head_bias=arrays.get("head.bias"),
+            input_mean=arrays.get("input_mean"),
+            input_std=arrays.get("input_std"),
+            info=dict(meta.get("info", {})),
+        )
+    except KeyError as exc:
+        raise CheckpointError(f"{meta_path}: missing field {exc}") from None
+    except CheckpointError as exc:
+        raise CheckpointError(f"{path}: {exc}") from None

@@ -1,0 +1,105 @@
+"""Input encoding of one frame for the association network (DESIGN §7).
+
+Layout of the input vector (length ``3·N + 5·M``):
+
+* per agent ``j`` (N blocks): ``cos ψ_j, sin ψ_j, age_j`` — the latest reported absolute heading
+  ``ψ_j`` as a unit vector (periodic angles never jump) and the report's age in seconds at this
+  frame (clipped to ``max_age_s``; an agent never heard from has ``(0, 0, max_age_s)``);
+* per detection slot (M blocks): ``x, y, cos φ, sin φ, γ`` — ground position in metres, absolute
+  visual heading ``φ`` as a unit vector, detector probability ``γ``. Empty slots are all zeros.
+
+When a frame has more than M detections, the M most probable are kept.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lookalike.types import Detections
+
+ENCODING_VERSION = 1
+AGENT_WIDTH = 3
+SLOT_WIDTH = 5
+
+
+@dataclass(frozen=True)
+class EncodingSpec:
+    """Sizes of the encoding: ``n_agents`` (N) reporting agents, ``n_slots`` (M) detection slots."""
+
+    n_agents: int
+    n_slots: int
+    max_age_s: float = 5.0
+
+    def __post_init__(self) -> None:
+        if self.n_agents < 1 or self.n_slots < 1:
+            raise ValueError(f"n_agents and n_slots must be >= 1, got {self.n_agents}, {self.n_slots}")
+
+    @property
+    def n_inputs(self) -> int:
+        """Length of one frame's input vector."""
+        return AGENT_WIDTH * self.n_agents + SLOT_WIDTH * self.n_slots
+
+    @property
+    def n_classes(self) -> int:
+        """Classes per slot: agents 0..N-1, then the false-positive class N."""
+        return self.n_agents + 1
+
+
+def encode_agents(spec: EncodingSpec, heading_rad: np.ndarray, age_s: np.ndarray) -> np.ndarray:
+    """Agent blocks ``(..., 3·N)`` from latest headings and report ages ``(..., N)`` (NaN = never heard)."""
+    heading = np.asarray(heading_rad, dtype=float)
+    age = np.asarray(age_s, dtype=float)
+    known = np.isfinite(heading) & np.isfinite(age)
+    h = np.where(known, heading, 0.0)
+    out = np.stack(
+        [
+            np.where(known, np.cos(h), 0.0),
+            np.where(known, np.sin(h), 0.0),
+            np.where(known, np.clip(age, 0.0, spec.max_age_s), spec.max_age_s),
+        ],
+        axis=-1,
+    )
+    return out.reshape(*heading.shape[:-1], AGENT_WIDTH * spec.n_agents)
+
+
+def encode_slots(
+    spec: EncodingSpec, position_m: np.ndarray, heading_rad: np.ndarray, probability: np.ndarray
+) -> np.ndarray:
+    """Slot blocks ``(5·M,)`` for up to M detections given in slot order (rows beyond M are an error)."""
+    n = len(probability)
+    if n > spec.n_slots:
+        raise ValueError(f"{n} detections for {spec.n_slots} slots; select the most probable first")
+    slots = np.zeros((spec.n_slots, SLOT_WIDTH))
+    slots[:n, 0:2] = position_m
+    slots[:n, 2] = np.cos(heading_rad)
+    slots[:n, 3] = np.sin(heading_rad)
+    slots[:n, 4] = probability
+    return slots.reshape(-1)
+
+
+def select_slots(score: np.ndarray, n_slots: int) -> np.ndarray:
+    """Indices of the (at most) ``n_slots`` most probable detections, most probable first."""
+    order = np.argsort(-np.asarray(score), kind="stable")
+    return order[:n_slots]
+
+
+def encode_frame(
+    spec: EncodingSpec,
+    detections: Detections,
+    latest_heading_rad: np.ndarray,
+    report_age_s: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """One frame's input ``(n_inputs,)`` and the detection index of each used slot ``(k,)``.
+
+    ``detections`` must carry ``position`` (metres) and ``heading`` (radians).
+    """
+    if detections.position is None or detections.heading is None:
+        raise ValueError("the LSTM encoding needs Detections.position and Detections.heading")
+    used = select_slots(detections.score, spec.n_slots)
+    slots = encode_slots(
+        spec, detections.position[used], detections.heading[used], detections.score[used]
+    )
+    agents = encode_agents(spec, np.asarray(latest_heading_rad)[None], np.asarray(report_age_s)[None])[0]
+    return np.concatenate([agents, slots]), used

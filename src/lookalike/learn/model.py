@@ -1,0 +1,65 @@
+"""The association network in PyTorch (training only; import needs torch).
+
+Stacked recurrent layers (LSTM by default, GRU as the paper's comparison) followed by one linear
+layer that holds the M output heads: its ``M·(N+1)`` outputs are read as M softmax groups.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+from torch import nn
+
+from lookalike.learn.checkpoint import NetworkWeights
+from lookalike.learn.encoding import EncodingSpec
+
+
+class AssociationNet(nn.Module):
+    """``forward(x (b, t, n_inputs), state) -> (log-probabilities (b, t, M, N+1), state)``."""
+
+    def __init__(self, spec: EncodingSpec, hidden: int = 64, num_layers: int = 5, cell: str = "lstm") -> None:
+        super().__init__()
+        if cell not in ("lstm", "gru"):
+            raise ValueError(f"cell must be 'lstm' or 'gru', got {cell!r}")
+        self.spec, self.hidden, self.cell = spec, hidden, cell
+        rnn = nn.LSTM if cell == "lstm" else nn.GRU
+        self.rnn = rnn(spec.n_inputs, hidden, num_layers=num_layers, batch_first=True)
+        self.head = nn.Linear(hidden, spec.n_slots * spec.n_classes)
+        self.register_buffer("input_mean", torch.zeros(spec.n_inputs, dtype=torch.float64))
+        self.register_buffer("input_std", torch.ones(spec.n_inputs, dtype=torch.float64))
+
+    def set_normalisation(self, mean: np.ndarray, std: np.ndarray) -> None:
+        """Store input standardisation statistics (saved with the weights)."""
+        self.input_mean.copy_(torch.as_tensor(mean, dtype=torch.float64))
+        self.input_std.copy_(torch.as_tensor(np.maximum(std, 1e-6), dtype=torch.float64))
+
+    def forward(self, x: torch.Tensor, state=None):
+        z = ((x.double() - self.input_mean) / self.input_std).to(self.head.weight.dtype)
+        out, state = self.rnn(z, state)
+        logits = self.head(out)
+        logits = logits.view(*logits.shape[:-1], self.spec.n_slots, self.spec.n_classes)
+        return torch.log_softmax(logits, dim=-1), state
+
+    def export(self, info: dict | None = None) -> NetworkWeights:
+        """The weights as numpy arrays for :class:`~lookalike.learn.numpy_net.NumpyAssociationNet`."""
+        layers = []
+        for i in range(self.rnn.num_layers):
+            layers.append(
+                {name: getattr(self.rnn, f"{name}_l{i}").detach().double().numpy().copy()
+                 for name in ("weight_ih", "weight_hh", "bias_ih", "bias_hh")}
+            )
+        layers = [
+            {"w_ih": l["weight_ih"], "w_hh": l["weight_hh"], "b_ih": l["bias_ih"], "b_hh": l["bias_hh"]}
+            for l in layers
+        ]
+        return NetworkWeights(
+            spec=self.spec,
+            cell=self.cell,
+            hidden=self.hidden,
+            layers=layers,
+            head_weight=self.head.weight.detach().double().numpy().copy(),
+            head_bias=self.head.bias.detach().double().numpy().copy(),
+            input_mean=self.input_mean.numpy().copy(),
+            input_std=self.input_std.numpy().copy(),
+            info=dict(info or {}),
+        )
