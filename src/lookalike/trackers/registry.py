@@ -103,6 +103,16 @@ def _convert(key: str, text: str, hint: Any) -> Any:
     raise ValueError(f"parameter {key!r} of type {hint} cannot be set from text")
 
 
+# Trackers defined above the trackers layer (they need the learned network); imported by name
+# so that this layer never imports upwards.
+PLUGIN_MODULES = ("lookalike.learn.tracker",)
+
+
 def _load_builtin() -> None:
     # Importing the tracker modules registers them.
+    import importlib
+
     import lookalike.trackers  # noqa: F401
+
+    for module in PLUGIN_MODULES:
+        importlib.import_module(module)

@@ -1,0 +1,127 @@
+"""The LSTM identifier (seed A) as a registered tracker: labels every detection "agent j" or
+"false positive" from the detections and the agents' heading reports, with the numpy network.
+
+Tracks are the agents themselves: ``T_j ← α·L_k + (1−α)·T_j`` where ``L_k`` is the position of
+the detection labelled ``j`` and ``α`` its class probability (DESIGN §5).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from lookalike.learn.checkpoint import load_weights
+from lookalike.learn.encoding import EncodingSpec, encode_frame
+from lookalike.learn.numpy_net import NumpyAssociationNet
+from lookalike.learn.weights import shipped_weights_path
+from lookalike.trackers.base import param
+from lookalike.trackers.registry import register_tracker
+from lookalike.types import Frame, TrackSnapshot, TrackStatus
+
+
+class BeaconMemory:
+    """The latest heading report per agent, keeping the newest by send time (late duplicates ignored)."""
+
+    def __init__(self, n_agents: int) -> None:
+        self.heading = np.full(n_agents, np.nan)
+        self.t_sent = np.full(n_agents, -np.inf)
+
+    def add(self, frame: Frame) -> None:
+        b = frame.beacons
+        for agent, t_sent, heading in zip(b.agent_id, b.t_sent, b.heading):
+            if agent < len(self.heading) and t_sent > self.t_sent[agent]:
+                self.t_sent[agent] = t_sent
+                self.heading[agent] = heading
+
+    def age(self, time_s: float) -> np.ndarray:
+        """Seconds since each agent's latest report was sent (NaN: never heard)."""
+        age = time_s - self.t_sent
+        return np.where(np.isfinite(age), age, np.nan)
+
+
+def decode(prob: np.ndarray, n_used: int, one_to_one: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Labels ``(n_used,)`` (agent or -1) and their probabilities from slot probabilities ``(M, N+1)``."""
+    p = prob[:n_used]
+    n_agents = p.shape[1] - 1
+    if not one_to_one:
+        label = p.argmax(axis=1)
+        conf = p[np.arange(n_used), label]
+        return np.where(label == n_agents, -1, label), conf
+    # Each detection may be a false positive; each agent takes at most one detection.
+    cost = -np.log(np.clip(np.hstack([p[:, :n_agents], np.repeat(p[:, n_agents:], n_used, axis=1)]), 1e-12, 1))
+    rows, cols = linear_sum_assignment(cost)
+    label = np.full(n_used, -1)
+    label[rows] = np.where(cols < n_agents, cols, -1)
+    conf = np.where(label >= 0, p[np.arange(n_used), np.maximum(label, 0)], p[:, n_agents])
+    return label, conf
+
+
+@register_tracker("lstm")
+class LstmIdentifier:
+    """The deep LSTM associator: per-detection identities and low-pass filtered agent positions."""
+
+    @dataclass(frozen=True)
+    class Config:
+        n_agents: int = param(3, "number of reporting agents N")
+        n_slots: int = param(5, "detection slots M of the network")
+        weights: str | None = param(None, "path of model.npz (None: the shipped weights for N, M)")
+        one_to_one: bool = param(True, "decode with Hungarian on -log p (else per-slot argmax, as the paper)")
+
+    def __init__(self, config: "LstmIdentifier.Config | None" = None) -> None:
+        self.config = config or LstmIdentifier.Config()
+        cfg = self.config
+        path = cfg.weights or shipped_weights_path(cfg.n_agents, cfg.n_slots)
+        self.net = NumpyAssociationNet(load_weights(path, cfg.n_agents, cfg.n_slots))
+        self.spec: EncodingSpec = self.net.spec
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the recurrent state, the reports and the agents' positions."""
+        self.net.reset()
+        self._beacons = BeaconMemory(self.config.n_agents)
+        self._position = np.full((self.config.n_agents, 2), np.nan)
+        self._last_seen = np.full(self.config.n_agents, -1)
+        self.last_labels = np.zeros(0, dtype=int)
+        self.last_probabilities = np.zeros(0)
+
+    def update(self, frame: Frame) -> list[TrackSnapshot]:
+        """Label the frame's detections and return one snapshot per agent seen so far."""
+        self._beacons.add(frame)
+        det = frame.detections
+        n = len(det)
+        x, used = encode_frame(self.spec, det, self._beacons.heading, self._beacons.age(frame.time))
+        prob = self.net.step(x)
+        slot_label, slot_conf = decode(prob, len(used), self.config.one_to_one)
+        labels, conf = np.full(n, -1), np.zeros(n)
+        labels[used], conf[used] = slot_label, slot_conf
+        self.last_labels, self.last_probabilities = labels, conf
+        det_of_agent = np.full(self.config.n_agents, -1)
+        for k in np.argsort(-conf):  # the most confident detection of an agent updates it
+            j = labels[k]
+            if j >= 0 and det_of_agent[j] < 0:
+                det_of_agent[j] = k
+        snapshots = []
+        for j in range(self.config.n_agents):
+            k = det_of_agent[j]
+            if k >= 0:
+                alpha = conf[k]
+                target = det.position[k]
+                prev = self._position[j]
+                self._position[j] = target if np.isnan(prev).any() else alpha * target + (1 - alpha) * prev
+                self._last_seen[j] = frame.index
+            if self._last_seen[j] < 0:
+                continue
+            snapshots.append(
+                TrackSnapshot(
+                    track_id=j + 1,
+                    status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
+                    position=self._position[j].copy(),
+                    heading=float(det.heading[k]) if k >= 0 else None,
+                    agent_id=j,
+                    identity_prob=float(conf[k]) if k >= 0 else None,
+                    detection_index=int(k),
+                )
+            )
+        return snapshots

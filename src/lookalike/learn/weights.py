@@ -1,0 +1,21 @@
+"""Where the shipped network weights live inside the package."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from lookalike.learn.checkpoint import CheckpointError
+
+WEIGHTS_DIR = Path(__file__).with_name("weights_data")
+
+
+def shipped_weights_path(n_agents: int, n_slots: int) -> Path:
+    """The shipped ``model.npz`` for set-up (M=n_slots, N=n_agents); a clear error when none ships."""
+    path = WEIGHTS_DIR / f"lstm_m{n_slots}_n{n_agents}.npz"
+    if not path.is_file():
+        available = sorted(p.stem for p in WEIGHTS_DIR.glob("*.npz"))
+        raise CheckpointError(
+            f"no shipped weights for M={n_slots}, N={n_agents} ({path.name}); shipped: "
+            f"{available or 'none'}. Train some with `lookalike train` and pass weights=PATH."
+        )
+    return path
