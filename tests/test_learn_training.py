@@ -1,0 +1,56 @@
+import numpy as np
+import pytest
+
+from lookalike.types import Beacons, Detections, Frame
+
+torch = pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
+
+from lookalike.learn.training import TrainConfig, plot_log, train  # noqa: E402
+
+
+def toy_frames(seed: int, n_frames: int):
+    """Two agents whose visual heading matches their reported heading; one false positive."""
+    rng = np.random.default_rng(seed)
+    heading = rng.uniform(-np.pi, np.pi, 2)
+    frames = []
+    for k in range(n_frames):
+        heading = heading + rng.normal(0, 0.05, 2)
+        pos = rng.uniform(0, 5, (3, 2))
+        vis = np.concatenate([heading + rng.normal(0, 0.2, 2), rng.uniform(-np.pi, np.pi, 1)])
+        det = Detections(position=pos, heading=vis, score=[0.9, 0.9, 0.5], label=[0, 1, -1])
+        b = Beacons(agent_id=[0, 1], t_sent=[k / 30] * 2, t_received=[k / 30] * 2, heading=heading)
+        frames.append(Frame(index=k, time=k / 30, detections=det, beacons=b))
+    return frames
+
+
+def _config(**kw):
+    base = dict(n_agents=2, n_slots=3, hidden=16, num_layers=1, bptt=15, sequence_length=30, batch_size=4,
+                steps=30, validation_every=10, validation_sequences=4, learning_rate=0.01, patience=100)
+    base.update(kw)
+    return TrainConfig(**base)
+
+
+def test_tiny_training_learns_and_writes_outputs(tmp_path):
+    torch.set_num_threads(1)
+    result = train(_config(), toy_frames, tmp_path)
+    losses = [h["loss"] for h in result.history]
+    assert losses[-1] < losses[0]
+    assert result.best_success > 0.6  # chance is about 1/3
+    assert result.weights_path.is_file() and result.weights_path.with_suffix(".json").is_file()
+    assert plot_log(result.log_path, tmp_path / "log.png").stat().st_size > 0
+
+
+def test_training_is_deterministic_for_a_seed(tmp_path):
+    torch.set_num_threads(1)
+    a = train(_config(steps=10, validation_every=5), toy_frames, tmp_path / "a")
+    b = train(_config(steps=10, validation_every=5), toy_frames, tmp_path / "b")
+    assert [h["loss"] for h in a.history] == [h["loss"] for h in b.history]
+
+
+def test_resume_continues_where_it_stopped(tmp_path):
+    torch.set_num_threads(1)
+    train(_config(steps=10, validation_every=5), toy_frames, tmp_path)
+    resumed = train(_config(steps=10, validation_every=5), toy_frames, tmp_path, resume=True)
+    assert resumed.steps == 10 and len(resumed.history) == 2  # nothing left to do
+    with pytest.raises(ValueError, match="another configuration"):
+        train(_config(steps=20, validation_every=5), toy_frames, tmp_path, resume=True)
