@@ -1,0 +1,24 @@
+"""Evaluation: CLEAR MOT, identity and HOTA (TrackEval's definitions), and the identification
+metrics of seed A (identification success rate, localisation error).
+
+Values are fractions (0.73 for 73 %), named as in TrackEval.
+"""
+
+from lookalike.eval.api import METRICS, combine, evaluate_data, evaluate_points, evaluate_sequence
+from lookalike.eval.data import SequenceData
+from lookalike.eval.prepare import BENCHMARKS, prepare_boxes, prepare_points
+from lookalike.eval.similarity import box_iou, point_similarity
+
+__all__ = [
+    "BENCHMARKS",
+    "METRICS",
+    "SequenceData",
+    "box_iou",
+    "combine",
+    "evaluate_data",
+    "evaluate_points",
+    "evaluate_sequence",
+    "point_similarity",
+    "prepare_boxes",
+    "prepare_points",
+]

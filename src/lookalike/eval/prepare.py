@@ -1,0 +1,192 @@
+"""Turn ground-truth and result tables into :class:`SequenceData`, applying benchmark rules.
+
+Rules (``benchmark``):
+
+- ``"MOT16"``, ``"MOT17"``, ``"MOT20"``: MOTChallenge preprocessing. Per frame, tracker boxes are
+  matched to *all* ground-truth boxes (Hungarian on IoU, IoU >= 0.5); tracker boxes matched to a
+  distractor class (person on vehicle 2, static person 7, distractor 8, reflection 12, and for
+  MOT20 non-MOT vehicle 6) are removed. Then only ground truth with a non-zero consider flag
+  (column 7) and class pedestrian (column 8 = 1) is kept.
+- ``"MOT15"``: ground truth with a zero consider flag is dropped; nothing else.
+- ``"custom"``: everything is kept.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from lookalike.eval.data import SequenceData
+from lookalike.eval.similarity import box_iou, point_similarity
+from lookalike.io.motchallenge import MotTable
+
+BENCHMARKS = ("MOT15", "MOT16", "MOT17", "MOT20", "custom")
+_DISTRACTORS = {"MOT16": (2, 7, 8, 12), "MOT17": (2, 7, 8, 12), "MOT20": (2, 6, 7, 8, 12)}
+_VALID_CLASSES = np.arange(1, 14)
+_EPS = np.finfo(float).eps
+
+
+def where(table: MotTable, row: int, name: str) -> str:
+    """``path:line`` (or ``name row k``) of a table's 0-based ``row``, for error messages."""
+    if table.path is None:
+        return f"{name} row {row + 1}"
+    try:
+        lines = table.path.read_text().splitlines()
+    except OSError:
+        return f"{table.path} row {row + 1}"
+    numbers = [i + 1 for i, ln in enumerate(lines) if ln.strip()]
+    return f"{table.path}:{numbers[row] if row < len(numbers) else '?'}"
+
+
+def check_table(table: MotTable, num_frames: int, name: str, keep: np.ndarray | None = None) -> None:
+    """Raise ``ValueError`` for frames beyond ``num_frames`` or an id twice in one frame (among
+    the rows in ``keep``, all by default)."""
+    beyond = np.flatnonzero(table.frame > num_frames)
+    if len(beyond):
+        row = int(beyond[0])
+        raise ValueError(
+            f"{where(table, row, name)}: frame {int(table.frame[row])} is beyond the sequence "
+            f"length {num_frames}"
+        )
+    kept = np.arange(len(table)) if keep is None else np.flatnonzero(keep)
+    if len(kept) > 1:
+        order = kept[np.lexsort((table.track_id[kept], table.frame[kept]))]
+        same = (np.diff(table.frame[order]) == 0) & (np.diff(table.track_id[order]) == 0)
+        if same.any():
+            row = int(order[np.flatnonzero(same)[0] + 1])
+            raise ValueError(
+                f"{where(table, row, name)}: id {int(table.track_id[row])} appears twice in frame "
+                f"{int(table.frame[row])}"
+            )
+
+
+def _bounds(frames: np.ndarray, num_frames: int) -> tuple[np.ndarray, np.ndarray]:
+    order = np.argsort(frames, kind="stable")
+    return order, np.searchsorted(frames[order], np.arange(1, num_frames + 2))
+
+
+def _relabel(ids: list[np.ndarray]) -> tuple[list[np.ndarray], int]:
+    if not ids:
+        return [], 0
+    flat = np.concatenate(ids) if ids else np.zeros(0, int)
+    unique, inverse = np.unique(flat, return_inverse=True)
+    splits = np.cumsum([len(i) for i in ids])[:-1]
+    return list(np.split(inverse.astype(int).ravel(), splits)), len(unique)
+
+
+def prepare_boxes(
+    gt: MotTable, result: MotTable, *, num_frames: int | None = None, benchmark: str = "MOT15"
+) -> SequenceData:
+    """Box sequences (IoU similarity) with ``benchmark`` rules; frames ``1 .. num_frames``.
+
+    ``num_frames`` defaults to the last frame of either table.
+    """
+    if benchmark not in BENCHMARKS:
+        raise ValueError(f"benchmark must be one of {BENCHMARKS}, got {benchmark!r}")
+    n = _num_frames(gt, result, num_frames)
+    check_table(result, n, "result")
+    distractors = _DISTRACTORS.get(benchmark)
+    if distractors is not None:
+        if gt.extra.shape[1] < 1:
+            raise ValueError(f"{gt.path or 'gt'}: {benchmark} ground truth needs a class column (8th)")
+        gt_class = gt.extra[:, 0].astype(int)
+        bad = np.flatnonzero(~np.isin(gt_class, _VALID_CLASSES))
+        if len(bad):
+            raise ValueError(f"{where(gt, int(bad[0]), 'gt')}: unknown MOTChallenge class {gt_class[bad[0]]}")
+        keep_gt = (gt.conf != 0) & (gt_class == 1)
+    elif benchmark == "MOT15":
+        gt_class, keep_gt = None, gt.conf != 0
+    else:
+        gt_class, keep_gt = None, np.ones(len(gt), bool)
+    check_table(gt, n, "gt", keep_gt)
+    g_order, g_bounds = _bounds(gt.frame, n)
+    r_order, r_bounds = _bounds(result.frame, n)
+    gt_ids, tr_ids, sims = [], [], []
+    for t in range(n):
+        g = g_order[g_bounds[t] : g_bounds[t + 1]]
+        r = r_order[r_bounds[t] : r_bounds[t + 1]]
+        sim = box_iou(gt.xywh[g], result.xywh[r])
+        if distractors is not None and len(g) and len(r):
+            drop = _distractor_matches(sim, gt_class[g], distractors)
+            if len(drop):
+                keep_r = np.ones(len(r), bool)
+                keep_r[drop] = False
+                r, sim = r[keep_r], sim[:, keep_r]
+        k = keep_gt[g]
+        gt_ids.append(gt.track_id[g[k]])
+        tr_ids.append(result.track_id[r])
+        sims.append(sim[k])
+    return _finish(gt_ids, tr_ids, sims)
+
+
+def _distractor_matches(sim: np.ndarray, classes: np.ndarray, distractors: tuple[int, ...]) -> np.ndarray:
+    score = sim.copy()
+    score[score < 0.5 - _EPS] = 0.0
+    rows, cols = linear_sum_assignment(-score)
+    ok = score[rows, cols] > _EPS
+    rows, cols = rows[ok], cols[ok]
+    return cols[np.isin(classes[rows], distractors)]
+
+
+def prepare_points(
+    gt_frame: np.ndarray,
+    gt_id: np.ndarray,
+    gt_xy: np.ndarray,
+    result_frame: np.ndarray,
+    result_id: np.ndarray,
+    result_xy: np.ndarray,
+    *,
+    radius: float,
+    num_frames: int | None = None,
+) -> SequenceData:
+    """Point sequences (``(n, 2)`` positions in pixels or metres; 1-based frames) scored with
+    :func:`point_similarity` at match distance ``radius`` (same unit as the positions)."""
+    gt = _point_table(gt_frame, gt_id, gt_xy, "gt")
+    res = _point_table(result_frame, result_id, result_xy, "result")
+    n = _num_frames(gt, res, num_frames)
+    check_table(gt, n, "gt")
+    check_table(res, n, "result")
+    return _per_frame(gt, res, n, lambda a, b: point_similarity(a, b, radius))
+
+
+def _per_frame(gt: MotTable, res: MotTable, n: int, sim_fn: Callable[..., np.ndarray]) -> SequenceData:
+    g_order, g_bounds = _bounds(gt.frame, n)
+    r_order, r_bounds = _bounds(res.frame, n)
+    gt_ids, tr_ids, sims = [], [], []
+    for t in range(n):
+        g = g_order[g_bounds[t] : g_bounds[t + 1]]
+        r = r_order[r_bounds[t] : r_bounds[t + 1]]
+        gt_ids.append(gt.track_id[g])
+        tr_ids.append(res.track_id[r])
+        sims.append(sim_fn(gt.xywh[g, :2], res.xywh[r, :2]))
+    return _finish(gt_ids, tr_ids, sims)
+
+
+def _point_table(frame: np.ndarray, ids: np.ndarray, xy: np.ndarray, name: str) -> MotTable:
+    frame = np.asarray(frame).astype(int).ravel()
+    ids = np.asarray(ids).astype(int).ravel()
+    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    if not len(frame) == len(ids) == len(xy):
+        raise ValueError(f"{name}: frame, id and xy lengths differ ({len(frame)}, {len(ids)}, {len(xy)})")
+    if len(frame) and (frame.min() < 1 or not np.isfinite(xy).all()):
+        raise ValueError(f"{name}: frames must be >= 1 and positions finite")
+    xywh = np.zeros((len(frame), 4))
+    xywh[:, :2] = xy
+    return MotTable(frame, ids, xywh, np.ones(len(frame)), np.zeros((len(frame), 0)))
+
+
+def _num_frames(gt: MotTable, res: MotTable, num_frames: int | None) -> int:
+    if num_frames is not None:
+        if num_frames < 0:
+            raise ValueError(f"num_frames must be >= 0, got {num_frames}")
+        return int(num_frames)
+    last = [int(t.frame.max()) for t in (gt, res) if len(t)]
+    return max(last) if last else 0
+
+
+def _finish(gt_ids: list[np.ndarray], tr_ids: list[np.ndarray], sims: list[np.ndarray]) -> SequenceData:
+    gt_rel, n_gt = _relabel(gt_ids)
+    tr_rel, n_tr = _relabel(tr_ids)
+    return SequenceData(gt_rel, tr_rel, sims, n_gt, n_tr)
