@@ -6,6 +6,13 @@ Values are fractions (0.73 for 73 %), named as in TrackEval.
 
 from lookalike.eval.api import METRICS, combine, evaluate_data, evaluate_points, evaluate_sequence
 from lookalike.eval.data import SequenceData
+from lookalike.eval.identification import (
+    identification_by_agent,
+    identification_success_rate,
+    localisation_coverage,
+    localisation_error,
+    localisation_error_by_agent,
+)
 from lookalike.eval.prepare import BENCHMARKS, prepare_boxes, prepare_points
 from lookalike.eval.similarity import box_iou, point_similarity
 
@@ -18,6 +25,11 @@ __all__ = [
     "evaluate_data",
     "evaluate_points",
     "evaluate_sequence",
+    "identification_by_agent",
+    "identification_success_rate",
+    "localisation_coverage",
+    "localisation_error",
+    "localisation_error_by_agent",
     "point_similarity",
     "prepare_boxes",
     "prepare_points",

@@ -1,0 +1,90 @@
+"""Seed A's identification metrics: how often a detection carries the right agent label, and how
+far estimated agent positions are from the true ones.
+
+Labels are agent ids (``>= 0``) or ``-1`` for a false positive (a detection of no agent).
+Positions are ``(n_frames, n_agents, 2)`` arrays in metres, agent ``k`` in column ``k``, NaN where
+the agent is absent (truth) or has no estimate (estimated).
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+
+def _flatten_labels(predicted: Sequence[np.ndarray], true: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    if len(predicted) != len(true):
+        raise ValueError(f"predicted_labels has {len(predicted)} frames, true_labels {len(true)}")
+    p_parts, t_parts = [], []
+    for k, (p, t) in enumerate(zip(predicted, true)):
+        p, t = np.asarray(p).ravel(), np.asarray(t).ravel()
+        if p.shape != t.shape:
+            raise ValueError(f"frame {k}: predicted_labels has {p.size} labels, true_labels {t.size}")
+        for name, a in (("predicted_labels", p), ("true_labels", t)):
+            if a.size and (not np.issubdtype(a.dtype, np.integer) or a.min() < -1):
+                raise ValueError(f"frame {k}: {name} must be integers >= -1")
+        p_parts.append(p.astype(int))
+        t_parts.append(t.astype(int))
+    cat = (lambda parts: np.concatenate(parts) if parts else np.zeros(0, int))
+    return cat(p_parts), cat(t_parts)
+
+
+def identification_success_rate(
+    predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]
+) -> float:
+    """Correct labels / all detections, over all frames (lists of ``(n_t,)`` int arrays).
+
+    A false positive (true label -1) labelled -1 is correct. NaN when there are no detections.
+    """
+    p, t = _flatten_labels(predicted_labels, true_labels)
+    return float(np.mean(p == t)) if p.size else float("nan")
+
+
+def identification_by_agent(
+    predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]
+) -> dict[int, float]:
+    """Success rate per true label (agent id, and -1 for the false positives): the fraction of
+    that agent's detections that carry its label."""
+    p, t = _flatten_labels(predicted_labels, true_labels)
+    return {int(a): float(np.mean(p[t == a] == a)) for a in np.unique(t)}
+
+
+def _positions(estimated: np.ndarray, truth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    e = np.asarray(estimated, dtype=float)
+    g = np.asarray(truth, dtype=float)
+    if g.ndim != 3 or g.shape[2] != 2:
+        raise ValueError(f"truth must be (n_frames, n_agents, 2), got shape {g.shape}")
+    if e.shape != g.shape:
+        raise ValueError(f"estimated has shape {e.shape}, truth {g.shape}")
+    return e, g
+
+
+def localisation_error_by_agent(estimated: np.ndarray, truth: np.ndarray) -> np.ndarray:
+    """Mean distance (metres) per agent ``(n_agents,)`` over the frames where the agent is present
+    and estimated; NaN for an agent never both."""
+    e, g = _positions(estimated, truth)
+    d = np.linalg.norm(e - g, axis=2)
+    ok = np.isfinite(d)
+    count = ok.sum(axis=0)
+    total = np.where(ok, d, 0.0).sum(axis=0)
+    return np.divide(total, count, out=np.full(count.shape, np.nan), where=count > 0)
+
+
+def localisation_error(estimated: np.ndarray, truth: np.ndarray) -> float:
+    """Mean distance (metres) between estimated and true positions over every (frame, agent) where
+    the agent is present and estimated; NaN when there is none. Frames where a present agent has
+    no estimate are excluded here; see :func:`localisation_coverage`."""
+    e, g = _positions(estimated, truth)
+    d = np.linalg.norm(e - g, axis=2)
+    d = d[np.isfinite(d)]
+    return float(d.mean()) if d.size else float("nan")
+
+
+def localisation_coverage(estimated: np.ndarray, truth: np.ndarray) -> float:
+    """Fraction of (frame, agent) presences in ``truth`` that have an estimate (NaN if none)."""
+    e, g = _positions(estimated, truth)
+    present = np.isfinite(g).all(axis=2)
+    if not present.any():
+        return float("nan")
+    return float(np.isfinite(e).all(axis=2)[present].mean())
