@@ -7,6 +7,7 @@ from lookalike.cli.app import app
 # Importing the command modules registers their commands on ``app``.
 from lookalike.cli import track as _track  # noqa: E402,F401
 from lookalike.cli import demo as _demo  # noqa: E402,F401
+from lookalike.cli import eval as _eval  # noqa: E402,F401
 
 
 def main() -> None:

@@ -1,0 +1,93 @@
+"""``lookalike eval``: score result folders against MOTChallenge ground truth."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import Optional
+
+import typer
+from rich import box
+from rich.table import Table
+
+from lookalike.cli.app import app, console, fail
+from lookalike.eval import BENCHMARKS, COMBINED, METRICS, evaluate_folders
+
+HEADLINE = {
+    "HOTA": ("HOTA", "DetA", "AssA"),
+    "CLEAR": ("MOTA", "MOTP", "IDSW", "Frag", "CLR_FP", "CLR_FN"),
+    "Identity": ("IDF1",),
+}
+SHORT = {"CLR_FP": "FP", "CLR_FN": "FN"}
+PERCENT = {"HOTA", "DetA", "AssA", "LocA", "MOTA", "MOTP", "IDF1", "IDP", "IDR"}
+
+
+def _cell(key: str, value: float) -> str:
+    return f"{100 * value:.2f}" if key in PERCENT else f"{value:g}"
+
+
+def _columns(metrics: list[str]) -> list[str]:
+    return [k for m in ("HOTA", "CLEAR", "Identity") if m in metrics for k in HEADLINE[m]]
+
+
+@app.command("eval")
+def eval_command(
+    gt: Path = typer.Option(..., "--gt", help="Ground-truth root: sequence folders with gt/gt.txt."),
+    results: list[Path] = typer.Option(..., "--results", help="Folder of <sequence>.txt results (repeat to compare trackers)."),
+    benchmark: str = typer.Option("MOT15", help=f"Ground-truth rules: {', '.join(BENCHMARKS)}."),
+    metrics: Optional[list[str]] = typer.Option(None, "--metrics", help=f"Any of {', '.join(METRICS)} (repeatable; default all)."),
+    iou_threshold: float = typer.Option(0.5, help="IoU a CLEAR/identity match needs."),
+    workers: int = typer.Option(1, help="Processes scoring sequences in parallel."),
+    json_path: Optional[Path] = typer.Option(None, "--json", help="Write every value as JSON here."),
+    csv_path: Optional[Path] = typer.Option(None, "--csv", help="Write every value as CSV here (one row per tracker and sequence)."),
+) -> None:
+    """Score trackers with HOTA, CLEAR MOT and identity metrics (values shown in %)."""
+    chosen = [next((m for m in METRICS if m.lower() == x.lower()), x) for x in (metrics or METRICS)]
+    names = [p.name or str(p) for p in results]
+    if len(set(names)) != len(names):
+        names = [str(p) for p in results]
+    scores: dict[str, dict[str, dict[str, float]]] = {}
+    for name, folder in zip(names, results):
+        try:
+            scores[name] = evaluate_folders(gt, folder, benchmark=benchmark, metrics=chosen,
+                                            iou_threshold=iou_threshold, workers=workers)
+        except (FileNotFoundError, ValueError) as exc:
+            fail(str(exc))
+    columns = _columns(chosen)
+    if len(scores) == 1:
+        name, per_seq = next(iter(scores.items()))
+        table = _table(f"{name} ({benchmark})", "sequence", columns)
+        for seq, values in per_seq.items():
+            style = "bold" if seq == COMBINED else None
+            table.add_row(seq, *[_cell(c, values[c]) for c in columns], style=style)
+    else:
+        table = _table(f"trackers, combined over sequences ({benchmark})", "tracker", columns)
+        for name, per_seq in scores.items():
+            table.add_row(name, *[_cell(c, per_seq[COMBINED][c]) for c in columns])
+    console.print(table)
+    if json_path is not None:
+        json_path.parent.mkdir(parents=True, exist_ok=True)
+        json_path.write_text(json.dumps(scores, indent=1))
+    if csv_path is not None:
+        _write_csv(csv_path, scores)
+
+
+def _table(title: str, first: str, columns: list[str]) -> Table:
+    table = Table(title=title, box=box.SIMPLE_HEAD, show_edge=False, pad_edge=False,
+                  padding=(0, 1), collapse_padding=True)
+    table.add_column(first, no_wrap=True)
+    for c in columns:
+        table.add_column(SHORT.get(c, c), justify="right", no_wrap=True)
+    return table
+
+
+def _write_csv(path: Path, scores: dict[str, dict[str, dict[str, float]]]) -> None:
+    keys = list(next(iter(next(iter(scores.values())).values())).keys())
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(["tracker", "seq", *keys])
+        for tracker, per_seq in scores.items():
+            for seq, values in per_seq.items():
+                writer.writerow([tracker, seq, *[repr(values.get(k, "")) for k in keys]])
