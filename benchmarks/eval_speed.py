@@ -1,0 +1,141 @@
+"""Time HOTA + CLEAR + Identity over the 7 MOT17 training sequences: lookalike vs TrackEval.
+
+    .venv/bin/python benchmarks/eval_speed.py [--trackeval-python /tmp/tev/bin/python] [--repeats 3]
+
+TrackEval (PyPI ``trackeval``) needs numpy < 2, so it usually lives in its own virtualenv: it is
+imported here when available, otherwise run through ``--trackeval-python`` (the same script in
+that interpreter, timed there, values sent back as JSON). Both sides read the files and score;
+the script prints both times, the ratio and the largest difference over every shared value.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+MOT17 = SHARED_DATA / "mot17"
+
+
+def _lengths() -> dict[str, int]:
+    out = {}
+    for seq in sorted((MOT17 / "gt").iterdir()):
+        for line in (seq / "seqinfo.ini").read_text().splitlines():
+            if line.startswith("seqLength="):
+                out[seq.name] = int(line.split("=")[1])
+    return out
+
+
+def run_lookalike(repeats: int) -> tuple[float, dict[str, dict[str, float]]]:
+    from lookalike.eval import evaluate_folders
+
+    times, result = [], {}
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        result = evaluate_folders(MOT17 / "gt", MOT17 / "tracker_output", benchmark="MOT17")
+        times.append(time.perf_counter() - t0)
+    result.pop("COMBINED")
+    return statistics.median(times), result
+
+
+def run_trackeval_here(repeats: int) -> tuple[float, dict[str, dict[str, float]]]:
+    import numpy as np
+    import trackeval
+
+    lengths = _lengths()
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "tracker").mkdir()
+        (Path(tmp) / "tracker" / "data").symlink_to(MOT17 / "tracker_output")
+        dataset_config = {
+            "GT_FOLDER": str(MOT17 / "gt"), "TRACKERS_FOLDER": tmp, "TRACKERS_TO_EVAL": ["tracker"],
+            "BENCHMARK": "MOT17", "SPLIT_TO_EVAL": "train", "SKIP_SPLIT_FOL": True,
+            "SEQ_INFO": lengths, "DO_PREPROC": True, "PRINT_CONFIG": False,
+        }
+        eval_config = {
+            "USE_PARALLEL": False, "PRINT_RESULTS": False, "PRINT_ONLY_COMBINED": False,
+            "PRINT_CONFIG": False, "TIME_PROGRESS": False, "DISPLAY_LESS_PROGRESS": True,
+            "OUTPUT_SUMMARY": False, "OUTPUT_DETAILED": False, "PLOT_CURVES": False,
+            "OUTPUT_EMPTY_CLASSES": False,
+        }
+        times, res = [], None
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            evaluator = trackeval.Evaluator(eval_config)
+            dataset = trackeval.datasets.MotChallenge2DBox(dataset_config)
+            metrics = [trackeval.metrics.HOTA(), trackeval.metrics.CLEAR(), trackeval.metrics.Identity()]
+            res, _ = evaluator.evaluate([dataset], metrics)
+            times.append(time.perf_counter() - t0)
+    values: dict[str, dict[str, float]] = {}
+    for seq, per_class in res["MotChallenge2DBox"]["tracker"].items():
+        if seq == "COMBINED_SEQ":
+            continue
+        flat = {}
+        for family in per_class["pedestrian"].values():
+            for key, v in family.items():
+                if np.ndim(v) == 1 and len(v) == 19:
+                    for label, x in zip(range(5, 100, 5), v):
+                        flat[f"{key}___{label}"] = float(x)
+                elif np.ndim(v) == 0:
+                    flat[key] = float(v)
+        values[seq] = flat
+    return statistics.median(times), values
+
+
+def run_trackeval(repeats: int, python: str | None) -> tuple[float, dict[str, dict[str, float]]] | None:
+    try:
+        import trackeval  # noqa: F401
+
+        return run_trackeval_here(repeats)
+    except ImportError:
+        pass
+    if python is None:
+        print("TrackEval: not importable here (pip install trackeval 'numpy<2' in another venv and pass "
+              "--trackeval-python); timing lookalike only")
+        return None
+    proc = subprocess.run([python, __file__, "--trackeval-json", "--repeats", str(repeats)],
+                          capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        print(f"TrackEval via {python} failed:\n{proc.stderr[-2000:]}")
+        return None
+    payload = json.loads(proc.stdout.splitlines()[-1])
+    return payload["seconds"], payload["values"]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--trackeval-python", default=None, help="an interpreter that can import trackeval")
+    parser.add_argument("--trackeval-json", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if not MOT17.is_dir():
+        sys.exit(f"MOT17 data not found at {MOT17}")
+    if args.trackeval_json:
+        seconds, values = run_trackeval_here(args.repeats)
+        print(json.dumps({"seconds": seconds, "values": values}))
+        return
+    ours_s, ours = run_lookalike(args.repeats)
+    print(f"lookalike: {ours_s:.3f} s for HOTA+CLEAR+Identity over {len(ours)} MOT17 sequences "
+          f"(median of {args.repeats}, files read included)")
+    theirs = run_trackeval(args.repeats, args.trackeval_python)
+    if theirs is None:
+        return
+    te_s, te = theirs
+    print(f"TrackEval: {te_s:.3f} s (median of {args.repeats}, same work)")
+    print(f"speed-up: {te_s / ours_s:.1f}x")
+    worst, n = 0.0, 0
+    for seq, values in te.items():
+        for key, v in values.items():
+            if key in ours[seq]:
+                worst = max(worst, abs(ours[seq][key] - v))
+                n += 1
+    print(f"values compared: {n}, largest absolute difference: {worst:.3g}")
+
+
+if __name__ == "__main__":
+    main()
