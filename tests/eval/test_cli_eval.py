@@ -52,7 +52,7 @@ def test_eval_missing_sequence_is_an_error(tmp_path: Path) -> None:
 def test_fast_reader_equals_read_mot(tmp_path: Path) -> None:
     import numpy as np
 
-    from lookalike.eval.folders import read_table
+    from lookalike.cli.eval import read_table
     from lookalike.io import read_mot
 
     good = tmp_path / "a.txt"

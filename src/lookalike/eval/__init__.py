@@ -6,7 +6,6 @@ Values are fractions (0.73 for 73 %), named as in TrackEval.
 
 from lookalike.eval.api import METRICS, combine, evaluate_data, evaluate_points, evaluate_sequence
 from lookalike.eval.data import SequenceData
-from lookalike.eval.folders import COMBINED, evaluate_folders
 from lookalike.eval.identification import (
     identification_by_agent,
     identification_success_rate,
@@ -19,13 +18,11 @@ from lookalike.eval.similarity import box_iou, point_similarity
 
 __all__ = [
     "BENCHMARKS",
-    "COMBINED",
     "METRICS",
     "SequenceData",
     "box_iou",
     "combine",
     "evaluate_data",
-    "evaluate_folders",
     "evaluate_points",
     "evaluate_sequence",
     "identification_by_agent",

@@ -12,8 +12,7 @@ import numpy as np
 
 from lookalike.eval import clear, hota, identity
 from lookalike.eval.data import SequenceData
-from lookalike.eval.prepare import prepare_boxes, prepare_points
-from lookalike.io.motchallenge import MotTable
+from lookalike.eval.prepare import MotTable, prepare_boxes, prepare_points
 
 METRICS = ("CLEAR", "Identity", "HOTA")
 COUNT_FIELDS = ("Dets", "GT_Dets", "IDs", "GT_IDs")
@@ -67,7 +66,8 @@ def evaluate_sequence(
     metrics: Sequence[str] = METRICS,
     num_frames: int | None = None,
 ) -> dict[str, float]:
-    """CLEAR, identity and HOTA of tracker boxes ``result`` against ground truth ``gt``.
+    """CLEAR, identity and HOTA of tracker boxes ``result`` against ground truth ``gt``
+    (:class:`lookalike.io.MotTable`, or anything with its columns).
 
     ``benchmark`` picks the ground-truth rules (see :mod:`lookalike.eval.prepare`): ``"MOT17"``
     (also MOT16/MOT20) for MOTChallenge preprocessing, ``"MOT15"`` or ``"custom"`` for plain.

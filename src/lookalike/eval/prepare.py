@@ -13,14 +13,46 @@ Rules (``benchmark``):
 
 from __future__ import annotations
 
-from typing import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Protocol
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import SequenceData
 from lookalike.eval.similarity import box_iou, point_similarity
-from lookalike.io.motchallenge import MotTable
+
+
+class MotTable(Protocol):
+    """What scoring needs of a table of boxes; :class:`lookalike.io.MotTable` has it.
+
+    ``frame`` ``(n,)`` 1-based, ``track_id`` ``(n,)``, ``xywh`` ``(n, 4)`` pixels, ``conf`` ``(n,)``
+    (the ground truth's consider flag), ``extra`` ``(n, k)`` (class in column 0 for MOT16+ gt),
+    ``path`` the source file or None.
+    """
+
+    frame: np.ndarray
+    track_id: np.ndarray
+    xywh: np.ndarray
+    conf: np.ndarray
+    extra: np.ndarray
+    path: Path | None
+
+    def __len__(self) -> int: ...
+
+
+@dataclass(frozen=True, eq=False)
+class _Table:
+    frame: np.ndarray
+    track_id: np.ndarray
+    xywh: np.ndarray
+    conf: np.ndarray
+    extra: np.ndarray
+    path: Path | None = None
+
+    def __len__(self) -> int:
+        return int(self.frame.shape[0])
 
 BENCHMARKS = ("MOT15", "MOT16", "MOT17", "MOT20", "custom")
 _DISTRACTORS = {"MOT16": (2, 7, 8, 12), "MOT17": (2, 7, 8, 12), "MOT20": (2, 6, 7, 8, 12)}
@@ -174,7 +206,7 @@ def _point_table(frame: np.ndarray, ids: np.ndarray, xy: np.ndarray, name: str) 
         raise ValueError(f"{name}: frames must be >= 1 and positions finite")
     xywh = np.zeros((len(frame), 4))
     xywh[:, :2] = xy
-    return MotTable(frame, ids, xywh, np.ones(len(frame)), np.zeros((len(frame), 0)))
+    return _Table(frame, ids, xywh, np.ones(len(frame)), np.zeros((len(frame), 0)))
 
 
 def _num_frames(gt: MotTable, res: MotTable, num_frames: int | None) -> int:
