@@ -116,3 +116,13 @@ def test_real_sequences_load(shared_data):
     for s in seqs:
         t = read_mot(s.det_path)
         assert len(t) > 0 and t.frame.max() <= s.length
+
+
+def test_fast_and_careful_parsers_agree(tmp_path):
+    from lookalike.io.motchallenge import _parse_slowly
+
+    p = _write(tmp_path / "a.txt", "1,2,3.5,4,5,6,0.9,1,0.5\n\n2,3,1,1,2,2,1,7,1\n")
+    fast = read_mot(p)
+    rows = [(i + 1, ln) for i, ln in enumerate(p.read_text().splitlines()) if ln.strip()]
+    np.testing.assert_array_equal(fast.xywh, _parse_slowly(p, rows, 6)[:, 2:6])
+    np.testing.assert_array_equal(fast.extra, [[1, 0.5], [7, 1]])

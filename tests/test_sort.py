@@ -116,3 +116,33 @@ def test_permuting_detections_does_not_change_tracks(seed):
         boxes_a = sorted(map(tuple, np.round(list(ta.values()), 6)))
         boxes_b = sorted(map(tuple, np.round(list(tb.values()), 6)))
         assert boxes_a == boxes_b
+
+
+# Reference SORT (abewley/sort defaults) on ../shared/data/mot15, scored by TrackEval (MOT15, IoU 0.5).
+REFERENCE = {
+    "ADL-Rundle-6": (38.09, 75),
+    "ETH-Bahnhof": (44.64, 71),
+    "ETH-Sunnyday": (59.15, 22),
+    "KITTI-13": (19.29, 16),
+    "PETS09-S2L1": (61.86, 103),
+    "TUD-Campus": (62.67, 6),
+    "TUD-Stadtmitte": (71.71, 10),
+}
+
+
+@pytest.mark.parametrize("name", sorted(REFERENCE))
+def test_mota_matches_reference_sort_on_mot15(shared_data, name):
+    from lookalike.eval import evaluate_sequence
+    from lookalike.io import MotTable, tracks_to_rows
+
+    seq = find_sequences(shared_data / "mot15" / name)[0]
+    tracker = Sort()
+    rows = np.vstack(
+        [tracks_to_rows(f.index, tracker.update(f)) for f in frames_from_table(read_mot(seq.det_path), seq.length, seq.frame_rate)]
+    )
+    result = MotTable(frame=rows[:, 0].astype(int), track_id=rows[:, 1].astype(int), xywh=rows[:, 2:6],
+                      conf=rows[:, 6], extra=rows[:, 7:])
+    scores = evaluate_sequence(read_mot(seq.gt_path), result, benchmark="MOT15", num_frames=seq.length)
+    mota, idsw = REFERENCE[name]
+    assert 100 * scores["MOTA"] == pytest.approx(mota, abs=0.2)
+    assert abs(scores["IDSW"] - idsw) <= 2

@@ -47,22 +47,3 @@ def test_eval_missing_sequence_is_an_error(tmp_path: Path) -> None:
     out = CliRunner().invoke(app, ["eval", "--gt", str(gt_root), "--results", str(good)])
     assert out.exit_code != 0
     assert "SEQ-1" in out.output
-
-
-def test_fast_reader_equals_read_mot(tmp_path: Path) -> None:
-    import numpy as np
-
-    from lookalike.cli.eval import read_table
-    from lookalike.io import read_mot
-
-    good = tmp_path / "a.txt"
-    good.write_text("1,2,3.5,4,5,6,0.9,1,0.5\n\n2,3,1,1,2,2,1,7,1\n")
-    fast, slow = read_table(good), read_mot(good)
-    for field in ("frame", "track_id", "xywh", "conf", "extra"):
-        np.testing.assert_array_equal(getattr(fast, field), getattr(slow, field))
-    bad = tmp_path / "b.txt"
-    bad.write_text("1,2,3,4,5,6,1\n1,2,3,4,-5,6,1\n")
-    import pytest
-
-    with pytest.raises(ValueError, match="b.txt:2"):
-        read_table(bad)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable, Iterator, Sequence
@@ -50,24 +51,39 @@ def read_mot(path: str | os.PathLike[str], min_columns: int = 6) -> MotTable:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
-    text = path.read_text()
-    lines = text.splitlines()
-    rows = [(i + 1, ln) for i, ln in enumerate(lines) if ln.strip()]
+    fast = _parse_fast(path, min_columns)
+    if fast is not None:
+        return _table(fast, path)
+    rows = [(i + 1, ln) for i, ln in enumerate(path.read_text().splitlines()) if ln.strip()]
     if not rows:
         return _table(np.zeros((0, 7)), path)
-    try:
-        data = np.array([ln.split(",") for _, ln in rows], dtype=float)
-    except ValueError:
-        data = None
-    if data is None or data.ndim != 2 or data.shape[1] < min_columns:
-        data = _parse_slowly(path, rows, min_columns)
-    bad = ~np.isfinite(data[:, :6]).all(axis=1) | (data[:, 4:6] < 0).any(axis=1) | (data[:, 0] < 1)
+    data = _parse_slowly(path, rows, min_columns)
+    bad = _invalid_rows(data)
     if bad.any():
         line_no, line = rows[int(np.flatnonzero(bad)[0])]
         raise ValueError(
             f"{path}:{line_no}: invalid box (NaN/inf, negative size or frame < 1): {line.strip()!r}"
         )
     return _table(data, path)
+
+
+def _invalid_rows(data: np.ndarray) -> np.ndarray:
+    return ~np.isfinite(data[:, :6]).all(axis=1) | (data[:, 4:6] < 0).any(axis=1) | (data[:, 0] < 1)
+
+
+def _parse_fast(path: Path, min_columns: int) -> np.ndarray | None:
+    """numpy's C parser for regular, valid files; None when anything needs a closer look."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # an empty file warns
+            data = np.loadtxt(path, delimiter=",", ndmin=2)
+    except ValueError:
+        return None
+    if data.shape[0] == 0:
+        return np.zeros((0, 7)) if not path.read_text().strip() else None
+    if data.shape[1] < min_columns or _invalid_rows(data).any():
+        return None
+    return data
 
 
 def _parse_slowly(path: Path, rows: list[tuple[int, str]], min_columns: int) -> np.ndarray:
