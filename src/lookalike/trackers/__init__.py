@@ -9,10 +9,14 @@ from lookalike.trackers.registry import (
     tracker_names,
     tracker_parameters,
 )
+from lookalike.trackers.deepsort import DeepSort
+from lookalike.trackers.diversort import DiverSort
 from lookalike.trackers.sort import Sort
 from lookalike.types.tracks import TrackStatus
 
 __all__ = [
+    "DeepSort",
+    "DiverSort",
     "ParameterInfo",
     "Sort",
     "TrackStatus",

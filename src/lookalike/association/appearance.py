@@ -1,0 +1,122 @@
+"""Appearance association shared by the appearance trackers: cosine distances, per-track feature
+galleries and the matching cascade (deep SORT, seed B).
+
+Features are L2-normalised rows, so the cosine distance ``1 - f·g`` lies in ``[0, 2]``.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from lookalike.association.solver import Assignment, assign
+
+
+def cosine_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``(m, k)`` cosine distances ``1 - a_i·b_j`` between L2-normalised rows ``a (m, d)`` and ``b (k, d)``."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    if a.ndim != 2 or b.ndim != 2 or (a.size and b.size and a.shape[1] != b.shape[1]):
+        raise ValueError(f"cosine_distance: expected (m, d) and (k, d), got {a.shape} and {b.shape}")
+    return 1.0 - a @ b.T
+
+
+class FeatureGallery:
+    """The last ``budget`` features of every track (a ring buffer per track id)."""
+
+    def __init__(self, budget: int = 100) -> None:
+        if budget < 1:
+            raise ValueError(f"budget must be at least 1, got {budget}")
+        self.budget = budget
+        self._store: dict[int, np.ndarray] = {}
+
+    def __contains__(self, track_id: int) -> bool:
+        return track_id in self._store
+
+    def __len__(self) -> int:
+        return len(self._store)
+
+    def add(self, track_id: int, feature: np.ndarray) -> None:
+        """Append one feature ``(d,)`` (or several ``(k, d)``) to a track, keeping the newest ``budget``."""
+        new = np.atleast_2d(np.asarray(feature, dtype=float))
+        old = self._store.get(track_id)
+        stacked = new if old is None else np.vstack([old, new])
+        self._store[track_id] = stacked[-self.budget :]
+
+    def features(self, track_id: int) -> np.ndarray:
+        """The stored features ``(k, d)`` of a track, oldest first (``(0, 0)`` if none)."""
+        return self._store.get(track_id, np.zeros((0, 0)))
+
+    def remove(self, track_id: int) -> None:
+        """Forget a track's features."""
+        self._store.pop(track_id, None)
+
+    def merge(self, source: int, target: int) -> None:
+        """Move ``source``'s features behind ``target``'s (newest kept) and forget ``source``."""
+        if source in self._store:
+            self.add(target, self._store.pop(source))
+
+    def min_distance(self, track_ids: list[int] | np.ndarray, features: np.ndarray) -> np.ndarray:
+        """``(k, n)``: for each track, the smallest cosine distance of each feature ``(n, d)`` to its gallery.
+
+        A track without stored features gets ``inf``.
+        """
+        feats = np.asarray(features, dtype=float)
+        out = np.full((len(track_ids), len(feats)), np.inf)
+        if not len(feats):
+            return out
+        for row, tid in enumerate(track_ids):
+            gallery = self._store.get(int(tid))
+            if gallery is not None and len(gallery):
+                out[row] = cosine_distance(gallery, feats).min(axis=0)
+        return out
+
+    def pair_fraction_below(self, a: int, b: int, threshold: float) -> float:
+        """Fraction of all gallery pairs (one feature of ``a``, one of ``b``) closer than ``threshold``."""
+        fa, fb = self.features(a), self.features(b)
+        if not len(fa) or not len(fb):
+            return 0.0
+        return float((cosine_distance(fa, fb) < threshold).mean())
+
+
+def matching_cascade(
+    cost_fn: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    track_age: np.ndarray,
+    detections: np.ndarray,
+    max_age: int,
+    max_cost: float,
+) -> Assignment:
+    """Match tracks to detections level by level, most recently updated tracks first.
+
+    Args:
+        cost_fn: ``cost_fn(track_rows, det_cols) -> (len(track_rows), len(det_cols))`` costs,
+            ``inf`` forbidden.
+        track_age: ``(k,)`` frames since each track's last update (1 = updated last frame).
+        detections: ``(n,)`` indices of the detections to match.
+        max_age: deepest level; tracks older than this are not matched.
+        max_cost: pairs costing more are forbidden.
+
+    Returns:
+        An :class:`Assignment` whose matches are ``(track_row, detection_index)`` pairs.
+    """
+    track_age = np.asarray(track_age, dtype=int)
+    remaining = np.asarray(detections, dtype=int)
+    pairs: list[np.ndarray] = []
+    for level in range(1, max_age + 1):
+        if not len(remaining):
+            break
+        rows = np.flatnonzero(track_age == level)
+        if not len(rows):
+            continue
+        result = assign(cost_fn(rows, remaining), max_cost)
+        if len(result.matches):
+            pairs.append(np.column_stack([rows[result.matches[:, 0]], remaining[result.matches[:, 1]]]))
+            remaining = remaining[result.unmatched_cols]
+    matches = np.vstack(pairs) if pairs else np.zeros((0, 2), dtype=int)
+    matched_rows = matches[:, 0] if len(matches) else np.zeros(0, dtype=int)
+    return Assignment(
+        matches=matches[np.argsort(matches[:, 0], kind="stable")] if len(matches) else matches,
+        unmatched_rows=np.setdiff1d(np.arange(len(track_age)), matched_rows),
+        unmatched_cols=np.sort(remaining),
+    )

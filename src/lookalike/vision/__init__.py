@@ -1,0 +1,1 @@
+"""Vision: per-detection cues computed from images (appearance features, crops)."""
