@@ -140,9 +140,7 @@ def test_mota_matches_reference_sort_on_mot15(shared_data, name):
     rows = np.vstack(
         [tracks_to_rows(f.index, tracker.update(f)) for f in frames_from_table(read_mot(seq.det_path), seq.length, seq.frame_rate)]
     )
-    result = MotTable(frame=rows[:, 0].astype(int), track_id=rows[:, 1].astype(int), xywh=rows[:, 2:6],
-                      conf=rows[:, 6], extra=rows[:, 7:])
-    scores = evaluate_sequence(read_mot(seq.gt_path), result, benchmark="MOT15", num_frames=seq.length)
+    scores = evaluate_sequence(read_mot(seq.gt_path), MotTable.from_rows(rows), benchmark="MOT15", num_frames=seq.length)
     mota, idsw = REFERENCE[name]
     assert 100 * scores["MOTA"] == pytest.approx(mota, abs=0.2)
     assert abs(scores["IDSW"] - idsw) <= 2

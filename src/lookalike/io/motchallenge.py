@@ -41,6 +41,12 @@ class MotTable:
     def __len__(self) -> int:
         return int(self.frame.shape[0])
 
+    @classmethod
+    def from_rows(cls, rows: np.ndarray) -> "MotTable":
+        """A table from in-memory MOTChallenge rows ``(n, >= 7)`` such as :func:`tracks_to_rows` makes."""
+        data = np.asarray(rows, dtype=float).reshape(-1, max(np.shape(rows)[-1], 7) if np.size(rows) else 10)
+        return _table(data, None)
+
 
 def read_mot(path: str | os.PathLike[str], min_columns: int = 6) -> MotTable:
     """Read a MOTChallenge text file.
