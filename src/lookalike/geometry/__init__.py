@@ -1,6 +1,7 @@
-"""Box conversions, IoU matrices and angle arithmetic."""
+"""Box conversions, IoU matrices, angle arithmetic, the camera model and observer odometry."""
 
 from lookalike.geometry.angles import angle_diff, circular_mean, wrap_angle
+from lookalike.geometry.camera import Camera, Extrinsics, Intrinsics, Pose2D, integrate_odometry
 from lookalike.geometry.boxes import (
     iou_matrix,
     xywh_to_cxcywh,
@@ -11,6 +12,11 @@ from lookalike.geometry.boxes import (
 )
 
 __all__ = [
+    "Camera",
+    "Extrinsics",
+    "Intrinsics",
+    "Pose2D",
+    "integrate_odometry",
     "angle_diff",
     "circular_mean",
     "iou_matrix",
