@@ -73,6 +73,7 @@ class DiverSort:
         location_weight: float = param(1.0, "weight of d²/location_gate added to tied costs")
         tie_margin: float = param(0.02, "tracks this close to a detection's best cost count as tied")
         long_term_after: int = param(5, "frames unseen after which only appearance is used")
+        recent_first: bool = param(False, "match recently seen tracks before long-unseen ones (ours)")
         n_init: int = param(3, "consecutive matches that make a track an identity")
         recovery_window: int = param(15, "a track alive this many frames or fewer may be merged")
         recovery_fraction: float = param(0.25, "share of gallery pairs under the threshold that merges")
@@ -129,11 +130,14 @@ class DiverSort:
         pairs = self._shortcut(det.xywh)
         left_tracks = np.setdiff1d(np.arange(len(self._ids)), pairs[:, 0])
         left_dets = np.setdiff1d(np.arange(len(det)), pairs[:, 1])
-        if len(left_tracks) and len(left_dets):
-            cost = self._cost(left_tracks, det.xywh[left_dets], centre[left_dets], features[left_dets])
-            found = assign(cost)
-            pairs = np.vstack([pairs, np.column_stack([left_tracks[found.matches[:, 0]],
-                                                       left_dets[found.matches[:, 1]]])])
+        long_term = self._since[left_tracks] > self.config.long_term_after
+        stages = [left_tracks[~long_term], left_tracks[long_term]] if self.config.recent_first else [left_tracks]
+        for rows in stages:
+            if not len(rows) or not len(left_dets):
+                continue
+            found = assign(self._cost(rows, det.xywh[left_dets], centre[left_dets], features[left_dets]))
+            pairs = np.vstack([pairs, np.column_stack([rows[found.matches[:, 0]], left_dets[found.matches[:, 1]]])])
+            left_dets = left_dets[found.unmatched_cols]
         det_of_track = np.full(len(self._ids), -1, dtype=int)
         if len(pairs):
             self._correct(pairs[:, 0], det.xywh[pairs[:, 1]], centre[pairs[:, 1]], features[pairs[:, 1]])

@@ -16,9 +16,10 @@ blocks:
 
 The foreground is the set of pixels whose LAB colour differs from the crop's border (the water)
 by more than half the crop's 95th-percentile difference. Raw vectors are standardised per
-dimension (statistics from :meth:`HandcraftedFeatures.fit`, or, until fitted, running statistics
-of the first ``warmup`` crops, then frozen), each block is weighted so that it contributes equally,
-and rows are L2-normalised so that ``1 - f·g`` is the cosine distance.
+dimension (statistics from :func:`fit_stats`, or, without them, running statistics of the first
+``warmup`` crops, then frozen), weighted (equal block weights, or weights calibrated on labelled
+validation crops by :func:`fit_stats`), and rows are L2-normalised so that ``1 - f·g`` is the
+cosine distance.
 
 OpenCV is imported inside the functions that need it.
 """
@@ -54,27 +55,41 @@ class FeatureExtractor(Protocol):
 
 @dataclass(frozen=True)
 class FeatureStats:
-    """Per-dimension standardisation of raw features: ``(raw - mean) / scale``, both ``(RAW_DIM,)``."""
+    """Per-dimension standardisation of raw features, ``weight · (raw - mean) / scale``, all ``(RAW_DIM,)``.
+
+    ``weight`` defaults to equal block weights (each block contributes the same expected share).
+    """
 
     mean: np.ndarray
     scale: np.ndarray
+    weight: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        for name in ("mean", "scale"):
+        if self.weight is None:
+            object.__setattr__(self, "weight", _block_weights())
+        for name in ("mean", "scale", "weight"):
             arr = np.asarray(getattr(self, name), dtype=float)
             if arr.shape != (RAW_DIM,) or not np.isfinite(arr).all():
                 raise ValueError(f"FeatureStats.{name}: expected {RAW_DIM} finite values, got shape {arr.shape}")
             object.__setattr__(self, name, arr)
         if (self.scale <= 0).any():
             raise ValueError("FeatureStats.scale: every value must be positive")
+        if (self.weight < 0).any():
+            raise ValueError("FeatureStats.weight: every value must be >= 0")
 
 
-def fit_stats(raw: np.ndarray, labels: np.ndarray | None = None, floor: float = 1e-3) -> FeatureStats:
+def _block_weights() -> np.ndarray:
+    return np.concatenate([np.full(size, 1.0 / np.sqrt(size)) for _, size in BLOCKS])
+
+
+def fit_stats(raw: np.ndarray, labels: np.ndarray | None = None, floor: float = 1e-3,
+              max_weight: float = 3.0) -> FeatureStats:
     """Standardisation statistics from raw vectors ``(m, RAW_DIM)``.
 
-    Without labels the scale is each dimension's standard deviation. With identity ``labels (m,)``
-    it is the pooled within-identity standard deviation, so that a dimension counts by how stable
-    it is for one target (still a standardisation, but of the noise that matters for re-ID).
+    Without labels: each dimension's mean and standard deviation, equal block weights. With
+    identity ``labels (m,)`` (calibration data): the scale is the pooled within-identity standard
+    deviation and each dimension is weighted by ``sqrt(between / within)`` variance (clipped to
+    ``max_weight``), a diagonal discriminant that lets stable, telling dimensions dominate.
     """
     raw = np.asarray(raw, dtype=float)
     if raw.ndim != 2 or raw.shape[1] != RAW_DIM or len(raw) < 2:
@@ -93,7 +108,13 @@ def fit_stats(raw: np.ndarray, labels: np.ndarray | None = None, floor: float = 
         spread = np.sqrt((resid**2).mean(axis=0))
     total = raw.std(axis=0)
     scale = np.maximum(spread, floor * np.maximum(total, 1.0))
-    return FeatureStats(mean=mean, scale=scale)
+    if labels is None:
+        return FeatureStats(mean=mean, scale=scale)
+    between = np.maximum(total**2 - spread**2, 0.0)
+    weight = np.minimum(np.sqrt(between) / scale, max_weight)
+    if not weight.any():
+        raise ValueError("labels: no dimension separates the identities")
+    return FeatureStats(mean=mean, scale=scale, weight=weight)
 
 
 class HandcraftedFeatures:
@@ -112,7 +133,6 @@ class HandcraftedFeatures:
         self._sum = np.zeros(RAW_DIM)
         self._sumsq = np.zeros(RAW_DIM)
         self._count = 0
-        self._weights = np.concatenate([np.full(size, 1.0 / np.sqrt(size)) for _, size in BLOCKS])
 
     def __call__(self, image: np.ndarray, xywh: np.ndarray) -> np.ndarray:
         """``(n, RAW_DIM)`` standardised, block-weighted, L2-normalised features of the boxes."""
@@ -136,7 +156,8 @@ class HandcraftedFeatures:
             scale = np.sqrt(np.maximum(var, 1e-6)) if self._count >= 2 else np.ones(RAW_DIM)
         else:
             mean, scale = self.stats_.mean, self.stats_.scale
-        z = (raw - mean) / scale * self._weights
+        weight = _block_weights() if self.stats_ is None else self.stats_.weight
+        z = (raw - mean) / scale * weight
         norm = np.linalg.norm(z, axis=1, keepdims=True)
         return z / np.maximum(norm, 1e-12)
 
