@@ -1,0 +1,217 @@
+"""Background-subtraction blob detector for static cameras over arenas (DESIGN §6).
+
+Foreground is where a frame differs from the background model by more than ``threshold`` grey
+levels (largest difference over the three colour channels, after a Gaussian blur). Two models:
+
+- ``median``: the per-pixel median of frames sampled across the video (:meth:`BlobDetector.fit`),
+  the robust choice when the animals keep moving; without ``fit`` the detector keeps a rolling
+  buffer of sampled frames and uses their median;
+- ``mog2``: OpenCV's adaptive Gaussian-mixture model, learned online frame by frame.
+
+The mask is cleaned by a morphological opening then closing, split into external contours, and
+each contour with ``min_area_px <= area <= max_area_px`` becomes one detection: its bounding box
+and a score ``contrast / (contrast + threshold)`` in (0.5, 1) from the mean difference inside it.
+OpenCV is imported lazily.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Iterable
+
+import numpy as np
+
+from lookalike.types import Detections
+from lookalike.vision.hog_features import as_bgr_image
+
+_METHODS = ("median", "mog2")
+_POLARITIES = ("any", "dark", "bright")
+
+
+@dataclass(frozen=True)
+class BlobConfig:
+    """Blob detector settings; sizes in pixels of the input image, differences in grey levels (0..255)."""
+
+    method: str = "median"
+    threshold: float = 30.0
+    polarity: str = "any"  # "dark": objects darker than the background (zebrafish), "bright", or both
+    min_area_px: float = 80.0
+    max_area_px: float = math.inf
+    blur_px: int = 5  # Gaussian blur kernel (odd; 0 or 1 disables)
+    open_px: int = 3
+    close_px: int = 9
+    history: int = 25  # frames in the median (sampled across the video by fit) or MOG2 history
+    sample_every: int = 5  # rolling median without fit: keep every k-th frame
+    stabilise: bool = False  # undo camera shake: shift each frame onto the first (phase correlation)
+
+    def __post_init__(self) -> None:
+        if self.method not in _METHODS:
+            raise ValueError(f"BlobConfig.method: expected one of {_METHODS}, got {self.method!r}")
+        if self.polarity not in _POLARITIES:
+            raise ValueError(f"BlobConfig.polarity: expected one of {_POLARITIES}, got {self.polarity!r}")
+        if not 0 < self.threshold < 255:
+            raise ValueError(f"BlobConfig.threshold: must be in (0, 255), got {self.threshold!r}")
+        if not 0 <= self.min_area_px <= self.max_area_px:
+            raise ValueError(
+                f"BlobConfig.min_area_px/max_area_px: need 0 <= min <= max, got {self.min_area_px}, {self.max_area_px}"
+            )
+        for name in ("blur_px", "open_px", "close_px"):
+            if int(getattr(self, name)) < 0:
+                raise ValueError(f"BlobConfig.{name}: must be >= 0, got {getattr(self, name)!r}")
+        if self.blur_px > 1 and self.blur_px % 2 == 0:
+            raise ValueError(f"BlobConfig.blur_px: must be odd, got {self.blur_px}")
+        for name in ("history", "sample_every"):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f"BlobConfig.{name}: must be >= 1, got {getattr(self, name)!r}")
+
+
+@dataclass
+class BlobDetector:
+    """Detects moving blobs in ``(h, w, 3)`` BGR frames of one static camera; one instance per video."""
+
+    config: BlobConfig = field(default_factory=BlobConfig)
+    background_: np.ndarray | None = field(default=None, init=False, repr=False)
+    _buffer: deque = field(init=False, repr=False)
+    _seen: int = field(default=0, init=False, repr=False)
+    _mog: object = field(default=None, init=False, repr=False)
+    _fitted: bool = field(default=False, init=False, repr=False)
+    _reference: np.ndarray | None = field(default=None, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._buffer = deque(maxlen=self.config.history)
+
+    def reset(self) -> None:
+        """Forget the background model."""
+        self.background_ = None
+        self._buffer.clear()
+        self._seen = 0
+        self._mog = None
+        self._fitted = False
+        self._reference = None
+
+    def fit(self, frames: Iterable[np.ndarray] | np.ndarray) -> "BlobDetector":
+        """Median background from ``frames`` (an iterable or ``(n, h, w, 3)`` array), sampling at most
+        ``history`` of them evenly. Only for the ``median`` method."""
+        if self.config.method != "median":
+            raise ValueError("BlobDetector.fit: only the 'median' method has a fitted background")
+        frames = list(frames)
+        if not frames:
+            raise ValueError("frames: no frames to fit a background on")
+        pick = np.unique(np.linspace(0, len(frames) - 1, min(len(frames), self.config.history)).round().astype(int))
+        stack = np.stack([self._prepare(frames[i], f"frames[{i}]") for i in pick])
+        self.background_ = np.median(stack, axis=0).astype(np.float32)
+        self._fitted = True
+        return self
+
+    def foreground(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(mask, difference)``: a ``(h, w)`` uint8 mask (255 = foreground, after morphology) and the
+        ``(h, w)`` float32 difference from the background in grey levels; updates an online model."""
+        import cv2
+
+        cfg = self.config
+        img = self._prepare(image, "image")
+        if cfg.method == "mog2":
+            if self._mog is None:
+                self._mog = cv2.createBackgroundSubtractorMOG2(
+                    history=cfg.history, varThreshold=(cfg.threshold / 2.5) ** 2, detectShadows=False
+                )
+            raw = self._mog.apply(img.astype(np.uint8))
+            bg = self._mog.getBackgroundImage()
+            diff = self._difference(img, bg.astype(np.float32) if bg is not None else img)
+            mask = np.where((raw > 0) & (diff > 0), 255, 0).astype(np.uint8)
+        else:
+            if not self._fitted:
+                if self._seen % cfg.sample_every == 0:
+                    self._buffer.append(img)
+                    self.background_ = np.median(np.stack(self._buffer), axis=0).astype(np.float32)
+                self._seen += 1
+            if self.background_ is None or self.background_.shape != img.shape:
+                raise ValueError(
+                    f"image: shape {img.shape[:2]} differs from the background's "
+                    f"{None if self.background_ is None else self.background_.shape[:2]}"
+                )
+            diff = self._difference(img, self.background_)
+            mask = np.where(diff > cfg.threshold, 255, 0).astype(np.uint8)
+        if cfg.open_px > 1:
+            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (cfg.open_px,) * 2))
+        if cfg.close_px > 1:
+            mask = cv2.morphologyEx(
+                mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (cfg.close_px,) * 2)
+            )
+        return mask, diff
+
+    def __call__(self, image: np.ndarray) -> Detections:
+        """Detections of one frame: boxes ``xywh`` (px) of the blobs and their scores."""
+        import cv2
+
+        cfg = self.config
+        mask, diff = self.foreground(image)
+        count, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        boxes, scores = [], []
+        for k in range(1, count):
+            x, y, w, h, area = (int(v) for v in stats[k])
+            if not cfg.min_area_px <= area <= cfg.max_area_px:
+                continue
+            contrast = float(diff[y : y + h, x : x + w][labels[y : y + h, x : x + w] == k].mean())
+            boxes.append((x, y, w, h))
+            scores.append(contrast / (contrast + cfg.threshold))
+        if not boxes:
+            return Detections.empty()
+        return Detections(xywh=np.array(boxes, dtype=float), score=np.array(scores))
+
+    detect = __call__
+
+    def _prepare(self, image: np.ndarray, name: str) -> np.ndarray:
+        import cv2
+
+        img = as_bgr_image(image, name)
+        if self.config.blur_px > 1:
+            img = cv2.GaussianBlur(img, (self.config.blur_px,) * 2, 0)
+        out = img.astype(np.float32)
+        if self.config.stabilise:
+            out = self._stabilise(out)
+        return out
+
+    def _stabilise(self, img: np.ndarray) -> np.ndarray:
+        """Shift ``img`` (float32 BGR) by the translation that best aligns it with the first frame seen."""
+        import cv2
+
+        grey = img.mean(axis=2)
+        if self._reference is None or self._reference.shape != grey.shape:
+            self._reference = grey
+            return img
+        window = cv2.createHanningWindow(grey.shape[::-1], cv2.CV_32F)
+        (dx, dy), _ = cv2.phaseCorrelate(self._reference.astype(np.float32), grey.astype(np.float32), window)
+        shift = np.float32([[1, 0, -dx], [0, 1, -dy]])
+        return cv2.warpAffine(img, shift, grey.shape[::-1], borderMode=cv2.BORDER_REPLICATE)
+
+    def _difference(self, img: np.ndarray, background: np.ndarray) -> np.ndarray:
+        d = img - background
+        if self.config.polarity == "dark":
+            return np.maximum(-d, 0).max(axis=2)
+        if self.config.polarity == "bright":
+            return np.maximum(d, 0).max(axis=2)
+        return np.abs(d).max(axis=2)
+
+
+def read_video(path: str, max_frames: int | None = None) -> list[np.ndarray]:
+    """All frames (or the first ``max_frames``) of a video file as ``(h, w, 3)`` uint8 BGR arrays."""
+    import cv2
+
+    cap = cv2.VideoCapture(str(path))
+    if not cap.isOpened():
+        raise ValueError(f"video: cannot open {path}")
+    frames: list[np.ndarray] = []
+    try:
+        while max_frames is None or len(frames) < max_frames:
+            ok, frame = cap.read()
+            if not ok:
+                break
+            frames.append(frame)
+    finally:
+        cap.release()
+    if not frames:
+        raise ValueError(f"video: {path} has no readable frames")
+    return frames

@@ -1,0 +1,123 @@
+"""Image checks and HOG building blocks: per-orientation integral histograms and block descriptors.
+
+The orientation histogram of an image is a stack of ``bins`` gradient-magnitude maps, one per
+unsigned orientation bin (0..π), soft-assigned between the two nearest bins. Its integral image
+(summed-area table) lets the descriptor of any rectangle be read in four look-ups per bin, which
+is what makes variable-size HOG blocks cheap (Zhu et al., as used by seed A). Everything here is
+numpy; OpenCV is only imported lazily for colour conversion and resizing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+BINS = 9  # unsigned orientation bins over [0, π)
+
+
+def as_bgr_image(image: np.ndarray, name: str = "image") -> np.ndarray:
+    """Validate an image and return it as ``(h, w, 3)`` uint8 BGR.
+
+    Grey ``(h, w)`` or ``(h, w, 1)`` images are replicated to three channels, BGRA drops alpha,
+    float images in [0, 1] are scaled to 0..255, other integer types are clipped. Empty images,
+    other shapes and non-finite values raise ``ValueError`` naming ``name``.
+    """
+    arr = np.asarray(image)
+    if arr.size == 0:
+        raise ValueError(f"{name}: empty image (shape {arr.shape})")
+    if arr.ndim == 3 and arr.shape[2] == 1:
+        arr = arr[:, :, 0]
+    if arr.ndim == 2:
+        arr = np.repeat(arr[:, :, None], 3, axis=2)
+    elif arr.ndim == 3 and arr.shape[2] == 4:
+        arr = arr[:, :, :3]
+    if arr.ndim != 3 or arr.shape[2] != 3:
+        raise ValueError(f"{name}: expected (h, w), (h, w, 1), (h, w, 3) or (h, w, 4), got shape {arr.shape}")
+    if arr.dtype == np.uint8:
+        return np.ascontiguousarray(arr)
+    if arr.dtype == bool or not np.issubdtype(arr.dtype, np.number):
+        raise ValueError(f"{name}: unsupported dtype {arr.dtype}; use uint8, an integer type or float in [0, 1]")
+    if np.issubdtype(arr.dtype, np.floating):
+        if not np.isfinite(arr).all():
+            raise ValueError(f"{name}: contains NaN or infinity")
+        peak = float(arr.max())
+        scale = 255.0 if peak <= 1.0 else 1.0
+        return np.clip(np.rint(arr * scale), 0, 255).astype(np.uint8)
+    return np.clip(arr, 0, 255).astype(np.uint8)
+
+
+def to_grey(image_bgr: np.ndarray) -> np.ndarray:
+    """``(h, w)`` float32 luminance in 0..255 of a ``(h, w, 3)`` uint8 BGR image."""
+    img = image_bgr.astype(np.float32)
+    return 0.114 * img[..., 0] + 0.587 * img[..., 1] + 0.299 * img[..., 2]
+
+
+def hue_channel(image_bgr: np.ndarray) -> np.ndarray:
+    """``(h, w)`` float32 hue of a BGR uint8 image, scaled to 0..255 (OpenCV's full-range HSV)."""
+    import cv2
+
+    return cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV_FULL)[..., 0].astype(np.float32)
+
+
+def orientation_maps(grey: np.ndarray, bins: int = BINS) -> np.ndarray:
+    """``(bins, h, w)`` float32 gradient magnitude soft-assigned to unsigned orientation bins.
+
+    Gradients are central differences (zero at the border) of ``grey (h, w)``.
+    """
+    g = np.asarray(grey, dtype=np.float32)
+    if g.ndim != 2:
+        raise ValueError(f"grey: expected shape (h, w), got {g.shape}")
+    gx = np.zeros_like(g)
+    gy = np.zeros_like(g)
+    gx[:, 1:-1] = g[:, 2:] - g[:, :-2]
+    gy[1:-1, :] = g[2:, :] - g[:-2, :]
+    mag = np.sqrt(gx * gx + gy * gy)
+    ang = np.mod(np.arctan2(gy, gx), np.pi) * (bins / np.pi) - 0.5  # bin centres at integers
+    lo = np.floor(ang)
+    frac = (ang - lo).astype(np.float32)
+    lo = lo.astype(np.int64) % bins
+    hi = (lo + 1) % bins
+    out = np.zeros((bins,) + g.shape, dtype=np.float32)
+    rows, cols = np.indices(g.shape)
+    np.add.at(out, (lo, rows, cols), mag * (1.0 - frac))
+    np.add.at(out, (hi, rows, cols), mag * frac)
+    return out
+
+
+def integral_maps(maps: np.ndarray) -> np.ndarray:
+    """Summed-area tables ``(c, h+1, w+1)`` float64 of ``maps (c, h, w)``; entry ``[c, y, x]`` is the sum over
+    rows ``< y`` and columns ``< x``."""
+    m = np.asarray(maps, dtype=np.float64)
+    out = np.zeros((m.shape[0], m.shape[1] + 1, m.shape[2] + 1))
+    np.cumsum(np.cumsum(m, axis=1), axis=2, out=out[:, 1:, 1:])
+    return out
+
+
+def rect_sums(integral: np.ndarray, x0: np.ndarray, y0: np.ndarray, x1: np.ndarray, y1: np.ndarray) -> np.ndarray:
+    """Sums of every channel over rectangles ``[y0, y1) × [x0, x1)`` (pixel indices, broadcastable
+    integer arrays) from ``integral (c, h+1, w+1)``; result shape ``(c,) + broadcast shape``."""
+    return integral[:, y1, x1] - integral[:, y0, x1] - integral[:, y1, x0] + integral[:, y0, x0]
+
+
+def block_descriptor(cell_sums: np.ndarray, eps: float = 1e-3) -> np.ndarray:
+    """L2-normalised HOG block descriptors from the orientation sums of its 2×2 cells.
+
+    ``cell_sums`` has shape ``(4, bins, ...)``; the result ``(4 * bins, ...)``. ``eps`` (in
+    gradient units per pixel-area of the cells) keeps flat regions near zero.
+    """
+    flat = cell_sums.reshape((-1,) + cell_sums.shape[2:])
+    norm = np.sqrt((flat * flat).sum(axis=0, keepdims=True)) + eps
+    return flat / norm
+
+
+def dense_hog(channel: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndarray:
+    """Dense HOG of a ``(h, w)`` channel: cells of ``cell_px`` pixels, overlapping 2×2-cell blocks,
+    each L2-normalised; returns a flat float32 vector of ``(h//cell - 1) * (w//cell - 1) * 4 * bins``."""
+    c = np.asarray(channel, dtype=np.float32)
+    ny, nx = c.shape[0] // cell_px, c.shape[1] // cell_px
+    if ny < 2 or nx < 2:
+        raise ValueError(f"channel: {c.shape} is smaller than 2×2 cells of {cell_px} px")
+    maps = orientation_maps(c[: ny * cell_px, : nx * cell_px], bins)
+    cells = maps.reshape(bins, ny, cell_px, nx, cell_px).sum(axis=(2, 4))  # (bins, ny, nx)
+    quads = np.stack([cells[:, :-1, :-1], cells[:, :-1, 1:], cells[:, 1:, :-1], cells[:, 1:, 1:]])
+    area = float(cell_px * cell_px)
+    return block_descriptor(quads, eps=area).astype(np.float32).ravel()
