@@ -1,0 +1,65 @@
+"""Speed of appearance features + diver SORT on 640x480 rendered video with 4 divers, one core.
+
+Run: ``.venv/bin/python benchmarks/diver_speed.py [--frames 300]``. Frames are rendered and
+detected first (not timed); the timed loop is feature extraction from the image plus the tracker
+update, as on the robot after the detector. Target (DESIGN §11): >= 100 frames/s.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import argparse  # noqa: E402
+import dataclasses  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--frames", type=int, default=300)
+    parser.add_argument("--scenario", default="pool_four_crossing")
+    args = parser.parse_args()
+
+    import cv2
+
+    cv2.setNumThreads(1)
+    from lookalike.sim.divers import DetectorModel, scenario, simulate_divers
+    from lookalike.sim.divers_run import fit_diver_features
+    from lookalike.trackers import make_tracker
+    from lookalike.types import Frame
+
+    # Every diver stays in view and every one is detected: 4 crops per frame.
+    sc = dataclasses.replace(scenario(args.scenario), frames=args.frames, leave_rate=0.0,
+                             detector=DetectorModel(recall=1.0, false_positives=0.0, min_visibility=0.0))
+    assert sc.n_divers == 4 and sc.image_size == (640, 480)
+    scene = simulate_divers(sc)
+    frames = scene.frames()
+    images = [scene.image(k) for k in range(len(frames))]
+    extractor = fit_diver_features()
+    tracker = make_tracker("diversort")
+    n_crops = 0
+    feat_s = track_s = 0.0
+    for frame, image in zip(frames, images):
+        t0 = time.perf_counter()
+        det = frame.detections
+        det = det.replace(feature=extractor(image, det.xywh) if len(det) else np.zeros((0, extractor.dim)))
+        t1 = time.perf_counter()
+        tracker.update(Frame(index=frame.index, time=frame.time, detections=det))
+        t2 = time.perf_counter()
+        feat_s += t1 - t0
+        track_s += t2 - t1
+        n_crops += len(det)
+    n = len(frames)
+    print(f"scenario {sc.name}: {n} frames 640x480, {n_crops / n:.2f} detections/frame")
+    print(f"features:        {1e3 * feat_s / max(n_crops, 1):.3f} ms per crop, {1e3 * feat_s / n:.2f} ms per frame")
+    print(f"diver SORT:      {1e3 * track_s / n:.2f} ms per frame")
+    print(f"features + SORT: {n / (feat_s + track_s):.0f} frames/s (target >= 100)")
+
+
+if __name__ == "__main__":
+    main()
