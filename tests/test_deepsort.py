@@ -5,7 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.association.appearance import FeatureGallery, cosine_distance, matching_cascade
+from lookalike.association.appearance import (
+    FeatureGallery,
+    cosine_distance,
+    matching_cascade,
+)
 from lookalike.trackers import make_tracker
 from lookalike.trackers.deepsort import DeepSort, xyah_to_xywh, xywh_to_xyah
 from lookalike.types import Detections, Frame

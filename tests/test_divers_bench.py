@@ -8,10 +8,10 @@ import pytest
 
 pytest.importorskip("lookalike.cli.bench", reason="the bench sub-app (lookalike.cli.bench) is not there yet")
 
-from typer.testing import CliRunner  # noqa: E402
+from typer.testing import CliRunner
 
-from lookalike.cli import app  # noqa: E402
-from lookalike.cli.bench_divers import COLUMNS, bar_chart, diver_table  # noqa: E402
+from lookalike.cli import app
+from lookalike.cli.bench_divers import COLUMNS, bar_chart, diver_table
 
 
 def test_table_rows_and_all_row(tmp_path) -> None:

@@ -16,9 +16,9 @@ def test_diversort_beats_deepsort_beats_sort_on_identical_detections() -> None:
     for sc in SCENARIOS[::2]:  # four scenarios, shortened
         prepared = prepare(dataclasses.replace(sc, frames=150), extractor)
         gt = MotTable.from_rows(prepared.gt)
-        for name in scores:
+        for name, per_scenario in scores.items():
             rows, _ = run_tracker(name, prepared.frames)
-            scores[name].append(evaluate_sequence(gt, MotTable.from_rows(rows), metrics=["Identity"], num_frames=150))
+            per_scenario.append(evaluate_sequence(gt, MotTable.from_rows(rows), metrics=["Identity"], num_frames=150))
     idf1 = {name: combine(s)["IDF1"] for name, s in scores.items()}
     assert idf1["diversort"] > idf1["deepsort"] + 0.1
     assert idf1["deepsort"] > idf1["sort"]

@@ -6,7 +6,7 @@ Features are L2-normalised rows, so the cosine distance ``1 - f·g`` lies in ``[
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 

@@ -13,7 +13,7 @@ import csv
 import dataclasses
 import json
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 import typer
@@ -95,11 +95,11 @@ def bar_chart(rows: list[dict[str, Any]], path: Path) -> Path:
 
 @bench_app.command("divers")
 def divers(
-    scenario_names: Optional[list[str]] = typer.Option(None, "--scenario", help="Scenario name (repeatable)."),
-    frames: Optional[int] = typer.Option(None, min=10, help="Shorten every scenario to this many frames."),
-    png: Optional[Path] = typer.Option(None, "--png", help="Write the IDF1 bar chart here."),
-    json_path: Optional[Path] = typer.Option(None, "--json", help="Write the table as JSON rows."),
-    csv_path: Optional[Path] = typer.Option(None, "--csv", help="Write the table as CSV."),
+    scenario_names: list[str] | None = typer.Option(None, "--scenario", help="Scenario name (repeatable)."),
+    frames: int | None = typer.Option(None, min=10, help="Shorten every scenario to this many frames."),
+    png: Path | None = typer.Option(None, "--png", help="Write the IDF1 bar chart here."),
+    json_path: Path | None = typer.Option(None, "--json", help="Write the table as JSON rows."),
+    csv_path: Path | None = typer.Option(None, "--csv", help="Write the table as CSV."),
 ) -> None:
     """SORT vs deep SORT style vs diver SORT on the rendered diver scenarios (paper Table 2)."""
     try:

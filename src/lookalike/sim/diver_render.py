@@ -117,10 +117,10 @@ def draw_diver(image: np.ndarray, pose: Pose, look: DiverLook, focal_px: float, 
            for k in ("suit", "accent", "tank", "fins", "hood")}
 
     def P(name: str) -> tuple[int, int]:
-        return int(round(pts[name][0])), int(round(pts[name][1]))
+        return round(pts[name][0]), round(pts[name][1])
 
     def thick(m: float) -> int:
-        return max(int(round(m * s)), 1)
+        return max(round(m * s), 1)
 
     box = diver_box(pose, look.size, focal_px)
     h, w = image.shape[:2]

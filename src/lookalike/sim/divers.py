@@ -20,7 +20,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lookalike.geometry.boxes import iou_matrix
-from lookalike.sim.diver_render import TEAM, Pose, background, diver_box, draw_bubbles, draw_diver
+from lookalike.sim.diver_render import (
+    TEAM,
+    Pose,
+    background,
+    diver_box,
+    draw_bubbles,
+    draw_diver,
+)
 from lookalike.types import Detections, Frame
 
 
@@ -376,11 +383,11 @@ def detection_quality(frames: list[Frame], gt: np.ndarray, min_iou: float = 0.5)
 
 
 __all__ = [
+    "SCENARIOS",
+    "VALIDATION_SCENARIOS",
     "DetectorModel",
     "DiverScenario",
     "DiverScene",
-    "SCENARIOS",
-    "VALIDATION_SCENARIOS",
     "detection_quality",
     "scenario",
     "simulate_divers",

@@ -11,10 +11,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.sim.divers import VALIDATION_SCENARIOS, DiverScenario, DiverScene, simulate_divers
+from lookalike.sim.divers import (
+    VALIDATION_SCENARIOS,
+    DiverScenario,
+    DiverScene,
+    simulate_divers,
+)
 from lookalike.trackers import make_tracker
 from lookalike.types import Frame, TrackSnapshot
-from lookalike.vision.appearance import FeatureExtractor, HandcraftedFeatures, crop_boxes, fit_stats, raw_features
+from lookalike.vision.appearance import (
+    FeatureExtractor,
+    HandcraftedFeatures,
+    crop_boxes,
+    fit_stats,
+    raw_features,
+)
 
 
 @dataclass(frozen=True, eq=False)

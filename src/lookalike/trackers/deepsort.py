@@ -89,7 +89,7 @@ class DeepSort:
             if not 0 < self.gate_probability < 1:
                 raise ValueError(f"Config.gate_probability must be in (0, 1), got {self.gate_probability}")
 
-    def __init__(self, config: "DeepSort.Config | None" = None) -> None:
+    def __init__(self, config: DeepSort.Config | None = None) -> None:
         self.config = config or DeepSort.Config()
         self._gate = chi2_gate(4, self.config.gate_probability)
         self.reset()

@@ -97,7 +97,7 @@ class DiverSort:
             if self.iou_shortcut > 1 or self.recovery_fraction >= 1:
                 raise ValueError("Config.iou_shortcut must be <= 1 and recovery_fraction < 1")
 
-    def __init__(self, config: "DiverSort.Config | None" = None) -> None:
+    def __init__(self, config: DiverSort.Config | None = None) -> None:
         self.config = config or DiverSort.Config()
         self.reset()
 
