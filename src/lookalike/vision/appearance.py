@@ -335,7 +335,7 @@ def _shape_stats(mask: np.ndarray, s: int) -> tuple[np.ndarray, np.ndarray]:
 
 def _hu(weight: np.ndarray) -> np.ndarray:
     """Log-scaled Hu moment invariants ``(n, 7)`` of the masks ``weight (n, s, s)``, vectorised."""
-    n, s, _ = weight.shape
+    s = weight.shape[1]
     coord = np.arange(s, dtype=float)
     m00 = weight.sum(axis=(1, 2))
     col_sum = weight.sum(axis=1)  # (n, s) over rows, indexed by x
