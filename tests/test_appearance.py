@@ -133,3 +133,16 @@ def test_features_and_diversort_on_real_mot17_frames() -> None:
             assert all(0 <= t.detection_index < len(det) for t in tracks)
             reported += len(tracks)
         assert reported > 0
+
+
+def test_scale_and_jitter_move_features_less_than_another_diver() -> None:
+    import cv2
+
+    ext = fitted()
+    img = scene(*DIVER_1, seed=3)
+    base = ext(img, BOX)[0]
+    small = cv2.resize(img, (140, 140), interpolation=cv2.INTER_AREA)
+    scaled = ext(small, BOX * 0.7)[0]
+    shifted = ext(img, BOX + [4, -3, 6, 5])[0]
+    other = ext(scene(*DIVER_2, seed=3), BOX)[0]
+    assert max(1 - base @ scaled, 1 - base @ shifted) < 0.5 * (1 - base @ other)
