@@ -1,0 +1,188 @@
+"""The robot world of seed A (DESIGN §8): identical robots seen by an observer, heading reports.
+
+:func:`simulate_arrays` makes a whole sequence with array operations over time (tens of
+thousands of frames per second) and returns :class:`RobotArrays`: detections padded to the
+set-up's M slots per frame, the reports received, and the truth. :class:`RobotSequence` wraps the
+arrays and builds :class:`~lookalike.types.Frame` objects lazily for trackers.
+
+Detections are in the observer frame (x forward, y left, metres) with absolute visual headings
+(radians); their ``label`` is the truth (agent id or -1 for a false positive) and must not be
+read by trackers. Within a frame the detections are in random order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterator
+
+import numpy as np
+
+from lookalike.geometry.angles import wrap_angle
+from lookalike.sim.network import ReportArrays, simulate_reports
+from lookalike.sim.robots_config import RobotWorldConfig
+from lookalike.sim.robots_motion import observer_pose, simulate_motion, to_observer_frame
+from lookalike.sim.robots_sensors import (
+    detection_probability,
+    in_view,
+    occlusion_fraction,
+    position_noise_std,
+    visual_heading,
+)
+from lookalike.types import Beacons, Detections, Frame
+
+
+@dataclass(frozen=True, eq=False)
+class RobotArrays:
+    """One simulated sequence as arrays (T frames, N robots, M detection slots).
+
+    Attributes:
+        time: ``(T,)`` frame times, seconds.
+        det_valid: ``(T, M)`` whether a slot holds a detection (valid slots come first).
+        det_position: ``(T, M, 2)`` observer-frame positions, metres (0 in empty slots).
+        det_heading: ``(T, M)`` absolute visual headings, radians.
+        det_score: ``(T, M)`` detector scores in (0, 1).
+        det_label: ``(T, M)`` truth: agent id, -1 for a false positive or an empty slot.
+        true_position: ``(T, N, 2)`` robots' observer-frame positions, metres.
+        true_heading: ``(T, N)`` robots' absolute headings, radians.
+        visible: ``(T, N)`` robot inside the field of view and range (whether detected or not).
+        occlusion: ``(T, N)`` hidden fraction of each robot's width.
+        field_position: ``(T, N, 2)`` robots' field positions, metres.
+        observer: ``(T, 3)`` observer field pose ``(x, y, yaw)``.
+        reports: the heading reports received (see :class:`ReportArrays`).
+        n_false_positives: ``(T,)`` false positives made before keeping the M best.
+        n_misses: ``(T,)`` visible robots not detected (before keeping the M best).
+    """
+
+    time: np.ndarray
+    det_valid: np.ndarray
+    det_position: np.ndarray
+    det_heading: np.ndarray
+    det_score: np.ndarray
+    det_label: np.ndarray
+    true_position: np.ndarray
+    true_heading: np.ndarray
+    visible: np.ndarray
+    occlusion: np.ndarray
+    field_position: np.ndarray
+    observer: np.ndarray
+    reports: ReportArrays
+    n_false_positives: np.ndarray
+    n_misses: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.time.shape[0])
+
+
+def simulate_arrays(config: RobotWorldConfig, n_frames: int, seed: int) -> RobotArrays:
+    """Simulate ``n_frames`` frames of scenario ``config`` with random seed ``seed``."""
+    if int(n_frames) != n_frames or n_frames < 1:
+        raise ValueError(f"n_frames must be a positive integer, got {n_frames!r}")
+    rng = np.random.default_rng(seed)
+    T, N, M = int(n_frames), config.n_agents, config.max_detections
+    dt = config.dt_s
+    sensor, obs_cfg = config.sensor, config.observer
+    field_pos, heading_unwrapped = simulate_motion(config.motion, config.field_m, T, N, dt, rng)
+    pose = observer_pose(obs_cfg, T, dt, rng)
+    rel = to_observer_frame(field_pos, pose)
+    dist = np.hypot(rel[..., 0], rel[..., 1])
+    bearing = np.arctan2(rel[..., 1], rel[..., 0])
+    visible = in_view(rel, obs_cfg)
+    occlusion = occlusion_fraction(rel, config.motion.robot_radius_m)
+    p_det = np.where(visible, detection_probability(dist, occlusion, sensor, obs_cfg), 0.0)
+    detected = rng.random((T, N)) < p_det
+
+    # True positives: noisy positions, classifier-like headings, scores lowered by occlusion.
+    std = position_noise_std(dist, sensor)
+    tp_pos = rel + rng.normal(size=rel.shape) * std
+    tp_head = visual_heading(heading_unwrapped, bearing + pose[:, 2:3], sensor, rng)
+    tp_score = rng.beta(*sensor.tp_score_beta, (T, N)) * (1.0 - 0.5 * occlusion)
+
+    # False positives: Poisson per frame, uniform over the visible sector (area-uniform in range).
+    n_fp = rng.poisson(sensor.fp_per_frame, T)
+    cap = int(n_fp.max()) if T else 0
+    fp_valid = np.arange(cap)[None, :] < n_fp[:, None]
+    r0, r1 = obs_cfg.min_range_m, obs_cfg.max_range_m
+    fp_r = np.sqrt(rng.uniform(r0 * r0, r1 * r1, (T, cap)))
+    fp_b = rng.uniform(-obs_cfg.fov_rad / 2, obs_cfg.fov_rad / 2, (T, cap))
+    fp_pos = np.stack([fp_r * np.cos(fp_b), fp_r * np.sin(fp_b)], -1)
+    fp_head = rng.uniform(-np.pi, np.pi, (T, cap))
+    fp_score = rng.beta(*sensor.fp_score_beta, (T, cap))
+
+    # All candidates of a frame; keep the M best scores, then shuffle slots.
+    pos = np.concatenate([tp_pos, fp_pos], axis=1)
+    head = np.concatenate([tp_head, fp_head], axis=1)
+    score = np.clip(np.concatenate([tp_score, fp_score], axis=1), 1e-3, 1 - 1e-3)
+    label = np.concatenate([np.broadcast_to(np.arange(N), (T, N)), np.full((T, cap), -1)], axis=1)
+    valid = np.concatenate([detected, fp_valid], axis=1)
+    rank_key = np.where(valid, score, -1.0)
+    best = np.argsort(-rank_key, axis=1, kind="stable")[:, :M]
+    rows = np.arange(T)[:, None]
+    kept = valid[rows, best]
+    shuffle_key = np.where(kept, rng.random(kept.shape), 2.0)
+    order = best[rows, np.argsort(shuffle_key, axis=1)]
+    pad = M - order.shape[1]
+    if pad > 0:  # fewer candidates than slots in every frame
+        order = np.concatenate([order, np.zeros((T, pad), dtype=int)], axis=1)
+    slot_valid = np.concatenate([np.sort(kept, axis=1)[:, ::-1], np.zeros((T, pad), dtype=bool)], axis=1)
+    det_position = np.where(slot_valid[..., None], pos[rows, order], 0.0)
+    det_heading = np.where(slot_valid, head[rows, order], 0.0)
+    det_score = np.where(slot_valid, score[rows, order], 0.0)
+    det_label = np.where(slot_valid, label[rows, order], -1)
+
+    reports = simulate_reports(heading_unwrapped, dt, config.network, rng)
+    return RobotArrays(
+        time=np.arange(T) * dt, det_valid=slot_valid, det_position=det_position, det_heading=det_heading,
+        det_score=det_score, det_label=det_label.astype(int), true_position=rel,
+        true_heading=np.asarray(wrap_angle(heading_unwrapped)), visible=visible, occlusion=occlusion,
+        field_position=field_pos, observer=pose, reports=reports, n_false_positives=n_fp,
+        n_misses=(visible & ~detected).sum(axis=1),
+    )
+
+
+class RobotSequence:
+    """A simulated sequence: its scenario, seed and arrays, with frames built on demand."""
+
+    def __init__(self, config: RobotWorldConfig, seed: int, arrays: RobotArrays) -> None:
+        self.config = config
+        self.seed = seed
+        self.arrays = arrays
+
+    def __len__(self) -> int:
+        return len(self.arrays)
+
+    def frame(self, k: int) -> Frame:
+        """Frame ``k`` (0-based) with its detections (truth in ``label``) and received reports."""
+        a = self.arrays
+        if not 0 <= k < len(a):
+            raise ValueError(f"frame index {k} out of range for a sequence of {len(a)} frames")
+        n = int(a.det_valid[k].sum())
+        std = self.config.sensor.heading_std_rad
+        det = Detections(
+            position=a.det_position[k, :n], heading=a.det_heading[k, :n], heading_std=np.full(n, std),
+            score=a.det_score[k, :n], label=a.det_label[k, :n],
+        )
+        r = a.reports
+        lo, hi = r.frame_offsets[k], r.frame_offsets[k + 1]
+        beacons = Beacons(agent_id=r.agent_id[lo:hi], t_sent=r.t_sent[lo:hi], t_received=r.t_received[lo:hi],
+                          heading=r.heading[lo:hi])
+        return Frame(index=k, time=float(a.time[k]), detections=det, beacons=beacons)
+
+    def frames(self) -> Iterator[Frame]:
+        """All frames in order."""
+        for k in range(len(self)):
+            yield self.frame(k)
+
+    def true_labels(self) -> list[np.ndarray]:
+        """Per-frame truth labels of the detections (agent id or -1)."""
+        a = self.arrays
+        return [a.det_label[k, : int(a.det_valid[k].sum())] for k in range(len(a))]
+
+    def true_positions_visible(self) -> np.ndarray:
+        """``(T, N, 2)`` true observer-frame positions, NaN where a robot is out of view."""
+        a = self.arrays
+        return np.where(a.visible[..., None], a.true_position, np.nan)
+
+
+def simulate_robots(config: RobotWorldConfig, n_frames: int, seed: int) -> RobotSequence:
+    """Simulate a sequence and wrap it as a :class:`RobotSequence`."""
+    return RobotSequence(config, seed, simulate_arrays(config, n_frames, seed))
