@@ -12,15 +12,19 @@ read by trackers. Within a frame the detections are in random order.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Iterator
 
 import numpy as np
 
 from lookalike.geometry.angles import wrap_angle
 from lookalike.sim.network import ReportArrays, simulate_reports
 from lookalike.sim.robots_config import RobotWorldConfig
-from lookalike.sim.robots_motion import observer_pose, simulate_motion, to_observer_frame
+from lookalike.sim.robots_motion import (
+    observer_pose,
+    simulate_motion,
+    to_observer_frame,
+)
 from lookalike.sim.robots_sensors import (
     detection_probability,
     in_view,

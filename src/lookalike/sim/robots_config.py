@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any
 
 
 def _require(owner: str, name: str, value: float, low: float, high: float = math.inf,
@@ -201,7 +202,7 @@ class RobotWorldConfig:
         return dataclasses.asdict(self)
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "RobotWorldConfig":
+    def from_dict(cls, data: Mapping[str, Any]) -> RobotWorldConfig:
         """Inverse of :meth:`to_dict`; unknown keys raise ``ValueError``."""
         parts = {"observer": ObserverConfig, "motion": MotionConfig, "sensor": SensorConfig,
                  "network": NetworkConfig}
