@@ -5,6 +5,8 @@ from lookalike.types import Beacons, Detections, Frame
 
 torch = pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
 
+from lookalike.learn.data import frames_to_arrays  # noqa: E402
+from lookalike.learn.encoding import EncodingSpec  # noqa: E402
 from lookalike.learn.training import TrainConfig, plot_log, train  # noqa: E402
 
 
@@ -23,6 +25,10 @@ def toy_frames(seed: int, n_frames: int):
     return frames
 
 
+def toy_sampler(seed, n_frames, rng):
+    return frames_to_arrays(EncodingSpec(2, 3), toy_frames(seed, n_frames), rng)
+
+
 def _config(**kw):
     base = dict(n_agents=2, n_slots=3, hidden=16, num_layers=1, bptt=15, sequence_length=30, batch_size=4,
                 steps=30, validation_every=10, validation_sequences=4, learning_rate=0.01, patience=100)
@@ -32,7 +38,7 @@ def _config(**kw):
 
 def test_tiny_training_learns_and_writes_outputs(tmp_path):
     torch.set_num_threads(1)
-    result = train(_config(), toy_frames, tmp_path)
+    result = train(_config(), toy_sampler, tmp_path)
     losses = [h["loss"] for h in result.history]
     assert losses[-1] < losses[0]
     assert result.best_success > 0.6  # chance is about 1/3
@@ -42,15 +48,15 @@ def test_tiny_training_learns_and_writes_outputs(tmp_path):
 
 def test_training_is_deterministic_for_a_seed(tmp_path):
     torch.set_num_threads(1)
-    a = train(_config(steps=10, validation_every=5), toy_frames, tmp_path / "a")
-    b = train(_config(steps=10, validation_every=5), toy_frames, tmp_path / "b")
+    a = train(_config(steps=10, validation_every=5), toy_sampler, tmp_path / "a")
+    b = train(_config(steps=10, validation_every=5), toy_sampler, tmp_path / "b")
     assert [h["loss"] for h in a.history] == [h["loss"] for h in b.history]
 
 
 def test_resume_continues_where_it_stopped(tmp_path):
     torch.set_num_threads(1)
-    train(_config(steps=10, validation_every=5), toy_frames, tmp_path)
-    resumed = train(_config(steps=10, validation_every=5), toy_frames, tmp_path, resume=True)
+    train(_config(steps=10, validation_every=5), toy_sampler, tmp_path)
+    resumed = train(_config(steps=10, validation_every=5), toy_sampler, tmp_path, resume=True)
     assert resumed.steps == 10 and len(resumed.history) == 2  # nothing left to do
     with pytest.raises(ValueError, match="another configuration"):
-        train(_config(steps=20, validation_every=5), toy_frames, tmp_path, resume=True)
+        train(_config(steps=20, validation_every=5), toy_sampler, tmp_path, resume=True)

@@ -8,6 +8,7 @@ from lookalike.cli.app import app
 from lookalike.cli import track as _track  # noqa: E402,F401
 from lookalike.cli import demo as _demo  # noqa: E402,F401
 from lookalike.cli import eval as _eval  # noqa: E402,F401
+from lookalike.cli import train as _train  # noqa: E402,F401
 
 
 def main() -> None:

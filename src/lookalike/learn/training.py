@@ -20,10 +20,9 @@ import torch
 from torch import nn
 
 from lookalike.learn.checkpoint import save_weights
-from lookalike.learn.data import IGNORE, frames_to_arrays, success_rate
+from lookalike.learn.data import IGNORE, success_rate
 from lookalike.learn.encoding import EncodingSpec
 from lookalike.learn.model import AssociationNet
-from lookalike.types import Frame
 
 TRAIN_SEED_BASE = 2_000_000_000  # training sequences use seeds from here on
 VALIDATION_SEED_BASE = 1_900_000_000  # fixed held-out validation seeds
@@ -65,11 +64,12 @@ class TrainResult:
     history: list[dict] = field(default_factory=list)
 
 
-FrameMaker = Callable[[int, int], Sequence[Frame]]  # (seed, n_frames) -> frames
+# (seed, n_frames, rng for slot shuffling) -> inputs (T, n_inputs), targets (T, M)
+Sampler = Callable[[int, int, "np.random.Generator | None"], tuple[np.ndarray, np.ndarray]]
 
 
-def _batch(spec: EncodingSpec, make: FrameMaker, seeds: Sequence[int], length: int, rng: np.random.Generator):
-    xs, ys = zip(*(frames_to_arrays(spec, make(int(s), length), rng) for s in seeds))
+def _batch(sample: Sampler, seeds: Sequence[int], length: int, rng: np.random.Generator):
+    xs, ys = zip(*(sample(int(s), length, rng) for s in seeds))
     return np.stack(xs), np.stack(ys)
 
 
@@ -84,12 +84,12 @@ def _validate(model: AssociationNet, x: np.ndarray, y: np.ndarray) -> float:
 
 def train(
     config: TrainConfig,
-    make_frames: FrameMaker,
+    sample: Sampler,
     out_dir: str | Path,
     resume: bool = False,
     on_step: Callable[[dict], None] | None = None,
 ) -> TrainResult:
-    """Train on sequences from ``make_frames(seed, n_frames)``; write weights, checkpoint and log to ``out_dir``."""
+    """Train on sequences from ``sample(seed, n_frames, rng)``; write weights, checkpoint and log to ``out_dir``."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(config.seed)
@@ -98,7 +98,7 @@ def train(
     if config.sequence_length % config.bptt:
         raise ValueError(f"sequence_length {config.sequence_length} must be a multiple of bptt {config.bptt}")
     val_x, val_y = _batch(
-        spec, make_frames, [VALIDATION_SEED_BASE + i for i in range(config.validation_sequences)],
+        sample, [VALIDATION_SEED_BASE + i for i in range(config.validation_sequences)],
         config.sequence_length, np.random.default_rng(12345),
     )
     model = AssociationNet(spec, config.hidden, config.num_layers, config.cell)
@@ -125,7 +125,7 @@ def train(
         if config.minutes is not None and time.monotonic() - started > 60 * config.minutes:
             break
         seeds = TRAIN_SEED_BASE + config.seed * 10_000_000 + step * config.batch_size + np.arange(config.batch_size)
-        x, y = _batch(spec, make_frames, seeds, config.sequence_length, rng)
+        x, y = _batch(sample, seeds, config.sequence_length, rng)
         xt, yt = torch.as_tensor(x), torch.as_tensor(y)
         state_h, losses = None, []
         for lo in range(0, config.sequence_length, config.bptt):
