@@ -1,0 +1,80 @@
+"""The node's counters, publish latencies and structured (JSON Lines) log events."""
+
+from __future__ import annotations
+
+import json
+import logging
+from collections import Counter, deque
+from typing import Any
+
+import numpy as np
+
+# What the node counts, besides the rejection reasons of lookalike.node.messages.
+EVENTS = (
+    "received",  # datagrams read from the socket
+    "reports",  # heading reports accepted
+    "frames",  # detection frames accepted and tracked
+    "published",  # team-state datagrams sent
+    "status_requests",  # status requests answered
+    "late",  # reports older than the newest one of that robot, or too old for the current frame
+    "duplicate",  # a report or frame seen already (same sequence number / frame index)
+    "unknown_robot",  # reports from a robot id outside the team
+    "time_backwards",  # a report whose send time goes back for an increasing sequence number
+    "frame_backwards",  # a detection frame older than the last one (dropped)
+    "camera_lost",  # the camera went silent for longer than the timeout
+    "camera_restarts",  # the camera came back with an earlier time: the tracker was reset
+    "rate_limited",  # datagrams dropped because their sender exceeded its packet rate
+    "send_errors",  # team-state datagrams the OS refused to send
+    "tracker_errors",  # frames the tracker raised on (dropped; the node goes on)
+)
+
+
+class NodeCounters:
+    """Counts of every event, rejections by reason, and the latest publish latencies.
+
+    Latency: seconds from reading a detections datagram to having sent its team state, kept for
+    the last ``window`` frames.
+    """
+
+    def __init__(self, window: int = 1000) -> None:
+        self.events: Counter[str] = Counter({name: 0 for name in EVENTS})
+        self.rejected: Counter[str] = Counter()
+        self.latency_s: deque[float] = deque(maxlen=window)
+
+    def add(self, event: str, count: int = 1) -> None:
+        """Count ``event`` (one of ``EVENTS``)."""
+        if event not in self.events:
+            raise ValueError(f"event: unknown counter {event!r}; known: {list(EVENTS)}")
+        self.events[event] += count
+
+    def reject(self, reason: str) -> None:
+        """Count a datagram rejected for ``reason``."""
+        self.rejected[reason] += 1
+
+    def snapshot(self) -> dict[str, Any]:
+        """All counters as a JSON-ready dict (latency figures in milliseconds)."""
+        out: dict[str, Any] = dict(self.events)
+        out["rejected"] = dict(sorted(self.rejected.items()))
+        out["rejected_total"] = sum(self.rejected.values())
+        if self.latency_s:
+            lat = np.asarray(self.latency_s) * 1e3
+            out["latency_ms"] = {"median": round(float(np.median(lat)), 4),
+                                 "p99": round(float(np.percentile(lat, 99)), 4), "frames": len(lat)}
+        return out
+
+    def status_line(self) -> str:
+        """One human-readable line: the main counts and the latency."""
+        e = self.events
+        line = (f"received {e['received']} reports {e['reports']} frames {e['frames']} published {e['published']} "
+                f"rejected {sum(self.rejected.values())} late {e['late']} duplicate {e['duplicate']} "
+                f"rate-limited {e['rate_limited']}")
+        if self.latency_s:
+            lat = np.asarray(self.latency_s) * 1e3
+            line += f" latency median {np.median(lat):.2f} ms p99 {np.percentile(lat, 99):.2f} ms"
+        return line
+
+
+def log_event(logger: logging.Logger, event: str, level: int = logging.INFO, **fields: Any) -> None:
+    """Log one structured event as a JSON object ``{"event": ..., **fields}``."""
+    if logger.isEnabledFor(level):
+        logger.log(level, json.dumps({"event": event, **fields}, separators=(",", ":"), default=str))

@@ -1,0 +1,308 @@
+"""The node's wire format: versioned, validated messages encoded as compact UTF-8 JSON.
+
+Every message is one UDP datagram holding a JSON object with ``"v"`` (the schema version) and
+``"type"``. Inbound: ``report`` (a robot's heading report), ``detections`` (a camera frame) and
+``status_request``. Outbound: ``team`` (identified positions of every robot, per camera frame)
+and ``status`` (the node's counters). Times are simulated seconds, positions metres in the
+observer frame, headings radians. ``decode`` never raises anything but ``MessageError``, whose
+``reason`` is a short stable code that the node counts.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+SCHEMA_VERSION = 1
+MAX_DATAGRAM_BYTES = 65_000
+MAX_DETECTIONS = 256
+
+# Rejection reasons (stable codes, counted by the node).
+MALFORMED = "malformed"  # not UTF-8 JSON, or not a JSON object
+TOO_LARGE = "too_large"
+VERSION = "wrong_version"
+UNKNOWN_TYPE = "unknown_type"
+INVALID = "invalid"  # a field is missing, unknown, of the wrong type or out of range
+UNEXPECTED = "unexpected_type"  # a valid message of a type the receiver does not take
+
+
+class MessageError(ValueError):
+    """A datagram that is not a valid message; ``reason`` is one of the codes above."""
+
+    def __init__(self, reason: str, detail: str) -> None:
+        super().__init__(f"{reason}: {detail}")
+        self.reason = reason
+        self.detail = detail
+
+
+@dataclass(frozen=True)
+class HeadingReport:
+    """A robot's report of its own heading (robot -> node).
+
+    Attributes:
+        robot: robot id, 0-based.
+        seq: the robot's message counter, increasing by one per report sent.
+        t_sent: simulated time the robot sent the report, seconds.
+        heading: the robot's absolute heading, radians.
+    """
+
+    robot: int
+    seq: int
+    t_sent: float
+    heading: float
+
+
+@dataclass(frozen=True)
+class DetectionsMessage:
+    """One camera frame of world-frame detections (camera -> node).
+
+    Attributes:
+        frame: frame index, 0-based.
+        time: simulated time of the frame, seconds.
+        position: ``n`` pairs ``[x, y]`` in metres.
+        heading: ``n`` visual headings in radians.
+        score: ``n`` detector confidences.
+    """
+
+    frame: int
+    time: float
+    position: tuple[tuple[float, float], ...]
+    heading: tuple[float, ...]
+    score: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class RobotEstimate:
+    """The node's estimate of one robot.
+
+    Attributes:
+        id: robot id, 0-based.
+        position: ``[x, y]`` metres.
+        heading: radians, or None when unknown.
+        confidence: identification confidence in [0, 1], or None.
+        age: seconds since a detection last updated the estimate.
+    """
+
+    id: int
+    position: tuple[float, float]
+    heading: float | None
+    confidence: float | None
+    age: float
+
+
+@dataclass(frozen=True)
+class TeamState:
+    """Identified positions after one camera frame (node -> robots and subscribers).
+
+    Attributes:
+        frame: the camera frame index.
+        time: its simulated time, seconds.
+        robots: one estimate per identified robot.
+        labels: per detection of the frame, the robot id it was identified as (-1: none).
+    """
+
+    frame: int
+    time: float
+    robots: tuple[RobotEstimate, ...]
+    labels: tuple[int, ...] = ()
+
+
+@dataclass(frozen=True)
+class StatusRequest:
+    """Ask the node for its counters; the reply goes to the sender."""
+
+
+@dataclass(frozen=True)
+class Status:
+    """The node's counters (node -> requester)."""
+
+    counters: dict[str, Any] = field(default_factory=dict)
+
+
+Message = HeadingReport | DetectionsMessage | TeamState | StatusRequest | Status
+
+_TYPE_OF = {
+    HeadingReport: "report",
+    DetectionsMessage: "detections",
+    TeamState: "team",
+    StatusRequest: "status_request",
+    Status: "status",
+}
+
+
+def encode(message: Message) -> bytes:
+    """The datagram of ``message`` (compact UTF-8 JSON); raises ``ValueError`` for non-finite numbers."""
+    kind = _TYPE_OF.get(type(message))
+    if kind is None:
+        raise ValueError(f"message: cannot encode {type(message).__name__}")
+    body: dict[str, Any] = {"v": SCHEMA_VERSION, "type": kind}
+    if isinstance(message, TeamState):
+        body.update(
+            frame=message.frame, time=message.time, labels=list(message.labels),
+            robots=[
+                {"id": r.id, "position": list(r.position), "heading": r.heading,
+                 "confidence": r.confidence, "age": r.age}
+                for r in message.robots
+            ],
+        )
+    elif isinstance(message, DetectionsMessage):
+        body.update(frame=message.frame, time=message.time, position=[list(p) for p in message.position],
+                    heading=list(message.heading), score=list(message.score))
+    elif isinstance(message, Status):
+        body["counters"] = message.counters
+    elif isinstance(message, HeadingReport):
+        body.update(robot=message.robot, seq=message.seq, t_sent=message.t_sent, heading=message.heading)
+    try:
+        data = json.dumps(body, separators=(",", ":"), allow_nan=False).encode()
+    except ValueError:
+        raise ValueError(f"{kind} message: holds a non-finite number") from None
+    if len(data) > MAX_DATAGRAM_BYTES:
+        raise ValueError(f"{kind} message: {len(data)} bytes exceeds {MAX_DATAGRAM_BYTES}")
+    return data
+
+
+def decode(data: bytes) -> Message:
+    """Parse and validate one datagram; raises ``MessageError`` with a reason code."""
+    if len(data) > MAX_DATAGRAM_BYTES:
+        raise MessageError(TOO_LARGE, f"{len(data)} bytes exceeds {MAX_DATAGRAM_BYTES}")
+    try:
+        body = json.loads(data.decode("utf-8"), parse_constant=_reject_constant)
+    except (UnicodeDecodeError, ValueError, RecursionError) as exc:
+        raise MessageError(MALFORMED, f"not UTF-8 JSON ({exc})") from None
+    if not isinstance(body, dict):
+        raise MessageError(MALFORMED, f"expected a JSON object, got {type(body).__name__}")
+    version = body.get("v")
+    if version != SCHEMA_VERSION or isinstance(version, bool):
+        raise MessageError(VERSION, f"schema version {version!r}, this node speaks {SCHEMA_VERSION}")
+    kind = body.get("type")
+    parser = _PARSERS.get(kind) if isinstance(kind, str) else None
+    if parser is None:
+        raise MessageError(UNKNOWN_TYPE, f"type {kind!r}; known: {sorted(_PARSERS)}")
+    return parser(_Fields(kind, body))
+
+
+def _reject_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not allowed")
+
+
+class _Fields:
+    """Typed access to a message's fields, raising ``MessageError(INVALID)`` naming the field."""
+
+    def __init__(self, kind: str, body: dict[str, Any]) -> None:
+        self.kind, self.body = kind, body
+        self.used = {"v", "type"}
+
+    def _get(self, name: str, optional: bool = False) -> Any:
+        self.used.add(name)
+        if name not in self.body:
+            if optional:
+                return None
+            raise self.error(name, "is missing")
+        return self.body[name]
+
+    def error(self, name: str, problem: str) -> MessageError:
+        return MessageError(INVALID, f"{self.kind}.{name} {problem}")
+
+    def integer(self, name: str, minimum: int = 0) -> int:
+        value = self._get(name)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.error(name, f"must be an integer, got {value!r}")
+        if value < minimum:
+            raise self.error(name, f"must be >= {minimum}, got {value}")
+        return value
+
+    def number(self, name: str, optional: bool = False) -> float | None:
+        value = self._get(name, optional)
+        if value is None and optional:
+            return None
+        return self._finite(name, value)
+
+    def _finite(self, name: str, value: Any) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise self.error(name, f"must be a finite number, got {value!r}")
+        return float(value)
+
+    def numbers(self, name: str, length: int | None = None) -> tuple[float, ...]:
+        value = self._get(name)
+        if not isinstance(value, list):
+            raise self.error(name, f"must be a list, got {type(value).__name__}")
+        if length is not None and len(value) != length:
+            raise self.error(name, f"has {len(value)} entries, expected {length}")
+        if len(value) > MAX_DETECTIONS:
+            raise self.error(name, f"has {len(value)} entries, at most {MAX_DETECTIONS} allowed")
+        return tuple(self._finite(f"{name}[{i}]", v) for i, v in enumerate(value))
+
+    def finish(self) -> None:
+        unknown = sorted(set(self.body) - self.used)
+        if unknown:
+            raise MessageError(INVALID, f"{self.kind}: unknown field(s) {unknown}")
+
+
+def _report(f: _Fields) -> HeadingReport:
+    msg = HeadingReport(robot=f.integer("robot"), seq=f.integer("seq"), t_sent=f.number("t_sent"),  # type: ignore[arg-type]
+                        heading=f.number("heading"))  # type: ignore[arg-type]
+    f.finish()
+    return msg
+
+
+def _detections(f: _Fields) -> DetectionsMessage:
+    frame, time = f.integer("frame"), f.number("time")
+    raw = f._get("position")
+    if not isinstance(raw, list) or len(raw) > MAX_DETECTIONS:
+        raise f.error("position", f"must be a list of at most {MAX_DETECTIONS} [x, y] pairs")
+    position = []
+    for i, pair in enumerate(raw):
+        if not isinstance(pair, list) or len(pair) != 2:
+            raise f.error(f"position[{i}]", f"must be an [x, y] pair, got {pair!r}")
+        position.append((f._finite(f"position[{i}]", pair[0]), f._finite(f"position[{i}]", pair[1])))
+    msg = DetectionsMessage(frame=frame, time=time, position=tuple(position),  # type: ignore[arg-type]
+                            heading=f.numbers("heading", len(raw)), score=f.numbers("score", len(raw)))
+    f.finish()
+    return msg
+
+
+def _team(f: _Fields) -> TeamState:
+    frame, time = f.integer("frame"), f.number("time")
+    raw = f._get("robots")
+    if not isinstance(raw, list):
+        raise f.error("robots", "must be a list")
+    robots = []
+    for i, item in enumerate(raw):
+        if not isinstance(item, dict):
+            raise f.error(f"robots[{i}]", "must be an object")
+        sub = _Fields(f"team.robots[{i}]", item)
+        sub.used.clear()
+        pos = sub.numbers("position", 2)
+        robots.append(RobotEstimate(id=sub.integer("id"), position=(pos[0], pos[1]), heading=sub.number("heading", True),
+                                    confidence=sub.number("confidence", True), age=sub.number("age")))  # type: ignore[arg-type]
+        sub.finish()
+    labels = f._get("labels")
+    if not isinstance(labels, list) or any(isinstance(v, bool) or not isinstance(v, int) or v < -1 for v in labels):
+        raise f.error("labels", "must be a list of integers >= -1")
+    msg = TeamState(frame=frame, time=time, robots=tuple(robots), labels=tuple(labels))  # type: ignore[arg-type]
+    f.finish()
+    return msg
+
+
+def _status_request(f: _Fields) -> StatusRequest:
+    f.finish()
+    return StatusRequest()
+
+
+def _status(f: _Fields) -> Status:
+    counters = f._get("counters")
+    if not isinstance(counters, dict):
+        raise f.error("counters", "must be an object")
+    f.finish()
+    return Status(counters=counters)
+
+
+_PARSERS = {
+    "report": _report,
+    "detections": _detections,
+    "team": _team,
+    "status_request": _status_request,
+    "status": _status,
+}

@@ -1,0 +1,244 @@
+"""The observer node's UDP server: one socket, a selector loop, per-sender rate limits.
+
+Each datagram is read, rate-limited by sender, decoded, and handed to the ``TeamIdentifier``. A
+detections frame is tracked at once and its team state sent to every ``publish`` address and,
+when ``reply_to_robots`` is set, to the address each robot last reported from. Nothing a peer
+sends can stop the loop: every failure is counted and logged. Default addresses are loopback.
+"""
+
+from __future__ import annotations
+
+import logging
+import selectors
+import socket
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from lookalike.node.counters import NodeCounters, log_event
+from lookalike.node.identifier import IdentifierConfig, TeamIdentifier
+from lookalike.node.messages import (
+    UNEXPECTED,
+    DetectionsMessage,
+    HeadingReport,
+    MessageError,
+    Status,
+    StatusRequest,
+    TeamState,
+    decode,
+    encode,
+)
+
+Address = tuple[str, int]
+LOCALHOST = "127.0.0.1"
+
+
+def parse_address(text: str, default_host: str = LOCALHOST) -> Address:
+    """``HOST:PORT`` or ``PORT`` as ``(host, port)``; raises ``ValueError`` naming the text."""
+    host, sep, port = text.rpartition(":")
+    host = host if sep else default_host
+    try:
+        number = int(port)
+    except ValueError:
+        raise ValueError(f"address {text!r}: expected HOST:PORT with an integer port") from None
+    if not 0 <= number <= 65535 or not host:
+        raise ValueError(f"address {text!r}: port must be in 0..65535 and the host non-empty")
+    return host, number
+
+
+@dataclass(frozen=True)
+class NodeConfig:
+    """Network settings of the node.
+
+    Attributes:
+        listen: address to bind (port 0: an ephemeral port).
+        publish: addresses that receive every team state.
+        reply_to_robots: also send each team state to the address each robot reports from.
+        sender_rate: packets per second one sender may send before being rate-limited.
+        sender_burst: packets one sender may send at once.
+        max_senders: rate-limit buckets kept (the oldest are forgotten beyond this).
+        camera_timeout_s: wall seconds without frames after which the camera counts as lost.
+        status_interval_s: wall seconds between status log lines (0: never).
+        recv_buffer_bytes: socket receive buffer asked of the OS.
+        batch: datagrams read per loop iteration before timers are checked.
+    """
+
+    listen: Address = (LOCALHOST, 0)
+    publish: tuple[Address, ...] = ()
+    reply_to_robots: bool = True
+    sender_rate: float = 2000.0
+    sender_burst: float = 500.0
+    max_senders: int = 1024
+    camera_timeout_s: float = 2.0
+    status_interval_s: float = 5.0
+    recv_buffer_bytes: int = 4 << 20
+    batch: int = 256
+
+    def __post_init__(self) -> None:
+        for name in ("sender_rate", "sender_burst", "camera_timeout_s"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"NodeConfig.{name} must be > 0, got {getattr(self, name)}")
+        if self.max_senders < 1 or self.batch < 1:
+            raise ValueError("NodeConfig.max_senders and NodeConfig.batch must be >= 1")
+
+
+class NodeServer:
+    """The running node. Use as a context manager; ``serve(stop)`` loops until ``stop()`` is true."""
+
+    def __init__(self, tracker: object, config: NodeConfig | None = None,
+                 identifier_config: IdentifierConfig | None = None,
+                 logger: logging.Logger | None = None) -> None:
+        self.config = config or NodeConfig()
+        self.identifier = TeamIdentifier(tracker, identifier_config)
+        self.counters = NodeCounters()
+        self.log = logger or logging.getLogger("lookalike.node")
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, self.config.recv_buffer_bytes)
+            self.sock.bind(self.config.listen)
+        except OSError:
+            self.sock.close()
+            raise
+        self.sock.setblocking(False)
+        self.selector = selectors.DefaultSelector()
+        self.selector.register(self.sock, selectors.EVENT_READ)
+        self._buckets: dict[Address, list[float]] = {}
+        self._robot_addr: dict[int, Address] = {}
+        self._last_frame_wall: float | None = None
+        self._next_status = time.monotonic() + self.config.status_interval_s
+        log_event(self.log, "listening", address=list(self.address))
+
+    @property
+    def address(self) -> Address:
+        """The bound ``(host, port)``."""
+        return self.sock.getsockname()
+
+    def __enter__(self) -> NodeServer:  # noqa: PYI034
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Log the final counters and close the socket."""
+        if self.sock.fileno() >= 0:
+            log_event(self.log, "stopped", counters=self.counters.snapshot())
+            self.selector.close()
+            self.sock.close()
+
+    def serve(self, stop: Callable[[], bool], tick_s: float = 0.05) -> None:
+        """Serve until ``stop()`` returns true (checked at least every ``tick_s`` seconds)."""
+        while not stop():
+            self.poll(tick_s)
+
+    def poll(self, timeout_s: float) -> int:
+        """Wait up to ``timeout_s`` for datagrams, handle up to ``batch`` of them; return how many."""
+        handled = 0
+        if self.selector.select(timeout_s):
+            while handled < self.config.batch:
+                try:
+                    data, addr = self.sock.recvfrom(65_535)
+                except (BlockingIOError, InterruptedError):
+                    break
+                except OSError as exc:  # e.g. an ICMP error reported on the socket
+                    log_event(self.log, "socket_error", logging.WARNING, error=str(exc))
+                    break
+                handled += 1
+                self.handle(data, addr, time.perf_counter())
+        self._timers()
+        return handled
+
+    def handle(self, data: bytes, addr: Address, t_received: float) -> None:
+        """Process one datagram read at ``t_received`` (``time.perf_counter`` seconds)."""
+        self.counters.add("received")
+        if not self._allow(addr, t_received):
+            self.counters.add("rate_limited")
+            return
+        try:
+            message = decode(data)
+        except MessageError as exc:
+            self.counters.reject(exc.reason)
+            log_event(self.log, "rejected", logging.DEBUG, sender=list(addr), reason=exc.reason, detail=exc.detail)
+            return
+        if isinstance(message, HeadingReport):
+            outcome = self.identifier.add_report(message)
+            self.counters.add(outcome)
+            if outcome == "reports":
+                self._robot_addr[message.robot] = addr
+            else:
+                log_event(self.log, outcome, logging.DEBUG, sender=list(addr), robot=message.robot, seq=message.seq)
+        elif isinstance(message, DetectionsMessage):
+            self._frame(message, addr, t_received)
+        elif isinstance(message, StatusRequest):
+            self.counters.add("status_requests")
+            self._send(encode(Status(counters=self.counters.snapshot())), [addr], counted=False)
+        else:  # a team or status message sent to the node
+            self.counters.reject(UNEXPECTED)
+
+    def _frame(self, message: DetectionsMessage, addr: Address, t_received: float) -> None:
+        restarts = self.identifier.restarts
+        try:
+            outcome, team = self.identifier.add_frame(message)
+        except Exception as exc:  # noqa: BLE001 (a tracker bug must not take the node down)
+            self.counters.add("tracker_errors")
+            log_event(self.log, "tracker_error", logging.ERROR, frame=message.frame, error=repr(exc))
+            return
+        if self.identifier.restarts > restarts:
+            self.counters.add("camera_restarts")
+            log_event(self.log, "camera_restart", frame=message.frame, time=message.time)
+        self.counters.add(outcome)
+        if team is None:
+            log_event(self.log, outcome, logging.DEBUG, sender=list(addr), frame=message.frame)
+            return
+        self._last_frame_wall = time.monotonic()
+        self._publish(team)
+        self.counters.latency_s.append(time.perf_counter() - t_received)
+
+    def _publish(self, team: TeamState) -> None:
+        try:
+            data = encode(team)
+        except ValueError as exc:
+            log_event(self.log, "encode_error", logging.ERROR, frame=team.frame, error=str(exc))
+            return
+        targets = list(self.config.publish)
+        if self.config.reply_to_robots:
+            targets += [a for a in self._robot_addr.values() if a not in targets]
+        self._send(data, targets)
+
+    def _send(self, data: bytes, targets: list[Address], counted: bool = True) -> None:
+        """Send ``data`` to each target; team states count as ``published``."""
+        for target in targets:
+            try:
+                self.sock.sendto(data, target)
+                if counted:
+                    self.counters.add("published")
+            except OSError as exc:
+                self.counters.add("send_errors")
+                log_event(self.log, "send_error", logging.WARNING, target=list(target), error=str(exc))
+
+    def _allow(self, addr: Address, now: float) -> bool:
+        """Token bucket per sender address."""
+        bucket = self._buckets.get(addr)
+        if bucket is None:
+            if len(self._buckets) >= self.config.max_senders:
+                self._buckets.pop(next(iter(self._buckets)))
+            bucket = self._buckets[addr] = [self.config.sender_burst, now]
+        tokens = min(self.config.sender_burst, bucket[0] + (now - bucket[1]) * self.config.sender_rate)
+        bucket[1] = now
+        if tokens < 1.0:
+            bucket[0] = tokens
+            return False
+        bucket[0] = tokens - 1.0
+        return True
+
+    def _timers(self) -> None:
+        now = time.monotonic()
+        last = self._last_frame_wall
+        if last is not None and not self.identifier.camera_lost and now - last > self.config.camera_timeout_s:
+            self.identifier.camera_lost = True
+            self.counters.add("camera_lost")
+            log_event(self.log, "camera_lost", logging.WARNING, silent_s=round(now - last, 3),
+                      last_frame=self.identifier.last_frame)
+        if self.config.status_interval_s > 0 and now >= self._next_status:
+            self._next_status = now + self.config.status_interval_s
+            log_event(self.log, "status", line=self.counters.status_line(), counters=self.counters.snapshot())
