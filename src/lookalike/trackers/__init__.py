@@ -11,12 +11,17 @@ from lookalike.trackers.registry import (
 )
 from lookalike.trackers.deepsort import DeepSort
 from lookalike.trackers.diversort import DiverSort
+from lookalike.trackers.jpda import JpdaTracker
+from lookalike.trackers.kalman_ha import KalmanHA, KalmanHA2
 from lookalike.trackers.sort import Sort
 from lookalike.types.tracks import TrackStatus
 
 __all__ = [
     "DeepSort",
     "DiverSort",
+    "JpdaTracker",
+    "KalmanHA",
+    "KalmanHA2",
     "ParameterInfo",
     "Sort",
     "TrackStatus",

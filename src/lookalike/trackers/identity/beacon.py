@@ -1,0 +1,157 @@
+"""The beacon identifier: which of the N reporting agents each track is (DESIGN §5).
+
+Each frame, tracks are assigned to agents by the Hungarian method. The cost of track ``i`` and
+agent ``j`` is the mean over the last ``window_frames`` frames (where the track had a visual
+heading) of ``(1 - cos(φ_i(t) - ψ_j(t))) / 2`` in [0, 1], where ``ψ_j(t)`` is agent ``j``'s
+reported heading *at that frame's time*: interpolated between the reports sent around it, or
+extrapolated from the latest report with the agent's turn rate (estimated from its last two
+reports, clipped to ``max_turn_rate``) for at most ``max_extrapolation_s`` — this compensates for
+report age. Agents never heard from cannot be assigned. Hysteresis: a track's current agent costs
+``hysteresis`` less, so identities do not flicker; pairs costing more than ``max_cost`` are not
+assigned. The identity probability reported is ``1 - cost``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lookalike.association.solver import assign
+from lookalike.geometry.angles import angle_diff
+from lookalike.types import Beacons
+
+
+@dataclass(frozen=True)
+class IdentifierConfig:
+    """Parameters of :class:`BeaconIdentifier` (frames, seconds, radians, costs in [0, 1])."""
+
+    n_agents: int = 3
+    window_frames: int = 30
+    max_cost: float = 0.3
+    hysteresis: float = 0.08
+    history: int = 16
+    max_extrapolation_s: float = 1.0
+    max_turn_rate: float = 3.0
+
+    def __post_init__(self) -> None:
+        if self.n_agents < 0 or self.window_frames < 1 or self.history < 2:
+            raise ValueError(f"IdentifierConfig: need n_agents >= 0, window_frames >= 1, history >= 2; got {self}")
+        for name in ("max_cost", "hysteresis", "max_extrapolation_s", "max_turn_rate"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"IdentifierConfig.{name} must be >= 0, got {getattr(self, name)}")
+
+
+class BeaconIdentifier:
+    """Identifies tracks with reporting agents; owns the report history and per-track windows."""
+
+    def __init__(self, config: IdentifierConfig) -> None:
+        self.config = config
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget reports, windows and identities."""
+        n, r, w = self.config.n_agents, self.config.history, self.config.window_frames
+        self._t = np.full((n, r), np.nan)  # report send times, sorted, NaN padded at the front
+        self._h = np.full((n, r), np.nan)
+        self._times = np.full(w, np.nan)  # frame times of the ring
+        self._slot = -1
+        self._samples: dict[int, np.ndarray] = {}
+        self._agent: dict[int, int] = {}
+
+    # -- inputs ------------------------------------------------------------------------------
+
+    def begin_frame(self, time_s: float, beacons: Beacons) -> None:
+        """Start a frame at ``time_s``: store its received reports and open a window slot."""
+        for a in np.unique(beacons.agent_id):
+            if a >= self.config.n_agents:
+                continue
+            rows = beacons.agent_id == a
+            t = np.concatenate([self._t[a], beacons.t_sent[rows]])
+            h = np.concatenate([self._h[a], beacons.heading[rows]])
+            known = np.isfinite(t)
+            t, h = t[known], h[known]
+            t, first = np.unique(t, return_index=True)  # sorted, duplicates dropped
+            h = h[first]
+            r = self.config.history
+            t, h = t[-r:], h[-r:]
+            self._t[a] = np.nan
+            self._h[a] = np.nan
+            self._t[a, r - len(t):] = t
+            self._h[a, r - len(h):] = h
+        self._slot = (self._slot + 1) % self.config.window_frames
+        self._times[self._slot] = time_s
+        for samples in self._samples.values():
+            samples[self._slot] = np.nan
+
+    def observe(self, track_id: int, heading_rad: float) -> None:
+        """Record the visual heading of track ``track_id`` in the current frame."""
+        if self._slot < 0:
+            raise ValueError("observe() before begin_frame()")
+        samples = self._samples.get(track_id)
+        if samples is None:
+            samples = self._samples[track_id] = np.full(self.config.window_frames, np.nan)
+        samples[self._slot] = heading_rad
+
+    def drop(self, track_ids: list[int] | np.ndarray) -> None:
+        """Forget deleted tracks."""
+        for t in track_ids:
+            self._samples.pop(int(t), None)
+            self._agent.pop(int(t), None)
+
+    # -- outputs -----------------------------------------------------------------------------
+
+    def agent_headings(self, times_s: np.ndarray) -> np.ndarray:
+        """Report-based headings ``(len(times), N)`` of every agent at ``times_s``; NaN where unknown."""
+        cfg = self.config
+        out = np.full((len(times_s), cfg.n_agents), np.nan)
+        for a in range(cfg.n_agents):
+            known = np.isfinite(self._t[a])
+            t, h = self._t[a, known], self._h[a, known]
+            if not len(t):
+                continue
+            q = np.asarray(times_s, dtype=float)
+            i = np.searchsorted(t, q, side="right")  # reports at or before q: t[:i]
+            before = np.clip(i - 1, 0, len(t) - 1)
+            after = np.clip(i, 0, len(t) - 1)
+            span = t[after] - t[before]
+            frac = np.divide(q - t[before], span, out=np.zeros_like(q), where=span > 0)
+            inter = h[before] + np.clip(frac, 0, 1) * angle_diff(h[after], h[before])
+            rate = 0.0
+            if len(t) >= 2 and t[-1] > t[-2]:
+                rate = float(np.clip(angle_diff(h[-1], h[-2]) / (t[-1] - t[-2]), -cfg.max_turn_rate, cfg.max_turn_rate))
+            ahead = np.clip(q - t[-1], 0.0, cfg.max_extrapolation_s)
+            value = np.where(i >= len(t), h[-1] + rate * ahead, np.where(i == 0, h[0], inter))
+            out[:, a] = value
+        return out
+
+    def costs(self, track_ids: list[int]) -> np.ndarray:
+        """Cost matrix ``(len(track_ids), N)`` in [0, 1]; inf where no sample or no report."""
+        n = self.config.n_agents
+        if not track_ids or n == 0:
+            return np.zeros((len(track_ids), n))
+        samples = np.stack([self._samples.get(t, np.full(self.config.window_frames, np.nan)) for t in track_ids])
+        agent = self.agent_headings(self._times)  # (W, N)
+        d = (1.0 - np.cos(samples[:, :, None] - agent[None])) / 2.0  # (k, W, N)
+        valid = np.isfinite(d)
+        count = valid.sum(axis=1)
+        total = np.where(valid, d, 0.0).sum(axis=1)
+        return np.divide(total, count, out=np.full(count.shape, np.inf), where=count > 0)
+
+    def assign(self, track_ids: list[int]) -> dict[int, tuple[int, float]]:
+        """Identities of ``track_ids``: ``{track_id: (agent_id, probability)}`` for those assigned."""
+        cfg = self.config
+        cost = self.costs(track_ids)
+        biased = cost.copy()
+        for row, t in enumerate(track_ids):
+            a = self._agent.get(t)
+            if a is not None and np.isfinite(biased[row, a]):
+                biased[row, a] = max(biased[row, a] - cfg.hysteresis, 0.0)
+        matches, _, _ = assign(biased, cfg.max_cost)
+        result = {}
+        for row, a in matches:
+            result[track_ids[row]] = (int(a), float(1.0 - cost[row, a]))
+        self._agent = {t: a for t, (a, _) in result.items()} | {
+            t: a for t, a in self._agent.items() if t not in track_ids
+        }
+        return result

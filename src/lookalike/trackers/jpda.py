@@ -1,0 +1,97 @@
+"""JPDA tracker (seed A's third baseline): joint probabilistic data association in world coordinates.
+
+Every track is updated with all gated detections weighted by the exact JPDA marginals
+(:func:`lookalike.association.jpda.jpda_marginals`): hypothesis weights ``1 - P_D·P_G`` for a
+miss and ``P_D·N(z; ẑ, S)/λ`` for a gated detection, then the mixture-reduced Kalman update
+
+    x⁺ = x + K Σ_j β_j ν_j,
+    P⁺ = β_0 P + (1 - β_0)(P - K S Kᵀ) + K (Σ_j β_j ν_j ν_jᵀ - ν̄ ν̄ᵀ) Kᵀ.
+
+For identification and labels, the one-to-one detection of each track is found by the Hungarian
+method on ``1 - β`` (pairs with ``β < min_assignment_prob`` are not assigned); that pair counts
+as the track's hit. Detections that no track explains (``Σ_i β_ij < 0.5``) may start tracks. The
+lifecycle, births and identification are Kalman-HA2's (:mod:`lookalike.trackers.kalman_ha`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lookalike.association.jpda import jpda_marginals
+from lookalike.association.solver import assign
+from lookalike.motion import kalman
+from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.kalman_ha import H, HeuristicsConfig, WorldTracker
+from lookalike.trackers.registry import register_tracker
+from lookalike.types import Detections
+
+
+@dataclass(frozen=True)
+class JpdaConfig(HeuristicsConfig):
+    """Kalman-HA2's parameters plus JPDA's detection and clutter model."""
+
+    p_detection: float = param(0.85, "probability P_D that a tracked target is detected")
+    clutter_density: float = param(0.03, "false positives per square metre of the view, λ")
+    min_assignment_prob: float = param(0.3, "smallest β of a track's labelled detection")
+    max_events: int = param(5000, "joint events enumerated per cluster before the exact subset DP")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_positive(self, "clutter_density", "max_events")
+        check_positive(self, "min_assignment_prob", allow_zero=True)
+        if not 0 < self.p_detection <= 1:
+            raise ValueError(f"JpdaConfig.p_detection must be in (0, 1], got {self.p_detection}")
+
+
+@register_tracker("jpda")
+class JpdaTracker(WorldTracker):
+    """JPDA track maintenance with Kalman-HA2's lifecycle and the beacon identifier."""
+
+    heuristics = True
+    Config = JpdaConfig
+
+    def __init__(self, config: JpdaConfig | None = None) -> None:
+        super().__init__(config or JpdaConfig())
+        self._explained = np.zeros(0)
+
+    def _associate_and_update(self, det: Detections) -> np.ndarray:
+        cfg: JpdaConfig = self.config  # type: ignore[assignment]
+        k, m = len(self._ids), len(det)
+        det_of_track = np.full(k, -1, dtype=int)
+        self._explained = np.zeros(m)
+        if not k or not m:
+            return det_of_track
+        R = self._noise(self._mean[:, :2])
+        z_hat, S = kalman.project(self._mean, self._cov, H, R)
+        d2 = kalman.gating_distance(self._mean, self._cov, det.position, H, R)
+        d2 = np.where(d2 <= self._gate, d2, np.inf)
+        norm = 1.0 / (2 * np.pi * np.sqrt(np.linalg.det(S)))  # (k,)
+        likelihood = np.where(np.isfinite(d2), cfg.p_detection * norm[:, None] * np.exp(-0.5 * np.where(
+            np.isfinite(d2), d2, 0.0)) / cfg.clutter_density, 0.0)
+        p_gate = 1.0 - np.exp(-0.5 * self._gate)  # chi-square CDF with 2 dof
+        miss = np.full(k, 1.0 - cfg.p_detection * p_gate)
+        beta, beta_miss = jpda_marginals(likelihood, miss, cfg.max_events)
+        self._explained = beta.sum(axis=0)
+        # Mixture-reduced update.
+        nu = det.position[None, :, :] - z_hat[:, None, :]  # (k, m, 2)
+        nu_bar = np.einsum("km,kmd->kd", beta, nu)
+        PHt = self._cov @ H.T
+        K = np.swapaxes(np.linalg.solve(S, np.swapaxes(PHt, -1, -2)), -1, -2)  # (k, 6, 2)
+        spread = np.einsum("km,kmd,kme->kde", beta, nu, nu) - nu_bar[:, :, None] * nu_bar[:, None, :]
+        KSKt = K @ S @ np.swapaxes(K, -1, -2)
+        updated = 1.0 - beta_miss
+        self._mean = self._mean + np.einsum("kij,kj->ki", K, nu_bar)
+        cov = self._cov - updated[:, None, None] * KSKt + K @ spread @ np.swapaxes(K, -1, -2)
+        self._cov = 0.5 * (cov + np.swapaxes(cov, -1, -2))  # keep it symmetric against round-off
+        # One detection per track for labels and the lifecycle.
+        matches, _, _ = assign(1.0 - beta, 1.0 - cfg.min_assignment_prob)
+        det_of_track[matches[:, 0]] = matches[:, 1]
+        return det_of_track
+
+    def _birth_candidates(self, det: Detections, det_of_track: np.ndarray) -> np.ndarray:
+        new = super()._birth_candidates(det, det_of_track)
+        if len(self._explained) == len(det):
+            new = new[self._explained[new] < 0.5]
+        return new
