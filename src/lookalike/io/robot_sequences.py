@@ -1,0 +1,132 @@
+"""Simulated robot sequences on disk as JSON Lines (one file per sequence).
+
+Line 1 is a header object::
+
+    {"format": "lookalike-robots", "version": 1, "seed": 900000, "n_frames": 1000,
+     "reports_sent": 29870, "config": {...RobotWorldConfig as nested objects...}}
+
+then one object per frame, in order::
+
+    {"frame": 0, "time": 0.0,
+     "detections": {"position": [[x, y], ...], "heading": [...], "score": [...], "label": [...]},
+     "beacons": {"agent_id": [...], "t_sent": [...], "t_received": [...], "heading": [...]},
+     "truth": {"position": [[x, y] x N], "heading": [N], "visible": [N], "occlusion": [N],
+               "field_position": [[x, y] x N], "observer": [x, y, yaw],
+               "n_false_positives": 1, "n_misses": 0}}
+
+Positions in metres (detections and ``truth.position`` in the observer frame: x forward, y left;
+``field_position`` and ``observer`` in field coordinates), angles in radians, times in seconds;
+``label`` is the agent id or -1 for a false positive. Floats are written with full precision,
+so reading gives back the simulated arrays exactly.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from lookalike.sim import ReportArrays, RobotArrays, RobotSequence, RobotWorldConfig
+
+FORMAT = "lookalike-robots"
+VERSION = 1
+
+
+def write_robot_sequence(path: str | Path, sequence: RobotSequence) -> Path:
+    """Write ``sequence`` to ``path`` (atomically: a temporary file renamed); returns the path."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    a, r = sequence.arrays, sequence.arrays.reports
+    header = {"format": FORMAT, "version": VERSION, "seed": sequence.seed, "n_frames": len(a),
+              "reports_sent": r.n_sent, "config": sequence.config.to_dict()}
+    tmp = path.with_name(path.name + ".tmp")
+    with tmp.open("w") as fh:
+        fh.write(json.dumps(header) + "\n")
+        for k in range(len(a)):
+            n = int(a.det_valid[k].sum())
+            lo, hi = r.frame_offsets[k], r.frame_offsets[k + 1]
+            row = {
+                "frame": k, "time": float(a.time[k]),
+                "detections": {"position": a.det_position[k, :n].tolist(), "heading": a.det_heading[k, :n].tolist(),
+                               "score": a.det_score[k, :n].tolist(), "label": a.det_label[k, :n].tolist()},
+                "beacons": {"agent_id": r.agent_id[lo:hi].tolist(), "t_sent": r.t_sent[lo:hi].tolist(),
+                            "t_received": r.t_received[lo:hi].tolist(), "heading": r.heading[lo:hi].tolist()},
+                "truth": {"position": a.true_position[k].tolist(), "heading": a.true_heading[k].tolist(),
+                          "visible": a.visible[k].tolist(), "occlusion": a.occlusion[k].tolist(),
+                          "field_position": a.field_position[k].tolist(), "observer": a.observer[k].tolist(),
+                          "n_false_positives": int(a.n_false_positives[k]), "n_misses": int(a.n_misses[k])},
+            }
+            fh.write(json.dumps(row) + "\n")
+    os.replace(tmp, path)
+    return path
+
+
+def read_robot_sequence(path: str | Path) -> RobotSequence:
+    """Read a sequence written by :func:`write_robot_sequence`; malformed files raise ``ValueError``."""
+    path = Path(path)
+    with path.open() as fh:
+        lines = [line for line in fh if line.strip()]
+    if not lines:
+        raise ValueError(f"{path}: empty file")
+    try:
+        header = json.loads(lines[0])
+        rows = [json.loads(line) for line in lines[1:]]
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not JSON Lines ({exc})") from None
+    if header.get("format") != FORMAT or header.get("version") != VERSION:
+        raise ValueError(f"{path}: not a {FORMAT} v{VERSION} file (header {str(header)[:80]})")
+    config = RobotWorldConfig.from_dict(header["config"])
+    T, N, M = len(rows), config.n_agents, config.max_detections
+    if T != header.get("n_frames"):
+        raise ValueError(f"{path}: header says {header.get('n_frames')} frames, file has {T}")
+    try:
+        return _assemble(config, header, rows, T, N, M)
+    except (KeyError, TypeError, IndexError) as exc:
+        raise ValueError(f"{path}: malformed frame record ({exc!r})") from None
+
+
+def _assemble(config: RobotWorldConfig, header: dict, rows: list[dict], T: int, N: int, M: int) -> RobotSequence:
+    valid = np.zeros((T, M), dtype=bool)
+    pos, head, score = np.zeros((T, M, 2)), np.zeros((T, M)), np.zeros((T, M))
+    label = np.full((T, M), -1, dtype=int)
+    b_parts: dict[str, list] = {"agent_id": [], "t_sent": [], "t_received": [], "heading": []}
+    offsets = np.zeros(T + 1, dtype=int)
+    truth = {k: [] for k in ("position", "heading", "visible", "occlusion", "field_position", "observer",
+                              "n_false_positives", "n_misses")}
+    time = np.zeros(T)
+    for k, row in enumerate(rows):
+        if row["frame"] != k:
+            raise ValueError(f"frame records out of order: record {k} is frame {row['frame']}")
+        time[k] = row["time"]
+        d = row["detections"]
+        n = len(d["label"])
+        if n > M:
+            raise ValueError(f"frame {k}: {n} detections exceed max_detections {M}")
+        valid[k, :n] = True
+        if n:
+            pos[k, :n], head[k, :n], score[k, :n], label[k, :n] = d["position"], d["heading"], d["score"], d["label"]
+        b = row["beacons"]
+        for key, values in b_parts.items():
+            values.extend(b[key])
+        offsets[k + 1] = offsets[k] + len(b["agent_id"])
+        for key, values in truth.items():
+            values.append(row["truth"][key])
+    reports = ReportArrays(
+        agent_id=np.asarray(b_parts["agent_id"], dtype=int), t_sent=np.asarray(b_parts["t_sent"], dtype=float),
+        t_received=np.asarray(b_parts["t_received"], dtype=float), heading=np.asarray(b_parts["heading"], dtype=float),
+        frame_offsets=offsets, n_sent=int(header["reports_sent"]),
+    )
+    arrays = RobotArrays(
+        time=time, det_valid=valid, det_position=pos, det_heading=head, det_score=score, det_label=label,
+        true_position=np.asarray(truth["position"], dtype=float).reshape(T, N, 2),
+        true_heading=np.asarray(truth["heading"], dtype=float).reshape(T, N),
+        visible=np.asarray(truth["visible"], dtype=bool).reshape(T, N),
+        occlusion=np.asarray(truth["occlusion"], dtype=float).reshape(T, N),
+        field_position=np.asarray(truth["field_position"], dtype=float).reshape(T, N, 2),
+        observer=np.asarray(truth["observer"], dtype=float).reshape(T, 3), reports=reports,
+        n_false_positives=np.asarray(truth["n_false_positives"], dtype=int),
+        n_misses=np.asarray(truth["n_misses"], dtype=int),
+    )
+    return RobotSequence(config, int(header["seed"]), arrays)
