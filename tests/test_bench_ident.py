@@ -1,0 +1,30 @@
+"""``lookalike bench ident``: runs, writes its table, and ranks the baselines as the paper does."""
+
+from __future__ import annotations
+
+import json
+
+from typer.testing import CliRunner
+
+from lookalike.cli import app
+from lookalike.cli.bench import IDENT_COLUMNS, ident_table
+
+
+def test_command_writes_json_and_csv(tmp_path):
+    result = CliRunner().invoke(app, ["bench", "ident", "--setups", "m3n2", "--sequences", "1", "--frames", "60",
+                                      "--json", str(tmp_path / "t.json"), "--csv", str(tmp_path / "t.csv")])
+    assert result.exit_code == 0, result.output
+    rows = json.loads((tmp_path / "t.json").read_text())
+    assert [r["Tracker"] for r in rows] == ["kalman_ha", "kalman_ha2", "jpda"]
+    assert all(list(r) == list(IDENT_COLUMNS) for r in rows)
+    assert all(0 <= r["Success rate (%)"] <= 100 for r in rows)
+    assert (tmp_path / "t.csv").read_text().startswith("Setup,Tracker")
+    bad = CliRunner().invoke(app, ["bench", "ident", "--trackers", "nope"])
+    assert bad.exit_code != 0
+
+
+def test_heuristics_and_jpda_beat_kalman_ha():
+    rows = ident_table(["m10n7"], ["kalman_ha", "kalman_ha2", "jpda"], sequences=2, frames=400, seed=123_000)
+    rate = {r["Tracker"]: r["Success rate (%)"] for r in rows}
+    assert rate["kalman_ha2"] > rate["kalman_ha"] + 3
+    assert rate["jpda"] > rate["kalman_ha"] + 3
