@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 import typer
-from rich.table import Table
+from rich.console import Console
+from rich.table import Column, Table
 
 from lookalike.cli.app import console, fail
 from lookalike.cli.bench import bench_app
@@ -106,13 +107,13 @@ def divers(
         rows = diver_table(scenario_names, frames=frames)
     except ValueError as exc:
         fail(str(exc))
-    table = Table(*COLUMNS)
+    table = Table(*(Column(c, no_wrap=True) for c in COLUMNS))
     last = None
     for r in rows:
         first = r["Scenario"] != last
         last = r["Scenario"]
         table.add_row(*(str(r[c]) if first or c not in ("Scenario", "Location", "DP", "DR") else "" for c in COLUMNS))
-    console.print(table)
+    Console(width=max(console.width, 120)).print(table)  # the table is wider than a default terminal
     if json_path:
         json_path.parent.mkdir(parents=True, exist_ok=True)
         json_path.write_text(json.dumps(rows, indent=1))
