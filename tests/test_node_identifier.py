@@ -9,7 +9,6 @@ from lookalike.node import (
     HeadingReport,
     IdentifierConfig,
     TeamIdentifier,
-    labels_from_snapshots,
 )
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
@@ -101,9 +100,3 @@ def test_frame_rules_and_camera_restart():
     node.camera_lost = True
     assert node.add_frame(_frame(9, []))[0] == "frames" and node.restarts == 1
 
-
-def test_labels_from_snapshots():
-    snaps = [TrackSnapshot(1, TrackStatus.CONFIRMED, agent_id=2, detection_index=1),
-             TrackSnapshot(2, TrackStatus.LOST, agent_id=0, detection_index=-1),
-             TrackSnapshot(3, TrackStatus.CONFIRMED, agent_id=None, detection_index=0)]
-    assert list(labels_from_snapshots(3, snaps)) == [-1, 2, -1]

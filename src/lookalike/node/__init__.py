@@ -7,7 +7,6 @@ from lookalike.node.counters import EVENTS, NodeCounters, log_event
 from lookalike.node.identifier import (
     IdentifierConfig,
     TeamIdentifier,
-    labels_from_snapshots,
 )
 from lookalike.node.messages import (
     SCHEMA_VERSION,
@@ -41,7 +40,6 @@ __all__ = [
     "TeamState",
     "decode",
     "encode",
-    "labels_from_snapshots",
     "log_event",
     "parse_address",
 ]

@@ -21,6 +21,7 @@ from lookalike.node.messages import (
     RobotEstimate,
     TeamState,
 )
+from lookalike.trackers.identity import labels_from_tracks
 from lookalike.types import Beacons, Detections, Frame, TrackSnapshot
 
 
@@ -41,15 +42,6 @@ class IdentifierConfig:
             raise ValueError(f"n_robots must be >= 1, got {self.n_robots}")
         if not self.max_report_age_s > 0:
             raise ValueError(f"max_report_age_s must be > 0, got {self.max_report_age_s}")
-
-
-def labels_from_snapshots(n_detections: int, snapshots: Sequence[TrackSnapshot]) -> np.ndarray:
-    """Per detection, the agent id of the snapshot updated by it (-1 where none): ``(n,)`` int."""
-    labels = np.full(n_detections, -1)
-    for s in snapshots:
-        if s.agent_id is not None and 0 <= s.detection_index < n_detections:
-            labels[s.detection_index] = s.agent_id
-    return labels
 
 
 class TeamIdentifier:
@@ -122,6 +114,7 @@ class TeamIdentifier:
             position=np.asarray(message.position, dtype=float).reshape(n, 2),
             heading=np.asarray(message.heading, dtype=float),
             score=np.asarray(message.score, dtype=float),
+            heading_std=None if message.heading_std is None else np.asarray(message.heading_std, dtype=float),
         )
         reports, self._pending = self._pending, []
         beacons = Beacons(
@@ -154,7 +147,7 @@ class TeamIdentifier:
                 heading=_finite_or_none(s.heading), confidence=_finite_or_none(s.identity_prob),
                 age=float(frame.time - self._last_update[j]),
             ))
-        labels = labels_from_snapshots(n, snapshots)
+        labels = labels_from_tracks(n, snapshots)
         return TeamState(frame=frame.index, time=frame.time, robots=tuple(robots),
                          labels=tuple(int(v) for v in labels))
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 SCHEMA_VERSION = 1
 MAX_DATAGRAM_BYTES = 65_000
@@ -64,6 +64,7 @@ class DetectionsMessage:
         position: ``n`` pairs ``[x, y]`` in metres.
         heading: ``n`` visual headings in radians.
         score: ``n`` detector confidences.
+        heading_std: ``n`` spreads of the visual headings in radians, or None.
     """
 
     frame: int
@@ -71,6 +72,7 @@ class DetectionsMessage:
     position: tuple[tuple[float, float], ...]
     heading: tuple[float, ...]
     score: tuple[float, ...]
+    heading_std: tuple[float, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -150,6 +152,8 @@ def encode(message: Message) -> bytes:
     elif isinstance(message, DetectionsMessage):
         body.update(frame=message.frame, time=message.time, position=[list(p) for p in message.position],
                     heading=list(message.heading), score=list(message.score))
+        if message.heading_std is not None:
+            body["heading_std"] = list(message.heading_std)
     elif isinstance(message, Status):
         body["counters"] = message.counters
     elif isinstance(message, HeadingReport):
@@ -224,8 +228,10 @@ class _Fields:
             raise self.error(name, f"must be a finite number, got {value!r}")
         return float(value)
 
-    def numbers(self, name: str, length: int | None = None) -> tuple[float, ...]:
-        value = self._get(name)
+    def numbers(self, name: str, length: int | None = None, optional: bool = False) -> tuple[float, ...] | None:
+        value = self._get(name, optional)
+        if value is None and optional:
+            return None
         if not isinstance(value, list):
             raise self.error(name, f"must be a list, got {type(value).__name__}")
         if length is not None and len(value) != length:
@@ -258,7 +264,8 @@ def _detections(f: _Fields) -> DetectionsMessage:
             raise f.error(f"position[{i}]", f"must be an [x, y] pair, got {pair!r}")
         position.append((f._finite(f"position[{i}]", pair[0]), f._finite(f"position[{i}]", pair[1])))
     msg = DetectionsMessage(frame=frame, time=time, position=tuple(position),  # type: ignore[arg-type]
-                            heading=f.numbers("heading", len(raw)), score=f.numbers("score", len(raw)))
+                            heading=f.numbers("heading", len(raw)), score=f.numbers("score", len(raw)),  # type: ignore[arg-type]
+                            heading_std=f.numbers("heading_std", len(raw), optional=True))
     f.finish()
     return msg
 
@@ -274,7 +281,7 @@ def _team(f: _Fields) -> TeamState:
             raise f.error(f"robots[{i}]", "must be an object")
         sub = _Fields(f"team.robots[{i}]", item)
         sub.used.clear()
-        pos = sub.numbers("position", 2)
+        pos = cast(tuple[float, float], sub.numbers("position", 2))
         robots.append(RobotEstimate(id=sub.integer("id"), position=(pos[0], pos[1]), heading=sub.number("heading", True),
                                     confidence=sub.number("confidence", True), age=sub.number("age")))  # type: ignore[arg-type]
         sub.finish()

@@ -1,0 +1,206 @@
+"""``lookalike serve`` (the observer node), ``lookalike robot-sim`` and ``lookalike camera-sim``."""
+
+from __future__ import annotations
+
+import json
+import logging
+import signal
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from lookalike.cli.app import app, fail
+from lookalike.cli.track import build_tracker
+from lookalike.node import (
+    Endpoint,
+    IdentifierConfig,
+    NodeConfig,
+    NodeServer,
+    log_event,
+    parse_address,
+)
+from lookalike.node.teamsim import (
+    SimClock,
+    camera_messages,
+    run_camera,
+    run_robot,
+    team_sequence,
+)
+from lookalike.sim.presets import PRESET_NAMES
+from lookalike.trackers import tracker_parameters
+
+
+class _Stop:
+    """Set by SIGINT/SIGTERM (or a deadline); the serving loops poll it."""
+
+    def __init__(self, duration_s: float = 0.0) -> None:
+        self.deadline = time.monotonic() + duration_s if duration_s > 0 else None
+        self.signal: int | None = None
+        self._old: dict[int, Any] = {}
+
+    def __enter__(self) -> _Stop:  # noqa: PYI034
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            self._old[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for sig, handler in self._old.items():
+            signal.signal(sig, handler)
+
+    def _handle(self, signum: int, _frame: object) -> None:
+        self.signal = signum
+
+    def __call__(self) -> bool:
+        return self.signal is not None or (self.deadline is not None and time.monotonic() >= self.deadline)
+
+
+def _logger(level: str) -> logging.Logger:
+    """The node's logger: one JSON object per line on stderr, with a time stamp and level."""
+    numeric = logging.getLevelName(level.upper())
+    if not isinstance(numeric, int):
+        fail(f"--log-level: unknown level {level!r}; use debug, info, warning or error")
+    logger = logging.getLogger("lookalike.node")
+    logger.handlers.clear()
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter('{"ts":%(created).3f,"level":"%(levelname)s","log":%(message)s}'))
+    logger.addHandler(handler)
+    logger.setLevel(numeric)
+    logger.propagate = False
+    return logger
+
+
+def _address(text: str, option: str) -> tuple[str, int]:
+    try:
+        return parse_address(text)
+    except ValueError as exc:
+        fail(f"{option}: {exc}")
+    raise AssertionError  # unreachable: fail() exits
+
+
+@app.command()
+def serve(
+    tracker: str = typer.Option("lstm", "--tracker", "-t", help="Registered tracker/identifier name."),
+    set_: list[str] | None = typer.Option(None, "--set", "-s", help="Tracker parameter KEY=VALUE (repeatable)."),
+    robots: int = typer.Option(3, help="Robots in the team (ids 0..N-1); also the tracker's n_agents unless set."),
+    listen: str = typer.Option("127.0.0.1:7700", help="HOST:PORT to receive reports and detections on (port 0: any)."),
+    publish: list[str] | None = typer.Option(None, help="HOST:PORT that receives every team state (repeatable)."),
+    reply: bool = typer.Option(True, help="Also send each team state to the address every robot reports from."),
+    max_report_age: float = typer.Option(1.0, help="Drop reports sent this many seconds before the last frame."),
+    camera_timeout: float = typer.Option(2.0, help="Wall seconds without frames before the camera counts as lost."),
+    rate: float = typer.Option(2000.0, help="Packets/s one sender may send before being rate-limited."),
+    burst: float = typer.Option(500.0, help="Packets one sender may send at once."),
+    status_interval: float = typer.Option(5.0, help="Seconds between status log lines (0: none)."),
+    duration: float = typer.Option(0.0, help="Stop after this many wall seconds (0: run until SIGINT/SIGTERM)."),
+    port_file: Path | None = typer.Option(None, help="Write the bound HOST:PORT to this file once listening."),
+    log_level: str = typer.Option("info", help="debug, info, warning or error."),
+) -> None:
+    """Run the observer node: receive heading reports and detections over UDP, identify the
+    robots with a tracker, publish their positions at the camera rate. Logs are JSON Lines on
+    stderr; send a status_request message for the counters."""
+    listen_address = _address(listen, "--listen")
+    publish_addresses = tuple(_address(p, "--publish") for p in publish or [])
+    settings = list(set_ or [])
+    try:
+        params = {p.name for p in tracker_parameters(tracker)}
+    except KeyError as exc:
+        fail(str(exc.args[0]))
+    if "n_agents" in params and not any(s.split("=", 1)[0].strip() == "n_agents" for s in settings):
+        settings.append(f"n_agents={robots}")
+    trk = build_tracker(tracker, settings)
+    log = _logger(log_level)
+    try:
+        config = NodeConfig(listen=listen_address, publish=publish_addresses,
+                            reply_to_robots=reply, sender_rate=rate, sender_burst=burst,
+                            camera_timeout_s=camera_timeout, status_interval_s=status_interval)
+        id_config = IdentifierConfig(n_robots=robots, max_report_age_s=max_report_age)
+        server = NodeServer(trk, config, id_config, log)
+    except OSError as exc:
+        fail(f"--listen {listen}: {exc}")
+    except ValueError as exc:
+        fail(str(exc))
+    with server, _Stop(duration) as stop:
+        host, port = server.address
+        if port_file is not None:
+            tmp = port_file.with_name(port_file.name + ".tmp")
+            tmp.write_text(f"{host}:{port}\n")
+            tmp.replace(port_file)
+        server.serve(stop)
+        if stop.signal is not None:
+            log_event(log, "signal", signal=stop.signal)
+
+
+def _clock(start_at: str, speed: float) -> SimClock:
+    """``now``, a UNIX time, or ``stdin`` (print ``ready``, then read the UNIX time from stdin)."""
+    if start_at == "stdin":
+        print("ready", flush=True)
+        start_at = sys.stdin.readline().strip()
+    try:
+        epoch = time.time() if start_at == "now" else float(start_at)
+        return SimClock(epoch=epoch, speed=speed)
+    except ValueError as exc:
+        fail(f"--start-at / --speed: {exc}")
+    raise AssertionError  # unreachable
+
+
+_PRESET_HELP = f"Robot-world preset: {', '.join(PRESET_NAMES)}."
+_START_HELP = "Wall time of simulated t=0: now, a UNIX time, or stdin (print 'ready', read it from stdin)."
+
+
+def _sequence(preset_name: str, seed: int, duration: float, loss: float | None, delay: float | None,
+              jitter: float | None) -> Any:
+    try:
+        return team_sequence(preset_name, seed, duration, loss, delay, jitter)
+    except ValueError as exc:
+        fail(str(exc))
+
+
+@app.command("robot-sim")
+def robot_sim(
+    robot: int = typer.Option(..., help="This robot's id (0-based)."),
+    node: str = typer.Option("127.0.0.1:7700", help="The node's HOST:PORT."),
+    preset_name: str = typer.Option("m5n3", "--preset", help=_PRESET_HELP),
+    seed: int = typer.Option(0, help="Seed of the shared simulated sequence."),
+    duration: float = typer.Option(20.0, help="Simulated seconds."),
+    loss: float | None = typer.Option(None, help="Report loss probability (default: the preset's)."),
+    delay: float | None = typer.Option(None, help="Report delay, seconds (default: the preset's)."),
+    jitter: float | None = typer.Option(None, help="Mean exponential jitter, seconds (default: the preset's)."),
+    speed: float = typer.Option(1.0, help="Simulated seconds per wall second (same for the whole team)."),
+    start_at: str = typer.Option("now", help=_START_HELP),
+    bind: str = typer.Option("127.0.0.1:0", help="Local HOST:PORT to send from and receive positions on."),
+) -> None:
+    """A simulated robot: send heading reports to the node over a lossy, jittery link, receive
+    the team state, and print the error of its identified position against its true one (JSON)."""
+    sequence = _sequence(preset_name, seed, duration, loss, delay, jitter)
+    if not 0 <= robot < sequence.config.n_agents:
+        fail(f"--robot {robot}: preset {preset_name} has robots 0..{sequence.config.n_agents - 1}")
+    with Endpoint(_address(node, "--node"), _address(bind, "--bind")) as endpoint:
+        clock = _clock(start_at, speed)
+        with _Stop() as stop:
+            log = run_robot(endpoint, robot, sequence, clock, stop=stop)
+    print(json.dumps(log.summary()), flush=True)
+
+
+@app.command("camera-sim")
+def camera_sim(
+    node: str = typer.Option("127.0.0.1:7700", help="The node's HOST:PORT."),
+    preset_name: str = typer.Option("m5n3", "--preset", help=_PRESET_HELP),
+    seed: int = typer.Option(0, help="Seed of the shared simulated sequence."),
+    duration: float = typer.Option(20.0, help="Simulated seconds."),
+    loss: float | None = typer.Option(None, help="Report loss probability of the team (keeps the sequence shared)."),
+    delay: float | None = typer.Option(None, help="Report delay of the team, seconds."),
+    jitter: float | None = typer.Option(None, help="Mean jitter of the team, seconds."),
+    speed: float = typer.Option(1.0, help="Simulated seconds per wall second (same for the whole team)."),
+    start_at: str = typer.Option("now", help=_START_HELP),
+    first_frame: int = typer.Option(0, help="Start at this frame (to resume after a crash)."),
+) -> None:
+    """A simulated camera: send each frame's detections to the node at the camera rate."""
+    sequence = _sequence(preset_name, seed, duration, loss, delay, jitter)
+    messages = camera_messages(sequence)[max(first_frame, 0):]
+    with Endpoint(_address(node, "--node")) as endpoint:
+        clock = _clock(start_at, speed)
+        with _Stop() as stop:
+            sent = run_camera(endpoint, messages, clock, stop)
+    print(json.dumps({"camera_frames_sent": sent}), flush=True)
