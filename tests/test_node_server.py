@@ -214,3 +214,33 @@ def test_camera_dying_and_coming_back():
             assert node.identifier.tracker.resets == 1
         finally:
             robot.close()
+
+
+class _Exploding(HeadingMatcher):
+    """Raises on frames whose index is odd: a tracker bug the node must survive."""
+
+    def update(self, frame):
+        if frame.index % 2:
+            raise RuntimeError("boom")
+        return super().update(frame)
+
+
+def test_a_failing_tracker_is_counted_and_the_node_goes_on():
+    server = NodeServer(_Exploding(), NodeConfig(status_interval_s=0), IdentifierConfig(n_robots=3))
+    stop = threading.Event()
+    thread = threading.Thread(target=server.serve, args=(stop.is_set, 0.01), daemon=True)
+    thread.start()
+    try:
+        with Endpoint(server.address) as robot, Endpoint(server.address) as camera:
+            robot.send(HeadingReport(robot=0, seq=0, t_sent=0.0, heading=0.0))
+            _wait_for(server.address, lambda c: c["reports"] == 1)
+            for k in range(4):
+                camera.send(_detections(k))
+            teams = _teams(robot, 2)
+            c = _wait_for(server.address, lambda c: c["tracker_errors"] == 2)
+    finally:
+        stop.set()
+        thread.join(timeout=10)
+        server.close()
+    assert [t.frame for t in teams] == [0, 2]
+    assert c["tracker_errors"] == 2 and c["frames"] == 2

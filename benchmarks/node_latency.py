@@ -1,0 +1,98 @@
+"""Node latency: time from reading a detections frame to having published its team state.
+
+Starts ``lookalike serve`` as its own process on loopback, then plays a simulated team in real
+time (30 Hz camera, M=10 detections at most, N=7 robots reporting at 10 Hz with the preset's
+network) from this process, and prints:
+
+- the node's own figure (``latency_ms`` of its counters: socket read to last ``sendto``), and
+- the round trip seen by a subscriber (camera ``sendto`` to the team state's arrival).
+
+Target (issue 8): median <= 2 ms, p99 <= 10 ms.
+
+    .venv/bin/python benchmarks/node_latency.py [--tracker kalman_ha2] [--seconds 20]
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+from lookalike.node import Endpoint, Status, StatusRequest, TeamState
+from lookalike.node.teamsim import SimClock, camera_messages, run_robot, team_sequence
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--tracker", default="kalman_ha2")
+    parser.add_argument("--preset", default="m10n7")
+    parser.add_argument("--seconds", type=float, default=20.0)
+    args = parser.parse_args()
+
+    sequence = team_sequence(args.preset, 0, args.seconds)
+    n_robots = sequence.config.n_agents
+    subscriber = Endpoint(("127.0.0.1", 1))
+    with tempfile.TemporaryDirectory() as tmp:
+        port_file = Path(tmp) / "addr"
+        node = subprocess.Popen(
+            [sys.executable, "-c", "from lookalike.cli import main; main()", "serve", "--tracker", args.tracker,
+             "--robots", str(n_robots), "--listen", "127.0.0.1:0", "--port-file", str(port_file),
+             "--publish", "{}:{}".format(*subscriber.address), "--status-interval", "0", "--log-level", "warning"])
+        while not port_file.is_file():
+            if node.poll() is not None:
+                raise SystemExit("the node did not start")
+            time.sleep(0.05)
+        host, port = port_file.read_text().strip().rsplit(":", 1)
+    address = (host, int(port))
+
+    clock = SimClock(epoch=time.time() + 0.5, speed=1.0)
+    robots = [threading.Thread(target=lambda j=j: run_robot(Endpoint(address), j, sequence, clock, linger_s=0.1))
+              for j in range(n_robots)]
+    sent_at: dict[int, float] = {}
+    arrived_at: dict[int, float] = {}
+
+    def camera() -> None:
+        with Endpoint(address) as cam:
+            for message in camera_messages(sequence):
+                clock.wait_until(message.time)
+                sent_at[message.frame] = time.perf_counter()
+                cam.send(message)
+
+    threads = robots + [threading.Thread(target=camera)]
+    for t in threads:
+        t.start()
+    end = clock.epoch + args.seconds + 1.0
+    while time.time() < end:
+        message = subscriber.receive(0.05)
+        if isinstance(message, TeamState):
+            arrived_at.setdefault(message.frame, time.perf_counter())
+    for t in threads:
+        t.join()
+    with Endpoint(address) as client:
+        client.send(StatusRequest())
+        status = client.receive(2.0)
+    node.terminate()
+    node.wait(timeout=20)
+    if not isinstance(status, Status):
+        raise SystemExit("no status from the node")
+    lat = status.counters.get("latency_ms", {})
+    round_trip = np.array([arrived_at[k] - sent_at[k] for k in arrived_at if k in sent_at]) * 1e3
+    print(f"tracker {args.tracker}, preset {args.preset} (N={n_robots}, M={sequence.config.max_detections}), "
+          f"{len(sequence)} frames at {sequence.config.frame_rate_hz:g} Hz")
+    print(f"node: read frame -> published: median {lat.get('median', float('nan')):.3f} ms, "
+          f"p99 {lat.get('p99', float('nan')):.3f} ms over the last {lat.get('frames', 0)} frames")
+    print(f"subscriber round trip: median {np.median(round_trip):.3f} ms, p99 {np.percentile(round_trip, 99):.3f} ms "
+          f"({round_trip.size} of {len(sequence)} frames received)")
+    c = status.counters
+    print(f"counters: frames {c['frames']} reports {c['reports']} late {c['late']} published {c['published']} "
+          f"rejected {c['rejected_total']}")
+
+
+if __name__ == "__main__":
+    main()
