@@ -6,7 +6,7 @@ EXTRAS ?= test,vision,viz,train
 comma := ,
 STAMP := $(VENV)/.installed-$(subst $(comma),-,$(EXTRAS))
 
-.PHONY: venv demo test bench clean
+.PHONY: venv demo test bench clean browser
 
 venv: $(STAMP)
 
@@ -19,8 +19,15 @@ $(STAMP): pyproject.toml constraints.txt
 demo: venv
 	$(VENV)/bin/lookalike demo
 
-test: venv
+test: venv browser
 	$(PY) -m pytest -q
+
+# Debian's Chromium for the browser tests; skipped quietly where it cannot be installed
+# (the tests then skip with a reason).
+browser:
+	@command -v chromium >/dev/null 2>&1 || { command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ] && \
+		(apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) ; } \
+		|| echo "chromium not available: browser tests will be skipped"
 
 # The peers need numpy < 2, so benchmarks run in their own environment.
 BENCH_VENV := .venv-bench
