@@ -165,3 +165,52 @@ def test_team_on_loopback_matches_offline_identification(tmp_path, tracker, sett
     offline = offline_identification(sequence, make_tracker(tracker, n_agents=3, **settings))
     assert covered >= 0.95 * n_frames
     assert abs(online - offline) <= 0.02, (online, offline)
+
+
+def _status_of(address: tuple[str, int]) -> dict:
+    with Endpoint(address) as client:
+        for _ in range(20):
+            client.send(StatusRequest())
+            status = client.receive(0.5)
+            if isinstance(status, Status):
+                return status.counters
+    raise AssertionError("no status reply")
+
+
+def test_camera_process_killed_and_restarted(tmp_path):
+    duration, speed = 8.0, 2.0
+    team = ["--preset", PRESET, "--seed", "1", "--duration", str(duration), "--speed", str(speed)]
+    node, address = _serve(tmp_path, "--tracker", "kalman_ha2", "--camera-timeout", "0.3")
+    node_arg = "{}:{}".format(*address)
+    robot = _start(["robot-sim", "--robot", "0", "--node", node_arg, *team, "--start-at", "stdin"], stdin=subprocess.PIPE)
+    camera = _start(["camera-sim", "--node", node_arg, *team, "--start-at", "stdin"], stdin=subprocess.PIPE)
+    second = None
+    try:
+        for proc in (robot, camera):
+            assert _readline(proc, 60) == "ready"
+        epoch = time.time() + 0.3
+        for proc in (robot, camera):
+            proc.stdin.write(f"{epoch}\n")
+            proc.stdin.flush()
+        time.sleep(0.3 + 1.0)
+        camera.kill()  # dies without a word
+        camera.wait(timeout=10)
+        before = _status_of(address)
+        assert before["frames"] > 0
+        # A new camera process resumes the shared clock after the last frame the node saw.
+        second = _start(["camera-sim", "--node", node_arg, *team, "--start-at", str(epoch),
+                         "--first-frame", str(before["frames"] + 1)])
+        assert json.loads(_readline(second, 30))["camera_frames_sent"] > 0
+        assert second.wait(timeout=10) == 0
+        summary = json.loads(_readline(robot, 10))
+        assert robot.wait(timeout=10) == 0
+    finally:
+        for proc in (robot, camera, second):
+            if proc is not None and proc.poll() is None:
+                proc.kill()
+        code, logs = _stop(node)
+    assert code == 0
+    counters = logs[-1]["log"]["counters"]
+    assert counters["camera_lost"] >= 1 and counters["tracker_errors"] == 0
+    assert counters["frames"] > before["frames"] + 10
+    assert summary["team_states"] > before["frames"] + 10  # the robot kept receiving positions

@@ -19,6 +19,7 @@ from lookalike.node import (
     IdentifierConfig,
     NodeConfig,
     NodeServer,
+    TeamState,
     log_event,
     parse_address,
 )
@@ -170,6 +171,7 @@ def robot_sim(
     speed: float = typer.Option(1.0, help="Simulated seconds per wall second (same for the whole team)."),
     start_at: str = typer.Option("now", help=_START_HELP),
     bind: str = typer.Option("127.0.0.1:0", help="Local HOST:PORT to send from and receive positions on."),
+    verbose: bool = typer.Option(False, help="Print every received position and its error as JSON on stderr."),
 ) -> None:
     """A simulated robot: send heading reports to the node over a lossy, jittery link, receive
     the team state, and print the error of its identified position against its true one (JSON)."""
@@ -179,8 +181,19 @@ def robot_sim(
     with Endpoint(_address(node, "--node"), _address(bind, "--bind")) as endpoint:
         clock = _clock(start_at, speed)
         with _Stop() as stop:
-            log = run_robot(endpoint, robot, sequence, clock, stop=stop)
+            log = run_robot(endpoint, robot, sequence, clock, stop=stop,
+                            on_position=_print_position(robot) if verbose else None)
     print(json.dumps(log.summary()), flush=True)
+
+
+def _print_position(robot: int) -> Any:
+    def show(team: TeamState, error_m: float) -> None:
+        mine = next(r for r in team.robots if r.id == robot)
+        print(json.dumps({"frame": team.frame, "time": team.time, "position": mine.position, "heading": mine.heading,
+                          "confidence": mine.confidence, "age": mine.age, "error_m": round(error_m, 4)}),
+              file=sys.stderr, flush=True)
+
+    return show
 
 
 @app.command("camera-sim")

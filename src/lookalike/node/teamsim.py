@@ -135,10 +135,11 @@ class RobotLog:
 
 
 def run_robot(endpoint: Endpoint, robot: int, sequence: RobotSequence, clock: SimClock,
-              linger_s: float = 0.5, stop: Callable[[], bool] = lambda: False) -> RobotLog:
+              linger_s: float = 0.5, stop: Callable[[], bool] = lambda: False,
+              on_position: Callable[[TeamState, float], None] | None = None) -> RobotLog:
     """Send robot ``robot``'s reports on time, meanwhile receive team states and log the error of
-    the node's estimate of this robot against its true observer-frame position; stop ``linger_s``
-    simulated seconds after the last frame."""
+    the node's estimate of this robot against its true observer-frame position (also passed to
+    ``on_position(team_state, error_m)``); stop ``linger_s`` simulated seconds after the last frame."""
     log = RobotLog(robot)
     truth = sequence.arrays.true_position[:, robot]
     schedule = robot_reports(sequence, robot)
@@ -159,7 +160,10 @@ def run_robot(endpoint: Endpoint, robot: int, sequence: RobotSequence, clock: Si
             log.team_states += 1
             for estimate in message.robots:
                 if estimate.id == robot and 0 <= message.frame < len(truth):
-                    log.errors_m.append(float(np.hypot(*(np.asarray(estimate.position) - truth[message.frame]))))
+                    error = float(np.hypot(*(np.asarray(estimate.position) - truth[message.frame])))
+                    log.errors_m.append(error)
+                    if on_position is not None:
+                        on_position(message, error)
     return log
 
 
