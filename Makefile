@@ -6,7 +6,7 @@ EXTRAS ?= test,vision,viz,train
 comma := ,
 STAMP := $(VENV)/.installed-$(subst $(comma),-,$(EXTRAS))
 
-.PHONY: venv demo test bench clean browser
+.PHONY: venv demo test bench clean browser train
 
 venv: $(STAMP)
 
@@ -39,6 +39,12 @@ $(BENCH_VENV)/.installed: pyproject.toml constraints-bench.txt
 
 bench: $(BENCH_VENV)/.installed
 	@for script in benchmarks/[a-z]*.py; do echo "== $$script"; $(BENCH_VENV)/bin/python $$script || exit 1; done
+
+# Reproduce the shipped LSTM weights (about 10-40 minutes per set-up on 2 cores).
+train: venv
+	$(VENV)/bin/lookalike train --preset m3n2 -o runs/m3n2 --steps 3000 --minutes 25 --ship
+	$(VENV)/bin/lookalike train --preset m5n3 -o runs/m5n3 --steps 8000 --minutes 35 --ship
+	$(VENV)/bin/lookalike train --preset m10n7 -o runs/m10n7 --steps 8000 --minutes 40 --ship
 
 clean:
 	rm -rf $(VENV) $(BENCH_VENV) demo-out .pytest_cache
