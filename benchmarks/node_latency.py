@@ -5,7 +5,8 @@ time (30 Hz camera, M=10 detections at most, N=7 robots reporting at 10 Hz with 
 network) from this process, and prints:
 
 - the node's own figure (``latency_ms`` of its counters: socket read to last ``sendto``), and
-- the round trip seen by a subscriber (camera ``sendto`` to the team state's arrival).
+- the round trip seen by a subscriber (camera ``sendto`` to the team state's arrival), and
+- without sockets, in this process: decode + identify + encode per frame, and the tracker's share.
 
 Target (issue 8): median <= 2 ms, p99 <= 10 ms.
 
@@ -24,8 +25,52 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.node import Endpoint, Status, StatusRequest, TeamState
-from lookalike.node.teamsim import SimClock, camera_messages, run_robot, team_sequence
+from lookalike.node import (
+    Endpoint,
+    IdentifierConfig,
+    Status,
+    StatusRequest,
+    TeamIdentifier,
+    TeamState,
+    decode,
+    encode,
+)
+from lookalike.node.teamsim import (
+    SimClock,
+    camera_messages,
+    robot_reports,
+    run_robot,
+    team_sequence,
+)
+from lookalike.trackers import make_tracker
+
+
+def in_process(tracker_name: str, sequence) -> tuple[np.ndarray, np.ndarray]:
+    """Per-frame milliseconds of decode + identify + encode, and of ``tracker.update`` alone."""
+    n = sequence.config.n_agents
+    identifier = TeamIdentifier(make_tracker(tracker_name, n_agents=n), IdentifierConfig(n_robots=n))
+    tracker, tracker_ms = identifier.tracker, []
+    update = tracker.update
+
+    def timed(frame):
+        t0 = time.perf_counter()
+        out = update(frame)
+        tracker_ms.append((time.perf_counter() - t0) * 1e3)
+        return out
+
+    tracker.update = timed
+    reports = sorted((item for j in range(n) for item in robot_reports(sequence, j)), key=lambda item: item[0])
+    total_ms, i = [], 0
+    for data in [encode(m) for m in camera_messages(sequence)]:
+        t0 = time.perf_counter()
+        message = decode(data)
+        while i < len(reports) and reports[i][0] <= message.time:
+            identifier.add_report(reports[i][1])
+            i += 1
+        _, team = identifier.add_frame(message)
+        encode(team)
+        total_ms.append((time.perf_counter() - t0) * 1e3)
+    return np.array(total_ms), np.array(tracker_ms)
 
 
 def main() -> None:
@@ -90,6 +135,10 @@ def main() -> None:
     print(f"subscriber round trip: median {np.median(round_trip):.3f} ms, p99 {np.percentile(round_trip, 99):.3f} ms "
           f"({round_trip.size} of {len(sequence)} frames received)")
     c = status.counters
+    total, tracker = in_process(args.tracker, sequence)
+    print(f"in process, no sockets: decode+identify+encode median {np.median(total):.3f} ms, "
+          f"p99 {np.percentile(total, 99):.3f} ms; tracker alone median {np.median(tracker):.3f} ms, "
+          f"p99 {np.percentile(tracker, 99):.3f} ms")
     print(f"counters: frames {c['frames']} reports {c['reports']} late {c['late']} published {c['published']} "
           f"rejected {c['rejected_total']}")
 
