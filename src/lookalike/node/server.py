@@ -177,6 +177,7 @@ class NodeServer:
 
     def _frame(self, message: DetectionsMessage, addr: Address, t_received: float) -> None:
         restarts = self.identifier.restarts
+        self._last_frame_wall = time.monotonic()  # any valid frame shows the camera is alive
         try:
             outcome, team = self.identifier.add_frame(message)
         except Exception as exc:  # noqa: BLE001 (a tracker bug must not take the node down)
@@ -190,7 +191,6 @@ class NodeServer:
         if team is None:
             log_event(self.log, outcome, logging.DEBUG, sender=list(addr), frame=message.frame)
             return
-        self._last_frame_wall = time.monotonic()
         self._publish(team)
         self.counters.latency_s.append(time.perf_counter() - t_received)
 
