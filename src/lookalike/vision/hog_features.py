@@ -74,12 +74,12 @@ def orientation_maps(grey: np.ndarray, bins: int = BINS) -> np.ndarray:
     ang = np.mod(np.arctan2(gy, gx), np.pi) * (bins / np.pi) - 0.5  # bin centres at integers
     lo = np.floor(ang)
     frac = (ang - lo).astype(np.float32)
-    lo = lo.astype(np.int64) % bins
-    hi = (lo + 1) % bins
-    out = np.zeros((bins,) + g.shape, dtype=np.float32)
-    rows, cols = np.indices(g.shape)
-    np.add.at(out, (lo, rows, cols), mag * (1.0 - frac))
-    np.add.at(out, (hi, rows, cols), mag * frac)
+    lo = lo.astype(np.int16) % bins
+    w_hi = mag * frac
+    w_lo = mag - w_hi
+    out = np.empty((bins,) + g.shape, dtype=np.float32)
+    for b in range(bins):
+        out[b] = np.where(lo == b, w_lo, 0.0) + np.where(lo == (b - 1) % bins, w_hi, 0.0)
     return out
 
 
@@ -121,3 +121,45 @@ def dense_hog(channel: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndarray
     quads = np.stack([cells[:, :-1, :-1], cells[:, :-1, 1:], cells[:, 1:, :-1], cells[:, 1:, 1:]])
     area = float(cell_px * cell_px)
     return block_descriptor(quads, eps=area).astype(np.float32).ravel()
+
+
+def crop_window(grey: np.ndarray, xywh: np.ndarray, window_px: tuple[int, int], pad: float = 0.1) -> np.ndarray:
+    """A ``(h+2, w+2)`` float32 crop of ``grey (H, W)`` around box ``xywh`` (px), widened to the window's aspect
+    ratio with ``pad`` (fraction of the box height) of context, resized, with a 1-px margin for gradients."""
+    import cv2
+
+    w_px, h_px = window_px
+    x, y, w, h = (float(v) for v in xywh)
+    cx, cy = x + w / 2, y + h / 2
+    hh = h * (1.0 + 2.0 * pad)
+    ww = hh * w_px / h_px
+    sx, sy = ww / w_px, hh / h_px
+    # Affine map from the output (with margin) to the source image.
+    m = np.float32([[sx, 0, cx - ww / 2 - sx], [0, sy, cy - hh / 2 - sy]])
+    return cv2.warpAffine(np.asarray(grey, np.float32), m, (w_px + 2, h_px + 2),
+                          flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE)
+
+
+def augment_windows(windows: np.ndarray, copies: int, rng: np.random.Generator, max_rot_deg: float = 15.0,
+                    scale_std: float = 0.06, cutout: float = 0.5) -> np.ndarray:
+    """``copies`` random variants of each ``(h, w)`` window: rotation within ±``max_rot_deg`` (normal, clipped),
+    scale jitter, horizontal flip, and with probability ``cutout`` a cut-out rectangle (up to a quarter of
+    the window) filled with the window's mean (partial occlusion)."""
+    import cv2
+
+    out = []
+    for win in np.asarray(windows, np.float32):
+        h, w = win.shape
+        for _ in range(copies):
+            ang = float(np.clip(rng.normal(0, max_rot_deg / 2), -max_rot_deg, max_rot_deg))
+            m = cv2.getRotationMatrix2D((w / 2, h / 2), ang, float(np.exp(rng.normal(0, scale_std))))
+            v = cv2.warpAffine(win, m, (w, h), borderMode=cv2.BORDER_REPLICATE)
+            if rng.random() < 0.5:
+                v = v[:, ::-1]
+            if rng.random() < cutout:
+                ch, cw = int(rng.integers(h // 8, h // 2)), int(rng.integers(w // 4, w // 2 + 1))
+                y0, x0 = int(rng.integers(0, h - ch)), int(rng.integers(0, w - cw))
+                v = v.copy()
+                v[y0 : y0 + ch, x0 : x0 + cw] = v.mean()
+            out.append(np.ascontiguousarray(v))
+    return np.array(out, dtype=np.float32).reshape(-1, *np.asarray(windows).shape[1:])

@@ -1,0 +1,338 @@
+"""HOG cascade detector (seed A, DESIGN §6): variable-size HOG blocks, boosted stages, a cascade of rejectors.
+
+A window of ``window_px`` (width, height) is described by a pool of rectangular blocks of several
+sizes and aspect ratios; each block is split into 2×2 cells and gives an L2-normalised 36-value
+descriptor read from per-orientation integral histograms (:mod:`lookalike.vision.hog_features`).
+Stage ``k`` of the cascade is a discrete AdaBoost (scikit-learn, decision stumps) over the pooled
+block descriptors, with a threshold set so that the stage keeps ``stage_hit_rate`` of the training
+positives; a window is a detection when every stage accepts it. Between stages the negatives are
+refilled with windows of negative images that the cascade so far still accepts (hard negatives).
+
+Detection slides the window over an image pyramid, keeps the windows that pass every stage, maps
+their last-stage margin to a probability with a logistic fit, and applies non-maximum suppression.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from lookalike.geometry.boxes import iou_matrix
+from lookalike.types import Detections
+from lookalike.vision.hog_features import (
+    BINS,
+    as_bgr_image,
+    integral_maps,
+    orientation_maps,
+    to_grey,
+)
+
+FORMAT = "lookalike-hog-cascade"
+VERSION = 1
+
+
+@dataclass(frozen=True)
+class CascadeConfig:
+    """Training and detection settings; sizes in pixels."""
+
+    window_px: tuple[int, int] = (32, 64)  # width, height
+    cell_px: int = 4  # block positions and sizes are multiples of this
+    stages: int = 20
+    stage_hit_rate: float = 0.995
+    max_stumps: int = 40
+    negatives_per_stage: int = 2000
+    scale_step: float = 1.2
+    min_height_px: float = 48.0
+    max_height_px: float = 320.0
+    stride_cells: int = 2
+    nms_iou: float = 0.4
+
+    def __post_init__(self) -> None:
+        w, h = self.window_px
+        if w % self.cell_px or h % self.cell_px or w < 4 * self.cell_px or h < 4 * self.cell_px:
+            raise ValueError(f"CascadeConfig.window_px: {self.window_px} must be multiples of cell_px and >= 4 cells")
+        if not 1 <= self.stages <= 100:
+            raise ValueError(f"CascadeConfig.stages: must be in 1..100, got {self.stages}")
+        if not 0.5 < self.stage_hit_rate <= 1:
+            raise ValueError(f"CascadeConfig.stage_hit_rate: must be in (0.5, 1], got {self.stage_hit_rate}")
+        if self.scale_step <= 1:
+            raise ValueError(f"CascadeConfig.scale_step: must be > 1, got {self.scale_step}")
+
+
+def block_pool(window_px: tuple[int, int], cell_px: int) -> np.ndarray:
+    """``(b, 4)`` blocks ``(x, y, w, h)`` in pixels inside the window: several sizes and aspect ratios, even
+    numbers of cells so that each block splits into 2×2 cells, stepped by half a block."""
+    w, h = window_px[0] // cell_px, window_px[1] // cell_px
+    blocks = set()
+    for bw in range(2, w + 1, 2):
+        for bh in range(2, h + 1, 2):
+            if max(bw, bh) > 3 * min(bw, bh):
+                continue
+            sx, sy = max(1, bw // 2), max(1, bh // 2)
+            for y in range(0, h - bh + 1, sy):
+                for x in range(0, w - bw + 1, sx):
+                    blocks.add((x * cell_px, y * cell_px, bw * cell_px, bh * cell_px))
+    return np.array(sorted(blocks), dtype=np.int64)
+
+
+def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray) -> np.ndarray:
+    """Descriptors of ``blocks (b, 4)`` for windows at offsets ``ox, oy (k,)`` (px) of ``integral (BINS, H+1, W+1)``;
+    returns ``(k, b * 4 * BINS)`` float32."""
+    out = []
+    for bx, by, bw, bh in blocks:
+        hw, hh = bw // 2, bh // 2
+        cells = []
+        for cy in (0, 1):
+            for cx in (0, 1):
+                x0 = ox + bx + cx * hw
+                y0 = oy + by + cy * hh
+                cells.append(integral[:, y0 + hh, x0 + hw] - integral[:, y0, x0 + hw]
+                             - integral[:, y0 + hh, x0] + integral[:, y0, x0])
+        d = np.concatenate(cells, axis=0)  # (4 * BINS, k)
+        d /= np.sqrt((d * d).sum(axis=0, keepdims=True)) + float(bw * bh)
+        out.append(d.T)
+    return np.concatenate(out, axis=1).astype(np.float32) if out else np.zeros((len(ox), 0), np.float32)
+
+
+def window_features(windows: np.ndarray, blocks: np.ndarray) -> np.ndarray:
+    """Pooled descriptors ``(n, b * 36)`` of ``windows (n, h+2, w+2)`` grey crops with a 1-px margin."""
+    wins = np.asarray(windows, dtype=np.float32)
+    if wins.ndim != 3 or len(wins) == 0:
+        return np.zeros((0, len(blocks) * 4 * BINS), np.float32)
+    n, hh, ww = wins.shape
+    # Tile the windows side by side: one gradient pass and one integral image serve them all; each
+    # window's 1-px margin keeps its gradients its own.
+    tiled = wins.transpose(1, 0, 2).reshape(hh, n * ww)
+    integral = integral_maps(orientation_maps(tiled))
+    ox = np.arange(n, dtype=np.int64) * ww + 1
+    oy = np.ones(n, dtype=np.int64)
+    return block_features(integral, blocks, ox, oy)
+
+
+@dataclass
+class Stage:
+    """One boosted rejector: stumps on feature ``index`` (pooled descriptor column) at ``threshold``; each votes
+    ``weight`` times +1 (above when ``sign`` is +1, below when -1) or -1; the stage accepts when the sum >= ``bias``."""
+
+    index: np.ndarray
+    threshold: np.ndarray
+    sign: np.ndarray
+    weight: np.ndarray
+    bias: float
+
+    def margin(self, features: np.ndarray) -> np.ndarray:
+        votes = np.where((features[:, self.index] > self.threshold) == (self.sign > 0), 1.0, -1.0)
+        return votes @ self.weight
+
+
+@dataclass
+class HogCascade:
+    """A trained cascade; call it on an image to get :class:`Detections`."""
+
+    config: CascadeConfig
+    blocks: np.ndarray
+    stages: list[Stage]
+    calibration: tuple[float, float] = (1.0, 0.0)  # probability = sigmoid(a * last margin + b)
+    _needed: dict = field(default_factory=dict, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        used = np.unique(np.concatenate([s.index for s in self.stages])) if self.stages else np.zeros(0, int)
+        self._needed = {int(b): i for i, b in enumerate(np.unique(used // (4 * BINS)))}
+
+    def classify(self, features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(accepted (n,) bool, last-stage margin (n,))`` for pooled descriptors ``(n, b * 36)``."""
+        alive = np.ones(len(features), bool)
+        margin = np.zeros(len(features))
+        for stage in self.stages:
+            idx = np.flatnonzero(alive)
+            m = stage.margin(features[idx])
+            margin[idx] = m
+            alive[idx[m < stage.bias]] = False
+        return alive, margin
+
+    def __call__(self, image: np.ndarray) -> Detections:
+        """Detections (boxes in pixels, probability scores) in a ``(h, w, 3)`` BGR or grey image."""
+        import cv2
+
+        cfg = self.config
+        grey = to_grey(as_bgr_image(image))
+        win_w, win_h = cfg.window_px
+        step = cfg.stride_cells * cfg.cell_px
+        boxes, margins = [], []
+        scale = win_h / cfg.min_height_px
+        while win_h / scale <= cfg.max_height_px:
+            size = (int(round(grey.shape[1] * scale)), int(round(grey.shape[0] * scale)))
+            if size[0] < win_w or size[1] < win_h:
+                break
+            level = cv2.resize(grey, size, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
+            integral = integral_maps(orientation_maps(level))
+            ys, xs = np.mgrid[0 : size[1] - win_h + 1 : step, 0 : size[0] - win_w + 1 : step]
+            ox, oy = xs.ravel(), ys.ravel()
+            alive = np.arange(len(ox))
+            margin = np.zeros(0)
+            cache: dict[int, np.ndarray] = {}
+            for stage in self.stages:
+                if not len(alive):
+                    break
+                cols = np.empty((len(alive), len(stage.index)), np.float32)
+                for j, col in enumerate(stage.index):
+                    b = int(col) // (4 * BINS)
+                    if b not in cache:
+                        cache[b] = block_features(integral, self.blocks[b : b + 1], ox, oy)
+                    cols[:, j] = cache[b][alive, int(col) % (4 * BINS)]
+                votes = np.where((cols > stage.threshold) == (stage.sign > 0), 1.0, -1.0)
+                margin = votes @ stage.weight
+                keep = margin >= stage.bias
+                alive, margin = alive[keep], margin[keep]
+            for k, m in zip(alive, margin):
+                boxes.append((ox[k] / scale, oy[k] / scale, win_w / scale, win_h / scale))
+                margins.append(m)
+            scale /= cfg.scale_step
+        if not boxes:
+            return Detections.empty()
+        xywh = np.array(boxes, dtype=float)
+        a, b = self.calibration
+        prob = 1.0 / (1.0 + np.exp(-(a * np.array(margins) + b)))
+        keep = nms(xywh, prob, cfg.nms_iou)
+        return Detections(xywh=xywh[keep], score=prob[keep])
+
+    detect = __call__
+
+    def save(self, path: str | Path) -> Path:
+        """Write the model to ``path`` (``.npz``) with its format name and version."""
+        path = Path(path)
+        header = {"format": FORMAT, "version": VERSION, "config": asdict(self.config),
+                  "calibration": list(self.calibration), "biases": [s.bias for s in self.stages]}
+        arrays = {"blocks": self.blocks}
+        for k, s in enumerate(self.stages):
+            arrays.update({f"s{k}_index": s.index, f"s{k}_threshold": s.threshold, f"s{k}_sign": s.sign,
+                           f"s{k}_weight": s.weight})
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with open(path, "wb") as fh:
+            np.savez(fh, header=np.array(json.dumps(header)), **arrays)
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> HogCascade:
+        """Read a model written by :meth:`save`; a foreign, corrupt or newer file raises ``ValueError``."""
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                header = json.loads(str(data["header"]))
+                arrays = {k: data[k] for k in data.files}
+        except (OSError, ValueError, KeyError, json.JSONDecodeError) as exc:
+            raise ValueError(f"{path}: not a readable HOG cascade model ({exc})") from None
+        if header.get("format") != FORMAT:
+            raise ValueError(f"{path}: not a HOG cascade model (format {header.get('format')!r})")
+        if header.get("version") != VERSION:
+            raise ValueError(f"{path}: model version {header.get('version')} but this lookalike reads version {VERSION}")
+        try:
+            cfg = header["config"]
+            config = CascadeConfig(**{**cfg, "window_px": tuple(cfg["window_px"])})
+            stages = [Stage(arrays[f"s{k}_index"], arrays[f"s{k}_threshold"], arrays[f"s{k}_sign"],
+                            arrays[f"s{k}_weight"], float(b)) for k, b in enumerate(header["biases"])]
+            model = cls(config, arrays["blocks"], stages, tuple(header["calibration"]))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"{path}: corrupt HOG cascade model ({exc})") from None
+        expected = block_pool(config.window_px, config.cell_px)
+        if not np.array_equal(expected, model.blocks):
+            raise ValueError(f"{path}: block pool does not match window {config.window_px}")
+        return model
+
+
+def nms(xywh: np.ndarray, score: np.ndarray, iou: float) -> np.ndarray:
+    """Indices of boxes kept by greedy non-maximum suppression (highest score first)."""
+    order = np.argsort(-score, kind="stable")
+    overlap = iou_matrix(xywh[order], xywh[order])
+    keep: list[int] = []
+    suppressed = np.zeros(len(order), bool)
+    for i in range(len(order)):
+        if suppressed[i]:
+            continue
+        keep.append(int(order[i]))
+        suppressed |= overlap[i] > iou
+    return np.array(keep, dtype=int)
+
+
+def train_cascade(
+    positives: np.ndarray,
+    negative_windows: Callable[[int, np.random.Generator], np.ndarray],
+    config: CascadeConfig = CascadeConfig(),
+    seed: int = 0,
+    progress: Callable[[int, str], None] | None = None,
+) -> HogCascade:
+    """Train a cascade.
+
+    Args:
+        positives: ``(n, h+2, w+2)`` grey positive windows with a 1-px margin (augmented already).
+        negative_windows: ``(count, rng) -> (m, h+2, w+2)`` random background windows (called repeatedly;
+            those the cascade so far rejects are discarded, so only hard negatives are kept).
+        progress: called with ``(stage, message)`` after each stage.
+    """
+    from sklearn.ensemble import AdaBoostClassifier
+    from sklearn.linear_model import LogisticRegression
+    from sklearn.tree import DecisionTreeClassifier
+
+    rng = np.random.default_rng(seed)
+    blocks = block_pool(config.window_px, config.cell_px)
+    pos = window_features(positives, blocks)
+    model = HogCascade(config, blocks, [])
+    neg = np.zeros((0, pos.shape[1]), np.float32)
+    last_neg = neg
+    for k in range(config.stages):
+        # Refill the negatives with windows that the cascade so far accepts.
+        tries = 0
+        while len(neg) < config.negatives_per_stage and tries < 20:
+            cand = window_features(negative_windows(config.negatives_per_stage, rng), blocks)
+            if model.stages:
+                cand = cand[model.classify(cand)[0]]
+            neg = np.concatenate([neg, cand])[: config.negatives_per_stage]
+            tries += 1
+        if len(neg) < 20:
+            if progress:
+                progress(k, f"stopped: only {len(neg)} hard negatives left")
+            break
+        live = model.classify(pos)[0] if model.stages else np.ones(len(pos), bool)
+        x = np.concatenate([pos[live], neg])
+        y = np.concatenate([np.ones(int(live.sum())), -np.ones(len(neg))])
+        n_stumps = min(config.max_stumps, 3 + 2 * k)
+        boost = AdaBoostClassifier(DecisionTreeClassifier(max_depth=1), n_estimators=n_stumps,
+                                   random_state=int(rng.integers(2**31 - 1)))
+        boost.fit(x, y)
+        stage = _stage_from_boost(boost)
+        m_pos = stage.margin(pos[live])
+        stage.bias = float(np.quantile(m_pos, 1.0 - config.stage_hit_rate)) - 1e-9
+        model.stages.append(stage)
+        model.__post_init__()
+        rejected = float((stage.margin(neg) < stage.bias).mean())
+        last_neg = neg
+        neg = neg[stage.margin(neg) >= stage.bias]
+        if progress:
+            progress(k, f"{len(stage.index)} stumps, rejects {rejected:.1%} of {len(last_neg)} negatives")
+    # Probability: logistic fit of the last-stage margin, positives vs the last negatives.
+    if model.stages and len(last_neg):
+        last = model.stages[-1]
+        m = np.concatenate([last.margin(pos), last.margin(last_neg)])
+        yy = np.concatenate([np.ones(len(pos)), np.zeros(len(last_neg))])
+        lr = LogisticRegression().fit(m[:, None], yy)
+        model.calibration = (float(lr.coef_[0, 0]), float(lr.intercept_[0]))
+    return model
+
+
+def _stage_from_boost(boost) -> Stage:
+    index, threshold, sign, weight = [], [], [], []
+    for est, w in zip(boost.estimators_, boost.estimator_weights_):
+        tree = est.tree_
+        if tree.node_count < 3 or w <= 0:
+            continue
+        left = tree.value[tree.children_left[0]][0]
+        index.append(int(tree.feature[0]))
+        threshold.append(float(tree.threshold[0]))
+        # classes_ are (-1, +1); the right branch (> threshold) votes +1 when the left one is mostly negative.
+        sign.append(1 if left[0] >= left[1] else -1)
+        weight.append(float(w))
+    return Stage(np.array(index, np.int64), np.array(threshold, np.float32), np.array(sign, np.int64),
+                 np.array(weight), 0.0)

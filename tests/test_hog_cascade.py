@@ -1,0 +1,73 @@
+import numpy as np
+import pytest
+
+from lookalike.vision.hog_cascade import CascadeConfig, HogCascade, block_pool, nms, train_cascade, window_features
+from lookalike.vision.hog_features import augment_windows, integral_maps, orientation_maps, rect_sums
+
+
+def _window(rng, positive):
+    """66x34 grey window (1-px margin): a bright upright bar (positive) or random clutter."""
+    w = rng.normal(100, 12, (66, 34)).astype(np.float32)
+    if positive:
+        w[8:58, 11:23] += 90
+    else:
+        y, x = rng.integers(0, 50), rng.integers(0, 20)
+        w[y : y + 16, x : x + 14] += rng.uniform(-80, 80)
+    return w
+
+
+def test_integral_histogram_matches_direct_sums():
+    rng = np.random.default_rng(0)
+    g = rng.uniform(0, 255, (20, 30)).astype(np.float32)
+    maps = orientation_maps(g)
+    np.testing.assert_allclose(maps.sum(axis=0)[1:-1, 1:-1], np.hypot(
+        g[1:-1, 2:] - g[1:-1, :-2], g[2:, 1:-1] - g[:-2, 1:-1]), rtol=1e-5)
+    ii = integral_maps(maps)
+    np.testing.assert_allclose(rect_sums(ii, 3, 2, 11, 9), maps[:, 2:9, 3:11].sum(axis=(1, 2)), rtol=1e-6)
+
+
+def test_train_detect_save_load(tmp_path):
+    rng = np.random.default_rng(1)
+    cfg = CascadeConfig(stages=3, negatives_per_stage=300, min_height_px=64, max_height_px=64, nms_iou=0.3)
+    pos = np.array([_window(rng, True) for _ in range(150)])
+    inner = augment_windows(pos[:, 1:-1, 1:-1], 1, rng, cutout=0.3)
+    pos = np.concatenate([pos, np.pad(inner, ((0, 0), (1, 1), (1, 1)), mode="edge")])
+    model = train_cascade(pos, lambda n, r: np.array([_window(r, False) for _ in range(n)]), cfg, seed=0)
+    assert 1 <= len(model.stages) <= 3
+    blocks = block_pool(cfg.window_px, cfg.cell_px)
+    test_pos = window_features(np.array([_window(rng, True) for _ in range(100)]), blocks)
+    test_neg = window_features(np.array([_window(rng, False) for _ in range(300)]), blocks)
+    assert model.classify(test_pos)[0].mean() > 0.9
+    assert model.classify(test_neg)[0].mean() < 0.1
+    # A scene with one bar: found at the right place, scored as a probability.
+    scene = rng.normal(100, 12, (120, 160)).astype(np.float32)
+    scene[30:80, 71:83] += 90
+    det = model(np.clip(scene, 0, 255).astype(np.uint8))
+    assert len(det) >= 1
+    best = det.xywh[np.argmax(det.score)]
+    assert abs(best[0] + best[2] / 2 - 77) < 8 and abs(best[1] + best[3] / 2 - 55) < 10
+    assert ((det.score > 0) & (det.score < 1)).all()
+    path = model.save(tmp_path / "m.npz")
+    again = HogCascade.load(path)
+    np.testing.assert_array_equal(again(scene.clip(0, 255).astype(np.uint8)).xywh, det.xywh)
+
+
+def test_bad_model_files_are_refused(tmp_path):
+    junk = tmp_path / "junk.npz"
+    junk.write_bytes(b"not a model")
+    with pytest.raises(ValueError, match="not a readable HOG cascade"):
+        HogCascade.load(junk)
+    other = tmp_path / "other.npz"
+    np.savez(other, header=np.array('{"format": "something-else", "version": 1}'))
+    with pytest.raises(ValueError, match="not a HOG cascade model"):
+        HogCascade.load(other)
+    newer = tmp_path / "newer.npz"
+    np.savez(newer, header=np.array('{"format": "lookalike-hog-cascade", "version": 99}'))
+    with pytest.raises(ValueError, match="version 99"):
+        HogCascade.load(newer)
+
+
+def test_nms_keeps_best_of_overlapping():
+    boxes = np.array([[0, 0, 10, 20], [1, 1, 10, 20], [50, 50, 10, 20]], float)
+    keep = nms(boxes, np.array([0.5, 0.9, 0.7]), 0.4)
+    assert keep.tolist() == [1, 2]
