@@ -3,7 +3,8 @@
 The end-to-end test is issue 8's acceptance test: the node, 3 robot processes and a camera
 process run 20 s of simulated time (at 2x real time) with 20% report loss and 100 ms mean jitter;
 every robot must receive its position and the identification success rate must be within
-2 points of the same sequence run offline. Every process is started with a deadline and killed
+2 points of the same sequence run offline (Kalman-HA2 on M=5, N=3; the LSTM on each set-up with
+shipped weights). Every process is started with a deadline and killed
 if it overstays it.
 """
 
@@ -103,32 +104,35 @@ def test_serve_rejects_bad_options(tmp_path):
         assert proc.returncode == 2 and message in err
 
 
-def _lstm_available() -> bool:
+def _lstm_available(n_agents: int, n_slots: int) -> bool:
     try:
-        make_tracker("lstm", n_agents=3, n_slots=5)
-    except Exception:  # noqa: BLE001 (no shipped weights yet: a CheckpointError)
+        make_tracker("lstm", n_agents=n_agents, n_slots=n_slots)
+    except Exception:  # noqa: BLE001 (no shipped weights for this set-up: a CheckpointError)
         return False
     return True
 
 
+def _lstm(preset: str, n_agents: int, n_slots: int):
+    return pytest.param("lstm", preset, {"n_slots": n_slots}, id=f"lstm-{preset}", marks=pytest.mark.skipif(
+        not _lstm_available(n_agents, n_slots), reason=f"no shipped LSTM weights for M={n_slots}, N={n_agents}"))
+
+
 @pytest.mark.parametrize(
-    "tracker, settings",
-    [
-        ("kalman_ha2", {}),
-        pytest.param("lstm", {"n_slots": 5}, marks=pytest.mark.skipif(
-            not _lstm_available(), reason="no shipped LSTM weights for M=5, N=3 yet")),
-    ],
+    "tracker, preset_name, settings",
+    [pytest.param("kalman_ha2", PRESET, {}, id="kalman_ha2-m5n3"), _lstm("m3n2", 2, 3), _lstm(PRESET, 3, 5)],
 )
-def test_team_on_loopback_matches_offline_identification(tmp_path, tracker, settings):
+def test_team_on_loopback_matches_offline_identification(tmp_path, tracker, preset_name, settings):
     sets = [a for k, v in settings.items() for a in ("--set", f"{k}={v}")]
-    team = ["--preset", PRESET, "--seed", str(SEED), "--duration", str(DURATION_S), "--speed", str(SPEED),
+    sequence = team_sequence(preset_name, SEED, DURATION_S, loss=LOSS, jitter_s=JITTER_S)
+    n_robots = sequence.config.n_agents
+    team = ["--preset", preset_name, "--seed", str(SEED), "--duration", str(DURATION_S), "--speed", str(SPEED),
             "--loss", str(LOSS), "--jitter", str(JITTER_S), "--start-at", "stdin"]
     subscriber = Endpoint(("127.0.0.1", 1))
-    node, address = _serve(tmp_path, "--tracker", tracker, *sets, "--robots", "3",
+    node, address = _serve(tmp_path, "--tracker", tracker, *sets, "--robots", str(n_robots),
                            "--publish", "{}:{}".format(*subscriber.address), "--status-interval", "2")
     node_arg = "{}:{}".format(*address)
     sims = [_start(["robot-sim", "--robot", str(j), "--node", node_arg, *team], stdin=subprocess.PIPE)
-            for j in range(3)]
+            for j in range(n_robots)]
     sims.append(_start(["camera-sim", "--node", node_arg, *team], stdin=subprocess.PIPE))
     teams: list[TeamState] = []
     try:
@@ -154,15 +158,14 @@ def test_team_on_loopback_matches_offline_identification(tmp_path, tracker, sett
         subscriber.close()
     assert code == 0, logs[-3:]
     counters = logs[-1]["log"]["counters"]
-    sequence = team_sequence(PRESET, SEED, DURATION_S, loss=LOSS, jitter_s=JITTER_S)
     n_frames = len(sequence)
     assert summaries[-1] == {"camera_frames_sent": n_frames}
-    for j, summary in enumerate(summaries[:3]):
+    for j, summary in enumerate(summaries[:n_robots]):
         assert summary["robot"] == j and summary["reports_sent"] > 0
         assert summary["team_states"] >= 0.9 * n_frames and summary["positions"] > 0, summary
     assert counters["frames"] == n_frames and counters["tracker_errors"] == 0
     online, covered = online_identification(sequence, teams)
-    offline = offline_identification(sequence, make_tracker(tracker, n_agents=3, **settings))
+    offline = offline_identification(sequence, make_tracker(tracker, n_agents=n_robots, **settings))
     assert covered >= 0.95 * n_frames
     assert abs(online - offline) <= 0.02, (online, offline)
 
