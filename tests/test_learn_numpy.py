@@ -72,6 +72,11 @@ def test_encoding_layout():
     np.testing.assert_allclose(x[:6], [-1, 0, 0.5, 0, 0, spec.max_age_s], atol=1e-12)
     np.testing.assert_allclose(x[6:11], [3, 4, 0, 1, 0.9], atol=1e-12)
     np.testing.assert_allclose(x[11:], [5, 6, -1, 0, 0.5], atol=1e-12)
+    rel = EncodingSpec(n_agents=2, n_slots=2, relative_headings=True)
+    xr, _ = encode_frame(rel, det, latest_heading_rad=np.array([np.pi, np.nan]), report_age_s=np.array([0.5, np.nan]))
+    assert rel.n_inputs == 6 + 2 * 9
+    # slot 0 holds the detection with heading pi/2: relative to agent 0 (pi) it is -pi/2; agent 1 unknown.
+    np.testing.assert_allclose(xr[6:15], [3, 4, 0, 1, 0.9, 0, -1, 0, 0], atol=1e-12)
     with pytest.raises(ValueError, match="position"):
         encode_frame(spec, Detections(xywh=[[0, 0, 1, 1]]), np.zeros(2), np.zeros(2))
 

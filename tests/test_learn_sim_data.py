@@ -7,11 +7,11 @@ from lookalike.learn.sim_data import arrays_to_training
 from lookalike.sim import preset, simulate_robots
 
 
-@pytest.mark.parametrize("name", ["m3n2", "m10n7"])
-def test_vectorised_encoding_equals_frame_by_frame(name):
+@pytest.mark.parametrize("name, relative", [("m3n2", False), ("m10n7", False), ("m5n3", True), ("m10n7", True)])
+def test_vectorised_encoding_equals_frame_by_frame(name, relative):
     config = preset(name)
     seq = simulate_robots(config, 300, seed=4)
-    spec = EncodingSpec(config.n_agents, config.max_detections)
+    spec = EncodingSpec(config.n_agents, config.max_detections, relative_headings=relative)
     x_fast, y_fast = arrays_to_training(spec, seq.arrays)
     x_slow, y_slow = frames_to_arrays(spec, list(seq.frames()))
     np.testing.assert_allclose(x_fast, x_slow, atol=1e-12)

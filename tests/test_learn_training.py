@@ -26,7 +26,7 @@ def toy_frames(seed: int, n_frames: int):
 
 
 def toy_sampler(seed, n_frames, rng):
-    return frames_to_arrays(EncodingSpec(2, 3), toy_frames(seed, n_frames), rng)
+    return frames_to_arrays(EncodingSpec(2, 3, relative_headings=True), toy_frames(seed, n_frames), rng)
 
 
 def _config(**kw):

@@ -26,6 +26,7 @@ def train(
     hidden: int = typer.Option(64, help="Units per recurrent layer."),
     layers: int = typer.Option(5, help="Stacked recurrent layers."),
     seed: int = typer.Option(0, help="Seed of the run (weights and data)."),
+    relative: bool = typer.Option(True, help="Add slot-minus-agent heading differences to the input (ours)."),
     threads: int = typer.Option(1, help="Torch threads."),
     resume: bool = typer.Option(False, help="Continue from OUTPUT/checkpoint.pt."),
     ship: bool = typer.Option(False, help="Copy the best weights into the package's shipped weights."),
@@ -43,7 +44,7 @@ def train(
     try:
         world = preset(preset_name)
         config = TrainConfig(
-            n_agents=world.n_agents, n_slots=world.max_detections, cell=cell, hidden=hidden, num_layers=layers,
+            n_agents=world.n_agents, n_slots=world.max_detections, relative_headings=relative, cell=cell, hidden=hidden, num_layers=layers,
             batch_size=batch_size, sequence_length=sequence_length, steps=steps, minutes=minutes, seed=seed,
         )
     except ValueError as exc:
@@ -62,7 +63,7 @@ def train(
             progress.update(task, completed=row["step"], **fields)
 
         try:
-            result = run_training(config, make_sim_sampler(world), output, resume=resume, on_step=on_step)
+            result = run_training(config, make_sim_sampler(world, relative), output, resume=resume, on_step=on_step)
         except ValueError as exc:
             fail(str(exc))
     png = plot_log(result.log_path, output / "training_log.png")

@@ -93,6 +93,7 @@ def save_weights(weights: NetworkWeights, path: str | os.PathLike[str]) -> Path:
         "n_agents": weights.spec.n_agents,
         "n_slots": weights.spec.n_slots,
         "max_age_s": weights.spec.max_age_s,
+        "relative_headings": weights.spec.relative_headings,
         "info": weights.info,
     }
     path.with_suffix(".json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
@@ -132,7 +133,8 @@ def load_weights(
     except (OSError, ValueError) as exc:
         raise CheckpointError(f"{path}: cannot read the weights ({exc})") from None
     try:
-        spec = EncodingSpec(int(meta["n_agents"]), int(meta["n_slots"]), float(meta["max_age_s"]))
+        spec = EncodingSpec(int(meta["n_agents"]), int(meta["n_slots"]), float(meta["max_age_s"]),
+                            bool(meta.get("relative_headings", False)))
         layers = [
             {name: arrays.get(f"layer{i}.{name}") for name in ("w_ih", "w_hh", "b_ih", "b_hh")}
             for i in range(int(meta["num_layers"]))

@@ -36,7 +36,9 @@ def frames_to_arrays(
         if rng is not None:
             keep = rng.permutation(keep)
         x[t, :n_agent_inputs] = encode_agents(spec, memory.heading[None], memory.age(frame.time)[None])[0]
-        x[t, n_agent_inputs:] = encode_slots(spec, det.position[keep], det.heading[keep], det.score[keep])
+        x[t, n_agent_inputs:] = encode_slots(
+            spec, det.position[keep], det.heading[keep], det.score[keep], memory.heading
+        )
         labels = det.label[keep]
         y[t, : len(keep)] = np.where(labels >= 0, labels, spec.n_agents)
     return x, y

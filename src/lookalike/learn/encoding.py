@@ -6,7 +6,10 @@ Layout of the input vector (length ``3·N + 5·M``):
   ``ψ_j`` as a unit vector (periodic angles never jump) and the report's age in seconds at this
   frame (clipped to ``max_age_s``; an agent never heard from has ``(0, 0, max_age_s)``);
 * per detection slot (M blocks): ``x, y, cos φ, sin φ, γ`` — ground position in metres, absolute
-  visual heading ``φ`` as a unit vector, detector probability ``γ``. Empty slots are all zeros.
+  visual heading ``φ`` as a unit vector, detector probability ``γ``; with ``relative_headings``
+  (our addition, not in the paper) followed by ``cos(φ − ψ_j), sin(φ − ψ_j)`` for every agent j
+  (zeros for an agent never heard from), which spares the network learning N angle comparisons.
+  Empty slots are all zeros.
 
 When a frame has more than M detections, the M most probable are kept.
 """
@@ -31,6 +34,7 @@ class EncodingSpec:
     n_agents: int
     n_slots: int
     max_age_s: float = 5.0
+    relative_headings: bool = False
 
     def __post_init__(self) -> None:
         if self.n_agents < 1 or self.n_slots < 1:
@@ -39,7 +43,12 @@ class EncodingSpec:
     @property
     def n_inputs(self) -> int:
         """Length of one frame's input vector."""
-        return AGENT_WIDTH * self.n_agents + SLOT_WIDTH * self.n_slots
+        return AGENT_WIDTH * self.n_agents + self.slot_width * self.n_slots
+
+    @property
+    def slot_width(self) -> int:
+        """Inputs per detection slot."""
+        return SLOT_WIDTH + (2 * self.n_agents if self.relative_headings else 0)
 
     @property
     def n_classes(self) -> int:
@@ -65,18 +74,39 @@ def encode_agents(spec: EncodingSpec, heading_rad: np.ndarray, age_s: np.ndarray
 
 
 def encode_slots(
-    spec: EncodingSpec, position_m: np.ndarray, heading_rad: np.ndarray, probability: np.ndarray
+    spec: EncodingSpec,
+    position_m: np.ndarray,
+    heading_rad: np.ndarray,
+    probability: np.ndarray,
+    agent_heading_rad: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Slot blocks ``(5·M,)`` for up to M detections given in slot order (rows beyond M are an error)."""
+    """Slot blocks ``(slot_width·M,)`` for up to M detections given in slot order.
+
+    ``agent_heading_rad (N,)`` (NaN = never heard) is needed with ``spec.relative_headings``.
+    """
     n = len(probability)
     if n > spec.n_slots:
         raise ValueError(f"{n} detections for {spec.n_slots} slots; select the most probable first")
-    slots = np.zeros((spec.n_slots, SLOT_WIDTH))
+    slots = np.zeros((spec.n_slots, spec.slot_width))
     slots[:n, 0:2] = position_m
     slots[:n, 2] = np.cos(heading_rad)
     slots[:n, 3] = np.sin(heading_rad)
     slots[:n, 4] = probability
+    if spec.relative_headings:
+        if agent_heading_rad is None:
+            raise ValueError("relative_headings needs the agents' latest headings")
+        slots[:n, SLOT_WIDTH:] = relative_headings(np.asarray(heading_rad)[None], np.asarray(agent_heading_rad)[None])[0]
     return slots.reshape(-1)
+
+
+def relative_headings(slot_heading_rad: np.ndarray, agent_heading_rad: np.ndarray) -> np.ndarray:
+    """``cos, sin`` of every slot's heading minus every agent's: ``(..., M, 2N)`` from ``(..., M)``
+    and ``(..., N)``; zeros for agents whose heading is NaN."""
+    agent = np.asarray(agent_heading_rad, dtype=float)
+    known = np.isfinite(agent)[..., None, :]
+    diff = np.asarray(slot_heading_rad, dtype=float)[..., :, None] - np.where(np.isfinite(agent), agent, 0.0)[..., None, :]
+    out = np.stack([np.where(known, np.cos(diff), 0.0), np.where(known, np.sin(diff), 0.0)], axis=-1)
+    return out.reshape(*out.shape[:-2], out.shape[-2] * out.shape[-1])
 
 
 def select_slots(score: np.ndarray, n_slots: int) -> np.ndarray:
@@ -99,7 +129,7 @@ def encode_frame(
         raise ValueError("the LSTM encoding needs Detections.position and Detections.heading")
     used = select_slots(detections.score, spec.n_slots)
     slots = encode_slots(
-        spec, detections.position[used], detections.heading[used], detections.score[used]
+        spec, detections.position[used], detections.heading[used], detections.score[used], latest_heading_rad
     )
     agents = encode_agents(spec, np.asarray(latest_heading_rad)[None], np.asarray(report_age_s)[None])[0]
     return np.concatenate([agents, slots]), used

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from lookalike.learn.data import IGNORE
-from lookalike.learn.encoding import AGENT_WIDTH, EncodingSpec, encode_agents
+from lookalike.learn.encoding import AGENT_WIDTH, EncodingSpec, encode_agents, relative_headings
 from lookalike.sim import RobotArrays, RobotWorldConfig, simulate_arrays
 
 
@@ -54,20 +54,20 @@ def arrays_to_training(
     take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
     v = take(valid)
     phi = take(arrays.det_heading)
-    slots = np.stack(
-        [take(arrays.det_position[..., 0]), take(arrays.det_position[..., 1]), np.cos(phi), np.sin(phi),
-         take(arrays.det_score)],
-        axis=-1,
-    ) * v[..., None]
+    columns = [take(arrays.det_position[..., 0])[..., None], take(arrays.det_position[..., 1])[..., None],
+               np.cos(phi)[..., None], np.sin(phi)[..., None], take(arrays.det_score)[..., None]]
+    if spec.relative_headings:
+        columns.append(relative_headings(phi, heading))
+    slots = np.concatenate(columns, axis=-1) * v[..., None]
     x[:, n_agent_inputs:] = slots.reshape(T, -1)
     label = take(arrays.det_label)
     y = np.where(v, np.where(label >= 0, label, spec.n_agents), IGNORE).astype(np.int64)
     return x, y
 
 
-def make_sim_sampler(config: RobotWorldConfig):
+def make_sim_sampler(config: RobotWorldConfig, relative: bool = True):
     """A ``(seed, n_frames, rng) -> (x, y)`` sampler over the robot world ``config``."""
-    spec = EncodingSpec(config.n_agents, config.max_detections)
+    spec = EncodingSpec(config.n_agents, config.max_detections, relative_headings=relative)
 
     def sample(seed: int, n_frames: int, rng: np.random.Generator | None) -> tuple[np.ndarray, np.ndarray]:
         return arrays_to_training(spec, simulate_arrays(config, n_frames, seed), rng)

@@ -34,6 +34,7 @@ class TrainConfig:
 
     n_agents: int
     n_slots: int
+    relative_headings: bool = True
     cell: str = "lstm"
     hidden: int = 64
     num_layers: int = 5
@@ -94,7 +95,7 @@ def train(
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(config.seed)
     rng = np.random.default_rng(config.seed)
-    spec = EncodingSpec(config.n_agents, config.n_slots)
+    spec = EncodingSpec(config.n_agents, config.n_slots, relative_headings=config.relative_headings)
     if config.sequence_length % config.bptt:
         raise ValueError(f"sequence_length {config.sequence_length} must be a multiple of bptt {config.bptt}")
     val_x, val_y = _batch(
