@@ -9,6 +9,7 @@ from lookalike.trackers.registry import (
     tracker_names,
     tracker_parameters,
 )
+from lookalike.trackers.boxtrack import BoxTrack
 from lookalike.trackers.deepsort import DeepSort
 from lookalike.trackers.diversort import DiverSort
 from lookalike.trackers.jpda import JpdaTracker
@@ -17,6 +18,7 @@ from lookalike.trackers.sort import Sort
 from lookalike.types.tracks import TrackStatus
 
 __all__ = [
+    "BoxTrack",
     "DeepSort",
     "DiverSort",
     "JpdaTracker",

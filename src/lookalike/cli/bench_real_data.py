@@ -1,0 +1,116 @@
+"""The real datasets of ``lookalike bench real``: MOT15 and pig boxes, HexBug blobs and head points.
+
+Every sequence becomes a :class:`RealSequence` holding the detections every tracker receives
+(identical for all of them) and the ground truth it is scored against. Box data (MOT15, pigs) is
+scored with CLEAR/identity/HOTA on boxes (IoU 0.5, MOT15 rules); HexBug clips are scored on points:
+the centre of each reported box against the annotated head position within ``radius`` pixels.
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from lookalike.io import MotTable, find_sequences, read_mot
+
+DATASETS = ("mot15", "pigs", "hexbug")
+PIGS_COUNT = 23  # the pigs folder documents 23 animals (../shared/data/README.md), not read from gt
+HEXBUG_FPS = 10.0
+# Clips whose CSV has x and y swapped (listed in ../shared/data/README.md).
+HEXBUG_SWAPPED_XY = frozenset({"training020", "training058", "training076", "training078", "training079",
+                               "training082", "training083", "training089"})
+
+
+@dataclass(frozen=True, eq=False)
+class RealSequence:
+    """One sequence: per-frame detections (0-based frames) and its ground truth.
+
+    Attributes:
+        dataset: ``"mot15"``, ``"pigs"`` or ``"hexbug"``.
+        name: sequence or clip name.
+        frame_rate: frames per second.
+        length: number of frames.
+        det_xywh: per frame, ``(n, 4)`` boxes in pixels.
+        det_score: per frame, ``(n,)`` detector scores.
+        gt: ground-truth boxes (:class:`MotTable`) for box data, else None.
+        gt_points: ``(frame (n,) 1-based, id (n,), xy (n, 2) px)`` for point data, else None.
+        image_size: ``(width, height)`` in pixels, or None.
+        n_targets: the documented number of targets when the set is closed, else None.
+    """
+
+    dataset: str
+    name: str
+    frame_rate: float
+    length: int
+    det_xywh: list[np.ndarray] = field(repr=False)
+    det_score: list[np.ndarray] = field(repr=False)
+    gt: MotTable | None = field(default=None, repr=False)
+    gt_points: tuple[np.ndarray, np.ndarray, np.ndarray] | None = field(default=None, repr=False)
+    image_size: tuple[int, int] | None = None
+    n_targets: int | None = None
+
+
+def _split_frames(table: MotTable, length: int) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    order = np.argsort(table.frame, kind="stable")
+    frames = table.frame[order]
+    bounds = np.searchsorted(frames, np.arange(1, length + 2))
+    xywh, conf = table.xywh[order], table.conf[order]
+    return ([xywh[bounds[k]:bounds[k + 1]] for k in range(length)],
+            [conf[bounds[k]:bounds[k + 1]] for k in range(length)])
+
+
+def load_boxes(root: Path, dataset: str) -> list[RealSequence]:
+    """MOTChallenge-style sequences under ``root`` (each with ``det/det.txt`` and ``gt/gt.txt``)."""
+    out = []
+    for seq in find_sequences(root):
+        if seq.det_path is None or seq.gt_path is None:
+            continue
+        det, gt = read_mot(seq.det_path), read_mot(seq.gt_path)
+        length = seq.length or int(max(det.frame.max(initial=0), gt.frame.max(initial=0)))
+        xywh, score = _split_frames(det, length)
+        out.append(RealSequence(dataset, seq.name, seq.frame_rate, length, xywh, score, gt=gt,
+                                image_size=seq.image_size,
+                                n_targets=PIGS_COUNT if dataset == "pigs" else None))
+    if not out:
+        raise ValueError(f"{root}: no sequence with det/det.txt and gt/gt.txt")
+    return out
+
+
+def read_hexbug_points(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(frame 1-based (n,), id (n,), xy (n, 2) px)`` from a HexBug CSV (``,t,hexbug,x,y``)."""
+    rows = []
+    with open(path, newline="") as fh:
+        for rec in csv.DictReader(fh):
+            try:
+                rows.append((float(rec["t"]), float(rec["hexbug"]), float(rec["x"]), float(rec["y"])))
+            except (KeyError, TypeError, ValueError):
+                raise ValueError(f"{path}: expected columns t, hexbug, x, y with numbers") from None
+    arr = np.array(rows, dtype=float).reshape(-1, 4)
+    arr = arr[np.isfinite(arr).all(axis=1)]
+    xy = arr[:, 2:4][:, ::-1] if path.stem in HEXBUG_SWAPPED_XY else arr[:, 2:4]
+    return arr[:, 0].astype(int) + 1, arr[:, 1].astype(int), np.ascontiguousarray(xy)
+
+
+def hexbug_clips(root: Path) -> list[Path]:
+    """The HexBug videos that have an annotation CSV next to them."""
+    return [v for v in sorted(root.glob("*.mp4")) if v.with_suffix(".csv").is_file()]
+
+
+def detect_hexbug(video: Path) -> RealSequence:
+    """Run the blob detector over one HexBug clip (OpenCV needed) and attach its head points.
+
+    Detector settings are those of ``benchmarks/hexbug_blobs.py`` (median background, threshold 30
+    grey levels, blobs of at least 800 px², opening 9 px, stabilised), chosen on the video alone.
+    """
+    from lookalike.vision.blob import BlobConfig, BlobDetector, read_video
+
+    frames = read_video(str(video))
+    detector = BlobDetector(BlobConfig(threshold=30.0, min_area_px=800.0, open_px=9, stabilise=True)).fit(frames)
+    dets = [detector(image) for image in frames]
+    height, width = frames[0].shape[:2]
+    return RealSequence("hexbug", video.stem, HEXBUG_FPS, len(frames), [d.xywh for d in dets],
+                        [d.score for d in dets], gt_points=read_hexbug_points(video.with_suffix(".csv")),
+                        image_size=(width, height))
