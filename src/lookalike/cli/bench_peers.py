@@ -53,12 +53,12 @@ def _sv_detections(xywh: np.ndarray, score: np.ndarray):  # noqa: ANN202 - super
                          class_id=np.zeros(len(score), dtype=int))
 
 
-def _run_sv_like(make: Callable[[], object], seq: RealSequence) -> np.ndarray:
-    """A tracker with ``update(sv.Detections) -> sv.Detections`` carrying ``tracker_id``."""
-    tracker = make()
+def _run_sv_like(make: Callable[[], object], seq: RealSequence, method: str = "update") -> np.ndarray:
+    """A tracker whose ``method(sv.Detections)`` returns ``sv.Detections`` carrying ``tracker_id``."""
+    step = getattr(make(), method)
     out = []
     for k in range(seq.length):
-        res = tracker.update(_sv_detections(seq.det_xywh[k], seq.det_score[k]))  # type: ignore[attr-defined]
+        res = step(_sv_detections(seq.det_xywh[k], seq.det_score[k]))
         ids = np.asarray(res.tracker_id if res.tracker_id is not None else [], dtype=int)
         keep = ids >= 0
         if keep.any():
@@ -70,7 +70,8 @@ def supervision_bytetrack(seq: RealSequence) -> np.ndarray:
     """supervision's ``sv.ByteTrack`` (defaults; ``frame_rate`` of the sequence)."""
     import supervision as sv
 
-    return _run_sv_like(lambda: sv.ByteTrack(frame_rate=max(int(round(seq.frame_rate)), 1)), seq)
+    return _run_sv_like(lambda: sv.ByteTrack(frame_rate=max(int(round(seq.frame_rate)), 1)), seq,
+                        "update_with_detections")
 
 
 def _roboflow(cls_name: str) -> PeerFn:
@@ -140,6 +141,8 @@ def peer_status(names: list[str] | None = None) -> dict[str, str | None]:
         package = PEERS[name][0]
         try:
             importlib.import_module(package)
+        except ModuleNotFoundError:
+            out[name] = f"{package} not installed"
         except Exception as exc:  # an installed package can fail to import (numpy ABI, ...)
             out[name] = f"{package} not importable ({type(exc).__name__}: {exc})"[:200]
         else:

@@ -12,6 +12,8 @@ them as Ray tasks (``--address`` of a cluster, else a local ``ray.init()``); tab
 
 from __future__ import annotations
 
+import csv
+import json
 from pathlib import Path
 from typing import Any
 
@@ -20,7 +22,7 @@ import typer
 from rich.table import Table
 
 from lookalike.cli.app import console, fail
-from lookalike.cli.bench import bench_app, write_rows
+from lookalike.cli.bench import bench_app
 from lookalike.cli.bench_peers import PEERS, peer_status
 from lookalike.cli.bench_real_data import DATASETS, RealSequence, detect_hexbug, hexbug_clips, load_boxes
 from lookalike.cli.bench_real_run import BACKENDS, Entry, map_jobs, run_jobs
@@ -54,7 +56,7 @@ def load_datasets(root: Path, datasets: list[str], *, sequences: list[str] | Non
 
 
 def default_entries(trackers: list[str], peers: list[str], closed_set: bool = True) -> list[Entry]:
-    """lookalike trackers with defaults (plus ``boxtrack`` closed-set where the count is known) and peers."""
+    """lookalike trackers (plus ``boxtrack`` closed-set where the count is known) and peers."""
     entries = [Entry(t, t) for t in trackers]
     if closed_set and "boxtrack" in trackers:
         entries.append(Entry("boxtrack-closed", "boxtrack", closed_set=True))
@@ -215,11 +217,14 @@ def real(
             console.print(f"[red]{r['Dataset']} / {r['Tracker']} failed: {r['Error']}[/red]")
     if json_path is not None:
         json_path.parent.mkdir(parents=True, exist_ok=True)
-        import json
-
         json_path.write_text(json.dumps({"datasets": rows, "combined": combined, "sequences": per_seq,
                                          "skipped": {k: v for k, v in status.items() if v}}, indent=2) + "\n")
-    write_rows(rows, None, csv_path)
+    if csv_path is not None:
+        csv_path.parent.mkdir(parents=True, exist_ok=True)
+        with csv_path.open("w", newline="") as fh:
+            writer = csv.DictWriter(fh, fieldnames=[*COLUMNS, "Error"], restval="")
+            writer.writeheader()
+            writer.writerows(rows)
     if plots is not None:
         for p in plot_leaderboard([r for r in rows if "Error" not in r], plots):
             console.print(f"plot: {p}")

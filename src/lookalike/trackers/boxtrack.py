@@ -50,6 +50,7 @@ from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
 _H = np.hstack([np.eye(4), np.zeros((4, 4))])
 _REPORTS = ("detection", "filtered")
+_SCORE_MEMORY = 20_000  # detector scores kept for the quantile thresholds
 
 
 def _transition(steps: float) -> np.ndarray:
@@ -93,6 +94,8 @@ class BoxTrack:
         closed_distance: float = param(4.0, "closed set: centre distance (track heights) gating recovery")
         pos_noise: float = param(1 / 20, "position noise per frame, as a fraction of the box size")
         vel_noise: float = param(1 / 160, "velocity noise per frame, as a fraction of the box size")
+        score_quantiles: bool = param(
+            False, "high_score and birth_score are quantiles of the scores seen so far, not raw scores")
         report: str = param("filtered", "reported box: 'detection' or 'filtered'")
         frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)")
 
@@ -101,7 +104,10 @@ class BoxTrack:
                            "tentative_iou", "coast_s", "reid_distance", "reid_growth", allow_zero=True)
             check_positive(self, "n_init", "max_age_s", "reid_scale", "max_targets", "closed_distance",
                            "pos_noise", "vel_noise", "frame_interval_s")
-            if self.low_score > self.high_score:
+            if self.score_quantiles and not (self.high_score <= 1 and self.birth_score <= 1):
+                raise ValueError("BoxTrack.Config: high_score and birth_score are quantiles in [0, 1] "
+                                 f"when score_quantiles is set, got {self.high_score}, {self.birth_score}")
+            if not self.score_quantiles and self.low_score > self.high_score:
                 raise ValueError(f"BoxTrack.Config.low_score ({self.low_score}) exceeds high_score ({self.high_score})")
             if self.reid_scale < 1:
                 raise ValueError(f"BoxTrack.Config.reid_scale must be >= 1, got {self.reid_scale}")
@@ -123,6 +129,7 @@ class BoxTrack:
         self._next_id = 1
         self._frame_count = 0
         self._clock = FrameClock(self.config.frame_interval_s)
+        self._scores = np.zeros(0)  # detector scores seen so far (for quantile thresholds)
 
     # -- frame -----------------------------------------------------------------------------------
 
@@ -137,11 +144,12 @@ class BoxTrack:
         det_idx = np.flatnonzero(keep)
         det_box = _to_cxcywh(dets.xywh[keep])
         score = dets.score[keep]
+        high_score, birth_score = self._thresholds(score)
         was_tracked = self._lost_s == 0
         self._predict(steps, dt)
         det_of_track = np.full(len(self._ids), -1, dtype=int)
         free = np.ones(len(det_idx), dtype=bool)
-        high = score >= cfg.high_score
+        high = score >= high_score
         pred = _to_xywh(self._mean[:, :4])
         dxywh = dets.xywh[keep]
 
@@ -172,13 +180,24 @@ class BoxTrack:
             self._lost_s[matched] = 0.0
         self._hits[det_of_track < 0] = 0
         self._confirmed |= (self._hits >= cfg.n_init) | ((self._frame_count == 1) & (self._hits > 0))
-        born = self._births(np.flatnonzero(free & (score >= cfg.birth_score)), det_box)
+        born = self._births(np.flatnonzero(free & (score >= birth_score)), det_box)
         det_of_track = np.concatenate([det_of_track, born])
         out = self._report(det_of_track, det_idx, dets.xywh)
         self._prune()
         return out
 
     # -- steps -----------------------------------------------------------------------------------
+
+    def _thresholds(self, score: np.ndarray) -> tuple[float, float]:
+        """The high and birth score thresholds for this frame (raw, or quantiles of scores seen)."""
+        cfg = self.config
+        if not cfg.score_quantiles:
+            return cfg.high_score, cfg.birth_score
+        self._scores = np.concatenate([self._scores, score])[-_SCORE_MEMORY:]
+        if not len(self._scores):
+            return np.inf, np.inf
+        high, birth = np.quantile(self._scores, [cfg.high_score, cfg.birth_score])
+        return float(high), float(birth)
 
     @staticmethod
     def _noise(size: np.ndarray, scale: float) -> np.ndarray:

@@ -1,0 +1,173 @@
+"""``lookalike bench real``: boxtrack behaviour, the job backends (serial, processes, Ray) and the
+leaderboard on real data (skipped without ../shared/data)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from lookalike.cli import app
+from lookalike.cli.bench_real import default_entries, leaderboard
+from lookalike.cli.bench_real_data import RealSequence
+from lookalike.cli.bench_real_run import Entry, map_jobs, run_jobs, track_rows
+from lookalike.io import MotTable
+from lookalike.trackers import make_tracker
+from lookalike.types import Detections, Frame
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+
+def _synthetic(seed: int, n_frames: int = 40, n_targets: int = 3, name: str = "syn") -> RealSequence:
+    """Targets walking in straight lines; detections = truth + 1 px noise, 10 % missed."""
+    rng = np.random.default_rng(seed)
+    start = rng.uniform(50, 400, size=(n_targets, 2))
+    vel = rng.uniform(-3, 3, size=(n_targets, 2))
+    gt_rows, det_xywh, det_score = [], [], []
+    for k in range(n_frames):
+        xy = start + vel * k
+        boxes = np.hstack([xy, np.tile([40.0, 80.0], (n_targets, 1))])
+        for i, b in enumerate(boxes):
+            gt_rows.append([k + 1, i + 1, *b, 1, 1, 1, 1])
+        seen = rng.random(n_targets) > 0.1
+        det_xywh.append(boxes[seen] + rng.normal(0, 1.0, size=(seen.sum(), 4)) * [1, 1, 0, 0])
+        det_score.append(rng.uniform(0.96, 1.0, size=seen.sum()))
+    return RealSequence("synthetic", name, 10.0, n_frames, det_xywh, det_score,
+                        gt=MotTable.from_rows(np.array(gt_rows)), n_targets=n_targets)
+
+
+def _frame(k: int, xywh: list[list[float]], score: float = 0.99) -> Frame:
+    boxes = np.array(xywh, dtype=float).reshape(-1, 4)
+    return Frame(index=k, time=k / 10.0, detections=Detections(xywh=boxes, score=np.full(len(boxes), score)))
+
+
+def test_boxtrack_reidentifies_a_target_after_a_gap() -> None:
+    tracker = make_tracker("boxtrack")
+    ids = []
+    for k in range(20):
+        boxes = [] if 8 <= k < 12 else [[100.0 + 4 * k, 100.0, 40.0, 80.0]]  # 0.4 s without detections
+        ids += [t.track_id for t in tracker.update(_frame(k, boxes))]
+    assert len(ids) >= 14 and set(ids) == {1}
+
+
+def test_boxtrack_low_scores_never_start_tracks() -> None:
+    tracker = make_tracker("boxtrack")
+    out = [tracker.update(_frame(k, [[10.0 * k, 50.0, 40.0, 80.0]], score=0.5)) for k in range(10)]
+    assert all(not tracks for tracks in out)
+
+
+def test_boxtrack_closed_set_never_exceeds_the_target_count() -> None:
+    seq = _synthetic(3, n_frames=60, n_targets=4)
+    rng = np.random.default_rng(0)
+    tracker = make_tracker("boxtrack", max_targets=4)
+    seen: set[int] = set()
+    for k in range(seq.length):
+        extra = rng.uniform(0, 500, size=(2, 4)) * [1, 1, 0.1, 0.2] + [0, 0, 20, 40]  # clutter
+        boxes = np.vstack([seq.det_xywh[k], extra])
+        dets = Detections(xywh=boxes, score=np.full(len(boxes), 0.99))
+        seen |= {t.track_id for t in tracker.update(Frame(index=k, time=k / 10, detections=dets))}
+    assert seen and max(seen) <= 4
+
+
+def test_boxtrack_config_rejects_bad_values() -> None:
+    with pytest.raises(ValueError, match="report"):
+        make_tracker("boxtrack", report="middle")
+    with pytest.raises(ValueError, match="max_targets"):
+        make_tracker("boxtrack", max_targets=0)
+    with pytest.raises(ValueError, match="low_score"):
+        make_tracker("boxtrack", low_score=0.95, high_score=0.5)
+
+
+def _square(x: int) -> int:
+    return x * x
+
+
+def test_map_jobs_processes_equal_serial_in_order() -> None:
+    items = list(range(7))
+    assert map_jobs(_square, items, workers=2) == map_jobs(_square, items) == [x * x for x in items]
+    with pytest.raises(ValueError, match="backend"):
+        map_jobs(_square, items, backend="dask")
+
+
+def _tables(results: list, entries: list[Entry], seqs: list[RealSequence]) -> tuple:
+    rows, combined, per_seq = leaderboard(entries, seqs, results)
+    strip = [{k: v for k, v in r.items() if k != "Frames/s"} for r in rows]
+    return strip, combined, per_seq
+
+
+def test_leaderboard_is_the_same_with_processes() -> None:
+    seqs = [_synthetic(1, name="a"), _synthetic(2, name="b")]
+    entries = default_entries(["sort", "boxtrack"], [])
+    serial = _tables(run_jobs(entries, seqs), entries, seqs)
+    parallel = _tables(run_jobs(entries, seqs, workers=2), entries, seqs)
+    assert serial == parallel
+    rows = serial[0]
+    assert {r["Tracker"] for r in rows} == {"sort", "boxtrack", "boxtrack-closed"}
+    assert sorted(r["Rank"] for r in rows) == [1, 2, 3]
+    assert all(0 < r["IDF1"] <= 100 for r in rows)
+
+
+def test_unknown_peer_is_reported_not_fatal() -> None:
+    seq = _synthetic(4)
+    with pytest.raises(ValueError, match="unknown peer"):
+        track_rows(Entry("x", "no-such-peer", kind="peer"), seq)
+    (result,) = run_jobs([Entry("x", "no-such-peer", kind="peer")], [seq])
+    assert "unknown peer" in result["error"]
+
+
+def test_ray_backend_gives_the_local_tables() -> None:
+    ray = pytest.importorskip("ray", reason="ray is not installed")
+    seqs = [_synthetic(5, name="a"), _synthetic(6, name="b")]
+    entries = default_entries(["sort", "boxtrack"], [])
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        remote = run_jobs(entries, seqs, backend="ray")
+        squares = map_jobs(_square, [1, 2, 3], backend="ray")
+    finally:
+        ray.shutdown()
+    assert squares == [1, 4, 9]
+    assert _tables(remote, entries, seqs) == _tables(run_jobs(entries, seqs), entries, seqs)
+
+
+def _need_data(sub: str) -> Path:
+    path = DATA / sub
+    if not path.is_dir():
+        pytest.skip(f"real data not found at {path} (../shared/data)")
+    return path
+
+
+def test_bench_real_cli_on_tud_campus(tmp_path: Path) -> None:
+    _need_data("mot15/TUD-Campus")
+    out = tmp_path / "real.json"
+    res = CliRunner().invoke(app, ["bench", "real", "--data", str(DATA), "--datasets", "mot15", "--sequences",
+                                   "TUD-Campus", "--peers", "none", "--json", str(out), "--csv",
+                                   str(tmp_path / "real.csv")])
+    assert res.exit_code == 0, res.output
+    tables = json.loads(out.read_text())
+    names = {r["Tracker"] for r in tables["datasets"]}
+    assert names == {"sort", "boxtrack"}  # no closed-set entry: MOT15 has no known target count
+    sort_row = next(r for r in tables["datasets"] if r["Tracker"] == "sort")
+    assert sort_row["MOTA"] == pytest.approx(62.7, abs=0.1)  # SORT's published behaviour on TUD-Campus
+    assert (tmp_path / "real.csv").read_text().startswith("Dataset,Tracker,HOTA")
+
+
+def test_boxtrack_closed_set_beats_sort_on_the_pigs() -> None:
+    _need_data("pigs")
+    from lookalike.cli.bench_real_data import load_boxes
+
+    (pigs,) = load_boxes(DATA / "pigs", "pigs")
+    entries = [Entry("sort", "sort"), Entry("boxtrack-closed", "boxtrack", closed_set=True)]
+    rows, _, _ = leaderboard(entries, [pigs], run_jobs(entries, [pigs]))
+    idf1 = {r["Tracker"]: r["IDF1"] for r in rows}
+    assert idf1["boxtrack-closed"] > idf1["sort"] + 5
+
+
+def test_bench_real_rejects_bad_options() -> None:
+    runner = CliRunner()
+    res = runner.invoke(app, ["bench", "real", "--backend", "spark", "--peers", "none"])
+    assert res.exit_code != 0 and "backend" in res.output
+    res = runner.invoke(app, ["bench", "real", "--trackers", "jpda", "--peers", "none"])
+    assert res.exit_code != 0 and "box tracker" in res.output
