@@ -1,0 +1,116 @@
+"""A single self-contained HTML report: headings, text, tables, embedded images (base64), links.
+
+Images (PNG, GIF, JPEG) are read when added and embedded as ``data:`` URIs, so the file can be
+mailed on its own; videos are linked by a path relative to the report.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import os
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+_MIME = {".png": "image/png", ".gif": "image/gif", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
+
+_STYLE = """
+body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; padding: 0 1em; color: #222; }
+h1 { font-size: 1.6em; } h2 { margin-top: 1.8em; border-bottom: 1px solid #ddd; }
+table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.9em; }
+th, td { padding: 3px 10px; border-bottom: 1px solid #e4e4e4; }
+th { background: #f4f4f4; text-align: left; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
+figure { display: inline-block; margin: 0.6em 1em 0.6em 0; vertical-align: top; }
+figure img { max-width: 100%; border: 1px solid #ccc; } figcaption { font-size: 0.85em; color: #555; }
+.note { color: #555; font-size: 0.9em; }
+"""
+
+
+def _cell(value: Any) -> tuple[str, bool]:
+    if isinstance(value, bool) or value is None:
+        return html.escape(str(value)), False
+    if isinstance(value, int):
+        return f"{value:,}", True
+    if isinstance(value, float):
+        return ("—" if value != value else f"{value:,.3f}".rstrip("0").rstrip(".")), True
+    return html.escape(str(value)), False
+
+
+class HtmlReport:
+    """Collects report blocks in order; :meth:`write` saves one HTML file."""
+
+    def __init__(self, title: str) -> None:
+        self.title = title
+        self._blocks: list[str] = []
+
+    def heading(self, text: str) -> None:
+        """A section heading."""
+        self._blocks.append(f"<h2>{html.escape(text)}</h2>")
+
+    def text(self, text: str, note: bool = False) -> None:
+        """A paragraph (plain text, escaped)."""
+        cls = ' class="note"' if note else ""
+        self._blocks.append(f"<p{cls}>{html.escape(text)}</p>")
+
+    def table(self, rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None = None,
+              caption: str = "") -> None:
+        """A table of ``rows`` (dicts) with ``columns`` (default: the first row's keys)."""
+        if not rows:
+            self.text(f"{caption}: no rows." if caption else "No rows.", note=True)
+            return
+        cols = list(columns or rows[0].keys())
+        out = ["<table>"]
+        if caption:
+            out.append(f"<caption>{html.escape(caption)}</caption>")
+        out.append("<tr>" + "".join(f"<th>{html.escape(str(c))}</th>" for c in cols) + "</tr>")
+        for r in rows:
+            cells = []
+            for c in cols:
+                text, numeric = _cell(r.get(c, ""))
+                cells.append(f'<td class="num">{text}</td>' if numeric else f"<td>{text}</td>")
+            out.append("<tr>" + "".join(cells) + "</tr>")
+        out.append("</table>")
+        self._blocks.append("\n".join(out))
+
+    def image(self, path: Path | str, caption: str = "", width: int | None = None) -> None:
+        """Embed the image file at ``path`` (PNG, GIF or JPEG) with a caption."""
+        p = Path(path)
+        mime = _MIME.get(p.suffix.lower())
+        if mime is None:
+            raise ValueError(f"image: unsupported type {p.suffix!r} of {p} (use {', '.join(_MIME)})")
+        if not p.is_file():
+            raise ValueError(f"image: no such file {p}")
+        data = base64.b64encode(p.read_bytes()).decode("ascii")
+        style = f' style="width:{int(width)}px"' if width else ""
+        alt = html.escape(caption or p.name, quote=True)
+        self._blocks.append(
+            f'<figure><img src="data:{mime};base64,{data}" alt="{alt}"{style}>'
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>"
+        )
+
+    def link(self, target: Path | str, text: str, relative_to: Path | str | None = None) -> None:
+        """A link to ``target`` (e.g. a video), written relative to the folder ``relative_to``."""
+        t = Path(target)
+        href = os.path.relpath(t, relative_to) if relative_to is not None else str(t)
+        self._blocks.append(f'<p><a href="{html.escape(Path(href).as_posix(), quote=True)}">{html.escape(text)}</a></p>')
+
+    def code(self, text: str) -> None:
+        """A preformatted block (commands to try)."""
+        self._blocks.append(f"<pre>{html.escape(text)}</pre>")
+
+    def render(self) -> str:
+        """The whole HTML document."""
+        return (
+            "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f"<title>{html.escape(self.title)}</title><style>{_STYLE}</style></head><body>\n"
+            f"<h1>{html.escape(self.title)}</h1>\n" + "\n".join(self._blocks) + "\n</body></html>\n"
+        )
+
+    def write(self, path: Path | str) -> Path:
+        """Write the document to ``path`` atomically (a temporary file renamed into place)."""
+        out = Path(path)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = out.with_name(out.name + ".tmp")
+        tmp.write_text(self.render(), encoding="utf-8")
+        os.replace(tmp, out)
+        return out

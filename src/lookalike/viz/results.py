@@ -1,0 +1,71 @@
+"""Reading ``eval``/``bench`` JSON outputs and adding them to an :class:`HtmlReport` as tables and charts.
+
+Recognised files: ``lookalike bench ident --json`` (rows with ``Setup`` and ``Success rate (%)``),
+``lookalike bench divers --json`` and the demo's diver rows (rows with ``Scenario`` and ``IDF1``),
+and ``lookalike eval --json`` (``{tracker: {sequence: {metric: fraction}}}``).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from lookalike.viz.plots import grouped_bar_chart
+from lookalike.viz.report import HtmlReport
+
+EVAL_COLUMNS = ("IDF1", "HOTA", "MOTA", "IDSW")
+
+
+def load_results(path: Path | str) -> tuple[str, list[dict[str, Any]]]:
+    """``(kind, rows)`` of a results file; kind is ``"ident"``, ``"divers"`` or ``"eval"``."""
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"results: no such file {p}")
+    try:
+        data = json.loads(p.read_text())
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"results: {p} is not JSON ({exc})") from None
+    if isinstance(data, list) and data and all(isinstance(r, dict) for r in data):
+        if "Setup" in data[0] and "Success rate (%)" in data[0]:
+            return "ident", data
+        if "Scenario" in data[0] and "IDF1" in data[0]:
+            return "divers", data
+    if isinstance(data, dict) and data and all(isinstance(v, dict) for v in data.values()):
+        rows = []
+        for tracker, per_seq in data.items():
+            for seq, values in per_seq.items():
+                if not isinstance(values, dict) or not all(c in values for c in EVAL_COLUMNS):
+                    raise ValueError(f"results: {p}: {tracker}/{seq} lacks one of {', '.join(EVAL_COLUMNS)}")
+                rows.append({"Tracker": tracker, "Sequence": seq,
+                             **{c: (int(values[c]) if c == "IDSW" else round(100 * float(values[c]), 2))
+                                for c in EVAL_COLUMNS}})
+        if rows:
+            return "eval", rows
+    raise ValueError(f"results: {p} is not an eval or bench JSON output (see `lookalike report --help`)")
+
+
+def add_results(report: HtmlReport, kind: str, rows: list[dict[str, Any]], charts_dir: Path, stem: str,
+                title: str | None = None) -> list[Path]:
+    """A section with the rows' table and a bar chart (PNG written in ``charts_dir``, then embedded)."""
+    if kind == "ident":
+        report.heading(title or "Robot identification")
+        report.table(rows)
+        chart = grouped_bar_chart(charts_dir / f"{stem}.png", rows, "Setup", "Tracker", "Success rate (%)",
+                                  title="Identification success rate per set-up")
+        report.image(chart, "Identification success rate (%) per set-up and identifier")
+    elif kind == "divers":
+        report.heading(title or "Diver tracking")
+        report.table(rows)
+        chart = grouped_bar_chart(charts_dir / f"{stem}.png", rows, "Scenario", "Tracker", "IDF1",
+                                  ylabel="IDF1 (%)", title="IDF1 per scenario")
+        report.image(chart, "IDF1 (%) per scenario and tracker")
+    elif kind == "eval":
+        report.heading(title or "Evaluation (values in %)")
+        report.table(rows)
+        chart = grouped_bar_chart(charts_dir / f"{stem}.png", rows, "Sequence", "Tracker", "IDF1",
+                                  ylabel="IDF1 (%)", title="IDF1 per sequence")
+        report.image(chart, "IDF1 (%) per sequence and tracker")
+    else:
+        raise ValueError(f"kind: unknown results kind {kind!r}; known: ident, divers, eval")
+    return [chart]

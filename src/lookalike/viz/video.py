@@ -1,0 +1,128 @@
+"""Writing annotated videos (MP4 through OpenCV) and short animated GIFs (Pillow), reading videos.
+
+OpenCV and Pillow are imported lazily inside the functions that need them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from types import TracebackType
+
+import numpy as np
+
+
+class VideoWriter:
+    """An MP4 file written frame by frame (``(h, w, 3)`` uint8 BGR, every frame the same size).
+
+    Use as a context manager so the file is finalised even when interrupted. ``gif`` also keeps
+    every ``gif_every``-th of the first ``gif_frames`` frames, downscaled to ``gif_width`` pixels, and
+    writes them as an animated GIF when closed.
+    """
+
+    def __init__(self, path: Path | str, fps: float, gif: Path | str | None = None, gif_every: int = 2,
+                 gif_frames: int = 120, gif_width: int = 320) -> None:
+        if not fps > 0:
+            raise ValueError(f"fps: must be positive, got {fps!r}")
+        if gif_every < 1 or gif_frames < 1 or gif_width < 16:
+            raise ValueError(f"gif_every/gif_frames/gif_width: got {gif_every}, {gif_frames}, {gif_width}")
+        self.path, self.fps = Path(path), float(fps)
+        self.gif = Path(gif) if gif is not None else None
+        self.gif_every, self.gif_frames, self.gif_width = gif_every, gif_frames, gif_width
+        self.count = 0
+        self._writer = None
+        self._size: tuple[int, int] | None = None
+        self._gif_images: list[np.ndarray] = []
+
+    def write(self, image: np.ndarray) -> None:
+        """Append one frame."""
+        import cv2
+
+        img = np.asarray(image)
+        if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8:
+            raise ValueError(f"image: expected (h, w, 3) uint8 BGR, got {img.shape} {img.dtype}")
+        size = (img.shape[1], img.shape[0])
+        if self._writer is None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter_fourcc(*"mp4v"), self.fps, size)
+            if not self._writer.isOpened():
+                raise ValueError(f"path: OpenCV cannot write an MP4 video at {self.path}")
+            self._size = size
+        elif size != self._size:
+            raise ValueError(f"image: frame {self.count} is {size}, earlier frames {self._size}")
+        self._writer.write(np.ascontiguousarray(img))
+        if self.gif is not None and self.count < self.gif_frames and self.count % self.gif_every == 0:
+            h = round(img.shape[0] * self.gif_width / img.shape[1])
+            self._gif_images.append(cv2.resize(img, (self.gif_width, h), interpolation=cv2.INTER_AREA))
+        self.count += 1
+
+    def close(self) -> None:
+        """Finalise the MP4 (and write the GIF)."""
+        if self._writer is not None:
+            self._writer.release()
+            self._writer = None
+        if self.gif is not None and self._gif_images:
+            write_gif(self.gif, self._gif_images, fps=self.fps / self.gif_every)
+            self._gif_images = []
+
+    def __enter__(self) -> "VideoWriter":
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.close()
+
+
+def write_gif(path: Path | str, images: list[np.ndarray], fps: float) -> Path:
+    """An animated, looping GIF of BGR ``images`` at ``fps`` frames per second (adaptive palette)."""
+    from PIL import Image
+
+    if not images:
+        raise ValueError("images: no frames for the GIF")
+    if not fps > 0:
+        raise ValueError(f"fps: must be positive, got {fps!r}")
+    frames = [Image.fromarray(np.ascontiguousarray(im[..., ::-1])).quantize(colors=128) for im in images]
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    frames[0].save(out, save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0,
+                   optimize=False)
+    return out
+
+
+def read_frames(path: Path | str) -> Iterator[np.ndarray]:
+    """The frames of a video file, ``(h, w, 3)`` uint8 BGR, in order."""
+    import cv2
+
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"video: no such file {p}")
+    cap = cv2.VideoCapture(str(p))
+    if not cap.isOpened():
+        raise ValueError(f"video: OpenCV cannot open {p}")
+    try:
+        while True:
+            ok, img = cap.read()
+            if not ok:
+                break
+            yield img
+    finally:
+        cap.release()
+
+
+def video_info(path: Path | str) -> tuple[int, float, tuple[int, int]]:
+    """Frame count (as the container says), frames per second and ``(width, height)`` of a video."""
+    import cv2
+
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"video: no such file {p}")
+    cap = cv2.VideoCapture(str(p))
+    if not cap.isOpened():
+        raise ValueError(f"video: OpenCV cannot open {p}")
+    try:
+        n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
+        fps = float(cap.get(cv2.CAP_PROP_FPS)) or 30.0
+        size = (int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT)))
+    finally:
+        cap.release()
+    return n, fps, size
