@@ -105,16 +105,17 @@ class Tails:
 
 
 def draw_box_tracks(image: np.ndarray, frame: int, ids: np.ndarray, xywh: np.ndarray, tails: Tails,
-                    prefix: str = "id ") -> None:
+                    prefix: str = "id ", max_gap: int = 5) -> None:
     """Boxes ``xywh (n, 4)`` (px) of tracks ``ids (n,)`` in their identity colours, with tails of
-    their bottom-centres (``tails`` is updated with this frame's points)."""
+    their bottom-centres (``tails`` is updated with this frame's points; tails of tracks unseen for
+    more than ``max_gap`` frames are dropped)."""
     boxes = np.asarray(xywh, dtype=float).reshape(-1, 4)
     ids = np.asarray(ids).reshape(-1).astype(int)
     if len(ids) != len(boxes):
         raise ValueError(f"ids: {len(ids)} ids for {len(boxes)} boxes")
     for i, b in zip(ids, boxes):
         tails.add(frame, int(i), np.array([b[0] + b[2] / 2, b[1] + b[3]]))
-    tails.expire(frame, tails.length)
+    tails.expire(frame, max_gap)
     for i, pts in tails.items():
         draw_tail(image, pts, identity_colour(i))
     for i, b in zip(ids, boxes):

@@ -47,10 +47,10 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
         out_dir.mkdir(parents=True, exist_ok=True)
         files = {"video": out_dir / "divers.mp4", "gif": out_dir / "divers.gif",
                  "still": out_dir / "divers-still.png", "raw": out_dir / "divers-raw.mp4"}
-        video = VideoWriter(files["video"], fps=sc.frame_rate, gif=files["gif"], gif_every=1, gif_frames=80)
+        video = VideoWriter(files["video"], fps=sc.frame_rate, gif=files["gif"], gif_every=2, gif_frames=80)
         raw = VideoWriter(files["raw"], fps=sc.frame_rate)
     tails = Tails(length=25)
-    still_at = len(frames) // 2
+    best_still = -1  # the still is the frame with the most tracks shown, in the second quarter onwards
     try:
         for frame in frames:
             k = frame.index
@@ -80,7 +80,8 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
                 draw_caption(img, [f"{sc.name}: {sc.n_divers} look-alike divers, tracker: {video_tracker}",
                                    f"frame {k + 1}/{len(frames)}  t = {frame.time:.1f} s"])
                 video.write(img)
-                if k == still_at:
+                if (k >= len(frames) // 4 and len(shown) > best_still) or not files["still"].exists():
+                    best_still = len(shown) if k >= len(frames) // 4 else -1
                     cv2.imwrite(str(files["still"]), img)
             if advance is not None:
                 advance()

@@ -97,7 +97,7 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
     files = {"video": out_dir / "robots.mp4", "gif": out_dir / "robots.gif", "still": out_dir / "robots-still.png"}
     still_at = min(frames - 1, (2 * frames) // 3)
     correct = total = 0
-    with VideoWriter(files["video"], fps=cfg.frame_rate_hz, gif=files["gif"], gif_every=3, gif_frames=180) as video:
+    with VideoWriter(files["video"], fps=cfg.frame_rate_hz, gif=files["gif"], gif_every=3, gif_frames=120) as video:
         for k in range(frames):
             frame = seq.frame(k)
             det = frame.detections

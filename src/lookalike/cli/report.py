@@ -1,0 +1,32 @@
+"""``lookalike report``: one self-contained HTML report from ``eval``/``bench`` JSON outputs."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import typer
+
+from lookalike.cli.app import app, console, fail
+from lookalike.viz.report import HtmlReport
+from lookalike.viz.results import add_results, load_results
+
+
+@app.command()
+def report(
+    results: list[Path] = typer.Argument(..., help="JSON files from `lookalike eval --json`, `bench ident --json`, "
+                                                   "`bench divers --json` (or the demo's robots-ident.json/divers.json)."),
+    output: Path = typer.Option(Path("report.html"), "-o", "--output", help="HTML file to write."),
+    title: str = typer.Option("lookalike results", help="Title of the report."),
+) -> None:
+    """Build an HTML report (tables and bar charts, images embedded) from result files."""
+    doc = HtmlReport(title)
+    try:
+        loaded = [(p, *load_results(p)) for p in results]
+        with tempfile.TemporaryDirectory() as tmp:
+            for i, (path, kind, rows) in enumerate(loaded):
+                add_results(doc, kind, rows, Path(tmp), f"chart{i}", title=f"{path.name}")
+            out = doc.write(output)
+    except ValueError as exc:
+        fail(str(exc))
+    console.print(f"wrote {out} ({len(loaded)} result file(s))")

@@ -1,0 +1,117 @@
+"""``lookalike demo --quick`` end to end, ``lookalike render`` and ``lookalike report``."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+pytest.importorskip("cv2")
+pytest.importorskip("matplotlib")
+
+from typer.testing import CliRunner  # noqa: E402
+
+from lookalike.cli import app  # noqa: E402
+from lookalike.cli.demo import QUICK, lstm_status  # noqa: E402
+from lookalike.viz import read_frames, video_info  # noqa: E402
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def demo_out(tmp_path_factory):
+    out = tmp_path_factory.mktemp("demo") / "demo-out"
+    r = runner.invoke(app, ["demo", "--quick", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    return out, r.output
+
+
+def test_demo_writes_every_file(demo_out):
+    out, text = demo_out
+    for name in ("robots.mp4", "robots.gif", "robots-still.png", "robots-birdseye.png", "divers.mp4", "divers.gif",
+                 "divers-still.png", "divers-raw.mp4", "divers-idf1.png", "robots-ident.png", "report.html",
+                 "robots-ident.json", "divers.json", "divers-sort.txt", "divers-diversort.txt"):
+        assert (out / name).is_file() and (out / name).stat().st_size > 0, name
+    assert "report.html" in text and "Try next" in text
+
+
+def test_demo_videos_decode_with_the_scene_frame_counts(demo_out):
+    out, _ = demo_out
+    assert len(list(read_frames(out / "robots.mp4"))) == QUICK.robot_frames
+    assert len(list(read_frames(out / "divers.mp4"))) == QUICK.diver_video_frames
+    assert video_info(out / "divers-raw.mp4")[0] == QUICK.diver_video_frames
+
+
+def test_demo_tables_cover_trackers_and_lstm_presence(demo_out):
+    out, text = demo_out
+    ident = json.loads((out / "robots-ident.json").read_text())
+    divers = json.loads((out / "divers.json").read_text())
+    assert {r["Tracker"] for r in divers} == {"sort", "deepsort", "diversort"}
+    assert len({r["Scenario"] for r in divers}) == QUICK.diver_scenarios
+    for setup, label in (("m3n2", "M=3, N=2"), ("m5n3", "M=5, N=3"), ("m10n7", "M=10, N=7")):
+        names = {r["Tracker"] for r in ident if r["Setup"] == label}
+        assert {"kalman_ha", "kalman_ha2", "jpda"} <= names
+        if lstm_status(setup) is None:
+            assert "lstm" in names
+        else:
+            assert "lstm" not in names and f"no shipped LSTM weights for {label}" in " ".join(text.split())
+    for r in ident:
+        assert 0 <= r["Success rate (%)"] <= 100
+    html = (out / "report.html").read_text()
+    assert len(re.findall(r'<img src="data:image/(png|gif);base64,', html)) >= 6
+    assert 'href="robots.mp4"' in html and 'href="divers.mp4"' in html
+
+
+def test_render_overlays_demo_tracks(demo_out, tmp_path):
+    out, _ = demo_out
+    target = tmp_path / "sort.mp4"
+    r = runner.invoke(app, ["render", "--video", str(out / "divers-raw.mp4"), "--tracks", str(out / "divers-sort.txt"),
+                            "-o", str(target), "--gif", str(tmp_path / "sort.gif")])
+    assert r.exit_code == 0, r.output
+    assert video_info(target)[0] == video_info(out / "divers-raw.mp4")[0]
+    assert len(list(read_frames(target))) == QUICK.diver_video_frames
+    assert (tmp_path / "sort.gif").stat().st_size > 0
+
+
+def test_render_rejects_missing_inputs(tmp_path):
+    tracks = tmp_path / "t.txt"
+    tracks.write_text("1,1,5,5,10,10,1,-1,-1,-1\n")
+    r = runner.invoke(app, ["render", "--video", str(tmp_path / "none.mp4"), "--tracks", str(tracks),
+                            "-o", str(tmp_path / "o.mp4")])
+    assert r.exit_code != 0 and "none.mp4" in r.output
+
+
+def test_report_from_results(demo_out, tmp_path):
+    out, _ = demo_out
+    evaluation = {"sort": {"seq-a": {"IDF1": 0.5, "HOTA": 0.4, "MOTA": 0.6, "IDSW": 3},
+                           "COMBINED": {"IDF1": 0.5, "HOTA": 0.4, "MOTA": 0.6, "IDSW": 3}}}
+    (tmp_path / "eval.json").write_text(json.dumps(evaluation))
+    target = tmp_path / "r.html"
+    r = runner.invoke(app, ["report", str(out / "robots-ident.json"), str(out / "divers.json"),
+                            str(tmp_path / "eval.json"), "-o", str(target)])
+    assert r.exit_code == 0, r.output
+    html = target.read_text()
+    assert html.count("data:image/png;base64,") == 3
+    assert "seq-a" in html and "M=10, N=7" in html
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"rows": 3}))
+    r = runner.invoke(app, ["report", str(bad), "-o", str(target)])
+    assert r.exit_code != 0 and "bad.json" in r.output
+
+
+def test_demo_rejects_unknown_preset(tmp_path):
+    r = runner.invoke(app, ["demo", "--quick", "--robot-preset", "m99", "-o", str(tmp_path)])
+    assert r.exit_code != 0 and "m99" in r.output
+
+
+def test_html_report_escapes_and_rejects_unknown_images(tmp_path):
+    from lookalike.viz import HtmlReport
+
+    doc = HtmlReport("<b>x</b>")
+    doc.table([{"a": "<script>", "b": np.float64(1.5)}])
+    with pytest.raises(ValueError, match="image"):
+        doc.image(tmp_path / "x.bmp")
+    html = doc.render()
+    assert "<script>" not in html and "&lt;script&gt;" in html

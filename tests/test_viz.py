@@ -1,0 +1,108 @@
+"""viz: annotation, video writing (decodes with OpenCV, same frame count), plots, overlay."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+cv2 = pytest.importorskip("cv2")
+
+from lookalike.io import MotTable  # noqa: E402
+from lookalike.viz import (  # noqa: E402
+    Tails,
+    VideoWriter,
+    birdseye_plot,
+    draw_box_tracks,
+    grouped_bar_chart,
+    identity_colour,
+    read_frames,
+    video_info,
+)
+from lookalike.viz.overlay import overlay_tracks  # noqa: E402
+
+
+def _frames(n: int, w: int = 96, h: int = 64) -> list[np.ndarray]:
+    rng = np.random.default_rng(0)
+    return [np.full((h, w, 3), 40, np.uint8) + rng.integers(0, 20, (h, w, 3), dtype=np.uint8) for _ in range(n)]
+
+
+def test_identity_colours_are_stable_and_distinct():
+    assert identity_colour(3) == identity_colour(3)
+    assert len({identity_colour(i) for i in range(10)}) == 10
+    assert identity_colour(-1) != identity_colour(0)
+
+
+def test_draw_box_tracks_paints_in_identity_colour():
+    img = np.zeros((60, 80, 3), np.uint8)
+    tails = Tails(5)
+    for k in range(3):
+        draw_box_tracks(img, k, np.array([2]), np.array([[10.0 + k, 20.0, 30.0, 25.0]]), tails)
+    colour = np.array(identity_colour(2))
+    assert (np.abs(img.reshape(-1, 3).astype(int) - colour).sum(axis=1) < 10).sum() > 50
+    with pytest.raises(ValueError, match="ids"):
+        draw_box_tracks(img, 0, np.array([1, 2]), np.zeros((1, 4)), tails)
+
+
+def test_video_writer_round_trip_and_gif(tmp_path):
+    frames = _frames(17)
+    with VideoWriter(tmp_path / "v.mp4", fps=10, gif=tmp_path / "v.gif", gif_every=2) as w:
+        for f in frames:
+            w.write(f)
+    decoded = list(read_frames(tmp_path / "v.mp4"))
+    assert len(decoded) == 17
+    assert decoded[0].shape == frames[0].shape
+    n, fps, size = video_info(tmp_path / "v.mp4")
+    assert (n, size) == (17, (96, 64)) and fps == pytest.approx(10)
+    from PIL import Image
+
+    with Image.open(tmp_path / "v.gif") as gif:
+        assert gif.n_frames == 9
+
+
+def test_video_writer_rejects_bad_frames(tmp_path):
+    with VideoWriter(tmp_path / "v.mp4", fps=10) as w:
+        w.write(_frames(1)[0])
+        with pytest.raises(ValueError, match="image"):
+            w.write(np.zeros((10, 10, 3), np.uint8))
+        with pytest.raises(ValueError, match="image"):
+            w.write(np.zeros((64, 96), np.uint8))
+    with pytest.raises(ValueError, match="fps"):
+        VideoWriter(tmp_path / "x.mp4", fps=0)
+
+
+def test_overlay_keeps_the_input_frame_count(tmp_path):
+    with VideoWriter(tmp_path / "in.mp4", fps=12) as w:
+        for f in _frames(23, 160, 120):
+            w.write(f)
+    rows = np.array([[k, 1, 10 + k, 20, 30, 40, 1, -1, -1, -1] for k in range(1, 20)]
+                    + [[5, 2, 80, 30, 20, 20, 1, -1, -1, -1]], dtype=float)
+    n = overlay_tracks(tmp_path / "in.mp4", MotTable.from_rows(rows), tmp_path / "out.mp4")
+    assert n == 23
+    out = list(read_frames(tmp_path / "out.mp4"))
+    assert len(out) == 23
+    src = list(read_frames(tmp_path / "in.mp4"))
+    assert np.abs(out[4].astype(int) - src[4].astype(int)).mean() > np.abs(out[22].astype(int) - src[22].astype(int)).mean()
+
+
+def test_overlay_reads_image_folders(tmp_path):
+    folder = tmp_path / "img1"
+    folder.mkdir()
+    for k, f in enumerate(_frames(5)):
+        cv2.imwrite(str(folder / f"{k + 1:06d}.jpg"), f)
+    rows = np.array([[1, 1, 5, 5, 20, 20, 1, -1, -1, -1]], dtype=float)
+    assert overlay_tracks(folder, MotTable.from_rows(rows), tmp_path / "o.mp4") == 5
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match="no images"):
+        overlay_tracks(tmp_path / "empty", MotTable.from_rows(rows), tmp_path / "x.mp4")
+
+
+def test_plots_write_pngs(tmp_path):
+    t = np.cumsum(np.random.default_rng(1).normal(0, 0.1, (50, 2, 2)), axis=0)
+    p = birdseye_plot(tmp_path / "b.png", t, t + 0.05, field_m=(9, 6), observer=np.array([-4.3, 0.0]))
+    assert cv2.imread(str(p)).shape[0] > 100
+    rows = [{"S": "a", "T": "x", "V": 50.0}, {"S": "a", "T": "y", "V": 70.0}, {"S": "b", "T": "x", "V": 10.0}]
+    assert cv2.imread(str(grouped_bar_chart(tmp_path / "g.png", rows, "S", "T", "V"))) is not None
+    with pytest.raises(ValueError, match="column"):
+        grouped_bar_chart(tmp_path / "g.png", rows, "S", "T", "missing")
+    with pytest.raises(ValueError, match="T, N, 2"):
+        birdseye_plot(tmp_path / "b.png", t, t[:, :1])
