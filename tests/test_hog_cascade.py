@@ -71,3 +71,30 @@ def test_nms_keeps_best_of_overlapping():
     boxes = np.array([[0, 0, 10, 20], [1, 1, 10, 20], [50, 50, 10, 20]], float)
     keep = nms(boxes, np.array([0.5, 0.9, 0.7]), 0.4)
     assert keep.tolist() == [1, 2]
+
+
+def test_cell_histograms_equal_summed_orientation_maps():
+    from lookalike.vision.hog_features import cell_histograms
+
+    g = np.random.default_rng(5).uniform(0, 255, (37, 50)).astype(np.float32)
+    ref = orientation_maps(g)[:, :36, :48].reshape(9, 9, 4, 12, 4).sum(axis=(2, 4))
+    np.testing.assert_allclose(cell_histograms(g, 4), ref, rtol=1e-5, atol=1e-3)
+
+
+def test_hard_negative_search_stops_when_cascade_is_good_enough():
+    rng = np.random.default_rng(6)
+    cfg = CascadeConfig(stages=10, negatives_per_stage=200, max_draws_per_stage=6, target_false_positive_rate=0.05)
+    pos = np.array([_window(rng, True) for _ in range(120)])
+    draws = []
+
+    def negatives(n, r):
+        draws.append(n)
+        return np.array([_window(r, False) for _ in range(n)])
+
+    messages = []
+    model = train_cascade(pos, negatives, cfg, seed=0, progress=lambda k, m: messages.append(m))
+    assert len(model.stages) < cfg.stages
+    assert "stopped" in messages[-1]
+    assert len(draws) <= cfg.max_draws_per_stage * (len(model.stages) + 1)
+    with pytest.raises(ValueError, match="target_false_positive_rate"):
+        CascadeConfig(target_false_positive_rate=1.5)

@@ -26,6 +26,7 @@ from lookalike.types import Detections
 from lookalike.vision.hog_features import (
     BINS,
     as_bgr_image,
+    cell_histograms,
     integral_maps,
     orientation_maps,
     to_grey,
@@ -45,6 +46,9 @@ class CascadeConfig:
     stage_hit_rate: float = 0.995
     max_stumps: int = 40
     negatives_per_stage: int = 2000
+    max_draws_per_stage: int = 10  # hard-negative search: at most this many batches of negatives_per_stage windows
+    min_hard_negatives: int = 20  # stop training when a stage's search finds fewer hard negatives than this
+    target_false_positive_rate: float = 1e-4  # stop when the cascade accepts fewer background windows than this
     scale_step: float = 1.2
     min_height_px: float = 48.0
     max_height_px: float = 320.0
@@ -59,6 +63,11 @@ class CascadeConfig:
             raise ValueError(f"CascadeConfig.stages: must be in 1..100, got {self.stages}")
         if not 0.5 < self.stage_hit_rate <= 1:
             raise ValueError(f"CascadeConfig.stage_hit_rate: must be in (0.5, 1], got {self.stage_hit_rate}")
+        if self.max_draws_per_stage < 1 or self.min_hard_negatives < 1:
+            raise ValueError("CascadeConfig.max_draws_per_stage/min_hard_negatives: must be >= 1")
+        if not 0 <= self.target_false_positive_rate < 1:
+            raise ValueError(f"CascadeConfig.target_false_positive_rate: must be in [0, 1), got "
+                             f"{self.target_false_positive_rate}")
         if self.scale_step <= 1:
             raise ValueError(f"CascadeConfig.scale_step: must be > 1, got {self.scale_step}")
 
@@ -79,17 +88,20 @@ def block_pool(window_px: tuple[int, int], cell_px: int) -> np.ndarray:
     return np.array(sorted(blocks), dtype=np.int64)
 
 
-def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray) -> np.ndarray:
-    """Descriptors of ``blocks (b, 4)`` for windows at offsets ``ox, oy (k,)`` (px) of ``integral (BINS, H+1, W+1)``;
+def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
+                   unit_px: int = 1) -> np.ndarray:
+    """Descriptors of ``blocks (b, 4)`` (px) for windows at offsets ``ox, oy (k,)`` (px) of ``integral (BINS, H+1, W+1)``
+    whose entries are ``unit_px`` pixels apart (1: a pixel integral; ``cell_px``: an integral of
+    :func:`~lookalike.vision.hog_features.cell_histograms`, all offsets then multiples of it);
     returns ``(k, b * 4 * BINS)`` float32."""
     out = []
     for bx, by, bw, bh in blocks:
-        hw, hh = bw // 2, bh // 2
+        hw, hh = bw // 2 // unit_px, bh // 2 // unit_px
         cells = []
         for cy in (0, 1):
             for cx in (0, 1):
-                x0 = ox + bx + cx * hw
-                y0 = oy + by + cy * hh
+                x0 = (ox + bx) // unit_px + cx * hw
+                y0 = (oy + by) // unit_px + cy * hh
                 cells.append(integral[:, y0 + hh, x0 + hw] - integral[:, y0, x0 + hw]
                              - integral[:, y0 + hh, x0] + integral[:, y0, x0])
         d = np.concatenate(cells, axis=0)  # (4 * BINS, k)
@@ -169,21 +181,18 @@ class HogCascade:
             if size[0] < win_w or size[1] < win_h:
                 break
             level = cv2.resize(grey, size, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
-            integral = integral_maps(orientation_maps(level))
+            integral = integral_maps(cell_histograms(level, cfg.cell_px))  # over cells: corners lie on the grid
             ys, xs = np.mgrid[0 : size[1] - win_h + 1 : step, 0 : size[0] - win_w + 1 : step]
             ox, oy = xs.ravel(), ys.ravel()
             alive = np.arange(len(ox))
             margin = np.zeros(0)
-            cache: dict[int, np.ndarray] = {}
             for stage in self.stages:
                 if not len(alive):
                     break
-                cols = np.empty((len(alive), len(stage.index)), np.float32)
-                for j, col in enumerate(stage.index):
-                    b = int(col) // (4 * BINS)
-                    if b not in cache:
-                        cache[b] = block_features(integral, self.blocks[b : b + 1], ox, oy)
-                    cols[:, j] = cache[b][alive, int(col) % (4 * BINS)]
+                # Descriptors of this stage's blocks, for the windows still alive only.
+                used = np.unique(stage.index // (4 * BINS))
+                feats = block_features(integral, self.blocks[used], ox[alive], oy[alive], cfg.cell_px)
+                cols = feats[:, np.searchsorted(used, stage.index // (4 * BINS)) * (4 * BINS) + stage.index % (4 * BINS)]
                 votes = np.where((cols > stage.threshold) == (stage.sign > 0), 1.0, -1.0)
                 margin = votes @ stage.weight
                 keep = margin >= stage.bias
@@ -284,16 +293,30 @@ def train_cascade(
     last_neg = neg
     for k in range(config.stages):
         # Refill the negatives with windows that the cascade so far accepts.
-        tries = 0
-        while len(neg) < config.negatives_per_stage and tries < 20:
+        # Stop rule: at most max_draws_per_stage batches; stop early once the measured false-positive rate
+        # of the cascade so far is below the target (the search would otherwise stall on a good cascade).
+        drawn = accepted = 0
+        for _ in range(config.max_draws_per_stage):
+            if len(neg) >= config.negatives_per_stage:
+                break
             cand = window_features(negative_windows(config.negatives_per_stage, rng), blocks)
+            drawn += len(cand)
             if model.stages:
                 cand = cand[model.classify(cand)[0]]
+            accepted += len(cand)
             neg = np.concatenate([neg, cand])[: config.negatives_per_stage]
-            tries += 1
-        if len(neg) < 20:
+            if model.stages and drawn >= 5 * config.negatives_per_stage and \
+                    accepted < config.target_false_positive_rate * drawn:
+                break
+        fp_rate = accepted / drawn if drawn else None
+        if model.stages and fp_rate is not None and fp_rate < config.target_false_positive_rate:
             if progress:
-                progress(k, f"stopped: only {len(neg)} hard negatives left")
+                progress(k, f"stopped: false-positive rate {fp_rate:.2e} below the target "
+                            f"{config.target_false_positive_rate:.0e} ({accepted} of {drawn} windows)")
+            break
+        if len(neg) < config.min_hard_negatives:
+            if progress:
+                progress(k, f"stopped: only {len(neg)} hard negatives in {drawn} windows")
             break
         live = model.classify(pos)[0] if model.stages else np.ones(len(pos), bool)
         x = np.concatenate([pos[live], neg])
