@@ -54,7 +54,16 @@ def test_boxtrack_reidentifies_a_target_after_a_gap() -> None:
 
 
 def test_boxtrack_low_scores_never_start_tracks() -> None:
+    # Birth needs a score above min(birth_score, median of the scores seen): 0.2 is below both.
     tracker = make_tracker("boxtrack")
+    ids = set()
+    for k in range(10):
+        boxes = np.array([[10.0 * k, 50.0, 40.0, 80.0], [300.0, 10.0 * k, 40.0, 80.0], [600.0, 50, 40, 80]])
+        dets = Detections(xywh=boxes, score=np.array([0.99, 0.2, 0.98]))
+        ids |= {(t.track_id, t.detection_index) for t in tracker.update(Frame(index=k, time=k / 10, detections=dets))}
+    assert {d for _, d in ids} == {0, 2}
+    # With raw thresholds only, a detector that never exceeds 0.5 starts nothing.
+    tracker = make_tracker("boxtrack", birth_quantile=None)
     out = [tracker.update(_frame(k, [[10.0 * k, 50.0, 40.0, 80.0]], score=0.5)) for k in range(10)]
     assert all(not tracks for tracks in out)
 
