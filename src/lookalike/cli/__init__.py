@@ -14,6 +14,7 @@ from lookalike.cli import bench_real as _bench_real  # noqa: E402,F401
 from lookalike.cli import simulate as _simulate  # noqa: E402,F401
 from lookalike.cli import train as _train  # noqa: E402,F401
 from lookalike.cli import node as _node  # noqa: E402,F401
+from lookalike.cli import vision as _vision  # noqa: E402,F401
 from lookalike.cli import render as _render  # noqa: E402,F401
 from lookalike.cli import report as _report  # noqa: E402,F401
 

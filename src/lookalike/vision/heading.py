@@ -323,6 +323,8 @@ def _platt_pairs(svc, x: np.ndarray, y: np.ndarray, folds: int, seed: int) -> tu
         dec = cross_val_predict(clone(svc), x, y, cv=cv, method="decision_function")
     except ValueError:  # a class too rare to be in every training fold: in-sample values (overconfident)
         dec = svc.decision_function(x)
+    if dec.reshape(len(x), -1).shape[1] != len(svc.classes_) * (len(svc.classes_) - 1) // 2:
+        dec = svc.decision_function(x)
     classes = svc.classes_
     k = len(classes)
     dec = dec.reshape(len(x), -1)

@@ -1,0 +1,56 @@
+import cv2
+import numpy as np
+from typer.testing import CliRunner
+
+from lookalike.cli import app
+from lookalike.vision.heading import HeadingClassifier
+from lookalike.vision.hog_cascade import HogCascade
+
+runner = CliRunner()
+
+
+def test_train_detector_from_folder_and_refusals(tmp_path):
+    rng = np.random.default_rng(0)
+    data = tmp_path / "data"
+    (data / "positives").mkdir(parents=True)
+    (data / "negatives").mkdir()
+    for i in range(40):  # a bright upright bar on noise
+        img = rng.normal(100, 12, (64, 32)).astype(np.float32)
+        img[8:56, 10:22] += 90
+        cv2.imwrite(str(data / "positives" / f"p{i}.png"), np.clip(img, 0, 255).astype(np.uint8))
+    for i in range(4):
+        img = rng.normal(100, 12, (120, 160, 3))
+        y, x = rng.integers(0, 80), rng.integers(0, 120)
+        img[y : y + 30, x : x + 30] += 60
+        cv2.imwrite(str(data / "negatives" / f"n{i}.png"), np.clip(img, 0, 255).astype(np.uint8))
+    out = tmp_path / "det.npz"
+    res = runner.invoke(app, ["train-detector", "--data", str(data), "-o", str(out), "--stages", "2",
+                              "--negatives", "200", "--copies", "1"])
+    assert res.exit_code == 0, res.output
+    model = HogCascade.load(out)
+    assert 1 <= len(model.stages) <= 2
+    res = runner.invoke(app, ["train-detector", "--data", str(tmp_path / "nothing"), "-o", str(out)])
+    assert res.exit_code != 0 and "positives" in res.output
+    (data / "positives" / "bad.png").write_bytes(b"not an image")
+    res = runner.invoke(app, ["train-detector", "--data", str(data), "-o", str(out)])
+    assert res.exit_code != 0 and "not a readable image" in res.output
+
+
+def test_train_detector_on_rendered_frames(tmp_path):
+    out = tmp_path / "det.npz"
+    res = runner.invoke(app, ["train-detector", "-o", str(out), "--frames", "8", "--stages", "2",
+                              "--negatives", "150", "--copies", "0"])
+    assert res.exit_code == 0, res.output
+    assert len(HogCascade.load(out).stages) >= 1
+
+
+def test_train_heading_reports_error(tmp_path):
+    out = tmp_path / "heading.npz"
+    res = runner.invoke(app, ["train-heading", "-o", str(out), "--frames", "12", "--test-frames", "3",
+                              "--folds", "2"])
+    assert res.exit_code == 0, res.output
+    assert "held-out mean absolute heading error" in res.output
+    model = HeadingClassifier.load(out)
+    assert model.support.shape[1] == len(model.mean)
+    res = runner.invoke(app, ["train-heading", "-o", str(out), "--frames", "0"])
+    assert res.exit_code != 0 and "--frames" in res.output
