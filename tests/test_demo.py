@@ -11,11 +11,11 @@ import pytest
 pytest.importorskip("cv2")
 pytest.importorskip("matplotlib")
 
-from typer.testing import CliRunner  # noqa: E402
+from typer.testing import CliRunner
 
-from lookalike.cli import app  # noqa: E402
-from lookalike.cli.demo import QUICK, lstm_status  # noqa: E402
-from lookalike.viz import read_frames, video_info  # noqa: E402
+from lookalike.cli import app
+from lookalike.cli.demo import QUICK, lstm_status
+from lookalike.viz import read_frames, video_info
 
 runner = CliRunner()
 
@@ -115,3 +115,26 @@ def test_html_report_escapes_and_rejects_unknown_images(tmp_path):
         doc.image(tmp_path / "x.bmp")
     html = doc.render()
     assert "<script>" not in html and "&lt;script&gt;" in html
+
+
+def test_demo_interrupt_exits_130_with_a_message(monkeypatch, tmp_path):
+    import lookalike.cli.demo as demo_module
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(demo_module, "run_demo", interrupted)
+    r = runner.invoke(app, ["demo", "--quick", "-o", str(tmp_path)])
+    assert r.exit_code == 130 and "Interrupted" in r.output
+
+
+def test_video_interrupted_midway_is_still_decodable(tmp_path):
+    from lookalike.viz import VideoWriter
+
+    frame = np.full((48, 64, 3), 90, np.uint8)
+    with pytest.raises(KeyboardInterrupt), VideoWriter(tmp_path / "v.mp4", fps=10) as w:
+        for k in range(30):
+            if k == 12:
+                raise KeyboardInterrupt
+            w.write(frame)
+    assert len(list(read_frames(tmp_path / "v.mp4"))) == 12

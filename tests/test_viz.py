@@ -7,8 +7,8 @@ import pytest
 
 cv2 = pytest.importorskip("cv2")
 
-from lookalike.io import MotTable  # noqa: E402
-from lookalike.viz import (  # noqa: E402
+from lookalike.io import MotTable
+from lookalike.viz import (
     Tails,
     VideoWriter,
     birdseye_plot,
@@ -18,7 +18,7 @@ from lookalike.viz import (  # noqa: E402
     read_frames,
     video_info,
 )
-from lookalike.viz.overlay import overlay_tracks  # noqa: E402
+from lookalike.viz.overlay import overlay_tracks
 
 
 def _frames(n: int, w: int = 96, h: int = 64) -> list[np.ndarray]:

@@ -3,10 +3,15 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+)
 
 from lookalike.cli.app import app, console, fail
 from lookalike.io import read_mot
@@ -18,9 +23,9 @@ def render(
     video: Path = typer.Option(..., "--video", help="Video file, or a folder of images (e.g. a MOTChallenge img1)."),
     tracks: Path = typer.Option(..., "--tracks", help="MOTChallenge result file (frame,id,x,y,w,h,...)."),
     output: Path = typer.Option(..., "-o", "--output", help="Annotated MP4 to write."),
-    gif: Optional[Path] = typer.Option(None, "--gif", help="Also write a short animated GIF here."),
+    gif: Path | None = typer.Option(None, "--gif", help="Also write a short animated GIF here."),
     tail: int = typer.Option(25, min=1, help="Track tail length in frames."),
-    fps: Optional[float] = typer.Option(None, min=0.1, help="Output frame rate (default: the input's; 30 for images)."),
+    fps: float | None = typer.Option(None, min=0.1, help="Output frame rate (default: the input's; 30 for images)."),
 ) -> None:
     """Draw tracks (identity colours, ids, tails) on every frame of a video."""
     try:

@@ -3,7 +3,14 @@
 OpenCV, matplotlib and Pillow are imported lazily inside the functions that use them.
 """
 
-from lookalike.viz.annotate import Tails, draw_box, draw_box_tracks, draw_caption, draw_label, draw_tail
+from lookalike.viz.annotate import (
+    Tails,
+    draw_box,
+    draw_box_tracks,
+    draw_caption,
+    draw_label,
+    draw_tail,
+)
 from lookalike.viz.colors import identity_colour, rgb_hex
 from lookalike.viz.plots import birdseye_plot, grouped_bar_chart
 from lookalike.viz.report import HtmlReport

@@ -76,7 +76,7 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
                     if i not in taken:
                         draw_box(img, det.xywh[i], FALSE_POSITIVE, "unmatched", thickness=1, dashed=True)
                 draw_box_tracks(img, k, np.array([t.track_id for t in shown], dtype=int),
-                                np.array([t.xywh for t in shown]).reshape(-1, 4), tails, prefix="diver ")
+                                np.array([t.xywh for t in shown]).reshape(-1, 4), tails, prefix="track ")
                 draw_caption(img, [f"{sc.name}: {sc.n_divers} look-alike divers, tracker: {video_tracker}",
                                    f"frame {k + 1}/{len(frames)}  t = {frame.time:.1f} s"])
                 video.write(img)

@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import base64
 import html
+import math
 import os
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 _MIME = {".png": "image/png", ".gif": "image/gif", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
 
@@ -32,7 +34,7 @@ def _cell(value: Any) -> tuple[str, bool]:
     if isinstance(value, int):
         return f"{value:,}", True
     if isinstance(value, float):
-        return ("—" if value != value else f"{value:,.3f}".rstrip("0").rstrip(".")), True
+        return ("—" if math.isnan(value) else f"{value:,.3f}".rstrip("0").rstrip(".")), True
     return html.escape(str(value)), False
 
 
