@@ -135,7 +135,7 @@ def test_rendered_robots_tiny_training_beats_chance():
     ft, ht = rendered_heading_samples(12, seed=12, config=cfg, camera=cam)
     assert len(f) >= 150 and len(ft) >= 30 and f.shape[1] == ft.shape[1]
     f2, _ = rendered_heading_samples(2, seed=11, config=cfg, camera=cam)
-    np.testing.assert_array_equal(f2, f[: len(f2)])  # deterministic by seed
+    np.testing.assert_allclose(f2, f[: len(f2)], rtol=1e-5, atol=1e-6)  # deterministic by seed (SIMD rounding aside)
     model = train_heading(f, h, cfg, seed=0)
     # Chance is 90 degrees; ~170 renders already do much better (~1300 reach ~12 degrees, see the note).
     err = mean_abs_error_deg(model.estimate(ft).heading_rad, ht)
