@@ -138,3 +138,13 @@ def test_video_interrupted_midway_is_still_decodable(tmp_path):
                 raise KeyboardInterrupt
             w.write(frame)
     assert len(list(read_frames(tmp_path / "v.mp4"))) == 12
+
+
+def test_render_birdseye_needs_no_video(tmp_path):
+    rows = "\n".join(f"{f},1,0,0,0,0,1,{0.1 * f:.2f},0.5,0" for f in range(1, 11))
+    (tmp_path / "w.txt").write_text(rows + "\n")
+    r = runner.invoke(app, ["render", "--birdseye", "--tracks", str(tmp_path / "w.txt"), "-o", str(tmp_path / "b.mp4")])
+    assert r.exit_code == 0, r.output
+    assert video_info(tmp_path / "b.mp4")[0] == 10
+    r = runner.invoke(app, ["render", "--tracks", str(tmp_path / "w.txt"), "-o", str(tmp_path / "c.mp4")])
+    assert r.exit_code != 0 and "--video" in r.output

@@ -106,3 +106,35 @@ def test_plots_write_pngs(tmp_path):
         grouped_bar_chart(tmp_path / "g.png", rows, "S", "T", "missing")
     with pytest.raises(ValueError, match="T, N, 2"):
         birdseye_plot(tmp_path / "b.png", t, t[:, :1])
+
+
+def test_birdseye_video_has_one_frame_per_frame_number(tmp_path):
+    from lookalike.viz.overlay import birdseye_video
+
+    rows = []
+    for f in range(1, 16):
+        rows.append([f, 1, -1, -1, -1, -1, 1, 0.1 * f, 1.0, 0])
+        if f % 2:
+            rows.append([f, 2, -1, -1, -1, -1, 1, 2.0, -0.2 * f, 0])
+    n = birdseye_video(MotTable.from_rows(np.array(rows, dtype=float)), tmp_path / "b.mp4", size_px=200)
+    assert n == 15 and len(list(read_frames(tmp_path / "b.mp4"))) == 15
+    unset = np.array([[1, 1, 5, 5, 10, 10, 1, -1, -1, -1]], dtype=float)
+    with pytest.raises(ValueError, match="world"):
+        birdseye_video(MotTable.from_rows(unset), tmp_path / "x.mp4")
+
+
+def test_eval_results_with_some_metrics_only(tmp_path):
+    import json
+
+    from lookalike.viz import HtmlReport
+    from lookalike.viz.results import add_results, load_results
+
+    path = tmp_path / "e.json"
+    path.write_text(json.dumps({"sort": {"a": {"MOTA": -0.25, "IDSW": 4}, "b": {"MOTA": 0.5, "IDSW": 1}}}))
+    kind, rows = load_results(path)
+    assert kind == "eval" and rows[0] == {"Tracker": "sort", "Sequence": "a", "MOTA": -25.0, "IDSW": 4}
+    doc = HtmlReport("t")
+    assert len(add_results(doc, kind, rows, tmp_path, "c")) == 1
+    path.write_text(json.dumps({"sort": {"a": {"Recall": 0.5}}}))
+    with pytest.raises(ValueError, match="none of"):
+        load_results(path)

@@ -1,4 +1,4 @@
-"""``lookalike render``: overlay MOTChallenge tracking results on a video (MP4, optional GIF)."""
+"""``lookalike render``: overlay MOTChallenge tracking results on a video, or draw world tracks from above."""
 
 from __future__ import annotations
 
@@ -15,30 +15,39 @@ from rich.progress import (
 
 from lookalike.cli.app import app, console, fail
 from lookalike.io import read_mot
-from lookalike.viz.overlay import overlay_tracks, source_frames
+from lookalike.viz.overlay import birdseye_video, overlay_tracks, source_frames
 
 
 @app.command()
 def render(
-    video: Path = typer.Option(..., "--video", help="Video file, or a folder of images (e.g. a MOTChallenge img1)."),
-    tracks: Path = typer.Option(..., "--tracks", help="MOTChallenge result file (frame,id,x,y,w,h,...)."),
+    tracks: Path = typer.Option(..., "--tracks", help="MOTChallenge result file (frame,id,x,y,w,h,conf,wx,wy,wz)."),
     output: Path = typer.Option(..., "-o", "--output", help="Annotated MP4 to write."),
+    video: Path | None = typer.Option(None, "--video", help="Video file, or a folder of images (e.g. a MOTChallenge "
+                                                            "img1); needed unless --birdseye."),
+    birdseye: bool = typer.Option(False, "--birdseye", help="Draw the world positions (columns 8, 9, metres; the box may be 0,0,0,0) from "
+                                                            "above instead of boxes on a video."),
     gif: Path | None = typer.Option(None, "--gif", help="Also write a short animated GIF here."),
     tail: int = typer.Option(25, min=1, help="Track tail length in frames."),
-    fps: float | None = typer.Option(None, min=0.1, help="Output frame rate (default: the input's; 30 for images)."),
+    fps: float | None = typer.Option(None, min=0.1, help="Output frame rate (default: the input's; 30 otherwise)."),
 ) -> None:
-    """Draw tracks (identity colours, ids, tails) on every frame of a video."""
+    """Draw tracks (identity colours, ids, tails) on every frame of a video, or from above (--birdseye)."""
+    if video is None and not birdseye:
+        fail("--video: give the video to draw on (or --birdseye for world tracks seen from above)")
     try:
-        table = read_mot(tracks)
-        _, total, _ = source_frames(video)
+        table = read_mot(tracks, min_columns=6)
+        total = int(table.frame.max()) if birdseye and len(table) else source_frames(video)[1] if video else 0
     except (ValueError, FileNotFoundError, OSError) as exc:
         fail(str(exc))
     try:
         with Progress(TextColumn("rendering"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                       console=console) as progress:
             task = progress.add_task("render", total=total or None)
-            n = overlay_tracks(video, table, output, gif=gif, tail=tail, fps=fps,
-                               advance=lambda: progress.advance(task))
+            advance = lambda: progress.advance(task)
+            if birdseye:
+                n = birdseye_video(table, output, fps=fps or 30.0, gif=gif, tail=tail, advance=advance)
+            else:
+                assert video is not None
+                n = overlay_tracks(video, table, output, gif=gif, tail=tail, fps=fps, advance=advance)
     except ValueError as exc:
         fail(str(exc))
     except KeyboardInterrupt:

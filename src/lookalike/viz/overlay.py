@@ -1,4 +1,5 @@
-"""Overlaying MOTChallenge tracking results on a video or an image folder (MP4 out, optional GIF)."""
+"""Overlaying MOTChallenge tracking results on a video or an image folder, or drawing world tracks
+from above (MP4 out, optional GIF)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,14 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.io import MotTable
-from lookalike.viz.annotate import Tails, draw_box_tracks, draw_caption
+from lookalike.viz.annotate import (
+    Tails,
+    draw_box_tracks,
+    draw_caption,
+    draw_label,
+    draw_tail,
+)
+from lookalike.viz.colors import identity_colour
 from lookalike.viz.video import VideoWriter, read_frames, video_info
 
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")
@@ -67,4 +75,62 @@ def overlay_tracks(source: Path | str, tracks: MotTable, output: Path | str, *, 
                 advance()
     if count == 0:
         raise ValueError(f"video: {source} has no frames")
+    return count
+
+
+def world_positions(tracks: MotTable) -> np.ndarray:
+    """``(n, 2)`` world ``x, y`` (m) of a MOTChallenge table (columns 8 and 9, 1-based); ValueError when absent."""
+    extra = np.asarray(tracks.extra, dtype=float)
+    if extra.ndim != 2 or extra.shape[1] < 2 or len(extra) == 0:
+        raise ValueError("tracks: no world coordinates (MOTChallenge columns 8 and 9 hold world x, y in metres)")
+    xy = extra[:, :2]
+    if np.all(xy == -1):
+        raise ValueError("tracks: world coordinates are all -1 (unset); write x, y in metres in columns 8 and 9")
+    return xy
+
+
+def birdseye_video(tracks: MotTable, output: Path | str, *, size_px: int = 640, fps: float = 30.0,
+                   gif: Path | str | None = None, tail: int = 60, advance: Callable[[], None] | None = None) -> int:
+    """World tracks seen from above as an MP4 (one frame per frame number 1..last): a metre grid,
+    each id as a dot in its identity colour with a tail; returns the number of frames written."""
+    import cv2
+
+    xy = world_positions(tracks)
+    frame_no = np.asarray(tracks.frame).astype(int)
+    ids = np.asarray(tracks.track_id).astype(int)
+    ok = np.isfinite(xy).all(axis=1) & (ids >= 0)
+    if not ok.any():
+        raise ValueError("tracks: no rows with an id >= 0 and finite world coordinates")
+    lo, hi = xy[ok].min(axis=0) - 0.5, xy[ok].max(axis=0) + 0.5
+    scale = (size_px - 40) / float(max(hi - lo))
+
+    def px(p: np.ndarray) -> np.ndarray:  # x right, y up
+        return np.column_stack([20 + (p[:, 0] - lo[0]) * scale, size_px - 20 - (p[:, 1] - lo[1]) * scale])
+
+    base = np.full((size_px, size_px, 3), 250, np.uint8)
+    for gx in np.arange(np.ceil(lo[0]), hi[0] + 1e-9):
+        u = int(px(np.array([[gx, lo[1]]]))[0, 0])
+        cv2.line(base, (u, 0), (u, size_px), (225, 225, 225), 1)
+    for gy in np.arange(np.ceil(lo[1]), hi[1] + 1e-9):
+        v = int(px(np.array([[lo[0], gy]]))[0, 1])
+        cv2.line(base, (0, v), (size_px, v), (225, 225, 225), 1)
+    tails = Tails(length=max(tail, 1))
+    count = 0
+    with VideoWriter(output, fps=fps, gif=gif) as writer:
+        for f in range(1, int(frame_no[ok].max()) + 1):
+            sel = ok & (frame_no == f)
+            img = base.copy()
+            for i, p in zip(ids[sel], px(xy[sel])):
+                tails.add(f, int(i), p)
+            tails.expire(f, 5)
+            for i, pts in tails.items():
+                draw_tail(img, pts, identity_colour(i))
+            for i, p in zip(ids[sel], px(xy[sel])):
+                cv2.circle(img, (round(p[0]), round(p[1])), 6, identity_colour(int(i)), -1, cv2.LINE_AA)
+                draw_label(img, f"{int(i)}", (round(p[0]) + 6, round(p[1]) - 6), identity_colour(int(i)))
+            draw_caption(img, [f"frame {f}  tracks: {int(sel.sum())}  grid: 1 m"])
+            writer.write(img)
+            count += 1
+            if advance is not None:
+                advance()
     return count

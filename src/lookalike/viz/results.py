@@ -35,11 +35,12 @@ def load_results(path: Path | str) -> tuple[str, list[dict[str, Any]]]:
         rows = []
         for tracker, per_seq in data.items():
             for seq, values in per_seq.items():
-                if not isinstance(values, dict) or not all(c in values for c in EVAL_COLUMNS):
-                    raise ValueError(f"results: {p}: {tracker}/{seq} lacks one of {', '.join(EVAL_COLUMNS)}")
+                present = [c for c in EVAL_COLUMNS if isinstance(values, dict) and c in values]
+                if not present:
+                    raise ValueError(f"results: {p}: {tracker}/{seq} has none of {', '.join(EVAL_COLUMNS)}")
                 rows.append({"Tracker": tracker, "Sequence": seq,
                              **{c: (int(values[c]) if c == "IDSW" else round(100 * float(values[c]), 2))
-                                for c in EVAL_COLUMNS}})
+                                for c in present}})
         if rows:
             return "eval", rows
     raise ValueError(f"results: {p} is not an eval or bench JSON output (see `lookalike report --help`)")
@@ -63,9 +64,12 @@ def add_results(report: HtmlReport, kind: str, rows: list[dict[str, Any]], chart
     elif kind == "eval":
         report.heading(title or "Evaluation (values in %)")
         report.table(rows)
-        chart = grouped_bar_chart(charts_dir / f"{stem}.png", rows, "Sequence", "Tracker", "IDF1",
-                                  ylabel="IDF1 (%)", title="IDF1 per sequence")
-        report.image(chart, "IDF1 (%) per sequence and tracker")
+        metric = next((c for c in EVAL_COLUMNS if c in rows[0] and c != "IDSW"), None)
+        if metric is None:
+            return []
+        chart = grouped_bar_chart(charts_dir / f"{stem}.png", rows, "Sequence", "Tracker", metric,
+                                  ylabel=f"{metric} (%)", ylim=None, title=f"{metric} per sequence")
+        report.image(chart, f"{metric} (%) per sequence and tracker")
     else:
         raise ValueError(f"kind: unknown results kind {kind!r}; known: ident, divers, eval")
     return [chart]
