@@ -1,0 +1,91 @@
+"""``lookalike label``: label a robot sequence's detections with identities in the browser."""
+
+from __future__ import annotations
+
+import ipaddress
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from lookalike.cli.app import app, console, fail
+from lookalike.sim import RobotSequence
+from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
+from lookalike.trackers.identity import labels_from_tracks
+
+
+def tracker_labels(name: str, sequence: RobotSequence) -> list[list[int]]:
+    """Per-frame detection labels from running registered tracker ``name`` over ``sequence``."""
+    known = {p.name for p in tracker_parameters(name)}
+    cfg = sequence.config
+    params = {k: v for k, v in (("n_agents", cfg.n_agents), ("n_slots", cfg.max_detections)) if k in known}
+    tracker = make_tracker(name, **params)
+    return [labels_from_tracks(len(f.detections), tracker.update(f)).tolist() for f in sequence.frames()]
+
+
+@app.command()
+def label(
+    sequence: Path = typer.Argument(..., help="A robot sequence (.jsonl from `lookalike simulate`)."),
+    tracks: Optional[str] = typer.Option(
+        None, "--tracks",
+        help="Starting labels: a tracker name (run on the sequence), a label file (.json), a labelled "
+             "sequence (.jsonl) or a MOTChallenge file (.txt) from the export. Ignored when saved labels exist."),
+    port: int = typer.Option(8765, "--port", min=0, max=65535, help="Port (0: any free one)."),
+    host: str = typer.Option("127.0.0.1", "--host", help="Address to bind (others on the network can reach non-loopback ones)."),
+    benchmark: bool = typer.Option(False, "--benchmark", help="Human benchmark: hide the truth, time the session, score it at the end."),
+    fresh: bool = typer.Option(False, "--fresh", help="Start over: move saved labels to <stem>.labels.json.bak."),
+    export: bool = typer.Option(False, "--export", help="Write the exports from the saved labels and exit (no server)."),
+) -> None:
+    """Serve the labelling page: click detections to cycle their robot (left forward, right back).
+
+    Labels are saved after every click to STEM.labels.json beside the sequence. Export (the
+    button or --export) writes STEM.labelled.jsonl (simulator truth format) and
+    STEM.labels.mot.txt (MOTChallenge, positions in the world columns).
+    """
+    from lookalike.io.robot_sequences import read_robot_sequence
+    from lookalike.viz.label import load_labels, make_server, open_label_app
+
+    if not sequence.is_file():
+        fail(f"SEQUENCE: {sequence}: no such file")
+    if benchmark and tracks:
+        fail("--benchmark starts from no labels; leave out --tracks")
+    initial, source = None, "empty"
+    try:
+        if tracks and not fresh and (sequence.with_name(f"{sequence.stem}.labels.json")).exists():
+            console.print("saved labels exist: --tracks ignored (use --fresh to start over from them)")
+        elif tracks:
+            seq = read_robot_sequence(sequence)
+            if Path(tracks).is_file():
+                initial, source = load_labels(tracks, seq), f"file {Path(tracks).name}"
+            elif tracks in tracker_names():
+                console.print(f"running {tracks} on {sequence.name} …")
+                initial, source = tracker_labels(tracks, seq), f"tracker {tracks}"
+            else:
+                fail(f"--tracks: {tracks!r} is neither a file nor a tracker ({', '.join(tracker_names())})")
+        label_app = open_label_app(sequence, initial, source, benchmark, fresh)
+    except ValueError as exc:
+        fail(str(exc))
+    if export:
+        r = label_app.export()
+        console.print(f"wrote {r['truth']} and {r['mot']} ({r['mot_rows']} rows, {r['unset']} not labelled) "
+                      f"in {label_app.folder}")
+        return
+    try:
+        server = make_server(label_app, host, port)
+    except OSError as exc:
+        fail(f"cannot listen on {host}:{port}: {exc}")
+    try:
+        if not ipaddress.ip_address(server.server_address[0]).is_loopback:
+            console.print(f"[yellow]warning:[/] {host} is reachable from other machines")
+    except ValueError:
+        pass
+    url = f"http://{host if ':' not in host else f'[{host}]'}:{server.server_address[1]}/"
+    console.print(f"labelling {sequence.name} ({len(label_app.sequence)} frames) at [bold]{url}[/] — "
+                  f"labels saved to {label_app.store.path.name}; Ctrl-C to stop", highlight=False)
+    try:
+        server.serve_forever()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.server_close()
+    console.print("stopped; labels are saved")

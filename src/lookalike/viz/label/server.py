@@ -1,0 +1,284 @@
+"""The labelling page's HTTP server (standard library ``ThreadingHTTPServer``).
+
+Routes (JSON unless stated)::
+
+    GET  /                       the page (static/index.html); GET /static/<name> its files
+    GET  /api/meta               sequence facts, colours, mode, image pattern
+    GET  /api/frames?start=&count=   frames' detections and latest reports (truth unless benchmark)
+    GET  /api/labels             all labels and the benchmark state
+    POST /api/label              {"frame", "detection", "label"}: set one label (saved at once)
+    POST /api/benchmark/start    start timing;  POST /api/benchmark/finish  stop and score
+    GET  /api/score              success rate against the truth (benchmark mode: after finishing)
+    POST /api/export             write <stem>.labelled.jsonl and <stem>.labels.mot.txt beside the sequence
+    GET  /files/<path>           a file inside the sequence's folder (video frames); others are refused
+
+Requests with a foreign ``Host`` header (DNS rebinding) or POSTs that are not
+``application/json`` (cross-site forms) are refused; malformed requests get 400 and the server
+keeps serving.
+"""
+
+from __future__ import annotations
+
+import json
+import mimetypes
+from http import HTTPStatus
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+from typing import Any, Callable
+from urllib.parse import parse_qs, unquote, urlsplit
+
+import numpy as np
+
+from lookalike.sim import RobotSequence
+from lookalike.viz.colors import FALSE_POSITIVE, identity_colour, rgb_hex
+from lookalike.viz.label.exports import export_mot, export_truth
+from lookalike.viz.label.store import LabelStore, score_labels
+
+STATIC_DIR = Path(__file__).resolve().parent / "static"
+MAX_BODY_BYTES = 64 * 1024
+MAX_FRAMES_PER_REQUEST = 500
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
+
+
+class LabelApp:
+    """What the server serves: one sequence, its label store and the mode.
+
+    Args:
+        sequence_path: the robot sequence file (JSON Lines); its folder is the only one served.
+        sequence: the sequence read from it.
+        store: its labels.
+        benchmark: human-benchmark mode (truth never sent to the page; timed; scored at the end).
+    """
+
+    def __init__(self, sequence_path: str | Path, sequence: RobotSequence, store: LabelStore,
+                 benchmark: bool = False) -> None:
+        self.sequence_path = Path(sequence_path).resolve()
+        self.folder = self.sequence_path.parent
+        self.sequence = sequence
+        self.store = store
+        self.benchmark = benchmark
+        self.truth = sequence.true_labels()
+        self._reports = _latest_reports(sequence)
+        self.image_pattern = _find_images(self.folder, self.sequence_path.stem)
+
+    def meta(self) -> dict[str, Any]:
+        cfg = self.sequence.config
+        return {
+            "name": self.sequence_path.name, "n_frames": len(self.sequence), "n_agents": cfg.n_agents,
+            "max_detections": cfg.max_detections, "benchmark": self.benchmark, "has_truth": not self.benchmark,
+            "fov_rad": cfg.observer.fov_rad, "max_range_m": cfg.observer.max_range_m,
+            "colours": [rgb_hex(identity_colour(i)) for i in range(cfg.n_agents)],
+            "fp_colour": rgb_hex(FALSE_POSITIVE), "source": self.store.source, "image_pattern": self.image_pattern,
+        }
+
+    def frames(self, start: int, count: int) -> list[dict[str, Any]]:
+        a = self.sequence.arrays
+        out = []
+        for k in range(max(start, 0), min(start + count, len(a))):
+            n = int(a.det_valid[k].sum())
+            det = [{"x": float(a.det_position[k, j, 0]), "y": float(a.det_position[k, j, 1]),
+                    "heading": float(a.det_heading[k, j]), "score": float(a.det_score[k, j])} for j in range(n)]
+            row: dict[str, Any] = {"frame": k, "time": float(a.time[k]), "detections": det, "reports": self._reports[k]}
+            if not self.benchmark:
+                row["truth"] = self.truth[k].tolist()
+            out.append(row)
+        return out
+
+    def score(self) -> dict[str, Any]:
+        return score_labels(self.store.snapshot(), self.truth, self.sequence.config.n_agents)
+
+    def export(self) -> dict[str, Any]:
+        labels = self.store.snapshot()
+        stem = self.sequence_path.stem
+        truth_path, unset = export_truth(self.sequence, labels, self.folder / f"{stem}.labelled.jsonl")
+        mot_path, rows = export_mot(self.sequence, labels, self.folder / f"{stem}.labels.mot.txt")
+        return {"truth": truth_path.name, "mot": mot_path.name, "unset": unset, "mot_rows": rows}
+
+
+def _latest_reports(sequence: RobotSequence) -> list[list[dict[str, Any]]]:
+    """Per frame, each agent's latest received report so far: agent, heading (rad), age (s)."""
+    a, r = sequence.arrays, sequence.arrays.reports
+    n = sequence.config.n_agents
+    heading, sent = np.full(n, np.nan), np.full(n, np.nan)
+    out = []
+    for k in range(len(a)):
+        for i in range(r.frame_offsets[k], r.frame_offsets[k + 1]):
+            agent = int(r.agent_id[i])
+            if 0 <= agent < n and not r.t_sent[i] < sent[agent]:
+                heading[agent], sent[agent] = r.heading[i], r.t_sent[i]
+        out.append([{"agent": j, "heading": float(heading[j]), "age": float(a.time[k] - sent[j])}
+                    for j in range(n) if np.isfinite(heading[j])])
+    return out
+
+
+def _find_images(folder: Path, stem: str) -> str | None:
+    """``files/<dir>/{frame:06d}<ext>`` when ``<stem>_frames/`` or ``img1/`` holds 1-based frame images."""
+    for name in (f"{stem}_frames", "img1"):
+        d = folder / name
+        if d.is_dir():
+            for ext in IMAGE_SUFFIXES:
+                if (d / f"000001{ext}").is_file():
+                    return f"files/{name}/{{frame:06d}}{ext}"
+    return None
+
+
+class _BadRequest(Exception):
+    def __init__(self, status: HTTPStatus, message: str) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+def _int(query: dict[str, list[str]], name: str, default: int) -> int:
+    try:
+        return int(query.get(name, [str(default)])[0])
+    except ValueError:
+        raise _BadRequest(HTTPStatus.BAD_REQUEST, f"query parameter {name} must be an integer") from None
+
+
+def make_handler(app: LabelApp, log: Callable[[str], None] | None = None) -> type[BaseHTTPRequestHandler]:
+    """A request handler class bound to ``app`` (``log`` receives one line per request)."""
+
+    class Handler(BaseHTTPRequestHandler):
+        server_version = "lookalike-label"
+        timeout = 30  # seconds a connection may stay silent
+
+        def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 (base class name)
+            if log is not None:
+                log(f"{self.address_string()} {format % args}")
+
+        def _send(self, status: HTTPStatus, body: bytes, content_type: str) -> None:
+            self.send_response(status)
+            self.send_header("Content-Type", content_type)
+            self.send_header("Content-Length", str(len(body)))
+            self.send_header("Cache-Control", "no-store")
+            self.send_header("X-Content-Type-Options", "nosniff")
+            self.end_headers()
+            if self.command != "HEAD":
+                self.wfile.write(body)
+
+        def _json(self, payload: Any, status: HTTPStatus = HTTPStatus.OK) -> None:
+            self._send(status, json.dumps(payload, allow_nan=False).encode(), "application/json")
+
+        def _check_host(self) -> None:
+            host = (self.headers.get("Host") or "").rsplit(":", 1)[0].strip("[]").lower()
+            bound = self.server.server_address[0]
+            if bound in ("127.0.0.1", "::1", "localhost") and host not in ("127.0.0.1", "localhost", "::1"):
+                raise _BadRequest(HTTPStatus.FORBIDDEN, f"unexpected Host header {host!r}")
+
+        def _dispatch(self, route: Callable[[], None]) -> None:
+            try:
+                self._check_host()
+                route()
+            except _BadRequest as exc:
+                self._json({"error": str(exc)}, exc.status)
+            except ValueError as exc:
+                self._json({"error": str(exc)}, HTTPStatus.BAD_REQUEST)
+            except (BrokenPipeError, ConnectionResetError):
+                pass
+            except Exception as exc:  # a bug must not take the server down
+                self._json({"error": f"internal error: {exc!r}"}, HTTPStatus.INTERNAL_SERVER_ERROR)
+
+        def do_GET(self) -> None:  # noqa: N802 (http.server naming)
+            self._dispatch(self._get)
+
+        def do_HEAD(self) -> None:  # noqa: N802
+            self._dispatch(self._get)
+
+        def do_POST(self) -> None:  # noqa: N802
+            self._dispatch(self._post)
+
+        def _get(self) -> None:
+            url = urlsplit(self.path)
+            query = parse_qs(url.query)
+            path = url.path
+            if path in ("/", "/index.html"):
+                self._static("index.html")
+            elif path.startswith("/static/"):
+                self._static(path[len("/static/"):])
+            elif path.startswith("/files/"):
+                self._file(path[len("/files/"):])
+            elif path == "/api/meta":
+                self._json(app.meta())
+            elif path == "/api/frames":
+                start, count = _int(query, "start", 0), _int(query, "count", 100)
+                if start < 0 or not 0 < count <= MAX_FRAMES_PER_REQUEST:
+                    raise _BadRequest(HTTPStatus.BAD_REQUEST, f"need start >= 0 and 0 < count <= {MAX_FRAMES_PER_REQUEST}")
+                self._json({"frames": app.frames(start, count)})
+            elif path == "/api/labels":
+                self._json({"labels": app.store.snapshot(), "benchmark": app.store.benchmark})
+            elif path == "/api/score":
+                bench = app.store.benchmark
+                if app.benchmark and not (bench and bench.get("finished_at") is not None):
+                    raise _BadRequest(HTTPStatus.FORBIDDEN, "the score is shown when the benchmark session ends")
+                self._json(app.score())
+            else:
+                raise _BadRequest(HTTPStatus.NOT_FOUND, f"no such page {path!r}")
+
+        def _static(self, name: str) -> None:
+            if name not in {p.name for p in STATIC_DIR.iterdir() if p.is_file()}:
+                raise _BadRequest(HTTPStatus.NOT_FOUND, f"no static file {name!r}")
+            p = STATIC_DIR / name
+            self._send(HTTPStatus.OK, p.read_bytes(), mimetypes.guess_type(p.name)[0] or "application/octet-stream")
+
+        def _file(self, rel: str) -> None:
+            rel = unquote(rel)
+            if "\x00" in rel:
+                raise _BadRequest(HTTPStatus.BAD_REQUEST, "NUL in path")
+            target = (app.folder / rel).resolve()
+            if not target.is_relative_to(app.folder) or target == app.folder:
+                raise _BadRequest(HTTPStatus.FORBIDDEN, "outside the sequence folder")
+            if not target.is_file():
+                raise _BadRequest(HTTPStatus.NOT_FOUND, f"no file {rel!r}")
+            ctype = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
+            self._send(HTTPStatus.OK, target.read_bytes(), ctype)
+
+        def _body(self) -> dict[str, Any]:
+            ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
+            if ctype != "application/json":
+                raise _BadRequest(HTTPStatus.UNSUPPORTED_MEDIA_TYPE, "POST bodies must be application/json")
+            try:
+                length = int(self.headers.get("Content-Length", ""))
+            except ValueError:
+                raise _BadRequest(HTTPStatus.LENGTH_REQUIRED, "Content-Length required") from None
+            if not 0 <= length <= MAX_BODY_BYTES:
+                raise _BadRequest(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"body over {MAX_BODY_BYTES} bytes")
+            raw = self.rfile.read(length) if length else b"{}"
+            try:
+                body = json.loads(raw)
+            except (json.JSONDecodeError, UnicodeDecodeError):
+                raise _BadRequest(HTTPStatus.BAD_REQUEST, "body is not JSON") from None
+            if not isinstance(body, dict):
+                raise _BadRequest(HTTPStatus.BAD_REQUEST, "body must be a JSON object")
+            return body
+
+        def _post(self) -> None:
+            path = urlsplit(self.path).path
+            body = self._body()
+            if path == "/api/label":
+                missing = [k for k in ("frame", "detection", "label") if k not in body]
+                if missing:
+                    raise _BadRequest(HTTPStatus.BAD_REQUEST, f"missing {', '.join(missing)}")
+                app.store.set_label(body["frame"], body["detection"], body["label"])
+                self._json({"ok": True})
+            elif path == "/api/benchmark/start":
+                if not app.benchmark:
+                    raise _BadRequest(HTTPStatus.CONFLICT, "not in benchmark mode")
+                self._json({"benchmark": app.store.start_benchmark()})
+            elif path == "/api/benchmark/finish":
+                if not app.benchmark:
+                    raise _BadRequest(HTTPStatus.CONFLICT, "not in benchmark mode")
+                self._json({"benchmark": app.store.finish_benchmark(app.truth)})
+            elif path == "/api/export":
+                self._json(app.export())
+            else:
+                raise _BadRequest(HTTPStatus.NOT_FOUND, f"no such action {path!r}")
+
+    return Handler
+
+
+def make_server(app: LabelApp, host: str = "127.0.0.1", port: int = 8765,
+                log: Callable[[str], None] | None = None) -> ThreadingHTTPServer:
+    """A server for ``app`` bound to ``host:port`` (port 0: any free port); call ``serve_forever``."""
+    server = ThreadingHTTPServer((host, port), make_handler(app, log))
+    server.daemon_threads = True
+    return server
