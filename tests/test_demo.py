@@ -148,3 +148,27 @@ def test_render_birdseye_needs_no_video(tmp_path):
     assert video_info(tmp_path / "b.mp4")[0] == 10
     r = runner.invoke(app, ["render", "--tracks", str(tmp_path / "w.txt"), "-o", str(tmp_path / "c.mp4")])
     assert r.exit_code != 0 and "--video" in r.output
+
+
+def test_demo_rerun_recording(tmp_path):
+    pytest.importorskip("rerun", reason="the optional rerun-sdk is not installed")
+    rrd = tmp_path / "demo.rrd"
+    r = runner.invoke(app, ["demo", "--quick", "-o", str(tmp_path / "out"), "--rerun-save", str(rrd)])
+    assert r.exit_code == 0, r.output
+    assert rrd.stat().st_size > 100_000  # the logged frames are in it
+    assert f"rerun {rrd}" in " ".join(r.output.split())
+
+
+def test_rerun_missing_is_a_clear_error(monkeypatch, tmp_path):
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_rerun(name, *args, **kwargs):
+        if name == "rerun" or name.startswith("rerun."):
+            raise ImportError(name)
+        return real_import(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_rerun)
+    r = runner.invoke(app, ["demo", "--quick", "-o", str(tmp_path), "--rerun-save", str(tmp_path / "x.rrd")])
+    assert r.exit_code != 0 and "rerun-sdk" in r.output

@@ -92,8 +92,9 @@ def _rich_table(title: str, rows: list[dict[str, Any]], columns: list[str]) -> T
     return table
 
 
-def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str) -> dict[str, Path]:
-    """Run the whole demo into ``output``; returns the files written (name → path)."""
+def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str, rerun: Any = None) -> dict[str, Path]:
+    """Run the whole demo into ``output``; returns the files written (name → path). ``rerun``: an
+    optional :class:`~lookalike.viz.rerun_log.RerunLogger` that also receives the video scenes."""
     output.mkdir(parents=True, exist_ok=True)
     notes = {s: lstm_status(s) for s in PRESET_NAMES}
     for s, why in notes.items():
@@ -105,7 +106,8 @@ def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str) -> dict
         robot_trackers = list(ROBOT_TRACKERS) + (["lstm"] if notes[robot_preset] is None else [])
         with _task(progress, f"Robots {preset_label(robot_preset)}: render + identify", size.robot_frames) as adv:
             robots = run_robot_scene(output, preset_name=robot_preset, frames=size.robot_frames, seed=seed,
-                                     trackers=robot_trackers, video_tracker=video_tracker, advance=adv)
+                                     trackers=robot_trackers, video_tracker=video_tracker, advance=adv,
+                                     rerun=rerun)
         files.update({f"robots-{k}": v for k, v in robots.files.items()})
         ident_rows: list[dict[str, Any]] = []
         with _task(progress, "Robot identification, all set-ups", len(PRESET_NAMES)) as adv:
@@ -120,7 +122,8 @@ def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str) -> dict
         video_sc = dataclasses.replace(scenario("ocean_four_long_absences"), frames=size.diver_video_frames)
         with _task(progress, f"Divers {video_sc.name}: render + track", video_sc.frames) as adv:
             diver_rows, diver_files = run_diver_scenario(video_sc, extractor, DIVER_TRACKERS, out_dir=output,
-                                                         video_tracker="diversort", advance=adv)
+                                                         video_tracker="diversort", advance=adv,
+                                                         rerun=rerun)
         files.update({f"divers-{k}": v for k, v in diver_files.items()})
         others = [sc for sc in SCENARIOS if sc.name != video_sc.name][: max(size.diver_scenarios - 1, 0)]
         with _task(progress, "Divers: other scenarios", len(others) * size.diver_frames) as adv:
@@ -187,18 +190,32 @@ def demo(
     seed: int = typer.Option(0, help="Seed of the simulated scenes."),
     quick: bool = typer.Option(False, "--quick", help="A reduced run (seconds): fewer frames and scenarios."),
     robot_preset: str = typer.Option("m5n3", "--robot-preset", help=f"Robot set-up of the video: {', '.join(PRESET_NAMES)}."),
+    rerun: bool = typer.Option(False, "--rerun", help="Also stream frames, boxes and positions to a Rerun viewer "
+                                                      "(needs the optional rerun-sdk)."),
+    rerun_save: Path | None = typer.Option(None, "--rerun-save", help="Also write a Rerun recording (.rrd) here."),
 ) -> None:
     """Simulate robots and divers, run every relevant tracker, write videos, plots and an HTML report."""
     from lookalike.cli.app import fail
 
     if robot_preset not in PRESET_NAMES:
         fail(f"--robot-preset: unknown preset {robot_preset!r}; known: {', '.join(PRESET_NAMES)}")
+    logger = None
+    if rerun or rerun_save is not None:
+        from lookalike.viz.rerun_log import open_rerun
+
+        try:
+            logger = open_rerun("lookalike-demo", save=rerun_save, spawn=rerun)
+        except ValueError as exc:
+            fail(str(exc))
     t0 = time.perf_counter()
     try:
-        files = run_demo(output, seed, QUICK if quick else DemoSize(), robot_preset)
+        files = run_demo(output, seed, QUICK if quick else DemoSize(), robot_preset, rerun=logger)
     except KeyboardInterrupt:
         console.print(f"\n[yellow]Interrupted.[/] Files finished so far are in {output}/.")
         raise typer.Exit(130) from None
+    finally:
+        if logger is not None:
+            logger.close()
     console.print(f"\nDone in {time.perf_counter() - t0:.0f} s. Results are in [bold]{output}/[/]:")
     console.print(f"  report      {files['report']}   (open it in a browser: tables, pictures, links to videos)")
     console.print(f"  videos      {files['robots-video']}, {files['divers-video']} (and .gif)")
@@ -207,3 +224,5 @@ def demo(
                   "`lookalike bench divers`,")
     console.print(f"  `lookalike render --video {output}/divers-raw.mp4 --tracks {output}/divers-sort.txt "
                   f"-o {output}/divers-sort.mp4`")
+    if rerun_save is not None:
+        console.print(f"  `rerun {rerun_save}` to inspect the logged frames, boxes and positions")

@@ -27,11 +27,13 @@ Extractor = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *,
                        out_dir: Path | None = None, video_tracker: str | None = None,
-                       advance: Callable[[], None] | None = None) -> tuple[list[dict[str, Any]], dict[str, Path]]:
+                       advance: Callable[[], None] | None = None,
+                       rerun: Any = None) -> tuple[list[dict[str, Any]], dict[str, Path]]:
     """Score ``trackers`` on scenario ``sc`` (rows keyed Scenario, Tracker, IDF1, HOTA, MOTA, IDSW,
     Frames/s; metrics in %). With ``out_dir`` and ``video_tracker`` also write
     ``divers.mp4``/``divers.gif``/``divers-still.png``/``divers-raw.mp4`` and
-    ``divers-<tracker>.txt``; returns the rows and the files written."""
+    ``divers-<tracker>.txt``; returns the rows and the files written. ``rerun`` (a
+    :class:`~lookalike.viz.rerun_log.RerunLogger`) also receives the frames and the video tracker's boxes."""
     import cv2
 
     if video_tracker is not None and (out_dir is None or video_tracker not in trackers):
@@ -68,6 +70,11 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
                         results[name].append([k + 1, t.track_id, *t.xywh, 1.0, -1, -1, -1])
                 if name == video_tracker:
                     shown = [t for t in tracks if t.xywh is not None and t.status is TrackStatus.CONFIRMED]
+            if rerun is not None and shown is not None:
+                rerun.set_time(k, frame.time)
+                rerun.image("divers/camera", image)
+                rerun.boxes("divers/camera/tracks", np.array([t.xywh for t in shown]).reshape(-1, 4),
+                            np.array([t.track_id for t in shown], dtype=int), [f"track {t.track_id}" for t in shown])
             if video is not None and raw is not None and shown is not None:
                 raw.write(image)
                 img = image.copy()

@@ -71,12 +71,13 @@ def _to_fixed(ego: np.ndarray, pose: np.ndarray) -> np.ndarray:
 
 def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 300, seed: int = 0,
                     trackers: list[str], video_tracker: str, render_width: int = 320, scale: int = 2,
-                    advance: Callable[[], None] | None = None) -> RobotSceneResult:
+                    advance: Callable[[], None] | None = None, rerun: Any = None) -> RobotSceneResult:
     """Simulate ``frames`` frames of preset ``preset_name``, run ``trackers`` and write
     ``robots.mp4``, ``robots.gif``, ``robots-still.png`` and ``robots-birdseye.png`` in ``out_dir``.
 
     The scene is rendered ``render_width`` pixels wide (4:3) and annotated at ``scale`` times that
-    size. ``advance`` is called after every frame (progress bars).
+    size. ``advance`` is called after every frame (progress bars). ``rerun`` (a
+    :class:`~lookalike.viz.rerun_log.RerunLogger`) also receives frames, boxes and world positions.
     """
     import cv2
 
@@ -118,6 +119,9 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
             img = cv2.resize(img, (img.shape[1] * scale, img.shape[0] * scale), interpolation=cv2.INTER_LINEAR)
             labels = predicted[video_tracker][-1]
             truth = truth_labels[k]
+            if rerun is not None:
+                _log_robots(rerun, k, float(a.time[k]), img, camera, scale, det, labels,
+                            _to_fixed(estimated[video_tracker][k], pose), a.field_position[k])
             correct += int((labels == truth).sum())
             total += len(labels)
             for j in range(n):
@@ -168,3 +172,14 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
         title=f"{preset_label(preset_name)}: true paths (lines) vs {video_tracker} estimates (dots), field frame",
     )
     return RobotSceneResult(rows=rows, files=files, video_tracker=video_tracker)
+
+
+def _log_robots(rerun: Any, k: int, time_s: float, img: np.ndarray, camera: Camera, scale: int, det: Any,
+                labels: np.ndarray, estimated: np.ndarray, truth: np.ndarray) -> None:
+    rerun.set_time(k, time_s)
+    rerun.image("robots/camera", img)
+    boxes = camera.ground_to_box(det.position, ROBOT_HEIGHT_M, ROBOT_WIDTH_M) * scale if len(det) else np.zeros((0, 4))
+    rerun.boxes("robots/camera/detections", boxes, labels,
+                ["false positive" if j < 0 else f"robot {j}" for j in labels])
+    rerun.points("robots/world/estimated", estimated, np.arange(len(estimated)))
+    rerun.points("robots/world/true", truth, np.arange(len(truth)), radius=0.04)
