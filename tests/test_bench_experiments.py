@@ -1,0 +1,49 @@
+import json
+
+import numpy as np
+from typer.testing import CliRunner
+
+from lookalike.cli import app
+from lookalike.cli.bench_experiments import _recovery_s, _reindex, _swap_reports
+from lookalike.sim import preset, simulate_robots
+
+
+def test_swap_exchanges_only_reports_in_the_window():
+    seq = simulate_robots(preset("m3n2"), 120, seed=3)
+    frames = list(seq.frames())
+    swapped = _swap_reports(frames, 1.0, 2.0)
+    for a, b in zip(frames, swapped):
+        inside = (a.beacons.t_sent >= 1.0) & (a.beacons.t_sent < 2.0)
+        np.testing.assert_array_equal(b.beacons.agent_id[~inside], a.beacons.agent_id[~inside])
+        np.testing.assert_array_equal(b.beacons.agent_id[inside], 1 - a.beacons.agent_id[inside])
+
+
+def test_reindexed_frames_run_forward_in_time():
+    seq = simulate_robots(preset("m3n2"), 30, seed=3)
+    frames = list(seq.frames())[::-1]
+    out = _reindex(frames)
+    assert [f.index for f in out] == list(range(30))
+    assert all(b.time > a.time for a, b in zip(out, out[1:]))
+    assert out[0].detections is frames[0].detections
+
+
+def test_recovery_time_counts_from_the_restore():
+    clean = [np.array([0, 1])] * 100
+    swapped = [np.array([1, 0])] * 40 + [np.array([0, 1])] * 60
+    assert _recovery_s(clean, swapped, restore=30, window=10, rate=10.0) == 1.0
+    assert _recovery_s(clean, [np.array([1, 0])] * 100, restore=30, window=10, rate=10.0) == float("inf")
+
+
+def test_commands_print_and_write_tables(tmp_path):
+    runner = CliRunner()
+    out = tmp_path / "shuffle.json"
+    r = runner.invoke(app, ["bench", "shuffle", "--setups", "m3n2", "--trackers", "kalman_ha2", "--sequences", "1",
+                            "--frames", "200", "--json", str(out)])
+    assert r.exit_code == 0, r.output
+    row = json.loads(out.read_text())[0]
+    assert row["In order (%)"] > row["Random order (%)"]
+    out = tmp_path / "recovery.json"
+    r = runner.invoke(app, ["bench", "recovery", "--setups", "m3n2", "--trackers", "kalman_ha2", "--sequences", "1",
+                            "--frames", "450", "--swap-at-s", "3", "--swap-s", "5", "--json", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "Recovery, mean (s)" in json.loads(out.read_text())[0]
