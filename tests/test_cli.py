@@ -58,6 +58,6 @@ def test_trackers_listing():
 
 
 def test_demo_runs(tmp_path):
-    r = runner.invoke(app, ["demo", "-o", str(tmp_path / "demo")])
+    r = runner.invoke(app, ["demo", "--quick", "-o", str(tmp_path / "demo")])
     assert r.exit_code == 0, r.output
     assert (tmp_path / "demo").is_dir()
