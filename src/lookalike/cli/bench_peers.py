@@ -103,8 +103,17 @@ def norfair_iou(seq: RealSequence) -> np.ndarray:
 
 def _boxmot(module: str, cls_name: str) -> PeerFn:
     def run(seq: RealSequence) -> np.ndarray:
+        import logging
+
         mod = importlib.import_module(module)
-        tracker = getattr(mod, cls_name)()
+        from boxmot.utils import logger as boxmot_logger
+
+        level = boxmot_logger.level
+        boxmot_logger.setLevel(logging.WARNING)  # it logs every tracker's settings at INFO
+        try:
+            tracker = getattr(mod, cls_name)()
+        finally:
+            boxmot_logger.setLevel(level)
         width, height = seq.image_size or (1920, 1080)
         image = np.zeros((height, width, 3), dtype=np.uint8)
         out = []

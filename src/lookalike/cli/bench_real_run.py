@@ -24,11 +24,17 @@ from lookalike.trackers import make_tracker
 from lookalike.types import Detections, Frame
 
 BACKENDS = ("local", "ray")
-# Detector-dependent score thresholds of boxtrack per dataset, chosen on the first half of the data
-# alone (pigs: frames 1..315, grid high/birth score ∈ {0.5, 0.7, 0.8, 0.9}, best HOTA+IDF1+MOTA);
-# MOT15 and HexBug use the defaults, chosen on the first halves of the MOT15 sequences.
+# boxtrack's parameters per dataset where its detector differs from MOT15's, each chosen on the first
+# half of that dataset alone (benchmarks/real_boxtrack_grid.py; best HOTA + IDF1 + MOTA):
+# - pigs (frames 1..315): high/birth score ∈ {0.5, 0.7, 0.8, 0.9};
+# - hexbug (frames 1..50 of each clip, blob detector): match_iou ∈ {0.01, 0.05, 0.1, 0.3},
+#   n_init ∈ {2, 3}, report, tentative_iou ∈ {0.1, 0.3}, reid_distance ∈ {0.5, 1, 2},
+#   max_age_s ∈ {1, 3} (blobs of 10 fps bugs barely overlap from frame to frame).
+# MOT15 uses boxtrack's defaults, chosen on the first halves of its sequences.
 DATASET_PARAMS: dict[str, dict[str, dict[str, Any]]] = {
     "pigs": {"boxtrack": {"high_score": 0.7, "birth_score": 0.7}},
+    "hexbug": {"boxtrack": {"match_iou": 0.01, "n_init": 2, "report": "detection", "tentative_iou": 0.1,
+                            "reid_distance": 2.0, "max_age_s": 1.0}},
 }
 HEXBUG_RADIUS_PX = 120.0  # a box centre lies about half a bug from its head (benchmarks/hexbug_blobs.py)
 

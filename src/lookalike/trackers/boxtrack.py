@@ -20,7 +20,9 @@ Built on SORT's idea (Kalman filter + Hungarian matching on IoU) with what makes
   track dies at its first miss, a confirmed one after ``max_age_s`` seconds without an update.
   Detector scores are not calibrated alike across detectors, so the birth threshold is
   ``min(birth_score, birth_quantile of all scores seen so far)`` (a histogram of 1000 bins on
-  [0, 1]); ``high_quantile`` does the same for ``high_score`` (off by default).
+  [0, 1]); ``high_quantile`` does the same for ``high_score`` (off by default). The high threshold
+  never exceeds the birth threshold: a detection good enough to start a track is good enough to
+  continue one (this only matters for detectors with lower scores, such as the HexBug blobs).
 - **Closed-set identity** (``max_targets``): when the number of targets is known (23 pigs), at most
   ``max_targets`` tracks exist at once, confirmed tracks never die, and left-over detections are
   assigned to lost tracks by centre distance alone (gated at ``closed_distance`` box heights), so an
@@ -205,17 +207,18 @@ class BoxTrack:
         cfg = self.config
         high, birth = cfg.high_score, cfg.birth_score
         if cfg.high_quantile is None and cfg.birth_quantile is None:
-            return high, birth
+            return min(high, birth), birth
         bins = np.clip((score * _SCORE_BINS).astype(int), 0, _SCORE_BINS - 1)
         self._score_hist += np.bincount(bins, minlength=_SCORE_BINS)
         cum = np.cumsum(self._score_hist)
         if cum[-1]:
-            for name, q in (("high", cfg.high_quantile), ("birth", cfg.birth_quantile)):
-                if q is not None:
-                    # lower edge of the bin holding the q-quantile: never above any score it stands for
-                    edge = int(np.searchsorted(cum, q * cum[-1], side="left")) / _SCORE_BINS
-                    high, birth = (min(high, edge), birth) if name == "high" else (high, min(birth, edge))
-        return high, birth
+            # the lower edge of the bin holding the q-quantile: never above a score it stands for
+            edge = lambda q: int(np.searchsorted(cum, q * cum[-1], side="left")) / _SCORE_BINS  # noqa: E731
+            if cfg.high_quantile is not None:
+                high = min(high, edge(cfg.high_quantile))
+            if cfg.birth_quantile is not None:
+                birth = min(birth, edge(cfg.birth_quantile))
+        return min(high, birth), birth
 
     @staticmethod
     def _noise(size: np.ndarray, scale: float) -> np.ndarray:
