@@ -26,7 +26,7 @@ from lookalike.io import MotTable
 from lookalike.trackers.registry import parse_parameter
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import SHARED_DATA  # noqa: E402
+from _common import SHARED_DATA
 
 
 def first_half(seq: RealSequence) -> RealSequence:

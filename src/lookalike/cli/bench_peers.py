@@ -16,7 +16,7 @@ A peer whose package is not installed is reported as skipped by :func:`peer_stat
 from __future__ import annotations
 
 import importlib.util
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
@@ -46,7 +46,7 @@ def _stack(chunks: list[np.ndarray]) -> np.ndarray:
     return np.vstack(chunks) if chunks else np.zeros((0, 10))
 
 
-def _sv_detections(xywh: np.ndarray, score: np.ndarray):  # noqa: ANN202 - supervision type
+def _sv_detections(xywh: np.ndarray, score: np.ndarray):
     import supervision as sv
 
     return sv.Detections(xyxy=_xyxy(xywh), confidence=np.asarray(score, dtype=float),
@@ -70,7 +70,7 @@ def supervision_bytetrack(seq: RealSequence) -> np.ndarray:
     """supervision's ``sv.ByteTrack`` (defaults; ``frame_rate`` of the sequence)."""
     import supervision as sv
 
-    return _run_sv_like(lambda: sv.ByteTrack(frame_rate=max(int(round(seq.frame_rate)), 1)), seq,
+    return _run_sv_like(lambda: sv.ByteTrack(frame_rate=max(round(seq.frame_rate), 1)), seq,
                         "update_with_detections")
 
 
@@ -152,7 +152,7 @@ def peer_status(names: list[str] | None = None) -> dict[str, str | None]:
             importlib.import_module(package)
         except ModuleNotFoundError:
             out[name] = f"{package} not installed"
-        except Exception as exc:  # an installed package can fail to import (numpy ABI, ...)
+        except Exception as exc:  # noqa: BLE001 - an installed package can fail to import (numpy ABI, ...)
             out[name] = f"{package} not importable ({type(exc).__name__}: {exc})"[:200]
         else:
             out[name] = None

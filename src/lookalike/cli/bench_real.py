@@ -24,8 +24,14 @@ from rich.table import Table
 from lookalike.cli.app import console, fail
 from lookalike.cli.bench import bench_app
 from lookalike.cli.bench_peers import PEERS, peer_status
-from lookalike.cli.bench_real_data import DATASETS, RealSequence, detect_hexbug, hexbug_clips, load_boxes
-from lookalike.cli.bench_real_run import BACKENDS, Entry, map_jobs, run_jobs
+from lookalike.cli.bench_real_data import (
+    DATASETS,
+    RealSequence,
+    detect_hexbug,
+    hexbug_clips,
+    load_boxes,
+)
+from lookalike.cli.bench_real_run import BACKENDS, Entry, job_pairs, map_jobs, run_jobs
 from lookalike.eval import combine
 
 DEFAULT_DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
@@ -76,23 +82,20 @@ def leaderboard(entries: list[Entry], sequences: list[RealSequence],
                 results: list[dict[str, Any]]) -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[dict[str, Any]]]:
     """``(dataset rows, combined ranking rows, per-sequence rows)`` from :func:`run_jobs` results."""
     per_seq, table = [], []
-    it = iter(results)
+    pairs = job_pairs(entries, sequences)
+    if len(pairs) != len(results):
+        raise ValueError(f"results: expected {len(pairs)} job results, got {len(results)}")
     grouped: dict[tuple[str, str], list[tuple[RealSequence, dict[str, Any]]]] = {}
-    for seq in sequences:
-        for e in entries:
-            if e.closed_set and seq.n_targets is None:
-                next(it)
-                continue
-            r = next(it)
-            grouped.setdefault((seq.dataset, e.label), []).append((seq, r))
-            row = {"Dataset": seq.dataset, "Sequence": seq.name, "Tracker": e.label}
-            if "error" in r:
-                row["Error"] = r["error"]
-            else:
-                s = r["scores"]
-                row.update({"HOTA": round(100 * s["HOTA"], 2), "IDF1": round(100 * s["IDF1"], 2),
-                            "MOTA": round(100 * s["MOTA"], 2), "IDSW": int(s["IDSW"])})
-            per_seq.append(row)
+    for (e, seq), r in zip(pairs, results):
+        grouped.setdefault((seq.dataset, e.label), []).append((seq, r))
+        row = {"Dataset": seq.dataset, "Sequence": seq.name, "Tracker": e.label}
+        if "error" in r:
+            row["Error"] = r["error"]
+        else:
+            s = r["scores"]
+            row.update({"HOTA": round(100 * s["HOTA"], 2), "IDF1": round(100 * s["IDF1"], 2),
+                        "MOTA": round(100 * s["MOTA"], 2), "IDSW": int(s["IDSW"])})
+        per_seq.append(row)
     for dataset in dict.fromkeys(s.dataset for s in sequences):
         rows = []
         for e in entries:

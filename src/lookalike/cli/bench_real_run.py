@@ -10,9 +10,10 @@ a local instance (``ray.init()``); the sequences are put in Ray's object store o
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -86,7 +87,7 @@ def run_job(job: tuple[Entry, RealSequence]) -> dict[str, Any]:
     t0 = time.perf_counter()
     try:
         rows = track_rows(entry, seq)
-    except Exception as exc:  # a peer's failure is reported in the table, never fatal
+    except Exception as exc:  # noqa: BLE001 - a peer's failure is reported in the table, never fatal
         return {"error": f"{type(exc).__name__}: {exc}"[:300], "frames": seq.length, "seconds": 0.0}
     seconds = time.perf_counter() - t0
     return {"scores": score_rows(seq, rows), "frames": seq.length, "seconds": seconds}
@@ -113,10 +114,15 @@ def map_jobs(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int = 1
     return [fn(x) for x in items]
 
 
+def job_pairs(entries: Sequence[Entry], sequences: Sequence[RealSequence]) -> list[tuple[Entry, RealSequence]]:
+    """``(entry, sequence)`` for every sequence and entry, closed-set entries only where the count is known."""
+    return [(e, s) for s in sequences for e in entries if not (e.closed_set and s.n_targets is None)]
+
+
 def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, workers: int = 1,
              backend: str = "local", address: str | None = None) -> list[dict[str, Any]]:
-    """Every entry on every sequence; results in order ``[(e, s) for s in sequences for e in entries]``."""
-    jobs = [(e, s) for s in sequences for e in entries]
+    """Results of :func:`job_pairs`, in its order."""
+    jobs = job_pairs(entries, sequences)
     if backend != "ray":
         return map_jobs(run_job, jobs, workers=workers, backend=backend)
     ray = _ray(address, workers)

@@ -127,7 +127,7 @@ class BoxTrack:
             if self.report not in _REPORTS:
                 raise ValueError(f"BoxTrack.Config.report must be one of {_REPORTS}, got {self.report!r}")
 
-    def __init__(self, config: "BoxTrack.Config | None" = None) -> None:
+    def __init__(self, config: BoxTrack.Config | None = None) -> None:
         self.config = config or BoxTrack.Config()
         self.reset()
 
@@ -179,7 +179,7 @@ class BoxTrack:
 
         confirmed = np.flatnonzero(self._confirmed)
         match(confirmed, np.flatnonzero(high), cfg.match_iou, True)
-        unmatched = lambda mask: np.flatnonzero(mask & (det_of_track < 0))  # noqa: E731
+        unmatched = lambda mask: np.flatnonzero(mask & (det_of_track < 0))
         match(unmatched(self._confirmed & was_tracked), np.flatnonzero(free & ~high), cfg.low_iou, False)
         match(unmatched(~self._confirmed), np.flatnonzero(free & high), cfg.tentative_iou, False)
         self._reidentify(unmatched(self._confirmed), np.flatnonzero(free & high), det_box, det_of_track, free)
@@ -213,7 +213,7 @@ class BoxTrack:
         cum = np.cumsum(self._score_hist)
         if cum[-1]:
             # the lower edge of the bin holding the q-quantile: never above a score it stands for
-            edge = lambda q: int(np.searchsorted(cum, q * cum[-1], side="left")) / _SCORE_BINS  # noqa: E731
+            edge = lambda q: int(np.searchsorted(cum, q * cum[-1], side="left")) / _SCORE_BINS
             if cfg.high_quantile is not None:
                 high = min(high, edge(cfg.high_quantile))
             if cfg.birth_quantile is not None:
