@@ -12,6 +12,7 @@ from lookalike.trackers.registry import (
 from lookalike.trackers.boxtrack import BoxTrack
 from lookalike.trackers.deepsort import DeepSort
 from lookalike.trackers.diversort import DiverSort
+from lookalike.trackers.health import HealthConfig, HealthMonitor, HealthStatus
 from lookalike.trackers.jpda import JpdaTracker
 from lookalike.trackers.kalman_ha import KalmanHA, KalmanHA2
 from lookalike.trackers.sort import Sort
@@ -21,6 +22,9 @@ __all__ = [
     "BoxTrack",
     "DeepSort",
     "DiverSort",
+    "HealthConfig",
+    "HealthMonitor",
+    "HealthStatus",
     "JpdaTracker",
     "KalmanHA",
     "KalmanHA2",
