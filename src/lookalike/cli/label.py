@@ -50,6 +50,8 @@ def label(
     if benchmark and tracks:
         fail("--benchmark starts from no labels; leave out --tracks")
     initial, source = None, "empty"
+    if tracks and not Path(tracks).is_file() and tracks not in tracker_names():
+        fail(f"--tracks: {tracks!r} is neither a file nor a tracker ({', '.join(tracker_names())})")
     try:
         if tracks and not fresh and (sequence.with_name(f"{sequence.stem}.labels.json")).exists():
             console.print("saved labels exist: --tracks ignored (use --fresh to start over from them)")
@@ -57,11 +59,9 @@ def label(
             seq = read_robot_sequence(sequence)
             if Path(tracks).is_file():
                 initial, source = load_labels(tracks, seq), f"file {Path(tracks).name}"
-            elif tracks in tracker_names():
+            else:
                 console.print(f"running {tracks} on {sequence.name} …")
                 initial, source = tracker_labels(tracks, seq), f"tracker {tracks}"
-            else:
-                fail(f"--tracks: {tracks!r} is neither a file nor a tracker ({', '.join(tracker_names())})")
         label_app = open_label_app(sequence, initial, source, benchmark, fresh)
     except ValueError as exc:
         fail(str(exc))
