@@ -4,14 +4,27 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeRemainingColumn,
+)
 from rich.table import Table
 
 from lookalike.cli.app import app, console, fail
-from lookalike.io import find_sequences, frames_from_table, read_mot, tracks_to_rows, write_mot
+from lookalike.cli.track_video import run_track_video
+from lookalike.io import (
+    find_sequences,
+    frames_from_table,
+    read_mot,
+    tracks_to_rows,
+    write_mot,
+)
 from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
 from lookalike.trackers.registry import parse_parameter
 
@@ -29,15 +42,42 @@ def build_tracker(name: str, settings: list[str]) -> Any:
 
 @app.command()
 def track(
-    path: Path = typer.Argument(..., help="det.txt, a sequence folder, or a folder of sequences."),
-    output: Path = typer.Option(..., "-o", "--output", help="Result file (single det.txt) or folder."),
+    path: Path | None = typer.Argument(
+        None, help="det.txt, a sequence folder, or a folder of sequences (with --video: the det.txt)."
+    ),
+    output: Path = typer.Option(..., "-o", "--output", help="Result file (single det.txt or --video) or folder."),
     tracker: str = typer.Option("sort", "--tracker", "-t", help="Registered tracker name."),
-    set_: Optional[list[str]] = typer.Option(
+    set_: list[str] | None = typer.Option(
         None, "--set", "-s", help="Tracker parameter KEY=VALUE (repeatable); see `lookalike trackers`."
     ),
     min_score: float = typer.Option(float("-inf"), help="Drop detections with a lower score."),
+    video: Path | None = typer.Option(
+        None, "--video", help="Video file or image folder (img1): appearance features from its pixels; also "
+        "writes <output stem>.health.csv and, for merging trackers, <output stem>.merges.csv."
+    ),
+    detections: Path | None = typer.Option(None, "--detections", help="det.txt for --video (or give it as PATH)."),
+    annotate: Path | None = typer.Option(
+        None, "--annotate", help="With --video: annotated MP4 (uncertain identities dashed with '?', health banner)."
+    ),
+    team_size: int | None = typer.Option(None, "--team-size", min=0, help="Known number of targets (health checks)."),
+    health_window: int = typer.Option(15, "--health-window", min=1, help="Health monitor window in frames."),
+    fps: float | None = typer.Option(None, "--fps", min=0.1, help="With --video: frame rate (default: the input's)."),
+    features: str = typer.Option("video", "--features", help="With --video: standardise the hand-crafted features "
+                                 "on this video's detections ('video') or use the diver calibration ('divers')."),
 ) -> None:
-    """Run a tracker over MOTChallenge detections and write MOTChallenge results."""
+    """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
+    if video is not None:
+        det_path = detections or path
+        if det_path is None or (detections is not None and path is not None):
+            fail("--video: give the detections once, as --detections det.txt (or as PATH)")
+        run_track_video(video, det_path, output, build_tracker(tracker, set_ or []), tracker, annotate=annotate,
+                        team_size=team_size, health_window=health_window, min_score=min_score, fps=fps,
+                        features=features)
+        return
+    if annotate is not None or detections is not None:
+        fail("--annotate/--detections: only with --video")
+    if path is None:
+        fail("PATH: give det.txt, a sequence folder or a folder of sequences (or --video with --detections)")
     try:
         sequences = [s for s in find_sequences(path) if s.det_path is not None]
     except (FileNotFoundError, ValueError) as exc:

@@ -1,0 +1,279 @@
+"""Tracking on real video: detections from a MOTChallenge file, appearance features from the frames'
+pixels, any registered tracker, the detector-health monitor, and an optional annotated video.
+
+In the annotated video a track whose identity is not settled is drawn with a dashed box and a
+``?`` after its id: a tentative track, a track the tracker itself calls uncertain (diver SORT's
+:meth:`~lookalike.trackers.DiverSort.uncertain`: young enough to be merged into an earlier
+identity), or, for trackers without such a method, a track first reported fewer than
+``new_frames`` frames ago. A track that just absorbed another by identity recovery is labelled
+``id T<-S`` for ``new_frames`` frames. Detections no track took are thin grey dashed boxes. When
+the health monitor finds the frame or its window unhealthy, a red banner at the bottom gives the
+reasons. OpenCV is imported lazily.
+"""
+
+from __future__ import annotations
+
+import csv
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookalike.association.solver import assign
+from lookalike.geometry.boxes import iou_matrix
+from lookalike.io import MotTable, frames_from_table, read_seqinfo, tracks_to_rows
+from lookalike.trackers.health import (
+    HEALTH_CSV_HEADER,
+    HealthConfig,
+    HealthMonitor,
+    HealthStatus,
+    health_row,
+)
+from lookalike.types import Detections, Frame, TrackSnapshot, TrackStatus
+from lookalike.vision.appearance import (
+    RAW_DIM,
+    HandcraftedFeatures,
+    crop_boxes,
+    fit_stats,
+    raw_features,
+)
+from lookalike.viz.annotate import Tails, draw_box, draw_caption, draw_tail
+from lookalike.viz.colors import FALSE_POSITIVE, identity_colour
+from lookalike.viz.overlay import source_frames
+from lookalike.viz.video import VideoWriter
+
+UNHEALTHY_BGR = (40, 40, 200)
+
+
+@dataclass(frozen=True, eq=False)
+class VideoTrackingResult:
+    """What :func:`track_video` produced.
+
+    Attributes:
+        frames: number of video frames read (and written to the annotated video, if any).
+        rows: ``(n, 10)`` MOTChallenge result rows (1-based frames).
+        merges: ``(frame, source id, target id)`` identity recoveries, frames 1-based.
+        health: one :class:`HealthStatus` per frame.
+        uncertain: ``(frame, track id)`` pairs drawn as uncertain (frames 1-based).
+        ignored_rows: detection rows whose frame is past the video's end.
+        tracker_s, feature_s: seconds spent in the tracker and in the feature extractor.
+    """
+
+    frames: int
+    rows: np.ndarray
+    merges: list[tuple[int, int, int]]
+    health: list[HealthStatus]
+    uncertain: list[tuple[int, int]] = field(default_factory=list)
+    ignored_rows: int = 0
+    tracker_s: float = 0.0
+    feature_s: float = 0.0
+
+
+def source_frame_rate(source: Path | str) -> float | None:
+    """Frame rate of an image folder from the ``seqinfo.ini`` beside it (MOTChallenge), else None."""
+    p = Path(source)
+    info = p.parent / "seqinfo.ini"
+    if p.is_dir() and info.is_file():
+        rate = read_seqinfo(info).get("frameRate")
+        try:
+            return float(rate) if rate is not None and float(rate) > 0 else None
+        except ValueError:
+            raise ValueError(f"{info}: frameRate {rate!r} is not a number") from None
+    return None
+
+
+def fit_video_features(source: Path | str, detections: MotTable, *, min_score: float = -np.inf,
+                       max_crops: int = 3000, crop_px: int = 32, link_iou: float = 0.6) -> HandcraftedFeatures:
+    """Hand-crafted features standardised on this video's own detections, without ground truth.
+
+    Raw features of up to ``max_crops`` boxes (blocks of 10 consecutive frames, evenly spread) are
+    linked into short chains: a box joins the box of the previous frame it overlaps with IoU >=
+    ``link_iou`` (one-to-one), which almost surely shows the same target. The chains serve as
+    identity labels for :func:`~lookalike.vision.appearance.fit_stats` (within-chain spread as the
+    scale, discriminant weights); with fewer than two chains the plain mean and spread are used.
+    """
+    if max_crops < 2:
+        raise ValueError(f"max_crops: must be >= 2, got {max_crops}")
+    keep = detections.conf >= min_score
+    frames = detections.frame[keep].astype(int)
+    if len(frames) < 2:
+        raise ValueError("detections: fewer than 2 boxes to standardise the appearance features on")
+    xywh = detections.xywh[keep]
+    blocks = max(int(np.ceil(len(frames) / max_crops)), 1)
+    images, _, _ = source_frames(source)
+    raws, labels = [], []
+    prev_boxes, prev_labels, next_label = np.zeros((0, 4)), np.zeros(0, dtype=int), 0
+    for k, image in enumerate(images):
+        boxes = xywh[frames == k + 1]
+        if (k // 10) % blocks or not len(boxes):
+            prev_boxes, prev_labels = np.zeros((0, 4)), np.zeros(0, dtype=int)
+            continue
+        lab = np.arange(next_label, next_label + len(boxes))
+        next_label += len(boxes)
+        if len(prev_boxes):
+            iou = iou_matrix(prev_boxes, boxes)
+            found = assign(np.where(iou >= link_iou, 1.0 - iou, np.inf))
+            lab[found.matches[:, 1]] = prev_labels[found.matches[:, 0]]
+        raws.append(raw_features(crop_boxes(image, boxes, crop_px)))
+        labels.append(lab)
+        prev_boxes, prev_labels = boxes, lab
+    raw = np.vstack(raws) if raws else np.zeros((0, RAW_DIM))
+    if len(raw) < 2:
+        raise ValueError(f"detections: fewer than 2 boxes fall on the frames of {source}")
+    label = np.concatenate(labels)
+    ids, counts = np.unique(label, return_counts=True)
+    chained = np.isin(label, ids[counts >= 2])
+    if len(ids[counts >= 2]) >= 2:
+        try:
+            return HandcraftedFeatures(stats=fit_stats(raw[chained], label[chained]), crop_px=crop_px)
+        except ValueError:
+            pass  # no dimension separates the chains: fall back to the plain statistics
+    return HandcraftedFeatures(stats=fit_stats(raw), crop_px=crop_px)
+
+
+def track_video(source: Path | str, detections: MotTable, tracker: Any, extractor: Any, *,
+                annotate: Path | str | None = None, health: HealthConfig | None = None,
+                fps: float | None = None, min_score: float = -np.inf, new_frames: int = 10,
+                tail: int = 25, advance: Callable[[], None] | None = None) -> VideoTrackingResult:
+    """Run ``tracker`` (reset first) over the frames of ``source`` (a video file or an image folder)
+    with ``detections`` (1-based frames, pixels); each frame's boxes get ``extractor(image, xywh)``
+    as ``feature``. With ``annotate`` also write that MP4, one frame per input frame."""
+    if new_frames < 1:
+        raise ValueError(f"new_frames: must be >= 1, got {new_frames}")
+    images, n_declared, source_fps = source_frames(source)
+    rate = fps or source_frame_rate(source) or source_fps
+    if not rate > 0:
+        raise ValueError(f"fps: must be positive, got {rate!r}")
+    last_det = int(detections.frame.max()) if len(detections) else 0
+    det_frames = list(frames_from_table(detections, max(n_declared, last_det), rate, min_score))
+    tracker.reset()
+    monitor = HealthMonitor(health)
+    writer = VideoWriter(annotate, fps=rate) if annotate is not None else None
+    tails = Tails(length=max(tail, 1))
+    first_seen: dict[int, int] = {}
+    rows: list[np.ndarray] = []
+    statuses: list[HealthStatus] = []
+    uncertain: list[tuple[int, int]] = []
+    merged_label: dict[int, tuple[int, int]] = {}  # target id -> (source id, frame of the merge)
+    tracker_s = feature_s = 0.0
+    count = 0
+    try:
+        for k, image in enumerate(images):
+            det = det_frames[k].detections if k < len(det_frames) else Detections.empty()
+            t0 = time.perf_counter()
+            feats = extractor(image, det.xywh) if len(det) else np.zeros((0, int(extractor.dim)))
+            feature_s += time.perf_counter() - t0
+            frame = Frame(index=k, time=k / rate, detections=det.replace(feature=feats))
+            n_merges = len(getattr(tracker, "merges", []))
+            t0 = time.perf_counter()
+            tracks = tracker.update(frame)
+            tracker_s += time.perf_counter() - t0
+            for m in getattr(tracker, "merges", [])[n_merges:]:
+                merged_label[int(m.target_id)] = (int(m.source_id), k)
+            rows.append(tracks_to_rows(k, tracks))
+            status = monitor.update(frame)
+            statuses.append(status)
+            shown = [t for t in tracks if t.xywh is not None]
+            doubtful = [_uncertain(tracker, t, first_seen, k, new_frames) for t in shown]
+            uncertain.extend((k + 1, t.track_id) for t, u in zip(shown, doubtful) if u)
+            if writer is not None:
+                img = image.copy()
+                _draw(img, k, det.xywh, shown, doubtful, merged_label, new_frames, tails)
+                lines = [f"{type(tracker).__name__}  frame {k + 1}",
+                         f"tracks: {len(shown)}  uncertain (dashed, ?): {sum(doubtful)}  detections: {len(det)}"]
+                draw_caption(img, lines)
+                if not status.healthy:
+                    draw_banner(img, "DETECTOR UNHEALTHY - identities unreliable: "
+                                + "; ".join(status.reasons + status.window_reasons))
+                writer.write(img)
+            count += 1
+            if advance is not None:
+                advance()
+    finally:
+        if writer is not None:
+            writer.close()
+    if count == 0:
+        raise ValueError(f"video: {source} has no frames")
+    merges = [(int(m.frame_index) + 1, int(m.source_id), int(m.target_id)) for m in getattr(tracker, "merges", [])]
+    ignored = int((detections.frame > count).sum())
+    table = np.vstack(rows) if rows else np.zeros((0, 10))
+    return VideoTrackingResult(count, table, merges, statuses, uncertain, ignored, tracker_s, feature_s)
+
+
+def _uncertain(tracker: Any, t: TrackSnapshot, first_seen: dict[int, int], k: int, new_frames: int) -> bool:
+    """Whether track ``t``'s identity is unsettled at frame ``k`` (see the module docstring)."""
+    born = first_seen.setdefault(t.track_id, k)
+    if t.status is TrackStatus.TENTATIVE:
+        return True
+    ask = getattr(tracker, "uncertain", None)
+    if callable(ask):
+        return bool(ask(t.track_id))
+    return k - born < new_frames
+
+
+def _draw(img: np.ndarray, k: int, det_xywh: np.ndarray, shown: list[TrackSnapshot], doubtful: list[bool],
+          merged_label: dict[int, tuple[int, int]], new_frames: int, tails: Tails) -> None:
+    taken = {t.detection_index for t in shown if t.detection_index is not None}
+    for i, box in enumerate(np.asarray(det_xywh).reshape(-1, 4)):
+        if i not in taken:
+            draw_box(img, box, FALSE_POSITIVE, None, thickness=1, dashed=True)
+    for t in shown:
+        assert t.xywh is not None
+        b = t.xywh
+        tails.add(k, t.track_id, np.array([b[0] + b[2] / 2, b[1] + b[3]]))
+    tails.expire(k, 5)
+    for i, pts in tails.items():
+        draw_tail(img, pts, identity_colour(i))
+    for t, u in zip(shown, doubtful):
+        assert t.xywh is not None
+        label = f"id {t.track_id}"
+        src = merged_label.get(t.track_id)
+        if src is not None and k - src[1] < new_frames:
+            label += f"<-{src[0]}"
+        draw_box(img, t.xywh, identity_colour(t.track_id), label + ("?" if u else ""), dashed=u)
+
+
+def draw_banner(image: np.ndarray, text: str, colour: tuple[int, int, int] = UNHEALTHY_BGR) -> None:
+    """A filled band of ``colour`` across the bottom of ``image`` (BGR uint8, in place) with white ``text``
+    (cut with an ellipsis to the image width)."""
+    import cv2
+
+    scale, h = 0.45, 22
+    width = image.shape[1] - 12
+    while text and cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)[0][0] > width:
+        text = text[: max(len(text) - 4, 0)] + "..." if len(text) > 4 else ""
+    band = image[max(image.shape[0] - h, 0):]
+    band[:] = (band.astype(np.uint16) * 2 // 5 + np.array(colour, dtype=np.uint16) * 3 // 5).astype(np.uint8)
+    cv2.putText(image, text, (6, image.shape[0] - 7), cv2.FONT_HERSHEY_SIMPLEX, scale, (255, 255, 255), 1,
+                cv2.LINE_AA)
+
+
+def side_file(output: Path | str, kind: str) -> Path:
+    """The side file ``<output stem>.<kind>.csv`` next to a result file (``tracks.txt`` → ``tracks.merges.csv``)."""
+    p = Path(output)
+    return p.with_name(f"{p.stem}.{kind}.csv")
+
+
+def write_merges_csv(path: Path | str, merges: list[tuple[int, int, int]]) -> Path:
+    """``frame,source_id,target_id`` (frame 1-based; from that frame on the source is reported as the target)."""
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    with p.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["frame", "source_id", "target_id"])
+        w.writerows(merges)
+    return p
+
+
+def write_health_csv(path: Path | str, statuses: list[HealthStatus]) -> Path:
+    """One row per frame, columns :data:`~lookalike.trackers.health.HEALTH_CSV_HEADER`."""
+    p = Path(path)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    with p.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(HEALTH_CSV_HEADER)
+        w.writerows(health_row(s) for s in statuses)
+    return p
