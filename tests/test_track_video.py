@@ -202,3 +202,21 @@ def test_mot17_mini_real_pixels(tmp_path, tracker):
     assert len(health) == n_images and all(int(h["n_detections"]) > 0 for h in health)
     assert len(read_mot(out)) > 0
     assert make_tracker(tracker) is not None
+
+
+def test_fit_video_features_links_boxes_into_chains(diver_scene):
+    from lookalike.vision.appearance import FeatureStats
+    from lookalike.viz.video_tracking import fit_video_features
+
+    root, det = diver_scene
+    table = read_mot(det)
+    ext = fit_video_features(root / "divers.mp4", table)
+    equal = FeatureStats(mean=np.zeros_like(ext.stats_.mean), scale=np.ones_like(ext.stats_.scale)).weight
+    assert not np.allclose(ext.stats_.weight, equal)  # discriminant weights from the IoU chains
+    feats = ext(next(read_frames(root / "divers.mp4")), table.xywh[table.frame == 1])
+    assert np.allclose(np.linalg.norm(feats, axis=1), 1.0)
+    with pytest.raises(ValueError, match="fewer than 2 boxes"):
+        fit_video_features(root / "divers.mp4", MotTable.from_rows(np.array([[1, -1, 0, 0, 5, 5, 1, -1, -1, -1]])))
+    r = runner.invoke(app, ["track", "--video", str(root / "divers.mp4"), "--detections", str(det),
+                            "-o", str(root / "x.txt"), "--features", "nope"])
+    assert r.exit_code == 2 and "--features" in r.output
