@@ -93,10 +93,10 @@ def test_refuses_a_symlink_out_of_the_folder(served, seq_path):
 def test_survives_malformed_requests(served):
     port = served.server_address[1]
     for raw in (b"GARBAGE\r\n\r\n", b"GET\r\n\r\n", b"\x00\xff\xfe nonsense\r\n\r\n",
-                b"POST /api/label HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                b"Content-Length: 999999999\r\n\r\n{}",
-                b"POST /api/label HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                b"Content-Length: abc\r\n\r\n",
+                (b"POST /api/label HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+                 b"Content-Length: 999999999\r\n\r\n{}"),
+                (b"POST /api/label HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+                 b"Content-Length: abc\r\n\r\n"),
                 b"GET /api/meta HTTP/1.1\r\n" + b"X: " + b"a" * 70000 + b"\r\n\r\n"):
         with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
             s.sendall(raw)

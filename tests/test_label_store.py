@@ -12,7 +12,6 @@ from lookalike.io.robot_sequences import read_robot_sequence, write_robot_sequen
 from lookalike.sim import preset, simulate_robots
 from lookalike.viz.label import (
     UNSET,
-    LabelStore,
     export_mot,
     export_truth,
     label_path_for,

@@ -21,10 +21,11 @@ from __future__ import annotations
 
 import json
 import mimetypes
+from collections.abc import Callable
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
 import numpy as np
@@ -142,7 +143,7 @@ def make_handler(app: LabelApp, log: Callable[[str], None] | None = None) -> typ
         server_version = "lookalike-label"
         timeout = 30  # seconds a connection may stay silent
 
-        def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 (base class name)
+        def log_message(self, format: str, *args: Any) -> None:
             if log is not None:
                 log(f"{self.address_string()} {format % args}")
 
@@ -175,16 +176,16 @@ def make_handler(app: LabelApp, log: Callable[[str], None] | None = None) -> typ
                 self._json({"error": str(exc)}, HTTPStatus.BAD_REQUEST)
             except (BrokenPipeError, ConnectionResetError):
                 pass
-            except Exception as exc:  # a bug must not take the server down
+            except Exception as exc:  # noqa: BLE001 (a bug must not take the server down)
                 self._json({"error": f"internal error: {exc!r}"}, HTTPStatus.INTERNAL_SERVER_ERROR)
 
-        def do_GET(self) -> None:  # noqa: N802 (http.server naming)
+        def do_GET(self) -> None:
             self._dispatch(self._get)
 
-        def do_HEAD(self) -> None:  # noqa: N802
+        def do_HEAD(self) -> None:
             self._dispatch(self._get)
 
-        def do_POST(self) -> None:  # noqa: N802
+        def do_POST(self) -> None:
             self._dispatch(self._post)
 
         def _get(self) -> None:

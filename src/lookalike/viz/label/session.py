@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 from lookalike.io.robot_sequences import read_robot_sequence
 from lookalike.viz.label.server import LabelApp

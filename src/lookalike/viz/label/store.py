@@ -15,12 +15,14 @@ Every change rewrites the file atomically (a temporary file in the same folder, 
 from __future__ import annotations
 
 import json
+import math
 import os
 import tempfile
 import threading
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -122,7 +124,7 @@ class LabelStore:
         """Set one detection's label (agent id, -1 false positive, -2 unset) and save."""
         for name, v in (("frame", frame), ("detection", detection), ("label", label)):
             if isinstance(v, bool) or not isinstance(v, int):
-                raise ValueError(f"{name} must be an integer, got {v!r}")
+                raise ValueError(f"{name} must be an integer, got {v!r}")  # noqa: TRY004 (bad input: ValueError)
         if not 0 <= frame < len(self.counts):
             raise ValueError(f"frame {frame} out of range 0 .. {len(self.counts) - 1}")
         if not 0 <= detection < self.counts[frame]:
@@ -192,4 +194,4 @@ def score_labels(labels: Sequence[Sequence[int]], truth: Sequence[np.ndarray], n
 
 def _finite(x: float) -> float | None:
     """``x``, or None for NaN (JSON has no NaN)."""
-    return None if x != x else x
+    return None if math.isnan(x) else x
