@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import ipaddress
 from pathlib import Path
-from typing import Optional
 
 import typer
 
@@ -26,7 +25,7 @@ def tracker_labels(name: str, sequence: RobotSequence) -> list[list[int]]:
 @app.command()
 def label(
     sequence: Path = typer.Argument(..., help="A robot sequence (.jsonl from `lookalike simulate`)."),
-    tracks: Optional[str] = typer.Option(
+    tracks: str | None = typer.Option(
         None, "--tracks",
         help="Starting labels: a tracker name (run on the sequence), a label file (.json), a labelled "
              "sequence (.jsonl) or a MOTChallenge file (.txt) from the export. Ignored when saved labels exist."),
