@@ -129,7 +129,7 @@ class RobotRenderer:
         obs = observer or Pose2D()
         ego = obs.fixed_to_ego(pos)
         ego_heading = np.asarray(obs.heading_to_ego(head), dtype=float).reshape(-1)
-        cfg, k = self.config, self.camera.intrinsics
+        k = self.camera.intrinsics
         img = self._background(obs)
         ids = np.zeros((k.height, k.width), dtype=np.int32)
         cam_c = self.camera.centre_m
