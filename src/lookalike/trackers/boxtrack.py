@@ -54,7 +54,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.association.solver import assign
-from lookalike.geometry.boxes import iou_matrix
+from lookalike.geometry.boxes import iou_matrix, xywh_to_cxcywh
 from lookalike.motion import kalman
 from lookalike.trackers.base import check_positive, param
 from lookalike.trackers.registry import register_tracker
@@ -70,12 +70,6 @@ def _transition(steps: float) -> np.ndarray:
     F = np.eye(8)
     F[:4, 4:] = np.eye(4) * steps
     return F
-
-
-def _to_cxcywh(xywh: np.ndarray) -> np.ndarray:
-    out = np.array(xywh, dtype=float).reshape(-1, 4)
-    out[:, :2] += out[:, 2:] / 2
-    return out
 
 
 def _to_xywh(cxcywh: np.ndarray) -> np.ndarray:
@@ -158,7 +152,7 @@ class BoxTrack:
         dets = frame.detections
         keep = dets.score >= cfg.low_score
         det_idx = np.flatnonzero(keep)
-        det_box = _to_cxcywh(dets.xywh[keep])
+        det_box = xywh_to_cxcywh(dets.xywh[keep])
         score = dets.score[keep]
         high_score, birth_score = self._thresholds(score)
         high_score, birth_score = self._thresholds(score)
