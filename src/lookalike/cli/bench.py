@@ -31,7 +31,7 @@ from lookalike.sim import (
     simulate_robots,
 )
 from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.identity import agent_positions, labels_from_tracks
 from lookalike.types import TrackSnapshot
 
 bench_app = typer.Typer(help="Benchmarks that print tables (also written with --json/--csv).", no_args_is_help=True)
@@ -48,18 +48,6 @@ def _build(name: str, sequence: RobotSequence) -> Any:
     cfg = sequence.config
     params = {k: v for k, v in (("n_agents", cfg.n_agents), ("n_slots", cfg.max_detections)) if k in known}
     return make_tracker(name, **params)
-
-
-def _agent_positions(tracks: list[TrackSnapshot], n_agents: int) -> np.ndarray:
-    """``(N, 2)`` position of each agent's most confident identified track, NaN when none."""
-    out = np.full((n_agents, 2), np.nan)
-    best = np.full(n_agents, -np.inf)
-    for t in tracks:
-        if t.agent_id is not None and t.position is not None and 0 <= t.agent_id < n_agents:
-            p = t.identity_prob if t.identity_prob is not None else 0.0
-            if p > best[t.agent_id]:
-                out[t.agent_id], best[t.agent_id] = t.position, p
-    return out
 
 
 def run_identifier(name: str, sequences: list[RobotSequence]) -> dict[str, float]:
@@ -79,7 +67,7 @@ def run_identifier(name: str, sequences: list[RobotSequence]) -> dict[str, float
         n_frames += len(frames)
         for k, (frame, tracks) in enumerate(zip(frames, outputs)):
             predicted.append(labels_from_tracks(len(frame.detections), tracks))
-            positions[k] = _agent_positions(tracks, n)
+            positions[k] = agent_positions(tracks, n)
         truth.extend(seq.true_labels())
         est.append(positions)
         true_pos.append(seq.true_positions_visible())

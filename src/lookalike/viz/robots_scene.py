@@ -27,7 +27,7 @@ from lookalike.sim.render_robots import (
     RobotRenderer,
 )
 from lookalike.trackers import make_tracker, tracker_parameters
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.identity import agent_positions, labels_from_tracks
 from lookalike.types import TrackSnapshot
 from lookalike.viz.annotate import Tails, draw_box, draw_caption, draw_label, draw_tail
 from lookalike.viz.colors import identity_colour
@@ -44,18 +44,6 @@ class RobotSceneResult:
     rows: list[dict[str, Any]]
     files: dict[str, Path] = field(default_factory=dict)
     video_tracker: str = ""
-
-
-def agent_positions(tracks: list[TrackSnapshot], n_agents: int) -> np.ndarray:
-    """``(N, 2)`` position (m) of each agent's most confident identified track, NaN when none."""
-    out = np.full((n_agents, 2), np.nan)
-    best = np.full(n_agents, -np.inf)
-    for t in tracks:
-        if t.agent_id is not None and t.position is not None and 0 <= t.agent_id < n_agents:
-            p = t.identity_prob if t.identity_prob is not None else 0.0
-            if p > best[t.agent_id]:
-                out[t.agent_id], best[t.agent_id] = t.position, p
-    return out
 
 
 def _make(name: str, n_agents: int, n_slots: int) -> Any:

@@ -34,3 +34,15 @@ def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np
         label[k], best[k] = t.agent_id, p
         claimed[t.agent_id] = p
     return label
+
+
+def agent_positions(tracks: Sequence[TrackSnapshot], n_agents: int) -> np.ndarray:
+    """``(N, 2)`` position (m) of each agent's most confident identified track, NaN when none."""
+    out = np.full((n_agents, 2), np.nan)
+    best = np.full(n_agents, -np.inf)
+    for t in tracks:
+        if t.agent_id is not None and t.position is not None and 0 <= t.agent_id < n_agents:
+            p = t.identity_prob if t.identity_prob is not None else 0.0
+            if p > best[t.agent_id]:
+                out[t.agent_id], best[t.agent_id] = t.position, p
+    return out
