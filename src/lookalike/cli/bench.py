@@ -32,7 +32,6 @@ from lookalike.sim import (
 )
 from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
 from lookalike.trackers.identity import agent_positions, labels_from_tracks
-from lookalike.types import TrackSnapshot
 
 bench_app = typer.Typer(help="Benchmarks that print tables (also written with --json/--csv).", no_args_is_help=True)
 app.add_typer(bench_app, name="bench")

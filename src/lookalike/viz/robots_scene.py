@@ -28,7 +28,6 @@ from lookalike.sim.render_robots import (
 )
 from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.identity import agent_positions, labels_from_tracks
-from lookalike.types import TrackSnapshot
 from lookalike.viz.annotate import Tails, draw_box, draw_caption, draw_label, draw_tail
 from lookalike.viz.colors import identity_colour
 from lookalike.viz.plots import birdseye_plot
