@@ -4,7 +4,7 @@ import numpy as np
 from typer.testing import CliRunner
 
 from lookalike.cli import app
-from lookalike.cli.bench_experiments import _recovery_s, _reindex, _swap_reports
+from lookalike.cli.bench_experiments import _pair_hits, _recovery_s, _reindex, _swap_reports
 from lookalike.sim import preset, simulate_robots
 
 
@@ -28,10 +28,15 @@ def test_reindexed_frames_run_forward_in_time():
 
 
 def test_recovery_time_counts_from_the_restore():
-    clean = [np.array([0, 1])] * 100
-    swapped = [np.array([1, 0])] * 40 + [np.array([0, 1])] * 60
+    clean = [(2, 2)] * 100
+    swapped = [(0, 2)] * 40 + [(2, 2)] * 60
     assert _recovery_s(clean, swapped, restore=30, window=10, rate=10.0) == 1.0
-    assert _recovery_s(clean, [np.array([1, 0])] * 100, restore=30, window=10, rate=10.0) == float("inf")
+    assert _recovery_s(clean, [(0, 2)] * 100, restore=30, window=10, rate=10.0) == float("inf")
+
+
+def test_pair_hits_count_only_robots_0_and_1():
+    hits = _pair_hits([np.array([0, 1, 2, -1]), np.array([1])], [np.array([0, 0, 2, 1]), np.array([1])])
+    assert hits == [(1, 3), (1, 1)]
 
 
 def test_commands_print_and_write_tables(tmp_path):
