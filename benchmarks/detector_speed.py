@@ -1,7 +1,8 @@
 """HOG cascade detector speed (frames/s on 640x480, one core) and precision/recall at IoU 0.5 on rendered
 test frames (seeds disjoint from training).
 
-    python benchmarks/detector_speed.py [--model det.npz] [--frames 40] [--train-frames 150]
+    python benchmarks/detector_speed.py [--model det.npz | --save det.npz] [--frames 40] [--train-frames 150]
+                                        [--stages 20] [--negatives 1000] [--no-mining]
 
 Without --model, a cascade is trained on rendered robots first (train-detector's code path).
 """
@@ -26,6 +27,9 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=40)
     ap.add_argument("--train-frames", type=int, default=150)
     ap.add_argument("--stages", type=int, default=20)
+    ap.add_argument("--negatives", type=int, default=1000, help="hard negatives per stage")
+    ap.add_argument("--no-mining", action="store_true", help="random background windows only (no scene mining)")
+    ap.add_argument("--save", help="write the trained model here")
     args = ap.parse_args()
     import cv2
 
@@ -33,14 +37,17 @@ def main() -> None:
     if args.model:
         model = HogCascade.load(args.model)
     else:
-        cfg = CascadeConfig(stages=args.stages, negatives_per_stage=1000)
+        cfg = CascadeConfig(stages=args.stages, negatives_per_stage=args.negatives)
         heights = (cfg.min_height_px, cfg.max_height_px)
         t = time.perf_counter()
         pos, frames, truths = rendered_detector_data(args.train_frames, 1, cfg.window_px, height_px=heights)
         extra = augment_windows(pos[:, 1:-1, 1:-1], 2, np.random.default_rng(0))
         pos = np.concatenate([pos, np.pad(extra, ((0, 0), (1, 1), (1, 1)), mode="edge")])
         model = train_cascade(pos, negative_sampler(frames, truths, cfg.window_px, heights), cfg,
-                              progress=lambda k, m: print(f"  stage {k + 1}: {m}", flush=True))
+                              progress=lambda k, m: print(f"  stage {k + 1}: {m}", flush=True),
+                              scenes=() if args.no_mining else list(zip(frames, truths)))
+        if args.save:
+            model.save(args.save)
         print(f"trained {len(model.stages)} stages on {len(pos)} positives in {time.perf_counter() - t:.0f} s")
     from lookalike.geometry.camera import Camera
     from lookalike.sim.render_robots import RobotRenderer

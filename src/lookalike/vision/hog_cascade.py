@@ -15,7 +15,7 @@ their last-stage margin to a probability with a logistic fit, and applies non-ma
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -49,11 +49,12 @@ class CascadeConfig:
     max_draws_per_stage: int = 10  # hard-negative search: at most this many batches of negatives_per_stage windows
     min_hard_negatives: int = 20  # stop training when a stage's search finds fewer hard negatives than this
     target_false_positive_rate: float = 1e-4  # stop when the cascade accepts fewer background windows than this
-    scale_step: float = 1.2
-    min_height_px: float = 48.0
+    scale_step: float = 1.25
+    min_height_px: float = 64.0  # = window height: the finest pyramid level is the image itself
     max_height_px: float = 320.0
     stride_cells: int = 2
     nms_iou: float = 0.4
+    hard_negative_max_iou: float = 0.3  # scene mining: a window overlapping a true box more than this is no negative
 
     def __post_init__(self) -> None:
         w, h = self.window_px
@@ -68,6 +69,8 @@ class CascadeConfig:
         if not 0 <= self.target_false_positive_rate < 1:
             raise ValueError(f"CascadeConfig.target_false_positive_rate: must be in [0, 1), got "
                              f"{self.target_false_positive_rate}")
+        if not 0 <= self.hard_negative_max_iou < 1:
+            raise ValueError(f"CascadeConfig.hard_negative_max_iou: must be in [0, 1), got {self.hard_negative_max_iou}")
         if self.scale_step <= 1:
             raise ValueError(f"CascadeConfig.scale_step: must be > 1, got {self.scale_step}")
 
@@ -166,12 +169,14 @@ class HogCascade:
             alive[idx[m < stage.bias]] = False
         return alive, margin
 
-    def __call__(self, image: np.ndarray) -> Detections:
-        """Detections (boxes in pixels, probability scores) in a ``(h, w, 3)`` BGR or grey image."""
+    def windows(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every pyramid window of a ``(h, w, 3)`` BGR or grey image that passes all stages, before non-maximum
+        suppression: ``(xywh (n, 4) px, last-stage margin (n,))``."""
         import cv2
 
         cfg = self.config
-        grey = to_grey(as_bgr_image(image))
+        img = np.asarray(image)
+        grey = img.astype(np.float32) if img.ndim == 2 and img.dtype == np.float32 else to_grey(as_bgr_image(img))
         win_w, win_h = cfg.window_px
         step = cfg.stride_cells * cfg.cell_px
         boxes, margins = [], []
@@ -180,7 +185,8 @@ class HogCascade:
             size = (int(round(grey.shape[1] * scale)), int(round(grey.shape[0] * scale)))
             if size[0] < win_w or size[1] < win_h:
                 break
-            level = cv2.resize(grey, size, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
+            level = grey if size == (grey.shape[1], grey.shape[0]) else cv2.resize(
+                grey, size, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
             integral = integral_maps(cell_histograms(level, cfg.cell_px))  # over cells: corners lie on the grid
             ys, xs = np.mgrid[0 : size[1] - win_h + 1 : step, 0 : size[0] - win_w + 1 : step]
             ox, oy = xs.ravel(), ys.ravel()
@@ -197,16 +203,23 @@ class HogCascade:
                 margin = votes @ stage.weight
                 keep = margin >= stage.bias
                 alive, margin = alive[keep], margin[keep]
-            for k, m in zip(alive, margin):
-                boxes.append((ox[k] / scale, oy[k] / scale, win_w / scale, win_h / scale))
-                margins.append(m)
+            if len(alive):
+                boxes.append(np.column_stack([ox[alive] / scale, oy[alive] / scale,
+                                              np.full(len(alive), win_w / scale), np.full(len(alive), win_h / scale)]))
+                margins.append(margin)
             scale /= cfg.scale_step
         if not boxes:
+            return np.zeros((0, 4)), np.zeros(0)
+        return np.concatenate(boxes).astype(float), np.concatenate(margins)
+
+    def __call__(self, image: np.ndarray) -> Detections:
+        """Detections (boxes in pixels, probability scores) in a ``(h, w, 3)`` BGR or grey image."""
+        xywh, margins = self.windows(image)
+        if not len(xywh):
             return Detections.empty()
-        xywh = np.array(boxes, dtype=float)
         a, b = self.calibration
-        prob = 1.0 / (1.0 + np.exp(-(a * np.array(margins) + b)))
-        keep = nms(xywh, prob, cfg.nms_iou)
+        prob = 1.0 / (1.0 + np.exp(-(a * margins + b)))
+        keep = nms(xywh, prob, self.config.nms_iou)
         return Detections(xywh=xywh[keep], score=prob[keep])
 
     detect = __call__
@@ -272,6 +285,7 @@ def train_cascade(
     config: CascadeConfig = CascadeConfig(),
     seed: int = 0,
     progress: Callable[[int, str], None] | None = None,
+    scenes: Sequence[tuple[np.ndarray, np.ndarray]] = (),
 ) -> HogCascade:
     """Train a cascade.
 
@@ -280,6 +294,10 @@ def train_cascade(
         negative_windows: ``(count, rng) -> (m, h+2, w+2)`` random background windows (called repeatedly;
             those the cascade so far rejects are discarded, so only hard negatives are kept).
         progress: called with ``(stage, message)`` after each stage.
+        scenes: ``(grey (H, W) float32 frame, true boxes (m, 4) px)`` pairs. From the second stage on, the
+            cascade so far is run over them and every window it accepts that overlaps no true box by more
+            than ``hard_negative_max_iou`` becomes a negative (windows beside robots, field lines, partly
+            visible robots); random windows from ``negative_windows`` fill up the rest.
     """
     from sklearn.ensemble import AdaBoostClassifier
     from sklearn.linear_model import LogisticRegression
@@ -295,6 +313,11 @@ def train_cascade(
         # Refill the negatives with windows that the cascade so far accepts.
         # Stop rule: at most max_draws_per_stage batches; stop early once the measured false-positive rate
         # of the cascade so far is below the target (the search would otherwise stall on a good cascade).
+        mined = 0
+        if model.stages and scenes:
+            found = _mine_scenes(model, scenes, config, config.negatives_per_stage - len(neg), rng)
+            mined = len(found)
+            neg = np.concatenate([neg, window_features(found, blocks)])
         drawn = accepted = 0
         for _ in range(config.max_draws_per_stage):
             if len(neg) >= config.negatives_per_stage:
@@ -309,7 +332,8 @@ def train_cascade(
                     accepted < config.target_false_positive_rate * drawn:
                 break
         fp_rate = accepted / drawn if drawn else None
-        if model.stages and fp_rate is not None and fp_rate < config.target_false_positive_rate:
+        if model.stages and mined < config.min_hard_negatives and fp_rate is not None \
+                and fp_rate < config.target_false_positive_rate:
             if progress:
                 progress(k, f"stopped: false-positive rate {fp_rate:.2e} below the target "
                             f"{config.target_false_positive_rate:.0e} ({accepted} of {drawn} windows)")
@@ -334,7 +358,8 @@ def train_cascade(
         last_neg = neg
         neg = neg[stage.margin(neg) >= stage.bias]
         if progress:
-            progress(k, f"{len(stage.index)} stumps, rejects {rejected:.1%} of {len(last_neg)} negatives")
+            progress(k, f"{len(stage.index)} stumps, rejects {rejected:.1%} of {len(last_neg)} negatives "
+                        f"({mined} mined from scenes)")
     # Probability: logistic fit of the last-stage margin, positives vs the last negatives.
     if model.stages and len(last_neg):
         last = model.stages[-1]
@@ -343,6 +368,28 @@ def train_cascade(
         lr = LogisticRegression().fit(m[:, None], yy)
         model.calibration = (float(lr.coef_[0, 0]), float(lr.intercept_[0]))
     return model
+
+
+def _mine_scenes(model: HogCascade, scenes: Sequence[tuple[np.ndarray, np.ndarray]], config: CascadeConfig,
+                 count: int, rng: np.random.Generator) -> np.ndarray:
+    """Up to ``count`` windows ``(k, h+2, w+2)`` that ``model`` accepts in ``scenes`` away from their true boxes;
+    scenes in random order, at most a tenth of ``count`` from any one scene so that no frame dominates."""
+    from lookalike.vision.hog_features import crop_window
+
+    per_scene = max(1, count // 10)
+    out: list[np.ndarray] = []
+    for k in rng.permutation(len(scenes)):
+        if len(out) >= count:
+            break
+        grey, truth = scenes[k]
+        xywh, _ = model.windows(np.asarray(grey, np.float32))
+        if len(xywh) and len(truth):
+            xywh = xywh[iou_matrix(xywh, np.asarray(truth, float)).max(axis=1) <= config.hard_negative_max_iou]
+        if len(xywh) > per_scene:
+            xywh = xywh[rng.choice(len(xywh), per_scene, replace=False)]
+        out.extend(crop_window(grey, box, config.window_px, pad=0.0) for box in xywh[: count - len(out)])
+    h, w = config.window_px[1] + 2, config.window_px[0] + 2
+    return np.array(out, np.float32).reshape(-1, h, w)
 
 
 def _stage_from_boost(boost) -> Stage:
