@@ -98,3 +98,31 @@ def test_hard_negative_search_stops_when_cascade_is_good_enough():
     assert len(draws) <= cfg.max_draws_per_stage * (len(model.stages) + 1)
     with pytest.raises(ValueError, match="target_false_positive_rate"):
         CascadeConfig(target_false_positive_rate=1.5)
+
+
+def test_scene_mining_finds_hard_negatives_away_from_true_boxes():
+    from lookalike.vision.hog_cascade import _mine_scenes
+
+    rng = np.random.default_rng(7)
+    cfg = CascadeConfig(stages=4, negatives_per_stage=200, min_height_px=64, max_height_px=80)
+    pos = np.array([_window(rng, True) for _ in range(120)])
+    scenes = []
+    for _ in range(6):
+        scene = rng.normal(100, 12, (100, 140)).astype(np.float32)
+        scene[20:70, 20:32] += 90  # the target
+        scene[30:90, 90:100] += 70  # a look-alike distractor bar that random clutter never shows
+        scenes.append((scene, np.array([[10.0, 13.0, 32.0, 64.0]])))
+    messages = []
+    model = train_cascade(pos, lambda n, r: np.array([_window(r, False) for _ in range(n)]), cfg, seed=0,
+                          progress=lambda k, m: messages.append(m), scenes=scenes)
+    assert any("mined from scenes" in m and "(0 mined" not in m for m in messages)
+    xywh, margin = model.windows(scenes[0][0])
+    assert len(xywh) == len(margin)
+    det = model(scenes[0][0].clip(0, 255).astype(np.uint8))
+    assert len(det) <= len(xywh)
+    # Mined windows never overlap a true box by more than hard_negative_max_iou.
+    one_stage = HogCascade(cfg, model.blocks, model.stages[:1])
+    found = _mine_scenes(one_stage, scenes, cfg, 50, np.random.default_rng(0))
+    assert found.shape[1:] == (66, 34)
+    truth_crop = scenes[0][0][13 - 1 : 13 + 65, 10 - 1 : 10 + 33]
+    assert not any(np.allclose(f, truth_crop, atol=1.0) for f in found)
