@@ -97,20 +97,24 @@ def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy:
     whose entries are ``unit_px`` pixels apart (1: a pixel integral; ``cell_px``: an integral of
     :func:`~lookalike.vision.hog_features.cell_histograms`, all offsets then multiples of it);
     returns ``(k, b * 4 * BINS)`` float32."""
-    out = []
-    for bx, by, bw, bh in blocks:
+    rows = np.ascontiguousarray(np.asarray(integral).transpose(1, 2, 0)).reshape(-1, integral.shape[0])
+    return _block_features_rows(rows, integral.shape[2], blocks, ox, oy, unit_px)
+
+
+def _block_features_rows(rows: np.ndarray, width: int, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
+                         unit_px: int) -> np.ndarray:
+    """:func:`block_features` on an integral laid out as ``rows ((H+1) * width, BINS)``, one row per corner: the
+    nine corners of a block's 2×2 cells are nine row gathers."""
+    out = np.empty((len(ox), len(blocks) * 4 * BINS), np.float32)
+    for j, (bx, by, bw, bh) in enumerate(blocks):
         hw, hh = bw // 2 // unit_px, bh // 2 // unit_px
-        cells = []
-        for cy in (0, 1):
-            for cx in (0, 1):
-                x0 = (ox + bx) // unit_px + cx * hw
-                y0 = (oy + by) // unit_px + cy * hh
-                cells.append(integral[:, y0 + hh, x0 + hw] - integral[:, y0, x0 + hw]
-                             - integral[:, y0 + hh, x0] + integral[:, y0, x0])
-        d = np.concatenate(cells, axis=0)  # (4 * BINS, k)
-        d /= np.sqrt((d * d).sum(axis=0, keepdims=True)) + float(bw * bh)
-        out.append(d.T)
-    return np.concatenate(out, axis=1).astype(np.float32) if out else np.zeros((len(ox), 0), np.float32)
+        base = ((oy + by) // unit_px) * width + (ox + bx) // unit_px
+        step = (np.arange(3) * (hh * width))[:, None] + np.arange(3) * hw  # (3, 3) corner offsets
+        c = rows[base[:, None, None] + step]  # (k, 3, 3, BINS) corners
+        d = (c[:, 1:, 1:] - c[:, :-1, 1:] - c[:, 1:, :-1] + c[:, :-1, :-1]).reshape(len(base), 4 * BINS)
+        d /= np.sqrt((d * d).sum(axis=1, keepdims=True)) + float(bw * bh)
+        out[:, j * 4 * BINS : (j + 1) * 4 * BINS] = d
+    return out
 
 
 def window_features(windows: np.ndarray, blocks: np.ndarray) -> np.ndarray:
@@ -188,6 +192,8 @@ class HogCascade:
             level = grey if size == (grey.shape[1], grey.shape[0]) else cv2.resize(
                 grey, size, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
             integral = integral_maps(cell_histograms(level, cfg.cell_px))  # over cells: corners lie on the grid
+            width = integral.shape[2]
+            rows = np.ascontiguousarray(integral.transpose(1, 2, 0)).reshape(-1, BINS)
             ys, xs = np.mgrid[0 : size[1] - win_h + 1 : step, 0 : size[0] - win_w + 1 : step]
             ox, oy = xs.ravel(), ys.ravel()
             alive = np.arange(len(ox))
@@ -197,7 +203,7 @@ class HogCascade:
                     break
                 # Descriptors of this stage's blocks, for the windows still alive only.
                 used = np.unique(stage.index // (4 * BINS))
-                feats = block_features(integral, self.blocks[used], ox[alive], oy[alive], cfg.cell_px)
+                feats = _block_features_rows(rows, width, self.blocks[used], ox[alive], oy[alive], cfg.cell_px)
                 cols = feats[:, np.searchsorted(used, stage.index // (4 * BINS)) * (4 * BINS) + stage.index % (4 * BINS)]
                 votes = np.where((cols > stage.threshold) == (stage.sign > 0), 1.0, -1.0)
                 margin = votes @ stage.weight
