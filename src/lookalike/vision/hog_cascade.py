@@ -6,9 +6,12 @@ descriptor read from per-orientation integral histograms (:mod:`lookalike.vision
 Stage ``k`` of the cascade is a discrete AdaBoost (scikit-learn, decision stumps) over the pooled
 block descriptors, with a threshold set so that the stage keeps ``stage_hit_rate`` of the training
 positives; a window is a detection when every stage accepts it. Between stages the negatives are
-refilled with windows of negative images that the cascade so far still accepts (hard negatives).
+refilled with windows that the cascade so far still accepts (hard negatives): first windows mined by
+running it over whole training scenes away from the true boxes (beside robots, field lines, partly
+visible robots), then random background windows.
 
-Detection slides the window over an image pyramid, keeps the windows that pass every stage, maps
+Detection slides the window over an image pyramid (from the image itself, no upscaling), keeps the windows
+that pass every stage, shrinks them by the training context to target boxes, maps
 their last-stage margin to a probability with a logistic fit, and applies non-maximum suppression.
 """
 
@@ -54,6 +57,7 @@ class CascadeConfig:
     max_height_px: float = 320.0
     stride_cells: int = 2
     nms_iou: float = 0.4
+    context_pad: float = 0.1  # context around the target in training windows, a fraction of its height per side
     hard_negative_max_iou: float = 0.3  # scene mining: a window overlapping a true box more than this is no negative
 
     def __post_init__(self) -> None:
@@ -69,6 +73,8 @@ class CascadeConfig:
         if not 0 <= self.target_false_positive_rate < 1:
             raise ValueError(f"CascadeConfig.target_false_positive_rate: must be in [0, 1), got "
                              f"{self.target_false_positive_rate}")
+        if not 0 <= self.context_pad < 1:
+            raise ValueError(f"CascadeConfig.context_pad: must be in [0, 1), got {self.context_pad}")
         if not 0 <= self.hard_negative_max_iou < 1:
             raise ValueError(f"CascadeConfig.hard_negative_max_iou: must be in [0, 1), got {self.hard_negative_max_iou}")
         if self.scale_step <= 1:
@@ -218,11 +224,20 @@ class HogCascade:
             return np.zeros((0, 4)), np.zeros(0)
         return np.concatenate(boxes).astype(float), np.concatenate(margins)
 
+    def target_boxes(self, windows_xywh: np.ndarray) -> np.ndarray:
+        """Target boxes ``(n, 4)`` px inside detection windows ``(n, 4)`` px: the window less its
+        ``context_pad`` margin, about the same centre."""
+        w = np.asarray(windows_xywh, float).reshape(-1, 4)
+        f = 1.0 / (1.0 + 2.0 * self.config.context_pad)
+        cx, cy = w[:, 0] + w[:, 2] / 2, w[:, 1] + w[:, 3] / 2
+        return np.column_stack([cx - w[:, 2] * f / 2, cy - w[:, 3] * f / 2, w[:, 2] * f, w[:, 3] * f])
+
     def __call__(self, image: np.ndarray) -> Detections:
-        """Detections (boxes in pixels, probability scores) in a ``(h, w, 3)`` BGR or grey image."""
+        """Detections (target boxes in pixels, probability scores) in a ``(h, w, 3)`` BGR or grey image."""
         xywh, margins = self.windows(image)
         if not len(xywh):
             return Detections.empty()
+        xywh = self.target_boxes(xywh)
         a, b = self.calibration
         prob = 1.0 / (1.0 + np.exp(-(a * margins + b)))
         keep = nms(xywh, prob, self.config.nms_iou)
@@ -390,7 +405,8 @@ def _mine_scenes(model: HogCascade, scenes: Sequence[tuple[np.ndarray, np.ndarra
         grey, truth = scenes[k]
         xywh, _ = model.windows(np.asarray(grey, np.float32))
         if len(xywh) and len(truth):
-            xywh = xywh[iou_matrix(xywh, np.asarray(truth, float)).max(axis=1) <= config.hard_negative_max_iou]
+            far = iou_matrix(model.target_boxes(xywh), np.asarray(truth, float)).max(axis=1)
+            xywh = xywh[far <= config.hard_negative_max_iou]
         if len(xywh) > per_scene:
             xywh = xywh[rng.choice(len(xywh), per_scene, replace=False)]
         out.extend(crop_window(grey, box, config.window_px, pad=0.0) for box in xywh[: count - len(out)])
