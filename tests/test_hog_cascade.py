@@ -28,7 +28,7 @@ def test_integral_histogram_matches_direct_sums():
 
 def test_train_detect_save_load(tmp_path):
     rng = np.random.default_rng(1)
-    cfg = CascadeConfig(stages=3, negatives_per_stage=300, min_height_px=64, max_height_px=64, nms_iou=0.3)
+    cfg = CascadeConfig(stages=3, negatives_per_stage=300, min_height_px=64, max_height_px=64)
     pos = np.array([_window(rng, True) for _ in range(150)])
     inner = augment_windows(pos[:, 1:-1, 1:-1], 1, rng, cutout=0.3)
     pos = np.concatenate([pos, np.pad(inner, ((0, 0), (1, 1), (1, 1)), mode="edge")])
@@ -71,6 +71,20 @@ def test_nms_keeps_best_of_overlapping():
     boxes = np.array([[0, 0, 10, 20], [1, 1, 10, 20], [50, 50, 10, 20]], float)
     keep = nms(boxes, np.array([0.5, 0.9, 0.7]), 0.4)
     assert keep.tolist() == [1, 2]
+
+
+def test_merge_nms_suppresses_parts_and_averages_shifted_copies():
+    from lookalike.vision.hog_cascade import merge_nms
+
+    boxes = np.array([[0, 0, 10, 20], [2, 0, 10, 20], [2, 2, 5, 8], [50, 50, 10, 20]], float)
+    out, keep = merge_nms(boxes, np.array([0.9, 0.8, 0.95, 0.7]), 0.3, 0.3)
+    # The part box scores best: it is kept and suppresses both whole windows (overlap is measured against
+    # the smaller box), and is not averaged with them (IoU 0.2 at most).
+    assert keep.tolist() == [2, 3]
+    out, keep = merge_nms(boxes[[0, 1, 3]], np.array([0.9, 0.8, 0.7]), 0.3, 0.3)
+    assert keep.tolist() == [0, 2]
+    np.testing.assert_allclose(out[0], [1, 0, 10, 20])
+    np.testing.assert_allclose(out[1], [50, 50, 10, 20])
 
 
 def test_cell_histograms_equal_summed_orientation_maps():

@@ -36,7 +36,7 @@ from lookalike.vision.hog_features import (
 )
 
 FORMAT = "lookalike-hog-cascade"
-VERSION = 1
+VERSION = 2  # 2: target boxes less context_pad, merging NMS
 
 
 @dataclass(frozen=True)
@@ -56,7 +56,8 @@ class CascadeConfig:
     min_height_px: float = 64.0  # = window height: the finest pyramid level is the image itself
     max_height_px: float = 320.0
     stride_cells: int = 2
-    nms_iou: float = 0.4
+    nms_overlap: float = 0.3  # suppress a window whose intersection with a better one exceeds this of the smaller
+    merge_iou: float = 0.3  # a kept box is the mean of the windows overlapping it by more than this IoU
     context_pad: float = 0.1  # context around the target in training windows, a fraction of its height per side
     hard_negative_max_iou: float = 0.3  # scene mining: a window overlapping a true box more than this is no negative
 
@@ -240,8 +241,8 @@ class HogCascade:
         xywh = self.target_boxes(xywh)
         a, b = self.calibration
         prob = 1.0 / (1.0 + np.exp(-(a * margins + b)))
-        keep = nms(xywh, prob, self.config.nms_iou)
-        return Detections(xywh=xywh[keep], score=prob[keep])
+        boxes, keep = merge_nms(xywh, prob, self.config.nms_overlap, self.config.merge_iou)
+        return Detections(xywh=boxes, score=prob[keep])
 
     detect = __call__
 
@@ -298,6 +299,38 @@ def nms(xywh: np.ndarray, score: np.ndarray, iou: float) -> np.ndarray:
         keep.append(int(order[i]))
         suppressed |= overlap[i] > iou
     return np.array(keep, dtype=int)
+
+
+def merge_nms(xywh: np.ndarray, score: np.ndarray, overlap: float, merge_iou: float) -> tuple[np.ndarray, np.ndarray]:
+    """Greedy suppression by intersection over the smaller box, with box averaging.
+
+    Boxes ``(n, 4)`` px are visited best ``score`` first; each one not yet suppressed is kept and suppresses
+    every box whose intersection with it exceeds ``overlap`` of the smaller area (windows on parts of
+    a target, or shifted copies). Its output box is the plain mean of the not yet suppressed boxes overlapping
+    it by IoU > ``merge_iou``, which localises better than the single best window of a coarse pyramid.
+    Returns ``(boxes (k, 4) px, index (k,) of each kept box)``.
+    """
+    x = np.asarray(xywh, float).reshape(-1, 4)
+    order = np.argsort(-np.asarray(score), kind="stable")
+    xo = x[order]
+    x0, y0, x1, y1 = xo[:, 0], xo[:, 1], xo[:, 0] + xo[:, 2], xo[:, 1] + xo[:, 3]
+    iw = np.clip(np.minimum(x1[:, None], x1) - np.maximum(x0[:, None], x0), 0, None)
+    ih = np.clip(np.minimum(y1[:, None], y1) - np.maximum(y0[:, None], y0), 0, None)
+    area = xo[:, 2] * xo[:, 3]
+    inter = iw * ih
+    over_min = inter / np.maximum(np.minimum(area[:, None], area), 1e-12)
+    iou = inter / np.maximum(area[:, None] + area - inter, 1e-12)
+    boxes, keep = [], []
+    suppressed = np.zeros(len(order), bool)
+    for i in range(len(order)):
+        if suppressed[i]:
+            continue
+        group = (iou[i] > merge_iou) & ~suppressed
+        group[i] = True
+        boxes.append(xo[group].mean(axis=0))
+        keep.append(int(order[i]))
+        suppressed |= over_min[i] > overlap
+    return np.array(boxes).reshape(-1, 4), np.array(keep, dtype=int)
 
 
 def train_cascade(
