@@ -234,7 +234,8 @@ class HogCascade:
         return np.column_stack([cx - w[:, 2] * f / 2, cy - w[:, 3] * f / 2, w[:, 2] * f, w[:, 3] * f])
 
     def __call__(self, image: np.ndarray) -> Detections:
-        """Detections (target boxes in pixels, probability scores) in a ``(h, w, 3)`` BGR or grey image."""
+        """Detections (target boxes in pixels, clipped to the image; probability scores) in a ``(h, w, 3)`` BGR
+        or grey image."""
         xywh, margins = self.windows(image)
         if not len(xywh):
             return Detections.empty()
@@ -242,7 +243,12 @@ class HogCascade:
         a, b = self.calibration
         prob = 1.0 / (1.0 + np.exp(-(a * margins + b)))
         boxes, keep = merge_nms(xywh, prob, self.config.nms_overlap, self.config.merge_iou)
-        return Detections(xywh=boxes, score=prob[keep])
+        h, w = np.asarray(image).shape[:2]
+        x0, y0 = np.clip(boxes[:, 0], 0, w), np.clip(boxes[:, 1], 0, h)  # the visible part of each box
+        x1, y1 = np.clip(boxes[:, 0] + boxes[:, 2], 0, w), np.clip(boxes[:, 1] + boxes[:, 3], 0, h)
+        boxes = np.column_stack([x0, y0, x1 - x0, y1 - y0])
+        ok = (boxes[:, 2] > 0) & (boxes[:, 3] > 0)
+        return Detections(xywh=boxes[ok], score=prob[keep][ok])
 
     detect = __call__
 
