@@ -72,9 +72,8 @@ def _gradient_bins(grey: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray,
     gy = cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=1)
     gx[:, 0] = gx[:, -1] = 0.0
     gy[0, :] = gy[-1, :] = 0.0
-    mag = cv2.magnitude(gx, gy)
-    ang = np.arctan2(gy, gx)
-    ang += np.float32(np.pi) * (ang < 0)  # unsigned orientation in [0, π]
+    mag, ang = cv2.cartToPolar(gx, gy)  # angle in [0, 2π), accurate to about 0.3°
+    ang -= np.float32(np.pi) * (ang >= np.pi)  # unsigned orientation in [0, π)
     ang *= np.float32(bins / np.pi)
     ang -= np.float32(0.5)  # bin centres at integers
     lo = np.floor(ang)
