@@ -130,7 +130,9 @@ def train_detector(
     from lookalike.vision.hog_features import augment_windows
 
     try:
-        config = CascadeConfig(stages=stages, negatives_per_stage=negatives)
+        # Folder positives fill their whole window; rendered ones carry the default context margin.
+        pad = {"context_pad": 0.0} if data is not None else {}
+        config = CascadeConfig(stages=stages, negatives_per_stage=negatives, **pad)
         if frames < 1 or copies < 0:
             raise ValueError(f"--frames/--copies: need frames >= 1 and copies >= 0, got {frames}, {copies}")
         heights = (config.min_height_px, config.max_height_px)
@@ -154,7 +156,9 @@ def train_detector(
             def on_stage(k: int, message: str) -> None:
                 bar.update(task, completed=k + 1, note=message)
 
-            model = train_cascade(pos, sampler, config, seed=seed, progress=on_stage)
+            # Hard negatives are also mined from whole frames (windows the cascade accepts away from robots).
+            model = train_cascade(pos, sampler, config, seed=seed, progress=on_stage,
+                                  scenes=list(zip(neg_images, truths)))
     except ValueError as exc:
         fail(str(exc))
     model.save(output)
