@@ -16,7 +16,6 @@ with the sector's own width).
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -24,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.vision.hog_features import as_bgr_image, dense_hog, hue_channel, to_grey
+from lookalike.vision.model_file import load_model_file, save_model_file
 
 FORMAT = "lookalike-heading-svm"
 VERSION = 1
@@ -201,29 +201,13 @@ class HeadingClassifier:
 
     def save(self, path: str | Path) -> Path:
         """Write the model to ``path`` (``.npz``, no pickle) with its format name and version."""
-        path = Path(path)
-        header = {"format": FORMAT, "version": VERSION, "config": asdict(self.config), "gamma": self.gamma,
-                  "c": self.c, "features": len(self.mean)}
-        arrays = {name: getattr(self, name) for name in _ARRAYS}
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "wb") as fh:
-            np.savez(fh, header=np.array(json.dumps(header)), **arrays)
-        return path
+        header = {"config": asdict(self.config), "gamma": self.gamma, "c": self.c, "features": len(self.mean)}
+        return save_model_file(path, FORMAT, VERSION, header, {name: getattr(self, name) for name in _ARRAYS})
 
     @classmethod
     def load(cls, path: str | Path) -> HeadingClassifier:
         """Read a model written by :meth:`save`; a foreign, corrupt or other-version file raises ``ValueError``."""
-        try:
-            with np.load(path, allow_pickle=False) as data:
-                header = json.loads(str(data["header"]))
-                arrays = {k: data[k] for k in data.files if k != "header"}
-        except (OSError, ValueError, KeyError, EOFError, json.JSONDecodeError) as exc:
-            raise ValueError(f"{path}: not a readable heading model ({exc})") from None
-        if not isinstance(header, dict) or header.get("format") != FORMAT:
-            fmt = header.get("format") if isinstance(header, dict) else None
-            raise ValueError(f"{path}: not a heading model (format {fmt!r})")
-        if header.get("version") != VERSION:
-            raise ValueError(f"{path}: model version {header.get('version')} but this lookalike reads version {VERSION}")
+        header, arrays = load_model_file(path, FORMAT, VERSION, "heading model")
         try:
             cfg = header["config"]
             config = HeadingConfig(**{**cfg, "patch_px": tuple(cfg["patch_px"]), "c_grid": tuple(cfg["c_grid"]),

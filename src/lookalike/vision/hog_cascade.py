@@ -17,7 +17,6 @@ their last-stage margin to a probability with a logistic fit, and applies non-ma
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -26,7 +25,6 @@ import numpy as np
 
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.types import Detections
-from lookalike.vision.nms import merge_nms, nms  # noqa: F401  (nms is part of this module's API)
 from lookalike.vision.hog_features import (
     BINS,
     as_bgr_image,
@@ -35,6 +33,8 @@ from lookalike.vision.hog_features import (
     orientation_maps,
     to_grey,
 )
+from lookalike.vision.model_file import load_model_file, save_model_file
+from lookalike.vision.nms import merge_nms, nms  # noqa: F401  (nms is part of this module's API)
 
 FORMAT = "lookalike-hog-cascade"
 VERSION = 2  # 2: target boxes less context_pad, merging NMS
@@ -257,31 +257,18 @@ class HogCascade:
 
     def save(self, path: str | Path) -> Path:
         """Write the model to ``path`` (``.npz``) with its format name and version."""
-        path = Path(path)
-        header = {"format": FORMAT, "version": VERSION, "config": asdict(self.config),
-                  "calibration": list(self.calibration), "biases": [s.bias for s in self.stages]}
+        header = {"config": asdict(self.config), "calibration": list(self.calibration),
+                  "biases": [s.bias for s in self.stages]}
         arrays = {"blocks": self.blocks}
         for k, s in enumerate(self.stages):
             arrays.update({f"s{k}_index": s.index, f"s{k}_threshold": s.threshold, f"s{k}_sign": s.sign,
                            f"s{k}_weight": s.weight})
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "wb") as fh:
-            np.savez(fh, header=np.array(json.dumps(header)), **arrays)
-        return path
+        return save_model_file(path, FORMAT, VERSION, header, arrays)
 
     @classmethod
     def load(cls, path: str | Path) -> HogCascade:
         """Read a model written by :meth:`save`; a foreign, corrupt or newer file raises ``ValueError``."""
-        try:
-            with np.load(path, allow_pickle=False) as data:
-                header = json.loads(str(data["header"]))
-                arrays = {k: data[k] for k in data.files}
-        except (OSError, ValueError, KeyError, json.JSONDecodeError) as exc:
-            raise ValueError(f"{path}: not a readable HOG cascade model ({exc})") from None
-        if header.get("format") != FORMAT:
-            raise ValueError(f"{path}: not a HOG cascade model (format {header.get('format')!r})")
-        if header.get("version") != VERSION:
-            raise ValueError(f"{path}: model version {header.get('version')} but this lookalike reads version {VERSION}")
+        header, arrays = load_model_file(path, FORMAT, VERSION, "HOG cascade model")
         try:
             cfg = header["config"]
             config = CascadeConfig(**{**cfg, "window_px": tuple(cfg["window_px"])})
