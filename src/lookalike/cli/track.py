@@ -17,6 +17,7 @@ from rich.progress import (
 from rich.table import Table
 
 from lookalike.cli.app import app, console, fail
+from lookalike.cli.track_blobs import run_track_blobs
 from lookalike.cli.track_video import run_track_video
 from lookalike.io import (
     find_sequences,
@@ -64,8 +65,19 @@ def track(
     fps: float | None = typer.Option(None, "--fps", min=0.1, help="With --video: frame rate (default: the input's)."),
     features: str = typer.Option("video", "--features", help="With --video: standardise the hand-crafted features "
                                  "on this video's detections ('video') or use the diver calibration ('divers')."),
+    detector: str | None = typer.Option(None, "--detector", help="With --video: detect with 'blob' (static camera) "
+                                        "instead of reading a det.txt; boxes go to <output stem>.det.txt."),
+    blob: list[str] | None = typer.Option(None, "--blob", help="Blob detector setting KEY=VALUE (repeatable), "
+                                          "e.g. threshold=30 polarity=dark min_area_px=80 max_area_px=5000."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
+    if detector is not None or blob:
+        if video is None or detections is not None or path is not None or detector is None:
+            fail("--detector/--blob: use --video FILE --detector blob, without det.txt")
+        run_track_blobs(video, output, build_tracker(tracker, set_ or []), tracker, detector, blob or [],
+                        annotate=annotate, team_size=team_size, health_window=health_window,
+                        min_score=min_score, fps=fps, features=features)
+        return
     if video is not None:
         det_path = detections or path
         if det_path is None or (detections is not None and path is not None):
