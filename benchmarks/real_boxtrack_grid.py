@@ -16,13 +16,11 @@ from __future__ import annotations
 import argparse
 import itertools
 import sys
-from dataclasses import replace
 from pathlib import Path
 
-from lookalike.cli.bench_real_data import RealSequence, load_boxes
+from lookalike.cli.bench_real_data import RealSequence, cut_sequence, load_boxes
 from lookalike.cli.bench_real_run import Entry, run_jobs
 from lookalike.eval import combine
-from lookalike.io import MotTable
 from lookalike.trackers.registry import parse_parameter
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -31,11 +29,7 @@ from _common import SHARED_DATA
 
 def first_half(seq: RealSequence) -> RealSequence:
     """The sequence cut to frames ``1..⌊length/2⌋`` (detections and ground truth)."""
-    n = seq.length // 2
-    gt = seq.gt
-    keep = gt.frame <= n
-    cut = MotTable(gt.frame[keep], gt.track_id[keep], gt.xywh[keep], gt.conf[keep], gt.extra[keep])
-    return replace(seq, length=n, det_xywh=seq.det_xywh[:n], det_score=seq.det_score[:n], gt=cut)
+    return cut_sequence(seq, "first")
 
 
 def main() -> None:

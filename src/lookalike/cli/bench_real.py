@@ -5,7 +5,9 @@ sequences with their Faster R-CNN detections, the pigs (23 identical animals; bo
 clips (blob detector, head points). Every entry runs on identical detections; peers that are not
 installed are listed as skipped. Per dataset the table gives HOTA, IDF1, MOTA (combined over the
 sequences as TrackEval does), IDSW, frames/s (tracking only) and a rank: entries are ordered by the
-mean of their ranks on HOTA, IDF1 and MOTA (ties: IDF1). The combined ranking orders entries by
+mean of their ranks on HOTA, IDF1 and MOTA (ties: IDF1). ``--part first|second`` scores the first
+or second half of every sequence instead (boxtrack's parameters were chosen on first halves, so the
+second halves are unseen by that choice). The combined ranking orders entries by
 their mean rank over the datasets. ``--workers N`` runs jobs in N processes; ``--backend ray`` runs
 them as Ray tasks (``--address`` of a cluster, else a local ``ray.init()``); tables are identical.
 """
@@ -26,7 +28,9 @@ from lookalike.cli.bench import bench_app
 from lookalike.cli.bench_peers import PEERS, peer_status
 from lookalike.cli.bench_real_data import (
     DATASETS,
+    PARTS,
     RealSequence,
+    cut_sequence,
     detect_hexbug,
     hexbug_clips,
     load_boxes,
@@ -175,6 +179,8 @@ def real(
     peers: list[str] = typer.Option(list(PEERS), "--peers", help="Peers to try ('none' for none); absent ones are skipped."),
     sequences: list[str] | None = typer.Option(None, "--sequences", help="Only these sequences/clips."),
     max_clips: int | None = typer.Option(None, "--max-clips", min=1, help="At most this many HexBug clips."),
+    part: str = typer.Option("full", "--part", help="Score whole sequences ('full'), their first halves "
+                             "(where boxtrack's parameters were chosen: 'first') or second halves ('second')."),
     workers: int = typer.Option(1, "--workers", min=1, help="Local processes (or Ray CPUs for a local Ray)."),
     backend: str = typer.Option("local", "--backend", help=f"One of {', '.join(BACKENDS)}."),
     address: str | None = typer.Option(None, "--address", help="Ray cluster address (default: a local ray.init())."),
@@ -184,6 +190,8 @@ def real(
 ) -> None:
     """Leaderboard on real data: HOTA, IDF1, MOTA, IDSW, frames/s and rank per dataset, and combined."""
     tracker_list, peer_list = _split(trackers), [p for p in _split(peers) if p != "none"]
+    if part not in PARTS:
+        fail(f"--part: expected one of {', '.join(PARTS)}, got {part!r}")
     if backend not in BACKENDS:
         fail(f"--backend: expected one of {', '.join(BACKENDS)}, got {backend!r}")
     for t in tracker_list:
@@ -195,6 +203,7 @@ def real(
                              workers=workers, backend=backend, address=address)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
+    seqs = [cut_sequence(s, part) for s in seqs]
     for name, why in status.items():
         if why is not None:
             console.print(f"[yellow]skipped peer {name}: {why}[/yellow]")
@@ -203,7 +212,8 @@ def real(
     rows, combined, per_seq = leaderboard(entries, seqs, results)
     for dataset in dict.fromkeys(r["Dataset"] for r in rows):
         n = sum(1 for s in seqs if s.dataset == dataset)
-        table = Table(title=f"{dataset}: {n} sequence(s), identical detections")
+        what = "" if part == "full" else f" ({part} halves)"
+        table = Table(title=f"{dataset}: {n} sequence(s){what}, identical detections")
         for c in COLUMNS[1:]:
             table.add_column(c, justify="left" if c == "Tracker" else "right")
         for r in (r for r in rows if r["Dataset"] == dataset):
@@ -220,7 +230,7 @@ def real(
             console.print(f"[red]{r['Dataset']} / {r['Tracker']} failed: {r['Error']}[/red]")
     if json_path is not None:
         json_path.parent.mkdir(parents=True, exist_ok=True)
-        json_path.write_text(json.dumps({"datasets": rows, "combined": combined, "sequences": per_seq,
+        json_path.write_text(json.dumps({"part": part, "datasets": rows, "combined": combined, "sequences": per_seq,
                                          "skipped": {k: v for k, v in status.items() if v}}, indent=2) + "\n")
     if csv_path is not None:
         csv_path.parent.mkdir(parents=True, exist_ok=True)

@@ -9,7 +9,7 @@ the centre of each reported box against the annotated head position within ``rad
 from __future__ import annotations
 
 import csv
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +17,7 @@ import numpy as np
 from lookalike.io import MotTable, find_sequences, read_mot
 
 DATASETS = ("mot15", "pigs", "hexbug")
+PARTS = ("full", "first", "second")  # whole sequences, frames 1..⌊N/2⌋, frames ⌊N/2⌋+1..N
 PIGS_COUNT = 23  # the pigs folder documents 23 animals (../shared/data/README.md), not read from gt
 HEXBUG_FPS = 10.0
 # Clips whose CSV has x and y swapped (listed in ../shared/data/README.md).
@@ -77,6 +78,30 @@ def load_boxes(root: Path, dataset: str) -> list[RealSequence]:
     if not out:
         raise ValueError(f"{root}: no sequence with det/det.txt and gt/gt.txt")
     return out
+
+
+def cut_sequence(seq: RealSequence, part: str) -> RealSequence:
+    """``seq`` whole (``"full"``), cut to frames ``1..⌊N/2⌋`` (``"first"``, where parameters are
+    chosen) or to frames ``⌊N/2⌋+1..N`` (``"second"``, unseen by that choice, renumbered from 1).
+
+    Detections and ground truth (boxes or points) are cut alike; a tracker starts afresh on a part.
+    """
+    if part not in PARTS:
+        raise ValueError(f"part: expected one of {PARTS}, got {part!r}")
+    if part == "full":
+        return seq
+    n = seq.length // 2
+    lo, hi, shift = (0, n, 0) if part == "first" else (n, seq.length, n)
+    gt, points = seq.gt, seq.gt_points
+    if gt is not None:
+        keep = (gt.frame > lo) & (gt.frame <= hi)
+        gt = MotTable(gt.frame[keep] - shift, gt.track_id[keep], gt.xywh[keep], gt.conf[keep], gt.extra[keep])
+    if points is not None:
+        frame, ids, xy = points
+        keep = (frame > lo) & (frame <= hi)
+        points = (frame[keep] - shift, ids[keep], xy[keep])
+    return replace(seq, name=f"{seq.name}[{part}]", length=hi - lo, det_xywh=seq.det_xywh[lo:hi],
+                   det_score=seq.det_score[lo:hi], gt=gt, gt_points=points)
 
 
 def read_hexbug_points(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
