@@ -18,6 +18,7 @@ from rich.table import Table
 
 from lookalike.cli.app import app, console, fail
 from lookalike.cli.track_blobs import run_track_blobs
+from lookalike.cli.track_pixels import run_track_pixels
 from lookalike.cli.track_video import run_track_video
 from lookalike.io import (
     find_sequences,
@@ -69,8 +70,17 @@ def track(
                                         "instead of reading a det.txt; boxes go to <output stem>.det.txt."),
     blob: list[str] | None = typer.Option(None, "--blob", help="Blob detector setting KEY=VALUE (repeatable), "
                                           "e.g. threshold=30 polarity=dark min_area_px=80 max_area_px=5000."),
+    pipeline: str | None = typer.Option(None, "--pipeline", help="With --video: 'robots' finds, orients, places and "
+                                        "identifies (-t kalman_ha|kalman_ha2|jpda|lstm) robots from the pixels."),
+    reports: Path | None = typer.Option(None, "--reports", help="With --pipeline: heading reports (`simulate` .jsonl)."),
+    detector_model: Path | None = typer.Option(None, "--detector-model", help="With --pipeline: `train-detector` model."),
+    heading_model: Path | None = typer.Option(None, "--heading-model", help="With --pipeline: `train-heading` model."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
+    if pipeline is not None:
+        run_track_pixels(video, output, pipeline, reports, detector_model, heading_model, tracker, set_ or [],
+                         annotate=annotate, fps=fps, min_score=min_score)
+        return
     if detector is not None or blob:
         if video is None or detections is not None or path is not None or detector is None:
             fail("--detector/--blob: use --video FILE --detector blob, without det.txt")

@@ -1,0 +1,254 @@
+"""From pixels to robot identities (DESIGN §1.3, §6; seed A's full chain).
+
+:class:`RobotPipeline` runs, per camera frame: the HOG-cascade detector → the visual heading
+classifier on each box → the ground position of each box through the calibrated camera → an
+identifier from :func:`lookalike.trackers.registry.make_tracker` (``kalman_ha``, ``kalman_ha2``,
+``jpda`` or ``lstm``) fed with the heading reports received since the previous frame.
+
+Conventions: boxes ``xywh`` in pixels; ground positions in metres in the observer's egocentric
+frame (x forward, y left); the classifier sees egocentric headings, which the pipeline turns into
+absolute headings by adding the observer's yaw (radians, from odometry; 0 for a fixed camera whose
+forward axis is the reports' reference direction), so that they compare with the robots' IMU
+reports. A box whose bottom edge touches the image border hides the robot's feet: its ground
+position then comes from the top edge at the robot's known height (when that edge is inside).
+
+The perception step (:meth:`RobotPipeline.perceive`) and the identification step
+(:meth:`RobotPipeline.identify`) are also public, so one frame's detections can feed several
+identifiers (as ``lookalike bench pixels`` does).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+
+from lookalike.geometry.camera import Camera
+from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.registry import make_tracker, tracker_class
+from lookalike.types import Beacons, Detections, Frame, TrackSnapshot
+
+IDENTIFIERS = ("kalman_ha", "kalman_ha2", "jpda", "lstm")
+ROBOT_HEIGHT_M = 0.62  # height of the rendered robots (lookalike.sim.render_robots), metres
+
+
+class Detector(Protocol):
+    """Anything that finds boxes (``xywh`` px, ``score`` in [0, 1]) in a ``(h, w, 3)`` uint8 BGR image."""
+
+    def __call__(self, image: np.ndarray) -> Detections: ...
+
+
+class HeadingModel(Protocol):
+    """Anything that estimates egocentric headings of boxes ``(n, 4)`` px: returns an object with
+    ``heading_rad (n,)`` and ``heading_std_rad (n,)`` (radians)."""
+
+    def __call__(self, image: np.ndarray, xywh: np.ndarray) -> Any: ...
+
+
+@dataclass(frozen=True)
+class PipelineConfig:
+    """Settings of the chain.
+
+    Attributes:
+        identifier: registered identifier name (one of :data:`IDENTIFIERS`, or any tracker that
+            reads ground positions and headings).
+        n_agents: number of reporting robots N.
+        max_detections: M, the most probable detections kept per frame (also the LSTM's slots).
+        min_score: detector probability below which a box is dropped.
+        detect_scale: the image is resized by this factor before detection (> 1 finds robots
+            smaller than the detector window, at a cost in speed); boxes are mapped back.
+        target_height_m: height of the targets (m), used when a box's bottom is cut by the image border.
+        border_px: a box edge this close to the image border (px) counts as cut.
+        identifier_params: further ``make_tracker`` parameters as ``(name, value)`` pairs; those
+            the identifier does not know are refused.
+    """
+
+    identifier: str = "kalman_ha2"
+    n_agents: int = 3
+    max_detections: int = 5
+    min_score: float = 0.5
+    detect_scale: float = 1.0
+    target_height_m: float = ROBOT_HEIGHT_M
+    border_px: float = 2.0
+    identifier_params: tuple[tuple[str, Any], ...] = field(default_factory=tuple)
+
+    def __post_init__(self) -> None:
+        own = "PipelineConfig"
+        if int(self.n_agents) != self.n_agents or self.n_agents < 1:
+            raise ValueError(f"{own}.n_agents: need a positive integer, got {self.n_agents!r}")
+        if int(self.max_detections) != self.max_detections or self.max_detections < 1:
+            raise ValueError(f"{own}.max_detections: need a positive integer, got {self.max_detections!r}")
+        if not 0.0 <= self.min_score <= 1.0:
+            raise ValueError(f"{own}.min_score: must be in [0, 1], got {self.min_score!r}")
+        if not 0.25 <= self.detect_scale <= 4.0:
+            raise ValueError(f"{own}.detect_scale: must be in [0.25, 4], got {self.detect_scale!r}")
+        if not self.target_height_m > 0 or self.border_px < 0:
+            raise ValueError(f"{own}.target_height_m/border_px: need > 0 and >= 0, got "
+                             f"{self.target_height_m!r}, {self.border_px!r}")
+
+    def identifier_kwargs(self) -> dict[str, Any]:
+        """``make_tracker`` keyword arguments: N (and M for slot-based identifiers) plus ``identifier_params``."""
+        try:
+            known = {f.name for f in dataclasses.fields(tracker_class(self.identifier).Config)}
+        except KeyError as exc:
+            raise ValueError(f"PipelineConfig.identifier: {exc.args[0]}") from None
+        kwargs: dict[str, Any] = {k: v for k, v in (("n_agents", self.n_agents), ("n_slots", self.max_detections))
+                                  if k in known}
+        kwargs.update(dict(self.identifier_params))
+        return kwargs
+
+
+@dataclass(frozen=True)
+class PipelineResult:
+    """One frame's output.
+
+    Attributes:
+        frame: the :class:`Frame` given to the identifier (its detections carry ``xywh`` px,
+            ``score``, ``position (n, 2)`` m, absolute ``heading (n,)`` rad and ``heading_std (n,)`` rad).
+        tracks: the identifier's snapshots.
+        labels: ``(n,)`` agent id (0-based) given to each detection, -1 for none (false positive).
+    """
+
+    frame: Frame
+    tracks: list[TrackSnapshot]
+    labels: np.ndarray
+
+    @property
+    def detections(self) -> Detections:
+        return self.frame.detections
+
+
+def check_image(image: np.ndarray, size: tuple[int, int] | None = None, name: str = "image") -> np.ndarray:
+    """``image`` as ``(h, w, 3)`` uint8 BGR. Accepts uint8 BGR ``(h, w, 3)`` or grey ``(h, w)`` / ``(h, w, 1)``;
+    ``size`` = (width, height) in pixels it must have. Anything else raises ``ValueError`` naming ``name``."""
+    if not isinstance(image, np.ndarray):
+        raise ValueError(f"{name}: expected a numpy array, got {type(image).__name__}")
+    if image.size == 0:
+        raise ValueError(f"{name}: empty image (shape {image.shape})")
+    if image.dtype != np.uint8:
+        raise ValueError(f"{name}: expected dtype uint8 (BGR or grey), got {image.dtype}")
+    if image.ndim == 3 and image.shape[2] == 1:
+        image = image[:, :, 0]
+    if image.ndim == 2:
+        image = np.repeat(image[:, :, None], 3, axis=2)
+    if image.ndim != 3 or image.shape[2] != 3:
+        raise ValueError(f"{name}: expected shape (h, w, 3) BGR or (h, w) grey, got {image.shape}")
+    if size is not None and (image.shape[1], image.shape[0]) != tuple(size):
+        raise ValueError(f"{name}: is {image.shape[1]}x{image.shape[0]} px but the camera is calibrated for "
+                         f"{size[0]}x{size[1]} px")
+    return np.ascontiguousarray(image)
+
+
+class RobotPipeline:
+    """Detector → heading classifier → ground projection → identifier, one frame at a time."""
+
+    def __init__(self, detector: Detector, heading: HeadingModel, camera: Camera | None = None,
+                 config: PipelineConfig | None = None) -> None:
+        self.detector = detector
+        self.heading = heading
+        self.camera = camera if camera is not None else Camera.default()
+        if not isinstance(self.camera, Camera):
+            raise ValueError(f"camera: expected a lookalike.geometry.Camera, got {type(self.camera).__name__}")
+        self.config = config if config is not None else PipelineConfig()
+        try:
+            self.identifier = make_tracker(self.config.identifier, **self.config.identifier_kwargs())
+        except (KeyError, TypeError) as exc:
+            raise ValueError(f"PipelineConfig.identifier: {exc}") from None
+        self._index = 0
+
+    @classmethod
+    def from_files(cls, detector_path: str | Path, heading_path: str | Path, camera: Camera | None = None,
+                   config: PipelineConfig | None = None) -> RobotPipeline:
+        """A pipeline with models written by ``lookalike train-detector`` and ``lookalike train-heading``."""
+        from lookalike.vision.heading import HeadingClassifier
+        from lookalike.vision.hog_cascade import HogCascade
+
+        return cls(HogCascade.load(detector_path), HeadingClassifier.load(heading_path), camera, config)
+
+    def reset(self) -> None:
+        """Start a new video: the identifier forgets its tracks and the frame counter restarts."""
+        self.identifier.reset()
+        self._index = 0
+
+    def perceive(self, image: np.ndarray, observer_yaw_rad: float = 0.0) -> Detections:
+        """Detections of one frame: boxes (px), scores, ground positions (m), absolute headings and
+        their spreads (rad); at most ``max_detections``, the most probable, in decreasing score."""
+        import cv2
+
+        cfg = self.config
+        k = self.camera.intrinsics
+        img = check_image(image, (k.width, k.height))
+        if not np.isfinite(observer_yaw_rad):
+            raise ValueError(f"observer_yaw_rad: must be finite, got {observer_yaw_rad!r}")
+        if cfg.detect_scale != 1.0:
+            size = (round(k.width * cfg.detect_scale), round(k.height * cfg.detect_scale))
+            det = self.detector(cv2.resize(img, size, interpolation=cv2.INTER_LINEAR))
+            xywh = det.xywh / cfg.detect_scale
+        else:
+            det = self.detector(img)
+            xywh = det.xywh
+        score = det.score
+        keep = (score >= cfg.min_score) & (xywh[:, 2] > 0) & (xywh[:, 3] > 0)
+        xywh, score = xywh[keep], score[keep]
+        position = self.ground_positions(xywh)
+        ok = np.isfinite(position).all(axis=1)
+        xywh, score, position = xywh[ok], score[ok], position[ok]
+        order = np.argsort(-score, kind="stable")[: cfg.max_detections]
+        xywh, score, position = xywh[order], score[order], position[order]
+        if len(xywh):
+            est = self.heading(img, xywh)
+            heading = np.angle(np.exp(1j * (np.asarray(est.heading_rad, float) + observer_yaw_rad)))
+            heading_std = np.asarray(est.heading_std_rad, float)
+        else:
+            heading, heading_std = np.zeros(0), np.zeros(0)
+        return Detections(xywh=xywh, score=score, position=position, heading=heading, heading_std=heading_std)
+
+    def ground_positions(self, xywh: np.ndarray) -> np.ndarray:
+        """Egocentric ground positions ``(n, 2)`` (m) of boxes ``(n, 4)`` (px): the bottom-centre on the
+        ground, or, when the bottom is cut by the image border, the top-centre at the target's height.
+        NaN where neither works (above the horizon, or both edges cut)."""
+        b = np.asarray(xywh, float).reshape(-1, 4)
+        pos = self.camera.box_to_ground(b)
+        k, cfg = self.camera.intrinsics, self.config
+        cut = b[:, 1] + b[:, 3] >= k.height - cfg.border_px
+        if cut.any():
+            top = np.column_stack([b[cut, 0] + 0.5 * b[cut, 2], b[cut, 1]])
+            head = self.camera.pixels_to_ground(top, z_m=cfg.target_height_m)
+            head[b[cut, 1] <= cfg.border_px] = np.nan
+            pos[cut] = head
+        return pos
+
+    def identify(self, detections: Detections, beacons: Beacons | None = None, time_s: float | None = None,
+                 index: int | None = None) -> PipelineResult:
+        """Feed one frame's detections and the reports received since the last frame to the identifier.
+        ``time_s`` defaults to the frame index / 30 Hz; ``index`` to the next frame."""
+        idx = self._index if index is None else int(index)
+        t = idx / 30.0 if time_s is None else float(time_s)
+        frame = Frame(index=idx, time=t, detections=detections,
+                      beacons=beacons if beacons is not None else Beacons.empty())
+        tracks = list(self.identifier.update(frame))
+        self._index = idx + 1
+        return PipelineResult(frame, tracks, labels_from_tracks(len(detections), tracks))
+
+    def update(self, image: np.ndarray, beacons: Beacons | None = None, time_s: float | None = None,
+               observer_yaw_rad: float = 0.0) -> PipelineResult:
+        """Run the whole chain on one image (uint8 BGR or grey) with the reports received since the last frame."""
+        return self.identify(self.perceive(image, observer_yaw_rad), beacons, time_s)
+
+
+def labelled_rows(index: int, detections: Detections, labels: Sequence[int] | np.ndarray,
+                  tracks: Sequence[TrackSnapshot]) -> np.ndarray:
+    """MOTChallenge result rows ``(k, 10)`` for the identified detections of 0-based frame ``index``:
+    ``frame, agent id + 1, box (px), identity confidence, ground x, y (m), -1``."""
+    lab = np.asarray(labels, int).reshape(-1)
+    prob = {t.detection_index: t.identity_prob for t in tracks if t.agent_id is not None and t.detection_index >= 0}
+    rows = []
+    for k in np.flatnonzero(lab >= 0):
+        p = prob.get(int(k))
+        pos = detections.position[k] if detections.position is not None else (np.nan, np.nan)
+        rows.append([index + 1, lab[k] + 1, *detections.xywh[k], 1.0 if p is None else p, pos[0], pos[1], -1.0])
+    return np.array(rows, float).reshape(-1, 10)
