@@ -1,0 +1,108 @@
+"""``lookalike track --video FILE --detector blob``: a synthetic arena video (dark discs on a bright
+background) end to end, the ``--blob`` settings parser and the refusals."""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from lookalike.cli import app
+from lookalike.cli.track_blobs import blob_config, blob_detection_rows
+from lookalike.io import read_mot
+
+runner = CliRunner()
+FRAMES = 30
+# (start x, start y, vx, vy) px and px/frame: three discs in their own lanes, never touching.
+DISCS = ((20, 20, 3, 0), (140, 60, -3, 0), (30, 100, 2, 0))
+
+
+def _write_video(path: Path, discs=DISCS, frames: int = FRAMES) -> Path:
+    import cv2
+
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 10, (160, 120))
+    assert writer.isOpened()
+    for k in range(frames):
+        img = np.full((120, 160, 3), 215, np.uint8)
+        for x, y, vx, vy in discs:
+            cv2.circle(img, (int(x + vx * k), int(y + vy * k)), 7, (35, 35, 35), -1)
+        writer.write(img)
+    writer.release()
+    return path
+
+
+@pytest.fixture(scope="module")
+def arena(tmp_path_factory) -> Path:
+    return _write_video(tmp_path_factory.mktemp("arena") / "discs.avi")
+
+
+def test_blob_detection_rows_find_every_disc(arena):
+    rows, n = blob_detection_rows(arena, blob_config(["polarity=dark", "min_area_px=20"]))
+    assert n == FRAMES
+    counts = np.bincount(rows[:, 0].astype(int), minlength=FRAMES + 1)[1:]
+    assert (counts == 3).all()
+    assert (rows[:, 1] == -1).all() and ((rows[:, 6] > 0.5) & (rows[:, 6] < 1)).all()
+    # a disc of radius 7 px gives a box of about 15 px
+    assert np.allclose(rows[:, 4:6], 15, atol=3)
+
+
+@pytest.mark.parametrize("tracker", ["sort", "boxtrack"])
+def test_track_cli_with_blob_detector(arena, tmp_path, tracker):
+    out = tmp_path / "tracks.txt"
+    args = ["track", "--video", str(arena), "--detector", "blob", "--blob", "polarity=dark",
+            "--blob", "min_area_px=20", "--tracker", tracker, "-o", str(out)]
+    if tracker == "boxtrack":
+        args += ["--set", "high_score=0.5", "--set", "birth_score=0.5", "--annotate", str(tmp_path / "a.mp4")]
+    r = runner.invoke(app, args)
+    assert r.exit_code == 0, r.output
+    tracks = read_mot(out)
+    assert len(np.unique(tracks.track_id)) == 3
+    # after confirmation every frame has the three discs
+    per_frame = np.bincount(tracks.frame.astype(int), minlength=FRAMES + 1)[1:]
+    assert (per_frame[5:] == 3).all()
+    assert len(read_mot(tmp_path / "tracks.det.txt")) == 3 * FRAMES
+    if tracker == "boxtrack":
+        assert (tmp_path / "a.mp4").stat().st_size > 0
+
+
+def test_blob_config_parsing():
+    cfg = blob_config(["threshold=40", "polarity=dark", "min_area_px=5", "max_area_px=inf", "open_px=0",
+                       "stabilise=yes", "method=mog2"])
+    assert (cfg.threshold, cfg.polarity, cfg.min_area_px, cfg.open_px, cfg.stabilise, cfg.method) == (
+        40.0, "dark", 5.0, 0, True, "mog2")
+    assert math.isinf(cfg.max_area_px)
+    with pytest.raises(ValueError, match="unknown setting"):
+        blob_config(["size=3"])
+    with pytest.raises(ValueError, match="threshold: expected a float"):
+        blob_config(["threshold=high"])
+    with pytest.raises(ValueError, match="open_px: expected a int"):
+        blob_config(["open_px=2.5"])
+    with pytest.raises(ValueError, match="KEY=VALUE"):
+        blob_config(["threshold"])
+    with pytest.raises(ValueError, match="BlobConfig.threshold"):
+        blob_config(["threshold=300"])
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--detector", "hog"], "--detector: choose one of blob"),
+    (["--detector", "blob", "--blob", "colour=red"], "--blob colour: unknown setting"),
+    (["--detector", "blob", "--blob", "polarity=sideways"], "BlobConfig.polarity"),
+    (["--detector", "blob", "--detections", "det.txt"], "without det.txt"),
+    (["--blob", "threshold=20"], "--video FILE --detector blob"),
+])
+def test_track_cli_blob_refusals(arena, tmp_path, extra, message):
+    r = runner.invoke(app, ["track", "--video", str(arena), "-o", str(tmp_path / "t.txt"), *extra])
+    assert r.exit_code != 0
+    assert message in " ".join(r.output.split())
+
+
+def test_track_cli_blob_needs_a_video_and_blobs(tmp_path):
+    r = runner.invoke(app, ["track", "--detector", "blob", "-o", str(tmp_path / "t.txt")])
+    assert r.exit_code != 0 and "--video FILE --detector blob" in " ".join(r.output.split())
+    r = runner.invoke(app, ["track", "--video", str(tmp_path / "none.avi"), "--detector", "blob",
+                            "-o", str(tmp_path / "t.txt")])
+    assert r.exit_code != 0 and "does not exist" in " ".join(r.output.split())
+    empty = _write_video(tmp_path / "empty.avi", discs=(), frames=10)
+    r = runner.invoke(app, ["track", "--video", str(empty), "--detector", "blob", "-o", str(tmp_path / "t.txt")])
+    assert r.exit_code != 0 and "found 0 box(es)" in " ".join(r.output.split())
