@@ -10,6 +10,7 @@ from lookalike.cli import demo as _demo  # noqa: E402,F401
 from lookalike.cli import eval as _eval  # noqa: E402,F401
 from lookalike.cli import bench as _bench  # noqa: E402,F401
 from lookalike.cli import bench_divers as _bench_divers  # noqa: E402,F401
+from lookalike.cli import bench_pixels as _bench_pixels  # noqa: E402,F401
 from lookalike.cli import bench_real as _bench_real  # noqa: E402,F401
 from lookalike.cli import bench_experiments as _bench_experiments  # noqa: E402,F401
 from lookalike.cli import simulate as _simulate  # noqa: E402,F401
