@@ -11,9 +11,8 @@ robot is the rendered robot whose visible box it overlaps best (Hungarian on IoU
 ``--min-iou``), otherwise it is a false positive. Success rate = correct labels / all detections,
 a false positive labelled as such counting as correct.
 
-Without ``--detector-model``/``--heading-model`` the models are trained first on rendered robots
-(the same code as ``lookalike train-detector``/``train-heading``, smaller by default; a few minutes);
-``--save-models DIR`` keeps them for the next run.
+The detector and heading models are those shipped in ``lookalike/vision/models_data`` unless
+``--detector-model``/``--heading-model`` name others.
 """
 
 from __future__ import annotations
@@ -121,7 +120,8 @@ def perceive_sequence(pipe: RobotPipeline, seq: RobotSequence, camera: Camera, m
     return out
 
 
-def _identifier(name: str, seq: RobotSequence, camera: Camera) -> Any:
+def _identifier(name: str, seq: RobotSequence, camera: Camera) -> PipelineConfig:
+    """The identification settings of ``name`` for the sequence's N and M and the camera's field of view."""
     return PipelineConfig(identifier=name, n_agents=seq.config.n_agents, max_detections=seq.config.max_detections,
                           identifier_params=identifier_settings(name, camera))
 
@@ -152,47 +152,6 @@ def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camer
             predicted.append(labels_from_tracks(len(frame.detections), tracker.update(frame)))
         truth.extend(p.sequence.true_labels())
     return identification_success_rate(predicted, truth), sum(len(t) for t in truth)
-
-
-def train_models(frames_detector: int, frames_heading: int, stages: int, seed: int, progress: Progress
-                 ) -> tuple[Any, Any]:
-    """A HOG cascade and a heading classifier trained on rendered robots (as ``lookalike train-detector`` and
-    ``train-heading`` do, with ``frames_*`` rendered frames), with progress bars."""
-    from lookalike.cli.vision import negative_sampler, rendered_detector_data
-    from lookalike.vision.heading import (
-        HeadingConfig,
-        rendered_heading_samples,
-        train_heading,
-    )
-    from lookalike.vision.hog_cascade import CascadeConfig, train_cascade
-    from lookalike.vision.hog_features import augment_windows
-
-    config = CascadeConfig(stages=stages)
-    heights = (config.min_height_px, config.max_height_px)
-    task = progress.add_task("detector: rendering", total=frames_detector)
-    pos, scenes, truths = rendered_detector_data(frames_detector, seed, config.window_px, height_px=heights,
-                                                 step=lambda: progress.advance(task))
-    if len(pos) < 10:
-        raise ValueError(f"only {len(pos)} positive windows from {frames_detector} frames; render more")
-    rng = np.random.default_rng(seed)
-    extra = augment_windows(pos[:, 1:-1, 1:-1], 2, rng)
-    pos = np.concatenate([pos, np.pad(extra, ((0, 0), (1, 1), (1, 1)), mode="edge")])
-    task = progress.add_task("detector: stages", total=stages)
-    detector = train_cascade(pos, negative_sampler(scenes, truths, config.window_px, heights), config, seed=seed,
-                             progress=lambda k, _: progress.update(task, completed=k + 1),
-                             scenes=list(zip(scenes, truths)))
-    progress.update(task, completed=stages)
-    hconfig = HeadingConfig()
-    task = progress.add_task("heading: rendering", total=frames_heading + 1)
-    parts = []
-    for start in range(0, frames_heading, 20):
-        n = min(20, frames_heading - start)
-        parts.append(rendered_heading_samples(n, seed * 7919 + start, hconfig))
-        progress.advance(task, n)
-    heading = train_heading(np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts]),
-                            hconfig, seed=seed)
-    progress.advance(task)
-    return detector, heading
 
 
 def pixels_table(setups: list[str], identifiers: list[str], sequences: int, frames: int, seed: int,
@@ -247,23 +206,17 @@ def pixels(
     sequences: int = typer.Option(2, "--sequences", min=1, help="Held-out sequences per set-up."),
     frames: int = typer.Option(150, "--frames", min=1, help="Frames per sequence (30 Hz)."),
     seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the held-out sequences."),
-    detector_model: Path | None = typer.Option(None, "--detector-model", help="HOG cascade (`lookalike train-detector`); "
-                                               "default: train one first."),
+    detector_model: Path | None = typer.Option(None, "--detector-model", help="HOG cascade (`lookalike "
+                                               "train-detector`); default: the shipped one."),
     heading_model: Path | None = typer.Option(None, "--heading-model", help="Heading classifier (`lookalike "
-                                              "train-heading`); default: train one first."),
-    train_frames: int = typer.Option(150, "--train-frames", min=1, help="Rendered frames to train the detector "
-                                     "(and twice as many for the heading classifier) when no model is given."),
-    stages: int = typer.Option(12, "--stages", min=1, help="Cascade stages when training the detector."),
-    save_models: Path | None = typer.Option(None, "--save-models", help="Folder to write trained models to "
-                                            "(detector.npz, heading.npz)."),
+                                              "train-heading`); default: the shipped one."),
+    detect_scale: float = typer.Option(1.0, "--detect-scale", help="Resize frames by this before detection "
+                                       "(> 1 finds farther robots, slower)."),
     min_iou: float = typer.Option(0.3, "--min-iou", min=0.0, max=1.0, help="IoU for a detection to be a robot."),
     json_path: Path | None = typer.Option(None, "--json", help="Also write the identification rows as JSON."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the identification rows as CSV."),
 ) -> None:
     """Identification success rate from rendered pixels next to the simulator's own detections, per identifier."""
-    from lookalike.vision.heading import HeadingClassifier
-    from lookalike.vision.hog_cascade import HogCascade
-
     setup_list = [s.strip() for s in setups.split(",") if s.strip()]
     ident_list = [s.strip() for s in identifiers.split(",") if s.strip()]
     for s in setup_list:
@@ -277,17 +230,9 @@ def pixels(
     camera = pixel_camera()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     try:
-        detector = HogCascade.load(detector_model) if detector_model else None
-        heading = HeadingClassifier.load(heading_model) if heading_model else None
+        config = PipelineConfig(detect_scale=detect_scale)
+        pipe = RobotPipeline.from_files(detector_model, heading_model, camera, config)
         with Progress(*columns, console=console) as progress:
-            if detector is None or heading is None:
-                trained = train_models(train_frames, 2 * train_frames, stages, seed=0, progress=progress)
-                detector = detector or trained[0]
-                heading = heading or trained[1]
-                if save_models is not None:
-                    detector.save(save_models / "detector.npz")
-                    heading.save(save_models / "heading.npz")
-            pipe = RobotPipeline(detector, heading, camera, PipelineConfig())
             rows, perception = pixels_table(setup_list, ident_list, sequences, frames, seed, pipe, camera, min_iou,
                                             progress)
     except (ValueError, FileNotFoundError) as exc:
@@ -297,4 +242,4 @@ def pixels(
     write_rows(rows, json_path, csv_path)
 
 
-__all__ = ["match_truth", "perceive_sequence", "pixels_table", "score_pixels", "score_simulated", "train_models"]
+__all__ = ["PerceivedSequence", "match_truth", "perceive_sequence", "pixels_table", "score_pixels", "score_simulated"]

@@ -6,7 +6,8 @@ estimates their headings, projects the boxes to the ground through the default r
 (:meth:`lookalike.geometry.Camera.default`: 640×480, 70° field of view, 0.9 m high, 25° down) and
 identifies them with the heading reports of a ``lookalike simulate`` file (``--reports``: its
 received beacons, frame times and observer yaw, frame k of the file belonging to frame k of the
-video). Not a command of its own: ``lookalike track`` hands over here.
+video). The models are the shipped ones unless ``--detector-model``/``--heading-model`` name others.
+Not a command of its own: ``lookalike track`` hands over here.
 """
 
 from __future__ import annotations
@@ -110,9 +111,8 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
         min_score = 0.5
     if pipeline not in PIPELINES:
         fail(f"--pipeline: choose one of {', '.join(PIPELINES)}, got {pipeline!r}")
-    if reports is None or detector_model is None or heading_model is None:
-        fail("--pipeline robots: needs --reports (a `lookalike simulate` .jsonl), --detector-model "
-             "(`lookalike train-detector`) and --heading-model (`lookalike train-heading`)")
+    if reports is None:
+        fail("--pipeline robots: needs --reports (the heading reports: a `lookalike simulate` .jsonl)")
     if identifier not in IDENTIFIERS:
         fail(f"--tracker: with --pipeline robots choose an identifier: {', '.join(IDENTIFIERS)} (got {identifier!r})")
     if output.is_dir():

@@ -33,6 +33,8 @@ from lookalike.trackers.registry import make_tracker, tracker_class
 from lookalike.types import Beacons, Detections, Frame, TrackSnapshot
 
 IDENTIFIERS = ("kalman_ha", "kalman_ha2", "jpda", "lstm")
+MODELS_DIR = Path(__file__).resolve().parent / "models_data"
+SHIPPED_MODELS = {"detector": "robot_detector.npz", "heading": "robot_heading.npz"}
 ROBOT_HEIGHT_M = 0.62  # height of the rendered robots (lookalike.sim.render_robots), metres
 
 
@@ -161,13 +163,16 @@ class RobotPipeline:
         self._index = 0
 
     @classmethod
-    def from_files(cls, detector_path: str | Path, heading_path: str | Path, camera: Camera | None = None,
-                   config: PipelineConfig | None = None) -> RobotPipeline:
-        """A pipeline with models written by ``lookalike train-detector`` and ``lookalike train-heading``."""
+    def from_files(cls, detector_path: str | Path | None = None, heading_path: str | Path | None = None,
+                   camera: Camera | None = None, config: PipelineConfig | None = None) -> RobotPipeline:
+        """A pipeline with models written by ``lookalike train-detector`` and ``lookalike train-heading``
+        (``None``: the models shipped with the package, see :func:`shipped_model_path`)."""
         from lookalike.vision.heading import HeadingClassifier
         from lookalike.vision.hog_cascade import HogCascade
 
-        return cls(HogCascade.load(detector_path), HeadingClassifier.load(heading_path), camera, config)
+        det = HogCascade.load(detector_path if detector_path is not None else shipped_model_path("detector"))
+        head = HeadingClassifier.load(heading_path if heading_path is not None else shipped_model_path("heading"))
+        return cls(det, head, camera, config)
 
     def reset(self) -> None:
         """Start a new video: the identifier forgets its tracks and the frame counter restarts."""
@@ -238,6 +243,18 @@ class RobotPipeline:
                observer_yaw_rad: float = 0.0) -> PipelineResult:
         """Run the whole chain on one image (uint8 BGR or grey) with the reports received since the last frame."""
         return self.identify(self.perceive(image, observer_yaw_rad), beacons, time_s)
+
+
+def shipped_model_path(kind: str) -> Path:
+    """The model shipped in ``lookalike/vision/models_data`` for ``kind`` ``"detector"`` or ``"heading"``
+    (trained on rendered robots by the commands in that folder's README.md)."""
+    if kind not in SHIPPED_MODELS:
+        raise ValueError(f"kind: expected one of {sorted(SHIPPED_MODELS)}, got {kind!r}")
+    path = MODELS_DIR / SHIPPED_MODELS[kind]
+    if not path.is_file():
+        raise ValueError(f"no shipped {kind} model at {path}; train one with `lookalike train-{kind} -o FILE` "
+                         f"and pass its path")
+    return path
 
 
 def labelled_rows(index: int, detections: Detections, labels: Sequence[int] | np.ndarray,
