@@ -1,85 +1,165 @@
 """HOG cascade detector speed (frames/s on 640x480, one core) and precision/recall at IoU 0.5 on rendered
-test frames (seeds disjoint from training).
+frames whose seeds were not used in training (training renders seed 1).
 
-    python benchmarks/detector_speed.py [--model det.npz | --save det.npz] [--frames 40] [--train-frames 150]
-                                        [--stages 20] [--negatives 1000] [--no-mining]
+    python benchmarks/detector_speed.py [--model det.npz | --save det.npz] [--frames 100] [--train-frames 300]
+                                        [--stages 20] [--negatives 1000] [--no-mining] [--split test|validation]
+                                        [--scale-step 1.25] [--threshold 0.5]
+
+Frames: 1-4 robots each, 1-5 m ahead (depth), anywhere across the field of view, random headings; the
+test split renders seed 424242, the validation split (for choosing settings) seed 515151. Three truths:
+
+- ``all``: every robot at least half visible (the border or other robots hide the rest); a detection
+  matching no such robot is a false positive;
+- ``1-5 m``: robots whose ground distance from the camera (egocentric position) is 1-5 m and that are
+  at least half visible; detections of the other robots in the image are neither hits nor false positives;
+- ``1-5 m, whole``: as ``1-5 m``, and the whole robot lies inside the image (not cut by the border).
 
 Without --model, a cascade is trained on rendered robots first (train-detector's code path).
+--scale-step overrides the model's pyramid step at detection time.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 
 import numpy as np
 
+from lookalike.association import assign
 from lookalike.cli.vision import negative_sampler, rendered_detector_data
 from lookalike.geometry.boxes import iou_matrix
-from lookalike.association import assign
 from lookalike.vision.hog_cascade import CascadeConfig, HogCascade, train_cascade
 from lookalike.vision.hog_features import augment_windows
+from lookalike.vision.hog_select import HeldOutScene, select_stages
+
+SPLIT_SEEDS = {"test": 424242, "validation": 515151}
+THRESHOLDS = (0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
+
+
+def render_split(frames: int, seed: int) -> tuple[list[np.ndarray], list[dict[str, np.ndarray]]]:
+    """Images and, per image, the robots in it: ``xywh`` (clipped, px), ``visible``, ``distance_m``, ``whole``."""
+    from lookalike.geometry.camera import Camera
+    from lookalike.sim.render_robots import RobotRenderer
+
+    renderer = RobotRenderer(camera=Camera.default(640, 480), seed=seed)
+    rng = np.random.default_rng(seed)
+    k = renderer.camera.intrinsics
+    half_fov = np.arctan(0.5 * k.width / k.fx)
+    images, truths = [], []
+    for _ in range(frames):
+        n = int(rng.integers(1, 5))
+        depth = rng.uniform(1.0, 5.0, n)
+        f = renderer.render(np.column_stack([depth, depth * np.tan(rng.uniform(-half_fov, half_fov, n))]),
+                            rng.uniform(-np.pi, np.pi, n))
+        full = f.xywh_full
+        whole = (full[:, 0] >= 0) & (full[:, 1] >= 0) & (full[:, 0] + full[:, 2] <= k.width) & \
+                (full[:, 1] + full[:, 3] <= k.height)
+        images.append(f.image)
+        truths.append({"xywh": f.xywh, "visible": f.visible, "distance_m": np.hypot(*f.position_m.T),
+                       "whole": whole})
+    return images, truths
+
+
+def _match(boxes: np.ndarray, gt: np.ndarray) -> np.ndarray:
+    """``(k, 2)`` one-to-one (box, truth) pairs with IoU >= 0.5."""
+    if not len(boxes) or not len(gt):
+        return np.zeros((0, 2), int)
+    cost = 1.0 - iou_matrix(boxes, gt)
+    return assign(np.where(cost <= 0.5, cost, np.inf), 0.5).matches
+
+
+def count(boxes: np.ndarray, truth: dict[str, np.ndarray], rule: str) -> tuple[int, int, int]:
+    """``(true positives, false positives, misses)`` of one image's ``boxes (m, 4)`` under truth ``rule``."""
+    half = truth["visible"] >= 0.5
+    if rule == "all":
+        scored, ignored = half, np.zeros_like(half)
+    else:
+        scored = half & (truth["distance_m"] >= 1.0) & (truth["distance_m"] <= 5.0)
+        if rule == "whole":
+            scored &= truth["whole"]
+        ignored = ~scored & (truth["visible"] > 0)
+    hits = _match(boxes, truth["xywh"][scored])
+    rest = np.setdiff1d(np.arange(len(boxes)), hits[:, 0])
+    excused = len(_match(boxes[rest], truth["xywh"][ignored]))
+    return len(hits), len(boxes) - len(hits) - excused, int(scored.sum()) - len(hits)
+
+
+def select(model: HogCascade, frames: int) -> HogCascade:
+    """``model`` cut to the prefix with the best F1 on ``frames`` validation frames, probability refitted there."""
+    images, truths = render_split(frames, SPLIT_SEEDS["validation"])
+    scenes = [HeldOutScene(img, t["xywh"][t["visible"] >= 0.5], t["xywh"][(t["visible"] < 0.5) & (t["visible"] > 0)])
+              for img, t in zip(images, truths)]
+    chosen, table = select_stages(model, scenes)
+    for s in table:
+        print(f"  validation, {s.stages} stages: precision {s.precision:.3f}, recall {s.recall:.3f}, F1 {s.f1:.3f}")
+    print(f"kept {len(chosen.stages)} of {len(model.stages)} stages; calibration {chosen.calibration}")
+    return chosen
+
+
+def train(args: argparse.Namespace) -> HogCascade:
+    cfg = CascadeConfig(stages=args.stages, negatives_per_stage=args.negatives)
+    heights = (cfg.min_height_px, cfg.max_height_px)
+    t = time.perf_counter()
+    pos, frames, truths = rendered_detector_data(args.train_frames, 1, cfg.window_px, height_px=heights)
+    extra = augment_windows(pos[:, 1:-1, 1:-1], 2, np.random.default_rng(0))
+    pos = np.concatenate([pos, np.pad(extra, ((0, 0), (1, 1), (1, 1)), mode="edge")])
+    model = train_cascade(pos, negative_sampler(frames, truths, cfg.window_px, heights), cfg,
+                          progress=lambda k, m: print(f"  stage {k + 1}: {m}", flush=True),
+                          scenes=() if args.no_mining else list(zip(frames, truths)))
+    if args.save and not args.select:
+        model.save(args.save)
+    print(f"trained {len(model.stages)} stages on {len(pos)} positives in {time.perf_counter() - t:.0f} s")
+    return model
 
 
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--model")
-    ap.add_argument("--frames", type=int, default=40)
-    ap.add_argument("--train-frames", type=int, default=150)
+    ap.add_argument("--frames", type=int, default=100)
+    ap.add_argument("--split", choices=list(SPLIT_SEEDS), default="test")
+    ap.add_argument("--train-frames", type=int, default=300)
     ap.add_argument("--stages", type=int, default=20)
     ap.add_argument("--negatives", type=int, default=1000, help="hard negatives per stage")
     ap.add_argument("--no-mining", action="store_true", help="random background windows only (no scene mining)")
     ap.add_argument("--save", help="write the trained model here")
+    ap.add_argument("--scale-step", type=float, help="pyramid step at detection time (default: the model's)")
+    ap.add_argument("--select", type=int, default=0, metavar="FRAMES",
+                    help="keep the cascade prefix with the best F1 on this many validation frames (0: all stages)")
+    ap.add_argument("--threshold", type=float, default=0.5, help="score threshold of the summary line")
     args = ap.parse_args()
     import cv2
 
     cv2.setNumThreads(1)
-    if args.model:
-        model = HogCascade.load(args.model)
-    else:
-        cfg = CascadeConfig(stages=args.stages, negatives_per_stage=args.negatives)
-        heights = (cfg.min_height_px, cfg.max_height_px)
-        t = time.perf_counter()
-        pos, frames, truths = rendered_detector_data(args.train_frames, 1, cfg.window_px, height_px=heights)
-        extra = augment_windows(pos[:, 1:-1, 1:-1], 2, np.random.default_rng(0))
-        pos = np.concatenate([pos, np.pad(extra, ((0, 0), (1, 1), (1, 1)), mode="edge")])
-        model = train_cascade(pos, negative_sampler(frames, truths, cfg.window_px, heights), cfg,
-                              progress=lambda k, m: print(f"  stage {k + 1}: {m}", flush=True),
-                              scenes=() if args.no_mining else list(zip(frames, truths)))
+    model = HogCascade.load(args.model) if args.model else train(args)
+    if args.select:
+        model = select(model, args.select)
         if args.save:
             model.save(args.save)
-        print(f"trained {len(model.stages)} stages on {len(pos)} positives in {time.perf_counter() - t:.0f} s")
-    from lookalike.geometry.camera import Camera
-    from lookalike.sim.render_robots import RobotRenderer
-
-    renderer = RobotRenderer(camera=Camera.default(640, 480), seed=424242)
-    rng = np.random.default_rng(424242)
-    half_fov = np.arctan(320 / renderer.camera.intrinsics.fx)
-    images, gts = [], []
-    for _ in range(args.frames):
-        n = int(rng.integers(1, 5))
-        depth = rng.uniform(1.0, 5.0, n)
-        f = renderer.render(np.column_stack([depth, depth * np.tan(rng.uniform(-half_fov, half_fov, n))]),
-                            rng.uniform(-np.pi, np.pi, n))
-        images.append(f.image)
-        gts.append(f.xywh[f.visible >= 0.5])
+    if args.scale_step:
+        model.config = dataclasses.replace(model.config, scale_step=args.scale_step)
+    images, truths = render_split(args.frames, SPLIT_SEEDS[args.split])
+    model(images[0])  # warm-up (imports, caches)
     t = time.perf_counter()
     dets = [model(img) for img in images]
     dt = time.perf_counter() - t
-    print(f"detector speed: {len(images) / dt:.1f} frames/s on 640x480 ({1000 * dt / len(images):.1f} ms/frame)")
-    for thr in (0.3, 0.5, 0.7, 0.9):
-        tp = fp = fn = 0
-        for d, gt in zip(dets, gts):
-            boxes = d.xywh[d.score >= thr]
-            if len(boxes) and len(gt):
-                cost = 1.0 - iou_matrix(boxes, gt)
-                m = assign(np.where(cost <= 0.5, cost, np.inf), 0.5).matches
-                k = len(m)
-            else:
-                k = 0
-            tp, fp, fn = tp + k, fp + len(boxes) - k, fn + len(gt) - k
-        print(f"score >= {thr}: precision {tp / max(tp + fp, 1):.3f}, recall {tp / max(tp + fn, 1):.3f} "
-              f"(IoU 0.5, {tp + fn} robots)")
+    print(f"{args.split} split (seed {SPLIT_SEEDS[args.split]}), {len(images)} frames, scale step "
+          f"{model.config.scale_step:g}")
+    print(f"detector speed: {len(images) / dt:.1f} frames/s on 640x480, one core ({1000 * dt / len(images):.1f} "
+          "ms/frame)")
+    summary = {}
+    for rule, label in (("all", "all"), ("range", "1-5 m"), ("whole", "1-5 m, whole")):
+        for thr in THRESHOLDS:
+            tp = fp = fn = 0
+            for d, truth in zip(dets, truths):
+                a, b, c = count(d.xywh[d.score >= thr], truth, rule)
+                tp, fp, fn = tp + a, fp + b, fn + c
+            p, r = tp / max(tp + fp, 1), tp / max(tp + fn, 1)
+            print(f"{label:<13} score >= {thr:.1f}: precision {p:.3f}, recall {r:.3f} ({tp + fn} robots)")
+            if abs(thr - args.threshold) < 1e-9:
+                summary[label] = (p, r, tp + fn)
+    for label, (p, r, n) in summary.items():
+        print(f"summary {label:<13} (score >= {args.threshold:g}): precision {p:.3f}, recall {r:.3f}, {n} robots")
 
 
 if __name__ == "__main__":

@@ -236,22 +236,35 @@ class HogCascade:
         cx, cy = w[:, 0] + w[:, 2] / 2, w[:, 1] + w[:, 3] / 2
         return np.column_stack([cx - w[:, 2] * f / 2, cy - w[:, 3] * f / 2, w[:, 2] * f, w[:, 3] * f])
 
-    def __call__(self, image: np.ndarray) -> Detections:
-        """Detections (target boxes in pixels, clipped to the image; probability scores) in a ``(h, w, 3)`` BGR
-        or grey image."""
+    def boxes_and_margins(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Target boxes ``(n, 4)`` px after non-maximum suppression, clipped to the image, and the last-stage
+        margin ``(n,)`` of the window each one was kept for."""
         xywh, margins = self.windows(image)
         if not len(xywh):
-            return Detections.empty()
-        xywh = self.target_boxes(xywh)
+            return np.zeros((0, 4)), np.zeros(0)
+        # Best first by the calibrated logit (probabilities of strong windows all round to 1).
         a, b = self.calibration
-        prob = 1.0 / (1.0 + np.exp(-(a * margins + b)))
-        boxes, keep = merge_nms(xywh, prob, self.config.nms_overlap, self.config.merge_iou)
+        boxes, keep = merge_nms(self.target_boxes(xywh), a * margins + b, self.config.nms_overlap,
+                                self.config.merge_iou)
         h, w = np.asarray(image).shape[:2]
         x0, y0 = np.clip(boxes[:, 0], 0, w), np.clip(boxes[:, 1], 0, h)  # the visible part of each box
         x1, y1 = np.clip(boxes[:, 0] + boxes[:, 2], 0, w), np.clip(boxes[:, 1] + boxes[:, 3], 0, h)
         boxes = np.column_stack([x0, y0, x1 - x0, y1 - y0])
         ok = (boxes[:, 2] > 0) & (boxes[:, 3] > 0)
-        return Detections(xywh=boxes[ok], score=prob[keep][ok])
+        return boxes[ok], margins[keep][ok]
+
+    def probability(self, margins: np.ndarray) -> np.ndarray:
+        """Detection probability of last-stage ``margins``: ``sigmoid(a * margin + b)`` (:attr:`calibration`)."""
+        a, b = self.calibration
+        return 1.0 / (1.0 + np.exp(-(a * np.asarray(margins, float) + b)))
+
+    def __call__(self, image: np.ndarray) -> Detections:
+        """Detections (target boxes in pixels, clipped to the image; probability scores) in a ``(h, w, 3)`` BGR
+        or grey image."""
+        boxes, margins = self.boxes_and_margins(image)
+        if not len(boxes):
+            return Detections.empty()
+        return Detections(xywh=boxes, score=self.probability(margins))
 
     detect = __call__
 

@@ -1,0 +1,97 @@
+"""Choosing how many stages of a trained HOG cascade to use, and calibrating its detection probability, on
+held-out scenes.
+
+Training adds stages until the hard negatives run out; the last stages then remove few false positives
+but reject true targets (each keeps ``stage_hit_rate`` of the *training* positives, fewer of unseen ones).
+:func:`select_stages` runs every cascade prefix from half its length to the whole over held-out scenes
+(images with their true boxes and boxes to ignore), matches detections to true boxes one-to-one at IoU >=
+``iou`` (Hungarian; a detection matching only an ignored box, say a mostly hidden robot, is neither a hit
+nor a false positive) and keeps the prefix with the best F1, the longer on ties. It then refits the
+probability of the kept prefix: a logistic regression of "this detection is a hit" on the last-stage
+margin of the held-out detections, so that the score of a box estimates its chance of being a target.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from lookalike.association import assign
+from lookalike.geometry.boxes import iou_matrix
+from lookalike.vision.hog_cascade import HogCascade
+
+
+@dataclass(frozen=True)
+class HeldOutScene:
+    """One held-out image: ``(h, w, 3)`` BGR or ``(h, w)`` grey; ``truth (m, 4)`` and ``ignore (k, 4)`` boxes (px)."""
+
+    image: np.ndarray
+    truth: np.ndarray
+    ignore: np.ndarray
+
+
+@dataclass(frozen=True)
+class PrefixScore:
+    """Held-out precision, recall and F1 of the first ``stages`` stages (IoU-matched detections)."""
+
+    stages: int
+    precision: float
+    recall: float
+    f1: float
+
+
+def match_detections(boxes: np.ndarray, truth: np.ndarray, ignore: np.ndarray,
+                     iou: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """``(hit (n,), excused (n,))`` booleans for detection ``boxes (n, 4)``: matched one-to-one to ``truth (m, 4)``
+    at IoU >= ``iou``, or else matched one-to-one to an ``ignore (k, 4)`` box. Boxes in pixels."""
+    if not 0 < iou <= 1:
+        raise ValueError(f"iou: must be in (0, 1], got {iou}")
+    boxes = np.asarray(boxes, float).reshape(-1, 4)
+    hit, excused = np.zeros(len(boxes), bool), np.zeros(len(boxes), bool)
+    for target, flag in ((truth, hit), (ignore, excused)):
+        target = np.asarray(target, float).reshape(-1, 4)
+        free = np.flatnonzero(~hit)
+        if not len(free) or not len(target):
+            continue
+        cost = 1.0 - iou_matrix(boxes[free], target)
+        matches = assign(np.where(cost <= 1.0 - iou, cost, np.inf)).matches
+        flag[free[matches[:, 0]]] = True
+    return hit, excused
+
+
+def select_stages(model: HogCascade, scenes: Sequence[HeldOutScene], *, iou: float = 0.5,
+                  min_stages: int | None = None) -> tuple[HogCascade, list[PrefixScore]]:
+    """The cascade prefix (at least ``min_stages`` stages, default half the cascade) with the best held-out
+    F1, with its probability refitted on the held-out detections; and the score of every prefix tried."""
+    if not scenes:
+        raise ValueError("scenes: need at least one held-out scene")
+    if not model.stages:
+        raise ValueError("model: has no stages")
+    n = len(model.stages)
+    lowest = max(1, (n + 1) // 2 if min_stages is None else min(int(min_stages), n))
+    results: list[tuple[PrefixScore, np.ndarray, np.ndarray]] = []
+    for k in range(n, lowest - 1, -1):
+        prefix = HogCascade(model.config, model.blocks, model.stages[:k], model.calibration)
+        tp = fp = total = 0
+        margins, labels = [], []
+        for scene in scenes:
+            boxes, margin = prefix.boxes_and_margins(scene.image)
+            hit, excused = match_detections(boxes, scene.truth, scene.ignore, iou)
+            tp, fp, total = tp + int(hit.sum()), fp + int((~hit & ~excused).sum()), total + len(scene.truth)
+            margins.append(margin[~excused])
+            labels.append(hit[~excused])
+        p, r = tp / max(tp + fp, 1), tp / max(total, 1)
+        f1 = 2 * p * r / (p + r) if p + r > 0 else 0.0
+        results.append((PrefixScore(k, p, r, f1), np.concatenate(margins), np.concatenate(labels)))
+    best, margin, label = max(results, key=lambda t: (t[0].f1, t[0].stages))
+    calibration = model.calibration
+    if 0 < label.sum() < len(label):
+        from sklearn.linear_model import LogisticRegression
+
+        lr = LogisticRegression().fit(margin[:, None], label.astype(int))
+        if lr.coef_[0, 0] > 0:  # a larger margin must mean a likelier target
+            calibration = (float(lr.coef_[0, 0]), float(lr.intercept_[0]))
+    chosen = HogCascade(model.config, model.blocks, model.stages[: best.stages], calibration)
+    return chosen, [t[0] for t in results]
