@@ -112,16 +112,20 @@ def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy:
 def _block_features_rows(rows: np.ndarray, width: int, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
                          unit_px: int) -> np.ndarray:
     """:func:`block_features` on an integral laid out as ``rows ((H+1) * width, BINS)``, one row per corner: the
-    nine corners of a block's 2×2 cells are nine row gathers."""
-    out = np.empty((len(ox), len(blocks) * 4 * BINS), np.float32)
-    for j, (bx, by, bw, bh) in enumerate(blocks):
+    nine corners of a block's 2×2 cells are nine row gathers, done for several blocks at once."""
+    k, d = len(ox), 4 * BINS
+    out = np.empty((k, len(blocks) * d), np.float32)
+    ox, oy = np.asarray(ox, np.int64), np.asarray(oy, np.int64)
+    chunk = max(1, 65536 // max(k, 1))  # blocks per gather: bounds the (k, chunk, 3, 3, BINS) corner array
+    for j0 in range(0, len(blocks), chunk):
+        bx, by, bw, bh = np.asarray(blocks[j0 : j0 + chunk], np.int64).T
         hw, hh = bw // 2 // unit_px, bh // 2 // unit_px
-        base = ((oy + by) // unit_px) * width + (ox + bx) // unit_px
-        step = (np.arange(3) * (hh * width))[:, None] + np.arange(3) * hw  # (3, 3) corner offsets
-        c = rows[base[:, None, None] + step]  # (k, 3, 3, BINS) corners
-        d = (c[:, 1:, 1:] - c[:, :-1, 1:] - c[:, 1:, :-1] + c[:, :-1, :-1]).reshape(len(base), 4 * BINS)
-        d /= np.sqrt((d * d).sum(axis=1, keepdims=True)) + float(bw * bh)
-        out[:, j * 4 * BINS : (j + 1) * 4 * BINS] = d
+        base = ((oy[:, None] + by) // unit_px) * width + (ox[:, None] + bx) // unit_px  # (k, b)
+        step = (np.arange(3)[:, None] * (hh * width)[:, None, None] + np.arange(3) * hw[:, None, None])  # (b, 3, 3)
+        c = rows[base[:, :, None, None] + step]  # (k, b, 3, 3, BINS) corners
+        cells = (c[:, :, 1:, 1:] - c[:, :, :-1, 1:] - c[:, :, 1:, :-1] + c[:, :, :-1, :-1]).reshape(k, len(bw), d)
+        cells /= np.sqrt((cells * cells).sum(axis=2, keepdims=True)) + (bw * bh).astype(cells.dtype)[:, None]
+        out[:, j0 * d : (j0 + len(bw)) * d] = cells.reshape(k, -1)
     return out
 
 
@@ -164,11 +168,15 @@ class HogCascade:
     blocks: np.ndarray
     stages: list[Stage]
     calibration: tuple[float, float] = (1.0, 0.0)  # probability = sigmoid(a * last margin + b)
-    _needed: dict = field(default_factory=dict, init=False, repr=False)
+    _stage_blocks: list = field(default_factory=list, init=False, repr=False)
 
     def __post_init__(self) -> None:
-        used = np.unique(np.concatenate([s.index for s in self.stages])) if self.stages else np.zeros(0, int)
-        self._needed = {int(b): i for i, b in enumerate(np.unique(used // (4 * BINS)))}
+        # Per stage: the blocks its stumps read, and each stump's column among those blocks' descriptors.
+        self._stage_blocks = []
+        for stage in self.stages:
+            used = np.unique(stage.index // (4 * BINS))
+            cols = np.searchsorted(used, stage.index // (4 * BINS)) * (4 * BINS) + stage.index % (4 * BINS)
+            self._stage_blocks.append((self.blocks[used], cols))
 
     def classify(self, features: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(accepted (n,) bool, last-stage margin (n,))`` for pooled descriptors ``(n, b * 36)``."""
@@ -208,13 +216,11 @@ class HogCascade:
             ox, oy = xs.ravel(), ys.ravel()
             alive = np.arange(len(ox))
             margin = np.zeros(0)
-            for stage in self.stages:
+            for stage, (used, columns) in zip(self.stages, self._stage_blocks):
                 if not len(alive):
                     break
                 # Descriptors of this stage's blocks, for the windows still alive only.
-                used = np.unique(stage.index // (4 * BINS))
-                feats = _block_features_rows(rows, width, self.blocks[used], ox[alive], oy[alive], cfg.cell_px)
-                cols = feats[:, np.searchsorted(used, stage.index // (4 * BINS)) * (4 * BINS) + stage.index % (4 * BINS)]
+                cols = _block_features_rows(rows, width, used, ox[alive], oy[alive], cfg.cell_px)[:, columns]
                 votes = np.where((cols > stage.threshold) == (stage.sign > 0), 1.0, -1.0)
                 margin = votes @ stage.weight
                 keep = margin >= stage.bias
