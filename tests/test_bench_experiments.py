@@ -52,3 +52,11 @@ def test_commands_print_and_write_tables(tmp_path):
                             "--frames", "450", "--swap-at-s", "3", "--swap-s", "5", "--json", str(out)])
     assert r.exit_code == 0, r.output
     assert "Recovery, mean (s)" in json.loads(out.read_text())[0]
+
+
+def test_swapped_pair_is_the_two_most_seen_robots():
+    from lookalike.cli.bench_experiments import _most_seen_pair
+
+    truth = [np.array([2, -1, 3]), np.array([3, 0]), np.array([3, 2, 1])]
+    assert _most_seen_pair(truth, 4) == (3, 2)
+    assert _most_seen_pair([np.array([-1])], 3) == (0, 1)

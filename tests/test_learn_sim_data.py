@@ -33,3 +33,33 @@ def test_shuffled_slots_keep_inputs_and_targets_together():
         b = sorted(zip(map(tuple, s1[t].round(12)), y1[t]))
         assert a == b
     assert not np.array_equal(y0, y1)  # some frame was really shuffled
+
+
+def test_identity_swap_moves_reports_and_targets_together():
+    from lookalike.learn.sim_data import latest_reports, swap_identities
+
+    arrays = simulate_robots(preset("m5n3"), 600, seed=5).arrays
+    swapped = swap_identities(arrays, 0, 1, 5.0, 10.0)
+    h0, _ = latest_reports(arrays, 3)
+    h1, _ = latest_reports(swapped, 3)
+    k = int(7.5 * 30)  # well inside the swap: reports and labels of 0 and 1 exchanged, robot 2 untouched
+    np.testing.assert_array_equal(h1[k], h0[k][[1, 0, 2]])
+    before, inside = arrays.det_label[k], swapped.det_label[k]
+    np.testing.assert_array_equal(inside, np.select([before == 0, before == 1], [1, 0], before))
+    for k in (int(2 * 30), int(13 * 30)):  # before the swap and after its reports are superseded
+        np.testing.assert_array_equal(swapped.det_label[k], arrays.det_label[k])
+        np.testing.assert_array_equal(h1[k], h0[k])
+
+
+def test_sim_sampler_is_picklable_and_swaps_only_when_asked():
+    import pickle
+
+    from lookalike.learn.sim_data import SimSampler
+
+    plain, always = SimSampler(preset("m3n2")), SimSampler(preset("m3n2"), swap_prob=1.0)
+    x0, y0 = pickle.loads(pickle.dumps(plain))(3, 450, None)
+    x1, y1 = always(3, 450, None)
+    assert x0.shape == x1.shape and not np.array_equal(y0, y1)
+    np.testing.assert_array_equal(always(3, 450, None)[1], y1)  # drawn from the seed
+    with pytest.raises(ValueError, match="swap_prob"):
+        SimSampler(preset("m3n2"), swap_prob=1.5)

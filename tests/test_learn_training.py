@@ -60,3 +60,31 @@ def test_resume_continues_where_it_stopped(tmp_path):
     assert resumed.steps == 10 and len(resumed.history) == 2  # nothing left to do
     with pytest.raises(ValueError, match="another configuration"):
         train(_config(steps=20, validation_every=5), toy_sampler, tmp_path, resume=True)
+
+
+def test_batches_made_in_worker_processes_train_identically(tmp_path):
+    from lookalike.parallel import JobPool
+
+    torch.set_num_threads(1)
+    serial = train(_config(steps=6, validation_every=3), toy_sampler, tmp_path / "a")
+    with JobPool(2) as pool:
+        parallel = train(_config(steps=6, validation_every=3), toy_sampler, tmp_path / "b", pool=pool)
+    assert [h["loss"] for h in serial.history] == [h["loss"] for h in parallel.history]
+
+
+def test_training_can_start_from_exported_weights(tmp_path):
+    from lookalike.learn.checkpoint import load_weights
+    from lookalike.learn.model import AssociationNet
+
+    torch.set_num_threads(1)
+    first = train(_config(steps=10, validation_every=10), toy_sampler, tmp_path / "a")
+    weights = load_weights(first.weights_path)
+    net = AssociationNet(weights.spec, 16, 1)
+    net.load_exported(weights)
+    again = net.export()
+    for name in ("head_weight", "head_bias", "input_mean", "input_std"):
+        np.testing.assert_array_equal(getattr(again, name), getattr(weights, name))
+    warm = train(_config(steps=1, validation_every=1, learning_rate=1e-12), toy_sampler, tmp_path / "b", init=weights)
+    assert warm.best_success == pytest.approx(first.best_success, abs=1e-9)
+    with pytest.raises(ValueError, match="do not fit"):
+        AssociationNet(weights.spec, 8, 1).load_exported(weights)

@@ -3,11 +3,12 @@
 ``bench shuffle``: the identifiers on frames fed in random order. A method that really uses the
 sequence (motion, report history) must collapse; one that only matched single frames would not.
 
-``bench recovery``: the heading reports of robots 0 and 1 are swapped for ``--swap-s`` seconds, so
-the identifiers learn wrong identities, then restored. Reported: the success rate on those two
-robots' detections while swapped (without the swap, for comparison), and how long after the
-restore their success rate over a one-second window is back within 5 points of the same run
-without the swap.
+``bench recovery``: the heading reports of two robots are swapped for ``--swap-s`` seconds, so
+the identifiers learn wrong identities, then restored. The two are, per sequence, the robots
+detected most often from the swap's start to 3 s after the restore (so that there is something to
+recover). Reported: the success rate on those two robots' detections while swapped (without the
+swap, for comparison), and how long after the restore their success rate over a one-second window
+is back within 5 points of the same run without the swap.
 """
 
 from __future__ import annotations
@@ -46,15 +47,15 @@ def _retime(beacons: Beacons, t: float) -> Beacons:
     return Beacons(agent_id=beacons.agent_id, t_sent=np.full(n, t), t_received=np.full(n, t), heading=beacons.heading)
 
 
-def _swap_reports(frames: list[Frame], start_s: float, stop_s: float) -> list[Frame]:
-    """Frames whose reports from robots 0 and 1 sent in ``[start_s, stop_s)`` carry each other's id."""
+def _swap_reports(frames: list[Frame], start_s: float, stop_s: float, pair: tuple[int, int] = (0, 1)) -> list[Frame]:
+    """Frames whose reports from the robots ``pair`` sent in ``[start_s, stop_s)`` carry each other's id."""
     out = []
     for f in frames:
         b = f.beacons
         ids = b.agent_id.copy()
         window = (b.t_sent >= start_s) & (b.t_sent < stop_s)
-        ids[window & (b.agent_id == 0)] = 1
-        ids[window & (b.agent_id == 1)] = 0
+        ids[window & (b.agent_id == pair[0])] = pair[1]
+        ids[window & (b.agent_id == pair[1])] = pair[0]
         swapped = Beacons(agent_id=ids, t_sent=b.t_sent, t_received=b.t_received, heading=b.heading)
         out.append(Frame(index=f.index, time=f.time, detections=f.detections, beacons=swapped))
     return out
@@ -123,9 +124,11 @@ def recovery(
                 seq = simulate_robots(cfg, frames, seed + 1000 * PRESET_NAMES.index(setup) + k)
                 fs = list(seq.frames())
                 truth = seq.true_labels()
-                clean = _pair_hits(_labels(name, seq, fs), truth)
-                swapped = _pair_hits(_labels(name, seq, _swap_reports(fs, swap_at_s, swap_at_s + swap_s)), truth)
                 start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
+                pair = _most_seen_pair(truth[start : restore + int(3 * rate)], cfg.n_agents)
+                clean = _pair_hits(_labels(name, seq, fs), truth, pair)
+                swapped_frames = _swap_reports(fs, swap_at_s, swap_at_s + swap_s, pair)
+                swapped = _pair_hits(_labels(name, seq, swapped_frames), truth, pair)
                 during_swapped.append(_rate(swapped[start:restore]))
                 during_clean.append(_rate(clean[start:restore]))
                 times.append(_recovery_s(clean, swapped, restore, int(rate), rate))
@@ -140,11 +143,18 @@ def recovery(
     write_rows(rows, _path(json_path), _path(csv_path))
 
 
-def _pair_hits(predicted: list[np.ndarray], truth: list[np.ndarray]) -> list[tuple[int, int]]:
-    """Per frame: (correct, total) labels of the detections that truly are robot 0 or 1."""
+def _most_seen_pair(truth: list[np.ndarray], n_agents: int) -> tuple[int, int]:
+    """The two robots with the most detections in ``truth`` (ties: lower ids)."""
+    counts = np.bincount(np.concatenate([t[t >= 0] for t in truth] + [np.zeros(0, int)]), minlength=n_agents)
+    a, b = np.argsort(-counts, kind="stable")[:2]
+    return int(a), int(b)
+
+
+def _pair_hits(predicted: list[np.ndarray], truth: list[np.ndarray], pair: tuple[int, int] = (0, 1)) -> list[tuple[int, int]]:
+    """Per frame: (correct, total) labels of the detections that truly are one of the robots ``pair``."""
     out = []
     for p, t in zip(predicted, truth):
-        mine = (t == 0) | (t == 1)
+        mine = (t == pair[0]) | (t == pair[1])
         out.append((int((p[mine] == t[mine]).sum()), int(mine.sum())))
     return out
 
@@ -155,7 +165,7 @@ def _rate(hits: list[tuple[int, int]]) -> float:
 
 
 def _recovery_s(clean, swapped, restore: int, window: int, rate: float, tolerance: float = 0.05) -> float:
-    """Seconds from ``restore`` until the swapped run's success on robots 0 and 1 over ``window``
+    """Seconds from ``restore`` until the swapped run's success on the swapped pair over ``window``
     frames is within ``tolerance`` of the clean run's over the same frames (inf: never)."""
     for t in range(restore, len(clean) - window + 1):
         a, b = _rate(swapped[t : t + window]), _rate(clean[t : t + window])

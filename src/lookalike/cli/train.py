@@ -27,7 +27,18 @@ def train(
     layers: int = typer.Option(5, help="Stacked recurrent layers."),
     seed: int = typer.Option(0, help="Seed of the run (weights and data)."),
     relative: bool = typer.Option(True, help="Add slot-minus-agent heading differences to the input (ours)."),
+    patience: int = typer.Option(12, min=1, help="Stop after this many validations (every 50 steps) without a new best."),
     threads: int = typer.Option(1, help="Torch threads."),
+    learning_rate: float = typer.Option(0.004, help="Adam's initial learning rate (the paper's 0.004)."),
+    swap_prob: float = typer.Option(
+        0.0, help="Fraction of training sequences in which two robots swap identities for 1-10 s (ours; "
+        "teaches fast re-identification)."),
+    init_from: Optional[Path] = typer.Option(
+        None, "--init-from", help="Start from these exported weights (.npz), e.g. the shipped ones, instead of random."),
+    device: str = typer.Option("cpu", help="Torch device for the network: cpu, cuda or auto."),
+    workers: int = typer.Option(1, min=1, help="Processes (or Ray CPUs) generating batches ahead."),
+    backend: str = typer.Option("local", help="Batch generation: local (processes) or ray."),
+    address: Optional[str] = typer.Option(None, help="Ray cluster address (default: a local ray.init())."),
     resume: bool = typer.Option(False, help="Continue from OUTPUT/checkpoint.pt."),
     ship: bool = typer.Option(False, help="Copy the best weights into the package's shipped weights."),
 ) -> None:
@@ -39,14 +50,25 @@ def train(
     from lookalike.learn.sim_data import make_sim_sampler
     from lookalike.learn.training import TrainConfig, plot_log
     from lookalike.learn.training import train as run_training
+    from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.weights import WEIGHTS_DIR
+    from lookalike.parallel import JobPool
 
+    if device == "auto":
+        device = "cuda" if torch.cuda.is_available() else "cpu"
+    if device.startswith("cuda") and not torch.cuda.is_available():
+        fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
     try:
         world = preset(preset_name)
         config = TrainConfig(
-            n_agents=world.n_agents, n_slots=world.max_detections, relative_headings=relative, cell=cell, hidden=hidden, num_layers=layers,
-            batch_size=batch_size, sequence_length=sequence_length, steps=steps, minutes=minutes, seed=seed,
+            n_agents=world.n_agents, n_slots=world.max_detections, relative_headings=relative, cell=cell,
+            hidden=hidden, num_layers=layers, batch_size=batch_size, sequence_length=sequence_length, steps=steps,
+            minutes=minutes, seed=seed, learning_rate=learning_rate, patience=patience, swap_prob=swap_prob,
+            init_from=str(init_from) if init_from else None,
         )
+        sampler = make_sim_sampler(world, relative, swap_prob)
+        init = load_weights(init_from, world.n_agents, world.max_detections) if init_from else None
+        pool = JobPool(workers, backend, address)
     except ValueError as exc:
         fail(str(exc))
     torch.set_num_threads(threads)
@@ -63,7 +85,9 @@ def train(
             progress.update(task, completed=row["step"], **fields)
 
         try:
-            result = run_training(config, make_sim_sampler(world, relative), output, resume=resume, on_step=on_step)
+            with pool:
+                result = run_training(config, sampler, output, resume=resume, on_step=on_step, device=device,
+                                      pool=pool, init=init, validation_sample=make_sim_sampler(world, relative))
         except ValueError as exc:
             fail(str(exc))
     png = plot_log(result.log_path, output / "training_log.png")

@@ -40,12 +40,26 @@ class AssociationNet(nn.Module):
         logits = logits.view(*logits.shape[:-1], self.spec.n_slots, self.spec.n_classes)
         return torch.log_softmax(logits, dim=-1), state
 
+    def load_exported(self, weights: NetworkWeights) -> None:
+        """Take the weights and normalisation of :meth:`export`'s output (same cell, sizes and input layout)."""
+        mine = (self.spec, self.cell, self.hidden, self.rnn.num_layers)
+        theirs = (weights.spec, weights.cell, weights.hidden, len(weights.layers))
+        if mine != theirs:
+            raise ValueError(f"weights of (spec, cell, hidden, layers) {theirs} do not fit this network {mine}")
+        with torch.no_grad():
+            for i, layer in enumerate(weights.layers):
+                for ours, key in (("weight_ih", "w_ih"), ("weight_hh", "w_hh"), ("bias_ih", "b_ih"), ("bias_hh", "b_hh")):
+                    getattr(self.rnn, f"{ours}_l{i}").copy_(torch.as_tensor(layer[key]))
+            self.head.weight.copy_(torch.as_tensor(weights.head_weight))
+            self.head.bias.copy_(torch.as_tensor(weights.head_bias))
+        self.set_normalisation(weights.input_mean, weights.input_std)
+
     def export(self, info: dict | None = None) -> NetworkWeights:
         """The weights as numpy arrays for :class:`~lookalike.learn.numpy_net.NumpyAssociationNet`."""
         layers = []
         for i in range(self.rnn.num_layers):
             layers.append(
-                {name: getattr(self.rnn, f"{name}_l{i}").detach().double().numpy().copy()
+                {name: getattr(self.rnn, f"{name}_l{i}").detach().cpu().double().numpy().copy()
                  for name in ("weight_ih", "weight_hh", "bias_ih", "bias_hh")}
             )
         layers = [
@@ -57,9 +71,9 @@ class AssociationNet(nn.Module):
             cell=self.cell,
             hidden=self.hidden,
             layers=layers,
-            head_weight=self.head.weight.detach().double().numpy().copy(),
-            head_bias=self.head.bias.detach().double().numpy().copy(),
-            input_mean=self.input_mean.numpy().copy(),
-            input_std=self.input_std.numpy().copy(),
+            head_weight=self.head.weight.detach().cpu().double().numpy().copy(),
+            head_bias=self.head.bias.detach().cpu().double().numpy().copy(),
+            input_mean=self.input_mean.cpu().numpy().copy(),
+            input_std=self.input_std.cpu().numpy().copy(),
             info=dict(info or {}),
         )

@@ -1,6 +1,15 @@
-"""Training arrays straight from the robot simulator's arrays (vectorised over time)."""
+"""Training arrays straight from the robot simulator's arrays (vectorised over time).
+
+Optional augmentation (ours, not the paper's): in a fraction of the training sequences two robots
+exchange identities for a while, as in the recovery experiment: robot ``a`` broadcasts ``b``'s
+reports and the reverse. Identity follows the reports, so the targets swap too, from the first
+frame that holds a swapped report. The network so learns to re-identify quickly when the reports
+contradict what it remembers, instead of trusting a wrong memory.
+"""
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 
@@ -65,11 +74,52 @@ def arrays_to_training(
     return x, y
 
 
-def make_sim_sampler(config: RobotWorldConfig, relative: bool = True):
+def swap_identities(arrays: RobotArrays, a: int, b: int, start_s: float, stop_s: float) -> RobotArrays:
+    """``arrays`` with robots ``a`` and ``b`` sending each other's reports from ``start_s`` to
+    ``stop_s`` (send time, seconds); detection labels of ``a`` and ``b`` swap on the frames whose
+    newest received report of ``a`` or ``b`` was sent in that interval."""
+    r = arrays.reports
+    sent_in = (r.t_sent >= start_s) & (r.t_sent < stop_s)
+    agent = r.agent_id.copy()
+    agent[sent_in & (r.agent_id == a)] = b
+    agent[sent_in & (r.agent_id == b)] = a
+    swapped = dataclasses.replace(arrays, reports=dataclasses.replace(r, agent_id=agent))
+    _, sent = latest_reports(swapped, max(a, b) + 1)
+    frames = (((sent[:, [a, b]] >= start_s) & (sent[:, [a, b]] < stop_s)).any(axis=1))[:, None]
+    label = arrays.det_label
+    label = np.where(frames & (label == a), b, np.where(frames & (label == b), a, label))
+    return dataclasses.replace(swapped, det_label=label)
+
+
+@dataclasses.dataclass(frozen=True)
+class SimSampler:
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler over the robot world ``config``.
+
+    ``swap_prob``: fraction of sequences in which two random robots swap identities for 1–10 s
+    (:func:`swap_identities`), drawn from the sequence's seed.
+    """
+
+    config: RobotWorldConfig
+    relative: bool = True
+    swap_prob: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not 0.0 <= self.swap_prob <= 1.0:
+            raise ValueError(f"swap_prob must lie in [0, 1], got {self.swap_prob}")
+
+    def __call__(self, seed: int, n_frames: int, rng: np.random.Generator | None) -> tuple[np.ndarray, np.ndarray]:
+        cfg = self.config
+        spec = EncodingSpec(cfg.n_agents, cfg.max_detections, relative_headings=self.relative)
+        arrays = simulate_arrays(cfg, n_frames, seed)
+        aug = np.random.default_rng([seed, 0x5A5])
+        if cfg.n_agents >= 2 and aug.random() < self.swap_prob:
+            a, b = aug.choice(cfg.n_agents, 2, replace=False)
+            duration_s = n_frames / cfg.frame_rate_hz
+            start = aug.uniform(0.0, 0.8 * duration_s)
+            arrays = swap_identities(arrays, int(a), int(b), start, start + aug.uniform(1.0, 10.0))
+        return arrays_to_training(spec, arrays, rng)
+
+
+def make_sim_sampler(config: RobotWorldConfig, relative: bool = True, swap_prob: float = 0.0) -> SimSampler:
     """A ``(seed, n_frames, rng) -> (x, y)`` sampler over the robot world ``config``."""
-    spec = EncodingSpec(config.n_agents, config.max_detections, relative_headings=relative)
-
-    def sample(seed: int, n_frames: int, rng: np.random.Generator | None) -> tuple[np.ndarray, np.ndarray]:
-        return arrays_to_training(spec, simulate_arrays(config, n_frames, seed), rng)
-
-    return sample
+    return SimSampler(config, relative, swap_prob)

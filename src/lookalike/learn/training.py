@@ -4,6 +4,11 @@ Adam with the paper's schedule (learning rate 0.004, decay ``lr_t = lr / (1 + 1e
 weight decay, truncated back-propagation through time over 150 steps, recurrent state reset
 between sequences, slot shuffling, validation on fixed held-out seeds, early stopping on the
 validation success rate, resumable checkpoints and a CSV log.
+
+Each training sequence is a pure function of its seed (slot shuffling included), so batches can be
+generated ahead of time in worker processes or as Ray tasks (:class:`~lookalike.parallel.JobPool`)
+with the same result as in this process. The network runs on ``device`` (``"cpu"`` or ``"cuda"``);
+training may start from exported weights (``init``) instead of random ones.
 """
 
 from __future__ import annotations
@@ -19,10 +24,11 @@ import numpy as np
 import torch
 from torch import nn
 
-from lookalike.learn.checkpoint import save_weights
+from lookalike.learn.checkpoint import NetworkWeights, save_weights
 from lookalike.learn.data import IGNORE, success_rate
 from lookalike.learn.encoding import EncodingSpec
 from lookalike.learn.model import AssociationNet
+from lookalike.parallel import JobPool
 
 TRAIN_SEED_BASE = 2_000_000_000  # training sequences use seeds from here on
 VALIDATION_SEED_BASE = 1_900_000_000  # fixed held-out validation seeds
@@ -51,6 +57,8 @@ class TrainConfig:
     patience: int = 12
     grad_clip: float = 1.0
     seed: int = 0
+    swap_prob: float = 0.0  # recorded here; the sampler applies it (sim_data.SimSampler)
+    init_from: str | None = None  # weights the run started from (recorded; passed as ``init``)
 
 
 @dataclass
@@ -69,18 +77,24 @@ class TrainResult:
 Sampler = Callable[[int, int, "np.random.Generator | None"], tuple[np.ndarray, np.ndarray]]
 
 
-def _batch(sample: Sampler, seeds: Sequence[int], length: int, rng: np.random.Generator):
-    xs, ys = zip(*(sample(int(s), length, rng) for s in seeds))
+def make_batch(sample: Sampler, seeds: Sequence[int], length: int) -> tuple[np.ndarray, np.ndarray]:
+    """Inputs ``(B, T, n_inputs)`` and targets ``(B, T, M)``; slots shuffled by a generator seeded
+    from each sequence's seed, so a batch depends on ``seeds`` alone."""
+    xs, ys = zip(*(sample(int(s), length, np.random.default_rng([int(s), 1])) for s in seeds))
     return np.stack(xs), np.stack(ys)
 
 
-def _validate(model: AssociationNet, x: np.ndarray, y: np.ndarray) -> float:
+def _validate(model: AssociationNet, x: torch.Tensor, y: np.ndarray) -> float:
     model.eval()
     with torch.no_grad():
-        logp, _ = model(torch.as_tensor(x))
+        logp, _ = model(x)
     model.train()
-    correct, total = success_rate(logp.numpy(), y)
+    correct, total = success_rate(logp.cpu().numpy(), y)
     return correct / max(total, 1)
+
+
+def _train_seeds(config: TrainConfig, step: int) -> np.ndarray:
+    return TRAIN_SEED_BASE + config.seed * 10_000_000 + step * config.batch_size + np.arange(config.batch_size)
 
 
 def train(
@@ -89,22 +103,37 @@ def train(
     out_dir: str | Path,
     resume: bool = False,
     on_step: Callable[[dict], None] | None = None,
+    *,
+    device: str = "cpu",
+    pool: JobPool | None = None,
+    init: NetworkWeights | None = None,
+    validation_sample: Sampler | None = None,
 ) -> TrainResult:
-    """Train on sequences from ``sample(seed, n_frames, rng)``; write weights, checkpoint and log to ``out_dir``."""
+    """Train on sequences from ``sample(seed, n_frames, rng)``; write weights, checkpoint and log to ``out_dir``.
+
+    ``pool`` generates batches ahead (two per worker); ``init`` starts from exported weights of
+    the same shape (normalisation statistics included) instead of random ones.
+    ``validation_sample`` (default ``sample``) makes the validation sequences, e.g. without augmentation.
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(config.seed)
-    rng = np.random.default_rng(config.seed)
     spec = EncodingSpec(config.n_agents, config.n_slots, relative_headings=config.relative_headings)
     if config.sequence_length % config.bptt:
         raise ValueError(f"sequence_length {config.sequence_length} must be a multiple of bptt {config.bptt}")
-    val_x, val_y = _batch(
-        sample, [VALIDATION_SEED_BASE + i for i in range(config.validation_sequences)],
-        config.sequence_length, np.random.default_rng(12345),
+    val_x, val_y = make_batch(
+        validation_sample or sample,
+        [VALIDATION_SEED_BASE + i for i in range(config.validation_sequences)],
+        config.sequence_length,
     )
     model = AssociationNet(spec, config.hidden, config.num_layers, config.cell)
-    flat = val_x.reshape(-1, spec.n_inputs)
-    model.set_normalisation(flat.mean(0), flat.std(0))
+    if init is not None:
+        model.load_exported(init)
+    else:
+        flat = val_x.reshape(-1, spec.n_inputs)
+        model.set_normalisation(flat.mean(0), flat.std(0))
+    model.to(device)
+    val_xt = torch.as_tensor(val_x, device=device)
     optimiser = torch.optim.Adam(model.parameters(), lr=config.learning_rate, weight_decay=config.weight_decay)
     schedule = torch.optim.lr_scheduler.LambdaLR(optimiser, lambda t: 1.0 / (1.0 + config.lr_decay * t))
     loss_fn = nn.NLLLoss(ignore_index=IGNORE)
@@ -112,22 +141,26 @@ def train(
     weights_path = out / "model.npz"
     step, best, best_step, history = 0, -1.0, 0, []
     if resume and ckpt_path.is_file():
-        state = torch.load(ckpt_path, weights_only=False)
+        state = torch.load(ckpt_path, weights_only=False, map_location=device)
         if state["config"] != asdict(config):
             raise ValueError(f"{ckpt_path}: was made with another configuration; remove it or drop --resume")
         model.load_state_dict(state["model"])
         optimiser.load_state_dict(state["optimiser"])
         schedule.load_state_dict(state["schedule"])
         step, best, best_step, history = state["step"], state["best"], state["best_step"], state["history"]
-        rng.bit_generator.state = state["rng"]
     started = time.monotonic()
     stale = len([h for h in history if h["step"] > best_step])
+    pool = pool or JobPool()
+    ahead = 2 * pool.workers if (pool.workers > 1 or pool.backend == "ray") else 1
+    pending = {}
     while step < config.steps:
         if config.minutes is not None and time.monotonic() - started > 60 * config.minutes:
             break
-        seeds = TRAIN_SEED_BASE + config.seed * 10_000_000 + step * config.batch_size + np.arange(config.batch_size)
-        x, y = _batch(sample, seeds, config.sequence_length, rng)
-        xt, yt = torch.as_tensor(x), torch.as_tensor(y)
+        for k in range(step, min(step + ahead, config.steps)):
+            if k not in pending:
+                pending[k] = pool.submit(make_batch, sample, _train_seeds(config, k), config.sequence_length)
+        x, y = pending.pop(step).result()
+        xt, yt = torch.as_tensor(x, device=device), torch.as_tensor(y, device=device)
         state_h, losses = None, []
         for lo in range(0, config.sequence_length, config.bptt):
             logp, state_h = model(xt[:, lo : lo + config.bptt], state_h)
@@ -143,7 +176,7 @@ def train(
         row = {"step": step, "loss": float(np.mean(losses)), "lr": schedule.get_last_lr()[0],
                "val_success": math.nan, "seconds": time.monotonic() - started}
         if step % config.validation_every == 0 or step == config.steps:
-            row["val_success"] = _validate(model, val_x, val_y)
+            row["val_success"] = _validate(model, val_xt, val_y)
             history.append(row)
             if row["val_success"] > best:
                 best, best_step, stale = row["val_success"], step, 0
@@ -154,7 +187,7 @@ def train(
             torch.save(
                 {"config": asdict(config), "model": model.state_dict(), "optimiser": optimiser.state_dict(),
                  "schedule": schedule.state_dict(), "step": step, "best": best, "best_step": best_step,
-                 "history": history, "rng": rng.bit_generator.state},
+                 "history": history},
                 ckpt_path,
             )
             _write_log(log_path, history)
@@ -164,7 +197,7 @@ def train(
             break
     if best < 0:  # stopped before the first validation
         row = {"step": step, "loss": math.nan, "lr": schedule.get_last_lr()[0],
-               "val_success": _validate(model, val_x, val_y), "seconds": time.monotonic() - started}
+               "val_success": _validate(model, val_xt, val_y), "seconds": time.monotonic() - started}
         history.append(row)
         best, best_step = row["val_success"], step
         save_weights(model.export({"config": asdict(config), "val_success": best, "step": step}), weights_path)

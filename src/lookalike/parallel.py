@@ -1,0 +1,87 @@
+"""Independent jobs run serially, in local processes, or as Ray tasks, with identical results.
+
+:class:`JobPool` is the one place where lookalike chooses how to spread work: benchmarks map jobs
+over sequences, and training prefetches simulated batches. ``backend="ray"`` uses Ray's own task
+API (``ray.remote`` / ``ray.get``) on the cluster at ``address``, or on a local ``ray.init()``.
+Jobs must be picklable top-level callables whose result depends only on their arguments.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+from concurrent.futures import Future, ProcessPoolExecutor
+from typing import Any, Callable, Sequence
+
+BACKENDS = ("local", "ray")
+
+
+class Pending:
+    """A submitted job; :meth:`result` blocks until it is done."""
+
+    def __init__(self, get: Callable[[], Any]) -> None:
+        self._get = get
+
+    def result(self) -> Any:
+        return self._get()
+
+
+class JobPool:
+    """``submit(fn, *args)`` and ``map(fn, items)`` over ``workers`` processes or a Ray cluster.
+
+    With ``workers=1`` and the local backend, jobs run in this process when their result is asked
+    for. Use as a context manager (or call :meth:`close`) to release the processes.
+    """
+
+    def __init__(self, workers: int = 1, backend: str = "local", address: str | None = None) -> None:
+        if backend not in BACKENDS:
+            raise ValueError(f"backend: expected one of {BACKENDS}, got {backend!r}")
+        if workers < 1:
+            raise ValueError(f"workers must be >= 1, got {workers}")
+        self.workers, self.backend = workers, backend
+        self._pool: ProcessPoolExecutor | None = None
+        self._ray = init_ray(address, workers) if backend == "ray" else None
+        self._remote: dict[Callable, Any] = {}
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Pending:
+        if self._ray is not None:
+            if fn not in self._remote:
+                self._remote[fn] = self._ray.remote(fn)
+            ref = self._remote[fn].remote(*args)
+            return Pending(lambda: self._ray.get(ref))
+        if self.workers > 1:
+            if self._pool is None:
+                # spawned, not forked: the parent may hold CUDA or Ray state that must not be copied
+                self._pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"))
+            future: Future = self._pool.submit(fn, *args)
+            return Pending(future.result)
+        return Pending(lambda: fn(*args))
+
+    def map(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
+        """``[fn(x) for x in items]``, in order."""
+        return [p.result() for p in [self.submit(fn, x) for x in items]]
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(cancel_futures=True)
+            self._pool = None
+
+    def __enter__(self) -> "JobPool":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def init_ray(address: str | None, workers: int) -> Any:
+    """The ``ray`` module, initialised on ``address`` or as a local instance (``workers`` CPUs)."""
+    try:
+        import ray
+    except ImportError:
+        raise ValueError("backend 'ray' needs the ray package (pip install 'lookalike[ray]')") from None
+    if not ray.is_initialized():
+        if address:
+            ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
+        else:
+            ray.init(num_cpus=workers if workers > 1 else None, ignore_reinit_error=True,
+                     include_dashboard=False, log_to_driver=False)
+    return ray
