@@ -8,14 +8,13 @@ from typer.testing import CliRunner
 
 from lookalike.cli import app
 from lookalike.cli.bench_pixels import match_truth
-from lookalike.cli.vision import negative_sampler, rendered_detector_data
 from lookalike.eval import identification_success_rate
 from lookalike.geometry.camera import Camera, Pose2D
 from lookalike.sim.render_robots import ROBOT_HEIGHT_M, ROBOT_WIDTH_M, RobotRenderer, random_walk_poses
 from lookalike.types import Beacons, Detections
-from lookalike.vision.heading import HeadingConfig, rendered_heading_samples, train_heading
-from lookalike.vision.hog_cascade import CascadeConfig, train_cascade
-from lookalike.vision.pipeline import PipelineConfig, RobotPipeline, check_image, labelled_rows
+from lookalike.vision.heading import HeadingClassifier
+from lookalike.vision.hog_cascade import HogCascade
+from lookalike.vision.pipeline import PipelineConfig, RobotPipeline, check_image, labelled_rows, shipped_model_path
 from lookalike.viz.video import video_info
 
 runner = CliRunner()
@@ -23,18 +22,10 @@ N_ROBOTS, FRAMES, DT = 2, 40, 0.1
 
 
 @pytest.fixture(scope="module")
-def models(tmp_path_factory):
-    """A small detector and heading classifier trained on rendered robots (seconds, not minutes)."""
-    cfg = CascadeConfig(stages=4, negatives_per_stage=400, max_stumps=15)
-    heights = (cfg.min_height_px, cfg.max_height_px)
-    pos, scenes, truths = rendered_detector_data(20, 0, cfg.window_px, height_px=heights)
-    det = train_cascade(pos, negative_sampler(scenes, truths, cfg.window_px, heights), cfg, seed=0,
-                        scenes=list(zip(scenes, truths)))
-    hcfg = HeadingConfig(folds=2, c_grid=(10.0,), gamma_grid=(1.0,))
-    f, h = rendered_heading_samples(80, 0, hcfg, robots_per_frame=6)
-    head = train_heading(f, h, hcfg, seed=0)
-    folder = tmp_path_factory.mktemp("pixel-models")
-    return det, head, det.save(folder / "det.npz"), head.save(folder / "head.npz")
+def models():
+    """The shipped detector and heading classifier, and their paths."""
+    det_path, head_path = shipped_model_path("detector"), shipped_model_path("heading")
+    return HogCascade.load(det_path), HeadingClassifier.load(head_path), det_path, head_path
 
 
 @pytest.fixture(scope="module")
@@ -72,8 +63,8 @@ def test_pipeline_identifies_rendered_robots_better_than_chance(models, scene, i
         truth.append(true)
     assert sum(len(t) for t in truth) >= FRAMES  # the robots are found
     assert np.median(position_errors) < 0.4  # metres: boxes land near the robots' feet
-    # Chance is 1/(N+1) = 0.33 for labels among {false positive, robot 0, robot 1}; the small models reach ~0.65.
-    assert identification_success_rate(predicted, truth) > 0.55
+    # Chance is 1/(N+1) = 0.33 for labels among {false positive, robot 0, robot 1}.
+    assert identification_success_rate(predicted, truth) > 0.7
 
 
 def test_bad_images_are_refused_clearly(models):
@@ -127,8 +118,7 @@ def test_labelled_rows_keep_identified_detections_only():
     np.testing.assert_allclose(rows, [[5, 2, 5, 6, 7, 8, 1.0, 2.0, -1.0, -1.0]])
 
 
-def test_track_pipeline_robots_end_to_end(models, tmp_path):
-    _, _, det_path, head_path = models
+def test_track_pipeline_robots_end_to_end(tmp_path):
     res = runner.invoke(app, ["simulate", "--preset", "m3n2", "--frames", "12", "--seed", "3", "-o", str(tmp_path)])
     assert res.exit_code == 0, res.output
     seq = tmp_path / "m3n2-000003.jsonl"
@@ -137,9 +127,8 @@ def test_track_pipeline_robots_end_to_end(models, tmp_path):
     assert res.exit_code == 0, res.output
     assert video_info(clip)[2] == (640, 480)
     tracks, annotated = tmp_path / "tracks.txt", tmp_path / "annotated.mp4"
-    args = ["track", "--video", str(clip), "--pipeline", "robots", "--reports", str(seq), "--detector-model",
-            str(det_path), "--heading-model", str(head_path), "-t", "kalman_ha", "-o", str(tracks),
-            "--annotate", str(annotated)]
+    args = ["track", "--video", str(clip), "--pipeline", "robots", "--reports", str(seq), "-t", "kalman_ha",
+            "-o", str(tracks), "--annotate", str(annotated)]  # the shipped models
     res = runner.invoke(app, args)
     assert res.exit_code == 0, res.output
     assert "12 frames" in res.output
@@ -152,6 +141,8 @@ def test_track_pipeline_robots_end_to_end(models, tmp_path):
     assert res.exit_code != 0 and "--reports" in res.output
     res = runner.invoke(app, [("sort" if a == "kalman_ha" else a) for a in args])
     assert res.exit_code != 0 and "identifier" in res.output
+    res = runner.invoke(app, args + ["--detector-model", str(seq)])
+    assert res.exit_code != 0 and "HOG cascade" in res.output
 
 
 def test_bench_pixels_tiny(models, tmp_path):
