@@ -94,6 +94,8 @@ def test_bad_configuration_is_refused(models):
         PipelineConfig(n_agents=0)
     with pytest.raises(ValueError, match="detect_scale"):
         PipelineConfig(detect_scale=0.0)
+    with pytest.raises(ValueError, match="kind"):
+        shipped_model_path("tracker")
     with pytest.raises(ValueError, match="no parameter"):
         RobotPipeline(det, head, config=PipelineConfig(identifier="lstm", identifier_params=(("fov_deg", 70.0),)))
 

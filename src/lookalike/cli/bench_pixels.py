@@ -11,6 +11,12 @@ robot is the rendered robot whose visible box it overlaps best (Hungarian on IoU
 ``--min-iou``), otherwise it is a false positive. Success rate = correct labels / all detections,
 a false positive labelled as such counting as correct.
 
+Identification table: ``Pixels (%)`` and ``Simulated (%)`` success rates, ``Gap (pp)`` = pixels − simulated,
+the detections scored on each side, and the identifier's own frames/s on the pixel detections.
+Perception table: recall of the rendered robots at least half visible, precision, mean absolute error
+of the absolute visual heading of matched detections (degrees), and perception frames/s (detector +
+heading + ground projection; rendering not counted).
+
 The detector and heading models are those shipped in ``lookalike/vision/models_data`` unless
 ``--detector-model``/``--heading-model`` name others.
 """
@@ -57,8 +63,8 @@ from lookalike.types import Beacons, Detections
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
 
 DEFAULT_SEED = 700_000
-PIXEL_COLUMNS = ("Setup", "Identifier", "Pixels (%)", "Simulated (%)", "Gap (pp)", "Pixel detections",
-                 "Simulated detections", "Identifier frames/s")
+PIXEL_COLUMNS = ("Setup", "Identifier", "Pixels (%)", "Simulated (%)", "Gap (pp)", "Pixel dets", "Sim dets",
+                 "Identifier frames/s")
 PERCEPTION_COLUMNS = ("Setup", "Frames", "Recall", "Precision", "Heading error (deg)", "Perception frames/s")
 
 
@@ -185,7 +191,7 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
             rows.append({
                 "Setup": preset_label(setup), "Identifier": name, "Pixels (%)": round(100 * pix, 2),
                 "Simulated (%)": round(100 * sim, 2), "Gap (pp)": round(100 * (pix - sim), 2),
-                "Pixel detections": n_pix, "Simulated detections": n_sim, "Identifier frames/s": round(fps, 1),
+                "Pixel dets": n_pix, "Sim dets": n_sim, "Identifier frames/s": round(fps, 1),
             })
     return rows, perception
 
