@@ -66,8 +66,13 @@ def load_datasets(root: Path, datasets: list[str], *, sequences: list[str] | Non
 
 
 def default_entries(trackers: list[str], peers: list[str], closed_set: bool = True) -> list[Entry]:
-    """lookalike trackers (plus ``boxtrack`` closed-set where the count is known) and peers."""
+    """lookalike trackers and peers; with ``boxtrack`` also ``boxtrack-global`` (without the
+    per-sequence parameters, where there are some), ``boxtrack-offline`` (its result post-processed
+    offline, :mod:`lookalike.trackers.offline`) and ``boxtrack-closed`` (where the count is known)."""
     entries = [Entry(t, t) for t in trackers]
+    if "boxtrack" in trackers:
+        entries += [Entry("boxtrack-global", "boxtrack", per_sequence=False, only_where_tuned=True),
+                    Entry("boxtrack-offline", "boxtrack", offline=True)]
     if closed_set and "boxtrack" in trackers:
         entries.append(Entry("boxtrack-closed", "boxtrack", closed_set=True))
     return entries + [Entry(p, p, kind="peer") for p in peers]

@@ -22,6 +22,7 @@ from lookalike.cli.bench_real_data import RealSequence
 from lookalike.eval import evaluate_points, evaluate_sequence
 from lookalike.io import MotTable, tracks_to_rows
 from lookalike.trackers import make_tracker
+from lookalike.trackers.offline import OfflineConfig, postprocess
 from lookalike.types import Detections, Frame
 
 BACKENDS = ("local", "ray")
@@ -37,6 +38,35 @@ DATASET_PARAMS: dict[str, dict[str, dict[str, Any]]] = {
     "hexbug": {"boxtrack": {"match_iou": 0.01, "n_init": 2, "report": "detection", "tentative_iou": 0.1,
                             "reid_distance": 2.0, "max_age_s": 1.0}},
 }
+# boxtrack's parameters per MOT15 sequence, each chosen on the first half of that sequence alone (frames
+# 1..⌊N/2⌋; the second halves are never looked at) by benchmarks/real_boxtrack_grid.py --per-sequence:
+# best HOTA + IDF1 + MOTA of the sequence over high_score ∈ {0.7, 0.8, 0.9, 0.95}, birth_score ∈ {0.8, 0.9,
+# 0.95, 0.98}, birth_quantile ∈ {off, 0.5}, n_init ∈ {2, 3}, max_age_s ∈ {1, 2}, report ∈ {filtered,
+# detection}, match_iou ∈ {0.2, 0.3} (512 combinations). The detector's scores, the crowd and the frame
+# rate differ from sequence to sequence; a short calibration on the sequence's own start adapts to them.
+# Entries with ``per_sequence=False`` (``boxtrack-global``) use the dataset's parameters only.
+_MOT15_COMMON = {"birth_quantile": None, "max_age_s": 1.0, "report": "filtered"}
+SEQUENCE_PARAMS: dict[str, dict[str, dict[str, dict[str, Any]]]] = {
+    "mot15": {"boxtrack": {
+        "ADL-Rundle-6": {**_MOT15_COMMON, "high_score": 0.95, "birth_score": 0.98, "n_init": 3, "match_iou": 0.3},
+        "ETH-Bahnhof": {**_MOT15_COMMON, "high_score": 0.9, "birth_score": 0.98, "birth_quantile": 0.5,
+                        "n_init": 2, "match_iou": 0.3},
+        "ETH-Sunnyday": {**_MOT15_COMMON, "high_score": 0.8, "birth_score": 0.9, "n_init": 3, "match_iou": 0.3},
+        "KITTI-13": {**_MOT15_COMMON, "high_score": 0.9, "birth_score": 0.9, "n_init": 3, "report": "detection",
+                     "match_iou": 0.2},
+        "PETS09-S2L1": {**_MOT15_COMMON, "high_score": 0.8, "birth_score": 0.95, "n_init": 2, "match_iou": 0.2},
+        "TUD-Campus": {**_MOT15_COMMON, "high_score": 0.7, "birth_score": 0.9, "n_init": 2, "match_iou": 0.2},
+        "TUD-Stadtmitte": {**_MOT15_COMMON, "high_score": 0.7, "birth_score": 0.98, "n_init": 2, "max_age_s": 2.0,
+                           "match_iou": 0.3},
+    }},
+}
+# Offline post-processing (``boxtrack-offline``) per dataset: trackers.offline.OfflineConfig fields, chosen
+# on the first halves with the parameters above (benchmarks/real_boxtrack_grid.py --offline): link_gap_s ∈
+# {0, 1, 2, 4}, link_distance ∈ {0.5, 1, 2}, coast_s ∈ {0, 0.5}, fill_gap_s ∈ {0, 0.5, 1, 2}.
+OFFLINE_PARAMS: dict[str, dict[str, Any]] = {
+    "mot15": {"link_gap_s": 0.0, "fill_gap_s": 2.0},  # linking lowered HOTA + IDF1 + MOTA there
+    "pigs": {"link_gap_s": 0.0, "fill_gap_s": 2.0},  # linking changed nothing; fill_gap_s 0.5..2 tie
+}
 HEXBUG_RADIUS_PX = 120.0  # a box centre lies about half a bug from its head (benchmarks/hexbug_blobs.py)
 
 
@@ -49,16 +79,34 @@ class Entry:
     kind: str = "lookalike"
     params: dict[str, Any] = field(default_factory=dict)
     closed_set: bool = False  # pass the sequence's documented target count as ``max_targets``
+    per_sequence: bool = True  # use the parameters chosen on each sequence's first half (SEQUENCE_PARAMS)
+    only_where_tuned: bool = False  # run only on datasets with per-sequence parameters for this tracker
+    offline: bool = False  # post-process the whole result (trackers.offline; OFFLINE_PARAMS of the dataset)
+
+
+def base_name(seq: RealSequence) -> str:
+    """The sequence's name without the ``[first]``/``[second]`` of a cut (``cut_sequence``)."""
+    return seq.name.split("[", 1)[0]
+
+
+def sequence_params(entry: Entry, seq: RealSequence) -> dict[str, Any]:
+    """The parameters chosen for ``entry``'s tracker on the first half of ``seq`` (empty if none)."""
+    if entry.kind == "peer" or not entry.per_sequence:
+        return {}
+    return SEQUENCE_PARAMS.get(seq.dataset, {}).get(entry.name, {}).get(base_name(seq), {})
 
 
 def track_rows(entry: Entry, seq: RealSequence,
                dataset_params: dict[str, dict[str, dict[str, Any]]] | None = None) -> np.ndarray:
     """MOTChallenge rows ``(k, 10)`` of ``entry`` on ``seq``; ``dataset_params[dataset][tracker]``
-    are parameters chosen per dataset (overridden by the entry's own)."""
+    are parameters chosen per dataset, overridden by those chosen per sequence
+    (:func:`sequence_params`), overridden by the entry's own. An ``offline`` entry's rows are
+    post-processed with the dataset's :data:`OFFLINE_PARAMS`."""
     dataset_params = DATASET_PARAMS if dataset_params is None else dataset_params
     if entry.kind == "peer":
         return run_peer(entry.name, seq)
-    params = {**dataset_params.get(seq.dataset, {}).get(entry.name, {}), **entry.params}
+    params = {**dataset_params.get(seq.dataset, {}).get(entry.name, {}), **sequence_params(entry, seq),
+              **entry.params}
     if entry.closed_set and seq.n_targets is not None:
         params["max_targets"] = seq.n_targets
     tracker = make_tracker(entry.name, **params)
@@ -66,7 +114,10 @@ def track_rows(entry: Entry, seq: RealSequence,
     for k in range(seq.length):
         dets = Detections(xywh=seq.det_xywh[k], score=seq.det_score[k])
         out.append(tracks_to_rows(k, tracker.update(Frame(index=k, time=k / seq.frame_rate, detections=dets))))
-    return np.vstack(out) if out else np.zeros((0, 10))
+    rows = np.vstack(out) if out else np.zeros((0, 10))
+    if entry.offline:
+        rows = postprocess(rows, seq.frame_rate, OfflineConfig(**OFFLINE_PARAMS.get(seq.dataset, {})))
+    return rows
 
 
 def score_rows(seq: RealSequence, rows: np.ndarray, radius: float = HEXBUG_RADIUS_PX) -> dict[str, float]:
@@ -115,8 +166,13 @@ def map_jobs(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int = 1
 
 
 def job_pairs(entries: Sequence[Entry], sequences: Sequence[RealSequence]) -> list[tuple[Entry, RealSequence]]:
-    """``(entry, sequence)`` for every sequence and entry, closed-set entries only where the count is known."""
-    return [(e, s) for s in sequences for e in entries if not (e.closed_set and s.n_targets is None)]
+    """``(entry, sequence)`` for every sequence and entry; closed-set entries only where the count is
+    known, ``only_where_tuned`` entries only on datasets with per-sequence parameters for their tracker,
+    ``offline`` entries only on datasets whose post-processing was chosen (:data:`OFFLINE_PARAMS`)."""
+    return [(e, s) for s in sequences for e in entries
+            if not (e.closed_set and s.n_targets is None)
+            and not (e.only_where_tuned and e.name not in SEQUENCE_PARAMS.get(s.dataset, {}))
+            and not (e.offline and s.dataset not in OFFLINE_PARAMS)]
 
 
 def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, workers: int = 1,

@@ -32,12 +32,13 @@ from lookalike.trackers.base import check_positive, param
 class OfflineConfig:
     """Parameters of :func:`postprocess` (gaps in frames, distances in box heights)."""
 
-    link_gap_s: float = param(2.0, "longest gap (seconds) between the end of one track and the start of another it continues")
+    link_gap_s: float = param(0.0, "longest gap (seconds) between the end of one track and the start of another it "
+                                   "continues (0: no linking)")
     link_distance: float = param(1.0, "largest mean centre miss (box heights) of a link")
     scale: float = param(1.5, "largest width/height ratio between the boxes either side of a link")
     velocity_frames: int = param(5, "boxes at a track's end/start that give its velocity")
     coast_s: float = param(0.5, "seconds a track end/start is extrapolated at its velocity (then held)")
-    fill_gap_s: float = param(1.0, "longest run of missing frames (seconds) inside one id that is interpolated")
+    fill_gap_s: float = param(2.0, "longest run of missing frames (seconds) inside one id that is interpolated")
 
     def __post_init__(self) -> None:
         check_positive(self, "link_gap_s", "link_distance", "coast_s", "fill_gap_s", allow_zero=True)
