@@ -207,11 +207,15 @@ class HogCascade:
                 break
             level = grey if size == (grey.shape[1], grey.shape[0]) else cv2.resize(
                 grey, size, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
-            integral = integral_maps(cell_histograms(level, cfg.cell_px))  # over cells: corners lie on the grid
-            width = integral.shape[2]
+            # Integral over cells (corners lie on the grid), summed in float64 in (y, x, bin) order: the
+            # histograms' own memory layout, and one row of BINS values per corner for the gathers.
+            hist = cell_histograms(level, cfg.cell_px).transpose(1, 2, 0)
+            integral = np.zeros((hist.shape[0] + 1, hist.shape[1] + 1, BINS))
+            np.cumsum(np.cumsum(hist, axis=0), axis=1, out=integral[1:, 1:])
+            width = integral.shape[1]
             # float32 corners (faster gathers): on 640x480 the corner sums stay below ~1e7, so rounding moves a
             # block sum by a few gradient units at most, far below the block sums the stumps threshold.
-            rows = np.ascontiguousarray(integral.transpose(1, 2, 0), dtype=np.float32).reshape(-1, BINS)
+            rows = integral.astype(np.float32).reshape(-1, BINS)
             ys, xs = np.mgrid[0 : size[1] - win_h + 1 : step, 0 : size[0] - win_w + 1 : step]
             ox, oy = xs.ravel(), ys.ravel()
             alive = np.arange(len(ox))

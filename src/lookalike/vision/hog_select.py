@@ -1,20 +1,22 @@
-"""Choosing how many stages of a trained HOG cascade to use, and calibrating its detection probability, on
-held-out scenes.
+"""Choosing how many stages of a trained HOG cascade to use and where its pyramid starts, and calibrating its
+detection probability, on held-out scenes.
 
 Training adds stages until the hard negatives run out; the last stages then remove few false positives
 but reject true targets (each keeps ``stage_hit_rate`` of the *training* positives, fewer of unseen ones).
 :func:`select_stages` runs every cascade prefix from half its length to the whole over held-out scenes
 (images with their true boxes and boxes to ignore), matches detections to true boxes one-to-one at IoU >=
 ``iou`` (Hungarian; a detection matching only an ignored box, say a mostly hidden robot, is neither a hit
-nor a false positive) and keeps the prefix with the best F1, the longer on ties. It then refits the
-probability of the kept prefix: a logistic regression of "this detection is a hit" on the last-stage
+nor a false positive) and keeps the prefix with the best F1, the longer on ties. Then it starts the image
+pyramid one or two levels coarser (smallest window ``min_height_px`` times ``scale_step`` or its square)
+when that loses at most ``f1_tolerance`` of held-out F1: the finest level is the costliest and only
+finds the smallest targets. Last it refits the probability of the kept model: a logistic regression of "this detection is a hit" on the last-stage
 margin of the held-out detections, so that the score of a box estimates its chance of being a target.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -33,10 +35,12 @@ class HeldOutScene:
 
 
 @dataclass(frozen=True)
-class PrefixScore:
-    """Held-out precision, recall and F1 of the first ``stages`` stages (IoU-matched detections)."""
+class HeldOutScore:
+    """Held-out precision, recall and F1 of the first ``stages`` stages with the pyramid's smallest window
+    ``min_height_px`` tall (IoU-matched detections)."""
 
     stages: int
+    min_height_px: float
     precision: float
     recall: float
     f1: float
@@ -61,37 +65,59 @@ def match_detections(boxes: np.ndarray, truth: np.ndarray, ignore: np.ndarray,
     return hit, excused
 
 
+def evaluate_held_out(model: HogCascade, scenes: Sequence[HeldOutScene],
+                      iou: float = 0.5) -> tuple[HeldOutScore, np.ndarray, np.ndarray]:
+    """``model``'s held-out score, and the last-stage margin ``(n,)`` and hit flag ``(n,)`` of every detection
+    that is a hit or a false positive (excused ones left out)."""
+    tp = fp = total = 0
+    margins, labels = [], []
+    for scene in scenes:
+        boxes, margin = model.boxes_and_margins(scene.image)
+        hit, excused = match_detections(boxes, scene.truth, scene.ignore, iou)
+        tp, fp, total = tp + int(hit.sum()), fp + int((~hit & ~excused).sum()), total + len(scene.truth)
+        margins.append(margin[~excused])
+        labels.append(hit[~excused])
+    p, r = tp / max(tp + fp, 1), tp / max(total, 1)
+    f1 = 2 * p * r / (p + r) if p + r > 0 else 0.0
+    score = HeldOutScore(len(model.stages), model.config.min_height_px, p, r, f1)
+    return score, np.concatenate(margins), np.concatenate(labels)
+
+
 def select_stages(model: HogCascade, scenes: Sequence[HeldOutScene], *, iou: float = 0.5,
-                  min_stages: int | None = None) -> tuple[HogCascade, list[PrefixScore]]:
+                  min_stages: int | None = None, coarser_levels: int = 2,
+                  f1_tolerance: float = 0.005) -> tuple[HogCascade, list[HeldOutScore]]:
     """The cascade prefix (at least ``min_stages`` stages, default half the cascade) with the best held-out
-    F1, with its probability refitted on the held-out detections; and the score of every prefix tried."""
+    F1, its pyramid started up to ``coarser_levels`` levels coarser where that costs at most ``f1_tolerance``
+    of F1, and its probability refitted on the held-out detections; and the score of every model tried."""
     if not scenes:
         raise ValueError("scenes: need at least one held-out scene")
     if not model.stages:
         raise ValueError("model: has no stages")
+    if coarser_levels < 0 or f1_tolerance < 0:
+        raise ValueError(f"coarser_levels/f1_tolerance: must be >= 0, got {coarser_levels}, {f1_tolerance}")
     n = len(model.stages)
     lowest = max(1, (n + 1) // 2 if min_stages is None else min(int(min_stages), n))
-    results: list[tuple[PrefixScore, np.ndarray, np.ndarray]] = []
-    for k in range(n, lowest - 1, -1):
-        prefix = HogCascade(model.config, model.blocks, model.stages[:k], model.calibration)
-        tp = fp = total = 0
-        margins, labels = [], []
-        for scene in scenes:
-            boxes, margin = prefix.boxes_and_margins(scene.image)
-            hit, excused = match_detections(boxes, scene.truth, scene.ignore, iou)
-            tp, fp, total = tp + int(hit.sum()), fp + int((~hit & ~excused).sum()), total + len(scene.truth)
-            margins.append(margin[~excused])
-            labels.append(hit[~excused])
-        p, r = tp / max(tp + fp, 1), tp / max(total, 1)
-        f1 = 2 * p * r / (p + r) if p + r > 0 else 0.0
-        results.append((PrefixScore(k, p, r, f1), np.concatenate(margins), np.concatenate(labels)))
-    best, margin, label = max(results, key=lambda t: (t[0].f1, t[0].stages))
-    calibration = model.calibration
+    tried = [evaluate_held_out(HogCascade(model.config, model.blocks, model.stages[:k], model.calibration),
+                               scenes, iou) + (k,) for k in range(n, lowest - 1, -1)]
+    score, margin, label, k = max(tried, key=lambda t: (t[0].f1, t[0].stages))
+    chosen = HogCascade(model.config, model.blocks, model.stages[:k], model.calibration)
+    best_f1 = score.f1
+    for level in range(1, coarser_levels + 1):
+        cfg = model.config
+        height = cfg.min_height_px * cfg.scale_step**level
+        if height > cfg.max_height_px:
+            break
+        coarser = HogCascade(replace(cfg, min_height_px=height), model.blocks, model.stages[:k], model.calibration)
+        result = evaluate_held_out(coarser, scenes, iou)
+        tried.append(result + (k,))
+        if result[0].f1 < best_f1 - f1_tolerance:
+            break
+        chosen, margin, label = coarser, result[1], result[2]
     if 0 < label.sum() < len(label):
         from sklearn.linear_model import LogisticRegression
 
         lr = LogisticRegression().fit(margin[:, None], label.astype(int))
         if lr.coef_[0, 0] > 0:  # a larger margin must mean a likelier target
-            calibration = (float(lr.coef_[0, 0]), float(lr.intercept_[0]))
-    chosen = HogCascade(model.config, model.blocks, model.stages[: best.stages], calibration)
-    return chosen, [t[0] for t in results]
+            chosen = HogCascade(chosen.config, chosen.blocks, chosen.stages,
+                                (float(lr.coef_[0, 0]), float(lr.intercept_[0])))
+    return chosen, [t[0] for t in tried]
