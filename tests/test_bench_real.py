@@ -239,3 +239,36 @@ def test_per_sequence_parameters_hold_on_unseen_second_halves() -> None:
         assert by["boxtrack"][metric] > by["boxtrack-global"][metric], metric
         assert by["boxtrack-offline"][metric] > by["sort"][metric], metric
     assert by["boxtrack"]["IDF1"] > by["sort"]["IDF1"] and by["boxtrack"]["MOTA"] > by["sort"]["MOTA"]
+
+
+def test_synthesized_detections_follow_the_noise_model() -> None:
+    from lookalike.cli.bench_real_data import synthesize_detections
+
+    n_frames, boxes = 200, []
+    for k in range(1, n_frames + 1):
+        boxes.append([k, 1, 100, 100, 50, 100, 1, 1, 1.0])  # a visible pedestrian
+        boxes.append([k, 2, 400, 100, 50, 100, 1, 1, 0.1])  # hidden: never detected
+        boxes.append([k, 3, 700, 100, 50, 100, 0, 1, 1.0])  # not considered: never detected
+    gt = MotTable.from_rows(np.array(boxes, dtype=float))
+    xywh, score = synthesize_detections(gt, n_frames, (1000, 500), np.random.default_rng(0))
+    det, conf = np.vstack(xywh), np.concatenate(score)
+    true = (np.abs(det[:, 0] - 100) < 30) & (np.abs(det[:, 1] - 100) < 30)
+    assert 0.84 < true.sum() / n_frames < 0.96  # 10 % missed
+    assert not np.any((np.abs(det[:, 0] - 400) < 5) & (np.abs(det[:, 1] - 100) < 5) & (np.abs(det[:, 2] - 50) < 5))
+    assert abs(np.std(det[true, 0] - 100) - 0.05 * 50) < 0.6  # noise std is 5 % of the width
+    assert conf[true].min() >= 0.6 and 50 < (~true).sum() < 150  # ~0.5 false boxes per frame
+    again, _ = synthesize_detections(gt, n_frames, (1000, 500), np.random.default_rng(0))
+    np.testing.assert_array_equal(np.vstack(again), det)
+    with pytest.raises(ValueError, match="gt"):
+        synthesize_detections(MotTable.from_rows(np.array(boxes, dtype=float)[:, :7]), 3, (10, 10),
+                              np.random.default_rng(0))
+
+
+def test_mot17_synth_loads_with_fixed_detections() -> None:
+    root = _need_data("mot17/gt")
+    from lookalike.cli.bench_real_data import load_mot17_synth
+
+    a, b = load_mot17_synth(root), load_mot17_synth(root)
+    assert len(a) == 7 and all(s.benchmark == "MOT17" and s.dataset == "mot17-synth" for s in a)
+    np.testing.assert_array_equal(a[0].det_xywh[10], b[0].det_xywh[10])
+    assert a[0].length == len(a[0].det_xywh)

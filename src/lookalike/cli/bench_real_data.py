@@ -1,14 +1,22 @@
-"""The real datasets of ``lookalike bench real``: MOT15 and pig boxes, HexBug blobs and head points.
+"""The real datasets of ``lookalike bench real``: MOT15 and pig boxes, HexBug blobs and head points,
+and ``mot17-synth``: the real MOT17 ground truth seen through a *synthetic* detector (labelled so).
 
 Every sequence becomes a :class:`RealSequence` holding the detections every tracker receives
 (identical for all of them) and the ground truth it is scored against. Box data (MOT15, pigs) is
-scored with CLEAR/identity/HOTA on boxes (IoU 0.5, MOT15 rules); HexBug clips are scored on points:
-the centre of each reported box against the annotated head position within ``radius`` pixels.
+scored with CLEAR/identity/HOTA on boxes (IoU 0.5, MOT15 rules; MOT17 rules for ``mot17-synth``);
+HexBug clips are scored on points: the centre of each reported box against the annotated head
+position within ``radius`` pixels.
+
+``mot17-synth`` is a set that no parameter of lookalike was chosen on: the 7 MOT17 training
+sequences' real trajectories (``mot17/gt``) with detections from the noise model of
+:func:`lookalike.sim.boxes.simulate_boxes`, scaled to the box size (:func:`synthesize_detections`,
+fixed seeds). Its detections are not a real detector's; use it for rankings, not absolute figures.
 """
 
 from __future__ import annotations
 
 import csv
+import zlib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -16,7 +24,7 @@ import numpy as np
 
 from lookalike.io import MotTable, find_sequences, read_mot
 
-DATASETS = ("mot15", "pigs", "hexbug")
+DATASETS = ("mot15", "pigs", "hexbug", "mot17-synth")
 PARTS = ("full", "first", "second")  # whole sequences, frames 1..⌊N/2⌋, frames ⌊N/2⌋+1..N
 PIGS_COUNT = 23  # the pigs folder documents 23 animals (../shared/data/README.md), not read from gt
 HEXBUG_FPS = 10.0
@@ -40,6 +48,7 @@ class RealSequence:
         gt_points: ``(frame (n,) 1-based, id (n,), xy (n, 2) px)`` for point data, else None.
         image_size: ``(width, height)`` in pixels, or None.
         n_targets: the documented number of targets when the set is closed, else None.
+        benchmark: the ground-truth rules of :func:`lookalike.eval.evaluate_sequence`.
     """
 
     dataset: str
@@ -52,6 +61,7 @@ class RealSequence:
     gt_points: tuple[np.ndarray, np.ndarray, np.ndarray] | None = field(default=None, repr=False)
     image_size: tuple[int, int] | None = None
     n_targets: int | None = None
+    benchmark: str = "MOT15"
 
 
 def _split_frames(table: MotTable, length: int) -> tuple[list[np.ndarray], list[np.ndarray]]:
@@ -102,6 +112,64 @@ def cut_sequence(seq: RealSequence, part: str) -> RealSequence:
         points = (frame[keep] - shift, ids[keep], xy[keep])
     return replace(seq, name=f"{seq.name}[{part}]", length=hi - lo, det_xywh=seq.det_xywh[lo:hi],
                    det_score=seq.det_score[lo:hi], gt=gt, gt_points=points)
+
+
+def synthesize_detections(gt: MotTable, length: int, image_size: tuple[int, int], rng: np.random.Generator, *,
+                          noise: float = 0.05, miss_rate: float = 0.1, min_visibility: float = 0.25,
+                          false_positives_per_frame: float = 0.5) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Per-frame detections ``(n, 4)`` px and scores ``(n,)`` of a synthetic detector looking at MOT17
+    ground truth ``gt`` (columns: consider flag, class, visibility).
+
+    The noise model of :func:`lookalike.sim.boxes.simulate_boxes`, with its noise proportional to the
+    box: a considered pedestrian (class 1) at least ``min_visibility`` visible is missed with
+    probability ``miss_rate``, else seen with Gaussian noise of std ``noise``·[w, h, w/2, h/2] on
+    ``[x, y, w, h]`` and a score uniform in [0.6, 1]; each frame adds Poisson(``false_positives_per_frame``)
+    false boxes, uniform over the image (``(width, height)`` px) with the size of a random true box,
+    scored uniform in [0.3, 0.8].
+    """
+    if gt.extra.shape[1] < 2:
+        raise ValueError("gt: expected MOT17 ground truth with class and visibility columns")
+    person = (gt.conf != 0) & (gt.extra[:, 0] == 1)
+    visible = person & (gt.extra[:, 1] >= min_visibility)
+    sizes = gt.xywh[person, 2:4]
+    if not len(sizes):
+        raise ValueError("gt: no considered pedestrian boxes")
+    width, height = image_size
+    xywh, score = [], []
+    for k in range(1, length + 1):
+        truth = gt.xywh[visible & (gt.frame == k)]
+        seen = truth[rng.random(len(truth)) >= miss_rate]
+        scale = np.column_stack([seen[:, 2], seen[:, 3], seen[:, 2] / 2, seen[:, 3] / 2])
+        boxes = seen + rng.normal(0.0, 1.0, seen.shape) * noise * scale
+        n_fp = rng.poisson(false_positives_per_frame)
+        fp_size = sizes[rng.integers(0, len(sizes), n_fp)]
+        fp = np.column_stack([rng.uniform(0, 1, (n_fp, 2)) * np.maximum([width, height] - fp_size, 1.0), fp_size])
+        boxes = np.vstack([boxes, fp])
+        boxes[:, 2:] = np.maximum(np.abs(boxes[:, 2:]), 1.0)
+        conf = np.concatenate([rng.uniform(0.6, 1.0, len(seen)), rng.uniform(0.3, 0.8, n_fp)])
+        order = rng.permutation(len(boxes))
+        xywh.append(boxes[order])
+        score.append(conf[order])
+    return xywh, score
+
+
+def load_mot17_synth(root: Path, seed: int = 0) -> list[RealSequence]:
+    """The MOT17 ground-truth sequences under ``root`` (``mot17/gt``) with :func:`synthesize_detections`
+    (seeded by ``seed`` and the sequence's name, so every run sees the same detections)."""
+    out = []
+    for seq in find_sequences(root):
+        if seq.gt_path is None:
+            continue
+        gt = read_mot(seq.gt_path)
+        length = seq.length or int(gt.frame.max(initial=0))
+        size = seq.image_size or (1920, 1080)
+        rng = np.random.default_rng([seed, zlib.crc32(seq.name.encode())])
+        xywh, score = synthesize_detections(gt, length, size, rng)
+        out.append(RealSequence("mot17-synth", seq.name, seq.frame_rate, length, xywh, score, gt=gt,
+                                image_size=size, benchmark="MOT17"))
+    if not out:
+        raise ValueError(f"{root}: no sequence with gt/gt.txt")
+    return out
 
 
 def read_hexbug_points(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
