@@ -43,7 +43,13 @@ IDF1 58.9, MOTA 51.2; whole sequences (the second halves unseen): HOTA 41.2, IDF
 Tried there and rejected (lower on the first halves): shifting lost tracks by the median offset of
 matched ones (camera motion), restarting a returning track's velocity from its last two
 observations, and recovering lost tracks by the IoU of their last detected box (OC-SORT's OCR).
-Other detectors get their own thresholds, chosen on their own first halves (``lookalike bench real``).
+Also rejected (issue #10; HOTA + IDF1 + MOTA on the first halves, 153.8 with the defaults): shifting
+*every* track by the frame's median residual of tracked tracks matched within 0.5–2 heights (a global
+camera shift; 136–148, and 150–154.0 when applied only beyond 2–5 standard errors, too little to keep),
+letting low-score detections continue tracks lost up to 0.1–1 s (150–153.5), reporting lost tracks at
+their predicted box for 0.1–0.4 s (146–153), and reid_scale 1.2/1.3/2 (152–153.4).
+Other detectors get their own thresholds, chosen on their own first halves (``lookalike bench real``,
+which on MOT15 also uses parameters chosen per sequence on its first half; ``SEQUENCE_PARAMS``).
 ``max_targets`` is not tuned: it is the documented number of animals.
 """
 
