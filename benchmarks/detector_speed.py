@@ -28,14 +28,14 @@ import time
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # one core: before numpy loads
     os.environ.setdefault(_var, "1")
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from lookalike.association import assign  # noqa: E402
-from lookalike.cli.vision import negative_sampler, rendered_detector_data  # noqa: E402
-from lookalike.geometry.boxes import iou_matrix  # noqa: E402
-from lookalike.vision.hog_cascade import CascadeConfig, HogCascade, train_cascade  # noqa: E402
-from lookalike.vision.hog_features import augment_windows  # noqa: E402
-from lookalike.vision.hog_select import HeldOutScene, select_stages  # noqa: E402
+from lookalike.association import assign
+from lookalike.cli.vision import negative_sampler, rendered_detector_data
+from lookalike.geometry.boxes import iou_matrix
+from lookalike.vision.hog_cascade import CascadeConfig, HogCascade, train_cascade
+from lookalike.vision.hog_features import augment_windows
+from lookalike.vision.hog_select import HeldOutScene, select_stages
 
 SPLIT_SEEDS = {"test": 424242, "validation": 515151}
 THRESHOLDS = (0.0, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)

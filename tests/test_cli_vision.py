@@ -39,9 +39,12 @@ def test_train_detector_from_folder_and_refusals(tmp_path):
 def test_train_detector_on_rendered_frames(tmp_path):
     out = tmp_path / "det.npz"
     res = runner.invoke(app, ["train-detector", "-o", str(out), "--frames", "8", "--stages", "2",
-                              "--negatives", "150", "--copies", "0"])
+                              "--negatives", "150", "--copies", "0", "--validation-frames", "3"])
     assert res.exit_code == 0, res.output
+    assert "held-out (3 frames): kept" in " ".join(res.output.split())
     assert len(HogCascade.load(out).stages) >= 1
+    res = runner.invoke(app, ["train-detector", "-o", str(out), "--validation-frames", "-1"])
+    assert res.exit_code != 0 and "--validation-frames" in res.output
 
 
 def test_train_heading_reports_error(tmp_path):

@@ -2,18 +2,26 @@
 
 Both train from rendered robots (:mod:`lookalike.sim.render_robots`) by default; the detector also
 trains from a folder with ``positives/`` (images each showing one target filling the window, any
-size) and ``negatives/`` (images without targets, from which windows are sampled).
+size) and ``negatives/`` (images without targets, from which windows are sampled). A detector trained on
+rendered robots is then cut to the cascade prefix (and pyramid start) with the best F1 on held-out
+renders, whose detections also calibrate its probability (:mod:`lookalike.vision.hog_select`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+)
 
 from lookalike.cli.app import app, console, fail
 
@@ -32,20 +40,10 @@ def rendered_detector_data(
 ) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray]]:
     """Grey positive windows ``(n, h+2, w+2)`` of rendered robots (1-5 m, random headings, 1-4 per frame), the
     grey frames and their ground-truth boxes ``(m, 4)`` (px) for sampling negatives. Deterministic by ``seed``."""
-    from lookalike.geometry.camera import Camera
-    from lookalike.sim.render_robots import RobotRenderer
     from lookalike.vision.hog_features import crop_window, to_grey
 
-    cam = camera if camera is not None else Camera.default()
-    renderer = RobotRenderer(camera=cam, seed=seed)
-    rng = np.random.default_rng(seed)
-    half_fov = np.arctan(0.5 * cam.intrinsics.width / cam.intrinsics.fx)
     pos, frames, truths = [], [], []
-    for _ in range(n_frames):
-        n = int(rng.integers(1, 5))
-        depth = rng.uniform(1.0, 5.0, n)
-        lateral = depth * np.tan(rng.uniform(-1.1 * half_fov, 1.1 * half_fov, n))
-        frame = renderer.render(np.column_stack([depth, lateral]), rng.uniform(-np.pi, np.pi, n))
+    for frame in _rendered_frames(n_frames, seed, camera):
         grey = to_grey(frame.image)
         frames.append(grey)
         truths.append(frame.xywh)
@@ -55,6 +53,32 @@ def rendered_detector_data(
             step()
     h, w = window_px[1] + 2, window_px[0] + 2
     return np.array(pos, np.float32).reshape(-1, h, w), frames, truths
+
+
+def _rendered_frames(n_frames: int, seed: int, camera: object | None = None) -> Iterator[Any]:
+    """Rendered frames of 1-4 robots 1-5 m ahead (depth), across a little more than the field of view,
+    random headings. Deterministic by ``seed``."""
+    from lookalike.geometry.camera import Camera
+    from lookalike.sim.render_robots import RobotRenderer
+
+    cam = camera if camera is not None else Camera.default()
+    renderer = RobotRenderer(camera=cam, seed=seed)
+    rng = np.random.default_rng(seed)
+    half_fov = np.arctan(0.5 * cam.intrinsics.width / cam.intrinsics.fx)
+    for _ in range(n_frames):
+        n = int(rng.integers(1, 5))
+        depth = rng.uniform(1.0, 5.0, n)
+        lateral = depth * np.tan(rng.uniform(-1.1 * half_fov, 1.1 * half_fov, n))
+        yield renderer.render(np.column_stack([depth, lateral]), rng.uniform(-np.pi, np.pi, n))
+
+
+def rendered_held_out_scenes(n_frames: int, seed: int, camera: object | None = None) -> list[Any]:
+    """Rendered frames as :class:`~lookalike.vision.hog_select.HeldOutScene`: robots at least half visible are
+    targets, the others in view are ignored."""
+    from lookalike.vision.hog_select import HeldOutScene
+
+    return [HeldOutScene(f.image, f.xywh[f.visible >= 0.5], f.xywh[(f.visible < 0.5) & (f.visible > 0)])
+            for f in _rendered_frames(n_frames, seed, camera)]
 
 
 def negative_sampler(frames: list[np.ndarray], truths: list[np.ndarray], window_px: tuple[int, int],
@@ -124,17 +148,22 @@ def train_detector(
     negatives: int = typer.Option(2000, help="Hard negatives per stage."),
     copies: int = typer.Option(2, help="Augmented copies per positive (rotation ±15°, scale, flip, cut-outs)."),
     seed: int = typer.Option(0, help="Seed of rendering, augmentation and boosting."),
+    validation_frames: int = typer.Option(100, help="Held-out rendered frames (seed + 1000003) that choose the "
+                                          "cascade prefix and pyramid start and calibrate the probability "
+                                          "(without --data; 0: keep every stage)."),
 ) -> None:
     """Train the HOG cascade robot detector and save it."""
     from lookalike.vision.hog_cascade import CascadeConfig, train_cascade
     from lookalike.vision.hog_features import augment_windows
+    from lookalike.vision.hog_select import select_stages
 
     try:
         # Folder positives fill their whole window; rendered ones carry the default context margin.
         pad = {"context_pad": 0.0} if data is not None else {}
         config = CascadeConfig(stages=stages, negatives_per_stage=negatives, **pad)
-        if frames < 1 or copies < 0:
-            raise ValueError(f"--frames/--copies: need frames >= 1 and copies >= 0, got {frames}, {copies}")
+        if frames < 1 or copies < 0 or validation_frames < 0:
+            raise ValueError(f"--frames/--copies/--validation-frames: need frames >= 1, copies >= 0 and "
+                             f"validation_frames >= 0, got {frames}, {copies}, {validation_frames}")
         heights = (config.min_height_px, config.max_height_px)
         with _progress() as bar:
             if data is not None:
@@ -159,9 +188,20 @@ def train_detector(
             # Hard negatives are also mined from whole frames (windows the cascade accepts away from robots).
             model = train_cascade(pos, sampler, config, seed=seed, progress=on_stage,
                                   scenes=list(zip(neg_images, truths)))
+            trained, tried = len(model.stages), []
+            if data is None and validation_frames:
+                task = bar.add_task("held-out selection", total=1, note="")
+                model, tried = select_stages(model, rendered_held_out_scenes(validation_frames, seed + 1000003))
+                bar.update(task, completed=1)
     except ValueError as exc:
         fail(str(exc))
     model.save(output)
+    if tried:
+        best = next(t for t in tried if t.stages == len(model.stages)
+                    and t.min_height_px == model.config.min_height_px)
+        console.print(f"held-out ({validation_frames} frames): kept {len(model.stages)} of {trained} stages, pyramid "
+                      f"from {model.config.min_height_px:g} px; precision {best.precision:.3f}, recall "
+                      f"{best.recall:.3f}")
     console.print(f"wrote {output}: {len(model.stages)} stages, {sum(len(s.index) for s in model.stages)} stumps")
 
 
@@ -174,7 +214,12 @@ def train_heading_command(
     seed: int = typer.Option(0, help="Seed of the training renders; held-out renders use seed + 1000003."),
 ) -> None:
     """Train the heading classifier on rendered robots, report its held-out error and save it."""
-    from lookalike.vision.heading import HeadingConfig, mean_abs_error_deg, rendered_heading_samples, train_heading
+    from lookalike.vision.heading import (
+        HeadingConfig,
+        mean_abs_error_deg,
+        rendered_heading_samples,
+        train_heading,
+    )
 
     try:
         config = HeadingConfig(folds=folds)
