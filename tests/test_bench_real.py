@@ -23,9 +23,9 @@ from lookalike.cli.bench_real_run import (
     sequence_params,
     track_rows,
 )
-from lookalike.trackers.offline import OfflineConfig, postprocess
 from lookalike.io import MotTable
 from lookalike.trackers import make_tracker
+from lookalike.trackers.offline import OfflineConfig, postprocess
 from lookalike.types import Detections, Frame
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"

@@ -5,7 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.trackers.offline import OfflineConfig, fill_gaps, link_tracks, postprocess
+from lookalike.trackers.offline import (
+    OfflineConfig,
+    fill_gaps,
+    link_tracks,
+    postprocess,
+)
 
 
 def _rows(track_id: int, frames: range | list[int], x0: float = 100.0, vx: float = 5.0) -> np.ndarray:

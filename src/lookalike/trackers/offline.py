@@ -65,7 +65,7 @@ def _ends(frames: np.ndarray, boxes: np.ndarray, k: int) -> tuple[np.ndarray, np
 def _frames(seconds: float, frame_rate: float) -> int:
     if not frame_rate > 0:
         raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
-    return int(round(seconds * frame_rate))
+    return round(seconds * frame_rate)
 
 
 def link_tracks(rows: np.ndarray, frame_rate: float, config: OfflineConfig | None = None) -> np.ndarray:
