@@ -7,7 +7,8 @@ ground-truth head point is found when a detection box, grown by ``--margin`` pix
 bench real`` (:func:`~lookalike.cli.bench_real_run.track_rows`, with boxtrack's HexBug parameters chosen
 on the clips' first halves) and its box centres are scored with point matching within 120 px
 (:func:`~lookalike.cli.bench_real_run.score_rows`: IDF1, MOTA; a box centre lies about half a bug from
-the head, hence the large radius).
+the head, hence the large radius). ``boxtrack8``-style closed sets: ``--closed`` adds boxtrack with
+``max_targets`` = the number of bugs annotated in the clip's CSV (the known team size).
 
     .venv/bin/python benchmarks/hexbug_blobs.py [--clips training010 ...] [--trackers boxtrack sort]
 """
@@ -55,16 +56,18 @@ def main() -> None:
     parser.add_argument("--clips", nargs="*", help="clip names (default: every clip with a video and a CSV)")
     parser.add_argument("--trackers", nargs="*", default=["boxtrack", "sort"])
     parser.add_argument("--margin", type=float, default=20.0, help="px a head point may lie outside its box")
+    parser.add_argument("--closed", action="store_true", help="also boxtrack with max_targets = bugs in the CSV")
     args = parser.parse_args()
     root = SHARED_DATA / "hexbug"
     if not root.is_dir():
         sys.exit(f"HexBug data not found at {root}")
     videos = [v for v in hexbug_clips(root) if not args.clips or v.stem in set(args.clips)]
     head = f"{'clip':<13}{'frames':>7}{'points':>7}{'recall':>8}{'prec':>7}{'det fps':>8}"
-    head += "".join(f"{t + ' IDF1':>15}{'MOTA':>7}" for t in args.trackers)
+    labels = args.trackers + (["closed"] if args.closed else [])
+    head += "".join(f"{t + ' IDF1':>15}{'MOTA':>7}" for t in labels)
     print(head)
     totals = np.zeros(3)
-    idf1: dict[str, list[float]] = {t: [] for t in args.trackers}
+    idf1: dict[str, list[float]] = {t: [] for t in labels}
     for video in videos:
         t0 = time.perf_counter()
         seq = detect_hexbug(video)
@@ -73,15 +76,18 @@ def main() -> None:
         totals += (found, points, boxes)
         line = (f"{seq.name:<13}{seq.length:>7}{points:>7}{found / max(points, 1):>8.3f}"
                 f"{found / max(boxes, 1):>7.3f}{fps:>8.1f}")
-        for t in args.trackers:
-            scores = score_rows(seq, track_rows(Entry(t, t), seq))
-            idf1[t].append(scores["IDF1"])
+        entries = [Entry(t, t) for t in args.trackers]
+        if args.closed:
+            entries.append(Entry("closed", "boxtrack", params={"max_targets": len(np.unique(seq.gt_points[1]))}))
+        for e in entries:
+            scores = score_rows(seq, track_rows(e, seq))
+            idf1[e.label].append(scores["IDF1"])
             line += f"{scores['IDF1']:>15.3f}{scores['MOTA']:>7.3f}"
         print(line, flush=True)
     if len(videos):
         line = f"{'all':<13}{'':>7}{int(totals[1]):>7}{totals[0] / max(totals[1], 1):>8.3f}"
         line += f"{totals[0] / max(totals[2], 1):>7.3f}{'':>8}"
-        line += "".join(f"{np.mean(idf1[t]):>15.3f}{'':>7}" for t in args.trackers)
+        line += "".join(f"{np.mean(idf1[t]):>15.3f}{'':>7}" for t in labels)
         print(line + "   (recall/precision pooled over points, IDF1 the mean over clips)")
 
 
