@@ -56,6 +56,11 @@ class JobPool:
             return Pending(future.result)
         return Pending(lambda: fn(*args))
 
+    def share(self, obj: Any) -> Any:
+        """``obj`` as an argument for many jobs: put once in Ray's object store (the tasks receive
+        the object itself), or ``obj`` unchanged locally."""
+        return self._ray.put(obj) if self._ray is not None else obj
+
     def map(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:
         """``[fn(x) for x in items]``, in order."""
         return [p.result() for p in [self.submit(fn, x) for x in items]]

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -21,11 +20,11 @@ from lookalike.cli.bench_peers import run_peer
 from lookalike.cli.bench_real_data import RealSequence
 from lookalike.eval import evaluate_points, evaluate_sequence
 from lookalike.io import MotTable, tracks_to_rows
+from lookalike.parallel import BACKENDS, JobPool
 from lookalike.trackers import make_tracker
 from lookalike.trackers.offline import OfflineConfig, postprocess
 from lookalike.types import Detections, Frame
 
-BACKENDS = ("local", "ray")
 # boxtrack's parameters per dataset where its detector differs from MOT15's, each chosen on the first
 # half of that dataset alone (benchmarks/real_boxtrack_grid.py; best HOTA + IDF1 + MOTA):
 # - pigs (frames 1..315): high/birth score ∈ {0.5, 0.7, 0.8, 0.9};
@@ -145,25 +144,15 @@ def run_job(job: tuple[Entry, RealSequence]) -> dict[str, Any]:
     return {"scores": score_rows(seq, rows), "frames": seq.length, "seconds": seconds}
 
 
-def _ray_job(entry: Entry, seq: RealSequence) -> dict[str, Any]:
+def _run_pair(entry: Entry, seq: RealSequence) -> dict[str, Any]:
     return run_job((entry, seq))
 
 
 def map_jobs(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int = 1,
              backend: str = "local", address: str | None = None) -> list[Any]:
     """``[fn(x) for x in items]`` serially, in ``workers`` processes, or as Ray tasks (in order)."""
-    if backend not in BACKENDS:
-        raise ValueError(f"backend: expected one of {BACKENDS}, got {backend!r}")
-    if workers < 1:
-        raise ValueError(f"workers must be >= 1, got {workers}")
-    if backend == "ray":
-        ray = _ray(address, workers)
-        remote = ray.remote(fn)
-        return list(ray.get([remote.remote(x) for x in items]))
-    if workers > 1 and len(items) > 1:
-        with ProcessPoolExecutor(max_workers=min(workers, len(items))) as pool:
-            return list(pool.map(fn, items))
-    return [fn(x) for x in items]
+    with JobPool(min(workers, max(len(items), 1)), backend, address) as pool:
+        return pool.map(fn, items)
 
 
 def job_pairs(entries: Sequence[Entry], sequences: Sequence[RealSequence]) -> list[tuple[Entry, RealSequence]]:
@@ -180,24 +169,6 @@ def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, wor
              backend: str = "local", address: str | None = None) -> list[dict[str, Any]]:
     """Results of :func:`job_pairs`, in its order."""
     jobs = job_pairs(entries, sequences)
-    if backend != "ray":
-        return map_jobs(run_job, jobs, workers=workers, backend=backend)
-    ray = _ray(address, workers)
-    refs = {id(s): ray.put(s) for s in sequences}  # each sequence shipped once
-    remote = ray.remote(_ray_job)
-    return list(ray.get([remote.remote(e, refs[id(s)]) for e, s in jobs]))
-
-
-def _ray(address: str | None, workers: int) -> Any:
-    """The ``ray`` module, initialised (``address`` or a local instance; ``workers`` CPUs locally)."""
-    try:
-        import ray
-    except ImportError:
-        raise ValueError("backend 'ray' needs the ray package (pip install ray)") from None
-    if not ray.is_initialized():
-        if address:
-            ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)
-        else:
-            ray.init(num_cpus=workers if workers > 1 else None, ignore_reinit_error=True,
-                     include_dashboard=False, log_to_driver=False)
-    return ray
+    with JobPool(min(workers, max(len(jobs), 1)), backend, address) as pool:
+        shared = {id(s): pool.share(s) for s in sequences}  # each sequence shipped once
+        return [p.result() for p in [pool.submit(_run_pair, e, shared[id(s)]) for e, s in jobs]]
