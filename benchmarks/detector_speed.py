@@ -3,7 +3,7 @@ frames whose seeds were not used in training (training renders seed 1).
 
     python benchmarks/detector_speed.py [--model det.npz | --save det.npz] [--frames 100] [--train-frames 300]
                                         [--stages 20] [--negatives 1000] [--no-mining] [--split test|validation]
-                                        [--select 100] [--scale-step 1.25] [--threshold 0.4]
+                                        [--select 200] [--scale-step 1.25] [--threshold 0.4]
 
 Frames: 1-4 robots each, 1-5 m ahead (depth), anywhere across the field of view, random headings; the
 test split renders seed 424242, the validation split (for choosing settings) seed 515151. Three truths:
@@ -134,7 +134,7 @@ def main() -> None:
     ap.add_argument("--scale-step", type=float, help="pyramid step at detection time (default: the model's)")
     ap.add_argument("--select", type=int, metavar="FRAMES",
                     help="keep the cascade prefix (and pyramid start) with the best F1 on this many validation "
-                         "frames, probability refitted there (default: 100 after training, 0 with --model)")
+                         "frames, probability refitted there (default: 200 after training, 0 with --model)")
     ap.add_argument("--threshold", type=float, default=0.4,
                     help="score threshold of the summary lines (0.4: the highest keeping all validation hits)")
     args = ap.parse_args()
@@ -142,7 +142,7 @@ def main() -> None:
 
     cv2.setNumThreads(1)
     if args.select is None:
-        args.select = 0 if args.model else 100
+        args.select = 0 if args.model else 200
     model = HogCascade.load(args.model) if args.model else train(args)
     if args.select:
         model = select(model, args.select)
