@@ -106,3 +106,37 @@ def test_track_cli_blob_needs_a_video_and_blobs(tmp_path):
     empty = _write_video(tmp_path / "empty.avi", discs=(), frames=10)
     r = runner.invoke(app, ["track", "--video", str(empty), "--detector", "blob", "-o", str(tmp_path / "t.txt")])
     assert r.exit_code != 0 and "found 0 box(es)" in " ".join(r.output.split())
+
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+
+def test_zebrafish_clip_keeps_eight_identities(tmp_path):
+    """The first 60 frames of the real zebrafish video: blob detector + closed-set boxtrack report 8 fish."""
+    import cv2
+
+    video = DATA / "zebrafish" / "test_A.avi"
+    if not video.is_file():
+        pytest.skip(f"zebrafish video not found at {video} (../shared/data is not part of the repository)")
+    cap = cv2.VideoCapture(str(video))
+    clip = tmp_path / "fish.avi"
+    writer = None
+    for _ in range(60):
+        ok, frame = cap.read()
+        assert ok
+        if writer is None:
+            writer = cv2.VideoWriter(str(clip), cv2.VideoWriter_fourcc(*"MJPG"), 28, frame.shape[1::-1])
+        writer.write(frame)
+    cap.release()
+    writer.release()
+    out = tmp_path / "tracks.txt"
+    settings = ["max_targets=8", "reid_scale=10", "closed_distance=50", "high_score=0.55", "birth_score=0.55",
+                "low_score=0.5"]
+    r = runner.invoke(app, ["track", "--video", str(clip), "--detector", "blob", "--blob", "polarity=dark",
+                            "--blob", "min_area_px=50", "--tracker", "boxtrack", "-o", str(out),
+                            *[a for s in settings for a in ("--set", s)]])
+    assert r.exit_code == 0, r.output
+    tracks = read_mot(out)
+    assert len(np.unique(tracks.track_id)) == 8
+    per_frame = np.bincount(tracks.frame.astype(int), minlength=61)[1:]
+    assert (per_frame == 8).mean() > 0.6
