@@ -188,12 +188,14 @@ class BlobDetector:
         return cv2.warpAffine(img, shift, grey.shape[::-1], borderMode=cv2.BORDER_REPLICATE)
 
     def _difference(self, img: np.ndarray, background: np.ndarray) -> np.ndarray:
+        # Channel by channel: numpy reduces a last axis of length 3 far slower than two element-wise maxima.
         d = img - background
+        b, g, r = d[..., 0], d[..., 1], d[..., 2]
         if self.config.polarity == "dark":
-            return np.maximum(-d, 0).max(axis=2)
+            return np.maximum(-np.minimum(np.minimum(b, g), r), 0)
         if self.config.polarity == "bright":
-            return np.maximum(d, 0).max(axis=2)
-        return np.abs(d).max(axis=2)
+            return np.maximum(np.maximum(np.maximum(b, g), r), 0)
+        return np.maximum(np.maximum(np.abs(b), np.abs(g)), np.abs(r))
 
 
 def read_video(path: str, max_frames: int | None = None) -> list[np.ndarray]:
