@@ -78,6 +78,7 @@ class BlobDetector:
     _mog: object = field(default=None, init=False, repr=False)
     _fitted: bool = field(default=False, init=False, repr=False)
     _reference: np.ndarray | None = field(default=None, init=False, repr=False)
+    _window: np.ndarray | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._buffer = deque(maxlen=self.config.history)
@@ -90,6 +91,7 @@ class BlobDetector:
         self._mog = None
         self._fitted = False
         self._reference = None
+        self._window = None
 
     def fit(self, frames: Iterable[np.ndarray] | np.ndarray) -> "BlobDetector":
         """Median background from ``frames`` (an iterable or ``(n, h, w, 3)`` array), sampling at most
@@ -178,12 +180,12 @@ class BlobDetector:
         """Shift ``img`` (float32 BGR) by the translation that best aligns it with the first frame seen."""
         import cv2
 
-        grey = img.mean(axis=2)
+        grey = (img[..., 0] + img[..., 1] + img[..., 2]) / 3  # the channel mean, without a slow last-axis reduce
         if self._reference is None or self._reference.shape != grey.shape:
-            self._reference = grey
+            self._reference = grey.astype(np.float32)
+            self._window = cv2.createHanningWindow(grey.shape[::-1], cv2.CV_32F)
             return img
-        window = cv2.createHanningWindow(grey.shape[::-1], cv2.CV_32F)
-        (dx, dy), _ = cv2.phaseCorrelate(self._reference.astype(np.float32), grey.astype(np.float32), window)
+        (dx, dy), _ = cv2.phaseCorrelate(self._reference, grey.astype(np.float32), self._window)
         shift = np.float32([[1, 0, -dx], [0, 1, -dy]])
         return cv2.warpAffine(img, shift, grey.shape[::-1], borderMode=cv2.BORDER_REPLICATE)
 
