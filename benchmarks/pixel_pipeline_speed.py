@@ -12,9 +12,13 @@ projection) and the whole pipeline with each identifier (perception + identifica
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
-import numpy as np
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # one core: before numpy loads
+    os.environ.setdefault(_var, "1")
+
+import numpy as np  # noqa: E402
 
 from lookalike.cli.track_pixels import identifier_settings, pixel_camera, render_robot_frames, world_for_camera
 from lookalike.sim import preset, simulate_robots
