@@ -6,7 +6,7 @@ EXTRAS ?= test,vision,viz,train
 comma := ,
 STAMP := $(VENV)/.installed-$(subst $(comma),-,$(EXTRAS))
 
-.PHONY: venv demo test bench clean browser train train-refine
+.PHONY: venv demo test bench clean browser train train-base train-refine
 
 venv: $(STAMP)
 
@@ -40,18 +40,26 @@ $(BENCH_VENV)/.installed: pyproject.toml constraints-bench.txt
 bench: $(BENCH_VENV)/.installed
 	@for script in benchmarks/[a-z]*.py; do echo "== $$script"; $(BENCH_VENV)/bin/python $$script || exit 1; done
 
-# Reproduce the shipped LSTM weights (about 10-40 minutes per set-up on 2 cores). The shipped
-# M=10, N=7 weights then had a second stage (train-refine): 2,100 steps of 64 sequences with identity
-# swaps, 5.5 minutes on an H200 with 14 batch workers; on a CPU it is hours, so it is separate.
-train: venv
-	$(VENV)/bin/lookalike train --preset m3n2 -o runs/m3n2 --steps 3000 --minutes 25 --ship
-	$(VENV)/bin/lookalike train --preset m5n3 -o runs/m5n3 --steps 8000 --minutes 35 --ship
-	$(VENV)/bin/lookalike train --preset m10n7 -o runs/m10n7 --steps 8000 --minutes 40 --ship
+# Reproduce the shipped LSTM weights: a first run per set-up (train-base, 25-40 minutes each on 2
+# cores), then refinement with identity-swap augmentation (train-refine): M=3,N=2 and M=5,N=3 on
+# this CPU (5-10 minutes per stage); M=10,N=7 for 2,100 steps of 64 sequences, which took 5.5 minutes
+# on one H200 with 14 batch workers (--device auto uses a GPU where there is one; a CPU takes hours).
+train: train-base train-refine
 
+train-base: venv
+	$(VENV)/bin/lookalike train --preset m3n2 -o runs/m3n2 --steps 3000 --minutes 25 --no-relative
+	$(VENV)/bin/lookalike train --preset m5n3 -o runs/m5n3 --steps 8000 --minutes 35 --no-relative
+	$(VENV)/bin/lookalike train --preset m10n7 -o runs/m10n7 --steps 8000 --minutes 40
+
+REFINE = $(VENV)/bin/lookalike train --learning-rate 0.002 --patience 40 --steps 1500
 train-refine: venv
-	$(VENV)/bin/lookalike train --preset m10n7 -o runs/m10n7-refine --init-from runs/m10n7/model.npz \
-	    --batch-size 64 --learning-rate 0.002 --swap-prob 0.3 --patience 40 --steps 2100 \
-	    --device auto --workers $$(nproc) --ship
+	$(REFINE) --preset m3n2 --no-relative -o runs/m3n2-refine --init-from runs/m3n2/model.npz --swap-prob 0.3
+	$(REFINE) --preset m3n2 --no-relative -o runs/m3n2-refine2 --init-from runs/m3n2-refine/model.npz \
+	    --swap-prob 0.5 --learning-rate 0.0015 --seed 1 --ship
+	$(REFINE) --preset m5n3 --no-relative -o runs/m5n3-refine --init-from runs/m5n3/model.npz \
+	    --swap-prob 0.5 --learning-rate 0.0015 --seed 1 --ship
+	$(REFINE) --preset m10n7 -o runs/m10n7-refine --init-from runs/m10n7/model.npz --swap-prob 0.3 \
+	    --batch-size 64 --steps 2100 --device auto --workers $$(nproc) --ship
 
 clean:
 	rm -rf $(VENV) $(BENCH_VENV) demo-out .pytest_cache
