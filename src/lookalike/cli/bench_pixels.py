@@ -43,6 +43,7 @@ from lookalike.cli.app import console, fail
 from lookalike.cli.bench import bench_app, write_rows
 from lookalike.cli.track_pixels import (
     identifier_settings,
+    one_blas_thread,
     pixel_camera,
     render_robot_frames,
     world_for_camera,
@@ -238,7 +239,7 @@ def pixels(
     try:
         config = PipelineConfig(detect_scale=detect_scale)
         pipe = RobotPipeline.from_files(detector_model, heading_model, camera, config)
-        with Progress(*columns, console=console) as progress:
+        with Progress(*columns, console=console) as progress, one_blas_thread():
             rows, perception = pixels_table(setup_list, ident_list, sequences, frames, seed, pipe, camera, min_iou,
                                             progress)
     except (ValueError, FileNotFoundError) as exc:
