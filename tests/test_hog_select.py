@@ -5,17 +5,7 @@ import pytest
 
 from lookalike.vision.hog_cascade import CascadeConfig, HogCascade, train_cascade
 from lookalike.vision.hog_select import HeldOutScene, match_detections, select_stages
-
-
-def _window(rng, positive):
-    """66x34 grey window (1-px margin): a bright upright bar (positive) or random clutter."""
-    w = rng.normal(100, 12, (66, 34)).astype(np.float32)
-    if positive:
-        w[8:58, 11:23] += 90
-    else:
-        y, x = rng.integers(0, 50), rng.integers(0, 20)
-        w[y : y + 16, x : x + 14] += rng.uniform(-80, 80)
-    return w
+from tests.test_hog_cascade import _window
 
 
 def _scene(rng, x):
