@@ -5,6 +5,8 @@ every combination of the grid is tracked and scored there (CLEAR/identity/HOTA c
 sequences). Rows are sorted by HOTA + IDF1 + MOTA, the criterion used for boxtrack's defaults and
 for the pigs' score thresholds in ``lookalike bench real``. ``--per-sequence`` also prints the best
 combination of each sequence on its own first half (``SEQUENCE_PARAMS`` of ``lookalike bench real``).
+``--sequence-params`` starts every combination from the per-sequence parameters (as the ``boxtrack``
+entry of ``lookalike bench real``; the grid overrides them) instead of the defaults.
 ``--offline KEY=V1,...`` instead tracks once with ``lookalike bench real``'s parameters (per dataset
 and per sequence) and grids the offline post-processing (``trackers.offline``; ``OFFLINE_PARAMS``).
 
@@ -69,6 +71,9 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--offline", action="append", default=[],
                         help="KEY=V1,V2,... of trackers.offline.OfflineConfig (repeatable): grid the post-processing")
+    parser.add_argument("--sequence-params", action="store_true",
+                        help="start from lookalike bench real's per-sequence parameters (SEQUENCE_PARAMS), "
+                             "the grid overriding them (as the 'boxtrack' entry; default: as 'boxtrack-global')")
     parser.add_argument("--per-sequence", action="store_true",
                         help="also print the best combination of each sequence alone (its first half)")
     args = parser.parse_args()
@@ -91,8 +96,8 @@ def main() -> None:
         keys.append(key.strip())
         values.append([parse_parameter("boxtrack", f"{key}={v}")[1] for v in text.split(",")])
     combos = [dict(zip(keys, c), **fixed) for c in itertools.product(*values)] or [fixed]
-    # defaults plus the grid: never the per-sequence choices that ``lookalike bench real`` uses
-    entries = [Entry(str(k), "boxtrack", params=p, per_sequence=False) for k, p in enumerate(combos)]
+    # defaults plus the grid; the per-sequence choices of ``lookalike bench real`` only with --sequence-params
+    entries = [Entry(str(k), "boxtrack", params=p, per_sequence=args.sequence_params) for k, p in enumerate(combos)]
     results = run_jobs(entries, seqs, workers=args.workers)
     scored = []
     for k, params in enumerate(combos):

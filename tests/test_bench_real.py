@@ -272,3 +272,16 @@ def test_mot17_synth_loads_with_fixed_detections() -> None:
     assert len(a) == 7 and all(s.benchmark == "MOT17" and s.dataset == "mot17-synth" for s in a)
     np.testing.assert_array_equal(a[0].det_xywh[10], b[0].det_xywh[10])
     assert a[0].length == len(a[0].det_xywh)
+
+
+def test_mot17_synth2_is_the_same_truth_with_other_detections() -> None:
+    root = _need_data("mot17")
+    from lookalike.cli.bench_real import load_datasets
+
+    first = load_datasets(root.parent, ["mot17-synth"], sequences=["MOT17-02-FRCNN", "MOT17-02"])
+    second = load_datasets(root.parent, ["mot17-synth2"], sequences=["MOT17-02-FRCNN", "MOT17-02"])
+    assert len(first) == len(second) == 1 and second[0].dataset == "mot17-synth2"
+    assert first[0].gt is not None and second[0].gt is not None
+    np.testing.assert_array_equal(first[0].gt.xywh, second[0].gt.xywh)
+    assert not np.array_equal(first[0].det_score[10], second[0].det_score[10])
+    assert "mot17-synth2" in OFFLINE_PARAMS

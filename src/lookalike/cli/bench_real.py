@@ -3,8 +3,9 @@
 Datasets (``--data``, default ``../shared/data`` next to the repository): the 7 MOT15 training
 sequences with their Faster R-CNN detections, the pigs (23 identical animals; boxes), the HexBug
 clips (blob detector, head points), and ``mot17-synth``: the 7 MOT17 ground truths seen through a
-synthetic detector (the project's noise model; a set nothing was tuned on, not a real detector). Every entry runs on identical detections; peers that are not
-installed are listed as skipped. Per dataset the table gives HOTA, IDF1, MOTA (combined over the
+synthetic detector (the project's noise model; a set nothing was tuned on, not a real detector;
+``mot17-synth2``: the same with other noise seeds). Every entry runs on identical detections; peers that
+are not installed are listed as skipped. Per dataset the table gives HOTA, IDF1, MOTA (combined over the
 sequences as TrackEval does), IDSW, frames/s (tracking only) and a rank: entries are ordered by the
 mean of their ranks on HOTA, IDF1 and MOTA (ties: IDF1). ``--part first|second`` scores the first
 or second half of every sequence instead (boxtrack's parameters were chosen on first halves, so the
@@ -30,6 +31,7 @@ from lookalike.cli.bench_peers import PEERS, peer_status
 from lookalike.cli.bench_real_data import (
     DATASETS,
     PARTS,
+    SYNTH_SEEDS,
     RealSequence,
     cut_sequence,
     detect_hexbug,
@@ -53,11 +55,11 @@ def load_datasets(root: Path, datasets: list[str], *, sequences: list[str] | Non
     for name in datasets:
         if name not in DATASETS:
             raise ValueError(f"datasets: unknown dataset {name!r}; known: {', '.join(DATASETS)}")
-        folder = root / "mot17" / "gt" if name == "mot17-synth" else root / name
+        folder = root / "mot17" / "gt" if name in SYNTH_SEEDS else root / name
         if not folder.is_dir():
             raise FileNotFoundError(f"{folder}: dataset folder not found (set --data)")
-        if name == "mot17-synth":
-            out += [s for s in load_mot17_synth(folder) if not sequences or s.name in sequences
+        if name in SYNTH_SEEDS:
+            out += [s for s in load_mot17_synth(folder, SYNTH_SEEDS[name], name) if not sequences or s.name in sequences
                     or name in sequences]
         elif name == "hexbug":
             clips = [c for c in hexbug_clips(folder) if not sequences or c.stem in sequences][:max_clips]

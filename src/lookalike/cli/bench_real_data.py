@@ -11,6 +11,7 @@ position within ``radius`` pixels.
 sequences' real trajectories (``mot17/gt``) with detections from the noise model of
 :func:`lookalike.sim.boxes.simulate_boxes`, scaled to the box size (:func:`synthesize_detections`,
 fixed seeds). Its detections are not a real detector's; use it for rankings, not absolute figures.
+``mot17-synth2`` is the same with other seeds (:data:`SYNTH_SEEDS`): unseen by decisions made on ``mot17-synth``.
 """
 
 from __future__ import annotations
@@ -24,7 +25,10 @@ import numpy as np
 
 from lookalike.io import MotTable, find_sequences, read_mot
 
-DATASETS = ("mot15", "pigs", "hexbug", "mot17-synth")
+DATASETS = ("mot15", "pigs", "hexbug", "mot17-synth", "mot17-synth2")
+# The synthetic MOT17 sets and the seed of their detections: ``mot17-synth2`` is the same ground truth seen
+# with other noise draws, kept for a check after anything was decided with ``mot17-synth`` in view.
+SYNTH_SEEDS = {"mot17-synth": 0, "mot17-synth2": 1}
 PARTS = ("full", "first", "second")  # whole sequences, frames 1..⌊N/2⌋, frames ⌊N/2⌋+1..N
 PIGS_COUNT = 23  # the pigs folder documents 23 animals (../shared/data/README.md), not read from gt
 HEXBUG_FPS = 10.0
@@ -153,9 +157,9 @@ def synthesize_detections(gt: MotTable, length: int, image_size: tuple[int, int]
     return xywh, score
 
 
-def load_mot17_synth(root: Path, seed: int = 0) -> list[RealSequence]:
+def load_mot17_synth(root: Path, seed: int = 0, dataset: str = "mot17-synth") -> list[RealSequence]:
     """The MOT17 ground-truth sequences under ``root`` (``mot17/gt``) with :func:`synthesize_detections`
-    (seeded by ``seed`` and the sequence's name, so every run sees the same detections)."""
+    (seeded by ``seed`` and the sequence's name, so every run sees the same detections), labelled ``dataset``."""
     out = []
     for seq in find_sequences(root):
         if seq.gt_path is None:
@@ -165,7 +169,7 @@ def load_mot17_synth(root: Path, seed: int = 0) -> list[RealSequence]:
         size = seq.image_size or (1920, 1080)
         rng = np.random.default_rng([seed, zlib.crc32(seq.name.encode())])
         xywh, score = synthesize_detections(gt, length, size, rng)
-        out.append(RealSequence("mot17-synth", seq.name, seq.frame_rate, length, xywh, score, gt=gt,
+        out.append(RealSequence(dataset, seq.name, seq.frame_rate, length, xywh, score, gt=gt,
                                 image_size=size, benchmark="MOT17"))
     if not out:
         raise ValueError(f"{root}: no sequence with gt/gt.txt")
