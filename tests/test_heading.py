@@ -95,7 +95,8 @@ def test_save_load_round_trip_and_refusals(tmp_path):
     model = train_heading(f, h, SMALL, seed=1)
     path = model.save(tmp_path / "heading.npz")
     again = HeadingClassifier.load(path)
-    np.testing.assert_array_equal(again.estimate(f).prob, model.estimate(f).prob)
+    np.testing.assert_allclose(again.estimate(f).prob, model.estimate(f).prob, atol=1e-4)  # float32 support vectors
+    np.testing.assert_array_equal(again.estimate(f).label, model.estimate(f).label)
     assert again.config == model.config
     junk = tmp_path / "junk.npz"
     junk.write_bytes(b"garbage")

@@ -202,7 +202,9 @@ class HeadingClassifier:
     def save(self, path: str | Path) -> Path:
         """Write the model to ``path`` (``.npz``, no pickle) with its format name and version."""
         header = {"config": asdict(self.config), "gamma": self.gamma, "c": self.c, "features": len(self.mean)}
-        return save_model_file(path, FORMAT, VERSION, header, {name: getattr(self, name) for name in _ARRAYS})
+        arrays = {name: getattr(self, name) for name in _ARRAYS}
+        arrays["support"] = arrays["support"].astype(np.float32)  # half the size; read back as float64
+        return save_model_file(path, FORMAT, VERSION, header, arrays)
 
     @classmethod
     def load(cls, path: str | Path) -> HeadingClassifier:
@@ -212,6 +214,7 @@ class HeadingClassifier:
             cfg = header["config"]
             config = HeadingConfig(**{**cfg, "patch_px": tuple(cfg["patch_px"]), "c_grid": tuple(cfg["c_grid"]),
                                       "gamma_grid": tuple(cfg["gamma_grid"])})
+            arrays["support"] = np.asarray(arrays["support"], dtype=np.float64)
             model = cls(config, **{n: arrays[n] for n in _ARRAYS}, gamma=float(header["gamma"]), c=float(header["c"]))
             _check_shapes(model, int(header["features"]))
         except (KeyError, TypeError, ValueError) as exc:
