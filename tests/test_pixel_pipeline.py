@@ -145,6 +145,8 @@ def test_track_pipeline_robots_end_to_end(tmp_path):
     assert res.exit_code != 0 and "identifier" in res.output
     res = runner.invoke(app, args + ["--detector-model", str(seq)])
     assert res.exit_code != 0 and "HOG cascade" in res.output
+    res = runner.invoke(app, args + ["--detector", "blob"])
+    assert res.exit_code != 0 and "--pipeline" in res.output
 
 
 def test_bench_pixels_tiny(models, tmp_path):

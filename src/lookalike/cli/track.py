@@ -78,6 +78,8 @@ def track(
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
     if pipeline is not None:
+        if detector is not None or blob or detections is not None or path is not None:
+            fail("--pipeline: finds its own detections; drop --detector/--blob/--detections/PATH")
         run_track_pixels(video, output, pipeline, reports, detector_model, heading_model, tracker, set_ or [],
                          annotate=annotate, fps=fps, min_score=min_score)
         return
