@@ -51,6 +51,9 @@ again): ``high_quantile`` ∈ {off, 0.25, 0.3, 0.35, 0.4, 0.5} × ``tentative_qu
 tracks take any detection ≥ ``low_score``) 153.74 and pigs 0.16 lower, 0.1–0.3 no better, so it stays
 off. Also tried: quantiles only after 30–300 scores (±0.1). MOT15's per-sequence parameters of
 ``lookalike bench real`` were chosen without these and keep them off (with them: 161.41 → 160.06).
+Then scored once on mot17-synth (a detector scoring 0.6–1): ``boxtrack`` HOTA/IDF1/MOTA 45.05/55.57/
+55.59 → 48.49/58.95/60.39 (still 7th of 10), ``boxtrack-offline`` 56.69/65.04/71.36 (3rd);
+``mot17-synth2`` (other noise seeds) was not looked at.
 Tried there and rejected (lower on the first halves): shifting lost tracks by the median offset of
 matched ones (camera motion), restarting a returning track's velocity from its last two
 observations, and recovering lost tracks by the IoU of their last detected box (OC-SORT's OCR).
