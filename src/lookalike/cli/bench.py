@@ -15,6 +15,7 @@ import csv
 import json
 import time
 from pathlib import Path
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -97,6 +98,17 @@ def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: 
 
 def _split(values: list[str]) -> list[str]:
     return [v.strip() for item in values for v in item.split(",") if v.strip()]
+
+
+def print_rows(title: str, rows: list[dict[str, Any]], columns: Sequence[str] | None = None) -> None:
+    """Print table rows (dicts) with rich: text columns left, numbers right with thousands separators."""
+    columns = list(columns if columns is not None else (rows[0] if rows else []))
+    table = Table(title=title)
+    for c in columns:
+        table.add_column(c, justify="left" if c in ("Setup", "Tracker", "Identifier") else "right")
+    for r in rows:
+        table.add_row(*(f"{r[c]:,}" if isinstance(r[c], (int, float)) else str(r[c]) for c in columns))
+    console.print(table)
 
 
 def write_rows(rows: list[dict[str, Any]], json_path: Path | None, csv_path: Path | None) -> None:

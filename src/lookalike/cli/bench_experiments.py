@@ -17,10 +17,9 @@ from pathlib import Path
 
 import numpy as np
 import typer
-from rich.table import Table
 
-from lookalike.cli.app import console, fail
-from lookalike.cli.bench import _build, _split, bench_app, write_rows
+from lookalike.cli.app import fail
+from lookalike.cli.bench import _build, _split, bench_app, print_rows, write_rows
 from lookalike.eval import identification_success_rate
 from lookalike.sim import PRESET_NAMES, preset, preset_label, simulate_robots
 from lookalike.trackers.identity import labels_from_tracks
@@ -94,7 +93,7 @@ def shuffle(
                 "In order (%)": round(100 * identification_success_rate(ordered, truth_o), 2),
                 "Random order (%)": round(100 * identification_success_rate(shuffled, truth_s), 2),
             })
-    _print("Control: frames in random order", rows)
+    print_rows("Control: frames in random order", rows)
     write_rows(rows, _path(json_path), _path(csv_path))
 
 
@@ -139,7 +138,7 @@ def recovery(
                 "Recovery, mean (s)": round(float(np.mean(times)), 2),
                 "Recovery, worst (s)": round(float(np.max(times)), 2),
             })
-    _print(f"Recovery after {swap_s:g} s of swapped reports", rows)
+    print_rows(f"Recovery after {swap_s:g} s of swapped reports", rows)
     write_rows(rows, _path(json_path), _path(csv_path))
 
 
@@ -172,15 +171,6 @@ def _recovery_s(clean, swapped, restore: int, window: int, rate: float, toleranc
         if np.isfinite(a) and np.isfinite(b) and a >= b - tolerance:
             return (t - restore) / rate
     return float("inf")
-
-
-def _print(title: str, rows: list[dict]) -> None:
-    table = Table(title=title)
-    for column in rows[0] if rows else []:
-        table.add_column(column, justify="left" if column in ("Setup", "Tracker") else "right")
-    for row in rows:
-        table.add_row(*(str(v) for v in row.values()))
-    console.print(table)
 
 
 def _path(value: str | None) -> Path | None:

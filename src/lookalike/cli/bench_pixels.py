@@ -37,10 +37,9 @@ from rich.progress import (
     TextColumn,
     TimeElapsedColumn,
 )
-from rich.table import Table
 
 from lookalike.cli.app import console, fail
-from lookalike.cli.bench import bench_app, write_rows
+from lookalike.cli.bench import bench_app, print_rows, write_rows
 from lookalike.cli.track_pixels import (
     identifier_settings,
     one_blas_thread,
@@ -197,15 +196,6 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
     return rows, perception
 
 
-def _print(title: str, columns: tuple[str, ...], rows: list[dict[str, Any]]) -> None:
-    table = Table(title=title)
-    for c in columns:
-        table.add_column(c, justify="left" if c in ("Setup", "Identifier") else "right")
-    for r in rows:
-        table.add_row(*(f"{r[c]:,}" if isinstance(r[c], (int, float)) else str(r[c]) for c in columns))
-    console.print(table)
-
-
 @bench_app.command("pixels")
 def pixels(
     setups: str = typer.Option("m3n2,m5n3", "--setups", help="Presets, comma-separated."),
@@ -244,8 +234,8 @@ def pixels(
                                             progress)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
-    _print(f"Perception on rendered robots, {sequences} × {frames} frames per set-up", PERCEPTION_COLUMNS, perception)
-    _print("Identification success rate: from pixels vs the simulator's detections", PIXEL_COLUMNS, rows)
+    print_rows(f"Perception on rendered robots, {sequences} × {frames} frames per set-up", perception, PERCEPTION_COLUMNS)
+    print_rows("Identification success rate: from pixels vs the simulator's detections", rows, PIXEL_COLUMNS)
     write_rows(rows, json_path, csv_path)
 
 

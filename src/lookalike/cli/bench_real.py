@@ -39,8 +39,9 @@ from lookalike.cli.bench_real_data import (
     load_boxes,
     load_mot17_synth,
 )
-from lookalike.cli.bench_real_run import BACKENDS, Entry, job_pairs, map_jobs, run_jobs
+from lookalike.cli.bench_real_run import Entry, job_pairs, map_jobs, run_jobs
 from lookalike.eval import combine
+from lookalike.parallel import BACKENDS
 
 DEFAULT_DATA = Path(__file__).resolve().parents[3].parent / "shared" / "data"
 BOX_TRACKERS = ("sort", "boxtrack")  # lookalike trackers that need nothing but boxes and scores

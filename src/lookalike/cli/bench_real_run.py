@@ -20,7 +20,7 @@ from lookalike.cli.bench_peers import run_peer
 from lookalike.cli.bench_real_data import RealSequence
 from lookalike.eval import evaluate_points, evaluate_sequence
 from lookalike.io import MotTable, tracks_to_rows
-from lookalike.parallel import BACKENDS, JobPool
+from lookalike.parallel import JobPool
 from lookalike.trackers import make_tracker
 from lookalike.trackers.offline import OfflineConfig, postprocess
 from lookalike.types import Detections, Frame
