@@ -28,7 +28,8 @@ import itertools
 import sys
 from pathlib import Path
 
-from lookalike.cli.bench_real_data import RealSequence, cut_sequence, load_boxes
+from lookalike.cli.bench_real import load_datasets
+from lookalike.cli.bench_real_data import RealSequence, cut_sequence
 from lookalike.cli.bench_real_run import Entry, run_jobs, score_rows, track_rows
 from lookalike.eval import combine
 from lookalike.trackers.offline import OfflineConfig, postprocess
@@ -64,7 +65,7 @@ def offline_grid(seqs: list[RealSequence], grid: list[str]) -> list[tuple[dict, 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dataset", choices=("mot15", "pigs"), default="mot15")
+    parser.add_argument("--dataset", choices=("mot15", "pigs", "mot17-synth", "mot17-synth2"), default="mot15")
     parser.add_argument("--grid", action="append", default=[], help="KEY=V1,V2,... (repeatable)")
     parser.add_argument("--set", action="append", default=[], help="KEY=VALUE fixed for every run")
     parser.add_argument("--full", action="store_true", help="score whole sequences (for the report only)")
@@ -77,10 +78,10 @@ def main() -> None:
     parser.add_argument("--per-sequence", action="store_true",
                         help="also print the best combination of each sequence alone (its first half)")
     args = parser.parse_args()
-    root = SHARED_DATA / args.dataset
-    if not root.is_dir():
-        sys.exit(f"data not found at {root}")
-    seqs = load_boxes(root, args.dataset)
+    try:
+        seqs = load_datasets(SHARED_DATA, [args.dataset])
+    except FileNotFoundError as exc:
+        sys.exit(str(exc))
     if not args.full:
         seqs = [first_half(s) for s in seqs]
     if args.offline:

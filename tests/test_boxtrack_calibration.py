@@ -1,0 +1,98 @@
+"""boxtrack's self-calibration on the sequence's own tracks (issue #10): the high score threshold
+follows how often each score band continues confirmed tracks (``high_match_ratio``), and a missed
+track is reported at its prediction while tracks missed that long usually came back
+(``coast_report_prob``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lookalike.trackers import make_tracker
+from lookalike.types import Detections, Frame
+
+FPS = 10.0
+ROWS = 6
+
+
+def _truth(k: int) -> np.ndarray:
+    """``(ROWS, 4)`` boxes in frame ``k``: 40×80 px targets moving 3 px/frame right, rows 150 px apart."""
+    return np.array([[50.0 + 3.0 * k, 50.0 + 150.0 * r, 40.0, 80.0] for r in range(ROWS)])
+
+
+def _frame(k: int, boxes: np.ndarray, scores: np.ndarray) -> Frame:
+    return Frame(index=k, time=k / FPS, detections=Detections(xywh=boxes.reshape(-1, 4), score=scores))
+
+
+def _clutter(rng: np.random.Generator, n: int) -> np.ndarray:
+    """``n`` false boxes scattered far right of the targets (they never overlap one another for long)."""
+    return np.column_stack([rng.uniform(1200, 3000, n), rng.uniform(0, 2000, n), np.full(n, 40.0), np.full(n, 80.0)])
+
+
+def test_high_threshold_falls_when_middling_scores_are_as_reliable_as_top_ones() -> None:
+    rng = np.random.default_rng(0)
+    tracker = make_tracker("boxtrack")
+    for k in range(80):  # every target seen, scored uniformly in [0.6, 1]
+        tracker.update(_frame(k, _truth(k), rng.uniform(0.6, 1.0, ROWS)))
+    assert tracker._calibrated_high() == pytest.approx(0.6)
+
+
+def test_high_threshold_stays_when_middling_scores_are_clutter() -> None:
+    rng = np.random.default_rng(1)
+    tracker = make_tracker("boxtrack")
+    for k in range(80):  # targets scored 0.9-1; new false boxes scored 0.6-0.9 in every frame
+        boxes = np.vstack([_truth(k), _clutter(rng, 4)])
+        scores = np.concatenate([rng.uniform(0.9, 1.0, ROWS), rng.uniform(0.6, 0.9, 4)])
+        tracker.update(_frame(k, boxes, scores))
+    assert tracker._calibrated_high() >= 0.9
+
+
+def test_high_match_ratio_off_keeps_the_configured_threshold() -> None:
+    rng = np.random.default_rng(0)
+    tracker = make_tracker("boxtrack", high_match_ratio=None)
+    for k in range(80):
+        tracker.update(_frame(k, _truth(k), rng.uniform(0.6, 1.0, ROWS)))
+    assert tracker._calib_seen.sum() == 0  # nothing counted, so nothing can lower the threshold
+
+
+def _coast_run(tracker, miss: np.ndarray) -> list[list]:
+    """Snapshots per frame of targets missed where ``miss[k, r]``, all scored 0.95."""
+    out = []
+    for k in range(len(miss)):
+        seen = ~miss[k]
+        out.append(tracker.update(_frame(k, _truth(k)[seen], np.full(int(seen.sum()), 0.95))))
+    return out
+
+
+def test_short_misses_are_reported_at_the_prediction_once_they_usually_end_in_a_return() -> None:
+    rng = np.random.default_rng(2)
+    miss = rng.random((200, ROWS)) < 0.15
+    miss[:3] = False  # every target confirmed first
+    out = _coast_run(make_tracker("boxtrack"), miss)
+    late = range(150, 200)  # by then dozens of one-frame misses ended in a return
+    coasted = [s for k in late for s in out[k] if s.detection_index == -1]
+    missed = [(k, r) for k in late for r in range(ROWS) if miss[k, r] and not miss[k - 1, r]]
+    assert len(coasted) >= 0.9 * len(missed) > 0
+    for k in late:  # a coasted box keeps its track's id and sits near the missed target
+        for s in out[k]:
+            if s.detection_index == -1:
+                r = int(np.argmin(np.abs(_truth(k)[:, 1] - s.xywh[1])))
+                assert miss[k, r] and np.abs(s.xywh[0] - _truth(k)[r, 0]) < 10
+    off = _coast_run(make_tracker("boxtrack", coast_report_prob=None), miss)
+    assert not [s for snaps in off for s in snaps if s.detection_index == -1]
+
+
+def test_misses_that_end_tracks_are_not_reported() -> None:
+    tracker = make_tracker("boxtrack", max_age_s=0.2, n_init=1)  # a miss of 3 frames ends a track
+    out = []
+    for k in range(400):  # a target that vanishes for 5 frames out of every 10, again and again
+        boxes = _truth(k)[:1] if k % 10 < 5 else np.zeros((0, 4))
+        out.append(tracker.update(_frame(k, boxes, np.full(len(boxes), 0.95))))
+    assert not [s for snaps in out for s in snaps if s.detection_index == -1]
+
+
+@pytest.mark.parametrize("bad", [{"high_match_ratio": 1.5}, {"coast_report_prob": -0.1},
+                                 {"calib_min_count": 0}, {"coast_min_count": 0}])
+def test_calibration_settings_are_checked(bad: dict) -> None:
+    with pytest.raises(ValueError):
+        make_tracker("boxtrack", **bad)
