@@ -82,6 +82,11 @@ early bands judged on too few pigs); ``coast_report_prob`` ∈ {off, 0.6, …, 0
 {10, 30, 50}: MOT15 unchanged with 30 (10: 153.2–153.8), mot17-synth 194.9 → 212.2 (0.6–0.8 within 0.6),
 pigs unchanged. Lower ``birth_quantile`` (0.2, 0.35) or ``n_init`` 2 gained about 1–3 on mot17-synth and
 lost 0.5–4 on MOT15, so they stay.
+Also tried then and rejected (first halves; ``mot17-synth`` / MOT15 HOTA + IDF1 + MOTA against 212.2 /
+153.9): ``max_age_s`` 2–3 (up to 213.9 / down to 151.4), ``reid_distance`` 0–0.25 (212.3–212.9 / 150.3–150.5),
+matching tracks seen in the previous frame before lost ones (a cascade: 202.7 / 154.5), an unweighted
+first-stage cost (211.9 / 153.9) and a measurement noise apart from ``pos_noise`` (0.025–0.2: 203.4–211.1
+/ 132.4–151.8).
 Other detectors get their own thresholds, chosen on their own first halves (``lookalike bench real``,
 which on MOT15 also uses parameters chosen per sequence on its first half; ``SEQUENCE_PARAMS``).
 ``max_targets`` is not tuned: it is the documented number of animals.
