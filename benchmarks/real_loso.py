@@ -25,7 +25,7 @@ from lookalike.cli.bench_peers import PEERS, peer_status
 from lookalike.cli.bench_real import load_datasets
 from lookalike.cli.bench_real_data import RealSequence
 from lookalike.cli.bench_real_run import OFFLINE_PARAMS, Entry, run_jobs, score_rows, track_rows
-from lookalike.eval import combine
+from lookalike.eval import combine, headline, leave_one_out
 from lookalike.parallel import JobPool
 from lookalike.trackers.offline import OfflineConfig, postprocess
 from lookalike.trackers.registry import parse_parameter
@@ -37,29 +37,12 @@ DEFAULT_GRID = ("high_score=0.7,0.8,0.9,0.95", "birth_score=0.9,0.95,0.98", "n_i
                 "max_age_s=1,2")
 
 
-def _criterion(scores: dict[str, float]) -> float:
-    return scores["HOTA"] + scores["IDF1"] + scores["MOTA"]
-
-
 def track_both(job: tuple[dict[str, Any], RealSequence]) -> tuple[dict[str, float], dict[str, float]]:
     """Scores of boxtrack with ``params`` on the sequence: online, and post-processed offline."""
     params, seq = job
     rows = track_rows(Entry("boxtrack", "boxtrack", params=params, per_sequence=False), seq, dataset_params={})
     offline = postprocess(rows, seq.frame_rate, OfflineConfig(**OFFLINE_PARAMS.get(seq.dataset, {})))
     return score_rows(seq, rows), score_rows(seq, offline)
-
-
-def leave_one_out(seqs: list[RealSequence], combos: list[dict[str, Any]],
-                  scores: list[list[dict[str, float]]]) -> tuple[dict[str, float], list[tuple[str, dict[str, Any]]]]:
-    """Left-out scores combined over ``seqs`` and the combination chosen for each sequence;
-    ``scores[k][i]`` holds combination ``k`` on sequence ``i``."""
-    held, chosen = [], []
-    for i, seq in enumerate(seqs):
-        others = [j for j in range(len(seqs)) if j != i]
-        best = max(range(len(combos)), key=lambda k: (_criterion(combine([scores[k][j] for j in others])), -k))
-        held.append(scores[best][i])
-        chosen.append((seq.name, combos[best]))
-    return combine(held), chosen
 
 
 def main() -> None:
@@ -89,11 +72,11 @@ def main() -> None:
     offline = [[results[k * len(seqs) + i][1] for i in range(len(seqs))] for k in range(len(combos))]
     rows: list[tuple[str, dict[str, float]]] = []
     for label, table in (("boxtrack (left out)", online), ("boxtrack-offline (left out)", offline)):
-        held, chosen = leave_one_out(seqs, combos, table)
+        held, chosen = leave_one_out(table)
         rows.append((label, held))
         print(f"{label}: chosen on the other sequences")
-        for name, params in chosen:
-            print(f"  {name:16s} {params}")
+        for seq, k in zip(seqs, chosen):
+            print(f"  {seq.name:16s} {combos[k]}")
     default_runs = [track_both(({}, s)) for s in seqs]
     rows += [("boxtrack (defaults)", combine([r[0] for r in default_runs])),
              ("boxtrack-offline (defaults)", combine([r[1] for r in default_runs]))]
@@ -107,7 +90,7 @@ def main() -> None:
         if all("scores" in r for r in runs):
             rows.append((e.label, combine([r["scores"] for r in runs])))
     print(f"\n{'tracker':30s} {'HOTA':>6} {'IDF1':>6} {'MOTA':>6}")
-    for label, s in sorted(rows, key=lambda t: -_criterion(t[1])):
+    for label, s in sorted(rows, key=lambda t: -headline(t[1])):
         print(f"{label:30s} {100 * s['HOTA']:6.2f} {100 * s['IDF1']:6.2f} {100 * s['MOTA']:6.2f}")
 
 

@@ -14,6 +14,7 @@ from lookalike.eval.identification import (
     localisation_error_by_agent,
 )
 from lookalike.eval.prepare import BENCHMARKS, prepare_boxes, prepare_points
+from lookalike.eval.selection import headline, leave_one_out
 from lookalike.eval.similarity import box_iou, point_similarity
 
 __all__ = [
@@ -25,8 +26,10 @@ __all__ = [
     "evaluate_data",
     "evaluate_points",
     "evaluate_sequence",
+    "headline",
     "identification_by_agent",
     "identification_success_rate",
+    "leave_one_out",
     "localisation_coverage",
     "localisation_error",
     "localisation_error_by_agent",
