@@ -348,8 +348,8 @@ class BoxTrack:
             return out
         resolved = self._miss_returned + self._miss_ended
         ok = (resolved >= cfg.coast_min_count) & (self._miss_returned >= cfg.coast_report_prob * resolved)
-        ok[0] = False
-        ok = np.logical_and.accumulate(ok | (np.arange(len(ok)) == 0))  # every shorter miss qualifies too
+        ok[0] = True
+        ok = np.logical_and.accumulate(ok)  # every shorter miss must qualify too
         ok[0] = False
         inside = (missed > 0) & (missed <= _MAX_COAST_FRAMES)
         out[inside] = ok[missed[inside]]
