@@ -88,7 +88,7 @@ matching tracks seen in the previous frame before lost ones (a cascade: 202.7 / 
 first-stage cost (211.9 / 153.9), a measurement noise apart from ``pos_noise`` (0.025–0.2: 203.4–211.1
 / 132.4–151.8), and separate come-back shares for misses that start under other tracked boxes (on MOT15
 over the whole sequences 71% of those come back against 42% of the others, but per first half there
-are too few to judge: 211.0–211.6 / 153.6–153.9, and 153.7–154.0 with ``coast_min_count`` 5–20).
+are too few to judge: 210.8–211.2 / 153.9 unchanged, and 153.5–154.0 with ``coast_min_count`` 5–20).
 Other detectors get their own thresholds, chosen on their own first halves (``lookalike bench real``,
 which on MOT15 also uses parameters chosen per sequence on its first half; ``SEQUENCE_PARAMS``).
 ``max_targets`` is not tuned: it is the documented number of animals.
