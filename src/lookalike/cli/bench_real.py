@@ -164,8 +164,9 @@ def plot_leaderboard(rows: list[dict[str, Any]], folder: Path) -> list[Path]:
             ax.bar(x + (k - 1) * 0.27, [r[metric] for r in sub], width=0.27, label=metric)
         ax.set_xticks(x, [r["Tracker"] for r in sub], rotation=30, ha="right")
         ax.set_ylabel("%")
-        ax.set_title(f"{dataset}: identical detections")
-        ax.legend()
+        ax.set_title(f"{dataset}: identical detections (ordered by rank)", pad=22)
+        ax.legend(ncol=3, loc="lower center", bbox_to_anchor=(0.5, 1.0), frameon=False, fontsize=9)
+        ax.grid(axis="y", alpha=0.3)
         fig.tight_layout()
         path = folder / f"bench_real_{dataset}.png"
         fig.savefig(path, dpi=110)
