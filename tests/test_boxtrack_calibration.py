@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from lookalike.trackers import make_tracker
+from lookalike.trackers.self_calibration import MissReturns, ScoreBands
 from lookalike.types import Detections, Frame
 
 FPS = 10.0
@@ -24,6 +25,11 @@ def _frame(k: int, boxes: np.ndarray, scores: np.ndarray) -> Frame:
     return Frame(index=k, time=k / FPS, detections=Detections(xywh=boxes.reshape(-1, 4), score=scores))
 
 
+def _high(tracker) -> float:
+    """The high threshold the tracker's score bands support so far."""
+    return tracker._bands.threshold(tracker.config.high_match_ratio, tracker.config.calib_min_count)
+
+
 def _clutter(rng: np.random.Generator, n: int) -> np.ndarray:
     """``n`` false boxes scattered far right of the targets (they never overlap one another for long)."""
     return np.column_stack([rng.uniform(1200, 3000, n), rng.uniform(0, 2000, n), np.full(n, 40.0), np.full(n, 80.0)])
@@ -34,7 +40,7 @@ def test_high_threshold_falls_when_middling_scores_are_as_reliable_as_top_ones()
     tracker = make_tracker("boxtrack")
     for k in range(80):  # every target seen, scored uniformly in [0.6, 1]
         tracker.update(_frame(k, _truth(k), rng.uniform(0.6, 1.0, ROWS)))
-    assert tracker._calibrated_high() == pytest.approx(0.6)
+    assert _high(tracker) == pytest.approx(0.6)
 
 
 def test_high_threshold_stays_when_middling_scores_are_clutter() -> None:
@@ -44,7 +50,7 @@ def test_high_threshold_stays_when_middling_scores_are_clutter() -> None:
         boxes = np.vstack([_truth(k), _clutter(rng, 4)])
         scores = np.concatenate([rng.uniform(0.9, 1.0, ROWS), rng.uniform(0.6, 0.9, 4)])
         tracker.update(_frame(k, boxes, scores))
-    assert tracker._calibrated_high() >= 0.9
+    assert _high(tracker) >= 0.9
 
 
 def test_high_match_ratio_off_keeps_the_configured_threshold() -> None:
@@ -52,7 +58,7 @@ def test_high_match_ratio_off_keeps_the_configured_threshold() -> None:
     tracker = make_tracker("boxtrack", high_match_ratio=None)
     for k in range(80):
         tracker.update(_frame(k, _truth(k), rng.uniform(0.6, 1.0, ROWS)))
-    assert tracker._calib_seen.sum() == 0  # nothing counted, so nothing can lower the threshold
+    assert tracker._bands.seen.sum() == 0  # nothing counted, so nothing can lower the threshold
 
 
 def _coast_run(tracker, miss: np.ndarray) -> list[list]:
@@ -89,6 +95,27 @@ def test_misses_that_end_tracks_are_not_reported() -> None:
         boxes = _truth(k)[:1] if k % 10 < 5 else np.zeros((0, 4))
         out.append(tracker.update(_frame(k, boxes, np.full(len(boxes), 0.95))))
     assert not [s for snaps in out for s in snaps if s.detection_index == -1]
+
+
+def test_score_bands_descend_only_on_enough_evidence() -> None:
+    bands = ScoreBands(10)
+    assert bands.threshold(0.6, 10) == 1.0  # nothing seen yet
+    score = np.repeat([0.95, 0.75, 0.65, 0.55], 20)  # bands 9, 7, 6, 5; band 8 empty
+    bands.add(score, np.arange(60))  # every detection of bands 9, 7 and 6 continued a track, none of 5
+    assert bands.threshold(0.6, 10) == pytest.approx(0.9)  # the empty band 8 stops the descent
+    bands.add(np.full(20, 0.85), np.arange(20))
+    assert bands.threshold(0.6, 10) == pytest.approx(0.6)  # band 5 fails the ratio
+    assert bands.threshold(0.6, 30) == 1.0  # no band has 30 detections
+
+
+def test_miss_returns_count_every_shorter_miss() -> None:
+    misses = MissReturns(longest=4)
+    misses.came_back(np.array([1, 1, 2, 9]))  # a miss of 9 frames counts in lengths 1..4
+    misses.died(np.array([3, 0]))  # a track never missed does not count
+    assert misses.returned.tolist() == [0, 4, 2, 1, 1] and misses.ended.tolist() == [0, 1, 1, 1, 0]
+    # length 1: 4 of 5 back; 2: 2 of 3; 3: 1 of 2
+    assert misses.likely_present(np.array([0, 1, 2, 3, 5]), 0.6, 1).tolist() == [False, True, True, False, False]
+    assert misses.likely_present(np.array([1, 2]), 0.6, 4).tolist() == [True, False]  # length 2: 3 resolved
 
 
 @pytest.mark.parametrize("bad", [{"high_match_ratio": 1.5}, {"coast_report_prob": -0.1},

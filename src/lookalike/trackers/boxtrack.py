@@ -30,9 +30,9 @@ Built on SORT's idea (Kalman filter + Hungarian matching on IoU) with what makes
 - **Self-calibration on the sequence's own tracks** (issue #10; no ground truth involved): a detector's
   scores say little until one knows how that detector scores. Per 0.1-wide score band, boxtrack counts
   the detections and those that continued a confirmed track by overlap (the first two stages); going
-  down from the best band, the high threshold is lowered to every band whose share (its one-sided 95%
-  Wilson lower bound, after ``calib_min_count`` detections) is at least ``high_match_ratio`` times the
-  best band's. On MOT15's Faster R-CNN, detections below 0.9 continue tracks less than half as often
+  down from the highest band, the high threshold is lowered to every band whose share (its one-sided
+  95% Wilson lower bound, after ``calib_min_count`` detections) is at least ``high_match_ratio`` times
+  the best band's (:mod:`lookalike.trackers.self_calibration`). On MOT15's Faster R-CNN, detections below 0.9 continue tracks less than half as often
   as those above (mostly clutter), so nothing changes; on a detector scoring its true boxes evenly from
   0.6 to 1 the threshold falls to 0.6. Likewise, per miss length j (frames), it counts confirmed tracks
   that came back after at least j misses and those that died; while at least ``coast_report_prob`` of
@@ -105,13 +105,13 @@ from lookalike.geometry.boxes import iou_matrix, xywh_to_cxcywh
 from lookalike.motion import kalman
 from lookalike.trackers.base import check_positive, param
 from lookalike.trackers.registry import register_tracker
+from lookalike.trackers.self_calibration import MissReturns, ScoreBands
 from lookalike.trackers.timing import FrameClock
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
 _H = np.hstack([np.eye(4), np.zeros((4, 4))])
 _REPORTS = ("detection", "filtered")
 _SCORE_BINS = 1000  # resolution of the score histogram behind the quantile thresholds (scores in [0, 1])
-_CALIB_BINS = 10  # score bins of 0.1 on [0, 1] behind the self-calibrated high threshold (high_match_ratio)
 _MAX_COAST_FRAMES = 10  # longest miss (frames) after which a track may still be reported at its prediction
 
 
@@ -202,12 +202,8 @@ class BoxTrack:
         self._frame_count = 0
         self._clock = FrameClock(self.config.frame_interval_s)
         self._score_hist = np.zeros(_SCORE_BINS, dtype=np.int64)  # scores seen so far, binned on [0, 1]
-        # per 0.1-wide score bin: detections seen, and those that continued a confirmed track
-        self._calib_seen = np.zeros(_CALIB_BINS, dtype=np.int64)
-        self._calib_kept = np.zeros(_CALIB_BINS, dtype=np.int64)
-        # per miss length j (frames, index j): confirmed tracks missed at least j frames that came back / died
-        self._miss_returned = np.zeros(_MAX_COAST_FRAMES + 1, dtype=np.int64)
-        self._miss_ended = np.zeros(_MAX_COAST_FRAMES + 1, dtype=np.int64)
+        self._bands = ScoreBands(10)  # 0.1-wide score bands: detections, and those that continued tracks
+        self._misses = MissReturns(_MAX_COAST_FRAMES)  # misses of confirmed tracks that came back / died
 
     # -- frame -----------------------------------------------------------------------------------
 
@@ -245,7 +241,8 @@ class BoxTrack:
         match(confirmed, np.flatnonzero(high), cfg.match_iou, True)
         unmatched = lambda mask: np.flatnonzero(mask & (det_of_track < 0))
         match(unmatched(self._confirmed & was_tracked), np.flatnonzero(free & ~high), cfg.low_iou, False)
-        self._calibrate(score, det_of_track[det_of_track >= 0])  # only confirmed tracks matched so far
+        if cfg.high_match_ratio is not None:  # only confirmed tracks matched so far, by overlap
+            self._bands.add(score, det_of_track[det_of_track >= 0])
         match(unmatched(~self._confirmed), np.flatnonzero(free & high), cfg.tentative_iou, False)
         if tentative_score < high_score:  # ordinary scores for this detector, though below the high threshold
             match(unmatched(~self._confirmed), np.flatnonzero(free & ~high & (score >= tentative_score)),
@@ -261,7 +258,7 @@ class BoxTrack:
             self._hits[matched] += 1
             self._lost_s[matched] = 0.0
             back = matched[self._confirmed[matched] & (self._missed[matched] > 0)]
-            self._count_misses(self._miss_returned, self._missed[back])
+            self._misses.came_back(self._missed[back])
         self._hits[det_of_track < 0] = 0
         self._missed = np.where(det_of_track >= 0, 0, self._missed + 1)
         self._confirmed |= (self._hits >= cfg.n_init) | ((self._frame_count == 1) & (self._hits > 0))
@@ -279,7 +276,7 @@ class BoxTrack:
         cfg = self.config
         high, birth = cfg.high_score, cfg.birth_score
         if cfg.high_match_ratio is not None:
-            high = min(high, self._calibrated_high())
+            high = min(high, self._bands.threshold(cfg.high_match_ratio, cfg.calib_min_count))
         if cfg.high_quantile is None and cfg.birth_quantile is None and cfg.tentative_quantile is None:
             return min(high, birth), birth, min(high, birth)
         tentative = 1.0
@@ -297,65 +294,6 @@ class BoxTrack:
                 tentative = edge(cfg.tentative_quantile)
         high = min(high, birth)
         return high, birth, min(high, tentative)
-
-    def _calibrated_high(self) -> float:
-        """The high threshold the detector's own scores support so far (1.0 before any evidence).
-
-        Going down from the best-supported score bin, each bin with at least ``calib_min_count``
-        detections whose share continuing a confirmed track is at least ``high_match_ratio`` times the
-        best bin's share lowers the threshold to its lower edge; the first bin that fails, or lacks
-        evidence, stops the descent. A detector whose middling scores are as reliable as its top ones
-        (most detections true) thus gets them treated as confident; one whose middling scores are
-        mostly clutter keeps its ceiling."""
-        seen, kept = self._calib_seen, self._calib_kept
-        judged = seen >= self.config.calib_min_count
-        if not judged.any():
-            return 1.0
-        n = np.maximum(seen, 1)
-        rate = np.where(judged, kept / n, 0.0)
-        # one-sided 95% Wilson lower bound: a bin is trusted only as far as its evidence goes
-        z = 1.645
-        low = (rate + z * z / (2 * n) - z * np.sqrt(rate * (1 - rate) / n + z * z / (4 * n * n))) / (1 + z * z / n)
-        top = int(np.argmax(rate))
-        bar = self.config.high_match_ratio * rate[top]
-        b = top
-        while b > 0 and judged[b - 1] and low[b - 1] >= bar:
-            b -= 1
-        return b / _CALIB_BINS
-
-    def _calibrate(self, score: np.ndarray, continued: np.ndarray) -> None:
-        """Count this frame's detections per score bin, and those (indices ``continued``) that
-        continued a confirmed track by overlap (re-identification and closed-set recovery take any
-        detection near a lost track, so they say nothing of the detection's own reliability)."""
-        if self.config.high_match_ratio is None or not len(score):
-            return
-        b = np.clip((score * _CALIB_BINS).astype(int), 0, _CALIB_BINS - 1)
-        self._calib_seen += np.bincount(b, minlength=_CALIB_BINS)
-        self._calib_kept += np.bincount(b[continued], minlength=_CALIB_BINS)
-
-    @staticmethod
-    def _count_misses(counts: np.ndarray, missed: np.ndarray) -> None:
-        """Add each track missed ``m`` frames to ``counts[1..min(m, _MAX_COAST_FRAMES)]``."""
-        m = np.minimum(missed[missed > 0], _MAX_COAST_FRAMES)
-        if len(m):
-            counts[1:] += np.cumsum(np.bincount(m, minlength=_MAX_COAST_FRAMES + 1)[::-1])[::-1][1:]
-
-    def _coast_reported(self, missed: np.ndarray) -> np.ndarray:
-        """Whether a track missed ``missed`` frames is reported at its prediction: this sequence's
-        confirmed tracks missed that long came back with a share of at least ``coast_report_prob``,
-        judged on at least ``coast_min_count`` of them (came back or died)."""
-        cfg = self.config
-        out = np.zeros(len(missed), dtype=bool)
-        if cfg.coast_report_prob is None:
-            return out
-        resolved = self._miss_returned + self._miss_ended
-        ok = (resolved >= cfg.coast_min_count) & (self._miss_returned >= cfg.coast_report_prob * resolved)
-        ok[0] = True
-        ok = np.logical_and.accumulate(ok)  # every shorter miss must qualify too
-        ok[0] = False
-        inside = (missed > 0) & (missed <= _MAX_COAST_FRAMES)
-        out[inside] = ok[missed[inside]]
-        return out
 
     @staticmethod
     def _noise(size: np.ndarray, scale: float) -> np.ndarray:
@@ -423,7 +361,10 @@ class BoxTrack:
         k = len(self._ids)
         det_of_track = det_of_track[:k]
         shown = np.flatnonzero(self._confirmed & (self._lost_s == 0) & (det_of_track >= 0))
-        coasted = np.flatnonzero(self._confirmed & (det_of_track < 0) & self._coast_reported(self._missed[:k]))
+        coasted = np.zeros(0, dtype=int)
+        if self.config.coast_report_prob is not None:
+            coasted = np.flatnonzero(self._confirmed & (det_of_track < 0) & self._misses.likely_present(
+                self._missed[:k], self.config.coast_report_prob, self.config.coast_min_count))
         if not len(shown) and not len(coasted):
             return []
         original = det_idx[det_of_track[shown]]
@@ -450,6 +391,6 @@ class BoxTrack:
             return
         self._mean, self._cov = self._mean[alive], self._cov[alive]
         gone = ~alive & self._confirmed
-        self._count_misses(self._miss_ended, self._missed[gone])
+        self._misses.died(self._missed[gone])
         self._ids, self._hits, self._missed = self._ids[alive], self._hits[alive], self._missed[alive]
         self._lost_s, self._confirmed = self._lost_s[alive], self._confirmed[alive]

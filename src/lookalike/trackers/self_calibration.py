@@ -1,0 +1,87 @@
+"""Statistics a tracker gathers on its own tracks to calibrate itself to a detector, without ground truth.
+
+:class:`ScoreBands` says which score band a detector's confident detections start at (by how often
+each band continues confirmed tracks); :class:`MissReturns` says how long a missed track is still
+likely present (by how often tracks missed that long came back). Both only count; the tracker
+decides what to do with the answers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+_Z = 1.645  # one-sided 95% normal quantile of the Wilson lower bound
+
+
+class ScoreBands:
+    """Per score band (``bands`` equal bands on [0, 1]): detections seen and those that continued a
+    confirmed track."""
+
+    def __init__(self, bands: int = 10) -> None:
+        self.bands = bands
+        self.seen = np.zeros(bands, dtype=np.int64)
+        self.kept = np.zeros(bands, dtype=np.int64)
+
+    def add(self, score: np.ndarray, continued: np.ndarray) -> None:
+        """Count detections with ``score`` (in [0, 1]); ``continued`` indexes those that continued a track."""
+        b = np.clip((np.asarray(score) * self.bands).astype(int), 0, self.bands - 1)
+        self.seen += np.bincount(b, minlength=self.bands)
+        self.kept += np.bincount(b[continued], minlength=self.bands)
+
+    def threshold(self, ratio: float, min_count: int) -> float:
+        """The lowest score the evidence supports as confident (1.0 before any band has ``min_count``).
+
+        A band is judged once it holds ``min_count`` detections. Going down from the highest judged
+        band, each band whose share of continued detections (its one-sided 95% Wilson lower bound, so
+        a band is trusted only as far as its evidence goes) is at least ``ratio`` times the best judged
+        share lowers the threshold to its lower edge; the first band that fails, or is not judged,
+        stops the descent.
+        """
+        judged = self.seen >= min_count
+        if not judged.any():
+            return 1.0
+        n = np.maximum(self.seen, 1)
+        rate = np.where(judged, self.kept / n, 0.0)
+        low = (rate + _Z**2 / (2 * n) - _Z * np.sqrt(rate * (1 - rate) / n + _Z**2 / (4 * n * n))) / (1 + _Z**2 / n)
+        top = int(np.flatnonzero(judged)[-1])
+        b = top
+        while b > 0 and judged[b - 1] and low[b - 1] >= ratio * rate.max():
+            b -= 1
+        return b / self.bands
+
+
+class MissReturns:
+    """Per miss length j (frames, 1..``longest``): confirmed tracks missed at least j frames that came
+    back, and those that died."""
+
+    def __init__(self, longest: int = 10) -> None:
+        self.longest = longest
+        self.returned = np.zeros(longest + 1, dtype=np.int64)
+        self.ended = np.zeros(longest + 1, dtype=np.int64)
+
+    def _add(self, counts: np.ndarray, missed: np.ndarray) -> None:
+        m = np.minimum(missed[missed > 0], self.longest)
+        if len(m):
+            counts[1:] += np.cumsum(np.bincount(m, minlength=self.longest + 1)[::-1])[::-1][1:]
+
+    def came_back(self, missed: np.ndarray) -> None:
+        """Tracks updated again after ``missed`` frames without a detection."""
+        self._add(self.returned, np.asarray(missed))
+
+    def died(self, missed: np.ndarray) -> None:
+        """Tracks dropped after ``missed`` frames without a detection."""
+        self._add(self.ended, np.asarray(missed))
+
+    def likely_present(self, missed: np.ndarray, share: float, min_count: int) -> np.ndarray:
+        """Per track missed ``missed`` frames: whether, for every miss length up to its own, at least
+        ``share`` of at least ``min_count`` resolved tracks (came back or died) came back."""
+        missed = np.asarray(missed)
+        resolved = self.returned + self.ended
+        ok = (resolved >= min_count) & (self.returned >= share * resolved)
+        ok[0] = True
+        ok = np.logical_and.accumulate(ok)
+        ok[0] = False
+        out = np.zeros(len(missed), dtype=bool)
+        inside = (missed > 0) & (missed <= self.longest)
+        out[inside] = ok[missed[inside]]
+        return out
