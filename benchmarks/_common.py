@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import itertools
 import statistics
 import time
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
@@ -18,3 +19,16 @@ def median_seconds(run: Callable[[], object], repeats: int = 3) -> float:
         run()
         times.append(time.perf_counter() - t0)
     return statistics.median(times)
+
+
+def parameter_grid(tracker: str, specs: list[str] | tuple[str, ...]) -> list[dict[str, Any]]:
+    """Every combination of ``KEY=V1,V2,...`` specs, values parsed as ``tracker``'s parameters
+    (``[{}]`` for no specs)."""
+    from lookalike.trackers.registry import parse_parameter
+
+    keys, values = [], []
+    for spec in specs:
+        key, _, text = spec.partition("=")
+        keys.append(key.strip())
+        values.append([parse_parameter(tracker, f"{key}={v}")[1] for v in text.split(",")])
+    return [dict(zip(keys, combo)) for combo in itertools.product(*values)]

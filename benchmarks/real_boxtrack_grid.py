@@ -36,7 +36,7 @@ from lookalike.trackers.offline import OfflineConfig, postprocess
 from lookalike.trackers.registry import parse_parameter
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import SHARED_DATA
+from _common import SHARED_DATA, parameter_grid
 
 
 def first_half(seq: RealSequence) -> RealSequence:
@@ -91,12 +91,7 @@ def main() -> None:
             print(f"{100 * c['HOTA']:6.2f} {100 * c['IDF1']:6.2f} {100 * c['MOTA']:6.2f}  {params}")
         return
     fixed = dict(parse_parameter("boxtrack", a) for a in args.set)
-    keys, values = [], []
-    for g in args.grid:
-        key, _, text = g.partition("=")
-        keys.append(key.strip())
-        values.append([parse_parameter("boxtrack", f"{key}={v}")[1] for v in text.split(",")])
-    combos = [dict(zip(keys, c), **fixed) for c in itertools.product(*values)] or [fixed]
+    combos = [{**c, **fixed} for c in parameter_grid("boxtrack", args.grid)]
     # defaults plus the grid; the per-sequence choices of ``lookalike bench real`` only with --sequence-params
     entries = [Entry(str(k), "boxtrack", params=p, per_sequence=args.sequence_params) for k, p in enumerate(combos)]
     results = run_jobs(entries, seqs, workers=args.workers)

@@ -16,7 +16,6 @@ parameters are chosen carries to a sequence outside the choice.
 from __future__ import annotations
 
 import argparse
-import itertools
 import sys
 from pathlib import Path
 from typing import Any
@@ -28,10 +27,9 @@ from lookalike.cli.bench_real_run import OFFLINE_PARAMS, Entry, run_jobs, score_
 from lookalike.eval import combine, headline, leave_one_out
 from lookalike.parallel import JobPool
 from lookalike.trackers.offline import OfflineConfig, postprocess
-from lookalike.trackers.registry import parse_parameter
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import SHARED_DATA
+from _common import SHARED_DATA, parameter_grid
 
 DEFAULT_GRID = ("high_score=0.7,0.8,0.9,0.95", "birth_score=0.9,0.95,0.98", "n_init=2,3", "match_iou=0.2,0.3",
                 "max_age_s=1,2")
@@ -57,12 +55,7 @@ def main() -> None:
         seqs = load_datasets(SHARED_DATA, [args.dataset])
     except FileNotFoundError as exc:
         sys.exit(f"{exc} (this benchmark needs ../shared/data)")
-    keys, values = [], []
-    for g in args.grid or DEFAULT_GRID:
-        key, _, text = g.partition("=")
-        keys.append(key.strip())
-        values.append([parse_parameter("boxtrack", f"{key}={v}")[1] for v in text.split(",")])
-    combos = [dict(zip(keys, c)) for c in itertools.product(*values)]
+    combos = parameter_grid("boxtrack", args.grid or DEFAULT_GRID)
     print(f"{len(combos)} combinations × {len(seqs)} sequences ({args.dataset}), leave one sequence out",
           flush=True)
     jobs = [(p, s) for p in combos for s in seqs]
