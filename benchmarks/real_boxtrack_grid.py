@@ -65,7 +65,7 @@ def offline_grid(seqs: list[RealSequence], grid: list[str]) -> list[tuple[dict, 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dataset", choices=("mot15", "pigs", "hexbug", "mot17-synth", "mot17-synth2"), default="mot15")
+    parser.add_argument("--dataset", choices=("mot15", "pigs", "hexbug", "mot17-synth", "mot17-synth2", "mot17-synth3"), default="mot15")
     parser.add_argument("--grid", action="append", default=[], help="KEY=V1,V2,... (repeatable)")
     parser.add_argument("--set", action="append", default=[], help="KEY=VALUE fixed for every run")
     parser.add_argument("--full", action="store_true", help="score whole sequences (for the report only)")

@@ -45,7 +45,7 @@ def track_both(job: tuple[dict[str, Any], RealSequence]) -> tuple[dict[str, floa
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dataset", default="mot15", choices=("mot15", "mot17-synth", "mot17-synth2"))
+    parser.add_argument("--dataset", default="mot15", choices=("mot15", "mot17-synth", "mot17-synth2", "mot17-synth3"))
     parser.add_argument("--grid", action="append", default=[], help="KEY=V1,V2,... (repeatable; "
                         f"default: {' '.join(DEFAULT_GRID)})")
     parser.add_argument("--peers", default=",".join(PEERS), help="comma-separated peers, or 'none'")

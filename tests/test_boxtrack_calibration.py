@@ -123,3 +123,22 @@ def test_miss_returns_count_every_shorter_miss() -> None:
 def test_calibration_settings_are_checked(bad: dict) -> None:
     with pytest.raises(ValueError):
         make_tracker("boxtrack", **bad)
+
+
+def test_recently_seen_tracks_take_detections_before_long_lost_ones() -> None:
+    """Target B stands still at x=150 until frame 5, then is gone (its track waits there); target A walks
+    right along the same row and, at frame 12, is detected 11 px ahead of its prediction, right on B's
+    stale box. Matched all at once, B's stale track takes A's detection; with priority to tracks seen in
+    the last frames, A keeps it."""
+    def frames():
+        for k in range(14):
+            boxes = [[100.0 + 3.0 * k + (11.0 if k >= 12 else 0.0), 50.0, 40.0, 80.0]]
+            if k <= 5:
+                boxes.append([150.0, 50.0, 40.0, 80.0])
+            yield _frame(k, np.array(boxes), np.full(len(boxes), 0.95))
+
+    for recent, keeps in ((2, True), (None, False)):
+        tracker = make_tracker("boxtrack", recent_frames=recent)
+        ids = [{s.detection_index: s.track_id for s in tracker.update(f)} for f in frames()]
+        assert ids[0] == {0: 1, 1: 2}
+        assert (ids[12][0] == 1) is keeps

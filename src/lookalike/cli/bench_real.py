@@ -4,7 +4,7 @@ Datasets (``--data``, default ``../shared/data`` next to the repository): the 7 
 sequences with their Faster R-CNN detections, the pigs (23 identical animals; boxes), the HexBug
 clips (blob detector, head points), and ``mot17-synth``: the 7 MOT17 ground truths seen through a
 synthetic detector (the project's noise model; a set nothing was tuned on, not a real detector;
-``mot17-synth2``: the same with other noise seeds). Every entry runs on identical detections; peers that
+``mot17-synth2``, ``mot17-synth3``: the same with other noise seeds). Every entry runs on identical detections; peers that
 are not installed are listed as skipped. Per dataset the table gives HOTA, IDF1, MOTA (combined over the
 sequences as TrackEval does), IDSW, frames/s (tracking only) and a rank: entries are ordered by the
 mean of their ranks on HOTA, IDF1 and MOTA (ties: IDF1). ``--part first|second`` scores the first

@@ -11,7 +11,9 @@ position within ``radius`` pixels.
 sequences' real trajectories (``mot17/gt``) with detections from the noise model of
 :func:`lookalike.sim.boxes.simulate_boxes`, scaled to the box size (:func:`synthesize_detections`,
 fixed seeds). Its detections are not a real detector's; use it for rankings, not absolute figures.
-``mot17-synth2`` is the same with other seeds (:data:`SYNTH_SEEDS`): unseen by decisions made on ``mot17-synth``.
+``mot17-synth2`` and ``mot17-synth3`` are the same with other seeds (:data:`SYNTH_SEEDS`): unseen by decisions
+made on ``mot17-synth`` (``mot17-synth2`` was scored once after issue #10's self-calibration, ``mot17-synth3``
+after its matching priority).
 """
 
 from __future__ import annotations
@@ -25,10 +27,10 @@ import numpy as np
 
 from lookalike.io import MotTable, find_sequences, read_mot
 
-DATASETS = ("mot15", "pigs", "hexbug", "mot17-synth", "mot17-synth2")
-# The synthetic MOT17 sets and the seed of their detections: ``mot17-synth2`` is the same ground truth seen
-# with other noise draws, kept for a check after anything was decided with ``mot17-synth`` in view.
-SYNTH_SEEDS = {"mot17-synth": 0, "mot17-synth2": 1}
+DATASETS = ("mot15", "pigs", "hexbug", "mot17-synth", "mot17-synth2", "mot17-synth3")
+# The synthetic MOT17 sets and the seed of their detections: ``mot17-synth2`` and ``mot17-synth3`` are the same
+# ground truth seen with other noise draws, kept for checks after anything was decided with ``mot17-synth`` in view.
+SYNTH_SEEDS = {"mot17-synth": 0, "mot17-synth2": 1, "mot17-synth3": 2}
 PARTS = ("full", "first", "second")  # whole sequences, frames 1..⌊N/2⌋, frames ⌊N/2⌋+1..N
 PIGS_COUNT = 23  # the pigs folder documents 23 animals (../shared/data/README.md), not read from gt
 HEXBUG_FPS = 10.0

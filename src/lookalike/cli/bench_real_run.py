@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.cli.bench_peers import run_peer
-from lookalike.cli.bench_real_data import RealSequence
+from lookalike.cli.bench_real_data import SYNTH_SEEDS, RealSequence
 from lookalike.eval import evaluate_points, evaluate_sequence
 from lookalike.io import MotTable, tracks_to_rows
 from lookalike.parallel import JobPool
@@ -73,7 +73,7 @@ OFFLINE_PARAMS: dict[str, dict[str, Any]] = {
     "hexbug": {"link_gap_s": 0.0, "fill_gap_s": 0.5},
 }
 # chosen on other sequences (MOT15's first halves)
-OFFLINE_PARAMS["mot17-synth"] = OFFLINE_PARAMS["mot17-synth2"] = OFFLINE_PARAMS["mot15"]
+OFFLINE_PARAMS.update({name: OFFLINE_PARAMS["mot15"] for name in SYNTH_SEEDS})
 HEXBUG_RADIUS_PX = 120.0  # a box centre lies about half a bug from its head (benchmarks/hexbug_blobs.py)
 
 
