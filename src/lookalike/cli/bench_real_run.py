@@ -46,19 +46,24 @@ DATASET_PARAMS: dict[str, dict[str, dict[str, Any]]] = {
 # Entries with ``per_sequence=False`` (``boxtrack-global``) use the dataset's parameters only.
 # They were chosen with high_quantile off (boxtrack's default before issue #10) and keep it off. The choice
 # was run again after boxtrack's self-calibration (high_match_ratio, coast_report_prob) was added, with the
-# same grid and --set high_quantile=none: only ADL-Rundle-6 changed (n_init 3 -> 2).
+# same grid and --set high_quantile=none: only ADL-Rundle-6 changed (n_init 3 -> 2); and again with
+# recent_frames ∈ {off, 2} added to the grid (1024 combinations): KITTI-13 and TUD-Stadtmitte changed, and
+# ADL-Rundle-6 and PETS09-S2L1 keep recent_frames off (a tie, as for ETH-Bahnhof and TUD-Campus, keeps
+# the default).
 _MOT15_COMMON = {"birth_quantile": None, "high_quantile": None, "max_age_s": 1.0, "report": "filtered"}
 SEQUENCE_PARAMS: dict[str, dict[str, dict[str, dict[str, Any]]]] = {
     "mot15": {"boxtrack": {
-        "ADL-Rundle-6": {**_MOT15_COMMON, "high_score": 0.95, "birth_score": 0.98, "n_init": 2, "match_iou": 0.3},
+        "ADL-Rundle-6": {**_MOT15_COMMON, "high_score": 0.95, "birth_score": 0.98, "n_init": 2, "match_iou": 0.3,
+                         "recent_frames": None},
         "ETH-Bahnhof": {**_MOT15_COMMON, "high_score": 0.9, "birth_score": 0.98, "birth_quantile": 0.5,
                         "n_init": 2, "match_iou": 0.3},
         "ETH-Sunnyday": {**_MOT15_COMMON, "high_score": 0.8, "birth_score": 0.9, "n_init": 3, "match_iou": 0.3},
-        "KITTI-13": {**_MOT15_COMMON, "high_score": 0.9, "birth_score": 0.9, "n_init": 3, "report": "detection",
+        "KITTI-13": {**_MOT15_COMMON, "high_score": 0.9, "birth_score": 0.9, "n_init": 2, "report": "detection",
                      "match_iou": 0.2},
-        "PETS09-S2L1": {**_MOT15_COMMON, "high_score": 0.8, "birth_score": 0.95, "n_init": 2, "match_iou": 0.2},
+        "PETS09-S2L1": {**_MOT15_COMMON, "high_score": 0.8, "birth_score": 0.95, "n_init": 2, "match_iou": 0.2,
+                        "recent_frames": None},
         "TUD-Campus": {**_MOT15_COMMON, "high_score": 0.7, "birth_score": 0.9, "n_init": 2, "match_iou": 0.2},
-        "TUD-Stadtmitte": {**_MOT15_COMMON, "high_score": 0.7, "birth_score": 0.98, "n_init": 2, "max_age_s": 2.0,
+        "TUD-Stadtmitte": {**_MOT15_COMMON, "high_score": 0.8, "birth_score": 0.95, "n_init": 2, "max_age_s": 2.0,
                            "match_iou": 0.3},
     }},
 }
