@@ -224,10 +224,11 @@ def test_per_sequence_and_offline_entries() -> None:
     assert len(offline) > len(online)  # 10 % missed detections leave gaps to fill
 
 
-def test_per_sequence_parameters_hold_on_unseen_second_halves() -> None:
-    """On the MOT15 second halves (never used to choose anything): the per-sequence choice beats the
-    global defaults, boxtrack beats lookalike's SORT on IDF1 and MOTA (not on HOTA: 43.1 vs 43.2), and
-    the offline post-processing beats SORT on all three."""
+def test_boxtrack_beats_sort_on_unseen_second_halves() -> None:
+    """On the MOT15 second halves (never used to choose anything) every boxtrack entry beats lookalike's
+    SORT on HOTA, IDF1 and MOTA. The per-sequence choice beats the global defaults on MOTA only (54.3
+    against 53.0; HOTA 43.4 against 43.5, IDF1 58.5 against 59.7): first-half choices per sequence
+    carry over poorly, which is why boxtrack-global is reported beside them."""
     _need_data("mot15")
     from lookalike.cli.bench_real_data import load_boxes
 
@@ -235,10 +236,10 @@ def test_per_sequence_parameters_hold_on_unseen_second_halves() -> None:
     entries = default_entries(["sort", "boxtrack"], [])
     rows, _, _ = leaderboard(entries, seqs, run_jobs(entries, seqs))
     by = {r["Tracker"]: r for r in rows}
-    for metric in ("HOTA", "IDF1", "MOTA"):
-        assert by["boxtrack"][metric] > by["boxtrack-global"][metric], metric
-        assert by["boxtrack-offline"][metric] > by["sort"][metric], metric
-    assert by["boxtrack"]["IDF1"] > by["sort"]["IDF1"] and by["boxtrack"]["MOTA"] > by["sort"]["MOTA"]
+    for label in ("boxtrack", "boxtrack-global", "boxtrack-offline"):
+        for metric in ("HOTA", "IDF1", "MOTA"):
+            assert by[label][metric] > by["sort"][metric], (label, metric)
+    assert by["boxtrack"]["MOTA"] > by["boxtrack-global"]["MOTA"]
 
 
 def test_synthesized_detections_follow_the_noise_model() -> None:
