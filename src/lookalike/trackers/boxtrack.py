@@ -246,12 +246,9 @@ class BoxTrack:
                 det_of_track[tracks[r]] = cand[c]
                 free[cand[c]] = False
 
-        if cfg.recent_frames is not None:
-            recent = self._missed <= cfg.recent_frames
-            match(np.flatnonzero(self._confirmed & recent), np.flatnonzero(high), cfg.match_iou, True)
-            match(np.flatnonzero(self._confirmed & ~recent), np.flatnonzero(free & high), cfg.match_iou, True)
-        else:
-            match(np.flatnonzero(self._confirmed), np.flatnonzero(high), cfg.match_iou, True)
+        recent = self._missed <= (np.inf if cfg.recent_frames is None else cfg.recent_frames)
+        for group in (recent, ~recent):  # tracks seen lately first, then the longer-lost ones
+            match(np.flatnonzero(self._confirmed & group), np.flatnonzero(free & high), cfg.match_iou, True)
         unmatched = lambda mask: np.flatnonzero(mask & (det_of_track < 0))
         match(unmatched(self._confirmed & was_tracked), np.flatnonzero(free & ~high), cfg.low_iou, False)
         if cfg.high_match_ratio is not None:  # only confirmed tracks matched so far, by overlap
