@@ -29,9 +29,9 @@ import sys
 from pathlib import Path
 
 from lookalike.cli.bench_real import load_datasets
-from lookalike.cli.bench_real_data import RealSequence, cut_sequence
+from lookalike.cli.bench_real_data import DATASETS, RealSequence, cut_sequence
 from lookalike.cli.bench_real_run import Entry, run_jobs, score_rows, track_rows
-from lookalike.eval import combine
+from lookalike.eval import combine, headline
 from lookalike.trackers.offline import OfflineConfig, postprocess
 from lookalike.trackers.registry import parse_parameter
 
@@ -65,7 +65,7 @@ def offline_grid(seqs: list[RealSequence], grid: list[str]) -> list[tuple[dict, 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dataset", choices=("mot15", "pigs", "hexbug", "mot17-synth", "mot17-synth2", "mot17-synth3"), default="mot15")
+    parser.add_argument("--dataset", choices=DATASETS, default="mot15")
     parser.add_argument("--grid", action="append", default=[], help="KEY=V1,V2,... (repeatable)")
     parser.add_argument("--set", action="append", default=[], help="KEY=VALUE fixed for every run")
     parser.add_argument("--full", action="store_true", help="score whole sequences (for the report only)")
@@ -87,7 +87,7 @@ def main() -> None:
     if args.offline:
         scored_offline = offline_grid(seqs, args.offline)
         print(f"{'HOTA':>6} {'IDF1':>6} {'MOTA':>6}  offline parameters")
-        for c, params in sorted(scored_offline, key=lambda t: t[0]["HOTA"] + t[0]["IDF1"] + t[0]["MOTA"]):
+        for c, params in sorted(scored_offline, key=lambda t: headline(t[0])):
             print(f"{100 * c['HOTA']:6.2f} {100 * c['IDF1']:6.2f} {100 * c['MOTA']:6.2f}  {params}")
         return
     fixed = dict(parse_parameter("boxtrack", a) for a in args.set)
@@ -99,7 +99,7 @@ def main() -> None:
     for k, params in enumerate(combos):
         runs = [results[i * len(entries) + k] for i in range(len(seqs))]
         c = combine([r["scores"] for r in runs])
-        scored.append((100 * (c["HOTA"] + c["IDF1"] + c["MOTA"]), c, params))
+        scored.append((100 * headline(c), c, params))
     print(f"{'HOTA':>6} {'IDF1':>6} {'MOTA':>6}  parameters ({'whole' if args.full else 'first half of each'} sequence)")
     for _, c, params in sorted(scored, key=lambda t: t[0]):
         print(f"{100 * c['HOTA']:6.2f} {100 * c['IDF1']:6.2f} {100 * c['MOTA']:6.2f}  {params}")
@@ -107,7 +107,7 @@ def main() -> None:
         print("best per sequence (HOTA + IDF1 + MOTA of that sequence; first combination on ties):")
         for i, seq in enumerate(seqs):
             runs = [results[i * len(entries) + k]["scores"] for k in range(len(combos))]
-            best = max(range(len(combos)), key=lambda k: (runs[k]["HOTA"] + runs[k]["IDF1"] + runs[k]["MOTA"], -k))
+            best = max(range(len(combos)), key=lambda k: (headline(runs[k]), -k))
             s = runs[best]
             print(f"{seq.name}: {100 * s['HOTA']:.2f} {100 * s['IDF1']:.2f} {100 * s['MOTA']:.2f}  {combos[best]}")
 

@@ -22,7 +22,7 @@ from typing import Any
 
 from lookalike.cli.bench_peers import PEERS, peer_status
 from lookalike.cli.bench_real import load_datasets
-from lookalike.cli.bench_real_data import RealSequence
+from lookalike.cli.bench_real_data import DATASETS, RealSequence
 from lookalike.cli.bench_real_run import OFFLINE_PARAMS, Entry, run_jobs, score_rows, track_rows
 from lookalike.eval import combine, headline, leave_one_out
 from lookalike.parallel import JobPool
@@ -45,7 +45,7 @@ def track_both(job: tuple[dict[str, Any], RealSequence]) -> tuple[dict[str, floa
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dataset", default="mot15", choices=("mot15", "mot17-synth", "mot17-synth2", "mot17-synth3"))
+    parser.add_argument("--dataset", default="mot15", choices=DATASETS)
     parser.add_argument("--grid", action="append", default=[], help="KEY=V1,V2,... (repeatable; "
                         f"default: {' '.join(DEFAULT_GRID)})")
     parser.add_argument("--peers", default=",".join(PEERS), help="comma-separated peers, or 'none'")
@@ -55,6 +55,8 @@ def main() -> None:
         seqs = load_datasets(SHARED_DATA, [args.dataset])
     except FileNotFoundError as exc:
         sys.exit(f"{exc} (this benchmark needs ../shared/data)")
+    if len(seqs) < 2:
+        sys.exit(f"{args.dataset}: leaving one sequence out needs at least two sequences, it has {len(seqs)}")
     combos = parameter_grid("boxtrack", args.grid or DEFAULT_GRID)
     print(f"{len(combos)} combinations × {len(seqs)} sequences ({args.dataset}), leave one sequence out",
           flush=True)
