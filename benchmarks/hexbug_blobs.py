@@ -1,12 +1,12 @@
 """Blob detector + trackers on the HexBug clips, scored per clip against the CSV head points.
 
-Detections come from ``lookalike bench real``'s loader (:func:`lookalike.cli.bench_real_data.detect_hexbug`:
+Detections come from ``lookalike bench real``'s loader (:func:`lookalike.bench.datasets.detect_hexbug`:
 blob detector settings, head points with the swapped-x/y clips fixed). Detection recall/precision: a
 ground-truth head point is found when a detection box, grown by ``--margin`` pixels, contains it
 (one-to-one, Hungarian on the point-to-box distance). Tracking: each tracker runs as in ``lookalike
-bench real`` (:func:`~lookalike.cli.bench_real_run.track_rows`, with boxtrack's HexBug parameters chosen
+bench real`` (:func:`~lookalike.bench.runner.track_rows`, with boxtrack's HexBug parameters chosen
 on the clips' first halves) and its box centres are scored with point matching within 120 px
-(:func:`~lookalike.cli.bench_real_run.score_rows`: IDF1, MOTA; a box centre lies about half a bug from
+(:func:`~lookalike.bench.runner.score_rows`: IDF1, MOTA; a box centre lies about half a bug from
 the head, hence the large radius). ``boxtrack8``-style closed sets: ``--closed`` adds boxtrack with
 ``max_targets`` = the number of bugs annotated in the clip's CSV (the known team size).
 
@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.association import assign
-from lookalike.cli.bench_real_data import RealSequence, detect_hexbug, hexbug_clips
-from lookalike.cli.bench_real_run import Entry, score_rows, track_rows
+from lookalike.bench.datasets import RealSequence, detect_hexbug, hexbug_clips
+from lookalike.bench.runner import Entry, score_rows, track_rows
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA  # noqa: E402

@@ -11,12 +11,13 @@ import pytest
 from typer.testing import CliRunner
 
 from lookalike.cli import app
-from lookalike.cli.bench_real import default_entries, leaderboard
-from lookalike.cli.bench_real_data import RealSequence, cut_sequence
-from lookalike.cli.bench_real_run import (
+from lookalike.bench.datasets import RealSequence, cut_sequence
+from lookalike.bench.leaderboard import leaderboard
+from lookalike.bench.runner import (
     OFFLINE_PARAMS,
     SEQUENCE_PARAMS,
     Entry,
+    default_entries,
     job_pairs,
     map_jobs,
     run_jobs,
@@ -176,7 +177,7 @@ def test_bench_real_cli_on_tud_campus(tmp_path: Path) -> None:
 
 def test_boxtrack_closed_set_beats_sort_on_the_pigs() -> None:
     _need_data("pigs")
-    from lookalike.cli.bench_real_data import load_boxes
+    from lookalike.bench.datasets import load_boxes
 
     (pigs,) = load_boxes(DATA / "pigs", "pigs")
     entries = [Entry("sort", "sort"), Entry("boxtrack-closed", "boxtrack", closed_set=True)]
@@ -230,7 +231,7 @@ def test_boxtrack_beats_sort_on_unseen_second_halves() -> None:
     against 53.0; HOTA 43.4 against 43.5, IDF1 58.5 against 59.7): first-half choices per sequence
     carry over poorly, which is why boxtrack-global is reported beside them."""
     _need_data("mot15")
-    from lookalike.cli.bench_real_data import load_boxes
+    from lookalike.bench.datasets import load_boxes
 
     seqs = [cut_sequence(s, "second") for s in load_boxes(DATA / "mot15", "mot15")]
     entries = default_entries(["sort", "boxtrack"], [])
@@ -243,7 +244,7 @@ def test_boxtrack_beats_sort_on_unseen_second_halves() -> None:
 
 
 def test_synthesized_detections_follow_the_noise_model() -> None:
-    from lookalike.cli.bench_real_data import synthesize_detections
+    from lookalike.bench.datasets import synthesize_detections
 
     n_frames, boxes = 200, []
     for k in range(1, n_frames + 1):
@@ -267,7 +268,7 @@ def test_synthesized_detections_follow_the_noise_model() -> None:
 
 def test_mot17_synth_loads_with_fixed_detections() -> None:
     root = _need_data("mot17/gt")
-    from lookalike.cli.bench_real_data import load_mot17_synth
+    from lookalike.bench.datasets import load_mot17_synth
 
     a, b = load_mot17_synth(root), load_mot17_synth(root)
     assert len(a) == 7 and all(s.benchmark == "MOT17" and s.dataset == "mot17-synth" for s in a)
@@ -277,7 +278,7 @@ def test_mot17_synth_loads_with_fixed_detections() -> None:
 
 def test_mot17_synth2_is_the_same_truth_with_other_detections() -> None:
     root = _need_data("mot17")
-    from lookalike.cli.bench_real import load_datasets
+    from lookalike.bench.datasets import load_datasets
 
     first = load_datasets(root.parent, ["mot17-synth"], sequences=["MOT17-02-FRCNN", "MOT17-02"])
     second = load_datasets(root.parent, ["mot17-synth2"], sequences=["MOT17-02-FRCNN", "MOT17-02"])

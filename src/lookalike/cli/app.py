@@ -20,3 +20,8 @@ def fail(message: str, code: int = 2) -> None:
     """Print ``message`` as an error and exit with ``code``."""
     err_console.print(f"[bold red]error:[/] {message}")
     raise typer.Exit(code)
+
+
+def split_list(values: list[str] | None) -> list[str]:
+    """Option values given repeated and/or comma-separated, as one list (blanks dropped)."""
+    return [v.strip() for item in values or [] for v in item.split(",") if v.strip()]

@@ -1,4 +1,5 @@
-"""Reading and writing tracking data: MOTChallenge text files and sequence folders."""
+"""Reading and writing tracking data: MOTChallenge text files, sequence folders, and streaming
+input/output for the frame loop (:mod:`lookalike.io.stream`)."""
 
 from lookalike.io.motchallenge import (
     MotTable,
@@ -8,10 +9,13 @@ from lookalike.io.motchallenge import (
     write_mot,
 )
 from lookalike.io.sequences import MotSequence, find_sequences, read_seqinfo
+from lookalike.io.stream import DetectionStream, MotWriter
 
 __all__ = [
+    "DetectionStream",
     "MotSequence",
     "MotTable",
+    "MotWriter",
     "find_sequences",
     "frames_from_table",
     "read_mot",

@@ -9,43 +9,13 @@ from __future__ import annotations
 import os
 import tempfile
 import warnings
-from dataclasses import dataclass
+from collections.abc import Iterable, Iterator
 from pathlib import Path
-from typing import Iterable, Iterator, Sequence
 
 import numpy as np
 
-from lookalike.types import Detections, Frame, TrackSnapshot
-
-
-@dataclass(frozen=True, eq=False)
-class MotTable:
-    """A MOTChallenge file as columns (one row per box).
-
-    Attributes:
-        frame: ``(n,)`` 1-based frame numbers.
-        track_id: ``(n,)`` ids (-1 in detection files).
-        xywh: ``(n, 4)`` boxes in pixels.
-        conf: ``(n,)`` detector score, or the ground truth's consider flag.
-        extra: ``(n, k)`` the remaining columns (world xyz, or class and visibility in MOT16+ gt).
-        path: the file it came from, if any.
-    """
-
-    frame: np.ndarray
-    track_id: np.ndarray
-    xywh: np.ndarray
-    conf: np.ndarray
-    extra: np.ndarray
-    path: Path | None = None
-
-    def __len__(self) -> int:
-        return int(self.frame.shape[0])
-
-    @classmethod
-    def from_rows(cls, rows: np.ndarray) -> "MotTable":
-        """A table from in-memory MOTChallenge rows ``(n, >= 7)`` such as :func:`tracks_to_rows` makes."""
-        data = np.asarray(rows, dtype=float).reshape(-1, max(np.shape(rows)[-1], 7) if np.size(rows) else 10)
-        return _table(data, None)
+from lookalike.types import Detections, Frame
+from lookalike.types.mot_table import MotTable, format_row, stack_rows, table_from_array, tracks_to_rows
 
 
 def read_mot(path: str | os.PathLike[str], min_columns: int = 6) -> MotTable:
@@ -59,10 +29,10 @@ def read_mot(path: str | os.PathLike[str], min_columns: int = 6) -> MotTable:
         raise FileNotFoundError(f"{path}: no such file")
     fast = _parse_fast(path, min_columns)
     if fast is not None:
-        return _table(fast, path)
+        return table_from_array(fast, path)
     rows = [(i + 1, ln) for i, ln in enumerate(path.read_text().splitlines()) if ln.strip()]
     if not rows:
-        return _table(np.zeros((0, 7)), path)
+        return table_from_array(np.zeros((0, 7)), path)
     data = _parse_slowly(path, rows, min_columns)
     bad = _invalid_rows(data)
     if bad.any():
@@ -70,7 +40,7 @@ def read_mot(path: str | os.PathLike[str], min_columns: int = 6) -> MotTable:
         raise ValueError(
             f"{path}:{line_no}: invalid box (NaN/inf, negative size or frame < 1): {line.strip()!r}"
         )
-    return _table(data, path)
+    return table_from_array(data, path)
 
 
 def _invalid_rows(data: np.ndarray) -> np.ndarray:
@@ -111,20 +81,6 @@ def _parse_slowly(path: Path, rows: list[tuple[int, str]], min_columns: int) -> 
     return np.array([v[:width] for v in parsed], dtype=float)
 
 
-def _table(data: np.ndarray, path: Path | None) -> MotTable:
-    n = data.shape[0]
-    conf = data[:, 6] if data.shape[1] > 6 else np.ones(n)
-    extra = data[:, 7:] if data.shape[1] > 7 else np.zeros((n, 0))
-    return MotTable(
-        frame=data[:, 0].astype(int),
-        track_id=data[:, 1].astype(int),
-        xywh=data[:, 2:6].copy(),
-        conf=conf.copy(),
-        extra=extra.copy(),
-        path=path,
-    )
-
-
 def frames_from_table(
     table: MotTable, length: int | None = None, frame_rate: float = 30.0, min_score: float = -np.inf
 ) -> Iterator[Frame]:
@@ -152,31 +108,16 @@ def frames_from_table(
         )
 
 
-def tracks_to_rows(frame_index: int, tracks: Sequence[TrackSnapshot]) -> np.ndarray:
-    """MOTChallenge result rows ``(k, 10)`` for the boxed tracks of one 0-based frame index."""
-    boxed = [t for t in tracks if t.xywh is not None]
-    rows = np.full((len(boxed), 10), -1.0)
-    for r, t in enumerate(boxed):
-        rows[r, 0] = frame_index + 1
-        rows[r, 1] = t.track_id
-        rows[r, 2:6] = t.xywh
-        rows[r, 6] = 1.0 if t.identity_prob is None else t.identity_prob
-    return rows
-
-
 def write_mot(path: str | os.PathLike[str], rows: Iterable[np.ndarray] | np.ndarray) -> Path:
     """Write result rows ``(n, 10)`` atomically: a failure never leaves a half-written file."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    data = np.asarray(rows, dtype=float) if isinstance(rows, np.ndarray) else _stack(rows)
+    data = np.asarray(rows, dtype=float) if isinstance(rows, np.ndarray) else stack_rows(rows)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
         with os.fdopen(fd, "w") as fh:
             for row in data:
-                fh.write(
-                    f"{int(row[0])},{int(row[1])},{row[2]:.3f},{row[3]:.3f},{row[4]:.3f},"
-                    f"{row[5]:.3f},{row[6]:g},{row[7]:g},{row[8]:g},{row[9]:g}\n"
-                )
+                fh.write(format_row(row))
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -184,6 +125,4 @@ def write_mot(path: str | os.PathLike[str], rows: Iterable[np.ndarray] | np.ndar
     return path
 
 
-def _stack(chunks: Iterable[np.ndarray]) -> np.ndarray:
-    parts = [np.asarray(c, dtype=float).reshape(-1, 10) for c in chunks]
-    return np.vstack(parts) if parts else np.zeros((0, 10))
+__all__ = ["MotTable", "frames_from_table", "read_mot", "tracks_to_rows", "write_mot"]

@@ -20,7 +20,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from lookalike.cli.bench_real_data import RealSequence
+from lookalike.bench.datasets import RealSequence
 
 PeerFn = Callable[[RealSequence], np.ndarray]
 
@@ -164,3 +164,6 @@ def run_peer(name: str, seq: RealSequence) -> np.ndarray:
     if name not in PEERS:
         raise ValueError(f"peer: unknown peer {name!r}; known: {', '.join(PEERS)}")
     return PEERS[name][1](seq)
+
+
+__all__ = ["PEERS", "PeerFn", "peer_status", "run_peer"]

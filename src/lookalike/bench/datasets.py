@@ -5,38 +5,57 @@ Every sequence becomes a :class:`RealSequence` holding the detections every trac
 (identical for all of them) and the ground truth it is scored against. Box data (MOT15, pigs) is
 scored with CLEAR/identity/HOTA on boxes (IoU 0.5, MOT15 rules; MOT17 rules for ``mot17-synth``);
 HexBug clips are scored on points: the centre of each reported box against the annotated head
-position within ``radius`` pixels.
+position.
 
 ``mot17-synth`` is a set that no parameter of lookalike was chosen on: the 7 MOT17 training
-sequences' real trajectories (``mot17/gt``) with detections from the noise model of
-:func:`lookalike.sim.boxes.simulate_boxes`, scaled to the box size (:func:`synthesize_detections`,
-fixed seeds). Its detections are not a real detector's; use it for rankings, not absolute figures.
-``mot17-synth2`` and ``mot17-synth3`` are the same with other seeds (:data:`SYNTH_SEEDS`): unseen by decisions
-made on ``mot17-synth`` (``mot17-synth2`` was scored once after issue #10's self-calibration, ``mot17-synth3``
-after its matching priority).
+sequences' real trajectories (``mot17/gt``) with detections from
+:func:`~lookalike.bench.synthetic.synthesize_detections` (fixed seeds). Its detections are not a
+real detector's; use it for rankings, not absolute figures. ``mot17-synth2`` and ``mot17-synth3``
+are the same truth with other noise draws (:data:`SYNTH_SEEDS`).
+
+The data folder is found by :func:`resolve_data_root`: the ``--data`` option, else the environment
+variable ``LOOKALIKE_DATA``, else ``../shared/data`` relative to the current directory.
 """
 
 from __future__ import annotations
 
 import csv
+import os
 import zlib
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from lookalike.bench.synthetic import synthesize_detections
 from lookalike.io import MotTable, find_sequences, read_mot
+from lookalike.parallel import JobPool
+from lookalike.types import Detections, Frame
 
 DATASETS = ("mot15", "pigs", "hexbug", "mot17-synth", "mot17-synth2", "mot17-synth3")
-# The synthetic MOT17 sets and the seed of their detections: ``mot17-synth2`` and ``mot17-synth3`` are the same
-# ground truth seen with other noise draws, kept for checks after anything was decided with ``mot17-synth`` in view.
+# The synthetic MOT17 sets and the seed of their detections.
 SYNTH_SEEDS = {"mot17-synth": 0, "mot17-synth2": 1, "mot17-synth3": 2}
 PARTS = ("full", "first", "second")  # whole sequences, frames 1..⌊N/2⌋, frames ⌊N/2⌋+1..N
 PIGS_COUNT = 23  # the pigs folder documents 23 animals (../shared/data/README.md), not read from gt
 HEXBUG_FPS = 10.0
-# Clips whose CSV has x and y swapped (listed in ../shared/data/README.md).
-HEXBUG_SWAPPED_XY = frozenset({"training020", "training058", "training076", "training078", "training079",
-                               "training082", "training083", "training089"})
+DATA_ENV = "LOOKALIKE_DATA"
+
+
+def resolve_data_root(option: Path | str | None = None) -> Path:
+    """The data folder: ``option`` when given, else ``$LOOKALIKE_DATA``, else ``../shared/data``
+    relative to the current directory. Raises ``FileNotFoundError`` naming what was tried."""
+    if option is not None:
+        tried = [(Path(option), "--data")]
+    elif os.environ.get(DATA_ENV):
+        tried = [(Path(os.environ[DATA_ENV]), f"${DATA_ENV}")]
+    else:
+        tried = [(Path.cwd().parent / "shared" / "data", "../shared/data from the current directory")]
+    for path, _ in tried:
+        if path.is_dir():
+            return path
+    what = "; ".join(f"{p} ({why})" for p, why in tried)
+    raise FileNotFoundError(f"data folder not found: tried {what}; give --data FOLDER or set ${DATA_ENV}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,7 +63,7 @@ class RealSequence:
     """One sequence: per-frame detections (0-based frames) and its ground truth.
 
     Attributes:
-        dataset: ``"mot15"``, ``"pigs"`` or ``"hexbug"``.
+        dataset: ``"mot15"``, ``"pigs"``, ``"hexbug"`` or a ``mot17-synth`` set.
         name: sequence or clip name.
         frame_rate: frames per second.
         length: number of frames.
@@ -68,6 +87,12 @@ class RealSequence:
     image_size: tuple[int, int] | None = None
     n_targets: int | None = None
     benchmark: str = "MOT15"
+
+    def frames(self) -> Iterator[Frame]:
+        """The detections as :class:`Frame` objects, ``index`` 0-based, ``time = index / frame_rate``."""
+        for k in range(self.length):
+            dets = Detections(xywh=self.det_xywh[k], score=self.det_score[k])
+            yield Frame(index=k, time=k / self.frame_rate, detections=dets)
 
 
 def _split_frames(table: MotTable, length: int) -> tuple[list[np.ndarray], list[np.ndarray]]:
@@ -120,45 +145,6 @@ def cut_sequence(seq: RealSequence, part: str) -> RealSequence:
                    det_score=seq.det_score[lo:hi], gt=gt, gt_points=points)
 
 
-def synthesize_detections(gt: MotTable, length: int, image_size: tuple[int, int], rng: np.random.Generator, *,
-                          noise: float = 0.05, miss_rate: float = 0.1, min_visibility: float = 0.25,
-                          false_positives_per_frame: float = 0.5) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Per-frame detections ``(n, 4)`` px and scores ``(n,)`` of a synthetic detector looking at MOT17
-    ground truth ``gt`` (columns: consider flag, class, visibility).
-
-    The noise model of :func:`lookalike.sim.boxes.simulate_boxes`, with its noise proportional to the
-    box: a considered pedestrian (class 1) at least ``min_visibility`` visible is missed with
-    probability ``miss_rate``, else seen with Gaussian noise of std ``noise``·[w, h, w/2, h/2] on
-    ``[x, y, w, h]`` and a score uniform in [0.6, 1]; each frame adds Poisson(``false_positives_per_frame``)
-    false boxes, uniform over the image (``(width, height)`` px) with the size of a random true box,
-    scored uniform in [0.3, 0.8].
-    """
-    if gt.extra.shape[1] < 2:
-        raise ValueError("gt: expected MOT17 ground truth with class and visibility columns")
-    person = (gt.conf != 0) & (gt.extra[:, 0] == 1)
-    visible = person & (gt.extra[:, 1] >= min_visibility)
-    sizes = gt.xywh[person, 2:4]
-    if not len(sizes):
-        raise ValueError("gt: no considered pedestrian boxes")
-    width, height = image_size
-    xywh, score = [], []
-    for k in range(1, length + 1):
-        truth = gt.xywh[visible & (gt.frame == k)]
-        seen = truth[rng.random(len(truth)) >= miss_rate]
-        scale = np.column_stack([seen[:, 2], seen[:, 3], seen[:, 2] / 2, seen[:, 3] / 2])
-        boxes = seen + rng.normal(0.0, 1.0, seen.shape) * noise * scale
-        n_fp = rng.poisson(false_positives_per_frame)
-        fp_size = sizes[rng.integers(0, len(sizes), n_fp)]
-        fp = np.column_stack([rng.uniform(0, 1, (n_fp, 2)) * np.maximum([width, height] - fp_size, 1.0), fp_size])
-        boxes = np.vstack([boxes, fp])
-        boxes[:, 2:] = np.maximum(np.abs(boxes[:, 2:]), 1.0)
-        conf = np.concatenate([rng.uniform(0.6, 1.0, len(seen)), rng.uniform(0.3, 0.8, n_fp)])
-        order = rng.permutation(len(boxes))
-        xywh.append(boxes[order])
-        score.append(conf[order])
-    return xywh, score
-
-
 def load_mot17_synth(root: Path, seed: int = 0, dataset: str = "mot17-synth") -> list[RealSequence]:
     """The MOT17 ground-truth sequences under ``root`` (``mot17/gt``) with :func:`synthesize_detections`
     (seeded by ``seed`` and the sequence's name, so every run sees the same detections), labelled ``dataset``."""
@@ -178,8 +164,27 @@ def load_mot17_synth(root: Path, seed: int = 0, dataset: str = "mot17-synth") ->
     return out
 
 
-def read_hexbug_points(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(frame 1-based (n,), id (n,), xy (n, 2) px)`` from a HexBug CSV (``,t,hexbug,x,y``)."""
+def points_swapped(xy: np.ndarray, image_size: tuple[int, int] | None) -> bool:
+    """Whether points ``(n, 2)`` px were stored as (y, x): more of them fall outside the image
+    (``(width, height)`` px) read as (x, y) than read as (y, x). A tie (e.g. all inside both ways,
+    or no image size) keeps the order as written."""
+    if image_size is None or not len(xy):
+        return False
+    width, height = image_size
+
+    def outside(x: np.ndarray, y: np.ndarray) -> int:
+        return int(((x < 0) | (x >= width) | (y < 0) | (y >= height)).sum())
+
+    return outside(xy[:, 1], xy[:, 0]) < outside(xy[:, 0], xy[:, 1])
+
+
+def read_hexbug_points(path: Path, image_size: tuple[int, int] | None = None
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(frame 1-based (n,), id (n,), xy (n, 2) px)`` from a HexBug CSV (``,t,hexbug,x,y``).
+
+    Some CSVs store (y, x); with the clip's ``image_size`` (``(width, height)`` px) the order is
+    decided by :func:`points_swapped` (points outside the image as (x, y) but inside as (y, x)).
+    """
     rows = []
     with open(path, newline="") as fh:
         for rec in csv.DictReader(fh):
@@ -189,7 +194,7 @@ def read_hexbug_points(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
                 raise ValueError(f"{path}: expected columns t, hexbug, x, y with numbers") from None
     arr = np.array(rows, dtype=float).reshape(-1, 4)
     arr = arr[np.isfinite(arr).all(axis=1)]
-    xy = arr[:, 2:4][:, ::-1] if path.stem in HEXBUG_SWAPPED_XY else arr[:, 2:4]
+    xy = arr[:, 2:4][:, ::-1] if points_swapped(arr[:, 2:4], image_size) else arr[:, 2:4]
     return arr[:, 0].astype(int) + 1, arr[:, 1].astype(int), np.ascontiguousarray(xy)
 
 
@@ -210,6 +215,43 @@ def detect_hexbug(video: Path) -> RealSequence:
     detector = BlobDetector(BlobConfig(threshold=30.0, min_area_px=800.0, open_px=9, stabilise=True)).fit(frames)
     dets = [detector(image) for image in frames]
     height, width = frames[0].shape[:2]
+    points = read_hexbug_points(video.with_suffix(".csv"), (width, height))
     return RealSequence("hexbug", video.stem, HEXBUG_FPS, len(frames), [d.xywh for d in dets],
-                        [d.score for d in dets], gt_points=read_hexbug_points(video.with_suffix(".csv")),
-                        image_size=(width, height))
+                        [d.score for d in dets], gt_points=points, image_size=(width, height))
+
+
+def _selected(seqs: list[RealSequence], dataset: str, sequences: Sequence[str] | None) -> list[RealSequence]:
+    return [s for s in seqs if not sequences or s.name in sequences or dataset in sequences]
+
+
+def load_datasets(root: Path, names: Sequence[str], *, sequences: Sequence[str] | None = None,
+                  max_clips: int | None = None, workers: int = 1, backend: str = "local",
+                  address: str | None = None) -> list[RealSequence]:
+    """The sequences of datasets ``names`` under ``root`` (HexBug detection runs on the chosen backend).
+
+    ``sequences``: only these sequence/clip names (a dataset's name selects all of it);
+    ``max_clips``: at most this many HexBug clips.
+    """
+    out: list[RealSequence] = []
+    for name in names:
+        if name not in DATASETS:
+            raise ValueError(f"datasets: unknown dataset {name!r}; known: {', '.join(DATASETS)}")
+        folder = root / "mot17" / "gt" if name in SYNTH_SEEDS else root / name
+        if not folder.is_dir():
+            raise FileNotFoundError(f"{folder}: dataset folder not found (set --data)")
+        if name in SYNTH_SEEDS:
+            out += _selected(load_mot17_synth(folder, SYNTH_SEEDS[name], name), name, sequences)
+        elif name == "hexbug":
+            clips = [c for c in hexbug_clips(folder) if not sequences or c.stem in sequences][:max_clips]
+            with JobPool(min(workers, max(len(clips), 1)), backend, address) as pool:
+                out += pool.map(detect_hexbug, clips)
+        else:
+            out += _selected(load_boxes(folder, name), name, sequences)
+    if not out:
+        raise ValueError("no sequence selected")
+    return out
+
+
+__all__ = ["DATASETS", "DATA_ENV", "HEXBUG_FPS", "PARTS", "PIGS_COUNT", "SYNTH_SEEDS", "RealSequence",
+           "cut_sequence", "detect_hexbug", "hexbug_clips", "load_boxes", "load_datasets", "load_mot17_synth",
+           "points_swapped", "read_hexbug_points", "resolve_data_root", "synthesize_detections"]

@@ -1,0 +1,59 @@
+"""Parameter presets of the benches, read from the JSON files in ``presets/``.
+
+Each file says what every set of parameters was chosen on (``chosen_on``) and how (``search``):
+parameters chosen on data that is then scored are "tuned on this data", never a headline figure.
+
+- ``boxtrack.json``: boxtrack's parameters per dataset (``datasets``) and per sequence (``sequences``),
+- ``offline.json``: the offline post-processing (:class:`lookalike.trackers.offline.OfflineConfig`)
+  per dataset.
+"""
+
+from __future__ import annotations
+
+import json
+from functools import cache
+from importlib import resources
+from typing import Any
+
+PRESET_FILES = ("boxtrack", "offline")
+
+
+@cache
+def load_preset(name: str) -> dict[str, Any]:
+    """The parsed preset file ``presets/<name>.json`` (cached; do not modify the result)."""
+    if name not in PRESET_FILES:
+        raise ValueError(f"preset: unknown preset {name!r}; known: {', '.join(PRESET_FILES)}")
+    text = resources.files("lookalike.bench").joinpath("presets", f"{name}.json").read_text()
+    return dict(json.loads(text))
+
+
+def chosen_on(preset: str, dataset: str) -> str:
+    """What the parameters of ``preset`` for ``dataset`` were chosen on ("" when there are none)."""
+    data = load_preset(preset)
+    for group in ("datasets", "sequences"):
+        entry = data.get(group, {}).get(dataset)
+        if entry is not None:
+            return str(entry["chosen_on"])
+    return ""
+
+
+def _dataset_params() -> dict[str, dict[str, dict[str, Any]]]:
+    boxtrack = load_preset("boxtrack")
+    return {d: {boxtrack["tracker"]: dict(e["params"])} for d, e in boxtrack["datasets"].items()}
+
+
+def _sequence_params() -> dict[str, dict[str, dict[str, dict[str, Any]]]]:
+    boxtrack = load_preset("boxtrack")
+    return {d: {boxtrack["tracker"]: {s: dict(p) for s, p in e["params"].items()}}
+            for d, e in boxtrack["sequences"].items()}
+
+
+# dataset -> tracker -> parameters chosen on that dataset (boxtrack.json "datasets")
+DATASET_PARAMS: dict[str, dict[str, dict[str, Any]]] = _dataset_params()
+# dataset -> tracker -> sequence -> parameters chosen on that sequence's first half (boxtrack.json "sequences")
+SEQUENCE_PARAMS: dict[str, dict[str, dict[str, dict[str, Any]]]] = _sequence_params()
+# dataset -> OfflineConfig fields (offline.json)
+OFFLINE_PARAMS: dict[str, dict[str, Any]] = {d: dict(e["params"])
+                                             for d, e in load_preset("offline")["datasets"].items()}
+
+__all__ = ["DATASET_PARAMS", "OFFLINE_PARAMS", "PRESET_FILES", "SEQUENCE_PARAMS", "chosen_on", "load_preset"]

@@ -1,0 +1,158 @@
+"""Jobs of ``lookalike bench real`` and the backends that run them: serial, processes, Ray.
+
+A job is one tracker entry on one sequence; it returns the sequence's scores (counts that combine)
+and the tracking time. Every backend maps the same pure function over the same jobs and returns
+the results in job order, so the tables do not depend on the backend (frames/s aside). The Ray
+backend uses Ray's task API (``ray.remote`` / ``ray.get``), connecting to ``address`` or starting
+a local instance (``ray.init()``); the sequences are put in Ray's object store once.
+
+Parameters of an entry, lowest priority first: the dataset's preset
+(:data:`~lookalike.bench.presets.DATASET_PARAMS`), the sequence's preset
+(:data:`~lookalike.bench.presets.SEQUENCE_PARAMS`, when ``per_sequence``), the entry's own.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from lookalike.bench.datasets import RealSequence
+from lookalike.bench.peers import run_peer
+from lookalike.bench.presets import DATASET_PARAMS, OFFLINE_PARAMS, SEQUENCE_PARAMS
+from lookalike.eval import evaluate_points, evaluate_sequence
+from lookalike.io import MotTable
+from lookalike.loop import RowCollector, run
+from lookalike.parallel import JobPool
+from lookalike.trackers import make_tracker
+from lookalike.trackers.offline import OfflineConfig, postprocess
+
+HEXBUG_RADIUS_PX = 120.0  # a box centre lies about half a bug from its head (benchmarks/hexbug_blobs.py)
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One row of a table: a lookalike tracker with parameters, or a peer (``kind="peer"``)."""
+
+    label: str
+    name: str
+    kind: str = "lookalike"
+    params: dict[str, Any] = field(default_factory=dict)
+    closed_set: bool = False  # pass the sequence's documented target count as ``max_targets``
+    per_sequence: bool = True  # use the parameters chosen on each sequence's first half (SEQUENCE_PARAMS)
+    only_where_tuned: bool = False  # run only on datasets with per-sequence parameters for this tracker
+    offline: bool = False  # post-process the whole result (trackers.offline; OFFLINE_PARAMS of the dataset)
+
+
+def default_entries(trackers: Sequence[str], peers: Sequence[str], closed_set: bool = True) -> list[Entry]:
+    """lookalike trackers and peers; with ``boxtrack`` also ``boxtrack-global`` (without the
+    per-sequence parameters, where there are some), ``boxtrack-offline`` (its result post-processed
+    offline, :mod:`lookalike.trackers.offline`) and ``boxtrack-closed`` (where the count is known)."""
+    entries = [Entry(t, t) for t in trackers]
+    if "boxtrack" in trackers:
+        entries += [Entry("boxtrack-global", "boxtrack", per_sequence=False, only_where_tuned=True),
+                    Entry("boxtrack-offline", "boxtrack", offline=True)]
+    if closed_set and "boxtrack" in trackers:
+        entries.append(Entry("boxtrack-closed", "boxtrack", closed_set=True))
+    return entries + [Entry(p, p, kind="peer") for p in peers]
+
+
+def base_name(seq: RealSequence) -> str:
+    """The sequence's name without the ``[first]``/``[second]`` of a cut (``cut_sequence``)."""
+    return seq.name.split("[", 1)[0]
+
+
+def sequence_params(entry: Entry, seq: RealSequence) -> dict[str, Any]:
+    """The parameters chosen for ``entry``'s tracker on the first half of ``seq`` (empty if none)."""
+    if entry.kind == "peer" or not entry.per_sequence:
+        return {}
+    return SEQUENCE_PARAMS.get(seq.dataset, {}).get(entry.name, {}).get(base_name(seq), {})
+
+
+def entry_params(entry: Entry, seq: RealSequence,
+                 dataset_params: dict[str, dict[str, dict[str, Any]]] | None = None) -> dict[str, Any]:
+    """The parameters ``entry``'s tracker gets on ``seq`` (dataset < sequence < entry; the target
+    count as ``max_targets`` for a closed-set entry where it is known)."""
+    dataset_params = DATASET_PARAMS if dataset_params is None else dataset_params
+    params = {**dataset_params.get(seq.dataset, {}).get(entry.name, {}), **sequence_params(entry, seq),
+              **entry.params}
+    if entry.closed_set and seq.n_targets is not None:
+        params["max_targets"] = seq.n_targets
+    return params
+
+
+def track_rows(entry: Entry, seq: RealSequence,
+               dataset_params: dict[str, dict[str, dict[str, Any]]] | None = None) -> np.ndarray:
+    """MOTChallenge rows ``(k, 10)`` of ``entry`` on ``seq`` (parameters: :func:`entry_params`).
+    An ``offline`` entry's rows are post-processed with the dataset's :data:`OFFLINE_PARAMS`."""
+    if entry.kind == "peer":
+        return run_peer(entry.name, seq)
+    tracker = make_tracker(entry.name, **entry_params(entry, seq, dataset_params))
+    collect = RowCollector()
+    run(tracker, seq.frames(), collect)
+    rows = collect.rows()
+    if entry.offline:
+        rows = postprocess(rows, seq.frame_rate, OfflineConfig(**OFFLINE_PARAMS.get(seq.dataset, {})))
+    return rows
+
+
+def score_rows(seq: RealSequence, rows: np.ndarray, radius: float = HEXBUG_RADIUS_PX) -> dict[str, float]:
+    """Metrics of result rows against the sequence's ground truth (boxes, or points for HexBug)."""
+    if seq.gt is not None:
+        return evaluate_sequence(seq.gt, MotTable.from_rows(rows), num_frames=seq.length, benchmark=seq.benchmark)
+    if seq.gt_points is None:
+        raise ValueError(f"sequence {seq.name}: no ground truth")
+    frame, ids, xy = seq.gt_points
+    centres = rows[:, 2:4] + rows[:, 4:6] / 2
+    return evaluate_points(frame, ids, xy, rows[:, 0].astype(int), rows[:, 1].astype(int), centres,
+                           radius=radius, num_frames=seq.length)
+
+
+def run_job(job: tuple[Entry, RealSequence]) -> dict[str, Any]:
+    """Track and score one (entry, sequence); a failing tracker gives ``error`` instead of scores."""
+    entry, seq = job
+    t0 = time.perf_counter()
+    try:
+        rows = track_rows(entry, seq)
+    except Exception as exc:  # noqa: BLE001 - a peer's failure is reported in the table, never fatal
+        return {"error": f"{type(exc).__name__}: {exc}"[:300], "frames": seq.length, "seconds": 0.0}
+    seconds = time.perf_counter() - t0
+    return {"scores": score_rows(seq, rows), "frames": seq.length, "seconds": seconds}
+
+
+def _run_pair(entry: Entry, seq: RealSequence) -> dict[str, Any]:
+    return run_job((entry, seq))
+
+
+def map_jobs(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int = 1,
+             backend: str = "local", address: str | None = None) -> list[Any]:
+    """``[fn(x) for x in items]`` serially, in ``workers`` processes, or as Ray tasks (in order)."""
+    with JobPool(min(workers, max(len(items), 1)), backend, address) as pool:
+        return pool.map(fn, items)
+
+
+def job_pairs(entries: Sequence[Entry], sequences: Sequence[RealSequence]) -> list[tuple[Entry, RealSequence]]:
+    """``(entry, sequence)`` for every sequence and entry; closed-set entries only where the count is
+    known, ``only_where_tuned`` entries only on datasets with per-sequence parameters for their tracker,
+    ``offline`` entries only on datasets whose post-processing was chosen (:data:`OFFLINE_PARAMS`)."""
+    return [(e, s) for s in sequences for e in entries
+            if not (e.closed_set and s.n_targets is None)
+            and not (e.only_where_tuned and e.name not in SEQUENCE_PARAMS.get(s.dataset, {}))
+            and not (e.offline and s.dataset not in OFFLINE_PARAMS)]
+
+
+def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, workers: int = 1,
+             backend: str = "local", address: str | None = None) -> list[dict[str, Any]]:
+    """Results of :func:`job_pairs`, in its order."""
+    jobs = job_pairs(entries, sequences)
+    with JobPool(min(workers, max(len(jobs), 1)), backend, address) as pool:
+        shared = {id(s): pool.share(s) for s in sequences}  # each sequence shipped once
+        return [p.result() for p in [pool.submit(_run_pair, e, shared[id(s)]) for e, s in jobs]]
+
+
+__all__ = ["DATASET_PARAMS", "HEXBUG_RADIUS_PX", "OFFLINE_PARAMS", "SEQUENCE_PARAMS", "Entry", "base_name",
+           "default_entries", "entry_params", "job_pairs", "map_jobs", "run_job", "run_jobs", "score_rows",
+           "sequence_params", "track_rows"]

@@ -1,0 +1,186 @@
+"""Streaming MOTChallenge input and output for :func:`lookalike.loop.run`: frames read lazily from a
+detection file, and result rows written as they come to a file that appears atomically at the end.
+
+:class:`DetectionStream` checks the whole file first (chunk by chunk, constant memory: the same
+errors as :func:`~lookalike.io.read_mot`, before any frame is produced), then yields one
+:class:`~lookalike.types.Frame` per frame, parsing the file again a chunk at a time. A file whose
+frame numbers ever decrease (allowed, but unusual) or whose lines have differing column counts is
+read whole instead; either way the frames equal :func:`~lookalike.io.frames_from_table`'s.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import tempfile
+import warnings
+from collections.abc import Iterator
+from pathlib import Path
+from types import TracebackType
+from typing import Any, TextIO
+
+import numpy as np
+
+from lookalike.io.motchallenge import frames_from_table, read_mot
+from lookalike.types import Detections, Frame
+from lookalike.types.mot_table import format_row, tracks_to_rows
+
+CHUNK_LINES = 65_536
+
+
+def _chunks(path: Path, lines: int) -> Iterator[np.ndarray]:
+    """The file's rows, ``lines`` text lines at a time, parsed by numpy's C parser (``(k, c)``)."""
+    with open(path) as fh:
+        while True:
+            block = list(itertools.islice(fh, lines))
+            if not block:
+                return
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # a block of blank lines warns
+                data = np.loadtxt(block, delimiter=",", ndmin=2)
+            if data.size:
+                yield data
+
+
+class DetectionStream:
+    """The frames of a MOTChallenge detection file, produced lazily.
+
+    Args:
+        path: the detection file (``det.txt``).
+        length: number of frames (frames ``0 .. length-1``; rows past it are ignored), or None for
+            the last frame in the file.
+        frame_rate: frames per second (``time = index / frame_rate``).
+        min_score: boxes with a lower score are dropped.
+        chunk_lines: lines parsed at a time.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], length: int | None = None, frame_rate: float = 30.0,
+                 min_score: float = -np.inf, chunk_lines: int = CHUNK_LINES) -> None:
+        if frame_rate <= 0:
+            raise ValueError(f"frame_rate must be positive, got {frame_rate}")
+        self.path, self.length, self.frame_rate = Path(path), length, frame_rate
+        self.min_score, self.chunk_lines = min_score, chunk_lines
+        self._streamable: bool | None = None
+
+    def check(self) -> DetectionStream:
+        """Read the file once (constant memory); raise ``ValueError`` / ``FileNotFoundError`` as
+        :func:`~lookalike.io.read_mot` does for a malformed file. Returns ``self``."""
+        if not self.path.is_file():
+            raise FileNotFoundError(f"{self.path}: no such file")
+        last, width = 0, None
+        try:
+            for data in _chunks(self.path, self.chunk_lines):
+                frames = data[:, 0]
+                bad = (data.shape[1] < 6 or (width is not None and data.shape[1] != width)
+                       or not np.isfinite(data[:, :6]).all() or (data[:, 4:6] < 0).any() or frames.min() < 1
+                       or frames[0] < last or (np.diff(frames) < 0).any())
+                if bad:
+                    raise ValueError
+                width, last = data.shape[1], frames[-1]
+            self._streamable = True
+        except ValueError:
+            read_mot(self.path)  # raises the precise error, or the file is valid but irregular
+            self._streamable = False
+        return self
+
+    def __iter__(self) -> Iterator[Frame]:
+        if self._streamable is None:
+            self.check()
+        if not self._streamable:
+            table = read_mot(self.path)
+            yield from frames_from_table(table, self.length, self.frame_rate, self.min_score)
+            return
+        yield from self._stream()
+
+    def _frame(self, index: int, xywh: np.ndarray, score: np.ndarray) -> Frame:
+        return Frame(index=index, time=index / self.frame_rate, detections=Detections(xywh=xywh, score=score))
+
+    def _stream(self) -> Iterator[Frame]:
+        empty = self._frame  # frames without rows
+        nxt = 0  # index of the next frame to yield
+        pending: list[np.ndarray] = []  # rows of frame ``nxt`` seen so far (it may span chunks)
+        end = self.length
+        for data in _chunks(self.path, self.chunk_lines):
+            if end is not None:
+                data = data[data[:, 0] <= end]
+            if not len(data):
+                continue
+            frames = data[:, 0].astype(int) - 1  # 0-based, non-decreasing
+            cuts = np.flatnonzero(np.diff(frames)) + 1
+            for block in np.split(data, cuts):
+                index = int(block[0, 0]) - 1
+                if index > nxt:
+                    if pending:
+                        yield self._emit(nxt, pending)
+                        pending, nxt = [], nxt + 1
+                    while nxt < index:
+                        yield empty(nxt, np.zeros((0, 4)), np.zeros(0))
+                        nxt += 1
+                pending.append(block)
+        if pending:
+            yield self._emit(nxt, pending)
+            nxt += 1
+        while end is not None and nxt < end:
+            yield empty(nxt, np.zeros((0, 4)), np.zeros(0))
+            nxt += 1
+
+    def _emit(self, index: int, blocks: list[np.ndarray]) -> Frame:
+        data = blocks[0] if len(blocks) == 1 else np.vstack(blocks)
+        conf = data[:, 6].copy() if data.shape[1] > 6 else np.ones(len(data))
+        keep = conf >= self.min_score
+        return self._frame(index, data[keep, 2:6].copy(), conf[keep])
+
+
+class MotWriter:
+    """A sink for :func:`lookalike.loop.run` that writes MOTChallenge result rows as they come.
+
+    Rows go to a temporary file beside ``path``; :meth:`close` renames it to ``path`` (atomic), and
+    leaving a ``with`` block on an exception deletes it, so a failed run never leaves a half file.
+    """
+
+    def __init__(self, path: str | os.PathLike[str]) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", dir=self.path.parent)
+        self._tmp = Path(tmp)
+        self._fh: TextIO | None = os.fdopen(fd, "w")
+        self.rows = 0
+
+    def __call__(self, frame: Frame, tracks: Any) -> None:
+        self.write_rows(tracks_to_rows(frame.index, tracks))
+
+    def write_rows(self, rows: np.ndarray) -> None:
+        """Append result rows ``(k, 10)``."""
+        if self._fh is None:
+            raise ValueError(f"{self.path}: writer already closed")
+        for row in rows:
+            self._fh.write(format_row(row))
+        self.rows += len(rows)
+
+    def close(self) -> Path:
+        """Finish the file: rename the temporary file to ``path``. Returns ``path``."""
+        if self._fh is not None:
+            self._fh.close()
+            self._fh = None
+            os.replace(self._tmp, self.path)
+        return self.path
+
+    def abort(self) -> None:
+        """Drop the temporary file; ``path`` is left as it was."""
+        if self._fh is not None:
+            self._fh.close()
+            self._fh = None
+            self._tmp.unlink(missing_ok=True)
+
+    def __enter__(self) -> MotWriter:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        if kind is None:
+            self.close()
+        else:
+            self.abort()
+
+
+__all__ = ["CHUNK_LINES", "DetectionStream", "MotWriter"]

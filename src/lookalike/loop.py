@@ -1,0 +1,90 @@
+"""The one frame loop: feed frames to a tracker in order and hand each frame's tracks to a sink.
+
+``run(tracker, frames, sink)`` pulls frames one at a time from any iterable (a generator reading a
+file lazily, a simulated sequence, a list) and passes ``(frame, tracks)`` to ``sink`` at once, so
+nothing is kept per frame here: memory stays constant in the number of frames when the frames are
+produced lazily and the sink streams (e.g. :class:`lookalike.io.stream.MotWriter`). It times the
+tracker's ``update`` calls alone.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+from lookalike.types import Frame
+from lookalike.types.mot_table import stack_rows, tracks_to_rows
+
+
+class Updating(Protocol):
+    """What the loop needs of a tracker (every registered tracker has it)."""
+
+    def update(self, frame: Frame) -> Any:
+        """Process one frame; return the tracks reported for it (iterable of ``TrackSnapshot``)."""
+        ...
+
+
+Sink = Callable[[Frame, Any], None]
+
+
+@dataclass
+class RunStats:
+    """What one :func:`run` did: frames processed and seconds spent in the tracker's ``update``."""
+
+    frames: int = 0
+    seconds: float = 0.0
+
+    @property
+    def fps(self) -> float:
+        """Frames per second of the tracker alone (inf when no time was measured)."""
+        return self.frames / self.seconds if self.seconds > 0 else float("inf")
+
+
+def run(tracker: Updating, frames: Iterable[Frame], sink: Sink | None = None, *,
+        stats: RunStats | None = None) -> RunStats:
+    """Run ``tracker`` over ``frames`` in order, calling ``sink(frame, tracks)`` after every frame.
+
+    ``stats``: accumulate into an existing :class:`RunStats` (several sequences, one total).
+    Returns the stats (frames, tracker seconds).
+    """
+    stats = RunStats() if stats is None else stats
+    for frame in frames:
+        t0 = time.perf_counter()
+        tracks = tracker.update(frame)
+        stats.seconds += time.perf_counter() - t0
+        stats.frames += 1
+        if sink is not None:
+            sink(frame, tracks)
+    return stats
+
+
+class RowCollector:
+    """A sink that keeps the MOTChallenge rows of every frame in memory (small sequences: benches)."""
+
+    def __init__(self) -> None:
+        self._chunks: list[np.ndarray] = []
+
+    def __call__(self, frame: Frame, tracks: Any) -> None:
+        self._chunks.append(tracks_to_rows(frame.index, tracks))
+
+    def rows(self) -> np.ndarray:
+        """All rows so far, ``(n, 10)``."""
+        return stack_rows(self._chunks)
+
+
+class Sinks:
+    """Several sinks called in turn (e.g. a file writer and a progress bar)."""
+
+    def __init__(self, *sinks: Sink | None) -> None:
+        self._sinks = [s for s in sinks if s is not None]
+
+    def __call__(self, frame: Frame, tracks: Any) -> None:
+        for sink in self._sinks:
+            sink(frame, tracks)
+
+
+__all__ = ["RowCollector", "RunStats", "Sink", "Sinks", "Updating", "run"]
