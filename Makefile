@@ -2,11 +2,11 @@
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
-EXTRAS ?= test,vision,viz,train
+EXTRAS ?= test,vision,viz,train,docs
 comma := ,
 STAMP := $(VENV)/.installed-$(subst $(comma),-,$(EXTRAS))
 
-.PHONY: venv demo test bench clean browser train train-base train-refine
+.PHONY: venv demo test docs bench clean browser train train-base train-refine
 
 venv: $(STAMP)
 
@@ -19,8 +19,12 @@ $(STAMP): pyproject.toml constraints.txt
 demo: venv
 	$(VENV)/bin/lookalike demo
 
-test: venv browser
+test: venv browser docs
 	$(PY) -m pytest -q
+
+# The documentation site (mkdocs.yml, docs/), built strictly into a temporary folder.
+docs: venv
+	@out=$$(mktemp -d) && NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet -d "$$out" && rm -rf "$$out" && echo "docs: mkdocs build --strict passed"
 
 # Debian's Chromium for the browser tests; skipped quietly where it cannot be installed
 # (the tests then skip with a reason).
