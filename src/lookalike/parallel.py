@@ -9,8 +9,9 @@ Jobs must be picklable top-level callables whose result depends only on their ar
 from __future__ import annotations
 
 import multiprocessing
+from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
-from typing import Any, Callable, Sequence
+from typing import Any
 
 BACKENDS = ("local", "ray")
 
@@ -70,7 +71,7 @@ class JobPool:
             self._pool.shutdown(cancel_futures=True)
             self._pool = None
 
-    def __enter__(self) -> "JobPool":
+    def __enter__(self) -> JobPool:
         return self
 
     def __exit__(self, *exc: object) -> None:

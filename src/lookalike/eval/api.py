@@ -6,7 +6,7 @@ numbers. A result dict holds the metrics and the counts needed to combine it wit
 
 from __future__ import annotations
 
-from typing import Iterable, Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 

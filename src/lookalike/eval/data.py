@@ -7,6 +7,7 @@ so that metrics can index dense arrays with them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -41,7 +42,7 @@ class SequenceData:
     def num_tracker_dets(self) -> int:
         return int(sum(len(t) for t in self.tracker_ids))
 
-    def pairs(self) -> "Pairs":
+    def pairs(self) -> Pairs:
         """Every ``(gt, tracker)`` pair of every frame with a positive similarity, flattened."""
         frames, rows, cols, gts, trs, sims = [], [], [], [], [], []
         g_off = t_off = 0
@@ -55,7 +56,10 @@ class SequenceData:
             sims.append(sim[r, c])
             g_off += sim.shape[0]
             t_off += sim.shape[1]
-        cat = (lambda parts, dt: np.concatenate(parts).astype(dt) if parts else np.zeros(0, dt))
+
+        def cat(parts: list[Any], dt: type) -> np.ndarray:
+            return np.concatenate(parts).astype(dt) if parts else np.zeros(0, dt)
+
         return Pairs(
             frame=cat(frames, int),
             gt_det=cat(rows, int),

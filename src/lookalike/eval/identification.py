@@ -8,7 +8,7 @@ the agent is absent (truth) or has no estimate (estimated).
 
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -26,7 +26,9 @@ def _flatten_labels(predicted: Sequence[np.ndarray], true: Sequence[np.ndarray])
                 raise ValueError(f"frame {k}: {name} must be integers >= -1")
         p_parts.append(p.astype(int))
         t_parts.append(t.astype(int))
-    cat = (lambda parts: np.concatenate(parts) if parts else np.zeros(0, int))
+    def cat(parts: list[np.ndarray]) -> np.ndarray:
+        return np.concatenate(parts) if parts else np.zeros(0, int)
+
     return cat(p_parts), cat(t_parts)
 
 

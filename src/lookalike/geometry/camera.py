@@ -62,7 +62,7 @@ class Intrinsics:
             object.__setattr__(self, name, int(v))
 
     @classmethod
-    def from_fov(cls, width: int, height: int, hfov_rad: float) -> "Intrinsics":
+    def from_fov(cls, width: int, height: int, hfov_rad: float) -> Intrinsics:
         """Square pixels, principal point at the image centre, horizontal field of view ``hfov_rad``."""
         if not 0 < hfov_rad < math.pi:
             raise ValueError(f"Intrinsics.from_fov: hfov_rad must be in (0, π), got {hfov_rad!r}")
@@ -121,7 +121,7 @@ class Camera:
         object.__setattr__(self, "_r", r)
 
     @classmethod
-    def default(cls, width: int = 640, height: int = 480) -> "Camera":
+    def default(cls, width: int = 640, height: int = 480) -> Camera:
         """A robot-head camera: 0.9 m high, 25° down, 70° horizontal field of view."""
         return cls(Intrinsics.from_fov(width, height, math.radians(70.0)), Extrinsics(0.9, math.radians(25.0)))
 
@@ -168,7 +168,9 @@ class Camera:
         return out
 
     def box_to_ground(self, xywh: np.ndarray) -> np.ndarray:
-        """Ground positions ``(n, 2)`` (m) of the bottom-centres of boxes ``xywh (n, 4)`` (px); NaN above the horizon."""
+        """Ground positions ``(n, 2)`` (m) of the bottom-centres of boxes ``xywh (n, 4)`` (px).
+
+        NaN above the horizon."""
         b = _rows("xywh", xywh, 4)
         return self.pixels_to_ground(np.column_stack([b[:, 0] + 0.5 * b[:, 2], b[:, 1] + b[:, 3]]))
 
@@ -234,7 +236,7 @@ class Pose2D:
         h = np.asarray(heading_rad, dtype=float) - self.heading_rad
         return np.pi - np.mod(np.pi - h, 2.0 * np.pi)
 
-    def compose(self, dx_m: float, dy_m: float, dheading_rad: float) -> "Pose2D":
+    def compose(self, dx_m: float, dy_m: float, dheading_rad: float) -> Pose2D:
         """The pose after an odometry step ``(dx, dy, dθ)`` measured in this pose's own frame."""
         c, s = math.cos(self.heading_rad), math.sin(self.heading_rad)
         h = self.heading_rad + float(dheading_rad)
@@ -244,7 +246,7 @@ class Pose2D:
             _wrap(h),
         )
 
-    def relative_to(self, other: "Pose2D") -> tuple[float, float, float]:
+    def relative_to(self, other: Pose2D) -> tuple[float, float, float]:
         """The odometry step ``(dx, dy, dθ)`` that takes ``other`` to this pose (in ``other``'s frame)."""
         d = other.fixed_to_ego(np.array([[self.x_m, self.y_m]]))[0]
         return float(d[0]), float(d[1]), _wrap(self.heading_rad - other.heading_rad)

@@ -95,7 +95,9 @@ def encode_slots(
     if spec.relative_headings:
         if agent_heading_rad is None:
             raise ValueError("relative_headings needs the agents' latest headings")
-        slots[:n, SLOT_WIDTH:] = relative_headings(np.asarray(heading_rad)[None], np.asarray(agent_heading_rad)[None])[0]
+        slots[:n, SLOT_WIDTH:] = relative_headings(
+            np.asarray(heading_rad)[None], np.asarray(agent_heading_rad)[None]
+        )[0]
     return slots.reshape(-1)
 
 
@@ -104,7 +106,8 @@ def relative_headings(slot_heading_rad: np.ndarray, agent_heading_rad: np.ndarra
     and ``(..., N)``; zeros for agents whose heading is NaN."""
     agent = np.asarray(agent_heading_rad, dtype=float)
     known = np.isfinite(agent)[..., None, :]
-    diff = np.asarray(slot_heading_rad, dtype=float)[..., :, None] - np.where(np.isfinite(agent), agent, 0.0)[..., None, :]
+    agent_or_zero = np.where(np.isfinite(agent), agent, 0.0)
+    diff = np.asarray(slot_heading_rad, dtype=float)[..., :, None] - agent_or_zero[..., None, :]
     out = np.stack([np.where(known, np.cos(diff), 0.0), np.where(known, np.sin(diff), 0.0)], axis=-1)
     return out.reshape(*out.shape[:-2], out.shape[-2] * out.shape[-1])
 

@@ -48,7 +48,8 @@ class AssociationNet(nn.Module):
             raise ValueError(f"weights of (spec, cell, hidden, layers) {theirs} do not fit this network {mine}")
         with torch.no_grad():
             for i, layer in enumerate(weights.layers):
-                for ours, key in (("weight_ih", "w_ih"), ("weight_hh", "w_hh"), ("bias_ih", "b_ih"), ("bias_hh", "b_hh")):
+                names = (("weight_ih", "w_ih"), ("weight_hh", "w_hh"), ("bias_ih", "b_ih"), ("bias_hh", "b_hh"))
+                for ours, key in names:
                     getattr(self.rnn, f"{ours}_l{i}").copy_(torch.as_tensor(layer[key]))
             self.head.weight.copy_(torch.as_tensor(weights.head_weight))
             self.head.bias.copy_(torch.as_tensor(weights.head_bias))
@@ -63,8 +64,8 @@ class AssociationNet(nn.Module):
                  for name in ("weight_ih", "weight_hh", "bias_ih", "bias_hh")}
             )
         layers = [
-            {"w_ih": l["weight_ih"], "w_hh": l["weight_hh"], "b_ih": l["bias_ih"], "b_hh": l["bias_hh"]}
-            for l in layers
+            {"w_ih": lay["weight_ih"], "w_hh": lay["weight_hh"], "b_ih": lay["bias_ih"], "b_hh": lay["bias_hh"]}
+            for lay in layers
         ]
         return NetworkWeights(
             spec=self.spec,

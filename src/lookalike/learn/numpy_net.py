@@ -23,7 +23,12 @@ class NumpyAssociationNet:
         self.weights = weights
         self.spec = weights.spec
         self._layers = [
-            (layer["w_ih"].T.copy(), layer["w_hh"].T.copy(), layer["b_ih"] + (layer["b_hh"] if weights.cell == "lstm" else 0), layer["b_hh"])
+            (
+                layer["w_ih"].T.copy(),
+                layer["w_hh"].T.copy(),
+                layer["b_ih"] + (layer["b_hh"] if weights.cell == "lstm" else 0),
+                layer["b_hh"],
+            )
             for layer in weights.layers
         ]
         self._inv_std = 1.0 / weights.input_std

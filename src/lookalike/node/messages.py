@@ -282,7 +282,8 @@ def _team(f: _Fields) -> TeamState:
         sub = _Fields(f"team.robots[{i}]", item)
         sub.used.clear()
         pos = cast(tuple[float, float], sub.numbers("position", 2))
-        robots.append(RobotEstimate(id=sub.integer("id"), position=(pos[0], pos[1]), heading=sub.number("heading", True),
+        robots.append(RobotEstimate(id=sub.integer("id"), position=(pos[0], pos[1]),
+                                    heading=sub.number("heading", True),
                                     confidence=sub.number("confidence", True), age=sub.number("age")))  # type: ignore[arg-type]
         sub.finish()
     labels = f._get("labels")

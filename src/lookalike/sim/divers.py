@@ -107,7 +107,8 @@ VALIDATION_SCENARIOS: tuple[DiverScenario, ...] = (
     _s("val_ocean_four_murky", 902, n_divers=4, turbidity=0.6, attenuation=0.25, detector=DetectorModel(0.65, 0.6)),
     _s("val_pool_trio", 903, n_divers=3, pool=True, attenuation=0.06, turbidity=0.05, blur_per_m=0.1,
        detector=DetectorModel(0.9, 0.2)),
-    _s("val_ocean_four_bubbles", 904, n_divers=4, bubble_rate=0.08, leave_rate=0.008, detector=DetectorModel(0.75, 0.5)),
+    _s("val_ocean_four_bubbles", 904, n_divers=4, bubble_rate=0.08, leave_rate=0.008,
+       detector=DetectorModel(0.75, 0.5)),
 )
 
 
@@ -257,12 +258,8 @@ def simulate_divers(sc: DiverScenario) -> DiverScene:
         for i in range(n):
             if state[i] == 2:
                 away_left[i] -= 1
-                if away_left[i] <= 0:  # come back at a random side edge, swimming inwards
-                    side = rng.choice([-1.0, 1.0])
-                    z[i] = rng.uniform(3.0, 7.5)
-                    half = 0.9 * sc.focal_px / z[i]
-                    pos[i] = [camera[0] + (w + half if side > 0 else -half), camera[1] + rng.uniform(0.25 * h, 0.75 * h)]
-                    vel[i] = [-side * rng.uniform(2.5, 4.5), rng.normal(0, 0.5)]
+                if away_left[i] <= 0:
+                    _come_back(i, sc, rng, camera, pos, vel, z)
                     state[i] = 0
                 continue
             if state[i] == 0 and rng.random() < sc.leave_rate:
@@ -299,24 +296,13 @@ def simulate_divers(sc: DiverScenario) -> DiverScene:
                 m = rng.integers(5, 16)
                 clouds.append(np.column_stack([head + rng.normal(0, 6, (m, 2)), rng.uniform(2, 6, m) * 4 / z[i],
                                                np.zeros(m)]))
-        frame_poses: list[Pose | None] = []
-        for i in range(n):
-            if state[i] == 2:
-                frame_poses.append(None)
-                continue
-            rel = pos[i] - camera
-            frame_poses.append(Pose(float(rel[0]), float(rel[1]), float(z[i]), float(facing[i]), float(pitch[i]),
-                                    float(phase[i]), float(arms[i])))
-        # bubbles rise, spread and grow, then vanish
-        alive = []
-        for c in clouds:
-            c[:, 1] -= 3.0 + 0.2 * c[:, 2]
-            c[:, 0] += rng.normal(0, 0.8, len(c))
-            c[:, 2] *= 1.01
-            c[:, 3] += 1
-            if c[0, 3] < 45:
-                alive.append(c)
-        clouds = alive
+        frame_poses: list[Pose | None] = [
+            None if state[i] == 2 else
+            Pose(float(pos[i, 0] - camera[0]), float(pos[i, 1] - camera[1]), float(z[i]), float(facing[i]),
+                 float(pitch[i]), float(phase[i]), float(arms[i]))
+            for i in range(n)
+        ]
+        clouds = _age_bubbles(clouds, rng)
         bub = np.vstack([c[:, :3] for c in clouds]) if clouds else np.zeros((0, 3))
         bub = bub - np.array([camera[0], camera[1], 0.0])
         gt.extend(_truth(k, frame_poses, bub, sc))
@@ -324,6 +310,31 @@ def simulate_divers(sc: DiverScenario) -> DiverScene:
         cams.append(camera.copy())
         bubbles.append(bub)
     return DiverScene(sc, poses, np.array(cams), bubbles, np.array(gt, dtype=float).reshape(-1, 9))
+
+
+def _come_back(i: int, sc: DiverScenario, rng: np.random.Generator, camera: np.ndarray, pos: np.ndarray,
+               vel: np.ndarray, z: np.ndarray) -> None:
+    """Diver ``i`` comes back at a random side edge of the view, swimming inwards (arrays changed in place)."""
+    w, h = sc.image_size
+    side = rng.choice([-1.0, 1.0])
+    z[i] = rng.uniform(3.0, 7.5)
+    half = 0.9 * sc.focal_px / z[i]
+    x_edge = camera[0] + (w + half if side > 0 else -half)
+    pos[i] = [x_edge, camera[1] + rng.uniform(0.25 * h, 0.75 * h)]
+    vel[i] = [-side * rng.uniform(2.5, 4.5), rng.normal(0, 0.5)]
+
+
+def _age_bubbles(clouds: list[np.ndarray], rng: np.random.Generator) -> list[np.ndarray]:
+    """Bubble clouds one frame later: they rise, spread and grow, then vanish after 45 frames."""
+    alive = []
+    for c in clouds:
+        c[:, 1] -= 3.0 + 0.2 * c[:, 2]
+        c[:, 0] += rng.normal(0, 0.8, len(c))
+        c[:, 2] *= 1.01
+        c[:, 3] += 1
+        if c[0, 3] < 45:
+            alive.append(c)
+    return alive
 
 
 def _truth(k: int, poses: list[Pose | None], bubbles: np.ndarray, sc: DiverScenario) -> list[list[float]]:

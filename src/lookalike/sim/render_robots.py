@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lookalike.geometry.camera import Camera, Pose2D
 from lookalike.geometry.angles import wrap_angle
+from lookalike.geometry.camera import Camera, Pose2D
 
 BGR = tuple[int, int, int]
 
@@ -115,7 +115,9 @@ class RobotRenderer:
         texture = np.random.default_rng(self.seed + 7919).normal(0.0, 1.0, (k.height // 4 + 1, k.width // 4 + 1))
         self._texture = np.kron(texture, np.ones((4, 4)))[: k.height, : k.width]
 
-    def render(self, positions_m: np.ndarray, headings_rad: np.ndarray, observer: Pose2D | None = None) -> RenderedFrame:
+    def render(
+        self, positions_m: np.ndarray, headings_rad: np.ndarray, observer: Pose2D | None = None
+    ) -> RenderedFrame:
         """Draw robots at fixed-frame ``positions_m (N, 2)`` with fixed-frame ``headings_rad (N,)``, seen
         by an observer at ``observer`` (fixed frame; default the origin looking along +x)."""
         import cv2

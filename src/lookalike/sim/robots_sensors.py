@@ -42,7 +42,8 @@ def detection_probability(distance_m: np.ndarray, occlusion: np.ndarray, sensor:
     d = np.asarray(distance_m, dtype=float)
     below = np.clip((near - d) / max(near - observer.min_range_m, 1e-9), 0.0, 1.0)
     above = np.clip((d - far) / max(observer.max_range_m - far, 1e-9), 0.0, 1.0)
-    p = sensor.p_detect + below * (sensor.p_detect_near - sensor.p_detect) + above * (sensor.p_detect_far - sensor.p_detect)
+    p = (sensor.p_detect + below * (sensor.p_detect_near - sensor.p_detect)
+         + above * (sensor.p_detect_far - sensor.p_detect))
     return p * np.clip(1.0 - np.asarray(occlusion) / sensor.occlusion_hide, 0.0, 1.0)
 
 

@@ -78,7 +78,9 @@ class CascadeConfig:
         if not 0 <= self.context_pad < 1:
             raise ValueError(f"CascadeConfig.context_pad: must be in [0, 1), got {self.context_pad}")
         if not 0 <= self.hard_negative_max_iou < 1:
-            raise ValueError(f"CascadeConfig.hard_negative_max_iou: must be in [0, 1), got {self.hard_negative_max_iou}")
+            raise ValueError(
+                f"CascadeConfig.hard_negative_max_iou: must be in [0, 1), got {self.hard_negative_max_iou}"
+            )
         if self.scale_step <= 1:
             raise ValueError(f"CascadeConfig.scale_step: must be > 1, got {self.scale_step}")
 
@@ -101,9 +103,10 @@ def block_pool(window_px: tuple[int, int], cell_px: int) -> np.ndarray:
 
 def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
                    unit_px: int = 1) -> np.ndarray:
-    """Descriptors of ``blocks (b, 4)`` (px) for windows at offsets ``ox, oy (k,)`` (px) of ``integral (BINS, H+1, W+1)``
-    whose entries are ``unit_px`` pixels apart (1: a pixel integral; ``cell_px``: an integral of
-    :func:`~lookalike.vision.hog_features.cell_histograms`, all offsets then multiples of it);
+    """Descriptors of ``blocks (b, 4)`` (px) for windows at offsets ``ox, oy (k,)`` (px)
+    of ``integral (BINS, H+1, W+1)`` whose entries are ``unit_px`` pixels apart (1: a pixel integral;
+    ``cell_px``: an integral of :func:`~lookalike.vision.hog_features.cell_histograms`, all offsets
+    then multiples of it);
     returns ``(k, b * 4 * BINS)`` float32."""
     rows = np.ascontiguousarray(np.asarray(integral).transpose(1, 2, 0)).reshape(-1, integral.shape[0])
     return _block_features_rows(rows, integral.shape[2], blocks, ox, oy, unit_px)

@@ -9,8 +9,9 @@ but reject true targets (each keeps ``stage_hit_rate`` of the *training* positiv
 nor a false positive) and keeps the prefix with the best F1, the longer on ties. Then it starts the image
 pyramid one or two levels coarser (smallest window ``min_height_px`` times ``scale_step`` or its square)
 when that loses at most ``f1_tolerance`` of held-out F1: the finest level is the costliest and only
-finds the smallest targets. Last it refits the probability of the kept model: a logistic regression of "this detection is a hit" on the last-stage
-margin of the held-out detections, so that the score of a box estimates its chance of being a target.
+finds the smallest targets. Last it refits the probability of the kept model: a logistic regression
+of "this detection is a hit" on the last-stage margin of the held-out detections, so that the score
+of a box estimates its chance of being a target.
 """
 
 from __future__ import annotations

@@ -21,7 +21,9 @@ def save_model_file(path: str | Path, fmt: str, version: int, header: dict[str, 
     return path
 
 
-def load_model_file(path: str | Path, fmt: str, version: int, what: str) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+def load_model_file(
+    path: str | Path, fmt: str, version: int, what: str
+) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """The header and arrays of a file written by :func:`save_model_file`.
 
     Raises ``ValueError`` naming ``path`` when it is unreadable, of another format (``what`` names

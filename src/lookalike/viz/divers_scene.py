@@ -60,16 +60,7 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
             det = frame.detections
             feats = extractor(image, det.xywh) if len(det) else np.zeros((0, extractor.dim))
             f = Frame(index=k, time=frame.time, detections=det.replace(feature=feats))
-            shown = None
-            for name, tracker in instances.items():
-                t0 = time.perf_counter()
-                tracks = tracker.update(f)
-                elapsed[name] += time.perf_counter() - t0
-                for t in tracks:
-                    if t.xywh is not None:
-                        results[name].append([k + 1, t.track_id, *t.xywh, 1.0, -1, -1, -1])
-                if name == video_tracker:
-                    shown = [t for t in tracks if t.xywh is not None and t.status is TrackStatus.CONFIRMED]
+            shown = _update_all(instances, f, results, elapsed, video_tracker)
             if rerun is not None and shown is not None:
                 rerun.set_time(k, frame.time)
                 rerun.image("divers/camera", image)
@@ -77,15 +68,9 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
                             np.array([t.track_id for t in shown], dtype=int), [f"track {t.track_id}" for t in shown])
             if video is not None and raw is not None and shown is not None:
                 raw.write(image)
-                img = image.copy()
-                taken = {t.detection_index for t in shown}
-                for i in range(len(det)):
-                    if i not in taken:
-                        draw_box(img, det.xywh[i], FALSE_POSITIVE, "unmatched", thickness=1, dashed=True)
-                draw_box_tracks(img, k, np.array([t.track_id for t in shown], dtype=int),
-                                np.array([t.xywh for t in shown]).reshape(-1, 4), tails, prefix="track ")
-                draw_caption(img, [f"{sc.name}: {sc.n_divers} look-alike divers, tracker: {video_tracker}",
-                                   f"frame {k + 1}/{len(frames)}  t = {frame.time:.1f} s"])
+                caption = [f"{sc.name}: {sc.n_divers} look-alike divers, tracker: {video_tracker}",
+                           f"frame {k + 1}/{len(frames)}  t = {frame.time:.1f} s"]
+                img = _annotated(image, k, det.xywh, shown, tails, caption)
                 video.write(img)
                 if (k >= len(frames) // 4 and len(shown) > best_still) or not files["still"].exists():
                     best_still = len(shown) if k >= len(frames) // 4 else -1
@@ -103,10 +88,48 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
         table = np.array(results[name], dtype=float).reshape(-1, 10)
         if out_dir is not None and video_tracker is not None:
             files[f"tracks-{name}"] = write_mot(out_dir / f"divers-{name}.txt", table)
-        s = evaluate_sequence(gt, MotTable.from_rows(table), num_frames=len(frames))
-        rows.append({
-            "Scenario": sc.name, "Tracker": name, "IDF1": round(100 * s["IDF1"], 1), "HOTA": round(100 * s["HOTA"], 1),
-            "MOTA": round(100 * s["MOTA"], 1), "IDSW": int(s["IDSW"]),
-            "Frames/s": round(len(frames) / elapsed[name], 1) if elapsed[name] > 0 else float("inf"),
-        })
+        rows.append(_score_row(sc.name, name, gt, table, len(frames), elapsed[name]))
     return rows, files
+
+
+def _score_row(scenario: str, tracker: str, gt: MotTable, table: np.ndarray, n_frames: int,
+               elapsed_s: float) -> dict[str, Any]:
+    """One results row: IDF1, HOTA, MOTA (%), ID switches and frames per second of ``table`` against ``gt``."""
+    s = evaluate_sequence(gt, MotTable.from_rows(table), num_frames=n_frames)
+    return {
+        "Scenario": scenario, "Tracker": tracker, "IDF1": round(100 * s["IDF1"], 1), "HOTA": round(100 * s["HOTA"], 1),
+        "MOTA": round(100 * s["MOTA"], 1), "IDSW": int(s["IDSW"]),
+        "Frames/s": round(n_frames / elapsed_s, 1) if elapsed_s > 0 else float("inf"),
+    }
+
+
+def _update_all(instances: dict[str, Any], f: Frame, results: dict[str, list[list[float]]],
+                elapsed: dict[str, float], video_tracker: str | None) -> list[Any] | None:
+    """Update every tracker with frame ``f``, appending MOTChallenge rows to ``results`` and seconds to
+    ``elapsed``; returns the video tracker's confirmed tracks with a box (None without a video tracker)."""
+    shown = None
+    for name, tracker in instances.items():
+        t0 = time.perf_counter()
+        tracks = tracker.update(f)
+        elapsed[name] += time.perf_counter() - t0
+        for t in tracks:
+            if t.xywh is not None:
+                results[name].append([f.index + 1, t.track_id, *t.xywh, 1.0, -1, -1, -1])
+        if name == video_tracker:
+            shown = [t for t in tracks if t.xywh is not None and t.status is TrackStatus.CONFIRMED]
+    return shown
+
+
+def _annotated(image: np.ndarray, k: int, det_xywh: np.ndarray, shown: list[Any], tails: Tails,
+               caption: list[str]) -> np.ndarray:
+    """A copy of ``image`` with the shown tracks (identity colours, tails), the detections no track
+    took (grey, dashed, "unmatched") and ``caption``."""
+    img = image.copy()
+    taken = {t.detection_index for t in shown}
+    for i in range(len(det_xywh)):
+        if i not in taken:
+            draw_box(img, det_xywh[i], FALSE_POSITIVE, "unmatched", thickness=1, dashed=True)
+    draw_box_tracks(img, k, np.array([t.track_id for t in shown], dtype=int),
+                    np.array([t.xywh for t in shown]).reshape(-1, 4), tails, prefix="track ")
+    draw_caption(img, caption)
+    return img

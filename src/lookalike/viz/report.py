@@ -94,7 +94,8 @@ class HtmlReport:
         """A link to ``target`` (e.g. a video), written relative to the folder ``relative_to``."""
         t = Path(target)
         href = os.path.relpath(t, relative_to) if relative_to is not None else str(t)
-        self._blocks.append(f'<p><a href="{html.escape(Path(href).as_posix(), quote=True)}">{html.escape(text)}</a></p>')
+        link = html.escape(Path(href).as_posix(), quote=True)
+        self._blocks.append(f'<p><a href="{link}">{html.escape(text)}</a></p>')
 
     def code(self, text: str) -> None:
         """A preformatted block (commands to try)."""

@@ -136,145 +136,154 @@ def _int(query: dict[str, list[str]], name: str, default: int) -> int:
         raise _BadRequest(HTTPStatus.BAD_REQUEST, f"query parameter {name} must be an integer") from None
 
 
+class _Handler(BaseHTTPRequestHandler):
+    """Routes of the labelling app; :func:`make_handler` binds ``app`` and ``log_sink``."""
+
+    app: LabelApp
+    log_sink: Callable[[str], None] | None = None
+    server_version = "lookalike-label"
+    timeout = 30  # seconds a connection may stay silent
+
+    def log_message(self, format: str, *args: Any) -> None:
+        if self.log_sink is not None:
+            self.log_sink(f"{self.address_string()} {format % args}")
+
+    def _send(self, status: HTTPStatus, body: bytes, content_type: str) -> None:
+        self.send_response(status)
+        self.send_header("Content-Type", content_type)
+        self.send_header("Content-Length", str(len(body)))
+        self.send_header("Cache-Control", "no-store")
+        self.send_header("X-Content-Type-Options", "nosniff")
+        self.end_headers()
+        if self.command != "HEAD":
+            self.wfile.write(body)
+
+    def _json(self, payload: Any, status: HTTPStatus = HTTPStatus.OK) -> None:
+        self._send(status, json.dumps(payload, allow_nan=False).encode(), "application/json")
+
+    def _check_host(self) -> None:
+        host = (self.headers.get("Host") or "").rsplit(":", 1)[0].strip("[]").lower()
+        bound = self.server.server_address[0]
+        if bound in ("127.0.0.1", "::1", "localhost") and host not in ("127.0.0.1", "localhost", "::1"):
+            raise _BadRequest(HTTPStatus.FORBIDDEN, f"unexpected Host header {host!r}")
+
+    def _dispatch(self, route: Callable[[], None]) -> None:
+        try:
+            self._check_host()
+            route()
+        except _BadRequest as exc:
+            self._json({"error": str(exc)}, exc.status)
+        except ValueError as exc:
+            self._json({"error": str(exc)}, HTTPStatus.BAD_REQUEST)
+        except (BrokenPipeError, ConnectionResetError):
+            pass
+        except Exception as exc:  # noqa: BLE001 (a bug must not take the server down)
+            self._json({"error": f"internal error: {exc!r}"}, HTTPStatus.INTERNAL_SERVER_ERROR)
+
+    def do_GET(self) -> None:
+        self._dispatch(self._get)
+
+    def do_HEAD(self) -> None:
+        self._dispatch(self._get)
+
+    def do_POST(self) -> None:
+        self._dispatch(self._post)
+
+    def _get(self) -> None:
+        url = urlsplit(self.path)
+        query = parse_qs(url.query)
+        path = url.path
+        if path in ("/", "/index.html"):
+            self._static("index.html")
+        elif path.startswith("/static/"):
+            self._static(path[len("/static/"):])
+        elif path.startswith("/files/"):
+            self._file(path[len("/files/"):])
+        elif path == "/api/meta":
+            self._json(self.app.meta())
+        elif path == "/api/frames":
+            start, count = _int(query, "start", 0), _int(query, "count", 100)
+            if start < 0 or not 0 < count <= MAX_FRAMES_PER_REQUEST:
+                raise _BadRequest(
+                    HTTPStatus.BAD_REQUEST, f"need start >= 0 and 0 < count <= {MAX_FRAMES_PER_REQUEST}"
+                )
+            self._json({"frames": self.app.frames(start, count)})
+        elif path == "/api/labels":
+            self._json({"labels": self.app.store.snapshot(), "benchmark": self.app.store.benchmark})
+        elif path == "/api/score":
+            bench = self.app.store.benchmark
+            if self.app.benchmark and not (bench and bench.get("finished_at") is not None):
+                raise _BadRequest(HTTPStatus.FORBIDDEN, "the score is shown when the benchmark session ends")
+            self._json(self.app.score())
+        else:
+            raise _BadRequest(HTTPStatus.NOT_FOUND, f"no such page {path!r}")
+
+    def _static(self, name: str) -> None:
+        if name not in {p.name for p in STATIC_DIR.iterdir() if p.is_file()}:
+            raise _BadRequest(HTTPStatus.NOT_FOUND, f"no static file {name!r}")
+        p = STATIC_DIR / name
+        self._send(HTTPStatus.OK, p.read_bytes(), mimetypes.guess_type(p.name)[0] or "application/octet-stream")
+
+    def _file(self, rel: str) -> None:
+        rel = unquote(rel)
+        if "\x00" in rel:
+            raise _BadRequest(HTTPStatus.BAD_REQUEST, "NUL in path")
+        target = (self.app.folder / rel).resolve()
+        if not target.is_relative_to(self.app.folder) or target == self.app.folder:
+            raise _BadRequest(HTTPStatus.FORBIDDEN, "outside the sequence folder")
+        if not target.is_file():
+            raise _BadRequest(HTTPStatus.NOT_FOUND, f"no file {rel!r}")
+        ctype = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
+        self._send(HTTPStatus.OK, target.read_bytes(), ctype)
+
+    def _body(self) -> dict[str, Any]:
+        ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
+        if ctype != "application/json":
+            raise _BadRequest(HTTPStatus.UNSUPPORTED_MEDIA_TYPE, "POST bodies must be application/json")
+        try:
+            length = int(self.headers.get("Content-Length", ""))
+        except ValueError:
+            raise _BadRequest(HTTPStatus.LENGTH_REQUIRED, "Content-Length required") from None
+        if not 0 <= length <= MAX_BODY_BYTES:
+            raise _BadRequest(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"body over {MAX_BODY_BYTES} bytes")
+        raw = self.rfile.read(length) if length else b"{}"
+        try:
+            body = json.loads(raw)
+        except (json.JSONDecodeError, UnicodeDecodeError):
+            raise _BadRequest(HTTPStatus.BAD_REQUEST, "body is not JSON") from None
+        if not isinstance(body, dict):
+            raise _BadRequest(HTTPStatus.BAD_REQUEST, "body must be a JSON object")
+        return body
+
+    def _post(self) -> None:
+        path = urlsplit(self.path).path
+        body = self._body()
+        if path == "/api/label":
+            missing = [k for k in ("frame", "detection", "label") if k not in body]
+            if missing:
+                raise _BadRequest(HTTPStatus.BAD_REQUEST, f"missing {', '.join(missing)}")
+            self.app.store.set_label(body["frame"], body["detection"], body["label"])
+            self._json({"ok": True})
+        elif path == "/api/benchmark/start":
+            if not self.app.benchmark:
+                raise _BadRequest(HTTPStatus.CONFLICT, "not in benchmark mode")
+            self._json({"benchmark": self.app.store.start_benchmark()})
+        elif path == "/api/benchmark/finish":
+            if not self.app.benchmark:
+                raise _BadRequest(HTTPStatus.CONFLICT, "not in benchmark mode")
+            self._json({"benchmark": self.app.store.finish_benchmark(self.app.truth)})
+        elif path == "/api/export":
+            self._json(self.app.export())
+        else:
+            raise _BadRequest(HTTPStatus.NOT_FOUND, f"no such action {path!r}")
+
+
 def make_handler(app: LabelApp, log: Callable[[str], None] | None = None) -> type[BaseHTTPRequestHandler]:
     """A request handler class bound to ``app`` (``log`` receives one line per request)."""
-
-    class Handler(BaseHTTPRequestHandler):
-        server_version = "lookalike-label"
-        timeout = 30  # seconds a connection may stay silent
-
-        def log_message(self, format: str, *args: Any) -> None:
-            if log is not None:
-                log(f"{self.address_string()} {format % args}")
-
-        def _send(self, status: HTTPStatus, body: bytes, content_type: str) -> None:
-            self.send_response(status)
-            self.send_header("Content-Type", content_type)
-            self.send_header("Content-Length", str(len(body)))
-            self.send_header("Cache-Control", "no-store")
-            self.send_header("X-Content-Type-Options", "nosniff")
-            self.end_headers()
-            if self.command != "HEAD":
-                self.wfile.write(body)
-
-        def _json(self, payload: Any, status: HTTPStatus = HTTPStatus.OK) -> None:
-            self._send(status, json.dumps(payload, allow_nan=False).encode(), "application/json")
-
-        def _check_host(self) -> None:
-            host = (self.headers.get("Host") or "").rsplit(":", 1)[0].strip("[]").lower()
-            bound = self.server.server_address[0]
-            if bound in ("127.0.0.1", "::1", "localhost") and host not in ("127.0.0.1", "localhost", "::1"):
-                raise _BadRequest(HTTPStatus.FORBIDDEN, f"unexpected Host header {host!r}")
-
-        def _dispatch(self, route: Callable[[], None]) -> None:
-            try:
-                self._check_host()
-                route()
-            except _BadRequest as exc:
-                self._json({"error": str(exc)}, exc.status)
-            except ValueError as exc:
-                self._json({"error": str(exc)}, HTTPStatus.BAD_REQUEST)
-            except (BrokenPipeError, ConnectionResetError):
-                pass
-            except Exception as exc:  # noqa: BLE001 (a bug must not take the server down)
-                self._json({"error": f"internal error: {exc!r}"}, HTTPStatus.INTERNAL_SERVER_ERROR)
-
-        def do_GET(self) -> None:
-            self._dispatch(self._get)
-
-        def do_HEAD(self) -> None:
-            self._dispatch(self._get)
-
-        def do_POST(self) -> None:
-            self._dispatch(self._post)
-
-        def _get(self) -> None:
-            url = urlsplit(self.path)
-            query = parse_qs(url.query)
-            path = url.path
-            if path in ("/", "/index.html"):
-                self._static("index.html")
-            elif path.startswith("/static/"):
-                self._static(path[len("/static/"):])
-            elif path.startswith("/files/"):
-                self._file(path[len("/files/"):])
-            elif path == "/api/meta":
-                self._json(app.meta())
-            elif path == "/api/frames":
-                start, count = _int(query, "start", 0), _int(query, "count", 100)
-                if start < 0 or not 0 < count <= MAX_FRAMES_PER_REQUEST:
-                    raise _BadRequest(HTTPStatus.BAD_REQUEST, f"need start >= 0 and 0 < count <= {MAX_FRAMES_PER_REQUEST}")
-                self._json({"frames": app.frames(start, count)})
-            elif path == "/api/labels":
-                self._json({"labels": app.store.snapshot(), "benchmark": app.store.benchmark})
-            elif path == "/api/score":
-                bench = app.store.benchmark
-                if app.benchmark and not (bench and bench.get("finished_at") is not None):
-                    raise _BadRequest(HTTPStatus.FORBIDDEN, "the score is shown when the benchmark session ends")
-                self._json(app.score())
-            else:
-                raise _BadRequest(HTTPStatus.NOT_FOUND, f"no such page {path!r}")
-
-        def _static(self, name: str) -> None:
-            if name not in {p.name for p in STATIC_DIR.iterdir() if p.is_file()}:
-                raise _BadRequest(HTTPStatus.NOT_FOUND, f"no static file {name!r}")
-            p = STATIC_DIR / name
-            self._send(HTTPStatus.OK, p.read_bytes(), mimetypes.guess_type(p.name)[0] or "application/octet-stream")
-
-        def _file(self, rel: str) -> None:
-            rel = unquote(rel)
-            if "\x00" in rel:
-                raise _BadRequest(HTTPStatus.BAD_REQUEST, "NUL in path")
-            target = (app.folder / rel).resolve()
-            if not target.is_relative_to(app.folder) or target == app.folder:
-                raise _BadRequest(HTTPStatus.FORBIDDEN, "outside the sequence folder")
-            if not target.is_file():
-                raise _BadRequest(HTTPStatus.NOT_FOUND, f"no file {rel!r}")
-            ctype = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
-            self._send(HTTPStatus.OK, target.read_bytes(), ctype)
-
-        def _body(self) -> dict[str, Any]:
-            ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
-            if ctype != "application/json":
-                raise _BadRequest(HTTPStatus.UNSUPPORTED_MEDIA_TYPE, "POST bodies must be application/json")
-            try:
-                length = int(self.headers.get("Content-Length", ""))
-            except ValueError:
-                raise _BadRequest(HTTPStatus.LENGTH_REQUIRED, "Content-Length required") from None
-            if not 0 <= length <= MAX_BODY_BYTES:
-                raise _BadRequest(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"body over {MAX_BODY_BYTES} bytes")
-            raw = self.rfile.read(length) if length else b"{}"
-            try:
-                body = json.loads(raw)
-            except (json.JSONDecodeError, UnicodeDecodeError):
-                raise _BadRequest(HTTPStatus.BAD_REQUEST, "body is not JSON") from None
-            if not isinstance(body, dict):
-                raise _BadRequest(HTTPStatus.BAD_REQUEST, "body must be a JSON object")
-            return body
-
-        def _post(self) -> None:
-            path = urlsplit(self.path).path
-            body = self._body()
-            if path == "/api/label":
-                missing = [k for k in ("frame", "detection", "label") if k not in body]
-                if missing:
-                    raise _BadRequest(HTTPStatus.BAD_REQUEST, f"missing {', '.join(missing)}")
-                app.store.set_label(body["frame"], body["detection"], body["label"])
-                self._json({"ok": True})
-            elif path == "/api/benchmark/start":
-                if not app.benchmark:
-                    raise _BadRequest(HTTPStatus.CONFLICT, "not in benchmark mode")
-                self._json({"benchmark": app.store.start_benchmark()})
-            elif path == "/api/benchmark/finish":
-                if not app.benchmark:
-                    raise _BadRequest(HTTPStatus.CONFLICT, "not in benchmark mode")
-                self._json({"benchmark": app.store.finish_benchmark(app.truth)})
-            elif path == "/api/export":
-                self._json(app.export())
-            else:
-                raise _BadRequest(HTTPStatus.NOT_FOUND, f"no such action {path!r}")
-
-    return Handler
+    handler: type[BaseHTTPRequestHandler] = type(
+        "Handler", (_Handler,), {"app": app, "log_sink": None if log is None else staticmethod(log)}
+    )
+    return handler
 
 
 def make_server(app: LabelApp, host: str = "127.0.0.1", port: int = 8765,
