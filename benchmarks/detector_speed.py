@@ -33,7 +33,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # o
 import numpy as np
 
 from lookalike.association import assign
-from lookalike.cli.vision import negative_sampler, rendered_detector_data
+from lookalike.bench.training_data import negative_sampler, rendered_detector_data
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.vision.hog_cascade import CascadeConfig, HogCascade, train_cascade
 from lookalike.vision.hog_features import augment_windows

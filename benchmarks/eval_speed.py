@@ -33,7 +33,7 @@ def _lengths() -> dict[str, int]:
 
 
 def run_lookalike(repeats: int) -> tuple[float, dict[str, dict[str, float]]]:
-    from lookalike.cli.eval import evaluate_folders
+    from lookalike.bench.folders import evaluate_folders
 
     times, result = [], {}
     for _ in range(repeats):

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.cli.track_blobs import blob_config, blob_detection_rows
+from lookalike.viz.blob_video import blob_config, blob_detection_rows
 from lookalike.io import frames_from_table, read_mot, write_mot
 from lookalike.trackers import make_tracker
 

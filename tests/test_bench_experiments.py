@@ -4,24 +4,24 @@ import numpy as np
 from typer.testing import CliRunner
 
 from lookalike.cli import app
-from lookalike.cli.bench_experiments import _pair_hits, _recovery_s, _reindex, _swap_reports
+from lookalike.bench.experiments import pair_hits, recovery_s, reindex, swap_reports
 from lookalike.sim import preset, simulate_robots
 
 
 def test_swap_exchanges_only_reports_in_the_window():
     seq = simulate_robots(preset("m3n2"), 120, seed=3)
     frames = list(seq.frames())
-    swapped = _swap_reports(frames, 1.0, 2.0)
+    swapped = swap_reports(frames, 1.0, 2.0)
     for a, b in zip(frames, swapped):
         inside = (a.beacons.t_sent >= 1.0) & (a.beacons.t_sent < 2.0)
         np.testing.assert_array_equal(b.beacons.agent_id[~inside], a.beacons.agent_id[~inside])
         np.testing.assert_array_equal(b.beacons.agent_id[inside], 1 - a.beacons.agent_id[inside])
 
 
-def test_reindexed_frames_run_forward_in_time():
+def testreindexed_frames_run_forward_in_time():
     seq = simulate_robots(preset("m3n2"), 30, seed=3)
     frames = list(seq.frames())[::-1]
-    out = _reindex(frames)
+    out = reindex(frames)
     assert [f.index for f in out] == list(range(30))
     assert all(b.time > a.time for a, b in zip(out, out[1:]))
     assert out[0].detections is frames[0].detections
@@ -30,12 +30,12 @@ def test_reindexed_frames_run_forward_in_time():
 def test_recovery_time_counts_from_the_restore():
     clean = [(2, 2)] * 100
     swapped = [(0, 2)] * 40 + [(2, 2)] * 60
-    assert _recovery_s(clean, swapped, restore=30, window=10, rate=10.0) == 1.0
-    assert _recovery_s(clean, [(0, 2)] * 100, restore=30, window=10, rate=10.0) == float("inf")
+    assert recovery_s(clean, swapped, restore=30, window=10, rate=10.0) == 1.0
+    assert recovery_s(clean, [(0, 2)] * 100, restore=30, window=10, rate=10.0) == float("inf")
 
 
-def test_pair_hits_count_only_robots_0_and_1():
-    hits = _pair_hits([np.array([0, 1, 2, -1]), np.array([1])], [np.array([0, 0, 2, 1]), np.array([1])])
+def testpair_hits_count_only_robots_0_and_1():
+    hits = pair_hits([np.array([0, 1, 2, -1]), np.array([1])], [np.array([0, 0, 2, 1]), np.array([1])])
     assert hits == [(1, 3), (1, 1)]
 
 
@@ -55,8 +55,8 @@ def test_commands_print_and_write_tables(tmp_path):
 
 
 def test_swapped_pair_is_the_two_most_seen_robots():
-    from lookalike.cli.bench_experiments import _most_seen_pair
+    from lookalike.bench.experiments import most_seen_pair
 
     truth = [np.array([2, -1, 3]), np.array([3, 0]), np.array([3, 2, 1])]
-    assert _most_seen_pair(truth, 4) == (3, 2)
-    assert _most_seen_pair([np.array([-1])], 3) == (0, 1)
+    assert most_seen_pair(truth, 4) == (3, 2)
+    assert most_seen_pair([np.array([-1])], 3) == (0, 1)

@@ -7,7 +7,7 @@ import json
 from typer.testing import CliRunner
 
 from lookalike.cli import app
-from lookalike.cli.bench import IDENT_COLUMNS, ident_table
+from lookalike.bench.ident import IDENT_COLUMNS, ident_table
 
 
 def test_command_writes_json_and_csv(tmp_path):

@@ -14,7 +14,7 @@ pytest.importorskip("matplotlib")
 from typer.testing import CliRunner
 
 from lookalike.cli import app
-from lookalike.cli.demo import QUICK, lstm_status
+from lookalike.bench.demo import QUICK, lstm_status
 from lookalike.viz import read_frames, video_info
 
 runner = CliRunner()

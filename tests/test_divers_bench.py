@@ -11,7 +11,7 @@ pytest.importorskip("lookalike.cli.bench", reason="the bench sub-app (lookalike.
 from typer.testing import CliRunner
 
 from lookalike.cli import app
-from lookalike.cli.bench_divers import COLUMNS, bar_chart, diver_table
+from lookalike.bench.divers import COLUMNS, bar_chart, diver_table
 
 
 def test_table_rows_and_all_row(tmp_path) -> None:

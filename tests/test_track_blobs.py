@@ -9,7 +9,7 @@ import pytest
 from typer.testing import CliRunner
 
 from lookalike.cli import app
-from lookalike.cli.track_blobs import blob_config, blob_detection_rows
+from lookalike.viz.blob_video import blob_config, blob_detection_rows
 from lookalike.io import read_mot
 
 runner = CliRunner()

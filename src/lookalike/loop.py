@@ -21,14 +21,15 @@ from lookalike.types.mot_table import stack_rows, tracks_to_rows
 
 
 class Updating(Protocol):
-    """What the loop needs of a tracker (every registered tracker has it)."""
+    """What the loop needs of a tracker (every registered tracker has it; ``frame`` is usually a
+    :class:`~lookalike.types.Frame`, but any per-frame input the tracker takes will do)."""
 
-    def update(self, frame: Frame) -> Any:
+    def update(self, frame: Any) -> Any:
         """Process one frame; return the tracks reported for it (iterable of ``TrackSnapshot``)."""
         ...
 
 
-Sink = Callable[[Frame, Any], None]
+Sink = Callable[[Any, Any], None]
 
 
 @dataclass
@@ -44,7 +45,7 @@ class RunStats:
         return self.frames / self.seconds if self.seconds > 0 else float("inf")
 
 
-def run(tracker: Updating, frames: Iterable[Frame], sink: Sink | None = None, *,
+def run(tracker: Updating, frames: Iterable[Any], sink: Sink | None = None, *,
         stats: RunStats | None = None) -> RunStats:
     """Run ``tracker`` over ``frames`` in order, calling ``sink(frame, tracks)`` after every frame.
 

@@ -1,199 +1,21 @@
-"""``lookalike bench pixels``: identification from rendered pixels against the simulator's own detections.
-
-For each set-up, held-out robot sequences are simulated (seeds ``seed + 1000·setup + sequence``, the
-default ``seed`` 700000 being disjoint from the renders the detector and heading models train on:
-seeds below 400000) with the observer's field of view set to the camera's, and rendered through
-that camera (:func:`lookalike.cli.track_pixels.render_robot_frames`). Every frame goes once through
-the perception of :class:`~lookalike.vision.pipeline.RobotPipeline` (HOG cascade → heading
-classifier → ground projection); then each identifier runs on those detections, and, for
-comparison, on the simulator's own detections of the same sequences. A pixel detection's true
-robot is the rendered robot whose visible box it overlaps best (Hungarian on IoU, at least
-``--min-iou``), otherwise it is a false positive. Success rate = correct labels / all detections,
-a false positive labelled as such counting as correct.
-
-Identification table: ``Pixels (%)`` and ``Simulated (%)`` success rates, ``Gap (pp)`` = pixels − simulated,
-the detections scored on each side, and the identifier's own frames/s on the pixel detections.
-Perception table: recall of the rendered robots at least half visible, precision, mean absolute error
-of the absolute visual heading of matched detections (degrees), and perception frames/s (detector +
-heading + ground projection; rendering not counted).
-
-The detector and heading models are those shipped in ``lookalike/vision/models_data`` unless
-``--detector-model``/``--heading-model`` name others.
-"""
+"""``lookalike bench pixels``: identification from rendered pixels against the simulator's own
+detections (:mod:`lookalike.bench.pixels`)."""
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, field
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
-import numpy as np
 import typer
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-)
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from lookalike.cli.app import console, fail
-from lookalike.cli.bench import bench_app, print_rows, write_rows
-from lookalike.cli.track_pixels import (
-    identifier_settings,
-    one_blas_thread,
-    pixel_camera,
-    render_robot_frames,
-    world_for_camera,
-)
-from lookalike.eval import identification_success_rate
-from lookalike.geometry.boxes import iou_matrix
-from lookalike.geometry.camera import Camera
-from lookalike.sim import (
-    PRESET_NAMES,
-    RobotSequence,
-    preset,
-    preset_label,
-    simulate_robots,
-)
-from lookalike.trackers import make_tracker
-from lookalike.trackers.identity import labels_from_tracks
-from lookalike.types import Beacons, Detections
+from lookalike.bench.pixels import DEFAULT_SEED, PERCEPTION_COLUMNS, PIXEL_COLUMNS, pixels_table
+from lookalike.bench.tables import write_rows
+from lookalike.cli.app import console, fail, split_list
+from lookalike.cli.bench import bench_app, check_names, print_rows
+from lookalike.sim import PRESET_NAMES
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
-
-DEFAULT_SEED = 700_000
-PIXEL_COLUMNS = ("Setup", "Identifier", "Pixels (%)", "Simulated (%)", "Gap (pp)", "Pixel dets", "Sim dets",
-                 "Identifier frames/s")
-PERCEPTION_COLUMNS = ("Setup", "Frames", "Recall", "Precision", "Heading error (deg)", "Perception frames/s")
-
-
-@dataclass
-class PerceivedSequence:
-    """One sequence after perception: per frame the pixel detections, their true robots (-1: false
-    positive), the received reports and the time; plus detection and heading statistics."""
-
-    sequence: RobotSequence
-    detections: list[Detections] = field(default_factory=list)
-    truth: list[np.ndarray] = field(default_factory=list)
-    beacons: list[Beacons] = field(default_factory=list)
-    times: list[float] = field(default_factory=list)
-    matched: int = 0
-    robots: int = 0
-    heading_errors: list[float] = field(default_factory=list)
-    seconds: float = 0.0
-
-
-def match_truth(det_xywh: np.ndarray, true_xywh: np.ndarray, true_id: np.ndarray, min_iou: float) -> np.ndarray:
-    """``(n,)`` robot id of each detection box (px) from a one-to-one IoU matching with the rendered boxes, -1
-    where none overlaps by ``min_iou``."""
-    from scipy.optimize import linear_sum_assignment
-
-    out = np.full(len(det_xywh), -1, dtype=int)
-    if len(det_xywh) and len(true_xywh):
-        iou = iou_matrix(det_xywh, true_xywh)
-        rows, cols = linear_sum_assignment(-iou)
-        ok = iou[rows, cols] >= min_iou
-        out[rows[ok]] = np.asarray(true_id)[cols[ok]]
-    return out
-
-
-def perceive_sequence(pipe: RobotPipeline, seq: RobotSequence, camera: Camera, min_iou: float,
-                      min_visible: float, advance: Any = None) -> PerceivedSequence:
-    """Render ``seq`` and run the pipeline's perception on every frame (rendering not timed)."""
-    out = PerceivedSequence(seq)
-    a = seq.arrays
-    for k, rendered in enumerate(render_robot_frames(seq, camera, seed=seq.seed)):
-        t0 = time.perf_counter()
-        det = pipe.perceive(rendered.image, float(a.observer[k, 2]))
-        out.seconds += time.perf_counter() - t0
-        truth = match_truth(det.xywh, rendered.xywh, rendered.robot_id, min_iou)
-        frame = seq.frame(k)
-        out.detections.append(det)
-        out.truth.append(truth)
-        out.beacons.append(frame.beacons)
-        out.times.append(frame.time)
-        out.robots += int((rendered.visible >= min_visible).sum())
-        visible_ids = set(rendered.robot_id[rendered.visible >= min_visible].tolist())
-        out.matched += sum(int(t) in visible_ids for t in truth if t >= 0)
-        hit = truth >= 0
-        if hit.any():
-            true_abs = a.true_heading[k, truth[hit]]
-            diff = np.angle(np.exp(1j * (det.heading[hit] - true_abs)))
-            out.heading_errors.extend(np.degrees(np.abs(diff)).tolist())
-        if advance is not None:
-            advance()
-    return out
-
-
-def _identifier(name: str, seq: RobotSequence, camera: Camera) -> PipelineConfig:
-    """The identification settings of ``name`` for the sequence's N and M and the camera's field of view."""
-    return PipelineConfig(identifier=name, n_agents=seq.config.n_agents, max_detections=seq.config.max_detections,
-                          identifier_params=identifier_settings(name, camera))
-
-
-def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipeline, camera: Camera
-                 ) -> tuple[float, int, float]:
-    """Success rate, detection count and frames/s of identifier ``name`` on the pixel detections."""
-    predicted, truth, elapsed, frames = [], [], 0.0, 0
-    for p in perceived:
-        run = RobotPipeline(pipe.detector, pipe.heading, camera, _identifier(name, p.sequence, camera))
-        t0 = time.perf_counter()
-        for k, det in enumerate(p.detections):
-            predicted.append(run.identify(det, p.beacons[k], p.times[k], index=k).labels)
-        elapsed += time.perf_counter() - t0
-        frames += len(p.detections)
-        truth.extend(p.truth)
-    n = sum(len(t) for t in truth)
-    return identification_success_rate(predicted, truth), n, frames / elapsed if elapsed > 0 else float("inf")
-
-
-def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camera) -> tuple[float, int]:
-    """Success rate and detection count of identifier ``name`` on the simulator's own detections."""
-    predicted, truth = [], []
-    for p in perceived:
-        cfg = _identifier(name, p.sequence, camera)
-        tracker = make_tracker(name, **cfg.identifier_kwargs())
-        for frame in p.sequence.frames():
-            predicted.append(labels_from_tracks(len(frame.detections), tracker.update(frame)))
-        truth.extend(p.sequence.true_labels())
-    return identification_success_rate(predicted, truth), sum(len(t) for t in truth)
-
-
-def pixels_table(setups: list[str], identifiers: list[str], sequences: int, frames: int, seed: int,
-                 pipe: RobotPipeline, camera: Camera, min_iou: float, progress: Progress
-                 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """Rows of the identification table (:data:`PIXEL_COLUMNS`) and of the perception table
-    (:data:`PERCEPTION_COLUMNS`)."""
-    rows, perception = [], []
-    for setup in setups:
-        cfg = world_for_camera(preset(setup), camera)
-        task = progress.add_task(f"{setup}: rendering + perception", total=sequences * frames)
-        perceived = [
-            perceive_sequence(pipe, simulate_robots(cfg, frames, seed + 1000 * PRESET_NAMES.index(setup) + k),
-                              camera, min_iou, min_visible=0.5, advance=lambda task=task: progress.advance(task))
-            for k in range(sequences)
-        ]
-        seconds = sum(p.seconds for p in perceived)
-        n_det = sum(len(d) for p in perceived for d in p.detections)
-        matched = sum(p.matched for p in perceived)
-        errors = [e for p in perceived for e in p.heading_errors]
-        perception.append({
-            "Setup": preset_label(setup), "Frames": sequences * frames,
-            "Recall": round(matched / max(sum(p.robots for p in perceived), 1), 3),
-            "Precision": round(sum(int((t >= 0).sum()) for p in perceived for t in p.truth) / max(n_det, 1), 3),
-            "Heading error (deg)": round(float(np.mean(errors)), 1) if errors else float("nan"),
-            "Perception frames/s": round(sequences * frames / seconds, 1) if seconds > 0 else float("inf"),
-        })
-        for name in identifiers:
-            pix, n_pix, fps = score_pixels(name, perceived, pipe, camera)
-            sim, n_sim = score_simulated(name, perceived, camera)
-            rows.append({
-                "Setup": preset_label(setup), "Identifier": name, "Pixels (%)": round(100 * pix, 2),
-                "Simulated (%)": round(100 * sim, 2), "Gap (pp)": round(100 * (pix - sim), 2),
-                "Pixel dets": n_pix, "Sim dets": n_sim, "Identifier frames/s": round(fps, 1),
-            })
-    return rows, perception
+from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera
 
 
 @bench_app.command("pixels")
@@ -214,29 +36,24 @@ def pixels(
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the identification rows as CSV."),
 ) -> None:
     """Identification success rate from rendered pixels next to the simulator's own detections, per identifier."""
-    setup_list = [s.strip() for s in setups.split(",") if s.strip()]
-    ident_list = [s.strip() for s in identifiers.split(",") if s.strip()]
-    for s in setup_list:
-        if s not in PRESET_NAMES:
-            fail(f"--setups: unknown preset {s!r}; known: {', '.join(PRESET_NAMES)}")
-    for name in ident_list:
-        if name not in IDENTIFIERS:
-            fail(f"--identifiers: unknown identifier {name!r}; known: {', '.join(IDENTIFIERS)}")
+    setup_list, ident_list = split_list([setups]), split_list([identifiers])
+    check_names("--setups", setup_list, PRESET_NAMES, "preset")
+    check_names("--identifiers", ident_list, IDENTIFIERS, "identifier")
     if not setup_list or not ident_list:
         fail("--setups/--identifiers: need at least one of each")
     camera = pixel_camera()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     try:
-        config = PipelineConfig(detect_scale=detect_scale)
-        pipe = RobotPipeline.from_files(detector_model, heading_model, camera, config)
+        pipe = RobotPipeline.from_files(detector_model, heading_model, camera, PipelineConfig(detect_scale=detect_scale))
         with Progress(*columns, console=console) as progress, one_blas_thread():
+            def bar(description: str, total: int) -> Callable[[], None]:
+                task = progress.add_task(description, total=total)
+                return lambda: progress.advance(task)
+
             rows, perception = pixels_table(setup_list, ident_list, sequences, frames, seed, pipe, camera, min_iou,
-                                            progress)
+                                            bar)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     print_rows(f"Perception on rendered robots, {sequences} × {frames} frames per set-up", perception, PERCEPTION_COLUMNS)
     print_rows("Identification success rate: from pixels vs the simulator's detections", rows, PIXEL_COLUMNS)
     write_rows(rows, json_path, csv_path)
-
-
-__all__ = ["PerceivedSequence", "match_truth", "perceive_sequence", "pixels_table", "score_pixels", "score_simulated"]

@@ -1,32 +1,25 @@
-"""``lookalike track`` and ``lookalike trackers``."""
+"""``lookalike track`` and ``lookalike trackers``: argument parsing and printing; the frame loop is
+:func:`lookalike.loop.run`, the input and output streams are :mod:`lookalike.io.stream`."""
 
 from __future__ import annotations
 
-import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import typer
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeRemainingColumn,
-)
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from lookalike.cli.app import app, console, fail
 from lookalike.cli.track_blobs import run_track_blobs
 from lookalike.cli.track_pixels import run_track_pixels
 from lookalike.cli.track_video import run_track_video
-from lookalike.io import (
-    find_sequences,
-    frames_from_table,
-    read_mot,
-    tracks_to_rows,
-    write_mot,
-)
+from lookalike.io import find_sequences
+from lookalike.io.needs import box_input_problem
+from lookalike.io.stream import sequence_stream, track_to_file
+from lookalike.loop import RunStats
 from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
 from lookalike.trackers.registry import parse_parameter
 
@@ -40,6 +33,69 @@ def build_tracker(name: str, settings: list[str]) -> Any:
         return make_tracker(name, **params)
     except (ValueError, TypeError) as exc:
         fail(str(exc))
+
+
+def _box_tracker(name: str, settings: list[str], *, video: bool = False) -> Any:
+    """:func:`build_tracker`, refusing in one line a tracker that cannot run on boxes."""
+    tracker = build_tracker(name, settings)
+    problem = box_input_problem(name, video=video)
+    if problem is not None:
+        fail(problem)
+    return tracker
+
+
+@contextmanager
+def _progress_bars(count: int) -> Iterator[tuple[Progress, Any]]:
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
+    with Progress(*columns, console=console, transient=True) as progress:
+        yield progress, progress.add_task("sequences", total=count)
+
+
+def track_files(path: Path, output: Path, tracker: Any, min_score: float) -> tuple[int, RunStats]:
+    """Track every sequence at ``path`` (a det.txt, a sequence folder or a folder of them) into
+    ``output`` (a file for a single det.txt, else ``output/<sequence>.txt``), streaming."""
+    try:
+        sequences = [s for s in find_sequences(path) if s.det_path is not None]
+        if not sequences:
+            raise ValueError(f"{path}: no det/det.txt found")
+        streams = [(seq, sequence_stream(seq, min_score)) for seq in sequences]
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
+    stats = RunStats()
+    with _progress_bars(len(streams)) as (progress, overall):
+        for seq, frames in streams:
+            tracker.reset()
+            task = progress.add_task(seq.name, total=seq.length)
+            target = output if path.is_file() else output / f"{seq.name}.txt"
+            try:
+                track_to_file(tracker, frames, target, lambda f, t: progress.advance(task), stats)
+            except ValueError as exc:
+                fail(f"{seq.name}: {exc}")
+            progress.remove_task(task)
+            progress.advance(overall)
+    return len(streams), stats
+
+
+def _check_branches(path: Path | None, video: Path | None, detections: Path | None, annotate: Path | None,
+                    detector: str | None, blob: list[str] | None, pipeline: str | None) -> str:
+    """Which branch of ``track`` the options select (``pipeline``, ``blobs``, ``video``, ``files``)."""
+    if pipeline is not None:
+        if detector is not None or blob or detections is not None or path is not None:
+            fail("--pipeline: finds its own detections; drop --detector/--blob/--detections/PATH")
+        return "pipeline"
+    if detector is not None or blob:
+        if video is None or detections is not None or path is not None or detector is None:
+            fail("--detector/--blob: use --video FILE --detector blob, without det.txt")
+        return "blobs"
+    if video is not None:
+        if (detections or path) is None or (detections is not None and path is not None):
+            fail("--video: give the detections once, as --detections det.txt (or as PATH)")
+        return "video"
+    if annotate is not None or detections is not None:
+        fail("--annotate/--detections: only with --video")
+    if path is None:
+        fail("PATH: give det.txt, a sequence folder or a folder of sequences (or --video with --detections)")
+    return "files"
 
 
 @app.command()
@@ -77,72 +133,25 @@ def track(
     heading_model: Path | None = typer.Option(None, "--heading-model", help="With --pipeline: `train-heading` model."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
-    if pipeline is not None:
-        if detector is not None or blob or detections is not None or path is not None:
-            fail("--pipeline: finds its own detections; drop --detector/--blob/--detections/PATH")
-        run_track_pixels(video, output, pipeline, reports, detector_model, heading_model, tracker, set_ or [],
+    branch = _check_branches(path, video, detections, annotate, detector, blob, pipeline)
+    settings = set_ or []
+    video_options = dict(annotate=annotate, team_size=team_size, health_window=health_window,
+                         min_score=min_score, fps=fps, features=features)
+    if branch == "pipeline":
+        run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker, settings,
                          annotate=annotate, fps=fps, min_score=min_score)
-        return
-    if detector is not None or blob:
-        if video is None or detections is not None or path is not None or detector is None:
-            fail("--detector/--blob: use --video FILE --detector blob, without det.txt")
-        run_track_blobs(video, output, build_tracker(tracker, set_ or []), tracker, detector, blob or [],
-                        annotate=annotate, team_size=team_size, health_window=health_window,
-                        min_score=min_score, fps=fps, features=features)
-        return
-    if video is not None:
-        det_path = detections or path
-        if det_path is None or (detections is not None and path is not None):
-            fail("--video: give the detections once, as --detections det.txt (or as PATH)")
-        run_track_video(video, det_path, output, build_tracker(tracker, set_ or []), tracker, annotate=annotate,
-                        team_size=team_size, health_window=health_window, min_score=min_score, fps=fps,
-                        features=features)
-        return
-    if annotate is not None or detections is not None:
-        fail("--annotate/--detections: only with --video")
-    if path is None:
-        fail("PATH: give det.txt, a sequence folder or a folder of sequences (or --video with --detections)")
-    try:
-        sequences = [s for s in find_sequences(path) if s.det_path is not None]
-    except (FileNotFoundError, ValueError) as exc:
-        fail(str(exc))
-    if not sequences:
-        fail(f"{path}: no det/det.txt found")
-    single_file = path.is_file()
-    trk = build_tracker(tracker, set_ or [])
-    loaded = []
-    for seq in sequences:
-        try:
-            table = read_mot(seq.det_path)
-        except ValueError as exc:
-            fail(str(exc))
-        loaded.append((seq, table))
-    total_frames, total_time = 0, 0.0
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
-    with Progress(*columns, console=console, transient=True) as progress:
-        overall = progress.add_task("sequences", total=len(loaded))
-        for seq, table in loaded:
-            trk.reset()
-            frames = list(frames_from_table(table, seq.length, seq.frame_rate, min_score))
-            task = progress.add_task(seq.name, total=len(frames))
-            rows = []
-            for frame in frames:
-                t0 = time.perf_counter()
-                tracks = trk.update(frame)
-                total_time += time.perf_counter() - t0
-                rows.append(tracks_to_rows(frame.index, tracks))
-                progress.advance(task)
-            target = output if single_file else output / f"{seq.name}.txt"
-            write_mot(target, rows)
-            total_frames += len(frames)
-            progress.remove_task(task)
-            progress.advance(overall)
-    fps = total_frames / total_time if total_time > 0 else float("inf")
-    where = output if single_file else f"{output}/<sequence>.txt"
-    console.print(
-        f"[green]{tracker}[/]: {len(loaded)} sequence(s), {total_frames} frames, "
-        f"{fps:,.0f} frames/s (tracker only) → {where}"
-    )
+    elif branch == "blobs":
+        run_track_blobs(video, output, _box_tracker(tracker, settings, video=True), tracker, detector or "",
+                        blob or [], **video_options)
+    elif branch == "video":
+        run_track_video(video, detections or path, output, _box_tracker(tracker, settings, video=True), tracker,
+                        **video_options)
+    else:
+        assert path is not None
+        count, stats = track_files(path, output, _box_tracker(tracker, settings), min_score)
+        where = output if path.is_file() else f"{output}/<sequence>.txt"
+        console.print(f"[green]{tracker}[/]: {count} sequence(s), {stats.frames} frames, "
+                      f"{stats.fps:,.0f} frames/s (tracker only) → {where}")
 
 
 @app.command()

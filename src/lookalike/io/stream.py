@@ -14,7 +14,7 @@ import itertools
 import os
 import tempfile
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from types import TracebackType
 from typing import Any, TextIO
@@ -22,6 +22,8 @@ from typing import Any, TextIO
 import numpy as np
 
 from lookalike.io.motchallenge import frames_from_table, read_mot
+from lookalike.io.sequences import MotSequence
+from lookalike.loop import RunStats, Sink, Sinks, Updating, run
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import format_row, tracks_to_rows
 
@@ -183,4 +185,19 @@ class MotWriter:
             self.abort()
 
 
-__all__ = ["CHUNK_LINES", "DetectionStream", "MotWriter"]
+def sequence_stream(seq: MotSequence, min_score: float = -np.inf) -> DetectionStream:
+    """The checked :class:`DetectionStream` of a sequence's detection file (its length and frame rate)."""
+    if seq.det_path is None:
+        raise ValueError(f"{seq.name}: no detection file")
+    return DetectionStream(seq.det_path, seq.length, seq.frame_rate, min_score).check()
+
+
+def track_to_file(tracker: Updating, frames: Iterable[Frame], output: str | os.PathLike[str],
+                  sink: Sink | None = None, stats: RunStats | None = None) -> RunStats:
+    """Run ``tracker`` over ``frames`` with :func:`lookalike.loop.run`, streaming its MOTChallenge
+    rows to ``output`` (atomically; nothing is written when it fails); ``sink`` also sees every frame."""
+    with MotWriter(output) as writer:
+        return run(tracker, frames, Sinks(writer, sink), stats=stats)
+
+
+__all__ = ["CHUNK_LINES", "DetectionStream", "MotWriter", "sequence_stream", "track_to_file"]

@@ -1,0 +1,152 @@
+"""Seed A's control and recovery experiments (``lookalike bench shuffle`` / ``bench recovery``).
+
+Shuffle: the identifiers on frames fed in random order. A method that really uses the sequence
+(motion, report history) must collapse; one that only matched single frames would not.
+
+Recovery: the heading reports of two robots are swapped for ``swap_s`` seconds, so the identifiers
+learn wrong identities, then restored. The two are, per sequence, the robots detected most often
+from the swap's start to 3 s after the restore (so that there is something to recover). Reported:
+the success rate on those two robots' detections while swapped (without the swap, for comparison),
+and how long after the restore their success rate over a one-second window is back within 5 points
+of the same run without the swap.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from lookalike.bench.ident import identify
+from lookalike.eval import identification_success_rate
+from lookalike.sim import PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
+from lookalike.types import Beacons, Frame
+
+DEFAULT_SEED = 950_000  # disjoint from training (>= 1.9e9), tuning (< 100000) and bench ident (900000+)
+Hits = list[tuple[int, int]]
+
+
+def reindex(frames: list[Frame]) -> list[Frame]:
+    """Frames renumbered and re-timed in their new order (time must not run backwards)."""
+    times = np.sort([f.time for f in frames])
+    dt = float(np.median(np.diff(times))) if len(frames) > 1 else 1 / 30
+    return [Frame(index=k, time=k * dt, detections=f.detections, beacons=_retime(f.beacons, k * dt))
+            for k, f in enumerate(frames)]
+
+
+def _retime(beacons: Beacons, t: float) -> Beacons:
+    n = len(beacons)
+    return Beacons(agent_id=beacons.agent_id, t_sent=np.full(n, t), t_received=np.full(n, t), heading=beacons.heading)
+
+
+def swap_reports(frames: list[Frame], start_s: float, stop_s: float, pair: tuple[int, int] = (0, 1)) -> list[Frame]:
+    """Frames whose reports from the robots ``pair`` sent in ``[start_s, stop_s)`` carry each other's id."""
+    out = []
+    for f in frames:
+        b = f.beacons
+        ids = b.agent_id.copy()
+        window = (b.t_sent >= start_s) & (b.t_sent < stop_s)
+        ids[window & (b.agent_id == pair[0])] = pair[1]
+        ids[window & (b.agent_id == pair[1])] = pair[0]
+        swapped = Beacons(agent_id=ids, t_sent=b.t_sent, t_received=b.t_received, heading=b.heading)
+        out.append(Frame(index=f.index, time=f.time, detections=f.detections, beacons=swapped))
+    return out
+
+
+def most_seen_pair(truth: list[np.ndarray], n_agents: int) -> tuple[int, int]:
+    """The two robots with the most detections in ``truth`` (ties: lower ids)."""
+    counts = np.bincount(np.concatenate([t[t >= 0] for t in truth] + [np.zeros(0, int)]), minlength=n_agents)
+    a, b = np.argsort(-counts, kind="stable")[:2]
+    return int(a), int(b)
+
+
+def pair_hits(predicted: list[np.ndarray], truth: list[np.ndarray], pair: tuple[int, int] = (0, 1)) -> Hits:
+    """Per frame: (correct, total) labels of the detections that truly are one of the robots ``pair``."""
+    out = []
+    for p, t in zip(predicted, truth):
+        mine = (t == pair[0]) | (t == pair[1])
+        out.append((int((p[mine] == t[mine]).sum()), int(mine.sum())))
+    return out
+
+
+def hit_rate(hits: Hits) -> float:
+    """Correct / total over ``hits`` (NaN when there is nothing)."""
+    total = sum(n for _, n in hits)
+    return sum(c for c, _ in hits) / total if total else float("nan")
+
+
+def recovery_s(clean: Hits, swapped: Hits, restore: int, window: int, rate: float, tolerance: float = 0.05) -> float:
+    """Seconds from ``restore`` until the swapped run's success on the swapped pair over ``window``
+    frames is within ``tolerance`` of the clean run's over the same frames (inf: never)."""
+    for t in range(restore, len(clean) - window + 1):
+        a, b = hit_rate(swapped[t : t + window]), hit_rate(clean[t : t + window])
+        if np.isfinite(a) and np.isfinite(b) and a >= b - tolerance:
+            return (t - restore) / rate
+    return float("inf")
+
+
+def _sequences(setup: str, sequences: int, frames: int, seed: int) -> list[RobotSequence]:
+    cfg = preset(setup)
+    return [simulate_robots(cfg, frames, seed + 1000 * PRESET_NAMES.index(setup) + k) for k in range(sequences)]
+
+
+def shuffle_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int,
+                 seed: int = DEFAULT_SEED) -> list[dict[str, Any]]:
+    """Per set-up and identifier: success rate on frames in order and in random order (%)."""
+    rows = []
+    for setup in setups:
+        preset(setup)  # an unknown set-up fails before any work
+        for name in trackers:
+            ordered, shuffled, truth_o, truth_s = [], [], [], []
+            for k, seq in enumerate(_sequences(setup, sequences, frames, seed)):
+                fs = list(seq.frames())
+                truth = seq.true_labels()
+                perm = np.random.default_rng(seed + k).permutation(len(fs))
+                ordered += identify(name, seq, fs)
+                truth_o += truth
+                shuffled += identify(name, seq, reindex([fs[i] for i in perm]))
+                truth_s += [truth[i] for i in perm]
+            rows.append({
+                "Setup": preset_label(setup), "Tracker": name,
+                "In order (%)": round(100 * identification_success_rate(ordered, truth_o), 2),
+                "Random order (%)": round(100 * identification_success_rate(shuffled, truth_s), 2),
+            })
+    return rows
+
+
+def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float) -> tuple[float, float, float]:
+    """(success while swapped, same without the swap, recovery seconds) of one sequence."""
+    rate = seq.config.frame_rate_hz
+    fs = list(seq.frames())
+    truth = seq.true_labels()
+    start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
+    pair = most_seen_pair(truth[start : restore + int(3 * rate)], seq.config.n_agents)
+    clean = pair_hits(identify(name, seq, fs), truth, pair)
+    swapped = pair_hits(identify(name, seq, swap_reports(fs, swap_at_s, swap_at_s + swap_s, pair)), truth, pair)
+    return (hit_rate(swapped[start:restore]), hit_rate(clean[start:restore]),
+            recovery_s(clean, swapped, restore, int(rate), rate))
+
+
+def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,
+                  swap_s: float, seed: int = DEFAULT_SEED) -> list[dict[str, Any]]:
+    """Per set-up and identifier: success on the swapped pair while swapped (and without the swap),
+    and the mean and worst recovery time (s)."""
+    rows = []
+    for setup in setups:
+        preset(setup)
+        for name in trackers:
+            runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s)
+                             for seq in _sequences(setup, sequences, frames, seed)]).reshape(-1, 3)
+            rows.append({
+                "Setup": preset_label(setup), "Tracker": name,
+                "Swapped robots while swapped (%)": round(100 * float(np.mean(runs[:, 0])), 1),
+                "Same without swap (%)": round(100 * float(np.mean(runs[:, 1])), 1),
+                "Recovery, mean (s)": round(float(np.mean(runs[:, 2])), 2),
+                "Recovery, worst (s)": round(float(np.max(runs[:, 2])), 2),
+            })
+    return rows
+
+
+__all__ = ["DEFAULT_SEED", "hit_rate", "most_seen_pair", "pair_hits", "recovery_rows", "recovery_s", "reindex",
+           "shuffle_rows", "swap_reports"]

@@ -1,0 +1,62 @@
+"""Scoring folders of MOTChallenge results against ground-truth sequence folders (``lookalike eval``)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+from lookalike.eval import METRICS, combine, evaluate_sequence
+from lookalike.io import MotSequence, find_sequences, read_mot
+
+COMBINED = "COMBINED"
+
+
+def _result_file(results: Path, name: str) -> Path:
+    for candidate in (results / f"{name}.txt", results / "data" / f"{name}.txt"):
+        if candidate.is_file():
+            return candidate
+    raise ValueError(f"{results}: no result file for sequence {name} (expected {results / (name + '.txt')})")
+
+
+def _score(job: tuple[MotSequence, Path, str, tuple[str, ...], float]) -> dict[str, float]:
+    seq, res_path, benchmark, metrics, threshold = job
+    return evaluate_sequence(read_mot(seq.gt_path), read_mot(res_path), iou_threshold=threshold,
+                             benchmark=benchmark, metrics=metrics, num_frames=seq.length)
+
+
+def evaluate_folders(
+    gt_root: str | os.PathLike[str],
+    results: str | os.PathLike[str],
+    *,
+    benchmark: str = "MOT15",
+    metrics: Sequence[str] = METRICS,
+    iou_threshold: float = 0.5,
+    workers: int = 1,
+) -> dict[str, dict[str, float]]:
+    """Per-sequence results (sequence name -> metrics) and their combination under ``"COMBINED"``.
+
+    Every ground-truth sequence needs a result file; sequence lengths come from ``seqinfo.ini``
+    (else the last frame present). ``workers > 1`` scores sequences in that many processes.
+    """
+    if workers < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
+    sequences = [s for s in find_sequences(gt_root) if s.gt_path is not None]
+    if not sequences:
+        raise ValueError(f"{gt_root}: no sequence with gt/gt.txt")
+    results = Path(results)
+    if not results.is_dir():
+        raise ValueError(f"{results}: results folder not found")
+    jobs = [(s, _result_file(results, s.name), benchmark, tuple(metrics), iou_threshold) for s in sequences]
+    if workers > 1 and len(jobs) > 1:
+        with ProcessPoolExecutor(max_workers=min(workers, len(jobs))) as pool:
+            scored = list(pool.map(_score, jobs))
+    else:
+        scored = [_score(j) for j in jobs]
+    out = {s.name: r for s, r in zip(sequences, scored)}
+    out[COMBINED] = combine(scored)
+    return out
+
+
+__all__ = ["COMBINED", "evaluate_folders"]

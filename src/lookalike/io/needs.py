@@ -1,0 +1,36 @@
+"""What a tracker needs from its input beyond boxes and scores, so that a command can refuse early
+with one line instead of failing inside the tracker.
+
+A tracker class may declare ``needs`` (a short phrase); the built-in trackers that cannot run on
+boxes alone are listed in :data:`BUILTIN_NEEDS`.
+"""
+
+from __future__ import annotations
+
+from lookalike.trackers.registry import tracker_class
+
+_ROBOTS = ("ground positions, headings and heading reports of robots (a `lookalike simulate` sequence, "
+           "or --video V --pipeline robots --reports FILE)")
+_APPEARANCE = "appearance features from the pixels: give the video with --video VIDEO"
+BUILTIN_NEEDS = {
+    "deepsort": _APPEARANCE,
+    "diversort": _APPEARANCE,
+    "kalman_ha": _ROBOTS,
+    "kalman_ha2": _ROBOTS,
+    "jpda": _ROBOTS,
+    "lstm": _ROBOTS,
+}
+ROBOT_NEEDS = frozenset(n for n, why in BUILTIN_NEEDS.items() if why == _ROBOTS)
+
+
+def box_input_problem(name: str, *, video: bool = False) -> str | None:
+    """None when tracker ``name`` can run on MOTChallenge boxes (with a video when ``video``), else one
+    line naming what it needs."""
+    declared = getattr(tracker_class(name), "needs", None)
+    need = declared if isinstance(declared, str) else BUILTIN_NEEDS.get(name)
+    if need is None or (video and need == _APPEARANCE):
+        return None
+    return f"tracker {name!r} cannot run on boxes alone; it needs {need}"
+
+
+__all__ = ["BUILTIN_NEEDS", "ROBOT_NEEDS", "box_input_problem"]
