@@ -1,0 +1,420 @@
+"""Offline closed-set identity: a whole result's tracklets assigned to N identities in one optimisation.
+
+When the number of targets N is known (23 pigs, 8 fish, 3 bugs) and the whole video is available,
+the identities need not be decided frame by frame. :func:`assign_identities` takes the result of an
+online pass (MOTChallenge rows, any ids) and:
+
+1. **Cuts it into reliable tracklets** (:func:`split_tracklets`): a track is cut wherever it has
+   missing frames, wherever it jumps (a step between consecutive rows longer than ``jump`` times the
+   sequence's 90th-percentile step, and at least ``jump_floor`` box sizes) and around frames where its box
+   overlaps another track's box by IoU ≥ ``contact_iou``: the places where an online tracker may
+   have swapped identities. Each piece is a tracklet.
+2. **Scores links** between the end of one tracklet and the start of a later one (:func:`link_costs`):
+   each end is extrapolated at its velocity (mean over its last ``velocity_frames`` rows, for at most
+   ``coast_s`` seconds), each start likewise backwards, and the mean miss ``d`` (pixels) is compared
+   with the spread a target can reach over the gap of ``g`` frames, ``σ = pos_sigma·size + speed·g``
+   (``size`` the tracklets' mean √(w·h), ``speed`` the sequence's 90th-percentile step in px/frame, both
+   measured on the input). The cost is ``link_cost + ½ (d/σ)²``, a Gaussian negative log-likelihood;
+   pairs beyond ``max_z`` are not candidates, and only the ``candidates`` cheapest successors of every
+   end and predecessors of every start are kept, so the problem stays small.
+3. **Solves one integer programme** with scipy's HiGHS MILP (:func:`scipy.optimize.milp`): at most N
+   chains (a min-cost flow of N units from a source through tracklets to a sink), each tracklet on at
+   most one chain, each chain one identity. Links only go forward in time, so two tracklets that
+   overlap in time can never share an identity. A tracklet on no chain is clutter; using one earns
+   its number of rows minus ``tracklet_cost``, so short tracklets that need implausible links are
+   left out while long ones are kept even across long gaps.
+4. **Writes ids 1..N** (chains ordered by their first frame) and fills gaps of at most ``fill_gap_s``
+   seconds inside each identity by linear interpolation (:func:`lookalike.trackers.offline.fill_gaps`).
+
+:func:`track_closed_set` runs the online pass itself (``boxtrack`` with ``max_targets`` = N, reporting
+only detected boxes) on detection rows, then :func:`assign_identities`.
+
+All positions are pixels; times are converted with the sequence's frame rate (frames/s).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import sparse
+from scipy.optimize import Bounds, LinearConstraint, milp
+
+from lookalike.geometry.boxes import iou_matrix
+from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.offline import fill_gaps
+from lookalike.trackers.registry import make_tracker
+from lookalike.types import Detections, Frame
+
+__all__ = ["ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale", "place_short", "solve_chains", "split_tracklets", "track_closed_set"]
+
+
+@dataclass(frozen=True)
+class ClosedSetConfig:
+    """Parameters of :func:`assign_identities` (distances in box sizes √(w·h) unless stated)."""
+
+    contact_iou: float | None = param(0.3, "cut tracks around frames where their box overlaps another's by this "
+                                           "IoU (None: never)")
+    jump: float = param(3.0, "cut a track at a step longer than this times the 90th-percentile step")
+    jump_floor: float = param(0.5, "... and longer than this many box sizes")
+    velocity_frames: int = param(5, "rows at a tracklet's end/start that give its velocity")
+    pos_sigma: float = param(0.1, "spread of a link's miss at a gap of zero (box sizes)")
+    link_cost: float = param(1.0, "cost of every link (rows' worth), so fewer, longer pieces are preferred")
+    max_z: float = param(6.0, "largest miss of a link candidate, in spreads σ")
+    candidates: int = param(6, "cheapest successors per end and predecessors per start kept as links")
+    max_gap_s: float = param(math.inf, "longest gap (seconds) a link may bridge")
+    tracklet_cost: float = param(3.0, "cost of putting a tracklet on an identity (rows' worth); shorter "
+                                      "tracklets with costly links are left out as clutter")
+    min_rows: int = param(5, "tracklets with fewer rows are not chained but placed into the chains' gaps")
+    fill_gap_s: float = param(1.0, "longest gap (seconds) inside an identity filled by interpolation")
+    time_limit_s: float = param(60.0, "time limit of the MILP solver (seconds)")
+
+    def __post_init__(self) -> None:
+        check_positive(self, "jump", "velocity_frames", "pos_sigma", "max_z", "candidates", "max_gap_s",
+                       "time_limit_s")
+        check_positive(self, "contact_iou", "jump_floor", "link_cost", "tracklet_cost", "fill_gap_s",
+                       allow_zero=True)
+
+
+@dataclass(frozen=True, eq=False)
+class Tracklet:
+    """A piece of one track: its rows ``(k, 10)`` sorted by frame (consecutive frames)."""
+
+    rows: np.ndarray
+    source_id: int = -1  # the id it had in the input
+
+    @property
+    def first(self) -> int:
+        return int(self.rows[0, 0])
+
+    @property
+    def last(self) -> int:
+        return int(self.rows[-1, 0])
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+
+def _centres(rows: np.ndarray) -> np.ndarray:
+    return rows[:, 2:4] + rows[:, 4:6] / 2
+
+
+def _sizes(rows: np.ndarray) -> np.ndarray:
+    return np.sqrt(np.maximum(rows[:, 4] * rows[:, 5], 1.0))
+
+
+def _check_rows(rows: np.ndarray) -> np.ndarray:
+    arr = np.asarray(rows, dtype=float)
+    if arr.ndim != 2 or (arr.size and arr.shape[1] < 6):
+        raise ValueError(f"rows: expected MOTChallenge rows (k, >=6), got shape {arr.shape}")
+    if arr.size and arr.shape[1] < 10:
+        arr = np.hstack([arr, np.full((len(arr), 10 - arr.shape[1]), -1.0)])
+    return arr.reshape(-1, 10) if not arr.size else arr
+
+
+def _steps(rows: np.ndarray) -> np.ndarray:
+    """Per-frame centre steps (pixels) between consecutive-frame rows of the same id."""
+    order = np.lexsort((rows[:, 0], rows[:, 1]))
+    r = rows[order]
+    same = (np.diff(r[:, 1]) == 0) & (np.diff(r[:, 0]) == 1)
+    return np.linalg.norm(np.diff(_centres(r), axis=0), axis=1)[same]
+
+
+def _contact_frames(rows: np.ndarray, min_iou: float) -> np.ndarray:
+    """Row mask: the box overlaps another id's box in the same frame by IoU ≥ ``min_iou``."""
+    hit = np.zeros(len(rows), dtype=bool)
+    order = np.argsort(rows[:, 0], kind="stable")
+    frames = rows[order, 0]
+    bounds = np.flatnonzero(np.diff(frames)) + 1
+    for idx in np.split(order, bounds):
+        if len(idx) < 2:
+            continue
+        iou = iou_matrix(rows[idx, 2:6], rows[idx, 2:6])
+        np.fill_diagonal(iou, 0.0)
+        hit[idx] = (iou >= min_iou).any(axis=1)
+    return hit
+
+
+def _fill_short(mask: np.ndarray, k: int) -> np.ndarray:
+    """``mask`` with runs of fewer than ``k`` False values between two True values set True (a contact
+    that flickers for a few frames is one contact)."""
+    out = mask.copy()
+    on = np.flatnonzero(mask)
+    for a, b in zip(on[:-1], on[1:]):
+        if 1 < b - a <= k:
+            out[a:b] = True
+    return out
+
+
+def split_tracklets(rows: np.ndarray, config: ClosedSetConfig | None = None) -> list[Tracklet]:
+    """The tracklets of result ``rows``: each id cut at missing frames, jumps and contacts (module doc)."""
+    cfg = config or ClosedSetConfig()
+    rows = _check_rows(rows)
+    if not len(rows):
+        return []
+    steps = _steps(rows)
+    typical = float(np.percentile(steps, 90)) if len(steps) else 0.0
+    contact = _contact_frames(rows, cfg.contact_iou) if cfg.contact_iou is not None else np.zeros(len(rows), bool)
+    out: list[Tracklet] = []
+    for tid in np.unique(rows[:, 1]):
+        sel = np.flatnonzero(rows[:, 1] == tid)
+        sel = sel[np.argsort(rows[sel, 0], kind="stable")]
+        r, touch = rows[sel], contact[sel]
+        keep = np.r_[True, np.diff(r[:, 0]) > 0]  # one row per frame and id
+        r, touch = r[keep], _fill_short(touch[keep], cfg.velocity_frames)
+        step = np.linalg.norm(np.diff(_centres(r), axis=0), axis=1)
+        size = _sizes(r)
+        limit = np.maximum(cfg.jump * typical, cfg.jump_floor * np.minimum(size[:-1], size[1:]))
+        cut = (np.diff(r[:, 0]) > 1) | (step > limit) | (touch[1:] != touch[:-1])
+        for piece in np.split(np.arange(len(r)), np.flatnonzero(cut) + 1):
+            out.append(Tracklet(r[piece], int(tid)))
+    out.sort(key=lambda t: (t.first, t.last))
+    return out
+
+
+def _end_state(rows: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Centre (px) of the last row and velocity (px/frame) over the last ``k`` rows."""
+    c = _centres(rows[-k:])
+    f = rows[-k:, 0]
+    v = (c[-1] - c[0]) / (f[-1] - f[0]) if len(f) > 1 and f[-1] > f[0] else np.zeros(2)
+    return c[-1], v
+
+
+def motion_scale(tracklets: list[Tracklet]) -> tuple[float, float, float]:
+    """``(size px, speed px/frame, jitter px/frame²)`` of a sequence's tracklets: the mean box size √(w·h),
+    the 90th-percentile step between consecutive rows and the median second difference of centres."""
+    if not tracklets:
+        return 1.0, 0.0, 0.0
+    size = float(np.mean(_sizes(np.vstack([t.rows for t in tracklets]))))
+    steps = np.concatenate([np.linalg.norm(np.diff(_centres(t.rows), axis=0), axis=1) for t in tracklets])
+    speed = float(np.percentile(steps, 90)) if len(steps) else 0.0
+    bends = np.concatenate([np.linalg.norm(np.diff(_centres(t.rows), n=2, axis=0), axis=1) for t in tracklets])
+    jitter = float(np.median(bends)) if len(bends) else speed
+    return size, speed, jitter
+
+
+def link_costs(tracklets: list[Tracklet], frame_rate: float,
+               config: ClosedSetConfig | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Candidate links ``(i, j, cost)``: tracklet ``j`` continues tracklet ``i`` (module doc, step 2)."""
+    cfg = config or ClosedSetConfig()
+    if not frame_rate > 0:
+        raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
+    n = len(tracklets)
+    empty = (np.zeros(0, int), np.zeros(0, int), np.zeros(0))
+    if n < 2:
+        return empty
+    max_gap = math.inf if math.isinf(cfg.max_gap_s) else round(cfg.max_gap_s * frame_rate)
+    size, speed, jitter = motion_scale(tracklets)
+    first = np.array([t.first for t in tracklets])
+    last = np.array([t.last for t in tracklets])
+    k = cfg.velocity_frames
+    ends = [_end_state(t.rows, k) for t in tracklets]
+    starts = [_end_state(t.rows[::-1], k) for t in tracklets]  # backwards in time
+    c_end = np.array([e[0] for e in ends])
+    v_end = np.array([e[1] for e in ends])
+    c_start = np.array([s[0] for s in starts])
+    v_start = np.array([s[1] for s in starts])
+    gap = first[None, :] - last[:, None]  # [i, j]: frames from the end of i to the start of j
+    ii, jj = np.nonzero((gap >= 1) & (gap <= max_gap))
+    if not len(ii):
+        return empty
+    g = gap[ii, jj].astype(float)
+    # two motion hypotheses: constant velocity over the whole gap (spread grows with the jitter), or
+    # holding still (spread grows with the speed); each scored as a 2-D Gaussian negative log-likelihood
+    base = cfg.pos_sigma * size
+    forward = np.linalg.norm(c_end[ii] + v_end[ii] * g[:, None] - c_start[jj], axis=1)
+    backward = np.linalg.norm(c_start[jj] + v_start[jj] * g[:, None] - c_end[ii], axis=1)
+    spread_v = base + jitter * g
+    spread_h = base + speed * g
+    z_v = (forward + backward) / 2 / spread_v
+    z_h = np.linalg.norm(c_end[ii] - c_start[jj], axis=1) / spread_h
+    nll = np.minimum(0.5 * z_v**2 + 2 * np.log(spread_v / base), 0.5 * z_h**2 + 2 * np.log(spread_h / base))
+    z = np.minimum(z_v, z_h)
+    ok = z <= cfg.max_z
+    ii, jj, nll = ii[ok], jj[ok], nll[ok]
+    source = np.array([t.source_id for t in tracklets])
+    same = (source[ii] == source[jj]) & (gap[ii, jj] == 1)  # a cut inside one input track: free to keep
+    cost = np.where(same, -cfg.tracklet_cost, cfg.link_cost) + nll
+    keep = _cheapest(ii, cost, cfg.candidates) | _cheapest(jj, cost, cfg.candidates)
+    return ii[keep], jj[keep], cost[keep]
+
+
+def _cheapest(group: np.ndarray, cost: np.ndarray, k: int) -> np.ndarray:
+    """Mask of the ``k`` cheapest entries of every group."""
+    order = np.lexsort((cost, group))
+    g = group[order]
+    start = np.r_[0, np.flatnonzero(np.diff(g)) + 1]
+    rank = np.arange(len(g)) - np.repeat(start, np.diff(np.r_[start, len(g)]))
+    mask = np.zeros(len(group), dtype=bool)
+    mask[order[rank < k]] = True
+    return mask
+
+
+def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
+                 tracklet_cost: float, time_limit_s: float = 60.0) -> list[list[int]]:
+    """At most ``n_chains`` disjoint chains of tracklets (lists of indices in time order) maximising the
+    rows covered minus ``tracklet_cost`` per tracklet used minus the link costs, by HiGHS MILP.
+
+    Variables: ``x`` (tracklet used), ``y`` (link used), ``a`` (chain starts here), ``b`` (chain ends
+    here); flow conservation ``a_i + Σ_j y_ji = x_i = b_i + Σ_j y_ij`` and ``Σ a_i ≤ n_chains``.
+    """
+    n = len(lengths)
+    src, dst, cost = links
+    m = len(src)
+    if n == 0 or n_chains < 1:
+        return []
+    # variable blocks: x [0, n), y [n, n+m), a [n+m, 2n+m), b [2n+m, 3n+m)
+    c = np.concatenate([-(np.asarray(lengths, float) - tracklet_cost), cost, np.zeros(2 * n)])
+    eye = sparse.identity(n, format="csr")
+    into = sparse.csr_matrix((np.ones(m), (dst, np.arange(m))), shape=(n, m))
+    out = sparse.csr_matrix((np.ones(m), (src, np.arange(m))), shape=(n, m))
+    zero = sparse.csr_matrix((n, n))
+    conserve_in = sparse.hstack([-eye, into, eye, zero])
+    conserve_out = sparse.hstack([-eye, out, zero, eye])
+    chains = sparse.hstack([sparse.csr_matrix((1, n + m)), sparse.csr_matrix(np.ones((1, n))),
+                            sparse.csr_matrix((1, n))])
+    A = sparse.vstack([conserve_in, conserve_out, chains]).tocsr()
+    lo = np.concatenate([np.zeros(2 * n), [0.0]])
+    hi = np.concatenate([np.zeros(2 * n), [float(n_chains)]])
+    res = milp(c, constraints=LinearConstraint(A, lo, hi), integrality=np.ones(len(c)), bounds=Bounds(0, 1),
+               options={"time_limit": time_limit_s})
+    if res.x is None:
+        raise RuntimeError(f"closed-set assignment: the MILP solver found no solution ({res.message})")
+    x = np.round(res.x).astype(int)
+    used_link = x[n:n + m] > 0
+    nxt = dict(zip(src[used_link].tolist(), dst[used_link].tolist()))
+    heads = np.flatnonzero(x[n + m:2 * n + m] > 0)
+    result = []
+    for h in heads:
+        chain, k = [int(h)], int(h)
+        while k in nxt:
+            k = nxt[k]
+            chain.append(k)
+        result.append(chain)
+    return result
+
+
+def _chain_position(block: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Centres ``(k, 2)`` px of a chain (rows sorted by frame) interpolated at ``frames`` (held beyond its
+    ends) and the distance (frames) from each to the chain's nearest row; inf where it has a row there."""
+    f = block[:, 0]
+    c = _centres(block)
+    pos = np.column_stack([np.interp(frames, f, c[:, 0]), np.interp(frames, f, c[:, 1])])
+    idx = np.clip(np.searchsorted(f, frames), 0, len(f) - 1)
+    near = np.minimum(np.abs(f[idx] - frames), np.abs(f[np.maximum(idx - 1, 0)] - frames))
+    return pos, np.where(near == 0, np.inf, near)
+
+
+def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[float, float, float],
+                config: ClosedSetConfig | None = None) -> np.ndarray:
+    """Chain index (or -1, clutter) of every short tracklet: an assignment of the short tracklets to the
+    chains' gaps by HiGHS MILP. A piece costs ``link_cost + ½ z²`` minus its rows, ``z`` its mean miss from
+    the chain's interpolated centre over ``pos_sigma·size + speed·g`` (``g`` frames to the chain's nearest
+    row); pieces overlapping in time never go to the same chain, nor to frames where the chain has rows."""
+    cfg = config or ClosedSetConfig()
+    out = np.full(len(short), -1, dtype=int)
+    if not short or not chains:
+        return out
+    size, speed, _ = scale
+    pp, cc, cost = [], [], []
+    for p, t in enumerate(short):
+        frames = t.rows[:, 0]
+        for c, block in enumerate(chains):
+            pos, near = _chain_position(block, frames)
+            if np.isinf(near).any():
+                continue
+            z = float(np.mean(np.linalg.norm(pos - _centres(t.rows), axis=1) / (cfg.pos_sigma * size + speed * near)))
+            if z <= cfg.max_z:
+                pp.append(p)
+                cc.append(c)
+                cost.append(cfg.link_cost + 0.5 * z**2 - len(t))
+    if not pp:
+        return out
+    pp_a, cc_a, cost_a = np.array(pp), np.array(cc), np.array(cost)
+    m = len(pp_a)
+    rows_a = [sparse.csr_matrix((np.ones(m), (pp_a, np.arange(m))), shape=(len(short), m))]
+    span = np.array([(t.first, t.last) for t in short])
+    clash = []
+    for c in np.unique(cc_a):
+        idx = np.flatnonzero(cc_a == c)
+        for a in range(len(idx)):
+            for b in range(a + 1, len(idx)):
+                p, q = pp_a[idx[a]], pp_a[idx[b]]
+                if span[p, 0] <= span[q, 1] and span[q, 0] <= span[p, 1]:
+                    clash.append((idx[a], idx[b]))
+    if clash:
+        ci = np.repeat(np.arange(len(clash)), 2)
+        rows_a.append(sparse.csr_matrix((np.ones(2 * len(clash)), (ci, np.array(clash).ravel())),
+                                        shape=(len(clash), m)))
+    A = sparse.vstack(rows_a).tocsr()
+    res = milp(cost_a, constraints=LinearConstraint(A, -np.inf, 1.0), integrality=np.ones(m), bounds=Bounds(0, 1),
+               options={"time_limit": cfg.time_limit_s})
+    if res.x is None:
+        return out
+    chosen = np.round(res.x).astype(bool)
+    out[pp_a[chosen]] = cc_a[chosen]
+    return out
+
+
+def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
+                      config: ClosedSetConfig | None = None) -> np.ndarray:
+    """Result rows ``(k, 10)`` (any ids; 1-based frames, boxes in pixels) re-labelled with ids ``1..n_targets``
+    by one global assignment of their tracklets (module doc); rows on no identity (clutter) are dropped
+    and gaps of at most ``fill_gap_s`` inside an identity are interpolated. ``frame_rate`` in frames/s."""
+    cfg = config or ClosedSetConfig()
+    if int(n_targets) < 1:
+        raise ValueError(f"n_targets must be >= 1, got {n_targets}")
+    rows = _check_rows(rows)
+    pieces = split_tracklets(rows, cfg)
+    if not pieces:
+        return rows.copy()
+    tracklets = [t for t in pieces if len(t) >= cfg.min_rows] or pieces
+    short = [t for t in pieces if len(t) < cfg.min_rows and tracklets is not pieces]
+    links = link_costs(tracklets, frame_rate, cfg)
+    chains = solve_chains(np.array([len(t) for t in tracklets]), links, int(n_targets), cfg.tracklet_cost,
+                          cfg.time_limit_s)
+    chains.sort(key=lambda ch: (tracklets[ch[0]].first, tracklets[ch[0]].rows[0, 2]))
+    blocks = [np.vstack([tracklets[i].rows for i in chain]) for chain in chains]
+    placed = place_short(short, blocks, motion_scale(tracklets), cfg)
+    out = []
+    for new_id, block in enumerate(blocks, start=1):
+        extra = [short[p].rows for p in np.flatnonzero(placed == new_id - 1)]
+        block = np.vstack([block, *extra]).copy()
+        block[:, 1] = new_id
+        out.append(block)
+    merged = np.vstack(out) if out else np.zeros((0, 10))
+    merged = merged[np.lexsort((merged[:, 1], merged[:, 0]))]
+    return fill_gaps(merged, round(cfg.fill_gap_s * frame_rate)) if len(merged) else merged
+
+
+def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = None,
+                tracker: str = "boxtrack", **params: Any) -> np.ndarray:
+    """Result rows of an online pass of ``tracker`` over detection rows ``(k, >=7)`` (1-based frames,
+    boxes in pixels, score in column 7): only tracks matched to a detection, at that detection's box."""
+    det_rows = _check_rows(det_rows)
+    tracker_obj = make_tracker(tracker, **params)
+    n_frames = int(det_rows[:, 0].max()) if n_frames is None and len(det_rows) else int(n_frames or 0)
+    order = np.argsort(det_rows[:, 0], kind="stable")
+    det_rows = det_rows[order]
+    bounds = np.searchsorted(det_rows[:, 0], np.arange(1, n_frames + 2))
+    out = []
+    for k in range(n_frames):
+        block = det_rows[bounds[k]:bounds[k + 1]]
+        dets = Detections(xywh=block[:, 2:6], score=block[:, 6]) if len(block) else Detections.empty()
+        for t in tracker_obj.update(Frame(index=k, time=k / frame_rate, detections=dets)):
+            if t.detection_index is None or t.detection_index < 0:
+                continue  # coasted: no detection behind it
+            out.append([k + 1, t.track_id, *block[t.detection_index, 2:6], 1.0, -1, -1, -1])
+    return np.array(out, dtype=float).reshape(-1, 10)
+
+
+def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *, n_frames: int | None = None,
+                     online: dict[str, Any] | None = None, config: ClosedSetConfig | None = None) -> np.ndarray:
+    """Offline closed-set tracking of detection rows ``(k, >=7)``: an online ``boxtrack`` pass with
+    ``max_targets=n_targets`` (``online`` overrides its parameters), then :func:`assign_identities`.
+    Returns result rows ``(k, 10)`` with ids ``1..n_targets``."""
+    params = {"max_targets": int(n_targets), **(online or {})}
+    rows = online_rows(det_rows, frame_rate, n_frames, **params)
+    return assign_identities(rows, n_targets, frame_rate, config)
