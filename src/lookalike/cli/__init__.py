@@ -20,6 +20,7 @@ from lookalike.cli import vision as _vision  # noqa: E402,F401
 from lookalike.cli import render as _render  # noqa: E402,F401
 from lookalike.cli import report as _report  # noqa: E402,F401
 from lookalike.cli import label as _label  # noqa: E402,F401
+from lookalike.cli import tune as _tune  # noqa: E402,F401
 
 
 def main() -> None:

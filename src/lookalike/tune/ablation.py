@@ -1,0 +1,97 @@
+"""Which parameters earn their place: the left-out gain of tuning one parameter against fixing it.
+
+For each searched parameter, the candidates are the tracker's defaults and the defaults with that
+one parameter moved over its range (:func:`lookalike.tune.space.grid`). Every candidate is scored
+once on every sequence (:func:`lookalike.tune.objective.evaluate_table`); per fold, the best of a
+parameter's candidates on the training sequences is scored on the left-out ones and compared with
+the defaults there (a paired difference per fold, in criterion points x 100). A parameter is worth
+tuning when the mean gain exceeds twice its standard error over the folds.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from lookalike.trackers.registry import tracker_parameters
+from lookalike.tune.folds import Fold
+from lookalike.tune.objective import Scores, criterion, objective
+from lookalike.tune.selection import select_from_table
+from lookalike.tune.space import Space, grid, searched
+
+INERT_POINTS = 0.05  # a parameter whose whole range moves no fold's training objective more than this is inert
+
+
+def one_at_a_time(tracker: str, space: Space, points: int = 5) -> tuple[list[dict[str, Any]], dict[str, list[int]]]:
+    """``(candidates, by_parameter)``: candidate 0 is the defaults; ``by_parameter[name]`` lists the
+    indices of the candidates that move only ``name`` (``points`` values over its range)."""
+    defaults = {p.name: p.default for p in tracker_parameters(tracker)}
+    candidates: list[dict[str, Any]] = [{}]
+    by_parameter: dict[str, list[int]] = {}
+    for name, dim in searched(space).items():
+        by_parameter[name] = []
+        for value in grid(dim, points):
+            if value == defaults.get(name) and type(value) is type(defaults.get(name)):
+                continue
+            by_parameter[name].append(len(candidates))
+            candidates.append({name: value})
+    return candidates, by_parameter
+
+
+@dataclass(frozen=True)
+class ParameterGain:
+    """Left-out gain of tuning one parameter (points of the criterion x 100, per fold paired).
+
+    Attributes:
+        name: the parameter.
+        gains: per fold, left-out criterion of the tuned choice minus that of the defaults.
+        mean: mean gain over the folds.
+        sd: standard deviation of the per-fold gains (the fold-to-fold noise).
+        se: its standard error (``sd / sqrt(folds)``).
+        spread: the largest change the parameter's range makes to any fold's training objective.
+        chosen: per fold, the chosen value (``"default"`` when the defaults won).
+        verdict: ``"keep"`` (gain > 2 se), ``"drop"`` (inert: spread < :data:`INERT_POINTS`) or ``"fix"``.
+    """
+
+    name: str
+    gains: list[float]
+    mean: float
+    sd: float
+    se: float
+    spread: float
+    chosen: list[Any]
+    verdict: str
+
+
+def parameter_gains(table: Sequence[Sequence[Scores | None]], candidates: Sequence[dict[str, Any]],
+                    by_parameter: dict[str, list[int]], folds: Sequence[Fold], keys: Sequence[str],
+                    groups: Sequence[str] | None = None, metric: str = "hota+idf1+mota") -> list[ParameterGain]:
+    """:class:`ParameterGain` of every parameter from a table of :func:`one_at_a_time` candidates."""
+    crit = criterion(metric)
+    groups = list(keys) if groups is None else list(groups)
+    base = select_from_table(table, folds, keys, groups, metric, candidates, allowed=[0])
+    out = []
+    for name, idx in by_parameter.items():
+        tuned = select_from_table(table, folds, keys, groups, metric, candidates, allowed=[0, *idx])
+        gains = [100 * (t.test_value - b.test_value) for t, b in zip(tuned, base)]
+        n = len(gains)
+        mean = sum(gains) / n
+        sd = math.sqrt(sum((g - mean) ** 2 for g in gains) / (n - 1)) if n > 1 else 0.0
+        se = sd / math.sqrt(n) if n > 1 else 0.0
+        spread = 0.0
+        for fold in folds:
+            train = list(fold.train)
+            ref = objective([table[0][j] for j in train], [groups[j] for j in train], crit)  # type: ignore[misc]
+            for k in idx:
+                if all(table[k][j] is not None for j in train):
+                    v = objective([table[k][j] for j in train], [groups[j] for j in train], crit)  # type: ignore[misc]
+                    spread = max(spread, 100 * abs(v - ref))
+        verdict = "drop" if spread < INERT_POINTS else "keep" if mean > 2 * se and mean > 0 else "fix"
+        chosen = ["default" if t.candidate == 0 else candidates[t.candidate][name] for t in tuned]
+        out.append(ParameterGain(name, gains, mean, sd, se, spread, chosen, verdict))
+    return out
+
+
+__all__ = ["INERT_POINTS", "ParameterGain", "one_at_a_time", "parameter_gains"]

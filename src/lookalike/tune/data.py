@@ -1,0 +1,64 @@
+"""Labelled data to tune on: the bench datasets by name, or MOTChallenge sequence folders.
+
+This module is the one place where :mod:`lookalike.tune` reaches into the benches' data and
+runner (:mod:`lookalike.bench.datasets`, :mod:`lookalike.bench.runner`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookalike.bench.datasets import DATASETS, RealSequence, load_boxes, load_datasets
+from lookalike.bench.runner import Entry, score_rows, track_rows
+
+
+def sequence_key(seq: RealSequence) -> str:
+    """``dataset/name``: how a sequence is named in parameter files and reports."""
+    return f"{seq.dataset}/{seq.name}"
+
+
+def load_tuning_data(items: Sequence[str], data_root: Path | None = None) -> list[RealSequence]:
+    """Sequences from ``items``: bench dataset names (``mot15``, ``pigs``, ``mot17-synth``...; read
+    under ``data_root``) or folders holding MOTChallenge sequences (``gt/gt.txt`` and
+    ``det/det.txt``; a sequence folder or a folder of them, the dataset named after the folder).
+
+    Raises ``ValueError``/``FileNotFoundError`` with a message saying what is missing.
+    """
+    out: list[RealSequence] = []
+    for item in items:
+        path = Path(item)
+        if path.exists():
+            if not path.is_dir():
+                raise ValueError(f"{item}: expected a MOTChallenge sequence folder (gt/gt.txt, det/det.txt) "
+                                 "or a folder of them")
+            out += load_boxes(path, path.resolve().name)
+        elif item in DATASETS:
+            if data_root is None:
+                raise ValueError(f"{item}: a bench dataset needs the data folder (--data)")
+            out += load_datasets(data_root, [item])
+        else:
+            raise ValueError(f"{item}: neither a folder nor a bench dataset ({', '.join(DATASETS)})")
+    keys = [sequence_key(s) for s in out]
+    dupes = sorted({k for k in keys if keys.count(k) > 1})
+    if dupes:
+        raise ValueError(f"sequences given twice: {', '.join(dupes)}")
+    if not out:
+        raise ValueError("no sequence to tune on")
+    return out
+
+
+def run_params(tracker: str, params: dict[str, Any], seq: RealSequence) -> np.ndarray:
+    """MOTChallenge rows of ``tracker`` with exactly ``params`` on ``seq`` (no preset of the benches)."""
+    return track_rows(Entry(tracker, tracker, params=dict(params), per_sequence=False), seq, dataset_params={})
+
+
+def score_params(tracker: str, params: dict[str, Any], seq: RealSequence) -> dict[str, float]:
+    """Scores (combinable counts and metrics) of ``tracker`` with ``params`` on ``seq``."""
+    return score_rows(seq, run_params(tracker, params, seq))
+
+
+__all__ = ["RealSequence", "load_tuning_data", "run_params", "score_params", "sequence_key"]

@@ -1,0 +1,138 @@
+"""The honest figure: the left-out score of the whole selection procedure.
+
+Tuning maximises the score on the sequences it is given; that score says nothing about a sequence
+outside them. :func:`leave_one_out_selection` answers that: for each fold it runs a study on the
+*other* sequences only and scores the chosen parameters on the left-out ones, which the choice
+never saw. :func:`select_from_table` does the same from a table of stored per-sequence scores
+(every candidate scored once on every sequence): the choice of each fold is then an argmax over
+the stored scores of its training sequences. With candidates drawn at random (independently of any
+score) this is exactly the left-out figure of random search with that budget, for every fold at
+the cost of one pass.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from lookalike.eval import combine
+from lookalike.tune.data import score_params, sequence_key
+from lookalike.tune.folds import Fold, make_folds
+from lookalike.tune.objective import Evaluator, Scores, criterion, evaluate_job, objective
+from lookalike.tune.space import Space
+from lookalike.tune.study import run_study
+
+
+@dataclass(frozen=True)
+class FoldChoice:
+    """One fold: what was chosen on which sequences, and how it scored on the left-out ones.
+
+    Attributes:
+        fold: the fold's name (the left-out sequence or group).
+        chosen_on: names of the sequences the choice was made on.
+        left_out: names of the sequences it was scored on.
+        params: the chosen parameters (or, for a table, the candidate's).
+        candidate: the chosen candidate's index in the table (-1 for a study).
+        train_value: the objective on ``chosen_on``.
+        test_scores: left-out scores, combined over ``left_out``.
+        test_value: the criterion of ``test_scores``.
+        per_sequence: left-out scores per left-out sequence (same order as ``left_out``).
+    """
+
+    fold: str
+    chosen_on: list[str]
+    left_out: list[str]
+    params: dict[str, Any]
+    candidate: int
+    train_value: float
+    test_scores: Scores
+    test_value: float
+    per_sequence: list[Scores]
+
+
+def _valid(row: Sequence[Scores | None], idx: Sequence[int]) -> bool:
+    return all(row[i] is not None for i in idx)
+
+
+def select_from_table(table: Sequence[Sequence[Scores | None]], folds: Sequence[Fold], keys: Sequence[str],
+                      groups: Sequence[str] | None = None, metric: str = "hota+idf1+mota",
+                      candidates: Sequence[dict[str, Any]] | None = None,
+                      allowed: Sequence[int] | None = None) -> list[FoldChoice]:
+    """Per fold, the candidate with the best objective on the fold's training sequences (first on
+    ties; candidates failing on any of them excluded) and its scores on the left-out ones.
+
+    ``table[k][i]``: candidate ``k``'s scores on sequence ``i`` (None: failed); ``allowed``: only
+    these candidate indices may be chosen (default all). Only ``table[k][j]`` for ``j`` in a fold's
+    training sequences enter that fold's choice.
+    """
+    crit = criterion(metric)
+    groups = list(keys) if groups is None else list(groups)
+    pool = list(range(len(table))) if allowed is None else list(allowed)
+    out = []
+    for fold in folds:
+        train = list(fold.train)
+        usable = [k for k in pool if _valid(table[k], train) and _valid(table[k], fold.test)]
+        if not usable:
+            raise ValueError(f"fold {fold.name}: no candidate has scores on every sequence")
+        values = {k: objective([table[k][j] for j in train], [groups[j] for j in train], crit)  # type: ignore[misc]
+                  for k in usable}
+        best = max(usable, key=lambda k: (values[k], -k))
+        held = [table[best][i] for i in fold.test]
+        combined = combine(held)  # type: ignore[arg-type]
+        out.append(FoldChoice(fold.name, [keys[j] for j in train], [keys[i] for i in fold.test],
+                              dict(candidates[best]) if candidates is not None else {}, best, values[best],
+                              combined, crit(combined), held))  # type: ignore[arg-type]
+    return out
+
+
+def leave_one_out_selection(tracker: str, sequences: Sequence[Any], *, folds: str | int | Sequence[Fold] = "loso",
+                            space: Space | None = None, trials: int = 30, sampler: str = "tpe", seed: int = 0,
+                            metric: str = "hota+idf1+mota", groups: Sequence[str] | None = None,
+                            keys: Sequence[str] | None = None, storage: str | None = None,
+                            study_name: str | None = None, resume: bool = False, workers: int = 1,
+                            backend: str = "local", address: str | None = None, evaluator: Evaluator = score_params,
+                            progress: Callable[[str, int, int, float | None], None] | None = None
+                            ) -> list[FoldChoice]:
+    """For each fold, :func:`lookalike.tune.study.run_study` on the other sequences, then the chosen
+    parameters scored on the left-out ones (the only time they are run).
+
+    ``folds``: ``"loso"`` (one per sequence), ``"lodo"`` (one per dataset), K, or explicit
+    :class:`~lookalike.tune.folds.Fold` objects. The study of a fold is named
+    ``<study_name or tracker>/<fold>`` in ``storage``. Other arguments as for ``run_study``;
+    ``progress(fold, done, trials, best)``.
+    """
+    keys = [sequence_key(s) for s in sequences] if keys is None else list(keys)
+    groups = [str(getattr(s, "dataset", "")) for s in sequences] if groups is None else list(groups)
+    fold_list = make_folds(keys, folds, groups) if isinstance(folds, (str, int)) else list(folds)
+    crit = criterion(metric)
+    out = []
+    for fold in fold_list:
+        train = list(fold.train)
+
+        def report(done: int, total: int, best: float | None, _name: str = fold.name) -> None:
+            if progress is not None:
+                progress(_name, done, total, best)
+
+        result = run_study(tracker, [sequences[j] for j in train], space=space, trials=trials, sampler=sampler,
+                           seed=seed, metric=metric, groups=[groups[j] for j in train], keys=[keys[j] for j in train],
+                           storage=storage, study_name=f"{study_name or tracker}/{fold.name}", resume=resume,
+                           workers=workers, backend=backend, address=address, evaluator=evaluator, progress=report)
+        held = []
+        for i in fold.test:
+            r = evaluate_job(evaluator, tracker, result.params, sequences[i])
+            if "error" in r:
+                raise ValueError(f"fold {fold.name}: the chosen parameters failed on {keys[i]}: {r['error']}")
+            held.append(r["scores"])
+        combined = combine(held)
+        out.append(FoldChoice(fold.name, [keys[j] for j in train], [keys[i] for i in fold.test], result.params, -1,
+                              result.value, combined, crit(combined), held))
+    return out
+
+
+def combined_left_out(choices: Sequence[FoldChoice]) -> Scores:
+    """The left-out scores of every fold combined (each sequence left out once: the whole set)."""
+    return combine([s for c in choices for s in c.per_sequence])
+
+
+__all__ = ["FoldChoice", "combined_left_out", "leave_one_out_selection", "select_from_table"]

@@ -1,0 +1,277 @@
+"""Search spaces: which parameters of a tracker are searched, over which ranges.
+
+A space maps parameter names to :class:`Dim` (a range or a list of choices) or to a fixed value.
+Scale-like numbers (ages in seconds, distances in box heights, noise fractions, counts) are
+searched in log space; fractions (scores, IoUs, quantiles) linearly. An ``optional`` dimension
+may also be ``None`` (the mechanism switched off). The default space of ``sort`` and ``boxtrack``
+is declared here; other trackers get one built from their defaults (:func:`generic_space`).
+A JSON file overrides it (:func:`space_from_json`)::
+
+    {"high_score": {"low": 0.5, "high": 0.99},
+     "max_age_s": {"low": 0.25, "high": 4, "log": true},
+     "n_init": {"low": 1, "high": 5, "type": "int"},
+     "recent_frames": {"low": 1, "high": 10, "type": "int", "log": true, "optional": true},
+     "report": {"choices": ["filtered", "detection"]},
+     "low_score": 0.1}
+
+(a bare value fixes the parameter: it is passed to every trial and written to the result).
+"""
+
+from __future__ import annotations
+
+import math
+import typing
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from lookalike.trackers.registry import tracker_class, tracker_parameters
+
+KINDS = ("float", "int", "choice")
+NOT_SEARCHED = ("frame_interval_s", "max_targets")  # set by the data (frame rate, a known count), never tuned
+
+
+@dataclass(frozen=True)
+class Dim:
+    """One searched parameter: ``kind`` ``"float"``/``"int"`` in ``[low, high]`` (log-uniform when
+    ``log``), or ``"choice"`` among ``choices``; ``optional`` adds ``None`` (switched off)."""
+
+    kind: str
+    low: float | None = None
+    high: float | None = None
+    log: bool = False
+    choices: tuple[Any, ...] = ()
+    optional: bool = False
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"kind: expected one of {KINDS}, got {self.kind!r}")
+        if self.kind == "choice":
+            if not self.choices:
+                raise ValueError("a choice dimension needs at least one choice")
+            return
+        if self.low is None or self.high is None or not self.low <= self.high:
+            raise ValueError(f"range: expected low <= high, got [{self.low}, {self.high}]")
+        if self.log and self.low <= 0:
+            raise ValueError(f"a log-scale range needs low > 0, got {self.low}")
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON form read back by :func:`space_from_json`."""
+        if self.kind == "choice":
+            return {"choices": list(self.choices)}
+        out: dict[str, Any] = {"low": self.low, "high": self.high, "type": self.kind}
+        if self.log:
+            out["log"] = True
+        if self.optional:
+            out["optional"] = True
+        return out
+
+
+Space = dict[str, Any]  # name -> Dim, or a fixed value
+
+
+def _f(low: float, high: float, log: bool = False, optional: bool = False) -> Dim:
+    return Dim("float", low, high, log=log, optional=optional)
+
+
+def _i(low: int, high: int, log: bool = False, optional: bool = False) -> Dim:
+    return Dim("int", low, high, log=log, optional=optional)
+
+
+# The default spaces. Ranges bracket the defaults widely; the closed-set parameters (max_targets,
+# closed_distance) do nothing on open-set data and are left out.
+DEFAULT_SPACES: dict[str, Space] = {
+    "sort": {
+        "max_age": _i(1, 30, log=True),
+        "min_hits": _i(1, 5),
+        "iou_threshold": _f(0.1, 0.6),
+    },
+    "boxtrack": {
+        "high_score": _f(0.5, 0.99),
+        "low_score": _f(0.01, 0.5, log=True),
+        "birth_score": _f(0.5, 0.99),
+        "match_iou": _f(0.05, 0.6),
+        "low_iou": _f(0.1, 0.8),
+        "tentative_iou": _f(0.05, 0.6),
+        "n_init": _i(1, 5),
+        "max_age_s": _f(0.25, 4.0, log=True),
+        "coast_s": _f(0.1, 4.0, log=True),
+        "reid_distance": _f(0.1, 3.0, log=True),
+        "reid_growth": _f(0.0, 2.0),
+        "reid_scale": _f(1.1, 3.0, log=True),
+        "recent_frames": _i(1, 10, log=True, optional=True),
+        "pos_noise": _f(1 / 80, 1 / 5, log=True),
+        "vel_noise": _f(1 / 640, 1 / 40, log=True),
+        "high_quantile": _f(0.1, 0.9, optional=True),
+        "birth_quantile": _f(0.1, 0.9, optional=True),
+        "tentative_quantile": _f(0.0, 0.9, optional=True),
+        "high_match_ratio": _f(0.2, 0.95, optional=True),
+        "coast_report_prob": _f(0.4, 0.95, optional=True),
+        "calib_min_count": _i(10, 1000, log=True),
+        "coast_min_count": _i(5, 300, log=True),
+        "report": Dim("choice", choices=("filtered", "detection")),
+    },
+}
+
+_FRACTION_WORDS = ("score", "iou", "quantile", "ratio", "prob", "rate", "fraction")
+
+
+def _base_type(hint: Any) -> tuple[Any, bool]:
+    """``(type, optional)`` of a config field's annotation (``float | None`` -> ``(float, True)``)."""
+    args = [a for a in typing.get_args(hint) if a is not type(None)]
+    if args:
+        return args[0], len(args) < len(typing.get_args(hint))
+    return hint, False
+
+
+def generic_space(tracker: str) -> Space:
+    """A space from ``tracker``'s defaults: booleans both ways; a positive number ``d`` log-uniform
+    in ``[d/3, 3d]`` (fractions capped at 1; integers at least 1); zero, ``None`` and text defaults
+    are not searched (nor :data:`NOT_SEARCHED`)."""
+    hints = typing.get_type_hints(tracker_class(tracker).Config)
+    out: Space = {}
+    for p in tracker_parameters(tracker):
+        base, _ = _base_type(hints[p.name])
+        d = p.default
+        if p.name in NOT_SEARCHED or d is None:
+            continue
+        if base is bool:
+            out[p.name] = Dim("choice", choices=(False, True))
+        elif base is int and d > 0:
+            out[p.name] = _i(max(1, d // 3), max(3 * d, d + 2), log=True)
+        elif base is float and d > 0:
+            high = 3 * d
+            if d <= 1 and any(w in p.name for w in _FRACTION_WORDS):
+                high = min(high, 1.0)
+            out[p.name] = _f(d / 3, high, log=True)
+    return out
+
+
+def default_space(tracker: str) -> Space:
+    """The declared space of ``tracker`` (:data:`DEFAULT_SPACES`), else :func:`generic_space`;
+    names the tracker does not have are left out."""
+    if tracker not in DEFAULT_SPACES:
+        return generic_space(tracker)
+    known = {p.name for p in tracker_parameters(tracker)}
+    return {k: v for k, v in DEFAULT_SPACES[tracker].items() if k in known}
+
+
+def space_from_json(spec: Mapping[str, Any], tracker: str) -> Space:
+    """A space from its JSON form (module docstring), checked against ``tracker``'s parameters.
+
+    Raises ``ValueError`` naming an unknown parameter or a malformed entry.
+    """
+    hints = typing.get_type_hints(tracker_class(tracker).Config)
+    out: Space = {}
+    for name, entry in spec.items():
+        if name not in hints:
+            raise ValueError(f"space: tracker {tracker!r} has no parameter {name!r}; known: {sorted(hints)}")
+        if not isinstance(entry, Mapping):
+            out[name] = entry  # a fixed value
+            continue
+        unknown = set(entry) - {"low", "high", "log", "type", "choices", "optional"}
+        if unknown:
+            raise ValueError(f"space: {name}: unknown key(s) {sorted(unknown)}")
+        try:
+            if "choices" in entry:
+                out[name] = Dim("choice", choices=tuple(entry["choices"]))
+                continue
+            base, _ = _base_type(hints[name])
+            kind = entry.get("type", "int" if base is int else "float")
+            out[name] = Dim(kind, float(entry["low"]), float(entry["high"]), log=bool(entry.get("log", False)),
+                            optional=bool(entry.get("optional", False)))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"space: {name}: {exc}") from None
+    return out
+
+
+def space_to_json(space: Space) -> dict[str, Any]:
+    """The JSON form of ``space`` (module docstring)."""
+    return {k: (v.to_json() if isinstance(v, Dim) else v) for k, v in space.items()}
+
+
+def searched(space: Space) -> dict[str, Dim]:
+    """The dimensions of ``space`` that are searched (not fixed)."""
+    return {k: v for k, v in space.items() if isinstance(v, Dim)}
+
+
+def fixed(space: Space) -> dict[str, Any]:
+    """The fixed values of ``space``."""
+    return {k: v for k, v in space.items() if not isinstance(v, Dim)}
+
+
+def _cast(dim: Dim, value: float) -> Any:
+    return int(round(value)) if dim.kind == "int" else float(value)
+
+
+def suggest(trial: Any, space: Space) -> dict[str, Any]:
+    """Tracker parameters drawn by an Optuna ``trial`` from ``space`` (fixed values included).
+
+    An optional dimension is drawn as ``<name>:on`` (bool) and, when on, ``<name>``.
+    """
+    params = dict(fixed(space))
+    for name, dim in searched(space).items():
+        if dim.optional and not trial.suggest_categorical(f"{name}:on", [True, False]):
+            params[name] = None
+        elif dim.kind == "choice":
+            params[name] = trial.suggest_categorical(name, list(dim.choices))
+        elif dim.kind == "int":
+            params[name] = trial.suggest_int(name, int(dim.low), int(dim.high), log=dim.log)  # type: ignore[arg-type]
+        else:
+            params[name] = trial.suggest_float(name, float(dim.low), float(dim.high), log=dim.log)  # type: ignore[arg-type]
+    return params
+
+
+def trial_values(params: Mapping[str, Any], space: Space) -> dict[str, Any]:
+    """The Optuna trial parameters (:func:`suggest`'s names) that give tracker ``params``
+    (for ``enqueue_trial``); values outside a range are left to Optuna to reject."""
+    out: dict[str, Any] = {}
+    for name, dim in searched(space).items():
+        if name not in params:
+            continue
+        value = params[name]
+        if dim.optional:
+            out[f"{name}:on"] = value is not None
+        if value is not None:
+            out[name] = value
+    return out
+
+
+def sample(space: Space, rng: np.random.Generator) -> dict[str, Any]:
+    """Tracker parameters drawn uniformly (log-uniformly where ``log``) from ``space`` with ``rng``;
+    an optional dimension is off with probability 1/2 (random search without Optuna)."""
+    params = dict(fixed(space))
+    for name, dim in searched(space).items():
+        if dim.optional and rng.random() < 0.5:
+            params[name] = None
+        elif dim.kind == "choice":
+            params[name] = dim.choices[int(rng.integers(len(dim.choices)))]
+        elif dim.kind == "int":
+            lo, hi = int(dim.low), int(dim.high)  # type: ignore[arg-type]
+            if dim.log:
+                params[name] = min(hi, int(math.floor(math.exp(rng.uniform(math.log(lo), math.log(hi + 1))))))
+            else:
+                params[name] = int(rng.integers(lo, hi + 1))
+        else:
+            lo_f, hi_f = float(dim.low), float(dim.high)  # type: ignore[arg-type]
+            v = math.exp(rng.uniform(math.log(lo_f), math.log(hi_f))) if dim.log else rng.uniform(lo_f, hi_f)
+            params[name] = float(v)
+    return params
+
+
+def grid(dim: Dim, points: int = 5) -> list[Any]:
+    """``points`` values spread over ``dim`` (log-spaced where ``log``; integers deduplicated), its
+    choices, and ``None`` for an optional dimension."""
+    if dim.kind == "choice":
+        values = list(dim.choices)
+    else:
+        lo, hi = float(dim.low), float(dim.high)  # type: ignore[arg-type]
+        raw = np.geomspace(lo, hi, points) if dim.log else np.linspace(lo, hi, points)
+        values = list(dict.fromkeys(_cast(dim, v) for v in raw))
+    return values + [None] if dim.optional else values
+
+
+__all__ = ["DEFAULT_SPACES", "Dim", "NOT_SEARCHED", "Space", "default_space", "fixed", "generic_space", "grid",
+           "sample", "searched", "space_from_json", "space_to_json", "suggest", "trial_values"]

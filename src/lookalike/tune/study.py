@@ -1,0 +1,210 @@
+"""An Optuna study that chooses a tracker's parameters on labelled sequences.
+
+Each trial draws parameters from the search space (TPE or random search), runs the tracker on
+every sequence and scores it; the trial's value is the criterion of the combined scores
+(:func:`lookalike.tune.objective.objective`). The first trial of a new study is the tracker's
+defaults, so the choice is never worse than them *on the sequences it was made on*. Trials run in
+batches of ``workers`` on :class:`lookalike.parallel.JobPool` (local processes or Ray), one job
+per (trial, sequence). With ``storage`` (an Optuna RDB URL such as ``sqlite:///study.db``) every
+finished trial is saved with its parameters and per-sequence scores, and ``resume=True`` continues
+the study up to ``trials`` trials in all (trials cut short by an interruption are run again).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from lookalike.parallel import JobPool
+from lookalike.trackers.registry import tracker_parameters
+from lookalike.tune.data import score_params, sequence_key
+from lookalike.tune.objective import Evaluator, Scores, criterion, evaluate_job, objective
+from lookalike.tune.space import Space, default_space, searched, space_to_json, suggest, trial_values
+
+SAMPLERS = ("tpe", "random")
+
+
+@dataclass(frozen=True)
+class StudyResult:
+    """The outcome of :func:`run_study`.
+
+    Attributes:
+        params: the best trial's tracker parameters (fixed values of the space included).
+        value: its objective on the sequences it was chosen on.
+        trials: finished trials in the study (complete or failed).
+        study_name: the study's name in its storage.
+        chosen_on: the sequences (``dataset/name``) the choice was made on.
+        criterion: the criterion's name.
+        default_value: the objective of the tracker's defaults (the first trial), if it completed.
+        failed: finished trials that failed (parameters the tracker refused, or an error).
+    """
+
+    params: dict[str, Any]
+    value: float
+    trials: int
+    study_name: str
+    chosen_on: list[str]
+    criterion: str
+    default_value: float | None = None
+    failed: int = 0
+    errors: list[str] = field(default_factory=list)
+
+
+def make_sampler(name: str, seed: int) -> Any:
+    """An Optuna sampler: ``"tpe"`` (Tree-structured Parzen Estimator) or ``"random"``."""
+    import optuna
+
+    if name == "tpe":
+        return optuna.samplers.TPESampler(seed=seed)
+    if name == "random":
+        return optuna.samplers.RandomSampler(seed=seed)
+    raise ValueError(f"sampler: expected one of {', '.join(SAMPLERS)}, got {name!r}")
+
+
+def _import_optuna() -> Any:
+    try:
+        import optuna
+    except ImportError:
+        raise ValueError("lookalike tune needs optuna (pip install 'lookalike[tune]')") from None
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    return optuna
+
+
+def _open_study(optuna: Any, name: str, storage: str | None, resume: bool, sampler: Any,
+                meta: dict[str, Any]) -> Any:
+    if storage is not None and not resume:
+        try:
+            optuna.load_study(study_name=name, storage=storage)
+        except KeyError:
+            pass
+        else:
+            raise ValueError(f"study {name!r} already exists in {storage}; pass --resume to continue it "
+                             "or --study-name for a new one")
+    study = optuna.create_study(study_name=name, storage=storage, direction="maximize", sampler=sampler,
+                                load_if_exists=resume)
+    old = study.user_attrs
+    if old:
+        for key, value in meta.items():
+            if old.get(key) != value:
+                raise ValueError(f"study {name!r} was run with another {key} ({old.get(key)!r}); "
+                                 "resume it with the same settings or start a new study")
+    else:
+        for key, value in meta.items():
+            study.set_user_attr(key, value)
+    return study
+
+
+def _compact(scores: Scores) -> Scores:
+    """The scores as plain floats (JSON for the storage; everything :func:`combine` needs)."""
+    return {k: float(v) for k, v in scores.items()}
+
+
+def _defaults_in_space(tracker: str, space: Space) -> dict[str, Any]:
+    """Trial values of the tracker's defaults, where they lie inside the searched ranges."""
+    defaults = {p.name: p.default for p in tracker_parameters(tracker)}
+    out = {}
+    for name, dim in searched(space).items():
+        value = defaults.get(name)
+        if value is None:
+            if dim.optional:
+                out[name] = None
+            continue
+        if dim.kind == "choice":
+            if value in dim.choices:
+                out[name] = value
+        elif dim.low is not None and dim.high is not None and dim.low <= value <= dim.high:
+            out[name] = value
+    return trial_values(out, space)
+
+
+def run_study(tracker: str, sequences: Sequence[Any], *, space: Space | None = None, trials: int = 50,
+              sampler: str = "tpe", seed: int = 0, metric: str = "hota+idf1+mota",
+              groups: Sequence[str] | None = None, keys: Sequence[str] | None = None,
+              storage: str | None = None, study_name: str | None = None, resume: bool = False,
+              workers: int = 1, backend: str = "local", address: str | None = None,
+              evaluator: Evaluator = score_params,
+              progress: Callable[[int, int, float | None], None] | None = None) -> StudyResult:
+    """Choose ``tracker``'s parameters on ``sequences`` with Optuna (module docstring).
+
+    Args:
+        tracker: registered tracker name.
+        sequences: labelled sequences (:class:`lookalike.bench.datasets.RealSequence`).
+        space: the search space (default :func:`lookalike.tune.space.default_space`).
+        trials: trials in the study in all (a resumed study runs only the missing ones).
+        sampler: ``"tpe"`` or ``"random"``; ``seed`` seeds it.
+        metric: the criterion (:data:`lookalike.tune.objective.CRITERIA`).
+        groups: each sequence's group (default: its dataset); the objective is the mean over groups.
+        keys: each sequence's name in the study and results (default ``dataset/name``).
+        storage: Optuna storage URL (``sqlite:///study.db``); None keeps the study in memory.
+        study_name: the study's name (default ``<tracker>``).
+        resume: continue an existing study (it must have been run with the same settings).
+        workers, backend, address: where trials run (:class:`lookalike.parallel.JobPool`).
+        evaluator: ``(tracker, params, sequence) -> scores`` (tests replace it).
+        progress: called after each finished trial with ``(done, trials, best value so far)``.
+    """
+    optuna = _import_optuna()
+    crit = criterion(metric)
+    if trials < 1:
+        raise ValueError(f"trials must be >= 1, got {trials}")
+    if not sequences:
+        raise ValueError("no sequence to tune on")
+    space = default_space(tracker) if space is None else space
+    keys = [sequence_key(s) for s in sequences] if keys is None else list(keys)
+    groups = [str(getattr(s, "dataset", "")) for s in sequences] if groups is None else list(groups)
+    name = study_name or tracker
+    meta = {"tracker": tracker, "metric": metric.lower(), "sequences": keys, "space": space_to_json(space)}
+    study = _open_study(optuna, name, storage, resume, None, meta)
+    from optuna.trial import TrialState
+
+    for stale in study.get_trials(deepcopy=False, states=(TrialState.RUNNING, TrialState.WAITING)):
+        if stale.state == TrialState.RUNNING:
+            study.tell(stale.number, state=TrialState.FAIL)  # cut short by an interruption: run again
+    finished = (TrialState.COMPLETE, TrialState.FAIL, TrialState.PRUNED)
+    done = len(study.get_trials(deepcopy=False, states=finished))
+    # a fresh sampler seed per session: a resumed random search does not redraw the same points
+    study.sampler = make_sampler(sampler, seed + done)
+    if done == 0:
+        study.enqueue_trial(_defaults_in_space(tracker, space), skip_if_exists=True)
+    errors: list[str] = []
+    with JobPool(max(1, min(workers, (trials - done) * len(sequences) or 1)), backend, address) as pool:
+        shared = [pool.share(s) for s in sequences]
+        while done < trials:
+            batch = [study.ask() for _ in range(min(workers, trials - done))]
+            drawn = [suggest(t, space) for t in batch]
+            jobs = [[pool.submit(evaluate_job, evaluator, tracker, p, s) for s in shared] for p in drawn]
+            for trial, params, row in zip(batch, drawn, jobs):
+                results = [j.result() for j in row]
+                trial.set_user_attr("params", params)
+                failures = [f"{k}: {r['error']}" for k, r in zip(keys, results) if "error" in r]
+                if failures:
+                    trial.set_user_attr("error", failures[0])
+                    errors.append(failures[0])
+                    study.tell(trial, state=TrialState.FAIL)
+                else:
+                    per_seq = [r["scores"] for r in results]
+                    trial.set_user_attr("scores", {k: _compact(s) for k, s in zip(keys, per_seq)})
+                    study.tell(trial, objective(per_seq, groups, crit))
+                done += 1
+                if progress is not None:
+                    progress(done, trials, _best_value(study))
+    complete = study.get_trials(deepcopy=False, states=(TrialState.COMPLETE,))
+    if not complete:
+        why = errors[0] if errors else "no trial completed"
+        raise ValueError(f"{tracker}: no trial completed ({why})")
+    best = study.best_trial
+    first = min(study.get_trials(deepcopy=False), key=lambda t: t.number)
+    return StudyResult(params=dict(best.user_attrs["params"]), value=float(best.value), trials=done,
+                       study_name=name, chosen_on=keys, criterion=metric.lower(),
+                       default_value=float(first.value) if first.state == TrialState.COMPLETE else None,
+                       failed=len(study.get_trials(deepcopy=False, states=(TrialState.FAIL,))), errors=errors)
+
+
+def _best_value(study: Any) -> float | None:
+    try:
+        return float(study.best_value)
+    except ValueError:
+        return None
+
+
+__all__ = ["SAMPLERS", "StudyResult", "make_sampler", "run_study"]
