@@ -48,7 +48,8 @@ class JobPool:
             if fn not in self._remote:
                 self._remote[fn] = self._ray.remote(fn)
             ref = self._remote[fn].remote(*args)
-            return Pending(lambda: self._ray.get(ref))
+            ray = self._ray
+            return Pending(lambda: ray.get(ref))
         if self.workers > 1:
             if self._pool is None:
                 # spawned, not forked: the parent may hold CUDA or Ray state that must not be copied

@@ -44,16 +44,16 @@ def evaluate_data(
         "IDs": data.num_tracker_ids, "GT_IDs": data.num_gt_ids,
     }
     pairs = data.pairs() if ("HOTA" in chosen or "Identity" in chosen) else None
-    if "HOTA" in chosen:
+    if "HOTA" in chosen and pairs is not None:
         out.update(hota.flatten(hota.hota_final(hota.hota_arrays(data, pairs))))
     if "CLEAR" in chosen:
         counts = clear.clear_counts(data, threshold)
         out.update(counts)
         out.update(clear.clear_final(counts))
-    if "Identity" in chosen:
-        counts = identity.identity_counts(data, pairs, threshold)
-        out.update(counts)
-        out.update(identity.identity_final(counts))
+    if "Identity" in chosen and pairs is not None:
+        id_counts = identity.identity_counts(data, pairs, threshold)
+        out.update(id_counts)
+        out.update(identity.identity_final(id_counts))
     return out
 
 

@@ -72,7 +72,8 @@ def _global_alignment(pairs: Pairs, G: int, T: int, gt_count: np.ndarray, tr_cou
     denom = col_sum[pairs.tracker_det] + row_sum[pairs.gt_det] - sim
     share = np.divide(sim, denom, out=np.zeros_like(sim), where=denom > _EPS)
     potential = np.bincount(pairs.gt_id * T + pairs.tracker_id, share, minlength=G * T).reshape(G, T)
-    return potential / (gt_count[:, None] + tr_count[None, :] - potential)
+    result: np.ndarray = potential / (gt_count[:, None] + tr_count[None, :] - potential)
+    return result
 
 
 def hota_final(a: dict[str, np.ndarray]) -> dict[str, np.ndarray]:

@@ -70,7 +70,8 @@ def localisation_error_by_agent(estimated: np.ndarray, truth: np.ndarray) -> np.
     ok = np.isfinite(d)
     count = ok.sum(axis=0)
     total = np.where(ok, d, 0.0).sum(axis=0)
-    return np.divide(total, count, out=np.full(count.shape, np.nan), where=count > 0)
+    result: np.ndarray = np.divide(total, count, out=np.full(count.shape, np.nan), where=count > 0)
+    return result
 
 
 def localisation_error(estimated: np.ndarray, truth: np.ndarray) -> float:

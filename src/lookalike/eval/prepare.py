@@ -33,12 +33,18 @@ class MotTable(Protocol):
     ``path`` the source file or None.
     """
 
-    frame: np.ndarray
-    track_id: np.ndarray
-    xywh: np.ndarray
-    conf: np.ndarray
-    extra: np.ndarray
-    path: Path | None
+    @property
+    def frame(self) -> np.ndarray: ...
+    @property
+    def track_id(self) -> np.ndarray: ...
+    @property
+    def xywh(self) -> np.ndarray: ...
+    @property
+    def conf(self) -> np.ndarray: ...
+    @property
+    def extra(self) -> np.ndarray: ...
+    @property
+    def path(self) -> Path | None: ...
 
     def __len__(self) -> int: ...
 
@@ -141,7 +147,7 @@ def prepare_boxes(
         g = g_order[g_bounds[t] : g_bounds[t + 1]]
         r = r_order[r_bounds[t] : r_bounds[t + 1]]
         sim = box_iou(gt.xywh[g], result.xywh[r])
-        if distractors is not None and len(g) and len(r):
+        if distractors is not None and gt_class is not None and len(g) and len(r):
             drop = _distractor_matches(sim, gt_class[g], distractors)
             if len(drop):
                 keep_r = np.ones(len(r), bool)
@@ -160,7 +166,8 @@ def _distractor_matches(sim: np.ndarray, classes: np.ndarray, distractors: tuple
     rows, cols = linear_sum_assignment(-score)
     ok = score[rows, cols] > _EPS
     rows, cols = rows[ok], cols[ok]
-    return cols[np.isin(classes[rows], distractors)]
+    result: np.ndarray = cols[np.isin(classes[rows], distractors)]
+    return result
 
 
 def prepare_points(

@@ -34,7 +34,8 @@ def box_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
     inter[:, area_b <= _EPS] = 0.0
     inter[union <= _EPS] = 0.0
     union[union <= _EPS] = 1.0
-    return inter / union
+    result: np.ndarray = inter / union
+    return result
 
 
 def point_similarity(gt_xy: np.ndarray, tr_xy: np.ndarray, radius: float) -> np.ndarray:
@@ -47,4 +48,5 @@ def point_similarity(gt_xy: np.ndarray, tr_xy: np.ndarray, radius: float) -> np.
     a = np.asarray(gt_xy, dtype=float).reshape(-1, 2)
     b = np.asarray(tr_xy, dtype=float).reshape(-1, 2)
     d = np.sqrt(((a[:, None, :] - b[None, :, :]) ** 2).sum(axis=-1))
-    return np.maximum(0.0, 1.0 - d / (2.0 * radius))
+    result: np.ndarray = np.maximum(0.0, 1.0 - d / (2.0 * radius))
+    return result

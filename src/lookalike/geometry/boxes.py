@@ -15,7 +15,8 @@ def xywh_to_xyxy(xywh: np.ndarray) -> np.ndarray:
     b = np.asarray(xywh, dtype=float)
     out = b.copy()
     out[..., 2:] += b[..., :2]
-    return out
+    result: np.ndarray = out
+    return result
 
 
 def xyxy_to_xywh(xyxy: np.ndarray) -> np.ndarray:
@@ -23,7 +24,8 @@ def xyxy_to_xywh(xyxy: np.ndarray) -> np.ndarray:
     b = np.asarray(xyxy, dtype=float)
     out = b.copy()
     out[..., 2:] -= b[..., :2]
-    return out
+    result: np.ndarray = out
+    return result
 
 
 def xywh_to_cxcywh(xywh: np.ndarray) -> np.ndarray:
@@ -31,7 +33,8 @@ def xywh_to_cxcywh(xywh: np.ndarray) -> np.ndarray:
     b = np.asarray(xywh, dtype=float)
     out = b.copy()
     out[..., :2] += b[..., 2:] / 2.0
-    return out
+    result: np.ndarray = out
+    return result
 
 
 def xywh_to_xysr(xywh: np.ndarray) -> np.ndarray:
@@ -70,4 +73,5 @@ def iou_matrix(xywh_a: np.ndarray, xywh_b: np.ndarray) -> np.ndarray:
     ih = np.clip(np.minimum(ay2, by2) - np.maximum(ay1, by1), 0.0, None)
     inter = iw * ih
     union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
-    return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+    result: np.ndarray = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+    return result

@@ -100,7 +100,8 @@ class Extrinsics:
         yaw = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
         pitch = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])  # +pitch: forward tilts down
         roll = np.array([[cr, -sr, 0.0], [sr, cr, 0.0], [0.0, 0.0, 1.0]])  # about the optical axis
-        return yaw @ pitch @ _LEVEL @ roll
+        result: np.ndarray = yaw @ pitch @ _LEVEL @ roll
+        return result
 
 
 @dataclass(frozen=True)
@@ -145,7 +146,8 @@ class Camera:
     def depth_m(self, points_m: np.ndarray) -> np.ndarray:
         """Distance of points ``(n, 3)`` along the optical axis, metres ``(n,)`` (negative: behind)."""
         p = _rows("points_m", points_m, 3)
-        return (p - self.centre_m) @ self._r[:, 2]
+        result: np.ndarray = (p - self.centre_m) @ self._r[:, 2]
+        return result
 
     def ground_to_pixels(self, position_m: np.ndarray, z_m: float | np.ndarray = 0.0) -> np.ndarray:
         """Pixels ``(n, 2)`` of egocentric ground positions ``(n, 2)`` lifted to height ``z_m``."""
@@ -165,7 +167,8 @@ class Camera:
             s = -drop / rays[:, 2]
         out = rays[:, :2] * s[:, None]
         out[~(s > 0)] = np.nan
-        return out
+        result: np.ndarray = out
+        return result
 
     def box_to_ground(self, xywh: np.ndarray) -> np.ndarray:
         """Ground positions ``(n, 2)`` (m) of the bottom-centres of boxes ``xywh (n, 4)`` (px).
@@ -197,7 +200,8 @@ class Camera:
     def bearing_rad(self, position_m: np.ndarray) -> np.ndarray:
         """Egocentric bearing ``atan2(y, x)`` (rad) of ground positions ``(n, 2)``."""
         xy = _rows("position_m", position_m, 2)
-        return np.arctan2(xy[:, 1], xy[:, 0])
+        result: np.ndarray = np.arctan2(xy[:, 1], xy[:, 0])
+        return result
 
 
 @dataclass(frozen=True)
@@ -219,12 +223,14 @@ class Pose2D:
     def ego_to_fixed(self, position_m: np.ndarray) -> np.ndarray:
         """Egocentric positions ``(n, 2)`` (m) as positions in the fixed frame ``(n, 2)``."""
         xy = _rows("position_m", position_m, 2)
-        return xy @ self._rot().T + np.array([self.x_m, self.y_m])
+        result: np.ndarray = xy @ self._rot().T + np.array([self.x_m, self.y_m])
+        return result
 
     def fixed_to_ego(self, position_m: np.ndarray) -> np.ndarray:
         """Fixed-frame positions ``(n, 2)`` (m) in this observer's egocentric frame ``(n, 2)``."""
         xy = _rows("position_m", position_m, 2)
-        return (xy - np.array([self.x_m, self.y_m])) @ self._rot()
+        result: np.ndarray = (xy - np.array([self.x_m, self.y_m])) @ self._rot()
+        return result
 
     def heading_to_fixed(self, heading_rad: np.ndarray) -> np.ndarray:
         """Egocentric headings ``(n,)`` as fixed-frame headings in (-π, π]."""

@@ -53,7 +53,8 @@ def _check_shapes(w: NetworkWeights, source: str) -> None:
         width = n_in if i == 0 else h
         shapes = {"w_ih": (g * h, width), "w_hh": (g * h, h), "b_ih": (g * h,), "b_hh": (g * h,)}
         for name, shape in shapes.items():
-            got = np.shape(layer.get(name))
+            arr = layer.get(name)
+            got = () if arr is None else np.shape(arr)
             if got != shape:
                 raise CheckpointError(f"{source}: layer{i}.{name} has shape {got}, expected {shape}")
     checks = {
@@ -81,7 +82,8 @@ def save_weights(weights: NetworkWeights, path: str | os.PathLike[str]) -> Path:
         for name, arr in layer.items():
             arrays[f"layer{i}.{name}"] = arr
     tmp = path.with_name(path.name + ".tmp.npz")
-    np.savez(tmp, **{k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()})
+    payload: dict[str, Any] = {k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()}
+    np.savez(tmp, **payload)
     os.replace(tmp, path)
     meta = {
         "format": "lookalike-association-net",
@@ -132,11 +134,15 @@ def load_weights(
             arrays = {k: data[k] for k in data.files}
     except (OSError, ValueError) as exc:
         raise CheckpointError(f"{path}: cannot read the weights ({exc})") from None
+
+    def get(key: str) -> Any:  # None where missing: the shape check rejects it
+        return arrays.get(key)
+
     try:
         spec = EncodingSpec(int(meta["n_agents"]), int(meta["n_slots"]), float(meta["max_age_s"]),
                             bool(meta.get("relative_headings", False)))
         layers = [
-            {name: arrays.get(f"layer{i}.{name}") for name in ("w_ih", "w_hh", "b_ih", "b_hh")}
+            {name: get(f"layer{i}.{name}") for name in ("w_ih", "w_hh", "b_ih", "b_hh")}
             for i in range(int(meta["num_layers"]))
         ]
         return NetworkWeights(
@@ -144,10 +150,10 @@ def load_weights(
             cell=str(meta["cell"]),
             hidden=int(meta["hidden"]),
             layers=layers,
-            head_weight=arrays.get("head.weight"),
-            head_bias=arrays.get("head.bias"),
-            input_mean=arrays.get("input_mean"),
-            input_std=arrays.get("input_std"),
+            head_weight=get("head.weight"),
+            head_bias=get("head.bias"),
+            input_mean=get("input_mean"),
+            input_std=get("input_std"),
             info=dict(meta.get("info", {})),
         )
     except KeyError as exc:

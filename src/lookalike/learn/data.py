@@ -30,8 +30,8 @@ def frames_to_arrays(
     for t, frame in enumerate(frames):
         memory.add(frame)
         det = frame.detections
-        if det.label is None or det.position is None or det.heading is None:
-            raise ValueError(f"frame {frame.index}: training frames need position, heading and label")
+        if det.label is None or det.position is None or det.heading is None or det.score is None:
+            raise ValueError(f"frame {frame.index}: training frames need position, heading, score and label")
         keep = np.argsort(-det.score, kind="stable")[: spec.n_slots]
         if rng is not None:
             keep = rng.permutation(keep)

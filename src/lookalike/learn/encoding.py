@@ -128,8 +128,8 @@ def encode_frame(
 
     ``detections`` must carry ``position`` (metres) and ``heading`` (radians).
     """
-    if detections.position is None or detections.heading is None:
-        raise ValueError("the LSTM encoding needs Detections.position and Detections.heading")
+    if detections.position is None or detections.heading is None or detections.score is None:
+        raise ValueError("the LSTM encoding needs Detections.position, Detections.heading and Detections.score")
     used = select_slots(detections.score, spec.n_slots)
     slots = encode_slots(
         spec, detections.position[used], detections.heading[used], detections.score[used], latest_heading_rad

@@ -17,6 +17,9 @@ from lookalike.learn.encoding import EncodingSpec
 class AssociationNet(nn.Module):
     """``forward(x (b, t, n_inputs), state) -> (log-probabilities (b, t, M, N+1), state)``."""
 
+    input_mean: torch.Tensor  # registered buffers
+    input_std: torch.Tensor
+
     def __init__(self, spec: EncodingSpec, hidden: int = 64, num_layers: int = 5, cell: str = "lstm") -> None:
         super().__init__()
         if cell not in ("lstm", "gru"):

@@ -85,7 +85,7 @@ def swap_identities(arrays: RobotArrays, a: int, b: int, start_s: float, stop_s:
     agent[sent_in & (r.agent_id == b)] = a
     swapped = dataclasses.replace(arrays, reports=dataclasses.replace(r, agent_id=agent))
     _, sent = latest_reports(swapped, max(a, b) + 1)
-    frames = (((sent[:, [a, b]] >= start_s) & (sent[:, [a, b]] < stop_s)).any(axis=1))[:, None]
+    frames = np.asarray(((sent[:, [a, b]] >= start_s) & (sent[:, [a, b]] < stop_s)).any(axis=1))[:, None]
     label = arrays.det_label
     label = np.where(frames & (label == a), b, np.where(frames & (label == b), a, label))
     return dataclasses.replace(swapped, det_label=label)

@@ -173,7 +173,7 @@ def train(
             state_h = tuple(s.detach() for s in state_h) if isinstance(state_h, tuple) else state_h.detach()
             losses.append(loss.item())
         step += 1
-        row = {"step": step, "loss": float(np.mean(losses)), "lr": schedule.get_last_lr()[0],
+        row: dict[str, float] = {"step": step, "loss": float(np.mean(losses)), "lr": float(schedule.get_last_lr()[0]),
                "val_success": math.nan, "seconds": time.monotonic() - started}
         if step % config.validation_every == 0 or step == config.steps:
             row["val_success"] = _validate(model, val_xt, val_y)
@@ -196,7 +196,7 @@ def train(
         if stale >= config.patience:
             break
     if best < 0:  # stopped before the first validation
-        row = {"step": step, "loss": math.nan, "lr": schedule.get_last_lr()[0],
+        row = {"step": step, "loss": math.nan, "lr": float(schedule.get_last_lr()[0]),
                "val_success": _validate(model, val_xt, val_y), "seconds": time.monotonic() - started}
         history.append(row)
         best, best_step = row["val_success"], step

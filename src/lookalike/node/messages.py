@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, cast
 
@@ -182,7 +183,7 @@ def decode(data: bytes) -> Message:
         raise MessageError(VERSION, f"schema version {version!r}, this node speaks {SCHEMA_VERSION}")
     kind = body.get("type")
     parser = _PARSERS.get(kind) if isinstance(kind, str) else None
-    if parser is None:
+    if parser is None or not isinstance(kind, str):
         raise MessageError(UNKNOWN_TYPE, f"type {kind!r}; known: {sorted(_PARSERS)}")
     return parser(_Fields(kind, body))
 
@@ -307,7 +308,7 @@ def _status(f: _Fields) -> Status:
     return Status(counters=counters)
 
 
-_PARSERS = {
+_PARSERS: dict[str, Callable[[_Fields], Message]] = {
     "report": _report,
     "detections": _detections,
     "team": _team,

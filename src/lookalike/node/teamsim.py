@@ -123,7 +123,7 @@ class RobotLog:
     team_states: int = 0
     errors_m: list[float] = dataclasses.field(default_factory=list)
 
-    def summary(self) -> dict[str, float | int]:
+    def summary(self) -> dict[str, float | int | None]:
         """JSON-ready figures: counts, median and 95th-percentile position error in metres."""
         err = np.asarray(self.errors_m)
         return {

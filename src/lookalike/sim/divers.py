@@ -382,6 +382,7 @@ def detection_quality(frames: list[Frame], gt: np.ndarray, min_iou: float = 0.5)
     for f in frames:
         g = gt[gt[:, 0] == f.index + 1, 2:6]
         d = f.detections.xywh
+        assert d is not None  # simulated detections always have boxes
         if len(g) and len(d):
             iou = iou_matrix(g, d)
             m = assign(np.where(iou >= min_iou, 1 - iou, np.inf)).matches

@@ -58,6 +58,7 @@ def prepare(sc: DiverScenario, extractor: FeatureExtractor) -> PreparedScenario:
     frames = []
     for frame in scene.frames():
         det = frame.detections
+        assert det.xywh is not None  # simulated detections have boxes
         feats = extractor(scene.image(frame.index), det.xywh) if len(det) else np.zeros((0, extractor.dim))
         frames.append(Frame(index=frame.index, time=frame.time, detections=det.replace(feature=feats)))
     return PreparedScenario(sc, scene, frames, scene.gt)

@@ -78,7 +78,7 @@ def simulate_reports(
     if T == 0 or n_agents == 0 or k_max <= 0:
         z = np.zeros(0)
         return ReportArrays(np.zeros(0, int), z, z, z, frame_offsets_empty, 0)
-    phase = rng.uniform(0.0, period, n_agents)
+    phase = np.asarray(rng.uniform(0.0, period, n_agents))
     t_sent = phase[:, None] + period * np.arange(k_max)[None, :]  # (N, K)
     inside = t_sent <= horizon
     lost = (rng.random(t_sent.shape) < cfg.loss_prob) | _burst_mask(t_sent, cfg, horizon, rng)

@@ -198,7 +198,8 @@ class RobotRenderer:
                 if n @ (cam_c - centre) <= 0:
                     continue
                 shade = 0.55 + 0.45 * max(0.0, float(n @ light))
-                out.append((uv[list(idx)], tuple(int(min(255, ch * shade)) for ch in colour)))
+                b, g, r = (int(min(255, ch * shade)) for ch in colour)
+                out.append((uv[list(idx)], (b, g, r)))
         return out
 
     def _background(self, obs: Pose2D) -> np.ndarray:
@@ -227,7 +228,7 @@ class RobotRenderer:
         target = np.exp(rng.normal(0.0, cfg.brightness_std)) * np.exp(rng.normal(0.0, cfg.cast_std, 3))
         self._gain = 0.8 * self._gain + 0.2 * target  # slow drift of the lighting
         sigma = rng.uniform(0.0, cfg.blur_max_px)
-        out = img.astype(np.float32)
+        out: np.ndarray = img.astype(np.float32)
         if sigma > 0.3:
             out = cv2.GaussianBlur(out, (0, 0), sigma)
         out = out * self._gain[None, None, :].astype(np.float32)

@@ -74,7 +74,7 @@ class FeatureStats:
             object.__setattr__(self, name, arr)
         if (self.scale <= 0).any():
             raise ValueError("FeatureStats.scale: every value must be positive")
-        if (self.weight < 0).any():
+        if (np.asarray(self.weight) < 0).any():
             raise ValueError("FeatureStats.weight: every value must be >= 0")
 
 
@@ -156,7 +156,7 @@ class HandcraftedFeatures:
             scale = np.sqrt(np.maximum(var, 1e-6)) if self._count >= 2 else np.ones(RAW_DIM)
         else:
             mean, scale = self.stats_.mean, self.stats_.scale
-        weight = _block_weights() if self.stats_ is None else self.stats_.weight
+        weight = _block_weights() if self.stats_ is None or self.stats_.weight is None else self.stats_.weight
         z = (raw - mean) / scale * weight
         norm = np.linalg.norm(z, axis=1, keepdims=True)
         return z / np.maximum(norm, 1e-12)
@@ -314,7 +314,7 @@ def _shape_stats(mask: np.ndarray, s: int) -> tuple[np.ndarray, np.ndarray]:
         hull_idx = cv2.convexHull(big, returnPoints=False)
         hull_area = max(cv2.contourArea(big[hull_idx.ravel()]), 1.0)
         size = np.sqrt(hull_area)
-        depths = np.zeros(0)
+        depths: np.ndarray = np.zeros(0)
         if len(hull_idx) > 3 and len(big) > 3:
             try:
                 defects = cv2.convexityDefects(big, np.sort(hull_idx, axis=0))

@@ -19,11 +19,15 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from lookalike.vision.hog_features import as_bgr_image, dense_hog, hue_channel, to_grey
 from lookalike.vision.model_file import load_model_file, save_model_file
+
+if TYPE_CHECKING:
+    from lookalike.geometry.camera import Camera
 
 FORMAT = "lookalike-heading-svm"
 VERSION = 1
@@ -90,7 +94,7 @@ def heading_features(image: np.ndarray, xywh: np.ndarray, config: HeadingConfig 
     out = []
     for x, y, w, h in boxes:
         # Affine map from the patch to the upper half of the box (border pixels replicated).
-        m = np.float32([[w / pw, 0, x], [0, 0.5 * h / ph, y]])
+        m = np.array([[w / pw, 0, x], [0, 0.5 * h / ph, y]], dtype=np.float32)
         patch = cv2.warpAffine(img, m, (pw, ph), flags=cv2.INTER_AREA | cv2.WARP_INVERSE_MAP,
                                borderMode=cv2.BORDER_REPLICATE)
         centre = ((x + w / 2) / width, (y + h / 2) / height)
@@ -344,7 +348,7 @@ def rendered_heading_samples(
     range_m: tuple[float, float] = (1.0, 5.0),
     min_visible: float = 0.8,
     box_jitter: float = 0.05,
-    camera: object | None = None,
+    camera: Camera | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Features ``(n, d)`` and true egocentric headings ``(n,)`` (rad) of robots rendered by
     :class:`lookalike.sim.render_robots.RobotRenderer` at random places ``range_m`` (m) ahead inside the

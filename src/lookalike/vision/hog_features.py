@@ -167,7 +167,7 @@ def crop_window(grey: np.ndarray, xywh: np.ndarray, window_px: tuple[int, int], 
     ww = hh * w_px / h_px
     sx, sy = ww / w_px, hh / h_px
     # Affine map from the output (with margin) to the source image.
-    m = np.float32([[sx, 0, cx - ww / 2 - sx], [0, sy, cy - hh / 2 - sy]])
+    m = np.array([[sx, 0, cx - ww / 2 - sx], [0, sy, cy - hh / 2 - sy]], dtype=np.float32)
     return cv2.warpAffine(np.asarray(grey, np.float32), m, (w_px + 2, h_px + 2),
                           flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE)
 

@@ -17,7 +17,8 @@ def save_model_file(path: str | Path, fmt: str, version: int, header: dict[str, 
     path.parent.mkdir(parents=True, exist_ok=True)
     full = {"format": fmt, "version": version, **header}
     with open(path, "wb") as fh:
-        np.savez_compressed(fh, header=np.array(json.dumps(full)), **arrays)
+        payload: dict[str, Any] = {"header": np.array(json.dumps(full)), **arrays}
+        np.savez_compressed(fh, **payload)
     return path
 
 

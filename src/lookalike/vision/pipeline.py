@@ -95,9 +95,10 @@ class PipelineConfig:
     def identifier_kwargs(self) -> dict[str, Any]:
         """``make_tracker`` keyword arguments: N (and M for slot-based identifiers) plus ``identifier_params``."""
         try:
-            known = {f.name for f in dataclasses.fields(tracker_class(self.identifier).Config)}
+            tracker_cls: Any = tracker_class(self.identifier)
         except KeyError as exc:
             raise ValueError(f"PipelineConfig.identifier: {exc.args[0]}") from None
+        known = {f.name for f in dataclasses.fields(tracker_cls.Config)}
         kwargs: dict[str, Any] = {k: v for k, v in (("n_agents", self.n_agents), ("n_slots", self.max_detections))
                                   if k in known}
         kwargs.update(dict(self.identifier_params))
@@ -192,10 +193,10 @@ class RobotPipeline:
         if cfg.detect_scale != 1.0:
             size = (round(k.width * cfg.detect_scale), round(k.height * cfg.detect_scale))
             det = self.detector(cv2.resize(img, size, interpolation=cv2.INTER_LINEAR))
-            xywh = det.xywh / cfg.detect_scale
         else:
             det = self.detector(img)
-            xywh = det.xywh
+        assert det.xywh is not None and det.score is not None  # detectors fill boxes and scores
+        xywh = det.xywh / cfg.detect_scale if cfg.detect_scale != 1.0 else det.xywh
         score = det.score
         keep = (score >= cfg.min_score) & (xywh[:, 2] > 0) & (xywh[:, 3] > 0)
         xywh, score = xywh[keep], score[keep]
@@ -262,6 +263,7 @@ def labelled_rows(index: int, detections: Detections, labels: Sequence[int] | np
     """MOTChallenge result rows ``(k, 10)`` for the identified detections of 0-based frame ``index``:
     ``frame, agent id + 1, box (px), identity confidence, ground x, y (m), -1``."""
     lab = np.asarray(labels, int).reshape(-1)
+    assert detections.xywh is not None  # detections of the pixel pipeline have boxes
     prob = {t.detection_index: t.identity_prob for t in tracks if t.agent_id is not None and t.detection_index >= 0}
     rows = []
     for k in np.flatnonzero(lab >= 0):

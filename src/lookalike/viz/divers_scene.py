@@ -58,6 +58,7 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
             k = frame.index
             image = scene.image(k)
             det = frame.detections
+            assert det.xywh is not None  # simulated detections have boxes
             feats = extractor(image, det.xywh) if len(det) else np.zeros((0, extractor.dim))
             f = Frame(index=k, time=frame.time, detections=det.replace(feature=feats))
             shown = _update_all(instances, f, results, elapsed, video_tracker)

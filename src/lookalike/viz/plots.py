@@ -21,7 +21,7 @@ def _pyplot() -> Any:
 
 
 def birdseye_plot(path: Path | str, truth: np.ndarray, estimated: np.ndarray, *,
-                  field_m: tuple[float, float] | None = None, observer: np.ndarray | None = None,
+                  field_m: tuple[float, float] | None = None, observer: np.ndarray | tuple[float, float] | None = None,
                   title: str = "") -> Path:
     """True (solid) and estimated (dots) paths of each agent seen from above.
 

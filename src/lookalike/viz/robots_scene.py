@@ -121,7 +121,7 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
                 uv = camera.ground_to_pixels(np.nan_to_num(ego, nan=1e6)) * scale
                 uv[~np.isfinite(ego).all(axis=1)] = np.nan
                 draw_tail(img, uv, identity_colour(j), thickness=3)
-            if len(det):
+            if len(det) and det.position is not None:
                 boxes = camera.ground_to_box(det.position, ROBOT_HEIGHT_M, ROBOT_WIDTH_M) * scale
                 for b, lab, tru in zip(boxes, labels, truth):
                     text = "false positive" if lab < 0 else f"robot {lab}"

@@ -8,7 +8,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from pathlib import Path
 from types import TracebackType
-from typing import Self
+from typing import Any
 
 import numpy as np
 
@@ -31,7 +31,7 @@ class VideoWriter:
         self.gif = Path(gif) if gif is not None else None
         self.gif_every, self.gif_frames, self.gif_width = gif_every, gif_frames, gif_width
         self.count = 0
-        self._writer = None
+        self._writer: Any = None  # a cv2.VideoWriter once the first frame fixes the size
         self._size: tuple[int, int] | None = None
         self._gif_images: list[np.ndarray] = []
 
@@ -45,7 +45,7 @@ class VideoWriter:
         size = (img.shape[1], img.shape[0])
         if self._writer is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter_fourcc(*"mp4v"), self.fps, size)
+            self._writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter.fourcc(*"mp4v"), self.fps, size)
             if not self._writer.isOpened():
                 raise ValueError(f"path: OpenCV cannot write an MP4 video at {self.path}")
             self._size = size
@@ -66,7 +66,7 @@ class VideoWriter:
             write_gif(self.gif, self._gif_images, fps=self.fps / self.gif_every)
             self._gif_images = []
 
-    def __enter__(self) -> Self:
+    def __enter__(self) -> VideoWriter:
         return self
 
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,

@@ -164,6 +164,7 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
         for k, image in enumerate(images):
             det = det_frames[k].detections if k < len(det_frames) else Detections.empty()
             t0 = time.perf_counter()
+            assert det.xywh is not None  # box detections
             feats = extractor(image, det.xywh) if len(det) else np.zeros((0, int(extractor.dim)))
             feature_s += time.perf_counter() - t0
             frame = Frame(index=k, time=k / rate, detections=det.replace(feature=feats))

@@ -25,7 +25,7 @@ from collections.abc import Callable
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 from urllib.parse import parse_qs, unquote, urlsplit
 
 import numpy as np
@@ -163,7 +163,7 @@ class _Handler(BaseHTTPRequestHandler):
 
     def _check_host(self) -> None:
         host = (self.headers.get("Host") or "").rsplit(":", 1)[0].strip("[]").lower()
-        bound = self.server.server_address[0]
+        bound = cast(tuple[str, int], self.server.server_address)[0]
         if bound in ("127.0.0.1", "::1", "localhost") and host not in ("127.0.0.1", "localhost", "::1"):
             raise _BadRequest(HTTPStatus.FORBIDDEN, f"unexpected Host header {host!r}")
 
