@@ -163,6 +163,16 @@ def test_command_parses(cmd: Command):
     check_parses(cmd)
 
 
+def test_readme_links_exist():
+    """The README's relative links (into docs/) name files that exist (the site build checks the docs' own)."""
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    for target in re.findall(r"\]\(([^)\s]+)\)", text):
+        if re.match(r"[a-z]+:", target) or target.startswith("#"):
+            continue
+        path = target.split("#", 1)[0]
+        assert (REPO / path).exists(), f"README.md links to {target}, which does not exist"
+
+
 def test_benchmark_scripts_exist():
     """``python benchmarks/X.py`` in the docs names a script that exists."""
     for doc in DOC_FILES:
