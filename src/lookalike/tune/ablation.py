@@ -24,6 +24,12 @@ from lookalike.tune.space import Space, grid, searched
 INERT_POINTS = 0.05  # a parameter whose whole range moves no fold's training objective more than this is inert
 
 
+def _same(a: Any, b: Any) -> bool:
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)) and not isinstance(a, bool):
+        return math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-12)
+    return a == b and type(a) is type(b)
+
+
 def one_at_a_time(tracker: str, space: Space, points: int = 5) -> tuple[list[dict[str, Any]], dict[str, list[int]]]:
     """``(candidates, by_parameter)``: candidate 0 is the defaults; ``by_parameter[name]`` lists the
     indices of the candidates that move only ``name`` (``points`` values over its range)."""
@@ -33,7 +39,7 @@ def one_at_a_time(tracker: str, space: Space, points: int = 5) -> tuple[list[dic
     for name, dim in searched(space).items():
         by_parameter[name] = []
         for value in grid(dim, points):
-            if value == defaults.get(name) and type(value) is type(defaults.get(name)):
+            if _same(value, defaults.get(name)):
                 continue
             by_parameter[name].append(len(candidates))
             candidates.append({name: value})
