@@ -27,7 +27,7 @@ from lookalike.loop import RunStats, Sink, Sinks, Updating, run
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import format_row, tracks_to_rows
 
-CHUNK_LINES = 65_536
+CHUNK_LINES = 8_192
 
 
 def _chunks(path: Path, lines: int) -> Iterator[np.ndarray]:
