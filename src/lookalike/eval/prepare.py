@@ -14,7 +14,6 @@ Rules (``benchmark``):
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
 
@@ -23,6 +22,7 @@ from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import SequenceData
 from lookalike.eval.similarity import box_iou, point_similarity
+from lookalike.types.mot_table import MotTable as MotTableData
 
 
 class MotTable(Protocol):
@@ -48,18 +48,6 @@ class MotTable(Protocol):
 
     def __len__(self) -> int: ...
 
-
-@dataclass(frozen=True, eq=False)
-class _Table:
-    frame: np.ndarray
-    track_id: np.ndarray
-    xywh: np.ndarray
-    conf: np.ndarray
-    extra: np.ndarray
-    path: Path | None = None
-
-    def __len__(self) -> int:
-        return int(self.frame.shape[0])
 
 BENCHMARKS = ("MOT15", "MOT16", "MOT17", "MOT20", "custom")
 _DISTRACTORS = {"MOT16": (2, 7, 8, 12), "MOT17": (2, 7, 8, 12), "MOT20": (2, 6, 7, 8, 12)}
@@ -214,7 +202,7 @@ def _point_table(frame: np.ndarray, ids: np.ndarray, xy: np.ndarray, name: str) 
         raise ValueError(f"{name}: frames must be >= 1 and positions finite")
     xywh = np.zeros((len(frame), 4))
     xywh[:, :2] = xy
-    return _Table(frame, ids, xywh, np.ones(len(frame)), np.zeros((len(frame), 0)))
+    return MotTableData(frame, ids, xywh, np.ones(len(frame)), np.zeros((len(frame), 0)))
 
 
 def _num_frames(gt: MotTable, res: MotTable, num_frames: int | None) -> int:

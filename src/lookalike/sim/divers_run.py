@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lookalike.loop import RowCollector, run
 from lookalike.sim.divers import (
     VALIDATION_SCENARIOS,
     DiverScenario,
@@ -18,7 +19,7 @@ from lookalike.sim.divers import (
     simulate_divers,
 )
 from lookalike.trackers import make_tracker
-from lookalike.types import Frame, TrackSnapshot
+from lookalike.types import Frame
 from lookalike.vision.appearance import (
     FeatureExtractor,
     HandcraftedFeatures,
@@ -67,10 +68,6 @@ def prepare(sc: DiverScenario, extractor: FeatureExtractor) -> PreparedScenario:
 def run_tracker(name: str, frames: list[Frame], **params: object) -> tuple[np.ndarray, object]:
     """Run tracker ``name`` over ``frames``; MOTChallenge result rows ``(n, 10)`` and the tracker."""
     tracker = make_tracker(name, **params)
-    rows = []
-    for frame in frames:
-        tracks: list[TrackSnapshot] = tracker.update(frame)
-        for t in tracks:
-            if t.xywh is not None:
-                rows.append([frame.index + 1, t.track_id, *t.xywh, 1.0, -1, -1, -1])
-    return np.array(rows, dtype=float).reshape(-1, 10), tracker
+    collect = RowCollector()
+    run(tracker, frames, collect)
+    return collect.rows(), tracker
