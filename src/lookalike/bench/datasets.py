@@ -216,8 +216,8 @@ def detect_hexbug(video: Path) -> RealSequence:
     dets = [detector(image) for image in frames]
     height, width = frames[0].shape[:2]
     points = read_hexbug_points(video.with_suffix(".csv"), (width, height))
-    return RealSequence("hexbug", video.stem, HEXBUG_FPS, len(frames), [d.xywh for d in dets],
-                        [d.score for d in dets], gt_points=points, image_size=(width, height))
+    return RealSequence("hexbug", video.stem, HEXBUG_FPS, len(frames), [np.asarray(d.xywh) for d in dets],
+                        [np.asarray(d.score) for d in dets], gt_points=points, image_size=(width, height))
 
 
 def _selected(seqs: list[RealSequence], dataset: str, sequences: Sequence[str] | None) -> list[RealSequence]:

@@ -22,6 +22,7 @@ def _result_file(results: Path, name: str) -> Path:
 
 def _score(job: tuple[MotSequence, Path, str, tuple[str, ...], float]) -> dict[str, float]:
     seq, res_path, benchmark, metrics, threshold = job
+    assert seq.gt_path is not None  # only sequences with ground truth are scored
     return evaluate_sequence(read_mot(seq.gt_path), read_mot(res_path), iou_threshold=threshold,
                              benchmark=benchmark, metrics=metrics, num_frames=seq.length)
 

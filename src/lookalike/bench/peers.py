@@ -47,7 +47,7 @@ def _stack(chunks: list[np.ndarray]) -> np.ndarray:
 
 
 def _sv_detections(xywh: np.ndarray, score: np.ndarray):
-    import supervision as sv
+    import supervision as sv  # type: ignore[import-not-found,import-untyped,unused-ignore]
 
     return sv.Detections(xyxy=_xyxy(xywh), confidence=np.asarray(score, dtype=float),
                          class_id=np.zeros(len(score), dtype=int))
@@ -68,7 +68,7 @@ def _run_sv_like(make: Callable[[], object], seq: RealSequence, method: str = "u
 
 def supervision_bytetrack(seq: RealSequence) -> np.ndarray:
     """supervision's ``sv.ByteTrack`` (defaults; ``frame_rate`` of the sequence)."""
-    import supervision as sv
+    import supervision as sv  # type: ignore[import-not-found,import-untyped,unused-ignore]
 
     return _run_sv_like(lambda: sv.ByteTrack(frame_rate=max(round(seq.frame_rate), 1)), seq,
                         "update_with_detections")
@@ -76,7 +76,7 @@ def supervision_bytetrack(seq: RealSequence) -> np.ndarray:
 
 def _roboflow(cls_name: str) -> PeerFn:
     def run(seq: RealSequence) -> np.ndarray:
-        import trackers
+        import trackers  # type: ignore[import-not-found,import-untyped,unused-ignore]
 
         cls = getattr(trackers, cls_name)
         return _run_sv_like(lambda: cls(frame_rate=float(seq.frame_rate)), seq)
@@ -87,7 +87,7 @@ def _roboflow(cls_name: str) -> PeerFn:
 
 def norfair_iou(seq: RealSequence) -> np.ndarray:
     """norfair's ``Tracker`` on box corners with the IoU distance (threshold 0.7), other defaults."""
-    import norfair
+    import norfair  # type: ignore[import-not-found,import-untyped,unused-ignore]
 
     tracker = norfair.Tracker(distance_function="iou", distance_threshold=0.7)
     out = []
@@ -106,7 +106,7 @@ def _boxmot(module: str, cls_name: str) -> PeerFn:
         import logging
 
         mod = importlib.import_module(module)
-        from boxmot.utils import logger as boxmot_logger
+        from boxmot.utils import logger as boxmot_logger  # type: ignore[import-not-found,import-untyped,unused-ignore]
 
         level = boxmot_logger.level
         boxmot_logger.setLevel(logging.WARNING)  # it logs every tracker's settings at INFO

@@ -92,6 +92,7 @@ def perceive_sequence(pipe: RobotPipeline, seq: RobotSequence, camera: Camera, m
         t0 = time.perf_counter()
         det = pipe.perceive(rendered.image, float(a.observer[k, 2]))
         out.seconds += time.perf_counter() - t0
+        assert det.xywh is not None and det.heading is not None  # the pipeline fills both
         truth = match_truth(det.xywh, rendered.xywh, rendered.robot_id, min_iou)
         frame = seq.frame(k)
         out.detections.append(det)

@@ -23,7 +23,7 @@ def load_preset(name: str) -> dict[str, Any]:
     """The parsed preset file ``presets/<name>.json`` (cached; do not modify the result)."""
     if name not in PRESET_FILES:
         raise ValueError(f"preset: unknown preset {name!r}; known: {', '.join(PRESET_FILES)}")
-    text = resources.files("lookalike.bench").joinpath("presets", f"{name}.json").read_text()
+    text = resources.files("lookalike.bench").joinpath("presets").joinpath(f"{name}.json").read_text()
     return dict(json.loads(text))
 
 

@@ -3,25 +3,31 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from lookalike.geometry.camera import Camera
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
 
 
 def rendered_detector_data(
     n_frames: int, seed: int, window_px: tuple[int, int], min_visible: float = 0.7,
-    height_px: tuple[float, float] = (40.0, 400.0), camera: object | None = None,
+    height_px: tuple[float, float] = (40.0, 400.0), camera: Camera | None = None,
     step: Callable[[], None] | None = None,
 ) -> tuple[np.ndarray, list[np.ndarray], list[np.ndarray]]:
     """Grey positive windows ``(n, h+2, w+2)`` of rendered robots (1-5 m, random headings, 1-4 per frame), the
     grey frames and their ground-truth boxes ``(m, 4)`` (px) for sampling negatives. Deterministic by ``seed``."""
     from lookalike.vision.hog_features import crop_window, to_grey
 
-    pos, frames, truths = [], [], []
+    pos: list[np.ndarray] = []
+    frames: list[np.ndarray] = []
+    truths: list[np.ndarray] = []
     for frame in _rendered_frames(n_frames, seed, camera):
         grey = to_grey(frame.image)
         frames.append(grey)
@@ -34,7 +40,7 @@ def rendered_detector_data(
     return np.array(pos, np.float32).reshape(-1, h, w), frames, truths
 
 
-def _rendered_frames(n_frames: int, seed: int, camera: object | None = None) -> Iterator[Any]:
+def _rendered_frames(n_frames: int, seed: int, camera: Camera | None = None) -> Iterator[Any]:
     """Rendered frames of 1-4 robots 1-5 m ahead (depth), across a little more than the field of view,
     random headings. Deterministic by ``seed``."""
     from lookalike.geometry.camera import Camera
@@ -51,7 +57,7 @@ def _rendered_frames(n_frames: int, seed: int, camera: object | None = None) -> 
         yield renderer.render(np.column_stack([depth, lateral]), rng.uniform(-np.pi, np.pi, n))
 
 
-def rendered_held_out_scenes(n_frames: int, seed: int, camera: object | None = None) -> list[Any]:
+def rendered_held_out_scenes(n_frames: int, seed: int, camera: Camera | None = None) -> list[Any]:
     """Rendered frames as :class:`~lookalike.vision.hog_select.HeldOutScene`: robots at least half visible are
     targets, the others in view are ignored."""
     from lookalike.vision.hog_select import HeldOutScene
@@ -71,7 +77,7 @@ def negative_sampler(frames: list[np.ndarray], truths: list[np.ndarray], window_
     aspect = window_px[0] / window_px[1]
 
     def sample(count: int, rng: np.random.Generator) -> np.ndarray:
-        out = []
+        out: list[np.ndarray] = []
         while len(out) < count:
             k = int(rng.integers(len(frames)))
             img, gt = frames[k], truths[k]
@@ -137,8 +143,9 @@ def train_robot_detector(data: Path | None, frames: int, stages: int, negatives:
     from lookalike.vision.hog_select import select_stages
 
     # Folder positives fill their whole window; rendered ones carry the default context margin.
-    pad = {"context_pad": 0.0} if data is not None else {}
-    config = CascadeConfig(stages=stages, negatives_per_stage=negatives, **pad)
+    config = CascadeConfig(stages=stages, negatives_per_stage=negatives)
+    if data is not None:
+        config = dataclasses.replace(config, context_pad=0.0)
     if frames < 1 or copies < 0 or validation_frames < 0:
         raise ValueError(f"--frames/--copies/--validation-frames: need frames >= 1, copies >= 0 and "
                          f"validation_frames >= 0, got {frames}, {copies}, {validation_frames}")
@@ -162,7 +169,7 @@ def train_robot_detector(data: Path | None, frames: int, stages: int, negatives:
     # Hard negatives are also mined from whole frames (windows the cascade accepts away from robots).
     model = train_cascade(pos, sampler, config, seed=seed, progress=lambda k, message: training(k + 1, message),
                           scenes=list(zip(neg_images, truths)))
-    trained, tried = len(model.stages), []
+    trained, tried = len(model.stages), list[Any]()
     if data is None and validation_frames:
         selecting = step("held-out selection", 1)
         model, tried = select_stages(model, rendered_held_out_scenes(validation_frames, seed + 1000003))

@@ -74,7 +74,7 @@ def label(
     except OSError as exc:
         fail(f"cannot listen on {host}:{port}: {exc}")
     try:
-        if not ipaddress.ip_address(server.server_address[0]).is_loopback:
+        if not ipaddress.ip_address(str(server.server_address[0])).is_loopback:
             console.print(f"[yellow]warning:[/] {host} is reachable from other machines")
     except ValueError:
         pass

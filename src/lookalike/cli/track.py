@@ -135,17 +135,20 @@ def track(
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
     branch = _check_branches(path, video, detections, annotate, detector, blob, pipeline)
     settings = set_ or []
-    video_options = dict(annotate=annotate, team_size=team_size, health_window=health_window,
-                         min_score=min_score, fps=fps, features=features)
+    video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
+                                         min_score=min_score, fps=fps, features=features)
     if branch == "pipeline":
         run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker, settings,
                          annotate=annotate, fps=fps, min_score=min_score)
-    elif branch == "blobs":
-        run_track_blobs(video, output, _box_tracker(tracker, settings, video=True), tracker, detector or "",
-                        blob or [], **video_options)
-    elif branch == "video":
-        run_track_video(video, detections or path, output, _box_tracker(tracker, settings, video=True), tracker,
-                        **video_options)
+    elif branch in ("blobs", "video"):
+        assert video is not None
+        trk = _box_tracker(tracker, settings, video=True)
+        if branch == "blobs":
+            run_track_blobs(video, output, trk, tracker, detector or "", blob or [], **video_options)
+        else:
+            det_path = detections or path
+            assert det_path is not None
+            run_track_video(video, det_path, output, trk, tracker, **video_options)
     else:
         assert path is not None
         count, stats = track_files(path, output, _box_tracker(tracker, settings), min_score)

@@ -25,6 +25,7 @@ from __future__ import annotations
 import json
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -93,8 +94,8 @@ def _assemble(config: RobotWorldConfig, header: dict, rows: list[dict], T: int, 
     label = np.full((T, M), -1, dtype=int)
     b_parts: dict[str, list] = {"agent_id": [], "t_sent": [], "t_received": [], "heading": []}
     offsets = np.zeros(T + 1, dtype=int)
-    truth = {k: [] for k in ("position", "heading", "visible", "occlusion", "field_position", "observer",
-                              "n_false_positives", "n_misses")}
+    truth: dict[str, list[Any]] = {k: [] for k in ("position", "heading", "visible", "occlusion", "field_position",
+                                                   "observer", "n_false_positives", "n_misses")}
     time = np.zeros(T)
     for k, row in enumerate(rows):
         if row["frame"] != k:

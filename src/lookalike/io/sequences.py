@@ -35,7 +35,7 @@ def read_seqinfo(path: str | os.PathLike[str]) -> dict[str, str]:
     """The ``[Sequence]`` section of a ``seqinfo.ini`` as a dict (keys as written)."""
     path = Path(path)
     parser = configparser.ConfigParser()
-    parser.optionxform = str  # keep key case
+    parser.optionxform = str  # type: ignore[assignment,method-assign]  # keep key case
     try:
         parser.read_string(path.read_text(), source=str(path))
     except configparser.Error as exc:

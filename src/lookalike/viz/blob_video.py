@@ -88,7 +88,7 @@ def _background_sample(frames: Any, declared: int, count: int) -> list[np.ndarra
         wanted = set(np.linspace(0, declared - 1, min(declared, count)).round().astype(int).tolist())
         return [img for k, img in enumerate(frames) if k in wanted]
     every = list(frames)  # length unknown: keep the frames, then subsample
-    pick = np.unique(np.linspace(0, len(every) - 1, min(len(every), count)).round().astype(int)) if every else []
+    pick: Any = np.unique(np.linspace(0, len(every) - 1, min(len(every), count)).round().astype(int)) if every else []
     return [every[k] for k in pick]
 
 
