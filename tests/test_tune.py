@@ -56,7 +56,6 @@ def sequences() -> list[RealSequence]:
 
 def test_default_spaces_name_real_parameters():
     from lookalike.trackers import tracker_parameters
-
     from lookalike.tune import DEFAULT_SPACES
 
     for tracker in ("sort", "boxtrack"):

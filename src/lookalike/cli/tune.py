@@ -6,7 +6,15 @@ import json
 from pathlib import Path
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TaskID,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
 from rich.table import Table
 
 from lookalike.cli.app import app, console, fail
@@ -77,8 +85,10 @@ def tune(
         return
     if not data:
         fail("DATA: give at least one sequence folder or bench dataset")
+        return
     if output is None:
         fail("-o/--output: give the parameter file to write")
+        return
     if sampler not in SAMPLERS:
         fail(f"--sampler: expected one of {', '.join(SAMPLERS)}, got {sampler!r}")
     if backend not in BACKENDS:
@@ -112,7 +122,7 @@ def tune(
         choices = None
         if fold_list is not None:
             with _progress() as bar:
-                tasks: dict[str, int] = {}
+                tasks: dict[str, TaskID] = {}
 
                 def fold_step(fold: str, done: int, total: int, best: float | None) -> None:
                     if fold not in tasks:
@@ -148,8 +158,8 @@ def tune(
     console.print(table)
     if choices is not None:
         table = Table(title=f"Left-out scores ({folds}): each fold chosen on the other sequences only")
-        for c in ("Left out", "HOTA / IDF1 / MOTA", metric):
-            table.add_column(c, justify="left" if c == "Left out" else "right")
+        for column in ("Left out", "HOTA / IDF1 / MOTA", metric):
+            table.add_column(column, justify="left" if column == "Left out" else "right")
         for c in choices:
             table.add_row(", ".join(c.left_out), _pct(c.test_scores), f"{100 * c.test_value:.2f}")
         table.add_row("all (combined)", _pct(held), "")

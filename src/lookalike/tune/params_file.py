@@ -13,12 +13,12 @@ Extra keys (``score``, ``sampler``, ``folds``...) are kept but not needed.
 from __future__ import annotations
 
 import json
-import typing
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from lookalike.trackers.registry import make_tracker, tracker_class, tracker_names
+from lookalike.trackers.registry import make_tracker, tracker_names
+from lookalike.tune.space import config_hints
 
 REQUIRED = ("tracker", "params")
 
@@ -74,7 +74,7 @@ def check_params(tracker: str, params: dict[str, Any], source: str = "params") -
     unknown, or the tracker refuses the values."""
     if tracker not in tracker_names():
         raise ValueError(f"{source}: unknown tracker {tracker!r}; registered: {', '.join(tracker_names())}")
-    known = typing.get_type_hints(tracker_class(tracker).Config)
+    known = config_hints(tracker)
     unknown = sorted(set(params) - set(known))
     if unknown:
         raise ValueError(f"{source}: tracker {tracker!r} has no parameter(s) {', '.join(unknown)}; "

@@ -118,6 +118,12 @@ DEFAULT_SPACES: dict[str, Space] = {
 _FRACTION_WORDS = ("score", "iou", "quantile", "ratio", "prob", "rate", "fraction")
 
 
+def config_hints(tracker: str) -> dict[str, Any]:
+    """The annotations of ``tracker``'s ``Config`` fields (name -> type)."""
+    cls: Any = tracker_class(tracker)
+    return typing.get_type_hints(cls.Config)
+
+
 def _base_type(hint: Any) -> tuple[Any, bool]:
     """``(type, optional)`` of a config field's annotation (``float | None`` -> ``(float, True)``)."""
     args = [a for a in typing.get_args(hint) if a is not type(None)]
@@ -130,7 +136,7 @@ def generic_space(tracker: str) -> Space:
     """A space from ``tracker``'s defaults: booleans both ways; a positive number ``d`` log-uniform
     in ``[d/3, 3d]`` (fractions capped at 1; integers at least 1); zero, ``None`` and text defaults
     are not searched (nor :data:`NOT_SEARCHED`)."""
-    hints = typing.get_type_hints(tracker_class(tracker).Config)
+    hints = config_hints(tracker)
     out: Space = {}
     for p in tracker_parameters(tracker):
         base, _ = _base_type(hints[p.name])
@@ -163,7 +169,7 @@ def space_from_json(spec: Mapping[str, Any], tracker: str) -> Space:
 
     Raises ``ValueError`` naming an unknown parameter or a malformed entry.
     """
-    hints = typing.get_type_hints(tracker_class(tracker).Config)
+    hints = config_hints(tracker)
     out: Space = {}
     for name, entry in spec.items():
         if name not in hints:

@@ -103,7 +103,7 @@ def _compact(scores: Scores) -> Scores:
 def _defaults_in_space(tracker: str, space: Space) -> dict[str, Any]:
     """Trial values of the tracker's defaults, where they lie inside the searched ranges."""
     defaults = {p.name: p.default for p in tracker_parameters(tracker)}
-    out = {}
+    out: dict[str, Any] = {}
     for name, dim in searched(space).items():
         value = defaults.get(name)
         if value is None:
