@@ -5,25 +5,31 @@ the identities need not be decided frame by frame. :func:`assign_identities` tak
 online pass (MOTChallenge rows, any ids) and:
 
 1. **Cuts it into reliable tracklets** (:func:`split_tracklets`): a track is cut wherever it has
-   missing frames, wherever it jumps (a step between consecutive rows longer than ``jump`` times the
-   sequence's 90th-percentile step, and at least ``jump_floor`` box sizes) and around frames where its box
-   overlaps another track's box by IoU ≥ ``contact_iou``: the places where an online tracker may
-   have swapped identities. Each piece is a tracklet.
-2. **Scores links** between the end of one tracklet and the start of a later one (:func:`link_costs`):
-   each end is extrapolated at its velocity (mean over its last ``velocity_frames`` rows, for at most
-   ``coast_s`` seconds), each start likewise backwards, and the mean miss ``d`` (pixels) is compared
-   with the spread a target can reach over the gap of ``g`` frames, ``σ = pos_sigma·size + speed·g``
-   (``size`` the tracklets' mean √(w·h), ``speed`` the sequence's 90th-percentile step in px/frame, both
-   measured on the input). The cost is ``link_cost + ½ (d/σ)²``, a Gaussian negative log-likelihood;
-   pairs beyond ``max_z`` are not candidates, and only the ``candidates`` cheapest successors of every
-   end and predecessors of every start are kept, so the problem stays small.
+   missing frames (an online closed set re-assigns lost slots there), wherever it jumps (a step between
+   consecutive rows longer than ``jump`` times the sequence's 90th-percentile step, and at least
+   ``jump_floor`` box sizes) and, if ``contact_iou`` is set, around frames where its box overlaps
+   another track's box by that IoU. Each piece is a tracklet; pieces of fewer than ``min_rows`` rows
+   are set aside (step 4).
+2. **Scores links** between the end of one tracklet and the start of a later one, ``g`` frames on
+   (:func:`link_costs`), under two motion hypotheses: the target kept its velocity (mean over the last /
+   first ``velocity_frames`` rows; miss ``d`` = mean of the forward and backward extrapolation misses,
+   spread ``σ = pos_sigma·size + jitter·g``) or it went anywhere at its usual speed (miss = distance,
+   ``σ = pos_sigma·size + speed·g``). ``size`` (mean √(w·h)), ``speed`` (90th-percentile step, px/frame)
+   and ``jitter`` (median second difference of centres, px/frame²) are measured on the input. Each is
+   scored as a 2-D Gaussian negative log-likelihood ``½ (d/σ)² + 2 ln(σ / (pos_sigma·size))`` (the log
+   term makes the vague hypothesis pay for its spread) and the cheaper one is kept, plus ``link_cost``.
+   Pairs beyond ``max_z`` spreads are not candidates, and only the ``candidates`` cheapest successors of
+   every end and predecessors of every start are kept, so the problem stays small. Consecutive pieces
+   of one input track (cut by a contact) link at ``-tracklet_cost``, so a cut alone changes nothing.
 3. **Solves one integer programme** with scipy's HiGHS MILP (:func:`scipy.optimize.milp`): at most N
    chains (a min-cost flow of N units from a source through tracklets to a sink), each tracklet on at
    most one chain, each chain one identity. Links only go forward in time, so two tracklets that
    overlap in time can never share an identity. A tracklet on no chain is clutter; using one earns
    its number of rows minus ``tracklet_cost``, so short tracklets that need implausible links are
    left out while long ones are kept even across long gaps.
-4. **Writes ids 1..N** (chains ordered by their first frame) and fills gaps of at most ``fill_gap_s``
+4. **Places the short pieces** (:func:`place_short`): a second HiGHS MILP assigns each to at most one
+   chain, near the chain's interpolated position, never two overlapping pieces to one chain.
+5. **Writes ids 1..N** (chains ordered by their first frame) and fills gaps of at most ``fill_gap_s``
    seconds inside each identity by linear interpolation (:func:`lookalike.trackers.offline.fill_gaps`).
 
 :func:`track_closed_set` runs the online pass itself (``boxtrack`` with ``max_targets`` = N, reporting
@@ -55,7 +61,7 @@ __all__ = ["ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "mo
 class ClosedSetConfig:
     """Parameters of :func:`assign_identities` (distances in box sizes √(w·h) unless stated)."""
 
-    contact_iou: float | None = param(0.3, "cut tracks around frames where their box overlaps another's by this "
+    contact_iou: float | None = param(None, "cut tracks around frames where their box overlaps another's by this "
                                            "IoU (None: never)")
     jump: float = param(3.0, "cut a track at a step longer than this times the 90th-percentile step")
     jump_floor: float = param(0.5, "... and longer than this many box sizes")
@@ -68,7 +74,8 @@ class ClosedSetConfig:
     tracklet_cost: float = param(3.0, "cost of putting a tracklet on an identity (rows' worth); shorter "
                                       "tracklets with costly links are left out as clutter")
     min_rows: int = param(5, "tracklets with fewer rows are not chained but placed into the chains' gaps")
-    fill_gap_s: float = param(1.0, "longest gap (seconds) inside an identity filled by interpolation")
+    fill_gap_s: float = param(math.inf, "longest gap (seconds) inside an identity filled by interpolation "
+                                        "(a closed set's targets are always there)")
     time_limit_s: float = param(60.0, "time limit of the MILP solver (seconds)")
 
     def __post_init__(self) -> None:
@@ -235,8 +242,8 @@ def link_costs(tracklets: list[Tracklet], frame_rate: float,
     ok = z <= cfg.max_z
     ii, jj, nll = ii[ok], jj[ok], nll[ok]
     source = np.array([t.source_id for t in tracklets])
-    same = (source[ii] == source[jj]) & (gap[ii, jj] == 1)  # a cut inside one input track: free to keep
-    cost = np.where(same, -cfg.tracklet_cost, cfg.link_cost) + nll
+    cut = (source[ii] == source[jj]) & (gap[ii, jj] == 1)  # a cut inside one input track (a contact)
+    cost = np.where(cut, -cfg.tracklet_cost, cfg.link_cost) + nll
     keep = _cheapest(ii, cost, cfg.candidates) | _cheapest(jj, cost, cfg.candidates)
     return ii[keep], jj[keep], cost[keep]
 
@@ -386,7 +393,9 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
         out.append(block)
     merged = np.vstack(out) if out else np.zeros((0, 10))
     merged = merged[np.lexsort((merged[:, 1], merged[:, 0]))]
-    return fill_gaps(merged, round(cfg.fill_gap_s * frame_rate)) if len(merged) else merged
+    max_fill = len(np.unique(merged[:, 0])) + int(merged[:, 0].max()) if math.isinf(cfg.fill_gap_s) else round(
+        cfg.fill_gap_s * frame_rate)
+    return fill_gaps(merged, max_fill) if len(merged) else merged
 
 
 def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = None,
