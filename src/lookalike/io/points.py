@@ -1,0 +1,169 @@
+"""Anonymous points per frame as tracker input: readers, and points as small boxes for the box trackers.
+
+Two text formats are read, both comma-separated with 1-based frames:
+
+- **point CSV**: ``frame,x,y`` per line, optionally more columns (ignored) and an optional header
+  line whose first field is not a number (e.g. ``frame,x,y``); :func:`read_points_csv`.
+- **MOTChallenge rows with a point per row**: ``frame, id, x, y[, ...]`` where columns 3-4 hold the
+  point (id ignored, usually -1); or, with ``centre=True``, a box ``left, top, width, height`` whose
+  centre is the point; :func:`read_points_mot`.
+
+Both return :class:`PointFrames`: per frame (0-based list index = frame − 1) an ``(n, 2)`` array of
+positions (pixels, or whatever unit the file uses). Malformed input raises ``ValueError`` naming the
+file and the 1-based line.
+
+:func:`points_to_rows` turns points into MOTChallenge detection rows of small square boxes centred on
+them (side ``box_px``), so that box trackers and :func:`lookalike.trackers.closed_set.track_closed_set`
+track them; :func:`rows_to_points` takes result rows back to centres for
+:func:`lookalike.eval.evaluate_points`.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["PointFrames", "points_to_rows", "read_points_csv", "read_points_mot", "rows_to_points",
+           "typical_spacing"]
+
+
+@dataclass(frozen=True, eq=False)
+class PointFrames:
+    """Anonymous points of a sequence.
+
+    Attributes:
+        points: per frame (index = frame − 1), an ``(n, 2)`` float array of positions.
+        path: the file it came from, if any.
+    """
+
+    points: list[np.ndarray]
+    path: Path | None = None
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    @property
+    def count(self) -> int:
+        """Number of points over all frames."""
+        return int(sum(len(p) for p in self.points))
+
+
+def _parse(path: Path, columns: int) -> list[tuple[int, list[float]]]:
+    """``(line number, values)`` of the data lines (blank lines and one leading header skipped)."""
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    out = []
+    first = True
+    for no, line in enumerate(path.read_text().splitlines(), start=1):
+        text = line.strip()
+        if not text or text.startswith("#"):
+            continue
+        fields = [f.strip() for f in text.split(",")]
+        if first:
+            first = False
+            try:
+                float(fields[0])
+            except ValueError:
+                continue  # a header
+        if len(fields) < columns:
+            raise ValueError(f"{path}:{no}: expected at least {columns} comma-separated columns, got "
+                             f"{len(fields)}: {text!r}")
+        try:
+            values = [float(f) for f in fields[:columns]]
+        except ValueError:
+            raise ValueError(f"{path}:{no}: not a number in {text!r}") from None
+        if not all(math.isfinite(v) for v in values):
+            raise ValueError(f"{path}:{no}: NaN or infinity in {text!r}")
+        frame = values[0]
+        if frame < 1 or frame != int(frame):
+            raise ValueError(f"{path}:{no}: frame must be an integer >= 1, got {fields[0]!r}")
+        out.append((no, values))
+    return out
+
+
+def _group(path: Path, frames: np.ndarray, xy: np.ndarray, n_frames: int | None) -> PointFrames:
+    length = int(frames.max(initial=0))
+    if n_frames is not None:
+        if n_frames < length:
+            raise ValueError(f"{path}: frame {length} is past n_frames={n_frames}")
+        length = n_frames
+    order = np.argsort(frames, kind="stable")
+    frames, xy = frames[order], xy[order]
+    bounds = np.searchsorted(frames, np.arange(1, length + 2))
+    return PointFrames([xy[bounds[k]:bounds[k + 1]].copy() for k in range(length)], path)
+
+
+def read_points_csv(path: str | os.PathLike[str], n_frames: int | None = None) -> PointFrames:
+    """Points from a ``frame,x,y`` CSV (1-based frames, optional header line, extra columns ignored);
+    ``n_frames`` pads the sequence with empty frames up to that length."""
+    path = Path(path)
+    parsed = _parse(path, 3)
+    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 3)
+    return _group(path, data[:, 0].astype(int), data[:, 1:3], n_frames)
+
+
+def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *,
+                    centre: bool = False) -> PointFrames:
+    """Points from MOTChallenge-style rows ``frame, id, x, y, ...`` (columns 3-4 are the point), or with
+    ``centre=True`` rows ``frame, id, left, top, width, height, ...`` whose box centres are the points."""
+    path = Path(path)
+    parsed = _parse(path, 6 if centre else 4)
+    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 6 if centre else 4)
+    if centre:
+        bad = np.flatnonzero((data[:, 4:6] < 0).any(axis=1))
+        if len(bad):
+            no = parsed[int(bad[0])][0]
+            raise ValueError(f"{path}:{no}: negative box size")
+        xy = data[:, 2:4] + data[:, 4:6] / 2
+    else:
+        xy = data[:, 2:4]
+    return _group(path, data[:, 0].astype(int), xy, n_frames)
+
+
+def typical_spacing(points: PointFrames | list[np.ndarray]) -> float:
+    """Median distance from each point to its nearest neighbour in the same frame (input unit); 0 when
+    no frame has two points."""
+    per_frame = points.points if isinstance(points, PointFrames) else points
+    near = []
+    for p in per_frame:
+        if len(p) > 1:
+            d = np.linalg.norm(p[:, None, :] - p[None, :, :], axis=2)
+            np.fill_diagonal(d, np.inf)
+            near.append(d.min(axis=1))
+    return float(np.median(np.concatenate(near))) if near else 0.0
+
+
+def points_to_rows(points: PointFrames | list[np.ndarray], box_px: float | None = None,
+                   score: float = 1.0) -> np.ndarray:
+    """MOTChallenge detection rows ``(k, 10)`` (1-based frames, id -1) of square boxes of side ``box_px``
+    centred on the points. By default the side is half the :func:`typical_spacing` of the points (so
+    neighbours' boxes rarely overlap, yet a point moving less than a side keeps overlapping its box),
+    or 1 when there is none."""
+    per_frame = points.points if isinstance(points, PointFrames) else points
+    if box_px is None:
+        spacing = typical_spacing(per_frame)
+        box_px = spacing / 2 if spacing > 0 else 1.0
+    if not box_px > 0:
+        raise ValueError(f"box_px must be > 0, got {box_px}")
+    blocks = []
+    for k, p in enumerate(per_frame):
+        p = np.asarray(p, dtype=float).reshape(-1, 2)
+        if len(p):
+            block = np.full((len(p), 10), -1.0)
+            block[:, 0] = k + 1
+            block[:, 2:4] = p - box_px / 2
+            block[:, 4:6] = box_px
+            block[:, 6] = score
+            blocks.append(block)
+    return np.vstack(blocks) if blocks else np.zeros((0, 10))
+
+
+def rows_to_points(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(frame (k,), id (k,), centre (k, 2))`` of result rows, as :func:`lookalike.eval.evaluate_points`
+    takes them."""
+    rows = np.asarray(rows, dtype=float).reshape(-1, np.shape(rows)[-1] if np.size(rows) else 10)
+    return rows[:, 0].astype(int), rows[:, 1].astype(int), rows[:, 2:4] + rows[:, 4:6] / 2

@@ -1,0 +1,291 @@
+"""Blob detector settings estimated from the video itself (no per-video hand tuning).
+
+:func:`estimate_blob_config` looks at ``sample`` frames spread evenly over the video and derives every
+setting of :class:`~lookalike.vision.blob.BlobConfig` from statistics of that video:
+
+- **stabilise**: the translation of each sampled frame against the first (phase correlation); a
+  camera that moves by more than ``shake_px`` pixels (median over the samples) is stabilised.
+- **background**: the per-pixel median of the samples (the detector's own ``median`` model).
+- **polarity**: the foreground mass (pixels differing from the background by more than the noise
+  threshold) that is darker, and that is brighter than the background; when one side holds less than
+  ``polarity_ratio`` of the other, only the dominant side is kept (``dark``/``bright``), else ``any``.
+- **noise**: σ = 1.4826 × the median absolute difference from the background (most pixels are
+  background), in grey levels.
+- **threshold**: candidates at 4, 6, 8, 10, 14 and 20 σ (within 8..100 grey levels). At each, the
+  foreground's connected components give a typical target area ``A`` (with ``n_targets``: the median
+  area of each frame's ``n_targets`` largest components; without: the area-weighted median of all
+  components, i.e. where most of the foreground lies) and the blobs counted per frame between ``A/5``
+  and ``6·A``. With ``n_targets`` the threshold that gives exactly ``n_targets`` blobs in most sampled
+  frames wins; without, the one whose median count is the most common over the candidates (the count's
+  plateau: a real set of targets is counted alike over a range of thresholds, noise is not).
+- **areas**: ``min_area_px = A/5`` (smaller pieces are noise or fragments), ``max_area_px = 6·A`` (two or
+  three touching targets are still one detection; larger regions are lighting changes).
+- **morphology**: the targets' half thickness ``r`` (median largest inscribed radius, from a distance
+  transform) sets the opening to ``r`` (odd, 3..15 px: thinner structures than the targets go) and the
+  closing to ``2r`` (odd, 3..15 px: fragments of one target rejoin).
+
+The result is printed by :func:`BlobEstimate.summary` so that a user can see and override each value.
+OpenCV is imported lazily.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+
+from lookalike.vision.blob import BlobConfig
+from lookalike.vision.hog_features import as_bgr_image
+
+__all__ = ["BlobEstimate", "estimate_blob_config", "sample_frames"]
+
+_FACTORS = (4.0, 6.0, 8.0, 10.0, 14.0, 20.0)  # candidate thresholds in noise σ
+_THRESHOLD_RANGE = (8.0, 100.0)  # grey levels
+_MIN_AREA_FRACTION = 1 / 5
+_MAX_AREA_FACTOR = 6.0
+_WORK_SIDE_PX = 640  # frames are reduced to at most this many pixels a side for the statistics
+
+
+@dataclass(frozen=True)
+class BlobEstimate:
+    """An estimated :class:`BlobConfig` and the statistics it came from.
+
+    Attributes:
+        config: the settings to detect with.
+        noise: background noise σ (grey levels).
+        target_area_px: typical target area (px²).
+        half_thickness_px: median largest inscribed radius of the targets (px).
+        shake_px: median camera translation of the samples against the first (px).
+        dark_share: share of the foreground mass darker than the background.
+        counts: per candidate threshold, the median blob count per sampled frame.
+        n_targets: the number of targets given, or None.
+    """
+
+    config: BlobConfig
+    noise: float
+    target_area_px: float
+    half_thickness_px: float
+    shake_px: float
+    dark_share: float
+    counts: dict[float, float] = field(default_factory=dict)  # threshold -> median blobs per frame
+    n_targets: int | None = None
+
+    @property
+    def summary(self) -> str:
+        """One line per decision, with the ``--blob KEY=VALUE`` that overrides it."""
+        c = self.config
+        polarity = {"dark": "darker than the background", "bright": "brighter than the background",
+                    "any": "darker and brighter than the background"}[c.polarity]
+        lines = [
+            f"polarity={c.polarity}: targets {polarity} ({100 * self.dark_share:.0f}% of the foreground is darker)",
+            f"threshold={c.threshold:g}: grey levels from the background (noise σ {self.noise:.1f})",
+            f"min_area_px={c.min_area_px:g} max_area_px={c.max_area_px:g}: typical target "
+            f"{self.target_area_px:.0f} px²" + (f" (the {self.n_targets} largest blobs per frame)"
+                                                 if self.n_targets else ""),
+            f"open_px={c.open_px} close_px={c.close_px}: targets about {2 * self.half_thickness_px:.0f} px thick",
+            f"stabilise={'true' if c.stabilise else 'false'}: camera moves {self.shake_px:.1f} px (median)",
+        ]
+        return "\n".join(lines)
+
+
+def _odd(value: float, lo: int, hi: int) -> int:
+    v = int(min(max(round(value), lo), hi))
+    return v if v % 2 else v + 1 if v + 1 <= hi else v - 1
+
+
+def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
+    """Up to ``count`` frames spread evenly over a video file, read in one pass (BGR uint8)."""
+    import cv2
+
+    cap = cv2.VideoCapture(str(video))
+    if not cap.isOpened():
+        raise ValueError(f"video: cannot open {video}")
+    try:
+        total = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
+        frames: list[np.ndarray] = []
+        if total > 0:
+            wanted = set(np.linspace(0, total - 1, min(total, count)).round().astype(int).tolist())
+            k = 0
+            while True:
+                ok, frame = cap.read()
+                if not ok:
+                    break
+                if k in wanted:
+                    frames.append(frame)
+                k += 1
+        else:
+            while True:
+                ok, frame = cap.read()
+                if not ok:
+                    break
+                frames.append(frame)
+            pick = np.unique(np.linspace(0, len(frames) - 1, min(len(frames), count)).round().astype(int))
+            frames = [frames[i] for i in pick] if frames else []
+    finally:
+        cap.release()
+    if not frames:
+        raise ValueError(f"video: {video} has no readable frames")
+    return frames
+
+
+def _shifts(grey: list[np.ndarray]) -> np.ndarray:
+    """``(n, 2)`` translation (px) of each frame against the first (phase correlation)."""
+    import cv2
+
+    window = cv2.createHanningWindow(grey[0].shape[::-1], cv2.CV_32F)
+    return np.array([cv2.phaseCorrelate(grey[0], g, window)[0] for g in grey])
+
+
+def _components(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Areas (px²) and labels of the 8-connected components of a uint8 mask."""
+    import cv2
+
+    _, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    return stats[1:, cv2.CC_STAT_AREA].astype(float), labels
+
+
+def _target_area(areas: list[np.ndarray], n_targets: int | None) -> float:
+    if n_targets:
+        top = [np.sort(a)[::-1][:n_targets] for a in areas if len(a)]
+        pooled = np.concatenate(top) if top else np.zeros(0)
+        return float(np.median(pooled)) if len(pooled) else 0.0
+    pooled = np.concatenate(areas) if areas else np.zeros(0)
+    if not len(pooled):
+        return 0.0
+    order = np.sort(pooled)
+    cum = np.cumsum(order)
+    return float(order[np.searchsorted(cum, cum[-1] / 2)])
+
+
+def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: int | None = None, *,
+                         sample: int = 25, shake_px: float = 0.5, polarity_ratio: float = 0.1,
+                         base: BlobConfig | None = None) -> BlobEstimate:
+    """Blob detector settings estimated from a video (a file path, or its ``(h, w, 3)`` BGR frames),
+    optionally knowing the number of targets ``n_targets`` (module doc). ``base`` supplies the settings
+    that are not estimated (method, blur, history)."""
+    import cv2
+
+    if n_targets is not None and int(n_targets) < 1:
+        raise ValueError(f"n_targets must be >= 1, got {n_targets}")
+    base = base or BlobConfig()
+    if isinstance(frames, (str, Path)):
+        picked = sample_frames(frames, sample)
+    else:
+        every = list(frames)
+        if not every:
+            raise ValueError("frames: no frames to estimate blob settings on")
+        idx = np.unique(np.linspace(0, len(every) - 1, min(len(every), sample)).round().astype(int))
+        picked = [every[i] for i in idx]
+    blur = base.blur_px
+    height, width = as_bgr_image(picked[0], "frames[0]").shape[:2]
+    scale = min(1.0, _WORK_SIDE_PX / max(height, width))  # statistics on a reduced copy, for speed
+    imgs = []
+    for i, frame in enumerate(picked):
+        img = as_bgr_image(frame, f"frames[{i}]")
+        img = cv2.GaussianBlur(img, (blur, blur), 0) if blur > 1 else img
+        if scale < 1:
+            img = cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
+        imgs.append(img.astype(np.float32))
+    grey = [im.mean(axis=2).astype(np.float32) for im in imgs]
+    moves = _shifts(grey) if len(grey) > 1 else np.zeros((1, 2))
+    shake = float(np.median(np.hypot(moves[:, 0], moves[:, 1]))) / scale
+    stabilise = shake > shake_px
+    if stabilise:
+        h, w = grey[0].shape
+        imgs = [cv2.warpAffine(im, np.float32([[1, 0, -dx], [0, 1, -dy]]), (w, h), borderMode=cv2.BORDER_REPLICATE)
+                for im, (dx, dy) in zip(imgs, moves)]
+    stack = np.stack(imgs)
+    background = np.median(stack, axis=0)
+    diff = stack - background
+    dark = np.maximum(-diff.min(axis=3), 0)
+    bright = np.maximum(diff.max(axis=3), 0)
+    del diff, stack
+    noise = max(1.4826 * float(np.median(np.maximum(dark, bright))), 0.5)
+    cut = min(max(6 * noise, _THRESHOLD_RANGE[0]), _THRESHOLD_RANGE[1])
+    dark_mass, bright_mass = float((dark > cut).sum()), float((bright > cut).sum())
+    dark_share = dark_mass / max(dark_mass + bright_mass, 1.0)
+    if bright_mass < polarity_ratio * dark_mass:
+        polarity, signal = "dark", dark
+    elif dark_mass < polarity_ratio * bright_mass:
+        polarity, signal = "bright", bright
+    else:
+        polarity, signal = "any", np.maximum(dark, bright)
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3)) if scale > 0.67 else None
+    lo, hi = _THRESHOLD_RANGE
+    candidates = sorted({float(round(min(max(f * noise, lo), hi))) for f in _FACTORS})
+    results = {}
+    for thr in candidates:
+        per_frame, masks = [], []
+        for s in signal:
+            mask = np.where(s > thr, 255, 0).astype(np.uint8)
+            if kernel is not None:
+                mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
+            areas, _ = _components(mask)
+            per_frame.append(areas)
+            masks.append(mask)
+        area = _target_area(per_frame, n_targets)
+        lo_a, hi_a = area * _MIN_AREA_FRACTION, area * _MAX_AREA_FACTOR
+        counts = np.array([int(((a >= lo_a) & (a <= hi_a)).sum()) for a in per_frame])
+        results[thr] = (area, counts, masks)
+    medians = {thr: float(np.median(r[1])) for thr, r in results.items()}
+    if n_targets:
+        hit = {thr: float(np.mean(r[1] == n_targets)) for thr, r in results.items()}
+        best = max(hit.values())
+        chosen = [thr for thr in candidates if hit[thr] == best]
+    else:
+        values, freq = np.unique([medians[t] for t in candidates if medians[t] > 0] or [0.0], return_counts=True)
+        plateau = values[freq == freq.max()].max()
+        chosen = [thr for thr in candidates if medians[thr] == plateau]
+    threshold = chosen[len(chosen) // 2]
+    area, _, masks = results[threshold]
+    if area <= 0:
+        raise ValueError("frames: no foreground differs from the background; is the camera static and "
+                         "do the targets move?")
+    radii = []
+    for mask in masks:
+        _, labels = _components(mask)
+        dist = cv2.distanceTransform(mask, cv2.DIST_L2, 3)
+        count = int(labels.max())
+        if count:
+            peak = np.zeros(count + 1)
+            np.maximum.at(peak, labels.ravel(), dist.ravel())
+            sizes = np.bincount(labels.ravel(), minlength=count + 1)
+            ok = (sizes >= area * _MIN_AREA_FRACTION) & (sizes <= area * _MAX_AREA_FACTOR)
+            ok[0] = False
+            radii.extend(peak[ok].tolist())
+    r = (float(np.median(radii)) if radii else 1.0) / scale
+    area /= scale**2
+    config = replace(base, threshold=float(threshold), polarity=polarity,
+                     min_area_px=float(round(area * _MIN_AREA_FRACTION)),
+                     max_area_px=float(round(area * _MAX_AREA_FACTOR)) if math.isfinite(area) else math.inf,
+                     open_px=_odd(r, 3, 15), close_px=_odd(2 * r, 3, 15), stabilise=stabilise)
+    return BlobEstimate(config=config, noise=noise, target_area_px=area, half_thickness_px=r, shake_px=shake,
+                        dark_share=dark_share, counts=medians, n_targets=int(n_targets) if n_targets else None)
+
+
+def overlap_hint(det_rows: np.ndarray, default_iou: float = 0.3) -> dict[str, float]:
+    """Box-tracker overlap gates suited to blob detections ``(k, >=6)`` MOTChallenge rows (1-based frames,
+    boxes in pixels): fast or small targets seen at a low frame rate barely overlap from one frame to
+    the next, so an IoU gate of ``default_iou`` would miss them. Returns ``{"match_iou": q,
+    "tentative_iou": q}`` with ``q`` the 10th percentile of each blob's best IoU with the next frame's
+    blobs (those with any overlap), within 0.01..``default_iou``; empty when nothing overlaps."""
+    from lookalike.geometry.boxes import iou_matrix
+
+    rows = np.asarray(det_rows, dtype=float)
+    if rows.ndim != 2 or not len(rows):
+        return {}
+    frames = rows[:, 0].astype(int)
+    best: list[np.ndarray] = []
+    for f in np.unique(frames):
+        a, b = rows[frames == f, 2:6], rows[frames == f + 1, 2:6]
+        if len(a) and len(b):
+            iou = iou_matrix(a, b).max(axis=1)
+            best.append(iou[iou > 0])
+    pooled = np.concatenate(best) if best else np.zeros(0)
+    if not len(pooled):
+        return {}
+    q = float(min(max(np.percentile(pooled, 10), 0.01), default_iou))
+    return {"match_iou": round(q, 3), "tentative_iou": round(q, 3)}
