@@ -31,9 +31,9 @@ OpenCV is imported lazily.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Iterable
 
 import numpy as np
 
@@ -160,6 +160,25 @@ def _target_area(areas: list[np.ndarray], n_targets: int | None) -> float:
     return float(order[np.searchsorted(cum, cum[-1] / 2)])
 
 
+def _radii(masks: list[np.ndarray], area: float) -> list[float]:
+    """Largest inscribed radius (px) of every component of ``masks`` with a target's area."""
+    import cv2
+
+    radii: list[float] = []
+    for mask in masks:
+        _, labels = _components(mask)
+        dist = cv2.distanceTransform(mask, cv2.DIST_L2, 3)
+        count = int(labels.max())
+        if count:
+            peak = np.zeros(count + 1)
+            np.maximum.at(peak, labels.ravel(), dist.ravel())
+            sizes = np.bincount(labels.ravel(), minlength=count + 1)
+            ok = (sizes >= area * _MIN_AREA_FRACTION) & (sizes <= area * _MAX_AREA_FACTOR)
+            ok[0] = False
+            radii.extend(peak[ok].tolist())
+    return radii
+
+
 def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: int | None = None, *,
                          sample: int = 25, shake_px: float = 0.5, polarity_ratio: float = 0.1,
                          base: BlobConfig | None = None) -> BlobEstimate:
@@ -244,18 +263,7 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     if area <= 0:
         raise ValueError("frames: no foreground differs from the background; is the camera static and "
                          "do the targets move?")
-    radii = []
-    for mask in masks:
-        _, labels = _components(mask)
-        dist = cv2.distanceTransform(mask, cv2.DIST_L2, 3)
-        count = int(labels.max())
-        if count:
-            peak = np.zeros(count + 1)
-            np.maximum.at(peak, labels.ravel(), dist.ravel())
-            sizes = np.bincount(labels.ravel(), minlength=count + 1)
-            ok = (sizes >= area * _MIN_AREA_FRACTION) & (sizes <= area * _MAX_AREA_FACTOR)
-            ok[0] = False
-            radii.extend(peak[ok].tolist())
+    radii = _radii(masks, area)
     r = (float(np.median(radii)) if radii else 1.0) / scale
     area /= scale**2
     config = replace(base, threshold=float(threshold), polarity=polarity,
