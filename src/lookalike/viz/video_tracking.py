@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import csv
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -25,6 +25,7 @@ import numpy as np
 from lookalike.association.solver import assign
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.io import MotTable, frames_from_table, read_seqinfo, tracks_to_rows
+from lookalike.loop import run
 from lookalike.trackers.health import (
     HEALTH_CSV_HEADER,
     HealthConfig,
@@ -148,7 +149,7 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
     if not rate > 0:
         raise ValueError(f"fps: must be positive, got {rate!r}")
     last_det = int(detections.frame.max()) if len(detections) else 0
-    det_frames = list(frames_from_table(detections, max(n_declared, last_det), rate, min_score))
+    det_frames = frames_from_table(detections, max(n_declared, last_det), rate, min_score)
     tracker.reset()
     monitor = HealthMonitor(health)
     writer = VideoWriter(annotate, fps=rate) if annotate is not None else None
@@ -158,44 +159,51 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
     statuses: list[HealthStatus] = []
     uncertain: list[tuple[int, int]] = []
     merged_label: dict[int, tuple[int, int]] = {}  # target id -> (source id, frame of the merge)
-    tracker_s = feature_s = 0.0
-    count = 0
-    try:
+    current: dict[str, Any] = {"merges": 0, "feature_s": 0.0}  # the frame's image, merges seen so far
+
+    def frames() -> Iterator[Frame]:
         for k, image in enumerate(images):
-            det = det_frames[k].detections if k < len(det_frames) else Detections.empty()
+            found = next(det_frames, None)
+            det = found.detections if found is not None else Detections.empty()
             t0 = time.perf_counter()
             assert det.xywh is not None  # box detections
             feats = extractor(image, det.xywh) if len(det) else np.zeros((0, int(extractor.dim)))
-            feature_s += time.perf_counter() - t0
-            frame = Frame(index=k, time=k / rate, detections=det.replace(feature=feats))
-            n_merges = len(getattr(tracker, "merges", []))
-            t0 = time.perf_counter()
-            tracks = tracker.update(frame)
-            tracker_s += time.perf_counter() - t0
-            for m in getattr(tracker, "merges", [])[n_merges:]:
-                merged_label[int(m.target_id)] = (int(m.source_id), k)
-            rows.append(tracks_to_rows(k, tracks))
-            status = monitor.update(frame)
-            statuses.append(status)
-            shown = [t for t in tracks if t.xywh is not None]
-            doubtful = [_uncertain(tracker, t, first_seen, k, new_frames) for t in shown]
-            uncertain.extend((k + 1, t.track_id) for t, u in zip(shown, doubtful) if u)
-            if writer is not None:
-                img = image.copy()
-                _draw(img, k, det.xywh, shown, doubtful, merged_label, new_frames, tails)
-                lines = [f"{type(tracker).__name__}  frame {k + 1}",
-                         f"tracks: {len(shown)}  uncertain (dashed, ?): {sum(doubtful)}  detections: {len(det)}"]
-                draw_caption(img, lines)
-                if not status.healthy:
-                    draw_banner(img, "DETECTOR UNHEALTHY - identities unreliable: "
-                                + "; ".join(status.reasons + status.window_reasons))
-                writer.write(img)
-            count += 1
-            if advance is not None:
-                advance()
+            current["feature_s"] += time.perf_counter() - t0
+            current["image"] = image
+            yield Frame(index=k, time=k / rate, detections=det.replace(feature=feats))
+
+    def sink(frame: Frame, tracks: Any) -> None:
+        k, det = frame.index, frame.detections
+        merges = getattr(tracker, "merges", [])
+        for m in merges[current["merges"]:]:
+            merged_label[int(m.target_id)] = (int(m.source_id), k)
+        current["merges"] = len(merges)
+        rows.append(tracks_to_rows(k, tracks))
+        status = monitor.update(frame)
+        statuses.append(status)
+        shown = [t for t in tracks if t.xywh is not None]
+        doubtful = [_uncertain(tracker, t, first_seen, k, new_frames) for t in shown]
+        uncertain.extend((k + 1, t.track_id) for t, u in zip(shown, doubtful) if u)
+        if writer is not None:
+            assert det.xywh is not None
+            img = current["image"].copy()
+            _draw(img, k, det.xywh, shown, doubtful, merged_label, new_frames, tails)
+            lines = [f"{type(tracker).__name__}  frame {k + 1}",
+                     f"tracks: {len(shown)}  uncertain (dashed, ?): {sum(doubtful)}  detections: {len(det)}"]
+            draw_caption(img, lines)
+            if not status.healthy:
+                draw_banner(img, "DETECTOR UNHEALTHY - identities unreliable: "
+                            + "; ".join(status.reasons + status.window_reasons))
+            writer.write(img)
+        if advance is not None:
+            advance()
+
+    try:
+        stats = run(tracker, frames(), sink)
     finally:
         if writer is not None:
             writer.close()
+    count, tracker_s, feature_s = stats.frames, stats.seconds, float(current["feature_s"])
     if count == 0:
         raise ValueError(f"video: {source} has no frames")
     merges = [(int(m.frame_index) + 1, int(m.source_id), int(m.target_id)) for m in getattr(tracker, "merges", [])]
