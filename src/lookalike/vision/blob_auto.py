@@ -3,8 +3,10 @@
 :func:`estimate_blob_config` looks at ``sample`` frames spread evenly over the video and derives every
 setting of :class:`~lookalike.vision.blob.BlobConfig` from statistics of that video:
 
-- **stabilise**: the translation of each sampled frame against the first (phase correlation); a
-  camera that moves by more than ``shake_px`` pixels (median over the samples) is stabilised.
+- **stabilise**: the translation of each sampled frame against the median of the samples (phase
+  correlation), relative to the first sample's; a camera that moves by more than ``shake_px`` pixels
+  (median over the samples) is stabilised if aligning the samples cuts the 90th percentile of their
+  absolute differences from their median by at least 20% (a test that the motion is real).
 - **background**: the per-pixel median of the samples (the detector's own ``median`` model).
 - **polarity**: the foreground mass (pixels differing from the background by more than the noise
   threshold) that is darker, and that is brighter than the background; when one side holds less than
@@ -46,6 +48,7 @@ _FACTORS = (4.0, 6.0, 8.0, 10.0, 14.0, 20.0)  # candidate thresholds in noise σ
 _THRESHOLD_RANGE = (8.0, 100.0)  # grey levels
 _MIN_AREA_FRACTION = 1 / 5
 _MAX_AREA_FACTOR = 6.0
+_ALIGN_GAIN = 0.8  # stabilise when alignment cuts the spread of differences from the median by 20%+
 _WORK_SIDE_PX = 640  # frames are reduced to at most this many pixels a side for the statistics
 
 
@@ -131,12 +134,21 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
     return frames
 
 
+def _spread(stack: np.ndarray) -> float:
+    """90th percentile of the absolute differences from the per-pixel median (grey levels): edges of a
+    moving camera's scene are a minority of the pixels, so the median would not see them."""
+    return float(np.percentile(np.abs(stack - np.median(stack, axis=0)), 90))
+
+
 def _shifts(grey: list[np.ndarray]) -> np.ndarray:
-    """``(n, 2)`` translation (px) of each frame against the first (phase correlation)."""
+    """``(n, 2)`` translation (px) of each frame against the median of all (phase correlation; moving
+    targets are absent from the median, so they pull no peak of their own)."""
     import cv2
 
-    window = cv2.createHanningWindow(grey[0].shape[::-1], cv2.CV_32F)
-    return np.array([cv2.phaseCorrelate(grey[0], g, window)[0] for g in grey])
+    reference = np.median(np.stack(grey), axis=0).astype(np.float32)
+    window = cv2.createHanningWindow(reference.shape[::-1], cv2.CV_32F)
+    moves = np.array([cv2.phaseCorrelate(reference, g, window)[0] for g in grey])
+    return moves - moves[0]
 
 
 def _components(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -211,12 +223,14 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     grey = [im.mean(axis=2).astype(np.float32) for im in imgs]
     moves = _shifts(grey) if len(grey) > 1 else np.zeros((1, 2))
     shake = float(np.median(np.hypot(moves[:, 0], moves[:, 1]))) / scale
-    stabilise = shake > shake_px
-    if stabilise:
-        h, w = grey[0].shape
-        imgs = [cv2.warpAffine(im, np.float32([[1, 0, -dx], [0, 1, -dy]]), (w, h), borderMode=cv2.BORDER_REPLICATE)
-                for im, (dx, dy) in zip(imgs, moves)]
     stack = np.stack(imgs)
+    stabilise = False
+    if shake > shake_px:  # keep the alignment only if it makes the frames agree better with their median
+        h, w = grey[0].shape
+        aligned = np.stack([cv2.warpAffine(im, np.float32([[1, 0, -dx], [0, 1, -dy]]), (w, h),
+                                           borderMode=cv2.BORDER_REPLICATE) for im, (dx, dy) in zip(imgs, moves)])
+        if _spread(aligned) < _ALIGN_GAIN * _spread(stack):
+            stack, stabilise = aligned, True
     background = np.median(stack, axis=0)
     diff = stack - background
     dark = np.maximum(-diff.min(axis=3), 0)

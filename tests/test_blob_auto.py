@@ -1,0 +1,78 @@
+"""Blob settings estimated from the video (vision.blob_auto)."""
+
+import numpy as np
+import pytest
+
+from lookalike.vision.blob import BlobDetector
+from lookalike.vision.blob_auto import estimate_blob_config, overlap_hint
+
+
+def _bounce(x: float, lo: float, hi: float) -> float:
+    """``x`` reflected into ``[lo, hi]`` (a target bouncing off the walls, never resting there)."""
+    span = hi - lo
+    u = (x - lo) % (2 * span)
+    return lo + (u if u <= span else 2 * span - u)
+
+
+def _arena(n_targets: int, dark: bool, radius: int, n: int = 30, seed: int = 0, clutter: bool = True):
+    """Discs of ``radius`` px moving over a textured background (darker or brighter), plus 1-px speckles."""
+    rng = np.random.default_rng(seed)
+    base = 170 if dark else 60
+    bg = (base + rng.normal(0, 3, (160, 200, 3))).clip(0, 255)
+    yy, xx = np.mgrid[:160, :200]
+    bg[((xx // 25) + (yy // 20)) % 2 == 0] += 20 if dark else -20  # a static floor pattern, as in a real arena
+    start = rng.uniform(30, 130, (n_targets, 2))
+    vel = rng.normal(0, 2.5, (n_targets, 2))
+    frames = []
+    for t in range(n):
+        img = bg.copy()
+        for (x0, y0), (vx, vy) in zip(start, vel):
+            cx, cy = _bounce(x0 + vx * t, radius, 200 - radius), _bounce(y0 + vy * t, radius, 160 - radius)
+            img[(xx - cx) ** 2 + (yy - cy) ** 2 <= radius**2] = 40 if dark else 220
+        if clutter:
+            sy, sx = rng.integers(0, 160, 5), rng.integers(0, 200, 5)
+            img[sy, sx] = 255 - base
+        frames.append(img.astype(np.uint8))
+    return frames
+
+
+@pytest.mark.parametrize("dark", [True, False])
+def test_polarity_and_sizes_follow_the_video(dark: bool) -> None:
+    frames = _arena(4, dark, 7)
+    est = estimate_blob_config(frames)
+    cfg = est.config
+    assert cfg.polarity == ("dark" if dark else "bright")
+    assert 0.5 * np.pi * 49 < est.target_area_px < 2 * np.pi * 49
+    assert cfg.min_area_px < np.pi * 49 < cfg.max_area_px
+    assert not cfg.stabilise
+    assert "polarity=" in est.summary and "threshold=" in est.summary
+    detector = BlobDetector(cfg).fit(frames)
+    counts = [len(detector(f)) for f in frames]
+    assert np.mean(np.array(counts) == 4) > 0.8  # speckles are filtered out, touching discs aside
+
+
+def test_the_number_of_targets_picks_the_threshold_counting_them() -> None:
+    frames = _arena(3, True, 6, seed=1)
+    est = estimate_blob_config(frames, n_targets=3)
+    detector = BlobDetector(est.config).fit(frames)
+    assert np.mean([len(detector(f)) == 3 for f in frames]) > 0.8
+    assert est.n_targets == 3
+
+
+def test_a_still_video_is_refused_and_bad_input() -> None:
+    frames = _arena(2, True, 6, clutter=False)
+    with pytest.raises(ValueError, match="no foreground"):
+        estimate_blob_config([frames[0]] * 10)
+    with pytest.raises(ValueError, match="n_targets"):
+        estimate_blob_config(frames, n_targets=0)
+    with pytest.raises(ValueError, match="no frames"):
+        estimate_blob_config([])
+
+
+def test_overlap_hint_lowers_the_gate_for_blobs_that_barely_overlap() -> None:
+    rows = np.array([[f, -1, 10.0 * f, 0, 12, 12, 0.7, -1, -1, -1] for f in range(1, 20)])
+    hint = overlap_hint(rows)
+    assert 0.01 <= hint["match_iou"] < 0.3  # boxes move 10 px of 12 per frame: IoU about 0.09
+    still = np.array([[f, -1, 0.0, 0, 12, 12, 0.7, -1, -1, -1] for f in range(1, 20)])
+    assert overlap_hint(still)["match_iou"] == 0.3
+    assert overlap_hint(np.zeros((0, 10))) == {}

@@ -1,0 +1,107 @@
+"""Point data as tracker input (io.points) and closed-set tracking of anonymous points."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lookalike.eval import evaluate_points
+from lookalike.io.points import (
+    PointFrames,
+    points_to_rows,
+    read_points_csv,
+    read_points_mot,
+    rows_to_points,
+    typical_spacing,
+)
+from lookalike.trackers.closed_set import online_rows, track_closed_set
+
+
+def test_read_points_csv_with_and_without_header(tmp_path: Path) -> None:
+    a = tmp_path / "a.csv"
+    a.write_text("frame,x,y\n1,10,20\n1,30,40\n3,5,6\n")
+    pf = read_points_csv(a)
+    assert len(pf) == 3 and pf.count == 3
+    np.testing.assert_array_equal(pf.points[0], [[10, 20], [30, 40]])
+    assert pf.points[1].shape == (0, 2)
+    b = tmp_path / "b.csv"
+    b.write_text("2,1.5,2.5,extra\n\n1,0,0\n")
+    assert [len(p) for p in read_points_csv(b, n_frames=4).points] == [1, 1, 0, 0]
+
+
+def test_read_points_mot_points_and_box_centres(tmp_path: Path) -> None:
+    p = tmp_path / "det.txt"
+    p.write_text("1,-1,10,20,4,6,1,-1,-1,-1\n2,-1,11,21,4,6,1,-1,-1,-1\n")
+    np.testing.assert_array_equal(read_points_mot(p).points[0], [[10, 20]])
+    np.testing.assert_array_equal(read_points_mot(p, centre=True).points[1], [[13, 24]])
+
+
+@pytest.mark.parametrize("text, message", [
+    ("frame,x,y\n1,2\n", ":2: expected at least 3"),
+    ("1,2,3\n1,a,3\n", ":2: not a number"),
+    ("0,2,3\n", ":1: frame must be an integer >= 1"),
+    ("1.5,2,3\n", ":1: frame must be"),
+    ("1,nan,3\n", ":1: NaN"),
+])
+def test_bad_lines_name_file_and_line(tmp_path: Path, text: str, message: str) -> None:
+    p = tmp_path / "bad.csv"
+    p.write_text(text)
+    with pytest.raises(ValueError, match=f"bad.csv{message}"):
+        read_points_csv(p)
+
+
+def test_missing_file_and_short_n_frames(tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError):
+        read_points_csv(tmp_path / "nope.csv")
+    p = tmp_path / "p.csv"
+    p.write_text("5,1,1\n")
+    with pytest.raises(ValueError, match="past n_frames"):
+        read_points_csv(p, n_frames=3)
+
+
+def test_points_to_rows_and_back() -> None:
+    pts = [np.array([[0.0, 0.0], [10.0, 0.0]]), np.zeros((0, 2)), np.array([[5.0, 5.0]])]
+    assert typical_spacing(pts) == 10.0
+    rows = points_to_rows(PointFrames(pts))
+    assert rows.shape == (3, 10)
+    np.testing.assert_allclose(rows[:, 4:6], 5.0)  # half the typical spacing
+    frame, _, centre = rows_to_points(rows)
+    np.testing.assert_array_equal(frame, [1, 1, 3])
+    np.testing.assert_allclose(centre, [[0, 0], [10, 0], [5, 5]])
+    with pytest.raises(ValueError, match="box_px"):
+        points_to_rows(pts, box_px=0.0)
+
+
+def simulate_arena(n: int = 5, frames: int = 300, size: float = 400.0, seed: int = 0):
+    """``n`` identical points: correlated random walks bouncing off the walls, 1 px noise, 5% misses and
+    0.1 false points per frame. Returns the per-frame points and ground truth ``(frame, id, x, y)``."""
+    rng = np.random.default_rng(seed)
+    pos = rng.uniform(50, size - 50, (n, 2))
+    ang = rng.uniform(0, 2 * np.pi, n)
+    speed = 3.0 * rng.uniform(0.5, 1.5, n)
+    gt, pts = [], []
+    for k in range(frames):
+        ang += rng.normal(0, 0.3, n)
+        pos = pos + np.column_stack([np.cos(ang), np.sin(ang)]) * (speed * rng.uniform(0, 2, n))[:, None]
+        for d in range(2):
+            out = (pos[:, d] < 0) | (pos[:, d] > size)
+            pos[out, d] = np.clip(pos[out, d], 0, size)
+            ang[out] += np.pi
+        seen = rng.random(n) >= 0.05
+        pts.append(np.vstack([pos[seen] + rng.normal(0, 1.0, (int(seen.sum()), 2)),
+                              rng.uniform(0, size, (rng.poisson(0.1), 2))]))
+        gt += [(k + 1, i + 1, *pos[i]) for i in range(n)]
+    return pts, np.array(gt)
+
+
+def test_closed_set_tracks_anonymous_points_better_than_online() -> None:
+    pts, gt = simulate_arena(seed=1)
+    det = points_to_rows(pts)
+    scores = {}
+    for name, rows in (("online", online_rows(det, 25.0, len(pts), max_targets=5)),
+                       ("offline", track_closed_set(det, 5, 25.0, n_frames=len(pts)))):
+        f, i, xy = rows_to_points(rows)
+        scores[name] = evaluate_points(gt[:, 0].astype(int), gt[:, 1].astype(int), gt[:, 2:4], f, i, xy,
+                                       radius=10.0, num_frames=len(pts))["IDF1"]
+    assert scores["offline"] > 0.95
+    assert scores["offline"] >= scores["online"]
