@@ -21,13 +21,14 @@ def _arena(n_targets: int, dark: bool, radius: int, n: int = 30, seed: int = 0, 
     bg = (base + rng.normal(0, 3, (160, 200, 3))).clip(0, 255)
     yy, xx = np.mgrid[:160, :200]
     bg[((xx // 25) + (yy // 20)) % 2 == 0] += 20 if dark else -20  # a static floor pattern, as in a real arena
-    start = rng.uniform(30, 130, (n_targets, 2))
-    vel = rng.normal(0, 2.5, (n_targets, 2))
+    start = rng.uniform(30, 170, n_targets)
+    speed = rng.uniform(3, 6, n_targets) * rng.choice([-1, 1], n_targets)
+    lanes = np.linspace(radius + 5, 160 - radius - 5, n_targets)  # one lane each: the discs never touch
     frames = []
     for t in range(n):
         img = bg.copy()
-        for (x0, y0), (vx, vy) in zip(start, vel):
-            cx, cy = _bounce(x0 + vx * t, radius, 200 - radius), _bounce(y0 + vy * t, radius, 160 - radius)
+        for x0, v, cy in zip(start, speed, lanes):
+            cx = _bounce(x0 + v * t, radius, 200 - radius)
             img[(xx - cx) ** 2 + (yy - cy) ** 2 <= radius**2] = 40 if dark else 220
         if clutter:
             sy, sx = rng.integers(0, 160, 5), rng.integers(0, 200, 5)
