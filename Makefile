@@ -24,7 +24,7 @@ test: venv browser docs lint
 
 # Static checks (configured in pyproject.toml): ruff, mypy (strict on the core layers) and the import contracts.
 lint: venv
-	$(VENV)/bin/ruff check src tests benchmarks
+	$(VENV)/bin/ruff check src tests benchmarks tools
 	$(VENV)/bin/mypy
 	$(VENV)/bin/lint-imports --no-cache
 
