@@ -173,6 +173,22 @@ def test_readme_links_exist():
         assert (REPO / path).exists(), f"README.md links to {target}, which does not exist"
 
 
+def test_make_targets_and_extras_exist():
+    """``make X`` names a Makefile target and ``.[extra]`` / ``lookalike[extra]`` an extra of pyproject.toml."""
+    makefile = (REPO / "Makefile").read_text(encoding="utf-8")
+    targets = set(re.findall(r"^([\w.-]+):", makefile, flags=re.M))
+    pyproject = (REPO / "pyproject.toml").read_text(encoding="utf-8")
+    section = pyproject.split("[project.optional-dependencies]", 1)[1].split("\n[", 1)[0]
+    extras = set(re.findall(r"^([\w-]+)\s*=", section, flags=re.M))
+    for doc in DOC_FILES:
+        for _, text, _ in shell_blocks(doc):
+            for target in re.findall(r"(?:^|[;&]\s*)make\s+([\w.-]+)", text, flags=re.M):
+                assert target in targets, f"{doc.relative_to(REPO)}: no Makefile target {target!r}"
+        for names in re.findall(r"(?:\.|lookalike)\[([\w,-]+)\]", doc.read_text(encoding="utf-8")):
+            for name in names.split(","):
+                assert name in extras, f"{doc.relative_to(REPO)}: pyproject.toml has no extra {name!r}"
+
+
 def test_benchmark_scripts_exist():
     """``python benchmarks/X.py`` in the docs names a script that exists."""
     for doc in DOC_FILES:
