@@ -7,19 +7,15 @@ from pathlib import Path
 
 import typer
 
+from lookalike.bench.ident import identify
 from lookalike.cli.app import app, console, fail
 from lookalike.sim import RobotSequence
-from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers import tracker_names
 
 
 def tracker_labels(name: str, sequence: RobotSequence) -> list[list[int]]:
     """Per-frame detection labels from running registered tracker ``name`` over ``sequence``."""
-    known = {p.name for p in tracker_parameters(name)}
-    cfg = sequence.config
-    params = {k: v for k, v in (("n_agents", cfg.n_agents), ("n_slots", cfg.max_detections)) if k in known}
-    tracker = make_tracker(name, **params)
-    return [labels_from_tracks(len(f.detections), tracker.update(f)).tolist() for f in sequence.frames()]
+    return [labels.tolist() for labels in identify(name, sequence)]
 
 
 @app.command()
