@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.eval import evaluate_sequence
-from lookalike.io import MotTable, write_mot
+from lookalike.io import MotTable, tracks_to_rows, write_mot
 from lookalike.sim.divers import DiverScenario, simulate_divers
 from lookalike.trackers import TrackStatus, make_tracker
 from lookalike.types import Frame
@@ -113,9 +113,7 @@ def _update_all(instances: dict[str, Any], f: Frame, results: dict[str, list[lis
         t0 = time.perf_counter()
         tracks = tracker.update(f)
         elapsed[name] += time.perf_counter() - t0
-        for t in tracks:
-            if t.xywh is not None:
-                results[name].append([f.index + 1, t.track_id, *t.xywh, 1.0, -1, -1, -1])
+        results[name].extend(tracks_to_rows(f.index, tracks).tolist())
         if name == video_tracker:
             shown = [t for t in tracks if t.xywh is not None and t.status is TrackStatus.CONFIRMED]
     return shown
