@@ -146,3 +146,16 @@ def test_trackers_that_cannot_run_on_boxes_say_what_they_need_in_one_line(tmp_pa
     assert len(text.splitlines()) == 1 and "Traceback" not in text
     assert name in text and ("appearance" in text if "sort" in name else "headings" in text)
     assert not (tmp_path / "out.txt").exists()
+
+
+def test_box_input_problem_names_what_each_tracker_needs():
+    from lookalike.io.needs import box_input_problem
+    from lookalike.trackers import tracker_names
+
+    assert box_input_problem("sort") is None and box_input_problem("boxtrack") is None
+    assert box_input_problem("deepsort", video=True) is None  # a video gives it appearance features
+    assert "--video" in (box_input_problem("diversort") or "")
+    assert "headings" in (box_input_problem("kalman_ha", video=True) or "")
+    for name in tracker_names():
+        problem = box_input_problem(name)
+        assert problem is None or (name in problem and "\n" not in problem)
