@@ -68,6 +68,8 @@ class ClosedSetConfig:
     velocity_frames: int = param(5, "rows at a tracklet's end/start that give its velocity")
     pos_sigma: float = param(0.1, "spread of a link's miss at a gap of zero (box sizes)")
     link_cost: float = param(1.0, "cost of every link (rows' worth), so fewer, longer pieces are preferred")
+    continue_cost: float = param(-3.0, "cost of re-joining two consecutive pieces of one input track cut at a "
+                                       "contact (negative: trust the online pass)")
     max_z: float = param(6.0, "largest miss of a link candidate, in spreads σ")
     candidates: int = param(6, "cheapest successors per end and predecessors per start kept as links")
     max_gap_s: float = param(math.inf, "longest gap (seconds) a link may bridge")
@@ -91,6 +93,7 @@ class Tracklet:
 
     rows: np.ndarray
     source_id: int = -1  # the id it had in the input
+    contact: bool = False  # every row touches another track's box (identity there is unsure)
 
     @property
     def first(self) -> int:
@@ -176,7 +179,7 @@ def split_tracklets(rows: np.ndarray, config: ClosedSetConfig | None = None) -> 
         limit = np.maximum(cfg.jump * typical, cfg.jump_floor * np.minimum(size[:-1], size[1:]))
         cut = (np.diff(r[:, 0]) > 1) | (step > limit) | (touch[1:] != touch[:-1])
         for piece in np.split(np.arange(len(r)), np.flatnonzero(cut) + 1):
-            out.append(Tracklet(r[piece], int(tid)))
+            out.append(Tracklet(r[piece], int(tid), bool(touch[piece].all())))
     out.sort(key=lambda t: (t.first, t.last))
     return out
 
@@ -243,7 +246,7 @@ def link_costs(tracklets: list[Tracklet], frame_rate: float,
     ii, jj, nll = ii[ok], jj[ok], nll[ok]
     source = np.array([t.source_id for t in tracklets])
     cut = (source[ii] == source[jj]) & (gap[ii, jj] == 1)  # a cut inside one input track (a contact)
-    cost = np.where(cut, -cfg.tracklet_cost, cfg.link_cost) + nll
+    cost = np.where(cut, cfg.continue_cost, cfg.link_cost) + nll
     keep = _cheapest(ii, cost, cfg.candidates) | _cheapest(jj, cost, cfg.candidates)
     return ii[keep], jj[keep], cost[keep]
 
