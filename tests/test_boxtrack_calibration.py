@@ -27,7 +27,7 @@ def _frame(k: int, boxes: np.ndarray, scores: np.ndarray) -> Frame:
 
 def _high(tracker) -> float:
     """The high threshold the tracker's score bands support so far."""
-    return tracker._bands.threshold(tracker.config.high_match_ratio, tracker.config.calib_min_count)
+    return tracker._calibration.bands.threshold(tracker.config.high_match_ratio, tracker.config.calib_min_count)
 
 
 def _clutter(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -58,7 +58,7 @@ def test_high_match_ratio_off_keeps_the_configured_threshold() -> None:
     tracker = make_tracker("boxtrack", high_match_ratio=None)
     for k in range(80):
         tracker.update(_frame(k, _truth(k), rng.uniform(0.6, 1.0, ROWS)))
-    assert tracker._bands.seen.sum() == 0  # nothing counted, so nothing can lower the threshold
+    assert tracker._calibration.bands.seen.sum() == 0  # nothing counted, so nothing can lower the threshold
 
 
 def _coast_run(tracker, miss: np.ndarray) -> list[list]:

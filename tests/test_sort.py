@@ -49,7 +49,7 @@ def test_empty_frames_are_harmless():
     assert len(out) == 1  # first min_hits frames report new tracks at once
     for k in range(2, 6):
         assert tracker.update(_frame(k, np.zeros((0, 4)))) == []
-    assert tracker._ids.size == 0  # deleted after max_age
+    assert len(tracker._tracks) == 0  # deleted after max_age
 
 
 def test_one_detection_becomes_a_confirmed_track():

@@ -80,3 +80,32 @@ def test_track_snapshot_is_frozen():
     snap = TrackSnapshot(track_id=1, status=TrackStatus.CONFIRMED, xywh=np.zeros(4))
     with pytest.raises(AttributeError):
         snap.track_id = 2  # type: ignore[misc]
+
+
+def test_tracks_batch_reads_like_a_list_of_snapshots_and_writes_rows() -> None:
+    from lookalike.types import Tracks, TrackSnapshot, TrackStatus
+
+    boxes = np.array([[1.0, 2.0, 3.0, 4.0], [5.0, 6.0, 7.0, 8.0]])
+    tracks = Tracks(np.array([7, 9]), np.array([1, 0]), xywh=boxes, velocity=np.zeros((2, 2)),
+                    detection_index=np.array([0, -1]))
+    assert len(tracks) == 2 and bool(tracks) and tracks != [] and Tracks.empty() == []
+    first = tracks[0]
+    assert isinstance(first, TrackSnapshot) and first.track_id == 7 and first.status is TrackStatus.CONFIRMED
+    assert [t.track_id for t in tracks] == [7, 9] and tracks[-1].status is TrackStatus.TENTATIVE
+    assert tracks[1].detection_index == -1 and tracks[0].heading is None and tracks[0].agent_id is None
+    assert [t.track_id for t in tracks[:1]] == [7] and tracks.statuses()[1] is TrackStatus.TENTATIVE
+    rows = tracks.to_rows(4)
+    assert rows.shape == (2, 10) and rows[:, 0].tolist() == [5, 5] and rows[:, 1].tolist() == [7, 9]
+    np.testing.assert_array_equal(rows[:, 2:6], boxes)
+    assert rows[:, 6].tolist() == [1.0, 1.0] and (rows[:, 7:] == -1).all()
+    world = Tracks(np.array([1]), TrackStatus.LOST, position=np.array([[1.0, 2.0]]), heading=np.array([np.nan]),
+                   agent_id=np.array([2]), identity_prob=np.array([0.8]))
+    snap = world[0]
+    assert snap.xywh is None and snap.agent_id == 2 and snap.identity_prob == 0.8 and snap.status is TrackStatus.LOST
+    assert world.to_rows(0).shape == (0, 10)
+    back = Tracks.from_snapshots(list(tracks))
+    np.testing.assert_array_equal(back.to_rows(4), rows)
+    with pytest.raises(IndexError):
+        tracks[2]
+    with pytest.raises(ValueError):
+        Tracks(np.array([1, 2]), TrackStatus.CONFIRMED, xywh=np.zeros((1, 4)))

@@ -10,7 +10,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from lookalike.association.solver import Assignment, assign
+from lookalike.association.solver import Assignment
+from lookalike.association.stages import cascade, run_plan
 
 
 def cosine_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -19,7 +20,8 @@ def cosine_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     b = np.asarray(b, dtype=float)
     if a.ndim != 2 or b.ndim != 2 or (a.size and b.size and a.shape[1] != b.shape[1]):
         raise ValueError(f"cosine_distance: expected (m, d) and (k, d), got {a.shape} and {b.shape}")
-    return 1.0 - a @ b.T
+    out: np.ndarray = 1.0 - a @ b.T
+    return out
 
 
 class FeatureGallery:
@@ -101,22 +103,15 @@ def matching_cascade(
         An :class:`Assignment` whose matches are ``(track_row, detection_index)`` pairs.
     """
     track_age = np.asarray(track_age, dtype=int)
-    remaining = np.asarray(detections, dtype=int)
-    pairs: list[np.ndarray] = []
-    for level in range(1, max_age + 1):
-        if not len(remaining):
-            break
-        rows = np.flatnonzero(track_age == level)
-        if not len(rows):
-            continue
-        result = assign(cost_fn(rows, remaining), max_cost)
-        if len(result.matches):
-            pairs.append(np.column_stack([rows[result.matches[:, 0]], remaining[result.matches[:, 1]]]))
-            remaining = remaining[result.unmatched_cols]
-    matches = np.vstack(pairs) if pairs else np.zeros((0, 2), dtype=int)
-    matched_rows = matches[:, 0] if len(matches) else np.zeros(0, dtype=int)
+    detections = np.asarray(detections, dtype=int)
+    n_det = int(detections.max()) + 1 if len(detections) else 0
+    allowed = np.zeros(n_det, dtype=bool)
+    allowed[detections] = True
+    stages = cascade(track_age, max_age, np.ones(len(track_age), dtype=bool), allowed, cost_fn, max_cost)
+    found = run_plan(stages, len(track_age), n_det)
+    matched = found.det_of_track >= 0
     return Assignment(
-        matches=matches[np.argsort(matches[:, 0], kind="stable")] if len(matches) else matches,
-        unmatched_rows=np.setdiff1d(np.arange(len(track_age)), matched_rows),
-        unmatched_cols=np.sort(remaining),
+        matches=found.pairs,
+        unmatched_rows=np.flatnonzero(~matched),
+        unmatched_cols=np.flatnonzero(found.free & allowed),
     )

@@ -7,6 +7,7 @@ Rectangular, empty and all-forbidden matrices are legal.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,7 +28,7 @@ class Assignment:
     unmatched_rows: np.ndarray
     unmatched_cols: np.ndarray
 
-    def __iter__(self):  # allows ``matches, rows, cols = assign(...)``
+    def __iter__(self) -> Iterator[np.ndarray]:  # allows ``matches, rows, cols = assign(...)``
         return iter((self.matches, self.unmatched_rows, self.unmatched_cols))
 
 
@@ -98,4 +99,5 @@ def max_weight_complete(weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     w = _check(weight)
     if w.size == 0:
         return np.zeros(0, int), np.zeros(0, int)
-    return linear_sum_assignment(-w)
+    rows, cols = linear_sum_assignment(-w)
+    return np.asarray(rows), np.asarray(cols)

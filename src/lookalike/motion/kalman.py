@@ -52,4 +52,5 @@ def gating_distance(
     diff = z[None, :, :] - z_hat[:, None, :]  # (k, d, m)
     # Solve L y = diff^T for each track.
     y = np.linalg.solve(L, np.swapaxes(diff, -1, -2))  # (k, m, d)
-    return np.sum(y * y, axis=1)
+    out: np.ndarray = np.sum(y * y, axis=1)
+    return out

@@ -12,16 +12,33 @@ import math
 import numpy as np
 
 
-def _kinematic(dim: int, order: int, dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
+def _check(dim: int, dt: float) -> None:
     if dim < 1:
         raise ValueError(f"dim must be at least 1, got {dim}")
     if not (dt >= 0 and math.isfinite(dt)):
         raise ValueError(f"dt must be a finite non-negative number of seconds, got {dt}")
+
+
+def _f1(order: int, dt: float) -> np.ndarray:
     n = order + 1
     f1 = np.zeros((n, n))
     for i in range(n):
         for j in range(i, n):
             f1[i, j] = dt ** (j - i) / math.factorial(j - i)
+    return f1
+
+
+def kinematic_transition(dim: int, order: int, dt: float) -> np.ndarray:
+    """The transition ``F(dt)`` alone of a kinematic model of ``order`` (1: constant velocity,
+    2: constant acceleration) in ``dim`` dimensions; ``dt`` in seconds or frames."""
+    _check(dim, dt)
+    return np.kron(_f1(order, dt), np.eye(dim))
+
+
+def _kinematic(dim: int, order: int, dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
+    _check(dim, dt)
+    n = order + 1
+    f1 = _f1(order, dt)
     # Continuous white noise on the highest derivative, integrated exactly over dt.
     q1 = np.zeros((n, n))
     for i in range(n):

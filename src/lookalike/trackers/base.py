@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
 from lookalike.types import Frame, TrackSnapshot
@@ -15,8 +16,9 @@ class Tracker(Protocol):
     name: ClassVar[str]
     config: Any
 
-    def update(self, frame: Frame) -> list[TrackSnapshot]:
-        """Process one frame; return the tracks reported for it."""
+    def update(self, frame: Frame) -> Sequence[TrackSnapshot]:
+        """Process one frame; return the tracks reported for it (a :class:`~lookalike.types.Tracks`
+        batch for the built-in trackers; any sequence of snapshots is accepted)."""
         ...
 
     def reset(self) -> None:

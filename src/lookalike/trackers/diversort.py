@@ -23,97 +23,48 @@ The seven mechanisms of the paper, each a step of :meth:`DiverSort.update`:
 7. **Persistent identities**: confirmed tracks are never deleted (``max_age = None``), as the team
    is small and fixed.
 
-Threshold calibration: the paper's 1e-4 / 5e-4 appearance thresholds and its location gate of
-25 suit its feature scaling and motion noise. For ``lookalike.vision.appearance.HandcraftedFeatures``
-standardised on the validation crops (``lookalike.sim.divers_run.fit_diver_features``) and this
-filter's noise, a grid search of pooled IDF1 over the four validation scenarios
-(``lookalike.sim.divers.VALIDATION_SCENARIOS``, never the test ones) chose
-``appearance_threshold = 0.10``, ``long_term_threshold = 0.30`` (3x looser; the paper's is 5x),
-``recovery_threshold = 0.30``, ``location_gate = 9.21`` (the 99% chi-square quantile for 2 dof),
-``position_std_frac = 0.15``, ``location_weight = 0.1`` and ``tie_margin = 0.02`` (validation
-IDF1 0.679, against 0.652 for the best setting that keeps the gate at 25). Other feature
-extractors need their own calibration.
+Where the defaults come from: docs/trackers/diversort.md.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from lookalike.association.appearance import FeatureGallery
-from lookalike.association.solver import assign
+from lookalike.association.stages import Stage, run_plan
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion import kalman
-from lookalike.motion.models import constant_velocity
-from lookalike.trackers.base import check_positive, param
+from lookalike.motion.spaces import CentreCV
 from lookalike.trackers.deepsort import require_features
+from lookalike.trackers.diversort_config import DiverSortConfig, Merge
+from lookalike.trackers.lifecycle import Lifecycle
 from lookalike.trackers.registry import register_tracker
+from lookalike.trackers.table import TrackTable
 from lookalike.trackers.timing import FrameClock
-from lookalike.types import Frame, TrackSnapshot, TrackStatus
+from lookalike.types import Frame, Tracks, TrackStatus
 
-_H = np.hstack([np.eye(2), np.zeros((2, 2))])
+__all__ = ["DiverSort", "DiverSortConfig", "Merge"]
 
-
-@dataclass(frozen=True)
-class Merge:
-    """An identity recovery: from ``frame_index`` on, track ``source_id`` is reported as ``target_id``."""
-
-    frame_index: int
-    source_id: int
-    target_id: int
+_MOTION = ("mean", "cov", "box", "hits", "misses", "last_seen")  # what a merged track takes from its source
 
 
 @register_tracker("diversort")
 class DiverSort:
     """Diver SORT on boxes (pixels) and appearance features (``frame.detections.feature``)."""
 
-    @dataclass(frozen=True)
-    class Config:
-        iou_shortcut: float = param(0.75, "IoU with last frame's detection that joins its track directly")
-        appearance_threshold: float = param(0.10, "largest cosine cost of a match (paper 1e-4 for its features)")
-        long_term_threshold: float = param(0.30, "threshold for tracks unseen > long_term_after (paper 5e-4)")
-        location_gate: float = param(9.21, "largest squared Mahalanobis distance of the centre (paper 25)")
-        location_weight: float = param(0.1, "weight of d²/location_gate added to tied costs")
-        tie_margin: float = param(0.02, "tracks this close to a detection's best cost count as tied")
-        long_term_after: int = param(5, "frames unseen after which only appearance is used")
-        recent_first: bool = param(False, "match recently seen tracks before long-unseen ones (ours)")
-        n_init: int = param(3, "consecutive matches that make a track an identity")
-        recovery_window: int = param(15, "a track alive this many frames or fewer may be merged")
-        recovery_fraction: float = param(0.25, "share of gallery pairs under the threshold that merges")
-        recovery_threshold: float = param(0.30, "cosine distance counted as similar for recovery")
-        gallery_size: int = param(100, "features kept per track")
-        max_age: int | None = param(None, "frames a confirmed track survives unseen (None: forever)")
-        position_std_frac: float = param(0.15, "centre measurement noise as a fraction of box height")
-        accel_std_frac: float = param(1 / 20, "centre acceleration noise per frame, fraction of box height")
-        frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)")
+    Config = DiverSortConfig
 
-        def __post_init__(self) -> None:
-            check_positive(self, "iou_shortcut", "appearance_threshold", "long_term_threshold", "location_gate",
-                           "n_init", "recovery_window", "gallery_size", "max_age", "position_std_frac",
-                           "accel_std_frac", "frame_interval_s")
-            check_positive(self, "location_weight", "tie_margin", "long_term_after", allow_zero=True)
-            check_positive(self, "recovery_threshold", "recovery_fraction", allow_zero=True)
-            if self.iou_shortcut > 1 or self.recovery_fraction >= 1:
-                raise ValueError("Config.iou_shortcut must be <= 1 and recovery_fraction < 1")
-
-    def __init__(self, config: DiverSort.Config | None = None) -> None:
-        self.config = config or DiverSort.Config()
+    def __init__(self, config: DiverSortConfig | None = None) -> None:
+        self.config = cfg = config or DiverSortConfig()
+        self._space = CentreCV(cfg.position_std_frac, cfg.accel_std_frac)
+        self._lifecycle = Lifecycle(n_init=cfg.n_init, tentative_max_misses=1, max_misses=cfg.max_age)
         self.reset()
 
     def reset(self) -> None:
         """Forget every track and merge; ids restart at 1."""
-        self._mean = np.zeros((0, 4))
-        self._cov = np.zeros((0, 4, 4))
-        self._box = np.zeros((0, 4))  # latest matched detection box
-        self._ids = np.zeros(0, dtype=int)
-        self._hits = np.zeros(0, dtype=int)  # consecutive matches
-        self._since = np.zeros(0, dtype=int)  # frames since the last match
-        self._born = np.zeros(0, dtype=int)
-        self._last_seen = np.zeros(0, dtype=int)
-        self._confirmed = np.zeros(0, dtype=bool)
+        # hits: consecutive matches; box: the latest matched detection; born/last_seen: frame numbers
+        self._tracks = TrackTable(4, {"box": ((4,), float), "born": ((), int), "last_seen": ((), int)})
         self._gallery = FeatureGallery(self.config.gallery_size)
-        self._next_id = 1
         self._frame = -1
         self._clock = FrameClock(self.config.frame_interval_s)
         self.merges: list[Merge] = []
@@ -121,64 +72,64 @@ class DiverSort:
 
     def uncertain(self, track_id: int) -> bool:
         """True while a confirmed track is young enough to be merged (its identity is not yet settled)."""
-        rows = np.flatnonzero(self._ids == track_id)
-        return bool(len(rows)) and self._frame - int(self._born[rows[0]]) < self.config.recovery_window
+        t = self._tracks
+        rows = np.flatnonzero(t.ids == track_id)
+        return bool(len(rows)) and self._frame - int(t["born"][rows[0]]) < self.config.recovery_window
 
-    def update(self, frame: Frame) -> list[TrackSnapshot]:
+    def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections (which need ``feature``)."""
+        cfg, t = self.config, self._tracks
         det = frame.detections
         features = require_features(det, "diversort")
         self._frame += 1
-        self._predict(self._clock.steps(frame.time))
-        centre = det.xywh[:, :2] + det.xywh[:, 2:] / 2
-        pairs = self._shortcut(det.xywh)
-        left_tracks = np.setdiff1d(np.arange(len(self._ids)), pairs[:, 0])
-        left_dets = np.setdiff1d(np.arange(len(det)), pairs[:, 1])
-        long_term = self._since[left_tracks] > self.config.long_term_after
-        stages = [left_tracks[~long_term], left_tracks[long_term]] if self.config.recent_first else [left_tracks]
-        for rows in stages:
-            if not len(rows) or not len(left_dets):
-                continue
-            found = assign(self._cost(rows, det.xywh[left_dets], centre[left_dets], features[left_dets]))
-            pairs = np.vstack([pairs, np.column_stack([rows[found.matches[:, 0]], left_dets[found.matches[:, 1]]])])
-            left_dets = left_dets[found.unmatched_cols]
-        det_of_track = np.full(len(self._ids), -1, dtype=int)
-        if len(pairs):
-            self._correct(pairs[:, 0], det.xywh[pairs[:, 1]], centre[pairs[:, 1]], features[pairs[:, 1]])
-            det_of_track[pairs[:, 0]] = pairs[:, 1]
-        keep = (self._since == 0) | self._confirmed
-        if self.config.max_age is not None:
-            keep &= self._since <= self.config.max_age
+        steps = self._clock.steps(frame.time)
+        if len(t):
+            t.mean, t.cov = self._space.predict(t.mean, t.cov, steps, t["box"][:, 3])
+            t.age()
+        centre = self._space.measure(det.xywh)
+        every = np.ones(len(det), dtype=bool)
+
+        def shortcut(r: np.ndarray, c: np.ndarray) -> np.ndarray:  # (1)
+            iou = iou_matrix(t["box"][r], det.xywh[c])
+            return np.where(iou >= cfg.iou_shortcut, 1.0 - iou, np.inf)
+
+        def cost(r: np.ndarray, c: np.ndarray) -> np.ndarray:
+            return self._cost(r, det.xywh[c], centre[c], features[c])
+
+        long_term = t.misses > cfg.long_term_after
+        groups = [~long_term, long_term] if cfg.recent_first else [np.ones(len(t), dtype=bool)]
+        matching = run_plan([Stage(t.misses == 1, every, shortcut, name="IoU shortcut")]
+                            + [Stage(g, every, cost, name="appearance") for g in groups], len(t), len(det))
+        self.shortcut_matches += int((matching.stage_of_track == 0).sum())
+        det_of_track = matching.det_of_track
+        rows = np.flatnonzero(det_of_track >= 0)
+        if len(rows):
+            self._correct(rows, det.xywh[det_of_track[rows]], centre[det_of_track[rows]], features[det_of_track[rows]])
+        keep = self._lifecycle.alive(t)
         self._keep(keep)
         det_of_track = det_of_track[keep]
-        new = np.setdiff1d(np.arange(len(det)), pairs[:, 1])
+        new = np.flatnonzero(matching.free)
         if len(new):
-            self._birth(det.xywh[new], centre[new], features[new])
+            mean, cov = self._space.initial(centre[new], det.xywh[new, 3])
+            born = t.add(mean, cov, box=det.xywh[new], hits=1, born=self._frame, last_seen=self._frame,
+                         confirmed=self._lifecycle.born_confirmed())
+            for tid, feat in zip(t.ids[born], features[new]):
+                self._gallery.add(int(tid), feat)
             det_of_track = np.concatenate([det_of_track, new])
         det_of_track = self._recover(frame.index, det_of_track)
         return self._report(det_of_track)
 
     # -- mechanisms --------------------------------------------------------------------------
 
-    def _shortcut(self, xywh: np.ndarray) -> np.ndarray:
-        """(1) ``(k, 2)`` (track row, detection) pairs with IoU ≥ the shortcut to last frame's boxes."""
-        recent = np.flatnonzero(self._since == 1)
-        if not len(recent) or not len(xywh):
-            return np.zeros((0, 2), dtype=int)
-        iou = iou_matrix(self._box[recent], xywh)
-        found = assign(np.where(iou >= self.config.iou_shortcut, 1.0 - iou, np.inf))
-        self.shortcut_matches += len(found.matches)
-        return np.column_stack([recent[found.matches[:, 0]], found.matches[:, 1]]).astype(int)
-
     def _cost(self, rows: np.ndarray, xywh: np.ndarray, centre: np.ndarray, features: np.ndarray) -> np.ndarray:
         """(3, 5) ``(len(rows), n)`` costs of tracks ``rows`` for detections; ``inf`` unacceptable."""
-        cfg = self.config
-        appearance = self._gallery.min_distance(self._ids[rows], features)
-        long_term = self._since[rows] > cfg.long_term_after
-        R = _measurement_noise(xywh[:, 3], cfg.position_std_frac)  # per detection
+        cfg, t = self.config, self._tracks
+        appearance = self._gallery.min_distance(t.ids[rows], features)
+        long_term = t.misses[rows] > cfg.long_term_after
+        R = self._space.R(xywh[:, 3])  # per detection
         # Squared Mahalanobis distance with the innovation covariance of each (track, detection) pair.
-        S = self._cov[rows][:, None, :2, :2] + R[None]
-        diff = centre[None, :, :] - self._mean[rows][:, None, :2]
+        S = t.cov[rows][:, None, :2, :2] + R[None]
+        diff = centre[None, :, :] - t.mean[rows][:, None, :2]
         maha = np.einsum("tdi,tdi->td", diff, np.linalg.solve(S, diff[..., None])[..., 0])
         short_ok = (maha <= cfg.location_gate) & (appearance <= cfg.appearance_threshold)
         long_ok = appearance <= cfg.long_term_threshold
@@ -192,99 +143,50 @@ class DiverSort:
 
     def _recover(self, frame_index: int, det_of_track: np.ndarray) -> np.ndarray:
         """(6) Merge young confirmed tracks into identities unseen since their birth."""
-        cfg = self.config
-        young = np.flatnonzero(self._confirmed & (self._frame - self._born < cfg.recovery_window) & (self._since == 0))
-        for source in self._ids[young[np.argsort(self._born[young], kind="stable")]]:
-            row = int(np.flatnonzero(self._ids == source)[0])
-            candidates = np.flatnonzero(self._confirmed & (self._last_seen < self._born[row]))
+        cfg, t = self.config, self._tracks
+        born = t["born"]
+        young = np.flatnonzero(t.confirmed & (self._frame - born < cfg.recovery_window) & (t.misses == 0))
+        for source in t.ids[young[np.argsort(born[young], kind="stable")]]:
+            row = int(np.flatnonzero(t.ids == source)[0])
+            candidates = np.flatnonzero(t.confirmed & (t["last_seen"] < t["born"][row]))
             if not len(candidates):
                 continue
-            share = np.array([self._gallery.pair_fraction_below(int(source), int(self._ids[c]), cfg.recovery_threshold)
+            share = np.array([self._gallery.pair_fraction_below(int(source), int(t.ids[c]), cfg.recovery_threshold)
                               for c in candidates])
             if share.max() <= cfg.recovery_fraction:
                 continue
             target = int(candidates[share.argmax()])
-            self._absorb(row, target)
+            t.copy_row(row, target, _MOTION)
+            self._gallery.merge(int(t.ids[row]), int(t.ids[target]))
             det_of_track[target] = det_of_track[row]
-            self.merges.append(Merge(frame_index, int(source), int(self._ids[target])))
-            keep = np.ones(len(self._ids), dtype=bool)
+            self.merges.append(Merge(frame_index, int(source), int(t.ids[target])))
+            keep = np.ones(len(t), dtype=bool)
             keep[row] = False
             self._keep(keep)
             det_of_track = det_of_track[keep]
         return det_of_track
 
-    def _absorb(self, source: int, target: int) -> None:
-        """Give row ``target`` the motion state and features of row ``source``."""
-        for name in ("_mean", "_cov", "_box", "_hits", "_since", "_last_seen"):
-            arr = getattr(self, name)
-            arr[target] = arr[source]
-        self._gallery.merge(int(self._ids[source]), int(self._ids[target]))
-
     # -- state -------------------------------------------------------------------------------
 
-    def _predict(self, steps: float) -> None:
-        if not len(self._ids):
-            return
-        F, Q = constant_velocity(2, steps, 1.0)
-        accel = self.config.accel_std_frac * self._box[:, 3]
-        self._mean, self._cov = kalman.predict(self._mean, self._cov, F, Q[None] * (accel**2)[:, None, None])
-        self._since += 1
-
     def _correct(self, rows: np.ndarray, xywh: np.ndarray, centre: np.ndarray, features: np.ndarray) -> None:
-        R = _measurement_noise(xywh[:, 3], self.config.position_std_frac)
-        self._mean[rows], self._cov[rows] = kalman.update(self._mean[rows], self._cov[rows], centre, _H, R)
-        self._box[rows] = xywh
-        self._hits[rows] = np.where(self._since[rows] == 1, self._hits[rows] + 1, 1)
-        self._since[rows] = 0
-        self._last_seen[rows] = self._frame
-        self._confirmed[rows] |= self._hits[rows] >= self.config.n_init
+        t = self._tracks
+        t.mean[rows], t.cov[rows] = kalman.update(t.mean[rows], t.cov[rows], centre, self._space.H,
+                                                  self._space.R(xywh[:, 3]))
+        t["box"][rows] = xywh
+        t.hits[rows] = np.where(t.misses[rows] == 1, t.hits[rows] + 1, 1)
+        t.misses[rows] = 0
+        t["last_seen"][rows] = self._frame
+        self._lifecycle.confirm(t, rows)
         for row, feat in zip(rows, features):
-            self._gallery.add(int(self._ids[row]), feat)
+            self._gallery.add(int(t.ids[row]), feat)
 
-    def _birth(self, xywh: np.ndarray, centre: np.ndarray, features: np.ndarray) -> None:
-        n = len(xywh)
-        std = self.config.position_std_frac * xywh[:, 3]
-        cov = np.zeros((n, 4, 4))
-        cov[:, [0, 1], [0, 1]] = (std**2)[:, None]
-        cov[:, [2, 3], [2, 3]] = ((0.5 * xywh[:, 3]) ** 2)[:, None]  # unknown speed: half a height per frame
-        ids = np.arange(self._next_id, self._next_id + n)
-        self._next_id += n
-        self._mean = np.vstack([self._mean, np.hstack([centre, np.zeros((n, 2))])])
-        self._cov = np.concatenate([self._cov, cov])
-        self._box = np.vstack([self._box, xywh])
-        self._ids = np.concatenate([self._ids, ids])
-        self._hits = np.concatenate([self._hits, np.ones(n, dtype=int)])
-        self._since = np.concatenate([self._since, np.zeros(n, dtype=int)])
-        self._born = np.concatenate([self._born, np.full(n, self._frame)])
-        self._last_seen = np.concatenate([self._last_seen, np.full(n, self._frame)])
-        self._confirmed = np.concatenate([self._confirmed, np.full(n, self.config.n_init <= 1)])
-        for tid, feat in zip(ids, features):
-            self._gallery.add(int(tid), feat)
-
-    def _report(self, det_of_track: np.ndarray) -> list[TrackSnapshot]:
-        idx = np.flatnonzero(self._confirmed & (self._since == 0))
-        out = []
-        for i in idx:
-            w, h = self._box[i, 2:]
-            box = np.array([self._mean[i, 0] - w / 2, self._mean[i, 1] - h / 2, w, h])
-            out.append(TrackSnapshot(
-                track_id=int(self._ids[i]),
-                status=TrackStatus.CONFIRMED,
-                xywh=box,
-                velocity=self._mean[i, 2:] / self._clock.interval,
-                detection_index=int(det_of_track[i]),
-            ))
-        return out
+    def _report(self, det_of_track: np.ndarray) -> Tracks:
+        t = self._tracks
+        idx = np.flatnonzero(t.confirmed & (t.misses == 0))
+        return Tracks(t.ids[idx], TrackStatus.CONFIRMED, xywh=self._space.box(t.mean[idx], t["box"][idx]),
+                      velocity=t.mean[idx, 2:] / self._clock.interval, detection_index=det_of_track[idx])
 
     def _keep(self, mask: np.ndarray) -> None:
-        for tid in self._ids[~mask]:
+        for tid in self._tracks.ids[~mask]:
             self._gallery.remove(int(tid))
-        for name in ("_mean", "_cov", "_box", "_ids", "_hits", "_since", "_born", "_last_seen", "_confirmed"):
-            setattr(self, name, getattr(self, name)[mask])
-
-
-def _measurement_noise(height: np.ndarray, frac: float) -> np.ndarray:
-    """``(n, 2, 2)`` centre measurement covariances, standard deviation ``frac`` × box height."""
-    R = np.zeros((len(height), 2, 2))
-    R[:, [0, 1], [0, 1]] = ((frac * np.maximum(height, 1.0)) ** 2)[:, None]
-    return R
+        self._tracks.keep(mask)

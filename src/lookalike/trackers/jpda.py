@@ -23,8 +23,9 @@ from lookalike.association.jpda import jpda_marginals
 from lookalike.association.solver import assign
 from lookalike.motion import kalman
 from lookalike.trackers.base import check_positive, param
-from lookalike.trackers.kalman_ha import H, HeuristicsConfig, WorldTracker
+from lookalike.trackers.kalman_ha import H, WorldTracker
 from lookalike.trackers.registry import register_tracker
+from lookalike.trackers.world_rules import HeuristicsConfig, WorldRules, positions
 from lookalike.types import Detections
 
 
@@ -49,23 +50,23 @@ class JpdaConfig(HeuristicsConfig):
 class JpdaTracker(WorldTracker):
     """JPDA track maintenance with Kalman-HA2's lifecycle and the beacon identifier."""
 
-    heuristics = True
     Config = JpdaConfig
 
     def __init__(self, config: JpdaConfig | None = None) -> None:
-        super().__init__(config or JpdaConfig())
+        self.jpda = config or JpdaConfig()
+        super().__init__(self.jpda, WorldRules.from_config(self.jpda))
         self._explained = np.zeros(0)
 
     def _associate_and_update(self, det: Detections) -> np.ndarray:
-        cfg: JpdaConfig = self.config  # type: ignore[assignment]
-        k, m = len(self._ids), len(det)
+        cfg, t = self.jpda, self._tracks
+        k, m = len(t), len(det)
         det_of_track = np.full(k, -1, dtype=int)
         self._explained = np.zeros(m)
         if not k or not m:
             return det_of_track
-        R = self._noise(self._mean[:, :2])
-        z_hat, S = kalman.project(self._mean, self._cov, H, R)
-        d2 = kalman.gating_distance(self._mean, self._cov, det.position, H, R)
+        R = self._noise(t.mean[:, :2])
+        z_hat, S = kalman.project(t.mean, t.cov, H, R)
+        d2 = kalman.gating_distance(t.mean, t.cov, positions(det), H, R)
         d2 = np.where(d2 <= self._gate, d2, np.inf)
         norm = 1.0 / (2 * np.pi * np.sqrt(np.linalg.det(S)))  # (k,)
         likelihood = np.where(np.isfinite(d2), cfg.p_detection * norm[:, None] * np.exp(-0.5 * np.where(
@@ -75,16 +76,16 @@ class JpdaTracker(WorldTracker):
         beta, beta_miss = jpda_marginals(likelihood, miss, cfg.max_events)
         self._explained = beta.sum(axis=0)
         # Mixture-reduced update.
-        nu = det.position[None, :, :] - z_hat[:, None, :]  # (k, m, 2)
+        nu = positions(det)[None, :, :] - z_hat[:, None, :]  # (k, m, 2)
         nu_bar = np.einsum("km,kmd->kd", beta, nu)
-        PHt = self._cov @ H.T
+        PHt = t.cov @ H.T
         K = np.swapaxes(np.linalg.solve(S, np.swapaxes(PHt, -1, -2)), -1, -2)  # (k, 6, 2)
         spread = np.einsum("km,kmd,kme->kde", beta, nu, nu) - nu_bar[:, :, None] * nu_bar[:, None, :]
         KSKt = K @ S @ np.swapaxes(K, -1, -2)
         updated = 1.0 - beta_miss
-        self._mean = self._mean + np.einsum("kij,kj->ki", K, nu_bar)
-        cov = self._cov - updated[:, None, None] * KSKt + K @ spread @ np.swapaxes(K, -1, -2)
-        self._cov = 0.5 * (cov + np.swapaxes(cov, -1, -2))  # keep it symmetric against round-off
+        t.mean = t.mean + np.einsum("kij,kj->ki", K, nu_bar)
+        cov = t.cov - updated[:, None, None] * KSKt + K @ spread @ np.swapaxes(K, -1, -2)
+        t.cov = 0.5 * (cov + np.swapaxes(cov, -1, -2))  # keep it symmetric against round-off
         # One detection per track for labels and the lifecycle.
         matches, _, _ = assign(1.0 - beta, 1.0 - cfg.min_assignment_prob)
         det_of_track[matches[:, 0]] = matches[:, 1]

@@ -28,7 +28,7 @@ def register_tracker(name: str) -> Callable[[type], type]:
             raise ValueError(f"a tracker named {name!r} is already registered")
         if not dataclasses.is_dataclass(getattr(cls, "Config", None)):
             raise TypeError(f"tracker {name!r} needs a dataclass attribute 'Config'")
-        cls.name = name
+        setattr(cls, "name", name)  # noqa: B010 (a class attribute the protocol declares)
         _REGISTRY[name] = cls
         return cls
 
@@ -50,13 +50,17 @@ def tracker_class(name: str) -> type:
         raise KeyError(f"unknown tracker {name!r}; registered: {', '.join(sorted(_REGISTRY))}") from None
 
 
+def _config_class(name: str) -> Any:
+    return getattr(tracker_class(name), "Config")  # noqa: B009 (checked at registration)
+
+
 def tracker_parameters(name: str) -> list[ParameterInfo]:
     """The parameters of tracker ``name`` with their defaults and descriptions."""
-    config_cls = tracker_class(name).Config
+    config_cls = _config_class(name)
     hints = typing.get_type_hints(config_cls)
     out = []
     for f in dataclasses.fields(config_cls):
-        default = f.default if f.default is not dataclasses.MISSING else f.default_factory()  # type: ignore[misc]
+        default = f.default if f.default_factory is dataclasses.MISSING else f.default_factory()
         type_name = getattr(hints[f.name], "__name__", str(hints[f.name]))
         out.append(ParameterInfo(f.name, type_name, default, f.metadata.get("doc", "")))
     return out
@@ -65,11 +69,11 @@ def tracker_parameters(name: str) -> list[ParameterInfo]:
 def make_tracker(name: str, **params: Any) -> Any:
     """Build tracker ``name`` with config overrides; unknown parameters raise ``ValueError``."""
     cls = tracker_class(name)
-    known = {f.name for f in dataclasses.fields(cls.Config)}
+    known = {f.name for f in dataclasses.fields(_config_class(name))}
     unknown = sorted(set(params) - known)
     if unknown:
         raise ValueError(f"tracker {name!r} has no parameter(s) {unknown}; known: {sorted(known)}")
-    return cls(cls.Config(**params))
+    return cls(_config_class(name)(**params))
 
 
 def parse_parameter(name: str, assignment: str) -> tuple[str, Any]:
@@ -80,7 +84,7 @@ def parse_parameter(name: str, assignment: str) -> tuple[str, Any]:
     params = {p.name: p for p in tracker_parameters(name)}
     if key not in params:
         raise ValueError(f"tracker {name!r} has no parameter {key!r}; known: {sorted(params)}")
-    hint = typing.get_type_hints(tracker_class(name).Config)[key]
+    hint = typing.get_type_hints(_config_class(name))[key]
     return key, _convert(key, text, hint)
 
 

@@ -85,3 +85,63 @@ class MissReturns:
         inside = (missed > 0) & (missed <= self.longest)
         out[inside] = ok[missed[inside]]
         return out
+
+
+class ScoreCalibration:
+    """Owner of a tracker's score thresholds: observes the sequence's scores and which detections
+    continued confirmed tracks, and decides this frame's high, birth and tentative thresholds.
+
+    The absolute ``high_score`` and ``birth_score`` are ceilings; each is lowered to a quantile of
+    every score seen so far (a histogram of ``bins`` bins on [0, 1]) when its quantile is set, the
+    high one also to the :class:`ScoreBands` threshold when ``high_match_ratio`` is set. The high
+    threshold never exceeds the birth threshold; the tentative one (``tentative_quantile``) never
+    exceeds the high one.
+    """
+
+    def __init__(self, high_score: float, birth_score: float, *, high_quantile: float | None = None,
+                 birth_quantile: float | None = None, tentative_quantile: float | None = None,
+                 high_match_ratio: float | None = None, calib_min_count: int = 100, bins: int = 1000) -> None:
+        self.high_score, self.birth_score = high_score, birth_score
+        self.high_quantile, self.birth_quantile = high_quantile, birth_quantile
+        self.tentative_quantile = tentative_quantile
+        self.high_match_ratio, self.calib_min_count = high_match_ratio, calib_min_count
+        self.bins = bins
+        self.histogram = np.zeros(bins, dtype=np.int64)  # scores seen so far, binned on [0, 1]
+        self.bands = ScoreBands(10)  # 0.1-wide bands: detections, and those that continued tracks
+
+    @property
+    def _quantiles(self) -> bool:
+        return not (self.high_quantile is None and self.birth_quantile is None and self.tentative_quantile is None)
+
+    def observe_scores(self, score: np.ndarray) -> None:
+        """Count this frame's scores (in [0, 1]) into the running distribution."""
+        if self._quantiles:
+            b = np.clip((score * self.bins).astype(int), 0, self.bins - 1)
+            self.histogram += np.bincount(b, minlength=self.bins)
+
+    def observe_continued(self, score: np.ndarray, continued: np.ndarray) -> None:
+        """Count this frame's detections by band; ``continued`` indexes those that continued a confirmed track."""
+        if self.high_match_ratio is not None:
+            self.bands.add(score, continued)
+
+    def decide(self) -> tuple[float, float, float]:
+        """This frame's ``(high, birth, tentative)`` score thresholds."""
+        high, birth = self.high_score, self.birth_score
+        if self.high_match_ratio is not None:
+            high = min(high, self.bands.threshold(self.high_match_ratio, self.calib_min_count))
+        if not self._quantiles:
+            return min(high, birth), birth, min(high, birth)
+        tentative = 1.0
+        cum = np.cumsum(self.histogram)
+        if cum[-1]:
+            # the lower edge of the bin holding the q-quantile: never above a score it stands for
+            def edge(q: float) -> float:
+                return int(np.searchsorted(cum, q * cum[-1], side="left")) / self.bins
+            if self.high_quantile is not None:
+                high = min(high, edge(self.high_quantile))
+            if self.birth_quantile is not None:
+                birth = min(birth, edge(self.birth_quantile))
+            if self.tentative_quantile is not None:
+                tentative = edge(self.tentative_quantile)
+        high = min(high, birth)
+        return high, birth, min(high, tentative)

@@ -13,27 +13,41 @@ predicted and updated together as batched arrays.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
 from lookalike.association.solver import max_weight_complete
-from lookalike.geometry.boxes import iou_matrix, xysr_to_xywh, xywh_to_xysr
+from lookalike.association.stages import Stage, run_plan
+from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion import kalman
+from lookalike.motion.spaces import BoxXYSR
 from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.lifecycle import Lifecycle
 from lookalike.trackers.registry import register_tracker
+from lookalike.trackers.table import TrackTable
 from lookalike.trackers.timing import FrameClock
-from lookalike.types import Frame, TrackSnapshot, TrackStatus
+from lookalike.types import Frame, Tracks
 
-_H = np.hstack([np.eye(4), np.zeros((4, 3))])
-_R = np.diag([1.0, 1.0, 10.0, 10.0])
-_P0 = np.diag([10.0, 10.0, 10.0, 10.0, 1e4, 1e4, 1e4])
-_Q = np.diag([1.0, 1.0, 1.0, 1.0, 1e-2, 1e-2, 1e-4])
+_SPACE = BoxXYSR()
 
 
-def _transition(steps: float) -> np.ndarray:
-    F = np.eye(7)
-    F[0, 4] = F[1, 5] = F[2, 6] = steps
-    return F
+def solve_max_iou(threshold: float) -> Callable[[np.ndarray], np.ndarray]:
+    """SORT's solver on a ``(tracks, detections)`` IoU matrix: a direct match when every detection
+    and track has at most one pair above ``threshold``, else a maximum-IoU complete matching;
+    pairs below ``threshold`` are dropped afterwards."""
+
+    def solve(iou_td: np.ndarray) -> np.ndarray:
+        iou = iou_td.T  # detections × tracks, as the reference solves it (ties break alike)
+        above = iou > threshold
+        if above.sum(axis=1).max() == 1 and above.sum(axis=0).max() == 1:
+            rows, cols = np.nonzero(above)
+        else:
+            rows, cols = max_weight_complete(iou)
+        keep = iou[rows, cols] >= threshold
+        return np.stack([cols[keep], rows[keep]], axis=1).astype(int)
+
+    return solve
 
 
 @register_tracker("sort")
@@ -55,114 +69,63 @@ class Sort:
 
     def __init__(self, config: "Sort.Config | None" = None) -> None:
         self.config = config or Sort.Config()
+        # every track, tentative or not, survives max_age frames without an update
+        self._lifecycle = Lifecycle(tentative_max_misses=self.config.max_age + 1, max_misses=self.config.max_age)
         self.reset()
 
     def reset(self) -> None:
         """Forget every track; ids restart at 1."""
-        self._mean = np.zeros((0, 7))
-        self._cov = np.zeros((0, 7, 7))
-        self._ids = np.zeros(0, dtype=int)
-        self._hit_streak = np.zeros(0, dtype=int)
-        self._since_update = np.zeros(0, dtype=int)
-        self._next_id = 1
+        self._tracks = TrackTable(7)  # hits: the current streak of consecutive hits
         self._frame_count = 0
         self._clock = FrameClock(self.config.frame_interval_s)
 
-    def update(self, frame: Frame) -> list[TrackSnapshot]:
+    def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
-        cfg = self.config
+        t = self._tracks
         steps = self._clock.steps(frame.time)
         self._frame_count += 1
         det_xywh = frame.detections.xywh
         pred_xywh = self._predict(steps)
-        matches = self._associate(det_xywh, pred_xywh)
-        det_of_track = np.full(len(self._ids), -1, dtype=int)
-        if len(matches):
-            t, d = matches[:, 1], matches[:, 0]
-            z = xywh_to_xysr(det_xywh[d])
-            self._mean[t], self._cov[t] = kalman.update(self._mean[t], self._cov[t], z, _H, _R)
-            self._since_update[t] = 0
-            self._hit_streak[t] += 1
-            det_of_track[t] = d
-        unmatched = np.ones(len(det_xywh), dtype=bool)
-        unmatched[matches[:, 0]] = False
-        new = np.flatnonzero(unmatched)
+        matching = run_plan([Stage(
+            np.ones(len(t), dtype=bool), np.ones(len(det_xywh), dtype=bool),
+            lambda r, c: iou_matrix(det_xywh[c], pred_xywh[r]).T, solve=solve_max_iou(self.config.iou_threshold),
+        )], len(t), len(det_xywh))
+        det_of_track = matching.det_of_track
+        matched = np.flatnonzero(det_of_track >= 0)
+        if len(matched):
+            z = _SPACE.measure(det_xywh[det_of_track[matched]])
+            t.mean[matched], t.cov[matched] = kalman.update(t.mean[matched], t.cov[matched], z, _SPACE.H, _SPACE.R)
+            t.misses[matched] = 0
+            t.hits[matched] += 1
+        new = np.flatnonzero(matching.free)
         if len(new):
-            self._birth(xywh_to_xysr(det_xywh[new]))
+            t.add(*_SPACE.initial(_SPACE.measure(det_xywh[new])))
             det_of_track = np.concatenate([det_of_track, new])
-
         out = self._report(det_of_track)
-        alive = self._since_update <= cfg.max_age
+        alive = self._lifecycle.alive(t)
         if not alive.all():
-            self._keep(alive)
+            t.keep(alive)
         return out
-
-    # -- steps -------------------------------------------------------------------------------
 
     def _predict(self, steps: float) -> np.ndarray:
         """Predict every track; drop those whose box became invalid; return boxes ``(k, 4)``."""
-        if not len(self._ids):
+        t = self._tracks
+        if not len(t):
             return np.zeros((0, 4))
-        mean = self._mean
-        # Keep the predicted area positive, as the reference does.
-        mean[mean[:, 6] + mean[:, 2] <= 0, 6] = 0.0
-        self._mean, self._cov = kalman.predict(mean, self._cov, _transition(steps), _Q * steps)
-        self._hit_streak[self._since_update > 0] = 0
-        self._since_update += 1
-        boxes = xysr_to_xywh(self._mean[:, :4])
+        t.mean, t.cov = _SPACE.predict(t.mean, t.cov, steps)
+        t.hits[t.misses > 0] = 0
+        t.age()
+        boxes = _SPACE.box(t.mean)
         valid = np.isfinite(boxes).all(axis=1)
         if not valid.all():
-            self._keep(valid)
+            t.keep(valid)
             boxes = boxes[valid]
         return boxes
 
-    def _associate(self, det_xywh: np.ndarray, trk_xywh: np.ndarray) -> np.ndarray:
-        """``(k, 2)`` matched ``(detection, track)`` index pairs."""
-        if len(det_xywh) == 0 or len(trk_xywh) == 0:
-            return np.zeros((0, 2), dtype=int)
-        iou = iou_matrix(det_xywh, trk_xywh)
-        above = iou > self.config.iou_threshold
-        if above.sum(axis=1).max() == 1 and above.sum(axis=0).max() == 1:
-            rows, cols = np.nonzero(above)
-        else:
-            rows, cols = max_weight_complete(iou)
-        keep = iou[rows, cols] >= self.config.iou_threshold
-        return np.stack([rows[keep], cols[keep]], axis=1).astype(int)
-
-    def _birth(self, z: np.ndarray) -> None:
-        n = len(z)
-        mean = np.hstack([z, np.zeros((n, 3))])
-        self._mean = np.vstack([self._mean, mean])
-        self._cov = np.concatenate([self._cov, np.broadcast_to(_P0, (n, 7, 7))])
-        self._ids = np.concatenate([self._ids, np.arange(self._next_id, self._next_id + n)])
-        self._next_id += n
-        self._hit_streak = np.concatenate([self._hit_streak, np.zeros(n, dtype=int)])
-        self._since_update = np.concatenate([self._since_update, np.zeros(n, dtype=int)])
-
-    def _report(self, det_of_track: np.ndarray) -> list[TrackSnapshot]:
-        min_hits = self.config.min_hits
-        shown = (self._since_update < 1) & (
-            (self._hit_streak >= min_hits) | (self._frame_count <= min_hits)
-        )
+    def _report(self, det_of_track: np.ndarray) -> Tracks:
+        t, min_hits = self._tracks, self.config.min_hits
+        shown = (t.misses < 1) & ((t.hits >= min_hits) | (self._frame_count <= min_hits))
         idx = np.flatnonzero(shown)
-        if not len(idx):
-            return []
-        boxes = xysr_to_xywh(self._mean[idx, :4])
-        velocity = self._mean[idx, 4:6] / self._clock.interval
-        confirmed = self._hit_streak[idx] >= min_hits
-        return [
-            TrackSnapshot(
-                track_id=int(self._ids[i]),
-                status=TrackStatus.CONFIRMED if confirmed[j] else TrackStatus.TENTATIVE,
-                xywh=boxes[j],
-                velocity=velocity[j],
-                detection_index=int(det_of_track[i]),
-            )
-            for j, i in enumerate(idx)
-        ]
-
-    def _keep(self, mask: np.ndarray) -> None:
-        self._mean, self._cov = self._mean[mask], self._cov[mask]
-        self._ids = self._ids[mask]
-        self._hit_streak = self._hit_streak[mask]
-        self._since_update = self._since_update[mask]
+        confirmed = t.hits[idx] >= min_hits
+        return Tracks(t.ids[idx], np.where(confirmed, 1, 0), xywh=_SPACE.box(t.mean[idx]),
+                      velocity=t.mean[idx, 4:6] / self._clock.interval, detection_index=det_of_track[idx])

@@ -3,6 +3,6 @@
 from lookalike.types.detections import Detections
 from lookalike.types.beacons import Beacons
 from lookalike.types.frame import Frame
-from lookalike.types.tracks import TrackSnapshot, TrackStatus
+from lookalike.types.tracks import Tracks, TrackSnapshot, TrackStatus
 
-__all__ = ["Beacons", "Detections", "Frame", "TrackSnapshot", "TrackStatus"]
+__all__ = ["Beacons", "Detections", "Frame", "TrackSnapshot", "TrackStatus", "Tracks"]

@@ -15,7 +15,7 @@ def as_column(
     Raises ``ValueError`` naming ``owner.name`` when the shape does not fit.
     """
     try:
-        arr = np.array(value, dtype=dtype, copy=True)
+        arr: np.ndarray = np.array(value, dtype=dtype, copy=True)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{owner}.{name}: cannot convert to {dtype.__name__} array ({exc})") from None
     if width is None:

@@ -18,9 +18,9 @@ class Detections:
     """A frame's detections; every array has one row per detection.
 
     Attributes:
-        xywh: ``(n, 4)`` boxes, left/top/width/height in pixels. May be omitted for
-            world-only detections (then all zeros).
-        score: ``(n,)`` detector confidence, default 1.
+        xywh: ``(n, 4)`` boxes, left/top/width/height in pixels; always an array. May be omitted
+            for world-only detections (then all zeros).
+        score: ``(n,)`` detector confidence; always an array, default 1.
         position: ``(n, 2)`` ground-plane position in metres (observer frame: x forward,
             y left), or None.
         heading: ``(n,)`` absolute visual heading in radians, or None.
@@ -29,8 +29,9 @@ class Detections:
         label: ``(n,)`` integer labels (agent id, -1 for false positive), or None.
     """
 
-    xywh: np.ndarray | None = None
-    score: np.ndarray | None = None
+    # Always arrays after construction; None (the default) is accepted and filled in.
+    xywh: np.ndarray = None  # type: ignore[assignment]
+    score: np.ndarray = None  # type: ignore[assignment]
     position: np.ndarray | None = None
     heading: np.ndarray | None = None
     heading_std: np.ndarray | None = None
@@ -75,7 +76,7 @@ class Detections:
             object.__setattr__(self, "label", as_column(own, "label", self.label, n, None, int))
 
     def __len__(self) -> int:
-        return int(self.xywh.shape[0])  # type: ignore[union-attr]
+        return int(self.xywh.shape[0])
 
     @classmethod
     def empty(cls) -> "Detections":
@@ -90,7 +91,7 @@ class Detections:
 
     def select(self, index: np.ndarray | slice | list[int]) -> "Detections":
         """Rows ``index`` as a new batch (boolean mask or integer indices)."""
-        values = {}
+        values: dict[str, Any] = {}
         for f in dataclasses.fields(self):
             col = getattr(self, f.name)
             values[f.name] = None if col is None else col[index]

@@ -1,9 +1,12 @@
-"""``TrackSnapshot``: the immutable state of one track after a frame, and its lifecycle status."""
+"""``Tracks``: the tracks a tracker reports for one frame, as columns; ``TrackSnapshot``: the
+immutable state of one track (a row of ``Tracks``); ``TrackStatus``: its lifecycle status."""
 
 from __future__ import annotations
 
 import enum
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -41,3 +44,136 @@ class TrackSnapshot:
     agent_id: int | None = None
     identity_prob: float | None = None
     detection_index: int = -1
+
+
+_STATUS = (TrackStatus.TENTATIVE, TrackStatus.CONFIRMED, TrackStatus.LOST)
+_STATUS_CODE = {s: i for i, s in enumerate(_STATUS)}
+
+
+class Tracks(Sequence[TrackSnapshot]):
+    """The tracks a tracker reports for one frame, as columns; iterating or indexing gives
+    :class:`TrackSnapshot` views, so code written for a list of snapshots keeps working.
+
+    Attributes:
+        id: ``(k,)`` track ids.
+        status: ``(k,)`` status codes (0 tentative, 1 confirmed, 2 lost; :meth:`statuses` as enums).
+        xywh: ``(k, 4)`` boxes in pixels, or None for world-only trackers.
+        position: ``(k, 2)`` ground positions in metres, or None.
+        velocity: ``(k, d)`` velocities (pixels/s or metres/s), or None.
+        heading: ``(k,)`` headings in radians (NaN: none), or None.
+        agent_id: ``(k,)`` identified agents (-1: none), or None.
+        identity_prob: ``(k,)`` confidences of ``agent_id`` (NaN: none), or None.
+        detection_index: ``(k,)`` index of the detection that updated each track this frame, or -1.
+    """
+
+    __slots__ = ("id", "status", "xywh", "position", "velocity", "heading", "agent_id", "identity_prob",
+                 "detection_index")
+
+    def __init__(self, id: np.ndarray, status: np.ndarray | TrackStatus, *, xywh: np.ndarray | None = None,
+                 position: np.ndarray | None = None, velocity: np.ndarray | None = None,
+                 heading: np.ndarray | None = None, agent_id: np.ndarray | None = None,
+                 identity_prob: np.ndarray | None = None, detection_index: np.ndarray | None = None) -> None:
+        self.id = np.asarray(id, dtype=int).reshape(-1)
+        k = len(self.id)
+        if isinstance(status, TrackStatus):
+            self.status = np.full(k, _STATUS_CODE[status], dtype=np.int8)
+        else:
+            self.status = np.asarray(status, dtype=np.int8).reshape(k)
+        self.xywh = xywh
+        self.position = position
+        self.velocity = velocity
+        self.heading = heading
+        self.agent_id = agent_id
+        self.identity_prob = identity_prob
+        self.detection_index = (np.full(k, -1, dtype=int) if detection_index is None
+                                else np.asarray(detection_index, dtype=int).reshape(k))
+        for name in ("xywh", "position", "velocity", "heading", "agent_id", "identity_prob"):
+            col = getattr(self, name)
+            if col is not None and len(col) != k:
+                raise ValueError(f"Tracks.{name}: has {len(col)} rows but the batch has {k}")
+
+    @classmethod
+    def empty(cls) -> Tracks:
+        """No tracks."""
+        return cls(np.zeros(0, dtype=int), TrackStatus.CONFIRMED)
+
+    @classmethod
+    def from_snapshots(cls, snapshots: Sequence[TrackSnapshot]) -> Tracks:
+        """Columns from snapshots (a column is None when every snapshot lacks it)."""
+        snaps = list(snapshots)
+
+        def column(name: str, missing: float) -> np.ndarray | None:
+            values = [getattr(s, name) for s in snaps]
+            if not snaps or all(v is None for v in values):
+                return None
+            return np.array([missing if v is None else v for v in values], dtype=float)
+
+        def rows(name: str) -> np.ndarray | None:
+            values = [getattr(s, name) for s in snaps]
+            if not snaps or any(v is None for v in values):
+                return None
+            return np.array(values, dtype=float)
+
+        agents = column("agent_id", -1)
+        return cls(np.array([s.track_id for s in snaps], dtype=int),
+                   np.array([_STATUS_CODE[s.status] for s in snaps], dtype=np.int8),
+                   xywh=rows("xywh"), position=rows("position"), velocity=rows("velocity"),
+                   heading=column("heading", np.nan), agent_id=None if agents is None else agents.astype(int),
+                   identity_prob=column("identity_prob", np.nan),
+                   detection_index=np.array([s.detection_index for s in snaps], dtype=int))
+
+    def __len__(self) -> int:
+        return len(self.id)
+
+    @overload
+    def __getitem__(self, i: int) -> TrackSnapshot: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> list[TrackSnapshot]: ...
+
+    def __getitem__(self, i: int | slice) -> TrackSnapshot | list[TrackSnapshot]:
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(len(self)))]
+        if not -len(self) <= i < len(self):
+            raise IndexError(f"track {i} of {len(self)}")
+        heading = None if self.heading is None or np.isnan(self.heading[i]) else float(self.heading[i])
+        agent = None if self.agent_id is None or self.agent_id[i] < 0 else int(self.agent_id[i])
+        prob = (None if self.identity_prob is None or np.isnan(self.identity_prob[i])
+                else float(self.identity_prob[i]))
+        return TrackSnapshot(
+            track_id=int(self.id[i]), status=_STATUS[self.status[i]],
+            xywh=None if self.xywh is None else self.xywh[i],
+            position=None if self.position is None else self.position[i],
+            velocity=None if self.velocity is None else self.velocity[i],
+            heading=heading, agent_id=agent, identity_prob=prob, detection_index=int(self.detection_index[i]))
+
+    def __iter__(self) -> Iterator[TrackSnapshot]:
+        return (self[i] for i in range(len(self)))
+
+    def __eq__(self, other: object) -> bool:
+        """Equal to a list of snapshots only when both are empty (snapshots compare by identity)."""
+        if isinstance(other, (list, tuple)):
+            return len(self) == 0 and len(other) == 0
+        return NotImplemented
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"Tracks({len(self)} tracks, ids {self.id.tolist()})"
+
+    def statuses(self) -> list[TrackStatus]:
+        """The status of every track as an enum."""
+        return [_STATUS[c] for c in self.status]
+
+    def to_rows(self, frame_index: int) -> np.ndarray:
+        """MOTChallenge result rows ``(k, 10)`` for the 0-based ``frame_index`` (none without boxes):
+        frame (1-based), id, box, confidence (``identity_prob``, 1 when none), -1, -1, -1."""
+        if self.xywh is None:
+            return np.full((0, 10), -1.0)
+        rows = np.full((len(self), 10), -1.0)
+        rows[:, 0] = frame_index + 1
+        rows[:, 1] = self.id
+        rows[:, 2:6] = self.xywh
+        rows[:, 6] = 1.0 if self.identity_prob is None else np.where(np.isnan(self.identity_prob), 1.0,
+                                                                      self.identity_prob)
+        return rows

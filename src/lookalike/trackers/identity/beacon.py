@@ -136,7 +136,8 @@ class BeaconIdentifier:
         valid = np.isfinite(d)
         count = valid.sum(axis=1)
         total = np.where(valid, d, 0.0).sum(axis=1)
-        return np.divide(total, count, out=np.full(count.shape, np.inf), where=count > 0)
+        mean: np.ndarray = np.divide(total, count, out=np.full(count.shape, np.inf), where=count > 0)
+        return mean
 
     def assign(self, track_ids: list[int]) -> dict[int, tuple[int, float]]:
         """Identities of ``track_ids``: ``{track_id: (agent_id, probability)}`` for those assigned."""

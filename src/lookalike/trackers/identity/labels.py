@@ -25,14 +25,16 @@ def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np
         key=lambda t: -(t.identity_prob if t.identity_prob is not None else 0.0),
     )
     for t in ranked:
-        k = t.detection_index
+        agent, k = t.agent_id, t.detection_index
+        if agent is None:
+            continue
         if k >= n_detections:
             raise ValueError(f"track {t.track_id}: detection_index {k} out of range for {n_detections} detections")
         p = t.identity_prob if t.identity_prob is not None else 0.0
-        if t.agent_id in claimed or p <= best[k]:
+        if agent in claimed or p <= best[k]:
             continue
-        label[k], best[k] = t.agent_id, p
-        claimed[t.agent_id] = p
+        label[k], best[k] = agent, p
+        claimed[agent] = p
     return label
 
 

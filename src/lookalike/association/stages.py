@@ -1,0 +1,121 @@
+"""Association as data: an ordered plan of stages, each a track set, a detection set, a cost and a
+gate, run by one function.
+
+A stage only sees tracks still unmatched and detections still free when it runs, in the order it
+gives them (a boolean mask selects in index order; an index array keeps its own order, which
+decides the solver's tie-breaking). Each stage solves its own assignment; later stages take what
+is left.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from lookalike.association.solver import assign
+
+CostFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
+"""``cost(track_rows, det_indices) -> (len(track_rows), len(det_indices))``; ``inf`` forbids a pair."""
+
+SolveFn = Callable[[np.ndarray], np.ndarray]
+"""``solve(cost) -> (k, 2)`` matched ``(row, column)`` positions in the cost matrix."""
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One matching pass.
+
+    Attributes:
+        tracks: the eligible track rows, a boolean mask ``(k,)`` or an ordered index array.
+        detections: the eligible detections, a boolean mask ``(n,)`` or an ordered index array.
+        cost: the cost of every eligible (track, detection) pair.
+        max_cost: pairs costing more are forbidden (the solver's gate, see :func:`assign`).
+        solve: a replacement solver taking the cost matrix (default: :func:`assign` with ``max_cost``).
+        name: a label for diagnostics.
+    """
+
+    tracks: np.ndarray
+    detections: np.ndarray
+    cost: CostFn
+    max_cost: float = np.inf
+    solve: SolveFn | None = None
+    name: str = ""
+
+
+@dataclass
+class Matching:
+    """What a plan matched.
+
+    Attributes:
+        det_of_track: ``(k,)`` detection index per track row, -1 when unmatched.
+        free: ``(n,)`` True for detections no stage took.
+        stage_of_track: ``(k,)`` index of the stage that matched each track row, -1 when unmatched.
+    """
+
+    det_of_track: np.ndarray
+    free: np.ndarray
+    stage_of_track: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+
+    @classmethod
+    def empty(cls, n_tracks: int, n_detections: int) -> Matching:
+        """Nothing matched yet."""
+        return cls(np.full(n_tracks, -1, dtype=int), np.ones(n_detections, dtype=bool),
+                   np.full(n_tracks, -1, dtype=int))
+
+    @property
+    def unmatched_tracks(self) -> np.ndarray:
+        """``(k,)`` True for track rows without a detection."""
+        return self.det_of_track < 0
+
+    @property
+    def pairs(self) -> np.ndarray:
+        """``(m, 2)`` matched ``(track row, detection)`` pairs, by track row."""
+        rows = np.flatnonzero(self.det_of_track >= 0)
+        return np.column_stack([rows, self.det_of_track[rows]]).astype(int)
+
+
+def _eligible(selector: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+    sel = np.asarray(selector)
+    if sel.dtype == bool:
+        return np.flatnonzero(sel & allowed)
+    idx: np.ndarray = sel.astype(int)
+    out: np.ndarray = idx[allowed[idx]]
+    return out
+
+
+def run_stage(stage: Stage, matching: Matching, index: int = 0) -> Matching:
+    """Run one stage on what ``matching`` left over (updated in place and returned)."""
+    rows = _eligible(stage.tracks, matching.det_of_track < 0)
+    cols = _eligible(stage.detections, matching.free)
+    if not len(rows) or not len(cols):
+        return matching
+    cost = stage.cost(rows, cols)
+    found = stage.solve(cost) if stage.solve is not None else assign(cost, stage.max_cost).matches
+    if len(found):
+        r, c = rows[found[:, 0]], cols[found[:, 1]]
+        matching.det_of_track[r] = c
+        matching.free[c] = False
+        matching.stage_of_track[r] = index
+    return matching
+
+
+def run_plan(stages: list[Stage], n_tracks: int, n_detections: int,
+             start: Matching | None = None) -> Matching:
+    """Run ``stages`` in order on ``n_tracks`` tracks and ``n_detections`` detections (or on what
+    ``start`` left over); return the matches and the left-overs."""
+    matching = start if start is not None else Matching.empty(n_tracks, n_detections)
+    for i, stage in enumerate(stages):
+        run_stage(stage, matching, i)
+    return matching
+
+
+def cascade(track_age: np.ndarray, max_age: int, tracks: np.ndarray, detections: np.ndarray,
+            cost: CostFn, max_cost: float = np.inf) -> list[Stage]:
+    """Deep SORT's matching cascade as stages: the ``tracks`` (a mask) updated 1, 2, …, ``max_age``
+    frames ago (``track_age``), most recent first, each level on the detections the earlier left."""
+    age = np.asarray(track_age)
+    levels = np.unique(age[tracks & (age >= 1) & (age <= max_age)])
+    return [Stage(tracks & (age == level), detections, cost, max_cost, name=f"cascade level {level}")
+            for level in levels]

@@ -1,0 +1,233 @@
+"""State spaces: one per parametrisation of a track, each with its box↔state converters, its
+transition ``F``, process noise ``Q``, measurement model ``H``/``R`` and initial covariance ``P0``.
+
+Every space is batched over tracks (``mean (k, n)``, ``cov (k, n, n)``) and stateless; steps are
+nominal frame intervals (per-frame models) or seconds (``WorldCA``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from lookalike.geometry.boxes import xywh_to_cxcywh, xywh_to_xysr, xysr_to_xywh
+from lookalike.motion import kalman
+from lookalike.motion.models import constant_acceleration, constant_velocity, kinematic_transition
+
+
+def diagonal(values: np.ndarray) -> np.ndarray:
+    """``(k, m, m)`` diagonal matrices from rows ``(k, m)``."""
+    out = np.zeros(values.shape + (values.shape[1],))
+    idx = np.arange(values.shape[1])
+    out[:, idx, idx] = values
+    return out
+
+
+def _observe_first(n_measured: int, n_state: int) -> np.ndarray:
+    return np.hstack([np.eye(n_measured), np.zeros((n_measured, n_state - n_measured))])
+
+
+def xywh_to_xyah(xywh: np.ndarray) -> np.ndarray:
+    """``(n, 4)`` boxes to ``[centre x, centre y, aspect w/h, height]``."""
+    h = np.maximum(xywh[:, 3], 1e-6)
+    return np.column_stack([xywh[:, 0] + xywh[:, 2] / 2, xywh[:, 1] + xywh[:, 3] / 2, xywh[:, 2] / h, xywh[:, 3]])
+
+
+def xyah_to_xywh(xyah: np.ndarray) -> np.ndarray:
+    """Inverse of :func:`xywh_to_xyah`."""
+    w = xyah[:, 2] * xyah[:, 3]
+    return np.column_stack([xyah[:, 0] - w / 2, xyah[:, 1] - xyah[:, 3] / 2, w, xyah[:, 3]])
+
+
+def cxcywh_to_xywh(cxcywh: np.ndarray) -> np.ndarray:
+    """``(n, 4)`` centre/size boxes to left/top/width/height, sizes floored at 1e-3 pixels."""
+    out = np.array(cxcywh, dtype=float).reshape(-1, 4)
+    out[:, 2:] = np.maximum(out[:, 2:], 1e-3)
+    out[:, :2] -= out[:, 2:] / 2
+    return out
+
+
+class BoxXYSR:
+    """SORT's ``[u, v, s, r, u', v', s']`` (centre, area, aspect; pixels and pixels/frame) with the
+    reference noise: ``R = diag(1, 1, 10, 10)``, ``P0 = diag(10, 10, 10, 10, 1e4, 1e4, 1e4)``,
+    ``Q = diag(1, 1, 1, 1, 0.01, 0.01, 1e-4)`` per frame."""
+
+    H = _observe_first(4, 7)
+    R = np.diag([1.0, 1.0, 10.0, 10.0])
+    P0 = np.diag([10.0, 10.0, 10.0, 10.0, 1e4, 1e4, 1e4])
+    Q = np.diag([1.0, 1.0, 1.0, 1.0, 1e-2, 1e-2, 1e-4])
+
+    @staticmethod
+    def measure(xywh: np.ndarray) -> np.ndarray:
+        return xywh_to_xysr(xywh)
+
+    @staticmethod
+    def box(mean: np.ndarray) -> np.ndarray:
+        return xysr_to_xywh(mean[:, :4])
+
+    @staticmethod
+    def F(steps: float) -> np.ndarray:
+        return kinematic_transition(4, 1, steps)[:7, :7]  # the aspect has no velocity
+
+    def initial(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n = len(z)
+        return np.hstack([z, np.zeros((n, 3))]), np.broadcast_to(self.P0, (n, 7, 7))
+
+    def predict(self, mean: np.ndarray, cov: np.ndarray, steps: float) -> tuple[np.ndarray, np.ndarray]:
+        mean[mean[:, 6] + mean[:, 2] <= 0, 6] = 0.0  # keep the predicted area positive, as the reference
+        return kalman.predict(mean, cov, self.F(steps), self.Q * steps)
+
+
+@dataclass(frozen=True)
+class BoxCXCYWH:
+    """``[cx, cy, w, h, vx, vy, vw, vh]`` (pixels, pixels/frame) with noise proportional to the box
+    size: ``pos_noise``·[w, h] for positions and measurements, ``vel_noise``·[w, h] for velocities."""
+
+    pos_noise: float
+    vel_noise: float
+    H = _observe_first(4, 8)
+
+    @staticmethod
+    def measure(xywh: np.ndarray) -> np.ndarray:
+        return xywh_to_cxcywh(xywh)
+
+    @staticmethod
+    def box(mean: np.ndarray) -> np.ndarray:
+        return cxcywh_to_xywh(mean[:, :4])
+
+    def R(self, size: np.ndarray) -> np.ndarray:
+        """``(k, 4, 4)`` measurement covariances for box sizes ``(k, 2)``."""
+        std = self.pos_noise * np.hstack([size, size])
+        R: np.ndarray = np.einsum("ki,ij->kij", std**2, np.eye(4))
+        return R
+
+    def initial(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n = len(z)
+        size = np.maximum(z[:, 2:4], 1.0)
+        p, v = self.pos_noise, self.vel_noise
+        std = np.hstack([2 * p * size, 2 * p * size, 10 * v * size, 10 * v * size])
+        return np.hstack([z, np.zeros((n, 4))]), np.einsum("ki,ij->kij", std**2, np.eye(8))
+
+    def predict(self, mean: np.ndarray, cov: np.ndarray, steps: float) -> tuple[np.ndarray, np.ndarray]:
+        size = np.maximum(mean[:, 2:4], 1.0)
+        p, v = self.pos_noise, self.vel_noise
+        std = np.hstack([p * size, p * size, v * size, v * size])
+        Q = np.einsum("ki,ij->kij", std**2 * max(steps, 0.0), np.eye(8))
+        mean[:, 6:8] = np.where(mean[:, 2:4] + mean[:, 6:8] * steps <= 1.0, 0.0, mean[:, 6:8])  # sizes stay > 1
+        return kalman.predict(mean, cov, kinematic_transition(4, 1, steps), Q)
+
+
+@dataclass(frozen=True)
+class BoxXYAH:
+    """Deep SORT's ``[x, y, a, h]`` (centre pixels, aspect w/h, height pixels) plus velocities, noise
+    proportional to the height (``position_std_frac``, ``velocity_std_frac``) and ``aspect_std``."""
+
+    position_std_frac: float
+    velocity_std_frac: float
+    aspect_std: float
+    H = _observe_first(4, 8)
+
+    @staticmethod
+    def measure(xywh: np.ndarray) -> np.ndarray:
+        return xywh_to_xyah(xywh)
+
+    @staticmethod
+    def box(mean: np.ndarray) -> np.ndarray:
+        return xyah_to_xywh(mean[:, :4])
+
+    def R(self, height: np.ndarray) -> np.ndarray:
+        pos = self.position_std_frac * height
+        a = np.full_like(height, self.aspect_std)
+        return diagonal(np.column_stack([pos, pos, a * 10, pos]) ** 2)
+
+    def Q(self, height: np.ndarray, steps: float) -> np.ndarray:
+        pos = self.position_std_frac * height
+        vel = self.velocity_std_frac * height
+        a = np.full_like(height, self.aspect_std)
+        return diagonal(np.column_stack([pos, pos, a, pos, vel, vel, a * 1e-1, vel]) ** 2 * steps)
+
+    def initial(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n = len(z)
+        h = z[:, 3]
+        p, v = 2 * self.position_std_frac * h, 10 * self.velocity_std_frac * h
+        std = np.column_stack([p, p, np.full(n, 1e-2), p, v, v, np.full(n, 1e-5), v])
+        return np.hstack([z, np.zeros((n, 4))]), diagonal(std**2)
+
+    def predict(self, mean: np.ndarray, cov: np.ndarray, steps: float) -> tuple[np.ndarray, np.ndarray]:
+        mean, cov = kalman.predict(mean, cov, kinematic_transition(4, 1, steps), self.Q(mean[:, 3], steps))
+        mean[:, 3] = np.maximum(mean[:, 3], 1.0)
+        return mean, cov
+
+
+@dataclass(frozen=True)
+class CentreCV:
+    """Diver SORT's centre-only ``[x, y, vx, vy]`` (pixels, pixels/frame); box size comes from the
+    latest detection. Acceleration noise ``accel_std_frac`` and measurement noise
+    ``position_std_frac`` of the box height."""
+
+    position_std_frac: float
+    accel_std_frac: float
+    H = _observe_first(2, 4)
+
+    @staticmethod
+    def measure(xywh: np.ndarray) -> np.ndarray:
+        return xywh[:, :2] + xywh[:, 2:] / 2
+
+    @staticmethod
+    def box(mean: np.ndarray, xywh: np.ndarray) -> np.ndarray:
+        """Boxes centred on the state with the sizes of ``xywh``."""
+        w, h = xywh[:, 2], xywh[:, 3]
+        return np.column_stack([mean[:, 0] - w / 2, mean[:, 1] - h / 2, w, h])
+
+    def R(self, height: np.ndarray) -> np.ndarray:
+        R = np.zeros((len(height), 2, 2))
+        R[:, [0, 1], [0, 1]] = ((self.position_std_frac * np.maximum(height, 1.0)) ** 2)[:, None]
+        return R
+
+    def initial(self, centre: np.ndarray, height: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n = len(centre)
+        std = self.position_std_frac * height
+        cov = np.zeros((n, 4, 4))
+        cov[:, [0, 1], [0, 1]] = (std**2)[:, None]
+        cov[:, [2, 3], [2, 3]] = ((0.5 * height) ** 2)[:, None]  # unknown speed: half a height per frame
+        return np.hstack([centre, np.zeros((n, 2))]), cov
+
+    def predict(self, mean: np.ndarray, cov: np.ndarray, steps: float,
+                height: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        F, Q = constant_velocity(2, steps, 1.0)
+        accel = self.accel_std_frac * height
+        return kalman.predict(mean, cov, F, Q[None] * (accel**2)[:, None, None])
+
+
+@dataclass(frozen=True)
+class WorldCA:
+    """World-frame constant acceleration ``[x, y, vx, vy, ax, ay]`` (metres, seconds) with white jerk
+    ``q_jerk`` (m²/s⁵) and position noise ``meas_std0_m + meas_std_per_m · distance``."""
+
+    q_jerk: float
+    meas_std0_m: float
+    meas_std_per_m: float
+    init_velocity_std: float
+    init_accel_std: float
+    H = _observe_first(2, 6)
+
+    def R(self, position: np.ndarray) -> np.ndarray:
+        """Measurement covariances ``(k, 2, 2)`` for positions ``(k, 2)`` in metres."""
+        std = self.meas_std0_m + self.meas_std_per_m * np.hypot(position[:, 0], position[:, 1])
+        R: np.ndarray = (std**2)[:, None, None] * np.eye(2)[None]
+        return R
+
+    def initial(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        n = len(position)
+        mean = np.zeros((n, 6))
+        mean[:, :2] = position
+        cov = np.zeros((n, 6, 6))
+        cov[:, :2, :2] = self.R(position)
+        cov[:, 2, 2] = cov[:, 3, 3] = self.init_velocity_std**2
+        cov[:, 4, 4] = cov[:, 5, 5] = self.init_accel_std**2
+        return mean, cov
+
+    def predict(self, mean: np.ndarray, cov: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        F, Q = constant_acceleration(2, dt, self.q_jerk)
+        return kalman.predict(mean, cov, F, Q)

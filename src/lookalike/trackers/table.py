@@ -1,0 +1,107 @@
+"""``TrackTable``: a tracker's tracks as named numpy columns, one row per track.
+
+Every table has the columns ``ids`` (1-based, from a per-table counter), ``mean`` ``(k, n)`` and
+``cov`` ``(k, n, n)`` of the motion state, ``hits`` (the tracker's hit count), ``misses`` (frames
+since the last update), ``unseen_s`` (seconds since the last update) and ``confirmed``. A tracker
+declares its extra columns (name → trailing shape and dtype) when it builds the table.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+ColumnSpec = tuple[tuple[int, ...], Any]
+
+_CORE: dict[str, ColumnSpec] = {
+    "ids": ((), int),
+    "hits": ((), int),
+    "misses": ((), int),
+    "unseen_s": ((), float),
+    "confirmed": ((), bool),
+}
+
+
+class TrackTable:
+    """Tracks as equal-length columns; rows are added by :meth:`add` and removed by :meth:`keep`."""
+
+    ids: np.ndarray
+    mean: np.ndarray
+    cov: np.ndarray
+    hits: np.ndarray
+    misses: np.ndarray
+    unseen_s: np.ndarray
+    confirmed: np.ndarray
+
+    def __init__(self, state_dim: int, extra: dict[str, ColumnSpec] | None = None) -> None:
+        """A table for states of ``state_dim`` numbers plus ``extra`` columns (name → (trailing shape, dtype))."""
+        self._spec: dict[str, ColumnSpec] = {
+            **_CORE, "mean": ((state_dim,), float), "cov": ((state_dim, state_dim), float), **(extra or {})}
+        self.clear()
+
+    def clear(self) -> None:
+        """Remove every row; ids restart at 1."""
+        for name, (shape, dtype) in self._spec.items():
+            setattr(self, name, np.zeros((0,) + shape, dtype=dtype))
+        self.next_id = 1
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The column names."""
+        return tuple(self._spec)
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in self._spec:
+            raise KeyError(f"TrackTable has no column {name!r}; columns: {', '.join(self._spec)}")
+        return getattr(self, name)  # type: ignore[no-any-return]
+
+    def __setitem__(self, name: str, value: np.ndarray) -> None:
+        if name not in self._spec:
+            raise KeyError(f"TrackTable has no column {name!r}; columns: {', '.join(self._spec)}")
+        setattr(self, name, value)
+
+    def add(self, mean: np.ndarray, cov: np.ndarray, **values: Any) -> np.ndarray:
+        """Append tracks with new ids; columns not given start at zero (scalars broadcast).
+
+        Returns the row indices of the new tracks.
+        """
+        n = len(mean)
+        unknown = set(values) - set(self._spec)
+        if unknown:
+            raise KeyError(f"TrackTable has no column(s) {sorted(unknown)}")
+        start = len(self.ids)
+        given = {**values, "mean": mean, "cov": cov,
+                 "ids": np.arange(self.next_id, self.next_id + n)}
+        self.next_id += n
+        for name, (shape, dtype) in self._spec.items():
+            new = given.get(name)
+            if new is None:
+                new = np.zeros((n,) + shape, dtype=dtype)
+            elif np.ndim(new) == 0:
+                new = np.full((n,) + shape, new, dtype=dtype)
+            setattr(self, name, np.concatenate([getattr(self, name), new]))
+        return np.arange(start, start + n)
+
+    def keep(self, mask: np.ndarray) -> None:
+        """Keep the rows where ``mask`` is True (or the rows indexed by it)."""
+        for name in self._spec:
+            setattr(self, name, getattr(self, name)[mask])
+
+    def age(self) -> None:
+        """One more frame without an update for every track (``misses`` + 1)."""
+        self.misses += 1
+
+    def record(self, hit: np.ndarray, dt: float) -> None:
+        """After matching: tracks with ``hit`` were updated (``misses``, ``unseen_s`` reset), the
+        others missed one more frame of ``dt`` seconds."""
+        self.misses = np.where(hit, 0, self.misses + 1)
+        self.unseen_s = np.where(hit, 0.0, self.unseen_s + dt)
+
+    def copy_row(self, source: int, target: int, names: tuple[str, ...]) -> None:
+        """Overwrite columns ``names`` of row ``target`` with row ``source``'s values."""
+        for name in names:
+            self[name][target] = self[name][source]

@@ -1,0 +1,132 @@
+"""The shared tracker parts: track table, lifecycle, association plan, state spaces, coasting and
+score calibration."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lookalike.association.solver import assign
+from lookalike.association.stages import Stage, cascade, run_plan
+from lookalike.motion.models import constant_velocity, kinematic_transition
+from lookalike.motion.spaces import BoxCXCYWH, BoxXYAH, BoxXYSR, CentreCV, WorldCA, xyah_to_xywh, xywh_to_xyah
+from lookalike.trackers.coasting import Coasting
+from lookalike.trackers.lifecycle import Lifecycle
+from lookalike.trackers.self_calibration import ScoreCalibration
+from lookalike.trackers.table import TrackTable
+from lookalike.types import TrackStatus
+
+
+def _table(n: int = 3) -> TrackTable:
+    t = TrackTable(2, {"box": ((4,), float)})
+    t.add(np.zeros((n, 2)), np.zeros((n, 2, 2)), hits=1, box=np.ones((n, 4)))
+    return t
+
+
+def test_table_assigns_ids_from_its_own_counter_and_keeps_columns_aligned() -> None:
+    t = _table(3)
+    assert list(t.ids) == [1, 2, 3] and t.hits.tolist() == [1, 1, 1] and t["box"].shape == (3, 4)
+    t.keep(np.array([True, False, True]))
+    rows = t.add(np.ones((2, 2)), np.zeros((2, 2, 2)))
+    assert list(t.ids) == [1, 3, 4, 5] and rows.tolist() == [2, 3]
+    assert t.hits.tolist() == [1, 1, 0, 0] and t["box"].shape == (4, 4) and len(t) == 4
+    assert TrackTable(2).ids.tolist() == []  # another table counts on its own
+    t.clear()
+    assert len(t) == 0 and t.add(np.zeros((1, 2)), np.zeros((1, 2, 2))).tolist() == [0] and t.ids[0] == 1
+
+
+def test_table_ages_and_records_misses_in_frames_and_seconds() -> None:
+    t = _table(2)
+    t.age()
+    assert t.misses.tolist() == [1, 1]
+    t.record(np.array([True, False]), 0.5)
+    assert t.misses.tolist() == [0, 2] and t.unseen_s.tolist() == [0.0, 0.5]
+    with pytest.raises(KeyError):
+        t["nope"]
+    with pytest.raises(KeyError):
+        t.add(np.zeros((1, 2)), np.zeros((1, 2, 2)), nope=1)
+
+
+def test_lifecycle_confirms_coasts_and_deletes() -> None:
+    t = _table(3)
+    t.hits[:] = [1, 3, 3]
+    policy = Lifecycle(n_init=3, tentative_max_misses=1, max_misses=2)
+    policy.confirm(t)
+    assert t.confirmed.tolist() == [False, True, True]
+    t.misses[:] = [1, 2, 3]
+    assert policy.alive(t).tolist() == [False, True, False]
+    assert policy.closed_set().alive(t).tolist() == [False, True, True]  # a closed set keeps confirmed tracks
+    assert list(policy.status(t, np.arange(3))) == [TrackStatus.TENTATIVE, TrackStatus.LOST, TrackStatus.LOST]
+    t.unseen_s[:] = [0.0, 0.4, 0.9]
+    seconds = Lifecycle(n_init=3, tentative_max_misses=None, tentative_max_unseen_s=0.0, max_unseen_s=0.5)
+    assert seconds.alive(t).tolist() == [True, True, False]
+    assert seconds.alive(t, max_unseen_s=np.array([1.0, 0.1, 1.0])).tolist() == [True, False, True]
+    assert Lifecycle(n_init=1).born_confirmed() and Lifecycle(n_init=3).born_confirmed(first_frame=True)
+    with pytest.raises(ValueError):
+        Lifecycle(n_init=0)
+
+
+def test_plan_runs_stages_in_order_on_what_is_left() -> None:
+    cost = np.array([[0.1, 0.2, 0.9], [0.3, 0.1, 0.8]])
+    fn = lambda r, c: cost[np.ix_(r, c)]  # noqa: E731
+    first = Stage(np.array([False, True]), np.ones(3, dtype=bool), fn, name="second track only")
+    second = Stage(np.array([True, True]), np.ones(3, dtype=bool), fn, max_cost=0.5)
+    m = run_plan([first, second], 2, 3)
+    assert m.det_of_track.tolist() == [0, 1] and m.free.tolist() == [False, False, True]
+    assert m.stage_of_track.tolist() == [1, 0] and m.pairs.tolist() == [[0, 0], [1, 1]]
+    # an index array keeps its order; stages never see matched tracks or taken detections
+    seen: list[list[int]] = []
+    probe = Stage(np.array([1, 0]), np.ones(3, dtype=bool), lambda r, c: (seen.append(list(r)), cost[np.ix_(r, c)])[1])
+    run_plan([first, probe], 2, 3)
+    assert seen == [[0]]
+    assert run_plan([Stage(np.zeros(0, dtype=bool), np.ones(3, dtype=bool), fn)], 0, 3).det_of_track.tolist() == []
+
+
+def test_cascade_matches_recent_tracks_first() -> None:
+    age = np.array([2, 1, 1])
+    cost = np.array([[0.1], [0.2], [0.3]])
+    stages = cascade(age, 5, np.ones(3, dtype=bool), np.ones(1, dtype=bool), lambda r, c: cost[np.ix_(r, c)], 0.5)
+    assert [s.name for s in stages] == ["cascade level 1", "cascade level 2"]
+    assert run_plan(stages, 3, 1).det_of_track.tolist() == [-1, 0, -1]
+    assert assign(cost).matches.tolist() == [[0, 0]]  # one global assignment would pick the older track
+
+
+def test_state_spaces_round_trip_boxes_and_share_the_transition() -> None:
+    xywh = np.array([[10.0, 20.0, 30.0, 60.0]])
+    np.testing.assert_allclose(xyah_to_xywh(xywh_to_xyah(xywh)), xywh)
+    sort = BoxXYSR()
+    mean, cov = sort.initial(sort.measure(xywh))
+    np.testing.assert_allclose(sort.box(mean), xywh)
+    assert sort.F(2.0)[0, 4] == 2.0 and sort.F(2.0).shape == (7, 7)
+    for space in (BoxCXCYWH(0.05, 0.01), BoxXYAH(0.05, 0.01, 0.01)):
+        mean, cov = space.initial(space.measure(xywh))
+        np.testing.assert_allclose(space.box(mean), xywh)
+        m2, c2 = space.predict(mean.copy(), cov, 1.0)
+        np.testing.assert_allclose(space.box(m2), xywh)  # no velocity yet: the box stays
+        assert (np.linalg.eigvalsh(c2) > 0).all()
+    centre = CentreCV(0.15, 0.05)
+    mean, _ = centre.initial(centre.measure(xywh), xywh[:, 3])
+    np.testing.assert_allclose(centre.box(mean, xywh), xywh)
+    world = WorldCA(4.0, 0.05, 0.04, 0.5, 1.0)
+    mean, cov = world.initial(np.array([[3.0, 4.0]]))
+    assert cov[0, 0, 0] == pytest.approx((0.05 + 0.04 * 5) ** 2)
+    F, _ = constant_velocity(4, 0.5)
+    np.testing.assert_array_equal(kinematic_transition(4, 1, 0.5), F)
+
+
+def test_coasting_reports_only_misses_that_usually_end_in_a_return() -> None:
+    coast = Coasting(coast_s=0.5, report_prob=0.6, min_count=2)
+    assert coast.still(np.array([0.2, 0.5])).tolist() == [False, True]
+    coast.observe(came_back=np.array([1, 1, 1]), died=np.array([3]))
+    assert coast.decide(np.array([0, 1, 2, 3])).tolist() == [False, True, False, False]  # j=2: too few resolved
+    assert not Coasting(0.5).decide(np.array([1])).any()  # reporting off
+
+
+def test_score_calibration_lowers_thresholds_to_quantiles() -> None:
+    cal = ScoreCalibration(0.9, 0.95, high_quantile=0.5, birth_quantile=0.5)
+    assert cal.decide() == (0.9, 0.95, 0.9)  # nothing seen: the ceilings
+    cal.observe_scores(np.linspace(0.2, 0.8, 101))
+    high, birth, tentative = cal.decide()
+    assert high == birth == pytest.approx(0.5, abs=0.01) and tentative == high
+    plain = ScoreCalibration(0.9, 0.8)
+    assert plain.decide() == (0.8, 0.8, 0.8)  # high never above birth
