@@ -8,10 +8,10 @@ from lookalike.geometry import (
     circular_mean,
     iou_matrix,
     wrap_angle,
+    xysr_to_xywh,
     xywh_to_cxcywh,
     xywh_to_xysr,
     xywh_to_xyxy,
-    xysr_to_xywh,
     xyxy_to_xywh,
 )
 

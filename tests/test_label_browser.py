@@ -101,7 +101,8 @@ def test_label_page_end_to_end(tmp_path):
                 for _ in range(k0):
                     page.keyboard.press("ArrowRight")
                 page.wait_for_function(f"document.body.dataset.frame === '{k0}'")
-                page.wait_for_function(f"document.querySelectorAll('#detections tbody tr').length === {int(seq.arrays.det_valid[k0].sum())}")
+                n_rows = int(seq.arrays.det_valid[k0].sum())
+                page.wait_for_function(f"document.querySelectorAll('#detections tbody tr').length === {n_rows}")
                 assert [r[0] for r in _rows(page)][:2] == [-2, -2]
                 _click(page, 0)                   # unset -> robot 1
                 _click(page, 0)                   # -> robot 2

@@ -66,8 +66,10 @@ def test_wrong_shaped_weights_are_refused(tmp_path):
 
 def test_encoding_layout():
     spec = EncodingSpec(n_agents=2, n_slots=2)
-    det = Detections(position=[[1.0, 2.0], [3.0, 4.0], [5.0, 6.0]], heading=[0.0, np.pi / 2, np.pi], score=[0.2, 0.9, 0.5])
-    x, used = encode_frame(spec, det, latest_heading_rad=np.array([np.pi, np.nan]), report_age_s=np.array([0.5, np.nan]))
+    det = Detections(position=[[1.0, 2.0], [3.0, 4.0], [5.0, 6.0]], heading=[0.0, np.pi / 2, np.pi],
+                     score=[0.2, 0.9, 0.5])
+    x, used = encode_frame(spec, det, latest_heading_rad=np.array([np.pi, np.nan]),
+                           report_age_s=np.array([0.5, np.nan]))
     assert used.tolist() == [1, 2]  # the two most probable
     np.testing.assert_allclose(x[:6], [-1, 0, 0.5, 0, 0, spec.max_age_s], atol=1e-12)
     np.testing.assert_allclose(x[6:11], [3, 4, 0, 1, 0.9], atol=1e-12)

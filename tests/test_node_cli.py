@@ -185,7 +185,8 @@ def test_camera_process_killed_and_restarted(tmp_path):
     team = ["--preset", PRESET, "--seed", "1", "--duration", str(duration), "--speed", str(speed)]
     node, address = _serve(tmp_path, "--tracker", "kalman_ha2", "--camera-timeout", "0.3")
     node_arg = "{}:{}".format(*address)
-    robot = _start(["robot-sim", "--robot", "0", "--node", node_arg, *team, "--start-at", "stdin"], stdin=subprocess.PIPE)
+    robot = _start(["robot-sim", "--robot", "0", "--node", node_arg, *team, "--start-at", "stdin"],
+                   stdin=subprocess.PIPE)
     camera = _start(["camera-sim", "--node", node_arg, *team, "--start-at", "stdin"], stdin=subprocess.PIPE)
     second = None
     try:

@@ -73,7 +73,10 @@ def test_reports_reach_the_tracker_with_the_next_frame():
 
 def test_report_rules():
     node = TeamIdentifier(HeadingMatcher(), IdentifierConfig(n_robots=2, max_report_age_s=0.5))
-    add = lambda robot, seq, t: node.add_report(HeadingReport(robot=robot, seq=seq, t_sent=t, heading=0.0))
+
+    def add(robot, seq, t):
+        return node.add_report(HeadingReport(robot=robot, seq=seq, t_sent=t, heading=0.0))
+
     assert add(0, 5, 1.0) == "reports"
     assert add(0, 5, 1.0) == "duplicate"
     assert add(0, 4, 0.9) == "late"  # overtaken by seq 5

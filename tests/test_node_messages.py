@@ -41,7 +41,9 @@ def test_round_trip(message):
     assert decode(encode(message)) == message
 
 
-@pytest.mark.parametrize("data", [b"{", b"\xff\xfe", b"", b"[1, 2]", b"null", b'{"v": 1, "type": "report", "robot": NaN}'])
+@pytest.mark.parametrize(
+    "data", [b"{", b"\xff\xfe", b"", b"[1, 2]", b"null", b'{"v": 1, "type": "report", "robot": NaN}']
+)
 def test_malformed(data):
     with pytest.raises(MessageError) as err:
         decode(data)
