@@ -42,8 +42,9 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         ini = Path(tmp) / "mypy.ini"
         ini.write_text(pending_free_config())
-        out = subprocess.run([sys.executable, "-m", "mypy", "--config-file", str(ini)], cwd=ROOT,
-                             capture_output=True, text=True).stdout
+        # A cache of its own: the main run's cache holds no errors for the exempted modules.
+        command = [sys.executable, "-m", "mypy", "--config-file", str(ini), "--cache-dir", ".mypy_cache/pending"]
+        out = subprocess.run(command, cwd=ROOT, capture_output=True, text=True).stdout
     counts = collections.Counter(re.findall(r"^src/lookalike/(\w+)[/.].*: error:", out, flags=re.M))
     print(out, end="")
     print("errors per package:", ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) or "none")
