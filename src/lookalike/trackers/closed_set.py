@@ -32,8 +32,9 @@ online pass (MOTChallenge rows, any ids) and:
 5. **Writes ids 1..N** (chains ordered by their first frame) and fills gaps of at most ``fill_gap_s``
    seconds inside each identity by linear interpolation (:func:`lookalike.trackers.offline.fill_gaps`).
 
-:func:`track_closed_set` runs the online pass itself (``boxtrack`` with ``max_targets`` = N, reporting
-only detected boxes) on detection rows, then :func:`assign_identities`.
+:func:`track_closed_set` runs the online pass itself on detection rows (``boxtrack`` in an *open* set
+with ``n_init=1``, reporting only detected boxes: a closed online set leaves detections that no slot
+takes out of every tracklet), then :func:`assign_identities`.
 
 All positions are pixels; times are converted with the sequence's frame rate (frames/s).
 """
@@ -424,9 +425,12 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
 
 def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *, n_frames: int | None = None,
                      online: dict[str, Any] | None = None, config: ClosedSetConfig | None = None) -> np.ndarray:
-    """Offline closed-set tracking of detection rows ``(k, >=7)``: an online ``boxtrack`` pass with
-    ``max_targets=n_targets`` (``online`` overrides its parameters), then :func:`assign_identities`.
-    Returns result rows ``(k, 10)`` with ids ``1..n_targets``."""
-    params = {"max_targets": int(n_targets), **(online or {})}
+    """Offline closed-set tracking of detection rows ``(k, >=7)``: an open-set online ``boxtrack`` pass
+    with ``n_init=1`` (every detection enters some tracklet; the assignment decides what is clutter;
+    ``online`` overrides its parameters), then :func:`assign_identities`. Returns result rows ``(k, 10)``
+    with ids ``1..n_targets``."""
+    if int(n_targets) < 1:
+        raise ValueError(f"n_targets must be >= 1, got {n_targets}")
+    params = {"n_init": 1, **(online or {})}
     rows = online_rows(det_rows, frame_rate, n_frames, **params)
     return assign_identities(rows, n_targets, frame_rate, config)
