@@ -14,12 +14,14 @@ setting of :class:`~lookalike.vision.blob.BlobConfig` from statistics of that vi
 - **noise**: σ = 1.4826 × the median absolute difference from the background (most pixels are
   background), in grey levels.
 - **threshold**: candidates at 4, 6, 8, 10, 14 and 20 σ (within 8..100 grey levels). At each, the
-  foreground's connected components give a typical target area ``A`` (with ``n_targets``: the median
-  area of each frame's ``n_targets`` largest components; without: the area-weighted median of all
+  foreground's connected components give a typical target area ``A`` (the area-weighted median of the
   components, i.e. where most of the foreground lies) and the blobs counted per frame between ``A/5``
   and ``6·A``. With ``n_targets`` the threshold that gives exactly ``n_targets`` blobs in most sampled
-  frames wins; without, the one whose median count is the most common over the candidates (the count's
-  plateau: a real set of targets is counted alike over a range of thresholds, noise is not).
+  frames wins (if any does in at least 20% of them); otherwise the one whose median count is the most
+  common over the candidates (the count's plateau: a real set of targets is counted alike over a range
+  of thresholds, noise is not).
+- **persistence**: components lying mostly on pixels that are foreground in more than 30% of the
+  samples (a moved object, a lighting change) are left out of these statistics: targets move.
 - **areas**: ``min_area_px = A/5`` (smaller pieces are noise or fragments), ``max_area_px = 6·A`` (two or
   three touching targets are still one detection; larger regions are lighting changes).
 - **morphology**: the targets' half thickness ``r`` (median largest inscribed radius, from a distance
@@ -49,7 +51,9 @@ _THRESHOLD_RANGE = (8.0, 100.0)  # grey levels
 _MIN_AREA_FRACTION = 1 / 5
 _MAX_AREA_FACTOR = 6.0
 _ALIGN_GAIN = 0.8  # stabilise when alignment cuts the spread of differences from the median by 20%+
-_WORK_SIDE_PX = 640  # frames are reduced to at most this many pixels a side for the statistics
+_WORK_SIDE_PX = 640
+_MIN_HIT_SHARE = 0.2  # a threshold must count exactly N blobs in this share of the samples to be chosen by N
+_PERSISTENT_SHARE = 0.3  # pixels in the foreground of more sampled frames than this are not targets
 
 
 @dataclass(frozen=True)
@@ -86,8 +90,7 @@ class BlobEstimate:
             f"polarity={c.polarity}: targets {polarity} ({100 * self.dark_share:.0f}% of the foreground is darker)",
             f"threshold={c.threshold:g}: grey levels from the background (noise σ {self.noise:.1f})",
             f"min_area_px={c.min_area_px:g} max_area_px={c.max_area_px:g}: typical target "
-            f"{self.target_area_px:.0f} px²" + (f" (the {self.n_targets} largest blobs per frame)"
-                                                 if self.n_targets else ""),
+            f"{self.target_area_px:.0f} px²",
             f"open_px={c.open_px} close_px={c.close_px}: targets about {2 * self.half_thickness_px:.0f} px thick",
             f"stabilise={'true' if c.stabilise else 'false'}: camera moves {self.shake_px:.1f} px (median)",
         ]
@@ -159,11 +162,9 @@ def _components(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return stats[1:, cv2.CC_STAT_AREA].astype(float), labels
 
 
-def _target_area(areas: list[np.ndarray], n_targets: int | None) -> float:
-    if n_targets:
-        top = [np.sort(a)[::-1][:n_targets] for a in areas if len(a)]
-        pooled = np.concatenate(top) if top else np.zeros(0)
-        return float(np.median(pooled)) if len(pooled) else 0.0
+def _target_area(areas: list[np.ndarray]) -> float:
+    """Area-weighted median of the components' areas (px²): the size of the blobs holding most of the
+    foreground, whatever the number of small noise specks."""
     pooled = np.concatenate(areas) if areas else np.zeros(0)
     if not len(pooled):
         return 0.0
@@ -252,23 +253,24 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     results = {}
     for thr in candidates:
         per_frame, masks = [], []
-        for s in signal:
-            mask = np.where(s > thr, 255, 0).astype(np.uint8)
-            if kernel is not None:
-                mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
-            areas, _ = _components(mask)
-            per_frame.append(areas)
+        raw = [np.where(sig > thr, 255, 0).astype(np.uint8) for sig in signal]
+        if kernel is not None:
+            raw = [cv2.morphologyEx(m, cv2.MORPH_OPEN, kernel) for m in raw]
+        persistent = np.mean(np.stack(raw) > 0, axis=0) > _PERSISTENT_SHARE
+        for mask in raw:
+            areas, labels = _components(mask)
+            moving = np.bincount(labels.ravel(), weights=~persistent.ravel(), minlength=len(areas) + 1)[1:]
+            per_frame.append(areas[moving >= areas / 2])  # mostly where foreground is rare: a moving target
             masks.append(mask)
-        area = _target_area(per_frame, n_targets)
+        area = _target_area(per_frame)
         lo_a, hi_a = area * _MIN_AREA_FRACTION, area * _MAX_AREA_FACTOR
         counts = np.array([int(((a >= lo_a) & (a <= hi_a)).sum()) for a in per_frame])
         results[thr] = (area, counts, masks)
     medians = {thr: float(np.median(r[1])) for thr, r in results.items()}
-    if n_targets:
-        hit = {thr: float(np.mean(r[1] == n_targets)) for thr, r in results.items()}
-        best = max(hit.values())
-        chosen = [thr for thr in candidates if hit[thr] == best]
-    else:
+    hit = {thr: float(np.mean(r[1] == n_targets)) for thr, r in results.items()} if n_targets else {}
+    if hit and max(hit.values()) >= _MIN_HIT_SHARE:
+        chosen = [thr for thr in candidates if hit[thr] == max(hit.values())]
+    else:  # no N, or no threshold counts N blobs often (targets out of view, partly annotated clips)
         values, freq = np.unique([medians[t] for t in candidates if medians[t] > 0] or [0.0], return_counts=True)
         plateau = values[freq == freq.max()].max()
         chosen = [thr for thr in candidates if medians[thr] == plateau]
