@@ -58,6 +58,7 @@ def test_the_number_of_targets_picks_the_threshold_counting_them() -> None:
     detector = BlobDetector(est.config).fit(frames)
     assert np.mean([len(detector(f)) == 3 for f in frames]) > 0.8
     assert est.n_targets == 3
+    assert est.typical_count == 3
 
 
 def test_a_still_video_is_refused_and_bad_input() -> None:

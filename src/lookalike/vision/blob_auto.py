@@ -81,6 +81,12 @@ class BlobEstimate:
     n_targets: int | None = None
 
     @property
+    def typical_count(self) -> int:
+        """Median number of blobs per sampled frame at the chosen threshold: an estimate of the number
+        of targets when none is given (an arena whose animals are all in view)."""
+        return int(round(self.counts.get(self.config.threshold, 0.0)))
+
+    @property
     def summary(self) -> str:
         """One line per decision, with the ``--blob KEY=VALUE`` that overrides it."""
         c = self.config
@@ -93,6 +99,8 @@ class BlobEstimate:
             f"{self.target_area_px:.0f} px²",
             f"open_px={c.open_px} close_px={c.close_px}: targets about {2 * self.half_thickness_px:.0f} px thick",
             f"stabilise={'true' if c.stabilise else 'false'}: camera moves {self.shake_px:.1f} px (median)",
+            f"about {self.typical_count} blobs per frame" + (f" ({self.n_targets} targets given)"
+                                                            if self.n_targets else ""),
         ]
         return "\n".join(lines)
 
