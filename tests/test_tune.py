@@ -323,3 +323,34 @@ def test_cli_tune_refuses_data_without_ground_truth(tmp_path: Path):
 def test_folds_are_explicit_objects():
     fold = Fold("x", (0, 1), (2,))
     assert fold.train == (0, 1) and fold.test == (2,)
+
+
+def test_cli_space_file_and_show_space(tmp_path: Path):
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    shown = CliRunner().invoke(app, ["tune", "-t", "boxtrack", "--show-space"])
+    assert shown.exit_code == 0 and '"max_age_s"' in shown.output and '"log": true' in shown.output
+    bad = tmp_path / "space.json"
+    bad.write_text(json.dumps({"speed": {"low": 1, "high": 2}}))
+    refused = CliRunner().invoke(app, ["tune", "-t", "sort", "--space", str(bad), "--show-space"])
+    assert refused.exit_code == 2 and "no parameter 'speed'" in refused.output
+
+
+def test_cli_tune_with_a_space_file(tmp_path: Path):
+    pytest.importorskip("optuna")
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    data = tmp_path / "d"
+    _write_motchallenge(data / "a", 3)
+    space = tmp_path / "space.json"
+    space.write_text(json.dumps({"max_age": {"low": 1, "high": 8, "type": "int", "log": True}, "min_hits": 2}))
+    out = tmp_path / "p.json"
+    result = CliRunner().invoke(app, ["tune", "-t", "sort", str(data / "a"), "-o", str(out), "--trials", "2",
+                                      "--space", str(space), "--sampler", "random"])
+    assert result.exit_code == 0, result.output
+    params = load_params(out, "sort")
+    assert params["min_hits"] == 2 and 1 <= params["max_age"] <= 8 and set(params) == {"max_age", "min_hits"}
