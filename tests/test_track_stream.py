@@ -159,3 +159,14 @@ def test_box_input_problem_names_what_each_tracker_needs():
     for name in tracker_names():
         problem = box_input_problem(name)
         assert problem is None or (name in problem and "\n" not in problem)
+
+
+def test_targets_makes_a_closed_set_or_is_refused(tmp_path):
+    path = _det_file(tmp_path / "det.txt", frames=40)
+    out = tmp_path / "closed.txt"
+    result = runner.invoke(app, ["track", "-t", "boxtrack", "--targets", "2", str(path), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    ids = {int(line.split(",")[1]) for line in out.read_text().splitlines()}
+    assert 0 < len(ids) <= 2
+    refused = runner.invoke(app, ["track", "-t", "sort", "--targets", "2", str(path), "-o", str(tmp_path / "x.txt")])
+    assert refused.exit_code == 2 and "--targets" in refused.output

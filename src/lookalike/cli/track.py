@@ -35,8 +35,13 @@ def build_tracker(name: str, settings: list[str]) -> Any:
         fail(str(exc))
 
 
-def _box_tracker(name: str, settings: list[str], *, video: bool = False) -> Any:
-    """:func:`build_tracker`, refusing in one line a tracker that cannot run on boxes."""
+def _box_tracker(name: str, settings: list[str], *, video: bool = False, targets: int | None = None) -> Any:
+    """:func:`build_tracker`, refusing in one line a tracker that cannot run on boxes; ``targets``: the
+    known number of targets, the tracker's ``max_targets`` (a closed set)."""
+    if targets is not None:
+        if "max_targets" not in {p.name for p in tracker_parameters(name)}:
+            fail(f"--targets: tracker {name!r} has no closed-set mode (max_targets); use -t boxtrack")
+        settings = [*settings, f"max_targets={targets}"]
     tracker = build_tracker(name, settings)
     problem = box_input_problem(name, video=video)
     if problem is not None:
@@ -118,6 +123,8 @@ def track(
         None, "--annotate", help="With --video: annotated MP4 (uncertain identities dashed with '?', health banner)."
     ),
     team_size: int | None = typer.Option(None, "--team-size", min=0, help="Known number of targets (health checks)."),
+    targets: int | None = typer.Option(None, "--targets", min=1, help="Known number of targets N: a closed set of "
+                                       "N identities (the tracker's max_targets; also the health checks' team size)."),
     health_window: int = typer.Option(15, "--health-window", min=1, help="Health monitor window in frames."),
     fps: float | None = typer.Option(None, "--fps", min=0.1, help="With --video: frame rate (default: the input's)."),
     features: str = typer.Option("video", "--features", help="With --video: standardise the hand-crafted features "
@@ -135,6 +142,7 @@ def track(
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
     branch = _check_branches(path, video, detections, annotate, detector, blob, pipeline)
     settings = set_ or []
+    team_size = team_size if team_size is not None else targets
     video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
                                          min_score=min_score, fps=fps, features=features)
     if branch == "pipeline":
@@ -142,7 +150,7 @@ def track(
                          annotate=annotate, fps=fps, min_score=min_score)
     elif branch in ("blobs", "video"):
         assert video is not None
-        trk = _box_tracker(tracker, settings, video=True)
+        trk = _box_tracker(tracker, settings, video=True, targets=targets)
         if branch == "blobs":
             run_track_blobs(video, output, trk, tracker, detector or "", blob or [], **video_options)
         else:
@@ -151,7 +159,7 @@ def track(
             run_track_video(video, det_path, output, trk, tracker, **video_options)
     else:
         assert path is not None
-        count, stats = track_files(path, output, _box_tracker(tracker, settings), min_score)
+        count, stats = track_files(path, output, _box_tracker(tracker, settings, targets=targets), min_score)
         where = output if path.is_file() else f"{output}/<sequence>.txt"
         console.print(f"[green]{tracker}[/]: {count} sequence(s), {stats.frames} frames, "
                       f"{stats.fps:,.0f} frames/s (tracker only) → {where}")
