@@ -36,11 +36,12 @@ def _result(rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> Assig
     order = np.argsort(rows, kind="stable")
     rows, cols = rows[order], cols[order]
     matches = np.stack([rows, cols], axis=1).astype(int) if rows.size else np.zeros((0, 2), dtype=int)
-    return Assignment(
-        matches=matches,
-        unmatched_rows=np.setdiff1d(np.arange(shape[0]), rows).astype(int),
-        unmatched_cols=np.setdiff1d(np.arange(shape[1]), cols).astype(int),
-    )
+    free_rows = np.ones(shape[0], dtype=bool)
+    free_rows[rows] = False
+    free_cols = np.ones(shape[1], dtype=bool)
+    free_cols[cols] = False
+    return Assignment(matches=matches, unmatched_rows=np.flatnonzero(free_rows),
+                      unmatched_cols=np.flatnonzero(free_cols))
 
 
 def _check(cost: np.ndarray) -> np.ndarray:

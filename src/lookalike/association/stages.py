@@ -28,16 +28,16 @@ class Stage:
     """One matching pass.
 
     Attributes:
-        tracks: the eligible track rows, a boolean mask ``(k,)`` or an ordered index array.
-        detections: the eligible detections, a boolean mask ``(n,)`` or an ordered index array.
+        tracks: the eligible track rows, a boolean mask ``(k,)`` or an ordered index array (None: all).
+        detections: the eligible detections, a boolean mask ``(n,)`` or an ordered index array (None: all).
         cost: the cost of every eligible (track, detection) pair.
         max_cost: pairs costing more are forbidden (the solver's gate, see :func:`assign`).
         solve: a replacement solver taking the cost matrix (default: :func:`assign` with ``max_cost``).
         name: a label for diagnostics.
     """
 
-    tracks: np.ndarray
-    detections: np.ndarray
+    tracks: np.ndarray | None
+    detections: np.ndarray | None
     cost: CostFn
     max_cost: float = np.inf
     solve: SolveFn | None = None
@@ -76,7 +76,9 @@ class Matching:
         return np.column_stack([rows, self.det_of_track[rows]]).astype(int)
 
 
-def _eligible(selector: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+def _eligible(selector: np.ndarray | None, allowed: np.ndarray) -> np.ndarray:
+    if selector is None:
+        return np.flatnonzero(allowed)
     sel = np.asarray(selector)
     if sel.dtype == bool:
         return np.flatnonzero(sel & allowed)

@@ -8,6 +8,7 @@ noise intensity ``q`` is the spectral density of the white-noise highest derivat
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -30,30 +31,43 @@ def _f1(order: int, dt: float) -> np.ndarray:
 
 def kinematic_transition(dim: int, order: int, dt: float) -> np.ndarray:
     """The transition ``F(dt)`` alone of a kinematic model of ``order`` (1: constant velocity,
-    2: constant acceleration) in ``dim`` dimensions; ``dt`` in seconds or frames."""
+    2: constant acceleration) in ``dim`` dimensions; ``dt`` in seconds or frames. Read-only (cached)."""
     _check(dim, dt)
-    return np.kron(_f1(order, dt), np.eye(dim))
+    return _transition(dim, order, float(dt))
 
 
+@lru_cache(maxsize=256)
+def _transition(dim: int, order: int, dt: float) -> np.ndarray:
+    F = np.kron(_f1(order, dt), np.eye(dim))
+    F.setflags(write=False)
+    return F
+
+
+@lru_cache(maxsize=256)
 def _kinematic(dim: int, order: int, dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
-    _check(dim, dt)
     n = order + 1
-    f1 = _f1(order, dt)
     # Continuous white noise on the highest derivative, integrated exactly over dt.
     q1 = np.zeros((n, n))
     for i in range(n):
         for j in range(n):
             p = (n - 1 - i) + (n - 1 - j) + 1
             q1[i, j] = q * dt**p / (p * math.factorial(n - 1 - i) * math.factorial(n - 1 - j))
-    eye = np.eye(dim)
-    return np.kron(f1, eye), np.kron(q1, eye)
+    F, Q = _transition(dim, order, dt), np.kron(q1, np.eye(dim))
+    Q.setflags(write=False)
+    return F, Q
+
+
+def _model(dim: int, order: int, dt: float, q: float) -> tuple[np.ndarray, np.ndarray]:
+    _check(dim, dt)
+    F, Q = _kinematic(dim, order, float(dt), float(q))
+    return F.copy(), Q.copy()
 
 
 def constant_velocity(dim: int, dt: float, q: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """``(F, Q)`` for constant velocity in ``dim`` dimensions; state ``[p (dim), v (dim)]``."""
-    return _kinematic(dim, 1, dt, q)
+    return _model(dim, 1, dt, q)
 
 
 def constant_acceleration(dim: int, dt: float, q: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """``(F, Q)`` for constant acceleration; state ``[p (dim), v (dim), a (dim)]``."""
-    return _kinematic(dim, 2, dt, q)
+    return _model(dim, 2, dt, q)

@@ -66,6 +66,8 @@ class Lifecycle:
             tentative &= table.unseen_s <= self.tentative_max_unseen_s
         if self.closed:
             return table.confirmed | tentative
+        if not table.confirmed.any():
+            return tentative
         confirmed = np.ones(len(table), dtype=bool)
         if self.max_misses is not None:
             confirmed &= table.misses <= self.max_misses

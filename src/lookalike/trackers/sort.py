@@ -86,10 +86,8 @@ class Sort:
         self._frame_count += 1
         det_xywh = frame.detections.xywh
         pred_xywh = self._predict(steps)
-        matching = run_plan([Stage(
-            np.ones(len(t), dtype=bool), np.ones(len(det_xywh), dtype=bool),
-            lambda r, c: iou_matrix(det_xywh[c], pred_xywh[r]).T, solve=solve_max_iou(self.config.iou_threshold),
-        )], len(t), len(det_xywh))
+        matching = run_plan([Stage(None, None, lambda r, c: iou_matrix(det_xywh[c], pred_xywh[r]).T,
+                                   solve=solve_max_iou(self.config.iou_threshold))], len(t), len(det_xywh))
         det_of_track = matching.det_of_track
         matched = np.flatnonzero(det_of_track >= 0)
         if len(matched):
