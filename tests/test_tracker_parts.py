@@ -130,3 +130,28 @@ def test_score_calibration_lowers_thresholds_to_quantiles() -> None:
     assert high == birth == pytest.approx(0.5, abs=0.01) and tentative == high
     plain = ScoreCalibration(0.9, 0.8)
     assert plain.decide() == (0.8, 0.8, 0.8)  # high never above birth
+
+
+def test_costs_weigh_iou_by_score_and_gate_centre_distance_in_heights() -> None:
+    from lookalike.association.costs import centre_distance_cost, iou_cost
+
+    track = np.array([[0.0, 0.0, 10.0, 10.0]])
+    dets = np.array([[0.0, 0.0, 10.0, 10.0], [5.0, 0.0, 10.0, 10.0], [50.0, 50.0, 10.0, 10.0]])
+    plain = iou_cost(track, dets, min_iou=0.3)
+    assert plain[0, 0] == 0.0 and plain[0, 1] == pytest.approx(1 - 1 / 3) and plain[0, 2] == np.inf
+    weighed = iou_cost(track, dets, det_weight=np.array([0.5, 1.0, 1.0]))
+    assert weighed[0, 0] == pytest.approx(0.5) and weighed[0, 2] == 1.0
+    centre = np.array([[0.0, 0.0, 10.0, 20.0]])  # cx, cy, w, h
+    cand = np.array([[0.0, 10.0, 10.0, 20.0], [0.0, 30.0, 10.0, 20.0], [0.0, 1.0, 40.0, 20.0]])
+    cost = centre_distance_cost(centre, cand, np.array([[1.0]]), max_scale=1.5)
+    assert cost[0, 0] == pytest.approx(0.5) and cost[0, 1] == np.inf  # 1.5 heights away: beyond the gate
+    assert cost[0, 2] == np.inf  # four times as wide: not the same target
+
+
+def test_boxtrack_config_names_the_bad_field() -> None:
+    from lookalike.trackers.boxtrack_config import BoxTrackConfig
+
+    for bad in ({"n_init": 0}, {"high_quantile": 1.5}, {"low_score": 0.95}, {"reid_scale": 0.5},
+                {"report": "boxes"}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            BoxTrackConfig(**bad)
