@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.types.tracks import TrackSnapshot
+from lookalike.types.tracks import Tracks, TrackSnapshot
 
 ROW_WIDTH = 10
 
@@ -66,6 +66,8 @@ def table_from_array(data: np.ndarray, path: Path | None = None) -> MotTable:
 
 def tracks_to_rows(frame_index: int, tracks: Iterable[TrackSnapshot]) -> np.ndarray:
     """MOTChallenge result rows ``(k, 10)`` for the boxed tracks of one 0-based frame index."""
+    if isinstance(tracks, Tracks):  # columnar batch: no per-track objects
+        return tracks.to_rows(frame_index)
     boxed = [t for t in tracks if t.xywh is not None]
     rows = np.full((len(boxed), ROW_WIDTH), -1.0)
     for r, t in enumerate(boxed):
