@@ -203,21 +203,25 @@ def hexbug_clips(root: Path) -> list[Path]:
     return [v for v in sorted(root.glob("*.mp4")) if v.with_suffix(".csv").is_file()]
 
 
-def detect_hexbug(video: Path) -> RealSequence:
+def detect_hexbug(video: Path, cache: Path | bool = True) -> RealSequence:
     """Run the blob detector over one HexBug clip (OpenCV needed) and attach its head points.
 
-    Detector settings are those of ``benchmarks/hexbug_blobs.py`` (median background, threshold 30
-    grey levels, blobs of at least 800 px², opening 9 px, stabilised), chosen on the video alone.
+    The detector settings are those ``lookalike track --video V --detector blob`` uses: estimated from
+    the clip itself (:func:`lookalike.viz.blob_video.auto_blob_config`, no target count), nothing
+    chosen for the bench. Detections are cached on disk (:func:`~lookalike.viz.blob_video.cached_blob_detection_rows`;
+    ``cache``: a folder, ``True`` for the default one, ``False`` for none).
     """
-    from lookalike.vision.blob import BlobConfig, BlobDetector, read_video
+    from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows
+    from lookalike.viz.overlay import source_frames
 
-    frames = read_video(str(video))
-    detector = BlobDetector(BlobConfig(threshold=30.0, min_area_px=800.0, open_px=9, stabilise=True)).fit(frames)
-    dets = [detector(image) for image in frames]
-    height, width = frames[0].shape[:2]
+    config, _ = auto_blob_config(video, [], cache=cache)
+    rows, length = cached_blob_detection_rows(video, config, cache=cache)
+    frames, _, fps = source_frames(video)
+    height, width = next(iter(frames)).shape[:2]
     points = read_hexbug_points(video.with_suffix(".csv"), (width, height))
-    return RealSequence("hexbug", video.stem, HEXBUG_FPS, len(frames), [np.asarray(d.xywh) for d in dets],
-                        [np.asarray(d.score) for d in dets], gt_points=points, image_size=(width, height))
+    xywh, score = _split_frames(MotTable.from_rows(rows), length)
+    return RealSequence("hexbug", video.stem, float(fps) if fps and fps > 0 else HEXBUG_FPS, length, xywh, score,
+                        gt_points=points, image_size=(width, height))
 
 
 def _selected(seqs: list[RealSequence], dataset: str, sequences: Sequence[str] | None) -> list[RealSequence]:

@@ -4,6 +4,7 @@ Each file says what every set of parameters was chosen on (``chosen_on``) and ho
 parameters chosen on data that is then scored are "tuned on this data", never a headline figure.
 
 - ``boxtrack.json``: boxtrack's parameters per dataset (``datasets``) and per sequence (``sequences``),
+  and per dataset for the separate "tuned on this data" row only (``tuned``: never the headline),
 - ``offline.json``: the offline post-processing (:class:`lookalike.trackers.offline.OfflineConfig`)
   per dataset.
 """
@@ -30,7 +31,7 @@ def load_preset(name: str) -> dict[str, Any]:
 def chosen_on(preset: str, dataset: str) -> str:
     """What the parameters of ``preset`` for ``dataset`` were chosen on ("" when there are none)."""
     data = load_preset(preset)
-    for group in ("datasets", "sequences"):
+    for group in ("datasets", "sequences", "tuned"):
         entry = data.get(group, {}).get(dataset)
         if entry is not None:
             return str(entry["chosen_on"])
@@ -52,8 +53,12 @@ def _sequence_params() -> dict[str, dict[str, dict[str, dict[str, Any]]]]:
 DATASET_PARAMS: dict[str, dict[str, dict[str, Any]]] = _dataset_params()
 # dataset -> tracker -> sequence -> parameters chosen on that sequence's first half (boxtrack.json "sequences")
 SEQUENCE_PARAMS: dict[str, dict[str, dict[str, dict[str, Any]]]] = _sequence_params()
+# dataset -> tracker -> parameters chosen on that dataset for the "tuned on this data" row only (boxtrack.json "tuned")
+TUNED_PARAMS: dict[str, dict[str, dict[str, Any]]] = {
+    d: {load_preset("boxtrack")["tracker"]: dict(e["params"])} for d, e in load_preset("boxtrack").get("tuned", {}).items()}
 # dataset -> OfflineConfig fields (offline.json)
 OFFLINE_PARAMS: dict[str, dict[str, Any]] = {d: dict(e["params"])
                                              for d, e in load_preset("offline")["datasets"].items()}
 
-__all__ = ["DATASET_PARAMS", "OFFLINE_PARAMS", "PRESET_FILES", "SEQUENCE_PARAMS", "chosen_on", "load_preset"]
+__all__ = ["DATASET_PARAMS", "OFFLINE_PARAMS", "PRESET_FILES", "SEQUENCE_PARAMS", "TUNED_PARAMS", "chosen_on",
+           "load_preset"]

@@ -7,8 +7,12 @@ backend uses Ray's task API (``ray.remote`` / ``ray.get``), connecting to ``addr
 a local instance (``ray.init()``); the sequences are put in Ray's object store once.
 
 Parameters of an entry, lowest priority first: the dataset's preset
-(:data:`~lookalike.bench.presets.DATASET_PARAMS`), the sequence's preset
+(:data:`~lookalike.bench.presets.DATASET_PARAMS`, when ``presets``; for a ``tuned`` entry
+:data:`~lookalike.bench.presets.TUNED_PARAMS` instead), the sequence's preset
 (:data:`~lookalike.bench.presets.SEQUENCE_PARAMS`, when ``per_sequence``), the entry's own.
+
+``boxtrack-closed-offline`` runs the offline closed set (:func:`lookalike.trackers.closed_set.track_closed_set`)
+on the detections with boxtrack's defaults, as ``lookalike track --targets N --offline`` does.
 """
 
 from __future__ import annotations
@@ -22,12 +26,13 @@ import numpy as np
 
 from lookalike.bench.datasets import RealSequence
 from lookalike.bench.peers import run_peer
-from lookalike.bench.presets import DATASET_PARAMS, OFFLINE_PARAMS, SEQUENCE_PARAMS
+from lookalike.bench.presets import DATASET_PARAMS, OFFLINE_PARAMS, SEQUENCE_PARAMS, TUNED_PARAMS
 from lookalike.eval import evaluate_points, evaluate_sequence
 from lookalike.io import MotTable
 from lookalike.loop import RowCollector, run
 from lookalike.parallel import JobPool
 from lookalike.trackers import make_tracker
+from lookalike.trackers.closed_set import track_closed_set
 from lookalike.trackers.offline import OfflineConfig, postprocess
 
 HEXBUG_RADIUS_PX = 120.0  # a box centre lies about half a bug from its head (benchmarks/hexbug_blobs.py)
@@ -45,19 +50,43 @@ class Entry:
     per_sequence: bool = True  # use the parameters chosen on each sequence's first half (SEQUENCE_PARAMS)
     only_where_tuned: bool = False  # run only on datasets with per-sequence parameters for this tracker
     offline: bool = False  # post-process the whole result (trackers.offline; OFFLINE_PARAMS of the dataset)
+    presets: bool = True  # start from the dataset's preset (DATASET_PARAMS)
+    tuned: bool = False  # start from TUNED_PARAMS instead; run only on datasets that have them
+    closed_offline: bool = False  # offline closed set of the documented count (track_closed_set)
+
+
+TUNED_LABEL = "tuned on this data"
 
 
 def default_entries(trackers: Sequence[str], peers: Sequence[str], closed_set: bool = True) -> list[Entry]:
     """lookalike trackers and peers; with ``boxtrack`` also ``boxtrack-global`` (without the
     per-sequence parameters, where there are some), ``boxtrack-offline`` (its result post-processed
-    offline, :mod:`lookalike.trackers.offline`) and ``boxtrack-closed`` (where the count is known)."""
+    offline, :mod:`lookalike.trackers.offline`), ``boxtrack (tuned on this data)`` (where a dataset
+    has :data:`TUNED_PARAMS`), and, where the count is known, ``boxtrack-closed`` (online) and
+    ``boxtrack-closed-offline`` (the offline closed set with boxtrack's defaults)."""
     entries = [Entry(t, t) for t in trackers]
     if "boxtrack" in trackers:
         entries += [Entry("boxtrack-global", "boxtrack", per_sequence=False, only_where_tuned=True),
-                    Entry("boxtrack-offline", "boxtrack", offline=True)]
+                    Entry("boxtrack-offline", "boxtrack", offline=True),
+                    Entry(f"boxtrack ({TUNED_LABEL})", "boxtrack", tuned=True)]
     if closed_set and "boxtrack" in trackers:
-        entries.append(Entry("boxtrack-closed", "boxtrack", closed_set=True))
+        entries += [Entry("boxtrack-closed", "boxtrack", closed_set=True),
+                    Entry("boxtrack-closed-offline", "boxtrack", closed_set=True, closed_offline=True,
+                          presets=False, per_sequence=False)]
     return entries + [Entry(p, p, kind="peer") for p in peers]
+
+
+def params_entry(path: str, tracker: str, params: dict[str, Any], chosen_on: Sequence[str],
+                 sequences: Sequence[RealSequence]) -> Entry:
+    """The entry of a ``lookalike tune`` parameter file: labelled with the file's stem, and
+    ``(tuned on this data)`` when its ``chosen_on`` names any scored sequence (``dataset/name`` or a
+    dataset); no bench preset is applied."""
+    from pathlib import Path
+
+    scored = {f"{s.dataset}/{base_name(s)}" for s in sequences} | {s.dataset for s in sequences}
+    chosen = {str(c).split("[", 1)[0] for c in chosen_on}
+    label = Path(path).stem + (f" ({TUNED_LABEL})" if chosen & scored else "")
+    return Entry(label, tracker, params=dict(params), presets=False, per_sequence=False)
 
 
 def base_name(seq: RealSequence) -> str:
@@ -77,8 +106,8 @@ def entry_params(entry: Entry, seq: RealSequence,
     """The parameters ``entry``'s tracker gets on ``seq`` (dataset < sequence < entry; the target
     count as ``max_targets`` for a closed-set entry where it is known)."""
     dataset_params = DATASET_PARAMS if dataset_params is None else dataset_params
-    params = {**dataset_params.get(seq.dataset, {}).get(entry.name, {}), **sequence_params(entry, seq),
-              **entry.params}
+    preset = (TUNED_PARAMS if entry.tuned else dataset_params if entry.presets else {}).get(seq.dataset, {})
+    params = {**preset.get(entry.name, {}), **sequence_params(entry, seq), **entry.params}
     if entry.closed_set and seq.n_targets is not None:
         params["max_targets"] = seq.n_targets
     return params
@@ -90,6 +119,10 @@ def track_rows(entry: Entry, seq: RealSequence,
     An ``offline`` entry's rows are post-processed with the dataset's :data:`OFFLINE_PARAMS`."""
     if entry.kind == "peer":
         return run_peer(entry.name, seq)
+    if entry.closed_offline and seq.n_targets is not None:
+        online = {k: v for k, v in entry_params(entry, seq, dataset_params).items() if k != "max_targets"}
+        return track_closed_set(detection_rows(seq), seq.n_targets, seq.frame_rate, n_frames=seq.length,
+                                online=online)
     tracker = make_tracker(entry.name, **entry_params(entry, seq, dataset_params))
     collect = RowCollector()
     run(tracker, seq.frames(), collect)
@@ -97,6 +130,17 @@ def track_rows(entry: Entry, seq: RealSequence,
     if entry.offline:
         rows = postprocess(rows, seq.frame_rate, OfflineConfig(**OFFLINE_PARAMS.get(seq.dataset, {})))
     return rows
+
+
+def detection_rows(seq: RealSequence) -> np.ndarray:
+    """The sequence's detections as MOTChallenge rows ``(k, 10)`` (1-based frames, id -1)."""
+    blocks = []
+    for k, (xywh, score) in enumerate(zip(seq.det_xywh, seq.det_score)):
+        if len(xywh):
+            block = np.full((len(xywh), 10), -1.0)
+            block[:, 0], block[:, 2:6], block[:, 6] = k + 1, xywh, score
+            blocks.append(block)
+    return np.vstack(blocks) if blocks else np.zeros((0, 10))
 
 
 def score_rows(seq: RealSequence, rows: np.ndarray, radius: float = HEXBUG_RADIUS_PX) -> dict[str, float]:
@@ -141,6 +185,7 @@ def job_pairs(entries: Sequence[Entry], sequences: Sequence[RealSequence]) -> li
     return [(e, s) for s in sequences for e in entries
             if not (e.closed_set and s.n_targets is None)
             and not (e.only_where_tuned and e.name not in SEQUENCE_PARAMS.get(s.dataset, {}))
+            and not (e.tuned and e.name not in TUNED_PARAMS.get(s.dataset, {}))
             and not (e.offline and s.dataset not in OFFLINE_PARAMS)]
 
 
@@ -153,6 +198,6 @@ def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, wor
         return [p.result() for p in [pool.submit(_run_pair, e, shared[id(s)]) for e, s in jobs]]
 
 
-__all__ = ["DATASET_PARAMS", "HEXBUG_RADIUS_PX", "OFFLINE_PARAMS", "SEQUENCE_PARAMS", "Entry", "base_name",
-           "default_entries", "entry_params", "job_pairs", "map_jobs", "run_job", "run_jobs", "score_rows",
+__all__ = ["DATASET_PARAMS", "HEXBUG_RADIUS_PX", "OFFLINE_PARAMS", "SEQUENCE_PARAMS", "TUNED_LABEL", "TUNED_PARAMS",
+           "Entry", "base_name", "default_entries", "detection_rows", "entry_params", "params_entry", "job_pairs", "map_jobs", "run_job", "run_jobs", "score_rows",
            "sequence_params", "track_rows"]

@@ -14,6 +14,7 @@ from rich.table import Table
 
 from lookalike.cli.app import app, console, fail
 from lookalike.cli.track_blobs import run_track_blobs
+from lookalike.cli.track_closed import offline_files, offline_video, track_points
 from lookalike.cli.track_pixels import run_track_pixels
 from lookalike.cli.track_video import run_track_video
 from lookalike.io import find_sequences
@@ -22,27 +23,40 @@ from lookalike.io.stream import sequence_stream, track_to_file
 from lookalike.loop import RunStats
 from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
 from lookalike.trackers.registry import parse_parameter
+from lookalike.tune.params_file import load_params
 
 
-def build_tracker(name: str, settings: list[str]) -> Any:
-    """A tracker from its name and ``KEY=VALUE`` settings, failing with a readable message."""
+def tracker_params(name: str, settings: list[str], params_file: Path | None = None) -> dict[str, Any]:
+    """A tracker's parameters: those of the ``lookalike tune`` file ``params_file`` (if any), then the
+    ``KEY=VALUE`` ``settings`` on top; fails with a readable message."""
     if name not in tracker_names():
         fail(f"unknown tracker {name!r}; choose one of: {', '.join(tracker_names())}")
     try:
-        params = dict(parse_parameter(name, s) for s in settings)
+        base = load_params(params_file, name) if params_file is not None else {}
+        return {**base, **dict(parse_parameter(name, s) for s in settings)}
+    except (ValueError, TypeError) as exc:
+        fail(str(exc))
+
+
+def build_tracker(name: str, settings: list[str], params_file: Path | None = None) -> Any:
+    """A tracker from its name, an optional parameter file and ``KEY=VALUE`` settings (which win),
+    failing with a readable message."""
+    params = tracker_params(name, settings, params_file)
+    try:
         return make_tracker(name, **params)
     except (ValueError, TypeError) as exc:
         fail(str(exc))
 
 
-def _box_tracker(name: str, settings: list[str], *, video: bool = False, targets: int | None = None) -> Any:
+def _box_tracker(name: str, settings: list[str], *, video: bool = False, targets: int | None = None,
+                 params_file: Path | None = None) -> Any:
     """:func:`build_tracker`, refusing in one line a tracker that cannot run on boxes; ``targets``: the
     known number of targets, the tracker's ``max_targets`` (a closed set)."""
     if targets is not None:
         if "max_targets" not in {p.name for p in tracker_parameters(name)}:
             fail(f"--targets: tracker {name!r} has no closed-set mode (max_targets); use -t boxtrack")
         settings = [*settings, f"max_targets={targets}"]
-    tracker = build_tracker(name, settings)
+    tracker = build_tracker(name, settings, params_file)
     problem = box_input_problem(name, video=video)
     if problem is not None:
         fail(problem)
@@ -82,8 +96,13 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float) -> tup
 
 
 def _check_branches(path: Path | None, video: Path | None, detections: Path | None, annotate: Path | None,
-                    detector: str | None, blob: list[str] | None, pipeline: str | None) -> str:
-    """Which branch of ``track`` the options select (``pipeline``, ``blobs``, ``video``, ``files``)."""
+                    detector: str | None, blob: list[str] | None, pipeline: str | None,
+                    points: Path | None = None) -> str:
+    """Which branch of ``track`` the options select (``pipeline``, ``points``, ``blobs``, ``video``, ``files``)."""
+    if points is not None:
+        if any(x is not None for x in (path, video, detections, annotate, detector, pipeline)) or blob:
+            fail("--points: the points are the input; drop PATH/--video/--detections/--detector/--blob/--pipeline")
+        return "points"
     if pipeline is not None:
         if detector is not None or blob or detections is not None or path is not None:
             fail("--pipeline: finds its own detections; drop --detector/--blob/--detections/PATH")
@@ -101,6 +120,15 @@ def _check_branches(path: Path | None, video: Path | None, detections: Path | No
     if path is None:
         fail("PATH: give det.txt, a sequence folder or a folder of sequences (or --video with --detections)")
     return "files"
+
+
+def _video_info(video: Path) -> tuple[Any, int, float]:
+    from lookalike.viz.overlay import source_frames
+
+    try:
+        return source_frames(video)
+    except (ValueError, OSError) as exc:
+        fail(str(exc))
 
 
 @app.command()
@@ -138,28 +166,59 @@ def track(
     reports: Path | None = typer.Option(None, "--reports", help="With --pipeline: heading reports (`simulate` .jsonl)."),
     detector_model: Path | None = typer.Option(None, "--detector-model", help="With --pipeline: `train-detector` model."),
     heading_model: Path | None = typer.Option(None, "--heading-model", help="With --pipeline: `train-heading` model."),
+    params_file: Path | None = typer.Option(None, "--params", help="Parameter file written by `lookalike tune` "
+                                            "(for this tracker); --set overrides its values."),
+    offline: bool = typer.Option(False, "--offline", help="With --targets N: decide the N identities over the "
+                                 "whole sequence at once (offline closed set) before writing the result."),
+    points: Path | None = typer.Option(None, "--points", help="Anonymous points as input: a frame,x,y CSV, or "
+                                       "MOTChallenge rows frame,id,x,y (tracked as small boxes; --fps, default 25)."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
-    branch = _check_branches(path, video, detections, annotate, detector, blob, pipeline)
+    branch = _check_branches(path, video, detections, annotate, detector, blob, pipeline, points)
+    if offline and targets is None:
+        fail("--offline: needs --targets N (the known number of targets)")
+    if offline and (annotate is not None or branch == "pipeline"):
+        fail("--offline: not with --annotate or --pipeline (the closed set is decided after the whole video)")
+    if offline and tracker != "boxtrack":
+        fail(f"--offline: the closed set's online pass is boxtrack; use -t boxtrack, not {tracker!r}")
     settings = set_ or []
     team_size = team_size if team_size is not None else targets
     video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
                                          min_score=min_score, fps=fps, features=features)
     if branch == "pipeline":
+        if params_file is not None:
+            settings = [*(f"{k}={v}" for k, v in tracker_params(tracker, [], params_file).items()), *settings]
         run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker, settings,
                          annotate=annotate, fps=fps, min_score=min_score)
+        return
+    trk = _box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets, params_file=params_file)
+    online = tracker_params(tracker, settings, params_file) if offline else None
+    if branch == "points":
+        assert points is not None
+        track_points(points, output, trk, tracker, n_targets=targets, offline=offline, params=online or {}, fps=fps)
     elif branch in ("blobs", "video"):
         assert video is not None
-        trk = _box_tracker(tracker, settings, video=True, targets=targets)
         if branch == "blobs":
-            run_track_blobs(video, output, trk, tracker, detector or "", blob or [], **video_options)
+            run_track_blobs(video, output, trk, tracker, detector or "", blob or [], n_targets=targets,
+                            offline=online, **video_options)
         else:
             det_path = detections or path
             assert det_path is not None
-            run_track_video(video, det_path, output, trk, tracker, **video_options)
+            if online is not None and targets is not None:
+                if output.is_dir():
+                    fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
+                _, count, rate = _video_info(video)
+                offline_video(det_path, output, targets, online, fps or rate, count or None, min_score)
+            else:
+                run_track_video(video, det_path, output, trk, tracker, **video_options)
+    elif online is not None and targets is not None:
+        assert path is not None
+        count = offline_files(path, output, targets, online, min_score)
+        where = output if path.is_file() else f"{output}/<sequence>.txt"
+        console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
     else:
         assert path is not None
-        count, stats = track_files(path, output, _box_tracker(tracker, settings, targets=targets), min_score)
+        count, stats = track_files(path, output, trk, min_score)
         where = output if path.is_file() else f"{output}/<sequence>.txt"
         console.print(f"[green]{tracker}[/]: {count} sequence(s), {stats.frames} frames, "
                       f"{stats.fps:,.0f} frames/s (tracker only) → {where}")

@@ -1,10 +1,13 @@
 """``lookalike track --video FILE --detector blob``: detections from the blob detector instead of a det.txt.
 
-The video is read twice: once to fit the median background on ``history`` frames spread evenly over
-it (the ``median`` method; ``mog2`` learns online and skips this pass), once to detect. The blob
-boxes are written as a MOTChallenge detection file ``<output stem>.det.txt`` beside the result, and
-that file feeds the ordinary ``--video`` branch (:func:`~lookalike.cli.track_video.run_track_video`):
-any registered tracker, health monitor, optional annotated video. Not a command of its own.
+The blob settings are estimated from the video itself (:func:`~lookalike.viz.blob_video.auto_blob_config`,
+with ``--targets N`` when given) and printed, one ``KEY=VALUE`` per decision; ``--blob KEY=VALUE`` wins
+over the estimate. The detections are cached on disk (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``,
+keyed by the video's content, the settings and the version) and written as a MOTChallenge detection
+file ``<output stem>.det.txt`` beside the result; that file feeds the ordinary ``--video`` branch
+(:func:`~lookalike.cli.track_video.run_track_video`: any registered tracker, health monitor, optional
+annotated video) or, with ``--offline``, the closed set (:func:`~lookalike.cli.track_closed.offline_video`).
+Not a command of its own.
 """
 
 from __future__ import annotations
@@ -13,17 +16,21 @@ from pathlib import Path
 from typing import Any
 
 from lookalike.cli.app import console, fail
+from lookalike.cli.track_closed import offline_video
 from lookalike.cli.track_video import run_track_video
 from lookalike.io import write_mot
-from lookalike.viz.blob_video import blob_config, blob_detection_rows
+from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows
+from lookalike.viz.overlay import source_frames
 
 DETECTORS = ("blob",)
 
 
 def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, detector: str,
-                    settings: list[str], **options: Any) -> None:
+                    settings: list[str], *, n_targets: int | None = None, offline: dict[str, Any] | None = None,
+                    **options: Any) -> None:
     """Detect blobs on ``video``, write them to ``<output stem>.det.txt``, then track them as
-    :func:`~lookalike.cli.track_video.run_track_video` does (``options`` are passed on to it)."""
+    :func:`~lookalike.cli.track_video.run_track_video` does (``options`` are passed on to it) or, with
+    ``offline`` (the online pass's parameters), by the offline closed set of ``n_targets``."""
     if detector not in DETECTORS:
         fail(f"--detector: choose one of {', '.join(DETECTORS)}, got {detector!r}")
     if output.is_dir():
@@ -31,9 +38,18 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
     if not video.exists():
         fail(f"--video: {video} does not exist")
     try:
-        config = blob_config(settings)
+        with console.status(f"estimating blob settings on {video.name}"):
+            config, estimate = auto_blob_config(video, settings, n_targets)
+        if estimate is not None:
+            given = {s.partition("=")[0].strip() for s in settings}
+            console.print("blob settings estimated from the video (override with --blob KEY=VALUE):")
+            for line in estimate.summary.splitlines():
+                console.print(f"  {line}", markup=False)
+            if given:
+                console.print(f"  given with --blob: {', '.join(sorted(given))}", markup=False)
         with console.status(f"detecting blobs in {video.name}"):
-            rows, frames = blob_detection_rows(video, config)
+            rows, frames = cached_blob_detection_rows(video, config)
+        frame_rate = options.get("fps") or source_frames(video)[2]
     except (ValueError, OSError) as exc:
         fail(str(exc))
     det_path = write_mot(output.with_name(output.stem + ".det.txt"), rows)
@@ -41,4 +57,8 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
     if len(rows) < 2:
         fail(f"{video}: the blob detector found {len(rows)} box(es); try a lower --blob threshold=... "
              "or min_area_px=..., or polarity=dark/bright")
-    run_track_video(video, det_path, output, tracker, tracker_name, **options)
+    if offline is not None:
+        assert n_targets is not None
+        offline_video(det_path, output, n_targets, offline, float(frame_rate), frames, options["min_score"])
+    else:
+        run_track_video(video, det_path, output, tracker, tracker_name, **options)

@@ -2,12 +2,23 @@
 
 The video is read twice: once to fit the median background on ``history`` frames spread evenly over
 it (the ``median`` method; ``mog2`` learns online and skips this pass), once to detect.
+
+:func:`auto_blob_config` is the settings ``track --detector blob`` uses: those estimated from the video
+(:func:`lookalike.vision.blob_auto.estimate_blob_config`), overridden by the user's ``--blob KEY=VALUE``.
+:func:`cached_blob_detection_rows` keeps the detections on disk (``$LOOKALIKE_CACHE`` or
+``~/.cache/lookalike``, under ``blobs/``), keyed by the video's content hash, every setting of the
+configuration, the lookalike version and the detector's code, so a cached result is only served for the same inputs.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import io
+import json
 import math
+import os
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -15,15 +26,24 @@ from typing import Any
 import numpy as np
 
 from lookalike.vision.blob import BlobConfig, BlobDetector
+from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config
 from lookalike.viz.overlay import source_frames
 
 _BOOL_TRUE = ("1", "true", "yes", "on")
 _BOOL_FALSE = ("0", "false", "no", "off")
 
 
+CACHE_ENV = "LOOKALIKE_CACHE"
+
+
 def blob_config(settings: list[str]) -> BlobConfig:
     """A :class:`BlobConfig` from ``KEY=VALUE`` strings (keys are its field names, e.g. ``threshold=40``,
     ``polarity=dark``, ``min_area_px=50``); an unknown key or a bad value raises ``ValueError`` naming it."""
+    return BlobConfig(**blob_settings(settings))
+
+
+def blob_settings(settings: list[str]) -> dict[str, Any]:
+    """The ``KEY=VALUE`` strings of :func:`blob_config` as typed values (only the keys given)."""
     kinds = {f.name: str(f.type) for f in dataclasses.fields(BlobConfig)}
     values: dict[str, Any] = {}
     for text in settings:
@@ -49,7 +69,113 @@ def blob_config(settings: list[str]) -> BlobConfig:
                 values[key] = raw
         except ValueError:
             raise ValueError(f"--blob {key}: expected a {kind}, got {raw!r}") from None
-    return BlobConfig(**values)
+    return values
+
+
+def auto_blob_config(video: Path | str, settings: list[str], n_targets: int | None = None,
+                     cache: Path | None | bool = True) -> tuple[BlobConfig, BlobEstimate | None]:
+    """The blob settings for ``video``: estimated from the video (``n_targets`` when known), then the
+    ``KEY=VALUE`` ``settings`` on top (they win). No estimate is made when ``settings`` give the
+    threshold, polarity and both areas; the estimate is returned (None then) so it can be printed.
+    The estimate is cached as the detections are (``cache``: see :func:`cached_blob_detection_rows`)."""
+    given = blob_settings(settings)
+    if {"threshold", "polarity", "min_area_px", "max_area_px"} <= set(given):
+        return BlobConfig(**given), None
+    base = BlobConfig(**{k: v for k, v in given.items() if k in ("method", "blur_px", "history", "sample_every")})
+    estimate = _cached_estimate(video, n_targets, base, cache)
+    return dataclasses.replace(estimate.config, **given), estimate
+
+
+def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
+                     cache: Path | None | bool) -> BlobEstimate:
+    if cache is False or cache is None:
+        return estimate_blob_config(video, n_targets, base=base)
+    from lookalike.vision import blob_auto
+
+    path = (cache_dir() if cache is True else Path(cache)) / "blobs" / (
+        detection_cache_key(video, base, extra={"n_targets": n_targets, "estimate": _code_hash(blob_auto.__file__)})
+        + ".estimate.json")
+    if path.is_file():
+        try:
+            data = json.loads(path.read_text())
+            data["config"] = BlobConfig(**data["config"])
+            data["counts"] = {float(k): float(v) for k, v in data["counts"].items()}
+            return BlobEstimate(**data)
+        except (OSError, ValueError, TypeError, KeyError):
+            pass
+    estimate = estimate_blob_config(video, n_targets, base=base)
+    content = dataclasses.asdict(estimate)
+    content["counts"] = {repr(k): v for k, v in estimate.counts.items()}
+    _write_atomic(path, json.dumps(content, default=float).encode())
+    return estimate
+
+
+def _code_hash(*files: str) -> str:
+    return hashlib.sha256(b"".join(Path(f).read_bytes() for f in files)).hexdigest()
+
+
+def _write_atomic(path: Path, data: bytes) -> None:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except OSError:
+        pass  # a read-only cache folder: no cache, same result
+
+
+def cache_dir() -> Path:
+    """Where cached detections live: ``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``."""
+    root = os.environ.get(CACHE_ENV)
+    return Path(root) if root else Path.home() / ".cache" / "lookalike"
+
+
+def _file_hash(path: Path) -> str:
+    digest = hashlib.sha256()
+    files = sorted(q for q in path.iterdir() if q.is_file()) if path.is_dir() else [path]
+    for q in files:
+        digest.update(q.name.encode())
+        with open(q, "rb") as fh:
+            for chunk in iter(lambda: fh.read(1 << 20), b""):
+                digest.update(chunk)
+    return digest.hexdigest()
+
+
+def detection_cache_key(video: Path | str, config: BlobConfig, extra: dict[str, Any] | None = None) -> str:
+    """The cache key of ``video``'s blob detections: its content hash (every file of an image folder),
+    every field of ``config``, the lookalike version, the detector's source code and OpenCV's version."""
+    import cv2
+
+    from lookalike import __version__
+    from lookalike.vision import blob
+
+    code = _code_hash(blob.__file__, __file__)
+    payload = json.dumps({"video": _file_hash(Path(video)), "config": dataclasses.asdict(config),
+                          "version": str(__version__), "code": code, "opencv": cv2.__version__, **(extra or {})},
+                         sort_keys=True, default=str)
+    return hashlib.sha256(payload.encode()).hexdigest()[:32]
+
+
+def cached_blob_detection_rows(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
+                               cache: Path | None | bool = True) -> tuple[np.ndarray, int]:
+    """:func:`blob_detection_rows`, read from / written to the cache (``cache``: a folder, ``True`` for
+    :func:`cache_dir`, ``False`` or None for no cache). A damaged cache file is recomputed."""
+    if cache is False or cache is None:
+        return blob_detection_rows(video, config, advance)
+    folder = (cache_dir() if cache is True else Path(cache)) / "blobs"
+    path = folder / f"{detection_cache_key(video, config)}.npz"
+    if path.is_file():
+        try:
+            with np.load(path) as data:
+                return np.array(data["rows"], dtype=float).reshape(-1, 10), int(data["frames"])
+        except (OSError, ValueError, KeyError):
+            pass
+    rows, frames = blob_detection_rows(video, config, advance)
+    buffer = io.BytesIO()
+    np.savez(buffer, rows=rows, frames=frames)
+    _write_atomic(path, buffer.getvalue())
+    return rows, frames
 
 
 def blob_detection_rows(video: Path | str, config: BlobConfig,
@@ -92,4 +218,5 @@ def _background_sample(frames: Any, declared: int, count: int) -> list[np.ndarra
     return [every[k] for k in pick]
 
 
-__all__ = ["blob_config", "blob_detection_rows"]
+__all__ = ["CACHE_ENV", "auto_blob_config", "blob_config", "blob_detection_rows", "blob_settings", "cache_dir",
+           "cached_blob_detection_rows", "detection_cache_key"]

@@ -1,0 +1,126 @@
+"""``lookalike track --targets N --offline`` and ``lookalike track --points FILE``: the closed-set offline
+branch and the point-input branch of ``lookalike track``. Not commands of their own.
+
+``--offline`` hands the whole sequence's detections to
+:func:`lookalike.trackers.closed_set.track_closed_set` (an open-set online ``boxtrack`` pass with the
+user's parameters, then one global assignment of its tracklets to N identities) and writes the result
+atomically. ``--points`` reads anonymous points (:mod:`lookalike.io.points`), turns them into small
+boxes (:func:`~lookalike.io.points.points_to_rows`) and tracks them online or offline.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookalike.cli.app import console, fail
+from lookalike.io import find_sequences, read_mot, write_mot
+from lookalike.io.points import points_to_rows, read_points_csv, read_points_mot, typical_spacing
+from lookalike.io.stream import track_to_file
+from lookalike.trackers.closed_set import track_closed_set
+from lookalike.types import Detections, Frame
+
+POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given (frames/s)
+
+
+def table_rows(path: Path, min_score: float = float("-inf")) -> np.ndarray:
+    """Detection rows ``(k, 10)`` of a MOTChallenge file, those scoring below ``min_score`` dropped."""
+    table = read_mot(path)
+    rows = np.full((len(table), 10), -1.0)
+    rows[:, 0], rows[:, 2:6], rows[:, 6] = table.frame, table.xywh, table.conf
+    return rows[rows[:, 6] >= min_score]
+
+
+def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
+                    params: dict[str, Any]) -> np.ndarray:
+    """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online
+    ``boxtrack`` pass's parameters (``max_targets`` is dropped: that pass is an open set)."""
+    online = {k: v for k, v in params.items() if k != "max_targets"}
+    return track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online)
+
+
+def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float) -> int:
+    """``--offline`` over every sequence at ``path`` (as ``track_files``): returns the sequences written."""
+    try:
+        sequences = [s for s in find_sequences(path) if s.det_path is not None]
+        if not sequences:
+            raise ValueError(f"{path}: no det/det.txt found")
+        for seq in sequences:
+            assert seq.det_path is not None
+            det = table_rows(seq.det_path, min_score)
+            n_frames = max(seq.length or 0, int(det[:, 0].max(initial=0)))
+            with console.status(f"closed set of {n_targets} on {seq.name}"):
+                rows = closed_set_rows(det, n_targets, seq.frame_rate, n_frames, params)
+            write_mot(output if path.is_file() else output / f"{seq.name}.txt", rows)
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
+    return len(sequences)
+
+
+def offline_video(det_path: Path, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
+                  n_frames: int | None, min_score: float) -> None:
+    """``--video ... --offline``: the closed set over the detections at ``det_path``, written to ``output``."""
+    try:
+        det = table_rows(det_path, min_score)
+        with console.status(f"closed set of {n_targets}"):
+            rows = closed_set_rows(det, n_targets, frame_rate, n_frames, params)
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
+    write_mot(output, rows)
+    console.print(f"[green]boxtrack[/], offline closed set of {n_targets}: {len(np.unique(rows[:, 1]))} "
+                  f"identities, {len(rows)} rows at {frame_rate:g} frames/s → {output}")
+
+
+def read_points(path: Path) -> Any:
+    """Points of a ``frame,x,y`` CSV (``.csv``) or of MOTChallenge rows with a point per row (any other suffix)."""
+    return read_points_csv(path) if path.suffix.lower() == ".csv" else read_points_mot(path)
+
+
+def _frames(det_rows: np.ndarray, n_frames: int, frame_rate: float) -> Any:
+    order = np.argsort(det_rows[:, 0], kind="stable")
+    det_rows = det_rows[order]
+    bounds = np.searchsorted(det_rows[:, 0], np.arange(1, n_frames + 2))
+    for k in range(n_frames):
+        block = det_rows[bounds[k]:bounds[k + 1]]
+        dets = Detections(xywh=block[:, 2:6], score=block[:, 6]) if len(block) else Detections.empty()
+        yield Frame(index=k, time=k / frame_rate, detections=dets)
+
+
+def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: str, *, n_targets: int | None,
+                 offline: bool, params: dict[str, Any], fps: float | None) -> None:
+    """``--points FILE``: points as boxes of half their typical spacing, tracked online by ``tracker`` or,
+    with ``offline``, by the closed set of ``n_targets``; result rows (boxes centred on the points) to ``output``."""
+    if output.is_dir():
+        fail(f"-o/--output: {output} is a folder; with --points give a result file such as tracks.txt")
+    frame_rate = fps or POINTS_FPS
+    try:
+        points = read_points(points_path)
+        spacing = typical_spacing(points)
+        det = points_to_rows(points)
+    except (FileNotFoundError, ValueError) as exc:
+        fail(str(exc))
+    side = float(det[0, 4]) if len(det) else 1.0
+    console.print(f"points: {points.count} in {len(points)} frames, boxes of {side:.3g} (half the typical "
+                  f"spacing {spacing:.3g}), {frame_rate:g} frames/s" + ("" if fps else " (--fps to change)"))
+    if offline:
+        assert n_targets is not None
+        try:
+            rows = closed_set_rows(det, n_targets, frame_rate, len(points), params)
+        except ValueError as exc:
+            fail(str(exc))
+        write_mot(output, rows)
+    else:
+        try:
+            track_to_file(tracker, _frames(det, len(points), frame_rate), output)
+        except ValueError as exc:
+            fail(str(exc))
+        rows = read_mot(output)
+        rows = np.column_stack([rows.frame, rows.track_id]) if len(rows) else np.zeros((0, 2))
+    what = f"offline closed set of {n_targets}" if offline else "online"
+    console.print(f"[green]{tracker_name}[/], {what}: {len(np.unique(rows[:, 1]))} identities → {output}")
+
+
+__all__ = ["POINTS_FPS", "closed_set_rows", "offline_files", "offline_video", "read_points", "table_rows",
+           "track_points"]
