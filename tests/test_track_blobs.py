@@ -13,6 +13,12 @@ from lookalike.viz.blob_video import blob_config, blob_detection_rows
 from lookalike.io import read_mot
 
 runner = CliRunner()
+
+
+@pytest.fixture(autouse=True)
+def _private_cache(tmp_path, monkeypatch):
+    """Blob detections are cached on disk; each test gets its own cache folder (never ~/.cache)."""
+    monkeypatch.setenv("LOOKALIKE_CACHE", str(tmp_path / "cache"))
 FRAMES = 30
 # (start x, start y, vx, vy) px and px/frame: three discs in their own lanes, never touching.
 DISCS = ((20, 20, 3, 0), (140, 60, -3, 0), (30, 100, 2, 0))
@@ -105,7 +111,8 @@ def test_track_cli_blob_needs_a_video_and_blobs(tmp_path):
     assert r.exit_code != 0 and "does not exist" in " ".join(r.output.split())
     empty = _write_video(tmp_path / "empty.avi", discs=(), frames=10)
     r = runner.invoke(app, ["track", "--video", str(empty), "--detector", "blob", "-o", str(tmp_path / "t.txt")])
-    assert r.exit_code != 0 and "found 0 box(es)" in " ".join(r.output.split())
+    out = " ".join(r.output.split())
+    assert r.exit_code != 0 and ("found 0 box(es)" in out or "no foreground differs" in out)
 
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"

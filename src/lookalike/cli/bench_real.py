@@ -18,11 +18,12 @@ from rich.table import Table
 from lookalike.bench.datasets import DATASETS, PARTS, cut_sequence, load_datasets, resolve_data_root
 from lookalike.bench.leaderboard import COLUMNS, leaderboard, leaderboard_json, plot_leaderboard
 from lookalike.bench.peers import PEERS, peer_status
-from lookalike.bench.runner import default_entries, run_jobs
+from lookalike.bench.runner import default_entries, params_entry, run_jobs
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import console, fail, split_list
 from lookalike.cli.bench import bench_app
 from lookalike.parallel import BACKENDS
+from lookalike.tune.params_file import load_params, read_params
 
 BOX_TRACKERS = ("sort", "boxtrack")  # lookalike trackers that need nothing but boxes and scores
 
@@ -83,6 +84,8 @@ def real(
     json_path: Path | None = typer.Option(None, "--json", help="Write tables as JSON."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Write the dataset rows as CSV."),
     plots: Path | None = typer.Option(None, "--plots", help="Folder for one bar chart per dataset."),
+    params_file: Path | None = typer.Option(None, "--params", help="Parameter file of `lookalike tune`: adds a row "
+                                            "labelled with its name ('tuned on this data' when chosen on a scored sequence)."),
 ) -> None:
     """Leaderboard on real data: HOTA, IDF1, MOTA, IDSW, frames/s and rank per dataset, and combined."""
     tracker_list, peer_list = split_list(trackers), [p for p in split_list(peers) if p != "none"]
@@ -98,6 +101,18 @@ def real(
         if why is not None:
             console.print(f"[yellow]skipped peer {name}: {why}[/yellow]")
     entries = default_entries(tracker_list, [p for p, why in status.items() if why is None])
+    if params_file is not None:
+        try:
+            content = read_params(params_file)
+            if content.tracker not in BOX_TRACKERS:
+                raise ValueError(f"{params_file}: parameters for {content.tracker!r}; bench real runs "
+                                 f"{', '.join(BOX_TRACKERS)}")
+            entry = params_entry(str(params_file), content.tracker, load_params(params_file), content.chosen_on, seqs)
+        except ValueError as exc:
+            fail(str(exc))
+        console.print(f"{entry.label}: {content.tracker} with {params_file} (chosen on "
+                      f"{', '.join(content.chosen_on) or 'unknown data'})")
+        entries.append(entry)
     results = run_jobs(entries, seqs, workers=workers, backend=backend, address=address)
     rows, combined, per_seq = leaderboard(entries, seqs, results)
     counts = {d: sum(1 for s in seqs if s.dataset == d) for d in dict.fromkeys(s.dataset for s in seqs)}

@@ -13,6 +13,7 @@ from rich.table import Table
 
 from lookalike.cli.app import app, console, fail
 from lookalike.bench.folders import COMBINED, evaluate_folders
+from lookalike.cli.eval_points import score_points
 from lookalike.eval import BENCHMARKS, METRICS
 
 HEADLINE = {
@@ -34,8 +35,12 @@ def _columns(metrics: list[str]) -> list[str]:
 
 @app.command("eval")
 def eval_command(
-    gt: Path = typer.Option(..., "--gt", help="Ground-truth root: sequence folders with gt/gt.txt."),
-    results: list[Path] = typer.Option(..., "--results", help="Folder of <sequence>.txt results (repeat to compare trackers)."),
+    gt: Path = typer.Option(..., "--gt", help="Ground-truth root: sequence folders with gt/gt.txt (with --points: "
+                            "a frame,id,x,y file)."),
+    results: list[Path] = typer.Option(..., "--results", help="Folder of <sequence>.txt results (repeat to compare "
+                                       "trackers; with --points: result files, scored by box centres)."),
+    points: bool = typer.Option(False, "--points", help="Point ground truth (frame,id,x,y): match within --radius."),
+    radius: float | None = typer.Option(None, "--radius", min=0.0, help="With --points: match distance in pixels."),
     benchmark: str = typer.Option("MOT15", help=f"Ground-truth rules: {', '.join(BENCHMARKS)}."),
     metrics: Optional[list[str]] = typer.Option(None, "--metrics", help=f"Any of {', '.join(METRICS)} (repeatable; default all)."),
     iou_threshold: float = typer.Option(0.5, help="IoU a CLEAR/identity match needs."),
@@ -45,12 +50,19 @@ def eval_command(
 ) -> None:
     """Score trackers with HOTA, CLEAR MOT and identity metrics (values shown in %)."""
     chosen = [next((m for m in METRICS if m.lower() == x.lower()), x) for x in (metrics or METRICS)]
+    if points or radius is not None:
+        if not points or radius is None or radius <= 0:
+            fail("--points and --radius PX go together (point ground truth matched within PX pixels)")
     names = [p.name or str(p) for p in results]
     if len(set(names)) != len(names):
         names = [str(p) for p in results]
     scores: dict[str, dict[str, dict[str, float]]] = {}
     for name, folder in zip(names, results):
         try:
+            if points:
+                assert radius is not None
+                scores[name] = {COMBINED: score_points(gt, folder, radius)}
+                continue
             scores[name] = evaluate_folders(gt, folder, benchmark=benchmark, metrics=chosen,
                                             iou_threshold=iou_threshold, workers=workers)
         except (FileNotFoundError, ValueError) as exc:
