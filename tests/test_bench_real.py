@@ -125,8 +125,8 @@ def test_leaderboard_is_the_same_with_processes() -> None:
     parallel = _tables(run_jobs(entries, seqs, workers=2), entries, seqs)
     assert serial == parallel
     rows = serial[0]
-    assert {r["Tracker"] for r in rows} == {"sort", "boxtrack", "boxtrack-closed"}
-    assert sorted(r["Rank"] for r in rows) == [1, 2, 3]
+    assert {r["Tracker"] for r in rows} == {"sort", "boxtrack", "boxtrack-closed", "boxtrack-closed-offline"}
+    assert sorted(r["Rank"] for r in rows) == [1, 2, 3, 4]
     assert all(0 < r["IDF1"] <= 100 for r in rows)
 
 
@@ -215,7 +215,7 @@ def test_per_sequence_and_offline_entries() -> None:
     entries = default_entries(["boxtrack"], [])
     labels = lambda s: [e.label for e, _ in job_pairs(entries, [s])]
     # the synthetic dataset has neither per-sequence nor offline parameters
-    assert labels(syn) == ["boxtrack", "boxtrack-closed"]
+    assert labels(syn) == ["boxtrack", "boxtrack-closed", "boxtrack-closed-offline"]
     assert labels(seq) == ["boxtrack", "boxtrack-global", "boxtrack-offline"]
     # an offline entry is the online result post-processed with the dataset's chosen parameters
     pigs = RealSequence("pigs", "p", syn.frame_rate, syn.length, syn.det_xywh, syn.det_score, gt=syn.gt)
