@@ -156,6 +156,14 @@ def test_blob_settings_estimated_printed_and_overridden(tmp_path):
     text = _one_line_error(r)
     assert "estimated from the video" in text and "polarity=dark" in text and "threshold=" in text
     assert len(np.unique(read_mot(out).track_id)) == 3
+    again = tmp_path / "again.txt"  # the blob boxes re-tracked from their det.txt, same closed set
+    r = runner.invoke(app, ["track", "--video", str(video), "--detections", str(tmp_path / "t.det.txt"), "-t",
+                            "boxtrack", "--targets", "3", "--offline", "-o", str(again)])
+    assert r.exit_code == 0, r.output
+    np.testing.assert_array_equal(np.loadtxt(again, delimiter=","), np.loadtxt(out, delimiter=","))
+    r = runner.invoke(app, ["track", "--video", str(video), "--detector", "blob", "-t", "boxtrack", "--targets", "3",
+                            "--offline", "--annotate", str(tmp_path / "a.mp4"), "-o", str(out)])
+    assert r.exit_code != 0 and "--offline: not with --annotate" in _one_line_error(r)
     config, estimate = auto_blob_config(video, ["threshold=50", "open_px=5"], 3)
     assert estimate is not None and (config.threshold, config.open_px) == (50.0, 5)
     assert config.polarity == estimate.config.polarity == "dark"
