@@ -93,8 +93,8 @@ def test_boxtrack_closed_set_never_exceeds_the_target_count() -> None:
 
 
 def test_boxtrack_config_rejects_bad_values() -> None:
-    with pytest.raises(ValueError, match="report"):
-        make_tracker("boxtrack", report="middle")
+    with pytest.raises(ValueError, match="birth_quantile"):
+        make_tracker("boxtrack", birth_quantile=1.5)
     with pytest.raises(ValueError, match="max_targets"):
         make_tracker("boxtrack", max_targets=0)
     with pytest.raises(ValueError, match="low_score"):

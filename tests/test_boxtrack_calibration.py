@@ -1,14 +1,17 @@
 """boxtrack's self-calibration on the sequence's own tracks (issue #10): the high score threshold
 follows how often each score band continues confirmed tracks (``high_match_ratio``), and a missed
 track is reported at its prediction while tracks missed that long usually came back
-(``coast_report_prob``)."""
+(the constant ``COAST_REPORT_PROB``; issue 16 made it and the evidence counts constants)."""
 
 from __future__ import annotations
+
+from unittest.mock import patch
 
 import numpy as np
 import pytest
 
-from lookalike.trackers import make_tracker
+from lookalike.trackers import boxtrack_config, make_tracker
+from lookalike.trackers.boxtrack_config import CALIB_MIN_COUNT
 from lookalike.trackers.self_calibration import MissReturns, ScoreBands
 from lookalike.types import Detections, Frame
 
@@ -27,7 +30,7 @@ def _frame(k: int, boxes: np.ndarray, scores: np.ndarray) -> Frame:
 
 def _high(tracker) -> float:
     """The high threshold the tracker's score bands support so far."""
-    return tracker._calibration.bands.threshold(tracker.config.high_match_ratio, tracker.config.calib_min_count)
+    return tracker._calibration.bands.threshold(tracker.config.high_match_ratio, CALIB_MIN_COUNT)
 
 
 def _clutter(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -84,8 +87,6 @@ def test_short_misses_are_reported_at_the_prediction_once_they_usually_end_in_a_
             if s.detection_index == -1:
                 r = int(np.argmin(np.abs(_truth(k)[:, 1] - s.xywh[1])))
                 assert miss[k, r] and np.abs(s.xywh[0] - _truth(k)[r, 0]) < 10
-    off = _coast_run(make_tracker("boxtrack", coast_report_prob=None), miss)
-    assert not [s for snaps in off for s in snaps if s.detection_index == -1]
 
 
 def test_misses_that_end_tracks_are_not_reported() -> None:
@@ -118,8 +119,8 @@ def test_miss_returns_count_every_shorter_miss() -> None:
     assert misses.likely_present(np.array([1, 2]), 0.6, 4).tolist() == [True, False]  # length 2: 3 resolved
 
 
-@pytest.mark.parametrize("bad", [{"high_match_ratio": 1.5}, {"coast_report_prob": -0.1},
-                                 {"calib_min_count": 0}, {"coast_min_count": 0}])
+@pytest.mark.parametrize("bad", [{"high_match_ratio": 1.5}, {"high_match_ratio": -0.1},
+                                 {"calib_min_count": 100}, {"coast_report_prob": 0.7}])
 def test_calibration_settings_are_checked(bad: dict) -> None:
     with pytest.raises(ValueError):
         make_tracker("boxtrack", **bad)
@@ -137,8 +138,9 @@ def test_recently_seen_tracks_take_detections_before_long_lost_ones() -> None:
                 boxes.append([150.0, 50.0, 40.0, 80.0])
             yield _frame(k, np.array(boxes), np.full(len(boxes), 0.95))
 
-    for recent, keeps in ((2, True), (None, False)):
-        tracker = make_tracker("boxtrack", recent_frames=recent)
-        ids = [{s.detection_index: s.track_id for s in tracker.update(f)} for f in frames()]
+    for recent, keeps in ((2, True), (10**9, False)):  # the constant RECENT_FRAMES, and no priority
+        with patch.object(boxtrack_config, "RECENT_FRAMES", recent):
+            tracker = make_tracker("boxtrack")
+            ids = [{s.detection_index: s.track_id for s in tracker.update(f)} for f in frames()]
         assert ids[0] == {0: 1, 1: 2}
         assert (ids[12][0] == 1) is keeps

@@ -1,13 +1,15 @@
-"""boxtrack's score thresholds relative to the sequence's own scores (issue #10): ``high_quantile``
-lowers the high threshold for a detector that scores lower, ``tentative_quantile`` lets tentative
-tracks confirm on ordinary scores; both checked against the absolute thresholds alone."""
+"""boxtrack's score thresholds relative to the sequence's own scores (issue #10): the high threshold
+follows the 0.35-quantile of the scores seen (the constant ``HIGH_QUANTILE``), so a detector that
+scores lower gets a lower one; checked against the absolute thresholds alone."""
 
 from __future__ import annotations
+
+from unittest.mock import patch
 
 import numpy as np
 import pytest
 
-from lookalike.trackers import make_tracker
+from lookalike.trackers import boxtrack_config, make_tracker
 from lookalike.types import Detections, Frame
 
 FPS = 10.0
@@ -47,8 +49,9 @@ def test_high_quantile_recovers_targets_of_a_lower_scoring_detector() -> None:
     frames = _lower_scored_returns()
     # running scores: ~37-43% at 0.7, the rest 0.95 -> median 0.95 (birth 0.95, high 0.9),
     # 0.35-quantile 0.7
-    adaptive = _run(make_tracker("boxtrack", high_quantile=0.35), frames)
-    absolute = _run(make_tracker("boxtrack", high_quantile=None), frames)
+    adaptive = _run(make_tracker("boxtrack"), frames)
+    with patch.object(boxtrack_config, "HIGH_QUANTILE", 1.0):  # the absolute ceiling only
+        absolute = _run(make_tracker("boxtrack"), frames)
     first_ids = adaptive[0][4], adaptive[0][5]
     for k in range(13, 30):
         # a 0.7 detection is "high" for this detector: the lost tracks are re-identified by motion
@@ -61,37 +64,16 @@ def test_high_quantile_recovers_targets_of_a_lower_scoring_detector() -> None:
         assert len(frames[k][1]) - 1 not in adaptive[k]
 
 
-def test_tentative_quantile_confirms_on_ordinary_scores() -> None:
-    # three confident targets; a fourth appears in frame 5 scored 0.96 (born), then 0.7 (below high 0.9)
-    frames = []
-    for k in range(20):
-        boxes = [_box(k, r) for r in range(3)]
-        scores = [0.95] * 3
-        if k >= 5:
-            boxes.append(_box(k, 3))
-            scores.append(0.96 if k == 5 else 0.7)
-        frames.append((boxes, scores))
-    base = {"high_quantile": None, "n_init": 3}
-    with_low = _run(make_tracker("boxtrack", tentative_quantile=0.0, **base), frames)
-    without = _run(make_tracker("boxtrack", **base), frames)
-    # born in frame 5, hits in 6 and 7 -> confirmed and reported from frame 7 on, one identity
-    assert all(3 not in with_low[k] for k in range(7))
-    assert len({with_low[k][3] for k in range(7, 20)}) == 1
-    # without: the tentative track dies at its first frame without a confident detection
-    assert all(3 not in without[k] for k in range(20))
-    # a quantile above the target's scores changes nothing: 0.7 is the lowest score seen
-    assert _run(make_tracker("boxtrack", tentative_quantile=0.9, **base), frames) == without
-
-
 def test_quantile_thresholds_never_exceed_the_absolute_ones() -> None:
     # every score 0.99: quantiles lie above the absolute thresholds, which then apply unchanged
     frames = [([_box(k, r) for r in range(2)], [0.99, 0.99]) for k in range(15)]
-    out = _run(make_tracker("boxtrack", high_quantile=0.35, tentative_quantile=0.2), frames)
-    assert out == _run(make_tracker("boxtrack", high_quantile=None), frames)
+    out = _run(make_tracker("boxtrack", birth_quantile=0.2), frames)
+    with patch.object(boxtrack_config, "HIGH_QUANTILE", 1.0):
+        assert out == _run(make_tracker("boxtrack", birth_quantile=None), frames)
     assert all(out[k] == {0: 1, 1: 2} for k in range(15))
 
 
-@pytest.mark.parametrize("name", ["high_quantile", "birth_quantile", "tentative_quantile"])
+@pytest.mark.parametrize("name", ["birth_quantile", "high_match_ratio"])
 def test_quantiles_outside_unit_interval_are_rejected(name: str) -> None:
     with pytest.raises(ValueError, match=name):
         make_tracker("boxtrack", **{name: 1.5})

@@ -26,7 +26,9 @@ from lookalike.association.costs import centre_distance_cost, iou_cost
 from lookalike.association.stages import CostFn, Matching, Stage, run_plan
 from lookalike.motion import kalman
 from lookalike.motion.spaces import BoxCXCYWH, cxcywh_to_xywh
+from lookalike.trackers import boxtrack_config as const
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
+from lookalike.trackers.closed_slots import ClosedSlots
 from lookalike.trackers.coasting import Coasting
 from lookalike.trackers.lifecycle import Lifecycle
 from lookalike.trackers.registry import register_tracker
@@ -46,10 +48,12 @@ class BoxTrack:
 
     def __init__(self, config: BoxTrackConfig | None = None) -> None:
         self.config = cfg = config or BoxTrackConfig()
-        self._space = BoxCXCYWH(cfg.pos_noise, cfg.vel_noise)
+        self._space = BoxCXCYWH(const.POS_NOISE, cfg.vel_noise)
         lifecycle = Lifecycle(n_init=cfg.n_init, tentative_max_misses=None, tentative_max_unseen_s=0.0,
                               max_unseen_s=cfg.max_age_s)
         self._lifecycle = lifecycle.closed_set() if cfg.max_targets is not None else lifecycle
+        self._slots = None if cfg.max_targets is None else ClosedSlots(
+            cfg.max_targets, cfg.closed_distance, const.CLOSED_GATE_GROWTH, refill_s=cfg.max_age_s)
         self.reset()
 
     def reset(self) -> None:
@@ -59,10 +63,9 @@ class BoxTrack:
         self._frame_count = 0
         self._clock = FrameClock(cfg.frame_interval_s)
         self._calibration = ScoreCalibration(
-            cfg.high_score, cfg.birth_score, high_quantile=cfg.high_quantile, birth_quantile=cfg.birth_quantile,
-            tentative_quantile=cfg.tentative_quantile, high_match_ratio=cfg.high_match_ratio,
-            calib_min_count=cfg.calib_min_count)
-        self._coasting = Coasting(cfg.coast_s, cfg.coast_report_prob, cfg.coast_min_count)
+            cfg.high_score, cfg.birth_score, high_quantile=const.HIGH_QUANTILE, birth_quantile=cfg.birth_quantile,
+            high_match_ratio=cfg.high_match_ratio, calib_min_count=const.CALIB_MIN_COUNT)
+        self._coasting = Coasting(const.COAST_S, const.COAST_REPORT_PROB, const.COAST_MIN_COUNT)
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
@@ -77,12 +80,14 @@ class BoxTrack:
         det_box = self._space.measure(det_xywh)
         score = dets.score[keep]
         self._calibration.observe_scores(score)
-        high_score, birth_score, tentative_score = self._calibration.decide()
+        high_score, birth_score, _ = self._calibration.decide()
         was_tracked = t.unseen_s == 0
         if len(t):
+            if self._slots is not None:
+                self._slots.freeze_shape(t)
             t.mean[self._coasting.still(t.unseen_s), 4:] = 0.0  # a long-lost track waits where it was last seen
             t.mean, t.cov = self._space.predict(t.mean, t.cov, steps)
-        matching = self._associate(det_xywh, det_box, score, high_score, tentative_score, was_tracked,
+        matching = self._associate(det_xywh, det_box, score, high_score, was_tracked,
                                    t.unseen_s + dt)
         det_of_track, free = matching.det_of_track, matching.free
         matched = np.flatnonzero(det_of_track >= 0)
@@ -95,7 +100,11 @@ class BoxTrack:
             self._coasting.observe(came_back=t.misses[back])
         t.hits[det_of_track < 0] = 0
         t.record(det_of_track >= 0, dt)
-        t.confirmed |= (t.hits >= cfg.n_init) | ((self._frame_count == 1) & (t.hits > 0))
+        ready = (t.hits >= cfg.n_init) | ((self._frame_count == 1) & (t.hits > 0))
+        if self._slots is None:
+            t.confirmed |= ready
+        else:
+            det_of_track = self._slots.refill(t, ready, det_of_track)
         born = self._births(np.flatnonzero(free & (score >= birth_score)), det_box)
         out = self._report(np.concatenate([det_of_track, born]), det_idx, dets.xywh)
         alive = self._lifecycle.alive(t)
@@ -105,7 +114,7 @@ class BoxTrack:
         return out
 
     def _associate(self, det_xywh: np.ndarray, det_box: np.ndarray, score: np.ndarray, high_score: float,
-                   tentative_score: float, was_tracked: np.ndarray, unseen_s: np.ndarray) -> Matching:
+                   was_tracked: np.ndarray, unseen_s: np.ndarray) -> Matching:
         """The association plan: confident detections to confirmed tracks (recent ones first), low-score
         ones to tracks seen last frame, the rest to tentative tracks, then lost tracks by centre distance."""
         cfg, t = self.config, self._tracks
@@ -115,21 +124,18 @@ class BoxTrack:
         def overlap(min_iou: float, weigh: bool) -> CostFn:
             return lambda r, c: iou_cost(pred[r], det_xywh[c], min_iou, score[c] if weigh else None)
 
-        recent = t.misses <= (np.inf if cfg.recent_frames is None else cfg.recent_frames)
+        recent = t.misses <= const.RECENT_FRAMES
         matching = run_plan([
             Stage(t.confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent"),
             Stage(t.confirmed & ~recent, high, overlap(cfg.match_iou, True), name="confident, lost longer"),
-            Stage(t.confirmed & was_tracked, ~high, overlap(cfg.low_iou, False), name="low score"),
+            Stage(t.confirmed & was_tracked, ~high, overlap(const.LOW_IOU, False), name="low score"),
         ], len(t), len(score))
         self._calibration.observe_continued(score, matching.det_of_track[matching.det_of_track >= 0])
-        stages = [Stage(~t.confirmed, high, overlap(cfg.tentative_iou, False), name="tentative")]
-        if tentative_score < high_score:  # ordinary scores for this detector, though below the high threshold
-            stages.append(Stage(~t.confirmed, ~high & (score >= tentative_score), overlap(cfg.tentative_iou, False),
-                                name="tentative, ordinary score"))
-        if cfg.max_targets is not None:  # gates in track heights
-            gate = np.full((len(t), 1), cfg.closed_distance)
+        stages = [Stage(~t.confirmed, high, overlap(cfg.match_iou, False), name="tentative")]
+        if self._slots is not None:  # gates in track heights
+            gate = self._slots.gate(unseen_s)
         else:
-            gate = cfg.reid_distance + cfg.reid_growth * unseen_s[:, None]
+            gate = np.full((len(t), 1), cfg.reid_distance)
 
         def reid(r: np.ndarray, c: np.ndarray) -> np.ndarray:
             return centre_distance_cost(t.mean[r, :4], det_box[c], gate[r], cfg.reid_scale)
@@ -140,11 +146,12 @@ class BoxTrack:
     def _births(self, new: np.ndarray, det_box: np.ndarray) -> np.ndarray:
         """Start tentative tracks on detections ``new``; returns the detections used."""
         cfg, t = self.config, self._tracks
-        if cfg.max_targets is not None:
-            new = new[: max(cfg.max_targets - len(t), 0)]
+        if self._slots is not None:
+            new = new[: self._slots.room(t)]
         if len(new):
             mean, cov = self._space.initial(det_box[new])
-            t.add(mean, cov, hits=1, confirmed=self._frame_count == 1 or cfg.n_init <= 1)
+            first = self._frame_count == 1
+            t.add(mean, cov, hits=1, confirmed=first or (cfg.n_init <= 1 and self._slots is None))
         return new
 
     def _report(self, det_of_track: np.ndarray, det_idx: np.ndarray, det_xywh: np.ndarray) -> Tracks:
@@ -152,10 +159,7 @@ class BoxTrack:
         shown = np.flatnonzero(t.confirmed & (t.unseen_s == 0) & (det_of_track >= 0))
         coasted = np.flatnonzero(t.confirmed & (det_of_track < 0) & self._coasting.decide(t.misses))
         original = det_idx[det_of_track[shown]]
-        if self.config.report == "detection":
-            boxes = det_xywh[original]
-        else:
-            boxes = cxcywh_to_xywh(t.mean[shown, :4])
+        boxes = cxcywh_to_xywh(t.mean[shown, :4])
         if len(coasted):  # missed this frame but likely still there: the predicted box, no detection
             shown = np.concatenate([shown, coasted])
             original = np.concatenate([original, np.full(len(coasted), -1)])

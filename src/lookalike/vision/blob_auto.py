@@ -301,9 +301,9 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
 def overlap_hint(det_rows: np.ndarray, default_iou: float = 0.3) -> dict[str, float]:
     """Box-tracker overlap gates suited to blob detections ``(k, >=6)`` MOTChallenge rows (1-based frames,
     boxes in pixels): fast or small targets seen at a low frame rate barely overlap from one frame to
-    the next, so an IoU gate of ``default_iou`` would miss them. Returns ``{"match_iou": q,
-    "tentative_iou": q}`` with ``q`` the 10th percentile of each blob's best IoU with the next frame's
-    blobs (those with any overlap), within 0.01..``default_iou``; empty when nothing overlaps."""
+    the next, so an IoU gate of ``default_iou`` would miss them. Returns ``{"match_iou": q}`` with ``q``
+    the 10th percentile of each blob's best IoU with the next frame's blobs (those with any overlap),
+    within 0.01..``default_iou``; empty when nothing overlaps."""
     from lookalike.geometry.boxes import iou_matrix
 
     rows = np.asarray(det_rows, dtype=float)
@@ -320,4 +320,4 @@ def overlap_hint(det_rows: np.ndarray, default_iou: float = 0.3) -> dict[str, fl
     if not len(pooled):
         return {}
     q = float(min(max(np.percentile(pooled, 10), 0.01), default_iou))
-    return {"match_iou": round(q, 3), "tentative_iou": round(q, 3)}
+    return {"match_iou": round(q, 3)}

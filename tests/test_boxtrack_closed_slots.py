@@ -1,0 +1,83 @@
+"""Closed-set slots (``max_targets``): scenes built to lose a slot for good, and the rules that keep it.
+
+A lost slot's box shape is frozen while it coasts, its recovery gate grows with the time lost, and a
+slot lost longer than ``max_age_s`` is re-assigned to a confident detection that persisted
+``n_init`` frames where no slot recovered it."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lookalike.trackers import make_tracker
+from lookalike.trackers.closed_slots import ClosedSlots
+from lookalike.trackers.table import TrackTable
+from lookalike.types import Detections, Frame
+
+
+def _frame(k: int, boxes: list[list[float]], fps: float = 10.0) -> Frame:
+    xywh = np.array(boxes, dtype=float).reshape(-1, 4)
+    return Frame(index=k, time=k / fps, detections=Detections(xywh=xywh, score=np.full(len(xywh), 0.95)))
+
+
+def _ids(tracks) -> dict[int, np.ndarray]:  # type: ignore[no-untyped-def]
+    return {int(t.track_id): np.asarray(t.xywh) for t in tracks}
+
+
+def test_a_coasting_slot_keeps_its_shape() -> None:
+    # A target shrinking by 2 px a frame, then missing for 3 s: its box must not keep shrinking.
+    tracker = make_tracker("boxtrack", max_targets=2)
+    still = [400.0, 100.0, 30.0, 60.0]
+    for k in range(10):
+        tracker.update(_frame(k, [[100.0, 100.0, 60.0 - 2 * k, 120.0 - 4 * k], still]))
+    for k in range(10, 40):
+        tracker.update(_frame(k, [still]))
+    t = tracker._tracks
+    lost = int(np.flatnonzero(t.unseen_s > 0)[0])
+    w, h = t.mean[lost, 2:4]
+    assert 35 <= w <= 50 and 75 <= h <= 100  # the size at loss (42 x 84), not shrunk to nothing
+
+
+def test_a_target_back_far_away_after_long_gets_its_slot_back() -> None:
+    tracker = make_tracker("boxtrack", max_targets=2)
+    a, b = [100.0, 100.0, 20.0, 40.0], [500.0, 100.0, 20.0, 40.0]
+    for k in range(10):
+        tracker.update(_frame(k, [a, b]))
+    for k in range(10, 60):  # b missing 5 s
+        tracker.update(_frame(k, [a]))
+    seen: set[int] = set()
+    far = [500.0, 700.0, 20.0, 40.0]  # 15 heights away from where b was lost
+    for k in range(60, 80):
+        seen |= set(_ids(tracker.update(_frame(k, [a, far]))))
+    last = _ids(tracker.update(_frame(80, [a, far])))
+    assert seen <= {1, 2} and len(last) == 2  # no third identity; both reported
+
+
+def test_two_missing_at_once_both_come_back() -> None:
+    tracker = make_tracker("boxtrack", max_targets=3)
+    boxes = [[100.0, 100.0, 20.0, 40.0], [400.0, 100.0, 20.0, 40.0], [700.0, 100.0, 20.0, 40.0]]
+    for k in range(10):
+        tracker.update(_frame(k, boxes))
+    for k in range(10, 50):  # two of three missing 4 s
+        tracker.update(_frame(k, boxes[:1]))
+    back = [boxes[0], [400.0, 900.0, 20.0, 40.0], [700.0, 900.0, 20.0, 40.0]]
+    seen: set[int] = set()
+    for k in range(50, 70):
+        seen |= set(_ids(tracker.update(_frame(k, back))))
+    assert seen == {1, 2, 3}
+    assert len(_ids(tracker.update(_frame(70, back)))) == 3
+
+
+def test_the_recovery_gate_grows_with_time_lost() -> None:
+    slots = ClosedSlots(4, distance=4.0, growth=1.0, refill_s=1.0)
+    assert slots.gate(np.array([0.0, 2.0])).ravel().tolist() == [4.0, 6.0]
+
+
+def test_room_counts_free_and_long_lost_slots_less_waiting_candidates() -> None:
+    table = TrackTable(8)
+    table.add(np.zeros((3, 8)), np.zeros((3, 8, 8)), confirmed=True)
+    slots = ClosedSlots(3, distance=4.0, growth=1.0, refill_s=1.0)
+    assert slots.room(table) == 0
+    table.unseen_s[0] = 1.5  # lost long: its slot may be re-filled
+    assert slots.room(table) == 1
+    table.add(np.zeros((1, 8)), np.zeros((1, 8, 8)), hits=1)  # a candidate waiting
+    assert slots.room(table) == 0
