@@ -43,21 +43,8 @@ FPS = 25.0
 N_TARGETS = 3
 FEATURE_DIM = 8
 
-# (tracker, case) -> why it fails today (issue 17; trackers/ and learn/tracker.py are being refactored).
-_NAN = ("configs accept NaN: trackers.base.check_positive tests `value < 0`, which NaN passes; "
-        "no tracker checks isfinite")
-_TYPE = "a string parameter fails later with a TypeError from `<` that does not name the field"
-KNOWN_GAPS: dict[tuple[str, str], str] = {
-    **{(name, "nan"): _NAN for name in ("sort", "boxtrack", "deepsort", "diversort", "kalman_ha", "kalman_ha2",
-                                        "jpda", "lstm")},
-    **{(name, "wrong_type"): _TYPE for name in ("sort", "boxtrack", "deepsort", "diversort", "kalman_ha",
-                                                "kalman_ha2", "jpda")},
-    ("lstm", "wrong_type"): "LstmIdentifier.Config has no validation: n_slots='3' fails looking for shipped "
-                            "weights 'M=3' without naming the field",
-    ("lstm", "negative"): "LstmIdentifier.Config has no validation: n_agents=-1 fails looking for shipped "
-                          "weights 'N=-1' without naming the field",
-    ("lstm", "time_backwards"): "LstmIdentifier.update accepts an earlier time stamp (report ages go negative)",
-}
+# (tracker, case) -> why it fails today; empty when every tracker keeps the contract.
+KNOWN_GAPS: dict[tuple[str, str], str] = {}
 
 
 def _gap(name: str, case: str) -> list[Any]:

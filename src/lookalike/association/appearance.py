@@ -12,6 +12,19 @@ import numpy as np
 
 from lookalike.association.solver import Assignment
 from lookalike.association.stages import cascade, run_plan
+from lookalike.types import Detections
+
+
+def require_features(detections: Detections, tracker: str) -> np.ndarray:
+    """The ``(n, d)`` feature column, or ``ValueError`` when a non-empty batch lacks it."""
+    if detections.feature is None:
+        if len(detections) == 0:
+            return np.zeros((0, 0))
+        raise ValueError(
+            f"{tracker}: frame.detections.feature is missing; run an appearance extractor "
+            "(lookalike.vision.appearance) before the tracker"
+        )
+    return detections.feature
 
 
 def cosine_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -16,7 +16,7 @@ from lookalike.learn.checkpoint import load_weights
 from lookalike.learn.encoding import EncodingSpec, encode_frame
 from lookalike.learn.numpy_net import NumpyAssociationNet
 from lookalike.learn.weights import shipped_weights_path
-from lookalike.trackers.base import param
+from lookalike.trackers.base import check_positive, param
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
@@ -69,6 +69,9 @@ class LstmIdentifier:
         weights: str | None = param(None, "path of model.npz (None: the shipped weights for N, M)")
         one_to_one: bool = param(True, "decode with Hungarian on -log p (else per-slot argmax, as the paper)")
 
+        def __post_init__(self) -> None:
+            check_positive(self, "n_agents", "n_slots")
+
     def __init__(self, config: "LstmIdentifier.Config | None" = None) -> None:
         self.config = config or LstmIdentifier.Config()
         cfg = self.config
@@ -85,9 +88,13 @@ class LstmIdentifier:
         self._last_seen = np.full(self.config.n_agents, -1)
         self.last_labels = np.zeros(0, dtype=int)
         self.last_probabilities = np.zeros(0)
+        self._last_time = -np.inf
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
+        if frame.time < self._last_time:
+            raise ValueError(f"frame time went backwards: {self._last_time} s then {frame.time} s")
+        self._last_time = frame.time
         self._beacons.add(frame)
         det = frame.detections
         n = len(det)

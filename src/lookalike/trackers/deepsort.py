@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.association.appearance import FeatureGallery
+from lookalike.association.appearance import FeatureGallery, require_features
 from lookalike.association.stages import Stage, cascade, run_plan
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion import kalman
@@ -37,21 +37,9 @@ from lookalike.trackers.lifecycle import Lifecycle
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.table import TrackTable
 from lookalike.trackers.timing import FrameClock
-from lookalike.types import Detections, Frame, Tracks, TrackStatus
+from lookalike.types import Frame, Tracks, TrackStatus
 
 __all__ = ["DeepSort", "require_features", "xyah_to_xywh", "xywh_to_xyah"]
-
-
-def require_features(detections: Detections, tracker: str) -> np.ndarray:
-    """The ``(n, d)`` feature column, or ``ValueError`` when a non-empty batch lacks it."""
-    if detections.feature is None:
-        if len(detections) == 0:
-            return np.zeros((0, 0))
-        raise ValueError(
-            f"{tracker}: frame.detections.feature is missing; run an appearance extractor "
-            "(lookalike.vision.appearance) before the tracker"
-        )
-    return detections.feature
 
 
 @register_tracker("deepsort")

@@ -30,12 +30,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from lookalike.association.appearance import FeatureGallery
+from lookalike.association.appearance import FeatureGallery, require_features
 from lookalike.association.stages import Stage, run_plan
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion import kalman
 from lookalike.motion.spaces import CentreCV
-from lookalike.trackers.deepsort import require_features
 from lookalike.trackers.diversort_config import DiverSortConfig, Merge
 from lookalike.trackers.lifecycle import Lifecycle
 from lookalike.trackers.registry import register_tracker

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import typing
 from dataclasses import dataclass
 from typing import Any, Callable
+
+import numpy as np
 
 _REGISTRY: dict[str, type] = {}
 
@@ -73,7 +76,33 @@ def make_tracker(name: str, **params: Any) -> Any:
     unknown = sorted(set(params) - known)
     if unknown:
         raise ValueError(f"tracker {name!r} has no parameter(s) {unknown}; known: {sorted(known)}")
+    hints = typing.get_type_hints(_config_class(name))
+    for key, value in params.items():
+        check_value(name, key, value, hints[key])
     return cls(_config_class(name)(**params))
+
+
+def check_value(tracker: str, key: str, value: Any, hint: Any) -> None:
+    """``TypeError``/``ValueError`` naming ``key`` when ``value`` does not fit the parameter's type:
+    a number of the declared kind (``bool`` is not a number; an ``int`` is accepted for a ``float``),
+    finite, or None where the parameter is optional."""
+    args = [a for a in typing.get_args(hint) if a is not type(None)]
+    target = args[0] if args else hint
+    if value is None:
+        if type(None) not in typing.get_args(hint):
+            raise TypeError(f"tracker {tracker!r}: parameter {key!r} must not be None")
+        return
+    if target in (int, float):
+        kinds: tuple[type, ...] = (int, np.integer) if target is int else (int, float, np.integer, np.floating)
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, kinds):
+            raise TypeError(f"tracker {tracker!r}: parameter {key!r} must be {target.__name__}, "
+                            f"got {type(value).__name__} {value!r}")
+        if not math.isfinite(float(value)):
+            raise ValueError(f"tracker {tracker!r}: parameter {key!r} must be finite, got {value!r}")
+    elif target is bool and not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"tracker {tracker!r}: parameter {key!r} must be true or false, got {value!r}")
+    elif target is str and not isinstance(value, str):
+        raise TypeError(f"tracker {tracker!r}: parameter {key!r} must be text, got {value!r}")
 
 
 def parse_parameter(name: str, assignment: str) -> tuple[str, Any]:
@@ -112,11 +141,21 @@ def _convert(key: str, text: str, hint: Any) -> Any:
 PLUGIN_MODULES = ("lookalike.learn.tracker",)
 
 
+_PLUGINS_LOADED = False
+
+
 def _load_builtin() -> None:
-    # Importing the tracker modules registers them.
+    """Register the built-in trackers and the plugins: the entry points of group ``lookalike.trackers``
+    (read once), or :data:`PLUGIN_MODULES` where the package's metadata is not installed."""
+    global _PLUGINS_LOADED
+    import lookalike.trackers  # noqa: F401  (importing the tracker modules registers them)
+
+    if _PLUGINS_LOADED:
+        return
     import importlib
+    from importlib.metadata import entry_points
 
-    import lookalike.trackers  # noqa: F401
-
-    for module in PLUGIN_MODULES:
+    modules = {ep.module for ep in entry_points(group="lookalike.trackers")} or set(PLUGIN_MODULES)
+    for module in sorted(modules):
         importlib.import_module(module)
+    _PLUGINS_LOADED = True
