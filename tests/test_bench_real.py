@@ -65,7 +65,7 @@ def test_boxtrack_reidentifies_a_target_after_a_gap() -> None:
 
 
 def test_boxtrack_low_scores_never_start_tracks() -> None:
-    # Birth needs a score above min(birth_score, median of the scores seen): 0.2 is below both.
+    # Birth needs birth_score (0.95) until 100 detections have been judged for clutter: 0.2 is below.
     tracker = make_tracker("boxtrack")
     ids = set()
     for k in range(10):
@@ -74,7 +74,7 @@ def test_boxtrack_low_scores_never_start_tracks() -> None:
         ids |= {(t.track_id, t.detection_index) for t in tracker.update(Frame(index=k, time=k / 10, detections=dets))}
     assert {d for _, d in ids} == {0, 2}
     # With raw thresholds only, a detector that never exceeds 0.5 starts nothing.
-    tracker = make_tracker("boxtrack", birth_quantile=None)
+    tracker = make_tracker("boxtrack", clutter_factor=None)
     out = [tracker.update(_frame(k, [[10.0 * k, 50.0, 40.0, 80.0]], score=0.5)) for k in range(10)]
     assert all(not tracks for tracks in out)
 
@@ -93,8 +93,8 @@ def test_boxtrack_closed_set_never_exceeds_the_target_count() -> None:
 
 
 def test_boxtrack_config_rejects_bad_values() -> None:
-    with pytest.raises(ValueError, match="birth_quantile"):
-        make_tracker("boxtrack", birth_quantile=1.5)
+    with pytest.raises(ValueError, match="clutter_factor"):
+        make_tracker("boxtrack", clutter_factor=-1.0)
     with pytest.raises(ValueError, match="max_targets"):
         make_tracker("boxtrack", max_targets=0)
     with pytest.raises(ValueError, match="low_score"):

@@ -151,7 +151,7 @@ def test_costs_weigh_iou_by_score_and_gate_centre_distance_in_heights() -> None:
 def test_boxtrack_config_names_the_bad_field() -> None:
     from lookalike.trackers.boxtrack_config import BoxTrackConfig
 
-    for bad in ({"n_init": 0}, {"birth_quantile": 1.5}, {"low_score": 0.95}, {"reid_scale": 0.5},
+    for bad in ({"n_init": 0}, {"clutter_factor": 0}, {"low_score": 0.95}, {"reid_scale": 0.5},
                 {"vel_noise": 0}):
         with pytest.raises(ValueError, match=next(iter(bad))):
             BoxTrackConfig(**bad)

@@ -113,11 +113,11 @@ def test_folds():
 
 
 def test_parameter_file_round_trip(tmp_path: Path):
-    path = save_params(tmp_path / "p.json", "boxtrack", {"n_init": 2, "birth_quantile": None, "max_age_s": 1.5},
+    path = save_params(tmp_path / "p.json", "boxtrack", {"n_init": 2, "clutter_factor": None, "max_age_s": 1.5},
                        chosen_on=["sim/s0", "sim/s1"], criterion="hota+idf1+mota", trials=7, score=1.23)
     data = json.loads(path.read_text())
     assert {"tracker", "params", "chosen_on", "criterion", "trials", "lookalike_version"} <= set(data)
-    assert load_params(path, "boxtrack") == {"n_init": 2, "birth_quantile": None, "max_age_s": 1.5}
+    assert load_params(path, "boxtrack") == {"n_init": 2, "clutter_factor": None, "max_age_s": 1.5}
     content = read_params(path)
     assert content.chosen_on == ["sim/s0", "sim/s1"] and content.trials == 7 and content.extra["score"] == 1.23
 

@@ -29,6 +29,7 @@ from lookalike.motion.spaces import BoxCXCYWH, cxcywh_to_xywh
 from lookalike.trackers import boxtrack_config as const
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
 from lookalike.trackers.closed_slots import ClosedSlots
+from lookalike.trackers.clutter import ClutterShare
 from lookalike.trackers.coasting import Coasting
 from lookalike.trackers.lifecycle import Lifecycle
 from lookalike.trackers.registry import register_tracker
@@ -63,8 +64,9 @@ class BoxTrack:
         self._frame_count = 0
         self._clock = FrameClock(cfg.frame_interval_s)
         self._calibration = ScoreCalibration(
-            cfg.high_score, cfg.birth_score, high_quantile=const.HIGH_QUANTILE, birth_quantile=cfg.birth_quantile,
-            high_match_ratio=cfg.high_match_ratio, calib_min_count=const.CALIB_MIN_COUNT)
+            cfg.high_score, cfg.birth_score, high_quantile=const.HIGH_QUANTILE, high_match_ratio=cfg.high_match_ratio,
+            calib_min_count=const.CALIB_MIN_COUNT, clutter_factor=cfg.clutter_factor, clutter_floor=const.CLUTTER_FLOOR)
+        self._clutter = ClutterShare(const.CLUTTER_IOU, const.CALIB_MIN_COUNT)
         self._coasting = Coasting(const.COAST_S, const.COAST_REPORT_PROB, const.COAST_MIN_COUNT)
 
     def update(self, frame: Frame) -> Tracks:
@@ -80,7 +82,8 @@ class BoxTrack:
         det_box = self._space.measure(det_xywh)
         score = dets.score[keep]
         self._calibration.observe_scores(score)
-        high_score, birth_score, _ = self._calibration.decide()
+        self._clutter.observe(det_xywh)
+        high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
         was_tracked = t.unseen_s == 0
         if len(t):
             if self._slots is not None:

@@ -20,6 +20,8 @@ COAST_REPORT_PROB = 0.7  # missed tracks are reported at their prediction while 
 CALIB_MIN_COUNT = 100  # detections a score band needs before the self-calibration judges it
 COAST_MIN_COUNT = 30  # resolved misses of a length before the coast report judges that length
 POS_NOISE = 1 / 20  # position (and measurement) noise per frame, as a fraction of the box size
+CLUTTER_FLOOR = 0.1  # the birth threshold is never below this quantile of the scores seen
+CLUTTER_IOU = 0.5  # a detection overlapping a previous-frame detection this much is not clutter
 CLOSED_GATE_GROWTH = 1.0  # closed set: recovery gate grows by this many track heights per second lost
 
 
@@ -30,8 +32,9 @@ class BoxTrackConfig:
     high_score: float = param(0.9, "detections scoring at least this are matched first to confirmed tracks")
     low_score: float = param(0.1, "detections below this are ignored")
     birth_score: float = param(0.95, "detections scoring at least this may start tracks")
-    birth_quantile: float | None = param(
-        0.5, "if set, birth_score is lowered to this quantile of the scores seen so far")
+    clutter_factor: float | None = param(
+        2.0, "if set, birth_score is lowered to the quantile of the scores seen so far equal to this times the "
+             "share of detections overlapping none of the previous frame's (at least the 0.1-quantile)")
     high_match_ratio: float | None = param(
         0.6, "if set, high_score is lowered to the lowest 0.1-wide score bin from which every bin up continues "
              "confirmed tracks at least this fraction as often as the best bin")
@@ -51,7 +54,8 @@ class BoxTrackConfig:
         check_positive(self, "high_score", "low_score", "birth_score", "match_iou", "reid_distance", allow_zero=True)
         check_positive(self, "n_init", "max_age_s", "reid_scale", "max_targets", "closed_distance",
                        "vel_noise", "frame_interval_s")
-        for name in ("birth_quantile", "high_match_ratio"):
+        check_positive(self, "clutter_factor")
+        for name in ("high_match_ratio",):
             q = getattr(self, name)
             if q is not None and not 0 <= q <= 1:
                 raise ValueError(f"BoxTrack.Config.{name} must be in [0, 1], got {q}")

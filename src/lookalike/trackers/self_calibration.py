@@ -100,18 +100,21 @@ class ScoreCalibration:
 
     def __init__(self, high_score: float, birth_score: float, *, high_quantile: float | None = None,
                  birth_quantile: float | None = None, tentative_quantile: float | None = None,
-                 high_match_ratio: float | None = None, calib_min_count: int = 100, bins: int = 1000) -> None:
+                 high_match_ratio: float | None = None, calib_min_count: int = 100, bins: int = 1000,
+                 clutter_factor: float | None = None, clutter_floor: float = 0.1) -> None:
         self.high_score, self.birth_score = high_score, birth_score
         self.high_quantile, self.birth_quantile = high_quantile, birth_quantile
         self.tentative_quantile = tentative_quantile
         self.high_match_ratio, self.calib_min_count = high_match_ratio, calib_min_count
         self.bins = bins
+        self.clutter_factor, self.clutter_floor = clutter_factor, clutter_floor
         self.histogram = np.zeros(bins, dtype=np.int64)  # scores seen so far, binned on [0, 1]
         self.bands = ScoreBands(10)  # 0.1-wide bands: detections, and those that continued tracks
 
     @property
     def _quantiles(self) -> bool:
-        return not (self.high_quantile is None and self.birth_quantile is None and self.tentative_quantile is None)
+        return not (self.high_quantile is None and self.birth_quantile is None and self.tentative_quantile is None
+                    and self.clutter_factor is None)
 
     def observe_scores(self, score: np.ndarray) -> None:
         """Count this frame's scores (in [0, 1]) into the running distribution."""
@@ -124,8 +127,11 @@ class ScoreCalibration:
         if self.high_match_ratio is not None:
             self.bands.add(score, continued)
 
-    def decide(self) -> tuple[float, float, float]:
-        """This frame's ``(high, birth, tentative)`` score thresholds."""
+    def decide(self, clutter_share: float | None = None) -> tuple[float, float, float]:
+        """This frame's ``(high, birth, tentative)`` score thresholds; ``clutter_share`` (the share of
+        detections that are likely clutter, :class:`~lookalike.trackers.clutter.ClutterShare`) with
+        ``clutter_factor`` set lowers the birth one to the quantile ``clutter_factor·clutter_share``
+        (at least ``clutter_floor``) of the scores seen."""
         high, birth = self.high_score, self.birth_score
         if self.high_match_ratio is not None:
             high = min(high, self.bands.threshold(self.high_match_ratio, self.calib_min_count))
@@ -141,6 +147,8 @@ class ScoreCalibration:
                 high = min(high, edge(self.high_quantile))
             if self.birth_quantile is not None:
                 birth = min(birth, edge(self.birth_quantile))
+            if self.clutter_factor is not None and clutter_share is not None:
+                birth = min(birth, edge(min(max(self.clutter_factor * clutter_share, self.clutter_floor), 1.0)))
             if self.tentative_quantile is not None:
                 tentative = edge(self.tentative_quantile)
         high = min(high, birth)

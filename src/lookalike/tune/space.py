@@ -10,7 +10,7 @@ A JSON file overrides it (:func:`space_from_json`)::
     {"high_score": {"low": 0.5, "high": 0.99},
      "max_age_s": {"low": 0.25, "high": 4, "log": true},
      "n_init": {"low": 1, "high": 5, "type": "int"},
-     "birth_quantile": {"low": 0.05, "high": 0.9, "optional": true},
+     "clutter_factor": {"low": 0.5, "high": 8, "log": true, "optional": true},
      "low_score": 0.1}
 
 (a bare value fixes the parameter: it is passed to every trial and written to the result).
@@ -92,7 +92,7 @@ DEFAULT_SPACES: dict[str, Space] = {
         "high_score": _f(0.5, 0.99),
         "low_score": _f(0.01, 0.5, log=True),
         "birth_score": _f(0.5, 0.99),
-        "birth_quantile": _f(0.05, 0.9, optional=True),
+        "clutter_factor": _f(0.5, 8.0, log=True, optional=True),
         "high_match_ratio": _f(0.2, 0.95, optional=True),
         "match_iou": _f(0.05, 0.6),
         "n_init": _i(1, 5),

@@ -1,0 +1,42 @@
+"""Clutter share: how many of a detector's detections are one-frame flickers, without ground truth.
+
+A target is seen in consecutive frames, so its detection overlaps one of the previous frame's;
+most clutter does not. :class:`ClutterShare` counts, over the sequence so far, the detections that
+overlap none of the previous frame's detections (IoU below ``min_iou``). Their share estimates the
+fraction of a detector's detections that are clutter: low for a detector of large, slow animals
+that sees every target in every frame, higher for a pedestrian detector in a busy street. A birth
+threshold set at that quantile of the score distribution adapts to both (docs/trackers/boxtrack.md).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lookalike.geometry.boxes import iou_matrix
+
+
+class ClutterShare:
+    """Running share of detections with no overlap (IoU ≥ ``min_iou``) in the previous frame."""
+
+    def __init__(self, min_iou: float = 0.5, min_count: int = 100) -> None:
+        self.min_iou, self.min_count = min_iou, min_count
+        self.seen = 0
+        self.flicker = 0
+        self._previous: np.ndarray | None = None
+
+    def observe(self, xywh: np.ndarray) -> None:
+        """Count this frame's boxes ``(k, 4)`` (pixels) against the previous frame's."""
+        xywh = np.asarray(xywh, dtype=float).reshape(-1, 4)
+        if self._previous is not None and len(xywh):
+            if len(self._previous):
+                alone = iou_matrix(xywh, self._previous).max(axis=1) < self.min_iou
+            else:
+                alone = np.ones(len(xywh), dtype=bool)
+            self.seen += len(xywh)
+            self.flicker += int(alone.sum())
+        self._previous = xywh
+
+    @property
+    def share(self) -> float | None:
+        """The share of flickering detections, or None before ``min_count`` detections were judged."""
+        return self.flicker / self.seen if self.seen >= self.min_count else None
