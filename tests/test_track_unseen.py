@@ -150,15 +150,16 @@ def _arena(path: Path, frames: int = 30) -> Path:
 def test_blob_settings_estimated_printed_and_overridden(tmp_path):
     video = _arena(tmp_path / "arena.avi")
     out = tmp_path / "t.txt"
+    confident = ["--set", "high_score=0.5", "--set", "birth_score=0.5"]  # 90 blobs: too few to self-calibrate
     r = runner.invoke(app, ["track", "--video", str(video), "--detector", "blob", "-t", "boxtrack", "--targets", "3",
-                            "--offline", "-o", str(out)])
+                            "--offline", *confident, "-o", str(out)])
     assert r.exit_code == 0, r.output
     text = _one_line_error(r)
     assert "estimated from the video" in text and "polarity=dark" in text and "threshold=" in text
     assert len(np.unique(read_mot(out).track_id)) == 3
     again = tmp_path / "again.txt"  # the blob boxes re-tracked from their det.txt, same closed set
     r = runner.invoke(app, ["track", "--video", str(video), "--detections", str(tmp_path / "t.det.txt"), "-t",
-                            "boxtrack", "--targets", "3", "--offline", "-o", str(again)])
+                            "boxtrack", "--targets", "3", "--offline", *confident, "-o", str(again)])
     assert r.exit_code == 0, r.output
     np.testing.assert_array_equal(np.loadtxt(again, delimiter=","), np.loadtxt(out, delimiter=","))
     r = runner.invoke(app, ["track", "--video", str(video), "--detector", "blob", "-t", "boxtrack", "--targets", "3",
