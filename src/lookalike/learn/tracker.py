@@ -109,12 +109,16 @@ class LstmIdentifier:
             j = labels[k]
             if j >= 0 and det_of_agent[j] < 0:
                 det_of_agent[j] = k
+        if n and (det.position is None or det.heading is None):
+            raise ValueError("lstm: frame.detections need position (m) and heading (rad) columns")
+        position = det.position if det.position is not None else np.zeros((0, 2))
+        heading = det.heading if det.heading is not None else np.zeros(0)
         snapshots = []
         for j in range(self.config.n_agents):
             k = det_of_agent[j]
             if k >= 0:
                 alpha = conf[k]
-                target = det.position[k]
+                target = position[k]
                 prev = self._position[j]
                 self._position[j] = target if np.isnan(prev).any() else alpha * target + (1 - alpha) * prev
                 self._last_seen[j] = frame.index
@@ -125,7 +129,7 @@ class LstmIdentifier:
                     track_id=j + 1,
                     status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
                     position=self._position[j].copy(),
-                    heading=float(det.heading[k]) if k >= 0 else None,
+                    heading=float(heading[k]) if k >= 0 else None,
                     agent_id=j,
                     identity_prob=float(conf[k]) if k >= 0 else None,
                     detection_index=int(k),

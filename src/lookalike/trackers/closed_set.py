@@ -113,7 +113,8 @@ def _centres(rows: np.ndarray) -> np.ndarray:
 
 
 def _sizes(rows: np.ndarray) -> np.ndarray:
-    return np.sqrt(np.maximum(rows[:, 4] * rows[:, 5], 1.0))
+    out: np.ndarray = np.sqrt(np.maximum(rows[:, 4] * rows[:, 5], 1.0))
+    return out
 
 
 def _check_rows(rows: np.ndarray) -> np.ndarray:
@@ -130,7 +131,8 @@ def _steps(rows: np.ndarray) -> np.ndarray:
     order = np.lexsort((rows[:, 0], rows[:, 1]))
     r = rows[order]
     same = (np.diff(r[:, 1]) == 0) & (np.diff(r[:, 0]) == 1)
-    return np.linalg.norm(np.diff(_centres(r), axis=0), axis=1)[same]
+    steps: np.ndarray = np.linalg.norm(np.diff(_centres(r), axis=0), axis=1)[same]
+    return steps
 
 
 def _contact_frames(rows: np.ndarray, min_iou: float) -> np.ndarray:
@@ -151,7 +153,7 @@ def _contact_frames(rows: np.ndarray, min_iou: float) -> np.ndarray:
 def _fill_short(mask: np.ndarray, k: int) -> np.ndarray:
     """``mask`` with runs of fewer than ``k`` False values between two True values set True (a contact
     that flickers for a few frames is one contact)."""
-    out = mask.copy()
+    out: np.ndarray = mask.copy()
     on = np.flatnonzero(mask)
     for a, b in zip(on[:-1], on[1:]):
         if 1 < b - a <= k:
@@ -380,7 +382,8 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     rows = _check_rows(rows)
     pieces = split_tracklets(rows, cfg)
     if not pieces:
-        return rows.copy()
+        unchanged: np.ndarray = rows.copy()
+        return unchanged
     tracklets = [t for t in pieces if len(t) >= cfg.min_rows] or pieces
     short = [t for t in pieces if len(t) < cfg.min_rows and tracklets is not pieces]
     links = link_costs(tracklets, frame_rate, cfg)

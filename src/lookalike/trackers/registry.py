@@ -97,7 +97,7 @@ def check_value(tracker: str, key: str, value: Any, hint: Any) -> None:
         if isinstance(value, (bool, np.bool_)) or not isinstance(value, kinds):
             raise TypeError(f"tracker {tracker!r}: parameter {key!r} must be {target.__name__}, "
                             f"got {type(value).__name__} {value!r}")
-        if not math.isfinite(float(value)):
+        if not math.isfinite(float(typing.cast(float, value))):
             raise ValueError(f"tracker {tracker!r}: parameter {key!r} must be finite, got {value!r}")
     elif target is bool and not isinstance(value, (bool, np.bool_)):
         raise TypeError(f"tracker {tracker!r}: parameter {key!r} must be true or false, got {value!r}")

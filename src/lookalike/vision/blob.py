@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Iterable
+from typing import Any, Iterable
 
 import numpy as np
 
@@ -75,7 +75,7 @@ class BlobDetector:
     background_: np.ndarray | None = field(default=None, init=False, repr=False)
     _buffer: deque = field(init=False, repr=False)
     _seen: int = field(default=0, init=False, repr=False)
-    _mog: object = field(default=None, init=False, repr=False)
+    _mog: Any = field(default=None, init=False, repr=False)
     _fitted: bool = field(default=False, init=False, repr=False)
     _reference: np.ndarray | None = field(default=None, init=False, repr=False)
     _window: np.ndarray | None = field(default=None, init=False, repr=False)
@@ -122,7 +122,7 @@ class BlobDetector:
             raw = self._mog.apply(img.astype(np.uint8))
             bg = self._mog.getBackgroundImage()
             diff = self._difference(img, bg.astype(np.float32) if bg is not None else img)
-            mask = np.where((raw > 0) & (diff > 0), 255, 0).astype(np.uint8)
+            mask: np.ndarray = np.where((raw > 0) & (diff > 0), 255, 0).astype(np.uint8)
         else:
             if not self._fitted:
                 if self._seen % cfg.sample_every == 0:
@@ -186,7 +186,7 @@ class BlobDetector:
             self._window = cv2.createHanningWindow(grey.shape[::-1], cv2.CV_32F)
             return img
         (dx, dy), _ = cv2.phaseCorrelate(self._reference, grey.astype(np.float32), self._window)
-        shift = np.float32([[1, 0, -dx], [0, 1, -dy]])
+        shift = np.array([[1, 0, -dx], [0, 1, -dy]], dtype=np.float32)
         return cv2.warpAffine(img, shift, grey.shape[::-1], borderMode=cv2.BORDER_REPLICATE)
 
     def _difference(self, img: np.ndarray, background: np.ndarray) -> np.ndarray:

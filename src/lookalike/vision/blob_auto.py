@@ -232,11 +232,11 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     grey = [im.mean(axis=2).astype(np.float32) for im in imgs]
     moves = _shifts(grey) if len(grey) > 1 else np.zeros((1, 2))
     shake = float(np.median(np.hypot(moves[:, 0], moves[:, 1]))) / scale
-    stack = np.stack(imgs)
+    stack: np.ndarray = np.stack(imgs)
     stabilise = False
     if shake > shake_px:  # keep the alignment only if it makes the frames agree better with their median
         h, w = grey[0].shape
-        aligned = np.stack([cv2.warpAffine(im, np.float32([[1, 0, -dx], [0, 1, -dy]]), (w, h),
+        aligned = np.stack([cv2.warpAffine(im, np.array([[1, 0, -dx], [0, 1, -dy]], dtype=np.float32), (w, h),
                                            borderMode=cv2.BORDER_REPLICATE) for im, (dx, dy) in zip(imgs, moves)])
         if _spread(aligned) < _ALIGN_GAIN * _spread(stack):
             stack, stabilise = aligned, True
@@ -261,7 +261,7 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     results = {}
     for thr in candidates:
         per_frame, masks = [], []
-        raw = [np.where(sig > thr, 255, 0).astype(np.uint8) for sig in signal]
+        raw: list[np.ndarray] = [np.where(sig > thr, 255, 0).astype(np.uint8) for sig in signal]
         if kernel is not None:
             raw = [cv2.morphologyEx(m, cv2.MORPH_OPEN, kernel) for m in raw]
         persistent = np.mean(np.stack(raw) > 0, axis=0) > _PERSISTENT_SHARE
