@@ -400,7 +400,7 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
         out.append(block)
     merged = np.vstack(out) if out else np.zeros((0, 10))
     merged = merged[np.lexsort((merged[:, 1], merged[:, 0]))]
-    max_fill = len(np.unique(merged[:, 0])) + int(merged[:, 0].max()) if math.isinf(cfg.fill_gap_s) else round(
+    max_fill = len(np.unique(merged[:, 0])) + int(merged[:, 0].max(initial=0)) if math.isinf(cfg.fill_gap_s) else round(
         cfg.fill_gap_s * frame_rate)
     return fill_gaps(merged, max_fill) if len(merged) else merged
 
