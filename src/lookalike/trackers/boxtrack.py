@@ -66,7 +66,7 @@ class BoxTrack:
         self._calibration = ScoreCalibration(
             cfg.high_score, cfg.birth_score, high_quantile=const.HIGH_QUANTILE, high_match_ratio=cfg.high_match_ratio,
             calib_min_count=const.CALIB_MIN_COUNT, clutter_factor=cfg.clutter_factor, clutter_floor=const.CLUTTER_FLOOR)
-        self._clutter = ClutterShare(const.CLUTTER_IOU, const.CALIB_MIN_COUNT)
+        self._clutter = ClutterShare(const.CLUTTER_IOU, const.CLUTTER_MIN_COUNT)
         self._coasting = Coasting(const.COAST_S, const.COAST_REPORT_PROB, const.COAST_MIN_COUNT)
 
     def update(self, frame: Frame) -> Tracks:

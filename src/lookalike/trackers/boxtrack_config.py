@@ -22,6 +22,7 @@ COAST_MIN_COUNT = 30  # resolved misses of a length before the coast report judg
 POS_NOISE = 1 / 20  # position (and measurement) noise per frame, as a fraction of the box size
 CLUTTER_FLOOR = 0.1  # the birth threshold is never below this quantile of the scores seen
 CLUTTER_IOU = 0.5  # a detection overlapping a previous-frame detection this much is not clutter
+CLUTTER_MIN_COUNT = 10  # detections judged before the clutter share is used
 CLOSED_GATE_GROWTH = 1.0  # closed set: recovery gate grows by this many track heights per second lost
 
 
@@ -39,8 +40,9 @@ class BoxTrackConfig:
         0.6, "if set, high_score is lowered to the lowest 0.1-wide score bin from which every bin up continues "
              "confirmed tracks at least this fraction as often as the best bin")
     match_iou: float = param(0.3, "minimum IoU of a confident detection with a confirmed or tentative track")
-    n_init: int = param(3, "consecutive hits that confirm a track")
-    max_age_s: float = param(1.0, "seconds a confirmed track survives without a detection")
+    n_init: int = param(2, "consecutive hits that confirm a track")
+    max_age_s: float = param(2.0, "seconds a confirmed track survives without a detection (closed set: "
+                                  "before its slot may be re-filled)")
     reid_distance: float = param(0.5, "centre distance (track heights) that re-identifies a lost track")
     reid_scale: float = param(1.5, "largest width/height ratio between a lost track and its detection")
     vel_noise: float = param(
