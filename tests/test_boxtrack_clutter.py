@@ -57,7 +57,8 @@ def test_a_clutter_free_detector_gets_a_low_birth_threshold() -> None:
     assert len(ids) == 1
     off = make_tracker("boxtrack", clutter_factor=None)
     for k in range(60):
-        off.update(Frame(index=k, time=k / FPS, detections=Detections(xywh=_targets(k), score=rng.uniform(0.6, 1.0, 6))))
+        dets = Detections(xywh=_targets(k), score=rng.uniform(0.6, 1.0, 6))
+        off.update(Frame(index=k, time=k / FPS, detections=dets))
     assert _birth(off) == 0.95  # the absolute threshold alone
 
 
