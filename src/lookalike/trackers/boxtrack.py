@@ -5,17 +5,19 @@ A composition of shared parts: a :class:`~lookalike.trackers.table.TrackTable` o
 in pixels/frame), an association plan of IoU and centre-distance stages split by detection score
 (:mod:`lookalike.association.stages`), a :class:`~lookalike.trackers.lifecycle.Lifecycle` (confirmed
 after ``n_init`` hits, deleted after ``max_age_s`` seconds, never in a closed set), score thresholds
-that calibrate themselves on the sequence (:class:`~lookalike.trackers.self_calibration.ScoreCalibration`)
-and coasting (:class:`~lookalike.trackers.coasting.Coasting`).
+that calibrate themselves on the sequence (:class:`~lookalike.trackers.self_calibration.ScoreCalibration`),
+coasting (:class:`~lookalike.trackers.coasting.Coasting`), a birth threshold that follows the
+detector's clutter (:class:`~lookalike.trackers.clutter.ClutterShare`) and, with ``max_targets``,
+closed-set slots (:class:`~lookalike.trackers.closed_slots.ClosedSlots`).
 
 Each frame: detections below ``low_score`` are dropped; confirmed tracks take confident detections
-on ``1 - IoU·score`` (those missed at most ``recent_frames`` frames first), tracks updated in the
-previous frame take low-score ones on IoU, tentative tracks take the rest on IoU, and lost confirmed
-tracks take what confident detections remain on centre distance (re-identification). Left-over
-detections scoring at least the birth threshold start tentative tracks (at most ``max_targets``
-tracks exist in a closed set). Confirmed tracks matched this frame are reported with their filtered
-(or detected) box, and confirmed tracks likely still present at their predicted box
-(``detection_index`` -1). The mechanisms and where every default comes from: docs/trackers/boxtrack.md.
+on ``1 - IoU·score`` (those missed at most 2 frames first), tracks updated in the previous frame
+take low-score ones on IoU, tentative tracks take the rest on IoU, and lost confirmed tracks take
+what confident detections remain on centre distance (re-identification). Left-over detections
+scoring at least the birth threshold start tentative tracks (in a closed set, only where a slot is
+free or lost ``max_age_s``). Confirmed tracks matched this frame are reported with their filtered
+box, and confirmed tracks likely still present at their predicted box (``detection_index`` -1).
+The mechanisms and where every default comes from: docs/trackers/boxtrack.md.
 """
 
 from __future__ import annotations
