@@ -81,3 +81,17 @@ def test_room_counts_free_and_long_lost_slots_less_waiting_candidates() -> None:
     assert slots.room(table) == 1
     table.add(np.zeros((1, 8)), np.zeros((1, 8, 8)), hits=1)  # a candidate waiting
     assert slots.room(table) == 0
+
+
+def test_the_gate_grows_with_the_targets_typical_speed_and_sizes_ignore_turning() -> None:
+    table = TrackTable(8)
+    mean = np.zeros((2, 8))
+    mean[:, 2:4] = [10.0, 40.0]  # size sqrt(10*40) = 20 px
+    mean[:, 4] = 4.0  # 4 px/frame = 0.2 sizes/frame = 2 sizes/s at 10 frames/s
+    table.add(mean, np.zeros((2, 8, 8)), confirmed=True)
+    slots = ClosedSlots(2, distance=8.0, growth=1.0, refill_s=2.0)
+    slots.observe_speed(table, np.array([True, True]), dt=0.1)
+    assert slots.speed == np.float64(2.0)
+    assert slots.gate(np.array([1.0])).ravel().tolist() == [12.0]  # 8 + 2 x 2 sizes/s x 1 s
+    turned = ClosedSlots.squared(np.array([[0.0, 0.0, 40.0, 10.0]]))
+    assert turned[0, 2:].tolist() == [20.0, 20.0] == ClosedSlots.squared(mean[:1, :4])[0, 2:].tolist()

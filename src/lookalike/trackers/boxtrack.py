@@ -104,6 +104,8 @@ class BoxTrack:
             back = matched[t.confirmed[matched] & (t.misses[matched] > 0)]
             self._coasting.observe(came_back=t.misses[back])
         t.hits[det_of_track < 0] = 0
+        if self._slots is not None:
+            self._slots.observe_speed(t, det_of_track >= 0, self._clock.interval)
         t.record(det_of_track >= 0, dt)
         ready = (t.hits >= cfg.n_init) | ((self._frame_count == 1) & (t.hits > 0))
         if self._slots is None:
@@ -142,8 +144,13 @@ class BoxTrack:
         else:
             gate = np.full((len(t), 1), cfg.reid_distance)
 
+        track_box, box, scale = t.mean[:, :4], det_box, cfg.reid_scale
+        if self._slots is not None:  # closed set: sizes as sqrt(w·h), a turning target keeps its size
+            track_box, box = self._slots.squared(track_box), self._slots.squared(det_box)
+            scale = max(scale, const.CLOSED_SCALE)
+
         def reid(r: np.ndarray, c: np.ndarray) -> np.ndarray:
-            return centre_distance_cost(t.mean[r, :4], det_box[c], gate[r], cfg.reid_scale)
+            return centre_distance_cost(track_box[r], box[c], gate[r], scale)
 
         stages.append(Stage(t.confirmed, high, reid, name="re-identification"))
         return run_plan(stages, len(t), len(score), start=matching)

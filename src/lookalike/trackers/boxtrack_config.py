@@ -23,7 +23,8 @@ POS_NOISE = 1 / 20  # position (and measurement) noise per frame, as a fraction 
 CLUTTER_FLOOR = 0.1  # the birth threshold is never below this quantile of the scores seen
 CLUTTER_IOU = 0.5  # a detection overlapping a previous-frame detection this much is not clutter
 CLUTTER_MIN_COUNT = 10  # detections judged before the clutter share is used
-CLOSED_GATE_GROWTH = 1.0  # closed set: recovery gate grows by this many track heights per second lost
+CLOSED_GATE_GROWTH = 1.0  # closed set: recovery gate grows at least this many sizes per second lost
+CLOSED_SCALE = 3.0  # closed set: a recovered detection's sqrt(area) within this factor of its slot's
 
 
 @dataclass(frozen=True)
@@ -49,7 +50,7 @@ class BoxTrackConfig:
         1 / 160, "velocity noise per frame, as a fraction of the box size (position noise is 1/20)")
     max_targets: int | None = param(None, "known number of targets (closed set), None when open")
     closed_distance: float = param(
-        4.0, "closed set: centre distance (track heights) gating recovery, plus one height per second lost")
+        8.0, "closed set: centre distance (slot sizes, sqrt(w*h)) gating recovery; grows with the time lost")
     frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)")
 
     def __post_init__(self) -> None:

@@ -5,8 +5,11 @@ die. Three rules keep a slot recoverable however long it is lost:
 
 - while a slot coasts, its box shape is frozen (no size velocity), so the shape gate keeps
   accepting ordinary detections (:meth:`ClosedSlots.freeze_shape`);
-- the recovery gate (centre distance in the slot's heights) grows with the time lost
-  (:meth:`ClosedSlots.gate`);
+- the recovery gate (centre distance in the slot's size) grows with the time lost, by one size per
+  second or twice the targets' typical speed, whichever is more (:meth:`ClosedSlots.gate`;
+  :meth:`ClosedSlots.observe_speed` measures it on the tracked slots); sizes are ``sqrt(w·h)``, so
+  a target that turns (a fish bending, a wide box becoming tall) keeps passing the shape gate
+  (:meth:`ClosedSlots.squared`);
 - a slot lost for ``refill_s`` seconds or more is re-assigned to a candidate: a tentative track
   started on left-over confident detections that persisted for ``n_init`` frames (the evidence a
   target is there that no slot recovered). The slot keeps its id and takes the candidate's state
@@ -25,6 +28,7 @@ class ClosedSlots:
 
     def __init__(self, size: int, distance: float, growth: float, refill_s: float) -> None:
         self.size, self.distance, self.growth, self.refill_s = size, distance, growth, refill_s
+        self.speed = 0.0  # typical speed of tracked slots, sizes per second (running mean of frame medians)
 
     def freeze_shape(self, table: TrackTable) -> None:
         """Drop the size velocity of every slot that missed its last detection (pixels/frame)."""
@@ -32,8 +36,25 @@ class ClosedSlots:
         table.mean[lost, 6:8] = 0.0
 
     def gate(self, unseen_s: np.ndarray) -> np.ndarray:
-        """``(k, 1)`` recovery gate in track heights: ``distance`` plus ``growth`` per second lost."""
-        return (self.distance + self.growth * np.asarray(unseen_s, dtype=float))[:, None]
+        """``(k, 1)`` recovery gate in track sizes: ``distance`` plus, per second lost, ``growth`` or
+        twice the typical speed (sizes per second), whichever is more."""
+        rate = max(self.growth, 2.0 * self.speed)
+        return (self.distance + rate * np.asarray(unseen_s, dtype=float))[:, None]
+
+    def observe_speed(self, table: TrackTable, tracked: np.ndarray, dt: float) -> None:
+        """Update the typical speed from the slots ``tracked`` (mask) this frame (``dt`` seconds a frame)."""
+        rows = np.flatnonzero(tracked & table.confirmed)
+        if len(rows) and dt > 0:
+            size = np.sqrt(np.maximum(table.mean[rows, 2] * table.mean[rows, 3], 1e-9))
+            v = float(np.median(np.hypot(table.mean[rows, 4], table.mean[rows, 5]) / size)) / dt
+            self.speed = v if self.speed == 0.0 else 0.9 * self.speed + 0.1 * v
+
+    @staticmethod
+    def squared(box: np.ndarray) -> np.ndarray:
+        """``[cx, cy, w, h]`` boxes as squares of the same area (``[cx, cy, s, s]``, ``s = sqrt(w·h)``)."""
+        out = np.array(box[:, :4], dtype=float, copy=True)
+        out[:, 2] = out[:, 3] = np.sqrt(np.maximum(out[:, 2] * out[:, 3], 0.0))
+        return out
 
     def _refillable(self, table: TrackTable) -> np.ndarray:
         return np.flatnonzero(table.confirmed & (table.unseen_s >= self.refill_s))

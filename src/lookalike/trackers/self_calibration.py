@@ -131,7 +131,7 @@ class ScoreCalibration:
         """This frame's ``(high, birth, tentative)`` score thresholds; ``clutter_share`` (the share of
         detections that are likely clutter, :class:`~lookalike.trackers.clutter.ClutterShare`) with
         ``clutter_factor`` set lowers the birth one to the quantile ``clutter_factor·clutter_share``
-        (at least ``clutter_floor``) of the scores seen."""
+        (at least ``clutter_floor``) of the scores seen; to the median while the share is None."""
         high, birth = self.high_score, self.birth_score
         if self.high_match_ratio is not None:
             high = min(high, self.bands.threshold(self.high_match_ratio, self.calib_min_count))
@@ -147,8 +147,9 @@ class ScoreCalibration:
                 high = min(high, edge(self.high_quantile))
             if self.birth_quantile is not None:
                 birth = min(birth, edge(self.birth_quantile))
-            if self.clutter_factor is not None and clutter_share is not None:
-                birth = min(birth, edge(min(max(self.clutter_factor * clutter_share, self.clutter_floor), 1.0)))
+            if self.clutter_factor is not None:  # before the share is judged: the median
+                q = 0.5 if clutter_share is None else max(self.clutter_factor * clutter_share, self.clutter_floor)
+                birth = min(birth, edge(min(q, 1.0)))
             if self.tentative_quantile is not None:
                 tentative = edge(self.tentative_quantile)
         high = min(high, birth)
