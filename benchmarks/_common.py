@@ -5,8 +5,9 @@ from __future__ import annotations
 import itertools
 import statistics
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 

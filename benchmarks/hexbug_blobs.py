@@ -6,7 +6,8 @@ points oriented by the frame bounds). Detection recall/precision: a
 ground-truth head point is found when a detection box, grown by ``--margin`` pixels, contains it
 (one-to-one, Hungarian on the point-to-box distance). Tracking: each tracker runs as in ``lookalike
 bench real`` (:func:`~lookalike.bench.runner.track_rows`: boxtrack's defaults; its HexBug parameters chosen on
-the clips' first halves only in the separate "tuned on this data" row) and its box centres are scored with point matching within 120 px
+the clips' first halves only in the separate "tuned on this data" row) and its box centres are scored with point
+matching within 120 px
 (:func:`~lookalike.bench.runner.score_rows`: IDF1, MOTA; a box centre lies about half a bug from
 the head, hence the large radius). ``boxtrack8``-style closed sets: ``--closed`` adds boxtrack with
 ``max_targets`` = the number of bugs annotated in the clip's CSV (the known team size).

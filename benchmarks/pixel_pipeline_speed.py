@@ -20,9 +20,9 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # o
 
 import numpy as np  # noqa: E402
 
-from lookalike.viz.robot_pixels import identifier_settings, pixel_camera, render_robot_frames, world_for_camera
 from lookalike.sim import preset, simulate_robots
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
+from lookalike.viz.robot_pixels import identifier_settings, pixel_camera, render_robot_frames, world_for_camera
 
 
 def main() -> None:

@@ -53,7 +53,8 @@ def folds_for(keys: list[str], groups: list[str]) -> list[Fold]:
         out += [Fold(keys[i], tuple(j for j in mot15 if j != i), (i,)) for i in mot15]
     datasets = list(dict.fromkeys(groups))
     if len(datasets) >= 2:
-        out += [Fold(d, tuple(j for j, g in enumerate(groups) if g != d), tuple(j for j, g in enumerate(groups) if g == d))
+        out += [Fold(d, tuple(j for j, g in enumerate(groups) if g != d),
+                     tuple(j for j, g in enumerate(groups) if g == d))
                 for d in datasets]
     return out
 
@@ -97,7 +98,8 @@ def main() -> None:
     for g in sorted(gains, key=lambda g: -g.mean):
         loso = sum(g.gains[:n_loso]) / n_loso if n_loso else float("nan")
         lodo = sum(g.gains[n_loso:]) / (len(g.gains) - n_loso) if len(g.gains) > n_loso else float("nan")
-        chosen = ", ".join("d" if c == "default" else (f"{c:.3g}" if isinstance(c, float) else str(c)) for c in g.chosen)
+        chosen = ", ".join("d" if c == "default" else (f"{c:.3g}" if isinstance(c, float) else str(c))
+                           for c in g.chosen)
         lines.append(f"| {g.name} | {g.mean:+.2f} | {g.sd:.2f} / {g.se:.2f} | {loso:+.2f} | {lodo:+.2f} | "
                      f"{g.spread:.2f} | {chosen} | {g.verdict} |")
     text = "\n".join(lines)

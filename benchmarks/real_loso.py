@@ -114,7 +114,8 @@ def main() -> None:
         out["lodo"] = []
         for c in choices:
             on = sorted({k.split('/')[0] for k in c.chosen_on})
-            print(f"  left out {c.fold:12s} chose #{c.candidate:<3d} on {'+'.join(on)} -> left-out {_fmt(c.test_scores)}")
+            print(f"  left out {c.fold:12s} chose #{c.candidate:<3d} on {'+'.join(on)} "
+                  f"-> left-out {_fmt(c.test_scores)}")
             print(f"    params: {c.params or 'defaults'}")
             rows.setdefault(c.fold, []).append(("boxtrack (LODO choice)", "+".join(on), c.test_scores))
             out["lodo"].append({"left_out": c.fold, "chosen_on": on, "candidate": c.candidate, "params": c.params,
@@ -122,7 +123,8 @@ def main() -> None:
                                 "MOTA": c.test_scores["MOTA"]})
     for d in dict.fromkeys(groups):
         idx = [i for i, g in enumerate(groups) if g == d]
-        rows.setdefault(d, []).append(("boxtrack (defaults)", "boxtrack's defaults", combine([table[0][i] for i in idx])))
+        rows.setdefault(d, []).append(("boxtrack (defaults)", "boxtrack's defaults",
+                                       combine([table[0][i] for i in idx])))
     wanted = [] if args.peers == "none" else [p.strip() for p in args.peers.split(",") if p.strip()]
     status = peer_status(wanted) if wanted else {}
     for p, why in status.items():

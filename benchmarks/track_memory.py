@@ -52,7 +52,8 @@ def write_detections(path: Path, frames: int, targets: int, seed: int = 0) -> No
                      for x, y in seen]
             if k % 2 == 0:
                 x, y = rng.uniform(0, 1, 2) * (size - box)
-                lines.append(f"{k + 1},-1,{x:.2f},{y:.2f},{box[0]:.1f},{box[1]:.1f},{rng.uniform(0.3, 0.7):.3f},-1,-1,-1\n")
+                lines.append(f"{k + 1},-1,{x:.2f},{y:.2f},{box[0]:.1f},{box[1]:.1f},"
+                             f"{rng.uniform(0.3, 0.7):.3f},-1,-1,-1\n")
             fh.writelines(lines)
 
 
@@ -88,7 +89,8 @@ def main() -> int:
             mib, seconds = peak_rss_mib(det, Path(tmp) / f"out{n}.txt", args.tracker, args.src)
             rows = sum(1 for _ in (Path(tmp) / f"out{n}.txt").open())
             peaks.append(mib)
-            print(f"{args.tracker}: {n:>7,} frames ({det.stat().st_size / 2**20:6.1f} MiB det.txt, {rows:,} result rows): "
+            print(f"{args.tracker}: {n:>7,} frames ({det.stat().st_size / 2**20:6.1f} MiB det.txt, "
+                  f"{rows:,} result rows): "
                   f"peak RSS {mib:7.1f} MiB, {seconds:6.1f} s", flush=True)
     growth = peaks[-1] - peaks[0]
     ok = growth <= args.limit_mib

@@ -12,8 +12,8 @@ import argparse
 import sys
 
 import numpy as np
-
 from _common import SHARED_DATA, median_seconds
+
 from lookalike.geometry import xywh_to_xyxy
 from lookalike.io import find_sequences, frames_from_table, read_mot
 from lookalike.trackers import Sort
@@ -43,7 +43,8 @@ def peer_runners(seqs):
             for frames in xyxy:
                 tracker = norfair.Tracker(distance_function="iou", distance_threshold=0.7)
                 for boxes, scores in frames:
-                    dets = [norfair.Detection(points=b.reshape(2, 2), scores=np.array([s, s])) for b, s in zip(boxes, scores)]
+                    dets = [norfair.Detection(points=b.reshape(2, 2), scores=np.array([s, s]))
+                            for b, s in zip(boxes, scores)]
                     tracker.update(detections=dets)
 
         runners["norfair (iou, threshold 0.7)"] = run_norfair
@@ -56,7 +57,8 @@ def peer_runners(seqs):
             for frames in xyxy:
                 tracker = sv.ByteTrack()
                 for boxes, scores in frames:
-                    det = sv.Detections(xyxy=boxes.reshape(-1, 4), confidence=scores, class_id=np.zeros(len(boxes), int))
+                    det = sv.Detections(xyxy=boxes.reshape(-1, 4), confidence=scores,
+                                        class_id=np.zeros(len(boxes), int))
                     tracker.update_with_detections(det)
 
         runners["supervision ByteTrack"] = run_bytetrack

@@ -26,9 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.viz.blob_video import blob_config, blob_detection_rows
 from lookalike.io import frames_from_table, read_mot, write_mot
 from lookalike.trackers import make_tracker
+from lookalike.viz.blob_video import blob_config, blob_detection_rows
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA  # noqa: E402

@@ -3,8 +3,8 @@ import json
 import numpy as np
 from typer.testing import CliRunner
 
-from lookalike.cli import app
 from lookalike.bench.experiments import pair_hits, recovery_s, reindex, swap_reports
+from lookalike.cli import app
 from lookalike.sim import preset, simulate_robots
 
 

@@ -6,8 +6,8 @@ import json
 
 from typer.testing import CliRunner
 
-from lookalike.cli import app
 from lookalike.bench.ident import IDENT_COLUMNS, ident_table
+from lookalike.cli import app
 
 
 def test_command_writes_json_and_csv(tmp_path):

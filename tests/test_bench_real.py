@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from lookalike.cli import app
 from lookalike.bench.datasets import RealSequence, cut_sequence
 from lookalike.bench.leaderboard import leaderboard
 from lookalike.bench.runner import (
@@ -24,6 +23,7 @@ from lookalike.bench.runner import (
     sequence_params,
     track_rows,
 )
+from lookalike.cli import app
 from lookalike.io import MotTable
 from lookalike.trackers import make_tracker
 from lookalike.trackers.offline import OfflineConfig, postprocess
@@ -217,7 +217,10 @@ def test_per_sequence_and_offline_entries() -> None:
     assert sequence_params(Entry("g", "boxtrack", per_sequence=False), seq) == {}
     syn = _synthetic(8)
     entries = default_entries(["boxtrack"], [])
-    labels = lambda s: [e.label for e, _ in job_pairs(entries, [s])]
+
+    def labels(s):
+        return [e.label for e, _ in job_pairs(entries, [s])]
+
     # the synthetic dataset has neither per-sequence nor offline parameters
     assert labels(syn) == ["boxtrack", "boxtrack-closed", "boxtrack-closed-offline"]
     assert labels(seq) == ["boxtrack", "boxtrack-global", "boxtrack-offline"]
@@ -225,7 +228,8 @@ def test_per_sequence_and_offline_entries() -> None:
     pigs = RealSequence("pigs", "p", syn.frame_rate, syn.length, syn.det_xywh, syn.det_score, gt=syn.gt)
     online = track_rows(Entry("b", "boxtrack"), pigs)
     offline = track_rows(Entry("b", "boxtrack", offline=True), pigs)
-    np.testing.assert_array_equal(offline, postprocess(online, pigs.frame_rate, OfflineConfig(**OFFLINE_PARAMS["pigs"])))
+    np.testing.assert_array_equal(offline,
+                                  postprocess(online, pigs.frame_rate, OfflineConfig(**OFFLINE_PARAMS["pigs"])))
     assert len(offline) > len(online)  # 10 % missed detections leave gaps to fill
 
 

@@ -3,7 +3,6 @@ import pytest
 
 from lookalike.vision.blob import BlobConfig, BlobDetector, read_video
 from lookalike.vision.hog_features import as_bgr_image
-
 from tests.conftest import SHARED_DATA
 
 

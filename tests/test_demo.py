@@ -13,8 +13,8 @@ pytest.importorskip("matplotlib")
 
 from typer.testing import CliRunner
 
-from lookalike.cli import app
 from lookalike.bench.demo import QUICK, lstm_status
+from lookalike.cli import app
 from lookalike.viz import read_frames, video_info
 
 runner = CliRunner()

@@ -10,8 +10,8 @@ pytest.importorskip("lookalike.cli.bench", reason="the bench sub-app (lookalike.
 
 from typer.testing import CliRunner
 
-from lookalike.cli import app
 from lookalike.bench.divers import COLUMNS, bar_chart, diver_table
+from lookalike.cli import app
 
 
 def test_table_rows_and_all_row(tmp_path) -> None:

@@ -60,7 +60,10 @@ def test_without_shortcut_overlap_a_different_appearance_starts_a_new_track() ->
 def test_diver_absent_for_60_frames_returns_with_the_same_identity() -> None:
     rng = np.random.default_rng(0)
     trk = DiverSort()
-    noisy = lambda f: (f + 0.03 * rng.normal(size=D)) / np.linalg.norm(f + 0.03 * rng.normal(size=D))
+
+    def noisy(f):
+        return (f + 0.03 * rng.normal(size=D)) / np.linalg.norm(f + 0.03 * rng.normal(size=D))
+
     ids_a, ids_b = set(), set()
     for k in range(120):
         boxes, feats = [[400 + k, 200, 60, 120]], [noisy(B)]

@@ -37,7 +37,8 @@ def test_lstm_tracker_labels_every_detection(tmp_path):
     labelled = tracker.last_labels[tracker.last_labels >= 0]
     assert len(labelled) == len(set(labelled.tolist()))  # one-to-one decoding
     assert all(t.agent_id == t.track_id - 1 for t in out)
-    assert tracker.update(_frame(1, [])) == [] or all(t.status is TrackStatus.LOST for t in tracker.update(_frame(2, [])))
+    assert tracker.update(_frame(1, [])) == [] or all(
+        t.status is TrackStatus.LOST for t in tracker.update(_frame(2, [])))
 
 
 def test_wrong_setup_is_refused(tmp_path):

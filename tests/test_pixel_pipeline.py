@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from lookalike.cli import app
 from lookalike.bench.pixels import match_truth
+from lookalike.cli import app
 from lookalike.eval import identification_success_rate
 from lookalike.geometry.camera import Camera, Pose2D
 from lookalike.sim.render_robots import ROBOT_HEIGHT_M, ROBOT_WIDTH_M, RobotRenderer, random_walk_poses

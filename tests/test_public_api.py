@@ -30,7 +30,8 @@ def test_public_api_is_pinned():
 
 
 def test_import_needs_neither_torch_nor_opencv():
-    code = "import sys, lookalike, lookalike.trackers, lookalike.io; print('torch' in sys.modules, 'cv2' in sys.modules)"
+    code = ("import sys, lookalike, lookalike.trackers, lookalike.io; "
+            "print('torch' in sys.modules, 'cv2' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "False"]
 

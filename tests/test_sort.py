@@ -138,9 +138,11 @@ def test_mota_matches_reference_sort_on_mot15(shared_data, name):
     seq = find_sequences(shared_data / "mot15" / name)[0]
     tracker = Sort()
     rows = np.vstack(
-        [tracks_to_rows(f.index, tracker.update(f)) for f in frames_from_table(read_mot(seq.det_path), seq.length, seq.frame_rate)]
+        [tracks_to_rows(f.index, tracker.update(f))
+         for f in frames_from_table(read_mot(seq.det_path), seq.length, seq.frame_rate)]
     )
-    scores = evaluate_sequence(read_mot(seq.gt_path), MotTable.from_rows(rows), benchmark="MOT15", num_frames=seq.length)
+    scores = evaluate_sequence(read_mot(seq.gt_path), MotTable.from_rows(rows), benchmark="MOT15",
+                               num_frames=seq.length)
     mota, idsw = REFERENCE[name]
     assert 100 * scores["MOTA"] == pytest.approx(mota, abs=0.2)
     assert abs(scores["IDSW"] - idsw) <= 2

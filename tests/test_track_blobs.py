@@ -9,8 +9,8 @@ import pytest
 from typer.testing import CliRunner
 
 from lookalike.cli import app
-from lookalike.viz.blob_video import blob_config, blob_detection_rows
 from lookalike.io import read_mot
+from lookalike.viz.blob_video import blob_config, blob_detection_rows
 
 runner = CliRunner()
 

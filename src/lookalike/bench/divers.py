@@ -16,9 +16,9 @@ from typing import Any
 import numpy as np
 
 from lookalike.eval.api import combine, evaluate_sequence
-from lookalike.types.mot_table import MotTable
 from lookalike.sim.divers import SCENARIOS, detection_quality, scenario
 from lookalike.sim.divers_run import fit_diver_features, prepare, run_tracker
+from lookalike.types.mot_table import MotTable
 
 TRACKERS = ("sort", "deepsort", "diversort")
 COLUMNS = ("Scenario", "Location", "DP", "DR", "Tracker", "IDF1", "IDP", "IDR", "IDSW", "Frag")

@@ -36,7 +36,8 @@ def _percent(scores: dict[str, float]) -> dict[str, Any]:
             "MOTA": round(100 * scores["MOTA"], 2), "IDSW": int(scores["IDSW"])}
 
 
-def sequence_rows(pairs: Sequence[tuple[Entry, RealSequence]], results: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+def sequence_rows(pairs: Sequence[tuple[Entry, RealSequence]],
+                  results: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     """One row per job: dataset, sequence, tracker and its scores in % (or its error)."""
     out = []
     for (e, seq), r in zip(pairs, results):

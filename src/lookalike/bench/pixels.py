@@ -1,4 +1,5 @@
-"""The pixels bench (``lookalike bench pixels``): identification from rendered pixels against the simulator's own detections.
+"""The pixels bench (``lookalike bench pixels``): identification from rendered pixels against the simulator's own
+detections.
 
 For each set-up, held-out robot sequences are simulated (seeds ``seed + 1000·setup + sequence``, the
 default ``seed`` 700000 being disjoint from the renders the detector and heading models train on:
@@ -33,6 +34,7 @@ import numpy as np
 from lookalike.eval import identification_success_rate
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.geometry.camera import Camera
+from lookalike.loop import RunStats, run
 from lookalike.sim import (
     PRESET_NAMES,
     RobotSequence,
@@ -40,7 +42,6 @@ from lookalike.sim import (
     preset_label,
     simulate_robots,
 )
-from lookalike.loop import RunStats, run
 from lookalike.trackers import make_tracker
 from lookalike.trackers.identity import labels_from_tracks
 from lookalike.types import Beacons, Detections

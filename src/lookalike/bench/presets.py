@@ -55,7 +55,8 @@ DATASET_PARAMS: dict[str, dict[str, dict[str, Any]]] = _dataset_params()
 SEQUENCE_PARAMS: dict[str, dict[str, dict[str, dict[str, Any]]]] = _sequence_params()
 # dataset -> tracker -> parameters chosen on that dataset for the "tuned on this data" row only (boxtrack.json "tuned")
 TUNED_PARAMS: dict[str, dict[str, dict[str, Any]]] = {
-    d: {load_preset("boxtrack")["tracker"]: dict(e["params"])} for d, e in load_preset("boxtrack").get("tuned", {}).items()}
+    d: {load_preset("boxtrack")["tracker"]: dict(e["params"])}
+    for d, e in load_preset("boxtrack").get("tuned", {}).items()}
 # dataset -> OfflineConfig fields (offline.json)
 OFFLINE_PARAMS: dict[str, dict[str, Any]] = {d: dict(e["params"])
                                              for d, e in load_preset("offline")["datasets"].items()}

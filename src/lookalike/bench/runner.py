@@ -199,5 +199,6 @@ def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, wor
 
 
 __all__ = ["DATASET_PARAMS", "HEXBUG_RADIUS_PX", "OFFLINE_PARAMS", "SEQUENCE_PARAMS", "TUNED_LABEL", "TUNED_PARAMS",
-           "Entry", "base_name", "default_entries", "detection_rows", "entry_params", "params_entry", "job_pairs", "map_jobs", "run_job", "run_jobs", "score_rows",
+           "Entry", "base_name", "default_entries", "detection_rows", "entry_params", "params_entry", "job_pairs",
+           "map_jobs", "run_job", "run_jobs", "score_rows",
            "sequence_params", "track_rows"]

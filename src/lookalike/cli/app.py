@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import NoReturn
+
 import typer
 from rich.console import Console
 
@@ -16,7 +18,7 @@ console = Console()
 err_console = Console(stderr=True, soft_wrap=True)  # an error stays one line
 
 
-def fail(message: str, code: int = 2) -> None:
+def fail(message: str, code: int = 2) -> NoReturn:
     """Print ``message`` as an error and exit with ``code``."""
     err_console.print(f"[bold red]error:[/] {message}")
     raise typer.Exit(code)

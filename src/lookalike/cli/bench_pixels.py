@@ -44,7 +44,8 @@ def pixels(
     camera = pixel_camera()
     columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     try:
-        pipe = RobotPipeline.from_files(detector_model, heading_model, camera, PipelineConfig(detect_scale=detect_scale))
+        pipe = RobotPipeline.from_files(detector_model, heading_model, camera,
+                                        PipelineConfig(detect_scale=detect_scale))
         with Progress(*columns, console=console) as progress, one_blas_thread():
             def bar(description: str, total: int) -> Callable[[], None]:
                 task = progress.add_task(description, total=total)
@@ -54,6 +55,7 @@ def pixels(
                                             bar)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
-    print_rows(f"Perception on rendered robots, {sequences} × {frames} frames per set-up", perception, PERCEPTION_COLUMNS)
+    print_rows(f"Perception on rendered robots, {sequences} × {frames} frames per set-up", perception,
+               PERCEPTION_COLUMNS)
     print_rows("Identification success rate: from pixels vs the simulator's detections", rows, PIXEL_COLUMNS)
     write_rows(rows, json_path, csv_path)

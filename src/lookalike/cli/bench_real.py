@@ -26,6 +26,7 @@ from lookalike.parallel import BACKENDS
 from lookalike.tune.params_file import load_params, read_params
 
 BOX_TRACKERS = ("sort", "boxtrack")  # lookalike trackers that need nothing but boxes and scores
+_DATASETS_HELP = f"Datasets (comma-separated or repeated): {', '.join(DATASETS)}."
 
 
 def _cell(value: Any) -> str:
@@ -71,9 +72,10 @@ def real(
     data: Path | None = typer.Option(None, "--data", help="Folder with mot15/, pigs/, hexbug/, mot17/ "
                                      "(default: $LOOKALIKE_DATA, else ../shared/data from the current directory)."),
     datasets: list[str] = typer.Option(list(DATASETS[:3]), "--datasets",
-                                       help=f"Datasets (comma-separated or repeated): {', '.join(DATASETS)}."),
+                                       help=_DATASETS_HELP),
     trackers: list[str] = typer.Option(list(BOX_TRACKERS), "--trackers", help="lookalike box trackers."),
-    peers: list[str] = typer.Option(list(PEERS), "--peers", help="Peers to try ('none' for none); absent ones are skipped."),
+    peers: list[str] = typer.Option(list(PEERS), "--peers",
+                                    help="Peers to try ('none' for none); absent ones are skipped."),
     sequences: list[str] | None = typer.Option(None, "--sequences", help="Only these sequences/clips."),
     max_clips: int | None = typer.Option(None, "--max-clips", min=1, help="At most this many HexBug clips."),
     part: str = typer.Option("full", "--part", help="Score whole sequences ('full'), their first halves "
@@ -85,7 +87,8 @@ def real(
     csv_path: Path | None = typer.Option(None, "--csv", help="Write the dataset rows as CSV."),
     plots: Path | None = typer.Option(None, "--plots", help="Folder for one bar chart per dataset."),
     params_file: Path | None = typer.Option(None, "--params", help="Parameter file of `lookalike tune`: adds a row "
-                                            "labelled with its name ('tuned on this data' when chosen on a scored sequence)."),
+                                            "labelled with its name ('tuned on this data' when chosen on a scored "
+                                            "sequence)."),
 ) -> None:
     """Leaderboard on real data: HOTA, IDF1, MOTA, IDSW, frames/s and rank per dataset, and combined."""
     tracker_list, peer_list = split_list(trackers), [p for p in split_list(peers) if p != "none"]

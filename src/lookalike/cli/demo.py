@@ -55,7 +55,8 @@ def demo(
     output: Path = typer.Option(Path("demo-out"), "-o", "--output", help="Folder for the results."),
     seed: int = typer.Option(0, help="Seed of the simulated scenes."),
     quick: bool = typer.Option(False, "--quick", help="A reduced run (seconds): fewer frames and scenarios."),
-    robot_preset: str = typer.Option("m5n3", "--robot-preset", help=f"Robot set-up of the video: {', '.join(PRESET_NAMES)}."),
+    robot_preset: str = typer.Option("m5n3", "--robot-preset",
+                                     help=f"Robot set-up of the video: {', '.join(PRESET_NAMES)}."),
     rerun: bool = typer.Option(False, "--rerun", help="Also stream frames, boxes and positions to a Rerun viewer "
                                                       "(needs the optional rerun-sdk)."),
     rerun_save: Path | None = typer.Option(None, "--rerun-save", help="Also write a Rerun recording (.rrd) here."),

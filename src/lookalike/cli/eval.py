@@ -5,14 +5,13 @@ from __future__ import annotations
 import csv
 import json
 from pathlib import Path
-from typing import Optional
 
 import typer
 from rich import box
 from rich.table import Table
 
-from lookalike.cli.app import app, console, fail
 from lookalike.bench.folders import COMBINED, evaluate_folders
+from lookalike.cli.app import app, console, fail
 from lookalike.cli.eval_points import score_points
 from lookalike.eval import BENCHMARKS, METRICS
 
@@ -22,6 +21,7 @@ HEADLINE = {
     "Identity": ("IDF1",),
 }
 SHORT = {"CLR_FP": "FP", "CLR_FN": "FN"}
+_METRICS_HELP = f"Any of {', '.join(METRICS)} (repeatable; default all)."
 PERCENT = {"HOTA", "DetA", "AssA", "LocA", "MOTA", "MOTP", "IDF1", "IDP", "IDR"}
 
 
@@ -42,11 +42,12 @@ def eval_command(
     points: bool = typer.Option(False, "--points", help="Point ground truth (frame,id,x,y): match within --radius."),
     radius: float | None = typer.Option(None, "--radius", min=0.0, help="With --points: match distance in pixels."),
     benchmark: str = typer.Option("MOT15", help=f"Ground-truth rules: {', '.join(BENCHMARKS)}."),
-    metrics: Optional[list[str]] = typer.Option(None, "--metrics", help=f"Any of {', '.join(METRICS)} (repeatable; default all)."),
+    metrics: list[str] | None = typer.Option(None, "--metrics", help=_METRICS_HELP),
     iou_threshold: float = typer.Option(0.5, help="IoU a CLEAR/identity match needs."),
     workers: int = typer.Option(1, help="Processes scoring sequences in parallel."),
-    json_path: Optional[Path] = typer.Option(None, "--json", help="Write every value as JSON here."),
-    csv_path: Optional[Path] = typer.Option(None, "--csv", help="Write every value as CSV here (one row per tracker and sequence)."),
+    json_path: Path | None = typer.Option(None, "--json", help="Write every value as JSON here."),
+    csv_path: Path | None = typer.Option(None, "--csv", help="Write every value as CSV here "
+                                             "(one row per tracker and sequence)."),
 ) -> None:
     """Score trackers with HOTA, CLEAR MOT and identity metrics (values shown in %)."""
     chosen = [next((m for m in METRICS if m.lower() == x.lower()), x) for x in (metrics or METRICS)]

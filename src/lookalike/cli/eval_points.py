@@ -20,7 +20,7 @@ def read_id_points(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     rows (7 or more columns: ``frame,id,left,top,width,height,score,...``)."""
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
-    rows = []
+    rows: list[list[float]] = []
     for no, line in enumerate(path.read_text().splitlines(), start=1):
         fields = [f.strip() for f in line.split(",")] if line.strip() and not line.startswith("#") else []
         if not fields:

@@ -26,10 +26,13 @@ def label(
         help="Starting labels: a tracker name (run on the sequence), a label file (.json), a labelled "
              "sequence (.jsonl) or a MOTChallenge file (.txt) from the export. Ignored when saved labels exist."),
     port: int = typer.Option(8765, "--port", min=0, max=65535, help="Port (0: any free one)."),
-    host: str = typer.Option("127.0.0.1", "--host", help="Address to bind (others on the network can reach non-loopback ones)."),
-    benchmark: bool = typer.Option(False, "--benchmark", help="Human benchmark: hide the truth, time the session, score it at the end."),
+    host: str = typer.Option("127.0.0.1", "--host",
+                             help="Address to bind (others on the network can reach non-loopback ones)."),
+    benchmark: bool = typer.Option(False, "--benchmark",
+                                   help="Human benchmark: hide the truth, time the session, score it at the end."),
     fresh: bool = typer.Option(False, "--fresh", help="Start over: move saved labels to <stem>.labels.json.bak."),
-    export: bool = typer.Option(False, "--export", help="Write the exports from the saved labels and exit (no server)."),
+    export: bool = typer.Option(False, "--export",
+                                help="Write the exports from the saved labels and exit (no server)."),
 ) -> None:
     """Serve the labelling page: click detections to cycle their robot (left forward, right back).
 

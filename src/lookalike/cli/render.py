@@ -24,8 +24,8 @@ def render(
     output: Path = typer.Option(..., "-o", "--output", help="Annotated MP4 to write."),
     video: Path | None = typer.Option(None, "--video", help="Video file, or a folder of images (e.g. a MOTChallenge "
                                                             "img1); needed unless --birdseye."),
-    birdseye: bool = typer.Option(False, "--birdseye", help="Draw the world positions (columns 8, 9, metres; the box may be 0,0,0,0) from "
-                                                            "above instead of boxes on a video."),
+    birdseye: bool = typer.Option(False, "--birdseye", help="Draw the world positions (columns 8, 9, metres; the box "
+                                                            "may be 0,0,0,0) from above instead of boxes on a video."),
     gif: Path | None = typer.Option(None, "--gif", help="Also write a short animated GIF here."),
     tail: int = typer.Option(25, min=1, help="Track tail length in frames."),
     fps: float | None = typer.Option(None, min=0.1, help="Output frame rate (default: the input's; 30 otherwise)."),
@@ -42,7 +42,10 @@ def render(
         with Progress(TextColumn("rendering"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                       console=console) as progress:
             task = progress.add_task("render", total=total or None)
-            advance = lambda: progress.advance(task)
+
+            def advance() -> None:
+                progress.advance(task)
+
             if birdseye:
                 n = birdseye_video(table, output, fps=fps or 30.0, gif=gif, tail=tail, advance=advance)
             else:

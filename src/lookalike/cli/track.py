@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from lookalike.cli.app import app, console, fail
@@ -86,8 +86,12 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float) -> tup
             tracker.reset()
             task = progress.add_task(seq.name, total=seq.length)
             target = output if path.is_file() else output / f"{seq.name}.txt"
+
+            def advance(f: Any, t: Any, task: TaskID = task) -> None:
+                progress.advance(task)
+
             try:
-                track_to_file(tracker, frames, target, lambda f, t: progress.advance(task), stats)
+                track_to_file(tracker, frames, target, advance, stats)
             except ValueError as exc:
                 fail(f"{seq.name}: {exc}")
             progress.remove_task(task)
@@ -163,8 +167,10 @@ def track(
                                           "e.g. threshold=30 polarity=dark min_area_px=80 max_area_px=5000."),
     pipeline: str | None = typer.Option(None, "--pipeline", help="With --video: 'robots' finds, orients, places and "
                                         "identifies (-t kalman_ha|kalman_ha2|jpda|lstm) robots from the pixels."),
-    reports: Path | None = typer.Option(None, "--reports", help="With --pipeline: heading reports (`simulate` .jsonl)."),
-    detector_model: Path | None = typer.Option(None, "--detector-model", help="With --pipeline: `train-detector` model."),
+    reports: Path | None = typer.Option(None, "--reports",
+                                        help="With --pipeline: heading reports (`simulate` .jsonl)."),
+    detector_model: Path | None = typer.Option(None, "--detector-model",
+                                               help="With --pipeline: `train-detector` model."),
     heading_model: Path | None = typer.Option(None, "--heading-model", help="With --pipeline: `train-heading` model."),
     params_file: Path | None = typer.Option(None, "--params", help="Parameter file written by `lookalike tune` "
                                             "(for this tracker); --set overrides its values."),

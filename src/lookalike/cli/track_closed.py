@@ -116,8 +116,8 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
             track_to_file(tracker, _frames(det, len(points), frame_rate), output)
         except ValueError as exc:
             fail(str(exc))
-        rows = read_mot(output)
-        rows = np.column_stack([rows.frame, rows.track_id]) if len(rows) else np.zeros((0, 2))
+        table = read_mot(output)
+        rows = np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
     what = f"offline closed set of {n_targets}" if offline else "online"
     console.print(f"[green]{tracker_name}[/], {what}: {len(np.unique(rows[:, 1]))} identities → {output}")
 

@@ -59,7 +59,8 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
     except ValueError as exc:
         fail(str(exc))
     except KeyboardInterrupt:
-        console.print("\n[yellow]Interrupted.[/]" + (f" {annotate} holds the frames written so far." if annotate else ""))
+        console.print("\n[yellow]Interrupted.[/]"
+                      + (f" {annotate} holds the frames written so far." if annotate else ""))
         raise SystemExit(130) from None
     write_mot(output, result.rows)
     written = [output, write_health_csv(side_file(output, "health"), result.health)]

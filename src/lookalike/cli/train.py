@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 import shutil
 from pathlib import Path
-from typing import Optional
 
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -19,7 +18,7 @@ def train(
     preset_name: str = typer.Option("m3n2", "--preset", help=f"Robot world set-up: {', '.join(PRESET_NAMES)}."),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for model.npz/.json, log and checkpoint."),
     steps: int = typer.Option(3000, help="Maximum optimisation steps (batches of sequences)."),
-    minutes: Optional[float] = typer.Option(None, help="Stop after this many minutes."),
+    minutes: float | None = typer.Option(None, help="Stop after this many minutes."),
     cell: str = typer.Option("lstm", help="Recurrent cell: lstm or gru (the paper's comparison)."),
     batch_size: int = typer.Option(16, help="Sequences per batch."),
     sequence_length: int = typer.Option(600, help="Frames per training sequence (multiple of 150)."),
@@ -27,18 +26,20 @@ def train(
     layers: int = typer.Option(5, help="Stacked recurrent layers."),
     seed: int = typer.Option(0, help="Seed of the run (weights and data)."),
     relative: bool = typer.Option(True, help="Add slot-minus-agent heading differences to the input (ours)."),
-    patience: int = typer.Option(12, min=1, help="Stop after this many validations (every 50 steps) without a new best."),
+    patience: int = typer.Option(12, min=1,
+                                 help="Stop after this many validations (every 50 steps) without a new best."),
     threads: int = typer.Option(1, help="Torch threads."),
     learning_rate: float = typer.Option(0.004, help="Adam's initial learning rate (the paper's 0.004)."),
     swap_prob: float = typer.Option(
         0.0, help="Fraction of training sequences in which two robots swap identities for 1-10 s (ours; "
         "teaches fast re-identification)."),
-    init_from: Optional[Path] = typer.Option(
-        None, "--init-from", help="Start from these exported weights (.npz), e.g. the shipped ones, instead of random."),
+    init_from: Path | None = typer.Option(
+        None, "--init-from",
+        help="Start from these exported weights (.npz), e.g. the shipped ones, instead of random."),
     device: str = typer.Option("cpu", help="Torch device for the network: cpu, cuda or auto."),
     workers: int = typer.Option(1, min=1, help="Processes (or Ray CPUs) generating batches ahead."),
     backend: str = typer.Option("local", help="Batch generation: local (processes) or ray."),
-    address: Optional[str] = typer.Option(None, help="Ray cluster address (default: a local ray.init())."),
+    address: str | None = typer.Option(None, help="Ray cluster address (default: a local ray.init())."),
     resume: bool = typer.Option(False, help="Continue from OUTPUT/checkpoint.pt."),
     ship: bool = typer.Option(False, help="Copy the best weights into the package's shipped weights."),
 ) -> None:
@@ -47,10 +48,10 @@ def train(
         import torch
     except ImportError:
         fail("training needs PyTorch: pip install 'lookalike[train]' (torch==2.13.0)")
+    from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.sim_data import make_sim_sampler
     from lookalike.learn.training import TrainConfig, plot_log
     from lookalike.learn.training import train as run_training
-    from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.weights import WEIGHTS_DIR
     from lookalike.parallel import JobPool
 

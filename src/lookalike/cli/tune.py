@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import typer
 from rich.progress import (
@@ -37,7 +38,8 @@ def tune(
         "of them, and/or bench datasets by name (mot15, pigs, hexbug, mot17-synth...)."),
     output: Path | None = typer.Option(None, "-o", "--output", help="Parameter file to write (JSON)."),
     tracker: str = typer.Option("boxtrack", "--tracker", "-t", help="Registered tracker name."),
-    trials: int = typer.Option(50, "--trials", min=1, help="Trials in the study in all (a resumed study runs the rest)."),
+    trials: int = typer.Option(50, "--trials", min=1, help="Trials in the study in all (a resumed study "
+                                "runs the rest)."),
     sampler: str = typer.Option("tpe", "--sampler", help="'tpe' (Tree-structured Parzen Estimator) or 'random'."),
     seed: int = typer.Option(0, "--seed", help="Seed of the sampler."),
     folds: str = typer.Option("none", "--folds", help="Also estimate the score on unseen data: 'loso' (leave one "
@@ -49,7 +51,8 @@ def tune(
     address: str | None = typer.Option(None, "--address", help="Ray cluster address (default: a local ray.init())."),
     study: str | None = typer.Option(None, "--study", help="Optuna storage URL to save the study, e.g. "
                                      "sqlite:///study.db (default: in memory)."),
-    study_name: str | None = typer.Option(None, "--study-name", help="Study name in the storage (default: the tracker)."),
+    study_name: str | None = typer.Option(None, "--study-name", help="Study name in the storage "
+                                          "(default: the tracker)."),
     resume: bool = typer.Option(False, "--resume", help="Continue the study saved in --study."),
     space_path: Path | None = typer.Option(None, "--space", help="Search space JSON (see --show-space), replacing the "
                                            "default one."),
@@ -58,28 +61,9 @@ def tune(
                                           "or ../shared/data)."),
 ) -> None:
     """Choose a tracker's parameters on labelled sequences; write them for `track --params`."""
-    from lookalike.trackers import tracker_names
-    from lookalike.tune import (
-        SAMPLERS,
-        combined_left_out,
-        default_space,
-        leave_one_out_selection,
-        load_tuning_data,
-        make_folds,
-        run_study,
-        save_params,
-        space_from_json,
-        space_to_json,
-    )
+    from lookalike.tune import space_to_json
 
-    if tracker not in tracker_names():
-        fail(f"unknown tracker {tracker!r}; choose one of: {', '.join(tracker_names())}")
-    try:
-        space = default_space(tracker)
-        if space_path is not None:
-            space = space_from_json(json.loads(space_path.read_text()), tracker)
-    except (OSError, ValueError) as exc:
-        fail(f"--space: {exc}")
+    space = _load_space(tracker, space_path)
     if show_space:
         console.print_json(json.dumps(space_to_json(space)))
         return
@@ -89,12 +73,48 @@ def tune(
     if output is None:
         fail("-o/--output: give the parameter file to write")
         return
+    _check_options(sampler, backend, resume, study)
+    seqs, fold_list = _load_data(data, data_root, folds)
+    console.print(f"{tracker}: {len(seqs)} sequence(s), {trials} trials ({sampler}), criterion {metric}, "
+                  f"{len(space)} parameters in the space")
+    common: dict[str, Any] = dict(space=space, trials=trials, sampler=sampler, seed=seed, metric=metric,
+                                  workers=workers, backend=backend, address=address, storage=study, resume=resume)
+    result, choices = _run(tracker, seqs, fold_list, study_name, metric, trials, common)
+    path, held = _save(output, tracker, result, choices, space, sampler, seed, folds)
+    _print_results(tracker, metric, folds, seqs, result, choices, held, path)
+
+
+def _load_space(tracker: str, space_path: Path | None) -> Any:
+    """The tracker's search space: its default one, or the one in ``space_path``."""
+    from lookalike.trackers import tracker_names
+    from lookalike.tune import default_space, space_from_json
+
+    if tracker not in tracker_names():
+        fail(f"unknown tracker {tracker!r}; choose one of: {', '.join(tracker_names())}")
+    try:
+        space = default_space(tracker)
+        if space_path is not None:
+            space = space_from_json(json.loads(space_path.read_text()), tracker)
+    except (OSError, ValueError) as exc:
+        fail(f"--space: {exc}")
+    return space
+
+
+def _check_options(sampler: str, backend: str, resume: bool, study: str | None) -> None:
+    from lookalike.tune import SAMPLERS
+
     if sampler not in SAMPLERS:
         fail(f"--sampler: expected one of {', '.join(SAMPLERS)}, got {sampler!r}")
     if backend not in BACKENDS:
         fail(f"--backend: expected one of {', '.join(BACKENDS)}, got {backend!r}")
     if resume and study is None:
         fail("--resume: needs --study (the storage the study was saved in)")
+
+
+def _load_data(data: list[str], data_root: Path | None, folds: str) -> tuple[Any, Any]:
+    """The labelled sequences and the folds (None for ``--folds none``)."""
+    from lookalike.tune import load_tuning_data, make_folds
+
     try:
         root = None
         if any(not Path(d).exists() for d in data):
@@ -106,10 +126,14 @@ def tune(
         fold_list = None if folds.lower() == "none" else make_folds(keys, folds, [s.dataset for s in seqs])
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
-    console.print(f"{tracker}: {len(seqs)} sequence(s), {trials} trials ({sampler}), criterion {metric}, "
-                  f"{len(space)} parameters in the space")
-    common = dict(space=space, trials=trials, sampler=sampler, seed=seed, metric=metric, workers=workers,
-                  backend=backend, address=address, storage=study, resume=resume)
+    return seqs, fold_list
+
+
+def _run(tracker: str, seqs: Any, fold_list: Any, study_name: str | None, metric: str, trials: int,
+         common: dict[str, Any]) -> tuple[Any, Any]:
+    """The study on all sequences, and the per-fold choices (None without folds)."""
+    from lookalike.tune import leave_one_out_selection, run_study
+
     try:
         with _progress() as bar:
             task = bar.add_task("trials", total=trials)
@@ -118,7 +142,7 @@ def tune(
                 best_text = "–" if best is None else f"{100 * best:.2f}"
                 bar.update(task, completed=done, description=f"trials (best {metric} {best_text})")
 
-            result = run_study(tracker, seqs, study_name=study_name, progress=step, **common)  # type: ignore[arg-type]
+            result = run_study(tracker, seqs, study_name=study_name, progress=step, **common)
         choices = None
         if fold_list is not None:
             with _progress() as bar:
@@ -130,11 +154,20 @@ def tune(
                     bar.update(tasks[fold], completed=done)
 
                 choices = leave_one_out_selection(tracker, seqs, folds=fold_list, study_name=study_name,
-                                                  progress=fold_step, **common)  # type: ignore[arg-type]
+                                                  progress=fold_step, **common)
     except ValueError as exc:
         fail(str(exc))
+    return result, choices
+
+
+def _save(output: Path, tracker: str, result: Any, choices: Any, space: Any, sampler: str, seed: int,
+          folds: str) -> tuple[Any, Any]:
+    """Write the parameter file; its path and the combined left-out scores (None without folds)."""
+    from lookalike.tune import combined_left_out, save_params, space_to_json
+
     extra: dict[str, object] = {"score": result.value, "default_score": result.default_value, "sampler": sampler,
                                 "seed": seed, "space": space_to_json(space)}
+    held = None
     if choices is not None:
         held = combined_left_out(choices)
         extra["left_out"] = {"folds": folds, "combined": {m: held[m] for m in ("HOTA", "IDF1", "MOTA")},
@@ -145,6 +178,11 @@ def tune(
                            trials=result.trials, **extra)
     except ValueError as exc:
         fail(str(exc))
+    return path, held
+
+
+def _print_results(tracker: str, metric: str, folds: str, seqs: Any, result: Any, choices: Any, held: Any,
+                   path: Any) -> None:
     default = "–" if result.default_value is None else f"{100 * result.default_value:.2f}"
     console.print(f"best {metric} on the {len(seqs)} sequence(s) it was chosen on: {100 * result.value:.2f} "
                   f"(defaults {default}); {result.failed} failed trial(s)")

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import Optional
 
 import numpy as np
 import typer
@@ -35,7 +34,8 @@ def _progress() -> Progress:
 @app.command("train-detector")
 def train_detector(
     output: Path = typer.Option(..., "-o", "--output", help="Model file to write (.npz)."),
-    data: Optional[Path] = typer.Option(None, help="Folder with positives/ and negatives/ images; default: rendered robots."),
+    data: Path | None = typer.Option(None,
+                                     help="Folder with positives/ and negatives/ images; default: rendered robots."),
     frames: int = typer.Option(300, help="Rendered frames to train on (without --data)."),
     stages: int = typer.Option(20, help="Cascade stages."),
     negatives: int = typer.Option(2000, help="Hard negatives per stage."),

@@ -72,7 +72,7 @@ class LstmIdentifier:
         def __post_init__(self) -> None:
             check_positive(self, "n_agents", "n_slots")
 
-    def __init__(self, config: "LstmIdentifier.Config | None" = None) -> None:
+    def __init__(self, config: LstmIdentifier.Config | None = None) -> None:
         self.config = config or LstmIdentifier.Config()
         cfg = self.config
         path = cfg.weights or shipped_weights_path(cfg.n_agents, cfg.n_slots)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.geometry.boxes import xywh_to_cxcywh, xywh_to_xysr, xysr_to_xywh
+from lookalike.geometry.boxes import xysr_to_xywh, xywh_to_cxcywh, xywh_to_xysr
 from lookalike.motion import kalman
 from lookalike.motion.models import constant_acceleration, constant_velocity, kinematic_transition
 

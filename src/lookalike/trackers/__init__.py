@@ -1,6 +1,12 @@
 """Trackers: the protocol, the registry by name and the implementations."""
 
 from lookalike.trackers.base import Tracker
+from lookalike.trackers.boxtrack import BoxTrack
+from lookalike.trackers.deepsort import DeepSort
+from lookalike.trackers.diversort import DiverSort
+from lookalike.trackers.health import HealthConfig, HealthMonitor, HealthStatus
+from lookalike.trackers.jpda import JpdaTracker
+from lookalike.trackers.kalman_ha import KalmanHA, KalmanHA2
 from lookalike.trackers.registry import (
     ParameterInfo,
     make_tracker,
@@ -9,12 +15,6 @@ from lookalike.trackers.registry import (
     tracker_names,
     tracker_parameters,
 )
-from lookalike.trackers.boxtrack import BoxTrack
-from lookalike.trackers.deepsort import DeepSort
-from lookalike.trackers.diversort import DiverSort
-from lookalike.trackers.health import HealthConfig, HealthMonitor, HealthStatus
-from lookalike.trackers.jpda import JpdaTracker
-from lookalike.trackers.kalman_ha import KalmanHA, KalmanHA2
 from lookalike.trackers.sort import Sort
 from lookalike.types.tracks import TrackStatus
 

@@ -55,7 +55,8 @@ from lookalike.trackers.offline import fill_gaps
 from lookalike.trackers.registry import make_tracker
 from lookalike.types import Detections, Frame
 
-__all__ = ["ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale", "place_short", "solve_chains", "split_tracklets", "track_closed_set"]
+__all__ = ["ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale", "place_short",
+           "solve_chains", "split_tracklets", "track_closed_set"]
 
 
 @dataclass(frozen=True)

@@ -12,8 +12,8 @@ predicted and updated together as batched arrays.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
@@ -67,7 +67,7 @@ class Sort:
             check_positive(self, "max_age", "min_hits", "iou_threshold", allow_zero=True)
             check_positive(self, "frame_interval_s")
 
-    def __init__(self, config: "Sort.Config | None" = None) -> None:
+    def __init__(self, config: Sort.Config | None = None) -> None:
         self.config = config or Sort.Config()
         # every track, tentative or not, survives max_age frames without an update
         self._lifecycle = Lifecycle(tentative_max_misses=self.config.max_age + 1, max_misses=self.config.max_age)

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -44,13 +45,13 @@ class Beacons:
         return int(self.agent_id.shape[0])
 
     @classmethod
-    def empty(cls) -> "Beacons":
+    def empty(cls) -> Beacons:
         """No reports."""
         z = np.zeros(0)
         return cls(agent_id=np.zeros(0, dtype=int), t_sent=z, t_received=z, heading=z)
 
     @classmethod
-    def from_dict(cls, columns: Mapping[str, Any]) -> "Beacons":
+    def from_dict(cls, columns: Mapping[str, Any]) -> Beacons:
         """Build from a mapping of column name to values; unknown names raise ``ValueError``."""
         reject_unknown("Beacons", dict(columns), tuple(f.name for f in dataclasses.fields(cls)))
         return cls(**columns)

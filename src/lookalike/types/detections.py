@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -79,17 +80,17 @@ class Detections:
         return int(self.xywh.shape[0])
 
     @classmethod
-    def empty(cls) -> "Detections":
+    def empty(cls) -> Detections:
         """A batch with no detections."""
         return cls(xywh=np.zeros((0, 4)))
 
     @classmethod
-    def from_dict(cls, columns: Mapping[str, Any]) -> "Detections":
+    def from_dict(cls, columns: Mapping[str, Any]) -> Detections:
         """Build from a mapping of column name to values; unknown names raise ``ValueError``."""
         reject_unknown("Detections", dict(columns), tuple(f.name for f in dataclasses.fields(cls)))
         return cls(**columns)
 
-    def select(self, index: np.ndarray | slice | list[int]) -> "Detections":
+    def select(self, index: np.ndarray | slice | list[int]) -> Detections:
         """Rows ``index`` as a new batch (boolean mask or integer indices)."""
         values: dict[str, Any] = {}
         for f in dataclasses.fields(self):
@@ -97,7 +98,7 @@ class Detections:
             values[f.name] = None if col is None else col[index]
         return Detections(**values)
 
-    def replace(self, **changes: Any) -> "Detections":
+    def replace(self, **changes: Any) -> Detections:
         """A copy with some columns replaced (validated again)."""
         reject_unknown("Detections", changes, tuple(f.name for f in dataclasses.fields(self)))
         return dataclasses.replace(self, **changes)

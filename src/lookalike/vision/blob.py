@@ -18,8 +18,9 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any, Iterable
+from typing import Any
 
 import numpy as np
 
@@ -93,7 +94,7 @@ class BlobDetector:
         self._reference = None
         self._window = None
 
-    def fit(self, frames: Iterable[np.ndarray] | np.ndarray) -> "BlobDetector":
+    def fit(self, frames: Iterable[np.ndarray] | np.ndarray) -> BlobDetector:
         """Median background from ``frames`` (an iterable or ``(n, h, w, 3)`` array), sampling at most
         ``history`` of them evenly. Only for the ``median`` method."""
         if self.config.method != "median":
@@ -137,7 +138,8 @@ class BlobDetector:
             diff = self._difference(img, self.background_)
             mask = np.where(diff > cfg.threshold, 255, 0).astype(np.uint8)
         if cfg.open_px > 1:
-            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (cfg.open_px,) * 2))
+            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN,
+                                    cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (cfg.open_px,) * 2))
         if cfg.close_px > 1:
             mask = cv2.morphologyEx(
                 mask, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (cfg.close_px,) * 2)
