@@ -6,7 +6,7 @@ EXTRAS ?= test,vision,viz,train,docs
 comma := ,
 STAMP := $(VENV)/.installed-$(subst $(comma),-,$(EXTRAS))
 
-.PHONY: venv demo test lint typecheck-pending docs bench clean browser train train-base train-refine
+.PHONY: venv demo test lint docs bench clean browser train train-base train-refine
 
 venv: $(STAMP)
 
@@ -24,13 +24,9 @@ test: venv browser docs lint
 
 # Static checks (configured in pyproject.toml): ruff, mypy (strict on the core layers) and the import contracts.
 lint: venv
-	$(VENV)/bin/ruff check src tests benchmarks tools
+	$(VENV)/bin/ruff check src tests benchmarks
 	$(VENV)/bin/mypy
 	$(VENV)/bin/lint-imports --no-cache
-
-# The type errors of the modules pyproject still exempts (PENDING overrides, issue 17), counted per package.
-typecheck-pending: venv
-	$(PY) tools/mypy_pending.py
 
 # The documentation site (mkdocs.yml, docs/), built strictly into a temporary folder.
 docs: venv
