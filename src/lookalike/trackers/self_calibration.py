@@ -149,7 +149,7 @@ class ScoreCalibration:
                 birth = min(birth, edge(self.birth_quantile))
             if self.clutter_factor is not None:  # before the share is judged: the median
                 q = 0.5 if clutter_share is None else max(self.clutter_factor * clutter_share, self.clutter_floor)
-                birth = min(birth, edge(min(q, 1.0)))
+                birth = min(birth, edge(min(q, 0.5)))  # never above the median, however much clutter
             if self.tentative_quantile is not None:
                 tentative = edge(self.tentative_quantile)
         high = min(high, birth)
