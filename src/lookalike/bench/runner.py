@@ -34,6 +34,7 @@ from lookalike.parallel import JobPool
 from lookalike.trackers import make_tracker
 from lookalike.trackers.closed_set import track_closed_set
 from lookalike.trackers.offline import OfflineConfig, postprocess
+from lookalike.types.mot_table import detection_rows as mot_detection_rows
 
 HEXBUG_RADIUS_PX = 120.0  # a box centre lies about half a bug from its head (benchmarks/hexbug_blobs.py)
 
@@ -137,9 +138,7 @@ def detection_rows(seq: RealSequence) -> np.ndarray:
     blocks = []
     for k, (xywh, score) in enumerate(zip(seq.det_xywh, seq.det_score)):
         if len(xywh):
-            block = np.full((len(xywh), 10), -1.0)
-            block[:, 0], block[:, 2:6], block[:, 6] = k + 1, xywh, score
-            blocks.append(block)
+            blocks.append(mot_detection_rows(k + 1, xywh, score))
     return np.vstack(blocks) if blocks else np.zeros((0, 10))
 
 

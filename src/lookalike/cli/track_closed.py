@@ -21,6 +21,7 @@ from lookalike.io.points import points_to_rows, read_points_csv, read_points_mot
 from lookalike.io.stream import track_to_file
 from lookalike.trackers.closed_set import track_closed_set
 from lookalike.types import Detections, Frame
+from lookalike.types.mot_table import detection_rows
 
 POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given (frames/s)
 
@@ -28,8 +29,7 @@ POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given 
 def table_rows(path: Path, min_score: float = float("-inf")) -> np.ndarray:
     """Detection rows ``(k, 10)`` of a MOTChallenge file, those scoring below ``min_score`` dropped."""
     table = read_mot(path)
-    rows = np.full((len(table), 10), -1.0)
-    rows[:, 0], rows[:, 2:6], rows[:, 6] = table.frame, table.xywh, table.conf
+    rows = detection_rows(table.frame, table.xywh, table.conf)
     return rows[rows[:, 6] >= min_score]
 
 

@@ -27,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike.types.mot_table import detection_rows
+
 __all__ = ["PointFrames", "points_to_rows", "read_points_csv", "read_points_mot", "rows_to_points",
            "typical_spacing"]
 
@@ -153,12 +155,7 @@ def points_to_rows(points: PointFrames | list[np.ndarray], box_px: float | None 
     for k, p in enumerate(per_frame):
         p = np.asarray(p, dtype=float).reshape(-1, 2)
         if len(p):
-            block = np.full((len(p), 10), -1.0)
-            block[:, 0] = k + 1
-            block[:, 2:4] = p - box_px / 2
-            block[:, 4:6] = box_px
-            block[:, 6] = score
-            blocks.append(block)
+            blocks.append(detection_rows(k + 1, np.hstack([p - box_px / 2, np.full((len(p), 2), box_px)]), score))
     return np.vstack(blocks) if blocks else np.zeros((0, 10))
 
 

@@ -78,6 +78,15 @@ def tracks_to_rows(frame_index: int, tracks: Iterable[TrackSnapshot]) -> np.ndar
     return rows
 
 
+def detection_rows(frame: int | np.ndarray, xywh: np.ndarray, score: np.ndarray | float) -> np.ndarray:
+    """MOTChallenge detection rows ``(k, 10)``: 1-based ``frame`` (one or per row), id -1, boxes
+    ``xywh (k, 4)`` in pixels, ``score``, -1, -1, -1."""
+    xywh = np.asarray(xywh, dtype=float).reshape(-1, 4)
+    rows = np.full((len(xywh), ROW_WIDTH), -1.0)
+    rows[:, 0], rows[:, 2:6], rows[:, 6] = frame, xywh, score
+    return rows
+
+
 def format_row(row: np.ndarray) -> str:
     """One result row as a line of a MOTChallenge file (boxes to 1/1000 px), newline included."""
     return (f"{int(row[0])},{int(row[1])},{row[2]:.3f},{row[3]:.3f},{row[4]:.3f},"
@@ -90,4 +99,4 @@ def stack_rows(chunks: Iterable[np.ndarray]) -> np.ndarray:
     return np.vstack(parts) if parts else np.zeros((0, ROW_WIDTH))
 
 
-__all__ = ["ROW_WIDTH", "MotTable", "format_row", "stack_rows", "table_from_array", "tracks_to_rows"]
+__all__ = ["ROW_WIDTH", "MotTable", "detection_rows", "format_row", "stack_rows", "table_from_array", "tracks_to_rows"]

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.types.mot_table import detection_rows
 from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config
 from lookalike.viz.overlay import source_frames
@@ -195,11 +196,7 @@ def blob_detection_rows(video: Path | str, config: BlobConfig,
     for k, image in enumerate(frames):
         det = detector(image)
         if len(det):
-            block = np.full((len(det), 10), -1.0)
-            block[:, 0] = k + 1
-            block[:, 2:6] = det.xywh
-            block[:, 6] = det.score
-            rows.append(block)
+            rows.append(detection_rows(k + 1, det.xywh, det.score))
         count += 1
         if advance is not None:
             advance()
