@@ -33,3 +33,14 @@ def parameter_grid(tracker: str, specs: list[str] | tuple[str, ...]) -> list[dic
         keys.append(key.strip())
         values.append([parse_parameter(tracker, f"{key}={v}")[1] for v in text.split(",")])
     return [dict(zip(keys, combo)) for combo in itertools.product(*values)]
+
+
+def report_target(name: str, value: float, target: float, *, higher_is_better: bool = True,
+                  unit: str = "") -> bool:
+    """Print one ``make bench`` target line, ``TARGET <name>: <value> (target >= or <= <target>) PASS|FAIL``,
+    and return whether it passed."""
+    passed = value >= target if higher_is_better else value <= target
+    op = ">=" if higher_is_better else "<="
+    print(f"TARGET {name}: {value:.3g}{unit} (target {op} {target:g}{unit}) {'PASS' if passed else 'FAIL'}",
+          flush=True)
+    return passed
