@@ -16,7 +16,7 @@ import numpy as np
 
 from lookalike.eval import identification_success_rate, localisation_error
 from lookalike.loop import RunStats, run
-from lookalike.sim import PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
+from lookalike.sim import DEFAULT_NOISE, PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
 from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.identity import agent_positions, labels_from_tracks
 from lookalike.types import Frame
@@ -72,11 +72,12 @@ def run_identifier(name: str, sequences: list[RobotSequence]) -> dict[str, float
 
 
 def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: int,
-                seed: int = DEFAULT_SEED) -> list[dict[str, Any]]:
-    """Rows (keys :data:`IDENT_COLUMNS`) for every set-up and tracker, on identical sequences."""
+                seed: int = DEFAULT_SEED, noise: str = DEFAULT_NOISE) -> list[dict[str, Any]]:
+    """Rows (keys :data:`IDENT_COLUMNS`) for every set-up and tracker, on identical sequences of the
+    simulator with position-noise model ``noise`` (``"paper"`` or ``"ours"``)."""
     rows = []
     for setup in setups:
-        cfg = preset(setup)
+        cfg = preset(setup, noise)
         seqs = [simulate_robots(cfg, frames, seed + 1000 * PRESET_NAMES.index(setup) + k) for k in range(sequences)]
         for name in trackers:
             r = run_identifier(name, seqs)

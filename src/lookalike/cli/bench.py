@@ -53,13 +53,15 @@ def ident(
     seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the test sequences."),
     json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
+    noise: str = typer.Option("ours", "--noise", help="Simulator position noise: paper (seed A's) or ours."),
 ) -> None:
     """Seed A's Table I: identification success rate per set-up and identifier (+ error, speed)."""
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
     check_names("--trackers", tracker_list, tracker_names(), "tracker")
+    check_names("--noise", [noise], ("paper", "ours"), "noise model")
     try:
-        rows = ident_table(setup_list, tracker_list, sequences, frames, seed)
+        rows = ident_table(setup_list, tracker_list, sequences, frames, seed, noise)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     labels = [preset_label(s) for s in setup_list]
