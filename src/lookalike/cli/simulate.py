@@ -8,7 +8,7 @@ import typer
 
 from lookalike.cli.app import app, console, fail
 from lookalike.io.robot_sequences import write_robot_sequence
-from lookalike.sim import PRESET_NAMES, preset, simulate_robots
+from lookalike.sim import DEFAULT_NOISE, NOISE_MODELS, PRESET_NAMES, preset, simulate_robots
 
 
 @app.command()
@@ -18,6 +18,9 @@ def simulate(
     sequences: int = typer.Option(1, "--sequences", min=1, help="Number of sequences (seeds seed, seed+1, ...)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the first sequence."),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for the .jsonl files."),
+    noise: str = typer.Option(DEFAULT_NOISE, "--noise",
+                              help="Position-noise model: paper (seed A's, larger across the image) or ours "
+                              "(larger in depth)."),
 ) -> None:
     """Simulate identical robots seen by an observer, with heading reports; write JSON Lines files.
 
@@ -26,7 +29,9 @@ def simulate(
     """
     if preset_name not in PRESET_NAMES:
         fail(f"--preset: unknown preset {preset_name!r}; known: {', '.join(PRESET_NAMES)}")
-    cfg = preset(preset_name)
+    if noise not in NOISE_MODELS:
+        fail(f"--noise: unknown noise model {noise!r}; known: {', '.join(NOISE_MODELS)}")
+    cfg = preset(preset_name, noise)
     for k in range(sequences):
         seq = simulate_robots(cfg, frames, seed + k)
         path = write_robot_sequence(output / f"{preset_name}-{seed + k:06d}.jsonl", seq)

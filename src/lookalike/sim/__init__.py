@@ -2,7 +2,7 @@
 
 from lookalike.sim.boxes import BoxScene, BoxSceneConfig, simulate_boxes
 from lookalike.sim.network import ReportArrays, simulate_reports
-from lookalike.sim.presets import PRESET_NAMES, preset, preset_label
+from lookalike.sim.presets import DEFAULT_NOISE, NOISE_MODELS, PRESET_NAMES, noise_sensor, preset, preset_label
 from lookalike.sim.robots import RobotArrays, RobotSequence, simulate_arrays, simulate_robots
 from lookalike.sim.robots_config import (
     MotionConfig,
@@ -14,8 +14,10 @@ from lookalike.sim.robots_config import (
 
 __all__ = [
     "BoxScene",
+    "DEFAULT_NOISE",
     "BoxSceneConfig",
     "MotionConfig",
+    "NOISE_MODELS",
     "NetworkConfig",
     "ObserverConfig",
     "PRESET_NAMES",
@@ -24,6 +26,7 @@ __all__ = [
     "RobotSequence",
     "RobotWorldConfig",
     "SensorConfig",
+    "noise_sensor",
     "preset",
     "preset_label",
     "simulate_arrays",
