@@ -42,6 +42,11 @@ def train(
     address: str | None = typer.Option(None, help="Ray cluster address (default: a local ray.init())."),
     resume: bool = typer.Option(False, help="Continue from OUTPUT/checkpoint.pt."),
     ship: bool = typer.Option(False, help="Copy the best weights into the package's shipped weights."),
+    protocol: str = typer.Option(
+        "ours", help="Input layout: ours, or paper (seed A's N + 4M inputs, no ages, no relative headings, "
+        "no augmentation beyond slot shuffling; shipped as lstm_paper_*)."),
+    noise: str = typer.Option("ours", help="Simulator noise model of the training sequences: ours, paper or mix "
+                              "(each sequence draws one from its seed)."),
 ) -> None:
     """Train the association network on simulated sequences generated on the fly."""
     try:
@@ -49,6 +54,8 @@ def train(
     except ImportError:
         fail("training needs PyTorch: pip install 'lookalike[train]' (torch==2.13.0)")
     from lookalike.learn.checkpoint import load_weights
+    from lookalike.learn.encoding import EncodingSpec
+    from lookalike.learn.paper_protocol import NoiseMixSampler, noise_worlds
     from lookalike.learn.sim_data import make_sim_sampler
     from lookalike.learn.training import TrainConfig, plot_log
     from lookalike.learn.training import train as run_training
@@ -59,15 +66,23 @@ def train(
         device = "cuda" if torch.cuda.is_available() else "cpu"
     if device.startswith("cuda") and not torch.cuda.is_available():
         fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
+    if protocol not in ("ours", "paper"):
+        fail(f"--protocol: unknown protocol {protocol!r}; known: ours, paper")
+    if protocol == "paper" and (relative or swap_prob > 0):
+        relative, swap_prob = False, 0.0  # the paper's inputs; no augmentation beyond slot shuffling
     try:
         world = preset(preset_name)
+        worlds = noise_worlds(preset_name, noise)
         config = TrainConfig(
             n_agents=world.n_agents, n_slots=world.max_detections, relative_headings=relative, cell=cell,
             hidden=hidden, num_layers=layers, batch_size=batch_size, sequence_length=sequence_length, steps=steps,
             minutes=minutes, seed=seed, learning_rate=learning_rate, patience=patience, swap_prob=swap_prob,
-            init_from=str(init_from) if init_from else None,
+            init_from=str(init_from) if init_from else None, protocol=protocol, noise=noise,
         )
-        sampler = make_sim_sampler(world, relative, swap_prob)
+        spec = EncodingSpec(world.n_agents, world.max_detections, relative_headings=relative, protocol=protocol)
+        plain = noise == "ours" and protocol == "ours"
+        sampler = make_sim_sampler(world, relative, swap_prob) if plain else NoiseMixSampler(worlds, spec)
+        validation = make_sim_sampler(world, relative) if plain else NoiseMixSampler(worlds, spec)
         init = load_weights(init_from, world.n_agents, world.max_detections) if init_from else None
         pool = JobPool(workers, backend, address)
     except ValueError as exc:
@@ -88,7 +103,7 @@ def train(
         try:
             with pool:
                 result = run_training(config, sampler, output, resume=resume, on_step=on_step, device=device,
-                                      pool=pool, init=init, validation_sample=make_sim_sampler(world, relative))
+                                      pool=pool, init=init, validation_sample=validation)
         except ValueError as exc:
             fail(str(exc))
     png = plot_log(result.log_path, output / "training_log.png")
@@ -98,7 +113,8 @@ def train(
     )
     if ship:
         WEIGHTS_DIR.mkdir(exist_ok=True)
-        target = WEIGHTS_DIR / f"lstm_m{world.max_detections}_n{world.n_agents}"
+        stem = "lstm_paper" if protocol == "paper" else "lstm"
+        target = WEIGHTS_DIR / f"{stem}_m{world.max_detections}_n{world.n_agents}"
         shutil.copy(result.weights_path, target.with_suffix(".npz"))
         shutil.copy(result.weights_path.with_suffix(".json"), target.with_suffix(".json"))
         console.print(f"shipped as {target.with_suffix('.npz')}")
