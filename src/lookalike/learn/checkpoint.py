@@ -98,6 +98,8 @@ def save_weights(weights: NetworkWeights, path: str | os.PathLike[str]) -> Path:
         "relative_headings": weights.spec.relative_headings,
         "info": weights.info,
     }
+    if weights.spec.protocol != "ours":  # files of the default layout stay as they were
+        meta["protocol"] = weights.spec.protocol
     path.with_suffix(".json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
     return path
 
@@ -140,7 +142,7 @@ def load_weights(
 
     try:
         spec = EncodingSpec(int(meta["n_agents"]), int(meta["n_slots"]), float(meta["max_age_s"]),
-                            bool(meta.get("relative_headings", False)))
+                            bool(meta.get("relative_headings", False)), str(meta.get("protocol", "ours")))
         layers = [
             {name: get(f"layer{i}.{name}") for name in ("w_ih", "w_hh", "b_ih", "b_hh")}
             for i in range(int(meta["num_layers"]))

@@ -12,6 +12,12 @@ Layout of the input vector (length ``3·N + 5·M``):
   Empty slots are all zeros.
 
 When a frame has more than M detections, the M most probable are kept.
+
+The paper's protocol (``EncodingSpec(protocol="paper")``, seed A's ``Q = N + M·(D + 1)`` with
+``D = 3``; length ``N + 4·M``): per agent its latest reported absolute heading ``ψ_j / π`` (0 for
+an agent never heard from), per slot ``x, y`` (metres), ``φ / π`` and ``γ``; empty slots all
+zeros. No report ages, no relative headings; the network standardises every input (zero mean,
+unit variance), as the paper does.
 """
 
 from __future__ import annotations
@@ -25,29 +31,45 @@ from lookalike.types import Detections
 ENCODING_VERSION = 1
 AGENT_WIDTH = 3
 SLOT_WIDTH = 5
+PAPER_AGENT_WIDTH = 1
+PAPER_SLOT_WIDTH = 4
+PROTOCOLS = ("ours", "paper")
 
 
 @dataclass(frozen=True)
 class EncodingSpec:
-    """Sizes of the encoding: ``n_agents`` (N) reporting agents, ``n_slots`` (M) detection slots."""
+    """Sizes of the encoding: ``n_agents`` (N) reporting agents, ``n_slots`` (M) detection slots;
+    ``protocol`` ``"ours"`` (default) or ``"paper"`` (seed A's ``N + 4·M`` inputs)."""
 
     n_agents: int
     n_slots: int
     max_age_s: float = 5.0
     relative_headings: bool = False
+    protocol: str = "ours"
 
     def __post_init__(self) -> None:
         if self.n_agents < 1 or self.n_slots < 1:
             raise ValueError(f"n_agents and n_slots must be >= 1, got {self.n_agents}, {self.n_slots}")
+        if self.protocol not in PROTOCOLS:
+            raise ValueError(f"protocol must be one of {', '.join(PROTOCOLS)}, got {self.protocol!r}")
+        if self.protocol == "paper" and self.relative_headings:
+            raise ValueError("the paper protocol has no relative headings")
 
     @property
     def n_inputs(self) -> int:
         """Length of one frame's input vector."""
-        return AGENT_WIDTH * self.n_agents + self.slot_width * self.n_slots
+        return self.agent_width * self.n_agents + self.slot_width * self.n_slots
+
+    @property
+    def agent_width(self) -> int:
+        """Inputs per agent."""
+        return PAPER_AGENT_WIDTH if self.protocol == "paper" else AGENT_WIDTH
 
     @property
     def slot_width(self) -> int:
         """Inputs per detection slot."""
+        if self.protocol == "paper":
+            return PAPER_SLOT_WIDTH
         return SLOT_WIDTH + (2 * self.n_agents if self.relative_headings else 0)
 
     @property
@@ -112,6 +134,30 @@ def relative_headings(slot_heading_rad: np.ndarray, agent_heading_rad: np.ndarra
     return out.reshape(*out.shape[:-2], out.shape[-2] * out.shape[-1])
 
 
+def encode_agents_paper(heading_rad: np.ndarray) -> np.ndarray:
+    """The paper's agent inputs ``(..., N)``: latest reported headings ``ψ / π`` in (-1, 1], wrapped;
+    0 for an agent never heard from (NaN)."""
+    heading = np.asarray(heading_rad, dtype=float)
+    known = np.isfinite(heading)
+    wrapped = np.angle(np.exp(1j * np.where(known, heading, 0.0)))
+    return np.where(known, wrapped / np.pi, 0.0)
+
+
+def encode_slots_paper(
+    spec: EncodingSpec, position_m: np.ndarray, heading_rad: np.ndarray, probability: np.ndarray
+) -> np.ndarray:
+    """The paper's slot inputs ``(4·M,)`` — ``x, y`` (m), ``φ / π``, ``γ`` — for up to M detections
+    given in slot order; empty slots are zeros."""
+    n = len(probability)
+    if n > spec.n_slots:
+        raise ValueError(f"{n} detections for {spec.n_slots} slots; select the most probable first")
+    slots = np.zeros((spec.n_slots, PAPER_SLOT_WIDTH))
+    slots[:n, 0:2] = position_m
+    slots[:n, 2] = encode_agents_paper(np.asarray(heading_rad, dtype=float))
+    slots[:n, 3] = probability
+    return slots.reshape(-1)
+
+
 def select_slots(score: np.ndarray, n_slots: int) -> np.ndarray:
     """Indices of the (at most) ``n_slots`` most probable detections, most probable first."""
     order = np.argsort(-np.asarray(score), kind="stable")
@@ -124,13 +170,18 @@ def encode_frame(
     latest_heading_rad: np.ndarray,
     report_age_s: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """One frame's input ``(n_inputs,)`` and the detection index of each used slot ``(k,)``.
+    """One frame's input ``(n_inputs,)`` and the detection index of each used slot ``(k,)``, in the
+    layout of ``spec.protocol`` (the paper's ignores ``report_age_s``).
 
     ``detections`` must carry ``position`` (metres) and ``heading`` (radians).
     """
     if detections.position is None or detections.heading is None or detections.score is None:
         raise ValueError("the LSTM encoding needs Detections.position, Detections.heading and Detections.score")
     used = select_slots(detections.score, spec.n_slots)
+    if spec.protocol == "paper":
+        paper_slots = encode_slots_paper(spec, detections.position[used], detections.heading[used],
+                                         detections.score[used])
+        return np.concatenate([encode_agents_paper(latest_heading_rad), paper_slots]), used
     slots = encode_slots(
         spec, detections.position[used], detections.heading[used], detections.score[used], latest_heading_rad
     )

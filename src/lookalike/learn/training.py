@@ -59,6 +59,8 @@ class TrainConfig:
     seed: int = 0
     swap_prob: float = 0.0  # recorded here; the sampler applies it (sim_data.SimSampler)
     init_from: str | None = None  # weights the run started from (recorded; passed as ``init``)
+    protocol: str = "ours"  # input layout: "ours" or "paper" (seed A's N + 4M inputs)
+    noise: str = "ours"  # simulator noise model(s) of the sampler (recorded): ours, paper or mix
 
 
 @dataclass
@@ -118,7 +120,8 @@ def train(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(config.seed)
-    spec = EncodingSpec(config.n_agents, config.n_slots, relative_headings=config.relative_headings)
+    spec = EncodingSpec(config.n_agents, config.n_slots, relative_headings=config.relative_headings,
+                        protocol=config.protocol)
     if config.sequence_length % config.bptt:
         raise ValueError(f"sequence_length {config.sequence_length} must be a multiple of bptt {config.bptt}")
     val_x, val_y = make_batch(
