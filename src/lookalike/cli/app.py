@@ -2,13 +2,40 @@
 
 from __future__ import annotations
 
-from typing import NoReturn
+import shlex
+import sys
+from pathlib import Path
+from typing import Any, NoReturn
 
 import typer
 from rich.console import Console
+from typer._click import Context, HelpFormatter  # typer 0.29 vendors click (constraints.txt pins it)
+from typer._click.globals import get_current_context
+from typer.core import TyperGroup
+
+
+class SortedGroup(TyperGroup):
+    """A command group listing its commands alphabetically in ``--help``."""
+
+    def list_commands(self, ctx: Context) -> list[str]:
+        return sorted(super().list_commands(ctx))
+
+    def format_commands(self, ctx: Context, formatter: HelpFormatter) -> None:
+        """The commands with their whole first sentence, wrapped (click would cut it with '...')."""
+        rows = []
+        for name in self.list_commands(ctx):
+            cmd = self.get_command(ctx, name)
+            if cmd is not None and not cmd.hidden:
+                rows.append((name, cmd.get_short_help_str(limit=10_000)))
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
+
 
 app = typer.Typer(
     name="lookalike",
+    cls=SortedGroup,
+    rich_markup_mode=None,  # click's plain help: wraps cleanly at 80 columns
     help="Track and identify look-alike targets: robots, divers, animals.",
     no_args_is_help=True,
     add_completion=False,
@@ -16,6 +43,22 @@ app = typer.Typer(
 )
 console = Console()
 err_console = Console(stderr=True, soft_wrap=True)  # an error stays one line
+
+
+def _version(value: bool) -> None:
+    if value:
+        from lookalike.bench.results import lookalike_version
+
+        console.print(f"lookalike {lookalike_version()}", highlight=False)
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(
+    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True,
+                                 help="Print lookalike's version and exit."),
+) -> None:
+    """Track and identify look-alike targets: robots, divers, animals."""
 
 
 def fail(message: str, code: int = 2) -> NoReturn:
@@ -27,3 +70,26 @@ def fail(message: str, code: int = 2) -> NoReturn:
 def split_list(values: list[str] | None) -> list[str]:
     """Option values given repeated and/or comma-separated, as one list (blanks dropped)."""
     return [v.strip() for item in values or [] for v in item.split(",") if v.strip()]
+
+
+def command_line() -> str:
+    """The command line being run, for the header of a results file: ``sys.argv`` when run as the
+    ``lookalike`` script, else (tests, ``python -m``) the command path and its non-default options."""
+    if sys.argv and Path(sys.argv[0]).name in ("lookalike", "__main__.py"):
+        return shlex.join(["lookalike", *sys.argv[1:]])
+    ctx = get_current_context(silent=True)
+    if ctx is None:
+        return "lookalike"
+    words = ctx.command_path.split()
+    for param in ctx.command.params:
+        value = ctx.params.get(param.name or "")
+        if value is None or value == param.default or param.param_type_name != "option":
+            continue
+        values: list[Any] = list(value) if isinstance(value, (list, tuple)) else [value]
+        flag = param.opts[0]
+        if isinstance(value, bool):
+            words += [flag if value else (param.secondary_opts or [flag])[0]]
+            continue
+        for v in values:
+            words += [flag, str(v)]
+    return shlex.join(words)

@@ -12,11 +12,12 @@ from rich.table import Table
 
 from lookalike.bench.ident import DEFAULT_SEED, IDENT_COLUMNS, IDENT_TRACKERS, ident_table
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import app, console, fail, split_list
+from lookalike.cli.app import SortedGroup, app, console, fail, split_list
 from lookalike.sim import PRESET_NAMES, preset_label
 from lookalike.trackers import tracker_names
 
-bench_app = typer.Typer(help="Benchmarks that print tables (also written with --json/--csv).", no_args_is_help=True)
+bench_app = typer.Typer(help="Benchmarks that print tables (also written with --json/--csv).", no_args_is_help=True,
+                        cls=SortedGroup, rich_markup_mode=None)
 app.add_typer(bench_app, name="bench")
 TEXT_COLUMNS = ("Setup", "Tracker", "Identifier", "Scenario")
 

@@ -1,0 +1,227 @@
+"""One results schema for every ``--json`` (``eval``, ``bench ...``, the demo's data files).
+
+A document is ``{"schema": "lookalike-results/1", "header": {...}, "tables": {name: [row, ...]}}``,
+described by ``results.schema.json`` beside this module (:data:`SCHEMA_PATH`, shipped as package data).
+
+- header: ``lookalike_version``, ``command`` (the command line), ``kind`` (``"bench ident"``, ...),
+  ``seeds`` (of every simulated sequence; empty for recorded data), ``sequences`` and ``frames``
+  (counts, all sequences together), ``created_utc``, and free-form ``options`` and ``notes``;
+- row: ``dataset`` (``m3n2``, ``mot15``; ``None`` across data sets), ``sequence`` (``None`` across
+  sequences), ``tracker``, ``combined`` (``True`` for a row combining other rows of its table, e.g.
+  eval's combined row or the divers' ALL row), ``metrics`` (machine keys, see :func:`metric_key`;
+  fractions in [0, 1], never percent), optional ``info`` (text fields) and ``error``.
+
+Usage::
+
+    from lookalike.bench.results import Results
+
+    doc = Results("bench divers", command=command_line, seeds=seeds, sequences=len(scenarios),
+                  frames=total_frames, options={"frames": frames})
+    doc.add("divers", dataset="divers", sequence="pool-1", tracker="sort",
+            metrics={"idf1": 0.81, "idsw": 3}, info={"location": "pool"})
+    doc.add("divers", dataset="divers", sequence=None, tracker="sort", combined=True, metrics={...})
+    doc.write(path)   # or doc.to_dict() / doc.dumps()
+
+:meth:`Results.add` refuses keys that are not machine keys and fractions outside [0, 1] (NaN and
+infinities are written as ``null``). :func:`percent_row_metrics` turns a printed row (``"Success rate
+(%)": 93.1``) into metrics (``{"success_rate": 0.931}``). :func:`load_results` reads a document back.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import math
+import re
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+SCHEMA_ID = "lookalike-results/1"
+SCHEMA_PATH = Path(__file__).with_name("results.schema.json")
+KEY_PATTERN = re.compile(r"^[a-z][a-z0-9_]*$")
+#: Metrics that are fractions in [0, 1] (``gap`` in [-1, 1], MOTA/MODA at most 1).
+FRACTIONS = frozenset({
+    "success_rate", "success_rate_pixels", "success_rate_simulated", "success_rate_in_order",
+    "success_rate_random_order", "hota", "deta", "assa", "loca", "idf1", "idp", "idr", "motp", "dp", "dr",
+    "recall", "precision",
+})
+_ALPHA_FRACTION = re.compile(r"^(hota|deta|assa|loca|detre|detpr|assre|asspr|rhota)_([0-9]+|auc)$")
+_UNITS = {"(m)": "_m", "(s)": "_s", "(deg)": "_deg", "(px)": "_px"}
+
+
+def lookalike_version() -> str:
+    """The installed lookalike version (``"unknown"`` when not installed)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("lookalike")
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def metric_key(name: str) -> str:
+    """A machine key for a printed or TrackEval metric name: ``"HOTA(0)"`` -> ``"hota_0"``,
+    ``"HOTA___AUC"`` -> ``"hota_auc"``, ``"Localisation error (m)"`` -> ``"localisation_error_m"``,
+    ``"Frames/s"`` -> ``"frames_per_s"``, ``"Success rate (%)"`` -> ``"success_rate"``."""
+    text = name.strip()
+    for unit, suffix in _UNITS.items():
+        if text.endswith(unit):
+            text = text[: -len(unit)] + suffix
+    text = re.sub(r"\((%|pp)\)$", "", text).replace("/s", " per s")
+    key = re.sub(r"[^a-z0-9]+", "_", text.lower()).strip("_")
+    if not key or not key[0].isalpha():
+        key = f"m_{key}"
+    return key
+
+
+def is_fraction(key: str) -> bool:
+    """Whether metric ``key`` is a fraction in [0, 1]."""
+    return key in FRACTIONS or bool(_ALPHA_FRACTION.match(key))
+
+
+def _number(key: str, value: Any) -> float | int | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        try:
+            value = float(value)  # numpy scalars
+        except (TypeError, ValueError):
+            raise ValueError(f"metric {key!r}: not a number: {value!r}") from None
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, float) and value.is_integer() and key in ("idsw", "frag", "detections", "frames"):
+        return int(value)
+    return value
+
+
+def _check_metric(key: str, value: float | int | None) -> None:
+    if not KEY_PATTERN.match(key):
+        raise ValueError(f"metric {key!r}: not a machine key (lower case, digits, '_'); see metric_key()")
+    if value is None:
+        return
+    if is_fraction(key) and not 0.0 <= value <= 1.0:
+        raise ValueError(f"metric {key!r}: {value} is not a fraction in [0, 1] (percent only when printed)")
+    if key in ("mota", "moda") and value > 1.0:
+        raise ValueError(f"metric {key!r}: {value} is above 1 (a fraction, not percent)")
+    if key == "gap" and not -1.0 <= value <= 1.0:
+        raise ValueError(f"metric 'gap': {value} is not a fraction in [-1, 1]")
+
+
+def clean_metrics(metrics: Mapping[str, Any]) -> dict[str, float | int | None]:
+    """``metrics`` checked: machine keys, numbers (NaN/inf -> ``None``), fractions in [0, 1]."""
+    out: dict[str, float | int | None] = {}
+    for key, value in metrics.items():
+        number = _number(key, value)
+        _check_metric(key, number)
+        out[key] = number
+    return out
+
+
+def percent_row_metrics(row: Mapping[str, Any], skip: Iterable[str] = ()) -> dict[str, float | int | None]:
+    """Metrics of a printed table row: numeric cells under machine keys (:func:`metric_key`), cells
+    marked ``(%)`` or ``(pp)`` divided by 100; text cells and the columns in ``skip`` left out."""
+    skipped = set(skip)
+    out: dict[str, Any] = {}
+    for name, value in row.items():
+        if name in skipped or isinstance(value, (str, bool)) or value is None:
+            continue
+        scale = 0.01 if name.rstrip().endswith(("(%)", "(pp)")) else 1.0
+        out[metric_key(name)] = round(value * scale, 6) if scale != 1.0 else value
+    return clean_metrics(out)
+
+
+@dataclass
+class Results:
+    """A results document being built (see the module docstring); rows go into named tables."""
+
+    kind: str
+    command: str = ""
+    seeds: list[int] = field(default_factory=list)
+    sequences: int = 0
+    frames: int = 0
+    options: dict[str, Any] = field(default_factory=dict)
+    notes: dict[str, Any] = field(default_factory=dict)
+    tables: dict[str, list[dict[str, Any]]] = field(default_factory=dict)
+
+    def add(self, table: str, *, dataset: str | None, tracker: str, sequence: str | None = None,
+            combined: bool = False, metrics: Mapping[str, Any] | None = None,
+            info: Mapping[str, Any] | None = None, error: str | None = None) -> dict[str, Any]:
+        """Append one row to ``table`` (created on first use) and return it."""
+        if not KEY_PATTERN.match(table):
+            raise ValueError(f"table {table!r}: not a machine key (lower case, digits, '_')")
+        row: dict[str, Any] = {"dataset": dataset, "sequence": sequence, "tracker": str(tracker),
+                               "combined": bool(combined), "metrics": clean_metrics(metrics or {})}
+        if info:
+            row["info"] = {k: _plain(v) for k, v in info.items()}
+        if error is not None:
+            row["error"] = str(error)
+        self.tables.setdefault(table, []).append(row)
+        return row
+
+    def to_dict(self) -> dict[str, Any]:
+        """The document as plain JSON-able data."""
+        header = {
+            "lookalike_version": lookalike_version(), "command": self.command or f"lookalike {self.kind}",
+            "kind": self.kind, "seeds": [int(s) for s in self.seeds], "sequences": int(self.sequences),
+            "frames": int(self.frames),
+            "created_utc": _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat(),
+            "options": {k: _plain(v) for k, v in self.options.items()},
+        }
+        if self.notes:
+            header["notes"] = {k: _plain(v) for k, v in self.notes.items()}
+        return {"schema": SCHEMA_ID, "header": header, "tables": self.tables or {"rows": []}}
+
+    def dumps(self) -> str:
+        """The document as JSON text."""
+        return json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
+
+    def write(self, path: Path) -> Path:
+        """Write the document to ``path`` (parent folders created)."""
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(self.dumps())
+        return path
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if value is None or isinstance(value, (str, int, float, bool)):
+        return value
+    return str(value)
+
+
+def schema() -> dict[str, Any]:
+    """The JSON Schema of a results document."""
+    loaded: dict[str, Any] = json.loads(SCHEMA_PATH.read_text())
+    return loaded
+
+
+def load_results(path: Path) -> dict[str, Any]:
+    """A results document read from ``path``; ``ValueError`` naming the file when it is not one."""
+    try:
+        data = json.loads(Path(path).read_text())
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not JSON ({exc.msg}, line {exc.lineno})") from None
+    if not isinstance(data, dict) or data.get("schema") != SCHEMA_ID:
+        raise ValueError(f"{path}: not a lookalike results file (no \"schema\": \"{SCHEMA_ID}\")")
+    return data
+
+
+def rows(document: Mapping[str, Any], table: str | None = None) -> list[dict[str, Any]]:
+    """The rows of ``table`` (default: the first table) of a results document."""
+    tables = document["tables"]
+    if table is None:
+        return list(next(iter(tables.values()), []))
+    return list(tables.get(table, []))
+
+
+__all__ = ["FRACTIONS", "SCHEMA_ID", "SCHEMA_PATH", "Results", "clean_metrics", "is_fraction", "load_results",
+           "lookalike_version", "metric_key", "percent_row_metrics", "rows", "schema"]

@@ -1,0 +1,46 @@
+"""Progress bars with time left for the long commands (``bench ...``, ``tune``).
+
+Usage in a command::
+
+    with progress_bars() as progress:      # a lookalike.bench.progress.ProgressFactory
+        rows = ident_table(..., progress=progress)
+
+Bars go to stderr, so ``--json -`` style output and piped tables stay clean; they vanish when done
+and are not drawn when stderr is not a terminal (tests, logs).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+
+from lookalike.bench.progress import ProgressFactory, Step
+
+_console = Console(stderr=True)
+
+
+@contextmanager
+def progress_bars(console: Console | None = None) -> Iterator[ProgressFactory]:
+    """A progress factory drawing rich bars (done/total, elapsed, time left) while the block runs."""
+    out = console or _console
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+               TextColumn("left"), TimeRemainingColumn())
+    with Progress(*columns, console=out, transient=True, disable=not out.is_terminal) as bars:
+        def factory(description: str, total: int) -> Step:
+            task = bars.add_task(description, total=max(int(total), 1))
+            return lambda: bars.advance(task)
+
+        yield factory
+
+
+__all__ = ["progress_bars"]
