@@ -6,7 +6,7 @@ import json
 
 from typer.testing import CliRunner
 
-from lookalike.bench.ident import IDENT_COLUMNS, ident_table
+from lookalike.bench.ident import IDENT_TRACKERS, ident_table
 from lookalike.cli import app
 
 
@@ -14,10 +14,14 @@ def test_command_writes_json_and_csv(tmp_path):
     result = CliRunner().invoke(app, ["bench", "ident", "--setups", "m3n2", "--sequences", "1", "--frames", "60",
                                       "--json", str(tmp_path / "t.json"), "--csv", str(tmp_path / "t.csv")])
     assert result.exit_code == 0, result.output
-    rows = json.loads((tmp_path / "t.json").read_text())
-    assert [r["Tracker"] for r in rows] == ["kalman_ha", "kalman_ha2", "jpda"]
-    assert all(list(r) == list(IDENT_COLUMNS) for r in rows)
-    assert all(0 <= r["Success rate (%)"] <= 100 for r in rows)
+    doc = json.loads((tmp_path / "t.json").read_text())
+    rows = doc["tables"]["ident"]
+    assert [r["tracker"] for r in rows] == list(IDENT_TRACKERS)
+    assert rows[0]["tracker"] == "lstm"  # seed A's Table I leads with the learned identifier
+    assert {r["dataset"] for r in rows} == {"m3n2"}
+    assert all(0 <= r["metrics"]["success_rate"] <= 1 for r in rows)
+    assert set(rows[0]["metrics"]) == {"success_rate", "localisation_error_m", "frames_per_s", "detections"}
+    assert doc["header"]["seeds"] == [900_000] and doc["header"]["frames"] == 60
     assert (tmp_path / "t.csv").read_text().startswith("Setup,Tracker")
     bad = CliRunner().invoke(app, ["bench", "ident", "--trackers", "nope"])
     assert bad.exit_code != 0

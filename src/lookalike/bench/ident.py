@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.bench.progress import ProgressFactory, Step, no_progress
+from lookalike.bench.results import Results, percent_row_metrics
 from lookalike.eval import identification_success_rate, localisation_error
 from lookalike.loop import RunStats, run
 from lookalike.sim import DEFAULT_NOISE, PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
@@ -21,7 +23,7 @@ from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.identity import agent_positions, labels_from_tracks
 from lookalike.types import Frame
 
-IDENT_TRACKERS = ("kalman_ha", "kalman_ha2", "jpda")
+IDENT_TRACKERS = ("lstm", "kalman_ha", "kalman_ha2", "jpda")  # lstm: the learned identifier (seed A)
 IDENT_COLUMNS = ("Setup", "Tracker", "Success rate (%)", "Localisation error (m)", "Frames/s", "Detections")
 DEFAULT_SEED = 900_000
 
@@ -45,8 +47,9 @@ def identify(name: str, sequence: RobotSequence, frames: Sequence[Frame] | None 
     return labels
 
 
-def run_identifier(name: str, sequences: list[RobotSequence]) -> dict[str, float]:
-    """Success rate, localisation error, frames/s and detection count of tracker ``name``."""
+def run_identifier(name: str, sequences: list[RobotSequence], step: Step | None = None) -> dict[str, float]:
+    """Success rate, localisation error, frames/s and detection count of tracker ``name``
+    (``step()`` called after each sequence)."""
     predicted: list[np.ndarray] = []
     truth: list[np.ndarray] = []
     est, true_pos = [], []
@@ -63,6 +66,8 @@ def run_identifier(name: str, sequences: list[RobotSequence]) -> dict[str, float
         truth.extend(seq.true_labels())
         est.append(positions)
         true_pos.append(seq.true_positions_visible())
+        if step is not None:
+            step()
     return {
         "success": identification_success_rate(predicted, truth),
         "loc_error": localisation_error(np.concatenate(est), np.concatenate(true_pos)),
@@ -71,16 +76,24 @@ def run_identifier(name: str, sequences: list[RobotSequence]) -> dict[str, float
     }
 
 
+def sequence_seeds(setups: list[str], sequences: int, seed: int = DEFAULT_SEED) -> list[int]:
+    """Seeds of the test sequences, set-up after set-up (``seed + 1000·setup index + sequence``)."""
+    return [seed + 1000 * PRESET_NAMES.index(s) + k for s in setups for k in range(sequences)]
+
+
 def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: int,
-                seed: int = DEFAULT_SEED, noise: str = DEFAULT_NOISE) -> list[dict[str, Any]]:
+                seed: int = DEFAULT_SEED, noise: str = DEFAULT_NOISE,
+                progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
     """Rows (keys :data:`IDENT_COLUMNS`) for every set-up and tracker, on identical sequences of the
-    simulator with position-noise model ``noise`` (``"paper"`` or ``"ours"``)."""
+    simulator with position-noise model ``noise`` (``"paper"`` or ``"ours"``); ``progress`` advances
+    once per sequence and tracker."""
     rows = []
+    step = progress("bench ident", len(setups) * len(trackers) * sequences)
     for setup in setups:
         cfg = preset(setup, noise)
-        seqs = [simulate_robots(cfg, frames, seed + 1000 * PRESET_NAMES.index(setup) + k) for k in range(sequences)]
+        seqs = [simulate_robots(cfg, frames, s) for s in sequence_seeds([setup], sequences, seed)]
         for name in trackers:
-            r = run_identifier(name, seqs)
+            r = run_identifier(name, seqs, step)
             rows.append({
                 "Setup": preset_label(setup), "Tracker": name, "Success rate (%)": round(100 * r["success"], 2),
                 "Localisation error (m)": round(r["loc_error"], 3), "Frames/s": round(r["fps"], 1),
@@ -89,5 +102,20 @@ def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: 
     return rows
 
 
-__all__ = ["DEFAULT_SEED", "IDENT_COLUMNS", "IDENT_TRACKERS", "build_identifier", "ident_table", "identify",
-           "run_identifier"]
+def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int, frames: int,
+                  seed: int = DEFAULT_SEED, command: str = "", noise: str = DEFAULT_NOISE) -> Results:
+    """The rows of :func:`ident_table` as a results document (:mod:`lookalike.bench.results`):
+    table ``ident``, one row per set-up (dataset: the preset name) and identifier, over all its sequences."""
+    names = {preset_label(s): s for s in setups}
+    doc = Results("bench ident", command=command, seeds=sequence_seeds(setups, sequences, seed),
+                  sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
+                  options={"setups": setups, "sequences_per_setup": sequences, "frames_per_sequence": frames,
+                           "seed": seed, "noise": noise})
+    for r in rows:
+        doc.add("ident", dataset=names.get(r["Setup"], r["Setup"]), tracker=r["Tracker"],
+                metrics=percent_row_metrics(r, skip=("Setup", "Tracker")))
+    return doc
+
+
+__all__ = ["DEFAULT_SEED", "IDENT_COLUMNS", "IDENT_TRACKERS", "build_identifier", "ident_results", "ident_table",
+           "identify", "run_identifier", "sequence_seeds"]

@@ -10,9 +10,11 @@ from typing import Any
 import typer
 from rich.table import Table
 
-from lookalike.bench.ident import DEFAULT_SEED, IDENT_COLUMNS, IDENT_TRACKERS, ident_table
+from lookalike.bench.ident import DEFAULT_SEED, IDENT_COLUMNS, IDENT_TRACKERS, ident_results, ident_table
+from lookalike.bench.results import Results
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import SortedGroup, app, console, fail, split_list
+from lookalike.cli.app import SortedGroup, app, command_line, console, fail, split_list
+from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES, preset_label
 from lookalike.trackers import tracker_names
 
@@ -38,6 +40,16 @@ def print_rows(title: str | None, rows: list[dict[str, Any]], columns: Sequence[
     console.print(rich_table(title, rows, columns))
 
 
+def write_results(doc: Results, path: Path | None) -> None:
+    """Write a results document to ``path`` (if given); a one-line error when it cannot be written."""
+    if path is None:
+        return
+    try:
+        doc.write(path)
+    except OSError as exc:
+        fail(f"--json: cannot write {path}: {exc.strerror or exc}")
+
+
 def check_names(option: str, names: list[str], known: Sequence[str], what: str) -> None:
     """Fail naming the first of ``names`` not in ``known``."""
     for n in names:
@@ -48,7 +60,8 @@ def check_names(option: str, names: list[str], known: Sequence[str], what: str) 
 @bench_app.command("ident")
 def ident(
     setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help="Presets (comma-separated or repeated)."),
-    trackers: list[str] = typer.Option(list(IDENT_TRACKERS), "--trackers", help="Identifiers to compare."),
+    trackers: list[str] = typer.Option(list(IDENT_TRACKERS), "--trackers",
+                                       help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(10, "--sequences", min=1, help="Test sequences per set-up."),
     frames: int = typer.Option(1000, "--frames", min=1, help="Frames per sequence."),
     seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the test sequences."),
@@ -62,7 +75,8 @@ def ident(
     check_names("--trackers", tracker_list, tracker_names(), "tracker")
     check_names("--noise", [noise], ("paper", "ours"), "noise model")
     try:
-        rows = ident_table(setup_list, tracker_list, sequences, frames, seed, noise)
+        with progress_bars() as progress:
+            rows = ident_table(setup_list, tracker_list, sequences, frames, seed, noise, progress)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     labels = [preset_label(s) for s in setup_list]
@@ -70,7 +84,8 @@ def ident(
     summary = [{"Tracker": name, **{label: rate[(label, name)] for label in labels}} for name in tracker_list]
     print_rows(f"Robot identification success rate, {sequences} × {frames} frames per set-up", summary)
     print_rows("Per set-up details", rows, IDENT_COLUMNS)
-    write_rows(rows, json_path, csv_path)
+    write_results(ident_results(rows, setup_list, sequences, frames, seed, command_line(), noise), json_path)
+    write_rows(rows, None, csv_path)
 
 
-__all__ = ["bench_app", "check_names", "print_rows", "rich_table"]
+__all__ = ["bench_app", "check_names", "print_rows", "rich_table", "write_results"]
