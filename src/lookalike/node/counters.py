@@ -20,6 +20,8 @@ EVENTS = (
     "duplicate",  # a report or frame seen already (same sequence number / frame index)
     "unknown_robot",  # reports from a robot id outside the team
     "time_backwards",  # a report whose send time goes back for an increasing sequence number
+    "queue_dropped",  # accepted reports pushed out of their robot's full queue before a frame came
+    "queue_full",  # reports dropped because the queues of all robots together were full
     "frame_backwards",  # a detection frame older than the last one (dropped)
     "camera_lost",  # the camera went silent for longer than the timeout
     "camera_restarts",  # the camera came back with an earlier time: the tracker was reset

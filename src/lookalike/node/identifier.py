@@ -9,6 +9,7 @@ therefore run faster than wall time, as long as every process scales it the same
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -16,13 +17,14 @@ from typing import Any
 import numpy as np
 
 from lookalike.node.messages import (
+    MAX_ROBOTS,
     DetectionsMessage,
     HeadingReport,
     RobotEstimate,
     TeamState,
 )
 from lookalike.trackers.identity import labels_from_tracks
-from lookalike.types import Beacons, Detections, Frame, TrackSnapshot
+from lookalike.types import Beacons, Detections, Frame, Tracks, TrackSnapshot
 
 
 @dataclass(frozen=True)
@@ -32,16 +34,25 @@ class IdentifierConfig:
     Attributes:
         n_robots: robots in the team; ids ``0 .. n_robots-1`` are accepted.
         max_report_age_s: a report sent more than this before the latest frame is late (seconds).
+        max_queued_per_robot: reports of one robot kept for the next frame; beyond it the oldest
+            is dropped (counted ``queue_dropped``).
+        max_queued: reports of all robots kept for the next frame; beyond it a new report is
+            dropped (counted ``queue_full``).
     """
 
     n_robots: int = 3
     max_report_age_s: float = 1.0
+    max_queued_per_robot: int = 64
+    max_queued: int = 4096
 
     def __post_init__(self) -> None:
-        if self.n_robots < 1:
-            raise ValueError(f"n_robots must be >= 1, got {self.n_robots}")
-        if not self.max_report_age_s > 0:
-            raise ValueError(f"max_report_age_s must be > 0, got {self.max_report_age_s}")
+        if not 1 <= self.n_robots <= MAX_ROBOTS:
+            raise ValueError(f"n_robots must be in 1 .. {MAX_ROBOTS}, got {self.n_robots}")
+        if not (self.max_report_age_s > 0 and math.isfinite(self.max_report_age_s)):
+            raise ValueError(f"max_report_age_s must be a finite number > 0, got {self.max_report_age_s}")
+        if self.max_queued_per_robot < 1 or self.max_queued < 1:
+            raise ValueError(f"max_queued_per_robot and max_queued must be >= 1, got "
+                             f"{self.max_queued_per_robot} and {self.max_queued}")
 
 
 class TeamIdentifier:
@@ -49,6 +60,8 @@ class TeamIdentifier:
 
     ``add_report`` and ``add_frame`` return the name of the counter the message falls under
     (``"reports"``/``"frames"`` when accepted); ``add_frame`` also returns the team state.
+    Accepted reports wait for the next frame in bounded queues (``IdentifierConfig``);
+    ``queue_dropped`` counts the reports pushed out of a full robot queue since construction.
     """
 
     def __init__(self, tracker: Any, config: IdentifierConfig | None = None) -> None:
@@ -57,7 +70,10 @@ class TeamIdentifier:
         n = self.config.n_robots
         self._last_seq = np.full(n, -1)
         self._last_sent = np.full(n, -math.inf)
-        self._pending: list[HeadingReport] = []
+        self._pending: list[deque[tuple[int, HeadingReport]]] = [deque() for _ in range(n)]
+        self._queued = 0  # reports in all the queues
+        self._arrival = 0  # arrival number of the next report (keeps the frame's reports in arrival order)
+        self.queue_dropped = 0
         self._last_update = np.full(n, math.nan)  # frame time a detection last updated each robot
         self.last_frame: int | None = None
         self.last_time = -math.inf
@@ -79,9 +95,35 @@ class TeamIdentifier:
         # (seq < last_seq with a newer send time: the robot restarted its counter; accept.)
         if report.t_sent < self.last_time - self.config.max_report_age_s:
             return "late"
+        queue = self._pending[j]
+        if len(queue) >= self.config.max_queued_per_robot:
+            queue.popleft()
+            self._queued -= 1
+            self.queue_dropped += 1
+        elif self._queued >= self.config.max_queued:
+            return "queue_full"
         self._last_seq[j], self._last_sent[j] = report.seq, report.t_sent
-        self._pending.append(report)
+        queue.append((self._arrival, report))
+        self._arrival += 1
+        self._queued += 1
         return "reports"
+
+    @property
+    def queued(self) -> int:
+        """Reports waiting for the next frame."""
+        return self._queued
+
+    def _take_reports(self) -> list[HeadingReport]:
+        """Empty the queues; the reports in arrival order."""
+        if self._queued == 0:
+            return []
+        items = [item for queue in self._pending if queue for item in queue]
+        for queue in self._pending:
+            queue.clear()
+        self._queued = 0
+        if len(items) > 1:
+            items.sort(key=_first)
+        return [report for _, report in items]
 
     def add_frame(self, message: DetectionsMessage) -> tuple[str, TeamState | None]:
         """Track one camera frame with the reports queued since the previous one."""
@@ -102,7 +144,7 @@ class TeamIdentifier:
         """The camera came back with an earlier time: reset the tracker and the frame clock."""
         self.tracker.reset()
         self.restarts += 1
-        self._pending.clear()
+        self._take_reports()
         self._last_update[:] = math.nan
         self._last_sent[:] = -math.inf
         self._last_seq[:] = -1
@@ -116,7 +158,7 @@ class TeamIdentifier:
             score=np.asarray(message.score, dtype=float),
             heading_std=None if message.heading_std is None else np.asarray(message.heading_std, dtype=float),
         )
-        reports, self._pending = self._pending, []
+        reports = self._take_reports()
         beacons = Beacons(
             agent_id=np.array([r.robot for r in reports], dtype=int),
             t_sent=np.array([r.t_sent for r in reports], dtype=float),
@@ -127,33 +169,59 @@ class TeamIdentifier:
 
     def _team_state(self, frame: Frame, snapshots: Sequence[TrackSnapshot]) -> TeamState:
         n = len(frame.detections)
-        best: dict[int, TrackSnapshot] = {}
-        for s in snapshots:
-            j = s.agent_id
-            if j is None or not 0 <= j < self.config.n_robots or s.position is None:
-                continue
-            if j not in best or _rank(s) > _rank(best[j]):
-                best[j] = s
+        best: dict[int, _Row] = {}
+        for row in _rows(snapshots, self.config.n_robots):
+            j = row[0]
+            if j not in best or _rank(row) > _rank(best[j]):
+                best[j] = row
         robots = []
         for j in sorted(best):
-            s = best[j]
-            if s.detection_index >= 0 or math.isnan(self._last_update[j]):
+            _, det_index, prob, x, y, heading = best[j]
+            if det_index >= 0 or math.isnan(self._last_update[j]):
                 self._last_update[j] = frame.time
-            pos = np.asarray(s.position, dtype=float)
-            if not np.isfinite(pos).all():
+            if not (math.isfinite(x) and math.isfinite(y)):
                 continue
             robots.append(RobotEstimate(
-                id=int(j), position=(float(pos[0]), float(pos[1])),
-                heading=_finite_or_none(s.heading), confidence=_finite_or_none(s.identity_prob),
+                id=int(j), position=(x, y), heading=_finite_or_none(heading), confidence=_finite_or_none(prob),
                 age=float(frame.time - self._last_update[j]),
             ))
         labels = labels_from_tracks(n, snapshots)
-        return TeamState(frame=frame.index, time=frame.time, robots=tuple(robots),
-                         labels=tuple(int(v) for v in labels))
+        return TeamState(frame=frame.index, time=frame.time, robots=tuple(robots), labels=tuple(labels.tolist()))
 
 
-def _rank(s: TrackSnapshot) -> tuple[bool, float]:
-    return s.detection_index >= 0, s.identity_prob if s.identity_prob is not None else 0.0
+# (agent id, detection index, identity probability, x, y, heading) of an identified track
+_Row = tuple[int, int, float | None, float, float, float | None]
+
+
+def _rows(snapshots: Sequence[TrackSnapshot], n_robots: int) -> list[_Row]:
+    """The identified tracks with a position and an agent id in ``0 .. n_robots-1``, in order
+    (read from the columns when the tracker returns :class:`Tracks`)."""
+    if isinstance(snapshots, Tracks):
+        t = snapshots
+        if t.agent_id is None or t.position is None or not len(t):
+            return []
+        rows = np.flatnonzero((t.agent_id >= 0) & (t.agent_id < n_robots)).tolist()
+        prob = [None] * len(t) if t.identity_prob is None else t.identity_prob.tolist()
+        heading = [None] * len(t) if t.heading is None else t.heading.tolist()
+        agent, det, pos = t.agent_id.tolist(), t.detection_index.tolist(), t.position.tolist()
+        return [(agent[i], det[i], None if prob[i] is None or math.isnan(prob[i]) else prob[i],
+                 float(pos[i][0]), float(pos[i][1]), heading[i]) for i in rows]
+    out: list[_Row] = []
+    for s in snapshots:
+        j = s.agent_id
+        if j is None or not 0 <= j < n_robots or s.position is None:
+            continue
+        pos = np.asarray(s.position, dtype=float)
+        out.append((int(j), s.detection_index, s.identity_prob, float(pos[0]), float(pos[1]), s.heading))
+    return out
+
+
+def _first(item: tuple[int, HeadingReport]) -> int:
+    return item[0]
+
+
+def _rank(row: _Row) -> tuple[bool, float]:
+    return row[1] >= 0, row[2] if row[2] is not None else 0.0
 
 
 def _finite_or_none(value: float | None) -> float | None:

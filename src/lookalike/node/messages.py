@@ -6,6 +6,12 @@ Every message is one UDP datagram holding a JSON object with ``"v"`` (the schema
 and ``status`` (the node's counters). Times are simulated seconds, positions metres in the
 observer frame, headings radians. ``decode`` never raises anything but ``MessageError``, whose
 ``reason`` is a short stable code that the node counts.
+
+Bounds (checked on every field of every message, docs/howto/robot-team.md lists them): integers
+in ``[minimum, 2**63 - 1]`` (64-bit signed; ``bool`` is not an integer), numbers finite with
+``|x| <= MAX_ABS_NUMBER``, at most ``MAX_DETECTIONS`` detections or labels and ``MAX_ROBOTS``
+robot estimates per message, status counters at most ``MAX_COUNTERS`` entries with keys of at most
+``MAX_KEY_CHARS`` characters, no unknown fields, datagrams of at most ``MAX_DATAGRAM_BYTES``.
 """
 
 from __future__ import annotations
@@ -19,6 +25,12 @@ from typing import Any, cast
 SCHEMA_VERSION = 1
 MAX_DATAGRAM_BYTES = 65_000
 MAX_DETECTIONS = 256
+MAX_ROBOTS = 256  # robot estimates in one team state
+MAX_INT = 2**63 - 1  # integers are 64-bit signed on the wire
+MAX_ABS_NUMBER = 1e12  # |seconds|, |metres|, |radians|, scores: finite and at most this
+MAX_COUNTERS = 256  # entries of a status message's counters (nested objects included)
+MAX_KEY_CHARS = 64  # characters of a counter's name
+MAX_DETAIL_CHARS = 80  # a rejected value is quoted in the error detail up to this many characters
 
 # Rejection reasons (stable codes, counted by the node).
 MALFORMED = "malformed"  # not UTF-8 JSON, or not a JSON object
@@ -213,9 +225,9 @@ class _Fields:
     def integer(self, name: str, minimum: int = 0) -> int:
         value = self._get(name)
         if isinstance(value, bool) or not isinstance(value, int):
-            raise self.error(name, f"must be an integer, got {value!r}")
-        if value < minimum:
-            raise self.error(name, f"must be >= {minimum}, got {value}")
+            raise self.error(name, f"must be an integer, got {_quote(value)}")
+        if not minimum <= value <= MAX_INT:
+            raise self.error(name, f"must be in {minimum} .. {MAX_INT}, got {_quote(value)}")
         return value
 
     def number(self, name: str, optional: bool = False) -> float | None:
@@ -224,12 +236,15 @@ class _Fields:
             return None
         return self._finite(name, value)
 
-    def _finite(self, name: str, value: Any) -> float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise self.error(name, f"must be a finite number, got {value!r}")
+    def _finite(self, name: str, value: Any, minimum: float = -MAX_ABS_NUMBER) -> float:
+        # (ints are compared before any float conversion: a 400-digit integer must not overflow)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not (
+                minimum <= value <= MAX_ABS_NUMBER and math.isfinite(value)):
+            raise self.error(name, f"must be a finite number in {minimum:g} .. {MAX_ABS_NUMBER:g}, got {_quote(value)}")
         return float(value)
 
-    def numbers(self, name: str, length: int | None = None, optional: bool = False) -> tuple[float, ...] | None:
+    def numbers(self, name: str, length: int | None = None, optional: bool = False,
+                minimum: float = -MAX_ABS_NUMBER) -> tuple[float, ...] | None:
         value = self._get(name, optional)
         if value is None and optional:
             return None
@@ -239,12 +254,20 @@ class _Fields:
             raise self.error(name, f"has {len(value)} entries, expected {length}")
         if len(value) > MAX_DETECTIONS:
             raise self.error(name, f"has {len(value)} entries, at most {MAX_DETECTIONS} allowed")
-        return tuple(self._finite(f"{name}[{i}]", v) for i, v in enumerate(value))
+        return tuple(self._finite(f"{name}[{i}]", v, minimum) for i, v in enumerate(value))
 
     def finish(self) -> None:
         unknown = sorted(set(self.body) - self.used)
         if unknown:
-            raise MessageError(INVALID, f"{self.kind}: unknown field(s) {unknown}")
+            raise MessageError(INVALID, f"{self.kind}: unknown field(s) {_quote(unknown)}")
+
+
+def _quote(value: Any) -> str:
+    """``repr(value)`` cut to ``MAX_DETAIL_CHARS`` characters (details are logged; peers choose values)."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 10**30:
+        return f"an integer of {len(str(abs(value)))} digits"
+    text = repr(value)
+    return text if len(text) <= MAX_DETAIL_CHARS else text[:MAX_DETAIL_CHARS] + "..."
 
 
 def _report(f: _Fields) -> HeadingReport:
@@ -262,11 +285,11 @@ def _detections(f: _Fields) -> DetectionsMessage:
     position = []
     for i, pair in enumerate(raw):
         if not isinstance(pair, list) or len(pair) != 2:
-            raise f.error(f"position[{i}]", f"must be an [x, y] pair, got {pair!r}")
+            raise f.error(f"position[{i}]", f"must be an [x, y] pair, got {_quote(pair)}")
         position.append((f._finite(f"position[{i}]", pair[0]), f._finite(f"position[{i}]", pair[1])))
     msg = DetectionsMessage(frame=frame, time=time, position=tuple(position),  # type: ignore[arg-type]
                             heading=f.numbers("heading", len(raw)), score=f.numbers("score", len(raw)),  # type: ignore[arg-type]
-                            heading_std=f.numbers("heading_std", len(raw), optional=True))
+                            heading_std=f.numbers("heading_std", len(raw), optional=True, minimum=0.0))
     f.finish()
     return msg
 
@@ -274,8 +297,8 @@ def _detections(f: _Fields) -> DetectionsMessage:
 def _team(f: _Fields) -> TeamState:
     frame, time = f.integer("frame"), f.number("time")
     raw = f._get("robots")
-    if not isinstance(raw, list):
-        raise f.error("robots", "must be a list")
+    if not isinstance(raw, list) or len(raw) > MAX_ROBOTS:
+        raise f.error("robots", f"must be a list of at most {MAX_ROBOTS} robot estimates")
     robots = []
     for i, item in enumerate(raw):
         if not isinstance(item, dict):
@@ -288,8 +311,9 @@ def _team(f: _Fields) -> TeamState:
                                     confidence=sub.number("confidence", True), age=sub.number("age")))  # type: ignore[arg-type]
         sub.finish()
     labels = f._get("labels")
-    if not isinstance(labels, list) or any(isinstance(v, bool) or not isinstance(v, int) or v < -1 for v in labels):
-        raise f.error("labels", "must be a list of integers >= -1")
+    if not isinstance(labels, list) or len(labels) > MAX_DETECTIONS or any(
+            isinstance(v, bool) or not isinstance(v, int) or not -1 <= v <= MAX_INT for v in labels):
+        raise f.error("labels", f"must be a list of at most {MAX_DETECTIONS} integers in -1 .. {MAX_INT}")
     msg = TeamState(frame=frame, time=time, robots=tuple(robots), labels=tuple(labels))  # type: ignore[arg-type]
     f.finish()
     return msg
@@ -302,10 +326,29 @@ def _status_request(f: _Fields) -> StatusRequest:
 
 def _status(f: _Fields) -> Status:
     counters = f._get("counters")
-    if not isinstance(counters, dict):
-        raise f.error("counters", "must be an object")
+    if not isinstance(counters, dict) or _count_entries(counters) > MAX_COUNTERS:
+        raise f.error("counters", f"must be an object of at most {MAX_COUNTERS} entries")
+    _check_counters(f, counters, "counters")
     f.finish()
     return Status(counters=counters)
+
+
+def _count_entries(obj: dict[str, Any], depth: int = 0) -> int:
+    """Entries of ``obj`` and its nested objects (more than ``MAX_COUNTERS`` when nested too deep)."""
+    if depth > 3:
+        return MAX_COUNTERS + 1
+    return len(obj) + sum(_count_entries(v, depth + 1) for v in obj.values() if isinstance(v, dict))
+
+
+def _check_counters(f: _Fields, obj: dict[str, Any], where: str) -> None:
+    """Counter names are short strings; values numbers (bounded), null or nested counter objects."""
+    for key, value in obj.items():
+        if len(key) > MAX_KEY_CHARS:
+            raise f.error(where, f"has a key of {len(key)} characters, at most {MAX_KEY_CHARS} allowed")
+        if isinstance(value, dict):
+            _check_counters(f, value, f"{where}.{key}")
+        elif value is not None:
+            f._finite(f"{where}.{key}", value)
 
 
 _PARSERS: dict[str, Callable[[_Fields], Message]] = {

@@ -161,8 +161,11 @@ class NodeServer:
             log_event(self.log, "rejected", logging.DEBUG, sender=list(addr), reason=exc.reason, detail=exc.detail)
             return
         if isinstance(message, HeadingReport):
+            dropped = self.identifier.queue_dropped
             outcome = self.identifier.add_report(message)
             self.counters.add(outcome)
+            if self.identifier.queue_dropped > dropped:
+                self.counters.add("queue_dropped", self.identifier.queue_dropped - dropped)
             if outcome == "reports":
                 self._robot_addr[message.robot] = addr
             else:

@@ -18,7 +18,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.association.solver import assign
-from lookalike.geometry.angles import angle_diff
 from lookalike.types import Beacons
 
 
@@ -102,27 +101,46 @@ class BeaconIdentifier:
     # -- outputs -----------------------------------------------------------------------------
 
     def agent_headings(self, times_s: np.ndarray) -> np.ndarray:
-        """Report-based headings ``(len(times), N)`` of every agent at ``times_s``; NaN where unknown."""
+        """Report-based headings ``(len(times), N)`` of every agent at ``times_s``; NaN where unknown.
+
+        All agents at once: each history row holds its ``k`` known reports in its last ``k``
+        columns (sorted send times), so indices into the known reports are offsets from ``r - k``.
+        """
         cfg = self.config
-        out = np.full((len(times_s), cfg.n_agents), np.nan)
-        for a in range(cfg.n_agents):
-            known = np.isfinite(self._t[a])
-            t, h = self._t[a, known], self._h[a, known]
-            if not len(t):
-                continue
-            q = np.asarray(times_s, dtype=float)
-            i = np.searchsorted(t, q, side="right")  # reports at or before q: t[:i]
-            before = np.clip(i - 1, 0, len(t) - 1)
-            after = np.clip(i, 0, len(t) - 1)
-            span = t[after] - t[before]
-            frac = np.divide(q - t[before], span, out=np.zeros_like(q), where=span > 0)
-            inter = h[before] + np.clip(frac, 0, 1) * angle_diff(h[after], h[before])
-            rate = 0.0
-            if len(t) >= 2 and t[-1] > t[-2]:
-                rate = float(np.clip(angle_diff(h[-1], h[-2]) / (t[-1] - t[-2]), -cfg.max_turn_rate, cfg.max_turn_rate))
-            ahead = np.clip(q - t[-1], 0.0, cfg.max_extrapolation_s)
-            value = np.where(i >= len(t), h[-1] + rate * ahead, np.where(i == 0, h[0], inter))
-            out[:, a] = value
+        n, r = self._t.shape
+        q = np.asarray(times_s, dtype=float)
+        out = np.full((len(q), n), np.nan)
+        if n == 0 or not len(q):
+            return out
+        k = np.isfinite(self._t).sum(axis=1)  # known reports per agent
+        have = np.flatnonzero(k)
+        if not len(have):
+            return out
+        t, h, k = self._t[have], self._h[have], k[have]
+        first = r - k  # column of each agent's first known report
+        # i: reports at or before q (side="right"), per query and agent: (Q, A)
+        i = (t[None, :, :] <= q[:, None, None]).sum(axis=2)
+        i[np.isnan(q)] = k  # (a NaN time sorts after every report, as in np.searchsorted)
+        # (np.minimum/np.maximum instead of np.clip, and the wrap of angle_diff written out:
+        # the same arithmetic with less call overhead on these small arrays)
+        top = k - 1
+        rows = np.arange(len(have))
+        before = first + np.minimum(np.maximum(i - 1, 0), top)
+        after = first + np.minimum(i, top)
+        t_before, h_before = t[rows, before], h[rows, before]
+        span = t[rows, after] - t_before
+        frac = np.divide(q[:, None] - t_before, span, out=np.zeros_like(span), where=span > 0)
+        inter = h_before + np.minimum(np.maximum(frac, 0), 1) * _wrap(h[rows, after] - h_before)
+        t_last, h_last = t[:, -1], h[:, -1]
+        two = k >= 2
+        t_prev = np.where(two, t[:, -2], t_last)
+        turning = two & (t_last > t_prev)
+        gap = np.where(turning, t_last - t_prev, 1.0)
+        turn = _wrap(h_last - np.where(two, h[:, -2], h_last)) / gap
+        rate = np.where(turning, np.minimum(np.maximum(turn, -cfg.max_turn_rate), cfg.max_turn_rate), 0.0)
+        ahead = np.minimum(np.maximum(q[:, None] - t_last, 0.0), cfg.max_extrapolation_s)
+        value = np.where(i >= k, h_last + rate * ahead, np.where(i == 0, h[rows, first], inter))
+        out[:, have] = value
         return out
 
     def costs(self, track_ids: list[int]) -> np.ndarray:
@@ -156,3 +174,9 @@ class BeaconIdentifier:
             t: a for t, a in self._agent.items() if t not in track_ids
         }
         return result
+
+
+def _wrap(angle_rad: np.ndarray) -> np.ndarray:
+    """:func:`lookalike.geometry.angles.wrap_angle` of an array (the same formula, fewer calls)."""
+    wrapped: np.ndarray = np.pi - np.mod(np.pi - angle_rad, 2.0 * np.pi)
+    return wrapped

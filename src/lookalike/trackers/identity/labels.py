@@ -6,7 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from lookalike.types import TrackSnapshot
+from lookalike.types import Tracks, TrackSnapshot
 
 
 def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np.ndarray:
@@ -17,6 +17,8 @@ def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np
     """
     if n_detections < 0:
         raise ValueError(f"n_detections must be >= 0, got {n_detections}")
+    if isinstance(tracks, Tracks):
+        return _labels_from_columns(n_detections, tracks)
     label = np.full(n_detections, -1, dtype=int)
     best = np.full(n_detections, -np.inf)
     claimed: dict[int, float] = {}
@@ -35,6 +37,30 @@ def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np
             continue
         label[k], best[k] = agent, p
         claimed[agent] = p
+    return label
+
+
+def _labels_from_columns(n_detections: int, tracks: Tracks) -> np.ndarray:
+    """:func:`labels_from_tracks` on columns (same rule and result, without per-track snapshots)."""
+    label = np.full(n_detections, -1, dtype=int)
+    if tracks.agent_id is None or not len(tracks):
+        return label
+    det = tracks.detection_index
+    prob = (np.zeros(len(tracks)) if tracks.identity_prob is None
+            else np.where(np.isnan(tracks.identity_prob), 0.0, tracks.identity_prob))
+    rows = np.flatnonzero((tracks.agent_id >= 0) & (det >= 0))
+    rows = rows[np.argsort(-prob[rows], kind="stable")]
+    best = [-np.inf] * n_detections
+    claimed = set()
+    for i, agent, k, p in zip(rows.tolist(), tracks.agent_id[rows].tolist(), det[rows].tolist(),
+                              prob[rows].tolist()):
+        if k >= n_detections:
+            raise ValueError(f"track {int(tracks.id[i])}: detection_index {k} out of range for "
+                             f"{n_detections} detections")
+        if agent in claimed or p <= best[k]:
+            continue
+        label[k], best[k] = agent, p
+        claimed.add(agent)
     return label
 
 
