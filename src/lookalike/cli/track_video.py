@@ -15,8 +15,9 @@ from rich.progress import (
 )
 
 from lookalike.cli.app import console, fail
+from lookalike.cli.track_closed import offline_video
 from lookalike.io import read_mot, write_mot
-from lookalike.sim.divers_run import fit_diver_features
+from lookalike.sim.divers_run import diver_extractor, fit_diver_features
 from lookalike.trackers.health import HealthConfig
 from lookalike.viz.overlay import source_frames
 from lookalike.viz.video_tracking import (
@@ -27,7 +28,7 @@ from lookalike.viz.video_tracking import (
     write_merges_csv,
 )
 
-FEATURE_CHOICES = ("video", "divers")
+FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
 
 
 def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, tracker_name: str, *,
@@ -35,10 +36,11 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
                     min_score: float, fps: float | None, features: str = "video") -> None:
     """Track ``detections`` on ``video`` and write ``output``, its ``.health.csv`` (and ``.merges.csv``
     for trackers that merge identities) and, with ``annotate``, the annotated MP4. ``features``: ``video``
-    standardises the hand-crafted features on this video's detections, ``divers`` uses the statistics
-    calibrated on the rendered validation divers (those diver SORT's thresholds were chosen with)."""
-    if features not in FEATURE_CHOICES:
-        fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)}, got {features!r}")
+    standardises the hand-crafted features on this video's detections, ``divers`` (or ``handcrafted``)
+    uses the statistics calibrated on the rendered validation divers (those diver SORT's thresholds were
+    chosen with), ``learned`` the shipped ONNX embedding network, ``FILE.onnx`` another one."""
+    if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
+        fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
     if output.is_dir():
         fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
     try:
@@ -46,8 +48,9 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
         health = HealthConfig(team_size=team_size, window=health_window)
         total = source_frames(video)[1]
         with console.status("standardising appearance features"):
-            extractor = (fit_diver_features() if features == "divers"
-                         else fit_video_features(video, table, min_score=min_score))
+            extractor = (fit_diver_features() if features in ("divers", "handcrafted")
+                         else fit_video_features(video, table, min_score=min_score) if features == "video"
+                         else diver_extractor(features))
     except (ValueError, FileNotFoundError, OSError) as exc:
         fail(str(exc))
     columns = (TextColumn("tracking {task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
@@ -79,3 +82,44 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
     if result.ignored_rows:
         console.print(f"[yellow]note:[/] {result.ignored_rows} detection row(s) are past the video's "
                       f"{result.frames} frames and were ignored")
+
+
+def run_track_onnx(video: Path, output: Path, tracker: Any, tracker_name: str, model: Path, settings: list[str], *,
+                   n_targets: int | None = None, offline: dict[str, Any] | None = None, **options: Any) -> None:
+    """``track --video V --detector FILE.onnx``: run the ONNX detection model on every frame (settings
+    ``KEY=VALUE`` of :func:`~lookalike.vision.onnx_detector.config_from_settings`), write the boxes to
+    ``<output stem>.det.txt``, then track them as :func:`run_track_video` does (``options`` are passed
+    on) or, with ``offline``, by the offline closed set of ``n_targets``."""
+    import time
+
+    from lookalike.vision.onnx_detector import OnnxDetector, config_from_settings, detect_frames
+
+    if output.is_dir():
+        fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
+    if not video.exists():
+        fail(f"--video: {video} does not exist")
+    if not model.is_file():
+        fail(f"--detector: {model} does not exist")
+    try:
+        detector = OnnxDetector(model, config_from_settings(settings))
+        images, total, rate = source_frames(video)
+        columns = (TextColumn("detecting {task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+        with Progress(*columns, console=console, transient=True) as progress:
+            task = progress.add_task(video.name, total=total or None)
+            t0 = time.perf_counter()
+            rows, frames = detect_frames(images, detector, advance=lambda: progress.advance(task))
+            seconds = time.perf_counter() - t0
+    except (ValueError, FileNotFoundError, OSError) as exc:
+        fail(str(exc))
+    det_path = write_mot(output.with_name(output.stem + ".det.txt"), rows)
+    speed = f"{frames / seconds:,.1f} frames/s" if seconds > 0 else "inf frames/s"
+    console.print(f"{model.name} ({detector.layout}, input {detector.input_size[0]}x{detector.input_size[1]}): "
+                  f"{len(rows)} boxes in {frames} frames, {speed} → {det_path}")
+    if len(rows) < 2:
+        fail(f"{video}: the detector {model.name} found {len(rows)} box(es); try a lower score=... setting")
+    if offline is not None:
+        assert n_targets is not None
+        offline_video(det_path, output, n_targets, offline, float(options.get("fps") or rate), frames,
+                      options["min_score"])
+    else:
+        run_track_video(video, det_path, output, tracker, tracker_name, **options)

@@ -22,6 +22,7 @@ import numpy as np
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.sim.diver_render import (
     TEAM,
+    DiverLook,
     Pose,
     background,
     diver_box,
@@ -68,12 +69,18 @@ class DiverScenario:
     focal_px: float = 420.0
     detector: DetectorModel = field(default_factory=DetectorModel)
     seed: int = 0
+    looks: tuple[DiverLook, ...] | None = None  # None: the test team (:data:`TEAM`)
 
     def __post_init__(self) -> None:
-        if not 1 <= self.n_divers <= len(TEAM):
-            raise ValueError(f"DiverScenario.n_divers must be in 1..{len(TEAM)}, got {self.n_divers}")
+        if not 1 <= self.n_divers <= len(self.team):
+            raise ValueError(f"DiverScenario.n_divers must be in 1..{len(self.team)}, got {self.n_divers}")
         if self.frames < 1 or self.frame_rate <= 0:
             raise ValueError(f"DiverScenario {self.name!r}: frames and frame_rate must be positive")
+
+    @property
+    def team(self) -> tuple[DiverLook, ...]:
+        """The divers' looks (diver ``i`` wears ``team[i]``)."""
+        return TEAM if self.looks is None else self.looks
 
     @property
     def water(self) -> np.ndarray:
@@ -149,7 +156,7 @@ class DiverScene:
         bg = _backdrop(self._cache, sc, margin)
         off = np.clip(np.round(self.camera[k] % (2 * margin)).astype(int), 0, 2 * margin - 1)
         img = bg[off[1] : off[1] + h, off[0] : off[0] + w].copy()
-        present = [(p, TEAM[i]) for i, p in enumerate(self.poses[k]) if p is not None]
+        present = [(p, sc.team[i]) for i, p in enumerate(self.poses[k]) if p is not None]
         for pose, look in sorted(present, key=lambda pl: -pl[0].z):  # far to near
             draw_diver(img, pose, look, sc.focal_px, sc.water, sc.attenuation + 0.2 * sc.turbidity, sc.blur_per_m)
         bub = self.bubbles[k]
@@ -344,7 +351,7 @@ def _truth(k: int, poses: list[Pose | None], bubbles: np.ndarray, sc: DiverScena
     for i, p in enumerate(poses):
         if p is not None:
             ids.append(i)
-            full.append(diver_box(p, TEAM[i].size, sc.focal_px))
+            full.append(diver_box(p, sc.team[i].size, sc.focal_px))
     if not ids:
         return []
     full_b = np.array(full)

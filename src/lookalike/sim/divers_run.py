@@ -1,19 +1,25 @@
 """Running appearance trackers on simulated diver scenarios: render, detect, extract features, track.
 
-Every tracker sees the same detections with the same features (as in the paper's comparison).
-Feature standardisation is fitted on the validation scenarios' ground-truth crops
-(:func:`fit_diver_features`), never on the scenario being scored.
+Every tracker sees the same detections (as in the paper's comparison); the appearance features
+are chosen by name (:func:`diver_extractor`: ``handcrafted``, ``learned`` or a ``FILE.onnx``
+embedding network). Hand-crafted feature standardisation is fitted on the validation scenarios'
+ground-truth crops (:func:`fit_diver_features`), never on the scenario being scored. The trackers'
+cosine thresholds were chosen for the hand-crafted features; :func:`matched_thresholds` moves them
+to another extractor by matching quantiles of same-diver distances on the validation scenarios.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
 from lookalike.loop import RowCollector, run
 from lookalike.sim.divers import (
     VALIDATION_SCENARIOS,
+    DetectorModel,
     DiverScenario,
     DiverScene,
     simulate_divers,
@@ -53,11 +59,92 @@ def fit_diver_features(scenarios: tuple[DiverScenario, ...] = VALIDATION_SCENARI
     return HandcraftedFeatures(stats=fit_stats(np.vstack(raws), np.concatenate(labels)), crop_px=crop_px)
 
 
-def prepare(sc: DiverScenario, extractor: FeatureExtractor) -> PreparedScenario:
-    """Simulate, render, detect and extract the features of every detection of ``sc``."""
+FEATURE_NAMES = ("handcrafted", "learned")
+
+#: Cosine thresholds of the trackers' defaults, chosen with the hand-crafted features.
+HANDCRAFTED_THRESHOLDS: dict[str, dict[str, float]] = {
+    "deepsort": {"max_cosine_distance": 0.2},
+    "diversort": {"appearance_threshold": 0.10, "long_term_threshold": 0.30, "recovery_threshold": 0.30},
+}
+
+
+def diver_extractor(name: str) -> FeatureExtractor:
+    """Appearance features by name: ``handcrafted`` (calibrated on the validation divers), ``learned``
+    (the shipped ONNX embedding) or the path of an ONNX embedding network ``FILE.onnx``."""
+    if name == "handcrafted":
+        return _handcrafted()
+    from lookalike.vision.appearance_onnx import LEARNED_MODEL, OnnxAppearance
+
+    if name == "learned":
+        return OnnxAppearance(LEARNED_MODEL)
+    if name.lower().endswith(".onnx"):
+        return OnnxAppearance(Path(name))
+    raise ValueError(f"features: choose handcrafted, learned or FILE.onnx, got {name!r}")
+
+
+@lru_cache(maxsize=1)
+def _handcrafted() -> HandcraftedFeatures:
+    return fit_diver_features()
+
+
+def same_diver_distances(extractor: FeatureExtractor, scenarios: tuple[DiverScenario, ...] = VALIDATION_SCENARIOS,
+                         every: int = 10) -> np.ndarray:
+    """Cosine distances between crops of the same diver (ground-truth boxes of every ``every``-th frame,
+    visibility >= 0.5) of each scenario, all pairs pooled."""
+    out = []
+    for sc in scenarios:
+        scene = simulate_divers(sc)
+        feats, labels = [], []
+        for k in range(0, sc.frames, every):
+            rows = scene.gt[(scene.gt[:, 0] == k + 1) & (scene.gt[:, 8] >= 0.5)]
+            if len(rows):
+                feats.append(extractor(scene.image(k), rows[:, 2:6]))
+                labels.append(rows[:, 1])
+        if not feats:
+            continue
+        f, lab = np.vstack(feats), np.concatenate(labels)
+        for d in np.unique(lab):
+            g = f[lab == d]
+            iu = np.triu_indices(len(g), 1)
+            out.append((1 - g @ g.T)[iu])
+    return np.concatenate(out) if out else np.zeros(0)
+
+
+def matched_thresholds(extractor: FeatureExtractor, tracker: str) -> dict[str, float]:
+    """The tracker's cosine thresholds for ``extractor``: each hand-crafted threshold ``t`` becomes the
+    distance that lets through the same share of same-diver pairs on the validation scenarios
+    (quantile matching). Empty for trackers without appearance thresholds and for the hand-crafted
+    features themselves."""
+    names = HANDCRAFTED_THRESHOLDS.get(tracker)
+    if not names or isinstance(extractor, HandcraftedFeatures):
+        return {}
+    ref = _reference_distances()
+    own = _distances_of(extractor)
+    return {k: round(float(np.quantile(own, float(np.mean(ref <= t)))), 4) for k, t in names.items()}
+
+
+@lru_cache(maxsize=1)
+def _reference_distances() -> np.ndarray:
+    return same_diver_distances(_handcrafted())
+
+
+_DISTANCES: dict[tuple[str, int], np.ndarray] = {}
+
+
+def _distances_of(extractor: FeatureExtractor) -> np.ndarray:
+    key = (str(getattr(extractor, "path", type(extractor).__name__)), extractor.dim)
+    if key not in _DISTANCES:
+        _DISTANCES[key] = same_diver_distances(extractor)
+    return _DISTANCES[key]
+
+
+def prepare(sc: DiverScenario, extractor: FeatureExtractor, detector: DetectorModel | None = None,
+            detector_seed: int | None = None) -> PreparedScenario:
+    """Simulate, render, detect (``detector``: the scenario's own by default) and extract the features
+    of every detection of ``sc``."""
     scene = simulate_divers(sc)
     frames = []
-    for frame in scene.frames():
+    for frame in scene.frames(detector, detector_seed):
         det = frame.detections
         assert det.xywh is not None  # simulated detections have boxes
         feats = extractor(scene.image(frame.index), det.xywh) if len(det) else np.zeros((0, extractor.dim))

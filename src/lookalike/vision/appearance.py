@@ -173,8 +173,9 @@ class HandcraftedFeatures:
                 self.stats_ = FeatureStats(mean=mean, scale=std)
 
 
-def crop_boxes(image: np.ndarray, xywh: np.ndarray, size: int) -> np.ndarray:
-    """``(n, size, size, 3)`` uint8 crops of boxes ``xywh (n, 4)`` (pixels), clipped to the image.
+def crop_boxes(image: np.ndarray, xywh: np.ndarray, size: int | tuple[int, int]) -> np.ndarray:
+    """``(n, size, size, 3)`` uint8 crops of boxes ``xywh (n, 4)`` (pixels), clipped to the image;
+    ``size`` may be ``(width, height)`` for ``(n, height, width, 3)`` crops.
 
     A box wholly outside the image gives a black crop.
     """
@@ -189,10 +190,11 @@ def crop_boxes(image: np.ndarray, xywh: np.ndarray, size: int) -> np.ndarray:
     y0 = np.clip(np.floor(boxes[:, 1]), 0, h).astype(int)
     x1 = np.clip(np.ceil(boxes[:, 0] + boxes[:, 2]), 0, w).astype(int)
     y1 = np.clip(np.ceil(boxes[:, 1] + boxes[:, 3]), 0, h).astype(int)
-    out = np.zeros((len(boxes), size, size, 3), dtype=np.uint8)
+    cw, ch = (size, size) if isinstance(size, int) else (int(size[0]), int(size[1]))
+    out = np.zeros((len(boxes), ch, cw, 3), dtype=np.uint8)
     for i in range(len(boxes)):
         if x1[i] > x0[i] and y1[i] > y0[i]:
-            out[i] = cv2.resize(img[y0[i] : y1[i], x0[i] : x1[i]], (size, size), interpolation=cv2.INTER_AREA)
+            out[i] = cv2.resize(img[y0[i] : y1[i], x0[i] : x1[i]], (cw, ch), interpolation=cv2.INTER_AREA)
     return out
 
 
