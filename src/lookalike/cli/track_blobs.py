@@ -17,7 +17,7 @@ from typing import Any
 
 from lookalike.cli.app import console, fail
 from lookalike.cli.track_closed import offline_video
-from lookalike.cli.track_video import run_track_video
+from lookalike.cli.track_video import run_track_onnx, run_track_video
 from lookalike.io import write_mot
 from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows
 from lookalike.viz.overlay import source_frames
@@ -31,8 +31,11 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
     """Detect blobs on ``video``, write them to ``<output stem>.det.txt``, then track them as
     :func:`~lookalike.cli.track_video.run_track_video` does (``options`` are passed on to it) or, with
     ``offline`` (the online pass's parameters), by the offline closed set of ``n_targets``."""
+    if detector.lower().endswith(".onnx"):
+        return run_track_onnx(video, output, tracker, tracker_name, Path(detector), settings, n_targets=n_targets,
+                              offline=offline, **options)
     if detector not in DETECTORS:
-        fail(f"--detector: choose one of {', '.join(DETECTORS)}, got {detector!r}")
+        fail(f"--detector: choose one of {', '.join(DETECTORS)} or FILE.onnx, got {detector!r}")
     if output.is_dir():
         fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
     if not video.exists():
