@@ -18,6 +18,7 @@ from lookalike.cli import simulate as _simulate  # noqa: E402,F401
 # Importing the command modules registers their commands on ``app``.
 from lookalike.cli import track as _track  # noqa: E402,F401
 from lookalike.cli import train as _train  # noqa: E402,F401
+from lookalike.cli import train_appearance as _train_appearance  # noqa: E402,F401
 from lookalike.cli import tune as _tune  # noqa: E402,F401
 from lookalike.cli import vision as _vision  # noqa: E402,F401
 from lookalike.cli.app import app
