@@ -1,0 +1,132 @@
+"""Training arrays for the set associator (any team size), straight from the robot simulator.
+
+Unlike the LSTM's flat input vector (:mod:`lookalike.learn.encoding`), the set associator reads
+tokens: per agent ``cos ψ, sin ψ, age / max_age, known`` (the latest reported absolute heading
+``ψ``, the report's age in seconds clipped to ``max_age_s``, 1 if heard from else 0) and per
+detection ``x, y, cos φ, sin φ, γ`` (observer-frame position in metres, absolute visual heading,
+detector probability). A team size ``(N, M, false positives per frame)`` is drawn per batch
+from the batch's seed, so every batch is a pure function of its seed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from lookalike.learn.data import IGNORE
+from lookalike.learn.sim_data import latest_reports, swap_identities
+from lookalike.sim import RobotArrays, RobotWorldConfig, simulate_arrays
+from lookalike.sim.robots_config import SensorConfig
+
+AGENT_FEATURES = 4
+DET_FEATURES = 5
+MAX_AGE_S = 5.0
+
+
+def agent_tokens(heading_rad: np.ndarray, age_s: np.ndarray, max_age_s: float = MAX_AGE_S) -> np.ndarray:
+    """Agent tokens ``(..., N, 4)`` from latest headings and report ages ``(..., N)`` (NaN: never heard)."""
+    heading = np.asarray(heading_rad, dtype=float)
+    age = np.asarray(age_s, dtype=float)
+    known = np.isfinite(heading) & np.isfinite(age)
+    h = np.where(known, heading, 0.0)
+    return np.stack([
+        np.where(known, np.cos(h), 0.0),
+        np.where(known, np.sin(h), 0.0),
+        np.where(known, np.clip(age, 0.0, max_age_s) / max_age_s, 1.0),
+        known.astype(float),
+    ], axis=-1)
+
+
+def detection_tokens(position_m: np.ndarray, heading_rad: np.ndarray, probability: np.ndarray) -> np.ndarray:
+    """Detection tokens ``(..., K, 5)``: ``x, y`` (metres), ``cos φ, sin φ``, ``γ``."""
+    phi = np.asarray(heading_rad, dtype=float)
+    pos = np.asarray(position_m, dtype=float)
+    return np.concatenate([pos, np.cos(phi)[..., None], np.sin(phi)[..., None],
+                           np.asarray(probability, dtype=float)[..., None]], axis=-1)
+
+
+def arrays_to_tokens(
+    arrays: RobotArrays, n_agents: int, rng: np.random.Generator | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``agents (T, N, 4)``, ``detections (T, M, 5)``, ``valid (T, M)`` and targets ``(T, M)``
+    (agent id, N for a false positive, ``IGNORE`` for an empty slot). With ``rng`` the occupied
+    slots are shuffled per frame (the network must not rely on their order)."""
+    T, M = arrays.det_valid.shape
+    heading, sent = latest_reports(arrays, n_agents)
+    agents = agent_tokens(heading, arrays.time[:, None] - sent)
+    valid = arrays.det_valid
+    key = -arrays.det_score if rng is None else rng.random((T, M))
+    order = np.argsort(np.where(valid, key, np.inf), axis=1, kind="stable")
+
+    def take(a: np.ndarray) -> np.ndarray:
+        return np.take_along_axis(a, order, axis=1)
+
+    v = take(valid)
+    pos = np.stack([take(arrays.det_position[..., 0]), take(arrays.det_position[..., 1])], axis=-1)
+    dets = detection_tokens(pos, take(arrays.det_heading), take(arrays.det_score)) * v[..., None]
+    label = take(arrays.det_label)
+    y = np.where(v, np.where(label >= 0, label, n_agents), IGNORE).astype(np.int64)
+    return agents, dets, v, y
+
+
+@dataclasses.dataclass(frozen=True)
+class TeamSizes:
+    """The range of team sizes trained on: N in ``[n_min, n_max]``, M in ``[N, 2N + m_extra]``
+    (at least 1), false positives per frame uniform in ``fp_range`` — all drawn per batch."""
+
+    n_min: int = 1
+    n_max: int = 12
+    m_extra: int = 3
+    fp_range: tuple[float, float] = (0.3, 2.5)
+
+    def __post_init__(self) -> None:
+        if not 1 <= self.n_min <= self.n_max:
+            raise ValueError(f"TeamSizes: need 1 <= n_min <= n_max, got {self.n_min}, {self.n_max}")
+
+    def draw(self, rng: np.random.Generator) -> tuple[int, int, float]:
+        """``(N, M, false positives per frame)``."""
+        n = int(rng.integers(self.n_min, self.n_max + 1))
+        m = int(rng.integers(max(n, 1), 2 * n + self.m_extra + 1))
+        return n, m, float(rng.uniform(*self.fp_range))
+
+
+def world(n_agents: int, n_slots: int, fp_per_frame: float, frame_rate_hz: float = 30.0) -> RobotWorldConfig:
+    """The default robot world with ``n_agents`` robots, ``n_slots`` kept detections and this clutter."""
+    return RobotWorldConfig(n_agents=n_agents, max_detections=n_slots, frame_rate_hz=frame_rate_hz,
+                            sensor=dataclasses.replace(SensorConfig(), fp_per_frame=fp_per_frame))
+
+
+Batch = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]
+
+
+@dataclasses.dataclass(frozen=True)
+class SetBatchMaker:
+    """A picklable ``(seed, batch_size, n_frames) -> batch`` over team sizes ``sizes``.
+
+    A batch is ``agents (B, T, N, 4)``, ``detections (B, T, M, 5)``, ``valid (B, T, M)``, targets
+    ``(B, T, M)`` and the frame interval in seconds. With ``swap_prob`` two random robots exchange
+    identities for 1–10 s in that fraction of the sequences (:func:`~lookalike.learn.sim_data.swap_identities`).
+    ``fixed``: one ``(N, M, fp)`` for every batch instead of drawing from ``sizes``.
+    """
+
+    sizes: TeamSizes = TeamSizes()
+    swap_prob: float = 0.0
+    fixed: tuple[int, int, float] | None = None
+
+    def __call__(self, seed: int, batch_size: int, n_frames: int) -> Batch:
+        n, m, fp = self.fixed or self.sizes.draw(np.random.default_rng([seed, 0x5E7]))
+        cfg = world(n, m, fp)
+        out = []
+        for b in range(batch_size):
+            s = seed * 1000 + b
+            arrays = simulate_arrays(cfg, n_frames, s)
+            aug = np.random.default_rng([s, 0x5A5])
+            if n >= 2 and aug.random() < self.swap_prob:
+                i, j = aug.choice(n, 2, replace=False)
+                start = aug.uniform(0.0, 0.8 * n_frames * cfg.dt_s)
+                arrays = swap_identities(arrays, int(i), int(j), start, start + aug.uniform(1.0, 10.0))
+            out.append(arrays_to_tokens(arrays, n, np.random.default_rng([s, 1])))
+        a, d, v, y = (np.stack(parts) for parts in zip(*out))
+        k = max(int(v.sum(-1).max()), 1)  # occupied slots come first: drop the columns empty everywhere
+        return a, d[:, :, :k], v[:, :, :k], y[:, :, :k], cfg.dt_s

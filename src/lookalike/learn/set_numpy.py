@@ -1,0 +1,182 @@
+"""The set associator evaluated with numpy only, and its weight files (``.npz`` + ``.json``).
+
+Same maths as :class:`lookalike.learn.set_model.SetAssociator` for one sequence: any number of
+agents N and detections K per frame, no padding (absent detections simply are not passed).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookalike.learn.checkpoint import CheckpointError
+
+FORMAT = "lookalike-set-associator"
+FORMAT_VERSION = 1
+POSITION_SCALE_M = 4.0
+OFFSET_SCALE_M = 2.0
+
+
+@dataclass(frozen=True)
+class SetWeights:
+    """Parameters by PyTorch name, the widths ``token, pair, memory`` and free-form ``info``."""
+
+    arrays: dict[str, np.ndarray]
+    token: int
+    pair: int
+    memory: int
+    max_age_s: float = 5.0
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def shapes(self) -> dict[str, tuple[int, ...]]:
+        """Expected shape of every array."""
+        d, f, h = self.token, self.pair, self.memory
+        return {
+            "det.weight": (d, 5), "det.bias": (d,), "agent.weight": (d, 6 + h), "agent.bias": (d,),
+            "pair_d.weight": (f, d), "pair_a.weight": (f, d), "pair_q.weight": (f, 6), "pair_q.bias": (f,),
+            "pair2.weight": (f, f), "pair2.bias": (f,), "score.weight": (1, f), "score.bias": (1,),
+            "fp1.weight": (f, d + f), "fp1.bias": (f,), "fp2.weight": (1, f), "fp2.bias": (1,),
+            "gru.weight_ih": (3 * h, f + 5), "gru.weight_hh": (3 * h, h), "gru.bias_ih": (3 * h,),
+            "gru.bias_hh": (3 * h,),
+        }
+
+
+def save_set_weights(weights: SetWeights, path: str | os.PathLike[str]) -> Path:
+    """Write ``path`` (``.npz``) and its ``.json`` configuration; returns the ``.npz`` path."""
+    path = Path(path).with_suffix(".npz")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp.npz")
+    np.savez(tmp, **{k: np.asarray(v, dtype=np.float32) for k, v in weights.arrays.items()})
+    os.replace(tmp, path)
+    meta = {"format": FORMAT, "format_version": FORMAT_VERSION, "token": weights.token, "pair": weights.pair,
+            "memory": weights.memory, "max_age_s": weights.max_age_s, "info": weights.info}
+    path.with_suffix(".json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    return path
+
+
+def load_set_weights(path: str | os.PathLike[str]) -> SetWeights:
+    """Load weights written by :func:`save_set_weights`; :class:`CheckpointError` naming the file
+    when the metadata is missing, of another format or version, or an array has the wrong shape."""
+    path = Path(path).with_suffix(".npz")
+    meta_path = path.with_suffix(".json")
+    if not path.is_file() or not meta_path.is_file():
+        raise CheckpointError(f"{path}: expected {path.name} and {meta_path.name} side by side")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except json.JSONDecodeError as exc:
+        raise CheckpointError(f"{meta_path}: not valid JSON ({exc})") from None
+    if meta.get("format") != FORMAT:
+        raise CheckpointError(f"{meta_path}: not a lookalike set associator (format {meta.get('format')!r})")
+    if meta.get("format_version") != FORMAT_VERSION:
+        raise CheckpointError(f"{meta_path}: format_version {meta.get('format_version')} is not supported "
+                              f"(this lookalike reads {FORMAT_VERSION})")
+    try:
+        with np.load(path) as data:
+            arrays = {k: data[k].astype(np.float64) for k in data.files}
+    except (OSError, ValueError) as exc:
+        raise CheckpointError(f"{path}: cannot read the weights ({exc})") from None
+    try:
+        weights = SetWeights(arrays, int(meta["token"]), int(meta["pair"]), int(meta["memory"]),
+                             float(meta.get("max_age_s", 5.0)), dict(meta.get("info", {})))
+    except KeyError as exc:
+        raise CheckpointError(f"{meta_path}: missing field {exc}") from None
+    for name, shape in weights.shapes().items():
+        got = np.shape(arrays[name]) if name in arrays else ()
+        if got != shape:
+            raise CheckpointError(f"{path}: {name} has shape {got}, expected {shape}")
+        if not np.isfinite(arrays[name]).all():
+            raise CheckpointError(f"{path}: {name} holds NaN or infinity")
+    return weights
+
+
+def _relu(x: np.ndarray) -> np.ndarray:
+    return np.maximum(x, 0.0)
+
+
+def _sigmoid(x: np.ndarray) -> np.ndarray:
+    return 0.5 * (1.0 + np.tanh(0.5 * x))
+
+
+class NumpySetAssociator:
+    """Frame-by-frame evaluation: :meth:`reset` for N agents, then :meth:`step` per frame.
+
+    ``step(agents (N,4), dets (K,5), dt_s)`` returns class probabilities ``(K, N+1)`` (agents, then
+    false positive) and advances each agent's memory, remembered position and staleness.
+    """
+
+    def __init__(self, weights: SetWeights) -> None:
+        self.weights = weights
+        w = weights.arrays
+        t = {k: np.ascontiguousarray(v.T) for k, v in w.items() if v.ndim == 2}
+        self._t, self._b = t, w
+        h = weights.memory
+        self._gru_b = w["gru.bias_ih"].copy()
+        self._gru_b[: 2 * h] += w["gru.bias_hh"][: 2 * h]
+        self._scale = np.array([1 / POSITION_SCALE_M, 1 / POSITION_SCALE_M, 1.0, 1.0, 1.0])
+        self.reset(1)
+
+    def reset(self, n_agents: int) -> None:
+        """Forget everything; the next frames have ``n_agents`` agents."""
+        if n_agents < 1:
+            raise ValueError(f"n_agents must be >= 1, got {n_agents}")
+        self.n_agents = n_agents
+        self.h = np.zeros((n_agents, self.weights.memory))
+        self.p = np.zeros((n_agents, 2))
+        self.m = np.zeros((n_agents, 1))
+        self.s = np.zeros((n_agents, 1))
+
+    def step(self, agents: np.ndarray, dets: np.ndarray, dt_s: float) -> np.ndarray:
+        """Advance one frame; return ``(K, N+1)`` probabilities."""
+        t, b = self._t, self._b
+        agents = np.asarray(agents, dtype=float)
+        dets = np.asarray(dets, dtype=float).reshape(-1, 5)
+        n = self.n_agents
+        if agents.shape != (n, 4):
+            raise ValueError(f"agents must have shape ({n}, 4), got {agents.shape}")
+        u = _relu((dets * self._scale) @ t["det.weight"] + b["det.bias"])
+        a = _relu(np.concatenate([agents, self.m, np.log1p(self.s), self.h], axis=1) @ t["agent.weight"]
+                  + b["agent.bias"])
+        c_phi, s_phi = dets[:, 2:3], dets[:, 3:4]
+        c_psi, s_psi = agents[None, :, 0], agents[None, :, 1]
+        mj = self.m[None, :, 0]
+        off = dets[:, None, :2] - self.p[None]
+        dist = np.sqrt((off * off).sum(-1) + 1e-6)
+        k = len(dets)
+        q = np.stack([c_phi * c_psi + s_phi * s_psi, s_phi * c_psi - c_phi * s_psi,
+                      off[..., 0] * mj / OFFSET_SCALE_M, off[..., 1] * mj / OFFSET_SCALE_M,
+                      dist * mj / OFFSET_SCALE_M, np.broadcast_to(mj, (k, n))], axis=-1)
+        e = _relu((u @ t["pair_d.weight"])[:, None] + (a @ t["pair_a.weight"])[None]
+                  + q @ t["pair_q.weight"] + b["pair_q.bias"])
+        e2 = _relu(e @ t["pair2.weight"] + b["pair2.bias"])  # (K,N,F)
+        score = (e2 @ t["score.weight"])[..., 0] + b["score.bias"][0]
+        if k:
+            fp_in = np.concatenate([u, e2.max(axis=1)], axis=1)
+            fp = _relu(fp_in @ t["fp1.weight"] + b["fp1.bias"]) @ t["fp2.weight"] + b["fp2.bias"]
+        else:
+            fp = np.zeros((0, 1))
+        logits = np.concatenate([score, fp], axis=1)
+        logits = logits - logits.max(axis=1, keepdims=True) if k else logits
+        prob = np.exp(logits)
+        prob /= np.maximum(prob.sum(axis=1, keepdims=True), 1e-300)
+        w = prob[:, :n]  # (K,N)
+        total = w.sum(0)[:, None]
+        g = np.minimum(total, 1.0)
+        mean_pos = (w.T @ dets[:, :2]) / (total + 1e-6)
+        self.p = self.p + g * (mean_pos - self.p)
+        self.m = self.m + g * (1.0 - self.m)
+        self.s = (1.0 - g) * (self.s + dt_s)
+        msg = np.einsum("kn,knf->nf", w, e2)
+        x = np.concatenate([msg, g, agents], axis=1)
+        hd = self.weights.memory
+        gi = x @ t["gru.weight_ih"] + self._gru_b
+        gh = self.h @ t["gru.weight_hh"]
+        r = _sigmoid(gi[:, :hd] + gh[:, :hd])
+        z = _sigmoid(gi[:, hd : 2 * hd] + gh[:, hd : 2 * hd])
+        cand = np.tanh(gi[:, 2 * hd :] + r * (gh[:, 2 * hd :] + b["gru.bias_hh"][2 * hd :]))
+        self.h = (1.0 - z) * cand + z * self.h
+        return prob
