@@ -14,56 +14,112 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import SequenceData
+from lookalike.eval.matching import conflicted_frames, dense, frame_bounds
 
 _EPS = np.finfo(float).eps
 COUNTS = ("CLR_TP", "CLR_FN", "CLR_FP", "IDSW", "MT", "PT", "ML", "Frag", "MOTP_sum", "CLR_Frames")
 
 
 def clear_counts(data: SequenceData, threshold: float = 0.5) -> dict[str, float]:
-    """The summable CLEAR counts of one sequence (see :data:`COUNTS`)."""
-    n_gt = data.num_gt_ids
-    gt_frames = np.zeros(n_gt)
-    matched_frames = np.zeros(n_gt)
-    frag_starts = np.zeros(n_gt)
-    last_match = np.full(n_gt, np.nan)  # tracker id last matched, any earlier frame
-    prev_step = np.full(n_gt, np.nan)  # tracker id matched in the previous scored frame
-    tp = fn = fp = idsw = 0
-    motp_sum = 0.0
-    for gt_ids, tr_ids, sim in zip(data.gt_ids, data.tracker_ids, data.similarity):
-        if len(gt_ids) == 0:
-            fp += len(tr_ids)
-            continue
-        if len(tr_ids) == 0:
-            fn += len(gt_ids)
-            gt_frames[gt_ids] += 1
-            continue
-        score = 1000 * (tr_ids[None, :] == prev_step[gt_ids][:, None]) + sim
-        score[sim < threshold - _EPS] = 0
-        rows, cols = linear_sum_assignment(-score)
-        ok = score[rows, cols] > _EPS
-        rows, cols = rows[ok], cols[ok]
-        m_gt, m_tr = gt_ids[rows], tr_ids[cols]
-        before = last_match[m_gt]
-        idsw += int(np.sum(~np.isnan(before) & (m_tr != before)))
-        gt_frames[gt_ids] += 1
-        matched_frames[m_gt] += 1
-        was_untracked = np.isnan(prev_step)
-        last_match[m_gt] = m_tr
-        prev_step[:] = np.nan
-        prev_step[m_gt] = m_tr
-        frag_starts += was_untracked & ~np.isnan(prev_step)
-        tp += len(rows)
-        fn += len(gt_ids) - len(rows)
-        fp += len(tr_ids) - len(rows)
-        if len(rows):
-            motp_sum += float(sim[rows, cols].sum())
+    """The summable CLEAR counts of one sequence (see :data:`COUNTS`).
+
+    Frames whose pairs at ``threshold`` are one-to-one are matched without the Hungarian algorithm
+    (every such pair is a match whatever the previous frame did); the rest are solved in frame order.
+    """
+    n_gt, n_frames = data.num_gt_ids, data.num_frames
+    p = data.pairs()
+    cand = np.flatnonzero(p.similarity >= threshold - _EPS)
+    frame, gt_det, tr_det, sim = p.frame[cand], p.gt_det[cand], p.tracker_det[cand], p.similarity[cand]
+    n_g, n_t = np.diff(data.gt_bounds), np.diff(data.tracker_bounds)
+    scored = (n_g > 0) & (n_t > 0)
+    hard = conflicted_frames(frame, gt_det, tr_det, n_frames, data.num_gt_dets, data.num_tracker_dets)
+    hard |= np.bincount(frame[sim <= _EPS], minlength=n_frames) > 0  # a bonus could make such a pair count
+    hard &= scored
+    bounds = frame_bounds(frame, n_frames)
+    easy = ~hard[frame]
+    m_frame, m_gt, m_tr, m_sim = [frame[easy]], [gt_det[easy]], [tr_det[easy]], [sim[easy]]
+    if hard.any():
+        solved = _solve_hard_frames(data, np.flatnonzero(hard), scored, bounds, gt_det, tr_det, sim)
+        for part, extra in zip((m_frame, m_gt, m_tr, m_sim), solved):
+            part.append(extra)
+    mf, mg, mt, ms = (np.concatenate(x) for x in (m_frame, m_gt, m_tr, m_sim))
+    order = np.argsort(mf, kind="stable")
+    mf, mg, mt, ms = mf[order], data.gt_id[mg[order]], data.tracker_id[mt[order]], ms[order]
+    tp = len(mf)
+    # ID switches and fragments, per ground-truth id in frame order.
+    step = np.cumsum(scored) - 1  # index among scored frames
+    by_id = np.lexsort((mf, mg))
+    g_sorted, t_sorted, s_sorted = mg[by_id], mt[by_id], step[mf[by_id]]
+    same = g_sorted[1:] == g_sorted[:-1]
+    idsw = int(np.sum(same & (t_sorted[1:] != t_sorted[:-1])))
+    starts = np.ones(tp, bool)
+    starts[1:] = ~(same & (s_sorted[1:] == s_sorted[:-1] + 1))
+    frag_starts = np.bincount(g_sorted[starts], minlength=n_gt)
+    frag = float(np.sum(frag_starts[frag_starts > 0] - 1))
+    gt_frames = np.bincount(data.gt_id, minlength=n_gt).astype(float)
+    matched_frames = np.bincount(mg, minlength=n_gt).astype(float)
     present = gt_frames > 0
     ratio = matched_frames[present] / gt_frames[present]
-    mt = int(np.sum(ratio > 0.8))
-    pt = int(np.sum(ratio >= 0.2)) - mt
-    frag = float(np.sum(frag_starts[frag_starts > 0] - 1))
-    return {"CLR_TP": tp, "CLR_FN": fn, "CLR_FP": fp, "IDSW": idsw, "MT": mt, "PT": pt,
-            "ML": n_gt - mt - pt, "Frag": frag, "MOTP_sum": motp_sum, "CLR_Frames": data.num_frames}
+    mt_count = int(np.sum(ratio > 0.8))
+    pt = int(np.sum(ratio >= 0.2)) - mt_count
+    motp_sum = 0.0
+    if tp:
+        frame_starts = np.flatnonzero(np.concatenate([[True], mf[1:] != mf[:-1]]))
+        for v in np.add.reduceat(ms, frame_starts).tolist():
+            motp_sum += v
+    return {"CLR_TP": tp, "CLR_FN": data.num_gt_dets - tp, "CLR_FP": data.num_tracker_dets - tp,
+            "IDSW": idsw, "MT": mt_count, "PT": pt, "ML": n_gt - mt_count - pt, "Frag": frag,
+            "MOTP_sum": motp_sum, "CLR_Frames": n_frames}
+
+
+def _solve_hard_frames(data: SequenceData, hard: np.ndarray, scored: np.ndarray, bounds: np.ndarray,
+                       gt_det: np.ndarray, tr_det: np.ndarray,
+                       sim: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Matches ``(frame, gt det, tracker det, similarity)`` of the ``hard`` frames, in frame order: the
+    Hungarian algorithm on the thresholded similarity plus 1000 for a pair matched in the previous scored
+    frame (which is either one-to-one, so all its candidate pairs match, or an earlier hard frame)."""
+    n_frames = len(scored)
+    is_hard = np.zeros(n_frames, bool)
+    is_hard[hard] = True
+    scored_frames = np.flatnonzero(scored)
+    prev_of = np.full(n_frames, -1)
+    prev_of[scored_frames[1:]] = scored_frames[:-1]
+    next_of = np.full(n_frames, -1)
+    next_of[scored_frames[:-1]] = scored_frames[1:]
+    n_ids = max(data.num_tracker_ids, 1)
+    id_key = data.gt_id[gt_det] * n_ids + data.tracker_id[tr_det]
+    frame = np.repeat(np.arange(n_frames), np.diff(bounds))
+    # Continuations from one-to-one frames, known in advance: (next scored frame, id pair) of each of
+    # their pairs against (frame, id pair) of each candidate of a hard frame.
+    span = max(data.num_gt_ids, 1) * n_ids
+    nxt = next_of[frame]
+    src = (nxt * span + id_key)[~is_hard[frame] & (nxt >= 0) & is_hard[np.maximum(nxt, 0)]]
+    in_hard = is_hard[frame]
+    bonus = np.zeros(len(frame), bool)
+    bonus[in_hard] = np.isin(frame[in_hard] * span + id_key[in_hard], src)
+    gb, tb = data.gt_bounds, data.tracker_bounds
+    solved: dict[int, np.ndarray] = {}
+    out_g, out_t, counts = [], [], []
+    for t in hard.tolist():
+        a, b = bounds[t], bounds[t + 1]
+        q = int(prev_of[t])
+        cont = np.isin(id_key[a:b], solved[q]) if q in solved else bonus[a:b]
+        g0, t0 = gb[t], tb[t]
+        score = dense((int(gb[t + 1] - g0), int(tb[t + 1] - t0)), gt_det[a:b] - g0, tr_det[a:b] - t0,
+                      sim[a:b] + 1000.0 * cont)
+        rows, cols = linear_sum_assignment(-score)
+        ok = score[rows, cols] > _EPS
+        rows, cols = rows[ok] + g0, cols[ok] + t0
+        if is_hard[next_of[t]] and next_of[t] >= 0:
+            solved[t] = data.gt_id[rows] * n_ids + data.tracker_id[cols]
+        out_g.append(rows)
+        out_t.append(cols)
+        counts.append(len(rows))
+    g_all, t_all = np.concatenate(out_g), np.concatenate(out_t)
+    # Similarity of each match: every match is a candidate pair (its score is positive only there).
+    n_tr = max(data.num_tracker_dets, 1)
+    at = np.searchsorted(gt_det * n_tr + tr_det, g_all * n_tr + t_all)
+    return np.repeat(hard, counts), g_all, t_all, sim[at]
 
 
 def clear_final(c: dict[str, float]) -> dict[str, float]:

@@ -13,6 +13,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import Pairs, SequenceData
+from lookalike.eval.matching import conflicted_frames, dense, frame_bounds
 
 ALPHAS = np.arange(0.05, 0.99, 0.05)  # the exact float values TrackEval compares with
 LABELS = tuple(range(5, 100, 5))
@@ -32,20 +33,12 @@ def hota_arrays(data: SequenceData, pairs: Pairs) -> dict[str, np.ndarray]:
         out["LocA"][:] = 1.0
         return out
     G, T = data.num_gt_ids, data.num_tracker_ids
-    gt_count = np.bincount(np.concatenate(data.gt_ids), minlength=G).astype(float)
-    tr_count = np.bincount(np.concatenate(data.tracker_ids), minlength=T).astype(float)
+    gt_count = np.bincount(data.gt_id, minlength=G).astype(float)
+    tr_count = np.bincount(data.tracker_id, minlength=T).astype(float)
     alignment = _global_alignment(pairs, G, T, gt_count, tr_count)
-    m_gt, m_tr, m_sim = [], [], []
-    for gt_ids, tr_ids, sim in zip(data.gt_ids, data.tracker_ids, data.similarity):
-        if len(gt_ids) == 0 or len(tr_ids) == 0:
-            continue
-        rows, cols = linear_sum_assignment(-(alignment[np.ix_(gt_ids, tr_ids)] * sim))
-        s = sim[rows, cols]
-        keep = s >= ALPHAS[0] - _EPS
-        m_gt.append(gt_ids[rows[keep]])
-        m_tr.append(tr_ids[cols[keep]])
-        m_sim.append(s[keep])
-    s = np.concatenate(m_sim) if m_sim else np.zeros(0)
+    m_gt, m_tr, s = _match_frames(data, pairs, alignment)
+    keep = s >= ALPHAS[0] - _EPS
+    m_gt, m_tr, s = m_gt[keep], m_tr[keep], s[keep]
     hit = s[None, :] >= ALPHAS[:, None] - _EPS  # (19, k)
     tp = hit.sum(axis=1).astype(float)
     out["HOTA_TP"] = tp
@@ -53,7 +46,7 @@ def hota_arrays(data: SequenceData, pairs: Pairs) -> dict[str, np.ndarray]:
     out["HOTA_FP"] = n_tr - tp
     out["LocA"] = np.maximum(1e-10, (hit * s).sum(axis=1)) / np.maximum(1e-10, tp)
     if len(s):
-        key = np.concatenate(m_gt) * T + np.concatenate(m_tr)
+        key = m_gt * T + m_tr
         unique, inverse = np.unique(key, return_inverse=True)
         inverse = inverse.ravel()
         matches = np.stack([np.bincount(inverse, h, minlength=len(unique)) for h in hit])
@@ -63,6 +56,43 @@ def hota_arrays(data: SequenceData, pairs: Pairs) -> dict[str, np.ndarray]:
         out["AssRe"] = (matches * matches / np.maximum(1.0, gc)).sum(axis=1) / weight
         out["AssPr"] = (matches * matches / np.maximum(1.0, tc)).sum(axis=1) / weight
     return out
+
+
+def _match_frames(data: SequenceData, pairs: Pairs,
+                  alignment: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per frame, the Hungarian matching maximising ``alignment * similarity``: matched ``(gt id, tracker id,
+    similarity)`` in frame order, rows ascending within a frame (pairs of zero similarity included)."""
+    n_frames = data.num_frames
+    frame, gt_det, tr_det = pairs.frame, pairs.gt_det, pairs.tracker_det
+    score = alignment[pairs.gt_id, pairs.tracker_id] * pairs.similarity
+    hard = conflicted_frames(frame, gt_det, tr_det, n_frames, pairs.num_gt_dets, pairs.num_tracker_dets)
+    # One-to-one frames: every pair is matched. Others: the Hungarian algorithm on the dense frame matrix.
+    easy = ~hard[frame]
+    m_gt, m_tr = [gt_det[easy]], [tr_det[easy]]
+    hard_frames = np.flatnonzero(hard)
+    counts = []
+    gb, tb = data.gt_bounds, data.tracker_bounds
+    bounds = frame_bounds(frame, n_frames)
+    for t in hard_frames.tolist():
+        a, b = bounds[t], bounds[t + 1]
+        g0, t0 = gb[t], tb[t]
+        mat = dense((int(gb[t + 1] - g0), int(tb[t + 1] - t0)), gt_det[a:b] - g0, tr_det[a:b] - t0, score[a:b])
+        rows, cols = linear_sum_assignment(-mat)
+        m_gt.append(rows + g0)
+        m_tr.append(cols + t0)
+        counts.append(len(rows))
+    mf = np.concatenate([frame[easy], np.repeat(hard_frames, counts)])
+    mg, mt = np.concatenate(m_gt), np.concatenate(m_tr)
+    order = np.argsort(mf, kind="stable")
+    mg, mt = mg[order], mt[order]
+    # Similarity of each match: 0 unless it is a listed pair.
+    n_tr = max(pairs.num_tracker_dets, 1)
+    keys = gt_det * n_tr + tr_det
+    want = mg * n_tr + mt
+    at = np.minimum(np.searchsorted(keys, want), max(len(keys) - 1, 0))
+    found = keys[at] == want if len(keys) else np.zeros(len(want), bool)
+    s = np.where(found, pairs.similarity[at] if len(keys) else 0.0, 0.0)
+    return data.gt_id[mg], data.tracker_id[mt], s
 
 
 def _global_alignment(pairs: Pairs, G: int, T: int, gt_count: np.ndarray, tr_count: np.ndarray) -> np.ndarray:

@@ -15,13 +15,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import Protocol
+from typing import Literal, Protocol
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from lookalike.eval.data import SequenceData
-from lookalike.eval.similarity import box_iou, point_similarity
+from lookalike.eval.data import Pairs, SequenceData
+from lookalike.eval.matching import conflicted_frames, dense, frame_bounds
+from lookalike.eval.similarity import pair_iou, point_similarity
 from lookalike.types.mot_table import MotTable as MotTableData
 
 
@@ -130,32 +131,96 @@ def prepare_boxes(
     check_table(gt, n, "gt", keep_gt)
     g_order, g_bounds = _bounds(gt.frame, n)
     r_order, r_bounds = _bounds(result.frame, n)
-    gt_ids, tr_ids, sims = [], [], []
-    for t in range(n):
-        g = g_order[g_bounds[t] : g_bounds[t + 1]]
-        r = r_order[r_bounds[t] : r_bounds[t + 1]]
-        sim = box_iou(gt.xywh[g], result.xywh[r])
-        if distractors is not None and gt_class is not None and len(g) and len(r):
-            drop = _distractor_matches(sim, gt_class[g], distractors)
-            if len(drop):
-                keep_r = np.ones(len(r), bool)
-                keep_r[drop] = False
-                r, sim = r[keep_r], sim[:, keep_r]
-        k = keep_gt[g]
-        gt_ids.append(gt.track_id[g[k]])
-        tr_ids.append(result.track_id[r])
-        sims.append(sim[k])
-    return _finish(gt_ids, tr_ids, sims)
+    g = g_order[g_bounds[0] : g_bounds[n]]  # rows of frames 1..n, in frame order
+    r = r_order[r_bounds[0] : r_bounds[n]]
+    gb, rb = g_bounds - g_bounds[0], r_bounds - r_bounds[0]
+    g_frame = gt.frame[g].astype(np.int64) - 1
+    r_frame = result.frame[r].astype(np.int64) - 1
+    gi, ri, sim = _overlapping_pairs(gt.xywh[g], g_frame, result.xywh[r], r_frame)
+    keep_r = np.ones(len(r), bool)
+    if distractors is not None and gt_class is not None:
+        _drop_distractor_matches(keep_r, gi, ri, sim, g_frame, gb, rb, gt_class[g], distractors)
+    keep_g = keep_gt[g]
+    new_g = np.cumsum(keep_g) - 1
+    new_r = np.cumsum(keep_r) - 1
+    pk = keep_g[gi] & keep_r[ri]
+    gi, ri, sim = gi[pk], ri[pk], sim[pk]
+    gt_ids, n_gt = _relabel_flat(gt.track_id[g[keep_g]])
+    tr_ids, n_tr = _relabel_flat(result.track_id[r[keep_r]])
+    gt_det, tr_det = new_g[gi], new_r[ri]
+    pair = Pairs(g_frame[gi], gt_det, tr_det, gt_ids[gt_det], tr_ids[tr_det], sim, len(gt_ids), len(tr_ids))
+    frames = np.arange(n + 1)
+    return SequenceData(np.searchsorted(g_frame[keep_g], frames), gt_ids,
+                        np.searchsorted(r_frame[keep_r], frames), tr_ids, pair, n_gt, n_tr)
 
 
-def _distractor_matches(sim: np.ndarray, classes: np.ndarray, distractors: tuple[int, ...]) -> np.ndarray:
-    score = sim.copy()
-    score[score < 0.5 - _EPS] = 0.0
-    rows, cols = linear_sum_assignment(-score)
-    ok = score[rows, cols] > _EPS
-    rows, cols = rows[ok], cols[ok]
-    result: np.ndarray = cols[np.isin(classes[rows], distractors)]
-    return result
+def _relabel_flat(ids: np.ndarray) -> tuple[np.ndarray, int]:
+    unique, inverse = np.unique(ids, return_inverse=True)
+    return inverse.astype(np.int64).ravel(), len(unique)
+
+
+def _overlapping_pairs(a: np.ndarray, a_frame: np.ndarray, b: np.ndarray,
+                       b_frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every same-frame pair ``(i, j)`` of boxes ``a[i]``, ``b[j]`` (``(n, 4)`` xywh px, 0-based frames sorted)
+    with a positive IoU, sorted by ``i`` then ``j``, and that IoU (bit for bit :func:`box_iou`'s).
+
+    Boxes whose x ranges overlap have one left edge inside the other box's x range: ``b``'s left edge at or
+    right of ``a``'s and before its right edge, or ``a``'s strictly right of ``b``'s and before its right edge.
+    Both are sorted-range look-ups (with a pixel to spare); every other pair has IoU exactly 0."""
+    empty = np.zeros(0, np.int64)
+    if not len(a) or not len(b):
+        return empty, empty, np.zeros(0)
+    ax0, bx0 = a[:, 0], b[:, 0]
+    lo = min(float(ax0.min()), float(bx0.min()))
+    span = max(float((ax0 + a[:, 2]).max()), float((bx0 + b[:, 2]).max()), 0.0) - lo + 4.0
+    a0, a1 = a_frame * span + (ax0 - lo), a_frame * span + (ax0 + a[:, 2] - lo) + 1.0
+    b0, b1 = b_frame * span + (bx0 - lo), b_frame * span + (bx0 + b[:, 2] - lo) + 1.0
+    j1, i1 = _ranges(b0, a0, a1, "left")  # b's left edge in [a0, a1]
+    i2, j2 = _ranges(a0, b0, b1, "right")  # a's left edge in (b0, b1]
+    i, j = np.concatenate([i1, i2]), np.concatenate([j1, j2])
+    iou = pair_iou(a[i], b[j])
+    pos = (iou > 0) & (a_frame[i] == b_frame[j])
+    i, j, iou = i[pos], j[pos], iou[pos]
+    srt = np.argsort(i * len(b) + j)
+    return i[srt], j[srt], iou[srt]
+
+
+def _ranges(keys: np.ndarray, start: np.ndarray, stop: np.ndarray, side: Literal["left", "right"]
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """``(index into keys, index into start)`` of every key in ``[start, stop]`` (``(start, stop]`` with
+    ``side="right"``)."""
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    first = np.searchsorted(sorted_keys, start, side)
+    count = np.maximum(np.searchsorted(sorted_keys, stop, "right") - first, 0)
+    owner = np.repeat(np.arange(len(start)), count)
+    found = order[np.repeat(first - (np.cumsum(count) - count), count) + np.arange(int(count.sum()))]
+    return found, owner
+
+
+def _drop_distractor_matches(keep_r: np.ndarray, gi: np.ndarray, ri: np.ndarray, sim: np.ndarray,
+                             g_frame: np.ndarray, gb: np.ndarray, rb: np.ndarray, classes: np.ndarray,
+                             distractors: tuple[int, ...]) -> None:
+    """Clear ``keep_r`` for tracker boxes that the per-frame Hungarian matching at IoU >= 0.5 pairs with a
+    distractor-class ground-truth box (TrackEval's MOT16+ preprocessing)."""
+    strong = sim >= 0.5 - _EPS
+    gi, ri, sim = gi[strong], ri[strong], sim[strong]
+    frame = g_frame[gi]
+    distractor = np.isin(classes, distractors)
+    is_d = distractor[gi]
+    if not is_d.any():
+        return
+    n = len(gb) - 1
+    conflicted = conflicted_frames(frame, gi, ri, n, len(g_frame), len(keep_r))
+    keep_r[ri[is_d & ~conflicted[frame]]] = False  # one-to-one frames: every strong pair is a match
+    bounds = frame_bounds(frame, n)
+    for t in np.unique(frame[is_d & conflicted[frame]]):
+        a, b = bounds[t], bounds[t + 1]
+        score = dense((int(gb[t + 1] - gb[t]), int(rb[t + 1] - rb[t])), gi[a:b] - gb[t], ri[a:b] - rb[t], sim[a:b])
+        rows, cols = linear_sum_assignment(-score)
+        ok = score[rows, cols] > _EPS
+        rows, cols = rows[ok], cols[ok]
+        keep_r[rb[t] + cols[distractor[gb[t] + rows]]] = False
 
 
 def prepare_points(
@@ -217,4 +282,4 @@ def _num_frames(gt: MotTable, res: MotTable, num_frames: int | None) -> int:
 def _finish(gt_ids: list[np.ndarray], tr_ids: list[np.ndarray], sims: list[np.ndarray]) -> SequenceData:
     gt_rel, n_gt = _relabel(gt_ids)
     tr_rel, n_tr = _relabel(tr_ids)
-    return SequenceData(gt_rel, tr_rel, sims, n_gt, n_tr)
+    return SequenceData.from_frames(gt_rel, tr_rel, sims, n_gt, n_tr)
