@@ -106,3 +106,11 @@ def test_chi2_gate_known_value():
     assert chi2_gate(2) == pytest.approx(5.9915, abs=1e-4)
     with pytest.raises(ValueError):
         chi2_gate(0)
+
+
+@pytest.mark.parametrize("dof", range(1, 9))
+def test_chi2_gate_equals_scipy(dof):
+    from scipy.stats import chi2
+
+    for p in (0.01, 0.5, 0.9, 0.95, 0.99, 0.9999):
+        assert chi2_gate(dof, p) == pytest.approx(chi2.ppf(p, dof), rel=1e-12)

@@ -11,7 +11,14 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
+
+
+def linear_sum_assignment(cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """scipy's solver, imported on first use (scipy.optimize takes a noticeable time to import)."""
+    from scipy.optimize import linear_sum_assignment as solve
+
+    rows, cols = solve(cost)
+    return rows, cols
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,8 @@ import numpy as np
 
 from lookalike.types._validate import as_column, reject_unknown, require_finite
 
+_EMPTY: Beacons | None = None
+
 
 @dataclass(frozen=True, eq=False)
 class Beacons:
@@ -46,9 +48,12 @@ class Beacons:
 
     @classmethod
     def empty(cls) -> Beacons:
-        """No reports."""
-        z = np.zeros(0)
-        return cls(agent_id=np.zeros(0, dtype=int), t_sent=z, t_received=z, heading=z)
+        """No reports (one shared, read-only instance)."""
+        global _EMPTY
+        if _EMPTY is None:
+            z = np.zeros(0)
+            _EMPTY = cls(agent_id=np.zeros(0, dtype=int), t_sent=z, t_received=z, heading=z)
+        return _EMPTY
 
     @classmethod
     def from_dict(cls, columns: Mapping[str, Any]) -> Beacons:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -12,6 +13,7 @@ import numpy as np
 from lookalike.types._validate import as_column, reject_unknown, require_finite
 
 _OPTIONAL = ("position", "heading", "heading_std", "feature", "label")
+_EMPTY: Detections | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,6 +42,8 @@ class Detections:
     label: np.ndarray | None = None
 
     def __post_init__(self) -> None:
+        if self._fast_init():
+            return
         n = _infer_length(self)
         own = "Detections"
         xywh = np.zeros((n, 4)) if self.xywh is None else self.xywh
@@ -76,13 +80,40 @@ class Detections:
         if self.label is not None:
             object.__setattr__(self, "label", as_column(own, "label", self.label, n, None, int))
 
+    def _fast_init(self) -> bool:
+        """The common case, boxes and scores as float arrays and nothing else, checked with a few
+        whole-array operations; False (nothing set) when anything needs the full checks."""
+        xywh, score = self.xywh, self.score
+        if (type(xywh) is not np.ndarray or xywh.dtype != np.float64 or xywh.ndim != 2 or xywh.shape[1] != 4
+                or self.position is not None or self.heading is not None or self.heading_std is not None
+                or self.feature is not None or self.label is not None):
+            return False
+        n = xywh.shape[0]
+        if score is None:
+            score = np.ones(n)
+        elif type(score) is np.ndarray and score.dtype == np.float64 and score.shape == (n,):
+            score = score.copy()
+        else:
+            return False
+        if n and not (math.isfinite(float(xywh.sum()) + float(score.sum())) and xywh[:, 2:].min() >= 0):
+            return False
+        xywh = xywh.copy()
+        xywh.setflags(write=False)
+        score.setflags(write=False)
+        object.__setattr__(self, "xywh", xywh)
+        object.__setattr__(self, "score", score)
+        return True
+
     def __len__(self) -> int:
         return int(self.xywh.shape[0])
 
     @classmethod
     def empty(cls) -> Detections:
-        """A batch with no detections."""
-        return cls(xywh=np.zeros((0, 4)))
+        """A batch with no detections (one shared, read-only instance)."""
+        global _EMPTY
+        if _EMPTY is None:
+            _EMPTY = cls(xywh=np.zeros((0, 4)))
+        return _EMPTY
 
     @classmethod
     def from_dict(cls, columns: Mapping[str, Any]) -> Detections:
