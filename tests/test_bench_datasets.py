@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from lookalike.bench.datasets import hexbug_clips, points_swapped, read_hexbug_points, resolve_data_root
-from lookalike.bench.presets import DATASET_PARAMS, OFFLINE_PARAMS, SEQUENCE_PARAMS, chosen_on, load_preset
+from lookalike.bench.presets import SEQUENCE_PARAMS, TUNED_PARAMS, chosen_on, load_preset
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
@@ -70,13 +70,12 @@ def test_data_root_from_option_env_or_shared_data(tmp_path, monkeypatch):
 
 
 def test_presets_say_what_they_were_chosen_on():
-    for name in ("boxtrack", "offline"):
-        preset = load_preset(name)
-        for group in ("datasets", "sequences"):
-            for dataset, entry in preset.get(group, {}).items():
-                assert entry["chosen_on"] and entry["params"], (name, dataset)
-    assert DATASET_PARAMS["pigs"]["boxtrack"] == {"high_score": 0.7, "birth_score": 0.7}
+    preset = load_preset("boxtrack")
+    assert set(preset) == {"tracker", "about", "sequences", "tuned"}  # no group applied to a headline row
+    for group in ("sequences", "tuned"):
+        for dataset, entry in preset[group].items():
+            assert entry["chosen_on"] and entry["params"] and entry["label"] == "tuned on this data", dataset
+    assert TUNED_PARAMS["pigs"]["boxtrack"] == {"high_score": 0.7, "birth_score": 0.7}
     assert "report" not in SEQUENCE_PARAMS["mot15"]["boxtrack"]["KITTI-13"]  # a constant of boxtrack since issue 16
     assert SEQUENCE_PARAMS["mot15"]["boxtrack"]["ADL-Rundle-6"]["clutter_factor"] is None
-    assert OFFLINE_PARAMS["hexbug"] == {"link_gap_s": 0.0, "fill_gap_s": 0.5}
     assert "first half" in chosen_on("boxtrack", "mot15") and chosen_on("boxtrack", "nothing") == ""

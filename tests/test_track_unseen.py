@@ -200,14 +200,14 @@ def _seq(dataset: str, name: str = "s", n_targets: int | None = None) -> RealSeq
 def test_bench_entries_params_row_and_closed_offline():
     seqs = [_seq("mot15", "ADL-Rundle-6"), _seq("pigs", "pigs", 2)]
     entry = params_entry("runs/mine.json", "boxtrack", {"n_init": 1}, ["mot15/ADL-Rundle-6"], seqs)
-    assert entry.label == "mine (tuned on this data)" and not entry.presets
+    assert entry.label == "mine (tuned on this data)" and not entry.tuned
     assert params_entry("mine.json", "boxtrack", {}, ["mot15/KITTI-13"], seqs).label == "mine"
     labels = [e.label for e, _ in job_pairs(default_entries(["boxtrack"], []), [seqs[1]])]
     assert "boxtrack-closed-offline" in labels and "boxtrack (tuned on this data)" not in labels
     hexbug = _seq("hexbug", "clip")
     labels = [e.label for e, _ in job_pairs(default_entries(["boxtrack"], []), [hexbug])]
     assert "boxtrack (tuned on this data)" in labels
-    rows = track_rows(Entry("c", "boxtrack", closed_set=True, closed_offline=True, presets=False), seqs[1])
+    rows = track_rows(Entry("c", "boxtrack", closed_set=True, closed_offline=True), seqs[1])
     assert set(np.unique(rows[:, 1]).tolist()) == {1, 2}
 
 

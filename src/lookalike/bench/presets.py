@@ -3,10 +3,10 @@
 Each file says what every set of parameters was chosen on (``chosen_on``) and how (``search``):
 parameters chosen on data that is then scored are "tuned on this data", never a headline figure.
 
-- ``boxtrack.json``: boxtrack's parameters per dataset (``datasets``) and per sequence (``sequences``),
-  and per dataset for the separate "tuned on this data" row only (``tuned``: never the headline),
-- ``offline.json``: the offline post-processing (:class:`lookalike.trackers.offline.OfflineConfig`)
-  per dataset.
+- ``boxtrack.json``: boxtrack's parameters per MOT15 sequence (``sequences``) and per dataset
+  (``tuned``), both for the separate "tuned on this data" row only. The headline rows of
+  ``bench real`` use boxtrack's defaults and :class:`~lookalike.trackers.offline.OfflineConfig`'s,
+  as ``lookalike track`` does.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from functools import cache
 from importlib import resources
 from typing import Any
 
-PRESET_FILES = ("boxtrack", "offline")
+PRESET_FILES = ("boxtrack",)
 
 
 @cache
@@ -31,16 +31,11 @@ def load_preset(name: str) -> dict[str, Any]:
 def chosen_on(preset: str, dataset: str) -> str:
     """What the parameters of ``preset`` for ``dataset`` were chosen on ("" when there are none)."""
     data = load_preset(preset)
-    for group in ("datasets", "sequences", "tuned"):
+    for group in ("sequences", "tuned"):
         entry = data.get(group, {}).get(dataset)
         if entry is not None:
             return str(entry["chosen_on"])
     return ""
-
-
-def _dataset_params() -> dict[str, dict[str, dict[str, Any]]]:
-    boxtrack = load_preset("boxtrack")
-    return {d: {boxtrack["tracker"]: dict(e["params"])} for d, e in boxtrack["datasets"].items()}
 
 
 def _sequence_params() -> dict[str, dict[str, dict[str, dict[str, Any]]]]:
@@ -49,17 +44,11 @@ def _sequence_params() -> dict[str, dict[str, dict[str, dict[str, Any]]]]:
             for d, e in boxtrack["sequences"].items()}
 
 
-# dataset -> tracker -> parameters chosen on that dataset (boxtrack.json "datasets")
-DATASET_PARAMS: dict[str, dict[str, dict[str, Any]]] = _dataset_params()
-# dataset -> tracker -> sequence -> parameters chosen on that sequence's first half (boxtrack.json "sequences")
+# dataset -> tracker -> sequence -> parameters chosen on its first half (boxtrack.json "sequences"; tuned row only)
 SEQUENCE_PARAMS: dict[str, dict[str, dict[str, dict[str, Any]]]] = _sequence_params()
 # dataset -> tracker -> parameters chosen on that dataset for the "tuned on this data" row only (boxtrack.json "tuned")
 TUNED_PARAMS: dict[str, dict[str, dict[str, Any]]] = {
     d: {load_preset("boxtrack")["tracker"]: dict(e["params"])}
     for d, e in load_preset("boxtrack").get("tuned", {}).items()}
-# dataset -> OfflineConfig fields (offline.json)
-OFFLINE_PARAMS: dict[str, dict[str, Any]] = {d: dict(e["params"])
-                                             for d, e in load_preset("offline")["datasets"].items()}
 
-__all__ = ["DATASET_PARAMS", "OFFLINE_PARAMS", "PRESET_FILES", "SEQUENCE_PARAMS", "TUNED_PARAMS", "chosen_on",
-           "load_preset"]
+__all__ = ["PRESET_FILES", "SEQUENCE_PARAMS", "TUNED_PARAMS", "chosen_on", "load_preset"]

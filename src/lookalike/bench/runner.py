@@ -6,10 +6,10 @@ the results in job order, so the tables do not depend on the backend (frames/s a
 backend uses Ray's task API (``ray.remote`` / ``ray.get``), connecting to ``address`` or starting
 a local instance (``ray.init()``); the sequences are put in Ray's object store once.
 
-Parameters of an entry, lowest priority first: the dataset's preset
-(:data:`~lookalike.bench.presets.DATASET_PARAMS`, when ``presets``; for a ``tuned`` entry
-:data:`~lookalike.bench.presets.TUNED_PARAMS` instead), the sequence's preset
-(:data:`~lookalike.bench.presets.SEQUENCE_PARAMS`, when ``per_sequence``), the entry's own.
+Parameters of an entry: the tracker's defaults, overridden by the entry's own. Only a ``tuned``
+entry (the "tuned on this data" row) also gets the parameters chosen on the scored data: the
+dataset's :data:`~lookalike.bench.presets.TUNED_PARAMS`, then the sequence's
+:data:`~lookalike.bench.presets.SEQUENCE_PARAMS`.
 
 ``boxtrack-closed-offline`` runs the offline closed set (:func:`lookalike.trackers.closed_set.track_closed_set`)
 on the detections with boxtrack's defaults, as ``lookalike track --targets N --offline`` does.
@@ -26,7 +26,7 @@ import numpy as np
 
 from lookalike.bench.datasets import RealSequence
 from lookalike.bench.peers import run_peer
-from lookalike.bench.presets import DATASET_PARAMS, OFFLINE_PARAMS, SEQUENCE_PARAMS, TUNED_PARAMS
+from lookalike.bench.presets import SEQUENCE_PARAMS, TUNED_PARAMS
 from lookalike.eval import evaluate_points, evaluate_sequence
 from lookalike.io import MotTable
 from lookalike.loop import RowCollector, run
@@ -48,11 +48,8 @@ class Entry:
     kind: str = "lookalike"
     params: dict[str, Any] = field(default_factory=dict)
     closed_set: bool = False  # pass the sequence's documented target count as ``max_targets``
-    per_sequence: bool = True  # use the parameters chosen on each sequence's first half (SEQUENCE_PARAMS)
-    only_where_tuned: bool = False  # run only on datasets with per-sequence parameters for this tracker
-    offline: bool = False  # post-process the whole result (trackers.offline; OFFLINE_PARAMS of the dataset)
-    presets: bool = True  # start from the dataset's preset (DATASET_PARAMS)
-    tuned: bool = False  # start from TUNED_PARAMS instead; run only on datasets that have them
+    offline: bool = False  # post-process the whole result (trackers.offline, OfflineConfig's defaults)
+    tuned: bool = False  # add the parameters chosen on the scored data (TUNED_PARAMS, SEQUENCE_PARAMS)
     closed_offline: bool = False  # offline closed set of the documented count (track_closed_set)
 
 
@@ -60,20 +57,17 @@ TUNED_LABEL = "tuned on this data"
 
 
 def default_entries(trackers: Sequence[str], peers: Sequence[str], closed_set: bool = True) -> list[Entry]:
-    """lookalike trackers and peers; with ``boxtrack`` also ``boxtrack-global`` (without the
-    per-sequence parameters, where there are some), ``boxtrack-offline`` (its result post-processed
-    offline, :mod:`lookalike.trackers.offline`), ``boxtrack (tuned on this data)`` (where a dataset
-    has :data:`TUNED_PARAMS`), and, where the count is known, ``boxtrack-closed`` (online) and
-    ``boxtrack-closed-offline`` (the offline closed set with boxtrack's defaults)."""
+    """lookalike trackers and peers, all with their defaults; with ``boxtrack`` also ``boxtrack-offline``
+    (its result post-processed offline, :mod:`lookalike.trackers.offline`), ``boxtrack (tuned on this
+    data)`` (where parameters were chosen on the scored data), and, where the count is known,
+    ``boxtrack-closed`` (online) and ``boxtrack-closed-offline`` (the offline closed set)."""
     entries = [Entry(t, t) for t in trackers]
     if "boxtrack" in trackers:
-        entries += [Entry("boxtrack-global", "boxtrack", per_sequence=False, only_where_tuned=True),
-                    Entry("boxtrack-offline", "boxtrack", offline=True),
+        entries += [Entry("boxtrack-offline", "boxtrack", offline=True),
                     Entry(f"boxtrack ({TUNED_LABEL})", "boxtrack", tuned=True)]
     if closed_set and "boxtrack" in trackers:
         entries += [Entry("boxtrack-closed", "boxtrack", closed_set=True),
-                    Entry("boxtrack-closed-offline", "boxtrack", closed_set=True, closed_offline=True,
-                          presets=False, per_sequence=False)]
+                    Entry("boxtrack-closed-offline", "boxtrack", closed_set=True, closed_offline=True)]
     return entries + [Entry(p, p, kind="peer") for p in peers]
 
 
@@ -81,13 +75,13 @@ def params_entry(path: str, tracker: str, params: dict[str, Any], chosen_on: Seq
                  sequences: Sequence[RealSequence]) -> Entry:
     """The entry of a ``lookalike tune`` parameter file: labelled with the file's stem, and
     ``(tuned on this data)`` when its ``chosen_on`` names any scored sequence (``dataset/name`` or a
-    dataset); no bench preset is applied."""
+    dataset)."""
     from pathlib import Path
 
     scored = {f"{s.dataset}/{base_name(s)}" for s in sequences} | {s.dataset for s in sequences}
     chosen = {str(c).split("[", 1)[0] for c in chosen_on}
     label = Path(path).stem + (f" ({TUNED_LABEL})" if chosen & scored else "")
-    return Entry(label, tracker, params=dict(params), presets=False, per_sequence=False)
+    return Entry(label, tracker, params=dict(params))
 
 
 def base_name(seq: RealSequence) -> str:
@@ -96,40 +90,37 @@ def base_name(seq: RealSequence) -> str:
 
 
 def sequence_params(entry: Entry, seq: RealSequence) -> dict[str, Any]:
-    """The parameters chosen for ``entry``'s tracker on the first half of ``seq`` (empty if none)."""
-    if entry.kind == "peer" or not entry.per_sequence:
+    """The parameters chosen for a tuned ``entry``'s tracker on the first half of ``seq`` (empty if none)."""
+    if entry.kind == "peer" or not entry.tuned:
         return {}
     return SEQUENCE_PARAMS.get(seq.dataset, {}).get(entry.name, {}).get(base_name(seq), {})
 
 
-def entry_params(entry: Entry, seq: RealSequence,
-                 dataset_params: dict[str, dict[str, dict[str, Any]]] | None = None) -> dict[str, Any]:
-    """The parameters ``entry``'s tracker gets on ``seq`` (dataset < sequence < entry; the target
-    count as ``max_targets`` for a closed-set entry where it is known)."""
-    dataset_params = DATASET_PARAMS if dataset_params is None else dataset_params
-    preset = (TUNED_PARAMS if entry.tuned else dataset_params if entry.presets else {}).get(seq.dataset, {})
+def entry_params(entry: Entry, seq: RealSequence) -> dict[str, Any]:
+    """The parameters ``entry``'s tracker gets on ``seq`` (a tuned entry's dataset < sequence < the
+    entry's own; the target count as ``max_targets`` for a closed-set entry where it is known)."""
+    preset = TUNED_PARAMS.get(seq.dataset, {}) if entry.tuned else {}
     params = {**preset.get(entry.name, {}), **sequence_params(entry, seq), **entry.params}
     if entry.closed_set and seq.n_targets is not None:
         params["max_targets"] = seq.n_targets
     return params
 
 
-def track_rows(entry: Entry, seq: RealSequence,
-               dataset_params: dict[str, dict[str, dict[str, Any]]] | None = None) -> np.ndarray:
+def track_rows(entry: Entry, seq: RealSequence) -> np.ndarray:
     """MOTChallenge rows ``(k, 10)`` of ``entry`` on ``seq`` (parameters: :func:`entry_params`).
-    An ``offline`` entry's rows are post-processed with the dataset's :data:`OFFLINE_PARAMS`."""
+    An ``offline`` entry's rows are post-processed with :class:`OfflineConfig`'s defaults."""
     if entry.kind == "peer":
         return run_peer(entry.name, seq)
     if entry.closed_offline and seq.n_targets is not None:
-        online = {k: v for k, v in entry_params(entry, seq, dataset_params).items() if k != "max_targets"}
+        online = {k: v for k, v in entry_params(entry, seq).items() if k != "max_targets"}
         return track_closed_set(detection_rows(seq), seq.n_targets, seq.frame_rate, n_frames=seq.length,
                                 online=online)
-    tracker = make_tracker(entry.name, **entry_params(entry, seq, dataset_params))
+    tracker = make_tracker(entry.name, **entry_params(entry, seq))
     collect = RowCollector()
     run(tracker, seq.frames(), collect)
     rows = collect.rows()
     if entry.offline:
-        rows = postprocess(rows, seq.frame_rate, OfflineConfig(**OFFLINE_PARAMS.get(seq.dataset, {})))
+        rows = postprocess(rows, seq.frame_rate, OfflineConfig())
     return rows
 
 
@@ -179,13 +170,11 @@ def map_jobs(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int = 1
 
 def job_pairs(entries: Sequence[Entry], sequences: Sequence[RealSequence]) -> list[tuple[Entry, RealSequence]]:
     """``(entry, sequence)`` for every sequence and entry; closed-set entries only where the count is
-    known, ``only_where_tuned`` entries only on datasets with per-sequence parameters for their tracker,
-    ``offline`` entries only on datasets whose post-processing was chosen (:data:`OFFLINE_PARAMS`)."""
+    known, tuned entries only on datasets with parameters chosen on them."""
     return [(e, s) for s in sequences for e in entries
             if not (e.closed_set and s.n_targets is None)
-            and not (e.only_where_tuned and e.name not in SEQUENCE_PARAMS.get(s.dataset, {}))
-            and not (e.tuned and e.name not in TUNED_PARAMS.get(s.dataset, {}))
-            and not (e.offline and s.dataset not in OFFLINE_PARAMS)]
+            and not (e.tuned and e.name not in TUNED_PARAMS.get(s.dataset, {})
+                     and e.name not in SEQUENCE_PARAMS.get(s.dataset, {}))]
 
 
 def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, workers: int = 1,
@@ -197,7 +186,7 @@ def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, wor
         return [p.result() for p in [pool.submit(_run_pair, e, shared[id(s)]) for e, s in jobs]]
 
 
-__all__ = ["DATASET_PARAMS", "HEXBUG_RADIUS_PX", "OFFLINE_PARAMS", "SEQUENCE_PARAMS", "TUNED_LABEL", "TUNED_PARAMS",
+__all__ = ["HEXBUG_RADIUS_PX", "SEQUENCE_PARAMS", "TUNED_LABEL", "TUNED_PARAMS",
            "Entry", "base_name", "default_entries", "detection_rows", "entry_params", "params_entry", "job_pairs",
            "map_jobs", "run_job", "run_jobs", "score_rows",
            "sequence_params", "track_rows"]

@@ -53,7 +53,7 @@ def load_tuning_data(items: Sequence[str], data_root: Path | None = None) -> lis
 
 def run_params(tracker: str, params: dict[str, Any], seq: RealSequence) -> np.ndarray:
     """MOTChallenge rows of ``tracker`` with exactly ``params`` on ``seq`` (no preset of the benches)."""
-    return track_rows(Entry(tracker, tracker, params=dict(params), per_sequence=False), seq, dataset_params={})
+    return track_rows(Entry(tracker, tracker, params=dict(params)), seq)
 
 
 def score_params(tracker: str, params: dict[str, Any], seq: RealSequence) -> dict[str, float]:
