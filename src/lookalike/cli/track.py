@@ -234,7 +234,7 @@ def track(
 def trackers(
     names: bool = typer.Option(False, "--names", help="Print only the names, one per line."),
 ) -> None:
-    """List registered trackers and their parameters with defaults."""
+    """List registered trackers and their parameters with defaults and allowed values."""
     if names:
         for name in tracker_names():
             typer.echo(name)
@@ -244,8 +244,9 @@ def trackers(
         table.add_column("parameter")
         table.add_column("type")
         table.add_column("default")
+        table.add_column("allowed")
         table.add_column("meaning")
         for p in tracker_parameters(name):
-            table.add_row(p.name, p.type, repr(p.default), p.doc)
+            table.add_row(p.name, p.type, repr(p.default), p.allowed(), p.doc)
         console.print(table)
     console.print("Set any parameter with [bold]--set KEY=VALUE[/] on `lookalike track`.")

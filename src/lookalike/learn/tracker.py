@@ -16,7 +16,7 @@ from lookalike.learn.checkpoint import load_weights
 from lookalike.learn.encoding import EncodingSpec, encode_frame
 from lookalike.learn.numpy_net import NumpyAssociationNet
 from lookalike.learn.weights import shipped_weights_path
-from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.base import check_params, param
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
@@ -64,13 +64,13 @@ class LstmIdentifier:
 
     @dataclass(frozen=True)
     class Config:
-        n_agents: int = param(3, "number of reporting agents N")
-        n_slots: int = param(5, "detection slots M of the network")
+        n_agents: int = param(3, "number of reporting agents N", range=(1, 1000))
+        n_slots: int = param(5, "detection slots M of the network", range=(1, 1000))
         weights: str | None = param(None, "path of model.npz (None: the shipped weights for N, M)")
         one_to_one: bool = param(True, "decode with Hungarian on -log p (else per-slot argmax, as the paper)")
 
         def __post_init__(self) -> None:
-            check_positive(self, "n_agents", "n_slots")
+            check_params(self)
 
     def __init__(self, config: LstmIdentifier.Config | None = None) -> None:
         self.config = config or LstmIdentifier.Config()

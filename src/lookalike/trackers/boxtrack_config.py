@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.base import COUNT, NON_NEGATIVE, POSITIVE, UNIT, check_params, param
 
 # Former parameters, now constants: their whole range moved the left-out criterion little, or tuning
 # them did not beat the noise between folds (docs/tuning.md, "Which parameters earn their place").
@@ -31,38 +31,32 @@ CLOSED_SCALE = 3.0  # closed set: a recovered detection's sqrt(area) within this
 class BoxTrackConfig:
     """BoxTrack's parameters (pixels, seconds, scores in [0, 1]); validated on construction."""
 
-    high_score: float = param(0.9, "detections scoring at least this are matched first to confirmed tracks")
-    low_score: float = param(0.1, "detections below this are ignored")
-    birth_score: float = param(0.95, "detections scoring at least this may start tracks")
+    high_score: float = param(0.9, "detections scoring at least this are matched first to confirmed tracks", range=UNIT)
+    low_score: float = param(0.1, "detections below this are ignored", range=UNIT)
+    birth_score: float = param(0.95, "detections scoring at least this may start tracks", range=UNIT)
     clutter_factor: float | None = param(
         2.0, "if set, birth_score is lowered to the quantile of the scores seen so far equal to this times the "
-             "share of detections overlapping none of the previous frame's (at least the 0.1-quantile)")
+             "share of detections overlapping none of the previous frame's (at least the 0.1-quantile)", range=POSITIVE)
     high_match_ratio: float | None = param(
         0.6, "if set, high_score is lowered to the lowest 0.1-wide score bin from which every bin up continues "
-             "confirmed tracks at least this fraction as often as the best bin")
-    match_iou: float = param(0.3, "minimum IoU of a confident detection with a confirmed or tentative track")
-    n_init: int = param(2, "consecutive hits that confirm a track")
+             "confirmed tracks at least this fraction as often as the best bin", range=UNIT)
+    match_iou: float = param(0.3, "minimum IoU of a confident detection with a confirmed or tentative track",
+                             range=UNIT)
+    n_init: int = param(2, "consecutive hits that confirm a track", range=COUNT)
     max_age_s: float = param(2.0, "seconds a confirmed track survives without a detection (closed set: "
-                                  "before its slot may be re-filled)")
-    reid_distance: float = param(0.5, "centre distance (track heights) that re-identifies a lost track")
-    reid_scale: float = param(1.5, "largest width/height ratio between a lost track and its detection")
+                                  "before its slot may be re-filled)", range=POSITIVE)
+    reid_distance: float = param(0.5, "centre distance (track heights) that re-identifies a lost track",
+                                 range=NON_NEGATIVE)
+    reid_scale: float = param(1.5, "largest width/height ratio between a lost track and its detection", range=(1, None))
     vel_noise: float = param(
-        1 / 160, "velocity noise per frame, as a fraction of the box size (position noise is 1/20)")
-    max_targets: int | None = param(None, "known number of targets (closed set), None when open")
+        1 / 160, "velocity noise per frame, as a fraction of the box size (position noise is 1/20)", range=POSITIVE)
+    max_targets: int | None = param(None, "known number of targets (closed set), None when open", range=COUNT)
     closed_distance: float = param(
-        8.0, "closed set: centre distance (slot sizes, sqrt(w*h)) gating recovery; grows with the time lost")
-    frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)")
+        8.0, "closed set: centre distance (slot sizes, sqrt(w*h)) gating recovery; grows with the time lost",
+        range=POSITIVE)
+    frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)", range=POSITIVE)
 
     def __post_init__(self) -> None:
-        check_positive(self, "high_score", "low_score", "birth_score", "match_iou", "reid_distance", allow_zero=True)
-        check_positive(self, "n_init", "max_age_s", "reid_scale", "max_targets", "closed_distance",
-                       "vel_noise", "frame_interval_s")
-        check_positive(self, "clutter_factor")
-        for name in ("high_match_ratio",):
-            q = getattr(self, name)
-            if q is not None and not 0 <= q <= 1:
-                raise ValueError(f"BoxTrack.Config.{name} must be in [0, 1], got {q}")
+        check_params(self)
         if self.low_score > self.high_score:
-            raise ValueError(f"BoxTrack.Config.low_score ({self.low_score}) exceeds high_score ({self.high_score})")
-        if self.reid_scale < 1:
-            raise ValueError(f"BoxTrack.Config.reid_scale must be >= 1, got {self.reid_scale}")
+            raise ValueError(f"tracker 'boxtrack': low_score={self.low_score} exceeds high_score={self.high_score}")

@@ -32,7 +32,7 @@ from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion import kalman
 from lookalike.motion.gating import chi2_gate
 from lookalike.motion.spaces import BoxXYAH, xyah_to_xywh, xywh_to_xyah
-from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.base import COUNT, POSITIVE, PROBABILITY, Range, check_params, param
 from lookalike.trackers.lifecycle import Lifecycle
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.table import TrackTable
@@ -48,22 +48,22 @@ class DeepSort:
 
     @dataclass(frozen=True)
     class Config:
-        max_cosine_distance: float = param(0.2, "largest accepted gallery cosine distance (calibrated)")
-        max_iou_distance: float = param(0.7, "largest accepted 1 - IoU in the IoU fallback")
-        max_age: int = param(30, "frames a confirmed track survives without a match")
-        n_init: int = param(3, "consecutive hits that confirm a track")
-        gallery_size: int = param(100, "features kept per track")
-        gate_probability: float = param(0.95, "chi-square probability of the Mahalanobis gate")
-        position_std_frac: float = param(1 / 20, "position noise as a fraction of the box height")
-        velocity_std_frac: float = param(1 / 160, "velocity noise (per frame) as a fraction of the height")
-        aspect_std: float = param(1e-2, "process noise of the aspect ratio per frame")
-        frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)")
+        max_cosine_distance: float = param(0.2, "largest accepted gallery cosine distance (calibrated)",
+                                           range=Range(0, 2, low_open=True))
+        max_iou_distance: float = param(0.7, "largest accepted 1 - IoU in the IoU fallback",
+                                        range=Range(0, 1, low_open=True))
+        max_age: int = param(30, "frames a confirmed track survives without a match", range=COUNT)
+        n_init: int = param(3, "consecutive hits that confirm a track", range=COUNT)
+        gallery_size: int = param(100, "features kept per track", range=COUNT)
+        gate_probability: float = param(0.95, "chi-square probability of the Mahalanobis gate", range=PROBABILITY)
+        position_std_frac: float = param(1 / 20, "position noise as a fraction of the box height", range=POSITIVE)
+        velocity_std_frac: float = param(1 / 160, "velocity noise (per frame) as a fraction of the height",
+                                         range=POSITIVE)
+        aspect_std: float = param(1e-2, "process noise of the aspect ratio per frame", range=POSITIVE)
+        frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)", range=POSITIVE)
 
         def __post_init__(self) -> None:
-            check_positive(self, "max_cosine_distance", "max_iou_distance", "max_age", "n_init", "gallery_size")
-            check_positive(self, "position_std_frac", "velocity_std_frac", "aspect_std", "frame_interval_s")
-            if not 0 < self.gate_probability < 1:
-                raise ValueError(f"Config.gate_probability must be in (0, 1), got {self.gate_probability}")
+            check_params(self)
 
     def __init__(self, config: DeepSort.Config | None = None) -> None:
         self.config = cfg = config or DeepSort.Config()

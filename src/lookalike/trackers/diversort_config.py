@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.base import COUNT, COUNT0, NON_NEGATIVE, POSITIVE, Range, check_params, param
 
 
 @dataclass(frozen=True)
@@ -21,29 +21,27 @@ class Merge:
 class DiverSortConfig:
     """Diver SORT's parameters (pixels, frames, cosine distances); validated on construction."""
 
-    iou_shortcut: float = param(0.75, "IoU with last frame's detection that joins its track directly")
-    appearance_threshold: float = param(0.10, "largest cosine cost of a match (paper 1e-4 for its features)")
-    long_term_threshold: float = param(0.30, "threshold for tracks unseen > long_term_after (paper 5e-4)")
-    location_gate: float = param(9.21, "largest squared Mahalanobis distance of the centre (paper 25)")
-    location_weight: float = param(0.1, "weight of d²/location_gate added to tied costs")
-    tie_margin: float = param(0.02, "tracks this close to a detection's best cost count as tied")
-    long_term_after: int = param(5, "frames unseen after which only appearance is used")
+    iou_shortcut: float = param(0.75, "IoU with last frame's detection that joins its track directly",
+                                range=Range(0, 1, low_open=True))
+    appearance_threshold: float = param(0.10, "largest cosine cost of a match (paper 1e-4 for its features)",
+                                        range=Range(0, 2, low_open=True))
+    long_term_threshold: float = param(0.30, "threshold for tracks unseen > long_term_after (paper 5e-4)",
+                                       range=Range(0, 2, low_open=True))
+    location_gate: float = param(9.21, "largest squared Mahalanobis distance of the centre (paper 25)", range=POSITIVE)
+    location_weight: float = param(0.1, "weight of d²/location_gate added to tied costs", range=NON_NEGATIVE)
+    tie_margin: float = param(0.02, "tracks this close to a detection's best cost count as tied", range=NON_NEGATIVE)
+    long_term_after: int = param(5, "frames unseen after which only appearance is used", range=COUNT0)
     recent_first: bool = param(False, "match recently seen tracks before long-unseen ones (ours)")
-    n_init: int = param(3, "consecutive matches that make a track an identity")
-    recovery_window: int = param(15, "a track alive this many frames or fewer may be merged")
-    recovery_fraction: float = param(0.25, "share of gallery pairs under the threshold that merges")
-    recovery_threshold: float = param(0.30, "cosine distance counted as similar for recovery")
-    gallery_size: int = param(100, "features kept per track")
-    max_age: int | None = param(None, "frames a confirmed track survives unseen (None: forever)")
-    position_std_frac: float = param(0.15, "centre measurement noise as a fraction of box height")
-    accel_std_frac: float = param(1 / 20, "centre acceleration noise per frame, fraction of box height")
-    frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)")
+    n_init: int = param(3, "consecutive matches that make a track an identity", range=COUNT)
+    recovery_window: int = param(15, "a track alive this many frames or fewer may be merged", range=COUNT)
+    recovery_fraction: float = param(0.25, "share of gallery pairs under the threshold that merges",
+                                     range=Range(0, 1, high_open=True))
+    recovery_threshold: float = param(0.30, "cosine distance counted as similar for recovery", range=(0, 2))
+    gallery_size: int = param(100, "features kept per track", range=COUNT)
+    max_age: int | None = param(None, "frames a confirmed track survives unseen (None: forever)", range=COUNT)
+    position_std_frac: float = param(0.15, "centre measurement noise as a fraction of box height", range=POSITIVE)
+    accel_std_frac: float = param(1 / 20, "centre acceleration noise per frame, fraction of box height", range=POSITIVE)
+    frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)", range=POSITIVE)
 
     def __post_init__(self) -> None:
-        check_positive(self, "iou_shortcut", "appearance_threshold", "long_term_threshold", "location_gate",
-                       "n_init", "recovery_window", "gallery_size", "max_age", "position_std_frac",
-                       "accel_std_frac", "frame_interval_s")
-        check_positive(self, "location_weight", "tie_margin", "long_term_after", allow_zero=True)
-        check_positive(self, "recovery_threshold", "recovery_fraction", allow_zero=True)
-        if self.iou_shortcut > 1 or self.recovery_fraction >= 1:
-            raise ValueError("Config.iou_shortcut must be <= 1 and recovery_fraction < 1")
+        check_params(self)

@@ -22,7 +22,7 @@ import numpy as np
 from lookalike.association.jpda import jpda_marginals
 from lookalike.association.solver import assign
 from lookalike.motion import kalman
-from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.base import COUNT, POSITIVE, UNIT, Range, param
 from lookalike.trackers.kalman_ha import H, WorldTracker
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.world_rules import HeuristicsConfig, WorldRules, positions
@@ -33,17 +33,14 @@ from lookalike.types import Detections
 class JpdaConfig(HeuristicsConfig):
     """Kalman-HA2's parameters plus JPDA's detection and clutter model."""
 
-    p_detection: float = param(0.85, "probability P_D that a tracked target is detected")
-    clutter_density: float = param(0.03, "false positives per square metre of the view, λ")
-    min_assignment_prob: float = param(0.3, "smallest β of a track's labelled detection")
-    max_events: int = param(5000, "joint events enumerated per cluster before the exact subset DP")
+    p_detection: float = param(0.85, "probability P_D that a tracked target is detected",
+                               range=Range(0, 1, low_open=True))
+    clutter_density: float = param(0.03, "false positives per square metre of the view, λ", range=POSITIVE)
+    min_assignment_prob: float = param(0.3, "smallest β of a track's labelled detection", range=UNIT)
+    max_events: int = param(5000, "joint events enumerated per cluster before the exact subset DP", range=COUNT)
 
     def __post_init__(self) -> None:
-        super().__post_init__()
-        check_positive(self, "clutter_density", "max_events")
-        check_positive(self, "min_assignment_prob", allow_zero=True)
-        if not 0 < self.p_detection <= 1:
-            raise ValueError(f"JpdaConfig.p_detection must be in (0, 1], got {self.p_detection}")
+        super().__post_init__()  # checks every field (check_params)
 
 
 @register_tracker("jpda")

@@ -3,25 +3,37 @@
 from __future__ import annotations
 
 import dataclasses
-import math
 import typing
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
+from lookalike.trackers.base import Range, check_value, name_config
 
 _REGISTRY: dict[str, type] = {}
 
 
 @dataclass(frozen=True)
 class ParameterInfo:
-    """One tracker parameter: name, type name, default value and description."""
+    """One tracker parameter: name, type name, default value, description and the values it allows
+    (``range``, ``choices``; None: any value of its type)."""
 
     name: str
     type: str
     default: Any
     doc: str
+    range: Range | None = None
+    choices: tuple[Any, ...] | None = None
+
+    def allowed(self) -> str:
+        """The allowed values in words: ``[0, 1]``, ``one of 'a', 'b'``, ``(0, inf) or None``, ``true/false``."""
+        if self.range is not None:
+            text = str(self.range)
+        elif self.choices is not None:
+            text = "one of " + ", ".join(map(repr, self.choices))
+        else:
+            text = "true/false" if self.type == "bool" else ("text" if self.type.startswith("str") else "any")
+        return f"{text} or None" if "None" in self.type else text
 
 
 def register_tracker(name: str) -> Callable[[type], type]:
@@ -33,6 +45,7 @@ def register_tracker(name: str) -> Callable[[type], type]:
         if not dataclasses.is_dataclass(getattr(cls, "Config", None)):
             raise TypeError(f"tracker {name!r} needs a dataclass attribute 'Config'")
         setattr(cls, "name", name)  # noqa: B010 (a class attribute the protocol declares)
+        name_config(getattr(cls, "Config"), name)  # noqa: B009 (checked above)
         _REGISTRY[name] = cls
         return cls
 
@@ -66,48 +79,31 @@ def tracker_parameters(name: str) -> list[ParameterInfo]:
     for f in dataclasses.fields(config_cls):
         default = f.default if f.default_factory is dataclasses.MISSING else f.default_factory()
         type_name = getattr(hints[f.name], "__name__", str(hints[f.name]))
-        out.append(ParameterInfo(f.name, type_name, default, f.metadata.get("doc", "")))
+        out.append(ParameterInfo(f.name, type_name, default, f.metadata.get("doc", ""), f.metadata.get("range"),
+                                 f.metadata.get("choices")))
     return out
 
 
 def make_tracker(name: str, **params: Any) -> Any:
-    """Build tracker ``name`` with config overrides; unknown parameters raise ``ValueError``."""
+    """Build tracker ``name`` with config overrides; an unknown parameter, or a value outside its
+    declared type, range or choices (:func:`~lookalike.trackers.base.param`), raises ``ValueError``
+    (``TypeError`` for a wrong type) in one line naming the tracker and the parameter."""
     cls = tracker_class(name)
     known = {f.name for f in dataclasses.fields(_config_class(name))}
     unknown = sorted(set(params) - known)
     if unknown:
         raise ValueError(f"tracker {name!r} has no parameter(s) {unknown}; known: {sorted(known)}")
     hints = typing.get_type_hints(_config_class(name))
+    fields = {f.name: f for f in dataclasses.fields(_config_class(name))}
     for key, value in params.items():
-        check_value(name, key, value, hints[key])
+        meta = fields[key].metadata
+        check_value(name, key, value, hints[key], meta.get("range"), meta.get("choices"))
     return cls(_config_class(name)(**params))
 
 
-def check_value(tracker: str, key: str, value: Any, hint: Any) -> None:
-    """``TypeError``/``ValueError`` naming ``key`` when ``value`` does not fit the parameter's type:
-    a number of the declared kind (``bool`` is not a number; an ``int`` is accepted for a ``float``),
-    finite, or None where the parameter is optional."""
-    args = [a for a in typing.get_args(hint) if a is not type(None)]
-    target = args[0] if args else hint
-    if value is None:
-        if type(None) not in typing.get_args(hint):
-            raise TypeError(f"tracker {tracker!r}: parameter {key!r} must not be None")
-        return
-    if target in (int, float):
-        kinds: tuple[type, ...] = (int, np.integer) if target is int else (int, float, np.integer, np.floating)
-        if isinstance(value, (bool, np.bool_)) or not isinstance(value, kinds):
-            raise TypeError(f"tracker {tracker!r}: parameter {key!r} must be {target.__name__}, "
-                            f"got {type(value).__name__} {value!r}")
-        if not math.isfinite(float(typing.cast(float, value))):
-            raise ValueError(f"tracker {tracker!r}: parameter {key!r} must be finite, got {value!r}")
-    elif target is bool and not isinstance(value, (bool, np.bool_)):
-        raise TypeError(f"tracker {tracker!r}: parameter {key!r} must be true or false, got {value!r}")
-    elif target is str and not isinstance(value, str):
-        raise TypeError(f"tracker {tracker!r}: parameter {key!r} must be text, got {value!r}")
-
-
 def parse_parameter(name: str, assignment: str) -> tuple[str, Any]:
-    """Parse ``KEY=VALUE`` for tracker ``name``, converting VALUE to the parameter's type."""
+    """Parse ``KEY=VALUE`` for tracker ``name``, converting VALUE to the parameter's type and checking
+    it against the declared range or choices (``ValueError`` in one line otherwise)."""
     if "=" not in assignment:
         raise ValueError(f"expected KEY=VALUE, got {assignment!r}")
     key, text = (part.strip() for part in assignment.split("=", 1))
@@ -115,10 +111,15 @@ def parse_parameter(name: str, assignment: str) -> tuple[str, Any]:
     if key not in params:
         raise ValueError(f"tracker {name!r} has no parameter {key!r}; known: {sorted(params)}")
     hint = typing.get_type_hints(_config_class(name))[key]
-    return key, _convert(key, text, hint)
+    value = _convert(name, key, text, hint)
+    try:
+        check_value(name, key, value, hint, params[key].range, params[key].choices)
+    except TypeError as exc:
+        raise ValueError(str(exc)) from None
+    return key, value
 
 
-def _convert(key: str, text: str, hint: Any) -> Any:
+def _convert(name: str, key: str, text: str, hint: Any) -> Any:
     args = [a for a in typing.get_args(hint) if a is not type(None)]
     if args and text.lower() in ("none", "null"):
         return None
@@ -133,8 +134,8 @@ def _convert(key: str, text: str, hint: Any) -> Any:
         if target in (int, float, str):
             return target(text)
     except ValueError:
-        raise ValueError(f"parameter {key!r}: cannot read {text!r} as {target.__name__}") from None
-    raise ValueError(f"parameter {key!r} of type {hint} cannot be set from text")
+        raise ValueError(f"tracker {name!r}: {key}: cannot read {text!r} as {target.__name__}") from None
+    raise ValueError(f"tracker {name!r}: parameter {key!r} of type {hint} cannot be set from text")
 
 
 # Trackers defined above the trackers layer (they need the learned network); imported by name

@@ -22,7 +22,7 @@ from lookalike.association.stages import Stage, run_plan
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion import kalman
 from lookalike.motion.spaces import BoxXYSR
-from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.base import COUNT0, POSITIVE, UNIT, check_params, param
 from lookalike.trackers.lifecycle import Lifecycle
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.table import TrackTable
@@ -56,16 +56,15 @@ class Sort:
 
     @dataclass(frozen=True)
     class Config:
-        max_age: int = param(1, "frames a track survives without a matched detection")
-        min_hits: int = param(3, "consecutive hits before a track is reported")
-        iou_threshold: float = param(0.3, "minimum IoU of a detection/track match")
+        max_age: int = param(1, "frames a track survives without a matched detection", range=COUNT0)
+        min_hits: int = param(3, "consecutive hits before a track is reported", range=COUNT0)
+        iou_threshold: float = param(0.3, "minimum IoU of a detection/track match", range=UNIT)
         frame_interval_s: float | None = param(
-            None, "seconds per frame of the motion model (None: the smallest step seen)"
+            None, "seconds per frame of the motion model (None: the smallest step seen)", range=POSITIVE
         )
 
         def __post_init__(self) -> None:
-            check_positive(self, "max_age", "min_hits", "iou_threshold", allow_zero=True)
-            check_positive(self, "frame_interval_s")
+            check_params(self)
 
     def __init__(self, config: Sort.Config | None = None) -> None:
         self.config = config or Sort.Config()

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.base import COUNT, NON_NEGATIVE, POSITIVE, PROBABILITY, UNIT, Range, check_params, param
 from lookalike.trackers.lifecycle import Lifecycle
 from lookalike.types import Detections
 
@@ -16,47 +16,44 @@ from lookalike.types import Detections
 class WorldConfig:
     """Parameters shared by the world-frame trackers (metres, seconds, radians)."""
 
-    n_agents: int = param(3, "number of reporting agents N")
-    q_jerk: float = param(4.0, "white-jerk spectral density of the constant-acceleration model (m²/s⁵)")
-    meas_std0_m: float = param(0.05, "position noise at distance 0 (m)")
-    meas_std_per_m: float = param(0.04, "growth of the position noise per metre of distance")
-    init_velocity_std: float = param(0.5, "initial velocity standard deviation (m/s)")
-    init_accel_std: float = param(1.0, "initial acceleration standard deviation (m/s²)")
-    gate_probability: float = param(0.99, "chi-square gate probability (2 dof)")
-    window_frames: int = param(30, "identifier: frames of heading samples compared with the reports")
-    max_identity_cost: float = param(0.3, "identifier: largest mean (1 - cos)/2 heading cost assigned")
-    hysteresis: float = param(0.08, "identifier: cost bonus of a track's current agent")
+    n_agents: int = param(3, "number of reporting agents N", range=(0, 10_000))
+    q_jerk: float = param(4.0, "white-jerk spectral density of the constant-acceleration model (m²/s⁵)",
+                          range=NON_NEGATIVE)
+    meas_std0_m: float = param(0.05, "position noise at distance 0 (m)", range=NON_NEGATIVE)
+    meas_std_per_m: float = param(0.04, "growth of the position noise per metre of distance", range=NON_NEGATIVE)
+    init_velocity_std: float = param(0.5, "initial velocity standard deviation (m/s)", range=NON_NEGATIVE)
+    init_accel_std: float = param(1.0, "initial acceleration standard deviation (m/s²)", range=NON_NEGATIVE)
+    gate_probability: float = param(0.99, "chi-square gate probability (2 dof)", range=PROBABILITY)
+    window_frames: int = param(30, "identifier: frames of heading samples compared with the reports",
+                               range=(1, 1_000_000))
+    max_identity_cost: float = param(0.3, "identifier: largest mean (1 - cos)/2 heading cost assigned", range=UNIT)
+    hysteresis: float = param(0.08, "identifier: cost bonus of a track's current agent", range=NON_NEGATIVE)
 
     def __post_init__(self) -> None:
-        check_positive(self, "n_agents", "meas_std0_m", "meas_std_per_m", "init_velocity_std", "init_accel_std",
-                       "max_identity_cost", "hysteresis", "q_jerk", allow_zero=True)
-        check_positive(self, "window_frames")
-        if not 0 < self.gate_probability < 1:
-            raise ValueError(f"{type(self).__name__}.gate_probability must be in (0, 1), got {self.gate_probability}")
+        check_params(self)
 
 
 @dataclass(frozen=True)
 class HeuristicsConfig(WorldConfig):
     """Kalman-HA2's lifecycle heuristics on top of :class:`WorldConfig`."""
 
-    birth_min_score: float = param(0.45, "lowest detector score that starts a track")
-    birth_exclusion_m: float = param(0.35, "no birth this close to an existing track's prediction (m)")
-    confirm_hits: int = param(3, "hits needed to confirm a tentative track ...")
-    confirm_window: int = param(5, "... within this many latest frames")
-    tentative_max_misses: int = param(2, "consecutive misses that delete a tentative track")
-    max_coast_s: float = param(0.7, "longest coasting of a confirmed track predicted in view (s)")
-    max_out_of_view_s: float = param(3.0, "longest coasting of a confirmed track predicted out of view (s)")
-    coast_velocity_decay_s: float = param(1.0, "time constant of the velocity decay while coasting (s)")
-    fov_deg: float = param(80.0, "camera field of view (degrees) for out-of-view handling")
-    min_range_m: float = param(0.3, "nearest visible distance (m)")
-    max_range_m: float = param(7.0, "farthest visible distance (m)")
+    birth_min_score: float = param(0.45, "lowest detector score that starts a track", range=UNIT)
+    birth_exclusion_m: float = param(0.35, "no birth this close to an existing track's prediction (m)",
+                                     range=NON_NEGATIVE)
+    confirm_hits: int = param(3, "hits needed to confirm a tentative track ...", range=(1, 1_000_000))
+    confirm_window: int = param(5, "... within this many latest frames", range=(1, 1_000_000))
+    tentative_max_misses: int = param(2, "consecutive misses that delete a tentative track", range=COUNT)
+    max_coast_s: float = param(0.7, "longest coasting of a confirmed track predicted in view (s)", range=NON_NEGATIVE)
+    max_out_of_view_s: float = param(3.0, "longest coasting of a confirmed track predicted out of view (s)",
+                                     range=NON_NEGATIVE)
+    coast_velocity_decay_s: float = param(1.0, "time constant of the velocity decay while coasting (s)", range=POSITIVE)
+    fov_deg: float = param(80.0, "camera field of view (degrees) for out-of-view handling",
+                           range=Range(0, 360, low_open=True))
+    min_range_m: float = param(0.3, "nearest visible distance (m)", range=NON_NEGATIVE)
+    max_range_m: float = param(7.0, "farthest visible distance (m)", range=POSITIVE)
 
     def __post_init__(self) -> None:
-        super().__post_init__()
-        check_positive(self, "confirm_hits", "confirm_window", "tentative_max_misses", "coast_velocity_decay_s",
-                       "fov_deg", "max_range_m")
-        check_positive(self, "birth_min_score", "birth_exclusion_m", "max_coast_s", "max_out_of_view_s",
-                       "min_range_m", allow_zero=True)
+        super().__post_init__()  # checks every field (check_params)
         if self.confirm_hits > self.confirm_window:
             raise ValueError(f"{type(self).__name__}.confirm_hits ({self.confirm_hits}) exceeds confirm_window "
                              f"({self.confirm_window})")

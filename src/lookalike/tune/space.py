@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.trackers.base import Range
 from lookalike.trackers.registry import tracker_class, tracker_parameters
 
 KINDS = ("float", "int", "choice")
@@ -122,8 +123,8 @@ def _base_type(hint: Any) -> tuple[Any, bool]:
 
 def generic_space(tracker: str) -> Space:
     """A space from ``tracker``'s defaults: booleans both ways; a positive number ``d`` log-uniform
-    in ``[d/3, 3d]`` (fractions capped at 1; integers at least 1); zero, ``None`` and text defaults
-    are not searched (nor :data:`NOT_SEARCHED`)."""
+    in ``[d/3, 3d]`` (fractions capped at 1; integers at least 1), clipped to the parameter's declared
+    range; zero, ``None`` and text defaults are not searched (nor :data:`NOT_SEARCHED`)."""
     hints = config_hints(tracker)
     out: Space = {}
     for p in tracker_parameters(tracker):
@@ -134,13 +135,25 @@ def generic_space(tracker: str) -> Space:
         if base is bool:
             out[p.name] = Dim("choice", choices=(False, True))
         elif base is int and d > 0:
-            out[p.name] = _i(max(1, d // 3), max(3 * d, d + 2), log=True)
+            low_i, high_i = _inside(p.range, max(1, d // 3), max(3 * d, d + 2), d)
+            out[p.name] = _i(int(math.ceil(low_i)), int(math.floor(high_i)), log=True)
         elif base is float and d > 0:
             high = 3 * d
             if d <= 1 and any(w in p.name for w in _FRACTION_WORDS):
                 high = min(high, 1.0)
-            out[p.name] = _f(d / 3, high, log=True)
+            out[p.name] = _f(*_inside(p.range, d / 3, high, d), log=True)
     return out
+
+
+def _inside(bounds: Range | None, low: float, high: float, default: float) -> tuple[float, float]:
+    """``[low, high]`` clipped to the parameter's declared range (an open end: halfway from the default)."""
+    if bounds is None:
+        return low, high
+    if bounds.low is not None and low <= bounds.low:
+        low = (bounds.low + default) / 2 if bounds.low_open else bounds.low
+    if bounds.high is not None and high >= bounds.high:
+        high = (bounds.high + default) / 2 if bounds.high_open else bounds.high
+    return low, high
 
 
 def default_space(tracker: str) -> Space:
