@@ -19,7 +19,7 @@ from lookalike.learn.set_data import agent_tokens, detection_tokens
 from lookalike.learn.set_numpy import NumpySetAssociator, load_set_weights
 from lookalike.learn.tracker import BeaconMemory, decode
 from lookalike.learn.weights import WEIGHTS_DIR
-from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.base import check_params, param
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
@@ -43,13 +43,15 @@ class SetIdentifier:
 
     @dataclass(frozen=True)
     class Config:
-        n_agents: int = param(3, "number of reporting agents N (any; no per-size weights)")
-        n_slots: int | None = param(None, "keep at most this many most probable detections per frame (None: all)")
+        n_agents: int = param(3, "number of reporting agents N (any; no per-size weights)",
+                              range=(1, 1000))
+        n_slots: int | None = param(None, "keep at most this many most probable detections per frame (None: all)",
+                                     range=(1, 1000))
         weights: str | None = param(None, "path of set.npz (None: the shipped weights, any N and M)")
         one_to_one: bool = param(True, "decode with Hungarian on -log p (else per-detection argmax)")
 
         def __post_init__(self) -> None:
-            check_positive(self, "n_agents", "n_slots")
+            check_params(self)
 
     def __init__(self, config: SetIdentifier.Config | None = None) -> None:
         self.config = config or SetIdentifier.Config()
