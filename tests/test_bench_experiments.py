@@ -45,13 +45,14 @@ def test_commands_print_and_write_tables(tmp_path):
     r = runner.invoke(app, ["bench", "shuffle", "--setups", "m3n2", "--trackers", "kalman_ha2", "--sequences", "1",
                             "--frames", "200", "--json", str(out)])
     assert r.exit_code == 0, r.output
-    row = json.loads(out.read_text())[0]
-    assert row["In order (%)"] > row["Random order (%)"]
+    row = json.loads(out.read_text())["tables"]["shuffle"][0]
+    assert row["dataset"] == "m3n2" and row["tracker"] == "kalman_ha2"
+    assert row["metrics"]["success_rate_in_order"] > row["metrics"]["success_rate_random_order"]
     out = tmp_path / "recovery.json"
     r = runner.invoke(app, ["bench", "recovery", "--setups", "m3n2", "--trackers", "kalman_ha2", "--sequences", "1",
                             "--frames", "450", "--swap-at-s", "3", "--swap-s", "5", "--json", str(out)])
     assert r.exit_code == 0, r.output
-    assert "Recovery, mean (s)" in json.loads(out.read_text())[0]
+    assert "recovery_mean_s" in json.loads(out.read_text())["tables"]["recovery"][0]["metrics"]
 
 
 def test_swapped_pair_is_the_two_most_seen_robots():

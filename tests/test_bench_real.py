@@ -166,16 +166,19 @@ def _need_data(sub: str) -> Path:
 def test_bench_real_cli_on_tud_campus(tmp_path: Path) -> None:
     _need_data("mot15/TUD-Campus")
     out = tmp_path / "real.json"
-    res = CliRunner().invoke(app, ["bench", "real", "--data", str(DATA), "--datasets", "mot15", "--sequences",
+    res = CliRunner().invoke(app, ["bench", "real", "--data", str(DATA), "--datasets", "mot15", "--sequence",
                                    "TUD-Campus", "--peers", "none", "--json", str(out), "--csv",
                                    str(tmp_path / "real.csv")])
     assert res.exit_code == 0, res.output
-    tables = json.loads(out.read_text())
-    names = {r["Tracker"] for r in tables["datasets"]}
+    tables = json.loads(out.read_text())["tables"]
+    names = {r["tracker"] for r in tables["datasets"]}
     # no closed-set entry: MOT15 has no known target count
     assert names == {"sort", "boxtrack", "boxtrack-offline", "boxtrack (tuned on this data)"}
-    sort_row = next(r for r in tables["datasets"] if r["Tracker"] == "sort")
-    assert sort_row["MOTA"] == pytest.approx(62.7, abs=0.1)  # SORT's published behaviour on TUD-Campus
+    sort_row = next(r for r in tables["datasets"] if r["tracker"] == "sort")
+    assert sort_row["combined"] and sort_row["dataset"] == "mot15" and sort_row["sequence"] is None
+    assert sort_row["metrics"]["mota"] == pytest.approx(0.627, abs=0.001)  # SORT's published behaviour on TUD-Campus
+    assert {r["sequence"] for r in tables["sequences"]} == {"TUD-Campus"}
+    assert all(r["dataset"] is None and r["combined"] for r in tables["ranking"])
     assert (tmp_path / "real.csv").read_text().startswith("Dataset,Tracker,HOTA")
 
 

@@ -7,6 +7,7 @@ import pytest
 from typer.testing import CliRunner
 
 from lookalike.bench.pixels import match_truth
+from lookalike.bench.results import validate
 from lookalike.cli import app
 from lookalike.eval import identification_success_rate
 from lookalike.geometry.camera import Camera, Pose2D
@@ -156,11 +157,13 @@ def test_bench_pixels_tiny(models, tmp_path):
                               "--sequences", "1", "--frames", "10", "--detector-model", str(det_path),
                               "--heading-model", str(head_path), "--json", str(out)])
     assert res.exit_code == 0, res.output
-    rows = json.loads(out.read_text())
-    assert [r["Identifier"] for r in rows] == ["kalman_ha2", "lstm"]
+    doc = json.loads(out.read_text())
+    validate(doc)  # the results schema
+    rows = [r["metrics"] | {"tracker": r["tracker"]} for r in doc["tables"]["identification"]]
+    assert [r["tracker"] for r in rows] == ["kalman_ha2", "lstm"]
     for r in rows:
-        assert 0 <= r["Pixels (%)"] <= 100 and 0 <= r["Simulated (%)"] <= 100
-        assert r["Gap (pp)"] == pytest.approx(r["Pixels (%)"] - r["Simulated (%)"], abs=0.02)
+        assert 0 <= r["success_rate_pixels"] <= 1 and 0 <= r["success_rate_simulated"] <= 1
+        assert r["gap"] == pytest.approx(r["success_rate_pixels"] - r["success_rate_simulated"], abs=2e-4)
     assert "Perception" in res.output
     res = runner.invoke(app, ["bench", "pixels", "--setups", "m9n9"])
     assert res.exit_code != 0 and "m9n9" in res.output

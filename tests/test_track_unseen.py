@@ -121,8 +121,8 @@ def test_points_in_tracked_and_scored_with_eval_points(tmp_path, offline):
     assert r.exit_code == 0, r.output
     import json
 
-    scores = next(iter(json.loads(js.read_text()).values()))
-    idf1 = next(iter(scores.values()))["IDF1"]
+    (row,) = json.loads(js.read_text())["tables"]["scores"]
+    idf1 = row["metrics"]["idf1"]
     assert idf1 > (0.99 if offline else 0.9)
 
 
@@ -220,10 +220,10 @@ def test_bench_real_params_option(tmp_path):
     import json
 
     out = tmp_path / "r.json"
-    r = runner.invoke(app, ["bench", "real", "--data", str(data), "--datasets", "mot15", "--sequences", "TUD-Campus",
+    r = runner.invoke(app, ["bench", "real", "--data", str(data), "--datasets", "mot15", "--sequence", "TUD-Campus",
                             "--peers", "none", "--trackers", "sort", "--params", str(params), "--json", str(out)])
     assert r.exit_code == 0, r.output
-    names = {row["Tracker"] for row in json.loads(out.read_text())["datasets"]}
+    names = {row["tracker"] for row in json.loads(out.read_text())["tables"]["datasets"]}
     assert names == {"sort", "campus (tuned on this data)"}
 
 

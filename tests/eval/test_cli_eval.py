@@ -33,9 +33,12 @@ def test_eval_writes_json_and_csv_and_compares(tmp_path: Path) -> None:
                               "--json", str(tmp_path / "r.json"), "--csv", str(tmp_path / "r.csv")])
     assert out.exit_code == 0, out.output
     assert "good" in out.output and "bad" in out.output
-    scores = json.loads((tmp_path / "r.json").read_text())
-    assert scores["good"]["SEQ-1"]["MOTA"] == 1.0
-    assert scores["bad"]["COMBINED"]["MOTA"] == 0.75 and scores["bad"]["COMBINED"]["IDSW"] == 1
+    doc = json.loads((tmp_path / "r.json").read_text())
+    scores = {(r["tracker"], r["sequence"]): r for r in doc["tables"]["scores"]}
+    assert scores["good", "SEQ-1"]["metrics"]["mota"] == 1.0
+    combined = scores["bad", None]
+    assert combined["combined"] and combined["metrics"]["mota"] == 0.75 and combined["metrics"]["idsw"] == 1
+    assert doc["header"]["sequences"] == 1 and doc["header"]["frames"] == 4
     rows = list(csv.DictReader(open(tmp_path / "r.csv")))
     assert [(r["tracker"], r["seq"]) for r in rows] == [
         ("good", "SEQ-1"), ("good", "COMBINED"), ("bad", "SEQ-1"), ("bad", "COMBINED")]

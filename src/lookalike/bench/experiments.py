@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.bench.ident import identify
+from lookalike.bench.results import Results, add_printed_rows
 from lookalike.eval import identification_success_rate
 from lookalike.sim import PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
 from lookalike.types import Beacons, Frame
@@ -148,5 +149,24 @@ def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int
     return rows
 
 
-__all__ = ["DEFAULT_SEED", "hit_rate", "most_seen_pair", "pair_hits", "recovery_rows", "recovery_s", "reindex",
-           "shuffle_rows", "swap_reports"]
+EXPERIMENT_KEYS = {"In order (%)": "success_rate_in_order", "Random order (%)": "success_rate_random_order",
+                   "Swapped robots while swapped (%)": "success_rate_while_swapped",
+                   "Same without swap (%)": "success_rate_without_swap"}
+
+
+def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[str], sequences: int, frames: int,
+                       seed: int = DEFAULT_SEED, command: str = "", options: dict[str, Any] | None = None) -> Results:
+    """Rows of :func:`shuffle_rows` or :func:`recovery_rows` as a results document (table ``kind``,
+    e.g. ``"shuffle"``; success rates as fractions, recovery times in seconds, ``null`` when never)."""
+    names = {preset_label(s): s for s in setups}
+    seeds = [seed + 1000 * PRESET_NAMES.index(s) + k for s in setups for k in range(sequences)]
+    doc = Results(f"bench {kind}", command=command, seeds=seeds, sequences=len(setups) * sequences,
+                  frames=len(setups) * sequences * frames,
+                  options={"setups": list(setups), "sequences_per_setup": sequences, "frames_per_sequence": frames,
+                           "seed": seed, **(options or {})})
+    add_printed_rows(doc, kind, rows, datasets=names, rename=EXPERIMENT_KEYS)
+    return doc
+
+
+__all__ = ["DEFAULT_SEED", "EXPERIMENT_KEYS", "experiment_results", "hit_rate", "most_seen_pair", "pair_hits",
+           "recovery_rows", "recovery_s", "reindex", "shuffle_rows", "swap_reports"]

@@ -7,6 +7,7 @@ from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from lookalike.bench.results import Results, metric_key
 from lookalike.eval import METRICS, combine, evaluate_sequence
 from lookalike.io import MotSequence, find_sequences, read_mot
 
@@ -60,4 +61,29 @@ def evaluate_folders(
     return out
 
 
-__all__ = ["COMBINED", "evaluate_folders"]
+def folder_results(scores: dict[str, dict[str, dict[str, float]]], gt_root: str | os.PathLike[str],
+                   command: str = "", options: dict[str, object] | None = None) -> Results:
+    """Scores of :func:`evaluate_folders` per results folder (``{tracker: {sequence: metrics}}``) as a
+    results document: table ``scores``, one row per tracker and sequence (dataset: the ground-truth
+    folder's name) and the combined row (``sequence`` None, ``combined`` True); TrackEval's metric
+    names as machine keys (``HOTA`` -> ``hota``, ``CLR_FP`` -> ``clr_fp``, ``HOTA___AUC`` -> ``hota_auc``)."""
+    dataset = Path(gt_root).name or str(gt_root)
+    seqs = {s for per in scores.values() for s in per if s != COMBINED}
+    frames = 0
+    first = next(iter(scores.values()), {})
+    for seq, values in first.items():
+        if seq != COMBINED:
+            frames += int(values.get("CLR_Frames", 0))
+    if not seqs and first:
+        frames = int(first.get(COMBINED, {}).get("CLR_Frames", 0))
+    doc = Results("eval", command=command, sequences=max(len(seqs), 1 if first else 0), frames=frames,
+                  options=dict(options or {}))
+    for tracker, per_seq in scores.items():
+        for seq, values in per_seq.items():
+            combined = seq == COMBINED
+            doc.add("scores", dataset=dataset, sequence=None if combined else seq, tracker=tracker,
+                    combined=combined, metrics={metric_key(k): v for k, v in values.items()})
+    return doc
+
+
+__all__ = ["COMBINED", "evaluate_folders", "folder_results"]

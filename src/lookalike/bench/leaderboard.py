@@ -15,7 +15,9 @@ from typing import Any
 import numpy as np
 
 from lookalike.bench.datasets import RealSequence
-from lookalike.bench.runner import Entry, job_pairs
+from lookalike.bench.progress import ProgressFactory, no_progress
+from lookalike.bench.results import Results
+from lookalike.bench.runner import Entry, job_pairs, run_jobs
 from lookalike.eval import combine
 
 COLUMNS = ("Dataset", "Tracker", "HOTA", "IDF1", "MOTA", "IDSW", "Frames/s", "Rank")
@@ -101,11 +103,62 @@ def leaderboard(entries: Sequence[Entry], sequences: Sequence[RealSequence], res
     return table, combined_ranking(table), sequence_rows(pairs, results)
 
 
+def run_with_progress(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, workers: int = 1,
+                      backend: str = "local", address: str | None = None,
+                      progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
+    """:func:`~lookalike.bench.runner.run_jobs`, sequence after sequence on the local backend so that
+    ``progress`` advances once per sequence (same results, same order); one step on Ray."""
+    if backend != "local" or len(sequences) < 2:
+        step = progress("bench real", 1)
+        results = run_jobs(entries, sequences, workers=workers, backend=backend, address=address)
+        step()
+        return results
+    step = progress("bench real", len(sequences))
+    results = []
+    for seq in sequences:  # job_pairs is sequence-major: the concatenation keeps its order
+        results += run_jobs(entries, [seq], workers=workers, backend=backend, address=address)
+        step()
+    return results
+
+
 def leaderboard_json(part: str, rows: list[dict[str, Any]], combined: list[dict[str, Any]],
                      per_seq: list[dict[str, Any]], skipped: dict[str, str | None]) -> str:
     """The JSON document ``bench real --json`` writes."""
     return json.dumps({"part": part, "datasets": rows, "combined": combined, "sequences": per_seq,
                        "skipped": {k: v for k, v in skipped.items() if v}}, indent=2) + "\n"
+
+
+def _metrics(row: dict[str, Any]) -> dict[str, Any]:
+    out: dict[str, Any] = {k.lower(): row[k] / 100 for k in METRICS if k in row}
+    if "IDSW" in row and row["IDSW"] >= 0:
+        out["idsw"] = int(row["IDSW"])
+    if "Frames/s" in row:
+        out["frames_per_s"] = row["Frames/s"]
+    if "Rank" in row:
+        out["rank"] = row["Rank"]
+    return out
+
+
+def leaderboard_results(part: str, rows: list[dict[str, Any]], combined: list[dict[str, Any]],
+                        per_seq: list[dict[str, Any]], skipped: dict[str, str | None],
+                        sequences: Sequence[RealSequence], command: str = "",
+                        options: dict[str, Any] | None = None) -> Results:
+    """The leaderboard as a results document (:mod:`lookalike.bench.results`): tables ``datasets``
+    (one combined row per dataset and entry, with its ``rank``), ``sequences`` (one row per sequence
+    and entry) and ``ranking`` (``dataset`` None: ``mean_rank`` over the ``datasets`` it ran on)."""
+    doc = Results("bench real", command=command, sequences=len(sequences),
+                  frames=sum(s.length for s in sequences), options={"part": part, **(options or {})},
+                  notes={"skipped_peers": {k: v for k, v in skipped.items() if v}})
+    for r in rows:
+        doc.add("datasets", dataset=r["Dataset"], tracker=r["Tracker"], combined=True,
+                metrics={} if "Error" in r else _metrics(r), error=r.get("Error"))
+    for r in per_seq:
+        doc.add("sequences", dataset=r["Dataset"], sequence=r["Sequence"], tracker=r["Tracker"],
+                metrics={} if "Error" in r else _metrics(r), error=r.get("Error"))
+    for r in combined:
+        doc.add("ranking", dataset=None, tracker=r["Tracker"], combined=True,
+                metrics={"rank": r["Rank"], "mean_rank": r["Mean rank"], "datasets": r["Datasets"]})
+    return doc
 
 
 def plot_leaderboard(rows: list[dict[str, Any]], folder: Path) -> list[Path]:
@@ -137,4 +190,5 @@ def plot_leaderboard(rows: list[dict[str, Any]], folder: Path) -> list[Path]:
 
 
 __all__ = ["COLUMNS", "METRICS", "combined_ranking", "dataset_row", "leaderboard", "leaderboard_json",
+           "leaderboard_results", "run_with_progress",
            "plot_leaderboard", "rank_rows", "ranks", "sequence_rows"]

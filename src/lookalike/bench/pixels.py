@@ -25,12 +25,14 @@ The detector and heading models are those shipped in ``lookalike/vision/models_d
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from lookalike.bench.ident import sequence_seeds
+from lookalike.bench.progress import ProgressFactory
+from lookalike.bench.results import Results, add_printed_rows
 from lookalike.eval import identification_success_rate
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.geometry.camera import Camera
@@ -156,7 +158,7 @@ def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camer
 
 def pixels_table(setups: list[str], identifiers: list[str], sequences: int, frames: int, seed: int,
                  pipe: RobotPipeline, camera: Camera, min_iou: float,
-                 progress: Callable[[str, int], Callable[[], None]] | None = None
+                 progress: ProgressFactory | None = None
                  ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Rows of the identification table (:data:`PIXEL_COLUMNS`) and of the perception table
     (:data:`PERCEPTION_COLUMNS`). ``progress(description, total)`` returns a callable advanced once per frame."""
@@ -191,5 +193,25 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
     return rows, perception
 
 
-__all__ = ["DEFAULT_SEED", "PERCEPTION_COLUMNS", "PIXEL_COLUMNS", "PerceivedSequence", "match_truth",
-           "perceive_sequence", "pixels_table", "score_pixels", "score_simulated"]
+PIXEL_KEYS = {"Pixels (%)": "success_rate_pixels", "Simulated (%)": "success_rate_simulated",
+              "Pixel dets": "detections_pixels", "Sim dets": "detections_simulated"}
+
+
+def pixels_results(rows: list[dict[str, Any]], perception: list[dict[str, Any]], setups: list[str],
+                   sequences: int, frames: int, seed: int = DEFAULT_SEED, command: str = "",
+                   options: dict[str, Any] | None = None) -> Results:
+    """The tables of :func:`pixels_table` as a results document: ``identification`` (per set-up and
+    identifier: ``success_rate_pixels``, ``success_rate_simulated``, ``gap`` as fractions, detection
+    counts, frames/s) and ``perception`` (tracker ``perception``: recall, precision, heading error)."""
+    names = {preset_label(s): s for s in setups}
+    doc = Results("bench pixels", command=command, seeds=sequence_seeds(setups, sequences, seed),
+                  sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
+                  options={"setups": setups, "sequences_per_setup": sequences, "frames_per_sequence": frames,
+                           "seed": seed, **(options or {})})
+    add_printed_rows(doc, "identification", rows, tracker_key="Identifier", datasets=names, rename=PIXEL_KEYS)
+    add_printed_rows(doc, "perception", perception, tracker="perception", datasets=names)
+    return doc
+
+
+__all__ = ["DEFAULT_SEED", "PERCEPTION_COLUMNS", "PIXEL_COLUMNS", "PIXEL_KEYS", "PerceivedSequence", "match_truth",
+           "perceive_sequence", "pixels_results", "pixels_table", "score_pixels", "score_simulated"]

@@ -41,13 +41,14 @@ from typing import Any
 SCHEMA_ID = "lookalike-results/1"
 SCHEMA_PATH = Path(__file__).with_name("results.schema.json")
 KEY_PATTERN = re.compile(r"^[a-z][a-z0-9_]*$")
-#: Metrics that are fractions in [0, 1] (``gap`` in [-1, 1], MOTA/MODA at most 1).
+#: Metrics that are fractions in [0, 1], as are ``success_rate_*`` and HOTA's per-alpha values
+#: (``gap`` in [-1, 1], MOTA/MODA at most 1).
 FRACTIONS = frozenset({
-    "success_rate", "success_rate_pixels", "success_rate_simulated", "success_rate_in_order",
-    "success_rate_random_order", "hota", "deta", "assa", "loca", "idf1", "idp", "idr", "motp", "dp", "dr",
+    "success_rate", "hota", "deta", "assa", "loca", "idf1", "idp", "idr", "motp", "dp", "dr",
     "recall", "precision",
 })
-_ALPHA_FRACTION = re.compile(r"^(hota|deta|assa|loca|detre|detpr|assre|asspr|rhota)_([0-9]+|auc)$")
+_ALPHA_FRACTION = re.compile(
+    r"^((hota|deta|assa|loca|detre|detpr|assre|asspr|rhota)_([0-9]+|auc)|success_rate_[a-z0-9_]+)$")
 _UNITS = {"(m)": "_m", "(s)": "_s", "(deg)": "_deg", "(px)": "_px"}
 
 
@@ -119,17 +120,34 @@ def clean_metrics(metrics: Mapping[str, Any]) -> dict[str, float | int | None]:
     return out
 
 
-def percent_row_metrics(row: Mapping[str, Any], skip: Iterable[str] = ()) -> dict[str, float | int | None]:
-    """Metrics of a printed table row: numeric cells under machine keys (:func:`metric_key`), cells
-    marked ``(%)`` or ``(pp)`` divided by 100; text cells and the columns in ``skip`` left out."""
-    skipped = set(skip)
+def percent_row_metrics(row: Mapping[str, Any], skip: Iterable[str] = (),
+                        rename: Mapping[str, str] | None = None) -> dict[str, float | int | None]:
+    """Metrics of a printed table row: numeric cells under machine keys (:func:`metric_key`, or
+    ``rename[column]``), cells marked ``(%)`` or ``(pp)`` divided by 100; text cells and the columns
+    in ``skip`` left out."""
+    skipped, names = set(skip), dict(rename or {})
     out: dict[str, Any] = {}
     for name, value in row.items():
         if name in skipped or isinstance(value, (str, bool)) or value is None:
             continue
         scale = 0.01 if name.rstrip().endswith(("(%)", "(pp)")) else 1.0
-        out[metric_key(name)] = round(value * scale, 6) if scale != 1.0 else value
+        out[names.get(name) or metric_key(name)] = round(value * scale, 6) if scale != 1.0 else value
     return clean_metrics(out)
+
+
+def add_printed_rows(doc: Results, table: str, printed: Iterable[Mapping[str, Any]], *,
+                     dataset_key: str = "Setup", tracker_key: str = "Tracker",
+                     datasets: Mapping[str, str] | None = None, tracker: str = "",
+                     rename: Mapping[str, str] | None = None) -> None:
+    """Add printed table rows (one per data set and tracker, over all its sequences) to ``doc``:
+    ``dataset`` from column ``dataset_key`` (through ``datasets``, e.g. ``{"M=3, N=2": "m3n2"}``),
+    ``tracker`` from ``tracker_key`` (else ``tracker``), metrics by :func:`percent_row_metrics`."""
+    names = dict(datasets or {})
+    for r in printed:
+        label = r.get(dataset_key)
+        doc.add(table, dataset=None if label is None else names.get(str(label), str(label)),
+                tracker=str(r.get(tracker_key, tracker)),
+                metrics=percent_row_metrics(r, skip=(dataset_key, tracker_key), rename=rename))
 
 
 @dataclass
@@ -204,6 +222,14 @@ def schema() -> dict[str, Any]:
     return loaded
 
 
+def validate(document: Mapping[str, Any]) -> None:
+    """Check ``document`` against the schema (needs the ``jsonschema`` package of the test extra);
+    ``jsonschema.ValidationError`` when it does not conform."""
+    import jsonschema  # type: ignore[import-untyped]  # no stubs; test extra
+
+    jsonschema.validate(dict(document), schema())
+
+
 def load_results(path: Path) -> dict[str, Any]:
     """A results document read from ``path``; ``ValueError`` naming the file when it is not one."""
     try:
@@ -223,5 +249,5 @@ def rows(document: Mapping[str, Any], table: str | None = None) -> list[dict[str
     return list(tables.get(table, []))
 
 
-__all__ = ["FRACTIONS", "SCHEMA_ID", "SCHEMA_PATH", "Results", "clean_metrics", "is_fraction", "load_results",
-           "lookalike_version", "metric_key", "percent_row_metrics", "rows", "schema"]
+__all__ = ["FRACTIONS", "SCHEMA_ID", "SCHEMA_PATH", "Results", "add_printed_rows", "clean_metrics", "is_fraction",
+           "load_results", "lookalike_version", "metric_key", "percent_row_metrics", "rows", "schema", "validate"]

@@ -7,21 +7,22 @@ from pathlib import Path
 
 import typer
 
-from lookalike.bench.experiments import DEFAULT_SEED, recovery_rows, shuffle_rows
+from lookalike.bench.experiments import DEFAULT_SEED, experiment_results, recovery_rows, shuffle_rows
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import fail, split_list
-from lookalike.cli.bench import bench_app, print_rows
+from lookalike.cli.app import command_line, fail, split_list
+from lookalike.cli.bench import bench_app, print_rows, write_results
 from lookalike.sim import PRESET_NAMES
 
 
 @bench_app.command("shuffle")
 def shuffle(
     setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help="Presets (comma-separated or repeated)."),
-    trackers: list[str] = typer.Option(["jpda", "lstm"], "--trackers", help="Identifiers to compare."),
-    sequences: int = typer.Option(3, min=1, help="Test sequences per set-up."),
-    frames: int = typer.Option(1000, min=2, help="Frames per sequence."),
-    seed: int = typer.Option(DEFAULT_SEED, help="Base seed of the test sequences."),
-    json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON."),
+    trackers: list[str] = typer.Option(["jpda", "lstm"], "--trackers",
+                                       help="Identifiers (comma-separated or repeated)."),
+    sequences: int = typer.Option(3, "--sequences", min=1, help="Test sequences per set-up."),
+    frames: int = typer.Option(1000, "--frames", min=2, help="Frames per sequence."),
+    seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the test sequences."),
+    json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON (results schema)."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
 ) -> None:
     """Control experiment: success rate on frames in order and in random order."""
@@ -30,19 +31,22 @@ def shuffle(
     except ValueError as exc:
         fail(str(exc))
     print_rows("Control: frames in random order", rows)
-    write_rows(rows, json_path, csv_path)
+    write_results(experiment_results("shuffle", rows, split_list(setups), sequences, frames, seed, command_line()),
+                  json_path)
+    write_rows(rows, None, csv_path)
 
 
 @bench_app.command("recovery")
 def recovery(
     setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help="Presets (comma-separated or repeated)."),
-    trackers: list[str] = typer.Option(["kalman_ha2", "jpda", "lstm"], "--trackers", help="Identifiers."),
-    sequences: int = typer.Option(3, min=1, help="Test sequences per set-up."),
-    frames: int = typer.Option(900, min=300, help="Frames per sequence."),
-    swap_at_s: float = typer.Option(5.0, help="When the swap starts, seconds."),
-    swap_s: float = typer.Option(10.0, help="How long reports stay swapped, seconds."),
-    seed: int = typer.Option(DEFAULT_SEED, help="Base seed of the test sequences."),
-    json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON."),
+    trackers: list[str] = typer.Option(["kalman_ha2", "jpda", "lstm"], "--trackers",
+                                       help="Identifiers (comma-separated or repeated)."),
+    sequences: int = typer.Option(3, "--sequences", min=1, help="Test sequences per set-up."),
+    frames: int = typer.Option(900, "--frames", min=300, help="Frames per sequence."),
+    swap_at_s: float = typer.Option(5.0, "--swap-at-s", help="When the swap starts, seconds."),
+    swap_s: float = typer.Option(10.0, "--swap-s", help="How long reports stay swapped, seconds."),
+    seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the test sequences."),
+    json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON (results schema)."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
 ) -> None:
     """Recovery experiment: swap two robots' reports, restore them, time the return to normal."""
@@ -51,4 +55,7 @@ def recovery(
     except ValueError as exc:
         fail(str(exc))
     print_rows(f"Recovery after {swap_s:g} s of swapped reports", rows)
-    write_rows(rows, json_path, csv_path)
+    options = {"swap_at_s": swap_at_s, "swap_s": swap_s}
+    write_results(experiment_results("recovery", rows, split_list(setups), sequences, frames, seed, command_line(),
+                                     options), json_path)
+    write_rows(rows, None, csv_path)

@@ -3,16 +3,15 @@ detections (:mod:`lookalike.bench.pixels`)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from lookalike.bench.pixels import DEFAULT_SEED, PERCEPTION_COLUMNS, PIXEL_COLUMNS, pixels_table
+from lookalike.bench.pixels import DEFAULT_SEED, PERCEPTION_COLUMNS, PIXEL_COLUMNS, pixels_results, pixels_table
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import console, fail, split_list
-from lookalike.cli.bench import bench_app, check_names, print_rows
+from lookalike.cli.app import command_line, fail, split_list
+from lookalike.cli.bench import bench_app, check_names, print_rows, write_results
+from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
 from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera
@@ -20,8 +19,9 @@ from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera
 
 @bench_app.command("pixels")
 def pixels(
-    setups: str = typer.Option("m3n2,m5n3", "--setups", help="Presets, comma-separated."),
-    identifiers: str = typer.Option(",".join(IDENTIFIERS), "--identifiers", help="Identifiers, comma-separated."),
+    setups: list[str] = typer.Option(["m3n2", "m5n3"], "--setups", help="Presets (comma-separated or repeated)."),
+    identifiers: list[str] = typer.Option(list(IDENTIFIERS), "--trackers", "--identifiers",
+                                          help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(2, "--sequences", min=1, help="Held-out sequences per set-up."),
     frames: int = typer.Option(150, "--frames", min=1, help="Frames per sequence (30 Hz)."),
     seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the held-out sequences."),
@@ -32,30 +32,29 @@ def pixels(
     detect_scale: float = typer.Option(1.0, "--detect-scale", help="Resize frames by this before detection "
                                        "(> 1 finds farther robots, slower)."),
     min_iou: float = typer.Option(0.3, "--min-iou", min=0.0, max=1.0, help="IoU for a detection to be a robot."),
-    json_path: Path | None = typer.Option(None, "--json", help="Also write the identification rows as JSON."),
+    json_path: Path | None = typer.Option(None, "--json", help="Also write both tables as JSON (results schema)."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the identification rows as CSV."),
 ) -> None:
     """Identification success rate from rendered pixels next to the simulator's own detections, per identifier."""
-    setup_list, ident_list = split_list([setups]), split_list([identifiers])
+    setup_list, ident_list = split_list(setups), split_list(identifiers)
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
-    check_names("--identifiers", ident_list, IDENTIFIERS, "identifier")
+    check_names("--trackers", ident_list, IDENTIFIERS, "identifier")
     if not setup_list or not ident_list:
-        fail("--setups/--identifiers: need at least one of each")
+        fail("--setups/--trackers: need at least one of each")
     camera = pixel_camera()
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     try:
         pipe = RobotPipeline.from_files(detector_model, heading_model, camera,
                                         PipelineConfig(detect_scale=detect_scale))
-        with Progress(*columns, console=console) as progress, one_blas_thread():
-            def bar(description: str, total: int) -> Callable[[], None]:
-                task = progress.add_task(description, total=total)
-                return lambda: progress.advance(task)
-
+        with progress_bars() as progress, one_blas_thread():
             rows, perception = pixels_table(setup_list, ident_list, sequences, frames, seed, pipe, camera, min_iou,
-                                            bar)
+                                            progress)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     print_rows(f"Perception on rendered robots, {sequences} × {frames} frames per set-up", perception,
                PERCEPTION_COLUMNS)
     print_rows("Identification success rate: from pixels vs the simulator's detections", rows, PIXEL_COLUMNS)
-    write_rows(rows, json_path, csv_path)
+    options = {"detect_scale": detect_scale, "min_iou": min_iou, "detector_model": detector_model,
+               "heading_model": heading_model}
+    write_results(pixels_results(rows, perception, setup_list, sequences, frames, seed, command_line(), options),
+                  json_path)
+    write_rows(rows, None, csv_path)

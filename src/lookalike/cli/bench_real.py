@@ -16,12 +16,13 @@ import typer
 from rich.table import Table
 
 from lookalike.bench.datasets import DATASETS, PARTS, cut_sequence, load_datasets, resolve_data_root
-from lookalike.bench.leaderboard import COLUMNS, leaderboard, leaderboard_json, plot_leaderboard
+from lookalike.bench.leaderboard import COLUMNS, leaderboard, leaderboard_results, plot_leaderboard, run_with_progress
 from lookalike.bench.peers import PEERS, peer_status
-from lookalike.bench.runner import default_entries, params_entry, run_jobs
+from lookalike.bench.runner import default_entries, params_entry
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import console, fail, split_list
-from lookalike.cli.bench import bench_app
+from lookalike.cli.app import command_line, console, fail, split_list
+from lookalike.cli.bench import bench_app, write_results
+from lookalike.cli.progress import progress_bars
 from lookalike.parallel import BACKENDS
 from lookalike.tune.params_file import load_params, read_params
 
@@ -76,14 +77,15 @@ def real(
     trackers: list[str] = typer.Option(list(BOX_TRACKERS), "--trackers", help="lookalike box trackers."),
     peers: list[str] = typer.Option(list(PEERS), "--peers",
                                     help="Peers to try ('none' for none); absent ones are skipped."),
-    sequences: list[str] | None = typer.Option(None, "--sequences", help="Only these sequences/clips."),
+    sequence: list[str] | None = typer.Option(None, "--sequence", help="Only this sequence or clip (repeatable or "
+                                              "comma-separated)."),
     max_clips: int | None = typer.Option(None, "--max-clips", min=1, help="At most this many HexBug clips."),
     part: str = typer.Option("full", "--part", help="Score whole sequences ('full'), their first halves "
                              "(where boxtrack's bench presets were chosen: 'first') or second halves ('second')."),
     workers: int = typer.Option(1, "--workers", min=1, help="Local processes (or Ray CPUs for a local Ray)."),
     backend: str = typer.Option("local", "--backend", help=f"One of {', '.join(BACKENDS)}."),
     address: str | None = typer.Option(None, "--address", help="Ray cluster address (default: a local ray.init())."),
-    json_path: Path | None = typer.Option(None, "--json", help="Write tables as JSON."),
+    json_path: Path | None = typer.Option(None, "--json", help="Write the tables as JSON (results schema)."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Write the dataset rows as CSV."),
     plots: Path | None = typer.Option(None, "--plots", help="Folder for one bar chart per dataset."),
     params_file: Path | None = typer.Option(None, "--params", help="Parameter file of `lookalike tune`: adds a row "
@@ -95,7 +97,7 @@ def real(
     _check(part, backend, tracker_list)
     try:
         status = peer_status(peer_list)
-        seqs = load_datasets(resolve_data_root(data), split_list(datasets), sequences=split_list(sequences) or None,
+        seqs = load_datasets(resolve_data_root(data), split_list(datasets), sequences=split_list(sequence) or None,
                              max_clips=max_clips, workers=workers, backend=backend, address=address)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
@@ -116,13 +118,15 @@ def real(
         console.print(f"{entry.label}: {content.tracker} with {params_file} (chosen on "
                       f"{', '.join(content.chosen_on) or 'unknown data'})")
         entries.append(entry)
-    results = run_jobs(entries, seqs, workers=workers, backend=backend, address=address)
+    with progress_bars() as progress:
+        results = run_with_progress(entries, seqs, workers=workers, backend=backend, address=address,
+                                    progress=progress)
     rows, combined, per_seq = leaderboard(entries, seqs, results)
     counts = {d: sum(1 for s in seqs if s.dataset == d) for d in dict.fromkeys(s.dataset for s in seqs)}
     print_leaderboard(rows, combined, counts, part)
     if json_path is not None:
-        json_path.parent.mkdir(parents=True, exist_ok=True)
-        json_path.write_text(leaderboard_json(part, rows, combined, per_seq, status))
+        write_results(leaderboard_results(part, rows, combined, per_seq, status, seqs, command_line(),
+                                          {"datasets": split_list(datasets), "workers": workers}), json_path)
     write_rows(rows, None, csv_path, [*COLUMNS, "Error"])
     if plots is not None:
         for p in plot_leaderboard([r for r in rows if "Error" not in r], plots):

@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 
 import typer
 from rich import box
 from rich.table import Table
 
-from lookalike.bench.folders import COMBINED, evaluate_folders
-from lookalike.cli.app import app, console, fail
+from lookalike.bench.folders import COMBINED, evaluate_folders, folder_results
+from lookalike.cli.app import app, command_line, console, fail, split_list
+from lookalike.cli.bench import write_results
 from lookalike.cli.eval_points import score_points
 from lookalike.eval import BENCHMARKS, METRICS
 
@@ -21,7 +21,7 @@ HEADLINE = {
     "Identity": ("IDF1",),
 }
 SHORT = {"CLR_FP": "FP", "CLR_FN": "FN"}
-_METRICS_HELP = f"Any of {', '.join(METRICS)} (repeatable; default all)."
+_METRICS_HELP = f"Any of {', '.join(METRICS)} (comma-separated or repeated; default all)."
 PERCENT = {"HOTA", "DetA", "AssA", "LocA", "MOTA", "MOTP", "IDF1", "IDP", "IDR"}
 
 
@@ -50,7 +50,7 @@ def eval_command(
                                              "(one row per tracker and sequence)."),
 ) -> None:
     """Score trackers with HOTA, CLEAR MOT and identity metrics (values shown in %)."""
-    chosen = [next((m for m in METRICS if m.lower() == x.lower()), x) for x in (metrics or METRICS)]
+    chosen = _chosen(metrics)
     if points or radius is not None:
         if not points or radius is None or radius <= 0:
             fail("--points and --radius PX go together (point ground truth matched within PX pixels)")
@@ -81,10 +81,30 @@ def eval_command(
             table.add_row(name, *[_cell(c, per_seq[COMBINED][c]) for c in columns])
     console.print(table)
     if json_path is not None:
-        json_path.parent.mkdir(parents=True, exist_ok=True)
-        json_path.write_text(json.dumps(scores, indent=1))
+        _write_json(json_path, scores, gt, {"benchmark": benchmark, "metrics": chosen,
+                                            "iou_threshold": iou_threshold, "points": points, "radius": radius})
     if csv_path is not None:
-        _write_csv(csv_path, scores)
+        try:
+            _write_csv(csv_path, scores)
+        except OSError as exc:
+            fail(f"--csv: cannot write {csv_path}: {exc.strerror or exc}")
+
+
+def _chosen(metrics: list[str] | None) -> list[str]:
+    chosen = [next((m for m in METRICS if m.lower() == x.lower()), x) for x in (split_list(metrics) or METRICS)]
+    for m in chosen:
+        if m not in METRICS:
+            fail(f"--metrics: unknown metric {m!r}; known: {', '.join(METRICS)}")
+    return chosen
+
+
+def _write_json(path: Path, scores: dict[str, dict[str, dict[str, float]]], gt: Path,
+                options: dict[str, object]) -> None:
+    try:
+        doc = folder_results(scores, gt, command_line(), options)
+    except ValueError as exc:
+        fail(f"--json: {exc}")
+    write_results(doc, path)
 
 
 def _table(title: str, first: str, columns: list[str]) -> Table:
