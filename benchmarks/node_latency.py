@@ -8,9 +8,13 @@ network) from this process, and prints:
 - the round trip seen by a subscriber (camera ``sendto`` to the team state's arrival), and
 - without sockets, in this process: decode + identify + encode per frame, and the tracker's share.
 
-Target (issue 8): median <= 2 ms, p99 <= 10 ms.
+By default the node publishes each team state once to a loopback multicast group that the robots
+and the subscriber join (``serve --group``: one send per frame); ``--unicast`` measures the
+per-robot replies instead (one send per robot and subscriber).
 
-    .venv/bin/python benchmarks/node_latency.py [--tracker kalman_ha2] [--seconds 20]
+Target (issue 18): median <= 1 ms, p99 <= 5 ms at 30 Hz with 7 robots (the node's own figure).
+
+    .venv/bin/python benchmarks/node_latency.py [--tracker kalman_ha2] [--seconds 20] [--unicast]
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _common import report_target
 
 from lookalike.node import (
     Endpoint,
@@ -78,17 +83,20 @@ def main() -> None:
     parser.add_argument("--tracker", default="kalman_ha2")
     parser.add_argument("--preset", default="m10n7")
     parser.add_argument("--seconds", type=float, default=20.0)
+    parser.add_argument("--unicast", action="store_true", help="Per-robot replies instead of the multicast group.")
     args = parser.parse_args()
 
     sequence = team_sequence(args.preset, 0, args.seconds)
     n_robots = sequence.config.n_agents
-    subscriber = Endpoint(("127.0.0.1", 1))
+    group = None if args.unicast else ("239.255.77.1", _free_port())
+    subscriber = Endpoint(("127.0.0.1", 1), group=group)
+    fan_out = ["--group", "{}:{}".format(*group)] if group else ["--publish", "{}:{}".format(*subscriber.address)]
     with tempfile.TemporaryDirectory() as tmp:
         port_file = Path(tmp) / "addr"
         node = subprocess.Popen(
             [sys.executable, "-c", "from lookalike.cli import main; main()", "serve", "--tracker", args.tracker,
              "--robots", str(n_robots), "--listen", "127.0.0.1:0", "--port-file", str(port_file),
-             "--publish", "{}:{}".format(*subscriber.address), "--status-interval", "0", "--log-level", "warning"])
+             *fan_out, "--status-interval", "0", "--log-level", "warning"])
         while not port_file.is_file():
             if node.poll() is not None:
                 raise SystemExit("the node did not start")
@@ -97,7 +105,8 @@ def main() -> None:
     address = (host, int(port))
 
     clock = SimClock(epoch=time.time() + 0.5, speed=1.0)
-    robots = [threading.Thread(target=lambda j=j: run_robot(Endpoint(address), j, sequence, clock, linger_s=0.1))
+    robots = [threading.Thread(target=lambda j=j: run_robot(Endpoint(address, group=group), j, sequence, clock,
+                                                            linger_s=0.1))
               for j in range(n_robots)]
     sent_at: dict[int, float] = {}
     arrived_at: dict[int, float] = {}
@@ -129,7 +138,8 @@ def main() -> None:
     lat = status.counters.get("latency_ms", {})
     round_trip = np.array([arrived_at[k] - sent_at[k] for k in arrived_at if k in sent_at]) * 1e3
     print(f"tracker {args.tracker}, preset {args.preset} (N={n_robots}, M={sequence.config.max_detections}), "
-          f"{len(sequence)} frames at {sequence.config.frame_rate_hz:g} Hz")
+          f"{len(sequence)} frames at {sequence.config.frame_rate_hz:g} Hz, "
+          f"{'per-robot replies' if group is None else 'one multicast send per frame'}")
     print(f"node: read frame -> published: median {lat.get('median', float('nan')):.3f} ms, "
           f"p99 {lat.get('p99', float('nan')):.3f} ms over the last {lat.get('frames', 0)} frames")
     print(f"subscriber round trip: median {np.median(round_trip):.3f} ms, p99 {np.percentile(round_trip, 99):.3f} ms "
@@ -141,6 +151,17 @@ def main() -> None:
           f"p99 {np.percentile(tracker, 99):.3f} ms")
     print(f"counters: frames {c['frames']} reports {c['reports']} late {c['late']} published {c['published']} "
           f"rejected {c['rejected_total']}")
+    report_target("node median latency", lat.get("median", float("inf")), 1.0, higher_is_better=False, unit=" ms")
+    report_target("node p99 latency", lat.get("p99", float("inf")), 5.0, higher_is_better=False, unit=" ms")
+
+
+def _free_port() -> int:
+    """A UDP port free on this machine now (for the multicast group)."""
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("", 0))
+        return int(s.getsockname()[1])
 
 
 if __name__ == "__main__":

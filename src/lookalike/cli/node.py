@@ -23,6 +23,7 @@ from lookalike.node import (
     log_event,
     parse_address,
 )
+from lookalike.node.server import check_group
 from lookalike.node.teamsim import (
     SimClock,
     camera_messages,
@@ -89,6 +90,8 @@ def serve(
     listen: str = typer.Option("127.0.0.1:7700", help="HOST:PORT to receive reports and detections on (port 0: any)."),
     publish: list[str] | None = typer.Option(None, help="HOST:PORT that receives every team state (repeatable)."),
     reply: bool = typer.Option(True, help="Also send each team state to the address every robot reports from."),
+    group: str | None = typer.Option(None, help="IPv4 multicast GROUP:PORT that gets each team state once "
+                                     "(one send per frame) instead of one reply per robot; robots join it."),
     max_report_age: float = typer.Option(1.0, help="Drop reports sent this many seconds before the last frame."),
     camera_timeout: float = typer.Option(2.0, help="Wall seconds without frames before the camera counts as lost."),
     rate: float = typer.Option(2000.0, help="Packets/s one sender may send before being rate-limited."),
@@ -102,6 +105,7 @@ def serve(
     robots with a tracker, publish their positions at the camera rate. Logs are JSON Lines on
     stderr; send a status_request message for the counters."""
     listen_address = _address(listen, "--listen")
+    group_address = _group(group)
     publish_addresses = tuple(_address(p, "--publish") for p in publish or [])
     settings = list(set_ or [])
     try:
@@ -114,7 +118,7 @@ def serve(
     log = _logger(log_level)
     try:
         config = NodeConfig(listen=listen_address, publish=publish_addresses,
-                            reply_to_robots=reply, sender_rate=rate, sender_burst=burst,
+                            reply_to_robots=reply, group=group_address, sender_rate=rate, sender_burst=burst,
                             camera_timeout_s=camera_timeout, status_interval_s=status_interval)
         id_config = IdentifierConfig(n_robots=robots, max_report_age_s=max_report_age)
         server = NodeServer(trk, config, id_config, log)
@@ -131,6 +135,17 @@ def serve(
         server.serve(stop)
         if stop.signal is not None:
             log_event(log, "signal", signal=stop.signal)
+
+
+def _group(text: str | None) -> tuple[str, int] | None:
+    if text is None:
+        return None
+    group = _address(text, "--group")
+    try:
+        check_group(group)
+    except ValueError as exc:
+        fail(f"--group: {exc}")
+    return group
 
 
 def _clock(start_at: str, speed: float) -> SimClock:
@@ -171,6 +186,8 @@ def robot_sim(
     speed: float = typer.Option(1.0, help="Simulated seconds per wall second (same for the whole team)."),
     start_at: str = typer.Option("now", help=_START_HELP),
     bind: str = typer.Option("127.0.0.1:0", help="Local HOST:PORT to send from and receive positions on."),
+    group: str | None = typer.Option(None, help="Also receive team states sent to this multicast GROUP:PORT "
+                                     "(the node's --group)."),
     verbose: bool = typer.Option(False, help="Print every received position and its error as JSON on stderr."),
 ) -> None:
     """A simulated robot: send heading reports to the node over a lossy, jittery link, receive
@@ -178,7 +195,12 @@ def robot_sim(
     sequence = _sequence(preset_name, seed, duration, loss, delay, jitter)
     if not 0 <= robot < sequence.config.n_agents:
         fail(f"--robot {robot}: preset {preset_name} has robots 0..{sequence.config.n_agents - 1}")
-    with Endpoint(_address(node, "--node"), _address(bind, "--bind")) as endpoint:
+    node_address, bind_address, group_address = _address(node, "--node"), _address(bind, "--bind"), _group(group)
+    try:
+        endpoint = Endpoint(node_address, bind_address, group=group_address)
+    except OSError as exc:
+        fail(f"--bind {bind} / --group {group}: {exc}")
+    with endpoint:
         clock = _clock(start_at, speed)
         with _Stop() as stop:
             log = run_robot(endpoint, robot, sequence, clock, stop=stop,

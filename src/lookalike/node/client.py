@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import selectors
 import socket
 import time
 
@@ -12,15 +13,30 @@ Address = tuple[str, int]
 
 class Endpoint:
     """A UDP socket bound to ``bind`` (default: an ephemeral loopback port) that sends messages
-    to ``peer`` and receives decoded messages. Use as a context manager."""
+    to ``peer`` and receives decoded messages. Use as a context manager.
 
-    def __init__(self, peer: Address, bind: Address = ("127.0.0.1", 0)) -> None:
+    With ``group`` (an IPv4 multicast ``(address, port)``, joined on the interface ``interface``),
+    a second socket also receives what the node sends to the group: its batched team states.
+    """
+
+    def __init__(self, peer: Address, bind: Address = ("127.0.0.1", 0), group: Address | None = None,
+                 interface: str = "127.0.0.1") -> None:
         self.peer = peer
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self.group_sock: socket.socket | None = None
+        self.selector = selectors.DefaultSelector()
         try:
             self.sock.bind(bind)
+            self.selector.register(self.sock, selectors.EVENT_READ)
+            if group is not None:
+                self.group_sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+                self.group_sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+                self.group_sock.bind(("", group[1]))
+                self.group_sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
+                                           socket.inet_aton(group[0]) + socket.inet_aton(interface))
+                self.selector.register(self.group_sock, selectors.EVENT_READ)
         except OSError:
-            self.sock.close()
+            self.close()
             raise
         self.rejected = 0
 
@@ -36,8 +52,11 @@ class Endpoint:
         self.close()
 
     def close(self) -> None:
-        """Close the socket."""
+        """Close the sockets."""
+        self.selector.close()
         self.sock.close()
+        if self.group_sock is not None:
+            self.group_sock.close()
 
     def send(self, message: Message) -> None:
         """Send one message to the peer."""
@@ -55,17 +74,15 @@ class Endpoint:
             remaining = deadline - time.monotonic()
             if remaining <= 0:
                 return None
-            self.sock.settimeout(remaining)
-            try:
-                data, _ = self.sock.recvfrom(65_535)
-            except TimeoutError:
-                return None
-            except OSError:
-                continue
-            try:
-                return decode(data)
-            except MessageError:
-                self.rejected += 1
+            for key, _ in self.selector.select(remaining):
+                try:
+                    data, _ = key.fileobj.recvfrom(65_535, socket.MSG_DONTWAIT)  # type: ignore[union-attr]
+                except OSError:  # (nothing to read after all, or an ICMP error)
+                    continue
+                try:
+                    return decode(data)
+                except MessageError:
+                    self.rejected += 1
 
     def drain(self) -> list[Message]:
         """Every message already waiting, without blocking."""

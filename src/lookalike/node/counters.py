@@ -28,6 +28,7 @@ EVENTS = (
     "rate_limited",  # datagrams dropped because their sender exceeded its packet rate
     "send_errors",  # team-state datagrams the OS refused to send
     "tracker_errors",  # frames the tracker raised on (dropped; the node goes on)
+    "handler_errors",  # datagrams the node itself failed on (a bug; logged, the node goes on)
 )
 
 

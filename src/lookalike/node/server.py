@@ -1,13 +1,17 @@
 """The observer node's UDP server: one socket, a selector loop, per-sender rate limits.
 
 Each datagram is read, rate-limited by sender, decoded, and handed to the ``TeamIdentifier``. A
-detections frame is tracked at once and its team state sent to every ``publish`` address and,
-when ``reply_to_robots`` is set, to the address each robot last reported from. Nothing a peer
-sends can stop the loop: every failure is counted and logged. Default addresses are loopback.
+detections frame is tracked at once and its team state sent to every ``publish`` address and
+either once to the multicast ``group`` (the batched send: one datagram per frame reaches every
+robot that joined the group) or, when ``reply_to_robots`` is set and there is no group, to the
+address each robot last reported from. Nothing a peer sends can stop the loop: every failure is
+counted and logged (``handler_errors`` for a bug of the node itself). Default addresses are loopback.
 """
 
 from __future__ import annotations
 
+import gc
+import ipaddress
 import logging
 import selectors
 import socket
@@ -46,6 +50,17 @@ def parse_address(text: str, default_host: str = LOCALHOST) -> Address:
     return host, number
 
 
+def check_group(group: Address) -> None:
+    """Raise ``ValueError`` unless ``group`` is an IPv4 multicast address (224.0.0.0/4) with a port."""
+    try:
+        multicast = ipaddress.IPv4Address(group[0]).is_multicast
+    except ValueError:
+        multicast = False
+    if not multicast or not 0 < group[1] <= 65535:
+        raise ValueError(f"group {group[0]}:{group[1]}: expected an IPv4 multicast address "
+                         "(224.0.0.0 to 239.255.255.255) and a port in 1..65535")
+
+
 @dataclass(frozen=True)
 class NodeConfig:
     """Network settings of the node.
@@ -53,7 +68,11 @@ class NodeConfig:
     Attributes:
         listen: address to bind (port 0: an ephemeral port).
         publish: addresses that receive every team state.
-        reply_to_robots: also send each team state to the address each robot reports from.
+        reply_to_robots: also send each team state to the address each robot reports from
+            (when there is no ``group``).
+        group: an IPv4 multicast ``(group, port)`` that receives each team state once, in place
+            of the per-robot replies (robots join it: ``Endpoint(..., group=...)``).
+        group_interface: IPv4 address of the interface multicast leaves from (loopback by default).
         sender_rate: packets per second one sender may send before being rate-limited.
         sender_burst: packets one sender may send at once.
         max_senders: rate-limit buckets kept (the oldest are forgotten beyond this).
@@ -66,6 +85,8 @@ class NodeConfig:
     listen: Address = (LOCALHOST, 0)
     publish: tuple[Address, ...] = ()
     reply_to_robots: bool = True
+    group: Address | None = None
+    group_interface: str = LOCALHOST
     sender_rate: float = 2000.0
     sender_burst: float = 500.0
     max_senders: int = 1024
@@ -80,6 +101,8 @@ class NodeConfig:
                 raise ValueError(f"NodeConfig.{name} must be > 0, got {getattr(self, name)}")
         if self.max_senders < 1 or self.batch < 1:
             raise ValueError("NodeConfig.max_senders and NodeConfig.batch must be >= 1")
+        if self.group is not None:
+            check_group(self.group)
 
 
 class NodeServer:
@@ -96,6 +119,10 @@ class NodeServer:
         try:
             self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, self.config.recv_buffer_bytes)
             self.sock.bind(self.config.listen)
+            if self.config.group is not None:
+                self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF,
+                                     socket.inet_aton(self.config.group_interface))
+                self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
         except OSError:
             self.sock.close()
             raise
@@ -127,9 +154,18 @@ class NodeServer:
             self.sock.close()
 
     def serve(self, stop: Callable[[], bool], tick_s: float = 0.05) -> None:
-        """Serve until ``stop()`` returns true (checked at least every ``tick_s`` seconds)."""
-        while not stop():
-            self.poll(tick_s)
+        """Serve until ``stop()`` returns true (checked at least every ``tick_s`` seconds).
+
+        Objects alive at the start (modules, the tracker) are moved out of the garbage
+        collector's sight (``gc.freeze``), so its full collections stay short while serving.
+        """
+        gc.collect()
+        gc.freeze()
+        try:
+            while not stop():
+                self.poll(tick_s)
+        finally:
+            gc.unfreeze()
 
     def poll(self, timeout_s: float) -> int:
         """Wait up to ``timeout_s`` for datagrams, handle up to ``batch`` of them; return how many."""
@@ -144,7 +180,11 @@ class NodeServer:
                     log_event(self.log, "socket_error", logging.WARNING, error=str(exc))
                     break
                 handled += 1
-                self.handle(data, addr, time.perf_counter())
+                try:
+                    self.handle(data, addr, time.perf_counter())
+                except Exception as exc:  # noqa: BLE001 (a bug of the node must not stop the loop)
+                    self.counters.add("handler_errors")
+                    log_event(self.log, "handler_error", logging.ERROR, sender=list(addr), error=repr(exc))
         self._timers()
         return handled
 
@@ -204,7 +244,9 @@ class NodeServer:
             log_event(self.log, "encode_error", logging.ERROR, frame=team.frame, error=str(exc))
             return
         targets = list(self.config.publish)
-        if self.config.reply_to_robots:
+        if self.config.group is not None:
+            targets.append(self.config.group)
+        elif self.config.reply_to_robots:
             targets += [a for a in self._robot_addr.values() if a not in targets]
         self._send(data, targets)
 
