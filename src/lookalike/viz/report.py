@@ -1,7 +1,8 @@
 """A single self-contained HTML report: headings, text, tables, embedded images (base64), links.
 
 Images (PNG, GIF, JPEG) are read when added and embedded as ``data:`` URIs, so the file can be
-mailed on its own; videos are linked by a path relative to the report.
+mailed on its own; videos are shown inline by a ``<video>`` element (and linked) by a path relative
+to the report.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.9em; }
 th, td { padding: 3px 10px; border-bottom: 1px solid #e4e4e4; }
 th { background: #f4f4f4; text-align: left; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
 figure { display: inline-block; margin: 0.6em 1em 0.6em 0; vertical-align: top; }
-figure img { max-width: 100%; border: 1px solid #ccc; } figcaption { font-size: 0.85em; color: #555; }
+figure img, figure video { max-width: 100%; border: 1px solid #ccc; } figcaption { font-size: 0.85em; color: #555; }
 .note { color: #555; font-size: 0.9em; }
 """
 
@@ -96,6 +97,19 @@ class HtmlReport:
         href = os.path.relpath(t, relative_to) if relative_to is not None else str(t)
         link = html.escape(Path(href).as_posix(), quote=True)
         self._blocks.append(f'<p><a href="{link}">{html.escape(text)}</a></p>')
+
+    def video(self, target: Path | str, caption: str, relative_to: Path | str | None = None,
+              width: int | None = None) -> None:
+        """An inline video player for the MP4 at ``target`` (path relative to the folder ``relative_to``),
+        with a caption that also links to the file."""
+        t = Path(target)
+        href = os.path.relpath(t, relative_to) if relative_to is not None else str(t)
+        src = html.escape(Path(href).as_posix(), quote=True)
+        style = f' style="width:{int(width)}px"' if width else ""
+        self._blocks.append(
+            f'<figure><video controls muted playsinline preload="metadata" src="{src}"{style}></video>'
+            f'<figcaption><a href="{src}">{html.escape(caption)}</a></figcaption></figure>'
+        )
 
     def code(self, text: str) -> None:
         """A preformatted block (commands to try)."""

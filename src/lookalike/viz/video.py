@@ -1,11 +1,14 @@
-"""Writing annotated videos (MP4 through OpenCV) and short animated GIFs (Pillow), reading videos.
+"""Writing annotated videos and short animated GIFs (Pillow), reading videos (OpenCV).
 
-OpenCV and Pillow are imported lazily inside the functions that need them.
+MP4s are H.264 (yuv420p, ``+faststart``) through PyAV (the ``viz`` extra), so that every browser
+plays them inline; without PyAV they fall back to OpenCV's ``mp4v``, which browsers refuse.
+PyAV, OpenCV and Pillow are imported lazily inside the functions that need them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
+from fractions import Fraction
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -14,15 +17,16 @@ import numpy as np
 
 
 class VideoWriter:
-    """An MP4 file written frame by frame (``(h, w, 3)`` uint8 BGR, every frame the same size).
+    """An MP4 file (H.264) written frame by frame (``(h, w, 3)`` uint8 BGR, every frame the same size;
+    an odd width or height is padded by one black pixel).
 
     Use as a context manager so the file is finalised even when interrupted. ``gif`` also keeps
-    every ``gif_every``-th of the first ``gif_frames`` frames, downscaled to ``gif_width`` pixels, and
-    writes them as an animated GIF when closed.
+    every ``gif_every``-th of the first ``gif_frames`` frames, scaled to ``gif_width`` pixels (640 by
+    default, so that labels stay readable), and writes them as an animated GIF when closed.
     """
 
     def __init__(self, path: Path | str, fps: float, gif: Path | str | None = None, gif_every: int = 2,
-                 gif_frames: int = 120, gif_width: int = 320) -> None:
+                 gif_frames: int = 120, gif_width: int = 640) -> None:
         if not fps > 0:
             raise ValueError(f"fps: must be positive, got {fps!r}")
         if gif_every < 1 or gif_frames < 1 or gif_width < 16:
@@ -31,7 +35,7 @@ class VideoWriter:
         self.gif = Path(gif) if gif is not None else None
         self.gif_every, self.gif_frames, self.gif_width = gif_every, gif_frames, gif_width
         self.count = 0
-        self._writer: Any = None  # a cv2.VideoWriter once the first frame fixes the size
+        self._writer: Any = None  # an _H264Writer (or cv2.VideoWriter) once the first frame fixes the size
         self._size: tuple[int, int] | None = None
         self._gif_images: list[np.ndarray] = []
 
@@ -45,16 +49,16 @@ class VideoWriter:
         size = (img.shape[1], img.shape[0])
         if self._writer is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter.fourcc(*"mp4v"), self.fps, size)
-            if not self._writer.isOpened():
-                raise ValueError(f"path: OpenCV cannot write an MP4 video at {self.path}")
+            self._writer = _open_writer(self.path, self.fps, size)
             self._size = size
         elif size != self._size:
             raise ValueError(f"image: frame {self.count} is {size}, earlier frames {self._size}")
         self._writer.write(np.ascontiguousarray(img))
         if self.gif is not None and self.count < self.gif_frames and self.count % self.gif_every == 0:
             h = round(img.shape[0] * self.gif_width / img.shape[1])
-            self._gif_images.append(cv2.resize(img, (self.gif_width, h), interpolation=cv2.INTER_AREA))
+            shrink = self.gif_width < img.shape[1]
+            self._gif_images.append(cv2.resize(img, (self.gif_width, h),
+                                               interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR))
         self.count += 1
 
     def close(self) -> None:
@@ -72,6 +76,51 @@ class VideoWriter:
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
         self.close()
+
+
+class _H264Writer:
+    """H.264 MP4 through PyAV: yuv420p, even size (padded), ``+faststart`` for streaming."""
+
+    def __init__(self, path: Path, fps: float, size: tuple[int, int]) -> None:
+        import av
+
+        self.width, self.height = size[0] + size[0] % 2, size[1] + size[1] % 2
+        self.container: Any = av.open(str(path), mode="w", options={"movflags": "+faststart"})
+        self.stream: Any = self.container.add_stream("libx264", rate=Fraction(fps).limit_denominator(1001))
+        self.stream.width, self.stream.height, self.stream.pix_fmt = self.width, self.height, "yuv420p"
+        self.stream.options = {"crf": "23", "preset": "veryfast"}
+        self._frame_type = av.VideoFrame
+
+    def write(self, img: np.ndarray) -> None:
+        if img.shape[1] != self.width or img.shape[0] != self.height:
+            padded = np.zeros((self.height, self.width, 3), np.uint8)
+            padded[: img.shape[0], : img.shape[1]] = img
+            img = padded
+        frame = self._frame_type.from_ndarray(np.ascontiguousarray(img), format="bgr24")
+        for packet in self.stream.encode(frame):
+            self.container.mux(packet)
+
+    def release(self) -> None:
+        for packet in self.stream.encode(None):
+            self.container.mux(packet)
+        self.container.close()
+
+
+def _open_writer(path: Path, fps: float, size: tuple[int, int]) -> Any:
+    """An H.264 writer (PyAV), else OpenCV's mp4v (which browsers do not play)."""
+    try:
+        import av  # noqa: F401
+    except ImportError:
+        import cv2
+
+        writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"mp4v"), fps, size)
+        if not writer.isOpened():
+            raise ValueError(f"path: OpenCV cannot write an MP4 video at {path}") from None
+        return writer
+    try:
+        return _H264Writer(path, fps, size)
+    except Exception as exc:  # PyAV raises its own error types (e.g. a folder that cannot be written)
+        raise ValueError(f"path: cannot write an H.264 video at {path}: {exc}") from None
 
 
 def write_gif(path: Path | str, images: list[np.ndarray], fps: float) -> Path:
