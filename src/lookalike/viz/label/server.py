@@ -10,17 +10,21 @@ Routes (JSON unless stated)::
     POST /api/benchmark/start    start timing;  POST /api/benchmark/finish  stop and score
     GET  /api/score              success rate against the truth (benchmark mode: after finishing)
     POST /api/export             write <stem>.labelled.jsonl and <stem>.labels.mot.txt beside the sequence
-    GET  /files/<path>           a file inside the sequence's folder (video frames); others are refused
+    GET  /files/<path>           a file inside the sequence's folder (video frames); others are refused;
+                                 in benchmark mode only the frame images (nothing that holds the truth)
 
 Requests with a foreign ``Host`` header (DNS rebinding) or POSTs that are not
 ``application/json`` (cross-site forms) are refused; malformed requests get 400 and the server
-keeps serving.
+keeps serving. Every connection has its own thread; a connection silent for ``IDLE_TIMEOUT_S``
+is closed, and a request body not complete within ``BODY_TIMEOUT_S`` gets 408, so one slow
+client holds up nobody else. Pending connections queue up to ``LISTEN_BACKLOG``.
 """
 
 from __future__ import annotations
 
 import json
 import mimetypes
+import time
 from collections.abc import Callable
 from http import HTTPStatus
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -39,6 +43,9 @@ STATIC_DIR = Path(__file__).resolve().parent / "static"
 MAX_BODY_BYTES = 64 * 1024
 MAX_FRAMES_PER_REQUEST = 500
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
+IDLE_TIMEOUT_S = 10.0  # a connection silent this long is closed
+BODY_TIMEOUT_S = 5.0  # a request body must arrive completely within this
+LISTEN_BACKLOG = 128
 
 
 class LabelApp:
@@ -142,7 +149,8 @@ class _Handler(BaseHTTPRequestHandler):
     app: LabelApp
     log_sink: Callable[[str], None] | None = None
     server_version = "lookalike-label"
-    timeout = 30  # seconds a connection may stay silent
+    timeout = IDLE_TIMEOUT_S  # seconds a connection may stay silent
+    body_timeout_s = BODY_TIMEOUT_S
 
     def log_message(self, format: str, *args: Any) -> None:
         if self.log_sink is not None:
@@ -175,6 +183,10 @@ class _Handler(BaseHTTPRequestHandler):
             self._json({"error": str(exc)}, exc.status)
         except ValueError as exc:
             self._json({"error": str(exc)}, HTTPStatus.BAD_REQUEST)
+        except TimeoutError:
+            self.close_connection = True
+            self._json({"error": f"request body not received within {self.body_timeout_s:g} s"},
+                       HTTPStatus.REQUEST_TIMEOUT)
         except (BrokenPipeError, ConnectionResetError):
             pass
         except Exception as exc:  # noqa: BLE001 (a bug must not take the server down)
@@ -233,6 +245,8 @@ class _Handler(BaseHTTPRequestHandler):
             raise _BadRequest(HTTPStatus.FORBIDDEN, "outside the sequence folder")
         if not target.is_file():
             raise _BadRequest(HTTPStatus.NOT_FOUND, f"no file {rel!r}")
+        if self.app.benchmark and not _is_frame_image(target, self.app.folder, self.app.image_pattern):
+            raise _BadRequest(HTTPStatus.FORBIDDEN, "benchmark mode serves the frame images only")
         ctype = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
         self._send(HTTPStatus.OK, target.read_bytes(), ctype)
 
@@ -246,7 +260,7 @@ class _Handler(BaseHTTPRequestHandler):
             raise _BadRequest(HTTPStatus.LENGTH_REQUIRED, "Content-Length required") from None
         if not 0 <= length <= MAX_BODY_BYTES:
             raise _BadRequest(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"body over {MAX_BODY_BYTES} bytes")
-        raw = self.rfile.read(length) if length else b"{}"
+        raw = self._read_body(length) if length else b"{}"
         try:
             body = json.loads(raw)
         except (json.JSONDecodeError, UnicodeDecodeError):
@@ -254,6 +268,25 @@ class _Handler(BaseHTTPRequestHandler):
         if not isinstance(body, dict):
             raise _BadRequest(HTTPStatus.BAD_REQUEST, "body must be a JSON object")
         return body
+
+    def _read_body(self, length: int) -> bytes:
+        """``length`` bytes of body within ``body_timeout_s`` in all (``TimeoutError`` otherwise)."""
+        deadline = time.monotonic() + self.body_timeout_s
+        chunks, got = [], 0
+        try:
+            while got < length:
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    raise TimeoutError
+                self.connection.settimeout(remaining)
+                chunk = self.rfile.read1(length - got)
+                if not chunk:
+                    raise _BadRequest(HTTPStatus.BAD_REQUEST, f"body ended after {got} of {length} bytes")
+                chunks.append(chunk)
+                got += len(chunk)
+        finally:
+            self.connection.settimeout(self.timeout)
+        return b"".join(chunks)
 
     def _post(self) -> None:
         path = urlsplit(self.path).path
@@ -278,17 +311,33 @@ class _Handler(BaseHTTPRequestHandler):
             raise _BadRequest(HTTPStatus.NOT_FOUND, f"no such action {path!r}")
 
 
-def make_handler(app: LabelApp, log: Callable[[str], None] | None = None) -> type[BaseHTTPRequestHandler]:
+def _is_frame_image(target: Path, folder: Path, pattern: str | None) -> bool:
+    """Whether ``target`` is an image inside the folder of the sequence's frame images."""
+    if pattern is None or target.suffix.lower() not in IMAGE_SUFFIXES:
+        return False
+    images = (folder / pattern.split("/")[1]).resolve()
+    return target.parent == images
+
+
+def make_handler(app: LabelApp, log: Callable[[str], None] | None = None,
+                 body_timeout_s: float = BODY_TIMEOUT_S) -> type[BaseHTTPRequestHandler]:
     """A request handler class bound to ``app`` (``log`` receives one line per request)."""
     handler: type[BaseHTTPRequestHandler] = type(
-        "Handler", (_Handler,), {"app": app, "log_sink": None if log is None else staticmethod(log)}
+        "Handler", (_Handler,), {"app": app, "log_sink": None if log is None else staticmethod(log),
+                                 "body_timeout_s": body_timeout_s}
     )
     return handler
 
 
+class LabelServer(ThreadingHTTPServer):
+    """``ThreadingHTTPServer`` with a listen backlog of ``LISTEN_BACKLOG`` and daemon threads."""
+
+    request_queue_size = LISTEN_BACKLOG
+    daemon_threads = True
+
+
 def make_server(app: LabelApp, host: str = "127.0.0.1", port: int = 8765,
-                log: Callable[[str], None] | None = None) -> ThreadingHTTPServer:
-    """A server for ``app`` bound to ``host:port`` (port 0: any free port); call ``serve_forever``."""
-    server = ThreadingHTTPServer((host, port), make_handler(app, log))
-    server.daemon_threads = True
-    return server
+                log: Callable[[str], None] | None = None, body_timeout_s: float = BODY_TIMEOUT_S) -> LabelServer:
+    """A server for ``app`` bound to ``host:port`` (port 0: any free port); call ``serve_forever``.
+    ``body_timeout_s``: seconds a request body may take to arrive (then 408)."""
+    return LabelServer((host, port), make_handler(app, log, body_timeout_s))
