@@ -10,29 +10,61 @@ pytest.importorskip("lookalike.cli.bench", reason="the bench sub-app (lookalike.
 
 from typer.testing import CliRunner
 
-from lookalike.bench.divers import COLUMNS, bar_chart, diver_table
+from lookalike.bench.divers import COLUMNS, TRACKERS, bar_chart, diver_table, pearson
 from lookalike.cli import app
+from lookalike.sim.divers import SCENARIOS, simulate_divers
+from lookalike.sim.divers_paper import PAPER_DETECTORS, redraw, with_detections
 
 
 def test_table_rows_and_all_row(tmp_path) -> None:
     rows = diver_table(["ocean_pair_clear", "pool_pair"], frames=60)
-    assert [r["Tracker"] for r in rows[:3]] == ["sort", "deepsort", "diversort"]
-    assert len(rows) == 9 and all(set(r) == set(COLUMNS) for r in rows)
-    assert [r["Scenario"] for r in rows[-3:]] == ["ALL"] * 3
+    assert [r["Tracker"] for r in rows[:5]] == list(TRACKERS)
+    assert TRACKERS[1] == "deepsort/learned" and TRACKERS[3] == "diversort/handcrafted"
+    assert len(rows) == 15 and all(set(r) == set(COLUMNS) for r in rows)
+    assert [r["Scenario"] for r in rows[-5:]] == ["ALL"] * 5
     for r in rows:
         assert 0 <= r["IDF1"] <= 100 and 0 < r["DR"] <= 100 and r["IDSW"] >= 0
     png = bar_chart(rows, tmp_path / "idf1.png")
     assert png.stat().st_size > 1000
 
 
-def test_command_writes_json_csv_png(tmp_path) -> None:
+def test_pearson_per_tracker_leaves_out_all_rows() -> None:
+    rows = [{"Scenario": s, "Tracker": "t", "DP": dp, "IDP": idp}
+            for s, dp, idp in (("a", 30, 20), ("b", 50, 41), ("c", 80, 70), ("ALL", 0, 100))]
+    r, p = pearson(rows)["t"]
+    assert r > 0.99 and 0 <= p < 0.1
+    assert all(v != v for v in pearson(rows[:2])["t"])  # too few scenarios: nan
+
+
+def test_paper_detections_are_harder_and_seeds_redraw() -> None:
+    assert set(PAPER_DETECTORS) == {sc.name for sc in SCENARIOS}
+    sc = SCENARIOS[0]
+    hard = with_detections(sc, "paper")
+    assert hard.detector.recall < sc.detector.recall and hard.seed == sc.seed
+    assert redraw(sc, 0) is sc and redraw(sc, 2).seed != sc.seed
+    a, b = simulate_divers(redraw(hard, 1)), simulate_divers(hard)
+    assert a.gt.shape != b.gt.shape or not (a.gt == b.gt).all()
+    with pytest.raises(ValueError, match="detections"):
+        with_detections(sc, "perfect")
+
+
+def test_command_writes_results_csv_png(tmp_path) -> None:
     out = CliRunner().invoke(app, ["bench", "divers", "--scenario", "pool_pair", "--frames", "40",
-                                   "--json", str(tmp_path / "t.json"), "--csv", str(tmp_path / "t.csv"),
+                                   "--tracker", "sort", "--tracker", "diversort/handcrafted", "--detections", "both",
+                                   "--seed", "1", "--json", str(tmp_path / "t.json"), "--csv", str(tmp_path / "t.csv"),
                                    "--png", str(tmp_path / "f.png")])
     assert out.exit_code == 0, out.output
-    rows = json.loads((tmp_path / "t.json").read_text())
-    assert {r["Tracker"] for r in rows} == {"sort", "deepsort", "diversort"}
-    assert (tmp_path / "t.csv").read_text().splitlines()[0].split(",") == list(COLUMNS)
+    assert "Pearson" in out.output and "detections: paper" in out.output
+    doc = json.loads((tmp_path / "t.json").read_text())
+    assert doc["schema"] == "lookalike-results/1"
+    rows = doc["tables"]["divers"]
+    assert {r["tracker"] for r in rows} == {"sort", "diversort/handcrafted"}
+    assert {r["dataset"] for r in rows} == {"divers-sim", "divers-paper"}
+    assert [r["combined"] for r in rows if r["sequence"] is None] == [True] * 4
+    assert all(0 <= r["metrics"]["idf1"] <= 1 for r in rows)
+    assert (tmp_path / "t.csv").read_text().splitlines()[0].split(",") == ["Detections", *COLUMNS]
     assert (tmp_path / "f.png").exists()
     bad = CliRunner().invoke(app, ["bench", "divers", "--scenario", "atlantis"])
     assert bad.exit_code != 0 and "unknown diver scenario" in bad.output
+    bad = CliRunner().invoke(app, ["bench", "divers", "--scenario", "pool_pair", "--tracker", "magic"])
+    assert bad.exit_code == 2 and "magic" in bad.output

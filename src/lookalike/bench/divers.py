@@ -1,10 +1,17 @@
 """The diver bench (``lookalike bench divers``): the paper's Table 2 and Figure 5 on the rendered diver scenarios.
 
-Every scenario is rendered, passed through the detector model, and its detections' appearance
-features are extracted once (the extractor standardised on the validation scenarios); SORT, the
-deep SORT style tracker and diver SORT then run on the identical detections. The table gives the
-detector's DP/DR and each tracker's IDF1, IDP, IDR, IDSW and Frag (percentages and counts), with
-an ALL row per tracker (counts pooled over scenarios).
+Every scenario is rendered, passed through the detector model (``detections``: ``sim``, the
+scenario's own, or ``paper``, :data:`~lookalike.sim.divers_paper.PAPER_DETECTORS` with seed B's
+detection precision and recall), and its detections' appearance features are extracted once per
+feature set (``handcrafted``, standardised on the validation scenarios; ``learned``, the shipped ONNX
+embedding trained on other divers). The entries (:data:`ENTRIES`) then run on identical detections:
+SORT, deep SORT with the learned model (the paper's baseline), deep SORT with the hand-crafted
+features, diver SORT with the hand-crafted features (the paper's method) and diver SORT with the
+learned model. With learned features the trackers' cosine thresholds are moved by
+:func:`~lookalike.sim.divers_run.matched_thresholds` (validation scenarios). The table gives the
+detector's DP/DR and each entry's IDF1, IDP, IDR, IDSW and Frag (percentages and counts), with an
+ALL row per entry (counts pooled over scenarios); :func:`pearson` gives each entry's correlation
+between DP and IDP over the scenarios (the paper: 0.727 diver SORT, 0.850 deep SORT).
 """
 
 from __future__ import annotations
@@ -15,41 +22,61 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.bench.results import Results
 from lookalike.eval.api import combine, evaluate_sequence
 from lookalike.sim.divers import SCENARIOS, detection_quality, scenario
-from lookalike.sim.divers_run import fit_diver_features, prepare, run_tracker
+from lookalike.sim.divers_paper import redraw, with_detections
+from lookalike.sim.divers_run import diver_extractor, matched_thresholds, prepare_features, run_tracker
 from lookalike.types.mot_table import MotTable
 
-TRACKERS = ("sort", "deepsort", "diversort")
+#: (label, tracker, features): the paper's three trackers plus the two cross-overs of features.
+ENTRIES: tuple[tuple[str, str, str], ...] = (
+    ("sort", "sort", "handcrafted"),
+    ("deepsort/learned", "deepsort", "learned"),
+    ("deepsort/handcrafted", "deepsort", "handcrafted"),
+    ("diversort/handcrafted", "diversort", "handcrafted"),
+    ("diversort/learned", "diversort", "learned"),
+)
+TRACKERS = tuple(label for label, _, _ in ENTRIES)
 COLUMNS = ("Scenario", "Location", "DP", "DR", "Tracker", "IDF1", "IDP", "IDR", "IDSW", "Frag")
 
 
-def diver_table(names: list[str] | None = None, trackers: tuple[str, ...] = TRACKERS,
-                frames: int | None = None) -> list[dict[str, Any]]:
-    """Rows of Table 2 (keys :data:`COLUMNS`) for scenarios ``names`` (default: all test scenarios)."""
-    chosen = [scenario(n) for n in names] if names else list(SCENARIOS)
+def diver_table(names: list[str] | None = None, trackers: tuple[str, ...] = TRACKERS, frames: int | None = None,
+                detections: str = "sim", seed: int = 0) -> list[dict[str, Any]]:
+    """Rows of Table 2 (keys :data:`COLUMNS`) for scenarios ``names`` (default: all test scenarios),
+    entries ``trackers`` (labels of :data:`ENTRIES`), detector level ``detections`` and draw ``seed``."""
+    entries = {label: (tracker, feats) for label, tracker, feats in ENTRIES}
+    for t in trackers:
+        if t not in entries:
+            raise ValueError(f"unknown diver bench entry {t!r}; known: {', '.join(entries)}")
+    chosen = [redraw(with_detections(scenario(n), detections), seed) for n in names] if names else \
+        [redraw(with_detections(sc, detections), seed) for sc in SCENARIOS]
     if frames is not None:
         chosen = [dataclasses.replace(sc, frames=frames) for sc in chosen]
-    extractor = fit_diver_features()
+    extractors = {f: diver_extractor(f) for f in dict.fromkeys(entries[t][1] for t in trackers)}
+    params = {t: matched_thresholds(extractors[entries[t][1]], entries[t][0]) for t in trackers}
     rows: list[dict[str, Any]] = []
     per_tracker: dict[str, list[dict[str, float]]] = {t: [] for t in trackers}
     det_counts = np.zeros(3)  # tp, fp, fn pooled
     for sc in chosen:
-        prepared = prepare(sc, extractor)
-        dp, dr = detection_quality(prepared.frames, prepared.gt)
-        n_det = sum(len(f.detections) for f in prepared.frames)
+        prepared = prepare_features(sc, extractors)
+        first = next(iter(prepared.values()))
+        dp, dr = detection_quality(first.frames, first.gt)
+        n_det = sum(len(f.detections) for f in first.frames)
         tp = dp * n_det
-        det_counts += [tp, n_det - tp, tp / dr - tp if dr > 0 else len(prepared.gt)]
-        gt = MotTable.from_rows(prepared.gt)
-        for name in trackers:
-            result, _ = run_tracker(name, prepared.frames)
+        det_counts += [tp, n_det - tp, tp / dr - tp if dr > 0 else len(first.gt)]
+        gt = MotTable.from_rows(first.gt)
+        for label in trackers:
+            tracker, feats = entries[label]
+            result, _ = run_tracker(tracker, prepared[feats].frames, **params[label])
             scores = evaluate_sequence(gt, MotTable.from_rows(result), metrics=["CLEAR", "Identity"],
-                                       num_frames=len(prepared.frames))
-            per_tracker[name].append(scores)
-            rows.append(_row(sc.name, "pool" if sc.pool else "ocean", dp, dr, name, scores))
+                                       num_frames=len(first.frames))
+            per_tracker[label].append(scores)
+            rows.append(_row(sc.name, "pool" if sc.pool else "ocean", dp, dr, label, scores))
     tp, fp, fn = det_counts
-    for name in trackers:
-        rows.append(_row("ALL", "", tp / max(tp + fp, 1), tp / max(tp + fn, 1), name, combine(per_tracker[name])))
+    for label in trackers:
+        rows.append(_row("ALL", "", tp / max(tp + fp, 1), tp / max(tp + fn, 1), label,
+                         combine(per_tracker[label])))
     return rows
 
 
@@ -59,6 +86,45 @@ def _row(name: str, where: str, dp: float, dr: float, tracker: str, s: dict[str,
         "Tracker": tracker, "IDF1": round(100 * s["IDF1"], 1), "IDP": round(100 * s["IDP"], 1),
         "IDR": round(100 * s["IDR"], 1), "IDSW": int(s["IDSW"]), "Frag": int(s["Frag"]),
     }
+
+
+def pearson(rows: list[dict[str, Any]]) -> dict[str, tuple[float, float]]:
+    """Per entry, Pearson's r between DP and IDP over the scenario rows (ALL left out) and its
+    two-sided p-value; ``(nan, nan)`` with fewer than three scenarios or a constant column."""
+    from scipy.stats import pearsonr
+
+    out: dict[str, tuple[float, float]] = {}
+    for t in dict.fromkeys(r["Tracker"] for r in rows):
+        pts = np.array([(r["DP"], r["IDP"]) for r in rows if r["Tracker"] == t and r["Scenario"] != "ALL"])
+        if len(pts) < 3 or np.ptp(pts[:, 0]) == 0 or np.ptp(pts[:, 1]) == 0:
+            out[t] = (float("nan"), float("nan"))
+        else:
+            res = pearsonr(pts[:, 0], pts[:, 1])
+            out[t] = (float(res.statistic), float(res.pvalue))
+    return out
+
+
+def diver_results(tables: dict[str, list[dict[str, Any]]], frames: int, seed: int, command: str = "") -> Results:
+    """The tables of :func:`diver_table` (one per detection level) as a results document: table
+    ``divers``, dataset ``divers-<level>``, one row per scenario and entry, the ALL rows ``combined``
+    (sequence None); Pearson r and p per entry and level in the header's notes."""
+    sequences = sorted({r["Scenario"] for rows in tables.values() for r in rows if r["Scenario"] != "ALL"})
+    seeds = [redraw(scenario(n), seed).seed for n in sequences]
+    doc = Results("bench divers", command=command, seeds=seeds, sequences=len(sequences) * len(tables),
+                  frames=frames * len(sequences) * len(tables),
+                  options={"detections": list(tables), "seed": seed, "frames_per_scenario": frames})
+    notes: dict[str, Any] = {}
+    for level, rows in tables.items():
+        for r in rows:
+            combined = r["Scenario"] == "ALL"
+            metrics = {k.lower(): (r[k] / 100 if k in ("DP", "DR", "IDF1", "IDP", "IDR") else r[k])
+                       for k in ("DP", "DR", "IDF1", "IDP", "IDR", "IDSW", "Frag")}
+            doc.add("divers", dataset=f"divers-{level}", sequence=None if combined else r["Scenario"],
+                    tracker=r["Tracker"], combined=combined, metrics=metrics,
+                    info=None if combined else {"location": r["Location"]})
+        notes[f"pearson_dp_idp_{level}"] = {t: {"r": rp[0], "p": rp[1]} for t, rp in pearson(rows).items()}
+    doc.notes = notes
+    return doc
 
 
 def bar_chart(rows: list[dict[str, Any]], path: Path) -> Path:
@@ -79,7 +145,7 @@ def bar_chart(rows: list[dict[str, Any]], path: Path) -> Path:
     ax.set_xticks(x, scenarios, rotation=30, ha="right", fontsize=8)
     ax.set_ylabel("IDF1 (%)")
     ax.set_ylim(0, 100)
-    ax.legend()
+    ax.legend(fontsize=7)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
@@ -87,4 +153,4 @@ def bar_chart(rows: list[dict[str, Any]], path: Path) -> Path:
     return path
 
 
-__all__ = ["COLUMNS", "TRACKERS", "bar_chart", "diver_table"]
+__all__ = ["COLUMNS", "ENTRIES", "TRACKERS", "bar_chart", "diver_results", "diver_table", "pearson"]

@@ -2,42 +2,58 @@
 
 from __future__ import annotations
 
-import json
+import math
 from pathlib import Path
 
 import typer
 from rich.console import Console
 from rich.table import Column, Table
 
-from lookalike.bench.divers import COLUMNS, bar_chart, diver_table
+from lookalike.bench.divers import COLUMNS, TRACKERS, bar_chart, diver_results, diver_table, pearson
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import console, fail
-from lookalike.cli.bench import bench_app
+from lookalike.cli.app import command_line, console, fail
+from lookalike.cli.bench import bench_app, write_results
+from lookalike.sim.divers_paper import DETECTION_LEVELS
 
 GROUPED = ("Scenario", "Location", "DP", "DR")  # printed once per scenario
+ENTRY_HELP = f"Entry (repeatable): {', '.join(TRACKERS)}."
 
 
 @bench_app.command("divers")
 def divers(
     scenario_names: list[str] | None = typer.Option(None, "--scenario", help="Scenario name (repeatable)."),
     frames: int | None = typer.Option(None, min=10, help="Shorten every scenario to this many frames."),
-    png: Path | None = typer.Option(None, "--png", help="Write the IDF1 bar chart here."),
-    json_path: Path | None = typer.Option(None, "--json", help="Write the table as JSON rows."),
-    csv_path: Path | None = typer.Option(None, "--csv", help="Write the table as CSV."),
+    trackers: list[str] | None = typer.Option(None, "--tracker", help=ENTRY_HELP),
+    detections: str = typer.Option("sim", "--detections", help="Detector level: 'sim' (the scenarios' own), "
+                                   "'paper' (seed B's DP/DR per video) or 'both' (one table each)."),
+    seed: int = typer.Option(0, min=0, help="Scenario draw: 0 the published scenarios, others new draws."),
+    png: Path | None = typer.Option(None, "--png", help="Write the IDF1 bar chart here (of the last table)."),
+    json_path: Path | None = typer.Option(None, "--json", help="Write the results document (JSON)."),
+    csv_path: Path | None = typer.Option(None, "--csv", help="Write the table(s) as CSV (a Detections column first)."),
 ) -> None:
-    """SORT vs deep SORT style vs diver SORT on the rendered diver scenarios (paper Table 2)."""
+    """SORT, deep SORT and diver SORT with hand-crafted or learned features on the rendered divers (Table 2)."""
+    levels = list(DETECTION_LEVELS) if detections == "both" else [detections]
+    if detections != "both" and detections not in DETECTION_LEVELS:
+        fail(f"--detections: choose one of {', '.join(DETECTION_LEVELS)} or both, got {detections!r}")
+    tables = {}
     try:
-        rows = diver_table(scenario_names, frames=frames)
-    except ValueError as exc:
+        for level in levels:
+            tables[level] = diver_table(scenario_names, tuple(trackers) if trackers else TRACKERS, frames=frames,
+                                        detections=level, seed=seed)
+    except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
-    table = Table(*(Column(c, no_wrap=True) for c in COLUMNS))
-    for k, r in enumerate(rows):
-        first = k == 0 or r["Scenario"] != rows[k - 1]["Scenario"]
-        table.add_row(*(str(r[c]) if first or c not in GROUPED else "" for c in COLUMNS))
-    Console(width=max(console.width, 120)).print(table)  # the table is wider than a default terminal
-    if json_path:
-        json_path.parent.mkdir(parents=True, exist_ok=True)
-        json_path.write_text(json.dumps(rows, indent=1))
-    write_rows(rows, None, csv_path, COLUMNS)
+    wide = Console(width=max(console.width, 120))  # the table is wider than a default terminal
+    for level, rows in tables.items():
+        table = Table(*(Column(c, no_wrap=True) for c in COLUMNS), title=f"detections: {level}, seed {seed}")
+        for k, r in enumerate(rows):
+            first = k == 0 or r["Scenario"] != rows[k - 1]["Scenario"]
+            table.add_row(*(str(r[c]) if first or c not in GROUPED else "" for c in COLUMNS))
+        wide.print(table)
+        console.print("Pearson r between DP and IDP over the scenarios (p): " + ", ".join(
+            f"{t} {r:.3f} ({p:.3f})" if not math.isnan(r) else f"{t} n/a" for t, (r, p) in pearson(rows).items()))
+    frames_run = frames or 300
+    write_results(diver_results(tables, frames_run, seed, command_line()), json_path)
+    all_rows = [{"Detections": level, **r} for level, rows in tables.items() for r in rows]
+    write_rows(all_rows, None, csv_path, ("Detections", *COLUMNS))
     if png:
-        console.print(f"bar chart → {bar_chart(rows, png)}")
+        console.print(f"bar chart → {bar_chart(tables[levels[-1]], png)}")

@@ -152,6 +152,22 @@ def prepare(sc: DiverScenario, extractor: FeatureExtractor, detector: DetectorMo
     return PreparedScenario(sc, scene, frames, scene.gt)
 
 
+def prepare_features(sc: DiverScenario, extractors: dict[str, FeatureExtractor],
+                     detector: DetectorModel | None = None) -> dict[str, PreparedScenario]:
+    """:func:`prepare` for several feature sets at once (each frame rendered once): name -> scenario,
+    the same detections everywhere, only their features differ."""
+    scene = simulate_divers(sc)
+    frames: dict[str, list[Frame]] = {name: [] for name in extractors}
+    for frame in scene.frames(detector):
+        det = frame.detections
+        assert det.xywh is not None  # simulated detections have boxes
+        image = scene.image(frame.index) if len(det) else None
+        for name, extractor in extractors.items():
+            feats = extractor(image, det.xywh) if image is not None else np.zeros((0, extractor.dim))
+            frames[name].append(Frame(index=frame.index, time=frame.time, detections=det.replace(feature=feats)))
+    return {name: PreparedScenario(sc, scene, f, scene.gt) for name, f in frames.items()}
+
+
 def run_tracker(name: str, frames: list[Frame], **params: object) -> tuple[np.ndarray, object]:
     """Run tracker ``name`` over ``frames``; MOTChallenge result rows ``(n, 10)`` and the tracker."""
     tracker = make_tracker(name, **params)
