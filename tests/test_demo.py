@@ -14,6 +14,7 @@ pytest.importorskip("matplotlib")
 from typer.testing import CliRunner
 
 from lookalike.bench.demo import QUICK, lstm_status
+from lookalike.bench.results import validate
 from lookalike.cli import app
 from lookalike.viz import read_frames, video_info
 
@@ -46,22 +47,25 @@ def test_demo_videos_decode_with_the_scene_frame_counts(demo_out):
 
 def test_demo_tables_cover_trackers_and_lstm_presence(demo_out):
     out, text = demo_out
-    ident = json.loads((out / "robots-ident.json").read_text())
-    divers = json.loads((out / "divers.json").read_text())
-    assert {r["Tracker"] for r in divers} == {"sort", "deepsort", "diversort"}
-    assert len({r["Scenario"] for r in divers}) == QUICK.diver_scenarios
+    ident_doc = json.loads((out / "robots-ident.json").read_text())
+    divers_doc = json.loads((out / "divers.json").read_text())
+    validate(ident_doc)
+    validate(divers_doc)
+    ident, divers = ident_doc["tables"]["ident"], divers_doc["tables"]["divers"]
+    assert {r["tracker"] for r in divers} == {"sort", "deepsort", "diversort"}
+    assert len({r["sequence"] for r in divers}) == QUICK.diver_scenarios
     for setup, label in (("m3n2", "M=3, N=2"), ("m5n3", "M=5, N=3"), ("m10n7", "M=10, N=7")):
-        names = {r["Tracker"] for r in ident if r["Setup"] == label}
+        names = {r["tracker"] for r in ident if r["dataset"] == setup}
         assert {"kalman_ha", "kalman_ha2", "jpda"} <= names
         if lstm_status(setup) is None:
             assert "lstm" in names
         else:
             assert "lstm" not in names and f"no shipped LSTM weights for {label}" in " ".join(text.split())
     for r in ident:
-        assert 0 <= r["Success rate (%)"] <= 100
+        assert 0 <= r["metrics"]["success_rate"] <= 1
     html = (out / "report.html").read_text()
     assert len(re.findall(r'<img src="data:image/(png|gif);base64,', html)) >= 6
-    assert 'href="robots.mp4"' in html and 'href="divers.mp4"' in html
+    assert '<video controls' in html and 'src="robots.mp4"' in html and 'src="divers.mp4"' in html
 
 
 def test_render_overlays_demo_tracks(demo_out, tmp_path):
@@ -94,7 +98,7 @@ def test_report_from_results(demo_out, tmp_path):
     assert r.exit_code == 0, r.output
     html = target.read_text()
     assert html.count("data:image/png;base64,") == 3
-    assert "seq-a" in html and "M=10, N=7" in html
+    assert "seq-a" in html and "m10n7" in html
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({"rows": 3}))
     r = runner.invoke(app, ["report", str(bad), "-o", str(target)])
@@ -172,3 +176,13 @@ def test_rerun_missing_is_a_clear_error(monkeypatch, tmp_path):
     monkeypatch.setattr(builtins, "__import__", no_rerun)
     r = runner.invoke(app, ["demo", "--quick", "-o", str(tmp_path), "--rerun-save", str(tmp_path / "x.rrd")])
     assert r.exit_code != 0 and "rerun-sdk" in r.output
+
+
+def test_demo_rerun_save_errors_name_the_option(tmp_path):
+    try:
+        import rerun  # noqa: F401
+    except ImportError:
+        r = runner.invoke(app, ["demo", "--quick", "--rerun-save", str(tmp_path / "x.rrd"), "-o", str(tmp_path)])
+        assert r.exit_code == 2 and "--rerun-save:" in r.output and "Traceback" not in r.output
+    else:
+        pytest.skip("rerun-sdk is installed: no error to check")

@@ -10,13 +10,13 @@ test scenario (shortened). Everything lands in the output folder with a self-con
 from __future__ import annotations
 
 import dataclasses
-import json
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from lookalike.bench.ident import ident_table
+from lookalike.bench.ident import ident_results, ident_table
+from lookalike.bench.results import Results
 from lookalike.sim import PRESET_NAMES, preset, preset_label
 from lookalike.sim.divers import SCENARIOS, VALIDATION_SCENARIOS, scenario
 from lookalike.sim.divers_run import fit_diver_features
@@ -102,10 +102,25 @@ def _divers(output: Path, size: DemoSize, step: Step, rerun: Any) -> tuple[list[
     return rows, {f"divers-{k}": v for k, v in files.items()}
 
 
+def diver_results(rows: list[dict[str, Any]], size: DemoSize, command: str = "") -> Results:
+    """The demo's diver rows (metrics in %) as a results document: table ``divers``, dataset
+    ``divers-sim``, one row per scenario (``sequence``) and tracker, fractions."""
+    scenarios = list(dict.fromkeys(r["Scenario"] for r in rows))
+    frames = size.diver_video_frames + size.diver_frames * max(len(scenarios) - 1, 0)
+    doc = Results("demo divers", command=command, sequences=len(scenarios), frames=frames,
+                  options={"diver_video_frames": size.diver_video_frames, "diver_frames": size.diver_frames})
+    for r in rows:
+        metrics = {k.lower(): r[k] / 100 for k in ("IDF1", "HOTA", "MOTA") if k in r}
+        metrics.update({"idsw": r.get("IDSW"), "frames_per_s": r.get("Frames/s")})
+        doc.add("divers", dataset="divers-sim", sequence=r["Scenario"], tracker=r["Tracker"], metrics=metrics)
+    return doc
+
+
 def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str, rerun: Any = None,
-             step: Step = _silent) -> DemoResult:
+             step: Step = _silent, command: str = "") -> DemoResult:
     """Run the whole demo into ``output``. ``rerun``: an optional
-    :class:`~lookalike.viz.rerun_log.RerunLogger` that also receives the video scenes."""
+    :class:`~lookalike.viz.rerun_log.RerunLogger` that also receives the video scenes; ``command``:
+    the command line recorded in the JSON files' header."""
     output.mkdir(parents=True, exist_ok=True)
     notes = {s: lstm_status(s) for s in PRESET_NAMES}
     video_tracker = "lstm" if notes[robot_preset] is None else "kalman_ha2"
@@ -126,8 +141,9 @@ def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str, rerun: 
                                       ylabel="IDF1 (%)", title="Diver tracking: IDF1 per scenario")
     files["ident-chart"] = grouped_bar_chart(output / "robots-ident.png", ident_rows, "Setup", "Tracker",
                                              "Success rate (%)", title="Robot identification success rate")
-    (output / "robots-ident.json").write_text(json.dumps(ident_rows, indent=1) + "\n")
-    (output / "divers.json").write_text(json.dumps(diver_rows, indent=1) + "\n")
+    ident_results(ident_rows, list(PRESET_NAMES), size.ident_sequences, size.ident_frames, 900_000 + seed,
+                  command).write(output / "robots-ident.json")
+    diver_results(diver_rows, size, command).write(output / "divers.json")
     result = DemoResult(files, robots.rows, ident_rows, diver_rows, notes)
     files["report"] = write_report(output, result, video_tracker, size)
     return result
@@ -168,4 +184,5 @@ def write_report(output: Path, result: DemoResult, video_tracker: str, size: Dem
     return report.write(output / "report.html")
 
 
-__all__ = ["DIVER_COLS", "IDENT_COLS", "QUICK", "DemoResult", "DemoSize", "lstm_status", "run_demo", "write_report"]
+__all__ = ["DIVER_COLS", "IDENT_COLS", "QUICK", "DemoResult", "DemoSize", "diver_results", "lstm_status", "run_demo",
+           "write_report"]

@@ -8,10 +8,17 @@ from collections.abc import Callable
 from pathlib import Path
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
 
 from lookalike.bench.demo import DIVER_COLS, IDENT_COLS, QUICK, DemoSize, lstm_status, run_demo
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, command_line, console, fail
 from lookalike.cli.bench import rich_table
 from lookalike.sim import PRESET_NAMES, preset_label
 
@@ -23,10 +30,11 @@ def _open_rerun(rerun: bool, rerun_save: Path | None) -> object | None:
         return None
     from lookalike.viz.rerun_log import open_rerun
 
+    option = "--rerun" if rerun else "--rerun-save"
     try:
         return open_rerun("lookalike-demo", save=rerun_save, spawn=rerun)
-    except ValueError as exc:
-        fail(str(exc))
+    except (ValueError, OSError) as exc:
+        fail(f"{option}: {exc}")
     return None
 
 
@@ -36,12 +44,12 @@ def _run(output: Path, seed: int, size: DemoSize, robot_preset: str, logger: obj
         if why:
             console.print(f"[yellow]LSTM left out for {preset_label(s)}:[/] {why}")
     with Progress(TextColumn("{task.description:<42}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                  console=console, transient=False) as progress:
+                  TimeRemainingColumn(), console=console, transient=False) as progress:
         def step(description: str, total: int) -> Callable[[], None]:
             task = progress.add_task(description, total=total)
             return lambda: progress.advance(task)
 
-        result = run_demo(output, seed, size, robot_preset, rerun=logger, step=step)
+        result = run_demo(output, seed, size, robot_preset, rerun=logger, step=step, command=command_line())
     console.print(rich_table(f"Robot video scene ({preset_label(robot_preset)}, {size.robot_frames} frames)",
                              result.robot_rows, IDENT_COLS))
     console.print(rich_table(f"Robot identification ({size.ident_sequences} × {size.ident_frames} frames per set-up)",

@@ -61,7 +61,7 @@ def open_rerun(app_id: str = "lookalike", save: Path | str | None = None, spawn:
     try:
         import rerun as rr
     except ImportError:
-        raise ValueError("--rerun: the optional package rerun-sdk is not installed (pip install rerun-sdk)") from None
+        raise ValueError("the optional package rerun-sdk is not installed (pip install rerun-sdk)") from None
     if save is None and not spawn:
         raise ValueError("open_rerun: give a file to save to or spawn=True")
     rec = rr.RecordingStream(app_id)

@@ -1,8 +1,10 @@
 """Reading ``eval``/``bench`` JSON outputs and adding them to an :class:`HtmlReport` as tables and charts.
 
-Recognised files: ``lookalike bench ident --json`` (rows with ``Setup`` and ``Success rate (%)``),
-``lookalike bench divers --json`` and the demo's diver rows (rows with ``Scenario`` and ``IDF1``),
-and ``lookalike eval --json`` (``{tracker: {sequence: {metric: fraction}}}``).
+Recognised files: results documents (``"schema": "lookalike-results/1"``, see
+:mod:`lookalike.bench.results`) with a table ``ident`` (``bench ident --json``, the demo's
+``robots-ident.json``), ``divers`` (``bench divers --json``, the demo's ``divers.json``) or ``scores``
+(``eval --json``); and the older files: rows with ``Setup`` and ``Success rate (%)``, rows with
+``Scenario`` and ``IDF1``, ``{tracker: {sequence: {metric: fraction}}}``. Values are shown in %.
 """
 
 from __future__ import annotations
@@ -15,6 +17,42 @@ from lookalike.viz.plots import grouped_bar_chart
 from lookalike.viz.report import HtmlReport
 
 EVAL_COLUMNS = ("IDF1", "HOTA", "MOTA", "IDSW")
+SCHEMA_ID = "lookalike-results/1"  # lookalike.bench.results.SCHEMA_ID (bench sits above viz)
+
+
+def _percent(metrics: dict[str, Any], key: str) -> float | None:
+    value = metrics.get(key)
+    return None if value is None else round(100 * float(value), 2)
+
+
+def _from_schema(path: Path, data: dict[str, Any]) -> tuple[str, list[dict[str, Any]]]:
+    """``(kind, display rows in %)`` of a results document."""
+    tables = data.get("tables") or {}
+    if tables.get("ident"):
+        return "ident", [{"Setup": r["dataset"], "Tracker": r["tracker"],
+                          "Success rate (%)": _percent(r["metrics"], "success_rate"),
+                          "Localisation error (m)": r["metrics"].get("localisation_error_m"),
+                          "Frames/s": r["metrics"].get("frames_per_s")} for r in tables["ident"]]
+    if tables.get("divers"):
+        rows = []
+        for r in tables["divers"]:
+            m = r["metrics"]
+            row: dict[str, Any] = {"Scenario": "ALL" if r["combined"] else r["sequence"], "Tracker": r["tracker"]}
+            row.update({k.upper(): _percent(m, k) for k in ("idf1", "hota", "mota", "idp", "idr") if k in m})
+            row.update({k.upper(): m[k] for k in ("idsw",) if k in m})
+            rows.append(row)
+        return "divers", rows
+    if tables.get("scores"):
+        out = []
+        for r in tables["scores"]:
+            m = r["metrics"]
+            row = {"Tracker": r["tracker"], "Sequence": "COMBINED" if r["combined"] else r["sequence"]}
+            row.update({k.upper(): _percent(m, k) for k in ("idf1", "hota", "mota") if k in m})
+            if "idsw" in m:
+                row["IDSW"] = m["idsw"]
+            out.append(row)
+        return "eval", out
+    raise ValueError(f"results: {path} has none of the tables ident, divers, scores (see `lookalike report --help`)")
 
 
 def load_results(path: Path | str) -> tuple[str, list[dict[str, Any]]]:
@@ -26,6 +64,8 @@ def load_results(path: Path | str) -> tuple[str, list[dict[str, Any]]]:
         data = json.loads(p.read_text())
     except json.JSONDecodeError as exc:
         raise ValueError(f"results: {p} is not JSON ({exc})") from None
+    if isinstance(data, dict) and data.get("schema") == SCHEMA_ID:
+        return _from_schema(p, data)
     if isinstance(data, list) and data and all(isinstance(r, dict) for r in data):
         if "Setup" in data[0] and "Success rate (%)" in data[0]:
             return "ident", data
