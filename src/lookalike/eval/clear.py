@@ -14,7 +14,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import SequenceData
-from lookalike.eval.matching import conflicted_frames, dense, frame_bounds
+from lookalike.eval.matching import conflicted_frames, frame_bounds
 
 _EPS = np.finfo(float).eps
 COUNTS = ("CLR_TP", "CLR_FN", "CLR_FP", "IDSW", "MT", "PT", "ML", "Frag", "MOTP_sum", "CLR_Frames")
@@ -98,20 +98,32 @@ def _solve_hard_frames(data: SequenceData, hard: np.ndarray, scored: np.ndarray,
     bonus = np.zeros(len(frame), bool)
     bonus[in_hard] = np.isin(frame[in_hard] * span + id_key[in_hard], src)
     gb, tb = data.gt_bounds, data.tracker_bounds
-    solved: dict[int, np.ndarray] = {}
+    c_gt, c_tr = data.gt_id[gt_det], data.tracker_id[tr_det]
+    local_g, local_t = gt_det - gb[frame], tr_det - tb[frame]
+    planned = sim + 1000.0 * bonus
+    prev = np.full(max(data.num_gt_ids, 1), -1)  # tracker id matched in the previous (hard) frame
+    solved: dict[int, tuple[np.ndarray, np.ndarray]] = {}
     out_g, out_t, counts = [], [], []
+    cuts, g_cuts, t_cuts = bounds.tolist(), gb.tolist(), tb.tolist()
+    prev_list, next_list, hard_list = prev_of.tolist(), next_of.tolist(), is_hard.tolist()
     for t in hard.tolist():
-        a, b = bounds[t], bounds[t + 1]
-        q = int(prev_of[t])
-        cont = np.isin(id_key[a:b], solved[q]) if q in solved else bonus[a:b]
-        g0, t0 = gb[t], tb[t]
-        score = dense((int(gb[t + 1] - g0), int(tb[t + 1] - t0)), gt_det[a:b] - g0, tr_det[a:b] - t0,
-                      sim[a:b] + 1000.0 * cont)
+        a, b = cuts[t], cuts[t + 1]
+        q = prev_list[t]
+        if q in solved:
+            q_gt, q_tr = solved.pop(q)
+            prev[q_gt] = q_tr
+            values = sim[a:b] + 1000.0 * (c_tr[a:b] == prev[c_gt[a:b]])
+            prev[q_gt] = -1
+        else:
+            values = planned[a:b]
+        score = np.zeros((g_cuts[t + 1] - g_cuts[t], t_cuts[t + 1] - t_cuts[t]))
+        score[local_g[a:b], local_t[a:b]] = values
         rows, cols = linear_sum_assignment(-score)
         ok = score[rows, cols] > _EPS
-        rows, cols = rows[ok] + g0, cols[ok] + t0
-        if is_hard[next_of[t]] and next_of[t] >= 0:
-            solved[t] = data.gt_id[rows] * n_ids + data.tracker_id[cols]
+        rows, cols = rows[ok] + g_cuts[t], cols[ok] + t_cuts[t]
+        nxt = next_list[t]
+        if nxt >= 0 and hard_list[nxt]:
+            solved[t] = (data.gt_id[rows], data.tracker_id[cols])
         out_g.append(rows)
         out_t.append(cols)
         counts.append(len(rows))

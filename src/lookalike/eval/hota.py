@@ -13,7 +13,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import Pairs, SequenceData
-from lookalike.eval.matching import conflicted_frames, dense, frame_bounds
+from lookalike.eval.matching import conflicted_frames, frame_bounds
 
 ALPHAS = np.arange(0.05, 0.99, 0.05)  # the exact float values TrackEval compares with
 LABELS = tuple(range(5, 100, 5))
@@ -72,14 +72,15 @@ def _match_frames(data: SequenceData, pairs: Pairs,
     hard_frames = np.flatnonzero(hard)
     counts = []
     gb, tb = data.gt_bounds, data.tracker_bounds
-    bounds = frame_bounds(frame, n_frames)
+    local_g, local_t = gt_det - gb[frame], tr_det - tb[frame]
+    cuts, g_cuts, t_cuts = frame_bounds(frame, n_frames).tolist(), gb.tolist(), tb.tolist()
     for t in hard_frames.tolist():
-        a, b = bounds[t], bounds[t + 1]
-        g0, t0 = gb[t], tb[t]
-        mat = dense((int(gb[t + 1] - g0), int(tb[t + 1] - t0)), gt_det[a:b] - g0, tr_det[a:b] - t0, score[a:b])
+        a, b = cuts[t], cuts[t + 1]
+        mat = np.zeros((g_cuts[t + 1] - g_cuts[t], t_cuts[t + 1] - t_cuts[t]))
+        mat[local_g[a:b], local_t[a:b]] = score[a:b]
         rows, cols = linear_sum_assignment(-mat)
-        m_gt.append(rows + g0)
-        m_tr.append(cols + t0)
+        m_gt.append(rows + g_cuts[t])
+        m_tr.append(cols + t_cuts[t])
         counts.append(len(rows))
     mf = np.concatenate([frame[easy], np.repeat(hard_frames, counts)])
     mg, mt = np.concatenate(m_gt), np.concatenate(m_tr)

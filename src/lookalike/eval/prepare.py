@@ -13,7 +13,7 @@ Rules (``benchmark``):
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Literal, Protocol
 
@@ -175,27 +175,40 @@ def _overlapping_pairs(a: np.ndarray, a_frame: np.ndarray, b: np.ndarray,
     span = max(float((ax0 + a[:, 2]).max()), float((bx0 + b[:, 2]).max()), 0.0) - lo + 4.0
     a0, a1 = a_frame * span + (ax0 - lo), a_frame * span + (ax0 + a[:, 2] - lo) + 1.0
     b0, b1 = b_frame * span + (bx0 - lo), b_frame * span + (bx0 + b[:, 2] - lo) + 1.0
-    j1, i1 = _ranges(b0, a0, a1, "left")  # b's left edge in [a0, a1]
-    i2, j2 = _ranges(a0, b0, b1, "right")  # a's left edge in (b0, b1]
-    i, j = np.concatenate([i1, i2]), np.concatenate([j1, j2])
-    iou = pair_iou(a[i], b[j])
-    pos = (iou > 0) & (a_frame[i] == b_frame[j])
-    i, j, iou = i[pos], j[pos], iou[pos]
+    parts_i, parts_j, parts_s = [], [], []
+    # b's left edge in [a0, a1], then a's left edge in (b0, b1].
+    for keys, start, stop, side, owner_is_a in ((b0, a0, a1, "left", True), (a0, b0, b1, "right", False)):
+        for owner, found in _ranges(keys, start, stop, side):
+            i, j = (owner, found) if owner_is_a else (found, owner)
+            iou = pair_iou(a[i], b[j])
+            pos = (iou > 0) & (a_frame[i] == b_frame[j])
+            parts_i.append(i[pos])
+            parts_j.append(j[pos])
+            parts_s.append(iou[pos])
+    i, j, iou = np.concatenate(parts_i), np.concatenate(parts_j), np.concatenate(parts_s)
     srt = np.argsort(i * len(b) + j)
     return i[srt], j[srt], iou[srt]
 
 
-def _ranges(keys: np.ndarray, start: np.ndarray, stop: np.ndarray, side: Literal["left", "right"]
-            ) -> tuple[np.ndarray, np.ndarray]:
-    """``(index into keys, index into start)`` of every key in ``[start, stop]`` (``(start, stop]`` with
-    ``side="right"``)."""
+_CHUNK = 1 << 15  # candidate pairs per batch: keeps the IoU temporaries in cache
+
+
+def _ranges(keys: np.ndarray, start: np.ndarray, stop: np.ndarray,
+            side: Literal["left", "right"]) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Batches of ``(index into start, index into keys)`` of every key in ``[start, stop]`` (``(start, stop]``
+    with ``side="right"``), about :data:`_CHUNK` pairs each."""
     order = np.argsort(keys, kind="stable")
     sorted_keys = keys[order]
     first = np.searchsorted(sorted_keys, start, side)
     count = np.maximum(np.searchsorted(sorted_keys, stop, "right") - first, 0)
-    owner = np.repeat(np.arange(len(start)), count)
-    found = order[np.repeat(first - (np.cumsum(count) - count), count) + np.arange(int(count.sum()))]
-    return found, owner
+    ends = np.cumsum(count)
+    cuts = np.unique(np.concatenate([[0], np.searchsorted(ends, np.arange(_CHUNK, int(ends[-1]), _CHUNK)),
+                                     [len(count)]]))
+    for o0, o1 in zip(cuts[:-1].tolist(), cuts[1:].tolist()):
+        c = count[o0:o1]
+        owner = np.repeat(np.arange(o0, o1), c)
+        offset = np.repeat(first[o0:o1] - (np.cumsum(c) - c), c)
+        yield owner, order[offset + np.arange(len(owner))]
 
 
 def _drop_distractor_matches(keep_r: np.ndarray, gi: np.ndarray, ri: np.ndarray, sim: np.ndarray,
