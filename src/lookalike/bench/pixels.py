@@ -52,7 +52,7 @@ from lookalike.viz.robot_pixels import identifier_settings, render_robot_frames,
 
 DEFAULT_SEED = 700_000
 PIXEL_COLUMNS = ("Setup", "Identifier", "Pixels (%)", "Simulated (%)", "Gap (pp)", "Pixel dets", "Sim dets",
-                 "Identifier frames/s")
+                 "Frames/s")
 PERCEPTION_COLUMNS = ("Setup", "Frames", "Recall", "Precision", "Heading error (deg)", "Perception frames/s")
 
 
@@ -188,7 +188,7 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
             rows.append({
                 "Setup": preset_label(setup), "Identifier": name, "Pixels (%)": round(100 * pix, 2),
                 "Simulated (%)": round(100 * sim, 2), "Gap (pp)": round(100 * (pix - sim), 2),
-                "Pixel dets": n_pix, "Sim dets": n_sim, "Identifier frames/s": round(fps, 1),
+                "Pixel dets": n_pix, "Sim dets": n_sim, "Frames/s": round(fps, 1),
             })
     return rows, perception
 

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import typer
+from rich.console import Console
 from rich.table import Table
 
 from lookalike.bench.ident import DEFAULT_SEED, IDENT_COLUMNS, IDENT_TRACKERS, ident_results, ident_table
@@ -25,19 +26,24 @@ TEXT_COLUMNS = ("Setup", "Tracker", "Identifier", "Scenario")
 
 
 def rich_table(title: str | None, rows: list[dict[str, Any]], columns: Sequence[str] | None = None) -> Table:
-    """Table rows (dicts) as a rich table: text columns left, numbers right with thousands separators."""
+    """Table rows (dicts) as a rich table: text columns left and never cut, numbers right with thousands
+    separators."""
     columns = list(columns if columns is not None else (rows[0] if rows else []))
     table = Table(title=title)
-    for c in columns:
-        table.add_column(c, justify="left" if c in TEXT_COLUMNS else "right")
-    for r in rows:
-        table.add_row(*(f"{r[c]:,}" if isinstance(r[c], (int, float)) else str(r[c]) for c in columns))
+    cells = [[f"{r[c]:,}" if isinstance(r[c], (int, float)) else str(r[c]) for c in columns] for r in rows]
+    for k, c in enumerate(columns):  # no cell is ever cut ("kalman…"): headers wrap at spaces instead
+        widest = max([len(row[k]) for row in cells] + [max((len(w) for w in c.split()), default=0)])
+        table.add_column(c, justify="left" if c in TEXT_COLUMNS else "right", min_width=widest)
+    for row in cells:
+        table.add_row(*row)
     return table
 
 
 def print_rows(title: str | None, rows: list[dict[str, Any]], columns: Sequence[str] | None = None) -> None:
-    """Print table rows (dicts) with rich (:func:`rich_table`)."""
-    console.print(rich_table(title, rows, columns))
+    """Print table rows (dicts) with rich (:func:`rich_table`); wider than the terminal rather than cut."""
+    table = rich_table(title, rows, columns)
+    size = Console(width=10_000).measure(table)  # minimum: every cell whole, headers wrapped at spaces
+    (console if size.minimum <= console.width else Console(width=size.maximum)).print(table)
 
 
 def write_results(doc: Results, path: Path | None) -> None:
