@@ -36,9 +36,12 @@ def test_read_gt_with_class_and_visibility(tmp_path):
     [
         ("1,-1,10,20,30,40,0.9\n1,-1,10,20\n", ":2: expected at least 6"),
         ("1,-1,10,20,30,40,0.9\n2,-1,10,x,30,40,0.9\n", ":2: not a number"),
-        ("1,-1,10,20,30,40,0.9\n\n2,-1,10,nan,30,40,0.9\n", ":3: invalid box"),
+        ("1,-1,10,20,30,40,0.9\n\n2,-1,10,nan,30,40,0.9\n", ":3: NaN or infinity"),
         ("1,-1,10,20,-30,40,0.9\n", ":1: invalid box"),
-        ("0,-1,10,20,30,40,0.9\n", ":1: invalid box"),
+        ("0,-1,10,20,30,40,0.9\n", ":1: invalid frame"),
+        ("1,-1,10,20,30,40,0.9\n2.7,-1,10,20,30,40,0.9\n", ":2: invalid frame: frame 2.7 is not an integer"),
+        ("1,-1,10,20,30,40,nan\n", ":1: NaN or infinity"),
+        ("1,-1,10,20,30,40,0.9\n99999,-1,10,20,30,40,0.9\n", ":2: invalid frame: frame 99999 jumps"),
     ],
 )
 def test_malformed_lines_name_file_and_line(tmp_path, text, message):

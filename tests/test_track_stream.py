@@ -43,13 +43,22 @@ def _same_frames(a: list[Frame], b: list[Frame]) -> None:
         assert np.array_equal(x.detections.score, y.detections.score)
 
 
-@pytest.mark.parametrize("length", [None, 40, 75])
+@pytest.mark.parametrize("length", [None, 75])
 @pytest.mark.parametrize("min_score", [-np.inf, 0.5])
 @pytest.mark.parametrize("chunk", [5, 8192])
 def test_stream_yields_the_frames_of_the_whole_table(tmp_path, length, min_score, chunk):
     path = _det_file(tmp_path / "det.txt")
     expected = list(frames_from_table(read_mot(path), length, 25.0, min_score))
     _same_frames(list(DetectionStream(path, length, 25.0, min_score, chunk_lines=chunk)), expected)
+
+
+@pytest.mark.parametrize("chunk", [5, 8192])
+def test_a_frame_past_the_length_is_an_error_naming_the_line(tmp_path, chunk):
+    path = _det_file(tmp_path / "det.txt")
+    frames = [int(float(line.split(",")[0])) for line in path.read_text().splitlines()]
+    line = next(i for i, f in enumerate(frames, start=1) if f > 40)
+    with pytest.raises(ValueError, match=rf"det.txt:{line}: invalid frame: frame {frames[line - 1]} > 40 \(seqLength"):
+        DetectionStream(path, 40, 25.0, chunk_lines=chunk, length_name="seqLength in seqinfo.ini").check()
 
 
 def test_unsorted_file_falls_back_to_reading_it_whole(tmp_path):

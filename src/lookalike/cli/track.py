@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -12,13 +13,14 @@ import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, console, err_console, fail
 from lookalike.cli.track_blobs import run_track_blobs
 from lookalike.cli.track_closed import offline_files, offline_video, track_points
 from lookalike.cli.track_pixels import run_track_pixels
 from lookalike.cli.track_video import run_track_video
 from lookalike.io import find_sequences
 from lookalike.io.needs import box_input_problem
+from lookalike.io.outputs import ensure_writable, refuse_inputs, result_paths
 from lookalike.io.stream import sequence_stream, track_to_file
 from lookalike.loop import RunStats
 from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
@@ -70,22 +72,38 @@ def _progress_bars(count: int) -> Iterator[tuple[Progress, Any]]:
         yield progress, progress.add_task("sequences", total=count)
 
 
-def track_files(path: Path, output: Path, tracker: Any, min_score: float) -> tuple[int, RunStats]:
+_LENGTH_HINT = " (--no-seqinfo-length tracks every frame in the file)"
+
+
+def _input_error(exc: Exception) -> str:
+    """One line for a bad input; the seqLength rule names the option that lifts it."""
+    message = str(exc)
+    return message + _LENGTH_HINT if "(seqLength in" in message else message
+
+
+def track_files(path: Path, output: Path, tracker: Any, min_score: float,
+                use_length: bool = True) -> tuple[int, RunStats]:
     """Track every sequence at ``path`` (a det.txt, a sequence folder or a folder of them) into
-    ``output`` (a file for a single det.txt, else ``output/<sequence>.txt``), streaming."""
+    ``output`` (a file for a single det.txt, else ``output/<sequence>.txt``), streaming. Every input
+    file is checked and every output decided before the first frame is tracked; ``use_length``:
+    seqinfo.ini's seqLength bounds the frames (else every frame in the file is tracked)."""
     try:
         sequences = [s for s in find_sequences(path) if s.det_path is not None]
         if not sequences:
             raise ValueError(f"{path}: no det/det.txt found")
-        streams = [(seq, sequence_stream(seq, min_score)) for seq in sequences]
+        targets = result_paths(path, sequences, output)
+        streams = [(seq, sequence_stream(seq, min_score, use_length)) for seq in sequences]
+        ensure_writable(targets)
     except (FileNotFoundError, ValueError) as exc:
-        fail(str(exc))
+        fail(_input_error(exc))
+    for (seq, frames), target in zip(streams, targets):
+        if frames.rows == 0:
+            err_console.print(f"[yellow]warning:[/] {seq.det_path}: no detections; {target} will hold no tracks")
     stats = RunStats()
     with _progress_bars(len(streams)) as (progress, overall):
-        for seq, frames in streams:
+        for (seq, frames), target in zip(streams, targets):
             tracker.reset()
-            task = progress.add_task(seq.name, total=seq.length)
-            target = output if path.is_file() else output / f"{seq.name}.txt"
+            task = progress.add_task(seq.name, total=frames.length)
 
             def advance(f: Any, t: Any, task: TaskID = task) -> None:
                 progress.advance(task)
@@ -93,10 +111,28 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float) -> tup
             try:
                 track_to_file(tracker, frames, target, advance, stats)
             except ValueError as exc:
-                fail(f"{seq.name}: {exc}")
+                fail(f"{seq.name}: {_input_error(exc)}")
+            except OSError as exc:
+                fail(f"output {target}: cannot write ({exc.strerror or exc})")
             progress.remove_task(task)
             progress.advance(overall)
     return len(streams), stats
+
+
+def _speed(stats: RunStats) -> str:
+    """``N frames, F frames/s (tracker only)``, without a rate when nothing was tracked."""
+    if stats.frames == 0 or not math.isfinite(stats.fps):
+        return f"{stats.frames} frames"
+    return f"{stats.frames} frames, {stats.fps:,.0f} frames/s (tracker only)"
+
+
+def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None]) -> None:
+    """Refuse (exit 2) when the result, or a file written beside it, is one of the input files."""
+    siblings = [output.with_name(output.stem + s) for s in (".health.csv", ".merges.csv", ".det.txt")]
+    try:
+        refuse_inputs([output, *siblings], [p for p in inputs if p is not None and p.is_file()])
+    except ValueError as exc:
+        fail(str(exc))
 
 
 def _check_branches(path: Path | None, video: Path | None, detections: Path | None, annotate: Path | None,
@@ -178,6 +214,8 @@ def track(
                                  "whole sequence at once (offline closed set) before writing the result."),
     points: Path | None = typer.Option(None, "--points", help="Anonymous points as input: a frame,x,y CSV, or "
                                        "MOTChallenge rows frame,id,x,y (tracked as small boxes; --fps, default 25)."),
+    no_seqinfo_length: bool = typer.Option(False, "--no-seqinfo-length", help="Track every frame in det.txt even "
+                                           "past seqinfo.ini's seqLength (by default a frame past it is an error)."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
     branch = _check_branches(path, video, detections, annotate, detector, blob, pipeline, points)
@@ -187,48 +225,53 @@ def track(
         fail("--offline: not with --annotate or --pipeline (the closed set is decided after the whole video)")
     if offline and tracker != "boxtrack":
         fail(f"--offline: the closed set's online pass is boxtrack; use -t boxtrack, not {tracker!r}")
+    _refuse_overwriting_inputs(output, [path, video, detections, points, reports, params_file, detector_model,
+                                        heading_model])
     settings = set_ or []
     team_size = team_size if team_size is not None else targets
     video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
                                          min_score=min_score, fps=fps, features=features)
-    if branch == "pipeline":
-        if params_file is not None:
-            settings = [*(f"{k}={v}" for k, v in tracker_params(tracker, [], params_file).items()), *settings]
-        run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker, settings,
-                         annotate=annotate, fps=fps, min_score=min_score)
-        return
-    trk = _box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets, params_file=params_file)
-    online = tracker_params(tracker, settings, params_file) if offline else None
-    if branch == "points":
-        assert points is not None
-        track_points(points, output, trk, tracker, n_targets=targets, offline=offline, params=online or {}, fps=fps)
-    elif branch in ("blobs", "video"):
-        assert video is not None
-        if branch == "blobs":
-            run_track_blobs(video, output, trk, tracker, detector or "", blob or [], n_targets=targets,
-                            offline=online, **video_options)
-        else:
-            det_path = detections or path
-            assert det_path is not None
-            if online is not None and targets is not None:
-                if output.is_dir():
-                    fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
-                _, count, rate = _video_info(video)
-                offline_video(det_path, output, targets, online, fps or rate, count or None, min_score)
+    try:
+        if branch == "pipeline":
+            if params_file is not None:
+                settings = [*(f"{k}={v}" for k, v in tracker_params(tracker, [], params_file).items()), *settings]
+            run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker, settings,
+                             annotate=annotate, fps=fps, min_score=min_score)
+            return
+        trk = _box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets,
+                           params_file=params_file)
+        online = tracker_params(tracker, settings, params_file) if offline else None
+        if branch == "points":
+            assert points is not None
+            track_points(points, output, trk, tracker, n_targets=targets, offline=offline, params=online or {}, fps=fps)
+        elif branch in ("blobs", "video"):
+            assert video is not None
+            if branch == "blobs":
+                run_track_blobs(video, output, trk, tracker, detector or "", blob or [], n_targets=targets,
+                                offline=online, **video_options)
             else:
-                run_track_video(video, det_path, output, trk, tracker, **video_options)
-    elif online is not None and targets is not None:
-        assert path is not None
-        count = offline_files(path, output, targets, online, min_score)
-        where = output if path.is_file() else f"{output}/<sequence>.txt"
-        console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
-    else:
-        assert path is not None
-        count, stats = track_files(path, output, trk, min_score)
-        where = output if path.is_file() else f"{output}/<sequence>.txt"
-        console.print(f"[green]{tracker}[/]: {count} sequence(s), {stats.frames} frames, "
-                      f"{stats.fps:,.0f} frames/s (tracker only) → {where}")
+                det_path = detections or path
+                assert det_path is not None
+                if online is not None and targets is not None:
+                    if output.is_dir():
+                        fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
+                    _, count, rate = _video_info(video)
+                    offline_video(det_path, output, targets, online, fps or rate, count or None, min_score)
+                else:
+                    run_track_video(video, det_path, output, trk, tracker, **video_options)
+        elif online is not None and targets is not None:
+            assert path is not None
+            count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length)
+            where = output if path.is_file() else f"{output}/<sequence>.txt"
+            console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
+        else:
+            assert path is not None
+            count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length)
+            where = output if path.is_file() else f"{output}/<sequence>.txt"
+            console.print(f"[green]{tracker}[/]: {count} sequence(s), {_speed(stats)} → {where}")
 
+    except OSError as exc:  # an output that cannot be written, an input that cannot be read
+        fail(f"{exc.filename or output}: {exc.strerror or exc}")
 
 @app.command()
 def trackers(

@@ -17,6 +17,7 @@ import numpy as np
 
 from lookalike.cli.app import console, fail
 from lookalike.io import find_sequences, read_mot, write_mot
+from lookalike.io.outputs import ensure_writable, result_paths
 from lookalike.io.points import points_to_rows, read_points_csv, read_points_mot, typical_spacing
 from lookalike.io.stream import track_to_file
 from lookalike.trackers.closed_set import track_closed_set
@@ -26,9 +27,11 @@ from lookalike.types.mot_table import detection_rows
 POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given (frames/s)
 
 
-def table_rows(path: Path, min_score: float = float("-inf")) -> np.ndarray:
-    """Detection rows ``(k, 10)`` of a MOTChallenge file, those scoring below ``min_score`` dropped."""
-    table = read_mot(path)
+def table_rows(path: Path, min_score: float = float("-inf"), length: int | None = None,
+               length_name: str = "the length") -> np.ndarray:
+    """Detection rows ``(k, 10)`` of a MOTChallenge file, those scoring below ``min_score`` dropped
+    (``length``: frames past it are an error, :func:`~lookalike.io.read_mot`)."""
+    table = read_mot(path, length=length, length_name=length_name)
     rows = detection_rows(table.frame, table.xywh, table.conf)
     return rows[rows[:, 6] >= min_score]
 
@@ -41,21 +44,30 @@ def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_f
     return track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online)
 
 
-def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float) -> int:
-    """``--offline`` over every sequence at ``path`` (as ``track_files``): returns the sequences written."""
+def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float,
+                  use_length: bool = True) -> int:
+    """``--offline`` over every sequence at ``path`` (as ``track_files``: outputs decided and inputs
+    checked first; ``use_length``: seqinfo.ini's seqLength bounds the frames): returns the sequences written."""
     try:
         sequences = [s for s in find_sequences(path) if s.det_path is not None]
         if not sequences:
             raise ValueError(f"{path}: no det/det.txt found")
-        for seq in sequences:
+        targets = result_paths(path, sequences, output)
+        ensure_writable(targets)
+        for seq, target in zip(sequences, targets):
             assert seq.det_path is not None
-            det = table_rows(seq.det_path, min_score)
-            n_frames = max(seq.length or 0, int(det[:, 0].max(initial=0)))
+            length = seq.length if use_length else None
+            det = table_rows(seq.det_path, min_score, length, f"seqLength in {seq.root / 'seqinfo.ini'}"
+                             if seq.root is not None else "the length")
+            n_frames = max((seq.length if use_length else None) or 0, int(det[:, 0].max(initial=0)))
             with console.status(f"closed set of {n_targets} on {seq.name}"):
                 rows = closed_set_rows(det, n_targets, seq.frame_rate, n_frames, params)
-            write_mot(output if path.is_file() else output / f"{seq.name}.txt", rows)
+            write_mot(target, rows)
     except (FileNotFoundError, ValueError) as exc:
-        fail(str(exc))
+        message = str(exc)
+        fail(message + (" (--no-seqinfo-length tracks every frame in the file)" if "(seqLength in" in message else ""))
+    except OSError as exc:
+        fail(f"output {output}: cannot write ({exc.strerror or exc})")
     return len(sequences)
 
 

@@ -7,48 +7,61 @@ numbers and :func:`frames_from_table` yields 0-based :class:`Frame` objects.
 from __future__ import annotations
 
 import os
-import tempfile
 import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
 
+from lookalike.io.rules import frame_problems, read_text, temp_beside
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import MotTable, format_row, stack_rows, table_from_array, tracks_to_rows
 
 
-def read_mot(path: str | os.PathLike[str], min_columns: int = 6) -> MotTable:
-    """Read a MOTChallenge text file.
+def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | None = None,
+             length_name: str = "the length") -> MotTable:
+    """Read a MOTChallenge text file (UTF-8).
 
-    Raises ``ValueError`` naming the file and 1-based line number of a malformed line (too few
-    columns, a non-number, NaN or infinity, a negative size, a frame number below 1).
+    Raises ``ValueError`` naming the file and 1-based line number of a malformed line: too few
+    columns, a non-number, NaN or infinity in the first 7 columns (frame, id, box, score), a negative
+    size, a frame number that is not an integer >= 1, past ``length`` (named ``length_name``), or
+    that jumps too far (:mod:`lookalike.io.rules`); or naming the file when it is not UTF-8 text.
     """
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
     fast = _parse_fast(path, min_columns)
-    if fast is not None:
+    if fast is not None and row_problem(fast, length=length) is None:
         return table_from_array(fast, path)
-    rows = [(i + 1, ln) for i, ln in enumerate(path.read_text().splitlines()) if ln.strip()]
+    rows = [(i + 1, ln) for i, ln in enumerate(read_text(path).splitlines()) if ln.strip()]
     if not rows:
         return table_from_array(np.zeros((0, 7)), path)
     data = _parse_slowly(path, rows, min_columns)
-    bad = _invalid_rows(data)
-    if bad.any():
-        line_no, line = rows[int(np.flatnonzero(bad)[0])]
-        raise ValueError(
-            f"{path}:{line_no}: invalid box (NaN/inf, negative size or frame < 1): {line.strip()!r}"
-        )
+    problem = row_problem(data, length=length, length_name=length_name)
+    if problem is not None:
+        line_no, line = rows[problem[0]]
+        raise ValueError(f"{path}:{line_no}: {problem[1]}: {line.strip()[:80]!r}")
     return table_from_array(data, path)
 
 
-def _invalid_rows(data: np.ndarray) -> np.ndarray:
-    return ~np.isfinite(data[:, :6]).all(axis=1) | (data[:, 4:6] < 0).any(axis=1) | (data[:, 0] < 1)
+def row_problem(data: np.ndarray, previous_max: float = 0.0, length: int | None = None,
+                length_name: str = "the length") -> tuple[int, str] | None:
+    """``(row, reason)`` of the first row of ``data`` ``(k, c)`` that breaks the rules of
+    :func:`read_mot` (``previous_max``: the largest frame of the rows before), else None."""
+    if not len(data):
+        return None
+    box = ~np.isfinite(data[:, 1:7]).all(axis=1)
+    size = (data[:, 4:6] < 0).any(axis=1)
+    frame = frame_problems(data[:, 0], previous_max, length, length_name)
+    first = [(int(np.flatnonzero(box)[0]), "NaN or infinity in frame, id, box or score") if box.any() else None,
+             (int(np.flatnonzero(size)[0]), "invalid box: negative width or height") if size.any() else None,
+             (frame[0], f"invalid frame: {frame[1]}") if frame is not None else None]
+    found = [p for p in first if p is not None]
+    return min(found, key=lambda p: p[0]) if found else None
 
 
 def _parse_fast(path: Path, min_columns: int) -> np.ndarray | None:
-    """numpy's C parser for regular, valid files; None when anything needs a closer look."""
+    """numpy's C parser for regular files; None when anything needs a closer look."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # an empty file warns
@@ -56,8 +69,8 @@ def _parse_fast(path: Path, min_columns: int) -> np.ndarray | None:
     except ValueError:
         return None
     if data.shape[0] == 0:
-        return np.zeros((0, 7)) if not path.read_text().strip() else None
-    if data.shape[1] < min_columns or _invalid_rows(data).any():
+        return np.zeros((0, 7)) if not read_text(path).strip() else None
+    if data.shape[1] < min_columns:
         return None
     return data
 
@@ -113,7 +126,7 @@ def write_mot(path: str | os.PathLike[str], rows: Iterable[np.ndarray] | np.ndar
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     data = np.asarray(rows, dtype=float) if isinstance(rows, np.ndarray) else stack_rows(rows)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    fd, tmp = temp_beside(path)
     try:
         with os.fdopen(fd, "w") as fh:
             for row in data:

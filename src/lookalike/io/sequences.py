@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import configparser
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
+
+from lookalike.io.rules import read_text
 
 
 @dataclass(frozen=True)
@@ -32,12 +35,13 @@ class MotSequence:
 
 
 def read_seqinfo(path: str | os.PathLike[str]) -> dict[str, str]:
-    """The ``[Sequence]`` section of a ``seqinfo.ini`` as a dict (keys as written)."""
+    """The ``[Sequence]`` section of a ``seqinfo.ini`` as a dict (keys as written); ``ValueError``
+    naming the file when it is not UTF-8 text, malformed, or has no such section."""
     path = Path(path)
-    parser = configparser.ConfigParser()
+    parser = configparser.ConfigParser(interpolation=None)
     parser.optionxform = str  # type: ignore[assignment,method-assign]  # keep key case
     try:
-        parser.read_string(path.read_text(), source=str(path))
+        parser.read_string(read_text(path), source=str(path))
     except configparser.Error as exc:
         raise ValueError(f"{path}: malformed seqinfo.ini ({exc})") from None
     if "Sequence" not in parser:
@@ -45,21 +49,49 @@ def read_seqinfo(path: str | os.PathLike[str]) -> dict[str, str]:
     return dict(parser["Sequence"])
 
 
+def _positive_int(info: dict[str, str], key: str, path: Path) -> int:
+    text = info[key].strip()
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise ValueError(f"{path}: {key} must be an integer >= 1, got {text!r}")
+    return value
+
+
+def _frame_rate(info: dict[str, str], path: Path) -> float:
+    text = info["frameRate"].strip()
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{path}: frameRate must be a positive number (frames per second), got {text!r}")
+    return value
+
+
+def _plain_name(name: str, path: Path) -> str:
+    """``name`` if it can name a result file (``<name>.txt``): not empty, no folder separators."""
+    if not name.strip() or name in (".", "..") or any(c in name for c in "/\\\0") or name != name.strip():
+        raise ValueError(f"{path}: name must be a plain file name (no '/', not empty), got {name!r}")
+    return name
+
+
 def _sequence_from_folder(folder: Path) -> MotSequence:
+    """The sequence in ``folder``; its ``seqinfo.ini`` (if any) is checked: ``seqLength``, ``imWidth``,
+    ``imHeight`` integers >= 1, ``frameRate`` a positive number, ``name`` a plain file name."""
     det = folder / "det" / "det.txt"
     gt = folder / "gt" / "gt.txt"
     info_path = folder / "seqinfo.ini"
     name, rate, length, size = folder.name, 30.0, None, None
     if info_path.is_file():
         info = read_seqinfo(info_path)
-        try:
-            name = info.get("name", name)
-            rate = float(info.get("frameRate", rate))
-            length = int(info["seqLength"]) if "seqLength" in info else None
-            if "imWidth" in info and "imHeight" in info:
-                size = (int(info["imWidth"]), int(info["imHeight"]))
-        except ValueError as exc:
-            raise ValueError(f"{info_path}: {exc}") from None
+        name = _plain_name(info.get("name", name), info_path)
+        rate = _frame_rate(info, info_path) if "frameRate" in info else rate
+        length = _positive_int(info, "seqLength", info_path) if "seqLength" in info else None
+        if "imWidth" in info and "imHeight" in info:
+            size = (_positive_int(info, "imWidth", info_path), _positive_int(info, "imHeight", info_path))
     return MotSequence(
         name=name,
         root=folder,

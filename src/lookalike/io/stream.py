@@ -2,7 +2,7 @@
 detection file, and result rows written as they come to a file that appears atomically at the end.
 
 :class:`DetectionStream` checks the whole file first (chunk by chunk, constant memory: the same
-errors as :func:`~lookalike.io.read_mot`, before any frame is produced), then yields one
+errors as :func:`~lookalike.io.read_mot`, frame rules included, before any frame is produced), then yields one
 :class:`~lookalike.types.Frame` per frame, parsing the file again a chunk at a time. A file whose
 frame numbers ever decrease (allowed, but unusual) or whose lines have differing column counts is
 read whole instead; either way the frames equal :func:`~lookalike.io.frames_from_table`'s.
@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import itertools
 import os
-import tempfile
 import warnings
 from collections.abc import Iterable, Iterator
 from pathlib import Path
@@ -21,7 +20,8 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from lookalike.io.motchallenge import frames_from_table, read_mot
+from lookalike.io.motchallenge import frames_from_table, read_mot, row_problem
+from lookalike.io.rules import temp_beside
 from lookalike.io.sequences import MotSequence
 from lookalike.loop import RunStats, Sink, Sinks, Updating, run
 from lookalike.types import Detections, Frame
@@ -31,8 +31,9 @@ CHUNK_LINES = 8_192
 
 
 def _chunks(path: Path, lines: int) -> Iterator[np.ndarray]:
-    """The file's rows, ``lines`` text lines at a time, parsed by numpy's C parser (``(k, c)``)."""
-    with open(path) as fh:
+    """The file's rows, ``lines`` text lines at a time, parsed by numpy's C parser (``(k, c)``);
+    ``ValueError`` for anything it cannot parse (then :func:`read_mot` says where)."""
+    with open(path, encoding="utf-8") as fh:
         while True:
             block = list(itertools.islice(fh, lines))
             if not block:
@@ -49,39 +50,44 @@ class DetectionStream:
 
     Args:
         path: the detection file (``det.txt``).
-        length: number of frames (frames ``0 .. length-1``; rows past it are ignored), or None for
+        length: number of frames (frames ``0 .. length-1``; a row past it is an error), or None for
             the last frame in the file.
         frame_rate: frames per second (``time = index / frame_rate``).
         min_score: boxes with a lower score are dropped.
         chunk_lines: lines parsed at a time.
+        length_name: what ``length`` is, for error messages (e.g. ``seqLength in X/seqinfo.ini``).
     """
 
     def __init__(self, path: str | os.PathLike[str], length: int | None = None, frame_rate: float = 30.0,
-                 min_score: float = -np.inf, chunk_lines: int = CHUNK_LINES) -> None:
-        if frame_rate <= 0:
-            raise ValueError(f"frame_rate must be positive, got {frame_rate}")
+                 min_score: float = -np.inf, chunk_lines: int = CHUNK_LINES, length_name: str = "the length") -> None:
+        if not (np.isfinite(frame_rate) and frame_rate > 0):
+            raise ValueError(f"frame_rate must be a positive number, got {frame_rate}")
+        if length is not None and length < 0:
+            raise ValueError(f"length must be >= 0, got {length}")
         self.path, self.length, self.frame_rate = Path(path), length, frame_rate
-        self.min_score, self.chunk_lines = min_score, chunk_lines
+        self.min_score, self.chunk_lines, self.length_name = min_score, chunk_lines, length_name
         self._streamable: bool | None = None
+        self.rows = 0  # rows in the file (known after check())
 
     def check(self) -> DetectionStream:
         """Read the file once (constant memory); raise ``ValueError`` / ``FileNotFoundError`` as
-        :func:`~lookalike.io.read_mot` does for a malformed file. Returns ``self``."""
+        :func:`~lookalike.io.read_mot` does for a malformed file (with ``length``). Returns ``self``."""
         if not self.path.is_file():
             raise FileNotFoundError(f"{self.path}: no such file")
-        last, width = 0, None
+        last, width, rows = 0.0, None, 0
         try:
             for data in _chunks(self.path, self.chunk_lines):
                 frames = data[:, 0]
                 bad = (data.shape[1] < 6 or (width is not None and data.shape[1] != width)
-                       or not np.isfinite(data[:, :6]).all() or (data[:, 4:6] < 0).any() or frames.min() < 1
+                       or row_problem(data, last, self.length) is not None
                        or frames[0] < last or (np.diff(frames) < 0).any())
                 if bad:
                     raise ValueError
-                width, last = data.shape[1], frames[-1]
-            self._streamable = True
+                width, last, rows = data.shape[1], float(frames[-1]), rows + len(data)
+            self._streamable, self.rows = True, rows
         except ValueError:
-            read_mot(self.path)  # raises the precise error, or the file is valid but irregular
+            # raises the precise error, or the file is valid but irregular (read whole)
+            self.rows = len(read_mot(self.path, length=self.length, length_name=self.length_name))
             self._streamable = False
         return self
 
@@ -143,8 +149,7 @@ class MotWriter:
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", dir=self.path.parent)
-        self._tmp = Path(tmp)
+        fd, self._tmp = temp_beside(self.path)
         self._fh: TextIO | None = os.fdopen(fd, "w")
         self.rows = 0
 
@@ -162,9 +167,13 @@ class MotWriter:
     def close(self) -> Path:
         """Finish the file: rename the temporary file to ``path``. Returns ``path``."""
         if self._fh is not None:
-            self._fh.close()
-            self._fh = None
-            os.replace(self._tmp, self.path)
+            fh, self._fh = self._fh, None
+            try:
+                fh.close()
+                os.replace(self._tmp, self.path)
+            except BaseException:
+                self._tmp.unlink(missing_ok=True)
+                raise
         return self.path
 
     def abort(self) -> None:
@@ -185,11 +194,14 @@ class MotWriter:
             self.abort()
 
 
-def sequence_stream(seq: MotSequence, min_score: float = -np.inf) -> DetectionStream:
-    """The checked :class:`DetectionStream` of a sequence's detection file (its length and frame rate)."""
+def sequence_stream(seq: MotSequence, min_score: float = -np.inf, use_length: bool = True) -> DetectionStream:
+    """The checked :class:`DetectionStream` of a sequence's detection file (its frame rate, and its
+    ``seqLength`` unless ``use_length`` is false: then every frame in the file is tracked)."""
     if seq.det_path is None:
         raise ValueError(f"{seq.name}: no detection file")
-    return DetectionStream(seq.det_path, seq.length, seq.frame_rate, min_score).check()
+    length = seq.length if use_length else None
+    where = f"seqLength in {seq.root / 'seqinfo.ini'}" if seq.root is not None else "the length"
+    return DetectionStream(seq.det_path, length, seq.frame_rate, min_score, length_name=where).check()
 
 
 def track_to_file(tracker: Updating, frames: Iterable[Frame], output: str | os.PathLike[str],

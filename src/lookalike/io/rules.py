@@ -1,0 +1,95 @@
+"""The input rules every reader in :mod:`lookalike.io` applies, and file creation with the user's umask.
+
+Frame numbers in files are integers >= 1. A frame may not jump past the frames seen so far by more
+than ``max(MIN_GAP, GAP_FACTOR × the largest frame so far)``: one stray frame number such as 1e8 in a
+short file is an error, not a run over 10^8 empty frames. With a declared length (``seqLength`` in
+``seqinfo.ini``, ``n_frames``) frames past it are an error and the jump rule is not needed.
+docs/concepts/data-formats.md lists the rules and what each bad input gets.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+MIN_GAP = 10_000  # frames: a jump up to this is always allowed
+GAP_FACTOR = 10  # ... and up to this times the largest frame number seen before it
+
+
+def read_text(path: str | os.PathLike[str]) -> str:
+    """The text of ``path`` (UTF-8); ``FileNotFoundError``/``ValueError`` naming the file otherwise
+    (not a file, not readable, not UTF-8 text)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise ValueError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x}); "
+                         "expected a text file") from None
+
+
+def frame_problems(frames: np.ndarray, previous_max: float = 0.0, length: int | None = None,
+                   length_name: str = "the length") -> tuple[int, str] | None:
+    """``(index, reason)`` of the first frame number in ``frames`` (file order, 1-based) that breaks
+    the rules (not finite, not an integer >= 1, past ``length``, or a jump past the bound), else None.
+    ``previous_max``: the largest frame before these (streaming); ``length_name`` names the length."""
+    frames = np.asarray(frames, dtype=float)
+    if not len(frames):
+        return None
+    finite = np.isfinite(frames)
+    bad_int = ~finite | (frames < 1) | (np.floor(np.where(finite, frames, 0)) != np.where(finite, frames, 1))
+    bad_len = finite & (frames > length) if length is not None else np.zeros(len(frames), bool)
+    if length is None:
+        before = np.maximum.accumulate(np.concatenate([[previous_max], np.where(finite, frames, 0)]))[:-1]
+        bad_gap = finite & (frames - before > np.maximum(MIN_GAP, GAP_FACTOR * before))
+    else:
+        bad_gap = np.zeros(len(frames), bool)
+    bad = bad_int | bad_len | bad_gap
+    if not bad.any():
+        return None
+    i = int(np.flatnonzero(bad)[0])
+    f = frames[i]
+    if bad_int[i]:
+        return i, f"frame {f:g} is not an integer >= 1"
+    if bad_len[i]:
+        return i, f"frame {int(f)} > {length} ({length_name})"
+    prev = int(before[i])
+    return i, (f"frame {int(f)} jumps {int(f) - prev} frames past frame {prev} (at most "
+               f"max({MIN_GAP}, {GAP_FACTOR} x {prev}) allowed; is the frame number a typo?)")
+
+
+def user_mode() -> int:
+    """The mode a new file gets from ``open()``: ``0o666`` less the process umask."""
+    status = Path("/proc/self/status")
+    try:
+        for line in status.read_text().splitlines():
+            if line.startswith("Umask:"):
+                return 0o666 & ~int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)  # no other way to read it; restored at once
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def temp_beside(path: Path) -> tuple[int, Path]:
+    """A new temporary file beside ``path`` (same folder, so that ``os.replace`` is atomic), with
+    the mode of a file created by ``open()`` (:func:`user_mode`), not ``mkstemp``'s 0600."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        os.fchmod(fd, user_mode())
+    except OSError:
+        pass  # a file system without modes
+    return fd, Path(tmp)
+
+
+__all__ = ["GAP_FACTOR", "MIN_GAP", "frame_problems", "read_text", "temp_beside", "user_mode"]
