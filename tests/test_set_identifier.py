@@ -110,3 +110,20 @@ def test_shipped_weights_load_for_sizes_never_trained_separately():
     seq = simulate_robots(world(12, 14, 2.0), 10, 3)
     for frame in seq.frames():
         tracker.update(frame)
+
+
+def test_training_writes_loadable_weights_and_resumes(tmp_path):
+    pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
+    from dataclasses import replace
+
+    from lookalike.learn.set_training import SetTrainConfig, train_set
+
+    config = SetTrainConfig(token=8, pair=12, memory=6, n_max=3, batch_size=2, sequence_length=20, bptt=20, steps=2,
+                            validation_sequences=1, validation_length=20, validation_every=1)
+    first = train_set(config, tmp_path)
+    assert first.steps == 2 and 0.0 <= first.best_success <= 1.0
+    NumpySetAssociator(load_set_weights(first.weights_path))
+    with pytest.raises(ValueError, match="another configuration"):
+        train_set(replace(config, pair=10), tmp_path, resume=True)
+    more = train_set(replace(config), tmp_path, resume=True)  # already at its last step: nothing more to do
+    assert more.steps == 2

@@ -1,4 +1,5 @@
-"""``lookalike train``: train the LSTM associator on the robot simulator (needs the 'train' extra)."""
+"""``lookalike train``: train the LSTM associator (or, with ``--model set``, the set associator for every
+team size) on the robot simulator (needs the 'train' extra)."""
 
 from __future__ import annotations
 
@@ -47,12 +48,22 @@ def train(
         "no augmentation beyond slot shuffling; shipped as lstm_paper_*)."),
     noise: str = typer.Option("ours", help="Simulator noise model of the training sequences: ours, paper or mix "
                               "(each sequence draws one from its seed)."),
+    model: str = typer.Option(
+        "lstm", "--model", help="lstm (one network per --preset), or set: one set associator for every team size "
+        "(N 1-12, M up to 2N+3, drawn per batch; --preset, --cell, --layers, --relative, --protocol, --noise, "
+        "--init-from do not apply, --hidden is its memory width; shipped as set_any)."),
 ) -> None:
     """Train the association network on simulated sequences generated on the fly."""
     try:
         import torch
     except ImportError:
         fail("training needs PyTorch: pip install 'lookalike[train]' (torch==2.13.0)")
+    if model not in ("lstm", "set"):
+        fail(f"--model: unknown model {model!r}; known: lstm, set")
+    if model == "set":
+        _train_set(output, steps, minutes, batch_size, seed, patience, threads, device, workers, backend, address,
+                   resume, ship)
+        return
     from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.encoding import EncodingSpec
     from lookalike.learn.paper_protocol import NoiseMixSampler, noise_worlds
@@ -118,3 +129,53 @@ def train(
         shutil.copy(result.weights_path, target.with_suffix(".npz"))
         shutil.copy(result.weights_path.with_suffix(".json"), target.with_suffix(".json"))
         console.print(f"shipped as {target.with_suffix('.npz')}")
+
+
+def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int, seed: int, patience: int,
+               threads: int, device: str, workers: int, backend: str, address: str | None, resume: bool,
+               ship: bool) -> None:
+    """``lookalike train --model set``: the set associator over every team size (issue 23)."""
+    import torch
+
+    from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+    from lookalike.learn.set_training import SetTrainConfig, train_set
+    from lookalike.learn.training import plot_log
+    from lookalike.parallel import JobPool
+
+    if device == "auto":
+        device = "cuda" if torch.cuda.is_available() else "cpu"
+    if device.startswith("cuda") and not torch.cuda.is_available():
+        fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
+    try:
+        config = SetTrainConfig(steps=steps, minutes=minutes, batch_size=batch_size, seed=seed, patience=patience)
+        pool = JobPool(workers, backend, address)
+    except ValueError as exc:
+        fail(str(exc))
+    torch.set_num_threads(threads)
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+               TextColumn("loss {task.fields[loss]:.3f}  validation {task.fields[val]}"))
+    with Progress(*columns, console=console) as progress:
+        task = progress.add_task("training set (N 1-12)", total=steps, loss=math.nan, val="–")
+
+        def on_step(row: dict) -> None:
+            fields = {"loss": row["loss"]}
+            if not math.isnan(row["val_success"]):
+                fields["val"] = f"{100 * row['val_success']:.1f}%"
+            progress.update(task, completed=row["step"], **fields)
+
+        try:
+            with pool:
+                result = train_set(config, output, resume=resume, on_step=on_step, device=device, pool=pool)
+        except ValueError as exc:
+            fail(str(exc))
+    png = plot_log(result.log_path, output / "training_log.png")
+    console.print(
+        f"best validation success rate [bold]{100 * result.best_success:.1f}%[/] (mean over the validation teams) "
+        f"at step {result.best_step} of {result.steps}; weights {result.weights_path}, log {result.log_path}, "
+        f"plot {png}"
+    )
+    if ship:
+        SHIPPED_SET_WEIGHTS.parent.mkdir(exist_ok=True)
+        shutil.copy(result.weights_path, SHIPPED_SET_WEIGHTS)
+        shutil.copy(result.weights_path.with_suffix(".json"), SHIPPED_SET_WEIGHTS.with_suffix(".json"))
+        console.print(f"shipped as {SHIPPED_SET_WEIGHTS}")

@@ -39,7 +39,7 @@ class SetTrainConfig:
     """Hyper-parameters of one set-associator training run."""
 
     token: int = 32
-    pair: int = 64
+    pair: int = 48
     memory: int = 48
     n_min: int = 1
     n_max: int = 12
@@ -55,8 +55,8 @@ class SetTrainConfig:
     steps: int = 3000
     minutes: float | None = None
     validation_sequences: int = 2
-    validation_length: int = 600
-    validation_every: int = 50
+    validation_length: int = 450
+    validation_every: int = 25
     patience: int = 12
     grad_clip: float = 1.0
     seed: int = 0
@@ -99,6 +99,11 @@ def validate(model: SetAssociator, batches: list[tuple], device: str = "cpu") ->
     return float(np.mean(rates))
 
 
+def _run_shape(config: dict) -> dict:
+    """The configuration without the stopping rules (a run may be resumed with more steps or minutes)."""
+    return {k: v for k, v in config.items() if k not in ("steps", "minutes", "patience")}
+
+
 def _export(model: SetAssociator, config: SetTrainConfig, info: dict) -> SetWeights:
     return SetWeights(model.export(), config.token, config.pair, config.memory, info={"config": asdict(config), **info})
 
@@ -128,7 +133,7 @@ def train_set(
     history: list[dict] = []
     if resume and ckpt_path.is_file():
         state = torch.load(ckpt_path, weights_only=False, map_location=device)
-        if state["config"] != asdict(config):
+        if _run_shape(state["config"]) != _run_shape(asdict(config)):
             raise ValueError(f"{ckpt_path}: was made with another configuration; remove it or drop --resume")
         model.load_state_dict(state["model"])
         optimiser.load_state_dict(state["optimiser"])
