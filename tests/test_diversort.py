@@ -146,3 +146,44 @@ def test_missing_features_and_bad_config_raise() -> None:
     trk.update(Frame(index=0, time=0.0))  # an empty frame without features is fine
     with pytest.raises(ValueError, match="appearance_threshold"):
         make_tracker("diversort", appearance_threshold=-1.0)
+
+
+def _many_short_lived(trk: DiverSort, n_frames: int, seed: int = 0, start: int = 0) -> int:
+    """From frame ``start``, every 4 frames a new diver (its own random feature) swims for 4 frames
+    and leaves; returns the largest number of tracks held."""
+    rng = np.random.default_rng(seed)
+    feat, largest = None, 0
+    for k in range(start, start + n_frames):
+        if k % 4 == 0:
+            feat = rng.normal(size=64)  # (64 dimensions: unrelated divers look unrelated)
+            feat /= np.linalg.norm(feat)
+        trk.update(frame(k, [[100 + 300 * ((k // 4) % 2), 100, 60, 120]], [feat]))
+        largest = max(largest, len(trk._tracks))
+    return largest
+
+
+def test_long_lost_tracks_are_capped() -> None:
+    """Issue 19 row: with max_age=None memory grew without bound over long runs."""
+    capped = DiverSort(DiverSort.Config(max_lost=20))
+    assert _many_short_lived(capped, 600) <= 20 + 2
+    assert len(capped._gallery) <= 20 + 2
+    uncapped = DiverSort(DiverSort.Config(max_lost=None))
+    assert _many_short_lived(uncapped, 600) > 100  # (what happened before the cap)
+    default = DiverSort()
+    assert default.config.max_lost == 200
+    assert _many_short_lived(default, 1000) <= 200 + 2  # 250 identities
+
+
+def test_identity_persists_within_the_cap() -> None:
+    a64 = np.zeros(64)
+    a64[0] = 1.0
+    trk = DiverSort(DiverSort.Config(max_lost=30))
+    for k in range(4):
+        out = trk.update(frame(k, [[100, 100, 60, 120]], [a64]))
+    first = ids_of(out)[0]
+    _many_short_lived(trk, 80, start=4)  # 20 other identities come and go: fewer than the cap
+    out = [trk.update(frame(k, [[500, 50, 60, 120]], [a64])) for k in range(84, 87)][-1]
+    assert ids_of(out)[0] == first
+    _many_short_lived(trk, 200, seed=1, start=88)  # 50 more: A is the longest unseen and is forgotten
+    out = [trk.update(frame(k, [[500, 50, 60, 120]], [a64])) for k in range(288, 291)][-1]
+    assert ids_of(out)[0] != first

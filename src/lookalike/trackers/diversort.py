@@ -20,8 +20,8 @@ The seven mechanisms of the paper, each a step of :meth:`DiverSort.update`:
    (25%) of their pairwise gallery distances are below ``recovery_threshold``. Every merge is
    recorded in :attr:`DiverSort.merges` (frame index, source id, target id); the target id is
    reported from that frame on.
-7. **Persistent identities**: confirmed tracks are never deleted (``max_age = None``), as the team
-   is small and fixed.
+7. **Persistent identities**: confirmed tracks are not deleted for being unseen (``max_age = None``),
+   but at most ``max_lost`` (200) unseen ones are kept; beyond it the longest unseen is forgotten (ours).
 
 Where the defaults come from: docs/trackers/diversort.md.
 """
@@ -104,7 +104,7 @@ class DiverSort:
         rows = np.flatnonzero(det_of_track >= 0)
         if len(rows):
             self._correct(rows, det.xywh[det_of_track[rows]], centre[det_of_track[rows]], features[det_of_track[rows]])
-        keep = self._lifecycle.alive(t)
+        keep = self._lifecycle.alive(t) & self._within_lost_cap()
         self._keep(keep)
         det_of_track = det_of_track[keep]
         new = np.flatnonzero(matching.free)
@@ -139,6 +139,18 @@ class DiverSort:
         tied = (np.isfinite(cost) & (cost <= best + cfg.tie_margin)).sum(axis=0) > 1
         cost[:, tied] += cfg.location_weight * location[:, tied]
         return cost
+
+    def _within_lost_cap(self) -> np.ndarray:
+        """(7) Tracks kept: all but the longest-unseen confirmed ones beyond ``max_lost`` (ties: oldest id)."""
+        cap, t = self.config.max_lost, self._tracks
+        keep = np.ones(len(t), dtype=bool)
+        if cap is None:
+            return keep
+        lost = np.flatnonzero(t.confirmed & (t.misses > 0))
+        if len(lost) > cap:
+            order = lost[np.lexsort((t.ids[lost], t["last_seen"][lost]))]
+            keep[order[: len(lost) - cap]] = False
+        return keep
 
     def _recover(self, frame_index: int, det_of_track: np.ndarray) -> np.ndarray:
         """(6) Merge young confirmed tracks into identities unseen since their birth."""

@@ -39,6 +39,8 @@ class DiverSortConfig:
     recovery_threshold: float = param(0.30, "cosine distance counted as similar for recovery", range=(0, 2))
     gallery_size: int = param(100, "features kept per track", range=COUNT)
     max_age: int | None = param(None, "frames a confirmed track survives unseen (None: forever)", range=COUNT)
+    max_lost: int | None = param(200, "unseen confirmed tracks kept for re-identification; beyond it the longest "
+                                 "unseen is forgotten (None: no cap, memory grows)", range=COUNT)
     position_std_frac: float = param(0.15, "centre measurement noise as a fraction of box height", range=POSITIVE)
     accel_std_frac: float = param(1 / 20, "centre acceleration noise per frame, fraction of box height", range=POSITIVE)
     frame_interval_s: float | None = param(None, "seconds per frame (None: the smallest step seen)", range=POSITIVE)
