@@ -141,3 +141,34 @@ def test_eval_results_with_some_metrics_only(tmp_path):
     path.write_text(json.dumps({"sort": {"a": {"Recall": 0.5}}}))
     with pytest.raises(ValueError, match="none of"):
         load_results(path)
+
+
+def test_tails_break_at_jumps_and_keep_a_limited_length():
+    from lookalike.viz import Tails
+
+    tails = Tails(length=5, max_jump=1.0)
+    for f in range(4):
+        tails.add(f, 7, np.array([0.1 * f, 0.0]))
+    tails.add(4, 7, np.array([50.0, 0.0]))  # an identity switch: a jump
+    (_, pts), = tails.items()
+    assert len(pts) == 5 and np.isnan(pts[-2]).all() and pts[-1][0] == 50.0
+
+
+def test_labels_avoid_each_other():
+    from lookalike.viz import LabelSpace, draw_label
+
+    img = np.zeros((240, 320, 3), np.uint8)
+    space = LabelSpace()
+    a = draw_label(img, "false positive", (100, 100), (200, 200, 200), labels=space, box=(100, 100, 130, 160))
+    b = draw_label(img, "robot 2", (105, 100), (0, 140, 255), labels=space, box=(105, 100, 135, 160))
+    assert a[2] <= b[0] or b[2] <= a[0] or a[3] <= b[1] or b[3] <= a[1]  # no overlap
+
+
+def test_robot_labels_are_one_based_and_diver_boxes_are_true_false_or_missed():
+    from lookalike.viz.divers_scene import true_false_missed
+    from lookalike.viz.robots_scene import robot_label
+
+    assert robot_label(0) == "robot 1" and robot_label(-1) == "false positive"
+    gt = np.array([[1, 1, 0, 0, 10, 10, 1, 1, 1.0], [1, 2, 50, 50, 10, 10, 1, 1, 1.0]])
+    on, missed = true_false_missed(np.array([[1, 1, 10, 10], [100, 100, 10, 10]], float), gt)
+    assert on.tolist() == [True, False] and missed.tolist() == [[50, 50, 10, 10]]

@@ -4,11 +4,13 @@ OpenCV, matplotlib and Pillow are imported lazily inside the functions that use 
 """
 
 from lookalike.viz.annotate import (
+    LabelSpace,
     Tails,
     draw_box,
     draw_box_tracks,
     draw_caption,
     draw_label,
+    draw_legend,
     draw_tail,
 )
 from lookalike.viz.colors import identity_colour, rgb_hex
@@ -18,6 +20,7 @@ from lookalike.viz.video import VideoWriter, read_frames, video_info, write_gif
 
 __all__ = [
     "HtmlReport",
+    "LabelSpace",
     "Tails",
     "VideoWriter",
     "birdseye_plot",
@@ -25,6 +28,7 @@ __all__ = [
     "draw_box_tracks",
     "draw_caption",
     "draw_label",
+    "draw_legend",
     "draw_tail",
     "grouped_bar_chart",
     "identity_colour",

@@ -1,7 +1,9 @@
-"""Drawing tracking results on frames: identity-coloured boxes, labels, tails and a caption.
+"""Drawing tracking results on frames: identity-coloured boxes, labels, tails, a caption and a legend.
 
-All coordinates are pixels of the image being drawn on; images are ``(h, w, 3)`` uint8 BGR and are
-modified in place. OpenCV is imported lazily.
+Every coloured mark has a dark outline (:data:`~lookalike.viz.colors.OUTLINE`) so that it stands out
+on any scene; labels placed through a :class:`LabelSpace` avoid each other; tails keep a limited
+number of points and break at gaps and jumps. All coordinates are pixels of the image being drawn
+on; images are ``(h, w, 3)`` uint8 BGR and are modified in place. OpenCV is imported lazily.
 """
 
 from __future__ import annotations
@@ -10,12 +12,34 @@ from collections import deque
 
 import numpy as np
 
-from lookalike.viz.colors import BGR, identity_colour
+from lookalike.viz.colors import BGR, OUTLINE, identity_colour
+
+Rect = tuple[int, int, int, int]  # x0, y0, x1, y1 (px)
+
+
+class LabelSpace:
+    """The label tags already drawn on one image, so that the next label goes where it hides none."""
+
+    def __init__(self) -> None:
+        self.taken: list[Rect] = []
+
+    def free(self, rect: Rect) -> bool:
+        """Whether ``rect`` overlaps no tag placed so far."""
+        x0, y0, x1, y1 = rect
+        return all(x1 <= a0 or a1 <= x0 or y1 <= b0 or b1 <= y0 for a0, b0, a1, b1 in self.taken)
+
+
+def _segment(image: np.ndarray, a: tuple[int, int], b: tuple[int, int], colour: BGR, thickness: int) -> None:
+    import cv2
+
+    cv2.line(image, a, b, OUTLINE, thickness + 2, cv2.LINE_AA)
+    cv2.line(image, a, b, colour, thickness, cv2.LINE_AA)
 
 
 def draw_box(image: np.ndarray, xywh: np.ndarray, colour: BGR, label: str | None = None,
-             thickness: int = 2, dashed: bool = False) -> None:
-    """A box ``xywh (4,)`` (px) with an optional filled label above it (below when at the top edge)."""
+             thickness: int = 2, dashed: bool = False, labels: LabelSpace | None = None) -> None:
+    """A box ``xywh (4,)`` (px) with a dark outline and an optional filled label above it (placed
+    where it hides no earlier label of ``labels``)."""
     import cv2
 
     x, y, w, h = (float(v) for v in xywh)
@@ -28,38 +52,58 @@ def draw_box(image: np.ndarray, xywh: np.ndarray, colour: BGR, label: str | None
             for k in range(0, n, 2):
                 s = (round(a[0] + (b[0] - a[0]) * k / n), round(a[1] + (b[1] - a[1]) * k / n))
                 e = (round(a[0] + (b[0] - a[0]) * (k + 1) / n), round(a[1] + (b[1] - a[1]) * (k + 1) / n))
-                cv2.line(image, s, e, colour, thickness, cv2.LINE_AA)
+                _segment(image, s, e, colour, thickness)
     else:
+        cv2.rectangle(image, p0, p1, OUTLINE, thickness + 2, cv2.LINE_AA)
         cv2.rectangle(image, p0, p1, colour, thickness, cv2.LINE_AA)
     if label:
-        draw_label(image, label, (p0[0], p0[1]), colour)
+        draw_label(image, label, (p0[0], p0[1] - 2), colour, labels=labels, box=(p0[0], p0[1], p1[0], p1[1]))
 
 
-def draw_label(image: np.ndarray, text: str, anchor: tuple[int, int], colour: BGR, scale: float = 0.45) -> None:
-    """``text`` on a filled tag of ``colour`` whose bottom-left corner is ``anchor`` (px)."""
+def draw_label(image: np.ndarray, text: str, anchor: tuple[int, int], colour: BGR, scale: float = 0.45,
+               labels: LabelSpace | None = None, box: Rect | None = None) -> Rect:
+    """``text`` on a filled, outlined tag of ``colour`` whose bottom-left corner is ``anchor`` (px);
+    with ``labels``, the first of: above, below ``box``, further up, further down, that hides no
+    earlier tag. Returns the tag's rectangle."""
     import cv2
 
     (tw, th), base = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)
-    x = int(np.clip(anchor[0], 0, max(image.shape[1] - tw - 4, 0)))
-    y = anchor[1] if anchor[1] - th - base - 2 >= 0 else anchor[1] + th + base + 2
-    cv2.rectangle(image, (x, y - th - base - 2), (x + tw + 4, y), colour, -1)
+    h_tag, w_tag = th + base + 3, tw + 4
+    height, width = image.shape[:2]
+    x = int(np.clip(anchor[0], 0, max(width - w_tag, 0)))
+    below = (box[3] if box is not None else anchor[1]) + h_tag + 2
+    candidates = [anchor[1], below] + [anchor[1] - k * (h_tag + 1) for k in range(1, 4)] + \
+                 [below + k * (h_tag + 1) for k in range(1, 4)]
+    fits = [int(np.clip(y, h_tag, height)) for y in candidates]
+    y = fits[0]
+    if labels is not None:
+        y = next((c for c in fits if labels.free((x, c - h_tag, x + w_tag, c))), fits[0])
+    rect = (x, y - h_tag, x + w_tag, y)
+    cv2.rectangle(image, (rect[0] - 1, rect[1] - 1), (rect[2] + 1, rect[3] + 1), OUTLINE, -1)
+    cv2.rectangle(image, (rect[0], rect[1]), (rect[2], rect[3]), colour, -1)
     ink = (0, 0, 0) if sum(colour) > 450 else (255, 255, 255)
     cv2.putText(image, text, (x + 2, y - base - 1), cv2.FONT_HERSHEY_SIMPLEX, scale, ink, 1, cv2.LINE_AA)
+    if labels is not None:
+        labels.taken.append(rect)
+    return rect
 
 
 def draw_tail(image: np.ndarray, points: np.ndarray, colour: BGR, thickness: int = 2) -> None:
-    """A fading polyline through ``points (n, 2)`` (px, oldest first); NaN points break the line."""
+    """A fading, outlined polyline through ``points (n, 2)`` (px, oldest first); NaN points break the line."""
     import cv2
 
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     n = len(pts)
+    lim = 4.0 * max(image.shape[:2])  # far off-image points (behind the camera) are not drawn
     for k in range(1, n):
         a, b = pts[k - 1], pts[k]
-        if not (np.isfinite(a).all() and np.isfinite(b).all()):
+        if not (np.isfinite(a).all() and np.isfinite(b).all()) or np.abs(np.r_[a, b]).max() > lim:
             continue
         fade = 0.35 + 0.65 * k / n
         c = tuple(int(ch * fade + 255 * (1 - fade) * 0.3) for ch in colour)
-        cv2.line(image, (round(a[0]), round(a[1])), (round(b[0]), round(b[1])), c, thickness, cv2.LINE_AA)
+        pa, pb = (round(a[0]), round(a[1])), (round(b[0]), round(b[1]))
+        cv2.line(image, pa, pb, OUTLINE, thickness + 2, cv2.LINE_AA)
+        cv2.line(image, pa, pb, c, thickness, cv2.LINE_AA)
 
 
 def draw_caption(image: np.ndarray, lines: list[str]) -> None:
@@ -77,21 +121,31 @@ def draw_caption(image: np.ndarray, lines: list[str]) -> None:
 
 
 class Tails:
-    """The last ``length`` points of each id, for drawing track tails (any coordinate frame)."""
+    """The last ``length`` points of each id, for drawing track tails (any coordinate frame); a tail
+    breaks (NaN) where frames are missing or where a point jumps more than ``max_jump`` (same units)
+    from the previous one, so that an identity switch draws no streak across the picture."""
 
-    def __init__(self, length: int = 30) -> None:
+    def __init__(self, length: int = 30, max_jump: float | None = None) -> None:
         if length < 1:
             raise ValueError(f"Tails.length: must be >= 1, got {length}")
-        self.length = length
+        if max_jump is not None and not max_jump > 0:
+            raise ValueError(f"Tails.max_jump: must be positive, got {max_jump}")
+        self.length, self.max_jump = length, max_jump
         self._points: dict[int, deque[np.ndarray]] = {}
         self._last: dict[int, int] = {}
 
-    def add(self, frame: int, identity: int, point: np.ndarray) -> None:
-        """Record ``point (2,)`` of ``identity`` at ``frame``; a gap in frames breaks the tail (NaN)."""
+    def add(self, frame: int, identity: int, point: np.ndarray, max_jump: float | None = None) -> None:
+        """Record ``point (2,)`` of ``identity`` at ``frame``; a gap in frames or a jump of more than
+        ``max_jump`` (default: the tails' own) breaks the tail (NaN)."""
         q = self._points.setdefault(identity, deque(maxlen=self.length))
-        if identity in self._last and frame - self._last[identity] > 1 and q:
-            q.append(np.full(2, np.nan))
-        q.append(np.asarray(point, dtype=float).reshape(2))
+        p = np.asarray(point, dtype=float).reshape(2)
+        limit = max_jump if max_jump is not None else self.max_jump
+        if q and identity in self._last:
+            gap = frame - self._last[identity] > 1
+            jump = (limit is not None and np.isfinite(q[-1]).all() and float(np.hypot(*(p - q[-1]))) > limit)
+            if gap or jump:
+                q.append(np.full(2, np.nan))
+        q.append(p)
         self._last[identity] = frame
 
     def expire(self, frame: int, max_age: int) -> None:
@@ -105,18 +159,41 @@ class Tails:
 
 
 def draw_box_tracks(image: np.ndarray, frame: int, ids: np.ndarray, xywh: np.ndarray, tails: Tails,
-                    prefix: str = "id ", max_gap: int = 5) -> None:
+                    prefix: str = "id ", max_gap: int = 5, labels: LabelSpace | None = None,
+                    dashed: np.ndarray | None = None) -> None:
     """Boxes ``xywh (n, 4)`` (px) of tracks ``ids (n,)`` in their identity colours, with tails of
     their bottom-centres (``tails`` is updated with this frame's points; tails of tracks unseen for
-    more than ``max_gap`` frames are dropped)."""
+    more than ``max_gap`` frames are dropped; a jump of more than the box's height breaks a tail);
+    labels avoid each other (and those already in ``labels``); ``dashed (n,)`` marks boxes drawn dashed."""
     boxes = np.asarray(xywh, dtype=float).reshape(-1, 4)
     ids = np.asarray(ids).reshape(-1).astype(int)
     if len(ids) != len(boxes):
         raise ValueError(f"ids: {len(ids)} ids for {len(boxes)} boxes")
+    space = labels if labels is not None else LabelSpace()
     for i, b in zip(ids, boxes):
-        tails.add(frame, int(i), np.array([b[0] + b[2] / 2, b[1] + b[3]]))
+        jump = tails.max_jump if tails.max_jump is not None else max(float(b[3]), 1.0)
+        tails.add(frame, int(i), np.array([b[0] + b[2] / 2, b[1] + b[3]]), max_jump=jump)
     tails.expire(frame, max_gap)
     for i, pts in tails.items():
         draw_tail(image, pts, identity_colour(i))
-    for i, b in zip(ids, boxes):
-        draw_box(image, b, identity_colour(int(i)), f"{prefix}{int(i)}")
+    flags = np.zeros(len(ids), bool) if dashed is None else np.asarray(dashed, bool).reshape(-1)
+    for i, b, d in zip(ids, boxes, flags):
+        draw_box(image, b, identity_colour(int(i)), f"{prefix}{int(i)}", dashed=bool(d), labels=space)
+
+
+def draw_legend(image: np.ndarray, entries: list[tuple[str, BGR, bool]], scale: float = 0.45) -> None:
+    """A legend in the bottom-left corner: per entry a short box sample (``colour``, dashed or solid)
+    and its text, on a translucent dark band."""
+    import cv2
+
+    if not entries:
+        return
+    step = 20
+    width = max(cv2.getTextSize(t, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)[0][0] for t, _, _ in entries) + 52
+    top = image.shape[0] - step * len(entries) - 8
+    band = image[max(top, 0):, : min(width, image.shape[1])]
+    band[:] = (band.astype(np.uint16) * 2 // 5).astype(np.uint8)
+    for k, (text, colour, dashed) in enumerate(entries):
+        y = top + 6 + step * k
+        draw_box(image, np.array([8, y + 2, 28, step - 8], float), colour, thickness=2, dashed=dashed)
+        cv2.putText(image, text, (44, y + step - 7), cv2.FONT_HERSHEY_SIMPLEX, scale, (255, 255, 255), 1, cv2.LINE_AA)

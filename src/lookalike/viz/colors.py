@@ -1,14 +1,17 @@
-"""Identity colours: a fixed, distinguishable BGR colour per id (the same id keeps its colour)."""
+"""Identity colours: a fixed, distinguishable BGR colour per id (the same id keeps its colour), and
+the dark outline drawn around every coloured mark so that it contrasts with any scene."""
 
 from __future__ import annotations
 
 BGR = tuple[int, int, int]
 
-# Tableau-like palette in BGR, easy to tell apart on grass, water and white.
+# Saturated, light-to-mid colours in BGR, chosen to stand out on grass, water, sand and white
+# (no pure greens, which vanish on grass); everything drawn with them also gets a dark outline (OUTLINE).
 PALETTE: tuple[BGR, ...] = (
-    (180, 119, 31), (14, 127, 255), (44, 160, 44), (40, 39, 214), (189, 103, 148),
-    (75, 86, 140), (194, 119, 227), (34, 189, 188), (207, 190, 23), (127, 127, 127),
+    (0, 140, 255), (255, 160, 30), (230, 60, 230), (0, 230, 255), (255, 255, 90),
+    (190, 150, 255), (180, 105, 255), (255, 255, 255), (90, 190, 255), (160, 80, 255),
 )
+OUTLINE: BGR = (20, 20, 20)
 FALSE_POSITIVE: BGR = (200, 200, 200)
 
 

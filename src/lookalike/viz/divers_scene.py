@@ -1,7 +1,10 @@
 """The demo's diver scenes: render each frame once, extract appearance features, run every box
 tracker online, score them (IDF1, HOTA, MOTA, ID switches, frames/s) and optionally write an
-annotated video (track boxes in identity colours with tails; detections no track took are grey,
-dashed and labelled "unmatched"), the raw video, a still and the MOTChallenge files.
+annotated video, the raw video, a still and the MOTChallenge files.
+
+The annotated video tells true, false and missed apart against the ground truth: a track on a diver
+is a solid box in its identity colour, a track on no diver a dashed red box labelled "false", a
+visible diver without a track a dashed white box labelled "missed"; a legend says so.
 """
 
 from __future__ import annotations
@@ -14,13 +17,18 @@ from typing import Any
 import numpy as np
 
 from lookalike.eval import evaluate_sequence
+from lookalike.geometry.boxes import iou_matrix
 from lookalike.io import MotTable, tracks_to_rows, write_mot
 from lookalike.sim.divers import DiverScenario, simulate_divers
 from lookalike.trackers import TrackStatus, make_tracker
 from lookalike.types import Frame
-from lookalike.viz.annotate import Tails, draw_box, draw_box_tracks, draw_caption
-from lookalike.viz.colors import FALSE_POSITIVE
+from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_box_tracks, draw_caption, draw_legend
+from lookalike.viz.colors import BGR
 from lookalike.viz.video import VideoWriter
+
+FALSE_TRACK: BGR = (40, 40, 235)  # red: a track on no diver
+MISSED: BGR = (255, 255, 255)  # white: a visible diver without a track
+MATCH_IOU = 0.3  # a track box on a diver (coasting boxes lag a little)
 
 Extractor = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
@@ -71,7 +79,7 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
                 raw.write(image)
                 caption = [f"{sc.name}: {sc.n_divers} look-alike divers, tracker: {video_tracker}",
                            f"frame {k + 1}/{len(frames)}  t = {frame.time:.1f} s"]
-                img = _annotated(image, k, det.xywh, shown, tails, caption)
+                img = _annotated(image, k, scene.gt[scene.gt[:, 0] == k + 1], shown, tails, caption)
                 video.write(img)
                 if (k >= len(frames) // 4 and len(shown) > best_still) or not files["still"].exists():
                     best_still = len(shown) if k >= len(frames) // 4 else -1
@@ -119,16 +127,43 @@ def _update_all(instances: dict[str, Any], f: Frame, results: dict[str, list[lis
     return shown
 
 
-def _annotated(image: np.ndarray, k: int, det_xywh: np.ndarray, shown: list[Any], tails: Tails,
+def true_false_missed(track_xywh: np.ndarray, gt_rows: np.ndarray, min_iou: float = MATCH_IOU,
+                      min_visibility: float = 0.3) -> tuple[np.ndarray, np.ndarray]:
+    """``(on_diver (n,) bool, missed (m, 4) xywh)``: which track boxes lie on a diver (greedy IoU
+    matching at ``min_iou`` against the frame's ground-truth rows) and the boxes of the visible
+    divers (visibility >= ``min_visibility``) that no track covers. Pixels."""
+    boxes = np.asarray(track_xywh, dtype=float).reshape(-1, 4)
+    gt = np.asarray(gt_rows, dtype=float).reshape(-1, 9)
+    gt = gt[gt[:, 8] >= min_visibility]
+    on = np.zeros(len(boxes), bool)
+    covered = np.zeros(len(gt), bool)
+    if len(boxes) and len(gt):
+        iou = iou_matrix(boxes, gt[:, 2:6])
+        for flat in np.argsort(-iou, axis=None):
+            i, j = np.unravel_index(flat, iou.shape)
+            if iou[i, j] < min_iou:
+                break
+            if not on[i] and not covered[j]:
+                on[i], covered[j] = True, True
+    return on, gt[~covered, 2:6]
+
+
+def _annotated(image: np.ndarray, k: int, gt_rows: np.ndarray, shown: list[Any], tails: Tails,
                caption: list[str]) -> np.ndarray:
-    """A copy of ``image`` with the shown tracks (identity colours, tails), the detections no track
-    took (grey, dashed, "unmatched") and ``caption``."""
+    """A copy of ``image`` with the shown tracks (identity colours and tails; tracks on no diver
+    dashed, with a red frame), the visible divers no track covers ("missed"), ``caption`` and a legend."""
     img = image.copy()
-    taken = {t.detection_index for t in shown}
-    for i in range(len(det_xywh)):
-        if i not in taken:
-            draw_box(img, det_xywh[i], FALSE_POSITIVE, "unmatched", thickness=1, dashed=True)
-    draw_box_tracks(img, k, np.array([t.track_id for t in shown], dtype=int),
-                    np.array([t.xywh for t in shown]).reshape(-1, 4), tails, prefix="track ")
+    boxes = np.array([t.xywh for t in shown], dtype=float).reshape(-1, 4)
+    on_diver, missed = true_false_missed(boxes, gt_rows)
+    space = LabelSpace()
+    for b in missed:
+        draw_box(img, b, MISSED, "missed", thickness=1, dashed=True, labels=space)
+    for b in boxes[~on_diver]:
+        draw_box(img, b + np.array([-3, -3, 6, 6]), FALSE_TRACK, "false", thickness=2, labels=space)
+    draw_box_tracks(img, k, np.array([t.track_id for t in shown], dtype=int), boxes, tails, prefix="track ",
+                    labels=space, dashed=~on_diver)
     draw_caption(img, caption)
+    draw_legend(img, [("track on a diver (true)", (0, 140, 255), False),
+                      ("track on no diver (false)", FALSE_TRACK, False),
+                      ("diver without a track (missed)", MISSED, True)])
     return img

@@ -42,8 +42,8 @@ def birdseye_plot(path: Path | str, truth: np.ndarray, estimated: np.ndarray, *,
         ax.plot([0, 0], [-ly, ly], color="#6a9", lw=0.8)
     for j in range(t.shape[1]):
         c = rgb_hex(identity_colour(j))
-        ax.plot(t[:, j, 0], t[:, j, 1], color=c, lw=2, label=f"robot {j} true")
-        ax.plot(e[:, j, 0], e[:, j, 1], ".", color=c, ms=2.5, alpha=0.6, label=f"robot {j} estimated")
+        ax.plot(t[:, j, 0], t[:, j, 1], color=c, lw=2, label=f"robot {j + 1} true")
+        ax.plot(e[:, j, 0], e[:, j, 1], ".", color=c, ms=2.5, alpha=0.6, label=f"robot {j + 1} estimated")
     if observer is not None:
         ax.plot(*np.asarray(observer, dtype=float)[:2], "k^", ms=9, label="observer")
     ax.set_aspect("equal")

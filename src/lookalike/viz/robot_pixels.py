@@ -87,7 +87,7 @@ def annotate_frame(image: np.ndarray, result: PipelineResult, caption: list[str]
     det = result.detections
     assert det.xywh is not None and det.position is not None  # the pipeline fills both
     for box, lab, pos in zip(det.xywh, result.labels, det.position):
-        text = "false positive" if lab < 0 else f"robot {lab} {pos[0]:.1f},{pos[1]:.1f} m"
+        text = "false positive" if lab < 0 else f"robot {lab + 1} {pos[0]:.1f},{pos[1]:.1f} m"
         draw_box(out, box, identity_colour(int(lab)), label=text, dashed=lab < 0)
     draw_caption(out, caption)
     return out

@@ -28,7 +28,7 @@ from lookalike.sim.render_robots import (
 )
 from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.identity import agent_positions, labels_from_tracks
-from lookalike.viz.annotate import Tails, draw_box, draw_caption, draw_label, draw_tail
+from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_caption, draw_label, draw_legend, draw_tail
 from lookalike.viz.colors import identity_colour
 from lookalike.viz.plots import birdseye_plot
 from lookalike.viz.video import VideoWriter
@@ -85,7 +85,7 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
     predicted: dict[str, list[np.ndarray]] = {name: [] for name in trackers}
     estimated = {name: np.full((frames, n, 2), np.nan) for name in trackers}
     truth_labels = seq.true_labels()
-    tails = Tails(length=45)
+    tails = Tails(length=30, max_jump=0.5)  # 1 s at 30 Hz; an identity switch (a jump > 0.5 m) breaks it
     out_dir.mkdir(parents=True, exist_ok=True)
     files = {"video": out_dir / "robots.mp4", "gif": out_dir / "robots.gif", "still": out_dir / "robots-still.png"}
     best_still = -2  # the still: the frame after the first third with the most detections, all labelled right
@@ -118,24 +118,19 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
             tails.expire(k, 60)
             for j, pts in tails.items():
                 ego = observer.fixed_to_ego(pts)
+                ego[~(ego[:, 0] > 0.2)] = np.nan  # behind the camera: no streak across the picture
                 uv = camera.ground_to_pixels(np.nan_to_num(ego, nan=1e6)) * scale
                 uv[~np.isfinite(ego).all(axis=1)] = np.nan
                 draw_tail(img, uv, identity_colour(j), thickness=3)
-            if len(det) and det.position is not None:
-                boxes = camera.ground_to_box(det.position, ROBOT_HEIGHT_M, ROBOT_WIDTH_M) * scale
-                for b, lab, tru in zip(boxes, labels, truth):
-                    text = "false positive" if lab < 0 else f"robot {lab}"
-                    draw_box(img, b, identity_colour(int(lab)), dashed=lab < 0)
-                    if lab != tru:
-                        draw_box(img, b + np.array([-3, -3, 6, 6]), WRONG, thickness=1)
-                        text += " (wrong)"
-                    draw_label(img, text, (round(b[0]), round(b[1]) - 2), identity_colour(int(lab)))
+            _draw_detections(img, camera, scale, det, labels, truth)
             rate = 100.0 * correct / total if total else float("nan")
             draw_caption(img, [
                 f"{preset_label(preset_name)} identical robots, identifier: {video_tracker}",
                 f"frame {k + 1}/{frames}  t = {a.time[k]:.1f} s  correct so far: {rate:.1f}%",
-                "colour = identity from heading reports; red frame = wrong",
             ])
+            draw_legend(img, [("robot N: identity from heading reports (ids 1..N)", identity_colour(0), False),
+                              ("false positive (no robot)", identity_colour(-1), True),
+                              ("red frame: wrong label", WRONG, False)])
             video.write(img)
             score = (len(labels) if bool((labels == truth).all()) else -1) if k >= frames // 3 else -2
             if score > best_still or (k == 0):
@@ -161,12 +156,37 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
     return RobotSceneResult(rows=rows, files=files, video_tracker=video_tracker)
 
 
+def robot_label(label: int) -> str:
+    """The label shown for agent index ``label`` (0-based in files and APIs): ``"robot 1"`` for agent 0,
+    ``"false positive"`` for -1. Robots are numbered from 1 wherever they are shown."""
+    return "false positive" if label < 0 else f"robot {int(label) + 1}"
+
+
+def _draw_detections(img: np.ndarray, camera: Camera, scale: int, det: Any, labels: np.ndarray,
+                     truth: np.ndarray) -> None:
+    """Each detection's box in its identity's colour (false positives dashed grey), a red frame
+    around wrong labels, and labels that avoid each other (nearest robots first)."""
+    if not len(det) or det.position is None:
+        return
+    boxes = camera.ground_to_box(det.position, ROBOT_HEIGHT_M, ROBOT_WIDTH_M) * scale
+    space = LabelSpace()
+    for i in np.argsort(-boxes[:, 3]):  # the largest (nearest) boxes place their labels first
+        b, lab, tru = boxes[i], int(labels[i]), int(truth[i])
+        draw_box(img, b, identity_colour(lab), dashed=lab < 0)
+        text = robot_label(lab)
+        if lab != tru:
+            draw_box(img, b + np.array([-3, -3, 6, 6]), WRONG, thickness=1)
+            text += " (wrong)"
+        draw_label(img, text, (round(b[0]), round(b[1]) - 2), identity_colour(lab), labels=space,
+                   box=(round(b[0]), round(b[1]), round(b[0] + b[2]), round(b[1] + b[3])))
+
+
 def _log_robots(rerun: Any, k: int, time_s: float, img: np.ndarray, camera: Camera, scale: int, det: Any,
                 labels: np.ndarray, estimated: np.ndarray, truth: np.ndarray) -> None:
     rerun.set_time(k, time_s)
     rerun.image("robots/camera", img)
     boxes = camera.ground_to_box(det.position, ROBOT_HEIGHT_M, ROBOT_WIDTH_M) * scale if len(det) else np.zeros((0, 4))
     rerun.boxes("robots/camera/detections", boxes, labels,
-                ["false positive" if j < 0 else f"robot {j}" for j in labels])
+                [robot_label(int(j)) for j in labels])
     rerun.points("robots/world/estimated", estimated, np.arange(len(estimated)))
     rerun.points("robots/world/true", truth, np.arange(len(truth)), radius=0.04)
