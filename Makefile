@@ -18,6 +18,10 @@ $(STAMP): pyproject.toml constraints.txt
 
 demo: venv
 	$(VENV)/bin/lookalike demo
+	@echo ""
+	@echo "The lookalike command is installed in $(VENV)/bin. Run it as"
+	@echo "    $(VENV)/bin/lookalike --help"
+	@echo "or activate the environment first:  . $(VENV)/bin/activate  && lookalike --help"
 
 test: venv browser docs lint
 	$(PY) -m pytest -q
