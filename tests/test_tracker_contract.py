@@ -33,11 +33,11 @@ BOX, APPEARANCE, WORLD = "box", "appearance", "world"
 KINDS = {
     "sort": BOX, "boxtrack": BOX,
     "deepsort": APPEARANCE, "diversort": APPEARANCE,
-    "kalman_ha": WORLD, "kalman_ha2": WORLD, "jpda": WORLD, "lstm": WORLD,
+    "kalman_ha": WORLD, "kalman_ha2": WORLD, "jpda": WORLD, "lstm": WORLD, "set": WORLD,
 }
 # Identifiers report agents, not detections: the position is a confidence-weighted blend of the
 # detections labelled as the agent, so the round trip checks the label and the heading instead.
-IDENTIFIERS = {"lstm"}
+IDENTIFIERS = {"lstm", "set"}
 NAMES = tracker_names()
 FPS = 25.0
 N_TARGETS = 3
