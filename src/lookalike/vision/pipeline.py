@@ -32,7 +32,7 @@ from lookalike.trackers.identity import labels_from_tracks
 from lookalike.trackers.registry import make_tracker, tracker_class
 from lookalike.types import Beacons, Detections, Frame, TrackSnapshot
 
-IDENTIFIERS = ("kalman_ha", "kalman_ha2", "jpda", "lstm")
+IDENTIFIERS = ("kalman_ha", "kalman_ha2", "jpda", "lstm", "set")
 MODELS_DIR = Path(__file__).resolve().parent / "models_data"
 SHIPPED_MODELS = {"detector": "robot_detector.npz", "heading": "robot_heading.npz"}
 ROBOT_HEIGHT_M = 0.62  # height of the rendered robots (lookalike.sim.render_robots), metres
