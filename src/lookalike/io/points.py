@@ -10,7 +10,7 @@ Two text formats are read, both comma-separated with 1-based frames:
 
 Both return :class:`PointFrames`: per frame (0-based list index = frame − 1) an ``(n, 2)`` array of
 positions (pixels, or whatever unit the file uses). Malformed input raises ``ValueError`` naming the
-file and the 1-based line.
+file and the 1-based line; frame numbers follow :mod:`lookalike.io.rules` (integers >= 1, no stray jump).
 
 :func:`points_to_rows` turns points into MOTChallenge detection rows of small square boxes centred on
 them (side ``box_px``), so that box trackers and :func:`lookalike.trackers.closed_set.track_closed_set`
@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike.io.rules import frame_problems, read_text
 from lookalike.types.mot_table import detection_rows
 
 __all__ = ["PointFrames", "points_to_rows", "read_points_csv", "read_points_mot", "rows_to_points",
@@ -60,7 +61,7 @@ def _parse(path: Path, columns: int) -> list[tuple[int, list[float]]]:
         raise FileNotFoundError(f"{path}: no such file")
     out = []
     first = True
-    for no, line in enumerate(path.read_text().splitlines(), start=1):
+    for no, line in enumerate(read_text(path).splitlines(), start=1):
         text = line.strip()
         if not text or text.startswith("#"):
             continue
@@ -84,6 +85,9 @@ def _parse(path: Path, columns: int) -> list[tuple[int, list[float]]]:
         if frame < 1 or frame != int(frame):
             raise ValueError(f"{path}:{no}: frame must be an integer >= 1, got {fields[0]!r}")
         out.append((no, values))
+    problem = frame_problems(np.array([v[0] for _, v in out]))  # a stray huge frame number
+    if problem is not None:
+        raise ValueError(f"{path}:{out[problem[0]][0]}: invalid frame: {problem[1]}")
     return out
 
 

@@ -29,10 +29,13 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.io.rules import read_text
 from lookalike.sim import ReportArrays, RobotArrays, RobotSequence, RobotWorldConfig
 
 FORMAT = "lookalike-robots"
 VERSION = 1
+MAX_AGENTS = 1_000  # a header claiming more agents or detection slots is refused before allocating
+MAX_DETECTIONS = 10_000
 
 
 def write_robot_sequence(path: str | Path, sequence: RobotSequence) -> Path:
@@ -65,27 +68,37 @@ def write_robot_sequence(path: str | Path, sequence: RobotSequence) -> Path:
 
 
 def read_robot_sequence(path: str | Path) -> RobotSequence:
-    """Read a sequence written by :func:`write_robot_sequence`; malformed files raise ``ValueError``."""
+    """Read a sequence written by :func:`write_robot_sequence`. Anything else (not UTF-8, not JSON
+    Lines, another format, a malformed record, NaN or infinity in a detection) raises ``ValueError``
+    naming the file (and the line where it is known)."""
     path = Path(path)
-    with path.open() as fh:
-        lines = [line for line in fh if line.strip()]
+    lines = [(no, line) for no, line in enumerate(read_text(path).splitlines(), start=1) if line.strip()]
     if not lines:
         raise ValueError(f"{path}: empty file")
-    try:
-        header = json.loads(lines[0])
-        rows = [json.loads(line) for line in lines[1:]]
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{path}: not JSON Lines ({exc})") from None
+    records = []
+    for no, line in lines:
+        try:
+            records.append(json.loads(line))
+        except (json.JSONDecodeError, RecursionError) as exc:
+            raise ValueError(f"{path}:{no}: not JSON ({str(exc)[:80]})") from None
+        if not isinstance(records[-1], dict):
+            raise ValueError(f"{path}:{no}: expected a JSON object, got {type(records[-1]).__name__}")
+    header, rows = records[0], records[1:]
     if header.get("format") != FORMAT or header.get("version") != VERSION:
         raise ValueError(f"{path}: not a {FORMAT} v{VERSION} file (header {str(header)[:80]})")
-    config = RobotWorldConfig.from_dict(header["config"])
-    T, N, M = len(rows), config.n_agents, config.max_detections
+    try:
+        config = RobotWorldConfig.from_dict(header["config"])
+        T, N, M = len(rows), int(config.n_agents), int(config.max_detections)
+    except (KeyError, TypeError, ValueError, AttributeError, OverflowError) as exc:
+        raise ValueError(f"{path}:{lines[0][0]}: malformed header config ({str(exc)[:120]})") from None
+    if not (0 <= N <= MAX_AGENTS and 0 <= M <= MAX_DETECTIONS):
+        raise ValueError(f"{path}: n_agents={N} / max_detections={M} outside [0, {MAX_AGENTS}] / [0, {MAX_DETECTIONS}]")
     if T != header.get("n_frames"):
         raise ValueError(f"{path}: header says {header.get('n_frames')} frames, file has {T}")
     try:
         return _assemble(config, header, rows, T, N, M)
-    except (KeyError, TypeError, IndexError) as exc:
-        raise ValueError(f"{path}: malformed frame record ({exc!r})") from None
+    except (KeyError, TypeError, IndexError, ValueError, AttributeError, OverflowError) as exc:
+        raise ValueError(f"{path}: malformed frame record ({str(exc)[:120]})") from None
 
 
 def _assemble(config: RobotWorldConfig, header: dict, rows: list[dict], T: int, N: int, M: int) -> RobotSequence:
@@ -108,6 +121,8 @@ def _assemble(config: RobotWorldConfig, header: dict, rows: list[dict], T: int, 
         valid[k, :n] = True
         if n:
             pos[k, :n], head[k, :n], score[k, :n], label[k, :n] = d["position"], d["heading"], d["score"], d["label"]
+            if not all(np.isfinite(a[k, :n]).all() for a in (pos, head, score)):
+                raise ValueError(f"frame {k}: NaN or infinity in a detection")
         b = row["beacons"]
         for key, values in b_parts.items():
             values.extend(b[key])

@@ -43,7 +43,11 @@ def read_seqinfo(path: str | os.PathLike[str]) -> dict[str, str]:
     try:
         parser.read_string(read_text(path), source=str(path))
     except configparser.Error as exc:
-        raise ValueError(f"{path}: malformed seqinfo.ini ({exc})") from None
+        errors = getattr(exc, "errors", None)
+        line = errors[0][0] if errors else getattr(exc, "lineno", None)
+        where = f"{path}:{line}" if line else str(path)
+        detail = " ".join(str(exc).replace(str(path), "").split())[:120]
+        raise ValueError(f"{where}: malformed seqinfo.ini ({detail})") from None
     if "Sequence" not in parser:
         raise ValueError(f"{path}: no [Sequence] section")
     return dict(parser["Sequence"])
