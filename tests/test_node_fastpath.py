@@ -41,17 +41,41 @@ def plain_agent_headings(b: BeaconIdentifier, times_s: np.ndarray) -> np.ndarray
     return out
 
 
+def plain_store_reports(t_hist: np.ndarray, h_hist: np.ndarray, beacons: Beacons) -> None:
+    """The report history update of ``begin_frame`` before its one-new-report fast path."""
+    r = t_hist.shape[1]
+    for a in np.unique(beacons.agent_id):
+        if a >= len(t_hist):
+            continue
+        rows = beacons.agent_id == a
+        t = np.concatenate([t_hist[a], beacons.t_sent[rows]])
+        h = np.concatenate([h_hist[a], beacons.heading[rows]])
+        known = np.isfinite(t)
+        t, first = np.unique(t[known], return_index=True)
+        h = h[known][first][-r:]
+        t = t[-r:]
+        t_hist[a], h_hist[a] = np.nan, np.nan
+        t_hist[a, r - len(t):], h_hist[a, r - len(h):] = t, h
+
+
 @pytest.mark.parametrize("seed", range(5))
 def test_agent_headings_equal_the_plain_version(seed):
     rng = np.random.default_rng(seed)
     b = BeaconIdentifier(BeaconConfig(n_agents=6, window_frames=12, history=5))
+    t_plain, h_plain = b._t.copy(), b._h.copy()
     for f in range(30):
         t = f / 30
         ids = rng.choice(6, rng.integers(0, 4), replace=False)
+        if rng.random() < 0.3:
+            ids = np.concatenate([ids, ids[:1]])  # two reports of one robot in a frame
         sent = t - rng.uniform(0, 0.5, len(ids))
         sent[rng.random(len(ids)) < 0.2] = t - 0.1  # repeated send times
-        b.begin_frame(t, Beacons(agent_id=ids, t_sent=sent, t_received=np.full(len(ids), t),
-                                 heading=rng.uniform(-4, 4, len(ids))))
+        beacons = Beacons(agent_id=ids, t_sent=sent, t_received=np.full(len(ids), t),
+                          heading=rng.uniform(-4, 4, len(ids)))
+        b.begin_frame(t, beacons)
+        plain_store_reports(t_plain, h_plain, beacons)
+        np.testing.assert_array_equal(b._t, t_plain)
+        np.testing.assert_array_equal(b._h, h_plain)
         queries = np.concatenate([b._times, rng.uniform(-1, 2, 5), [np.nan, t]])
         np.testing.assert_array_equal(b.agent_headings(queries), plain_agent_headings(b, queries))
 

@@ -254,12 +254,26 @@ class _Fields:
             raise self.error(name, f"has {len(value)} entries, expected {length}")
         if len(value) > MAX_DETECTIONS:
             raise self.error(name, f"has {len(value)} entries, at most {MAX_DETECTIONS} allowed")
+        fast = _plain_numbers(value, minimum)
+        if fast is not None:
+            return fast
         return tuple(self._finite(f"{name}[{i}]", v, minimum) for i, v in enumerate(value))
 
     def finish(self) -> None:
         unknown = sorted(set(self.body) - self.used)
         if unknown:
             raise MessageError(INVALID, f"{self.kind}: unknown field(s) {_quote(unknown)}")
+
+
+def _plain_numbers(values: list[Any], minimum: float) -> tuple[float, ...] | None:
+    """``values`` as floats when every one is a JSON float (or a small int) within the bounds; None
+    otherwise (then each value is checked on its own, naming the first bad one)."""
+    if not all(type(v) is float or (type(v) is int and -(2**53) <= v <= 2**53) for v in values):
+        return None
+    out = tuple(float(v) for v in values)
+    if out and not (minimum <= min(out) and max(out) <= MAX_ABS_NUMBER):  # (NaN cannot come from JSON here)
+        return None
+    return out
 
 
 def _quote(value: Any) -> str:
@@ -282,12 +296,16 @@ def _detections(f: _Fields) -> DetectionsMessage:
     raw = f._get("position")
     if not isinstance(raw, list) or len(raw) > MAX_DETECTIONS:
         raise f.error("position", f"must be a list of at most {MAX_DETECTIONS} [x, y] pairs")
-    position = []
     for i, pair in enumerate(raw):
         if not isinstance(pair, list) or len(pair) != 2:
             raise f.error(f"position[{i}]", f"must be an [x, y] pair, got {_quote(pair)}")
-        position.append((f._finite(f"position[{i}]", pair[0]), f._finite(f"position[{i}]", pair[1])))
-    msg = DetectionsMessage(frame=frame, time=time, position=tuple(position),  # type: ignore[arg-type]
+    flat = _plain_numbers([v for pair in raw for v in pair], -MAX_ABS_NUMBER)
+    if flat is not None:
+        position = tuple(zip(flat[0::2], flat[1::2]))
+    else:
+        position = tuple((f._finite(f"position[{i}]", pair[0]), f._finite(f"position[{i}]", pair[1]))
+                         for i, pair in enumerate(raw))
+    msg = DetectionsMessage(frame=frame, time=time, position=position,  # type: ignore[arg-type]
                             heading=f.numbers("heading", len(raw)), score=f.numbers("score", len(raw)),  # type: ignore[arg-type]
                             heading_std=f.numbers("heading_std", len(raw), optional=True, minimum=0.0))
     f.finish()

@@ -62,17 +62,25 @@ class BeaconIdentifier:
 
     def begin_frame(self, time_s: float, beacons: Beacons) -> None:
         """Start a frame at ``time_s``: store its received reports and open a window slot."""
-        for a in np.unique(beacons.agent_id):
+        r = self.config.history
+        for a in np.unique(beacons.agent_id).tolist():
             if a >= self.config.n_agents:
                 continue
             rows = beacons.agent_id == a
-            t = np.concatenate([self._t[a], beacons.t_sent[rows]])
+            new_t = beacons.t_sent[rows]
+            if len(new_t) == 1 and not new_t[0] <= self._t[a, -1]:
+                # (the common case: one report newer than every one kept, or the first: append it;
+                # the same result as the sort and de-duplication below)
+                self._t[a, :-1] = self._t[a, 1:]
+                self._h[a, :-1] = self._h[a, 1:]
+                self._t[a, -1], self._h[a, -1] = new_t[0], beacons.heading[rows][0]
+                continue
+            t = np.concatenate([self._t[a], new_t])
             h = np.concatenate([self._h[a], beacons.heading[rows]])
             known = np.isfinite(t)
             t, h = t[known], h[known]
             t, first = np.unique(t, return_index=True)  # sorted, duplicates dropped
             h = h[first]
-            r = self.config.history
             t, h = t[-r:], h[-r:]
             self._t[a] = np.nan
             self._h[a] = np.nan
