@@ -6,6 +6,9 @@ image plus the tracker update, as on the robot after the detector, timed in CPU 
 process (``time.process_time``, one thread: the figure of one core even on a shared machine; the
 wall-clock rate is printed beside it). Targets (DESIGN §11, issue 22):
 features + diver SORT >= 100 frames/s for each feature set; learned features >= 500 crops/s.
+With ``--detector FILE.onnx`` the ONNX detector's time per frame is measured too and the end-to-end
+rate (detector + features + diver SORT) printed; the tracker still gets the simulated boxes, so the
+figure is the cost of a detector in the loop, not its accuracy.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ def main() -> None:
     parser.add_argument("--scenario", default="pool_four_crossing")
     parser.add_argument("--features", nargs="+", default=["handcrafted", "learned"],
                         help="handcrafted, learned or FILE.onnx (each timed)")
+    parser.add_argument("--detector", default=None, help="an ONNX detection model to time in the loop")
     args = parser.parse_args()
 
     import cv2
@@ -48,6 +52,16 @@ def main() -> None:
     images = [scene.image(k) for k in range(len(frames))]
     n = len(frames)
     print(f"scenario {sc.name}: {n} frames 640x480")
+    detector_s = 0.0
+    if args.detector:
+        from lookalike.vision.onnx_detector import OnnxDetector
+
+        detector = OnnxDetector(args.detector)
+        t0 = time.process_time()
+        for image in images:
+            detector(image)
+        detector_s = time.process_time() - t0
+        print(f"detector {args.detector}: {1e3 * detector_s / n:.2f} ms per frame (CPU), {n / detector_s:.1f} frames/s")
     for name in args.features:
         extractor = diver_extractor(name)
         tracker = make_tracker("diversort")
@@ -71,6 +85,8 @@ def main() -> None:
         if name != "handcrafted":
             report_target(f"{name} features, crops/s on one core", n_crops / feat_s, 500)
         report_target(f"{name} features + diver SORT, frames/s with 4 divers", n / (feat_s + track_s), 100)
+        if args.detector:
+            print(f"{name}: detector + features + diver SORT {n / (detector_s + feat_s + track_s):.1f} frames/s (CPU)")
 
 
 if __name__ == "__main__":

@@ -49,9 +49,11 @@ class AppearanceTrainConfig:
     threads: int = 1
     device: str = "cpu"
     minutes: float | None = None  # stop after this wall time
+    validation_every: int = 10  # validation crops from every n-th frame
 
     def __post_init__(self) -> None:
-        for name in ("scenarios", "frames", "every", "embedding", "channels", "epochs", "batch_size", "threads"):
+        for name in ("scenarios", "frames", "every", "embedding", "channels", "epochs", "batch_size", "threads",
+                     "validation_every"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be at least 1, got {getattr(self, name)}")
 
@@ -156,7 +158,7 @@ def train_appearance(config: AppearanceTrainConfig, output: Path,
     device = torch.device("cuda" if config.device == "auto" and torch.cuda.is_available()
                           else ("cpu" if config.device == "auto" else config.device))
     train = diver_crops(training_scenarios(config.scenarios, config.frames), every=config.every, seed=config.seed)
-    val = diver_crops(VALIDATION_SCENARIOS, every=10, jitter=0.05, seed=config.seed + 1)
+    val = diver_crops(VALIDATION_SCENARIOS, every=config.validation_every, jitter=0.05, seed=config.seed + 1)
     ids, labels = np.unique(train.labels, return_inverse=True)
     log(f"{len(train.labels)} training crops of {len(ids)} divers; {len(val.labels)} validation crops "
         f"({time.perf_counter() - start:.0f} s)")

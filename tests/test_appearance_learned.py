@@ -1,0 +1,85 @@
+"""The learned diver appearance model: training scenes, the shipped ONNX embedding, selection by name,
+and a tiny training run exported to ONNX."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+pytest.importorskip("onnxruntime")
+
+from lookalike.sim.diver_render import TEAM  # noqa: E402
+from lookalike.sim.divers import SCENARIOS, VALIDATION_SCENARIOS, DiverScenario, simulate_divers  # noqa: E402
+from lookalike.sim.divers_run import diver_extractor, matched_thresholds  # noqa: E402
+from lookalike.sim.divers_train import training_scenarios  # noqa: E402
+from lookalike.vision.appearance import HandcraftedFeatures, crop_boxes  # noqa: E402
+from lookalike.vision.appearance_onnx import LEARNED_MODEL, OnnxAppearance  # noqa: E402
+
+
+def test_training_scenes_have_new_divers_and_disjoint_seeds() -> None:
+    train = training_scenarios(6, frames=20)
+    seeds = {sc.seed for sc in train}
+    assert not seeds & {sc.seed for sc in SCENARIOS + VALIDATION_SCENARIOS}
+    for sc in train:
+        assert sc.looks is not None and len(sc.looks) == sc.n_divers
+        assert not set(sc.looks) & set(TEAM)
+    scene = simulate_divers(train[0])
+    assert scene.image(5).shape == (480, 640, 3) and len(scene.gt)
+    with pytest.raises(ValueError, match="n_divers"):
+        DiverScenario(name="x", n_divers=3, looks=TEAM[:2])
+
+
+def test_crop_boxes_width_height() -> None:
+    img = np.zeros((100, 200, 3), np.uint8)
+    img[:, 100:] = 255
+    crops = crop_boxes(img, np.array([[50.0, 10.0, 100.0, 50.0]]), (64, 32))
+    assert crops.shape == (1, 32, 64, 3)
+    assert crops[0, :, :30].max() == 0 and crops[0, :, 34:].min() == 255
+
+
+def test_shipped_model_embeds_and_tells_divers_apart() -> None:
+    meta = json.loads(LEARNED_MODEL.with_suffix(".json").read_text())
+    assert LEARNED_MODEL.stat().st_size < 2_000_000
+    assert set(meta["training"]["scenario_seeds"]).isdisjoint({sc.seed for sc in SCENARIOS + VALIDATION_SCENARIOS})
+    ex = diver_extractor("learned")
+    assert isinstance(ex, OnnxAppearance) and ex.dim == meta["output"]["dim"] == 32
+    sc = DiverScenario(name="t", n_divers=3, frames=40, pool=True, attenuation=0.06, turbidity=0.05, blur_per_m=0.1,
+                       leave_rate=0.0, seed=3)
+    scene = simulate_divers(sc)
+    feats, labels = [], []
+    for k in range(0, 40, 4):
+        rows = scene.gt[(scene.gt[:, 0] == k + 1) & (scene.gt[:, 8] > 0.5)]
+        feats.append(ex(scene.image(k), rows[:, 2:6]))
+        labels.append(rows[:, 1])
+    f, lab = np.vstack(feats), np.concatenate(labels)
+    assert len(np.unique(lab)) >= 2
+    assert np.allclose(np.linalg.norm(f, axis=1), 1.0)
+    d = 1 - f @ f.T
+    same = lab[:, None] == lab[None, :]
+    off = ~np.eye(len(f), dtype=bool)
+    assert d[same & off].mean() < d[~same].mean()
+    assert ex(scene.image(0), np.zeros((0, 4))).shape == (0, 32)
+
+
+def test_extractor_names() -> None:
+    assert matched_thresholds(HandcraftedFeatures(), "diversort") == {}
+    assert matched_thresholds(diver_extractor("learned"), "sort") == {}
+    with pytest.raises(ValueError, match="handcrafted, learned or FILE.onnx"):
+        diver_extractor("deep")
+    with pytest.raises(FileNotFoundError):
+        diver_extractor("missing.onnx")
+
+
+def test_tiny_training_run_exports_onnx(tmp_path) -> None:
+    pytest.importorskip("torch")
+    from lookalike.learn.appearance_train import AppearanceTrainConfig, train_appearance
+
+    config = AppearanceTrainConfig(scenarios=1, frames=20, every=5, epochs=1, channels=4, embedding=8,
+                                   validation_every=60)
+    info = train_appearance(config, tmp_path, log=lambda _: None)
+    assert (tmp_path / "diver_reid.onnx").exists() and info["training"]["identities"] >= 2
+    assert json.loads((tmp_path / "diver_reid.json").read_text())["config"]["embedding"] == 8
+    ex = OnnxAppearance(tmp_path / "diver_reid.onnx")
+    assert ex.dim == 8 and ex.crop_size == (64, 32)
