@@ -141,12 +141,12 @@ def pool_video(tmp_path_factory):
     return root / "pool.mp4", scene.gt, _darkness_grid_model(root / "dark.onnx")
 
 
-@pytest.mark.parametrize("tracker", ["sort", "diversort"])
-def test_track_video_with_onnx_detector_end_to_end(pool_video, tmp_path, tracker):
+@pytest.mark.parametrize(("tracker", "features"), [("sort", "video"), ("diversort", "learned")])
+def test_track_video_with_onnx_detector_end_to_end(pool_video, tmp_path, tracker, features):
     video, gt, model = pool_video
     out = tmp_path / "tracks.txt"
     r = runner.invoke(app, ["track", "--video", str(video), "--detector", str(model), "--blob", "score=0.15",
-                            "-t", tracker, "-o", str(out)])
+                            "-t", tracker, "--features", features, "-o", str(out)])
     assert r.exit_code == 0, r.output
     det = read_mot(tmp_path / "tracks.det.txt")
     assert len(det) >= 30 and det.conf.min() >= 0.15
@@ -170,3 +170,6 @@ def test_track_video_onnx_detector_errors(pool_video, tmp_path):
     bad = runner.invoke(app, ["track", "--video", str(video), "--detector", str(model), "--blob", "colour=red",
                               "-o", str(tmp_path / "t.txt")])
     assert bad.exit_code == 2 and "colour" in bad.output
+    feats = runner.invoke(app, ["track", "--video", str(video), "--detector", str(model), "--features", "deep",
+                                "-o", str(tmp_path / "t.txt")])
+    assert feats.exit_code == 2 and "--features" in feats.output
