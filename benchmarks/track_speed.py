@@ -1,89 +1,92 @@
-"""Tracker speed on the MOT15 detections: lookalike SORT beside the peers norfair and ByteTrack.
+"""Tracker speed on the MOT15 detections: lookalike's ``sort`` and ``boxtrack`` beside the reference
+SORT and the ``trackers`` package's SORT and ByteTrack, measured in one run.
 
 Run with ``make bench`` (installs the peers into .venv-bench) or directly:
-``python benchmarks/track_speed.py [--data ../shared/data/mot15] [--repeats 3]``.
-Times only the trackers' update calls on detections loaded beforehand; prints frames/s (median of
-``--repeats`` runs) and each peer's ratio to lookalike's SORT.
+``python benchmarks/track_speed.py [--data ../shared/data/mot15] [--rounds 5]``.
+Detections are loaded beforehand; each round runs every tracker once over all sequences in turn
+(interleaved, so a busy moment hurts all alike) and the median over rounds is reported, in
+frames/s, with each lookalike tracker's ratio to every peer. ``sort``'s output is compared with
+the reference's, frame by frame (same boxes; ids a consistent renaming, since the reference numbers
+new tracks of one frame in the order its solver leaves them and lookalike in detection order).
 """
 
 from __future__ import annotations
 
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import argparse
+import statistics
 import sys
+import time
 
 import numpy as np
-from _common import SHARED_DATA, median_seconds
+from _common import SHARED_DATA, report_target
+from _peers import load_mot_sequences, lookalike_runner, reference_rows, reference_sort, trackers_runner
 
-from lookalike.geometry import xywh_to_xyxy
-from lookalike.io import find_sequences, frames_from_table, read_mot
-from lookalike.trackers import Sort
-
-
-def load(root):
-    seqs = []
-    for s in find_sequences(root):
-        seqs.append(list(frames_from_table(read_mot(s.det_path), s.length, s.frame_rate)))
-    return seqs
+TARGETS = [  # (lookalike tracker, peer, minimum ratio)
+    ("sort", "reference SORT", 4.0),
+    ("sort", "trackers SORT", 2.0),
+    ("boxtrack", "reference SORT", 2.0),
+    ("boxtrack", "trackers ByteTrack", 1.5),
+]
 
 
-def run_lookalike(seqs):
-    for frames in seqs:
-        tracker = Sort()
-        for f in frames:
-            tracker.update(f)
-
-
-def peer_runners(seqs):
-    runners = {}
-    xyxy = [[(xywh_to_xyxy(f.detections.xywh), f.detections.score) for f in frames] for frames in seqs]
-    try:
-        import norfair
-
-        def run_norfair():
-            for frames in xyxy:
-                tracker = norfair.Tracker(distance_function="iou", distance_threshold=0.7)
-                for boxes, scores in frames:
-                    dets = [norfair.Detection(points=b.reshape(2, 2), scores=np.array([s, s]))
-                            for b, s in zip(boxes, scores)]
-                    tracker.update(detections=dets)
-
-        runners["norfair (iou, threshold 0.7)"] = run_norfair
-    except ImportError:
-        print("norfair not installed: skipped (make bench installs it)")
-    try:
-        import supervision as sv
-
-        def run_bytetrack():
-            for frames in xyxy:
-                tracker = sv.ByteTrack()
-                for boxes, scores in frames:
-                    det = sv.Detections(xyxy=boxes.reshape(-1, 4), confidence=scores,
-                                        class_id=np.zeros(len(boxes), int))
-                    tracker.update_with_detections(det)
-
-        runners["supervision ByteTrack"] = run_bytetrack
-    except ImportError:
-        print("supervision not installed: skipped (make bench installs it)")
-    return runners
+def same_as_reference(ours: list, reference: list) -> bool:
+    """Whether lookalike's ``sort`` reported the same boxes (to 1e-6 pixels) in every frame, with ids
+    that are a consistent renaming of the reference's (new tracks may be numbered in another order)."""
+    for seq_ours, seq_ref in zip(ours, reference):
+        renaming: dict[int, int] = {}
+        for tracks, ref in zip(seq_ours, reference_rows(seq_ref)):
+            if len(tracks) != len(ref):
+                return False
+            for i, box in zip(tracks.id.tolist(), tracks.xywh):
+                near = [rid for rid, rbox in ref if np.allclose(box, rbox, rtol=0, atol=1e-6)]
+                if len(near) != 1 or renaming.setdefault(i, near[0]) != near[0]:
+                    return False
+        if len(set(renaming.values())) != len(renaming):
+            return False
+    return True
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data", default=str(SHARED_DATA / "mot15"))
-    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--rounds", type=int, default=5)
     args = parser.parse_args()
     try:
-        seqs = load(args.data)
+        seqs, rates = load_mot_sequences(args.data)
     except FileNotFoundError:
         print(f"MOT15 data not found at {args.data}: nothing to measure")
         return 0
+    runners = {"sort": lookalike_runner("sort", rates), "boxtrack": lookalike_runner("boxtrack", rates)}
+    for name, runner in [("reference SORT", reference_sort()), ("trackers SORT", trackers_runner("sort", rates)),
+                         ("trackers ByteTrack", trackers_runner("bytetrack", rates))]:
+        if runner is None:
+            print(f"{name}: not installed, skipped (make bench installs it)")
+        else:
+            runners[name] = runner
     n_frames = sum(len(s) for s in seqs)
-    print(f"{len(seqs)} sequences, {n_frames} frames, median of {args.repeats} runs, tracker time only")
-    base = n_frames / median_seconds(lambda: run_lookalike(seqs), args.repeats)
-    print(f"{'lookalike sort':34s} {base:10,.0f} frames/s")
-    for name, run in peer_runners(seqs).items():
-        fps = n_frames / median_seconds(run, args.repeats)
-        print(f"{name:34s} {fps:10,.0f} frames/s   sort is {base / fps:5.1f}x faster")
+    print(f"{len(seqs)} sequences, {n_frames} frames, median of {args.rounds} interleaved rounds, "
+          "tracker time only (input objects built per frame)")
+    times: dict[str, list[float]] = {name: [] for name in runners}
+    outputs: dict[str, object] = {}
+    for _ in range(args.rounds):
+        for name, run in runners.items():
+            t0 = time.perf_counter()
+            outputs[name] = run(seqs)
+            times[name].append(time.perf_counter() - t0)
+    fps = {name: n_frames / statistics.median(t) for name, t in times.items()}
+    for name, value in fps.items():
+        print(f"{name:22s} {value:10,.0f} frames/s")
+    if "reference SORT" in outputs:
+        same = same_as_reference(outputs["sort"], outputs["reference SORT"])  # type: ignore[arg-type]
+        print(f"sort's output equals the reference SORT's on all {len(seqs)} sequences (ids renamed): {same}")
+    for ours, peer, target in TARGETS:
+        if peer in fps:
+            report_target(f"{ours} vs {peer} (MOT15, x)", fps[ours] / fps[peer], target)
     return 0
 
 

@@ -146,3 +146,31 @@ def test_mota_matches_reference_sort_on_mot15(shared_data, name):
     mota, idsw = REFERENCE[name]
     assert 100 * scores["MOTA"] == pytest.approx(mota, abs=0.2)
     assert abs(scores["IDSW"] - idsw) <= 2
+
+
+def _crowd(n_targets, frames, seed):
+    side = int(64 * np.sqrt(n_targets))
+    config = BoxSceneConfig(seed=seed, frames=frames, n_targets=n_targets, image_size=(side * 4 // 3, side),
+                            false_positives_per_frame=0.05 * n_targets, speed_px=6.0)
+    return simulate_boxes(config).frames
+
+
+def test_sparse_matching_equals_plain_oracle_with_100_detections_a_frame():
+    import lookalike.trackers.sort_core as core
+
+    frames = _crowd(100, 25, seed=1)
+    assert min(len(f.detections) * 80 for f in frames[1:]) >= core.SPARSE_FROM  # the sparse path runs
+    _run_both(frames)
+
+
+def test_sparse_matching_equals_dense_with_1000_detections_a_frame(monkeypatch):
+    import lookalike.trackers.sort_core as core
+
+    frames = _crowd(1000, 6, seed=2)
+    a, b = Sort(), Sort()
+    sparse = [a.update(f) for f in frames]
+    monkeypatch.setattr(core, "SPARSE_FROM", 10**12)
+    dense = [b.update(f) for f in frames]
+    for s, d in zip(sparse, dense):
+        assert np.array_equal(s.id, d.id) and np.array_equal(s.xywh, d.xywh)
+        assert np.array_equal(s.detection_index, d.detection_index)

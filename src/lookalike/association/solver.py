@@ -40,9 +40,10 @@ class Assignment:
 
 
 def _result(rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]) -> Assignment:
-    order = np.argsort(rows, kind="stable")
-    rows, cols = rows[order], cols[order]
-    matches = np.stack([rows, cols], axis=1).astype(int) if rows.size else np.zeros((0, 2), dtype=int)
+    """The assignment of pairs ``(rows, cols)`` already sorted by row."""
+    matches = np.empty((len(rows), 2), dtype=int)
+    matches[:, 0] = rows
+    matches[:, 1] = cols
     free_rows = np.ones(shape[0], dtype=bool)
     free_rows[rows] = False
     free_cols = np.ones(shape[1], dtype=bool)
@@ -55,10 +56,10 @@ def _check(cost: np.ndarray) -> np.ndarray:
     c = np.asarray(cost, dtype=float)
     if c.ndim != 2:
         raise ValueError(f"cost: expected a 2-D matrix, got shape {c.shape}")
-    if np.isnan(c).any():
-        row, col = np.argwhere(np.isnan(c))[0]
-        raise ValueError(f"cost: NaN at row {row}, column {col}; use inf to forbid a pair")
-    if np.isneginf(c).any():
+    if c.size and not (c > -np.inf).all():  # one pass for both NaN and -inf
+        if np.isnan(c).any():
+            row, col = np.argwhere(np.isnan(c))[0]
+            raise ValueError(f"cost: NaN at row {row}, column {col}; use inf to forbid a pair")
         row, col = np.argwhere(np.isneginf(c))[0]
         raise ValueError(f"cost: -inf at row {row}, column {col}")
     return c
@@ -74,9 +75,13 @@ def assign(cost: np.ndarray, max_cost: float = np.inf) -> Assignment:
     c = _check(cost)
     if c.size == 0:
         return _result(np.zeros(0, int), np.zeros(0, int), c.shape)
-    allowed = np.isfinite(c) & (c <= max_cost)
+    allowed = c <= max_cost if np.isfinite(max_cost) else c < np.inf
     if not allowed.any():
         return _result(np.zeros(0, int), np.zeros(0, int), c.shape)
+    if allowed.sum(axis=0).max() == 1 and allowed.sum(axis=1).max() == 1:
+        # The allowed pairs are disjoint: every optimum holds all of them, nothing else is kept.
+        rows, cols = np.nonzero(allowed)
+        return _result(rows, cols, c.shape)
     if np.isfinite(max_cost):
         # Clip forbidden pairs to just above the limit; they are dropped after solving.
         scale = max(abs(max_cost - float(c[allowed].min())), 1.0)

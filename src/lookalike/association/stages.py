@@ -78,20 +78,23 @@ class Matching:
 
 def _eligible(selector: np.ndarray | None, allowed: np.ndarray) -> np.ndarray:
     if selector is None:
-        return np.flatnonzero(allowed)
+        out: np.ndarray = allowed.nonzero()[0]
+        return out
     sel = np.asarray(selector)
     if sel.dtype == bool:
-        return np.flatnonzero(sel & allowed)
+        return (sel & allowed).nonzero()[0]  # type: ignore[no-any-return]
     idx: np.ndarray = sel.astype(int)
-    out: np.ndarray = idx[allowed[idx]]
+    out = idx[allowed[idx]]
     return out
 
 
 def run_stage(stage: Stage, matching: Matching, index: int = 0) -> Matching:
     """Run one stage on what ``matching`` left over (updated in place and returned)."""
     rows = _eligible(stage.tracks, matching.det_of_track < 0)
+    if not len(rows):
+        return matching
     cols = _eligible(stage.detections, matching.free)
-    if not len(rows) or not len(cols):
+    if not len(cols):
         return matching
     cost = stage.cost(rows, cols)
     found = stage.solve(cost) if stage.solve is not None else assign(cost, stage.max_cost).matches

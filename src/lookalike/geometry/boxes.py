@@ -69,9 +69,13 @@ def iou_matrix(xywh_a: np.ndarray, xywh_b: np.ndarray) -> np.ndarray:
     ax2, ay2 = ax1 + a[:, 2:3], ay1 + a[:, 3:4]
     bx1, by1 = b[:, 0], b[:, 1]
     bx2, by2 = bx1 + b[:, 2], by1 + b[:, 3]
-    iw = np.clip(np.minimum(ax2, bx2) - np.maximum(ax1, bx1), 0.0, None)
-    ih = np.clip(np.minimum(ay2, by2) - np.maximum(ay1, by1), 0.0, None)
+    iw = np.minimum(ax2, bx2) - np.maximum(ax1, bx1)
+    ih = np.minimum(ay2, by2) - np.maximum(ay1, by1)
+    np.maximum(iw, 0.0, out=iw)
+    np.maximum(ih, 0.0, out=ih)
     inter = iw * ih
     union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
-    result: np.ndarray = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
-    return result
+    if (union > 0).all():
+        result: np.ndarray = inter / union
+        return result
+    return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)

@@ -93,6 +93,17 @@ class Tracks(Sequence[TrackSnapshot]):
                 raise ValueError(f"Tracks.{name}: has {len(col)} rows but the batch has {k}")
 
     @classmethod
+    def trusted(cls, id: np.ndarray, status: np.ndarray, xywh: np.ndarray, velocity: np.ndarray,
+                detection_index: np.ndarray) -> Tracks:
+        """Box tracks from columns a tracker built itself, without the checks of ``__init__``:
+        ``id`` and ``detection_index`` int ``(k,)``, ``status`` int8 ``(k,)``, ``xywh (k, 4)``,
+        ``velocity (k, d)``."""
+        out = cls.__new__(cls)
+        out.id, out.status, out.xywh, out.velocity, out.detection_index = id, status, xywh, velocity, detection_index
+        out.position = out.heading = out.agent_id = out.identity_prob = None
+        return out
+
+    @classmethod
     def empty(cls) -> Tracks:
         """No tracks."""
         return cls(np.zeros(0, dtype=int), TrackStatus.CONFIRMED)
