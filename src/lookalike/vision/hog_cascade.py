@@ -132,6 +132,33 @@ def _block_features_rows(rows: np.ndarray, width: int, blocks: np.ndarray, ox: n
     return out
 
 
+def _block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int, int], stride: int,
+                         unit_px: int) -> np.ndarray:
+    """:func:`_block_features_rows` for every window of a ``grid`` (rows, columns) of windows ``stride`` corners
+    apart, starting at corner (0, 0), of an integral ``planes (BINS, H+1, W+1)`` float32: each corner of a block is
+    one strided slice per bin plane (long inner loops, no gathers); values bit for bit those of the gathers."""
+    ny, nx = grid
+    k, d = ny * nx, 4 * BINS
+    out = np.empty((k, len(blocks) * d), np.float32)
+    cells = np.empty((2, 2, BINS, ny, nx), np.float32)
+    for j, (bx, by, bw, bh) in enumerate(np.asarray(blocks, np.int64).tolist()):
+        x0, y0, hw, hh = bx // unit_px, by // unit_px, bw // 2 // unit_px, bh // 2 // unit_px
+        corner = [[planes[:, y0 + r * hh : y0 + r * hh + (ny - 1) * stride + 1 : stride,
+                          x0 + c * hw : x0 + c * hw + (nx - 1) * stride + 1 : stride] for c in range(3)]
+                  for r in range(3)]
+        for r in range(2):
+            for c in range(2):
+                cell = cells[r, c]
+                np.subtract(corner[r + 1][c + 1], corner[r][c + 1], out=cell)
+                cell -= corner[r + 1][c]
+                cell += corner[r][c]
+        # (window, cell row, cell column, bin), contiguous: the norm then sums in the same order as the gathers.
+        flat = np.ascontiguousarray(cells.transpose(3, 4, 0, 1, 2)).reshape(k, d)
+        flat /= np.sqrt((flat * flat).sum(axis=1, keepdims=True)) + np.float32(bw * bh)
+        out[:, j * d : (j + 1) * d] = flat
+    return out
+
+
 def window_features(windows: np.ndarray, blocks: np.ndarray) -> np.ndarray:
     """Pooled descriptors ``(n, b * 36)`` of ``windows (n, h+2, w+2)`` grey crops with a 1-px margin."""
     wins = np.asarray(windows, dtype=np.float32)
@@ -214,7 +241,7 @@ class HogCascade:
             # histograms' own memory layout, and one row of BINS values per corner for the gathers.
             hist = cell_histograms(level, cfg.cell_px).transpose(1, 2, 0)
             integral = np.zeros((hist.shape[0] + 1, hist.shape[1] + 1, BINS))
-            np.cumsum(np.cumsum(hist, axis=0), axis=1, out=integral[1:, 1:])
+            integral[1:, 1:] = np.cumsum(np.cumsum(hist, axis=0), axis=1)  # contiguous temporaries: faster
             width = integral.shape[1]
             # float32 corners (faster gathers): on 640x480 the corner sums stay below ~1e7, so rounding moves a
             # block sum by a few gradient units at most, far below the block sums the stumps threshold.
@@ -223,11 +250,16 @@ class HogCascade:
             ox, oy = xs.ravel(), ys.ravel()
             alive = np.arange(len(ox))
             margin = np.zeros(0)
-            for stage, (used, columns) in zip(self.stages, self._stage_blocks):
+            for k, (stage, (used, columns)) in enumerate(zip(self.stages, self._stage_blocks)):
                 if not len(alive):
                     break
-                # Descriptors of this stage's blocks, for the windows still alive only.
-                cols = _block_features_rows(rows, width, used, ox[alive], oy[alive], cfg.cell_px)[:, columns]
+                # Descriptors of this stage's blocks, for the windows still alive only (the first stage sees every
+                # window of the grid: strided slices of the integral instead of gathers, the same arithmetic).
+                if k == 0:
+                    planes = np.ascontiguousarray(integral.transpose(2, 0, 1), dtype=np.float32)
+                    cols = _block_features_grid(planes, used, xs.shape, cfg.stride_cells, cfg.cell_px)[:, columns]
+                else:
+                    cols = _block_features_rows(rows, width, used, ox[alive], oy[alive], cfg.cell_px)[:, columns]
                 votes = np.where((cols > stage.threshold) == (stage.sign > 0), 1.0, -1.0)
                 margin = votes @ stage.weight
                 keep = margin >= stage.bias

@@ -48,9 +48,17 @@ def as_bgr_image(image: np.ndarray, name: str = "image") -> np.ndarray:
 
 
 def to_grey(image_bgr: np.ndarray) -> np.ndarray:
-    """``(h, w)`` float32 luminance in 0..255 of a ``(h, w, 3)`` uint8 BGR image."""
-    img = image_bgr.astype(np.float32)
-    return 0.114 * img[..., 0] + 0.587 * img[..., 1] + 0.299 * img[..., 2]
+    """``(h, w)`` float32 luminance in 0..255 of a ``(h, w, 3)`` uint8 BGR image:
+    ``0.114 B + 0.587 G + 0.299 R`` in float32, channel by channel (contiguous planes)."""
+    import cv2
+
+    b, g, r = (c.astype(np.float32) for c in cv2.split(np.ascontiguousarray(image_bgr)))
+    b *= np.float32(0.114)
+    g *= np.float32(0.587)
+    r *= np.float32(0.299)
+    b += g
+    b += r
+    return b
 
 
 def hue_channel(image_bgr: np.ndarray) -> np.ndarray:
@@ -73,14 +81,15 @@ def _gradient_bins(grey: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray,
     gx[:, 0] = gx[:, -1] = 0.0
     gy[0, :] = gy[-1, :] = 0.0
     mag, ang = cv2.cartToPolar(gx, gy)  # angle in [0, 2π), accurate to about 0.3°
-    ang -= np.float32(np.pi) * (ang >= np.pi)  # unsigned orientation in [0, π)
+    np.subtract(ang, np.float32(np.pi), out=ang, where=ang >= np.pi)  # unsigned orientation in [0, π]
     ang *= np.float32(bins / np.pi)
-    ang -= np.float32(0.5)  # bin centres at integers
+    ang -= np.float32(0.5)  # bin centres at integers: ang in [-0.5, bins - 0.5]
     lo = np.floor(ang)
-    w_hi = mag * (ang - lo)
-    lo_i = lo.astype(np.int32)
-    lo_i %= bins
-    return lo_i, mag - w_hi, w_hi
+    ang -= lo
+    w_hi = np.multiply(mag, ang, out=ang)
+    # floor(ang) is -1 .. bins - 1; as unsigned, -1 is the largest value, so the minimum wraps it to bins - 1.
+    lo_i = np.minimum(lo.astype(np.int32).view(np.uint32), np.uint32(bins - 1)).view(np.int32)
+    return lo_i, np.subtract(mag, w_hi, out=mag), w_hi
 
 
 def orientation_maps(grey: np.ndarray, bins: int = BINS) -> np.ndarray:
@@ -97,22 +106,53 @@ def orientation_maps(grey: np.ndarray, bins: int = BINS) -> np.ndarray:
 
 def cell_histograms(grey: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndarray:
     """``(bins, h // cell_px, w // cell_px)`` float64 orientation histograms of square cells: equal to summing
-    :func:`orientation_maps` over each cell, in one pass (two weighted ``bincount`` calls, no per-bin maps)."""
+    :func:`orientation_maps` over each cell, in one pass (two weighted ``bincount`` calls, no per-bin maps).
+
+    Worked in bands of cell rows (a row of context above and below for the vertical gradient), so that the
+    temporaries stay in cache; every cell's sum runs over the same pixels in the same order as over the whole
+    image, so the result is bit for bit the same."""
     g = np.asarray(grey, dtype=np.float32)
     if g.ndim != 2:
         raise ValueError(f"grey: expected shape (h, w), got {g.shape}")
-    ny, nx = g.shape[0] // cell_px, g.shape[1] // cell_px
-    lo, w_lo, w_hi = _gradient_bins(g, bins)
-    lo, w_lo, w_hi = (a[: ny * cell_px, : nx * cell_px] for a in (lo, w_lo, w_hi))
-    rows = (np.arange(ny * cell_px, dtype=np.int32) // cell_px) * (nx * bins)
-    cols = (np.arange(nx * cell_px, dtype=np.int32) // cell_px) * bins
-    base = rows[:, None] + cols[None, :]
-    n = ny * nx * bins
-    hist = np.bincount((base + lo).ravel(), w_lo.ravel(), n)
-    lo += 1
-    lo[lo == bins] = 0
-    hist += np.bincount((base + lo).ravel(), w_hi.ravel(), n)
+    h, w = g.shape
+    ny, nx = h // cell_px, w // cell_px
+    hist = np.empty(ny * nx * bins)
+    band = max(1, _BAND_PIXELS // max(1, w * cell_px))  # cell rows per band
+    for r0 in range(0, ny, band):
+        r1 = min(ny, r0 + band)
+        y0, y1 = r0 * cell_px, r1 * cell_px
+        top, bottom = max(0, y0 - 1), min(h, y1 + 1)
+        lo, w_lo, w_hi = _gradient_bins(g[top:bottom], bins)  # rows top, bottom - 1 are context or the border
+        crop = (slice(y0 - top, y1 - top), slice(0, nx * cell_px))
+        lo = lo[crop]
+        base = _cell_base(r1 - r0, nx, cell_px, bins)
+        n = (r1 - r0) * nx * bins
+        part = np.bincount((base + lo).ravel(), w_lo[crop].astype(np.float64).ravel(), n)
+        lo += 1
+        lo *= lo != bins  # the next bin, wrapping bins to 0
+        lo += base
+        part += np.bincount(lo.ravel(), w_hi[crop].astype(np.float64).ravel(), n)
+        hist[r0 * nx * bins : r1 * nx * bins] = part
     return hist.reshape(ny, nx, bins).transpose(2, 0, 1)
+
+
+_BAND_PIXELS = 1 << 15  # pixels per band of cell_histograms
+_BASES: dict[tuple[int, int, int, int], np.ndarray] = {}
+
+
+def _cell_base(ny: int, nx: int, cell_px: int, bins: int) -> np.ndarray:
+    """``(ny * cell_px, nx * cell_px)`` int32: each pixel's cell index times ``bins`` (cached per shape)."""
+    key = (ny, nx, cell_px, bins)
+    base = _BASES.get(key)
+    if base is None:
+        rows = (np.arange(ny * cell_px, dtype=np.int32) // cell_px) * (nx * bins)
+        cols = (np.arange(nx * cell_px, dtype=np.int32) // cell_px) * bins
+        base = rows[:, None] + cols[None, :]
+        base.flags.writeable = False
+        if len(_BASES) > 64:
+            _BASES.clear()
+        _BASES[key] = base
+    return base
 
 
 def integral_maps(maps: np.ndarray) -> np.ndarray:
