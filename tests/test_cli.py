@@ -61,3 +61,45 @@ def test_demo_runs(tmp_path):
     r = runner.invoke(app, ["demo", "--quick", "-o", str(tmp_path / "demo")])
     assert r.exit_code == 0, r.output
     assert (tmp_path / "demo").is_dir()
+
+
+def test_version_and_sorted_commands():
+    from lookalike.bench.results import lookalike_version
+
+    r = runner.invoke(app, ["--version"])
+    assert r.exit_code == 0 and r.output.strip() == f"lookalike {lookalike_version()}"
+    for args in ([], ["bench"]):
+        text = runner.invoke(app, [*args, "--help"], terminal_width=80).output
+        names = [line.split()[0] for line in text.split("Commands:")[1].splitlines()
+                 if line.startswith("  ") and not line.startswith("   ")]
+        assert names == sorted(names) and len(names) >= 5, names
+
+
+def _commands(group=None, path=()):
+    from typer.main import get_command
+
+    group = group or get_command(app)
+    for name, cmd in getattr(group, "commands", {}).items():
+        yield (*path, name)
+        yield from _commands(cmd, (*path, name))
+
+
+def test_help_wraps_within_80_columns_without_cut_sentences():
+    for path in _commands():
+        text = runner.invoke(app, [*path, "--help"], terminal_width=80).output
+        long = [line for line in text.splitlines() if len(line) > 80]
+        assert not long, (path, long)
+        assert "…" not in text, path
+
+
+def test_bench_options_mean_the_same_everywhere():
+    from typer.main import get_command
+
+    bench = get_command(app).commands["bench"]
+    kinds = {}
+    for cmd in bench.commands.values():
+        for p in cmd.params:
+            for opt in p.opts:
+                if opt in ("--sequences", "--frames", "--setups", "--trackers", "--seed", "--json"):
+                    kinds.setdefault(opt, set()).add((p.multiple, str(p.bare_type())))
+    assert all(len(v) == 1 for v in kinds.values()), kinds
