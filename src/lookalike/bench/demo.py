@@ -35,13 +35,14 @@ Step = Callable[[str, int], Callable[[], None]]
 
 @dataclasses.dataclass(frozen=True)
 class DemoSize:
-    """How much the demo simulates (frames per scene and table)."""
+    """How much the demo simulates (frames per scene and table). The defaults keep ``lookalike demo``
+    near 50 s of CPU time (one core): measured in docs/getting-started.md."""
 
-    robot_frames: int = 300
+    robot_frames: int = 240
     ident_sequences: int = 2
-    ident_frames: int = 600
-    diver_video_frames: int = 300
-    diver_frames: int = 150
+    ident_frames: int = 400
+    diver_video_frames: int = 240
+    diver_frames: int = 100
     diver_scenarios: int = len(SCENARIOS)
     fit_frames: int = 150
 
