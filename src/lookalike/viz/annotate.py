@@ -177,8 +177,13 @@ def draw_box_tracks(image: np.ndarray, frame: int, ids: np.ndarray, xywh: np.nda
     for i, pts in tails.items():
         draw_tail(image, pts, identity_colour(i))
     flags = np.zeros(len(ids), bool) if dashed is None else np.asarray(dashed, bool).reshape(-1)
-    for i, b, d in zip(ids, boxes, flags):
-        draw_box(image, b, identity_colour(int(i)), f"{prefix}{int(i)}", dashed=bool(d), labels=space)
+    for i, b, d in zip(ids, boxes, flags):  # every box first, so that no box is drawn over a label
+        draw_box(image, b, identity_colour(int(i)), dashed=bool(d))
+    for i, b in zip(ids, boxes):
+        if np.isfinite(b).all():
+            x0, y0 = round(float(b[0])), round(float(b[1]))
+            draw_label(image, f"{prefix}{int(i)}", (x0, y0 - 2), identity_colour(int(i)), labels=space,
+                       box=(x0, y0, round(float(b[0] + b[2])), round(float(b[1] + b[3]))))
 
 
 def draw_legend(image: np.ndarray, entries: list[tuple[str, BGR, bool]], scale: float = 0.45) -> None:

@@ -22,7 +22,15 @@ from lookalike.io import MotTable, tracks_to_rows, write_mot
 from lookalike.sim.divers import DiverScenario, simulate_divers
 from lookalike.trackers import TrackStatus, make_tracker
 from lookalike.types import Frame
-from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_box_tracks, draw_caption, draw_legend
+from lookalike.viz.annotate import (
+    LabelSpace,
+    Tails,
+    draw_box,
+    draw_box_tracks,
+    draw_caption,
+    draw_label,
+    draw_legend,
+)
 from lookalike.viz.colors import BGR
 from lookalike.viz.video import VideoWriter
 
@@ -157,11 +165,16 @@ def _annotated(image: np.ndarray, k: int, gt_rows: np.ndarray, shown: list[Any],
     on_diver, missed = true_false_missed(boxes, gt_rows)
     space = LabelSpace()
     for b in missed:
-        draw_box(img, b, MISSED, "missed", thickness=1, dashed=True, labels=space)
+        draw_box(img, b, MISSED, thickness=1, dashed=True)
     for b in boxes[~on_diver]:
-        draw_box(img, b + np.array([-3, -3, 6, 6]), FALSE_TRACK, "false", thickness=2, labels=space)
+        draw_box(img, b + np.array([-3, -3, 6, 6]), FALSE_TRACK, thickness=2)
     draw_box_tracks(img, k, np.array([t.track_id for t in shown], dtype=int), boxes, tails, prefix="track ",
                     labels=space, dashed=~on_diver)
+    for b, text, colour in [*((b, "missed", MISSED) for b in missed),
+                            *((b + np.array([-3, -3, 6, 6]), "false", FALSE_TRACK) for b in boxes[~on_diver])]:
+        x0, y0 = round(float(b[0])), round(float(b[1]))
+        draw_label(img, text, (x0, y0 - 2), colour, labels=space,
+                   box=(x0, y0, round(float(b[0] + b[2])), round(float(b[1] + b[3]))))
     draw_caption(img, caption)
     draw_legend(img, [("track on a diver (true)", (0, 140, 255), False),
                       ("track on no diver (false)", FALSE_TRACK, False),

@@ -170,13 +170,15 @@ def _draw_detections(img: np.ndarray, camera: Camera, scale: int, det: Any, labe
         return
     boxes = camera.ground_to_box(det.position, ROBOT_HEIGHT_M, ROBOT_WIDTH_M) * scale
     space = LabelSpace()
-    for i in np.argsort(-boxes[:, 3]):  # the largest (nearest) boxes place their labels first
-        b, lab, tru = boxes[i], int(labels[i]), int(truth[i])
+    order = np.argsort(-boxes[:, 3])  # the largest (nearest) boxes place their labels first
+    for i in order:  # every box first, so that no box is drawn over a label
+        b, lab = boxes[i], int(labels[i])
         draw_box(img, b, identity_colour(lab), dashed=lab < 0)
-        text = robot_label(lab)
-        if lab != tru:
+        if lab != int(truth[i]):
             draw_box(img, b + np.array([-3, -3, 6, 6]), WRONG, thickness=1)
-            text += " (wrong)"
+    for i in order:
+        b, lab = boxes[i], int(labels[i])
+        text = robot_label(lab) + (" (wrong)" if lab != int(truth[i]) else "")
         draw_label(img, text, (round(b[0]), round(b[1]) - 2), identity_colour(lab), labels=space,
                    box=(round(b[0]), round(b[1]), round(b[0] + b[2]), round(b[1] + b[3])))
 
