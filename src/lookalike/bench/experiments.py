@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.bench.ident import identify
+from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.bench.results import Results, add_printed_rows
 from lookalike.eval import identification_success_rate
 from lookalike.sim import PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
@@ -93,11 +94,14 @@ def _sequences(setup: str, sequences: int, frames: int, seed: int) -> list[Robot
 
 
 def shuffle_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int,
-                 seed: int = DEFAULT_SEED) -> list[dict[str, Any]]:
-    """Per set-up and identifier: success rate on frames in order and in random order (%)."""
+                 seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
+    """Per set-up and identifier: success rate on frames in order and in random order (%)
+    (``progress`` advanced once per set-up and identifier)."""
     rows = []
     for setup in setups:
         preset(setup)  # an unknown set-up fails before any work
+    step = progress("bench shuffle", len(setups) * len(trackers))
+    for setup in setups:
         for name in trackers:
             ordered, shuffled, truth_o, truth_s = [], [], [], []
             for k, seq in enumerate(_sequences(setup, sequences, frames, seed)):
@@ -113,6 +117,7 @@ def shuffle_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int,
                 "In order (%)": round(100 * identification_success_rate(ordered, truth_o), 2),
                 "Random order (%)": round(100 * identification_success_rate(shuffled, truth_s), 2),
             })
+            step()
     return rows
 
 
@@ -130,12 +135,15 @@ def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float
 
 
 def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,
-                  swap_s: float, seed: int = DEFAULT_SEED) -> list[dict[str, Any]]:
+                  swap_s: float, seed: int = DEFAULT_SEED,
+                  progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
     """Per set-up and identifier: success on the swapped pair while swapped (and without the swap),
-    and the mean and worst recovery time (s)."""
+    and the mean and worst recovery time (s) (``progress`` advanced once per set-up and identifier)."""
     rows = []
     for setup in setups:
         preset(setup)
+    step = progress("bench recovery", len(setups) * len(trackers))
+    for setup in setups:
         for name in trackers:
             runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s)
                              for seq in _sequences(setup, sequences, frames, seed)]).reshape(-1, 3)
@@ -146,6 +154,7 @@ def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int
                 "Recovery, mean (s)": round(float(np.mean(runs[:, 2])), 2),
                 "Recovery, worst (s)": round(float(np.max(runs[:, 2])), 2),
             })
+            step()
     return rows
 
 

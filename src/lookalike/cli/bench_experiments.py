@@ -11,6 +11,7 @@ from lookalike.bench.experiments import DEFAULT_SEED, experiment_results, recove
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import command_line, fail, split_list
 from lookalike.cli.bench import bench_app, print_rows, write_results
+from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
 
 
@@ -27,7 +28,8 @@ def shuffle(
 ) -> None:
     """Control experiment: success rate on frames in order and in random order."""
     try:
-        rows = shuffle_rows(split_list(setups), split_list(trackers), sequences, frames, seed)
+        with progress_bars() as progress:
+            rows = shuffle_rows(split_list(setups), split_list(trackers), sequences, frames, seed, progress)
     except ValueError as exc:
         fail(str(exc))
     print_rows("Control: frames in random order", rows)
@@ -51,7 +53,9 @@ def recovery(
 ) -> None:
     """Recovery experiment: swap two robots' reports, restore them, time the return to normal."""
     try:
-        rows = recovery_rows(split_list(setups), split_list(trackers), sequences, frames, swap_at_s, swap_s, seed)
+        with progress_bars() as progress:
+            rows = recovery_rows(split_list(setups), split_list(trackers), sequences, frames, swap_at_s, swap_s, seed,
+                                 progress)
     except ValueError as exc:
         fail(str(exc))
     print_rows(f"Recovery after {swap_s:g} s of swapped reports", rows)
