@@ -241,7 +241,7 @@ class HogCascade:
             # histograms' own memory layout, and one row of BINS values per corner for the gathers.
             hist = cell_histograms(level, cfg.cell_px).transpose(1, 2, 0)
             integral = np.zeros((hist.shape[0] + 1, hist.shape[1] + 1, BINS))
-            integral[1:, 1:] = np.cumsum(np.cumsum(hist, axis=0), axis=1)  # contiguous temporaries: faster
+            np.cumsum(np.cumsum(hist, axis=0), axis=1, out=integral[1:, 1:])
             width = integral.shape[1]
             # float32 corners (faster gathers): on 640x480 the corner sums stay below ~1e7, so rounding moves a
             # block sum by a few gradient units at most, far below the block sums the stumps threshold.

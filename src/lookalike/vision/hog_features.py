@@ -81,7 +81,7 @@ def _gradient_bins(grey: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray,
     gx[:, 0] = gx[:, -1] = 0.0
     gy[0, :] = gy[-1, :] = 0.0
     mag, ang = cv2.cartToPolar(gx, gy)  # angle in [0, 2π), accurate to about 0.3°
-    np.subtract(ang, np.float32(np.pi), out=ang, where=ang >= np.pi)  # unsigned orientation in [0, π]
+    ang -= np.float32(np.pi) * (ang >= np.pi)  # unsigned orientation in [0, π]
     ang *= np.float32(bins / np.pi)
     ang -= np.float32(0.5)  # bin centres at integers: ang in [-0.5, bins - 0.5]
     lo = np.floor(ang)
