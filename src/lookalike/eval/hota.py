@@ -39,23 +39,31 @@ def hota_arrays(data: SequenceData, pairs: Pairs) -> dict[str, np.ndarray]:
     m_gt, m_tr, s = _match_frames(data, pairs, alignment)
     keep = s >= ALPHAS[0] - _EPS
     m_gt, m_tr, s = m_gt[keep], m_tr[keep], s[keep]
-    hit = s[None, :] >= ALPHAS[:, None] - _EPS  # (19, k)
-    tp = hit.sum(axis=1).astype(float)
+    # Each match counts at the alphas its similarity reaches: the first `level` ones.
+    n_a = len(ALPHAS)
+    level = np.searchsorted(ALPHAS - _EPS, s, side="right")
+    tp = _at_least(np.bincount(level, minlength=n_a + 1)).astype(float)
     out["HOTA_TP"] = tp
     out["HOTA_FN"] = n_gt - tp
     out["HOTA_FP"] = n_tr - tp
-    out["LocA"] = np.maximum(1e-10, (hit * s).sum(axis=1)) / np.maximum(1e-10, tp)
+    loc = _at_least(np.bincount(level, s, minlength=n_a + 1))
+    out["LocA"] = np.maximum(1e-10, loc) / np.maximum(1e-10, tp)
     if len(s):
-        key = m_gt * T + m_tr
-        unique, inverse = np.unique(key, return_inverse=True)
-        inverse = inverse.ravel()
-        matches = np.stack([np.bincount(inverse, h, minlength=len(unique)) for h in hit])
+        unique, inverse = np.unique(m_gt * T + m_tr, return_inverse=True)
+        per_level = np.bincount(inverse.ravel() * (n_a + 1) + level, minlength=len(unique) * (n_a + 1))
+        matches = _at_least(per_level.reshape(len(unique), n_a + 1).T).astype(float)  # (19, pairs)
         gc, tc = gt_count[unique // T], tr_count[unique % T]
         weight = np.maximum(1.0, tp)
         out["AssA"] = (matches * matches / np.maximum(1.0, gc + tc - matches)).sum(axis=1) / weight
         out["AssRe"] = (matches * matches / np.maximum(1.0, gc)).sum(axis=1) / weight
         out["AssPr"] = (matches * matches / np.maximum(1.0, tc)).sum(axis=1) / weight
     return out
+
+
+def _at_least(per_level: np.ndarray) -> np.ndarray:
+    """From totals per level ``0 .. A`` (first axis), the totals over levels above each alpha ``(A, ...)``."""
+    result: np.ndarray = np.cumsum(per_level[::-1], axis=0)[::-1][1:]
+    return result
 
 
 def _match_frames(data: SequenceData, pairs: Pairs,
