@@ -206,6 +206,8 @@ def soak(seconds: float, seed: int = 0, n_robots: int = 3, n_ports: int = 40) ->
                 result.max_buckets = max(result.max_buckets, len(node._buckets))
                 result.rss_peak_mb = max(result.rss_peak_mb, rss_mb())
                 time.sleep(0.002)  # let the node's thread catch up now and then
+        _, asks = _ask_status(node)  # (the node has read everything sent before its reply)
+        sent["status_requests"] += asks
         result.final_team, final_expected = _final_frame(node, subscriber, n_robots, frame + 1000, sim + 10.0)
         result.final_ok = result.final_team is not None and _matches(result.final_team, final_expected)
         sent["final"] = n_robots + 2
