@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.bench.ident_paper import resolve_identifier
 from lookalike.bench.progress import ProgressFactory, Step, no_progress
 from lookalike.bench.results import Results, percent_row_metrics
 from lookalike.eval import identification_success_rate, localisation_error
@@ -29,11 +30,13 @@ DEFAULT_SEED = 900_000
 
 
 def build_identifier(name: str, sequence: RobotSequence) -> Any:
-    """Tracker ``name`` configured for the sequence's N (and M for trackers with slots)."""
-    known = {p.name for p in tracker_parameters(name)}
+    """Tracker ``name`` (or a variant of :data:`~lookalike.bench.ident_paper.IDENT_VARIANTS`)
+    configured for the sequence's N (and M for trackers with slots)."""
+    base, extra = resolve_identifier(name)
+    known = {p.name for p in tracker_parameters(base)}
     cfg = sequence.config
     params = {k: v for k, v in (("n_agents", cfg.n_agents), ("n_slots", cfg.max_detections)) if k in known}
-    return make_tracker(name, **params)
+    return make_tracker(base, **params, **extra)
 
 
 def identify(name: str, sequence: RobotSequence, frames: Sequence[Frame] | None = None,

@@ -12,6 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from lookalike.bench.ident import DEFAULT_SEED, IDENT_COLUMNS, IDENT_TRACKERS, ident_results, ident_table
+from lookalike.bench.ident_paper import IDENT_VARIANTS, margin_rows
 from lookalike.bench.results import Results
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import SortedGroup, app, command_line, console, fail, split_list
@@ -78,7 +79,7 @@ def ident(
     """Seed A's Table I: identification success rate per set-up and identifier (+ error, speed)."""
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
-    check_names("--trackers", tracker_list, tracker_names(), "tracker")
+    check_names("--trackers", tracker_list, [*tracker_names(), *IDENT_VARIANTS], "tracker")
     check_names("--noise", [noise], ("paper", "ours"), "noise model")
     try:
         with progress_bars() as progress:
@@ -90,6 +91,9 @@ def ident(
     summary = [{"Tracker": name, **{label: rate[(label, name)] for label in labels}} for name in tracker_list]
     print_rows(f"Robot identification success rate, {sequences} × {frames} frames per set-up", summary)
     print_rows("Per set-up details", rows, IDENT_COLUMNS)
+    margins = margin_rows(rows, setup_list, labels)
+    if margins:
+        print_rows("LSTM margins over Kalman-HA on the same sequences, beside seed A's (Table I)", margins)
     write_results(ident_results(rows, setup_list, sequences, frames, seed, command_line(), noise), json_path)
     write_rows(rows, None, csv_path)
 

@@ -1,8 +1,12 @@
 """The LSTM identifier (seed A) as a registered tracker: labels every detection "agent j" or
 "false positive" from the detections and the agents' heading reports, with the numpy network.
 
-Tracks are the agents themselves: ``T_j ← α·L_k + (1−α)·T_j`` where ``L_k`` is the position of
-the detection labelled ``j`` and ``α`` its class probability (DESIGN §5).
+Tracks are the agents themselves, positioned by a localiser fed with the detection labelled ``j``
+and its class probability ``α``: seed A's Eq. 3 ``T_j ← α·L_k + (1−α)·T_j`` (``localiser="lowpass"``)
+or our per-agent Kalman filter (``"kalman"``, see :mod:`lookalike.trackers.identity.localiser`).
+
+With ``protocol="paper"`` the shipped weights are those of seed A's input protocol (``N + 4·M``
+inputs, ``lstm_paper_m{M}_n{N}``); decode them per slot (``one_to_one=False``) as the paper does.
 """
 
 from __future__ import annotations
@@ -13,10 +17,11 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from lookalike.learn.checkpoint import load_weights
-from lookalike.learn.encoding import EncodingSpec, encode_frame
+from lookalike.learn.encoding import PROTOCOLS, EncodingSpec, encode_frame
 from lookalike.learn.numpy_net import NumpyAssociationNet
 from lookalike.learn.weights import shipped_weights_path
 from lookalike.trackers.base import check_params, param
+from lookalike.trackers.identity.localiser import LOCALISERS, make_localiser
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
@@ -68,6 +73,10 @@ class LstmIdentifier:
         n_slots: int = param(5, "detection slots M of the network", range=(1, 1000))
         weights: str | None = param(None, "path of model.npz (None: the shipped weights for N, M)")
         one_to_one: bool = param(True, "decode with Hungarian on -log p (else per-slot argmax, as the paper)")
+        localiser: str = param("kalman", "agent positions: kalman (ours) or lowpass (seed A's Eq. 3)",
+                               choices=LOCALISERS)
+        protocol: str = param("ours", "shipped weights when weights is None: ours, or paper (seed A's N + 4M "
+                              "inputs)", choices=PROTOCOLS)
 
         def __post_init__(self) -> None:
             check_params(self)
@@ -75,7 +84,8 @@ class LstmIdentifier:
     def __init__(self, config: LstmIdentifier.Config | None = None) -> None:
         self.config = config or LstmIdentifier.Config()
         cfg = self.config
-        path = cfg.weights or shipped_weights_path(cfg.n_agents, cfg.n_slots)
+        stem = "lstm_paper" if cfg.protocol == "paper" else "lstm"
+        path = cfg.weights or shipped_weights_path(cfg.n_agents, cfg.n_slots, stem)
         self.net = NumpyAssociationNet(load_weights(path, cfg.n_agents, cfg.n_slots))
         self.spec: EncodingSpec = self.net.spec
         self.reset()
@@ -84,7 +94,7 @@ class LstmIdentifier:
         """Forget the recurrent state, the reports and the agents' positions."""
         self.net.reset()
         self._beacons = BeaconMemory(self.config.n_agents)
-        self._position = np.full((self.config.n_agents, 2), np.nan)
+        self._localiser = make_localiser(self.config.localiser, self.config.n_agents)
         self._last_seen = np.full(self.config.n_agents, -1)
         self.last_labels = np.zeros(0, dtype=int)
         self.last_probabilities = np.zeros(0)
@@ -113,22 +123,24 @@ class LstmIdentifier:
             raise ValueError("lstm: frame.detections need position (m) and heading (rad) columns")
         position = det.position if det.position is not None else np.zeros((0, 2))
         heading = det.heading if det.heading is not None else np.zeros(0)
+        assigned = det_of_agent >= 0
+        measured = np.full((self.config.n_agents, 2), np.nan)
+        weight = np.zeros(self.config.n_agents)
+        measured[assigned] = position[det_of_agent[assigned]]
+        weight[assigned] = conf[det_of_agent[assigned]]
+        located = self._localiser.update(frame.time, measured, weight)
         snapshots = []
         for j in range(self.config.n_agents):
             k = det_of_agent[j]
             if k >= 0:
-                alpha = conf[k]
-                target = position[k]
-                prev = self._position[j]
-                self._position[j] = target if np.isnan(prev).any() else alpha * target + (1 - alpha) * prev
                 self._last_seen[j] = frame.index
-            if self._last_seen[j] < 0:
-                continue
+            if self._last_seen[j] < 0 or not np.isfinite(located[j]).all():
+                continue  # never seen, or lost for longer than the localiser keeps a position
             snapshots.append(
                 TrackSnapshot(
                     track_id=j + 1,
                     status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
-                    position=self._position[j].copy(),
+                    position=located[j].copy(),
                     heading=float(heading[k]) if k >= 0 else None,
                     agent_id=j,
                     identity_prob=float(conf[k]) if k >= 0 else None,
@@ -136,3 +148,4 @@ class LstmIdentifier:
                 )
             )
         return snapshots
+

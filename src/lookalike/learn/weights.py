@@ -9,9 +9,10 @@ from lookalike.learn.checkpoint import CheckpointError
 WEIGHTS_DIR = Path(__file__).with_name("weights_data")
 
 
-def shipped_weights_path(n_agents: int, n_slots: int) -> Path:
-    """The shipped ``model.npz`` for set-up (M=n_slots, N=n_agents); a clear error when none ships."""
-    path = WEIGHTS_DIR / f"lstm_m{n_slots}_n{n_agents}.npz"
+def shipped_weights_path(n_agents: int, n_slots: int, stem: str = "lstm") -> Path:
+    """The shipped ``model.npz`` for set-up (M=n_slots, N=n_agents); a clear error when none ships.
+    ``stem``: ``"lstm"`` (our input protocol) or ``"lstm_paper"`` (seed A's)."""
+    path = WEIGHTS_DIR / f"{stem}_m{n_slots}_n{n_agents}.npz"
     if not path.is_file():
         available = sorted(p.stem for p in WEIGHTS_DIR.glob("*.npz"))
         raise CheckpointError(
