@@ -114,3 +114,19 @@ def test_server_counts_queue_drops():
 def test_identifier_config_bounds(config):
     with pytest.raises(ValueError):
         IdentifierConfig(**config)
+
+
+def test_flood_from_a_thousand_ports_stays_bounded():
+    """Row 2 as reported: valid reports from 1,000 ports and no camera frame."""
+    config = IdentifierConfig(n_robots=3)
+    node = NodeServer(HeadingMatcher(), identifier_config=config)
+    try:
+        for k in range(10_000):
+            node.handle(_report(robot=k % 3, seq=k, t_sent=0.001 * k), ("127.0.0.1", 20_000 + k % 1000), 0.0)
+        c = node.counters.snapshot()
+        assert c["reports"] == 10_000
+        assert node.identifier.queued == 3 * config.max_queued_per_robot
+        assert c["queue_dropped"] == 10_000 - node.identifier.queued
+        assert len(node._buckets) <= node.config.max_senders
+    finally:
+        node.close()
