@@ -11,7 +11,12 @@ def iou_cost(track_xywh: np.ndarray, det_xywh: np.ndarray, min_iou: float = 0.0,
              det_weight: np.ndarray | None = None) -> np.ndarray:
     """``1 - IoU`` (``1 - IoU·weight`` with a per-detection ``det_weight``, e.g. its score) for every
     track/detection pair, ``inf`` where IoU < ``min_iou``: ``(k, d)``."""
-    iou = iou_matrix(track_xywh, det_xywh)
+    return cost_from_iou(iou_matrix(track_xywh, det_xywh), min_iou, det_weight)
+
+
+def cost_from_iou(iou: np.ndarray, min_iou: float = 0.0, det_weight: np.ndarray | None = None) -> np.ndarray:
+    """:func:`iou_cost` from an IoU matrix ``(k, d)`` already computed (e.g. a block of a frame's
+    whole track × detection matrix)."""
     cost = 1.0 - (iou if det_weight is None else iou * det_weight[None, :])
     if min_iou > 0:
         cost[iou < min_iou] = np.inf

@@ -73,15 +73,30 @@ def assign(cost: np.ndarray, max_cost: float = np.inf) -> Assignment:
     allowed pairs, then minimises their total cost.
     """
     c = _check(cost)
+    rows, cols = _solve(c, max_cost)
+    return _result(rows, cols, c.shape)
+
+
+def assign_pairs(cost: np.ndarray, max_cost: float = np.inf) -> np.ndarray:
+    """The matched ``(row, col)`` pairs of :func:`assign` alone, ``(k, 2)`` sorted by row."""
+    rows, cols = _solve(_check(cost), max_cost)
+    matches = np.empty((len(rows), 2), dtype=int)
+    matches[:, 0] = rows
+    matches[:, 1] = cols
+    return matches
+
+
+def _solve(c: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray]:
+    none = np.zeros(0, dtype=int)
     if c.size == 0:
-        return _result(np.zeros(0, int), np.zeros(0, int), c.shape)
+        return none, none
     allowed = c <= max_cost if np.isfinite(max_cost) else c < np.inf
     if not allowed.any():
-        return _result(np.zeros(0, int), np.zeros(0, int), c.shape)
+        return none, none
     if allowed.sum(axis=0).max() == 1 and allowed.sum(axis=1).max() == 1:
         # The allowed pairs are disjoint: every optimum holds all of them, nothing else is kept.
-        rows, cols = np.nonzero(allowed)
-        return _result(rows, cols, c.shape)
+        rows, cols = allowed.nonzero()
+        return rows, cols
     if np.isfinite(max_cost):
         # Clip forbidden pairs to just above the limit; they are dropped after solving.
         scale = max(abs(max_cost - float(c[allowed].min())), 1.0)
@@ -101,7 +116,7 @@ def assign(cost: np.ndarray, max_cost: float = np.inf) -> Assignment:
         work = np.where(allowed, work, penalty)
     rows, cols = linear_sum_assignment(work)
     keep = allowed[rows, cols]
-    return _result(rows[keep], cols[keep], c.shape)
+    return rows[keep], cols[keep]
 
 
 def max_weight_complete(weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

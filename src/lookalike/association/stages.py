@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lookalike.association.solver import assign
+from lookalike.association.solver import assign_pairs
 
 CostFn = Callable[[np.ndarray, np.ndarray], np.ndarray]
 """``cost(track_rows, det_indices) -> (len(track_rows), len(det_indices))``; ``inf`` forbids a pair."""
@@ -97,7 +97,7 @@ def run_stage(stage: Stage, matching: Matching, index: int = 0) -> Matching:
     if not len(cols):
         return matching
     cost = stage.cost(rows, cols)
-    found = stage.solve(cost) if stage.solve is not None else assign(cost, stage.max_cost).matches
+    found = stage.solve(cost) if stage.solve is not None else assign_pairs(cost, stage.max_cost)
     if len(found):
         r, c = rows[found[:, 0]], cols[found[:, 1]]
         matching.det_of_track[r] = c

@@ -48,6 +48,9 @@ def cxcywh_to_xywh(cxcywh: np.ndarray) -> np.ndarray:
     return out
 
 
+_P, _V = np.arange(4), np.arange(4, 8)  # the value and velocity rows of an 8-number box state
+
+
 class BoxXYSR:
     """SORT's ``[u, v, s, r, u', v', s']`` (centre, area, aspect; pixels and pixels/frame) with the
     reference noise: ``R = diag(1, 1, 10, 10)``, ``P0 = diag(10, 10, 10, 10, 1e4, 1e4, 1e4)``,
@@ -110,12 +113,41 @@ class BoxCXCYWH:
         return np.hstack([z, np.zeros((n, 4))]), np.einsum("ki,ij->kij", std**2, np.eye(8))
 
     def predict(self, mean: np.ndarray, cov: np.ndarray, steps: float) -> tuple[np.ndarray, np.ndarray]:
+        """``F x`` and ``F P Fᵀ + Q`` on the 2×2 blocks (value, velocity) of each box number: the
+        covariance of this space stays block-diagonal (diagonal ``P0``, ``Q``, ``R``)."""
         size = np.maximum(mean[:, 2:4], 1.0)
-        p, v = self.pos_noise, self.vel_noise
-        std = np.hstack([p * size, p * size, v * size, v * size])
-        Q = np.einsum("ki,ij->kij", std**2 * max(steps, 0.0), np.eye(8))
+        sq = size * size
+        var = np.concatenate((sq, sq), axis=1)  # (k, 4) for [cx, cy, w, h]
+        var *= max(steps, 0.0)
         mean[:, 6:8] = np.where(mean[:, 2:4] + mean[:, 6:8] * steps <= 1.0, 0.0, mean[:, 6:8])  # sizes stay > 1
-        return kalman.predict(mean, cov, kinematic_transition(4, 1, steps), Q)
+        mean_p = mean.copy()
+        mean_p[:, :4] += steps * mean[:, 4:]
+        p11, p12, p21, p22 = cov[:, _P, _P], cov[:, _P, _V], cov[:, _V, _P], cov[:, _V, _V]
+        cov_p = cov.copy()
+        a = p12 + steps * p22
+        cov_p[:, _P, _P] = p11 + steps * p21 + steps * a + self.pos_noise**2 * var
+        cov_p[:, _P, _V] = a
+        cov_p[:, _V, _P] = p21 + steps * p22
+        cov_p[:, _V, _V] = p22 + self.vel_noise**2 * var
+        return mean_p, cov_p
+
+    def update(self, mean: np.ndarray, cov: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Kalman update with measurements ``z (k, 4)`` (noise :meth:`R` of their sizes) on the 2×2
+        blocks; the same posterior as :func:`lookalike.motion.kalman.update`, to rounding."""
+        std = self.pos_noise * np.concatenate((z[:, 2:4], z[:, 2:4]), axis=1)
+        p11, p12, p21, p22 = cov[:, _P, _P], cov[:, _P, _V], cov[:, _V, _P], cov[:, _V, _V]
+        s = p11 + std * std
+        k1, k2 = p11 / s, p21 / s
+        innovation = z - mean[:, :4]
+        mean_u = mean.copy()
+        mean_u[:, :4] += k1 * innovation
+        mean_u[:, 4:] += k2 * innovation
+        cov_u = cov.copy()
+        cov_u[:, _P, _P] = p11 - k1 * p11
+        cov_u[:, _P, _V] = p12 - k1 * p21
+        cov_u[:, _V, _P] = p21 - k2 * p11
+        cov_u[:, _V, _V] = p22 - k2 * p21
+        return mean_u, cov_u
 
 
 @dataclass(frozen=True)

@@ -24,9 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from lookalike.association.costs import centre_distance_cost, iou_cost
+from lookalike.association.costs import centre_distance_cost, cost_from_iou
 from lookalike.association.stages import CostFn, Matching, Stage, run_plan
-from lookalike.motion import kalman
+from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion.spaces import BoxCXCYWH, cxcywh_to_xywh
 from lookalike.trackers import boxtrack_config as const
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
@@ -38,7 +38,7 @@ from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.self_calibration import ScoreCalibration
 from lookalike.trackers.table import TrackTable
 from lookalike.trackers.timing import FrameClock
-from lookalike.types import Frame, Tracks, TrackStatus
+from lookalike.types import Frame, Tracks
 
 _to_xywh = cxcywh_to_xywh  # kept for callers of the old private helper
 
@@ -79,10 +79,12 @@ class BoxTrack:
         self._frame_count += 1
         dets = frame.detections
         keep = dets.score >= cfg.low_score
-        det_idx = np.flatnonzero(keep)
-        det_xywh = dets.xywh[keep]
+        if keep.all():  # the read-only columns themselves, no copies
+            det_idx, det_xywh, score = np.arange(len(keep)), dets.xywh, dets.score
+        else:
+            det_idx = keep.nonzero()[0]
+            det_xywh, score = dets.xywh[det_idx], dets.score[det_idx]
         det_box = self._space.measure(det_xywh)
-        score = dets.score[keep]
         self._calibration.observe_scores(score)
         self._clutter.observe(det_xywh)
         high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
@@ -95,18 +97,19 @@ class BoxTrack:
         matching = self._associate(det_xywh, det_box, score, high_score, was_tracked,
                                    t.unseen_s + dt)
         det_of_track, free = matching.det_of_track, matching.free
-        matched = np.flatnonzero(det_of_track >= 0)
+        hit = det_of_track >= 0
+        matched = hit.nonzero()[0]
         if len(matched):
             d = det_of_track[matched]
-            t.mean[matched], t.cov[matched] = kalman.update(
-                t.mean[matched], t.cov[matched], det_box[d], self._space.H, self._space.R(det_box[d, 2:]))
+            t.mean[matched], t.cov[matched] = self._space.update(t.mean[matched], t.cov[matched], det_box[d])
             t.hits[matched] += 1
             back = matched[t.confirmed[matched] & (t.misses[matched] > 0)]
-            self._coasting.observe(came_back=t.misses[back])
-        t.hits[det_of_track < 0] = 0
+            if len(back):
+                self._coasting.observe(came_back=t.misses[back])
+        t.hits[~hit] = 0
         if self._slots is not None:
-            self._slots.observe_speed(t, det_of_track >= 0, self._clock.interval)
-        t.record(det_of_track >= 0, dt)
+            self._slots.observe_speed(t, hit, self._clock.interval)
+        t.record(hit, dt)
         ready = (t.hits >= cfg.n_init) | ((self._frame_count == 1) & (t.hits > 0))
         if self._slots is None:
             t.confirmed |= ready
@@ -125,11 +128,13 @@ class BoxTrack:
         """The association plan: confident detections to confirmed tracks (recent ones first), low-score
         ones to tracks seen last frame, the rest to tentative tracks, then lost tracks by centre distance."""
         cfg, t = self.config, self._tracks
-        pred = cxcywh_to_xywh(t.mean[:, :4])
         high = score >= high_score
+        # one IoU matrix per frame; each stage takes its block of it
+        iou = iou_matrix(cxcywh_to_xywh(t.mean[:, :4]), det_xywh) if len(t) and len(score) else None
 
         def overlap(min_iou: float, weigh: bool) -> CostFn:
-            return lambda r, c: iou_cost(pred[r], det_xywh[c], min_iou, score[c] if weigh else None)
+            return lambda r, c: cost_from_iou(iou[r[:, None], c], min_iou,  # type: ignore[index]
+                                              score[c] if weigh else None)
 
         recent = t.misses <= const.RECENT_FRAMES
         matching = run_plan([
@@ -176,5 +181,5 @@ class BoxTrack:
             shown = np.concatenate([shown, coasted])
             original = np.concatenate([original, np.full(len(coasted), -1)])
             boxes = np.vstack([boxes, cxcywh_to_xywh(t.mean[coasted, :4])])
-        return Tracks(t.ids[shown], TrackStatus.CONFIRMED, xywh=boxes,
-                      velocity=t.mean[shown, 4:6] / self._clock.interval, detection_index=original)
+        return Tracks.trusted(t.ids[shown], np.ones(len(shown), dtype=np.int8), boxes,
+                              t.mean[shown, 4:6] / self._clock.interval, original)
