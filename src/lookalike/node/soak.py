@@ -10,6 +10,7 @@ queue and table sizes seen, resident memory, and whether the final team state wa
 from __future__ import annotations
 
 import json
+import logging
 import math
 import threading
 import time
@@ -157,10 +158,14 @@ def soak(seconds: float, seed: int = 0, n_robots: int = 3, n_ports: int = 40) ->
     sent = {"valid_reports": 0, "invalid": 0, "frames": 0, "status_requests": 0, "flood_reports": 0}
     subscriber = Endpoint(("127.0.0.1", 1))
     id_config = IdentifierConfig(n_robots=n_robots, max_queued_per_robot=64, max_queued=128)
+    quiet = logging.getLogger("lookalike.node.soak")  # (camera_lost and the like are expected here)
+    quiet.propagate = False
+    if not quiet.handlers:
+        quiet.addHandler(logging.NullHandler())
     node = NodeServer(LatestHeadingMatcher(n_robots),
                       NodeConfig(publish=(subscriber.address,), reply_to_robots=False, status_interval_s=0,
                                  max_senders=64, camera_timeout_s=0.5),
-                      id_config)
+                      id_config, logger=quiet)
     stop = threading.Event()
     thread = threading.Thread(target=node.serve, args=(stop.is_set, 0.01), daemon=True)
     thread.start()
