@@ -94,7 +94,9 @@ def test_banded_cell_histograms_equal_the_whole_image_ones(monkeypatch, band_pix
                 assert np.array_equal(cell_histograms(g, cell), plain_cell_histograms(g, cell)), (shape, cell)
 
 
-def test_grey_equals_the_plain_weighted_sum() -> None:
+@pytest.mark.parametrize("band_pixels", [1, 100, 1 << 15])
+def test_grey_equals_the_plain_weighted_sum(monkeypatch, band_pixels: int) -> None:
+    monkeypatch.setattr(hf, "_BAND_PIXELS", band_pixels)
     img = np.random.default_rng(1).integers(0, 256, (31, 47, 3)).astype(np.uint8)
     f = img.astype(np.float32)
     assert np.array_equal(to_grey(img), 0.114 * f[..., 0] + 0.587 * f[..., 1] + 0.299 * f[..., 2])

@@ -141,11 +141,17 @@ def _block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int
     k, d = ny * nx, 4 * BINS
     out = np.empty((k, len(blocks) * d), np.float32)
     cells = np.empty((2, 2, BINS, ny, nx), np.float32)
+    phases: dict[tuple[int, int], np.ndarray] = {}  # planes[:, py::stride, px::stride], contiguous
+
+    def corner_grid(y: int, x: int) -> np.ndarray:
+        key = (y % stride, x % stride)
+        if key not in phases:
+            phases[key] = np.ascontiguousarray(planes[:, key[0] :: stride, key[1] :: stride])
+        return phases[key][:, y // stride : y // stride + ny, x // stride : x // stride + nx]
+
     for j, (bx, by, bw, bh) in enumerate(np.asarray(blocks, np.int64).tolist()):
         x0, y0, hw, hh = bx // unit_px, by // unit_px, bw // 2 // unit_px, bh // 2 // unit_px
-        corner = [[planes[:, y0 + r * hh : y0 + r * hh + (ny - 1) * stride + 1 : stride,
-                          x0 + c * hw : x0 + c * hw + (nx - 1) * stride + 1 : stride] for c in range(3)]
-                  for r in range(3)]
+        corner = [[corner_grid(y0 + r * hh, x0 + c * hw) for c in range(3)] for r in range(3)]
         for r in range(2):
             for c in range(2):
                 cell = cells[r, c]

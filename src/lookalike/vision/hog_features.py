@@ -49,16 +49,21 @@ def as_bgr_image(image: np.ndarray, name: str = "image") -> np.ndarray:
 
 def to_grey(image_bgr: np.ndarray) -> np.ndarray:
     """``(h, w)`` float32 luminance in 0..255 of a ``(h, w, 3)`` uint8 BGR image:
-    ``0.114 B + 0.587 G + 0.299 R`` in float32, channel by channel (contiguous planes)."""
+    ``0.114 B + 0.587 G + 0.299 R`` in float32 (channel planes, in bands of rows that stay in cache)."""
     import cv2
 
-    b, g, r = (c.astype(np.float32) for c in cv2.split(np.ascontiguousarray(image_bgr)))
-    b *= np.float32(0.114)
-    g *= np.float32(0.587)
-    r *= np.float32(0.299)
-    b += g
-    b += r
-    return b
+    img = np.ascontiguousarray(image_bgr)
+    h, w = img.shape[:2]
+    out = np.empty((h, w), np.float32)
+    rows = max(1, _BAND_PIXELS // max(1, w))
+    for y0 in range(0, h, rows):
+        b, g, r = (c.astype(np.float32) for c in cv2.split(img[y0 : y0 + rows]))
+        b *= np.float32(0.114)
+        g *= np.float32(0.587)
+        r *= np.float32(0.299)
+        b += g
+        np.add(b, r, out=out[y0 : y0 + rows])
+    return out
 
 
 def hue_channel(image_bgr: np.ndarray) -> np.ndarray:
