@@ -75,12 +75,24 @@ def ident(
     json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
     noise: str = typer.Option("ours", "--noise", help="Simulator position noise: paper (seed A's) or ours."),
+    lengths: str | None = typer.Option(
+        None, "--lengths", help="Seed A's Table III instead: success rate on random windows of these lengths "
+        "(frames, comma-separated, e.g. 200,400,800) and on the whole recordings."),
+    draws: int = typer.Option(4, "--draws", min=1, help="Random windows per length (Table III)."),
+    recordings: Path | None = typer.Option(
+        None, "--recordings", help="Table III on the robot-sequence .jsonl files of this folder (one set-up) "
+        "instead of the simulated test sequences."),
 ) -> None:
-    """Seed A's Table I: identification success rate per set-up and identifier (+ error, speed)."""
+    """Seed A's Table I: identification success rate per set-up and identifier (+ error, speed).
+    With --lengths or --recordings: seed A's Table III protocol."""
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
     check_names("--trackers", tracker_list, [*tracker_names(), *IDENT_VARIANTS], "tracker")
     check_names("--noise", [noise], ("paper", "ours"), "noise model")
+    if lengths is not None or recordings is not None:
+        table3_command(setup_list, tracker_list, sequences, frames, seed, noise, lengths, draws, recordings,
+                       json_path, csv_path)
+        return
     try:
         with progress_bars() as progress:
             rows = ident_table(setup_list, tracker_list, sequences, frames, seed, noise, progress)
@@ -96,6 +108,27 @@ def ident(
         print_rows("LSTM margins over Kalman-HA on the same sequences, beside seed A's (Table I)", margins)
     write_results(ident_results(rows, setup_list, sequences, frames, seed, command_line(), noise), json_path)
     write_rows(rows, None, csv_path)
+
+
+def table3_command(setups: list[str], trackers: list[str], sequences: int, frames: int, seed: int, noise: str,
+                   lengths: str | None, draws: int, recordings: Path | None, json_path: Path | None,
+                   csv_path: Path | None) -> None:
+    """``bench ident --lengths/--recordings``: seed A's Table III per set-up (or on the recordings)."""
+    from lookalike.bench.table3 import DEFAULT_LENGTHS, table3_table
+
+    try:
+        length_list = [int(v) for v in split_list([lengths])] if lengths else list(DEFAULT_LENGTHS)
+    except ValueError:
+        fail(f"--lengths: expected comma-separated frame counts, got {lengths!r}")
+    try:
+        with progress_bars() as progress:
+            rows = table3_table(setups, trackers, sequences, frames, seed, noise, length_list, draws, recordings,
+                                progress)
+    except (ValueError, FileNotFoundError) as exc:
+        fail(str(exc))
+    print_rows(f"Success rate by sequence length (seed A's Table III protocol: {draws} random windows per "
+               "length, then whole recordings)", rows)
+    write_rows(rows, json_path, csv_path)
 
 
 __all__ = ["bench_app", "check_names", "print_rows", "rich_table", "write_results"]
