@@ -125,5 +125,5 @@ def test_training_writes_loadable_weights_and_resumes(tmp_path):
     NumpySetAssociator(load_set_weights(first.weights_path))
     with pytest.raises(ValueError, match="another configuration"):
         train_set(replace(config, pair=10), tmp_path, resume=True)
-    more = train_set(replace(config), tmp_path, resume=True)  # already at its last step: nothing more to do
-    assert more.steps == 2
+    cooled = train_set(replace(config, steps=3, learning_rate=0.001), tmp_path, resume=True)  # one step more
+    assert cooled.steps == 3 and [h["step"] for h in cooled.history] == [1, 2, 3]

@@ -3,6 +3,7 @@ team size) on the robot simulator (needs the 'train' extra)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import shutil
 from pathlib import Path
@@ -30,7 +31,9 @@ def train(
     patience: int = typer.Option(12, min=1,
                                  help="Stop after this many validations (every 50 steps) without a new best."),
     threads: int = typer.Option(1, help="Torch threads."),
-    learning_rate: float = typer.Option(0.004, help="Adam's initial learning rate (the paper's 0.004)."),
+    learning_rate: float | None = typer.Option(
+        None, help="Adam's initial learning rate (default: the paper's 0.004 for lstm, 0.003 for set; with "
+        "--model set --resume, a lower one cools the run down)."),
     swap_prob: float = typer.Option(
         0.0, help="Fraction of training sequences in which two robots swap identities for 1-10 s (ours; "
         "teaches fast re-identification)."),
@@ -62,8 +65,10 @@ def train(
         fail(f"--model: unknown model {model!r}; known: lstm, set")
     if model == "set":
         _train_set(output, steps, minutes, batch_size, seed, patience, threads, device, workers, backend, address,
-                   resume, ship)
+                   resume, ship, learning_rate)
         return
+    if learning_rate is None:
+        learning_rate = 0.004
     from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.encoding import EncodingSpec
     from lookalike.learn.paper_protocol import NoiseMixSampler, noise_worlds
@@ -133,7 +138,7 @@ def train(
 
 def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int, seed: int, patience: int,
                threads: int, device: str, workers: int, backend: str, address: str | None, resume: bool,
-               ship: bool) -> None:
+               ship: bool, learning_rate: float | None) -> None:
     """``lookalike train --model set``: the set associator over every team size (issue 23)."""
     import torch
 
@@ -148,6 +153,8 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
         fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
     try:
         config = SetTrainConfig(steps=steps, minutes=minutes, batch_size=batch_size, seed=seed, patience=patience)
+        if learning_rate is not None:
+            config = dataclasses.replace(config, learning_rate=learning_rate)
         pool = JobPool(workers, backend, address)
     except ValueError as exc:
         fail(str(exc))

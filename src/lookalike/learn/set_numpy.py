@@ -51,7 +51,8 @@ def save_set_weights(weights: SetWeights, path: str | os.PathLike[str]) -> Path:
     path = Path(path).with_suffix(".npz")
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp.npz")
-    np.savez(tmp, **{k: np.asarray(v, dtype=np.float32) for k, v in weights.arrays.items()})
+    payload: dict[str, Any] = {k: np.asarray(v, dtype=np.float32) for k, v in weights.arrays.items()}
+    np.savez_compressed(tmp, **payload)
     os.replace(tmp, path)
     meta = {"format": FORMAT, "format_version": FORMAT_VERSION, "token": weights.token, "pair": weights.pair,
             "memory": weights.memory, "max_age_s": weights.max_age_s, "info": weights.info}

@@ -100,8 +100,9 @@ def validate(model: SetAssociator, batches: list[tuple], device: str = "cpu") ->
 
 
 def _run_shape(config: dict) -> dict:
-    """The configuration without the stopping rules (a run may be resumed with more steps or minutes)."""
-    return {k: v for k, v in config.items() if k not in ("steps", "minutes", "patience")}
+    """The configuration without the stopping rules and the learning rate (a run may be resumed with
+    more steps or minutes, or cooled down at a lower learning rate)."""
+    return {k: v for k, v in config.items() if k not in ("steps", "minutes", "patience", "learning_rate")}
 
 
 def _export(model: SetAssociator, config: SetTrainConfig, info: dict) -> SetWeights:
@@ -138,7 +139,10 @@ def train_set(
         model.load_state_dict(state["model"])
         optimiser.load_state_dict(state["optimiser"])
         schedule.load_state_dict(state["schedule"])
+        schedule.base_lrs = [config.learning_rate] * len(schedule.base_lrs)  # a resumed run may lower it
         step, best, best_step, history = state["step"], state["best"], state["best_step"], state["history"]
+        for group in optimiser.param_groups:
+            group["lr"] = config.learning_rate / (1.0 + config.lr_decay * schedule.last_epoch)
     val = validation_batches(config)
     maker = config.batch_maker()
     started = time.monotonic()
