@@ -65,7 +65,11 @@ def test_shipped_model_embeds_and_tells_divers_apart() -> None:
 
 def test_extractor_names() -> None:
     assert matched_thresholds(HandcraftedFeatures(), "diversort") == {}
-    assert matched_thresholds(diver_extractor("learned"), "sort") == {}
+    learned = diver_extractor("learned")
+    assert matched_thresholds(learned, "sort") == {}
+    stored = matched_thresholds(learned, "diversort")  # from the shipped JSON, no rendering
+    assert set(stored) == {"appearance_threshold", "long_term_threshold", "recovery_threshold"}
+    assert 0 < stored["appearance_threshold"] < stored["long_term_threshold"] < 1
     with pytest.raises(ValueError, match="handcrafted, learned or FILE.onnx"):
         diver_extractor("deep")
     with pytest.raises(FileNotFoundError):
@@ -77,7 +81,7 @@ def test_tiny_training_run_exports_onnx(tmp_path) -> None:
     from lookalike.learn.appearance_train import AppearanceTrainConfig, train_appearance
 
     config = AppearanceTrainConfig(scenarios=1, frames=20, every=5, epochs=1, channels=4, embedding=8,
-                                   validation_every=60)
+                                   validation_every=60, match_thresholds=False)
     info = train_appearance(config, tmp_path, log=lambda _: None)
     assert (tmp_path / "diver_reid.onnx").exists() and info["training"]["identities"] >= 2
     assert json.loads((tmp_path / "diver_reid.json").read_text())["config"]["embedding"] == 8

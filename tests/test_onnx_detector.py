@@ -160,6 +160,7 @@ def test_track_video_with_onnx_detector_end_to_end(pool_video, tmp_path, tracker
     assert near >= 0.9 * len(det)
     assert len(read_mot(out)) > 0
     assert "frames/s" in r.output
+    assert ("--set appearance_threshold=" in r.output) == (features == "learned")
 
 
 def test_track_video_onnx_detector_errors(pool_video, tmp_path):

@@ -17,7 +17,7 @@ from rich.progress import (
 from lookalike.cli.app import console, fail
 from lookalike.cli.track_closed import offline_video
 from lookalike.io import read_mot, write_mot
-from lookalike.sim.divers_run import diver_extractor, fit_diver_features
+from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
 from lookalike.trackers.health import HealthConfig
 from lookalike.viz.overlay import source_frames
 from lookalike.viz.video_tracking import (
@@ -53,6 +53,11 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
                          else diver_extractor(features))
     except (ValueError, FileNotFoundError, OSError) as exc:
         fail(str(exc))
+    hint = stored_thresholds(extractor).get(tracker_name)
+    if hint:
+        console.print(f"note: {tracker_name}'s thresholds were chosen for the hand-crafted features; matched to "
+                      f"{features} on the validation divers they are "
+                      + " ".join(f"--set {k}={v:g}" for k, v in hint.items()), markup=False)
     columns = (TextColumn("tracking {task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     try:
         with Progress(*columns, console=console, transient=True) as progress:

@@ -50,6 +50,7 @@ class AppearanceTrainConfig:
     device: str = "cpu"
     minutes: float | None = None  # stop after this wall time
     validation_every: int = 10  # validation crops from every n-th frame
+    match_thresholds: bool = True  # store the trackers' thresholds matched to the model (validation scenarios)
 
     def __post_init__(self) -> None:
         for name in ("scenarios", "frames", "every", "embedding", "channels", "epochs", "batch_size", "threads",
@@ -215,6 +216,12 @@ def train_appearance(config: AppearanceTrainConfig, output: Path,
         "minutes": (time.perf_counter() - start) / 60,
         "torch": str(torch.__version__),
     }
+    if config.match_thresholds:
+        from lookalike.sim.divers_run import HANDCRAFTED_THRESHOLDS, matched_thresholds
+        from lookalike.vision.appearance_onnx import OnnxAppearance
+
+        model = OnnxAppearance(onnx_path)
+        info["matched_thresholds"] = {t: matched_thresholds(model, t) for t in HANDCRAFTED_THRESHOLDS}
     (output / f"{MODEL_NAME}.json").write_text(json.dumps(info, indent=1))
     log(f"best validation AUC {best[0]:.4f} → {onnx_path}")
     return info

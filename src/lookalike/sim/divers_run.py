@@ -113,14 +113,33 @@ def same_diver_distances(extractor: FeatureExtractor, scenarios: tuple[DiverScen
 def matched_thresholds(extractor: FeatureExtractor, tracker: str) -> dict[str, float]:
     """The tracker's cosine thresholds for ``extractor``: each hand-crafted threshold ``t`` becomes the
     distance that lets through the same share of same-diver pairs on the validation scenarios
-    (quantile matching). Empty for trackers without appearance thresholds and for the hand-crafted
-    features themselves."""
+    (quantile matching; read from the model's JSON when ``train-appearance`` stored them). Empty for
+    trackers without appearance thresholds and for the hand-crafted features themselves."""
     names = HANDCRAFTED_THRESHOLDS.get(tracker)
     if not names or isinstance(extractor, HandcraftedFeatures):
         return {}
+    stored = stored_thresholds(extractor).get(tracker)
+    if stored is not None and set(stored) == set(names):
+        return dict(stored)
     ref = _reference_distances()
     own = _distances_of(extractor)
     return {k: round(float(np.quantile(own, float(np.mean(ref <= t)))), 4) for k, t in names.items()}
+
+
+def stored_thresholds(extractor: FeatureExtractor) -> dict[str, dict[str, float]]:
+    """The matched thresholds that ``train-appearance`` stored in the JSON beside an ONNX model
+    (``matched_thresholds``: tracker -> parameter -> value); empty when there are none."""
+    path = getattr(extractor, "path", None)
+    meta = Path(path).with_suffix(".json") if path is not None else None
+    if meta is None or not meta.is_file():
+        return {}
+    import json
+
+    try:
+        found = json.loads(meta.read_text()).get("matched_thresholds", {})
+    except (ValueError, OSError):
+        return {}
+    return {t: {k: float(v) for k, v in p.items()} for t, p in found.items()} if isinstance(found, dict) else {}
 
 
 @lru_cache(maxsize=1)
