@@ -132,3 +132,9 @@ def test_shipped_detector_windows_equal_the_plain_path() -> None:
         assert np.array_equal(fast[0], plain[0]) and np.array_equal(fast[1], plain[1])
         found += len(fast[0])
     assert found > 0
+
+
+def test_row_by_row_cumsum_equals_numpy() -> None:
+    a = np.random.default_rng(4).uniform(0, 1e4, (37, 11, BINS))
+    assert np.array_equal(hc._cumsum_rows(a), np.cumsum(a, axis=0))
+    assert hc._cumsum_rows(np.zeros((0, 3))).shape == (0, 3)

@@ -132,6 +132,16 @@ def _block_features_rows(rows: np.ndarray, width: int, blocks: np.ndarray, ox: n
     return out
 
 
+def _cumsum_rows(a: np.ndarray) -> np.ndarray:
+    """``np.cumsum(a, axis=0)`` (the same sequential sums) as one vector add per row: faster on images."""
+    out = np.empty_like(a)
+    if len(a):
+        out[0] = a[0]
+    for y in range(1, len(a)):
+        np.add(out[y - 1], a[y], out=out[y])
+    return out
+
+
 def _block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int, int], stride: int,
                          unit_px: int) -> np.ndarray:
     """:func:`_block_features_rows` for every window of a ``grid`` (rows, columns) of windows ``stride`` corners
@@ -247,7 +257,7 @@ class HogCascade:
             # histograms' own memory layout, and one row of BINS values per corner for the gathers.
             hist = cell_histograms(level, cfg.cell_px).transpose(1, 2, 0)
             integral = np.zeros((hist.shape[0] + 1, hist.shape[1] + 1, BINS))
-            np.cumsum(np.cumsum(hist, axis=0), axis=1, out=integral[1:, 1:])
+            np.cumsum(_cumsum_rows(hist), axis=1, out=integral[1:, 1:])
             width = integral.shape[1]
             # float32 corners (faster gathers): on 640x480 the corner sums stay below ~1e7, so rounding moves a
             # block sum by a few gradient units at most, far below the block sums the stumps threshold.
