@@ -10,7 +10,7 @@ pytest.importorskip("lookalike.cli.bench", reason="the bench sub-app (lookalike.
 
 from typer.testing import CliRunner
 
-from lookalike.bench.divers import COLUMNS, TRACKERS, bar_chart, diver_table, pearson
+from lookalike.bench.divers import COLUMNS, ENTRIES, TRACKERS, bar_chart, diver_table, entries, pearson
 from lookalike.cli import app
 from lookalike.sim.divers import SCENARIOS, simulate_divers
 from lookalike.sim.divers_paper import PAPER_DETECTORS, redraw, with_detections
@@ -68,3 +68,18 @@ def test_command_writes_results_csv_png(tmp_path) -> None:
     assert bad.exit_code != 0 and "unknown diver scenario" in bad.output
     bad = CliRunner().invoke(app, ["bench", "divers", "--scenario", "pool_pair", "--tracker", "magic"])
     assert bad.exit_code == 2 and "magic" in bad.output
+
+
+def test_feature_sets_by_name_and_onnx_file(tmp_path) -> None:
+    import shutil
+
+    from lookalike.vision.appearance_onnx import LEARNED_MODEL
+
+    assert entries() == ENTRIES
+    assert [e[0] for e in entries(("handcrafted",))] == ["sort", "deepsort/handcrafted", "diversort/handcrafted"]
+    model = shutil.copy(LEARNED_MODEL, tmp_path / "reid2.onnx")
+    shutil.copy(LEARNED_MODEL.with_suffix(".json"), tmp_path / "reid2.json")
+    out = CliRunner().invoke(app, ["bench", "divers", "--scenario", "pool_pair", "--frames", "30",
+                                   "--features", str(model), "--tracker", "diversort/reid2"])
+    assert out.exit_code == 0, out.output
+    assert "diversort/reid2" in out.output

@@ -41,20 +41,38 @@ TRACKERS = tuple(label for label, _, _ in ENTRIES)
 COLUMNS = ("Scenario", "Location", "DP", "DR", "Tracker", "IDF1", "IDP", "IDR", "IDSW", "Frag")
 
 
-def diver_table(names: list[str] | None = None, trackers: tuple[str, ...] = TRACKERS, frames: int | None = None,
-                detections: str = "sim", seed: int = 0) -> list[dict[str, Any]]:
+def entries(features: tuple[str, ...] = ("handcrafted", "learned")) -> tuple[tuple[str, str, str], ...]:
+    """The bench entries ``(label, tracker, features)`` for feature sets ``features`` (``handcrafted``,
+    ``learned`` or ``FILE.onnx``, labelled by the file's stem): :data:`ENTRIES` for the default, else
+    SORT, then deep SORT and diver SORT with each feature set."""
+    if tuple(features) == ("handcrafted", "learned"):
+        return ENTRIES
+    if not features:
+        raise ValueError("features: give at least one feature set")
+    out = [("sort", "sort", features[0])]
+    for tracker in ("deepsort", "diversort"):
+        out += [(f"{tracker}/{Path(f).stem if f.lower().endswith('.onnx') else f}", tracker, f) for f in features]
+    return tuple(out)
+
+
+def diver_table(names: list[str] | None = None, trackers: tuple[str, ...] | None = None, frames: int | None = None,
+                detections: str = "sim", seed: int = 0,
+                features: tuple[str, ...] = ("handcrafted", "learned")) -> list[dict[str, Any]]:
     """Rows of Table 2 (keys :data:`COLUMNS`) for scenarios ``names`` (default: all test scenarios),
-    entries ``trackers`` (labels of :data:`ENTRIES`), detector level ``detections`` and draw ``seed``."""
-    entries = {label: (tracker, feats) for label, tracker, feats in ENTRIES}
+    entries ``trackers`` (labels of :func:`entries` for ``features``; default all), detector level
+    ``detections`` and draw ``seed``."""
+    known = entries(features)
+    entry = {label: (tracker, feats) for label, tracker, feats in known}
+    trackers = tuple(trackers) if trackers else tuple(label for label, _, _ in known)
     for t in trackers:
-        if t not in entries:
-            raise ValueError(f"unknown diver bench entry {t!r}; known: {', '.join(entries)}")
+        if t not in entry:
+            raise ValueError(f"unknown diver bench entry {t!r}; known: {', '.join(entry)}")
     chosen = [redraw(with_detections(scenario(n), detections), seed) for n in names] if names else \
         [redraw(with_detections(sc, detections), seed) for sc in SCENARIOS]
     if frames is not None:
         chosen = [dataclasses.replace(sc, frames=frames) for sc in chosen]
-    extractors = {f: diver_extractor(f) for f in dict.fromkeys(entries[t][1] for t in trackers)}
-    params = {t: matched_thresholds(extractors[entries[t][1]], entries[t][0]) for t in trackers}
+    extractors = {f: diver_extractor(f) for f in dict.fromkeys(entry[t][1] for t in trackers)}
+    params = {t: matched_thresholds(extractors[entry[t][1]], entry[t][0]) for t in trackers}
     rows: list[dict[str, Any]] = []
     per_tracker: dict[str, list[dict[str, float]]] = {t: [] for t in trackers}
     det_counts = np.zeros(3)  # tp, fp, fn pooled
@@ -67,7 +85,7 @@ def diver_table(names: list[str] | None = None, trackers: tuple[str, ...] = TRAC
         det_counts += [tp, n_det - tp, tp / dr - tp if dr > 0 else len(first.gt)]
         gt = MotTable.from_rows(first.gt)
         for label in trackers:
-            tracker, feats = entries[label]
+            tracker, feats = entry[label]
             result, _ = run_tracker(tracker, prepared[feats].frames, **params[label])
             scores = evaluate_sequence(gt, MotTable.from_rows(result), metrics=["CLEAR", "Identity"],
                                        num_frames=len(first.frames))
@@ -153,4 +171,4 @@ def bar_chart(rows: list[dict[str, Any]], path: Path) -> Path:
     return path
 
 
-__all__ = ["COLUMNS", "ENTRIES", "TRACKERS", "bar_chart", "diver_results", "diver_table", "pearson"]
+__all__ = ["COLUMNS", "ENTRIES", "TRACKERS", "bar_chart", "diver_results", "diver_table", "entries", "pearson"]

@@ -24,6 +24,9 @@ def divers(
     scenario_names: list[str] | None = typer.Option(None, "--scenario", help="Scenario name (repeatable)."),
     frames: int | None = typer.Option(None, min=10, help="Shorten every scenario to this many frames."),
     trackers: list[str] | None = typer.Option(None, "--tracker", help=ENTRY_HELP),
+    features: list[str] | None = typer.Option(None, "--features", help="Feature set (repeatable): handcrafted, "
+                                              "learned or FILE.onnx; deep SORT and diver SORT run with each "
+                                              "(default: handcrafted and learned, the entries above)."),
     detections: str = typer.Option("sim", "--detections", help="Detector level: 'sim' (the scenarios' own), "
                                    "'paper' (seed B's DP/DR per video) or 'both' (one table each)."),
     seed: int = typer.Option(0, min=0, help="Scenario draw: 0 the published scenarios, others new draws."),
@@ -38,8 +41,9 @@ def divers(
     tables = {}
     try:
         for level in levels:
-            tables[level] = diver_table(scenario_names, tuple(trackers) if trackers else TRACKERS, frames=frames,
-                                        detections=level, seed=seed)
+            tables[level] = diver_table(scenario_names, tuple(trackers) if trackers else None, frames=frames,
+                                        detections=level, seed=seed,
+                                        features=tuple(features) if features else ("handcrafted", "learned"))
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     wide = Console(width=max(console.width, 120))  # the table is wider than a default terminal
