@@ -11,10 +11,9 @@ tracked in the previous scored frame. MT: tracked > 80 % of its frames, ML: < 20
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import SequenceData
-from lookalike.eval.matching import conflicted_frames, frame_bounds
+from lookalike.eval.matching import conflicted_frames, frame_bounds, hungarian
 
 _EPS = np.finfo(float).eps
 COUNTS = ("CLR_TP", "CLR_FN", "CLR_FP", "IDSW", "MT", "PT", "ML", "Frag", "MOTP_sum", "CLR_Frames")
@@ -78,6 +77,7 @@ def _solve_hard_frames(data: SequenceData, hard: np.ndarray, scored: np.ndarray,
     """Matches ``(frame, gt det, tracker det, similarity)`` of the ``hard`` frames, in frame order: the
     Hungarian algorithm on the thresholded similarity plus 1000 for a pair matched in the previous scored
     frame (which is either one-to-one, so all its candidate pairs match, or an earlier hard frame)."""
+    linear_sum_assignment = hungarian()
     n_frames = len(scored)
     is_hard = np.zeros(n_frames, bool)
     is_hard[hard] = True

@@ -10,10 +10,9 @@ alphas); ``FIELD`` alone is the same mean.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import Pairs, SequenceData
-from lookalike.eval.matching import conflicted_frames, frame_bounds
+from lookalike.eval.matching import conflicted_frames, frame_bounds, hungarian
 
 ALPHAS = np.arange(0.05, 0.99, 0.05)  # the exact float values TrackEval compares with
 LABELS = tuple(range(5, 100, 5))
@@ -70,6 +69,7 @@ def _match_frames(data: SequenceData, pairs: Pairs,
                   alignment: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per frame, the Hungarian matching maximising ``alignment * similarity``: matched ``(gt id, tracker id,
     similarity)`` in frame order, rows ascending within a frame (pairs of zero similarity included)."""
+    linear_sum_assignment = hungarian()
     n_frames = data.num_frames
     frame, gt_det, tr_det = pairs.frame, pairs.gt_det, pairs.tracker_det
     score = alignment[pairs.gt_id, pairs.tracker_id] * pairs.similarity

@@ -5,15 +5,16 @@ ground-truth ids to tracker ids that maximises the number of frames both are mat
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import Pairs, SequenceData
+from lookalike.eval.matching import hungarian
 
 COUNTS = ("IDTP", "IDFN", "IDFP")
 
 
 def identity_counts(data: SequenceData, pairs: Pairs, threshold: float = 0.5) -> dict[str, float]:
     """``IDTP``, ``IDFN``, ``IDFP`` of one sequence; ``pairs`` is ``data.pairs()``."""
+    linear_sum_assignment = hungarian()
     n_gt, n_tr = data.num_gt_dets, data.num_tracker_dets
     if n_gt == 0 or n_tr == 0:
         return {"IDTP": 0, "IDFN": n_gt, "IDFP": n_tr}

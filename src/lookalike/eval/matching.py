@@ -9,7 +9,19 @@ tie-breaking).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
+
+
+def hungarian() -> Callable[..., Any]:
+    """SciPy's ``linear_sum_assignment``, imported on first use (``scipy.optimize`` takes a good part of a
+    second to import, which ``import lookalike`` should not pay)."""
+    from scipy.optimize import linear_sum_assignment
+
+    solve: Callable[..., Any] = linear_sum_assignment
+    return solve
 
 
 def frame_bounds(frame: np.ndarray, num_frames: int) -> np.ndarray:

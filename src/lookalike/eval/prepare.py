@@ -18,10 +18,9 @@ from pathlib import Path
 from typing import Literal, Protocol
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from lookalike.eval.data import Pairs, SequenceData
-from lookalike.eval.matching import conflicted_frames, dense, frame_bounds
+from lookalike.eval.matching import conflicted_frames, dense, frame_bounds, hungarian
 from lookalike.eval.similarity import pair_iou, point_similarity
 from lookalike.types.mot_table import MotTable as MotTableData
 
@@ -177,7 +176,9 @@ def _overlapping_pairs(a: np.ndarray, a_frame: np.ndarray, b: np.ndarray,
     b0, b1 = b_frame * span + (bx0 - lo), b_frame * span + (bx0 + b[:, 2] - lo) + 1.0
     parts_i, parts_j, parts_s = [], [], []
     # b's left edge in [a0, a1], then a's left edge in (b0, b1].
-    for keys, start, stop, side, owner_is_a in ((b0, a0, a1, "left", True), (a0, b0, b1, "right", False)):
+    searches: tuple[tuple[np.ndarray, np.ndarray, np.ndarray, Literal["left", "right"], bool], ...] = (
+        (b0, a0, a1, "left", True), (a0, b0, b1, "right", False))
+    for keys, start, stop, side, owner_is_a in searches:
         for owner, found in _ranges(keys, start, stop, side):
             i, j = (owner, found) if owner_is_a else (found, owner)
             iou = pair_iou(a[i], b[j])
@@ -216,6 +217,7 @@ def _drop_distractor_matches(keep_r: np.ndarray, gi: np.ndarray, ri: np.ndarray,
                              distractors: tuple[int, ...]) -> None:
     """Clear ``keep_r`` for tracker boxes that the per-frame Hungarian matching at IoU >= 0.5 pairs with a
     distractor-class ground-truth box (TrackEval's MOT16+ preprocessing)."""
+    linear_sum_assignment = hungarian()
     strong = sim >= 0.5 - _EPS
     gi, ri, sim = gi[strong], ri[strong], sim[strong]
     frame = g_frame[gi]
