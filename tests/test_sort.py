@@ -155,12 +155,15 @@ def _crowd(n_targets, frames, seed):
     return simulate_boxes(config).frames
 
 
-def test_sparse_matching_equals_plain_oracle_with_100_detections_a_frame():
+def test_sparse_matching_equals_plain_oracle_with_100_detections_a_frame(monkeypatch):
     import lookalike.trackers.sort_core as core
 
-    frames = _crowd(100, 25, seed=1)
-    assert min(len(f.detections) * 80 for f in frames[1:]) >= core.SPARSE_FROM  # the sparse path runs
-    _run_both(frames)
+    monkeypatch.setattr(core, "SPARSE_FROM", 1)  # the sparse path on every frame
+    _run_both(_crowd(100, 25, seed=1))
+
+
+def test_dense_matching_equals_plain_oracle_with_100_detections_a_frame():
+    _run_both(_crowd(100, 25, seed=3))
 
 
 def test_sparse_matching_equals_dense_with_1000_detections_a_frame(monkeypatch):

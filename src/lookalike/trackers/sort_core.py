@@ -27,7 +27,7 @@ P0_VELOCITY = np.array([1e4, 1e4, 1e4, 0.0])
 Q_POSITION = np.array([1.0, 1.0, 1.0, 1.0])
 Q_VELOCITY = np.array([1e-2, 1e-2, 1e-4, 0.0])
 WIDTH = 20
-SPARSE_FROM = 4096
+SPARSE_FROM = 30_000
 """Detections × tracks from which the sparse IoU and the per-component matching are used."""
 
 _transitions: dict[float, tuple[np.ndarray, np.ndarray]] = {}
