@@ -129,6 +129,8 @@ class LstmIdentifier:
         measured[assigned] = position[det_of_agent[assigned]]
         weight[assigned] = conf[det_of_agent[assigned]]
         located = self._localiser.update(frame.time, measured, weight)
+        fallback = assigned & ~np.isfinite(located).all(axis=1)  # labels never depend on the localiser
+        located[fallback] = measured[fallback]
         snapshots = []
         for j in range(self.config.n_agents):
             k = det_of_agent[j]
