@@ -83,7 +83,7 @@ def demo(
         if logger is not None:
             logger.close()  # type: ignore[attr-defined]
     console.print(f"\nDone in {time.perf_counter() - t0:.0f} s. Results are in [bold]{output}/[/]:")
-    console.print(f"  report      {files['report']}   (open it in a browser: tables, pictures, links to videos)")
+    console.print(f"  report      {files['report']}   (open it in a browser: tables, pictures, videos)")
     console.print(f"  videos      {files['robots-video']}, {files['divers-video']} (and .gif)")
     console.print(f"  plots       {files['robots-birdseye']}, {files['idf1']}")
     console.print("Try next: `lookalike trackers` (every tracker and its paper), `lookalike bench ident`, "
