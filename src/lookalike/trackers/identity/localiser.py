@@ -42,8 +42,9 @@ class LowPassLocaliser:
         new = seen & np.isnan(self._position).any(axis=1)
         alpha = np.clip(weight, 0.0, 1.0)[:, None]
         blend = alpha * measured + (1 - alpha) * self._position
-        self._position = np.where(new[:, None], measured, np.where(seen[:, None], blend, self._position))
-        return self._position.copy()
+        position: np.ndarray = np.where(new[:, None], measured, np.where(seen[:, None], blend, self._position))
+        self._position = position
+        return position.copy()
 
 
 @dataclass(frozen=True)
