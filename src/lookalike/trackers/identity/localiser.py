@@ -44,7 +44,8 @@ class LowPassLocaliser:
         blend = alpha * measured + (1 - alpha) * self._position
         position: np.ndarray = np.where(new[:, None], measured, np.where(seen[:, None], blend, self._position))
         self._position = position
-        return position.copy()
+        out: np.ndarray = position.copy()
+        return out
 
 
 @dataclass(frozen=True)
