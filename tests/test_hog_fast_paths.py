@@ -138,3 +138,18 @@ def test_row_by_row_cumsum_equals_numpy() -> None:
     a = np.random.default_rng(4).uniform(0, 1e4, (37, 11, BINS))
     assert np.array_equal(hc._cumsum_rows(a), np.cumsum(a, axis=0))
     assert hc._cumsum_rows(np.zeros((0, 3))).shape == (0, 3)
+
+
+def test_selected_columns_equal_the_full_features() -> None:
+    rng = np.random.default_rng(5)
+    integral = np.zeros((31, 41, BINS))
+    integral[1:, 1:] = rng.uniform(0, 50, (30, 40, BINS)).cumsum(axis=0).cumsum(axis=1)
+    blocks = hc.block_pool((32, 64), 4)[::9]
+    columns = rng.choice(len(blocks) * 4 * BINS, 17, replace=False)
+    ys, xs = np.mgrid[0 : 120 - 64 + 1 : 8, 0 : 160 - 32 + 1 : 8]
+    rows = integral.astype(np.float32).reshape(-1, BINS)
+    planes = np.ascontiguousarray(integral.transpose(2, 0, 1), dtype=np.float32)
+    full = hc._block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4)
+    assert np.array_equal(hc._block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4, columns),
+                          full[:, columns])
+    assert np.array_equal(hc._block_features_grid(planes, blocks, xs.shape, 2, 4, columns), full[:, columns])

@@ -113,11 +113,15 @@ def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy:
 
 
 def _block_features_rows(rows: np.ndarray, width: int, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
-                         unit_px: int) -> np.ndarray:
+                         unit_px: int, columns: np.ndarray | None = None) -> np.ndarray:
     """:func:`block_features` on an integral laid out as ``rows ((H+1) * width, BINS)``, one row per corner: the
-    nine corners of a block's 2×2 cells are nine row gathers, done for several blocks at once."""
+    nine corners of a block's 2×2 cells are nine row gathers, done for several blocks at once. With ``columns``,
+    only those columns of the result ``(k, len(columns))`` (each still normalised by its whole block)."""
     k, d = len(ox), 4 * BINS
-    out = np.empty((k, len(blocks) * d), np.float32)
+    cols = None if columns is None else np.asarray(columns, np.int64)
+    # Selected columns in column-major order, as ``features[:, columns]`` gives them: the vote matrix then keeps
+    # that layout and its product with the stage weights sums in the same order.
+    out = np.empty((k, len(blocks) * d), np.float32) if cols is None else np.empty((k, len(cols)), np.float32, "F")
     ox, oy = np.asarray(ox, np.int64), np.asarray(oy, np.int64)
     chunk = max(1, 65536 // max(k, 1))  # blocks per gather: bounds the (k, chunk, 3, 3, BINS) corner array
     for j0 in range(0, len(blocks), chunk):
@@ -127,8 +131,14 @@ def _block_features_rows(rows: np.ndarray, width: int, blocks: np.ndarray, ox: n
         step = (np.arange(3)[:, None] * (hh * width)[:, None, None] + np.arange(3) * hw[:, None, None])  # (b, 3, 3)
         c = rows[base[:, :, None, None] + step]  # (k, b, 3, 3, BINS) corners
         cells = (c[:, :, 1:, 1:] - c[:, :, :-1, 1:] - c[:, :, 1:, :-1] + c[:, :, :-1, :-1]).reshape(k, len(bw), d)
-        cells /= np.sqrt((cells * cells).sum(axis=2, keepdims=True)) + (bw * bh).astype(cells.dtype)[:, None]
-        out[:, j0 * d : (j0 + len(bw)) * d] = cells.reshape(k, -1)
+        denom = np.sqrt((cells * cells).sum(axis=2, keepdims=True)) + (bw * bh).astype(cells.dtype)[:, None]
+        if cols is None:
+            cells /= denom
+            out[:, j0 * d : (j0 + len(bw)) * d] = cells.reshape(k, -1)
+            continue
+        sel = np.flatnonzero((cols >= j0 * d) & (cols < (j0 + len(bw)) * d))
+        block, local = cols[sel] // d - j0, cols[sel] % d
+        out[:, sel] = cells[:, block, local] / denom[:, block, 0]
     return out
 
 
@@ -143,13 +153,16 @@ def _cumsum_rows(a: np.ndarray) -> np.ndarray:
 
 
 def _block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int, int], stride: int,
-                         unit_px: int) -> np.ndarray:
+                         unit_px: int, columns: np.ndarray | None = None) -> np.ndarray:
     """:func:`_block_features_rows` for every window of a ``grid`` (rows, columns) of windows ``stride`` corners
     apart, starting at corner (0, 0), of an integral ``planes (BINS, H+1, W+1)`` float32: each corner of a block is
-    one strided slice per bin plane (long inner loops, no gathers); values bit for bit those of the gathers."""
+    a slice of one bin-plane phase (long inner loops, no gathers); values bit for bit those of the gathers."""
     ny, nx = grid
     k, d = ny * nx, 4 * BINS
-    out = np.empty((k, len(blocks) * d), np.float32)
+    cols = None if columns is None else np.asarray(columns, np.int64)
+    # Selected columns in column-major order, as ``features[:, columns]`` gives them: the vote matrix then keeps
+    # that layout and its product with the stage weights sums in the same order.
+    out = np.empty((k, len(blocks) * d), np.float32) if cols is None else np.empty((k, len(cols)), np.float32, "F")
     cells = np.empty((2, 2, BINS, ny, nx), np.float32)
     phases: dict[tuple[int, int], np.ndarray] = {}  # planes[:, py::stride, px::stride], contiguous
 
@@ -160,6 +173,8 @@ def _block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int
         return phases[key][:, y // stride : y // stride + ny, x // stride : x // stride + nx]
 
     for j, (bx, by, bw, bh) in enumerate(np.asarray(blocks, np.int64).tolist()):
+        if cols is not None and not np.any(cols // d == j):
+            continue
         x0, y0, hw, hh = bx // unit_px, by // unit_px, bw // 2 // unit_px, bh // 2 // unit_px
         corner = [[corner_grid(y0 + r * hh, x0 + c * hw) for c in range(3)] for r in range(3)]
         for r in range(2):
@@ -170,8 +185,13 @@ def _block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int
                 cell += corner[r][c]
         # (window, cell row, cell column, bin), contiguous: the norm then sums in the same order as the gathers.
         flat = np.ascontiguousarray(cells.transpose(3, 4, 0, 1, 2)).reshape(k, d)
-        flat /= np.sqrt((flat * flat).sum(axis=1, keepdims=True)) + np.float32(bw * bh)
-        out[:, j * d : (j + 1) * d] = flat
+        denom = np.sqrt((flat * flat).sum(axis=1, keepdims=True)) + np.float32(bw * bh)
+        if cols is None:
+            flat /= denom
+            out[:, j * d : (j + 1) * d] = flat
+        else:
+            sel = np.flatnonzero(cols // d == j)
+            out[:, sel] = flat[:, cols[sel] % d] / denom
     return out
 
 
@@ -273,9 +293,9 @@ class HogCascade:
                 # window of the grid: strided slices of the integral instead of gathers, the same arithmetic).
                 if k == 0:
                     planes = np.ascontiguousarray(integral.transpose(2, 0, 1), dtype=np.float32)
-                    cols = _block_features_grid(planes, used, xs.shape, cfg.stride_cells, cfg.cell_px)[:, columns]
+                    cols = _block_features_grid(planes, used, xs.shape, cfg.stride_cells, cfg.cell_px, columns)
                 else:
-                    cols = _block_features_rows(rows, width, used, ox[alive], oy[alive], cfg.cell_px)[:, columns]
+                    cols = _block_features_rows(rows, width, used, ox[alive], oy[alive], cfg.cell_px, columns)
                 votes = np.where((cols > stage.threshold) == (stage.sign > 0), 1.0, -1.0)
                 margin = votes @ stage.weight
                 keep = margin >= stage.bias
