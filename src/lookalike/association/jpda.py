@@ -16,8 +16,6 @@ handles up to ``MAX_DP_DETECTIONS`` detections per cluster. Both give the exact 
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import connected_components
 
 MAX_DP_DETECTIONS = 20
 
@@ -57,6 +55,9 @@ def jpda_marginals(
     gated = L > 0
     adjacency = np.zeros((k + m, k + m), dtype=bool)
     adjacency[:k, k:] = gated
+    from scipy.sparse import csr_matrix  # imported on first use: scipy.sparse is slow to import
+    from scipy.sparse.csgraph import connected_components
+
     n_comp, comp = connected_components(csr_matrix(adjacency), directed=False)
     for c in range(n_comp):
         tracks = np.flatnonzero(comp[:k] == c)

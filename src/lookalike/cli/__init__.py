@@ -1,27 +1,53 @@
-"""The ``lookalike`` command line (typer). Each command lives in its own module of this package."""
+"""The ``lookalike`` command line (typer). Each command lives in its own module of this package.
+
+Importing a command module registers its commands on ``app``. Imported by anything else, this
+package imports every command module; run as the ``lookalike`` script (or ``python -m lookalike``)
+with a command of :data:`COMMAND_MODULES`, it imports only that command's module, so
+``lookalike trackers --names`` does not load the benchmarks' or the video pipeline's dependencies.
+"""
 
 from __future__ import annotations
 
-from lookalike.cli import bench as _bench  # noqa: E402,F401
-from lookalike.cli import bench_divers as _bench_divers  # noqa: E402,F401
-from lookalike.cli import bench_experiments as _bench_experiments  # noqa: E402,F401
-from lookalike.cli import bench_pixels as _bench_pixels  # noqa: E402,F401
-from lookalike.cli import bench_real as _bench_real  # noqa: E402,F401
-from lookalike.cli import demo as _demo  # noqa: E402,F401
-from lookalike.cli import eval as _eval  # noqa: E402,F401
-from lookalike.cli import label as _label  # noqa: E402,F401
-from lookalike.cli import node as _node  # noqa: E402,F401
-from lookalike.cli import render as _render  # noqa: E402,F401
-from lookalike.cli import report as _report  # noqa: E402,F401
-from lookalike.cli import simulate as _simulate  # noqa: E402,F401
+import importlib
+import sys
+from pathlib import Path
 
-# Importing the command modules registers their commands on ``app``.
-from lookalike.cli import track as _track  # noqa: E402,F401
-from lookalike.cli import train as _train  # noqa: E402,F401
-from lookalike.cli import train_appearance as _train_appearance  # noqa: E402,F401
-from lookalike.cli import tune as _tune  # noqa: E402,F401
-from lookalike.cli import vision as _vision  # noqa: E402,F401
 from lookalike.cli.app import app
+
+MODULES = ("bench", "bench_divers", "bench_experiments", "bench_pixels", "bench_real", "demo", "eval", "label",
+           "node", "render", "report", "simulate", "track", "track_pixels", "train", "train_appearance", "tune",
+           "vision")
+"""Every command module, in the order they are imported."""
+
+COMMAND_MODULES = {"track": "track", "trackers": "track", "eval": "eval", "simulate": "simulate",
+                   "render": "render", "report": "report", "demo": "demo", "label": "label"}
+"""Commands whose module alone is imported when the script runs them."""
+
+
+def _script_command() -> str | None:
+    """The command the ``lookalike`` script is running, or None (imported as a library, or no command)."""
+    if not sys.argv or Path(sys.argv[0]).name not in ("lookalike", "__main__.py"):
+        return None
+    return next((a for a in sys.argv[1:] if not a.startswith("-")), None)
+
+
+def _registered(command: str) -> bool:
+    names = {info.name or info.callback.__name__.replace("_", "-")  # type: ignore[union-attr]
+             for info in app.registered_commands}
+    return command in names | {info.name for info in app.registered_groups}
+
+
+def _load_commands() -> None:
+    command = _script_command()
+    only = COMMAND_MODULES.get(command or "")
+    for name in (only,) if only is not None else MODULES:
+        importlib.import_module(f"lookalike.cli.{name}")
+    if only is not None and not _registered(command or ""):
+        for name in MODULES:
+            importlib.import_module(f"lookalike.cli.{name}")
+
+
+_load_commands()
 
 
 def main() -> None:

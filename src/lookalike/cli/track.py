@@ -14,10 +14,6 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextC
 from rich.table import Table
 
 from lookalike.cli.app import app, console, err_console, fail
-from lookalike.cli.track_blobs import run_track_blobs
-from lookalike.cli.track_closed import offline_files, offline_video, track_points
-from lookalike.cli.track_pixels import run_track_pixels
-from lookalike.cli.track_video import run_track_video
 from lookalike.io import find_sequences
 from lookalike.io.needs import box_input_problem
 from lookalike.io.outputs import ensure_writable, refuse_inputs, result_paths
@@ -25,7 +21,6 @@ from lookalike.io.stream import sequence_stream, track_to_file
 from lookalike.loop import RunStats
 from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
 from lookalike.trackers.registry import parse_parameter
-from lookalike.tune.params_file import load_params
 
 
 def tracker_params(name: str, settings: list[str], params_file: Path | None = None) -> dict[str, Any]:
@@ -33,6 +28,8 @@ def tracker_params(name: str, settings: list[str], params_file: Path | None = No
     ``KEY=VALUE`` ``settings`` on top; fails with a readable message."""
     if name not in tracker_names():
         fail(f"unknown tracker {name!r}; choose one of: {', '.join(tracker_names())}")
+    from lookalike.tune.params_file import load_params  # imported when used: keeps the CLI's start-up short
+
     try:
         base = load_params(params_file, name) if params_file is not None else {}
         return {**base, **dict(parse_parameter(name, s) for s in settings)}
@@ -231,6 +228,12 @@ def track(
     team_size = team_size if team_size is not None else targets
     video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
                                          min_score=min_score, fps=fps, features=features)
+    # the video, pixel, blob and closed-set paths are imported when used: keeps the CLI's start-up short
+    from lookalike.cli.track_blobs import run_track_blobs
+    from lookalike.cli.track_closed import offline_files, offline_video, track_points
+    from lookalike.cli.track_pixels import run_track_pixels
+    from lookalike.cli.track_video import run_track_video
+
     try:
         if branch == "pipeline":
             if params_file is not None:

@@ -14,7 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from lookalike.learn.checkpoint import load_weights
 from lookalike.learn.encoding import PROTOCOLS, EncodingSpec, encode_frame
@@ -56,6 +55,8 @@ def decode(prob: np.ndarray, n_used: int, one_to_one: bool) -> tuple[np.ndarray,
         return np.where(label == n_agents, -1, label), conf
     # Each detection may be a false positive; each agent takes at most one detection.
     cost = -np.log(np.clip(np.hstack([p[:, :n_agents], np.repeat(p[:, n_agents:], n_used, axis=1)]), 1e-12, 1))
+    from scipy.optimize import linear_sum_assignment  # imported on first use (slow to import)
+
     rows, cols = linear_sum_assignment(cost)
     label = np.full(n_used, -1)
     label[rows] = np.where(cols < n_agents, cols, -1)

@@ -6,7 +6,6 @@ Field coordinates: origin at the field centre, x along the length, metres; headi
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import lfilter
 
 from lookalike.sim.robots_config import MotionConfig, ObserverConfig
 
@@ -14,6 +13,8 @@ from lookalike.sim.robots_config import MotionConfig, ObserverConfig
 def _lag(target: np.ndarray, alpha: float, initial: np.ndarray) -> np.ndarray:
     """First-order lag along axis 0: ``v_t = v_{t-1} + alpha (target_t - v_{t-1})``, ``v_{-1} = initial``."""
     zi = ((1.0 - alpha) * initial)[None]
+    from scipy.signal import lfilter  # imported on first use: scipy.signal is slow to import
+
     out, _ = lfilter([alpha], [1.0, -(1.0 - alpha)], target, axis=0, zi=zi)
     return out
 

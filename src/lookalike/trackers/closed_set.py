@@ -46,8 +46,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import sparse
-from scipy.optimize import Bounds, LinearConstraint, milp
 
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.trackers.base import check_positive, param
@@ -279,6 +277,9 @@ def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.nd
     m = len(src)
     if n == 0 or n_chains < 1:
         return []
+    from scipy import sparse  # imported on first use: scipy.optimize and scipy.sparse are slow to import
+    from scipy.optimize import Bounds, LinearConstraint, milp
+
     # variable blocks: x [0, n), y [n, n+m), a [n+m, 2n+m), b [2n+m, 3n+m)
     c = np.concatenate([-(np.asarray(lengths, float) - tracklet_cost), cost, np.zeros(2 * n)])
     eye = sparse.identity(n, format="csr")
@@ -346,6 +347,9 @@ def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[fl
                 cost.append(cfg.link_cost + 0.5 * z**2 - len(t))
     if not pp:
         return out
+    from scipy import sparse  # imported on first use: scipy.optimize and scipy.sparse are slow to import
+    from scipy.optimize import Bounds, LinearConstraint, milp
+
     pp_a, cc_a, cost_a = np.array(pp), np.array(cc), np.array(cost)
     m = len(pp_a)
     rows_a = [sparse.csr_matrix((np.ones(m), (pp_a, np.arange(m))), shape=(len(short), m))]
