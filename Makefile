@@ -51,8 +51,22 @@ $(BENCH_VENV)/.installed: pyproject.toml constraints-bench.txt
 	$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt -e ".[vision,viz,bench]"
 	touch $@
 
+# Peers whose declared requirements do not resolve next to numpy < 2 (trackers asks numpy >= 2, the packaged
+# reference SORT pins lap 0.4.0) go in without them; what they import is installed beside them.
+BENCH_PEERS_NODEPS := trackers pyDeprecate simple-online-realtime-tracking
 bench: $(BENCH_VENV)/.installed
-	@for script in benchmarks/[a-z]*.py; do echo "== $$script"; $(BENCH_VENV)/bin/python $$script || exit 1; done
+	@$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt filterpy lap
+	@$(BENCH_VENV)/bin/python -m pip install --quiet --no-deps -c constraints-bench.txt $(BENCH_PEERS_NODEPS)
+	@log=$$(mktemp); failed=""; \
+	for script in benchmarks/[a-z]*.py; do \
+		echo "== $$script" | tee -a $$log; \
+		$(BENCH_VENV)/bin/python $$script > $$log.one 2>&1 || failed="$$failed $$script"; \
+		cat $$log.one; cat $$log.one >> $$log; \
+	done; \
+	echo "== summary: every TARGET line"; grep '^TARGET' $$log; \
+	echo "$$(grep -c '^TARGET.* PASS$$' $$log) PASS, $$(grep -c '^TARGET.* FAIL$$' $$log) FAIL"; \
+	rm -f $$log $$log.one; \
+	if [ -n "$$failed" ]; then echo "scripts that failed:$$failed"; exit 1; fi
 
 # Reproduce the shipped LSTM weights: a first run per set-up (train-base, 25-40 minutes each on 2
 # cores), then refinement with identity-swap augmentation (train-refine): M=3,N=2 and M=5,N=3 on
