@@ -77,5 +77,6 @@ def iou_matrix(xywh_a: np.ndarray, xywh_b: np.ndarray) -> np.ndarray:
     union = a[:, 2:3] * a[:, 3:4] + b[:, 2] * b[:, 3] - inter
     if (union > 0).all():
         result: np.ndarray = inter / union
-        return result
-    return np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+    else:
+        result = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+    return result

@@ -65,7 +65,7 @@ def initial_state(z: np.ndarray) -> np.ndarray:
 def kalman_update(state: np.ndarray, z: np.ndarray) -> np.ndarray:
     """Posterior ``(k, 20)`` of tracks ``state (k, 20)`` given measurements ``z (k, 4)``."""
     k = len(state)
-    out = state.copy()
+    out: np.ndarray = state.copy()
     cov = state[:, 8:16].reshape(k, 2, 4)  # p11, p12
     gain = cov / (state[:, 8:12] + R)[:, None, :]  # k1 = p11 / S, k2 = p12 / S
     innovation = z - state[:, 0:4]
