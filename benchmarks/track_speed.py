@@ -1,13 +1,15 @@
 """Tracker speed on the MOT15 detections: lookalike's ``sort`` and ``boxtrack`` beside the reference
 SORT and the ``trackers`` package's SORT and ByteTrack, measured in one run.
 
-Run with ``make bench`` (installs the peers into .venv-bench) or directly:
-``python benchmarks/track_speed.py [--data ../shared/data/mot15] [--rounds 5]``.
-Detections are loaded beforehand; each round runs every tracker once over all sequences in turn
-(interleaved, so a busy moment hurts all alike) and the median over rounds is reported, in
-frames/s, with each lookalike tracker's ratio to every peer. ``sort``'s output is compared with
-the reference's, frame by frame (same boxes; ids a consistent renaming, since the reference numbers
-new tracks of one frame in the order its solver leaves them and lookalike in detection order).
+Run with ``make bench`` (installs the peers into .venv-bench) or directly: ``python
+benchmarks/track_speed.py [--data ../shared/data/mot15] [--rounds 5]``. Detections are loaded
+beforehand; each round runs every tracker once over all sequences in turn (interleaved, so a busy
+moment hurts all alike) and the median over rounds is reported, in frames/s of CPU time
+(``time.process_time``: on a shared machine the time spent waiting for a core is not counted; on an
+idle one it equals wall time), with each lookalike tracker's ratio to every peer. ``sort``'s output
+is compared with the reference's, frame by frame (same boxes; ids a consistent renaming, since the
+reference numbers new tracks of one frame in the order its solver leaves them and lookalike in
+detection order).
 """
 
 from __future__ import annotations
@@ -70,14 +72,14 @@ def main() -> int:
             runners[name] = runner
     n_frames = sum(len(s) for s in seqs)
     print(f"{len(seqs)} sequences, {n_frames} frames, median of {args.rounds} interleaved rounds, "
-          "tracker time only (input objects built per frame)")
+          "tracker CPU time only (input objects built per frame)")
     times: dict[str, list[float]] = {name: [] for name in runners}
     outputs: dict[str, object] = {}
     for _ in range(args.rounds):
         for name, run in runners.items():
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             outputs[name] = run(seqs)
-            times[name].append(time.perf_counter() - t0)
+            times[name].append(time.process_time() - t0)
     fps = {name: n_frames / statistics.median(t) for name, t in times.items()}
     for name, value in fps.items():
         print(f"{name:22s} {value:10,.0f} frames/s")
