@@ -174,7 +174,8 @@ class BoxTrack:
     def _report(self, det_of_track: np.ndarray, det_idx: np.ndarray, det_xywh: np.ndarray) -> Tracks:
         t = self._tracks
         shown = np.flatnonzero(t.confirmed & (t.unseen_s == 0) & (det_of_track >= 0))
-        coasted = np.flatnonzero(t.confirmed & (det_of_track < 0) & self._coasting.decide(t.misses))
+        missed = (t.confirmed & (det_of_track < 0)).nonzero()[0]
+        coasted = missed[self._coasting.decide(t.misses[missed])] if len(missed) else missed
         original = det_idx[det_of_track[shown]]
         boxes = cxcywh_to_xywh(t.mean[shown, :4])
         if len(coasted):  # missed this frame but likely still there: the predicted box, no detection
