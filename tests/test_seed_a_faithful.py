@@ -125,12 +125,15 @@ def test_table3_windows_and_rows():
 
 
 def test_cli_options_parse(tmp_path):
+    pytest.importorskip("torch")
     r = runner.invoke(app, ["simulate", "--preset", "m3n2", "--frames", "5", "--noise", "paper", "-o", str(tmp_path)])
     assert r.exit_code == 0, r.output
     header = json.loads(next(tmp_path.glob("*.jsonl")).read_text().splitlines()[0])
     assert header["config"]["sensor"]["std_y_per_m"] > header["config"]["sensor"]["std_x_per_m"]
     for args in (["simulate", "--noise", "x", "-o", str(tmp_path)], ["bench", "ident", "--noise", "x"],
-                 ["bench", "ident", "--lengths", "a,b"], ["bench", "ident", "--recordings", str(tmp_path / "none")]):
+                 ["bench", "ident", "--lengths", "a,b"], ["bench", "ident", "--recordings", str(tmp_path / "none")],
+                 ["train", "--protocol", "x", "-o", str(tmp_path / "run")],
+                 ["train", "--noise", "x", "-o", str(tmp_path / "run")]):
         bad = runner.invoke(app, args)
         assert bad.exit_code == 2 and "\n" not in bad.output.strip(), (args, bad.output)
     ok = runner.invoke(app, ["bench", "ident", "--setups", "m3n2", "--trackers", "kalman_ha,lstm-paper",
