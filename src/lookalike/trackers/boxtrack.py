@@ -34,6 +34,7 @@ from lookalike.trackers.closed_slots import ClosedSlots
 from lookalike.trackers.clutter import ClutterShare
 from lookalike.trackers.coasting import Coasting
 from lookalike.trackers.lifecycle import Lifecycle
+from lookalike.trackers.motion_fit import MotionFit
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.self_calibration import ScoreCalibration
 from lookalike.trackers.table import TrackTable
@@ -70,6 +71,7 @@ class BoxTrack:
             calib_min_count=const.CALIB_MIN_COUNT, clutter_factor=cfg.clutter_factor, clutter_floor=const.CLUTTER_FLOOR)
         self._clutter = ClutterShare(const.CLUTTER_IOU, const.CLUTTER_MIN_COUNT)
         self._coasting = Coasting(const.COAST_S, const.COAST_REPORT_PROB, const.COAST_MIN_COUNT)
+        self._fit = MotionFit(const.FIT_BATCH)
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
@@ -93,7 +95,7 @@ class BoxTrack:
             if self._slots is not None:
                 self._slots.freeze_shape(t)
             t.mean[self._coasting.still(t.unseen_s), 4:] = 0.0  # a long-lost track waits where it was last seen
-            t.mean, t.cov = self._space.predict(t.mean, t.cov, steps)
+            t.mean, t.cov = self._predict_space().predict(t.mean, t.cov, steps)
         matching = self._associate(det_xywh, det_box, score, high_score, was_tracked,
                                    t.unseen_s + dt)
         det_of_track, free = matching.det_of_track, matching.free
@@ -101,6 +103,7 @@ class BoxTrack:
         matched = hit.nonzero()[0]
         if len(matched):
             d = det_of_track[matched]
+            self._observe_fit(matched[t.confirmed[matched]], det_box[d[t.confirmed[matched]]])
             t.mean[matched], t.cov[matched] = self._space.update(t.mean[matched], t.cov[matched], det_box[d])
             t.hits[matched] += 1
             back = matched[t.confirmed[matched] & (t.misses[matched] > 0)]
@@ -159,6 +162,20 @@ class BoxTrack:
 
         stages.append(Stage(t.confirmed, high, reid, name="re-identification"))
         return run_plan(stages, len(t), len(score), start=matching)
+
+    def _predict_space(self) -> BoxCXCYWH:
+        """The motion model with its process noise scaled by :class:`MotionFit` (variance factor)."""
+        if self._fit.scale == 1.0:
+            return self._space
+        r = float(np.sqrt(self._fit.scale))
+        return BoxCXCYWH(self._space.pos_noise * r, self._space.vel_noise * r)
+
+    def _observe_fit(self, tracks: np.ndarray, z: np.ndarray) -> None:
+        """Centre innovations of confirmed ``tracks`` against their detections ``z`` (cx, cy, w, h)."""
+        if len(tracks):
+            mean, cov = self._tracks.mean[tracks], self._tracks.cov[tracks]
+            S = cov[:, :2, :2] + np.einsum("ki,ij->kij", (self._space.pos_noise * z[:, 2:4]) ** 2, np.eye(2))
+            self._fit.observe(z[:, :2] - mean[:, :2], S)
 
     def _births(self, new: np.ndarray, det_box: np.ndarray) -> np.ndarray:
         """Start tentative tracks on detections ``new``; returns the detections used."""

@@ -21,6 +21,7 @@ CALIB_MIN_COUNT = 100  # detections a score band needs before the self-calibrati
 COAST_MIN_COUNT = 30  # resolved misses of a length before the coast report judges that length
 POS_NOISE = 1 / 20  # position (and measurement) noise per frame, as a fraction of the box size
 CLUTTER_FLOOR = 0.1  # the birth threshold is never below this quantile of the scores seen
+FIT_BATCH = 30  # matched confirmed tracks per update of the process-noise scale (MotionFit)
 CLUTTER_IOU = 0.5  # a detection overlapping a previous-frame detection this much is not clutter
 CLUTTER_MIN_COUNT = 10  # detections judged before the clutter share is used
 CLOSED_GATE_GROWTH = 1.0  # closed set: recovery gate grows at least this many sizes per second lost

@@ -1,0 +1,48 @@
+"""How well a motion model fits the targets, judged on the tracker's own matches (no ground truth).
+
+A constant-velocity filter tuned for walking people lags behind targets that turn and dart (toy
+robots, insects): its innovations are then much larger than its covariance says. :class:`MotionFit`
+compares the normalised innovation squared (NIS) of confirmed tracks' centres with its distribution
+under the model (chi-square, 2 degrees of freedom) and scales the process noise until their medians
+agree. It only ever raises the noise (scale >= 1), so targets the model already fits keep it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+CHI2_2DOF_MEDIAN = 2.0 * math.log(2.0)  # median of the chi-square distribution with 2 degrees of freedom
+
+
+class MotionFit:
+    """Process-noise scale (variance factor, >= 1) learnt from centre innovations, ``batch`` at a time.
+
+    Each time ``batch`` innovations have been seen, the scale is multiplied by their median NIS over
+    the chi-square median (the innovations were measured with the scale in force, so the factor
+    converges to the one that makes the model's median fit), clipped to [1, ``max_scale``].
+    """
+
+    def __init__(self, batch: int = 30, max_scale: float = 1e4) -> None:
+        if batch < 1 or not max_scale >= 1.0:
+            raise ValueError(f"MotionFit: batch={batch} must be >= 1 and max_scale={max_scale} >= 1")
+        self.batch = batch
+        self.max_scale = max_scale
+        self.scale = 1.0
+        self._pending: list[np.ndarray] = []
+        self._count = 0
+
+    def observe(self, innovation: np.ndarray, S: np.ndarray) -> None:
+        """Centre innovations ``(k, 2)`` (pixels) of matched confirmed tracks and their covariances ``(k, 2, 2)``."""
+        if len(innovation) == 0:
+            return
+        a, b, d = S[:, 0, 0], S[:, 0, 1], S[:, 1, 1]
+        x, y = innovation[:, 0], innovation[:, 1]
+        nis = (d * x * x - 2.0 * b * x * y + a * y * y) / (a * d - b * b)  # innovation' S^-1 innovation
+        self._pending.append(nis)
+        self._count += len(nis)
+        if self._count >= self.batch:
+            median = float(np.median(np.concatenate(self._pending)))
+            self.scale = float(np.clip(self.scale * median / CHI2_2DOF_MEDIAN, 1.0, self.max_scale))
+            self._pending, self._count = [], 0
