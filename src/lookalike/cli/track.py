@@ -192,12 +192,15 @@ def track(
                                        "N identities (the tracker's max_targets; also the health checks' team size)."),
     health_window: int = typer.Option(15, "--health-window", min=1, help="Health monitor window in frames."),
     fps: float | None = typer.Option(None, "--fps", min=0.1, help="With --video: frame rate (default: the input's)."),
-    features: str = typer.Option("video", "--features", help="With --video: standardise the hand-crafted features "
-                                 "on this video's detections ('video') or use the diver calibration ('divers')."),
+    features: str = typer.Option("video", "--features", help="With --video: deepsort/diversort features: "
+                                 "hand-crafted, standardised on this video ('video') or with the diver calibration "
+                                 "('divers'); the shipped learned embedding ('learned'); or an embedding FILE.onnx."),
     detector: str | None = typer.Option(None, "--detector", help="With --video: detect with 'blob' (static camera) "
-                                        "instead of reading a det.txt; boxes go to <output stem>.det.txt."),
-    blob: list[str] | None = typer.Option(None, "--blob", help="Blob detector setting KEY=VALUE (repeatable), "
-                                          "e.g. threshold=30 polarity=dark min_area_px=80 max_area_px=5000."),
+                                        "or an ONNX model FILE.onnx instead of reading a det.txt; boxes go to "
+                                        "<output stem>.det.txt."),
+    blob: list[str] | None = typer.Option(None, "--blob", help="Detector setting KEY=VALUE (repeatable): for 'blob' "
+                                          "e.g. threshold=30 polarity=dark min_area_px=80; for FILE.onnx e.g. "
+                                          "score=0.4 classes=0 layout=yolo (docs: ONNX detector how-to)."),
     pipeline: str | None = typer.Option(None, "--pipeline", help="With --video: 'robots' finds, orients, places and "
                                         "identifies (-t kalman_ha|kalman_ha2|jpda|lstm) robots from the pixels."),
     reports: Path | None = typer.Option(None, "--reports",
