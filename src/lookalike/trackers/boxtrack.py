@@ -149,8 +149,8 @@ class BoxTrack:
         stages = [Stage(~t.confirmed, high, overlap(cfg.match_iou, False), name="tentative")]
         if self._slots is not None:  # gates in track heights
             gate = self._slots.gate(unseen_s)
-        else:
-            gate = np.full((len(t), 1), cfg.reid_distance)
+        else:  # in fitted standard deviations: a model that fits badly (MotionFit) widens the gate
+            gate = np.full((len(t), 1), cfg.reid_distance * np.sqrt(self._fit.scale))
 
         track_box, box, scale = t.mean[:, :4], det_box, cfg.reid_scale
         if self._slots is not None:  # closed set: sizes as sqrt(w·h), a turning target keeps its size
