@@ -24,7 +24,7 @@ from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.identity import agent_positions, labels_from_tracks
 from lookalike.types import Frame
 
-IDENT_TRACKERS = ("lstm", "kalman_ha", "kalman_ha2", "jpda")  # lstm: the learned identifier (seed A)
+IDENT_TRACKERS = ("lstm", "set", "kalman_ha", "kalman_ha2", "jpda")  # lstm: seed A; set: any team size
 IDENT_COLUMNS = ("Setup", "Tracker", "Success rate (%)", "Localisation error (m)", "Frames/s", "Detections")
 DEFAULT_SEED = 900_000
 
