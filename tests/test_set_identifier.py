@@ -127,3 +127,13 @@ def test_training_writes_loadable_weights_and_resumes(tmp_path):
         train_set(replace(config, pair=10), tmp_path, resume=True)
     cooled = train_set(replace(config, steps=3, learning_rate=0.001), tmp_path, resume=True)  # one step more
     assert cooled.steps == 3 and [h["step"] for h in cooled.history] == [1, 2, 3]
+
+
+def test_train_refuses_an_unknown_model_in_one_line(tmp_path):
+    pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    result = CliRunner().invoke(app, ["train", "--model", "nope", "-o", str(tmp_path)])
+    assert result.exit_code == 2 and "--model" in result.output and "Traceback" not in result.output
