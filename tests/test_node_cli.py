@@ -131,7 +131,7 @@ def test_team_on_loopback_matches_offline_identification(tmp_path, tracker, pres
     node, address = _serve(tmp_path, "--tracker", tracker, *sets, "--robots", str(n_robots),
                            "--publish", "{}:{}".format(*subscriber.address), "--status-interval", "2")
     node_arg = "{}:{}".format(*address)
-    sims = [_start(["robot-sim", "--robot", str(j), "--node", node_arg, *team], stdin=subprocess.PIPE)
+    sims = [_start(["robot-sim", "--robot", str(j + 1), "--node", node_arg, *team], stdin=subprocess.PIPE)
             for j in range(n_robots)]
     sims.append(_start(["camera-sim", "--node", node_arg, *team], stdin=subprocess.PIPE))
     teams: list[TeamState] = []
@@ -185,7 +185,7 @@ def test_camera_process_killed_and_restarted(tmp_path):
     team = ["--preset", PRESET, "--seed", "1", "--duration", str(duration), "--speed", str(speed)]
     node, address = _serve(tmp_path, "--tracker", "kalman_ha2", "--camera-timeout", "0.3")
     node_arg = "{}:{}".format(*address)
-    robot = _start(["robot-sim", "--robot", "0", "--node", node_arg, *team, "--start-at", "stdin"],
+    robot = _start(["robot-sim", "--robot", "1", "--node", node_arg, *team, "--start-at", "stdin"],
                    stdin=subprocess.PIPE)
     camera = _start(["camera-sim", "--node", node_arg, *team, "--start-at", "stdin"], stdin=subprocess.PIPE)
     second = None

@@ -175,7 +175,8 @@ def _sequence(preset_name: str, seed: int, duration: float, loss: float | None, 
 
 @app.command("robot-sim")
 def robot_sim(
-    robot: int = typer.Option(..., help="This robot's id (0-based)."),
+    robot: int = typer.Option(..., help="This robot's number, 1..N as in the pictures and the labelling page "
+                              "(its messages carry the 0-based id robot - 1)."),
     node: str = typer.Option("127.0.0.1:7700", help="The node's HOST:PORT."),
     preset_name: str = typer.Option("m5n3", "--preset", help=_PRESET_HELP),
     seed: int = typer.Option(0, help="Seed of the shared simulated sequence."),
@@ -193,8 +194,9 @@ def robot_sim(
     """A simulated robot: send heading reports to the node over a lossy, jittery link, receive
     the team state, and print the error of its identified position against its true one (JSON)."""
     sequence = _sequence(preset_name, seed, duration, loss, delay, jitter)
-    if not 0 <= robot < sequence.config.n_agents:
-        fail(f"--robot {robot}: preset {preset_name} has robots 0..{sequence.config.n_agents - 1}")
+    if not 1 <= robot <= sequence.config.n_agents:
+        fail(f"--robot {robot}: preset {preset_name} has robots 1..{sequence.config.n_agents}")
+    robot -= 1  # the wire protocol's 0-based id
     node_address, bind_address, group_address = _address(node, "--node"), _address(bind, "--bind"), _group(group)
     try:
         endpoint = Endpoint(node_address, bind_address, group=group_address)
