@@ -6,7 +6,7 @@ EXTRAS ?= test,vision,viz,train,docs,tune
 comma := ,
 STAMP := $(VENV)/.installed-$(subst $(comma),-,$(EXTRAS))
 
-.PHONY: venv demo test lint docs bench clean browser train train-base train-refine
+.PHONY: venv demo test lint docs bench clean browser train train-base train-refine train-set
 
 venv: $(STAMP)
 
@@ -88,6 +88,12 @@ train-refine: venv
 	    --swap-prob 0.5 --learning-rate 0.0015 --seed 1 --ship
 	$(REFINE) --preset m10n7 -o runs/m10n7-refine --init-from runs/m10n7/model.npz --swap-prob 0.3 \
 	    --batch-size 64 --steps 2100 --device auto --workers $$(nproc) --ship
+
+# The 'set' identifier (one network for every team size): 65 minutes of training on one CPU thread, then 8
+# minutes of cool-down at a lower learning rate; it stops on time, so a rerun reaches a similar step, not the same.
+train-set: venv
+	OMP_NUM_THREADS=1 $(VENV)/bin/lookalike train --model set -o runs/set --minutes 65
+	OMP_NUM_THREADS=1 $(VENV)/bin/lookalike train --model set -o runs/set --resume --minutes 8 --learning-rate 0.0008 --ship
 
 clean:
 	rm -rf $(VENV) $(BENCH_VENV) demo-out .pytest_cache
