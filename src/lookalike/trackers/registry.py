@@ -140,7 +140,7 @@ def _convert(name: str, key: str, text: str, hint: Any) -> Any:
 
 # Trackers defined above the trackers layer (they need the learned network); imported by name
 # so that this layer never imports upwards.
-PLUGIN_MODULES = ("lookalike.learn.tracker",)
+PLUGIN_MODULES = ("lookalike.learn.tracker", "lookalike.learn.set_tracker")
 
 
 _PLUGINS_LOADED = False
