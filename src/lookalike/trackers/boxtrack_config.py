@@ -36,7 +36,7 @@ class BoxTrackConfig:
     low_score: float = param(0.1, "detections below this are ignored", range=UNIT)
     birth_score: float = param(0.95, "detections scoring at least this may start tracks", range=UNIT)
     clutter_factor: float | None = param(
-        4.0, "if set, birth_score is lowered to the quantile of the scores seen so far equal to this times the "
+        2.0, "if set, birth_score is lowered to the quantile of the scores seen so far equal to this times the "
              "share of detections overlapping none of the previous frame's (at least the 0.1-quantile)", range=POSITIVE)
     high_match_ratio: float | None = param(
         0.6, "if set, high_score is lowered to the lowest 0.1-wide score bin from which every bin up continues "
