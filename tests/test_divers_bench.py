@@ -57,6 +57,10 @@ def test_command_writes_results_csv_png(tmp_path) -> None:
     assert "Pearson" in out.output and "detections: paper" in out.output
     doc = json.loads((tmp_path / "t.json").read_text())
     assert doc["schema"] == "lookalike-results/1"
+    jsonschema = pytest.importorskip("jsonschema", reason="jsonschema is in the test extra")
+    from lookalike.bench.results import schema
+
+    jsonschema.validate(doc, schema())
     rows = doc["tables"]["divers"]
     assert {r["tracker"] for r in rows} == {"sort", "diversort/handcrafted"}
     assert {r["dataset"] for r in rows} == {"divers-sim", "divers-paper"}
