@@ -6,12 +6,17 @@ from __future__ import annotations
 import dataclasses
 import math
 import shutil
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from lookalike.cli.app import app, console, fail
+
+if TYPE_CHECKING:
+    from lookalike.parallel import JobPool
 from lookalike.sim import PRESET_NAMES, preset
 
 
@@ -104,24 +109,9 @@ def train(
     except ValueError as exc:
         fail(str(exc))
     torch.set_num_threads(threads)
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-               TextColumn("loss {task.fields[loss]:.3f}  validation {task.fields[val]}"))
-    with Progress(*columns, console=console) as progress:
-        task = progress.add_task(f"training {preset_name}", total=steps, loss=math.nan, val="–")
-
-        def on_step(row: dict) -> None:
-            val = row["val_success"]
-            fields = {"loss": row["loss"]}
-            if not math.isnan(val):
-                fields["val"] = f"{100 * val:.1f}%"
-            progress.update(task, completed=row["step"], **fields)
-
-        try:
-            with pool:
-                result = run_training(config, sampler, output, resume=resume, on_step=on_step, device=device,
-                                      pool=pool, init=init, validation_sample=validation)
-        except ValueError as exc:
-            fail(str(exc))
+    result = _with_progress(f"training {preset_name}", steps, pool, lambda on_step: run_training(
+        config, sampler, output, resume=resume, on_step=on_step, device=device, pool=pool, init=init,
+        validation_sample=validation))
     png = plot_log(result.log_path, output / "training_log.png")
     console.print(
         f"best validation success rate [bold]{100 * result.best_success:.1f}%[/] at step {result.best_step} "
@@ -159,22 +149,8 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
     except ValueError as exc:
         fail(str(exc))
     torch.set_num_threads(threads)
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-               TextColumn("loss {task.fields[loss]:.3f}  validation {task.fields[val]}"))
-    with Progress(*columns, console=console) as progress:
-        task = progress.add_task("training set (N 1-12)", total=steps, loss=math.nan, val="–")
-
-        def on_step(row: dict) -> None:
-            fields = {"loss": row["loss"]}
-            if not math.isnan(row["val_success"]):
-                fields["val"] = f"{100 * row['val_success']:.1f}%"
-            progress.update(task, completed=row["step"], **fields)
-
-        try:
-            with pool:
-                result = train_set(config, output, resume=resume, on_step=on_step, device=device, pool=pool)
-        except ValueError as exc:
-            fail(str(exc))
+    result = _with_progress("training set (N 1-12)", steps, pool, lambda on_step: train_set(
+        config, output, resume=resume, on_step=on_step, device=device, pool=pool))
     png = plot_log(result.log_path, output / "training_log.png")
     console.print(
         f"best validation success rate [bold]{100 * result.best_success:.1f}%[/] (mean over the validation teams) "
@@ -186,3 +162,25 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
         shutil.copy(result.weights_path, SHIPPED_SET_WEIGHTS)
         shutil.copy(result.weights_path.with_suffix(".json"), SHIPPED_SET_WEIGHTS.with_suffix(".json"))
         console.print(f"shipped as {SHIPPED_SET_WEIGHTS}")
+
+
+def _with_progress(description: str, steps: int, pool: JobPool,
+                   train: Callable[[Callable[[dict], None]], Any]) -> Any:
+    """Run ``train(on_step)`` inside ``pool`` under a progress bar of ``steps`` showing the loss and the
+    validation success rate; a ``ValueError`` (bad configuration or checkpoint) becomes a one-line error."""
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+               TextColumn("loss {task.fields[loss]:.3f}  validation {task.fields[val]}"))
+    with Progress(*columns, console=console) as progress:
+        task = progress.add_task(description, total=steps, loss=math.nan, val="–")
+
+        def on_step(row: dict) -> None:
+            fields = {"loss": row["loss"]}
+            if not math.isnan(row["val_success"]):
+                fields["val"] = f"{100 * row['val_success']:.1f}%"
+            progress.update(task, completed=row["step"], **fields)
+
+        try:
+            with pool:
+                return train(on_step)
+        except ValueError as exc:
+            fail(str(exc))
