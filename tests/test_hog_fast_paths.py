@@ -7,6 +7,7 @@ import cv2
 import numpy as np
 import pytest
 
+import lookalike.vision.hog_blocks as hb
 import lookalike.vision.hog_cascade as hc
 import lookalike.vision.hog_features as hf
 from lookalike.vision.hog_features import BINS, as_bgr_image, cell_histograms, to_grey
@@ -68,7 +69,7 @@ def plain_windows(model: hc.HogCascade, image: np.ndarray) -> tuple[np.ndarray, 
         for stage, (used, columns) in zip(model.stages, model._stage_blocks):
             if not len(alive):
                 break
-            cols = hc._block_features_rows(rows, integral.shape[1], used, ox[alive], oy[alive], cfg.cell_px)[:, columns]
+            cols = hb.block_features_rows(rows, integral.shape[1], used, ox[alive], oy[alive], cfg.cell_px)[:, columns]
             margin = np.where((cols > stage.threshold) == (stage.sign > 0), 1.0, -1.0) @ stage.weight
             keep = margin >= stage.bias
             alive, margin = alive[keep], margin[keep]
@@ -107,12 +108,12 @@ def test_strided_first_stage_features_equal_the_gathers() -> None:
     hist = rng.uniform(0, 50, (30, 40, BINS))
     integral = np.zeros((31, 41, BINS))
     integral[1:, 1:] = hist.cumsum(axis=0).cumsum(axis=1)
-    blocks = hc.block_pool((32, 64), 4)[::7]
+    blocks = hb.block_pool((32, 64), 4)[::7]
     ys, xs = np.mgrid[0 : 120 - 64 + 1 : 8, 0 : 160 - 32 + 1 : 8]
     rows = integral.astype(np.float32).reshape(-1, BINS)
     planes = np.ascontiguousarray(integral.transpose(2, 0, 1), dtype=np.float32)
-    grid = hc._block_features_grid(planes, blocks, xs.shape, 2, 4)
-    assert np.array_equal(grid, hc._block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4))
+    grid = hb.block_features_grid(planes, blocks, xs.shape, 2, 4)
+    assert np.array_equal(grid, hb.block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4))
 
 
 def test_shipped_detector_windows_equal_the_plain_path() -> None:
@@ -136,20 +137,20 @@ def test_shipped_detector_windows_equal_the_plain_path() -> None:
 
 def test_row_by_row_cumsum_equals_numpy() -> None:
     a = np.random.default_rng(4).uniform(0, 1e4, (37, 11, BINS))
-    assert np.array_equal(hc._cumsum_rows(a), np.cumsum(a, axis=0))
-    assert hc._cumsum_rows(np.zeros((0, 3))).shape == (0, 3)
+    assert np.array_equal(hb.cumsum_rows(a), np.cumsum(a, axis=0))
+    assert hb.cumsum_rows(np.zeros((0, 3))).shape == (0, 3)
 
 
 def test_selected_columns_equal_the_full_features() -> None:
     rng = np.random.default_rng(5)
     integral = np.zeros((31, 41, BINS))
     integral[1:, 1:] = rng.uniform(0, 50, (30, 40, BINS)).cumsum(axis=0).cumsum(axis=1)
-    blocks = hc.block_pool((32, 64), 4)[::9]
+    blocks = hb.block_pool((32, 64), 4)[::9]
     columns = rng.choice(len(blocks) * 4 * BINS, 17, replace=False)
     ys, xs = np.mgrid[0 : 120 - 64 + 1 : 8, 0 : 160 - 32 + 1 : 8]
     rows = integral.astype(np.float32).reshape(-1, BINS)
     planes = np.ascontiguousarray(integral.transpose(2, 0, 1), dtype=np.float32)
-    full = hc._block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4)
-    assert np.array_equal(hc._block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4, columns),
+    full = hb.block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4)
+    assert np.array_equal(hb.block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4, columns),
                           full[:, columns])
-    assert np.array_equal(hc._block_features_grid(planes, blocks, xs.shape, 2, 4, columns), full[:, columns])
+    assert np.array_equal(hb.block_features_grid(planes, blocks, xs.shape, 2, 4, columns), full[:, columns])

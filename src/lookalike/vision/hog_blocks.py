@@ -1,0 +1,144 @@
+"""HOG block descriptors of the cascade detector: the block pool of a window and the L2-normalised 2×2-cell
+descriptors of many blocks for many windows, read from per-orientation integral histograms
+(:mod:`lookalike.vision.hog_features`). Two layouts compute the same values bit for bit: row gathers for
+windows anywhere (:func:`block_features_rows`) and strided slices for a regular grid of windows
+(:func:`block_features_grid`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lookalike.vision.hog_features import BINS, integral_maps, orientation_maps
+
+
+def _output(k: int, n_blocks: int, columns: np.ndarray | None) -> tuple[np.ndarray | None, np.ndarray]:
+    """The selected columns (int64, or None for all) and the float32 result to fill: ``(k, n_blocks * 36)``, or
+    ``(k, len(columns))`` in column-major order, as ``features[:, columns]`` gives them (the vote matrix then
+    keeps that layout and its product with the stage weights sums in the same order)."""
+    if columns is None:
+        return None, np.empty((k, n_blocks * 4 * BINS), np.float32)
+    cols = np.asarray(columns, np.int64)
+    return cols, np.empty((k, len(cols)), np.float32, "F")
+
+
+def block_pool(window_px: tuple[int, int], cell_px: int) -> np.ndarray:
+    """``(b, 4)`` blocks ``(x, y, w, h)`` in pixels inside the window: several sizes and aspect ratios, even
+    numbers of cells so that each block splits into 2×2 cells, stepped by half a block."""
+    w, h = window_px[0] // cell_px, window_px[1] // cell_px
+    blocks = set()
+    for bw in range(2, w + 1, 2):
+        for bh in range(2, h + 1, 2):
+            if max(bw, bh) > 3 * min(bw, bh):
+                continue
+            sx, sy = max(1, bw // 2), max(1, bh // 2)
+            for y in range(0, h - bh + 1, sy):
+                for x in range(0, w - bw + 1, sx):
+                    blocks.add((x * cell_px, y * cell_px, bw * cell_px, bh * cell_px))
+    return np.array(sorted(blocks), dtype=np.int64)
+
+
+def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
+                   unit_px: int = 1) -> np.ndarray:
+    """Descriptors of ``blocks (b, 4)`` (px) for windows at offsets ``ox, oy (k,)`` (px)
+    of ``integral (BINS, H+1, W+1)`` whose entries are ``unit_px`` pixels apart (1: a pixel integral;
+    ``cell_px``: an integral of :func:`~lookalike.vision.hog_features.cell_histograms`, all offsets
+    then multiples of it);
+    returns ``(k, b * 4 * BINS)`` float32."""
+    rows = np.ascontiguousarray(np.asarray(integral).transpose(1, 2, 0)).reshape(-1, integral.shape[0])
+    return block_features_rows(rows, integral.shape[2], blocks, ox, oy, unit_px)
+
+
+def block_features_rows(rows: np.ndarray, width: int, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
+                         unit_px: int, columns: np.ndarray | None = None) -> np.ndarray:
+    """:func:`block_features` on an integral laid out as ``rows ((H+1) * width, BINS)``, one row per corner: the
+    nine corners of a block's 2×2 cells are nine row gathers, done for several blocks at once. With ``columns``,
+    only those columns of the result ``(k, len(columns))`` (each still normalised by its whole block)."""
+    k, d = len(ox), 4 * BINS
+    cols, out = _output(k, len(blocks), columns)
+    ox, oy = np.asarray(ox, np.int64), np.asarray(oy, np.int64)
+    chunk = max(1, 65536 // max(k, 1))  # blocks per gather: bounds the (k, chunk, 3, 3, BINS) corner array
+    for j0 in range(0, len(blocks), chunk):
+        bx, by, bw, bh = np.asarray(blocks[j0 : j0 + chunk], np.int64).T
+        hw, hh = bw // 2 // unit_px, bh // 2 // unit_px
+        base = ((oy[:, None] + by) // unit_px) * width + (ox[:, None] + bx) // unit_px  # (k, b)
+        step = (np.arange(3)[:, None] * (hh * width)[:, None, None] + np.arange(3) * hw[:, None, None])  # (b, 3, 3)
+        c = rows[base[:, :, None, None] + step]  # (k, b, 3, 3, BINS) corners
+        cells = (c[:, :, 1:, 1:] - c[:, :, :-1, 1:] - c[:, :, 1:, :-1] + c[:, :, :-1, :-1]).reshape(k, len(bw), d)
+        denom = np.sqrt((cells * cells).sum(axis=2, keepdims=True)) + (bw * bh).astype(cells.dtype)[:, None]
+        if cols is None:
+            cells /= denom
+            out[:, j0 * d : (j0 + len(bw)) * d] = cells.reshape(k, -1)
+            continue
+        sel = np.flatnonzero((cols >= j0 * d) & (cols < (j0 + len(bw)) * d))
+        block, local = cols[sel] // d - j0, cols[sel] % d
+        out[:, sel] = cells[:, block, local] / denom[:, block, 0]
+    return out
+
+
+def cumsum_rows(a: np.ndarray) -> np.ndarray:
+    """``np.cumsum(a, axis=0)`` (the same sequential sums) as one vector add per row: faster on images."""
+    out = np.empty_like(a)
+    if len(a):
+        out[0] = a[0]
+    for y in range(1, len(a)):
+        np.add(out[y - 1], a[y], out=out[y])
+    return out
+
+
+def block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int, int], stride: int,
+                         unit_px: int, columns: np.ndarray | None = None) -> np.ndarray:
+    """:func:`block_features_rows` for every window of a ``grid`` (rows, columns) of windows ``stride`` corners
+    apart, starting at corner (0, 0), of an integral ``planes (BINS, H+1, W+1)`` float32: each corner of a block is
+    a slice of one bin-plane phase (long inner loops, no gathers); values bit for bit those of the gathers."""
+    ny, nx = grid
+    k, d = ny * nx, 4 * BINS
+    cols, out = _output(k, len(blocks), columns)
+    cells = np.empty((2, 2, BINS, ny, nx), np.float32)
+    phases: dict[tuple[int, int], np.ndarray] = {}  # planes[:, py::stride, px::stride], contiguous
+
+    def corner_grid(y: int, x: int) -> np.ndarray:
+        key = (y % stride, x % stride)
+        if key not in phases:
+            phases[key] = np.ascontiguousarray(planes[:, key[0] :: stride, key[1] :: stride])
+        return phases[key][:, y // stride : y // stride + ny, x // stride : x // stride + nx]
+
+    for j, (bx, by, bw, bh) in enumerate(np.asarray(blocks, np.int64).tolist()):
+        if cols is not None and not np.any(cols // d == j):
+            continue
+        x0, y0, hw, hh = bx // unit_px, by // unit_px, bw // 2 // unit_px, bh // 2 // unit_px
+        corner = [[corner_grid(y0 + r * hh, x0 + c * hw) for c in range(3)] for r in range(3)]
+        for r in range(2):
+            for c in range(2):
+                cell = cells[r, c]
+                np.subtract(corner[r + 1][c + 1], corner[r][c + 1], out=cell)
+                cell -= corner[r + 1][c]
+                cell += corner[r][c]
+        # (window, cell row, cell column, bin), contiguous: the norm then sums in the same order as the gathers.
+        flat = np.ascontiguousarray(cells.transpose(3, 4, 0, 1, 2)).reshape(k, d)
+        denom = np.sqrt((flat * flat).sum(axis=1, keepdims=True)) + np.float32(bw * bh)
+        if cols is None:
+            flat /= denom
+            out[:, j * d : (j + 1) * d] = flat
+        else:
+            sel = np.flatnonzero(cols // d == j)
+            out[:, sel] = flat[:, cols[sel] % d] / denom
+    return out
+
+
+def window_features(windows: np.ndarray, blocks: np.ndarray) -> np.ndarray:
+    """Pooled descriptors ``(n, b * 36)`` of ``windows (n, h+2, w+2)`` grey crops with a 1-px margin."""
+    wins = np.asarray(windows, dtype=np.float32)
+    if wins.ndim != 3 or len(wins) == 0:
+        return np.zeros((0, len(blocks) * 4 * BINS), np.float32)
+    n, hh, ww = wins.shape
+    # Tile the windows side by side: one gradient pass and one integral image serve them all; each
+    # window's 1-px margin keeps its gradients its own.
+    tiled = wins.transpose(1, 0, 2).reshape(hh, n * ww)
+    integral = integral_maps(orientation_maps(tiled))
+    ox = np.arange(n, dtype=np.int64) * ww + 1
+    oy = np.ones(n, dtype=np.int64)
+    return block_features(integral, blocks, ox, oy)
+
+
+__all__ = ["block_features", "block_features_grid", "block_features_rows", "block_pool", "cumsum_rows",
+           "window_features"]
