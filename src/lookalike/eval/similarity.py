@@ -18,43 +18,33 @@ def box_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
 
     Boxes of zero area, and pairs with no union, get 0.
     """
-    a = np.asarray(gt_xywh, dtype=float).reshape(-1, 4)
-    b = np.asarray(tr_xywh, dtype=float).reshape(-1, 4)
-    ax0, ay0 = a[:, 0], a[:, 1]
-    ax1, ay1 = ax0 + a[:, 2], ay0 + a[:, 3]
-    bx0, by0 = b[:, 0], b[:, 1]
-    bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
-    iw = np.minimum(ax1[:, None], bx1[None, :]) - np.maximum(ax0[:, None], bx0[None, :])
-    ih = np.minimum(ay1[:, None], by1[None, :]) - np.maximum(ay0[:, None], by0[None, :])
-    inter = np.maximum(iw, 0.0) * np.maximum(ih, 0.0)
-    area_a = (ax1 - ax0) * (ay1 - ay0)
-    area_b = (bx1 - bx0) * (by1 - by0)
-    union = area_a[:, None] + area_b[None, :] - inter
-    inter[area_a <= _EPS, :] = 0.0
-    inter[:, area_b <= _EPS] = 0.0
-    inter[union <= _EPS] = 0.0
-    union[union <= _EPS] = 1.0
-    result: np.ndarray = inter / union
-    return result
+    return _corner_iou(gt_xywh, tr_xywh, outer=True)
 
 
 def pair_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
     """IoU ``(k,)`` of ``k`` box pairs, ``(k, 4)`` each (left, top, width, height; pixels): bit for bit
     the entries :func:`box_iou` gives for the same pairs."""
+    return _corner_iou(gt_xywh, tr_xywh, outer=False)
+
+
+def _corner_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray, outer: bool) -> np.ndarray:
+    """IoU through corner coordinates: of every pair ``(n, m)`` (``outer``), or of row ``i`` with row ``i``."""
     a = np.asarray(gt_xywh, dtype=float).reshape(-1, 4)
     b = np.asarray(tr_xywh, dtype=float).reshape(-1, 4)
     ax0, ay0 = a[:, 0], a[:, 1]
     ax1, ay1 = ax0 + a[:, 2], ay0 + a[:, 3]
     bx0, by0 = b[:, 0], b[:, 1]
     bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
+    area_a = (ax1 - ax0) * (ay1 - ay0)
+    area_b = (bx1 - bx0) * (by1 - by0)
+    if outer:
+        ax0, ay0, ax1, ay1, area_a = (v[:, None] for v in (ax0, ay0, ax1, ay1, area_a))
+        bx0, by0, bx1, by1, area_b = (v[None, :] for v in (bx0, by0, bx1, by1, area_b))
     iw = np.minimum(ax1, bx1) - np.maximum(ax0, bx0)
     ih = np.minimum(ay1, by1) - np.maximum(ay0, by0)
     inter = np.maximum(iw, 0.0) * np.maximum(ih, 0.0)
-    area_a = (ax1 - ax0) * (ay1 - ay0)
-    area_b = (bx1 - bx0) * (by1 - by0)
     union = area_a + area_b - inter
-    empty = (area_a <= _EPS) | (area_b <= _EPS) | (union <= _EPS)
-    inter[empty] = 0.0
+    inter[(area_a <= _EPS) | (area_b <= _EPS) | (union <= _EPS)] = 0.0
     union[union <= _EPS] = 1.0
     result: np.ndarray = inter / union
     return result
