@@ -104,6 +104,24 @@ def save_weights(weights: NetworkWeights, path: str | os.PathLike[str]) -> Path:
     return path
 
 
+def read_metadata(path: str | os.PathLike[str], fmt: str, what: str) -> tuple[Path, Path, dict[str, Any]]:
+    """``(weights .npz path, metadata .json path, parsed metadata)`` of weights stored as an ``.npz``
+    with a ``.json`` beside it; :class:`CheckpointError` naming the file when either is missing, the
+    JSON is invalid or its ``format`` is not ``fmt`` (``what`` names the expected kind in the message)."""
+    path = Path(path).with_suffix(".npz")
+    meta_path = path.with_suffix(".json")
+    if not path.is_file() or not meta_path.is_file():
+        raise CheckpointError(f"{path}: expected {path.name} and {meta_path.name} side by side")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except json.JSONDecodeError as exc:
+        raise CheckpointError(f"{meta_path}: not valid JSON ({exc})") from None
+    if not isinstance(meta, dict) or meta.get("format") != fmt:
+        found = meta.get("format") if isinstance(meta, dict) else None
+        raise CheckpointError(f"{meta_path}: not a {what} (format {found!r})")
+    return path, meta_path, meta
+
+
 def load_weights(
     path: str | os.PathLike[str], n_agents: int | None = None, n_slots: int | None = None
 ) -> NetworkWeights:
@@ -113,16 +131,7 @@ def load_weights(
     version, when N or M differ from the requested ``n_agents``/``n_slots``, or when an array
     has the wrong shape.
     """
-    path = Path(path).with_suffix(".npz")
-    meta_path = path.with_suffix(".json")
-    if not path.is_file() or not meta_path.is_file():
-        raise CheckpointError(f"{path}: expected {path.name} and {meta_path.name} side by side")
-    try:
-        meta = json.loads(meta_path.read_text())
-    except json.JSONDecodeError as exc:
-        raise CheckpointError(f"{meta_path}: not valid JSON ({exc})") from None
-    if meta.get("format") != "lookalike-association-net":
-        raise CheckpointError(f"{meta_path}: not a lookalike association network")
+    path, meta_path, meta = read_metadata(path, "lookalike-association-net", "lookalike association network")
     for key, current in (("format_version", FORMAT_VERSION), ("encoding_version", ENCODING_VERSION)):
         if meta.get(key) != current:
             raise CheckpointError(

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.learn.checkpoint import CheckpointError
+from lookalike.learn.checkpoint import CheckpointError, read_metadata
 
 FORMAT = "lookalike-set-associator"
 FORMAT_VERSION = 1
@@ -63,16 +63,7 @@ def save_set_weights(weights: SetWeights, path: str | os.PathLike[str]) -> Path:
 def load_set_weights(path: str | os.PathLike[str]) -> SetWeights:
     """Load weights written by :func:`save_set_weights`; :class:`CheckpointError` naming the file
     when the metadata is missing, of another format or version, or an array has the wrong shape."""
-    path = Path(path).with_suffix(".npz")
-    meta_path = path.with_suffix(".json")
-    if not path.is_file() or not meta_path.is_file():
-        raise CheckpointError(f"{path}: expected {path.name} and {meta_path.name} side by side")
-    try:
-        meta = json.loads(meta_path.read_text())
-    except json.JSONDecodeError as exc:
-        raise CheckpointError(f"{meta_path}: not valid JSON ({exc})") from None
-    if meta.get("format") != FORMAT:
-        raise CheckpointError(f"{meta_path}: not a lookalike set associator (format {meta.get('format')!r})")
+    path, meta_path, meta = read_metadata(path, FORMAT, "lookalike set associator")
     if meta.get("format_version") != FORMAT_VERSION:
         raise CheckpointError(f"{meta_path}: format_version {meta.get('format_version')} is not supported "
                               f"(this lookalike reads {FORMAT_VERSION})")
