@@ -13,7 +13,7 @@ import numpy as np
 
 from lookalike.learn.data import IGNORE
 from lookalike.learn.encoding import EncodingSpec, encode_agents_paper
-from lookalike.learn.sim_data import arrays_to_training, latest_reports
+from lookalike.learn.sim_data import arrays_to_training, latest_reports, slot_order
 from lookalike.sim import RobotArrays, RobotWorldConfig, simulate_arrays
 
 NOISE_CHOICES = ("ours", "paper", "mix")
@@ -31,8 +31,7 @@ def arrays_to_training_paper(
         raise ValueError(f"the sequence has {M} detection slots, the encoding {spec.n_slots}")
     heading, _ = latest_reports(arrays, spec.n_agents)
     valid = arrays.det_valid
-    key = -arrays.det_score if rng is None else rng.random((T, M))
-    order = np.argsort(np.where(valid, key, np.inf), axis=1, kind="stable")
+    order = slot_order(arrays, rng)
 
     def take(a: np.ndarray) -> np.ndarray:
         return np.take_along_axis(a, order, axis=1)

@@ -15,7 +15,7 @@ import dataclasses
 import numpy as np
 
 from lookalike.learn.data import IGNORE
-from lookalike.learn.sim_data import latest_reports, swap_identities
+from lookalike.learn.sim_data import latest_reports, slot_order, swap_identities
 from lookalike.sim import RobotArrays, RobotWorldConfig, simulate_arrays
 from lookalike.sim.robots_config import SensorConfig
 
@@ -56,8 +56,7 @@ def arrays_to_tokens(
     heading, sent = latest_reports(arrays, n_agents)
     agents = agent_tokens(heading, arrays.time[:, None] - sent)
     valid = arrays.det_valid
-    key = -arrays.det_score if rng is None else rng.random((T, M))
-    order = np.argsort(np.where(valid, key, np.inf), axis=1, kind="stable")
+    order = slot_order(arrays, rng)
 
     def take(a: np.ndarray) -> np.ndarray:
         return np.take_along_axis(a, order, axis=1)

@@ -18,6 +18,15 @@ from lookalike.learn.encoding import AGENT_WIDTH, EncodingSpec, encode_agents, r
 from lookalike.sim import RobotArrays, RobotWorldConfig, simulate_arrays
 
 
+def slot_order(arrays: RobotArrays, rng: np.random.Generator | None) -> np.ndarray:
+    """Per frame, the detection slots ``(T, M)`` with the occupied ones first: by score (highest
+    first), or shuffled with ``rng`` (a network must not rely on the slots' order)."""
+    valid = arrays.det_valid
+    key = -arrays.det_score if rng is None else rng.random(valid.shape)
+    order: np.ndarray = np.argsort(np.where(valid, key, np.inf), axis=1, kind="stable")
+    return order
+
+
 def latest_reports(arrays: RobotArrays, n_agents: int) -> tuple[np.ndarray, np.ndarray]:
     """Per frame and agent, the newest report received so far (by send time): headings and send
     times ``(T, N)``, NaN where nothing was received yet. Late reports older than the kept one are
