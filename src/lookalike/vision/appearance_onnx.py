@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.vision.appearance import crop_boxes
+from lookalike.vision.onnx_session import open_session
 
 LEARNED_MODEL = Path(__file__).parent / "models_data" / "diver_reid.onnx"
 
@@ -22,19 +23,8 @@ class OnnxAppearance:
     """An ONNX embedding network as a :class:`~lookalike.vision.appearance.FeatureExtractor`."""
 
     def __init__(self, path: Path | str = LEARNED_MODEL, threads: int = 1, batch: int = 64) -> None:
-        import onnxruntime as ort  # type: ignore[import-untyped]
-
         self.path = Path(path)
-        if not self.path.is_file():
-            raise FileNotFoundError(f"{self.path}: no such ONNX appearance model")
-        options = ort.SessionOptions()
-        options.intra_op_num_threads = threads
-        options.inter_op_num_threads = 1
-        options.log_severity_level = 3
-        try:
-            self.session = ort.InferenceSession(str(self.path), options, providers=["CPUExecutionProvider"])
-        except Exception as exc:  # onnxruntime raises its own exception types
-            raise ValueError(f"{self.path}: not a loadable ONNX model ({str(exc).splitlines()[0]})") from None
+        self.session = open_session(self.path, threads, "ONNX appearance model")
         inputs, outputs = self.session.get_inputs(), self.session.get_outputs()
         if len(inputs) != 1 or len(inputs[0].shape) != 4 or len(outputs[0].shape) != 2:
             raise ValueError(f"{self.path}: expected crops (n, 3, h, w) in and embeddings (n, d) out")

@@ -32,6 +32,7 @@ import numpy as np
 from lookalike.types import Detections
 from lookalike.types.mot_table import detection_rows
 from lookalike.vision.nms import nms
+from lookalike.vision.onnx_session import open_session
 
 LAYOUTS = ("auto", "yolo", "yolo-obj", "ssd")
 
@@ -119,20 +120,9 @@ class OnnxDetector:
     (boxes ``xywh`` in frame pixels, ``score``, ``label`` = class index)."""
 
     def __init__(self, path: Path | str, config: OnnxDetectorConfig | None = None) -> None:
-        import onnxruntime as ort  # type: ignore[import-untyped]
-
         self.path = Path(path)
-        if not self.path.is_file():
-            raise FileNotFoundError(f"{self.path}: no such ONNX model")
         self.config = config or OnnxDetectorConfig()
-        options = ort.SessionOptions()
-        options.intra_op_num_threads = self.config.threads
-        options.inter_op_num_threads = 1
-        options.log_severity_level = 3
-        try:
-            self.session = ort.InferenceSession(str(self.path), options, providers=["CPUExecutionProvider"])
-        except Exception as exc:  # onnxruntime raises its own exception types
-            raise ValueError(f"{self.path}: not a loadable ONNX model ({str(exc).splitlines()[0]})") from None
+        self.session = open_session(self.path, self.config.threads, "ONNX model")
         inp = self.session.get_inputs()
         if len(inp) != 1 or len(inp[0].shape) != 4:
             raise ValueError(f"{self.path}: expected one NCHW image input, got {[i.shape for i in inp]}")

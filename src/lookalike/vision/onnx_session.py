@@ -1,0 +1,24 @@
+"""Opening an ONNX model with onnxruntime on the CPU, for the detectors and appearance models."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+
+def open_session(path: Path, threads: int, what: str) -> Any:
+    """An onnxruntime ``InferenceSession`` of ``path`` on the CPU with ``threads`` threads (quiet logs);
+    ``FileNotFoundError`` when the file is missing, ``ValueError`` naming it when onnxruntime cannot
+    load it (``what`` names the kind of model in the message)."""
+    import onnxruntime as ort  # type: ignore[import-untyped]
+
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such {what}")
+    options = ort.SessionOptions()
+    options.intra_op_num_threads = threads
+    options.inter_op_num_threads = 1
+    options.log_severity_level = 3
+    try:
+        return ort.InferenceSession(str(path), options, providers=["CPUExecutionProvider"])
+    except Exception as exc:  # onnxruntime raises its own exception types
+        raise ValueError(f"{path}: not a loadable ONNX model ({str(exc).splitlines()[0]})") from None
