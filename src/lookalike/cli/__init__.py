@@ -15,8 +15,8 @@ from pathlib import Path
 from lookalike.cli.app import app
 
 MODULES = ("bench", "bench_divers", "bench_experiments", "bench_pixels", "bench_real", "demo", "eval", "label",
-           "node", "render", "report", "simulate", "track", "track_pixels", "train", "train_appearance", "tune",
-           "vision")
+           "node", "record_pixels", "render", "report", "simulate", "track", "track_pixels", "train",
+           "train_appearance", "tune", "vision")
 """Every command module, in the order they are imported."""
 
 COMMAND_MODULES = {"track": "track", "trackers": "track", "eval": "eval", "simulate": "simulate",

@@ -1,0 +1,52 @@
+"""``lookalike record-pixels``: rendered robot sequences through the pixel pipeline, written as labelled
+recordings (``.labelled.jsonl``, renderer truth) for ``lookalike train --recordings``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from lookalike.cli.app import app, console, fail
+from lookalike.sim import PRESET_NAMES, preset
+
+
+@app.command("record-pixels")
+def record_pixels(
+    output: Path = typer.Option(..., "-o", "--output", help="Folder for the .labelled.jsonl recordings."),
+    preset_name: str = typer.Option("m10n7", "--preset", help=f"Robot world set-up: {', '.join(PRESET_NAMES)}."),
+    sequences: int = typer.Option(3, "--sequences", min=1, help="Recordings to make."),
+    frames: int = typer.Option(300, "--frames", min=1, help="Frames per recording (30 Hz)."),
+    seed: int = typer.Option(700_000, "--seed", help="Base seed (recording k: seed + 1000·preset index + k, as "
+                             "`bench pixels`; the shipped detector and heading models train on seeds below 400000)."),
+    max_detections: int | None = typer.Option(
+        None, "--max-detections", min=1, help="Most probable pixel detections kept per frame (default: the "
+        "preset's M)."),
+    detector_model: Path | None = typer.Option(None, "--detector-model", help="HOG cascade (default: shipped)."),
+    heading_model: Path | None = typer.Option(None, "--heading-model", help="Heading classifier (default: shipped)."),
+    min_iou: float = typer.Option(0.3, "--min-iou", min=0.0, max=1.0, help="IoU for a detection to be a robot."),
+) -> None:
+    """Render robot sequences, detect them from the pixels and write each as a labelled recording
+    (pixel detections, renderer truth as labels, the simulated reports)."""
+    from lookalike.bench.pixel_recordings import record_pixels as record
+    from lookalike.bench.pixel_recordings import write_recordings
+    from lookalike.cli.progress import progress_bars
+    from lookalike.vision.pipeline import PipelineConfig, RobotPipeline
+    from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera
+
+    if preset_name not in PRESET_NAMES:
+        fail(f"--preset: unknown preset {preset_name!r}; known: {', '.join(PRESET_NAMES)}")
+    world = preset(preset_name)
+    camera = pixel_camera()
+    try:
+        config = PipelineConfig(n_agents=world.n_agents, max_detections=max_detections or world.max_detections)
+        pipe = RobotPipeline.from_files(detector_model, heading_model, camera, config)
+        with progress_bars() as progress, one_blas_thread():
+            recordings = record(preset_name, sequences, frames, seed, pipe, camera, min_iou, progress)
+        paths = write_recordings(recordings, output, preset_name)
+    except (ValueError, FileNotFoundError, OSError) as exc:
+        fail(str(exc))
+    n_det = sum(int(r.arrays.det_valid.sum()) for r in recordings)
+    n_fp = sum(int(((r.arrays.det_label < 0) & r.arrays.det_valid).sum()) for r in recordings)
+    console.print(f"wrote {len(paths)} recordings to {output} ({sequences} × {frames} frames, {n_det} pixel "
+                  f"detections, {n_fp} false positives; seeds {recordings[0].seed}–{recordings[-1].seed})")
