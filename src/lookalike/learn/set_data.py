@@ -78,13 +78,21 @@ class TeamSizes:
     n_max: int = 12
     m_extra: int = 3
     fp_range: tuple[float, float] = (0.3, 2.5)
+    focus: tuple[tuple[int, int, float], ...] = ()
+    focus_prob: float = 0.0
 
     def __post_init__(self) -> None:
         if not 1 <= self.n_min <= self.n_max:
             raise ValueError(f"TeamSizes: need 1 <= n_min <= n_max, got {self.n_min}, {self.n_max}")
+        if not 0.0 <= self.focus_prob <= 1.0 or (self.focus_prob > 0 and not self.focus):
+            raise ValueError(f"TeamSizes: need 0 <= focus_prob <= 1 and focus teams when > 0, got {self.focus_prob}")
 
     def draw(self, rng: np.random.Generator) -> tuple[int, int, float]:
-        """``(N, M, false positives per frame)``."""
+        """``(N, M, false positives per frame)``; with ``focus_prob`` > 0 one of the ``focus`` teams
+        ``(N, M, fp)`` that often (e.g. more weight on the small set-ups)."""
+        if self.focus_prob > 0 and rng.random() < self.focus_prob:
+            n, m, fp = self.focus[int(rng.integers(len(self.focus)))]
+            return int(n), int(m), float(fp)
         n = int(rng.integers(self.n_min, self.n_max + 1))
         m = int(rng.integers(max(n, 1), 2 * n + self.m_extra + 1))
         return n, m, float(rng.uniform(*self.fp_range))
@@ -106,12 +114,17 @@ class SetBatchMaker:
     A batch is ``agents (B, T, N, 4)``, ``detections (B, T, M, 5)``, ``valid (B, T, M)``, targets
     ``(B, T, M)`` and the frame interval in seconds. With ``swap_prob`` two random robots exchange
     identities for 1–10 s in that fraction of the sequences (:func:`~lookalike.learn.sim_data.swap_identities`).
-    ``fixed``: one ``(N, M, fp)`` for every batch instead of drawing from ``sizes``.
+    ``swap_s``: the swap's duration range (seconds); with ``swap_ends`` the swap ends at least ``swap_ends``
+    seconds before the sequence does (the network sees the identities come back), else it starts in the
+    first 80% of the sequence and may outlast it. ``fixed``: one ``(N, M, fp)`` for every batch instead
+    of drawing from ``sizes``.
     """
 
     sizes: TeamSizes = TeamSizes()
     swap_prob: float = 0.0
     fixed: tuple[int, int, float] | None = None
+    swap_s: tuple[float, float] = (1.0, 10.0)
+    swap_ends: float | None = None
 
     def __call__(self, seed: int, batch_size: int, n_frames: int) -> Batch:
         n, m, fp = self.fixed or self.sizes.draw(np.random.default_rng([seed, 0x5E7]))
@@ -123,8 +136,15 @@ class SetBatchMaker:
             aug = np.random.default_rng([s, 0x5A5])
             if n >= 2 and aug.random() < self.swap_prob:
                 i, j = aug.choice(n, 2, replace=False)
-                start = aug.uniform(0.0, 0.8 * n_frames * cfg.dt_s)
-                arrays = swap_identities(arrays, int(i), int(j), start, start + aug.uniform(1.0, 10.0))
+                length_s = n_frames * cfg.dt_s
+                if self.swap_ends is None:
+                    start = aug.uniform(0.0, 0.8 * length_s)
+                    stop = start + aug.uniform(*self.swap_s)
+                else:
+                    duration = min(aug.uniform(*self.swap_s), max(length_s - self.swap_ends - 1.0, 0.5))
+                    start = aug.uniform(0.5, max(length_s - self.swap_ends - duration, 0.5))
+                    stop = start + duration
+                arrays = swap_identities(arrays, int(i), int(j), start, stop)
             out.append(arrays_to_tokens(arrays, n, np.random.default_rng([s, 1])))
         a, d, v, y = (np.stack(parts) for parts in zip(*out))
         k = max(int(v.sum(-1).max()), 1)  # occupied slots come first: drop the columns empty everywhere

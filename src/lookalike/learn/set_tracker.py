@@ -3,8 +3,10 @@
 Labels every detection "agent j" or "false positive" from the detections (ground position in
 metres, absolute visual heading in radians, detector score) and the agents' latest heading
 reports, with :class:`~lookalike.learn.set_numpy.NumpySetAssociator`; decoded one-to-one like the
-LSTM (Hungarian on ``-log p``, false positives allowed). Agent positions are low-pass filtered as
-the LSTM identifier does: ``T_j ← α·L_k + (1−α)·T_j``.
+LSTM (Hungarian on ``-log p``, false positives allowed). Agent positions come from the same
+localiser as the LSTM identifier's, fed with the detection labelled ``j`` and its class probability
+``α``: the per-agent Kalman filter by default (``localiser="kalman"``), or seed A's Eq. 3
+``T_j ← α·L_k + (1−α)·T_j`` (``"lowpass"``); see :mod:`lookalike.trackers.identity.localiser`.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from lookalike.learn.set_numpy import NumpySetAssociator, load_set_weights
 from lookalike.learn.tracker import BeaconMemory, decode
 from lookalike.learn.weights import WEIGHTS_DIR
 from lookalike.trackers.base import check_params, param
+from lookalike.trackers.identity.localiser import LOCALISERS, make_localiser
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
@@ -49,6 +52,8 @@ class SetIdentifier:
                                      range=(1, 1000))
         weights: str | None = param(None, "path of set.npz (None: the shipped weights, any N and M)")
         one_to_one: bool = param(True, "decode with Hungarian on -log p (else per-detection argmax)")
+        localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
+                               choices=LOCALISERS)
 
         def __post_init__(self) -> None:
             check_params(self)
@@ -64,7 +69,7 @@ class SetIdentifier:
         n = self.config.n_agents
         self.net.reset(n)
         self._beacons = BeaconMemory(n)
-        self._position = np.full((n, 2), np.nan)
+        self._localiser = make_localiser(self.config.localiser, n)
         self._last_seen = np.full(n, -1)
         self.last_labels = np.zeros(0, dtype=int)
         self.last_probabilities = np.zeros(0)
@@ -91,30 +96,35 @@ class SetIdentifier:
         labels, conf = np.full(n, -1), np.zeros(n)
         labels[used], conf[used] = slot_label, slot_conf
         self.last_labels, self.last_probabilities = labels, conf
-        return self._snapshots(labels, conf, position, heading, frame.index)
+        return self._snapshots(labels, conf, position, heading, frame)
 
     def _snapshots(self, labels: np.ndarray, conf: np.ndarray, position: np.ndarray, heading: np.ndarray,
-                   frame_index: int) -> list[TrackSnapshot]:
+                   frame: Frame) -> list[TrackSnapshot]:
         n_agents = self.config.n_agents
         det_of_agent = np.full(n_agents, -1)
         for k in np.argsort(-conf):  # the most confident detection of an agent updates it
             j = labels[k]
             if j >= 0 and det_of_agent[j] < 0:
                 det_of_agent[j] = k
+        assigned = det_of_agent >= 0
+        measured = np.full((n_agents, 2), np.nan)
+        weight = np.zeros(n_agents)
+        measured[assigned] = position[det_of_agent[assigned]]
+        weight[assigned] = conf[det_of_agent[assigned]]
+        located = self._localiser.update(frame.time, measured, weight)
+        fallback = assigned & ~np.isfinite(located).all(axis=1)  # an assigned agent always has a position
+        located[fallback] = measured[fallback]
         snapshots = []
         for j in range(n_agents):
             k = det_of_agent[j]
             if k >= 0:
-                alpha = conf[k]
-                prev = self._position[j]
-                self._position[j] = position[k] if np.isnan(prev).any() else alpha * position[k] + (1 - alpha) * prev
-                self._last_seen[j] = frame_index
-            if self._last_seen[j] < 0:
-                continue
+                self._last_seen[j] = frame.index
+            if self._last_seen[j] < 0 or not np.isfinite(located[j]).all():
+                continue  # never seen, or lost for longer than the localiser keeps a position
             snapshots.append(TrackSnapshot(
                 track_id=j + 1,
                 status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
-                position=self._position[j].copy(),
+                position=located[j].copy(),
                 heading=float(heading[k]) if k >= 0 else None,
                 agent_id=j,
                 identity_prob=float(conf[k]) if k >= 0 else None,

@@ -32,6 +32,8 @@ SET_SEED_OFFSET = 70_000_000  # keeps the set associator's seeds apart from the 
 VALIDATION_TEAMS: tuple[tuple[int, int, float], ...] = (
     (2, 3, 0.5), (3, 5, 0.8), (7, 10, 1.5), (1, 2, 0.5), (4, 6, 1.0), (6, 8, 1.2), (9, 12, 1.5), (12, 14, 2.0),
 )
+# The paper's three set-ups (N, M, false positives per frame), drawn ``focus_prob`` of the time when fine-tuning.
+FOCUS_TEAMS: tuple[tuple[int, int, float], ...] = ((2, 3, 0.5), (3, 5, 0.8), (7, 10, 1.5))
 
 
 @dataclass(frozen=True)
@@ -61,11 +63,18 @@ class SetTrainConfig:
     grad_clip: float = 1.0
     seed: int = 0
     swap_prob: float = 0.3
+    swap_min_s: float = 1.0
+    swap_max_s: float = 10.0
+    swap_ends_s: float | None = None  # None: a swap may outlast the sequence (the first training's draws)
+    focus_prob: float = 0.0  # fraction of batches on FOCUS_TEAMS (the paper's set-ups)
+    keep_snapshots: bool = False  # also write set_step{N}.npz at every validation
 
     def batch_maker(self, swap: bool = True) -> SetBatchMaker:
         """The batch generator of this run (with identity-swap augmentation unless ``swap`` is False)."""
-        sizes = TeamSizes(self.n_min, self.n_max, self.m_extra, (self.fp_min, self.fp_max))
-        return SetBatchMaker(sizes, self.swap_prob if swap else 0.0)
+        sizes = TeamSizes(self.n_min, self.n_max, self.m_extra, (self.fp_min, self.fp_max),
+                          FOCUS_TEAMS if self.focus_prob > 0 else (), self.focus_prob)
+        return SetBatchMaker(sizes, self.swap_prob if swap else 0.0, swap_s=(self.swap_min_s, self.swap_max_s),
+                             swap_ends=self.swap_ends_s)
 
 
 def _to_torch(batch: tuple, device: str) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor, float]:
@@ -102,11 +111,23 @@ def validate(model: SetAssociator, batches: list[tuple], device: str = "cpu") ->
 def _run_shape(config: dict) -> dict:
     """The configuration without the stopping rules and the learning rate (a run may be resumed with
     more steps or minutes, or cooled down at a lower learning rate)."""
-    return {k: v for k, v in config.items() if k not in ("steps", "minutes", "patience", "learning_rate")}
+    return {k: v for k, v in config.items()
+            if k not in ("steps", "minutes", "patience", "learning_rate", "keep_snapshots")}
 
 
 def _export(model: SetAssociator, config: SetTrainConfig, info: dict) -> SetWeights:
     return SetWeights(model.export(), config.token, config.pair, config.memory, info={"config": asdict(config), **info})
+
+
+def _new_model(config: SetTrainConfig, init: SetWeights | None) -> SetAssociator:
+    """A fresh model of ``config``'s widths, with ``init``'s parameters when given."""
+    model = SetAssociator(SetSizes(config.token, config.pair, config.memory))
+    if init is not None:
+        if (init.token, init.pair, init.memory) != (config.token, config.pair, config.memory):
+            raise ValueError(f"init weights have widths {(init.token, init.pair, init.memory)}, the run "
+                             f"{(config.token, config.pair, config.memory)}")
+        model.load_exported(init.arrays)
+    return model
 
 
 def train_set(
@@ -117,15 +138,16 @@ def train_set(
     *,
     device: str = "cpu",
     pool: JobPool | None = None,
+    init: SetWeights | None = None,
 ) -> TrainResult:
     """Train; write ``set.npz``/``.json`` (best validation), ``checkpoint.pt`` and ``training_log.csv``
-    to ``out_dir``."""
+    to ``out_dir``. ``init``: start from these weights (fine-tuning; same widths as ``config``)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if config.sequence_length % config.bptt:
         raise ValueError(f"sequence_length {config.sequence_length} must be a multiple of bptt {config.bptt}")
     torch.manual_seed(config.seed)
-    model = SetAssociator(SetSizes(config.token, config.pair, config.memory)).to(device)
+    model = _new_model(config, init).to(device)
     optimiser = torch.optim.Adam(model.parameters(), lr=config.learning_rate, weight_decay=config.weight_decay)
     schedule = torch.optim.lr_scheduler.LambdaLR(optimiser, lambda t: 1.0 / (1.0 + config.lr_decay * t))
     loss_fn = nn.NLLLoss(ignore_index=IGNORE)
@@ -182,6 +204,9 @@ def train_set(
                 save_set_weights(_export(model, config, {"val_success": best, "step": step}), weights_path)
             else:
                 stale += 1
+            if config.keep_snapshots:
+                save_set_weights(_export(model, config, {"val_success": row["val_success"], "step": step}),
+                                 out / f"set_step{step}.npz")
             torch.save({"config": asdict(config), "model": model.state_dict(), "optimiser": optimiser.state_dict(),
                         "schedule": schedule.state_dict(), "step": step, "best": best, "best_step": best_step,
                         "history": history}, ckpt_path)
