@@ -13,7 +13,10 @@ robot is the rendered robot whose visible box it overlaps best (Hungarian on IoU
 a false positive labelled as such counting as correct.
 
 Identification table: ``Pixels (%)`` and ``Simulated (%)`` success rates, ``Gap (pp)`` = pixels − simulated,
-the detections scored on each side, and the identifier's own frames/s on the pixel detections.
+seed A's Table II localisation error on each side (``Pixels loc. (m)``, ``Simulated loc. (m)``: mean distance
+in metres between each robot's identified position and its true observer-frame position over the frames where
+it is in view and has a position), the detections scored on each side, and the identifier's own frames/s on
+the pixel detections.
 Perception table: recall of the rendered robots at least half visible, precision, mean absolute error
 of the absolute visual heading of matched detections (degrees), and perception frames/s (detector +
 heading + ground projection; rendering not counted).
@@ -33,7 +36,7 @@ import numpy as np
 from lookalike.bench.ident import sequence_seeds
 from lookalike.bench.progress import ProgressFactory
 from lookalike.bench.results import Results, add_printed_rows
-from lookalike.eval import identification_success_rate
+from lookalike.eval import identification_success_rate, localisation_error
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.geometry.camera import Camera
 from lookalike.loop import RunStats, run
@@ -45,14 +48,14 @@ from lookalike.sim import (
     simulate_robots,
 )
 from lookalike.trackers import make_tracker
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.identity import agent_positions, labels_from_tracks
 from lookalike.types import Beacons, Detections
 from lookalike.vision.pipeline import PipelineConfig, PipelineResult, RobotPipeline
 from lookalike.viz.robot_pixels import identifier_settings, render_robot_frames, world_for_camera
 
 DEFAULT_SEED = 700_000
-PIXEL_COLUMNS = ("Setup", "Identifier", "Pixels (%)", "Simulated (%)", "Gap (pp)", "Pixel dets", "Sim dets",
-                 "Frames/s")
+PIXEL_COLUMNS = ("Setup", "Identifier", "Pixels (%)", "Simulated (%)", "Gap (pp)", "Pixels loc. (m)",
+                 "Simulated loc. (m)", "Pixel dets", "Sim dets", "Frames/s")
 PERCEPTION_COLUMNS = ("Setup", "Frames", "Recall", "Precision", "Heading error (deg)", "Perception frames/s")
 
 
@@ -131,29 +134,63 @@ class _Identify:
         return self.pipe.identify(self.p.detections[k], self.p.beacons[k], self.p.times[k], index=k)
 
 
-def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipeline, camera: Camera
-                 ) -> tuple[float, int, float]:
-    """Success rate, detection count and frames/s of identifier ``name`` on the pixel detections."""
+@dataclass
+class IdentScore:
+    """One identifier on one side (pixels or simulated): success rate (fraction), localisation error (metres,
+    NaN when no robot ever had a position while in view), detections scored and frames/s (tracking only)."""
+
+    success: float
+    loc_error: float
+    detections: int
+    fps: float
+
+
+def _localisation(positions: list[np.ndarray], perceived: list[PerceivedSequence]) -> float:
+    """Table II's error (m) of per-frame ``(N, 2)`` agent positions, sequence after sequence, against the truth."""
+    truth = [p.sequence.true_positions_visible() for p in perceived]
+    if not positions:
+        return float("nan")
+    return localisation_error(np.stack(positions), np.concatenate(truth))
+
+
+def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipeline, camera: Camera) -> IdentScore:
+    """Identifier ``name`` on the pixel detections."""
     predicted: list[np.ndarray] = []
+    positions: list[np.ndarray] = []
     truth: list[np.ndarray] = []
     stats = RunStats()
     for p in perceived:
+        n_agents = p.sequence.config.n_agents
+
+        def sink(k: int, result: PipelineResult, n_agents: int = n_agents) -> None:
+            predicted.append(result.labels)
+            positions.append(agent_positions(result.tracks, n_agents))
+
         step = _Identify(RobotPipeline(pipe.detector, pipe.heading, camera, _identifier(name, p.sequence, camera)), p)
-        run(step, range(len(p.detections)), lambda k, result: predicted.append(result.labels), stats=stats)
+        run(step, range(len(p.detections)), sink, stats=stats)
         truth.extend(p.truth)
-    n = sum(len(t) for t in truth)
-    return identification_success_rate(predicted, truth), n, stats.fps
+    return IdentScore(identification_success_rate(predicted, truth), _localisation(positions, perceived),
+                      sum(len(t) for t in truth), stats.fps)
 
 
-def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camera) -> tuple[float, int]:
-    """Success rate and detection count of identifier ``name`` on the simulator's own detections."""
-    predicted, truth = [], []
+def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camera) -> IdentScore:
+    """Identifier ``name`` on the simulator's own detections of the same sequences."""
+    predicted: list[np.ndarray] = []
+    positions: list[np.ndarray] = []
+    truth: list[np.ndarray] = []
+    stats = RunStats()
     for p in perceived:
         cfg = _identifier(name, p.sequence, camera)
-        run(make_tracker(name, **cfg.identifier_kwargs()), p.sequence.frames(),
-            lambda frame, tracks: predicted.append(labels_from_tracks(len(frame.detections), tracks)))
+        n_agents = p.sequence.config.n_agents
+
+        def sink(frame: Any, tracks: Any, n_agents: int = n_agents) -> None:
+            predicted.append(labels_from_tracks(len(frame.detections), tracks))
+            positions.append(agent_positions(tracks, n_agents))
+
+        run(make_tracker(name, **cfg.identifier_kwargs()), p.sequence.frames(), sink, stats=stats)
         truth.extend(p.sequence.true_labels())
-    return identification_success_rate(predicted, truth), sum(len(t) for t in truth)
+    return IdentScore(identification_success_rate(predicted, truth), _localisation(positions, perceived),
+                      sum(len(t) for t in truth), stats.fps)
 
 
 def pixels_table(setups: list[str], identifiers: list[str], sequences: int, frames: int, seed: int,
@@ -183,17 +220,19 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
             "Perception frames/s": round(sequences * frames / seconds, 1) if seconds > 0 else float("inf"),
         })
         for name in identifiers:
-            pix, n_pix, fps = score_pixels(name, perceived, pipe, camera)
-            sim, n_sim = score_simulated(name, perceived, camera)
+            pix = score_pixels(name, perceived, pipe, camera)
+            sim = score_simulated(name, perceived, camera)
             rows.append({
-                "Setup": preset_label(setup), "Identifier": name, "Pixels (%)": round(100 * pix, 2),
-                "Simulated (%)": round(100 * sim, 2), "Gap (pp)": round(100 * (pix - sim), 2),
-                "Pixel dets": n_pix, "Sim dets": n_sim, "Frames/s": round(fps, 1),
+                "Setup": preset_label(setup), "Identifier": name, "Pixels (%)": round(100 * pix.success, 2),
+                "Simulated (%)": round(100 * sim.success, 2), "Gap (pp)": round(100 * (pix.success - sim.success), 2),
+                "Pixels loc. (m)": round(pix.loc_error, 3), "Simulated loc. (m)": round(sim.loc_error, 3),
+                "Pixel dets": pix.detections, "Sim dets": sim.detections, "Frames/s": round(pix.fps, 1),
             })
     return rows, perception
 
 
 PIXEL_KEYS = {"Pixels (%)": "success_rate_pixels", "Simulated (%)": "success_rate_simulated",
+              "Pixels loc. (m)": "localisation_error_pixels", "Simulated loc. (m)": "localisation_error_simulated",
               "Pixel dets": "detections_pixels", "Sim dets": "detections_simulated"}
 
 
@@ -201,8 +240,9 @@ def pixels_results(rows: list[dict[str, Any]], perception: list[dict[str, Any]],
                    sequences: int, frames: int, seed: int = DEFAULT_SEED, command: str = "",
                    options: dict[str, Any] | None = None) -> Results:
     """The tables of :func:`pixels_table` as a results document: ``identification`` (per set-up and
-    identifier: ``success_rate_pixels``, ``success_rate_simulated``, ``gap`` as fractions, detection
-    counts, frames/s) and ``perception`` (tracker ``perception``: recall, precision, heading error)."""
+    identifier: ``success_rate_pixels``, ``success_rate_simulated``, ``gap`` as fractions,
+    ``localisation_error_pixels``/``_simulated`` in metres, detection counts, frames/s) and ``perception``
+    (tracker ``perception``: recall, precision, heading error)."""
     names = {preset_label(s): s for s in setups}
     doc = Results("bench pixels", command=command, seeds=sequence_seeds(setups, sequences, seed),
                   sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
@@ -213,5 +253,5 @@ def pixels_results(rows: list[dict[str, Any]], perception: list[dict[str, Any]],
     return doc
 
 
-__all__ = ["DEFAULT_SEED", "PERCEPTION_COLUMNS", "PIXEL_COLUMNS", "PIXEL_KEYS", "PerceivedSequence", "match_truth",
-           "perceive_sequence", "pixels_results", "pixels_table", "score_pixels", "score_simulated"]
+__all__ = ["DEFAULT_SEED", "PERCEPTION_COLUMNS", "PIXEL_COLUMNS", "PIXEL_KEYS", "IdentScore", "PerceivedSequence",
+           "match_truth", "perceive_sequence", "pixels_results", "pixels_table", "score_pixels", "score_simulated"]

@@ -5,6 +5,12 @@ recordings, each identifier runs on every window from a fresh state, and the suc
 correct labels / detections over the windows of that length; the ``Total`` column runs each
 identifier over every recording whole. Recordings are robot sequences (simulated, or rendered-pixel
 runs written in the robot-sequence format) with the truth in each detection's label.
+
+Human benchmark results (``lookalike label --benchmark`` writes one file per session,
+:mod:`lookalike.viz.label.human`) of the same set-up (N, M) add a ``human`` row: per length, the
+sessions in which the person worked through at least that many frames (the longest such length
+only), and in ``Total`` every session, each scored over the frames it worked through (correct
+labels / detections, unset labels wrong); people give no positions, so no localisation error.
 """
 
 from __future__ import annotations
@@ -23,9 +29,12 @@ from lookalike.loop import run
 from lookalike.sim import RobotSequence, preset, preset_label, simulate_robots
 from lookalike.trackers.identity import agent_positions, labels_from_tracks
 from lookalike.types import Frame
+from lookalike.viz.label.human import HumanResult, read_human_results
 
 DEFAULT_LENGTHS = (200, 400, 800)
 DEFAULT_DRAWS = 4
+NO_VALUE = "—"  # a cell a row has no figure for (the human row's localisation)
+HUMAN = "human"
 
 
 def draw_windows(lengths: Sequence[int], recording_lengths: Sequence[int], draws: int,
@@ -100,20 +109,63 @@ def table3_rows(recordings: Sequence[RobotSequence], trackers: Sequence[str], le
     return rows
 
 
+def recording_files(folder: Path) -> list[Path]:
+    """The robot-sequence ``.jsonl`` files of ``folder``, by name; a labelling page export
+    ``<stem>.labelled.jsonl`` is left out when ``<stem>.jsonl`` (its sequence, with its own truth) is there."""
+    files = sorted(folder.glob("*.jsonl")) if folder.is_dir() else []
+    names = {f.name for f in files}
+    return [f for f in files if not (f.name.endswith(".labelled.jsonl")
+                                     and f.name.removesuffix(".labelled.jsonl") + ".jsonl" in names)]
+
+
+def human_row(results: Sequence[HumanResult], lengths: Sequence[int], total_key: str) -> dict[str, Any]:
+    """The ``human`` row of :func:`table3_rows`'s columns from benchmark sessions (see the module docstring):
+    success rate (%) per length and in total (``total_key``), :data:`NO_VALUE` where no session counts."""
+    def rate(chosen: Sequence[HumanResult]) -> float | str:
+        detections = sum(r.detections_scored for r in chosen)
+        return round(100 * sum(r.correct for r in chosen) / detections, 2) if detections else NO_VALUE
+
+    ordered = sorted(lengths)
+    longest = [max((n for n in ordered if n <= r.frames_scored), default=None) for r in results]
+    row: dict[str, Any] = {"Tracker": HUMAN}
+    for length in lengths:
+        row[f"{length} frames (%)"] = rate([r for r, n in zip(results, longest) if n == length])
+    row[total_key] = rate(results)
+    row["Localisation error (m)"] = NO_VALUE
+    return row
+
+
+def human_sessions(results: Sequence[HumanResult], label: str) -> list[dict[str, Any]]:
+    """One printable row per benchmark session: labeller, sequence, frames worked through, success rate,
+    labelling time."""
+    return [{"Setup": label, "Labeller": r.labeller, "Sequence": r.sequence, "Frames": r.frames_scored,
+             "Detections": r.detections_scored,
+             "Success rate (%)": NO_VALUE if r.success_rate is None else round(100 * r.success_rate, 2),
+             "Time (s)": round(r.duration_s, 1),
+             "s/frame": NO_VALUE if r.seconds_per_frame is None else round(r.seconds_per_frame, 2)}
+            for r in results]
+
+
 def table3_table(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, seed: int,
                  noise: str, lengths: Sequence[int], draws: int, recordings: Path | None = None,
-                 progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
+                 progress: ProgressFactory = no_progress, human: Path | None = None,
+                 sessions: list[dict[str, Any]] | None = None) -> list[dict[str, Any]]:
     """Rows of :func:`table3_rows` with a ``Setup`` column: on the robot-sequence ``.jsonl`` files of
     folder ``recordings`` when given, else per set-up on the simulated test sequences of ``bench ident``
-    (``sequences`` × ``frames``, noise model ``noise``, seeds from ``seed``)."""
+    (``sequences`` × ``frames``, noise model ``noise``, seeds from ``seed``). Human-benchmark result files
+    in folder ``human`` (default: ``recordings``, if given) of a group's N and M add its ``human`` row
+    (:func:`human_row`); their sessions are appended to ``sessions`` (:func:`human_sessions`) when given."""
     if any(n < 1 for n in lengths):
         raise ValueError(f"--lengths: frame counts must be positive, got {list(lengths)}")
+    people = read_human_results(human) if human is not None else []
     groups: list[tuple[str, list[RobotSequence]]] = []
     if recordings is not None:
-        files = sorted(recordings.glob("*.jsonl")) if recordings.is_dir() else []
+        files = recording_files(recordings)
         if not files:
             raise ValueError(f"--recordings: no .jsonl robot sequences in {recordings}")
         groups.append((recordings.name, [read_robot_sequence(f) for f in files]))
+        if human is None:
+            people = read_human_results(recordings)
     else:
         for setup in setups:
             cfg = preset(setup, noise)
@@ -121,8 +173,16 @@ def table3_table(setups: Sequence[str], trackers: Sequence[str], sequences: int,
                            [simulate_robots(cfg, frames, s) for s in sequence_seeds([setup], sequences, seed)]))
     rows = []
     for label, seqs in groups:
-        rows += [{"Setup": label, **r} for r in table3_rows(seqs, trackers, lengths, draws, seed, progress)]
+        group = table3_rows(seqs, trackers, lengths, draws, seed, progress)
+        cfg = seqs[0].config
+        mine = [r for r in people if (r.n_agents, r.max_detections) == (cfg.n_agents, cfg.max_detections)]
+        if mine:
+            group.append(human_row(mine, lengths, f"Total, {sum(len(r) for r in seqs)} frames (%)"))
+            if sessions is not None:
+                sessions += human_sessions(mine, label)
+        rows += [{"Setup": label, **r} for r in group]
     return rows
 
 
-__all__ = ["DEFAULT_DRAWS", "DEFAULT_LENGTHS", "draw_windows", "table3_rows", "table3_table"]
+__all__ = ["DEFAULT_DRAWS", "DEFAULT_LENGTHS", "HUMAN", "NO_VALUE", "draw_windows", "human_row", "human_sessions",
+           "recording_files", "table3_rows", "table3_table"]

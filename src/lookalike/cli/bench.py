@@ -23,7 +23,7 @@ from lookalike.trackers import tracker_names
 bench_app = typer.Typer(help="Benchmarks that print tables (also written with --json/--csv).", no_args_is_help=True,
                         cls=SortedGroup, rich_markup_mode=None)
 app.add_typer(bench_app, name="bench")
-TEXT_COLUMNS = ("Setup", "Tracker", "Identifier", "Scenario")
+TEXT_COLUMNS = ("Setup", "Tracker", "Identifier", "Scenario", "Labeller", "Sequence")
 
 
 def rich_table(title: str | None, rows: list[dict[str, Any]], columns: Sequence[str] | None = None) -> Table:
@@ -82,6 +82,9 @@ def ident(
     recordings: Path | None = typer.Option(
         None, "--recordings", help="Table III on the robot-sequence .jsonl files of this folder (one set-up) "
         "instead of the simulated test sequences."),
+    human: Path | None = typer.Option(
+        None, "--human", help="Table III: add a 'human' row from the result files (*.human-*.json) that "
+        "`lookalike label --benchmark` wrote in this folder (default: the --recordings folder)."),
 ) -> None:
     """Seed A's Table I: identification success rate per set-up and identifier (+ error, speed).
     With --lengths or --recordings: seed A's Table III protocol."""
@@ -89,9 +92,9 @@ def ident(
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
     check_names("--trackers", tracker_list, [*tracker_names(), *IDENT_VARIANTS], "tracker")
     check_names("--noise", [noise], ("paper", "ours"), "noise model")
-    if lengths is not None or recordings is not None:
+    if lengths is not None or recordings is not None or human is not None:
         table3_command(setup_list, tracker_list, sequences, frames, seed, noise, lengths, draws, recordings,
-                       json_path, csv_path)
+                       json_path, csv_path, human)
         return
     try:
         with progress_bars() as progress:
@@ -112,22 +115,26 @@ def ident(
 
 def table3_command(setups: list[str], trackers: list[str], sequences: int, frames: int, seed: int, noise: str,
                    lengths: str | None, draws: int, recordings: Path | None, json_path: Path | None,
-                   csv_path: Path | None) -> None:
-    """``bench ident --lengths/--recordings``: seed A's Table III per set-up (or on the recordings)."""
+                   csv_path: Path | None, human: Path | None = None) -> None:
+    """``bench ident --lengths/--recordings/--human``: seed A's Table III per set-up (or on the recordings),
+    with the human benchmark's sessions when there are result files."""
     from lookalike.bench.table3 import DEFAULT_LENGTHS, table3_table
 
     try:
         length_list = [int(v) for v in split_list([lengths])] if lengths else list(DEFAULT_LENGTHS)
     except ValueError:
         fail(f"--lengths: expected comma-separated frame counts, got {lengths!r}")
+    sessions: list[dict[str, Any]] = []
     try:
         with progress_bars() as progress:
             rows = table3_table(setups, trackers, sequences, frames, seed, noise, length_list, draws, recordings,
-                                progress)
+                                progress, human, sessions)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     print_rows(f"Success rate by sequence length (seed A's Table III protocol: {draws} random windows per "
                "length, then whole recordings)", rows)
+    if sessions:
+        print_rows("Human benchmark sessions (lookalike label --benchmark): the 'human' rows", sessions)
     write_rows(rows, json_path, csv_path)
 
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import getpass
 import ipaddress
+import re
 from pathlib import Path
 
 import typer
@@ -11,6 +13,17 @@ from lookalike.bench.ident import identify
 from lookalike.cli.app import app, console, fail
 from lookalike.sim import RobotSequence
 from lookalike.trackers import tracker_names
+
+
+def login_name() -> str:
+    """The user's login name as a labeller id (characters other than letters, digits, ``.``, ``_``,
+    ``-`` become ``_``), or ``anonymous``."""
+    try:
+        name = getpass.getuser()
+    except (OSError, KeyError, ImportError):
+        return "anonymous"
+    name = re.sub(r"[^A-Za-z0-9._-]", "_", name)[:64].lstrip("._-")
+    return name or "anonymous"
 
 
 def tracker_labels(name: str, sequence: RobotSequence) -> list[list[int]]:
@@ -29,7 +42,12 @@ def label(
     host: str = typer.Option("127.0.0.1", "--host",
                              help="Address to bind (others on the network can reach non-loopback ones)."),
     benchmark: bool = typer.Option(False, "--benchmark",
-                                   help="Human benchmark: hide the truth, time the session, score it at the end."),
+                                   help="Human benchmark: hide the truth, time the session, score it at the end "
+                                        "and write STEM.human-LABELLER.json (time, success rate, labeller id)."),
+    labeller: str | None = typer.Option(None, "--labeller",
+                                        help="Who labels (the benchmark result's id; default: your login name)."),
+    results: Path | None = typer.Option(None, "--results",
+                                        help="Folder for the benchmark result file (default: the sequence's)."),
     fresh: bool = typer.Option(False, "--fresh", help="Start over: move saved labels to <stem>.labels.json.bak."),
     export: bool = typer.Option(False, "--export",
                                 help="Write the exports from the saved labels and exit (no server)."),
@@ -38,7 +56,9 @@ def label(
 
     Labels are saved after every click to STEM.labels.json beside the sequence. Export (the
     button or --export) writes STEM.labelled.jsonl (simulator truth format) and
-    STEM.labels.mot.txt (MOTChallenge, positions in the world columns).
+    STEM.labels.mot.txt (MOTChallenge, positions in the world columns); with --benchmark, --export
+    also (re)writes the finished session's result file. `bench ident --lengths ... --human DIR`
+    puts the result files beside the identifiers (seed A's Table III).
     """
     from lookalike.io.robot_sequences import read_robot_sequence
     from lookalike.viz.label import load_labels, make_server, open_label_app
@@ -60,13 +80,19 @@ def label(
             else:
                 console.print(f"running {tracks} on {sequence.name} …")
                 initial, source = tracker_labels(tracks, seq), f"tracker {tracks}"
-        label_app = open_label_app(sequence, initial, source, benchmark, fresh)
+        label_app = open_label_app(sequence, initial, source, benchmark, fresh,
+                                   labeller if labeller is not None else login_name(), results)
     except ValueError as exc:
         fail(str(exc))
     if export:
         r = label_app.export()
         console.print(f"wrote {r['truth']} and {r['mot']} ({r['mot_rows']} rows, {r['unset']} not labelled) "
                       f"in {label_app.folder}")
+        if benchmark:
+            try:
+                console.print(f"wrote {label_app.write_result()}")
+            except (ValueError, OSError) as exc:
+                fail(f"--benchmark: {exc}")
         return
     try:
         server = make_server(label_app, host, port)

@@ -7,7 +7,8 @@ Routes (JSON unless stated)::
     GET  /api/frames?start=&count=   frames' detections and latest reports (truth unless benchmark)
     GET  /api/labels             all labels and the benchmark state
     POST /api/label              {"frame", "detection", "label"}: set one label (saved at once)
-    POST /api/benchmark/start    start timing;  POST /api/benchmark/finish  stop and score
+    POST /api/benchmark/start    start timing;  POST /api/benchmark/finish  stop, score and write the
+                                 result file (<stem>.human-<labeller>.json, :mod:`lookalike.viz.label.human`)
     GET  /api/score              success rate against the truth (benchmark mode: after finishing)
     POST /api/export             write <stem>.labelled.jsonl and <stem>.labels.mot.txt beside the sequence
     GET  /files/<path>           a file inside the sequence's folder (video frames); others are refused;
@@ -37,6 +38,7 @@ import numpy as np
 from lookalike.sim import RobotSequence
 from lookalike.viz.colors import FALSE_POSITIVE, identity_colour, rgb_hex
 from lookalike.viz.label.exports import export_mot, export_truth
+from lookalike.viz.label.human import check_labeller, human_result, human_result_path, write_human_result
 from lookalike.viz.label.store import LabelStore, score_labels
 
 STATIC_DIR = Path(__file__).resolve().parent / "static"
@@ -56,15 +58,19 @@ class LabelApp:
         sequence: the sequence read from it.
         store: its labels.
         benchmark: human-benchmark mode (truth never sent to the page; timed; scored at the end).
+        labeller: who labels (an id for the benchmark's result file, :mod:`lookalike.viz.label.human`).
+        results_dir: folder of the benchmark's result file (default: the sequence's).
     """
 
     def __init__(self, sequence_path: str | Path, sequence: RobotSequence, store: LabelStore,
-                 benchmark: bool = False) -> None:
+                 benchmark: bool = False, labeller: str = "anonymous", results_dir: str | Path | None = None) -> None:
         self.sequence_path = Path(sequence_path).resolve()
         self.folder = self.sequence_path.parent
         self.sequence = sequence
         self.store = store
         self.benchmark = benchmark
+        self.labeller = check_labeller(labeller)
+        self.result_path = human_result_path(self.sequence_path, self.labeller, results_dir)
         self.truth = sequence.true_labels()
         self._reports = _latest_reports(sequence)
         self.image_pattern = _find_images(self.folder, self.sequence_path.stem)
@@ -77,6 +83,7 @@ class LabelApp:
             "fov_rad": cfg.observer.fov_rad, "max_range_m": cfg.observer.max_range_m,
             "colours": [rgb_hex(identity_colour(i)) for i in range(cfg.n_agents)],
             "fp_colour": rgb_hex(FALSE_POSITIVE), "source": self.store.source, "image_pattern": self.image_pattern,
+            "labeller": self.labeller,
         }
 
     def frames(self, start: int, count: int) -> list[dict[str, Any]]:
@@ -94,6 +101,23 @@ class LabelApp:
 
     def score(self) -> dict[str, Any]:
         return score_labels(self.store.snapshot(), self.truth, self.sequence.config.n_agents)
+
+    def finish_benchmark(self) -> dict[str, Any]:
+        """Stop and score the benchmark session (idempotent) and write its result file
+        (:attr:`result_path`: time, success rate, labeller id); returns the session's entry."""
+        bench = self.store.finish_benchmark(self.truth)
+        self.write_result()
+        return bench
+
+    def write_result(self) -> Path:
+        """Write the finished benchmark session's result file; ``ValueError`` if no session has finished."""
+        bench = self.store.benchmark
+        if bench is None or bench.get("finished_at") is None:
+            raise ValueError(f"{self.store.path.name}: no finished benchmark session")
+        cfg = self.sequence.config
+        result = human_result(self.sequence_path.name, self.labeller, cfg.n_agents, cfg.max_detections,
+                              len(self.sequence), bench)
+        return write_human_result(self.result_path, result)
 
     def export(self) -> dict[str, Any]:
         labels = self.store.snapshot()
@@ -304,7 +328,7 @@ class _Handler(BaseHTTPRequestHandler):
         elif path == "/api/benchmark/finish":
             if not self.app.benchmark:
                 raise _BadRequest(HTTPStatus.CONFLICT, "not in benchmark mode")
-            self._json({"benchmark": self.app.store.finish_benchmark(self.app.truth)})
+            self._json({"benchmark": self.app.finish_benchmark()})
         elif path == "/api/export":
             self._json(self.app.export())
         else:

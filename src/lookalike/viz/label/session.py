@@ -7,20 +7,25 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from lookalike.io.robot_sequences import read_robot_sequence
+from lookalike.viz.label.human import check_labeller
 from lookalike.viz.label.server import LabelApp
 from lookalike.viz.label.store import LabelStore, label_path_for
 
 
 def open_label_app(sequence_path: str | Path, initial: Sequence[Sequence[int]] | None = None,
-                   source: str = "empty", benchmark: bool = False, fresh: bool = False) -> LabelApp:
+                   source: str = "empty", benchmark: bool = False, fresh: bool = False,
+                   labeller: str = "anonymous", results_dir: str | Path | None = None) -> LabelApp:
     """A :class:`LabelApp` for the robot sequence at ``sequence_path``.
 
     Saved labels (``<stem>.labels.json`` beside the sequence) are loaded when present and then
     ``initial`` is not used; ``fresh=True`` first moves an existing label file to ``.bak``.
     Benchmark mode starts from no labels and refuses ``initial`` (a tracker's labels would give
-    answers away). Raises ``ValueError`` for unreadable or mismatched files.
+    answers away). A finished benchmark writes its result file, ``<stem>.human-<labeller>.json``, to
+    ``results_dir`` (default: beside the sequence). Raises ``ValueError`` for unreadable or mismatched
+    files or a bad labeller id.
     """
     sequence_path = Path(sequence_path)
+    check_labeller(labeller)
     if not sequence_path.is_file():
         raise ValueError(f"{sequence_path}: no such sequence file")
     if benchmark and initial is not None:
@@ -36,4 +41,4 @@ def open_label_app(sequence_path: str | Path, initial: Sequence[Sequence[int]] |
         raise ValueError(f"{label_path}: a benchmark session is under way; continue it with --benchmark")
     if benchmark and store.source != "empty":
         raise ValueError(f"{label_path}: labels started from {store.source}; a benchmark needs --fresh")
-    return LabelApp(sequence_path, sequence, store, benchmark)
+    return LabelApp(sequence_path, sequence, store, benchmark, labeller, results_dir)

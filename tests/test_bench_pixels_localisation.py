@@ -1,0 +1,24 @@
+"""``bench pixels`` reports seed A's Table II (localisation error) from pixels beside the simulator's."""
+
+from __future__ import annotations
+
+import math
+
+from lookalike.bench.pixels import PIXEL_COLUMNS, PIXEL_KEYS, pixels_results, pixels_table
+from lookalike.vision.pipeline import PipelineConfig, RobotPipeline
+from lookalike.viz.robot_pixels import pixel_camera
+
+
+def test_localisation_error_columns_from_pixels_and_simulated():
+    camera = pixel_camera()
+    pipe = RobotPipeline.from_files(None, None, camera, PipelineConfig())
+    # seed 700001: both robots in view from the first frames
+    rows, perception = pixels_table(["m3n2"], ["jpda"], 1, 12, 700_001, pipe, camera, 0.3)
+    (row,) = rows
+    assert list(row) == list(PIXEL_COLUMNS)
+    for key in ("Pixels loc. (m)", "Simulated loc. (m)"):
+        assert math.isnan(row[key]) or 0 <= row[key] < 10
+    assert row["Simulated loc. (m)"] >= 0  # the simulator's detections of visible robots give positions
+    doc = pixels_results(rows, perception, ["m3n2"], 1, 12)
+    metrics = doc.tables["identification"][0]["metrics"]
+    assert {PIXEL_KEYS["Pixels loc. (m)"], PIXEL_KEYS["Simulated loc. (m)"]} <= set(metrics)
