@@ -56,8 +56,8 @@ def margin_rows(rows: Sequence[dict[str, Any]], setups: Sequence[str], labels: S
         paper = PAPER_TABLE1.get(setup, {})
         paper_margin = paper["lstm"] - paper["kalman_ha"] if paper else math.nan
         for name, rate in mine.items():
-            if resolve_identifier(name)[0] != "lstm":
-                continue
+            if resolve_identifier(name)[0] != "lstm" or not isinstance(rate, (int, float)):
+                continue  # not an LSTM, or no figure (weights not trained for the set-up)
             out.append({"Setup": label, "Identifier": name, "Success rate (%)": rate,
                         f"{baseline} (%)": mine[baseline], "Margin (points)": round(rate - mine[baseline], 2),
                         "Seed A's margin (points)": round(paper_margin, 1)})

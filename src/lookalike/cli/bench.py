@@ -102,7 +102,8 @@ def ident(
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     labels = [preset_label(s) for s in setup_list]
-    rate = {(r["Setup"], r["Tracker"]): f"{r['Success rate (%)']:.1f}%" for r in rows}
+    rate = {(r["Setup"], r["Tracker"]): f"{v:.1f}%" if isinstance(v := r["Success rate (%)"], float) else str(v)
+            for r in rows}
     summary = [{"Tracker": name, **{label: rate[(label, name)] for label in labels}} for name in tracker_list]
     print_rows(f"Robot identification success rate, {sequences} × {frames} frames per set-up", summary)
     print_rows("Per set-up details", rows, IDENT_COLUMNS)
