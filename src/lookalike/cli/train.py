@@ -60,14 +60,52 @@ def train(
         "lstm", "--model", help="lstm (one network per --preset), or set: one set associator for every team size "
         "(N 1-12, M up to 2N+3, drawn per batch; --preset, --cell, --layers, --relative, --protocol, --noise, "
         "--init-from do not apply, --hidden is its memory width; shipped as set_any)."),
+    recordings: Path | None = typer.Option(
+        None, "--recordings", help="Fine-tune on the labelled recordings (*.labelled.jsonl, the labelling page's "
+        "export) of this folder instead of simulated sequences: N and M from the recordings, the network from "
+        "--init-from (default: the shipped weights for N, M), a validation split by recording, early stopping; "
+        "learning rate 0.001 unless given."),
+    validation_fraction: float = typer.Option(
+        0.25, "--validation-fraction", help="With --recordings: share of the recordings held out for validation."),
+    validate_every: int = typer.Option(50, "--validate-every", min=1, help="Steps between validations."),
+    test: Path | None = typer.Option(
+        None, "--test", help="With --recordings: after training, score the starting and the fine-tuned weights "
+        "(LSTM identification success rate) on the recordings of this folder."),
+    search: int | None = typer.Option(
+        None, "--search", min=1, help="Hyper-parameter search instead of one run: this many trials (in all, "
+        "a resumed study included) over hidden size, depth and learning rate in log space (--space), each a training "
+        "run of --steps/--minutes validated on held-out simulator seeds; trials run --workers at a time."),
+    sampler: str = typer.Option("tpe", "--sampler", help="With --search: tpe or random."),
+    space: str = typer.Option("hidden=16:256,layers=1:6,learning_rate=3e-4:3e-2", "--space",
+                              help="With --search: the ranges searched (log space)."),
+    study: str | None = typer.Option(
+        None, "--study", help="With --search: Optuna storage URL (default sqlite:///OUTPUT/search.db); an "
+        "existing study there is continued."),
 ) -> None:
-    """Train the association network on simulated sequences generated on the fly."""
+    """Train the association network on simulated sequences generated on the fly (or fine-tune it on labelled
+    recordings with --recordings, or search its hyper-parameters with --search)."""
     try:
         import torch
     except ImportError:
         fail("training needs PyTorch: pip install 'lookalike[train]' (torch==2.13.0)")
     if model not in ("lstm", "set"):
         fail(f"--model: unknown model {model!r}; known: lstm, set")
+    if recordings is not None and search is not None:
+        fail("--recordings and --search: choose one")
+    if recordings is not None:
+        from lookalike.cli.train_recordings import RecordingOptions, train_recordings
+
+        train_recordings(recordings, output, RecordingOptions(
+            init_from, steps, minutes, batch_size, sequence_length, seed, patience, threads, learning_rate,
+            validation_fraction, validate_every, device, workers, backend, address, resume, test))
+        return
+    if search is not None:
+        from lookalike.cli.train_search import SearchOptions, train_search
+
+        train_search(search, output, preset_name, SearchOptions(
+            steps, minutes, batch_size, sequence_length, seed, patience, validate_every, cell, relative, workers,
+            backend, address, sampler, study, threads, space))
+        return
     if model == "set":
         _train_set(output, steps, minutes, batch_size, seed, patience, threads, device, workers, backend, address,
                    resume, ship, learning_rate)
@@ -99,10 +137,11 @@ def train(
             hidden=hidden, num_layers=layers, batch_size=batch_size, sequence_length=sequence_length, steps=steps,
             minutes=minutes, seed=seed, learning_rate=learning_rate, patience=patience, swap_prob=swap_prob,
             init_from=str(init_from) if init_from else None, protocol=protocol, noise=noise,
+            validation_every=validate_every,
         )
         spec = EncodingSpec(world.n_agents, world.max_detections, relative_headings=relative, protocol=protocol)
         plain = noise == "ours" and protocol == "ours"
-        sampler = make_sim_sampler(world, relative, swap_prob) if plain else NoiseMixSampler(worlds, spec)
+        sample = make_sim_sampler(world, relative, swap_prob) if plain else NoiseMixSampler(worlds, spec)
         validation = make_sim_sampler(world, relative) if plain else NoiseMixSampler(worlds, spec)
         init = load_weights(init_from, world.n_agents, world.max_detections) if init_from else None
         pool = JobPool(workers, backend, address)
@@ -110,7 +149,7 @@ def train(
         fail(str(exc))
     torch.set_num_threads(threads)
     result = _with_progress(f"training {preset_name}", steps, pool, lambda on_step: run_training(
-        config, sampler, output, resume=resume, on_step=on_step, device=device, pool=pool, init=init,
+        config, sample, output, resume=resume, on_step=on_step, device=device, pool=pool, init=init,
         validation_sample=validation))
     png = plot_log(result.log_path, output / "training_log.png")
     console.print(

@@ -95,6 +95,14 @@ def _validate(model: AssociationNet, x: torch.Tensor, y: np.ndarray) -> float:
     return correct / max(total, 1)
 
 
+def _validation_batch(config: TrainConfig, sample: Sampler, given: tuple[np.ndarray, np.ndarray] | None
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    if given is not None:
+        return given
+    seeds = [VALIDATION_SEED_BASE + i for i in range(config.validation_sequences)]
+    return make_batch(sample, seeds, config.sequence_length)
+
+
 def _train_seeds(config: TrainConfig, step: int) -> np.ndarray:
     return TRAIN_SEED_BASE + config.seed * 10_000_000 + step * config.batch_size + np.arange(config.batch_size)
 
@@ -110,12 +118,17 @@ def train(
     pool: JobPool | None = None,
     init: NetworkWeights | None = None,
     validation_sample: Sampler | None = None,
+    validation: tuple[np.ndarray, np.ndarray] | None = None,
+    info: dict | None = None,
 ) -> TrainResult:
     """Train on sequences from ``sample(seed, n_frames, rng)``; write weights, checkpoint and log to ``out_dir``.
 
     ``pool`` generates batches ahead (two per worker); ``init`` starts from exported weights of
     the same shape (normalisation statistics included) instead of random ones.
-    ``validation_sample`` (default ``sample``) makes the validation sequences, e.g. without augmentation.
+    ``validation_sample`` (default ``sample``) makes the validation sequences, e.g. without augmentation;
+    ``validation`` gives the validation batch ``(B, T, n_inputs), (B, T, M)`` itself instead (e.g. held-out
+    recordings). With ``init``, the starting weights are validated first (step 0), so the weights kept are
+    never worse on validation than those the run started from. ``info`` is added to the exported metadata.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -124,11 +137,7 @@ def train(
                         protocol=config.protocol)
     if config.sequence_length % config.bptt:
         raise ValueError(f"sequence_length {config.sequence_length} must be a multiple of bptt {config.bptt}")
-    val_x, val_y = make_batch(
-        validation_sample or sample,
-        [VALIDATION_SEED_BASE + i for i in range(config.validation_sequences)],
-        config.sequence_length,
-    )
+    val_x, val_y = _validation_batch(config, validation_sample or sample, validation)
     model = AssociationNet(spec, config.hidden, config.num_layers, config.cell)
     if init is not None:
         model.load_exported(init)
@@ -152,6 +161,14 @@ def train(
         schedule.load_state_dict(state["schedule"])
         step, best, best_step, history = state["step"], state["best"], state["best_step"], state["history"]
     started = time.monotonic()
+    extra = dict(info or {})
+    notify = on_step or _ignore
+    if init is not None and not history:  # the starting weights are the first candidate
+        best = _validate(model, val_xt, val_y)
+        history.append({"step": 0, "loss": math.nan, "lr": config.learning_rate, "val_success": best, "seconds": 0.0})
+        save_weights(model.export({**extra, "config": asdict(config), "val_success": best, "step": 0}), weights_path)
+        _write_log(log_path, history)
+        notify(history[0])
     stale = len([h for h in history if h["step"] > best_step])
     pool = pool or JobPool()
     ahead = 2 * pool.workers if (pool.workers > 1 or pool.backend == "ray") else 1
@@ -183,8 +200,8 @@ def train(
             history.append(row)
             if row["val_success"] > best:
                 best, best_step, stale = row["val_success"], step, 0
-                info = {"config": asdict(config), "val_success": best, "step": step}
-                save_weights(model.export(info), weights_path)
+                meta = {**extra, "config": asdict(config), "val_success": best, "step": step}
+                save_weights(model.export(meta), weights_path)
             else:
                 stale += 1
             torch.save(
@@ -194,8 +211,7 @@ def train(
                 ckpt_path,
             )
             _write_log(log_path, history)
-        if on_step is not None:
-            on_step(row)
+        notify(row)
         if stale >= config.patience:
             break
     if best < 0:  # stopped before the first validation
@@ -203,9 +219,14 @@ def train(
                "val_success": _validate(model, val_xt, val_y), "seconds": time.monotonic() - started}
         history.append(row)
         best, best_step = row["val_success"], step
-        save_weights(model.export({"config": asdict(config), "val_success": best, "step": step}), weights_path)
+        save_weights(model.export({**extra, "config": asdict(config), "val_success": best, "step": step}),
+                     weights_path)
         _write_log(log_path, history)
     return TrainResult(best, best_step, step, weights_path, log_path, history)
+
+
+def _ignore(row: dict) -> None:
+    del row
 
 
 def _write_log(path: Path, history: list[dict]) -> None:

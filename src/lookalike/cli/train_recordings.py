@@ -1,0 +1,118 @@
+"""``lookalike train --recordings DIR``: fine-tune the LSTM associator on labelled recordings."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from lookalike.cli.app import console, fail
+from lookalike.sim import RobotSequence
+
+PATTERN = "*.labelled.jsonl"
+
+
+@dataclass(frozen=True)
+class RecordingOptions:
+    """The ``lookalike train`` options that apply with ``--recordings``."""
+
+    init_from: Path | None
+    steps: int
+    minutes: float | None
+    batch_size: int
+    sequence_length: int
+    seed: int
+    patience: int
+    threads: int
+    learning_rate: float | None
+    validation_fraction: float
+    validate_every: int
+    device: str
+    workers: int
+    backend: str
+    address: str | None
+    resume: bool
+    test: Path | None
+
+
+def read_recordings(folder: Path, option: str) -> list[RobotSequence]:
+    """The recordings (``*.labelled.jsonl``, sorted by name) of ``folder``; a one-line error naming the folder
+    when it holds none, or the file that cannot be read."""
+    from lookalike.io.robot_sequences import read_robot_sequence
+
+    if not folder.is_dir():
+        fail(f"{option}: {folder} is not a folder")
+    paths = sorted(folder.glob(PATTERN))
+    if not paths:
+        fail(f"{option}: {folder} holds no {PATTERN} (the labelling page's export)")
+    recordings = []
+    for path in paths:
+        try:
+            recordings.append(read_robot_sequence(path))
+        except (ValueError, OSError) as exc:
+            fail(str(exc) if str(path) in str(exc) else f"{path}: {exc}")
+    return recordings
+
+
+def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
+    """Fine-tune on the recordings of ``folder`` (split by recording), write ``OUTPUT/model.npz``; with
+    ``opt.test``, print the starting and fine-tuned success rates on the test recordings."""
+    import torch
+
+    from lookalike.cli.train import _with_progress
+    from lookalike.learn.checkpoint import load_weights
+    from lookalike.learn.recordings import RecordingSampler, check_recordings, split_recordings, validation_arrays
+    from lookalike.learn.training import TrainConfig, plot_log
+    from lookalike.learn.training import train as run_training
+    from lookalike.learn.weights import shipped_weights_path
+    from lookalike.parallel import JobPool
+
+    recordings = read_recordings(folder, "--recordings")
+    tests = read_recordings(opt.test, "--test") if opt.test is not None else []
+    paths = sorted(folder.glob(PATTERN))
+    names = [str(p) for p in paths]
+    n, m = recordings[0].config.n_agents, recordings[0].config.max_detections
+    device = opt.device
+    if device == "auto":
+        device = "cuda" if torch.cuda.is_available() else "cpu"
+    if device.startswith("cuda") and not torch.cuda.is_available():
+        fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
+    try:
+        init_path = opt.init_from if opt.init_from is not None else shipped_weights_path(n, m)
+        init = load_weights(init_path)
+        spec = init.spec
+        check_recordings(spec, recordings, names)
+        check_recordings(spec, tests, [str(p) for p in sorted(opt.test.glob(PATTERN))] if opt.test else [])
+        train_idx, val_idx = split_recordings(len(recordings), opt.validation_fraction, opt.seed)
+        config = TrainConfig(
+            n_agents=spec.n_agents, n_slots=spec.n_slots, relative_headings=spec.relative_headings, cell=init.cell,
+            hidden=init.hidden, num_layers=len(init.layers), batch_size=opt.batch_size,
+            sequence_length=opt.sequence_length, steps=opt.steps, minutes=opt.minutes, seed=opt.seed,
+            learning_rate=0.001 if opt.learning_rate is None else opt.learning_rate, patience=opt.patience,
+            init_from=str(init_path), protocol=spec.protocol, noise="recordings",
+            validation_every=opt.validate_every)
+        sampler = RecordingSampler(spec, tuple(recordings[i].arrays for i in train_idx))
+        validation = validation_arrays(spec, [recordings[i].arrays for i in val_idx], config.bptt)
+        pool = JobPool(opt.workers, opt.backend, opt.address)
+    except ValueError as exc:
+        fail(str(exc))
+    info = {"recordings": {"folder": str(folder), "training": [paths[i].name for i in train_idx],
+                           "validation": [paths[i].name for i in val_idx]}}
+    console.print(f"fine-tuning {init_path} on {len(train_idx)} recordings, validating on {len(val_idx)}: "
+                  f"{', '.join(info['recordings']['validation'])}")
+    torch.set_num_threads(opt.threads)
+    result = _with_progress(f"fine-tuning M={m}, N={n}", opt.steps, pool, lambda on_step: run_training(
+        config, sampler, output, resume=opt.resume, on_step=on_step, device=device, pool=pool, init=init,
+        validation=validation, info=info))
+    png = plot_log(result.log_path, output / "training_log.png")
+    start = result.history[0]["val_success"] if result.history and result.history[0]["step"] == 0 else float("nan")
+    console.print(
+        f"validation success rate (per slot, held-out recordings) {100 * start:.1f}% at the start, best "
+        f"[bold]{100 * result.best_success:.1f}%[/] at step {result.best_step} of {result.steps}; weights "
+        f"{result.weights_path}, log {result.log_path}, plot {png}")
+    if tests:
+        from lookalike.bench.pixel_recordings import score_identifier
+
+        before, count = score_identifier(tests, "lstm", weights=str(init_path))
+        after, _ = score_identifier(tests, "lstm", weights=str(result.weights_path))
+        console.print(f"test recordings ({len(tests)}, {count} detections): LSTM identification success rate "
+                      f"{100 * before:.1f}% with {init_path.name}, [bold]{100 * after:.1f}%[/] fine-tuned")

@@ -1,0 +1,242 @@
+"""Hyper-parameter search for the LSTM associator (seed A's: random search in log space over the network's
+size, depth and learning rate, chosen on held-out data), with Optuna.
+
+Each trial is one training run (:func:`lookalike.learn.training.train`) of the base configuration with
+the trial's ``hidden``, ``num_layers`` and ``learning_rate``, drawn in log space (TPE or random search);
+every trial trains on the same simulated sequences (the base configuration's seed) and its value is its
+best success rate on the training's fixed held-out validation seeds. Because the choice is made on those
+seeds, the chosen network is then scored again on other held-out seeds (:data:`CHECK_SEED_BASE`): that
+figure, not the study's best value, estimates how well the choice does on new sequences.
+
+Trials run ``workers`` at a time on :class:`lookalike.parallel.JobPool` (local processes or Ray), each
+a picklable job writing into its own folder ``trial-NNNN``. The study lives in an Optuna storage (an
+RDB URL such as ``sqlite:///search.db``): running the search again with the same storage continues it
+up to the requested number of trials, and trials cut short by an interruption are run again.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import shutil
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookalike.parallel import JobPool
+from lookalike.sim import RobotWorldConfig
+
+SAMPLERS = ("tpe", "random")
+CHECK_SEED_BASE = 1_800_000_000  # held-out seeds that score the chosen network (neither training nor validation)
+
+
+@dataclass(frozen=True)
+class SearchSpace:
+    """Ranges searched in log space: units per layer, stacked layers, Adam's initial learning rate."""
+
+    hidden: tuple[int, int] = (16, 256)
+    layers: tuple[int, int] = (1, 6)
+    learning_rate: tuple[float, float] = (3e-4, 3e-2)
+
+    def __post_init__(self) -> None:
+        for name in ("hidden", "layers", "learning_rate"):
+            lo, hi = getattr(self, name)
+            if not 0 < lo <= hi:
+                raise ValueError(f"SearchSpace.{name}: need 0 < low <= high, got ({lo}, {hi})")
+
+    @classmethod
+    def parse(cls, text: str) -> SearchSpace:
+        """From ``"hidden=16:256,layers=1:6,learning_rate=3e-4:3e-2"`` (names left out keep their defaults);
+        ``ValueError`` naming the bad part."""
+        ranges: dict[str, Any] = {}
+        for part in (p.strip() for p in text.split(",") if p.strip()):
+            name, _, span = part.partition("=")
+            lo, _, hi = span.partition(":")
+            if name not in ("hidden", "layers", "learning_rate") or not hi:
+                raise ValueError(f"search space: expected NAME=LOW:HIGH with NAME hidden, layers or learning_rate, "
+                                 f"got {part!r}")
+            try:
+                ranges[name] = (float(lo), float(hi)) if name == "learning_rate" else (int(lo), int(hi))
+            except ValueError:
+                raise ValueError(f"search space: {part!r} is not a numeric range") from None
+        return cls(**ranges)
+
+    def suggest(self, trial: Any) -> dict[str, Any]:
+        """The trial's ``hidden``, ``num_layers`` and ``learning_rate`` (all drawn in log space)."""
+        return {"hidden": trial.suggest_int("hidden", *self.hidden, log=True),
+                "num_layers": trial.suggest_int("num_layers", *self.layers, log=True),
+                "learning_rate": trial.suggest_float("learning_rate", *self.learning_rate, log=True)}
+
+
+@dataclass(frozen=True)
+class SearchResult:
+    """The outcome of :func:`run_search`: the chosen hyper-parameters, their validation success rate (the
+    criterion they were chosen on), their success rate on the check seeds, and where things were written."""
+
+    params: dict[str, Any]
+    value: float
+    check_success: float
+    check_sequences: int
+    trials: int
+    failed: int
+    best_trial: int
+    weights_path: Path
+    summary_path: Path
+    errors: list[str]
+
+
+def run_trial(config: Any, world: RobotWorldConfig, out_dir: str, threads: int = 1) -> dict[str, Any]:
+    """One training run (a job: picklable, its result depends on its arguments only): ``{"value", "step",
+    "steps", "seconds"}``, or ``{"error"}`` when the configuration fails."""
+    import torch
+
+    from lookalike.learn.sim_data import make_sim_sampler
+    from lookalike.learn.training import train
+
+    torch.set_num_threads(threads)
+    started = time.process_time()
+    try:
+        result = train(config, make_sim_sampler(world, config.relative_headings, config.swap_prob), out_dir)
+    except (ValueError, RuntimeError) as exc:
+        return {"error": f"{type(exc).__name__}: {str(exc)[:200]}"}
+    return {"value": result.best_success, "step": result.best_step, "steps": result.steps,
+            "seconds": time.process_time() - started}
+
+
+def check_success(weights_path: Path, world: RobotWorldConfig, sequences: int, length: int) -> float:
+    """Per-slot success rate of the network at ``weights_path`` on ``sequences`` sequences of ``length``
+    frames from the held-out check seeds (slots most probable first, as at inference)."""
+    from lookalike.learn.checkpoint import load_weights
+    from lookalike.learn.data import success_rate
+    from lookalike.learn.numpy_net import NumpyAssociationNet
+    from lookalike.learn.sim_data import make_sim_sampler
+
+    weights = load_weights(weights_path)
+    net = NumpyAssociationNet(weights)
+    sample = make_sim_sampler(world, weights.spec.relative_headings)
+    xs, ys = zip(*(sample(CHECK_SEED_BASE + k, length, None) for k in range(sequences)))
+    x, y = np.stack(xs), np.stack(ys)  # (B, T, n_inputs), (B, T, M)
+    net.reset(batch=sequences)
+    prob = np.stack([net.step(x[:, t]) for t in range(length)], axis=1)  # (B, T, M, N+1)
+    correct, total = success_rate(prob, y)
+    return correct / max(total, 1)
+
+
+def _open_study(storage: str, name: str, meta: dict[str, Any]) -> Any:
+    try:
+        import optuna
+    except ImportError:
+        raise ValueError("lookalike train --search needs optuna (pip install 'lookalike[tune]')") from None
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    study = optuna.create_study(study_name=name, storage=storage, direction="maximize", load_if_exists=True)
+    old = study.user_attrs
+    for key, value in meta.items():
+        if old and old.get(key) != value:
+            raise ValueError(f"{storage}: study {name!r} was run with another {key} ({old.get(key)!r}, now "
+                             f"{value!r}); continue it with the same settings or give another --study")
+        if not old:
+            study.set_user_attr(key, value)
+    return study
+
+
+def _sampler(name: str, seed: int) -> Any:
+    import optuna
+
+    if name == "tpe":
+        return optuna.samplers.TPESampler(seed=seed, n_startup_trials=5)
+    if name == "random":
+        return optuna.samplers.RandomSampler(seed=seed)
+    raise ValueError(f"sampler: expected one of {', '.join(SAMPLERS)}, got {name!r}")
+
+
+def run_search(base: Any, world: RobotWorldConfig, out_dir: str | Path, trials: int, *,
+               space: SearchSpace | None = None, sampler: str = "tpe", storage: str | None = None,
+               study_name: str = "lstm", workers: int = 1, backend: str = "local", address: str | None = None,
+               threads: int = 1, check_sequences: int = 8,
+               progress: Callable[[int, int, dict[str, Any]], None] | None = None) -> SearchResult:
+    """Search ``trials`` trials in all (a continued study runs only the missing ones) around the base
+    :class:`~lookalike.learn.training.TrainConfig` ``base`` on the robot world ``world``; write each trial
+    into ``out_dir/trial-NNNN``, the chosen network to ``out_dir/model.npz`` and the choice to
+    ``out_dir/search.json``. ``progress(done, trials, row)`` is called after each finished trial."""
+    from optuna.trial import TrialState
+
+    if trials < 1:
+        raise ValueError(f"trials must be >= 1, got {trials}")
+    space = space or SearchSpace()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    storage = storage or f"sqlite:///{out / 'search.db'}"
+    fixed = {k: v for k, v in dataclasses.asdict(base).items() if k not in ("hidden", "num_layers", "learning_rate")}
+    meta = {"base": fixed, "space": dataclasses.asdict(space)}
+    study = _open_study(storage, study_name, json.loads(json.dumps(meta)))
+    for stale in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
+        study.tell(stale.number, state=TrialState.FAIL)  # cut short by an interruption: run it again
+        study.enqueue_trial(stale.params, skip_if_exists=False)
+    finished = (TrialState.COMPLETE, TrialState.FAIL, TrialState.PRUNED)
+    done = len(study.get_trials(deepcopy=False, states=finished))
+    study.sampler = _sampler(sampler, base.seed + done)  # a fresh seed per session: no redrawn points
+    errors: list[str] = []
+    with JobPool(max(1, min(workers, trials - done)), backend, address) as pool:
+        while done < trials:
+            batch = [study.ask() for _ in range(min(workers, trials - done))]
+            drawn = [space.suggest(t) for t in batch]
+            jobs = [pool.submit(run_trial, dataclasses.replace(base, **p), world, str(out / f"trial-{t.number:04d}"),
+                                threads) for t, p in zip(batch, drawn)]
+            for trial, params, job in zip(batch, drawn, jobs):
+                row = job.result()
+                if "error" in row:
+                    errors.append(row["error"])
+                    trial.set_user_attr("error", row["error"])
+                    study.tell(trial, state=TrialState.FAIL)
+                else:
+                    for key in ("step", "steps", "seconds"):
+                        trial.set_user_attr(key, row[key])
+                    study.tell(trial, row["value"])
+                done += 1
+                if progress is not None:
+                    progress(done, trials, {"trial": trial.number, **params, **row, "best": _best(study)})
+    complete = study.get_trials(deepcopy=False, states=(TrialState.COMPLETE,))
+    if not complete:
+        raise ValueError(f"no trial completed ({errors[0] if errors else 'none ran'})")
+    best = study.best_trial
+    source = out / f"trial-{best.number:04d}" / "model.npz"
+    weights = out / "model.npz"
+    shutil.copy(source, weights)
+    shutil.copy(source.with_suffix(".json"), weights.with_suffix(".json"))
+    check = check_success(weights, world, check_sequences, base.sequence_length)
+    chosen = {"hidden": int(best.params["hidden"]), "num_layers": int(best.params["num_layers"]),
+              "learning_rate": float(best.params["learning_rate"])}
+    summary = {
+        "chosen": chosen, "validation_success": float(best.value), "best_trial": best.number,
+        "check_success": check, "check_sequences": check_sequences, "check_seed_base": CHECK_SEED_BASE,
+        "trials": len(study.get_trials(deepcopy=False, states=finished)),
+        "failed": len(study.get_trials(deepcopy=False, states=(TrialState.FAIL,))),
+        "sampler": sampler, "storage": storage, "study": study_name, "space": dataclasses.asdict(space),
+        "base": fixed, "weights": str(weights),
+        "all_trials": [{"trial": t.number, **t.params, "value": t.value, **t.user_attrs} for t in complete],
+    }
+    summary_path = out / "search.json"
+    summary_path.write_text(json.dumps(summary, indent=2, default=_json_default) + "\n")
+    return SearchResult(chosen, float(best.value), check, check_sequences, summary["trials"], summary["failed"],
+                        best.number, weights, summary_path, errors)
+
+
+def _best(study: Any) -> float:
+    try:
+        return float(study.best_value)
+    except ValueError:
+        return math.nan
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"not JSON: {type(value).__name__}")
+
+
+__all__ = ["CHECK_SEED_BASE", "SAMPLERS", "SearchResult", "SearchSpace", "check_success", "run_search", "run_trial"]
