@@ -15,6 +15,7 @@ format the labelling page exports (``.labelled.jsonl``), so the files train and 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -66,18 +67,19 @@ def to_recording(perceived: PerceivedSequence) -> RobotSequence:
 
 
 def record_pixels(setup: str, sequences: int, frames: int, seed: int, pipe: RobotPipeline, camera: Camera,
-                  min_iou: float = 0.3, progress: ProgressFactory | None = None) -> list[RobotSequence]:
-    """Pixel recordings of ``sequences`` sequences of ``frames`` frames of preset ``setup`` (see the module)."""
+                  min_iou: float = 0.3, progress: ProgressFactory | None = None) -> Iterator[RobotSequence]:
+    """Pixel recordings of ``sequences`` sequences of ``frames`` frames of preset ``setup`` (see the module),
+    one at a time as each is done."""
     cfg = world_for_camera(preset(setup), camera)
     advance = progress(f"{setup}: rendering + perception", sequences * frames) if progress else None
-    return [to_recording(perceive_sequence(pipe, simulate_robots(cfg, frames, s), camera, min_iou,
-                                           min_visible=0.5, advance=advance))
-            for s in recording_seeds(setup, sequences, seed)]
+    for s in recording_seeds(setup, sequences, seed):
+        yield to_recording(perceive_sequence(pipe, simulate_robots(cfg, frames, s), camera, min_iou,
+                                             min_visible=0.5, advance=advance))
 
 
-def write_recordings(recordings: list[RobotSequence], folder: str | Path, setup: str) -> list[Path]:
-    """Write each recording as ``FOLDER/pixels-SETUP-SEED.labelled.jsonl``; the paths written."""
-    return [write_robot_sequence(Path(folder) / f"pixels-{setup}-{r.seed}{SUFFIX}", r) for r in recordings]
+def write_recording(recording: RobotSequence, folder: str | Path, setup: str) -> Path:
+    """Write ``recording`` as ``FOLDER/pixels-SETUP-SEED.labelled.jsonl``; the path written."""
+    return write_robot_sequence(Path(folder) / f"pixels-{setup}-{recording.seed}{SUFFIX}", recording)
 
 
 def score_identifier(recordings: list[RobotSequence], name: str = "lstm", **params: object) -> tuple[float, int]:
@@ -97,4 +99,4 @@ def score_identifier(recordings: list[RobotSequence], name: str = "lstm", **para
     return identification_success_rate(predicted, truth), sum(len(t) for t in truth)
 
 
-__all__ = ["SUFFIX", "record_pixels", "recording_seeds", "score_identifier", "to_recording", "write_recordings"]
+__all__ = ["SUFFIX", "record_pixels", "recording_seeds", "score_identifier", "to_recording", "write_recording"]

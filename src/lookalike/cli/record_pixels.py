@@ -29,7 +29,7 @@ def record_pixels(
     """Render robot sequences, detect them from the pixels and write each as a labelled recording
     (pixel detections, renderer truth as labels, the simulated reports)."""
     from lookalike.bench.pixel_recordings import record_pixels as record
-    from lookalike.bench.pixel_recordings import write_recordings
+    from lookalike.bench.pixel_recordings import write_recording
     from lookalike.cli.progress import progress_bars
     from lookalike.vision.pipeline import PipelineConfig, RobotPipeline
     from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera
@@ -41,12 +41,14 @@ def record_pixels(
     try:
         config = PipelineConfig(n_agents=world.n_agents, max_detections=max_detections or world.max_detections)
         pipe = RobotPipeline.from_files(detector_model, heading_model, camera, config)
+        recordings = []
         with progress_bars() as progress, one_blas_thread():
-            recordings = record(preset_name, sequences, frames, seed, pipe, camera, min_iou, progress)
-        paths = write_recordings(recordings, output, preset_name)
+            for rec in record(preset_name, sequences, frames, seed, pipe, camera, min_iou, progress):
+                recordings.append(rec)
+                console.print(f"wrote {write_recording(rec, output, preset_name)}")
     except (ValueError, FileNotFoundError, OSError) as exc:
         fail(str(exc))
     n_det = sum(int(r.arrays.det_valid.sum()) for r in recordings)
     n_fp = sum(int(((r.arrays.det_label < 0) & r.arrays.det_valid).sum()) for r in recordings)
-    console.print(f"wrote {len(paths)} recordings to {output} ({sequences} × {frames} frames, {n_det} pixel "
+    console.print(f"wrote {len(recordings)} recordings to {output} ({sequences} × {frames} frames, {n_det} pixel "
                   f"detections, {n_fp} false positives; seeds {recordings[0].seed}–{recordings[-1].seed})")
