@@ -15,11 +15,11 @@ from pathlib import Path
 from lookalike.cli.app import app
 
 MODULES = ("bench", "bench_divers", "bench_experiments", "bench_pixels", "bench_real", "demo", "eval", "label",
-           "node", "record_pixels", "render", "report", "simulate", "track", "track_pixels", "train",
+           "node", "record_pixels", "render", "report", "simulate", "track", "track_pixels", "trackers", "train",
            "train_appearance", "tune", "vision")
 """Every command module, in the order they are imported."""
 
-COMMAND_MODULES = {"track": "track", "trackers": "track", "eval": "eval", "simulate": "simulate",
+COMMAND_MODULES = {"track": "track", "trackers": "trackers", "eval": "eval", "simulate": "simulate",
                    "render": "render", "report": "report", "demo": "demo", "label": "label"}
 """Commands whose module alone is imported when the script runs them."""
 

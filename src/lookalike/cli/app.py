@@ -13,6 +13,10 @@ from typer._click import Context, HelpFormatter  # typer 0.29 vendors click (con
 from typer._click.globals import get_current_context
 from typer.core import TyperGroup
 
+from lookalike.cli.coercion import install
+
+install()  # plain option values converted without pydantic (same values and errors as typer's)
+
 
 class SortedGroup(TyperGroup):
     """A command group listing its commands alphabetically in ``--help``."""

@@ -11,8 +11,6 @@ from rich.table import Table
 
 from lookalike.bench.folders import COMBINED, evaluate_folders, folder_results
 from lookalike.cli.app import app, command_line, console, fail, split_list
-from lookalike.cli.bench import write_results
-from lookalike.cli.eval_points import score_points
 from lookalike.eval import BENCHMARKS, METRICS
 
 HEADLINE = {
@@ -61,6 +59,8 @@ def eval_command(
     for name, folder in zip(names, results):
         try:
             if points:
+                from lookalike.cli.eval_points import score_points  # imported when used: a short start-up
+
                 assert radius is not None
                 scores[name] = {COMBINED: score_points(gt, folder, radius)}
                 continue
@@ -104,6 +104,8 @@ def _write_json(path: Path, scores: dict[str, dict[str, dict[str, float]]], gt: 
         doc = folder_results(scores, gt, command_line(), options)
     except ValueError as exc:
         fail(f"--json: {exc}")
+    from lookalike.cli.bench import write_results  # imported when used: a short start-up
+
     write_results(doc, path)
 
 

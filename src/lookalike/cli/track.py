@@ -1,4 +1,4 @@
-"""``lookalike track`` and ``lookalike trackers``: argument parsing and printing; the frame loop is
+"""``lookalike track``: argument parsing and printing; the frame loop is
 :func:`lookalike.loop.run`, the input and output streams are :mod:`lookalike.io.stream`."""
 
 from __future__ import annotations
@@ -11,7 +11,6 @@ from typing import Any
 
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
-from rich.table import Table
 
 from lookalike.cli.app import app, console, err_console, fail
 from lookalike.io import find_sequences
@@ -28,10 +27,12 @@ def tracker_params(name: str, settings: list[str], params_file: Path | None = No
     ``KEY=VALUE`` ``settings`` on top; fails with a readable message."""
     if name not in tracker_names():
         fail(f"unknown tracker {name!r}; choose one of: {', '.join(tracker_names())}")
-    from lookalike.tune.params_file import load_params  # imported when used: keeps the CLI's start-up short
-
     try:
-        base = load_params(params_file, name) if params_file is not None else {}
+        base: dict[str, Any] = {}
+        if params_file is not None:
+            from lookalike.tune.params_file import load_params  # imported when used: keeps the CLI's start-up short
+
+            base = load_params(params_file, name)
         return {**base, **dict(parse_parameter(name, s) for s in settings)}
     except (ValueError, TypeError) as exc:
         fail(str(exc))
@@ -69,6 +70,9 @@ def _progress_bars(count: int) -> Iterator[tuple[Progress, Any]]:
         yield progress, progress.add_task("sequences", total=count)
 
 
+_BAR_STEP = 25
+"""Frames between two moves of a sequence's progress bar."""
+
 _LENGTH_HINT = " (--no-seqinfo-length tracks every frame in the file)"
 
 
@@ -103,7 +107,8 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float,
             task = progress.add_task(seq.name, total=frames.length)
 
             def advance(f: Any, t: Any, task: TaskID = task) -> None:
-                progress.advance(task)
+                if f.index % _BAR_STEP == _BAR_STEP - 1:  # the bar moves every _BAR_STEP frames
+                    progress.advance(task, _BAR_STEP)
 
             try:
                 track_to_file(tracker, frames, target, advance, stats)
@@ -231,14 +236,11 @@ def track(
     team_size = team_size if team_size is not None else targets
     video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
                                          min_score=min_score, fps=fps, features=features)
-    # the video, pixel, blob and closed-set paths are imported when used: keeps the CLI's start-up short
-    from lookalike.cli.track_blobs import run_track_blobs
-    from lookalike.cli.track_closed import offline_files, offline_video, track_points
-    from lookalike.cli.track_pixels import run_track_pixels
-    from lookalike.cli.track_video import run_track_video
-
+    # the video, pixel, blob and closed-set paths are imported in their branch: keeps the CLI's start-up short
     try:
         if branch == "pipeline":
+            from lookalike.cli.track_pixels import run_track_pixels
+
             if params_file is not None:
                 settings = [*(f"{k}={v}" for k, v in tracker_params(tracker, [], params_file).items()), *settings]
             run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker, settings,
@@ -248,11 +250,15 @@ def track(
                            params_file=params_file)
         online = tracker_params(tracker, settings, params_file) if offline else None
         if branch == "points":
+            from lookalike.cli.track_closed import track_points
+
             assert points is not None
             track_points(points, output, trk, tracker, n_targets=targets, offline=offline, params=online or {}, fps=fps)
         elif branch in ("blobs", "video"):
             assert video is not None
             if branch == "blobs":
+                from lookalike.cli.track_blobs import run_track_blobs
+
                 run_track_blobs(video, output, trk, tracker, detector or "", blob or [], n_targets=targets,
                                 offline=online, **video_options)
             else:
@@ -261,11 +267,17 @@ def track(
                 if online is not None and targets is not None:
                     if output.is_dir():
                         fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
+                    from lookalike.cli.track_closed import offline_video
+
                     _, count, rate = _video_info(video)
                     offline_video(det_path, output, targets, online, fps or rate, count or None, min_score)
                 else:
+                    from lookalike.cli.track_video import run_track_video
+
                     run_track_video(video, det_path, output, trk, tracker, **video_options)
         elif online is not None and targets is not None:
+            from lookalike.cli.track_closed import offline_files
+
             assert path is not None
             count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length)
             where = output if path.is_file() else f"{output}/<sequence>.txt"
@@ -278,24 +290,3 @@ def track(
 
     except OSError as exc:  # an output that cannot be written, an input that cannot be read
         fail(f"{exc.filename or output}: {exc.strerror or exc}")
-
-@app.command()
-def trackers(
-    names: bool = typer.Option(False, "--names", help="Print only the names, one per line."),
-) -> None:
-    """List registered trackers and their parameters with defaults and allowed values."""
-    if names:
-        for name in tracker_names():
-            typer.echo(name)
-        return
-    for name in tracker_names():
-        table = Table(title=f"[bold]{name}[/]", title_justify="left", show_lines=False)
-        table.add_column("parameter")
-        table.add_column("type")
-        table.add_column("default")
-        table.add_column("allowed")
-        table.add_column("meaning")
-        for p in tracker_parameters(name):
-            table.add_row(p.name, p.type, repr(p.default), p.allowed(), p.doc)
-        console.print(table)
-    console.print("Set any parameter with [bold]--set KEY=VALUE[/] on `lookalike track`.")

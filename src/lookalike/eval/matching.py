@@ -16,9 +16,9 @@ import numpy as np
 
 
 def hungarian() -> Callable[..., Any]:
-    """SciPy's ``linear_sum_assignment``, imported on first use (``scipy.optimize`` takes a good part of a
-    second to import, which ``import lookalike`` should not pay)."""
-    from scipy.optimize import linear_sum_assignment
+    """SciPy's ``linear_sum_assignment``, loaded on first use without ``scipy.optimize`` (which takes a
+    good part of a second to import; :mod:`lookalike._lsap`)."""
+    from lookalike._lsap import linear_sum_assignment
 
     solve: Callable[..., Any] = linear_sum_assignment
     return solve

@@ -20,14 +20,16 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from lookalike.io.motchallenge import frames_from_table, read_mot, row_problem
+from lookalike.io.motchallenge import format_rows, frames_from_table, read_mot, row_problem
 from lookalike.io.rules import temp_beside
 from lookalike.io.sequences import MotSequence
 from lookalike.loop import RunStats, Sink, Sinks, Updating, run
 from lookalike.types import Detections, Frame
-from lookalike.types.mot_table import format_row, tracks_to_rows
+from lookalike.types.mot_table import tracks_to_rows
 
 CHUNK_LINES = 8_192
+WRITE_ROWS = 4_096
+"""Result rows a :class:`MotWriter` holds before formatting and writing them as one block."""
 
 
 def _chunks(path: Path, lines: int) -> Iterator[np.ndarray]:
@@ -67,6 +69,7 @@ class DetectionStream:
         self.path, self.length, self.frame_rate = Path(path), length, frame_rate
         self.min_score, self.chunk_lines, self.length_name = min_score, chunk_lines, length_name
         self._streamable: bool | None = None
+        self._single: np.ndarray | None = None  # the parsed file when it fits one chunk
         self.rows = 0  # rows in the file (known after check())
 
     def check(self) -> DetectionStream:
@@ -75,8 +78,12 @@ class DetectionStream:
         if not self.path.is_file():
             raise FileNotFoundError(f"{self.path}: no such file")
         last, width, rows = 0.0, None, 0
+        self._single = None
+        chunks: list[np.ndarray] = []
         try:
             for data in _chunks(self.path, self.chunk_lines):
+                if len(chunks) < 2:
+                    chunks.append(data)
                 frames = data[:, 0]
                 bad = (data.shape[1] < 6 or (width is not None and data.shape[1] != width)
                        or row_problem(data, last, self.length) is not None
@@ -85,6 +92,8 @@ class DetectionStream:
                     raise ValueError
                 width, last, rows = data.shape[1], float(frames[-1]), rows + len(data)
             self._streamable, self.rows = True, rows
+            if len(chunks) == 1:  # the whole file was one chunk: kept, not parsed again
+                self._single = chunks[0]
         except ValueError:
             # raises the precise error, or the file is valid but irregular (read whole)
             self.rows = len(read_mot(self.path, length=self.length, length_name=self.length_name))
@@ -108,7 +117,8 @@ class DetectionStream:
         nxt = 0  # index of the next frame to yield
         pending: list[np.ndarray] = []  # rows of frame ``nxt`` seen so far (it may span chunks)
         end = self.length
-        for data in _chunks(self.path, self.chunk_lines):
+        single, self._single = self._single, None  # a second pass parses the file again
+        for data in [single] if single is not None else _chunks(self.path, self.chunk_lines):
             if end is not None:
                 data = data[data[:, 0] <= end]
             if not len(data):
@@ -151,6 +161,8 @@ class MotWriter:
         self.path.parent.mkdir(parents=True, exist_ok=True)
         fd, self._tmp = temp_beside(self.path)
         self._fh: TextIO | None = os.fdopen(fd, "w")
+        self._pending: list[np.ndarray] = []  # rows not yet written (at most WRITE_ROWS)
+        self._pending_rows = 0
         self.rows = 0
 
     def __call__(self, frame: Frame, tracks: Any) -> None:
@@ -160,13 +172,27 @@ class MotWriter:
         """Append result rows ``(k, 10)``."""
         if self._fh is None:
             raise ValueError(f"{self.path}: writer already closed")
-        for row in rows:
-            self._fh.write(format_row(row))
+        if len(rows):
+            self._pending.append(np.array(rows, dtype=float))  # a copy: the caller may reuse its array
+            self._pending_rows += len(rows)
+            if self._pending_rows >= WRITE_ROWS:
+                self._flush()
         self.rows += len(rows)
+
+    def _flush(self) -> None:
+        if self._fh is not None and self._pending:
+            block = self._pending[0] if len(self._pending) == 1 else np.vstack(self._pending)
+            self._fh.write(format_rows(block))
+        self._pending, self._pending_rows = [], 0
 
     def close(self) -> Path:
         """Finish the file: rename the temporary file to ``path``. Returns ``path``."""
         if self._fh is not None:
+            try:
+                self._flush()
+            except BaseException:
+                self.abort()
+                raise
             fh, self._fh = self._fh, None
             try:
                 fh.close()
@@ -178,6 +204,7 @@ class MotWriter:
 
     def abort(self) -> None:
         """Drop the temporary file; ``path`` is left as it was."""
+        self._pending, self._pending_rows = [], 0
         if self._fh is not None:
             self._fh.close()
             self._fh = None
@@ -212,4 +239,4 @@ def track_to_file(tracker: Updating, frames: Iterable[Frame], output: str | os.P
         return run(tracker, frames, Sinks(writer, sink), stats=stats)
 
 
-__all__ = ["CHUNK_LINES", "DetectionStream", "MotWriter", "sequence_stream", "track_to_file"]
+__all__ = ["CHUNK_LINES", "WRITE_ROWS", "DetectionStream", "MotWriter", "sequence_stream", "track_to_file"]

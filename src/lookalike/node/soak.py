@@ -18,8 +18,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
+from lookalike._lsap import linear_sum_assignment
 from lookalike.node.client import Endpoint
 from lookalike.node.identifier import IdentifierConfig
 from lookalike.node.messages import (

@@ -1,22 +1,67 @@
-"""Trackers: the protocol, the registry by name and the implementations."""
+"""Trackers: the protocol, the registry by name and the implementations.
 
-from lookalike.trackers.base import Tracker
-from lookalike.trackers.boxtrack import BoxTrack
-from lookalike.trackers.deepsort import DeepSort
-from lookalike.trackers.diversort import DiverSort
-from lookalike.trackers.health import HealthConfig, HealthMonitor, HealthStatus
-from lookalike.trackers.jpda import JpdaTracker
-from lookalike.trackers.kalman_ha import KalmanHA, KalmanHA2
-from lookalike.trackers.registry import (
-    ParameterInfo,
-    make_tracker,
-    register_tracker,
-    tracker_class,
-    tracker_names,
-    tracker_parameters,
-)
-from lookalike.trackers.sort import Sort
-from lookalike.types.tracks import TrackStatus
+Names are imported on first use (``from lookalike.trackers import Sort`` imports only
+:mod:`lookalike.trackers.sort`), so that listing or building one tracker does not load the others.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from lookalike.trackers.base import Tracker
+    from lookalike.trackers.boxtrack import BoxTrack
+    from lookalike.trackers.deepsort import DeepSort
+    from lookalike.trackers.diversort import DiverSort
+    from lookalike.trackers.health import HealthConfig, HealthMonitor, HealthStatus
+    from lookalike.trackers.jpda import JpdaTracker
+    from lookalike.trackers.kalman_ha import KalmanHA, KalmanHA2
+    from lookalike.trackers.registry import (
+        ParameterInfo,
+        make_tracker,
+        register_tracker,
+        tracker_class,
+        tracker_names,
+        tracker_parameters,
+    )
+    from lookalike.trackers.sort import Sort
+    from lookalike.types.tracks import TrackStatus
+
+_HOME = {
+    "Tracker": "lookalike.trackers.base",
+    "BoxTrack": "lookalike.trackers.boxtrack",
+    "DeepSort": "lookalike.trackers.deepsort",
+    "DiverSort": "lookalike.trackers.diversort",
+    "HealthConfig": "lookalike.trackers.health",
+    "HealthMonitor": "lookalike.trackers.health",
+    "HealthStatus": "lookalike.trackers.health",
+    "JpdaTracker": "lookalike.trackers.jpda",
+    "KalmanHA": "lookalike.trackers.kalman_ha",
+    "KalmanHA2": "lookalike.trackers.kalman_ha",
+    "ParameterInfo": "lookalike.trackers.registry",
+    "make_tracker": "lookalike.trackers.registry",
+    "register_tracker": "lookalike.trackers.registry",
+    "tracker_class": "lookalike.trackers.registry",
+    "tracker_names": "lookalike.trackers.registry",
+    "tracker_parameters": "lookalike.trackers.registry",
+    "Sort": "lookalike.trackers.sort",
+    "TrackStatus": "lookalike.types.tracks",
+}
+
+
+def __getattr__(name: str) -> Any:
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module 'lookalike.trackers' has no attribute {name!r}")
+    value = getattr(importlib.import_module(home), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_HOME))
+
 
 __all__ = [
     "BoxTrack",

@@ -6,9 +6,10 @@ import dataclasses
 import typing
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from lookalike.trackers.base import Range, check_value, name_config
+if TYPE_CHECKING:
+    from lookalike.trackers.base import Range
 
 _REGISTRY: dict[str, type] = {}
 
@@ -40,6 +41,8 @@ def register_tracker(name: str) -> Callable[[type], type]:
     """Class decorator: register a tracker class (which has a ``Config`` dataclass) under ``name``."""
 
     def decorate(cls: type) -> type:
+        from lookalike.trackers.base import name_config
+
         if name in _REGISTRY and _REGISTRY[name] is not cls:
             raise ValueError(f"a tracker named {name!r} is already registered")
         if not dataclasses.is_dataclass(getattr(cls, "Config", None)):
@@ -53,14 +56,26 @@ def register_tracker(name: str) -> Callable[[type], type]:
 
 
 def tracker_names() -> list[str]:
-    """Names of all registered trackers, sorted."""
-    _load_builtin()
-    return sorted(_REGISTRY)
+    """Names of all registered trackers, sorted: the built-in ones (:data:`BUILTIN_TRACKERS`), the
+    plugins' entry-point names and any registered since, without importing a tracker module."""
+    plugins = _plugin_names()
+    if plugins is None:  # no package metadata: the plugin modules tell their names when imported
+        _load_builtin()
+        return sorted(_REGISTRY)
+    return sorted(set(BUILTIN_TRACKERS) | plugins | set(_REGISTRY))
 
 
 def tracker_class(name: str) -> type:
-    """The class registered under ``name``; unknown names raise ``KeyError`` listing the known ones."""
-    _load_builtin()
+    """The class registered under ``name``; unknown names raise ``KeyError`` listing the known ones.
+    Only the module that registers ``name`` is imported (every one for an unknown name)."""
+    if name not in _REGISTRY:
+        module = BUILTIN_TRACKERS.get(name) or _plugin_entry_points().get(name)
+        if module is not None:
+            import importlib
+
+            importlib.import_module(module)
+        if name not in _REGISTRY:
+            _load_builtin()
     try:
         return _REGISTRY[name]
     except KeyError:
@@ -88,6 +103,8 @@ def make_tracker(name: str, **params: Any) -> Any:
     """Build tracker ``name`` with config overrides; an unknown parameter, or a value outside its
     declared type, range or choices (:func:`~lookalike.trackers.base.param`), raises ``ValueError``
     (``TypeError`` for a wrong type) in one line naming the tracker and the parameter."""
+    from lookalike.trackers.base import check_value
+
     cls = tracker_class(name)
     known = {f.name for f in dataclasses.fields(_config_class(name))}
     unknown = sorted(set(params) - known)
@@ -104,6 +121,8 @@ def make_tracker(name: str, **params: Any) -> Any:
 def parse_parameter(name: str, assignment: str) -> tuple[str, Any]:
     """Parse ``KEY=VALUE`` for tracker ``name``, converting VALUE to the parameter's type and checking
     it against the declared range or choices (``ValueError`` in one line otherwise)."""
+    from lookalike.trackers.base import check_value
+
     if "=" not in assignment:
         raise ValueError(f"expected KEY=VALUE, got {assignment!r}")
     key, text = (part.strip() for part in assignment.split("=", 1))
@@ -138,26 +157,53 @@ def _convert(name: str, key: str, text: str, hint: Any) -> Any:
     raise ValueError(f"tracker {name!r}: parameter {key!r} of type {hint} cannot be set from text")
 
 
+BUILTIN_TRACKERS = {
+    "boxtrack": "lookalike.trackers.boxtrack",
+    "deepsort": "lookalike.trackers.deepsort",
+    "diversort": "lookalike.trackers.diversort",
+    "jpda": "lookalike.trackers.jpda",
+    "kalman_ha": "lookalike.trackers.kalman_ha",
+    "kalman_ha2": "lookalike.trackers.kalman_ha",
+    "sort": "lookalike.trackers.sort",
+}
+"""The trackers of this layer and the module that registers each (tests check the list is complete),
+so that :func:`tracker_names` needs no tracker module imported."""
+
 # Trackers defined above the trackers layer (they need the learned network); imported by name
 # so that this layer never imports upwards.
 PLUGIN_MODULES = ("lookalike.learn.tracker", "lookalike.learn.set_tracker")
 
+ENTRY_POINT_GROUP = "lookalike.trackers"
 
 _PLUGINS_LOADED = False
+_plugins: dict[str, str] | None = None
+
+
+def _plugin_entry_points() -> dict[str, str]:
+    """Entry-point name -> module of group ``lookalike.trackers`` (read once; empty without metadata)."""
+    global _plugins
+    if _plugins is None:
+        from importlib.metadata import entry_points
+
+        _plugins = {ep.name: ep.module for ep in entry_points(group=ENTRY_POINT_GROUP)}
+    return _plugins
+
+
+def _plugin_names() -> set[str] | None:
+    """The plugins' entry-point names, or None where the package's metadata is not installed."""
+    names = set(_plugin_entry_points())
+    return names or None
 
 
 def _load_builtin() -> None:
     """Register the built-in trackers and the plugins: the entry points of group ``lookalike.trackers``
     (read once), or :data:`PLUGIN_MODULES` where the package's metadata is not installed."""
     global _PLUGINS_LOADED
-    import lookalike.trackers  # noqa: F401  (importing the tracker modules registers them)
-
     if _PLUGINS_LOADED:
         return
     import importlib
-    from importlib.metadata import entry_points
 
-    modules = {ep.module for ep in entry_points(group="lookalike.trackers")} or set(PLUGIN_MODULES)
+    modules = set(BUILTIN_TRACKERS.values()) | (set(_plugin_entry_points().values()) or set(PLUGIN_MODULES))
     for module in sorted(modules):
         importlib.import_module(module)
     _PLUGINS_LOADED = True

@@ -127,7 +127,7 @@ def _solve_dense(iou: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndar
     if above.sum(axis=1).max() == 1 and above.sum(axis=0).max() == 1:
         rows, cols = np.nonzero(above)
     else:
-        from scipy.optimize import linear_sum_assignment
+        from lookalike._lsap import linear_sum_assignment
 
         rows, cols = linear_sum_assignment(-iou)
     keep = iou[rows, cols] >= threshold
@@ -167,9 +167,10 @@ def _solve_sparse(d_idx: np.ndarray, t_idx: np.ndarray, iou: np.ndarray, n_det: 
         if per_det.max() == 1 and per_trk.max() == 1:
             order = np.argsort(d_idx[above], kind="stable")
             return d_idx[above][order], t_idx[above][order]
-    from scipy.optimize import linear_sum_assignment
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
+
+    from lookalike._lsap import linear_sum_assignment
 
     graph = coo_matrix((np.ones(len(iou)), (d_idx, n_det + t_idx)), shape=(n_det + n_trk,) * 2)
     _, label = connected_components(graph, directed=False)

@@ -1,0 +1,65 @@
+"""Start-up and I/O fast paths (issue 18) give what the plain ones give."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lookalike.io import MotWriter
+from lookalike.io.motchallenge import format_rows
+from lookalike.types.mot_table import format_row
+
+
+def test_lsap_is_scipys_function_with_the_same_results():
+    from scipy.optimize import linear_sum_assignment as scipy_lsap
+
+    from lookalike._lsap import linear_sum_assignment
+
+    rng = np.random.default_rng(3)
+    for shape in [(1, 1), (3, 5), (6, 4), (20, 20), (0, 3)]:
+        cost = rng.integers(0, 4, size=shape).astype(float)  # ties: the same tie-breaking
+        for maximize in (False, True):
+            ours, theirs = linear_sum_assignment(cost, maximize), scipy_lsap(cost, maximize)
+            assert all(np.array_equal(a, b) for a, b in zip(ours, theirs))
+    with pytest.raises(ValueError):
+        linear_sum_assignment(np.array([[np.nan]]))
+
+
+def test_builtin_tracker_list_is_complete():
+    import importlib
+    import pkgutil
+
+    import lookalike.trackers as package
+    from lookalike.trackers import registry
+
+    for info in pkgutil.iter_modules(package.__path__):
+        importlib.import_module(f"lookalike.trackers.{info.name}")
+    ours = {name for name, cls in registry._REGISTRY.items() if cls.__module__.startswith("lookalike.trackers.")}
+    assert ours == set(registry.BUILTIN_TRACKERS)
+    assert all(registry._REGISTRY[n].__module__ == m for n, m in registry.BUILTIN_TRACKERS.items())
+    assert set(registry.tracker_names()) >= set(registry.BUILTIN_TRACKERS) | {"lstm", "set"}
+
+
+def test_format_rows_equals_format_row():
+    rng = np.random.default_rng(0)
+    rows = rng.normal(0, 1e3, (3000, 10))
+    rows[:, 0] = rng.integers(1, 10**6, len(rows))
+    rows[:, 1] = rng.integers(-5, 10**4, len(rows))
+    rows[::7, 6], rows[::11, 7], rows[::13, 8], rows[::17, 2] = np.nan, np.inf, -0.0, -0.0004
+    rows[::19, 3], rows[::23, 9], rows[::29, 4] = 1e17, 1e-7, 2.0005
+    assert format_rows(rows) == "".join(format_row(r) for r in rows)
+    assert format_rows(np.zeros((0, 10))) == ""
+    with pytest.raises(ValueError, match="shape"):
+        format_rows(np.zeros((2, 6)))
+
+
+def test_writer_buffers_and_writes_every_row_once(tmp_path):
+    rng = np.random.default_rng(1)
+    blocks = [rng.normal(0, 100, (k, 10)) for k in rng.integers(0, 900, 30)]
+    expected = "".join(format_row(r) for b in blocks for r in b)
+    with MotWriter(tmp_path / "out.txt") as writer:
+        for block in blocks:
+            writer.write_rows(block)
+            block[:] = 0  # the caller reusing its array changes nothing written
+    assert writer.rows == sum(len(b) for b in blocks)
+    assert (tmp_path / "out.txt").read_text() == expected
