@@ -63,3 +63,14 @@ def test_writer_buffers_and_writes_every_row_once(tmp_path):
             block[:] = 0  # the caller reusing its array changes nothing written
     assert writer.rows == sum(len(b) for b in blocks)
     assert (tmp_path / "out.txt").read_text() == expected
+
+
+def test_plugin_fallback_names_match_pyproject():
+    import tomllib
+    from pathlib import Path
+
+    from lookalike.trackers import registry
+
+    project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
+    declared = project["project"]["entry-points"]["lookalike.trackers"]
+    assert {name: target.split(":")[0] for name, target in declared.items()} == registry.PLUGIN_TRACKERS

@@ -171,7 +171,10 @@ so that :func:`tracker_names` needs no tracker module imported."""
 
 # Trackers defined above the trackers layer (they need the learned network); imported by name
 # so that this layer never imports upwards.
-PLUGIN_MODULES = ("lookalike.learn.tracker", "lookalike.learn.set_tracker")
+PLUGIN_TRACKERS = {"lstm": "lookalike.learn.tracker", "set": "lookalike.learn.set_tracker"}
+"""The plugins pyproject.toml declares (entry points of group ``lookalike.trackers``), used where the
+installed metadata does not list them (an install older than the entry points)."""
+PLUGIN_MODULES = tuple(PLUGIN_TRACKERS.values())
 
 ENTRY_POINT_GROUP = "lookalike.trackers"
 
@@ -180,30 +183,31 @@ _plugins: dict[str, str] | None = None
 
 
 def _plugin_entry_points() -> dict[str, str]:
-    """Entry-point name -> module of group ``lookalike.trackers`` (read once; empty without metadata)."""
+    """Entry-point name -> module of group ``lookalike.trackers`` (read once), or
+    :data:`PLUGIN_TRACKERS` where the installed metadata lists none."""
     global _plugins
     if _plugins is None:
         from importlib.metadata import entry_points
 
-        _plugins = {ep.name: ep.module for ep in entry_points(group=ENTRY_POINT_GROUP)}
+        _plugins = {ep.name: ep.module for ep in entry_points(group=ENTRY_POINT_GROUP)} or dict(PLUGIN_TRACKERS)
     return _plugins
 
 
 def _plugin_names() -> set[str] | None:
-    """The plugins' entry-point names, or None where the package's metadata is not installed."""
+    """The plugins' names (None: none known, the plugin modules must be imported to tell)."""
     names = set(_plugin_entry_points())
     return names or None
 
 
 def _load_builtin() -> None:
     """Register the built-in trackers and the plugins: the entry points of group ``lookalike.trackers``
-    (read once), or :data:`PLUGIN_MODULES` where the package's metadata is not installed."""
+    (read once), or :data:`PLUGIN_TRACKERS` where the installed metadata lists none."""
     global _PLUGINS_LOADED
     if _PLUGINS_LOADED:
         return
     import importlib
 
-    modules = set(BUILTIN_TRACKERS.values()) | (set(_plugin_entry_points().values()) or set(PLUGIN_MODULES))
+    modules = set(BUILTIN_TRACKERS.values()) | set(_plugin_entry_points().values())
     for module in sorted(modules):
         importlib.import_module(module)
     _PLUGINS_LOADED = True
