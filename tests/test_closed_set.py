@@ -130,3 +130,34 @@ def test_bad_input_is_refused() -> None:
     with pytest.raises(ValueError, match="candidates"):
         ClosedSetConfig(candidates=0)
     assert assign_identities(np.zeros((0, 10)), 2, FPS).shape == (0, 10)
+
+
+def test_a_broken_track_stays_one_identity_when_identities_are_spare() -> None:
+    """Two targets, N = 3: one target's track breaks for 6 frames; starting a spare identity mid-video costs
+    ``edge_cost``, so the motion-consistent link wins and the target keeps one identity."""
+    frames = 60
+    k = np.arange(frames, dtype=float)
+    paths = [np.column_stack([40 + 4 * k, 100 + 0 * k]), np.column_stack([40 + 4 * k, 300 + 0 * k])]
+    gone = (k >= 28) & (k < 34)
+    _, det = _rows(paths, [gone, np.zeros(frames, bool)], 0.3, 6)
+    rows = np.column_stack([det[:, 0], np.where(det[:, 3] < 200, np.where(det[:, 0] < 30, 1, 3), 2), det[:, 2:]])
+    out = assign_identities(rows, 3, FPS)
+    assert len(np.unique(out[:, 1])) == 2
+    split = assign_identities(rows, 3, FPS, ClosedSetConfig(edge_cost=0.0))
+    assert len(np.unique(split[:, 1])) == 3  # without it, the spare identity is free
+
+
+def test_a_stray_row_far_past_an_identity_end_is_not_bridged() -> None:
+    """A single detection 100 frames after a target's last row is not placed on it (no 100-frame fill)."""
+    track = np.array([[f, 1, 100 + 2 * f, 100, SIZE, SIZE, 1, -1, -1, -1] for f in range(1, 41)], float)
+    stray = np.array([[140, 2, 180, 100, SIZE, SIZE, 1, -1, -1, -1]], float)
+    out = assign_identities(np.vstack([track, stray]), 1, FPS)
+    assert out[:, 0].max() == 40
+
+
+def test_boxes_are_smoothed_along_an_identity() -> None:
+    """A one-frame detector error is removed from a still target; a steady motion is kept."""
+    rows = np.array([[f, 1, 100.0, 100.0, SIZE, SIZE, 1, -1, -1, -1] for f in range(1, 61)])
+    rows[30, 2:4] += 8.0
+    out = assign_identities(rows, 1, FPS)
+    assert np.abs(out[:, 2:4] - 100.0).max() < 1e-9

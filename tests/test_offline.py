@@ -10,6 +10,7 @@ from lookalike.trackers.offline import (
     fill_gaps,
     link_tracks,
     postprocess,
+    smooth_boxes,
 )
 
 
@@ -74,3 +75,15 @@ def test_bad_input_is_rejected() -> None:
         OfflineConfig(fill_gap_s=-1.0)
     with pytest.raises(ValueError, match="max_gap"):
         fill_gaps(_rows(1, [1, 2]), -1)
+
+
+def test_smooth_boxes_removes_outliers_and_keeps_a_steady_motion() -> None:
+    moving = _rows(1, range(1, 31))
+    np.testing.assert_allclose(smooth_boxes(moving, 5)[2:-2, 2:6], moving[2:-2, 2:6])  # ends are held
+    still = _rows(2, range(1, 31), vx=0.0)
+    noisy = still.copy()
+    noisy[10, 2:4] += 30.0  # one wrong box
+    np.testing.assert_allclose(smooth_boxes(noisy, 5)[:, 2:6], still[:, 2:6])
+    np.testing.assert_array_equal(smooth_boxes(noisy, 1), noisy)
+    both = np.vstack([moving, noisy])
+    np.testing.assert_allclose(smooth_boxes(both, 5)[30:, 2:6], still[:, 2:6])  # ids never mix

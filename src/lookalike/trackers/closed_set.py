@@ -26,11 +26,18 @@ online pass (MOTChallenge rows, any ids) and:
    most one chain, each chain one identity. Links only go forward in time, so two tracklets that
    overlap in time can never share an identity. A tracklet on no chain is clutter; using one earns
    its number of rows minus ``tracklet_cost``, so short tracklets that need implausible links are
-   left out while long ones are kept even across long gaps.
+   left out while long ones are kept even across long gaps. A chain that starts after the sequence's
+   first ``velocity_frames`` frames, or ends before its last, pays ``edge_cost``: a closed set's
+   targets are there all along, so when N exceeds the targets actually seen, a spare identity is not
+   a free way around a link.
 4. **Places the short pieces** (:func:`place_short`): a second HiGHS MILP assigns each to at most one
-   chain, near the chain's interpolated position, never two overlapping pieces to one chain.
-5. **Writes ids 1..N** (chains ordered by their first frame) and fills gaps of at most ``fill_gap_s``
-   seconds inside each identity by linear interpolation (:func:`lookalike.trackers.offline.fill_gaps`).
+   chain, near the chain's interpolated position, never two overlapping pieces to one chain, and only
+   where its rows outweigh a link's cost (so a stray row far past a chain's end is not bridged).
+5. **Writes ids 1..N** (chains ordered by their first frame), fills gaps of at most ``fill_gap_s``
+   seconds inside each identity by linear interpolation (:func:`lookalike.trackers.offline.fill_gaps`)
+   and smooths each identity's boxes by a running median (:func:`lookalike.trackers.offline.smooth_boxes`)
+   over :func:`smoothing_window` frames: at most ``smooth_s`` seconds and at most the time a target
+   typically takes to move ``smooth_move`` box sizes.
 
 :func:`track_closed_set` runs the online pass itself on detection rows (``boxtrack`` in an *open* set
 with ``n_init=1``, reporting only detected boxes: a closed online set leaves detections that no slot
@@ -49,12 +56,12 @@ import numpy as np
 
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.trackers.base import check_positive, param
-from lookalike.trackers.offline import fill_gaps
+from lookalike.trackers.offline import fill_gaps, smooth_boxes
 from lookalike.trackers.registry import make_tracker
 from lookalike.types import Detections, Frame
 
 __all__ = ["ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale", "place_short",
-           "solve_chains", "split_tracklets", "track_closed_set"]
+           "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
 
 
 @dataclass(frozen=True)
@@ -75,16 +82,22 @@ class ClosedSetConfig:
     max_gap_s: float = param(math.inf, "longest gap (seconds) a link may bridge")
     tracklet_cost: float = param(3.0, "cost of putting a tracklet on an identity (rows' worth); shorter "
                                       "tracklets with costly links are left out as clutter")
+    edge_cost: float = param(3.0, "cost (rows' worth) of an identity that starts after the sequence's first "
+                                   "frames or ends before its last (a closed set's targets are always there)")
     min_rows: int = param(5, "tracklets with fewer rows are not chained but placed into the chains' gaps")
     fill_gap_s: float = param(math.inf, "longest gap (seconds) inside an identity filled by interpolation "
                                         "(a closed set's targets are always there)")
+    smooth_s: float = param(1.0, "longest window (seconds) of the running median of each identity's box "
+                                 "centres and sizes (0: none)")
+    smooth_move: float = param(0.25, "... and no longer than the frames in which a target typically moves this "
+                                     "many box sizes")
     time_limit_s: float = param(60.0, "time limit of the MILP solver (seconds)")
 
     def __post_init__(self) -> None:
         check_positive(self, "jump", "velocity_frames", "pos_sigma", "max_z", "candidates", "max_gap_s",
                        "time_limit_s")
-        check_positive(self, "contact_iou", "jump_floor", "link_cost", "tracklet_cost", "fill_gap_s",
-                       allow_zero=True)
+        check_positive(self, "contact_iou", "jump_floor", "link_cost", "tracklet_cost", "fill_gap_s", "edge_cost",
+                       "smooth_s", "smooth_move", allow_zero=True)
 
 
 @dataclass(frozen=True, eq=False)
@@ -265,9 +278,11 @@ def _cheapest(group: np.ndarray, cost: np.ndarray, k: int) -> np.ndarray:
 
 
 def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
-                 tracklet_cost: float, time_limit_s: float = 60.0) -> list[list[int]]:
+                 tracklet_cost: float, time_limit_s: float = 60.0, start_cost: np.ndarray | None = None,
+                 end_cost: np.ndarray | None = None) -> list[list[int]]:
     """At most ``n_chains`` disjoint chains of tracklets (lists of indices in time order) maximising the
-    rows covered minus ``tracklet_cost`` per tracklet used minus the link costs, by HiGHS MILP.
+    rows covered minus ``tracklet_cost`` per tracklet used minus the link costs and the costs of starting
+    (``start_cost[i]``) or ending (``end_cost[i]``) a chain at tracklet ``i``, by HiGHS MILP.
 
     Variables: ``x`` (tracklet used), ``y`` (link used), ``a`` (chain starts here), ``b`` (chain ends
     here); flow conservation ``a_i + Σ_j y_ji = x_i = b_i + Σ_j y_ij`` and ``Σ a_i ≤ n_chains``.
@@ -281,7 +296,9 @@ def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.nd
     from scipy.optimize import Bounds, LinearConstraint, milp
 
     # variable blocks: x [0, n), y [n, n+m), a [n+m, 2n+m), b [2n+m, 3n+m)
-    c = np.concatenate([-(np.asarray(lengths, float) - tracklet_cost), cost, np.zeros(2 * n)])
+    c = np.concatenate([-(np.asarray(lengths, float) - tracklet_cost), cost,
+                        np.zeros(n) if start_cost is None else np.asarray(start_cost, float),
+                        np.zeros(n) if end_cost is None else np.asarray(end_cost, float)])
     eye = sparse.identity(n, format="csr")
     into = sparse.csr_matrix((np.ones(m), (dst, np.arange(m))), shape=(n, m))
     out = sparse.csr_matrix((np.ones(m), (src, np.arange(m))), shape=(n, m))
@@ -325,9 +342,11 @@ def _chain_position(block: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, 
 def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[float, float, float],
                 config: ClosedSetConfig | None = None) -> np.ndarray:
     """Chain index (or -1, clutter) of every short tracklet: an assignment of the short tracklets to the
-    chains' gaps by HiGHS MILP. A piece costs ``link_cost + ½ z²`` minus its rows, ``z`` its mean miss from
-    the chain's interpolated centre over ``pos_sigma·size + speed·g`` (``g`` frames to the chain's nearest
-    row); pieces overlapping in time never go to the same chain, nor to frames where the chain has rows."""
+    chains' gaps by HiGHS MILP. A piece costs ``link_cost + ½ z² + 2 ln(σ / (pos_sigma·size))`` minus its
+    rows (a link's negative log-likelihood), ``z`` its mean miss from the chain's interpolated centre over
+    ``σ = pos_sigma·size + speed·g`` (``g`` frames to the chain's nearest row); only pieces that earn more
+    than they cost are placed; pieces overlapping in time never go to the same chain, nor to frames where
+    the chain has rows."""
     cfg = config or ClosedSetConfig()
     out = np.full(len(short), -1, dtype=int)
     if not short or not chains:
@@ -340,11 +359,14 @@ def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[fl
             pos, near = _chain_position(block, frames)
             if np.isinf(near).any():
                 continue
-            z = float(np.mean(np.linalg.norm(pos - _centres(t.rows), axis=1) / (cfg.pos_sigma * size + speed * near)))
-            if z <= cfg.max_z:
+            base = cfg.pos_sigma * size
+            spread = base + speed * near
+            z = float(np.mean(np.linalg.norm(pos - _centres(t.rows), axis=1) / spread))
+            nll = 0.5 * z**2 + 2 * float(np.mean(np.log(spread / base)))
+            if z <= cfg.max_z and cfg.link_cost + nll < len(t):
                 pp.append(p)
                 cc.append(c)
-                cost.append(cfg.link_cost + 0.5 * z**2 - len(t))
+                cost.append(cfg.link_cost + nll - len(t))
     if not pp:
         return out
     from scipy import sparse  # imported on first use: scipy.optimize and scipy.sparse are slow to import
@@ -392,8 +414,11 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     tracklets = [t for t in pieces if len(t) >= cfg.min_rows] or pieces
     short = [t for t in pieces if len(t) < cfg.min_rows and tracklets is not pieces]
     links = link_costs(tracklets, frame_rate, cfg)
+    lo, hi = rows[:, 0].min() + cfg.velocity_frames, rows[:, 0].max() - cfg.velocity_frames
+    start_cost = np.array([cfg.edge_cost if t.first > lo else 0.0 for t in tracklets])
+    end_cost = np.array([cfg.edge_cost if t.last < hi else 0.0 for t in tracklets])
     chains = solve_chains(np.array([len(t) for t in tracklets]), links, int(n_targets), cfg.tracklet_cost,
-                          cfg.time_limit_s)
+                          cfg.time_limit_s, start_cost, end_cost)
     chains.sort(key=lambda ch: (tracklets[ch[0]].first, tracklets[ch[0]].rows[0, 2]))
     blocks = [np.vstack([tracklets[i].rows for i in chain]) for chain in chains]
     placed = place_short(short, blocks, motion_scale(tracklets), cfg)
@@ -407,7 +432,23 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     merged = merged[np.lexsort((merged[:, 1], merged[:, 0]))]
     max_fill = len(np.unique(merged[:, 0])) + int(merged[:, 0].max(initial=0)) if math.isinf(cfg.fill_gap_s) else round(
         cfg.fill_gap_s * frame_rate)
-    return fill_gaps(merged, max_fill) if len(merged) else merged
+    if not len(merged):
+        return merged
+    return smooth_boxes(fill_gaps(merged, max_fill), smoothing_window(merged, frame_rate, cfg))
+
+
+def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfig | None = None) -> int:
+    """Odd window (frames) of the running median of an identity's boxes: at most ``smooth_s`` seconds and
+    at most the frames in which a target typically moves ``smooth_move`` box sizes (median step between
+    consecutive rows; box sizes √(w·h)), so slow targets are smoothed long and fast ones briefly."""
+    cfg = config or ClosedSetConfig()
+    steps = _steps(rows)
+    size = float(np.mean(_sizes(rows))) if len(rows) else 1.0
+    step = float(np.median(steps)) if len(steps) else 0.0
+    frames = cfg.smooth_s * frame_rate
+    if step > 0:
+        frames = min(frames, cfg.smooth_move * size / step)
+    return max(int(frames) // 2 * 2 + 1, 1)
 
 
 def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = None,

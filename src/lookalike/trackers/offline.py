@@ -16,6 +16,9 @@ height (pixels), confidence, x, y, z.
   to one start at most, and vice versa), so chains form: the later track takes the earlier one's id.
 - **Filling** (:func:`fill_gaps`): frames missing inside one id's span, in runs of at most
   ``fill_gap_s`` seconds, get boxes interpolated linearly between the boxes on either side.
+- **Smoothing** (:func:`smooth_boxes`): each id's box centres and sizes replaced by their running
+  median over a window of frames (a median keeps a steady motion where it is and removes single-frame
+  detector errors).
 """
 
 from __future__ import annotations
@@ -136,6 +139,29 @@ def fill_gaps(rows: np.ndarray, max_gap: int) -> np.ndarray:
             out.append(new)
     merged = np.vstack(out)
     return merged[np.lexsort((merged[:, 1], merged[:, 0]))]
+
+
+def smooth_boxes(rows: np.ndarray, window: int) -> np.ndarray:
+    """``rows`` with each id's box centres and widths/heights replaced by their running median over
+    ``window`` consecutive rows of that id (1 or less: unchanged; the first and last rows repeated beyond
+    the ends)."""
+    rows = _check_rows(rows)
+    half = int(window) // 2
+    out: np.ndarray = rows.copy()
+    if half < 1 or not len(rows):
+        return out
+    from numpy.lib.stride_tricks import sliding_window_view
+
+    for i in np.unique(rows[:, 1]):
+        sel = np.flatnonzero(rows[:, 1] == i)
+        sel = sel[np.argsort(rows[sel, 0], kind="stable")]
+        box = rows[sel, 2:6]
+        values = np.column_stack([box[:, :2] + box[:, 2:4] / 2, box[:, 2:4]])
+        pad = np.pad(values, ((half, half), (0, 0)), mode="edge")
+        med = np.median(sliding_window_view(pad, 2 * half + 1, axis=0), axis=2)
+        out[sel, 2:4] = med[:, :2] - med[:, 2:4] / 2
+        out[sel, 4:6] = med[:, 2:4]
+    return out
 
 
 def postprocess(rows: np.ndarray, frame_rate: float, config: OfflineConfig | None = None) -> np.ndarray:
