@@ -44,6 +44,20 @@ def plain_cell_histograms(grey: np.ndarray, cell_px: int, bins: int = BINS) -> n
     return hist.reshape(ny, nx, bins).transpose(2, 0, 1)
 
 
+def plain_block_features_rows(rows: np.ndarray, width: int, blocks: np.ndarray, ox: np.ndarray,
+                              oy: np.ndarray, unit_px: int) -> np.ndarray:
+    """All block descriptors by row gathers, normalised with numpy's own sum over each block's 36 values."""
+    k, d = len(ox), 4 * BINS
+    bx, by, bw, bh = np.asarray(blocks, np.int64).T
+    hw, hh = bw // 2 // unit_px, bh // 2 // unit_px
+    base = ((oy[:, None] + by) // unit_px) * width + (ox[:, None] + bx) // unit_px
+    step = np.arange(3)[:, None] * (hh * width)[:, None, None] + np.arange(3) * hw[:, None, None]
+    c = rows[base[:, :, None, None] + step]
+    cells = (c[:, :, 1:, 1:] - c[:, :, :-1, 1:] - c[:, :, 1:, :-1] + c[:, :, :-1, :-1]).reshape(k, len(bw), d)
+    denom = np.sqrt((cells * cells).sum(axis=2, keepdims=True)) + (bw * bh).astype(cells.dtype)[:, None]
+    return (cells / denom).reshape(k, -1)
+
+
 def plain_windows(model: hc.HogCascade, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """HogCascade.windows with the plain histograms and gathers for every stage."""
     cfg = model.config
@@ -69,7 +83,8 @@ def plain_windows(model: hc.HogCascade, image: np.ndarray) -> tuple[np.ndarray, 
         for stage, (used, columns) in zip(model.stages, model._stage_blocks):
             if not len(alive):
                 break
-            cols = hb.block_features_rows(rows, integral.shape[1], used, ox[alive], oy[alive], cfg.cell_px)[:, columns]
+            cols = plain_block_features_rows(rows, integral.shape[1], used, ox[alive], oy[alive],
+                                             cfg.cell_px)[:, columns]
             margin = np.where((cols > stage.threshold) == (stage.sign > 0), 1.0, -1.0) @ stage.weight
             keep = margin >= stage.bias
             alive, margin = alive[keep], margin[keep]
@@ -113,7 +128,41 @@ def test_strided_first_stage_features_equal_the_gathers() -> None:
     rows = integral.astype(np.float32).reshape(-1, BINS)
     planes = np.ascontiguousarray(integral.transpose(2, 0, 1), dtype=np.float32)
     grid = hb.block_features_grid(planes, blocks, xs.shape, 2, 4)
-    assert np.array_equal(grid, hb.block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4))
+    plain = plain_block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4)
+    assert np.array_equal(grid, plain)
+    assert np.array_equal(hb.block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4), plain)
+
+
+def test_block_norms_equal_numpys_sum_over_wide_ranges() -> None:
+    rng = np.random.default_rng(6)
+    cells = (rng.standard_normal((2, 2, BINS, 50, 40)) * np.exp(rng.uniform(-10, 10, (2, 2, BINS, 50, 40))))
+    cells = cells.astype(np.float32)
+    cells[rng.random(cells.shape) < 0.3] = 0.0
+    flat = np.ascontiguousarray(cells.transpose(3, 4, 0, 1, 2)).reshape(50, 40, 4 * BINS)
+    expected = np.sqrt((flat * flat).sum(axis=2)) + np.float32(48)
+    assert np.array_equal(hb._block_norms(cells, np.float32(48)), expected)
+
+
+def test_stacked_integrals_equal_one_at_a_time() -> None:
+    rng = np.random.default_rng(8)
+    blocks = hb.block_pool((32, 64), 4)[::5]
+    parts, stacked, ox, oy, width, offset = [], [], [], [], [], []
+    first = 0
+    for h, w in ((30, 40), (24, 31), (17, 20)):
+        integral = np.zeros((h + 1, w + 1, BINS))
+        integral[1:, 1:] = rng.uniform(0, 50, (h, w, BINS)).cumsum(axis=0).cumsum(axis=1)
+        rows = integral.astype(np.float32).reshape(-1, BINS)
+        ys, xs = np.mgrid[0 : 4 * h - 64 + 1 : 8, 0 : 4 * w - 32 + 1 : 8]
+        parts.append(plain_block_features_rows(rows, w + 1, blocks, xs.ravel(), ys.ravel(), 4))
+        stacked.append(rows)
+        ox.append(xs.ravel())
+        oy.append(ys.ravel())
+        width.append(np.full(xs.size, w + 1))
+        offset.append(np.full(xs.size, first))
+        first += len(rows)
+    got = hb.block_features_rows(np.concatenate(stacked), np.concatenate(width), blocks, np.concatenate(ox),
+                                 np.concatenate(oy), 4, offset=np.concatenate(offset))
+    assert np.array_equal(got, np.concatenate(parts))
 
 
 def test_shipped_detector_windows_equal_the_plain_path() -> None:
@@ -150,7 +199,8 @@ def test_selected_columns_equal_the_full_features() -> None:
     ys, xs = np.mgrid[0 : 120 - 64 + 1 : 8, 0 : 160 - 32 + 1 : 8]
     rows = integral.astype(np.float32).reshape(-1, BINS)
     planes = np.ascontiguousarray(integral.transpose(2, 0, 1), dtype=np.float32)
-    full = hb.block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4)
+    full = plain_block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4)
+    assert np.array_equal(hb.block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4), full)
     assert np.array_equal(hb.block_features_rows(rows, 41, blocks, xs.ravel(), ys.ravel(), 4, columns),
                           full[:, columns])
     assert np.array_equal(hb.block_features_grid(planes, blocks, xs.shape, 2, 4, columns), full[:, columns])

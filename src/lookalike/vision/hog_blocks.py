@@ -21,6 +21,28 @@ def _output(k: int, n_blocks: int, columns: np.ndarray | None) -> tuple[np.ndarr
     return cols, np.empty((k, len(cols)), np.float32, "F")
 
 
+def _block_norms(cells: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """``sqrt(sum of squares) + area`` of each block from its cells ``(2, 2, BINS, ...)`` (cell row, cell column,
+    bin, then any block shape), in the order and grouping in which numpy sums a contiguous row of the 36 values
+    (cell row, cell column, bin): eight running sums of every eighth value, combined pairwise, then the last
+    four. So the norms equal ``np.sqrt((flat * flat).sum(axis=-1)) + area`` of the (block, 36) layout bit for bit
+    (tests/test_hog_fast_paths.py keeps that as the oracle) without transposing to it."""
+    sq = cells * cells
+    n = 4 * BINS  # numpy's pairwise summation of 8 <= n <= 128 values
+    v = [sq[j // (2 * BINS), (j // BINS) % 2, j % BINS] for j in range(n)]
+    acc = [v[j] + v[j + 8] for j in range(8)]
+    for i in range(16, n - n % 8, 8):
+        for j in range(8):
+            acc[j] += v[i + j]
+    total = (acc[0] + acc[1]) + (acc[2] + acc[3])
+    total += (acc[4] + acc[5]) + (acc[6] + acc[7])
+    for j in range(n - n % 8, n):
+        total += v[j]
+    norm = np.sqrt(total, out=total)
+    norm += area
+    return norm
+
+
 def block_pool(window_px: tuple[int, int], cell_px: int) -> np.ndarray:
     """``(b, 4)`` blocks ``(x, y, w, h)`` in pixels inside the window: several sizes and aspect ratios, even
     numbers of cells so that each block splits into 2×2 cells, stepped by half a block."""
@@ -48,30 +70,42 @@ def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy:
     return block_features_rows(rows, integral.shape[2], blocks, ox, oy, unit_px)
 
 
-def block_features_rows(rows: np.ndarray, width: int, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
-                         unit_px: int, columns: np.ndarray | None = None) -> np.ndarray:
+def block_features_rows(rows: np.ndarray, width: int | np.ndarray, blocks: np.ndarray, ox: np.ndarray,
+                         oy: np.ndarray, unit_px: int, columns: np.ndarray | None = None,
+                         offset: np.ndarray | None = None) -> np.ndarray:
     """:func:`block_features` on an integral laid out as ``rows ((H+1) * width, BINS)``, one row per corner: the
     nine corners of a block's 2×2 cells are nine row gathers, done for several blocks at once. With ``columns``,
-    only those columns of the result ``(k, len(columns))`` (each still normalised by its whole block)."""
+    only those columns of the result ``(k, len(columns))`` (each still normalised by its whole block).
+
+    Several integrals stacked in ``rows`` (e.g. the levels of a pyramid) are read at once with a per-window
+    ``width (k,)`` (corners per integral row) and ``offset (k,)`` (the integral's first row in ``rows``)."""
     k, d = len(ox), 4 * BINS
     cols, out = _output(k, len(blocks), columns)
     ox, oy = np.asarray(ox, np.int64), np.asarray(oy, np.int64)
-    chunk = max(1, 65536 // max(k, 1))  # blocks per gather: bounds the (k, chunk, 3, 3, BINS) corner array
+    per_window = np.ndim(width) > 0
+    wide = np.asarray(width, np.int64)[:, None] if per_window else width
+    chunk = max(1, 65536 // max(k, 1))  # blocks per gather: bounds the (3, 3, k, chunk, BINS) corner array
     for j0 in range(0, len(blocks), chunk):
         bx, by, bw, bh = np.asarray(blocks[j0 : j0 + chunk], np.int64).T
         hw, hh = bw // 2 // unit_px, bh // 2 // unit_px
-        base = ((oy[:, None] + by) // unit_px) * width + (ox[:, None] + bx) // unit_px  # (k, b)
-        step = (np.arange(3)[:, None] * (hh * width)[:, None, None] + np.arange(3) * hw[:, None, None])  # (b, 3, 3)
-        c = rows[base[:, :, None, None] + step]  # (k, b, 3, 3, BINS) corners
-        cells = (c[:, :, 1:, 1:] - c[:, :, :-1, 1:] - c[:, :, 1:, :-1] + c[:, :, :-1, :-1]).reshape(k, len(bw), d)
-        denom = np.sqrt((cells * cells).sum(axis=2, keepdims=True)) + (bw * bh).astype(cells.dtype)[:, None]
+        base = ((oy[:, None] + by) // unit_px) * wide + (ox[:, None] + bx) // unit_px  # (k, b)
+        if offset is not None:
+            base += np.asarray(offset, np.int64)[:, None]
+        down = hh * wide  # corner rows between a block's cell rows: (b,) or (k, b)
+        # (3, 3, k, b, BINS) corners, one contiguous (k, b, BINS) slab per corner of the 2×2 cells
+        c = np.take(rows, np.arange(3)[:, None, None, None] * down + np.arange(3)[:, None, None] * hw + base, axis=0)
+        cells = c[1:, 1:] - c[:-1, 1:]  # (2, 2, k, b, BINS): cell row, cell column, window, block, bin
+        cells -= c[1:, :-1]
+        cells += c[:-1, :-1]
+        denom = _block_norms(cells.transpose(0, 1, 4, 2, 3), (bw * bh).astype(cells.dtype))  # (k, b)
         if cols is None:
-            cells /= denom
-            out[:, j0 * d : (j0 + len(bw)) * d] = cells.reshape(k, -1)
+            whole = out.reshape(k, len(blocks), 2, 2, BINS)[:, j0 : j0 + len(bw)]
+            np.divide(cells.transpose(2, 3, 0, 1, 4), denom[:, :, None, None, None], out=whole)
             continue
         sel = np.flatnonzero((cols >= j0 * d) & (cols < (j0 + len(bw)) * d))
         block, local = cols[sel] // d - j0, cols[sel] % d
-        out[:, sel] = cells[:, block, local] / denom[:, block, 0]
+        picked = cells[local // (2 * BINS), (local // BINS) % 2, :, block, local % BINS]  # (len(sel), k)
+        out[:, sel] = picked.T / denom[:, block]
     return out
 
 
@@ -113,15 +147,15 @@ def block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int,
                 np.subtract(corner[r + 1][c + 1], corner[r][c + 1], out=cell)
                 cell -= corner[r + 1][c]
                 cell += corner[r][c]
-        # (window, cell row, cell column, bin), contiguous: the norm then sums in the same order as the gathers.
-        flat = np.ascontiguousarray(cells.transpose(3, 4, 0, 1, 2)).reshape(k, d)
-        denom = np.sqrt((flat * flat).sum(axis=1, keepdims=True)) + np.float32(bw * bh)
+        denom = _block_norms(cells, np.float32(bw * bh))  # (ny, nx)
         if cols is None:
-            flat /= denom
-            out[:, j * d : (j + 1) * d] = flat
+            np.divide(cells.transpose(3, 4, 0, 1, 2), denom[:, :, None, None, None],
+                      out=out.reshape(ny, nx, len(blocks), 2, 2, BINS)[:, :, j])
         else:
             sel = np.flatnonzero(cols // d == j)
-            out[:, sel] = flat[:, cols[sel] % d] / denom
+            local = cols[sel] % d
+            picked = cells[local // (2 * BINS), (local // BINS) % 2, local % BINS]  # (len(sel), ny, nx)
+            out[:, sel] = (picked / denom).reshape(len(sel), k).T
     return out
 
 

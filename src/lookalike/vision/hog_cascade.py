@@ -140,7 +140,11 @@ class HogCascade:
         grey = img.astype(np.float32) if img.ndim == 2 and img.dtype == np.float32 else to_grey(as_bgr_image(img))
         win_w, win_h = cfg.window_px
         step = cfg.stride_cells * cfg.cell_px
-        boxes, margins = [], []
+        # Per pyramid level: the first stage on its whole window grid; then every later stage once for the windows
+        # still alive on all levels together, their corners gathered from the levels' stacked integrals.
+        levels: list[tuple[float, int, np.ndarray, np.ndarray, np.ndarray]] = []  # scale, width, ox, oy, alive
+        stacked: list[np.ndarray] = []  # each level's integral, one row of BINS values per corner
+        first: list[np.ndarray] = []  # the first stage's margins of each level's windows that passed it
         scale = win_h / cfg.min_height_px
         while win_h / scale <= cfg.max_height_px:
             size = (int(round(grey.shape[1] * scale)), int(round(grey.shape[0] * scale)))
@@ -153,36 +157,50 @@ class HogCascade:
             hist = cell_histograms(level, cfg.cell_px).transpose(1, 2, 0)
             integral = np.zeros((hist.shape[0] + 1, hist.shape[1] + 1, BINS))
             np.cumsum(cumsum_rows(hist), axis=1, out=integral[1:, 1:])
-            width = integral.shape[1]
             # float32 corners (faster gathers): on 640x480 the corner sums stay below ~1e7, so rounding moves a
             # block sum by a few gradient units at most, far below the block sums the stumps threshold.
-            rows = integral.astype(np.float32).reshape(-1, BINS)
+            rows = integral.astype(np.float32)
             ys, xs = np.mgrid[0 : size[1] - win_h + 1 : step, 0 : size[0] - win_w + 1 : step]
-            ox, oy = xs.ravel(), ys.ravel()
-            alive = np.arange(len(ox))
-            margin = np.zeros(0)
-            for k, (stage, (used, columns)) in enumerate(zip(self.stages, self._stage_blocks)):
-                if not len(alive):
-                    break
-                # Descriptors of this stage's blocks, for the windows still alive only (the first stage sees every
-                # window of the grid: strided slices of the integral instead of gathers, the same arithmetic).
-                if k == 0:
-                    planes = np.ascontiguousarray(integral.transpose(2, 0, 1), dtype=np.float32)
-                    cols = block_features_grid(planes, used, xs.shape, cfg.stride_cells, cfg.cell_px, columns)
-                else:
-                    cols = block_features_rows(rows, width, used, ox[alive], oy[alive], cfg.cell_px, columns)
-                votes = np.where((cols > stage.threshold) == (stage.sign > 0), 1.0, -1.0)
-                margin = votes @ stage.weight
-                keep = margin >= stage.bias
-                alive, margin = alive[keep], margin[keep]
-            if len(alive):
-                boxes.append(np.column_stack([ox[alive] / scale, oy[alive] / scale,
-                                              np.full(len(alive), win_w / scale), np.full(len(alive), win_h / scale)]))
-                margins.append(margin)
+            # The first stage sees every window of the grid: strided slices of the integral instead of gathers,
+            # the same arithmetic.
+            if self.stages:
+                stage, (used, columns) = self.stages[0], self._stage_blocks[0]
+                planes = np.ascontiguousarray(rows.transpose(2, 0, 1))
+                margin = _margin(block_features_grid(planes, used, xs.shape, cfg.stride_cells, cfg.cell_px, columns),
+                                 stage)
+                alive = np.flatnonzero(margin >= stage.bias)
+                first.append(margin[alive])
+            else:
+                alive = np.arange(xs.size)
+                first.append(np.zeros(xs.size))
+            levels.append((scale, rows.shape[1], xs.ravel(), ys.ravel(), alive))
+            stacked.append(rows.reshape(-1, BINS))
             scale /= cfg.scale_step
-        if not boxes:
+        if not levels:
             return np.zeros((0, 4)), np.zeros(0)
-        return np.concatenate(boxes).astype(float), np.concatenate(margins)
+        corners = np.concatenate(stacked) if len(stacked) > 1 else stacked[0]
+        offsets = np.cumsum([0] + [len(r) for r in stacked[:-1]])
+        level_of = np.concatenate([np.full(len(a), i) for i, (_, _, _, _, a) in enumerate(levels)])
+        ox = np.concatenate([x[a] for (_, _, x, _, a) in levels])
+        oy = np.concatenate([y[a] for (_, _, _, y, a) in levels])
+        width = np.array([w for (_, w, _, _, _) in levels])[level_of]
+        margin = np.concatenate(first)
+        for stage, (used, columns) in zip(self.stages[1:], self._stage_blocks[1:]):
+            if not len(level_of):
+                break
+            cols = block_features_rows(corners, width, used, ox, oy, cfg.cell_px, columns, offsets[level_of])
+            # The votes of each level's windows are summed apart, as one matrix per level (the sum's rounding
+            # may depend on the matrix it is computed in).
+            bounds = np.searchsorted(level_of, np.arange(len(levels) + 1))
+            margin = np.concatenate([_margin(np.asfortranarray(cols[a:b]), stage)
+                                     for a, b in zip(bounds[:-1], bounds[1:]) if b > a])
+            keep = margin >= stage.bias
+            level_of, ox, oy, width, margin = (v[keep] for v in (level_of, ox, oy, width, margin))
+        if not len(level_of):
+            return np.zeros((0, 4)), np.zeros(0)
+        scales = np.array([sc for (sc, _, _, _, _) in levels])[level_of]
+        boxes = np.column_stack([ox / scales, oy / scales, win_w / scales, win_h / scales])
+        return boxes.astype(float), margin
 
     def target_boxes(self, windows_xywh: np.ndarray) -> np.ndarray:
         """Target boxes ``(n, 4)`` px inside detection windows ``(n, 4)`` px: the window less its
@@ -250,6 +268,12 @@ class HogCascade:
         if not np.array_equal(expected, model.blocks):
             raise ValueError(f"{path}: block pool does not match window {config.window_px}")
         return model
+
+
+def _margin(features: np.ndarray, stage: Stage) -> np.ndarray:
+    """``(k,)`` vote sums of ``stage`` on the ``(k, n)`` columns its stumps read (in stump order)."""
+    votes = np.where((features > stage.threshold) == (stage.sign > 0), 1.0, -1.0)
+    return votes @ stage.weight  # type: ignore[no-any-return]
 
 
 def train_cascade(
