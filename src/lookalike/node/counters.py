@@ -43,6 +43,7 @@ class NodeCounters:
         self.events: Counter[str] = Counter({name: 0 for name in EVENTS})
         self.rejected: Counter[str] = Counter()
         self.latency_s: deque[float] = deque(maxlen=window)
+        self.cpu_s: deque[float] = deque(maxlen=window)  # the node thread's CPU time per published frame
 
     def add(self, event: str, count: int = 1) -> None:
         """Count ``event`` (one of ``EVENTS``)."""
@@ -55,7 +56,8 @@ class NodeCounters:
         self.rejected[reason] += 1
 
     def snapshot(self) -> dict[str, Any]:
-        """All counters as a JSON-ready dict (latency figures in milliseconds)."""
+        """All counters as a JSON-ready dict (latency and CPU-time figures in milliseconds: ``latency_ms``
+        is wall time from reading a frame to its last send, ``cpu_ms`` the node thread's CPU time for it)."""
         out: dict[str, Any] = dict(self.events)
         out["rejected"] = dict(sorted(self.rejected.items()))
         out["rejected_total"] = sum(self.rejected.values())
@@ -63,6 +65,10 @@ class NodeCounters:
             lat = np.asarray(self.latency_s) * 1e3
             out["latency_ms"] = {"median": round(float(np.median(lat)), 4),
                                  "p99": round(float(np.percentile(lat, 99)), 4), "frames": len(lat)}
+        if self.cpu_s:
+            cpu = np.asarray(self.cpu_s) * 1e3
+            out["cpu_ms"] = {"median": round(float(np.median(cpu)), 4),
+                             "p99": round(float(np.percentile(cpu, 99)), 4), "frames": len(cpu)}
         return out
 
     def status_line(self) -> str:

@@ -133,6 +133,7 @@ class NodeServer:
         self._robot_addr: dict[int, Address] = {}
         self._last_frame_wall: float | None = None
         self._next_status = time.monotonic() + self.config.status_interval_s
+        self._cpu_received: float | None = None  # thread CPU time when the datagram being handled was read
         log_event(self.log, "listening", address=list(self.address))
 
     @property
@@ -180,6 +181,7 @@ class NodeServer:
                     log_event(self.log, "socket_error", logging.WARNING, error=str(exc))
                     break
                 handled += 1
+                self._cpu_received = time.thread_time()
                 try:
                     self.handle(data, addr, time.perf_counter())
                 except Exception as exc:  # noqa: BLE001 (a bug of the node must not stop the loop)
@@ -236,6 +238,8 @@ class NodeServer:
             return
         self._publish(team)
         self.counters.latency_s.append(time.perf_counter() - t_received)
+        if self._cpu_received is not None:
+            self.counters.cpu_s.append(time.thread_time() - self._cpu_received)
 
     def _publish(self, team: TeamState) -> None:
         try:

@@ -113,13 +113,14 @@ class WorldTracker:
         t = self._tracks
         det_of_track = np.full(len(t), -1, dtype=int)
         if len(t) and len(det):
-            d2 = gating_distance(t.mean, t.cov, positions(det), H, self._noise(t.mean[:, :2]))
+            noise = self._noise(t.mean[:, :2])  # (row by row: the matched rows' noise is noise[rows])
+            d2 = gating_distance(t.mean, t.cov, positions(det), H, noise)
             matches, _, _ = assign(np.where(d2 <= self._gate, d2, np.inf))
             rows = matches[:, 0]
             det_of_track[rows] = matches[:, 1]
             if len(rows):
                 t.mean[rows], t.cov[rows] = kalman.update(t.mean[rows], t.cov[rows], positions(det)[matches[:, 1]],
-                                                          H, self._noise(t.mean[rows, :2]))
+                                                          H, noise[rows])
         return det_of_track
 
     def _lifecycle(self, det_of_track: np.ndarray) -> np.ndarray:
@@ -129,7 +130,7 @@ class WorldTracker:
         if rules.confirm_window is None:
             t.confirmed[:] = True
         else:
-            t.hits = np.bitwise_count(t["hit_bits"] & ((1 << rules.confirm_window) - 1)).astype(int)
+            t.hits = bit_count(t["hit_bits"] & ((1 << rules.confirm_window) - 1))
             rules.lifecycle.confirm(t)
             limit_s = np.where(rules.in_view(t.mean[:, :2]), rules.max_coast_s, rules.max_out_of_view_s) + 1e-9
         keep = rules.lifecycle.alive(t, limit_s)
@@ -175,6 +176,15 @@ class WorldTracker:
         status = np.where(t.confirmed, np.where(seen, 1, 2), 0)
         return Tracks(t.ids.copy(), status, position=t.mean[:, :2].copy(), velocity=t.mean[:, 2:4].copy(),
                       heading=heading, agent_id=agent, identity_prob=prob, detection_index=det_of_track)
+
+
+def bit_count(bits: np.ndarray) -> np.ndarray:
+    """Set bits of each non-negative integer below 2**32 (``np.bitwise_count``, which numpy < 2 lacks)."""
+    if hasattr(np, "bitwise_count"):
+        return np.asarray(np.bitwise_count(bits)).astype(int)
+    as_bytes = np.ascontiguousarray(bits, dtype=np.uint32).view(np.uint8).reshape(len(bits), 4)
+    counts: np.ndarray = np.unpackbits(as_bytes, axis=1).sum(axis=1).astype(int)
+    return counts
 
 
 @register_tracker("kalman_ha")
