@@ -127,7 +127,6 @@ def block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int,
     ny, nx = grid
     k, d = ny * nx, 4 * BINS
     cols, out = _output(k, len(blocks), columns)
-    cells = np.empty((2, 2, BINS, ny, nx), np.float32)
     phases: dict[tuple[int, int], np.ndarray] = {}  # planes[:, py::stride, px::stride], contiguous
 
     def corner_grid(y: int, x: int) -> np.ndarray:
@@ -136,26 +135,27 @@ def block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int,
             phases[key] = np.ascontiguousarray(planes[:, key[0] :: stride, key[1] :: stride])
         return phases[key][:, y // stride : y // stride + ny, x // stride : x // stride + nx]
 
-    for j, (bx, by, bw, bh) in enumerate(np.asarray(blocks, np.int64).tolist()):
-        if cols is not None and not np.any(cols // d == j):
-            continue
+    all_blocks = np.asarray(blocks, np.int64)
+    needed = np.arange(len(all_blocks)) if cols is None else np.unique(cols // d)
+    cells = np.empty((2, 2, BINS, len(needed), ny, nx), np.float32)  # cell row, cell column, bin, block, window
+    for i, (bx, by, bw, bh) in enumerate(all_blocks[needed].tolist()):
         x0, y0, hw, hh = bx // unit_px, by // unit_px, bw // 2 // unit_px, bh // 2 // unit_px
         corner = [[corner_grid(y0 + r * hh, x0 + c * hw) for c in range(3)] for r in range(3)]
         for r in range(2):
             for c in range(2):
-                cell = cells[r, c]
+                cell = cells[r, c, :, i]
                 np.subtract(corner[r + 1][c + 1], corner[r][c + 1], out=cell)
                 cell -= corner[r + 1][c]
                 cell += corner[r][c]
-        denom = _block_norms(cells, np.float32(bw * bh))  # (ny, nx)
-        if cols is None:
-            np.divide(cells.transpose(3, 4, 0, 1, 2), denom[:, :, None, None, None],
-                      out=out.reshape(ny, nx, len(blocks), 2, 2, BINS)[:, :, j])
-        else:
-            sel = np.flatnonzero(cols // d == j)
-            local = cols[sel] % d
-            picked = cells[local // (2 * BINS), (local // BINS) % 2, local % BINS]  # (len(sel), ny, nx)
-            out[:, sel] = (picked / denom).reshape(len(sel), k).T
+    area = (all_blocks[needed, 2] * all_blocks[needed, 3]).astype(np.float32)
+    denom = _block_norms(cells, area[:, None, None])  # (block, ny, nx)
+    if cols is None:
+        np.divide(cells.transpose(4, 5, 3, 0, 1, 2), denom.transpose(1, 2, 0)[:, :, :, None, None, None],
+                  out=out.reshape(ny, nx, len(all_blocks), 2, 2, BINS))
+    else:
+        block, local = np.searchsorted(needed, cols // d), cols % d
+        picked = cells[local // (2 * BINS), (local // BINS) % 2, local % BINS, block]  # (len(cols), ny, nx)
+        out[:] = (picked / denom[block]).reshape(len(cols), k).T
     return out
 
 
