@@ -32,7 +32,7 @@ def test_median_background_finds_every_disc():
         got = got[np.argsort(got[:, 0])]
         exp = truth[np.argsort(truth[:, 0])]
         np.testing.assert_allclose(got, exp, atol=1.5)
-        assert ((d.score > 0.5) & (d.score < 1)).all()
+        assert (d.score == 1).all()  # a blob has no confidence of its own
 
 
 def test_area_limits_and_polarity():

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from lookalike.vision.blob import BlobDetector
-from lookalike.vision.blob_auto import estimate_blob_config, overlap_hint
+from lookalike.vision.blob_auto import estimate_blob_config, frame_counts, infer_target_count
 
 
 def _bounce(x: float, lo: float, hi: float) -> float:
@@ -71,10 +71,27 @@ def test_a_still_video_is_refused_and_bad_input() -> None:
         estimate_blob_config([])
 
 
-def test_overlap_hint_lowers_the_gate_for_blobs_that_barely_overlap() -> None:
-    rows = np.array([[f, -1, 10.0 * f, 0, 12, 12, 0.7, -1, -1, -1] for f in range(1, 20)])
-    hint = overlap_hint(rows)
-    assert 0.01 <= hint["match_iou"] < 0.3  # boxes move 10 px of 12 per frame: IoU about 0.09
-    still = np.array([[f, -1, 0.0, 0, 12, 12, 0.7, -1, -1, -1] for f in range(1, 20)])
-    assert overlap_hint(still)["match_iou"] == 0.3
-    assert overlap_hint(np.zeros((0, 10))) == {}
+def test_a_count_held_in_most_frames_is_the_number_of_targets() -> None:
+    # an arena of 4: two touch (3 blobs) or one hides now and then; a false blob rarely
+    counts = np.array([4] * 70 + [3] * 25 + [5] * 5)
+    inferred = infer_target_count(counts)
+    assert (inferred.n, inferred.closed) == (4, True) and inferred.share == 0.7
+    assert "inferred 4 targets" in inferred.summary and "--targets N" in inferred.summary
+
+
+def test_a_count_that_varies_over_the_video_is_no_closed_set() -> None:
+    # targets come and go (a street): every count holds in a minority of the frames
+    rng = np.random.default_rng(0)
+    counts = np.clip(np.round(6 + 3 * np.sin(np.arange(300) / 40) + rng.normal(0, 1, 300)), 0, None)
+    inferred = infer_target_count(counts)
+    assert not inferred.closed and "open set" in inferred.summary
+    assert infer_target_count(np.array([2] * 50 + [3] * 50)).n == 3  # a tie: the larger count
+    assert not infer_target_count(np.array([2] * 50 + [3] * 50)).closed  # but no majority
+    assert not infer_target_count(np.zeros(10)).closed and infer_target_count(np.zeros(0)).frames == 0
+
+
+def test_frame_counts_include_frames_without_blobs() -> None:
+    rows = np.array([[1, -1, 0, 0, 5, 5, 1, -1, -1, -1], [1, -1, 9, 0, 5, 5, 1, -1, -1, -1],
+                     [3, -1, 0, 0, 5, 5, 1, -1, -1, -1]], dtype=float)
+    assert frame_counts(rows, 4).tolist() == [2, 0, 1, 0]
+    assert frame_counts(np.zeros((0, 10)), 2).tolist() == [0, 0]

@@ -48,7 +48,7 @@ def test_blob_detection_rows_find_every_disc(arena):
     assert n == FRAMES
     counts = np.bincount(rows[:, 0].astype(int), minlength=FRAMES + 1)[1:]
     assert (counts == 3).all()
-    assert (rows[:, 1] == -1).all() and ((rows[:, 6] > 0.5) & (rows[:, 6] < 1)).all()
+    assert (rows[:, 1] == -1).all() and (rows[:, 6] == 1).all()
     # a disc of radius 7 px gives a box of about 15 px
     assert np.allclose(rows[:, 4:6], 15, atol=3)
 
@@ -59,7 +59,7 @@ def test_track_cli_with_blob_detector(arena, tmp_path, tracker):
     args = ["track", "--video", str(arena), "--detector", "blob", "--blob", "polarity=dark",
             "--blob", "min_area_px=20", "--tracker", tracker, "-o", str(out)]
     if tracker == "boxtrack":
-        args += ["--set", "high_score=0.5", "--set", "birth_score=0.5", "--annotate", str(tmp_path / "a.mp4")]
+        args += ["--annotate", str(tmp_path / "a.mp4")]
     r = runner.invoke(app, args)
     assert r.exit_code == 0, r.output
     tracks = read_mot(out)
@@ -70,6 +70,36 @@ def test_track_cli_with_blob_detector(arena, tmp_path, tracker):
     assert len(read_mot(tmp_path / "tracks.det.txt")) == 3 * FRAMES
     if tracker == "boxtrack":
         assert (tmp_path / "a.mp4").stat().st_size > 0
+        # three blobs in every frame: a closed set of 3 inferred from the video, and said so
+        assert "inferred 3 targets from the video: 3 blobs in 100% of the 30 frames" in " ".join(r.output.split())
+
+
+def test_a_video_whose_count_varies_stays_an_open_set(tmp_path):
+    """Discs arriving one by one (1, 2, then 3 in view, a third of the frames each): no count holds in a
+    majority of the frames, so no closed set is inferred; a given --targets N wins over the inference."""
+    import cv2
+
+    path = tmp_path / "arrivals.avi"
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 10, (160, 120))
+    for k in range(FRAMES):
+        img = np.full((120, 160, 3), 215, np.uint8)
+        for j, (x, y, vx, vy) in enumerate(DISCS):
+            if k >= 10 * j:
+                cv2.circle(img, (int(x + vx * k), int(y + vy * k)), 7, (35, 35, 35), -1)
+        writer.write(img)
+    writer.release()
+    out = tmp_path / "tracks.txt"
+    base = ["track", "--video", str(path), "--detector", "blob", "--blob", "polarity=dark", "--blob", "min_area_px=20",
+            "-t", "boxtrack", "-o", str(out)]
+    r = runner.invoke(app, base)
+    text = " ".join(r.output.split())
+    assert r.exit_code == 0, r.output
+    assert "no number of targets inferred" in text and "open set" in text
+    assert len(np.unique(read_mot(out).track_id)) == 3
+    r = runner.invoke(app, [*base, "--targets", "2"])
+    assert r.exit_code == 0, r.output
+    assert "inferred" not in " ".join(r.output.split())
+    assert len(np.unique(read_mot(out).track_id)) <= 2
 
 
 def test_blob_config_parsing():

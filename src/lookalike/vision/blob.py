@@ -10,7 +10,8 @@ levels (largest difference over the three colour channels, after a Gaussian blur
 
 The mask is cleaned by a morphological opening then closing, split into external contours, and
 each contour with ``min_area_px <= area <= max_area_px`` becomes one detection: its bounding box
-and a score ``contrast / (contrast + threshold)`` in (0.5, 1) from the mean difference inside it.
+and score 1: a blob carries no confidence of its own (its contrast says how dark a target is, not
+how likely it is one), so a box tracker's score thresholds pass every blob (docs/blobs.md).
 OpenCV is imported lazily.
 """
 
@@ -147,23 +148,21 @@ class BlobDetector:
         return mask, diff
 
     def __call__(self, image: np.ndarray) -> Detections:
-        """Detections of one frame: boxes ``xywh`` (px) of the blobs and their scores."""
+        """Detections of one frame: boxes ``xywh`` (px) of the blobs, each scoring 1."""
         import cv2
 
         cfg = self.config
-        mask, diff = self.foreground(image)
-        count, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
-        boxes, scores = [], []
+        mask, _ = self.foreground(image)
+        count, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        boxes = []
         for k in range(1, count):
             x, y, w, h, area = (int(v) for v in stats[k])
             if not cfg.min_area_px <= area <= cfg.max_area_px:
                 continue
-            contrast = float(diff[y : y + h, x : x + w][labels[y : y + h, x : x + w] == k].mean())
             boxes.append((x, y, w, h))
-            scores.append(contrast / (contrast + cfg.threshold))
         if not boxes:
             return Detections.empty()
-        return Detections(xywh=np.array(boxes, dtype=float), score=np.array(scores))
+        return Detections(xywh=np.array(boxes, dtype=float), score=np.ones(len(boxes)))
 
     detect = __call__
 

@@ -44,7 +44,8 @@ import numpy as np
 from lookalike.vision.blob import BlobConfig
 from lookalike.vision.hog_features import as_bgr_image
 
-__all__ = ["BlobEstimate", "estimate_blob_config", "sample_frames"]
+__all__ = ["BOX_TRACKER_PARAMS", "BlobEstimate", "TargetCount", "estimate_blob_config", "frame_counts",
+           "infer_target_count", "sample_frames"]
 
 _FACTORS = (4.0, 6.0, 8.0, 10.0, 14.0, 20.0)  # candidate thresholds in noise σ
 _THRESHOLD_RANGE = (8.0, 100.0)  # grey levels
@@ -298,26 +299,61 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
                         dark_share=dark_share, counts=medians, n_targets=int(n_targets) if n_targets else None)
 
 
-def overlap_hint(det_rows: np.ndarray, default_iou: float = 0.3) -> dict[str, float]:
-    """Box-tracker overlap gates suited to blob detections ``(k, >=6)`` MOTChallenge rows (1-based frames,
-    boxes in pixels): fast or small targets seen at a low frame rate barely overlap from one frame to
-    the next, so an IoU gate of ``default_iou`` would miss them. Returns ``{"match_iou": q}`` with ``q``
-    the 10th percentile of each blob's best IoU with the next frame's blobs (those with any overlap),
-    within 0.01..``default_iou``; empty when nothing overlaps."""
-    from lookalike.geometry.boxes import iou_matrix
+BOX_TRACKER_PARAMS: dict[str, float] = {"match_iou": 0.01}
+"""``boxtrack`` parameters for blob detections (docs/blobs.md): a track takes a blob its predicted box
+overlaps at all. Blobs are the separate foreground regions of one frame, so the IoU gate has no
+neighbours to keep apart; small targets seen at a low frame rate, turning and stopping, overlap
+their predicted box little (HexBug clips at 10 frames/s: many continuations below the default 0.3)."""
 
+_MAJORITY = 0.5  # a count holding in more than this share of the frames is an arena's number of targets
+
+
+@dataclass(frozen=True)
+class TargetCount:
+    """The number of targets read off a video's blob counts.
+
+    Attributes:
+        n: the most common number of blobs per frame (0 when no frame has a blob).
+        share: share of the frames with exactly ``n`` blobs.
+        frames: frames counted.
+    """
+
+    n: int
+    share: float
+    frames: int
+
+    @property
+    def closed(self) -> bool:
+        """Whether the evidence is strong enough for a closed set of ``n``: the same count in a strict
+        majority of the frames (an arena whose targets are all in view, counted lower only while
+        some touch or hide). A scene where targets come and go has no such count."""
+        return self.n >= 1 and self.share > _MAJORITY
+
+    @property
+    def summary(self) -> str:
+        """One line saying what was inferred and how to override it."""
+        seen = f"{self.n} blobs in {100 * self.share:.0f}% of the {self.frames} frames"
+        if self.closed:
+            return (f"inferred {self.n} targets from the video: {seen}; a closed set of {self.n} "
+                    f"(pass --targets N to override)")
+        return (f"no number of targets inferred from the video: at most {seen} (a closed set needs a "
+                f"majority); tracking an open set (pass --targets N for a closed set)")
+
+
+def infer_target_count(counts: np.ndarray) -> TargetCount:
+    """The number of targets from ``counts``, the blobs found in each frame (frames without a blob
+    included as 0): the most common count (the larger on a tie), with the share of frames showing it."""
+    counts = np.asarray(counts, dtype=int).ravel()
+    if not len(counts) or counts.max(initial=0) <= 0:
+        return TargetCount(0, 0.0, len(counts))
+    freq = np.bincount(np.maximum(counts, 0))
+    n = int(np.flatnonzero(freq == freq.max()).max())
+    return TargetCount(n, float(freq[n]) / len(counts), len(counts))
+
+
+def frame_counts(det_rows: np.ndarray, n_frames: int) -> np.ndarray:
+    """Detections per frame ``(n_frames,)`` from MOTChallenge rows ``(k, >=1)`` (1-based frames)."""
     rows = np.asarray(det_rows, dtype=float)
-    if rows.ndim != 2 or not len(rows):
-        return {}
-    frames = rows[:, 0].astype(int)
-    best: list[np.ndarray] = []
-    for f in np.unique(frames):
-        a, b = rows[frames == f, 2:6], rows[frames == f + 1, 2:6]
-        if len(a) and len(b):
-            iou = iou_matrix(a, b).max(axis=1)
-            best.append(iou[iou > 0])
-    pooled = np.concatenate(best) if best else np.zeros(0)
-    if not len(pooled):
-        return {}
-    q = float(min(max(np.percentile(pooled, 10), 0.01), default_iou))
-    return {"match_iou": round(q, 3)}
+    frames = rows[:, 0].astype(int) if rows.ndim == 2 and len(rows) else np.zeros(0, dtype=int)
+    length = max(int(n_frames), int(frames.max(initial=0)))
+    return np.bincount(frames, minlength=length + 1)[1 : length + 1]
