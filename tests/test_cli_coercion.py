@@ -13,7 +13,8 @@ from typer.main import get_command
 from lookalike.cli import app
 
 RAW = ["abc", "1", "-3", "0.05", "1e3", "inf", "-inf", "nan", "", "-", " 2 ", "1_000", "0", "x/y.txt", ".",
-       "README.md", "no/such/dir/", ("a", "b"), ["c"], (), 15, 0.5, float("-inf"), True, None]
+       "README.md", "no/such/dir/", ("a", "b"), ["c"], ("README.md", "x/y"), ["-"], (), ("a", 1), 15, 0.5,
+       float("-inf"), True, None]
 
 
 def _outcome(runtime, value, param, ctx):

@@ -5,8 +5,8 @@ built for each parameter of the command being run, even for an option left at it
 ``--help``): importing pydantic and building the adapters is a fifth of a short command's CPU time.
 :func:`install` makes typer build each parameter's converter on first use and convert the common
 plain cases directly, with typer's own rules: a ``str`` (kept as it is), a ``list[str]``, a default
-already of its ``int``/``float`` type within the option's bounds, and a ``Path`` given as text
-(``Path(text)``, then typer's own existence/readability checks, which need no pydantic). Anything
+already of its ``int``/``float`` type within the option's bounds, and a ``Path`` (or ``list[Path]``)
+given as text (``Path(text)``, then typer's own existence/readability checks, which need no pydantic). Anything
 else (every number typed on the command line, every value typer would reject, custom parsers,
 choices, files) goes to typer's pydantic converter, so values and error messages are typer's.
 ``tests/test_cli_coercion.py`` checks both give the same value or the same error for every option
@@ -36,10 +36,13 @@ def _plain_value(annotation: Any, info: Any, value: Any, param: Any, ctx: Any) -
         if value != value or (low is not None and value < low) or (high is not None and value > high):
             return _MISSING
         return value
-    if annotation is list[str]:
-        if kind in (list, tuple) and all(type(v) is str for v in value):
+    if annotation in (list[str], list[Path]):
+        if kind not in (list, tuple) or not all(type(v) is str for v in value):
+            return _MISSING
+        if annotation == list[str]:
             return list(value)
-        return _MISSING
+        items = [_plain_value(Path, info, v, param, ctx) for v in value]
+        return _MISSING if any(v is _MISSING for v in items) else items
     if annotation is Path and kind is str and not getattr(info, "allow_dash", False) \
             and getattr(info, "path_type", None) is None:
         from typer._param_types import coerce_cli_path
