@@ -93,7 +93,8 @@ def _solve(c: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray]:
     allowed = c <= max_cost if np.isfinite(max_cost) else c < np.inf
     if not allowed.any():
         return none, none
-    if allowed.sum(axis=0).max() == 1 and allowed.sum(axis=1).max() == 1:
+    most = np.maximum.reduce  # the ufunc methods themselves: the array methods add a Python layer per call
+    if most(np.add.reduce(allowed, axis=0)) == 1 and most(np.add.reduce(allowed, axis=1)) == 1:
         # The allowed pairs are disjoint: every optimum holds all of them, nothing else is kept.
         rows, cols = allowed.nonzero()
         return rows, cols

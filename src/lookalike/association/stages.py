@@ -61,8 +61,12 @@ class Matching:
     @classmethod
     def empty(cls, n_tracks: int, n_detections: int) -> Matching:
         """Nothing matched yet."""
-        return cls(np.full(n_tracks, -1, dtype=int), np.ones(n_detections, dtype=bool),
-                   np.full(n_tracks, -1, dtype=int))
+        det_of_track, stage_of_track = np.empty(n_tracks, int), np.empty(n_tracks, int)
+        free = np.empty(n_detections, bool)
+        det_of_track.fill(-1)
+        free.fill(True)
+        stage_of_track.fill(-1)
+        return cls(det_of_track, free, stage_of_track)
 
     @property
     def unmatched_tracks(self) -> np.ndarray:

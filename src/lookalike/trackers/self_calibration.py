@@ -8,9 +8,18 @@ decides what to do with the answers.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 _Z = 1.645  # one-sided 95% normal quantile of the Wilson lower bound
+
+
+def _bin_of(score: np.ndarray, bins: int) -> np.ndarray:
+    """``(n,)`` bin of each score among ``bins`` equal bins on [0, 1] (scores outside go to the end bins)."""
+    b = (score * bins).astype(int)
+    np.minimum(b, bins - 1, out=b)
+    return np.maximum(b, 0, out=b)
 
 
 class ScoreBands:
@@ -24,7 +33,7 @@ class ScoreBands:
 
     def add(self, score: np.ndarray, continued: np.ndarray) -> None:
         """Count detections with ``score`` (in [0, 1]); ``continued`` indexes those that continued a track."""
-        b = np.clip((np.asarray(score) * self.bands).astype(int), 0, self.bands - 1)
+        b = _bin_of(np.asarray(score), self.bands)
         self.seen += np.bincount(b, minlength=self.bands)
         self.kept += np.bincount(b[continued], minlength=self.bands)
 
@@ -37,15 +46,21 @@ class ScoreBands:
         share lowers the threshold to its lower edge; the first band that fails, or is not judged,
         stops the descent.
         """
-        judged = self.seen >= min_count
-        if not judged.any():
+        # Only the bands the descent visits are computed, one at a time (the same float operations as the
+        # whole-array form, so the same threshold to the last bit).
+        seen, kept = self.seen.tolist(), self.kept.tolist()
+        judged = [n >= min_count for n in seen]
+        if not any(judged):
             return 1.0
-        n = np.maximum(self.seen, 1)
-        rate = np.where(judged, self.kept / n, 0.0)
-        low = (rate + _Z**2 / (2 * n) - _Z * np.sqrt(rate * (1 - rate) / n + _Z**2 / (4 * n * n))) / (1 + _Z**2 / n)
-        top = int(np.flatnonzero(judged)[-1])
-        b = top
-        while b > 0 and judged[b - 1] and low[b - 1] >= ratio * rate.max():
+        rate = [k / max(n, 1) if j else 0.0 for n, k, j in zip(seen, kept, judged)]
+        best = ratio * max(rate)
+        z2 = _Z**2
+        b = len(judged) - 1 - judged[::-1].index(True)
+        while b > 0 and judged[b - 1]:
+            n, r = max(seen[b - 1], 1), rate[b - 1]
+            low = (r + z2 / (2 * n) - _Z * math.sqrt(r * (1 - r) / n + z2 / (4 * n * n))) / (1 + z2 / n)
+            if not low >= best:
+                break
             b -= 1
         return b / self.bands
 
@@ -58,11 +73,14 @@ class MissReturns:
         self.longest = longest
         self.returned = np.zeros(longest + 1, dtype=np.int64)
         self.ended = np.zeros(longest + 1, dtype=np.int64)
+        self._version = 0  # counts added so far (calls that changed them): keys likely_present's cached table
+        self._ok: tuple[tuple[int, float, int], np.ndarray] | None = None
 
     def _add(self, counts: np.ndarray, missed: np.ndarray) -> None:
         m = np.minimum(missed[missed > 0], self.longest)
         if len(m):
             counts[1:] += np.cumsum(np.bincount(m, minlength=self.longest + 1)[::-1])[::-1][1:]
+            self._version += 1
 
     def came_back(self, missed: np.ndarray) -> None:
         """Tracks updated again after ``missed`` frames without a detection."""
@@ -76,11 +94,15 @@ class MissReturns:
         """Per track missed ``missed`` frames: whether, for every miss length up to its own, at least
         ``share`` of at least ``min_count`` resolved tracks (came back or died) came back."""
         missed = np.asarray(missed)
-        resolved = self.returned + self.ended
-        ok = (resolved >= min_count) & (self.returned >= share * resolved)
-        ok[0] = True
-        ok = np.logical_and.accumulate(ok)
-        ok[0] = False
+        key = (self._version, share, min_count)
+        if self._ok is None or self._ok[0] != key:
+            resolved = self.returned + self.ended
+            ok = (resolved >= min_count) & (self.returned >= share * resolved)
+            ok[0] = True
+            ok = np.logical_and.accumulate(ok)
+            ok[0] = False
+            self._ok = (key, ok)
+        ok = self._ok[1]
         out = np.zeros(len(missed), dtype=bool)
         inside = (missed > 0) & (missed <= self.longest)
         out[inside] = ok[missed[inside]]
@@ -119,7 +141,7 @@ class ScoreCalibration:
     def observe_scores(self, score: np.ndarray) -> None:
         """Count this frame's scores (in [0, 1]) into the running distribution."""
         if self._quantiles:
-            b = np.clip((score * self.bins).astype(int), 0, self.bins - 1)
+            b = _bin_of(score, self.bins)
             self.histogram += np.bincount(b, minlength=self.bins)
 
     def observe_continued(self, score: np.ndarray, continued: np.ndarray) -> None:
@@ -139,18 +161,28 @@ class ScoreCalibration:
             return min(high, birth), birth, min(high, birth)
         tentative = 1.0
         cum = np.cumsum(self.histogram)
-        if cum[-1]:
-            # the lower edge of the bin holding the q-quantile: never above a score it stands for
-            def edge(q: float) -> float:
-                return int(np.searchsorted(cum, q * cum[-1], side="left")) / self.bins
+        total = int(cum[-1])
+        if total:
+            # the lower edge of the bin holding each q-quantile: never above a score it stands for
+            wanted: dict[str, float] = {}
             if self.high_quantile is not None:
-                high = min(high, edge(self.high_quantile))
+                wanted["high"] = self.high_quantile
             if self.birth_quantile is not None:
-                birth = min(birth, edge(self.birth_quantile))
+                wanted["birth"] = self.birth_quantile
             if self.clutter_factor is not None:  # before the share is judged: the median
                 q = 0.5 if clutter_share is None else max(self.clutter_factor * clutter_share, self.clutter_floor)
-                birth = min(birth, edge(min(q, 0.5)))  # never above the median, however much clutter
+                wanted["clutter"] = min(q, 0.5)  # never above the median, however much clutter
             if self.tentative_quantile is not None:
-                tentative = edge(self.tentative_quantile)
+                wanted["tentative"] = self.tentative_quantile
+            found = np.searchsorted(cum, np.array(list(wanted.values())) * total, side="left").tolist()
+            edge = {name: i / self.bins for name, i in zip(wanted, found)}
+            if "high" in edge:
+                high = min(high, edge["high"])
+            if "birth" in edge:
+                birth = min(birth, edge["birth"])
+            if "clutter" in edge:
+                birth = min(birth, edge["clutter"])
+            if "tentative" in edge:
+                tentative = edge["tentative"]
         high = min(high, birth)
         return high, birth, min(high, tentative)
