@@ -17,9 +17,10 @@ _Z = 1.645  # one-sided 95% normal quantile of the Wilson lower bound
 
 def _bin_of(score: np.ndarray, bins: int) -> np.ndarray:
     """``(n,)`` bin of each score among ``bins`` equal bins on [0, 1] (scores outside go to the end bins)."""
-    b = (score * bins).astype(int)
+    b: np.ndarray = (score * bins).astype(int)
     np.minimum(b, bins - 1, out=b)
-    return np.maximum(b, 0, out=b)
+    np.maximum(b, 0, out=b)
+    return b
 
 
 class ScoreBands:
