@@ -122,6 +122,11 @@ class NumpySetAssociator:
         self.m = np.zeros((n_agents, 1))
         self.s = np.zeros((n_agents, 1))
 
+    def forget(self, agents: np.ndarray) -> None:
+        """Forget the memory of the agents ``agents`` (indices or a boolean mask), as if never seen."""
+        for state in (self.h, self.p, self.m, self.s):
+            state[agents] = 0.0
+
     def step(self, agents: np.ndarray, dets: np.ndarray, dt_s: float) -> np.ndarray:
         """Advance one frame; return ``(K, N+1)`` probabilities."""
         t, b = self._t, self._b

@@ -7,6 +7,10 @@ LSTM (Hungarian on ``-log p``, false positives allowed). Agent positions come fr
 localiser as the LSTM identifier's, fed with the detection labelled ``j`` and its class probability
 ``α``: the per-agent Kalman filter by default (``localiser="kalman"``), or seed A's Eq. 3
 ``T_j ← α·L_k + (1−α)·T_j`` (``"lowpass"``); see :mod:`lookalike.trackers.identity.localiser`.
+
+An agent whose reported heading jumps by more than a robot can turn between two of its reports
+(``report_jump`` + ``turn_rate`` · gap, radians) has its memory forgotten: its reports now come from
+another robot (ids swapped or restored), so what the network remembers of it follows the wrong one.
 """
 
 from __future__ import annotations
@@ -52,6 +56,11 @@ class SetIdentifier:
                                      range=(1, 1000))
         weights: str | None = param(None, "path of set.npz (None: the shipped weights, any N and M)")
         one_to_one: bool = param(True, "decode with Hungarian on -log p (else per-detection argmax)")
+        report_jump: float | None = param(
+            0.5, "forget an agent's memory when its reported heading jumps by more than report_jump + "
+            "turn_rate * (seconds between its reports) radians (a report from another robot; None: never)",
+            range=(0.0, 10.0))
+        turn_rate: float = param(3.0, "fastest plausible turn of a robot for report_jump, rad/s", range=(0.0, 100.0))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
                                choices=LOCALISERS)
 
@@ -81,7 +90,10 @@ class SetIdentifier:
             raise ValueError(f"frame time went backwards: {self._last_time} s then {frame.time} s")
         dt = 0.0 if not np.isfinite(self._last_time) else frame.time - self._last_time
         self._last_time = frame.time
+        before = (self._beacons.heading.copy(), self._beacons.t_sent.copy())
         self._beacons.add(frame)
+        if self.config.report_jump is not None:
+            self._forget_jumps(*before, self.config.report_jump)
         det = frame.detections
         n = len(det)
         if n and (det.position is None or det.heading is None or det.score is None):
@@ -97,6 +109,19 @@ class SetIdentifier:
         labels[used], conf[used] = slot_label, slot_conf
         self.last_labels, self.last_probabilities = labels, conf
         return self._snapshots(labels, conf, position, heading, frame)
+
+    def _forget_jumps(self, heading: np.ndarray, t_sent: np.ndarray, jump: float) -> None:
+        """Forget the memory of every agent whose newest report turned farther from its previous one
+        than a robot can turn in between: the reports now come from another robot, the memory
+        follows the wrong one."""
+        new, old = self._beacons.heading, heading
+        fresh = np.isfinite(old) & np.isfinite(new) & (self._beacons.t_sent > t_sent)
+        if fresh.any():
+            turn = np.abs(np.angle(np.exp(1j * (new - old))))
+            gap = np.where(fresh, self._beacons.t_sent - np.where(fresh, t_sent, 0.0), 0.0)
+            jumped = fresh & (turn > jump + self.config.turn_rate * gap)
+            if jumped.any():
+                self.net.forget(jumped)
 
     def _snapshots(self, labels: np.ndarray, conf: np.ndarray, position: np.ndarray, heading: np.ndarray,
                    frame: Frame) -> list[TrackSnapshot]:
