@@ -49,6 +49,18 @@ def test_windows_and_validation_arrays_have_training_shapes():
     assert vx.shape == (2, 300, spec.n_inputs) and (vy[0, 100:] == IGNORE).all()
 
 
+def test_a_simulated_share_rehearses_the_recordings_world():
+    world = preset("m3n2")
+    spec = EncodingSpec(world.n_agents, world.max_detections, relative_headings=True)
+    arrays = (simulate_robots(world, 150, 1).arrays,)
+    only_sim = RecordingSampler(spec, arrays, world, sim_fraction=1.0)
+    x, y = only_sim(11, 150, None)
+    assert x.shape == (150, spec.n_inputs)
+    assert not np.array_equal(x, RecordingSampler(spec, arrays)(11, 150, None)[0])
+    with pytest.raises(ValueError, match="needs the world"):
+        RecordingSampler(spec, arrays, None, sim_fraction=0.5)
+
+
 @pytest.fixture
 def app():
     pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
@@ -63,13 +75,13 @@ def test_train_recordings_fine_tunes_and_records_the_split(app, tmp_path):
     out = tmp_path / "out"
     r = runner.invoke(app, ["train", "--recordings", str(tmp_path / "rec"), "-o", str(out), "--steps", "2",
                             "--sequence-length", "150", "--batch-size", "2", "--validate-every", "1",
-                            "--test", str(tmp_path / "test")])
+                            "--test", str(tmp_path / "test"), "--mix-sim", "0.5"])
     assert r.exit_code == 0, r.output
     meta = json.loads((out / "model.json").read_text())
     split = meta["info"]["recordings"]
     assert len(split["validation"]) == 1 and len(split["training"]) == 2
     assert not set(split["validation"]) & set(split["training"])
-    assert meta["info"]["config"]["init_from"].endswith("lstm_m3_n2.npz")
+    assert meta["info"]["config"]["init_from"].endswith("lstm_m3_n2.npz") and split["sim_fraction"] == 0.5
     assert "test recordings (1" in r.output and "fine-tuned" in r.output
 
 

@@ -65,6 +65,9 @@ def train(
         "export) of this folder instead of simulated sequences: N and M from the recordings, the network from "
         "--init-from (default: the shipped weights for N, M), a validation split by recording, early stopping; "
         "learning rate 0.001 unless given."),
+    mix_sim: float = typer.Option(
+        0.0, "--mix-sim", min=0.0, max=1.0, help="With --recordings: share of the training sequences simulated "
+        "in the recordings' own world (their header's set-up) instead of cut from the recordings."),
     validation_fraction: float = typer.Option(
         0.25, "--validation-fraction", help="With --recordings: share of the recordings held out for validation."),
     validate_every: int = typer.Option(50, "--validate-every", min=1, help="Steps between validations."),
@@ -97,7 +100,7 @@ def train(
 
         train_recordings(recordings, output, RecordingOptions(
             init_from, steps, minutes, batch_size, sequence_length, seed, patience, threads, learning_rate,
-            validation_fraction, validate_every, device, workers, backend, address, resume, test))
+            validation_fraction, validate_every, device, workers, backend, address, resume, test, mix_sim))
         return
     if search is not None:
         from lookalike.cli.train_search import SearchOptions, train_search

@@ -32,6 +32,7 @@ class RecordingOptions:
     address: str | None
     resume: bool
     test: Path | None
+    sim_fraction: float = 0.0
 
 
 def read_recordings(folder: Path, option: str) -> list[RobotSequence]:
@@ -90,13 +91,14 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
             learning_rate=0.001 if opt.learning_rate is None else opt.learning_rate, patience=opt.patience,
             init_from=str(init_path), protocol=spec.protocol, noise="recordings",
             validation_every=opt.validate_every)
-        sampler = RecordingSampler(spec, tuple(recordings[i].arrays for i in train_idx))
+        sampler = RecordingSampler(spec, tuple(recordings[i].arrays for i in train_idx), recordings[0].config,
+                                   opt.sim_fraction)
         validation = validation_arrays(spec, [recordings[i].arrays for i in val_idx], config.bptt)
         pool = JobPool(opt.workers, opt.backend, opt.address)
     except ValueError as exc:
         fail(str(exc))
     info = {"recordings": {"folder": str(folder), "training": [paths[i].name for i in train_idx],
-                           "validation": [paths[i].name for i in val_idx]}}
+                           "validation": [paths[i].name for i in val_idx], "sim_fraction": opt.sim_fraction}}
     console.print(f"fine-tuning {init_path} on {len(train_idx)} recordings, validating on {len(val_idx)}: "
                   f"{', '.join(info['recordings']['validation'])}")
     torch.set_num_threads(opt.threads)

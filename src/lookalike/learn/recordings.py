@@ -21,9 +21,9 @@ import numpy as np
 
 from lookalike.learn.data import IGNORE
 from lookalike.learn.encoding import EncodingSpec
-from lookalike.learn.paper_protocol import arrays_to_training_paper
+from lookalike.learn.paper_protocol import NoiseMixSampler, arrays_to_training_paper
 from lookalike.learn.sim_data import arrays_to_training
-from lookalike.sim import RobotArrays, RobotSequence
+from lookalike.sim import RobotArrays, RobotSequence, RobotWorldConfig
 
 
 def recording_arrays(spec: EncodingSpec, arrays: RobotArrays, rng: np.random.Generator | None = None
@@ -69,17 +69,29 @@ def _pad(x: np.ndarray, y: np.ndarray, length: int) -> tuple[np.ndarray, np.ndar
 
 @dataclass(frozen=True)
 class RecordingSampler:
-    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler of windows of ``recordings`` (see the module)."""
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler of windows of ``recordings`` (see the module).
+
+    ``sim_fraction``: share of the sequences simulated in ``world`` instead (drawn from the seed; rehearsal of
+    the simulator's sequences, which keeps a few recordings from being learnt by heart).
+    """
 
     spec: EncodingSpec
     recordings: tuple[RobotArrays, ...]
+    world: RobotWorldConfig | None = None
+    sim_fraction: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.recordings:
             raise ValueError("RecordingSampler: needs at least one recording")
+        if not 0.0 <= self.sim_fraction <= 1.0:
+            raise ValueError(f"simulated fraction must lie in [0, 1], got {self.sim_fraction}")
+        if self.sim_fraction > 0 and self.world is None:
+            raise ValueError("RecordingSampler: a simulated fraction needs the world to simulate")
 
     def __call__(self, seed: int, n_frames: int, rng: np.random.Generator | None) -> tuple[np.ndarray, np.ndarray]:
         draw = np.random.default_rng([seed, 0x2EC])
+        if draw.random() < self.sim_fraction and self.world is not None:
+            return NoiseMixSampler((self.world,), self.spec)(seed, n_frames, rng)
         lengths = np.array([len(a) for a in self.recordings], dtype=float)
         k = int(draw.choice(len(lengths), p=lengths / lengths.sum()))
         x, y = recording_arrays(self.spec, self.recordings[k], rng)
