@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import pickle
 import sys
 from pathlib import Path
 from typing import Any
@@ -34,10 +35,17 @@ from _common import SHARED_DATA
 CRITERION = "hota+idf1+mota"
 
 
-def candidates() -> list[dict[str, Any]]:
+GRIDS = {  # clutter_factor, max_age_s, n_init
+    "full": ([2.0, None, 1.0, 3.0, 4.0], [1.0, 2.0, 3.0], [3, 2]),
+    # for comparing mechanisms on a 2-core budget: every value the full grid's folds chose (fixed before scoring)
+    "small": ([2.0, 1.0, 4.0], [2.0, 3.0], [2]),
+}
+
+
+def candidates(grid: str = "full") -> list[dict[str, Any]]:
     """The grid: clutter_factor x max_age_s x n_init, every other parameter at boxtrack's default."""
     out = []
-    for k, age, n in itertools.product([2.0, None, 1.0, 3.0, 4.0], [1.0, 2.0, 3.0], [3, 2]):
+    for k, age, n in itertools.product(*GRIDS[grid]):
         out.append({"clutter_factor": k, "max_age_s": age, "n_init": n})
     return out
 
@@ -46,26 +54,57 @@ def _fmt(s: dict[str, float]) -> str:
     return f"{100 * s['HOTA']:.2f} / {100 * s['IDF1']:.2f} / {100 * s['MOTA']:.2f} (sum {100 * headline(s):.2f})"
 
 
+def _score(datasets: list[str], min_counts: str, grid_name: str) -> tuple[list[dict[str, Any]], list[list[Any]],
+                                                                        list[str], list[str]]:
+    """Every candidate once on every sequence: ``(candidates, table, sequence keys, dataset groups)``."""
+    seqs = load_datasets(SHARED_DATA, datasets)
+    keys, groups = [sequence_key(s) for s in seqs], [s.dataset for s in seqs]
+    cands: list[dict[str, Any]] = []
+    table: list[list[Any]] = []
+    for mc in (int(x) for x in min_counts.split(",")):
+        boxtrack_config.CLUTTER_MIN_COUNT = mc  # read by BoxTrack at construction (this process only)
+        grid = candidates(grid_name)
+        table += evaluate_table("boxtrack", grid, seqs, score_params, workers=1)
+        cands += [dict(c, clutter_min_count=mc) for c in grid]
+        print(f"clutter min count {mc}: {len(grid)} candidates scored", flush=True)
+    return cands, table, keys, groups
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--datasets", default="mot15,pigs,mot17-synth,hexbug")
     parser.add_argument("--min-counts", default="10,100", help="clutter share judged after these many detections")
+    parser.add_argument("--grid", choices=sorted(GRIDS), default="full", help="the candidates (see GRIDS)")
+    parser.add_argument("--set", action="append", default=[], metavar="CONST=VALUE",
+                        help="patch a constant of trackers/boxtrack_config in this process (a mechanism on/off)")
+    parser.add_argument("--save", type=Path, default=None, help="pickle the scores table here (for --load)")
+    parser.add_argument("--load", type=Path, default=None, help="a table saved by --save: select, do not run")
     args = parser.parse_args()
-    seqs = load_datasets(SHARED_DATA, args.datasets.split(","))
-    keys, groups = [sequence_key(s) for s in seqs], [s.dataset for s in seqs]
-    cands: list[dict[str, Any]] = []
-    table: list[list[Any]] = []
-    for mc in (int(x) for x in args.min_counts.split(",")):
-        boxtrack_config.CLUTTER_MIN_COUNT = mc  # read by BoxTrack at construction (this process only)
-        grid = candidates()
-        table += evaluate_table("boxtrack", grid, seqs, score_params, workers=1)
-        cands += [dict(c, clutter_min_count=mc) for c in grid]
-        print(f"clutter min count {mc}: {len(grid)} candidates scored", flush=True)
-    print(f"criterion (fixed): HOTA + IDF1 + MOTA; {len(cands)} candidates x {len(seqs)} sequences")
+    for spec in args.set:
+        name, value = spec.split("=", 1)
+        if not hasattr(boxtrack_config, name):
+            parser.error(f"--set {spec}: boxtrack_config has no constant {name}")
+        setattr(boxtrack_config, name, type(getattr(boxtrack_config, name))(float(value)))
+        print(f"constant {name} = {getattr(boxtrack_config, name)}")
+    if args.load is not None:
+        cands, table, keys, groups = pickle.loads(args.load.read_bytes())
+    else:
+        cands, table, keys, groups = _score(args.datasets.split(","), args.min_counts, args.grid)
+    if args.save is not None:
+        args.save.write_bytes(pickle.dumps((cands, table, keys, groups)))
+    print(f"criterion (fixed): HOTA + IDF1 + MOTA; {len(cands)} candidates x {len(keys)} sequences")
     for c in select_from_table(table, leave_one_group_out(groups), keys, groups, CRITERION, cands):
         on = sorted({k.split("/")[0] for k in c.chosen_on})
         print(f"left out {c.fold:12s} chosen on {'+'.join(on)}: {cands[c.candidate]} -> {_fmt(c.test_scores)}")
-    every = tuple(range(len(seqs)))
+    mot15 = [i for i, g in enumerate(groups) if g == "mot15"]
+    if len(mot15) >= 2:  # each MOT15 sequence left out of the choice, made on every other sequence
+        folds = [Fold(keys[i], tuple(j for j in range(len(keys)) if j != i), (i,)) for i in mot15]
+        loso = select_from_table(table, folds, keys, groups, CRITERION, cands)
+        for c in loso:
+            print(f"  MOT15 left out {c.fold:28s} chose {cands[c.candidate]} -> {_fmt(c.test_scores)}")
+        print(f"left out MOT15 sequence by sequence (7 folds, combined): "
+              f"{_fmt(combine([s for c in loso for s in c.per_sequence]))}")
+    every = tuple(range(len(keys)))
     best = select_from_table(table, [Fold("all", every, every)], keys, groups, CRITERION, cands)[0]
     print(f"chosen on all ({'+'.join(dict.fromkeys(groups))}): {cands[best.candidate]}")
     for d in dict.fromkeys(groups):

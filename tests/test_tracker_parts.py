@@ -152,6 +152,6 @@ def test_boxtrack_config_names_the_bad_field() -> None:
     from lookalike.trackers.boxtrack_config import BoxTrackConfig
 
     for bad in ({"n_init": 0}, {"clutter_factor": 0}, {"low_score": 0.95}, {"reid_scale": 0.5},
-                {"vel_noise": 0}):
+                {"max_age_s": 0}):
         with pytest.raises(ValueError, match=next(iter(bad))):
             BoxTrackConfig(**bad)

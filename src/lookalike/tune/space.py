@@ -82,7 +82,7 @@ def _i(low: int, high: int, log: bool = False, optional: bool = False) -> Dim:
 
 # The default spaces. Ranges bracket the defaults widely; the closed-set parameters (max_targets,
 # closed_distance) do nothing on open-set data and are left out. boxtrack's space is its whole public
-# parameter set but those (issue 16: 12 tunable parameters; the others are constants).
+# parameter set but those (issue 16: 10 tunable parameters; the others are constants).
 DEFAULT_SPACES: dict[str, Space] = {
     "sort": {
         "max_age": _i(1, 30, log=True),
@@ -98,9 +98,7 @@ DEFAULT_SPACES: dict[str, Space] = {
         "match_iou": _f(0.05, 0.6),
         "n_init": _i(1, 5),
         "max_age_s": _f(0.25, 4.0, log=True),
-        "reid_distance": _f(0.1, 3.0, log=True),
         "reid_scale": _f(1.1, 3.0, log=True),
-        "vel_noise": _f(1 / 640, 1 / 40, log=True),
     },
 }
 
