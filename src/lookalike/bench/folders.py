@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import os
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from lookalike.bench.results import Results, metric_key
 from lookalike.eval import METRICS, combine, evaluate_sequence
 from lookalike.io import MotSequence, find_sequences, read_mot
+
+if TYPE_CHECKING:
+    from lookalike.bench.results import Results
 
 COMBINED = "COMBINED"
 
@@ -52,6 +54,8 @@ def evaluate_folders(
         raise ValueError(f"{results}: results folder not found")
     jobs = [(s, _result_file(results, s.name), benchmark, tuple(metrics), iou_threshold) for s in sequences]
     if workers > 1 and len(jobs) > 1:
+        from concurrent.futures import ProcessPoolExecutor  # imported when used: a short start-up
+
         with ProcessPoolExecutor(max_workers=min(workers, len(jobs))) as pool:
             scored = list(pool.map(_score, jobs))
     else:
@@ -67,6 +71,8 @@ def folder_results(scores: dict[str, dict[str, dict[str, float]]], gt_root: str 
     results document: table ``scores``, one row per tracker and sequence (dataset: the ground-truth
     folder's name) and the combined row (``sequence`` None, ``combined`` True); TrackEval's metric
     names as machine keys (``HOTA`` -> ``hota``, ``CLR_FP`` -> ``clr_fp``, ``HOTA___AUC`` -> ``hota_auc``)."""
+    from lookalike.bench.results import Results, metric_key  # imported when used: a short start-up
+
     dataset = Path(gt_root).name or str(gt_root)
     seqs = {s for per in scores.values() for s in per if s != COMBINED}
     frames = 0
