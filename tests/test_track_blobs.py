@@ -102,6 +102,18 @@ def test_a_video_whose_count_varies_stays_an_open_set(tmp_path):
     assert len(np.unique(read_mot(out).track_id)) <= 2
 
 
+def test_targets_0_keeps_an_open_set(arena, tmp_path):
+    out = tmp_path / "tracks.txt"
+    r = runner.invoke(app, ["track", "--video", str(arena), "--detector", "blob", "--blob", "polarity=dark",
+                            "--blob", "min_area_px=20", "-t", "boxtrack", "--targets", "0", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "inferred" not in " ".join(r.output.split())
+    assert len(np.unique(read_mot(out).track_id)) == 3
+    r = runner.invoke(app, ["track", "--video", str(arena), "--detector", "blob", "-t", "boxtrack", "--targets", "0",
+                            "--offline", "-o", str(out)])
+    assert r.exit_code == 2 and "--offline: needs --targets N" in " ".join(r.output.split())
+
+
 def test_blob_config_parsing():
     cfg = blob_config(["threshold=40", "polarity=dark", "min_area_px=5", "max_area_px=inf", "open_px=0",
                        "stabilise=yes", "method=mog2"])

@@ -193,8 +193,9 @@ def track(
         None, "--annotate", help="With --video: annotated MP4 (uncertain identities dashed with '?', health banner)."
     ),
     team_size: int | None = typer.Option(None, "--team-size", min=0, help="Known number of targets (health checks)."),
-    targets: int | None = typer.Option(None, "--targets", min=1, help="Known number of targets N: a closed set of "
-                                       "N identities (the tracker's max_targets; also the health checks' team size)."),
+    targets: int | None = typer.Option(None, "--targets", min=0, help="Known number of targets N: a closed set of "
+                                       "N identities (the tracker's max_targets; also the health checks' team size); "
+                                       "0: an open set (no number inferred from a blob video)."),
     health_window: int = typer.Option(15, "--health-window", min=1, help="Health monitor window in frames."),
     fps: float | None = typer.Option(None, "--fps", min=0.1, help="With --video: frame rate (default: the input's)."),
     features: str = typer.Option("video", "--features", help="With --video: deepsort/diversort features: "
@@ -224,6 +225,8 @@ def track(
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
     branch = _check_branches(path, video, detections, annotate, detector, blob, pipeline, points)
+    open_set = targets == 0  # --targets 0: an open set, no number of targets inferred (blob videos)
+    targets = targets or None
     if offline and targets is None:
         fail("--offline: needs --targets N (the known number of targets)")
     if offline and (annotate is not None or branch == "pipeline"):
@@ -259,7 +262,8 @@ def track(
             if branch == "blobs":
                 from lookalike.cli.track_blobs import run_track_blobs
 
-                run_track_blobs(video, output, trk, tracker, detector or "", blob or [], n_targets=targets,
+                run_track_blobs(video, output, trk, tracker, detector or "", blob or [],
+                                n_targets=0 if open_set else targets,
                                 offline=online, **video_options)
             else:
                 det_path = detections or path

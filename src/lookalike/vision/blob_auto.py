@@ -335,7 +335,7 @@ class TargetCount:
         seen = f"{self.n} blobs in {100 * self.share:.0f}% of the {self.frames} frames"
         if self.closed:
             return (f"inferred {self.n} targets from the video: {seen}; a closed set of {self.n} "
-                    f"(pass --targets N to override)")
+                    f"(pass --targets N to override, --targets 0 for an open set)")
         return (f"no number of targets inferred from the video: at most {seen} (a closed set needs a "
                 f"majority); tracking an open set (pass --targets N for a closed set)")
 
