@@ -97,10 +97,11 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
         pool = JobPool(opt.workers, opt.backend, opt.address)
     except ValueError as exc:
         fail(str(exc))
+    held_out = [paths[i].name for i in val_idx]
     info = {"recordings": {"folder": str(folder), "training": [paths[i].name for i in train_idx],
-                           "validation": [paths[i].name for i in val_idx], "sim_fraction": opt.sim_fraction}}
+                           "validation": held_out, "sim_fraction": opt.sim_fraction}}
     console.print(f"fine-tuning {init_path} on {len(train_idx)} recordings, validating on {len(val_idx)}: "
-                  f"{', '.join(info['recordings']['validation'])}")
+                  f"{', '.join(held_out)}")
     torch.set_num_threads(opt.threads)
     result = _with_progress(f"fine-tuning M={m}, N={n}", opt.steps, pool, lambda on_step: run_training(
         config, sampler, output, resume=opt.resume, on_step=on_step, device=device, pool=pool, init=init,
