@@ -160,20 +160,21 @@ class HogCascade:
             # float32 corners (faster gathers): on 640x480 the corner sums stay below ~1e7, so rounding moves a
             # block sum by a few gradient units at most, far below the block sums the stumps threshold.
             rows = integral.astype(np.float32)
-            ys, xs = np.mgrid[0 : size[1] - win_h + 1 : step, 0 : size[0] - win_w + 1 : step]
+            grid_y, grid_x = np.arange(0, size[1] - win_h + 1, step), np.arange(0, size[0] - win_w + 1, step)
             # The first stage sees every window of the grid: strided slices of the integral instead of gathers,
             # the same arithmetic.
             if self.stages:
                 stage, (used, columns) = self.stages[0], self._stage_blocks[0]
                 planes = np.ascontiguousarray(rows.transpose(2, 0, 1))
-                margin = _margin(block_features_grid(planes, used, xs.shape, cfg.stride_cells, cfg.cell_px, columns),
-                                 stage)
+                grid = (len(grid_y), len(grid_x))
+                margin = _margin(block_features_grid(planes, used, grid, cfg.stride_cells, cfg.cell_px, columns), stage)
                 alive = np.flatnonzero(margin >= stage.bias)
                 first.append(margin[alive])
             else:
-                alive = np.arange(xs.size)
-                first.append(np.zeros(xs.size))
-            levels.append((scale, rows.shape[1], xs.ravel(), ys.ravel(), alive))
+                alive = np.arange(len(grid_y) * len(grid_x))
+                first.append(np.zeros(len(alive)))
+            # window origins (px), row by row as the grid lists them
+            levels.append((scale, rows.shape[1], np.tile(grid_x, len(grid_y)), np.repeat(grid_y, len(grid_x)), alive))
             stacked.append(rows.reshape(-1, BINS))
             scale /= cfg.scale_step
         if not levels:
