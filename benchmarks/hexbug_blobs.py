@@ -27,6 +27,7 @@ import numpy as np
 from lookalike.association import assign
 from lookalike.bench.datasets import RealSequence, detect_hexbug, hexbug_clips
 from lookalike.bench.runner import Entry, score_rows, track_rows
+from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, infer_target_count
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA  # noqa: E402
@@ -65,8 +66,9 @@ def main() -> None:
         sys.exit(f"HexBug data not found at {root}")
     videos = [v for v in hexbug_clips(root) if not args.clips or v.stem in set(args.clips)]
     head = f"{'clip':<13}{'frames':>7}{'points':>7}{'recall':>8}{'prec':>7}{'det fps':>8}"
-    labels = args.trackers + (["closed"] if args.closed else [])
-    head += "".join(f"{t + ' IDF1':>15}{'MOTA':>7}" for t in labels)
+    blob = ["boxtrack-blob"] if "boxtrack" in args.trackers else []
+    labels = args.trackers + blob + (["closed"] if args.closed else [])
+    head += "".join(f"{t + ' IDF1':>20}{'MOTA':>7}" for t in labels)
     print(head)
     totals = np.zeros(3)
     idf1: dict[str, list[float]] = {t: [] for t in labels}
@@ -79,17 +81,21 @@ def main() -> None:
         line = (f"{seq.name:<13}{seq.length:>7}{points:>7}{found / max(points, 1):>8.3f}"
                 f"{found / max(boxes, 1):>7.3f}{fps:>8.1f}")
         entries = [Entry(t, t) for t in args.trackers]
+        if blob:
+            count = infer_target_count(np.array([len(d) for d in seq.det_xywh]))
+            entries.append(Entry(blob[0], "boxtrack", params={**BOX_TRACKER_PARAMS,
+                                                               **({"max_targets": count.n} if count.closed else {})}))
         if args.closed:
             entries.append(Entry("closed", "boxtrack", params={"max_targets": len(np.unique(seq.gt_points[1]))}))
         for e in entries:
             scores = score_rows(seq, track_rows(e, seq))
             idf1[e.label].append(scores["IDF1"])
-            line += f"{scores['IDF1']:>15.3f}{scores['MOTA']:>7.3f}"
+            line += f"{scores['IDF1']:>20.3f}{scores['MOTA']:>7.3f}"
         print(line, flush=True)
     if len(videos):
         line = f"{'all':<13}{'':>7}{int(totals[1]):>7}{totals[0] / max(totals[1], 1):>8.3f}"
         line += f"{totals[0] / max(totals[2], 1):>7.3f}{'':>8}"
-        line += "".join(f"{np.mean(idf1[t]):>15.3f}{'':>7}" for t in labels)
+        line += "".join(f"{np.mean(idf1[t]):>20.3f}{'':>7}" for t in labels)
         print(line + "   (recall/precision pooled over points, IDF1 the mean over clips)")
 
 
