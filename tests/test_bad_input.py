@@ -115,7 +115,9 @@ def test_frames_past_seqlength_are_an_error_unless_no_seqinfo_length(tmp_path):
 @pytest.mark.parametrize("line, needle", [("2.7,-1,10,10,20,40,0.9", "frame 2.7 is not an integer"),
                                           ("3,-1,10,10,20,40,nan", "NaN or infinity"),
                                           ("3,-1,10,inf,20,40,0.9", "NaN or infinity"),
-                                          ("0,-1,10,10,20,40,0.9", "frame 0 is not an integer >= 1")])
+                                          ("0,-1,10,10,20,40,0.9", "frame 0 is not an integer >= 1"),
+                                          ("3,-1,10,10,0,40,0.9", "zero or negative width or height"),
+                                          ("3,-1,10,10,20,-4,0.9", "zero or negative width or height")])
 def test_non_integer_frames_and_nan_scores_are_errors_naming_the_line(tmp_path, line, needle):
     det = _det(tmp_path / "det.txt", range(1, 3), extra=line + "\n")
     _one_error_line(_track(det, "-o", tmp_path / "o.txt"), "det.txt:3", needle)

@@ -73,7 +73,7 @@ def test_malformed_file_fails_before_any_frame_with_read_mots_message(tmp_path):
     lines[30] = lines[30].replace(",30.000,", ",-3.000,")  # a negative width
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(ValueError) as expected:
-        read_mot(path)
+        read_mot(path, positive_size=True)
     with pytest.raises(ValueError) as got:
         DetectionStream(path, chunk_lines=8).check()
     assert str(got.value) == str(expected.value) and ":31:" in str(got.value)

@@ -22,25 +22,26 @@ _FORMAT_BLOCK = 4096
 
 
 def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | None = None,
-             length_name: str = "the length") -> MotTable:
+             length_name: str = "the length", positive_size: bool = False) -> MotTable:
     """Read a MOTChallenge text file (UTF-8).
 
     Raises ``ValueError`` naming the file and 1-based line number of a malformed line: too few
     columns, a non-number, NaN or infinity in the first 7 columns (frame, id, box, score), a negative
-    size, a frame number that is not an integer >= 1, past ``length`` (named ``length_name``), or
-    that jumps too far (:mod:`lookalike.io.rules`); or naming the file when it is not UTF-8 text.
+    size (with ``positive_size``, as detections need: a zero one too), a frame number that is not an
+    integer >= 1, past ``length`` (named ``length_name``), or that jumps too far
+    (:mod:`lookalike.io.rules`); or naming the file when it is not UTF-8 text.
     """
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
     fast = _parse_fast(path, min_columns)
-    if fast is not None and row_problem(fast, length=length) is None:
+    if fast is not None and row_problem(fast, length=length, positive_size=positive_size) is None:
         return table_from_array(fast, path)
     rows = [(i + 1, ln) for i, ln in enumerate(read_text(path).splitlines()) if ln.strip()]
     if not rows:
         return table_from_array(np.zeros((0, 7)), path)
     data = _parse_slowly(path, rows, min_columns)
-    problem = row_problem(data, length=length, length_name=length_name)
+    problem = row_problem(data, length=length, length_name=length_name, positive_size=positive_size)
     if problem is not None:
         line_no, line = rows[problem[0]]
         raise ValueError(f"{path}:{line_no}: {problem[1]}: {line.strip()[:80]!r}")
@@ -48,16 +49,18 @@ def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | N
 
 
 def row_problem(data: np.ndarray, previous_max: float = 0.0, length: int | None = None,
-                length_name: str = "the length") -> tuple[int, str] | None:
+                length_name: str = "the length", positive_size: bool = False) -> tuple[int, str] | None:
     """``(row, reason)`` of the first row of ``data`` ``(k, c)`` that breaks the rules of
     :func:`read_mot` (``previous_max``: the largest frame of the rows before), else None."""
     if not len(data):
         return None
     box = ~np.isfinite(data[:, 1:7]).all(axis=1)
-    size = (data[:, 4:6] < 0).any(axis=1)
+    size = ((data[:, 4:6] <= 0) if positive_size else (data[:, 4:6] < 0)).any(axis=1)
+    size_reason = "invalid box: zero or negative width or height" if positive_size else \
+        "invalid box: negative width or height"
     frame = frame_problems(data[:, 0], previous_max, length, length_name)
     first = [(int(np.flatnonzero(box)[0]), "NaN or infinity in frame, id, box or score") if box.any() else None,
-             (int(np.flatnonzero(size)[0]), "invalid box: negative width or height") if size.any() else None,
+             (int(np.flatnonzero(size)[0]), size_reason) if size.any() else None,
              (frame[0], f"invalid frame: {frame[1]}") if frame is not None else None]
     found = [p for p in first if p is not None]
     return min(found, key=lambda p: p[0]) if found else None

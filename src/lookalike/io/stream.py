@@ -86,7 +86,7 @@ class DetectionStream:
                     chunks.append(data)
                 frames = data[:, 0]
                 bad = (data.shape[1] < 6 or (width is not None and data.shape[1] != width)
-                       or row_problem(data, last, self.length) is not None
+                       or row_problem(data, last, self.length, positive_size=True) is not None
                        or frames[0] < last or (np.diff(frames) < 0).any())
                 if bad:
                     raise ValueError
@@ -96,7 +96,8 @@ class DetectionStream:
                 self._single = chunks[0]
         except ValueError:
             # raises the precise error, or the file is valid but irregular (read whole)
-            self.rows = len(read_mot(self.path, length=self.length, length_name=self.length_name))
+            self.rows = len(read_mot(self.path, length=self.length, length_name=self.length_name,
+                                     positive_size=True))
             self._streamable = False
         return self
 
@@ -169,11 +170,17 @@ class MotWriter:
         self.write_rows(tracks_to_rows(frame.index, tracks))
 
     def write_rows(self, rows: np.ndarray) -> None:
-        """Append result rows ``(k, 10)``."""
+        """Append result rows ``(k, 10)``; ``ValueError`` naming the frame for a NaN or infinite frame,
+        id, box or score (a file :func:`~lookalike.io.read_mot` would refuse is never written)."""
         if self._fh is None:
             raise ValueError(f"{self.path}: writer already closed")
         if len(rows):
-            self._pending.append(np.array(rows, dtype=float))  # a copy: the caller may reuse its array
+            rows = np.array(rows, dtype=float)  # a copy: the caller may reuse its array
+            bad = ~np.isfinite(rows[:, :7]).all(axis=1)
+            if bad.any():
+                raise ValueError(f"{self.path}: the tracker produced a NaN or infinite box at frame "
+                                 f"{rows[bad][0, 0]:g} (from a degenerate detection?); nothing written")
+            self._pending.append(rows)
             self._pending_rows += len(rows)
             if self._pending_rows >= WRITE_ROWS:
                 self._flush()
