@@ -17,16 +17,21 @@ OpenCV is imported lazily.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from lookalike.types import Detections
 from lookalike.vision.hog_features import as_bgr_image
+
+SOURCE_HASH = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+"""SHA-256 of this module's source as imported (cache keys name the code that runs, not the file on disk)."""
 
 _METHODS = ("median", "mog2")
 _POLARITIES = ("any", "dark", "bright")

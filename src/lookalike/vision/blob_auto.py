@@ -34,6 +34,7 @@ OpenCV is imported lazily.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass, field, replace
@@ -46,6 +47,9 @@ from lookalike.vision.hog_features import as_bgr_image
 
 __all__ = ["BOX_TRACKER_PARAMS", "BlobEstimate", "TargetCount", "estimate_blob_config", "frame_counts",
            "infer_target_count", "sample_frames"]
+
+SOURCE_HASH = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
+"""SHA-256 of this module's source as imported (cache keys name the code that runs, not the file on disk)."""
 
 _FACTORS = (4.0, 6.0, 8.0, 10.0, 14.0, 20.0)  # candidate thresholds in noise σ
 _THRESHOLD_RANGE = (8.0, 100.0)  # grey levels

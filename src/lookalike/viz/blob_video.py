@@ -35,6 +35,7 @@ _BOOL_FALSE = ("0", "false", "no", "off")
 
 
 CACHE_ENV = "LOOKALIKE_CACHE"
+_SOURCE_HASH = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()  # this module as imported
 
 
 def blob_config(settings: list[str]) -> BlobConfig:
@@ -94,7 +95,7 @@ def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
     from lookalike.vision import blob_auto
 
     path = (cache_dir() if cache is True else Path(cache)) / "blobs" / (
-        detection_cache_key(video, base, extra={"n_targets": n_targets, "estimate": _code_hash(blob_auto.__file__)})
+        detection_cache_key(video, base, extra={"n_targets": n_targets, "estimate": blob_auto.SOURCE_HASH})
         + ".estimate.json")
     if path.is_file():
         try:
@@ -111,8 +112,6 @@ def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
     return estimate
 
 
-def _code_hash(*files: str) -> str:
-    return hashlib.sha256(b"".join(Path(f).read_bytes() for f in files)).hexdigest()
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
@@ -151,7 +150,7 @@ def detection_cache_key(video: Path | str, config: BlobConfig, extra: dict[str, 
     from lookalike import __version__
     from lookalike.vision import blob
 
-    code = _code_hash(blob.__file__, __file__)
+    code = blob.SOURCE_HASH + _SOURCE_HASH  # the code as imported: a long run never files old rows under new code
     payload = json.dumps({"video": _file_hash(Path(video)), "config": dataclasses.asdict(config),
                           "version": str(__version__), "code": code, "opencv": cv2.__version__, **(extra or {})},
                          sort_keys=True, default=str)
