@@ -63,8 +63,7 @@ class BoxTrack:
     def reset(self) -> None:
         """Forget every track; ids restart at 1."""
         cfg = self.config
-        self._tracks = TrackTable(8, {"obs_mean": ((8,), float), "obs_cov": ((8, 8), float), "obs_steps": ((), float),
-                                  "obs_centres": ((const.MOMENTUM_FRAMES, 2), float)})
+        self._tracks = TrackTable(8)
         self._frame_count = 0
         self._clock = FrameClock(cfg.frame_interval_s)
         self._calibration = ScoreCalibration(
@@ -97,7 +96,6 @@ class BoxTrack:
                 self._slots.freeze_shape(t)
             t.mean[self._coasting.still(t.unseen_s), 4:] = 0.0  # a long-lost track waits where it was last seen
             t.mean, t.cov = self._predict_space().predict(t.mean, t.cov, steps)
-            t["obs_steps"] += steps
         matching = self._associate(det_xywh, det_box, score, high_score, was_tracked,
                                    t.unseen_s + dt)
         det_of_track, free = matching.det_of_track, matching.free
@@ -107,8 +105,6 @@ class BoxTrack:
             d = det_of_track[matched]
             self._observe_fit(matched[t.confirmed[matched]], det_box[d[t.confirmed[matched]]])
             t.mean[matched], t.cov[matched] = self._space.update(t.mean[matched], t.cov[matched], det_box[d])
-            if const.REUPDATE:
-                self._reupdate(matched[t.misses[matched] > 0], det_box[d[t.misses[matched] > 0]])
             t.hits[matched] += 1
             back = matched[t.confirmed[matched] & (t.misses[matched] > 0)]
             if len(back):
@@ -122,13 +118,6 @@ class BoxTrack:
             t.confirmed |= ready
         else:
             det_of_track = self._slots.refill(t, ready, det_of_track)
-        seen = t.misses == 0  # updated this frame (or a slot re-filled): the state to re-update from later
-        t["obs_mean"][seen], t["obs_cov"][seen], t["obs_steps"][seen] = t.mean[seen], t.cov[seen], 0.0
-        now = np.flatnonzero(det_of_track >= 0)
-        if len(now):  # the observed centres, newest first (a re-filled slot: its candidate's detection)
-            hist = t["obs_centres"]
-            hist[now, 1:] = hist[now, :-1]
-            hist[now, 0] = det_box[det_of_track[now], :2]
         born = self._births(np.flatnonzero(free & (score >= birth_score)), det_box)
         out = self._report(np.concatenate([det_of_track, born]), det_idx, dets.xywh)
         alive = self._lifecycle.alive(t)
@@ -150,16 +139,10 @@ class BoxTrack:
             return lambda r, c: cost_from_iou(iou[r[:, None], c], min_iou,  # type: ignore[index]
                                               score[c] if weigh else None)
 
-        def overlap_momentum(r: np.ndarray, c: np.ndarray) -> np.ndarray:
-            cost = overlap(cfg.match_iou, True)(r, c)
-            if const.MOMENTUM > 0 and len(r) and len(c):
-                cost = cost - const.MOMENTUM * score[c][None, :] * self._direction_agreement(r, det_box[c, :2])
-            return cost
-
         recent = t.misses <= const.RECENT_FRAMES
         matching = run_plan([
-            Stage(t.confirmed & recent, high, overlap_momentum, name="confident, recent"),
-            Stage(t.confirmed & ~recent, high, overlap_momentum, name="confident, lost longer"),
+            Stage(t.confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent"),
+            Stage(t.confirmed & ~recent, high, overlap(cfg.match_iou, True), name="confident, lost longer"),
             Stage(t.confirmed & was_tracked, ~high, overlap(const.LOW_IOU, False), name="low score"),
         ], len(t), len(score))
         self._calibration.observe_continued(score, matching.det_of_track[matching.det_of_track >= 0])
@@ -179,33 +162,6 @@ class BoxTrack:
 
         stages.append(Stage(t.confirmed, high, reid, name="re-identification"))
         return run_plan(stages, len(t), len(score), start=matching)
-
-    def _direction_agreement(self, rows: np.ndarray, centres: np.ndarray) -> np.ndarray:
-        """Observation-centric momentum (as OC-SORT): ``(k, d)`` agreement in [-1/2, 1/2] between the
-        direction of track ``rows`` over their last observations and the direction from their oldest
-        kept observation to each detection centre (pixels); 0 where a track has not moved."""
-        hist = self._tracks["obs_centres"][rows]
-        track_dir = hist[:, 0] - hist[:, -1]
-        to_det = centres[None, :, :] - hist[:, -1][:, None, :]
-        norm = np.linalg.norm(track_dir, axis=1)[:, None] * np.linalg.norm(to_det, axis=2)
-        cos = np.einsum("ki,kdi->kd", track_dir, to_det) / np.maximum(norm, 1e-9)
-        angle = np.arccos(np.clip(cos, -1.0, 1.0))
-        return np.where(norm > 0, (np.pi / 2 - angle) / np.pi, 0.0)
-
-    def _reupdate(self, rows: np.ndarray, z: np.ndarray) -> None:
-        """Observation-centric re-update (as OC-SORT): tracks ``rows`` found again after misses are
-        re-filtered from their state at the last update along a straight line of virtual observations
-        (box centre and size, one per frame step) ending at the new detection ``z``, instead of keeping
-        the state that drifted while coasting."""
-        t, space = self._tracks, self._predict_space()
-        for r, zr in zip(rows, z):
-            k = max(1, round(float(t["obs_steps"][r])))
-            mean, cov = t["obs_mean"][r : r + 1].copy(), t["obs_cov"][r : r + 1].copy()
-            start = mean[0, :4].copy()
-            for i in range(1, k + 1):
-                mean, cov = space.predict(mean, cov, 1.0)
-                mean, cov = self._space.update(mean, cov, (start + (zr - start) * (i / k))[None])
-            t.mean[r], t.cov[r] = mean[0], cov[0]
 
     def _predict_space(self) -> BoxCXCYWH:
         """The motion model with its process noise scaled by :class:`MotionFit` (variance factor)."""
@@ -229,8 +185,7 @@ class BoxTrack:
         if len(new):
             mean, cov = self._space.initial(det_box[new])
             first = self._frame_count == 1
-            rows = t.add(mean, cov, hits=1, confirmed=first or (cfg.n_init <= 1 and self._slots is None))
-            t["obs_centres"][rows] = det_box[new, None, :2]
+            t.add(mean, cov, hits=1, confirmed=first or (cfg.n_init <= 1 and self._slots is None))
         return new
 
     def _report(self, det_of_track: np.ndarray, det_idx: np.ndarray, det_xywh: np.ndarray) -> Tracks:

@@ -29,9 +29,6 @@ FIT_BATCH = 30  # matched confirmed tracks per update of the process-noise scale
 CLUTTER_IOU = 0.5  # a detection overlapping a previous-frame detection this much is not clutter
 CLUTTER_MIN_COUNT = 10  # detections judged before the clutter share is used
 CLOSED_GATE_GROWTH = 1.0  # closed set: recovery gate grows at least this many sizes per second lost
-REUPDATE = False  # a track found again is re-filtered along a straight line from its last update (OC-SORT)
-MOMENTUM = 0.0  # weight of the observation-centric direction agreement in the first stage's cost (OC-SORT)
-MOMENTUM_FRAMES = 3  # observed centres kept per track for that direction
 CLOSED_SCALE = 3.0  # closed set: a recovered detection's sqrt(area) within this factor of its slot's
 
 
