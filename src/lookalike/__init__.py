@@ -6,8 +6,9 @@ Names are imported on first use, so ``import lookalike`` itself loads nothing he
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from lookalike._lazy import lazy_attributes
 
 if TYPE_CHECKING:
     from lookalike.io import find_sequences, frames_from_table, read_mot, tracks_to_rows, write_mot
@@ -34,17 +35,7 @@ _HOME = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    home = _HOME.get(name)
-    if home is None:
-        raise AttributeError(f"module 'lookalike' has no attribute {name!r}")
-    value = getattr(importlib.import_module(home), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_HOME))
+__getattr__, __dir__ = lazy_attributes("lookalike", _HOME, globals())
 
 
 __all__ = [

@@ -6,8 +6,9 @@ Names are imported on first use (``from lookalike.trackers import Sort`` imports
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from lookalike._lazy import lazy_attributes
 
 if TYPE_CHECKING:
     from lookalike.trackers.base import Tracker
@@ -50,17 +51,7 @@ _HOME = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    home = _HOME.get(name)
-    if home is None:
-        raise AttributeError(f"module 'lookalike.trackers' has no attribute {name!r}")
-    value = getattr(importlib.import_module(home), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_HOME))
+__getattr__, __dir__ = lazy_attributes("lookalike.trackers", _HOME, globals())
 
 
 __all__ = [
