@@ -4,9 +4,10 @@
 An arena: N identical points on correlated random walks (speed 1.5-4.5 px/frame, turning, bouncing off
 the walls of a 400 px square), observed with 1 px noise, 5% of the points missed, 0.1 false points a
 frame, 600 frames at 25 frames/s. Seeds 0-9 are where closed-set choices may be made; seeds 100-109 are
-unseen by them (``--seeds``). ``--set KEY=VALUE`` overrides a ``ClosedSetConfig`` field. Run::
+unseen by them (``--seeds``). ``--set KEY=VALUE`` overrides a ``ClosedSetConfig`` field; ``--vel-noise``
+boxtrack's velocity noise for the points (default ``POINT_VEL_NOISE``, chosen on seeds 0-29). Run::
 
-    python benchmarks/closed_points.py [--seeds 100-109] [--targets 5] [--set smooth_s=0]
+    python benchmarks/closed_points.py [--seeds 100-109] [--targets 5] [--set smooth_s=0] [--vel-noise 0.00625]
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 from closed_pigs import parse_overrides
 
 from lookalike.eval import combine, evaluate_points
-from lookalike.io.points import PointFrames, points_to_rows, rows_to_points
+from lookalike.io.points import POINT_VEL_NOISE, PointFrames, points_to_rows, rows_to_points
 from lookalike.trackers.closed_set import ClosedSetConfig, assign_identities, online_rows
 
 FPS = 25.0
@@ -60,13 +61,16 @@ def main() -> None:
     ap.add_argument("--seeds", default="0-9", help="arena seeds, A-B (0-9: choices; 100-109: unseen)")
     ap.add_argument("--targets", type=int, default=5)
     ap.add_argument("--set", action="append", default=[], dest="overrides")
+    ap.add_argument("--vel-noise", type=float, default=POINT_VEL_NOISE,
+                    help="boxtrack's velocity noise for the points (0.00625: boxtrack's own, before the point rule)")
     args = ap.parse_args()
     cfg = ClosedSetConfig(**parse_overrides(args.overrides))  # type: ignore[arg-type]
     results, t0 = [], time.process_time()
     for seed in seeds_of(args.seeds):
         pf, gt = arena(n=args.targets, seed=seed)
         det = points_to_rows(pf)
-        rows = assign_identities(online_rows(det, FPS, len(pf), n_init=1), args.targets, FPS, cfg)
+        rows = assign_identities(online_rows(det, FPS, len(pf), n_init=1, vel_noise=args.vel_noise), args.targets, FPS,
+                                 cfg)
         f, i, xy = rows_to_points(rows)
         results.append(evaluate_points(gt[:, 0].astype(int), gt[:, 1].astype(int), gt[:, 2:4], f, i, xy,
                                        radius=RADIUS_PX, num_frames=len(pf)))

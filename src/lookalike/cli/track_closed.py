@@ -18,8 +18,9 @@ import numpy as np
 from lookalike.cli.app import console, fail
 from lookalike.io import find_sequences, read_mot, write_mot
 from lookalike.io.outputs import ensure_writable, result_paths
-from lookalike.io.points import points_to_rows, read_points_csv, read_points_mot, typical_spacing
+from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv, read_points_mot, typical_spacing
 from lookalike.io.stream import track_to_file
+from lookalike.trackers.boxtrack import BoxTrack
 from lookalike.trackers.closed_set import track_closed_set
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import detection_rows
@@ -37,11 +38,18 @@ def table_rows(path: Path, min_score: float = float("-inf"), length: int | None 
 
 
 def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
-                    params: dict[str, Any]) -> np.ndarray:
+                    params: dict[str, Any], vel_noise: float | None = None) -> np.ndarray:
     """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online
-    ``boxtrack`` pass's parameters (``max_targets`` is dropped: that pass is an open set)."""
+    ``boxtrack`` pass's parameters (``max_targets`` is dropped: that pass is an open set); ``vel_noise``:
+    its velocity noise when not boxtrack's own (points: ``POINT_VEL_NOISE``)."""
     online = {k: v for k, v in params.items() if k != "max_targets"}
-    return track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online)
+    return track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise)
+
+
+def point_tracker(tracker: Any) -> Any:
+    """``tracker`` for points as boxes: a ``boxtrack`` rebuilt with the same config and the points'
+    velocity noise (:data:`~lookalike.io.points.POINT_VEL_NOISE`); any other tracker unchanged."""
+    return BoxTrack(tracker.config, vel_noise=POINT_VEL_NOISE) if isinstance(tracker, BoxTrack) else tracker
 
 
 def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float,
@@ -103,7 +111,8 @@ def _frames(det_rows: np.ndarray, n_frames: int, frame_rate: float) -> Any:
 def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: str, *, n_targets: int | None,
                  offline: bool, params: dict[str, Any], fps: float | None) -> None:
     """``--points FILE``: points as boxes of half their typical spacing, tracked online by ``tracker`` or,
-    with ``offline``, by the closed set of ``n_targets``; result rows (boxes centred on the points) to ``output``."""
+    with ``offline``, by the closed set of ``n_targets`` (boxtrack with the points' velocity noise,
+    :func:`point_tracker`); result rows (boxes centred on the points) to ``output``."""
     if output.is_dir():
         fail(f"-o/--output: {output} is a folder; with --points give a result file such as tracks.txt")
     frame_rate = fps or POINTS_FPS
@@ -119,13 +128,13 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
     if offline:
         assert n_targets is not None
         try:
-            rows = closed_set_rows(det, n_targets, frame_rate, len(points), params)
+            rows = closed_set_rows(det, n_targets, frame_rate, len(points), params, vel_noise=POINT_VEL_NOISE)
         except ValueError as exc:
             fail(str(exc))
         write_mot(output, rows)
     else:
         try:
-            track_to_file(tracker, _frames(det, len(points), frame_rate), output)
+            track_to_file(point_tracker(tracker), _frames(det, len(points), frame_rate), output)
         except ValueError as exc:
             fail(str(exc))
         table = read_mot(output)
@@ -134,5 +143,5 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
     console.print(f"[green]{tracker_name}[/], {what}: {len(np.unique(rows[:, 1]))} identities → {output}")
 
 
-__all__ = ["POINTS_FPS", "closed_set_rows", "offline_files", "offline_video", "read_points", "table_rows",
-           "track_points"]
+__all__ = ["POINTS_FPS", "closed_set_rows", "offline_files", "offline_video", "point_tracker", "read_points",
+           "table_rows", "track_points"]

@@ -30,8 +30,15 @@ import numpy as np
 from lookalike.io.rules import frame_problems, read_text
 from lookalike.types.mot_table import detection_rows
 
-__all__ = ["PointFrames", "points_to_rows", "read_points_csv", "read_points_mot", "rows_to_points",
+__all__ = ["POINT_VEL_NOISE", "PointFrames", "points_to_rows", "read_points_csv", "read_points_mot", "rows_to_points",
            "typical_spacing"]
+
+# boxtrack's velocity noise (fraction of the box side per frame) for points as boxes. A point has no size:
+# its box side is half the points' typical spacing, so boxtrack's own VEL_NOISE (1/160 of an object's
+# extent) makes the motion model far too sure of the velocity for animals that turn and change speed.
+# Chosen among 1/160, 0.01, 0.02, 0.03, 0.05, 0.075, 0.1, 0.2 on the simulated arenas of
+# benchmarks/closed_points.py, seeds 0-29 only (docs/closed-set.md has the figures).
+POINT_VEL_NOISE = 0.02
 
 
 @dataclass(frozen=True, eq=False)

@@ -50,9 +50,14 @@ class BoxTrack:
 
     Config = BoxTrackConfig
 
-    def __init__(self, config: BoxTrackConfig | None = None) -> None:
+    def __init__(self, config: BoxTrackConfig | None = None, *, vel_noise: float | None = None) -> None:
+        """``vel_noise``: the velocity's process noise per frame as a fraction of the box size (default
+        ``boxtrack_config.VEL_NOISE``). Not a parameter of the tracker: a hook for inputs whose boxes are
+        not objects' extents (anonymous points as boxes, :data:`lookalike.io.points.POINT_VEL_NOISE`)."""
         self.config = cfg = config or BoxTrackConfig()
-        self._space = BoxCXCYWH(const.POS_NOISE, const.VEL_NOISE)
+        if vel_noise is not None and not vel_noise > 0:
+            raise ValueError(f"vel_noise must be > 0, got {vel_noise}")
+        self._space = BoxCXCYWH(const.POS_NOISE, const.VEL_NOISE if vel_noise is None else float(vel_noise))
         lifecycle = Lifecycle(n_init=cfg.n_init, tentative_max_misses=None, tentative_max_unseen_s=0.0,
                               max_unseen_s=cfg.max_age_s)
         self._lifecycle = lifecycle.closed_set() if cfg.max_targets is not None else lifecycle

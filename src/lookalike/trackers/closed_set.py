@@ -56,6 +56,7 @@ import numpy as np
 
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.trackers.base import check_positive, param
+from lookalike.trackers.boxtrack import BoxTrack
 from lookalike.trackers.offline import fill_gaps, smooth_boxes
 from lookalike.trackers.registry import make_tracker
 from lookalike.types import Detections, Frame
@@ -452,11 +453,18 @@ def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfi
 
 
 def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = None,
-                tracker: str = "boxtrack", **params: Any) -> np.ndarray:
+                tracker: str = "boxtrack", *, vel_noise: float | None = None, **params: Any) -> np.ndarray:
     """Result rows of an online pass of ``tracker`` over detection rows ``(k, >=7)`` (1-based frames,
-    boxes in pixels, score in column 7): only tracks matched to a detection, at that detection's box."""
+    boxes in pixels, score in column 7): only tracks matched to a detection, at that detection's box.
+    ``vel_noise``: ``boxtrack``'s velocity noise (fraction of the box size per frame) when not its default
+    (:class:`~lookalike.trackers.boxtrack.BoxTrack`'s hook; points as boxes use
+    :data:`lookalike.io.points.POINT_VEL_NOISE`)."""
     det_rows = _check_rows(det_rows)
     tracker_obj = make_tracker(tracker, **params)
+    if vel_noise is not None:
+        if not isinstance(tracker_obj, BoxTrack):
+            raise ValueError(f"vel_noise is a boxtrack setting, not one of {tracker!r}")
+        tracker_obj = BoxTrack(tracker_obj.config, vel_noise=vel_noise)
     n_frames = int(det_rows[:, 0].max()) if n_frames is None and len(det_rows) else int(n_frames or 0)
     order = np.argsort(det_rows[:, 0], kind="stable")
     det_rows = det_rows[order]
@@ -473,13 +481,14 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
 
 
 def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *, n_frames: int | None = None,
-                     online: dict[str, Any] | None = None, config: ClosedSetConfig | None = None) -> np.ndarray:
+                     online: dict[str, Any] | None = None, config: ClosedSetConfig | None = None,
+                     vel_noise: float | None = None) -> np.ndarray:
     """Offline closed-set tracking of detection rows ``(k, >=7)``: an open-set online ``boxtrack`` pass
     with ``n_init=1`` (every detection enters some tracklet; the assignment decides what is clutter;
-    ``online`` overrides its parameters), then :func:`assign_identities`. Returns result rows ``(k, 10)``
-    with ids ``1..n_targets``."""
+    ``online`` overrides its parameters; ``vel_noise`` as in :func:`online_rows`), then
+    :func:`assign_identities`. Returns result rows ``(k, 10)`` with ids ``1..n_targets``."""
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
     params = {"n_init": 1, **(online or {})}
-    rows = online_rows(det_rows, frame_rate, n_frames, **params)
+    rows = online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, **params)
     return assign_identities(rows, n_targets, frame_rate, config)

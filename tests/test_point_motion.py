@@ -1,0 +1,55 @@
+"""The point path gives boxtrack the points' velocity noise (POINT_VEL_NOISE); boxtrack's default is unchanged."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from lookalike.cli.track_closed import point_tracker, track_points
+from lookalike.io.points import POINT_VEL_NOISE
+from lookalike.trackers import boxtrack_config as const
+from lookalike.trackers.boxtrack import BoxTrack
+from lookalike.trackers.registry import make_tracker
+
+
+def test_boxtrack_default_motion_model_and_hook() -> None:
+    assert BoxTrack()._space.vel_noise == const.VEL_NOISE
+    assert BoxTrack(vel_noise=0.05)._space.vel_noise == 0.05
+    with pytest.raises(ValueError, match="vel_noise"):
+        BoxTrack(vel_noise=0.0)
+
+
+def test_point_tracker_keeps_config_and_uses_point_noise() -> None:
+    trk = make_tracker("boxtrack", n_init=2, max_targets=3)
+    pt = point_tracker(trk)
+    assert pt.config == trk.config and pt._space.vel_noise == POINT_VEL_NOISE
+    sort = make_tracker("sort")
+    assert point_tracker(sort) is sort
+
+
+def _points_csv(path: Path) -> Path:
+    rows = [f"{k},{10 + 3 * k + 40 * i},{50 + 30 * i}" for k in range(1, 31) for i in range(3)]
+    path.write_text("frame,x,y\n" + "\n".join(rows) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("offline", [False, True])
+def test_point_path_builds_boxtrack_with_point_noise(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                     offline: bool) -> None:
+    seen: list[float | None] = []
+    init = BoxTrack.__init__
+
+    def spy(self: BoxTrack, config: Any = None, *, vel_noise: float | None = None) -> None:
+        seen.append(vel_noise)
+        init(self, config, vel_noise=vel_noise)
+
+    monkeypatch.setattr(BoxTrack, "__init__", spy)
+    out = tmp_path / "tracks.txt"
+    track_points(_points_csv(tmp_path / "p.csv"), out, make_tracker("boxtrack", max_targets=3), "boxtrack",
+                 n_targets=3, offline=offline, params={}, fps=None)
+    assert POINT_VEL_NOISE in seen
+    rows = np.loadtxt(out, delimiter=",", ndmin=2)
+    assert len(np.unique(rows[:, 1])) == 3
