@@ -1,4 +1,4 @@
-"""The point path gives boxtrack the points' velocity noise (POINT_VEL_NOISE); boxtrack's default is unchanged."""
+"""The point path: boxtrack gets the points' velocity noise (POINT_VEL_NOISE), a lone point gets a box of its step."""
 
 from __future__ import annotations
 
@@ -53,3 +53,13 @@ def test_point_path_builds_boxtrack_with_point_noise(tmp_path: Path, monkeypatch
     assert POINT_VEL_NOISE in seen
     rows = np.loadtxt(out, delimiter=",", ndmin=2)
     assert len(np.unique(rows[:, 1])) == 3
+
+
+def test_single_target_boxes_follow_the_step() -> None:
+    from lookalike.io.points import PointFrames, points_to_rows, typical_step
+
+    pts = PointFrames([np.array([[10.0 * k, 0.0]]) for k in range(20)])  # one point, 10 units a frame
+    assert typical_step(pts) == 10.0
+    rows = points_to_rows(pts)
+    np.testing.assert_allclose(rows[:, 4:6], 20.0)  # no spacing: twice the step, consecutive boxes overlap
+    assert points_to_rows(PointFrames([np.array([[1.0, 2.0]])]))[0, 4] == 1.0  # neither: 1

@@ -123,8 +123,9 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
     except (FileNotFoundError, ValueError) as exc:
         fail(str(exc))
     side = float(det[0, 4]) if len(det) else 1.0
-    console.print(f"points: {points.count} in {len(points)} frames, boxes of {side:.3g} (half the typical "
-                  f"spacing {spacing:.3g}), {frame_rate:g} frames/s" + ("" if fps else " (--fps to change)"))
+    why = f"half the typical spacing {spacing:.3g}" if spacing > 0 else "one point a frame: twice the typical step"
+    console.print(f"points: {points.count} in {len(points)} frames, boxes of {side:.3g} ({why}), "
+                  f"{frame_rate:g} frames/s" + ("" if fps else " (--fps to change)"))
     if offline:
         assert n_targets is not None
         try:

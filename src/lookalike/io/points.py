@@ -31,7 +31,7 @@ from lookalike.io.rules import frame_problems, read_text
 from lookalike.types.mot_table import detection_rows
 
 __all__ = ["POINT_VEL_NOISE", "PointFrames", "points_to_rows", "read_points_csv", "read_points_mot", "rows_to_points",
-           "typical_spacing"]
+           "typical_spacing", "typical_step"]
 
 # boxtrack's velocity noise (fraction of the box side per frame) for points as boxes. A point has no size:
 # its box side is half the points' typical spacing, so boxtrack's own VEL_NOISE (1/160 of an object's
@@ -150,16 +150,29 @@ def typical_spacing(points: PointFrames | list[np.ndarray]) -> float:
     return float(np.median(np.concatenate(near))) if near else 0.0
 
 
+def typical_step(points: PointFrames | list[np.ndarray]) -> float:
+    """Median distance from each point to the nearest point of the previous frame (input unit per
+    frame); 0 when no two consecutive frames hold points."""
+    per_frame = points.points if isinstance(points, PointFrames) else points
+    near = []
+    for a, b in zip(per_frame[:-1], per_frame[1:]):
+        a, b = np.asarray(a, dtype=float).reshape(-1, 2), np.asarray(b, dtype=float).reshape(-1, 2)
+        if len(a) and len(b):
+            near.append(np.linalg.norm(b[:, None, :] - a[None, :, :], axis=2).min(axis=1))
+    return float(np.median(np.concatenate(near))) if near else 0.0
+
+
 def points_to_rows(points: PointFrames | list[np.ndarray], box_px: float | None = None,
                    score: float = 1.0) -> np.ndarray:
     """MOTChallenge detection rows ``(k, 10)`` (1-based frames, id -1) of square boxes of side ``box_px``
     centred on the points. By default the side is half the :func:`typical_spacing` of the points (so
-    neighbours' boxes rarely overlap, yet a point moving less than a side keeps overlapping its box),
-    or 1 when there is none."""
+    neighbours' boxes rarely overlap, yet a point moving less than a side keeps overlapping its box);
+    when no frame holds two points (a single target), twice the :func:`typical_step`, so that a typical
+    step keeps half a box of overlap; 1 when there is neither."""
     per_frame = points.points if isinstance(points, PointFrames) else points
     if box_px is None:
         spacing = typical_spacing(per_frame)
-        box_px = spacing / 2 if spacing > 0 else 1.0
+        box_px = spacing / 2 if spacing > 0 else 2 * typical_step(per_frame) or 1.0
     if not box_px > 0:
         raise ValueError(f"box_px must be > 0, got {box_px}")
     blocks = []
