@@ -35,7 +35,10 @@ def main() -> None:
     ap.add_argument("--radius", type=float, default=20.0, help="score radius (px)")
     ap.add_argument("--limit", type=int, default=0, help="first K clips only (0: all)")
     args = ap.parse_args()
-    root = resolve_data_root(args.data) / "hexbug"
+    try:
+        root = resolve_data_root(args.data) / "hexbug"
+    except FileNotFoundError as exc:
+        raise SystemExit(f"points_real: {exc}") from None
     clips = sorted(root.glob("*.csv"))[:args.limit or None]
     if not clips:
         raise SystemExit(f"{root}: no HexBug CSVs")
