@@ -49,233 +49,28 @@ All positions are pixels; times are converted with the sequence's frame rate (fr
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from lookalike.geometry.boxes import iou_matrix
-from lookalike.trackers.base import check_positive, param
 from lookalike.trackers.boxtrack import BoxTrack
+from lookalike.trackers.closed_set_config import ClosedSetConfig
 from lookalike.trackers.offline import fill_gaps, smooth_boxes
 from lookalike.trackers.registry import make_tracker
+from lookalike.trackers.tracklets import (
+    Tracklet,
+    checked_rows,
+    link_costs,
+    motion_scale,
+    row_centres,
+    row_sizes,
+    row_steps,
+    split_tracklets,
+)
 from lookalike.types import Detections, Frame
 
 __all__ = ["ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale", "place_short",
            "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
-
-
-@dataclass(frozen=True)
-class ClosedSetConfig:
-    """Parameters of :func:`assign_identities` (distances in box sizes √(w·h) unless stated)."""
-
-    contact_iou: float | None = param(None, "cut tracks around frames where their box overlaps another's by this "
-                                           "IoU (None: never)")
-    jump: float = param(3.0, "cut a track at a step longer than this times the 90th-percentile step")
-    jump_floor: float = param(0.5, "... and longer than this many box sizes")
-    velocity_frames: int = param(5, "rows at a tracklet's end/start that give its velocity")
-    pos_sigma: float = param(0.1, "spread of a link's miss at a gap of zero (box sizes)")
-    link_cost: float = param(1.0, "cost of every link (rows' worth), so fewer, longer pieces are preferred")
-    continue_cost: float = param(-3.0, "cost of re-joining two consecutive pieces of one input track cut at a "
-                                       "contact (negative: trust the online pass)")
-    max_z: float = param(6.0, "largest miss of a link candidate, in spreads σ")
-    candidates: int = param(6, "cheapest successors per end and predecessors per start kept as links")
-    max_gap_s: float = param(math.inf, "longest gap (seconds) a link may bridge")
-    tracklet_cost: float = param(3.0, "cost of putting a tracklet on an identity (rows' worth); shorter "
-                                      "tracklets with costly links are left out as clutter")
-    edge_cost: float = param(3.0, "cost (rows' worth) of an identity that starts after the sequence's first "
-                                   "frames or ends before its last (a closed set's targets are always there)")
-    min_rows: int = param(5, "tracklets with fewer rows are not chained but placed into the chains' gaps")
-    fill_gap_s: float = param(math.inf, "longest gap (seconds) inside an identity filled by interpolation "
-                                        "(a closed set's targets are always there)")
-    smooth_s: float = param(1.0, "longest window (seconds) of the running median of each identity's box "
-                                 "centres and sizes (0: none)")
-    smooth_move: float = param(0.25, "... and no longer than the frames in which a target typically moves this "
-                                     "many box sizes")
-    time_limit_s: float = param(60.0, "time limit of the MILP solver (seconds)")
-
-    def __post_init__(self) -> None:
-        check_positive(self, "jump", "velocity_frames", "pos_sigma", "max_z", "candidates", "max_gap_s",
-                       "time_limit_s")
-        check_positive(self, "contact_iou", "jump_floor", "link_cost", "tracklet_cost", "fill_gap_s", "edge_cost",
-                       "smooth_s", "smooth_move", allow_zero=True)
-
-
-@dataclass(frozen=True, eq=False)
-class Tracklet:
-    """A piece of one track: its rows ``(k, 10)`` sorted by frame (consecutive frames)."""
-
-    rows: np.ndarray
-    source_id: int = -1  # the id it had in the input
-    contact: bool = False  # every row touches another track's box (identity there is unsure)
-
-    @property
-    def first(self) -> int:
-        return int(self.rows[0, 0])
-
-    @property
-    def last(self) -> int:
-        return int(self.rows[-1, 0])
-
-    def __len__(self) -> int:
-        return len(self.rows)
-
-
-def _centres(rows: np.ndarray) -> np.ndarray:
-    return rows[:, 2:4] + rows[:, 4:6] / 2
-
-
-def _sizes(rows: np.ndarray) -> np.ndarray:
-    out: np.ndarray = np.sqrt(np.maximum(rows[:, 4] * rows[:, 5], 1.0))
-    return out
-
-
-def _check_rows(rows: np.ndarray) -> np.ndarray:
-    arr = np.asarray(rows, dtype=float)
-    if arr.ndim != 2 or (arr.size and arr.shape[1] < 6):
-        raise ValueError(f"rows: expected MOTChallenge rows (k, >=6), got shape {arr.shape}")
-    if arr.size and arr.shape[1] < 10:
-        arr = np.hstack([arr, np.full((len(arr), 10 - arr.shape[1]), -1.0)])
-    return arr.reshape(-1, 10) if not arr.size else arr
-
-
-def _steps(rows: np.ndarray) -> np.ndarray:
-    """Per-frame centre steps (pixels) between consecutive-frame rows of the same id."""
-    order = np.lexsort((rows[:, 0], rows[:, 1]))
-    r = rows[order]
-    same = (np.diff(r[:, 1]) == 0) & (np.diff(r[:, 0]) == 1)
-    steps: np.ndarray = np.linalg.norm(np.diff(_centres(r), axis=0), axis=1)[same]
-    return steps
-
-
-def _contact_frames(rows: np.ndarray, min_iou: float) -> np.ndarray:
-    """Row mask: the box overlaps another id's box in the same frame by IoU ≥ ``min_iou``."""
-    hit = np.zeros(len(rows), dtype=bool)
-    order = np.argsort(rows[:, 0], kind="stable")
-    frames = rows[order, 0]
-    bounds = np.flatnonzero(np.diff(frames)) + 1
-    for idx in np.split(order, bounds):
-        if len(idx) < 2:
-            continue
-        iou = iou_matrix(rows[idx, 2:6], rows[idx, 2:6])
-        np.fill_diagonal(iou, 0.0)
-        hit[idx] = (iou >= min_iou).any(axis=1)
-    return hit
-
-
-def _fill_short(mask: np.ndarray, k: int) -> np.ndarray:
-    """``mask`` with runs of fewer than ``k`` False values between two True values set True (a contact
-    that flickers for a few frames is one contact)."""
-    out: np.ndarray = mask.copy()
-    on = np.flatnonzero(mask)
-    for a, b in zip(on[:-1], on[1:]):
-        if 1 < b - a <= k:
-            out[a:b] = True
-    return out
-
-
-def split_tracklets(rows: np.ndarray, config: ClosedSetConfig | None = None) -> list[Tracklet]:
-    """The tracklets of result ``rows``: each id cut at missing frames, jumps and contacts (module doc)."""
-    cfg = config or ClosedSetConfig()
-    rows = _check_rows(rows)
-    if not len(rows):
-        return []
-    steps = _steps(rows)
-    typical = float(np.percentile(steps, 90)) if len(steps) else 0.0
-    contact = _contact_frames(rows, cfg.contact_iou) if cfg.contact_iou is not None else np.zeros(len(rows), bool)
-    out: list[Tracklet] = []
-    for tid in np.unique(rows[:, 1]):
-        sel = np.flatnonzero(rows[:, 1] == tid)
-        sel = sel[np.argsort(rows[sel, 0], kind="stable")]
-        r, touch = rows[sel], contact[sel]
-        keep = np.r_[True, np.diff(r[:, 0]) > 0]  # one row per frame and id
-        r, touch = r[keep], _fill_short(touch[keep], cfg.velocity_frames)
-        step = np.linalg.norm(np.diff(_centres(r), axis=0), axis=1)
-        size = _sizes(r)
-        limit = np.maximum(cfg.jump * typical, cfg.jump_floor * np.minimum(size[:-1], size[1:]))
-        cut = (np.diff(r[:, 0]) > 1) | (step > limit) | (touch[1:] != touch[:-1])
-        for piece in np.split(np.arange(len(r)), np.flatnonzero(cut) + 1):
-            out.append(Tracklet(r[piece], int(tid), bool(touch[piece].all())))
-    out.sort(key=lambda t: (t.first, t.last))
-    return out
-
-
-def _end_state(rows: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """Centre (px) of the last row and velocity (px/frame) over the last ``k`` rows."""
-    c = _centres(rows[-k:])
-    f = rows[-k:, 0]
-    v = (c[-1] - c[0]) / (f[-1] - f[0]) if len(f) > 1 and f[-1] > f[0] else np.zeros(2)
-    return c[-1], v
-
-
-def motion_scale(tracklets: list[Tracklet]) -> tuple[float, float, float]:
-    """``(size px, speed px/frame, jitter px/frame²)`` of a sequence's tracklets: the mean box size √(w·h),
-    the 90th-percentile step between consecutive rows and the median second difference of centres."""
-    if not tracklets:
-        return 1.0, 0.0, 0.0
-    size = float(np.mean(_sizes(np.vstack([t.rows for t in tracklets]))))
-    steps = np.concatenate([np.linalg.norm(np.diff(_centres(t.rows), axis=0), axis=1) for t in tracklets])
-    speed = float(np.percentile(steps, 90)) if len(steps) else 0.0
-    bends = np.concatenate([np.linalg.norm(np.diff(_centres(t.rows), n=2, axis=0), axis=1) for t in tracklets])
-    jitter = float(np.median(bends)) if len(bends) else speed
-    return size, speed, jitter
-
-
-def link_costs(tracklets: list[Tracklet], frame_rate: float,
-               config: ClosedSetConfig | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Candidate links ``(i, j, cost)``: tracklet ``j`` continues tracklet ``i`` (module doc, step 2)."""
-    cfg = config or ClosedSetConfig()
-    if not frame_rate > 0:
-        raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
-    n = len(tracklets)
-    empty = (np.zeros(0, int), np.zeros(0, int), np.zeros(0))
-    if n < 2:
-        return empty
-    max_gap = math.inf if math.isinf(cfg.max_gap_s) else round(cfg.max_gap_s * frame_rate)
-    size, speed, jitter = motion_scale(tracklets)
-    first = np.array([t.first for t in tracklets])
-    last = np.array([t.last for t in tracklets])
-    k = cfg.velocity_frames
-    ends = [_end_state(t.rows, k) for t in tracklets]
-    starts = [_end_state(t.rows[::-1], k) for t in tracklets]  # backwards in time
-    c_end = np.array([e[0] for e in ends])
-    v_end = np.array([e[1] for e in ends])
-    c_start = np.array([s[0] for s in starts])
-    v_start = np.array([s[1] for s in starts])
-    gap = first[None, :] - last[:, None]  # [i, j]: frames from the end of i to the start of j
-    ii, jj = np.nonzero((gap >= 1) & (gap <= max_gap))
-    if not len(ii):
-        return empty
-    g = gap[ii, jj].astype(float)
-    # two motion hypotheses: constant velocity over the whole gap (spread grows with the jitter), or
-    # holding still (spread grows with the speed); each scored as a 2-D Gaussian negative log-likelihood
-    base = cfg.pos_sigma * size
-    forward = np.linalg.norm(c_end[ii] + v_end[ii] * g[:, None] - c_start[jj], axis=1)
-    backward = np.linalg.norm(c_start[jj] + v_start[jj] * g[:, None] - c_end[ii], axis=1)
-    spread_v = base + jitter * g
-    spread_h = base + speed * g
-    z_v = (forward + backward) / 2 / spread_v
-    z_h = np.linalg.norm(c_end[ii] - c_start[jj], axis=1) / spread_h
-    nll = np.minimum(0.5 * z_v**2 + 2 * np.log(spread_v / base), 0.5 * z_h**2 + 2 * np.log(spread_h / base))
-    z = np.minimum(z_v, z_h)
-    ok = z <= cfg.max_z
-    ii, jj, nll = ii[ok], jj[ok], nll[ok]
-    source = np.array([t.source_id for t in tracklets])
-    cut = (source[ii] == source[jj]) & (gap[ii, jj] == 1)  # a cut inside one input track (a contact)
-    cost = np.where(cut, cfg.continue_cost, cfg.link_cost) + nll
-    keep = _cheapest(ii, cost, cfg.candidates) | _cheapest(jj, cost, cfg.candidates)
-    return ii[keep], jj[keep], cost[keep]
-
-
-def _cheapest(group: np.ndarray, cost: np.ndarray, k: int) -> np.ndarray:
-    """Mask of the ``k`` cheapest entries of every group."""
-    order = np.lexsort((cost, group))
-    g = group[order]
-    start = np.r_[0, np.flatnonzero(np.diff(g)) + 1]
-    rank = np.arange(len(g)) - np.repeat(start, np.diff(np.r_[start, len(g)]))
-    mask = np.zeros(len(group), dtype=bool)
-    mask[order[rank < k]] = True
-    return mask
 
 
 def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
@@ -333,7 +128,7 @@ def _chain_position(block: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, 
     """Centres ``(k, 2)`` px of a chain (rows sorted by frame) interpolated at ``frames`` (held beyond its
     ends) and the distance (frames) from each to the chain's nearest row; inf where it has a row there."""
     f = block[:, 0]
-    c = _centres(block)
+    c = row_centres(block)
     pos = np.column_stack([np.interp(frames, f, c[:, 0]), np.interp(frames, f, c[:, 1])])
     idx = np.clip(np.searchsorted(f, frames), 0, len(f) - 1)
     near = np.minimum(np.abs(f[idx] - frames), np.abs(f[np.maximum(idx - 1, 0)] - frames))
@@ -362,7 +157,7 @@ def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[fl
                 continue
             base = cfg.pos_sigma * size
             spread = base + speed * near
-            z = float(np.mean(np.linalg.norm(pos - _centres(t.rows), axis=1) / spread))
+            z = float(np.mean(np.linalg.norm(pos - row_centres(t.rows), axis=1) / spread))
             nll = 0.5 * z**2 + 2 * float(np.mean(np.log(spread / base)))
             if z <= cfg.max_z and cfg.link_cost + nll < len(t):
                 pp.append(p)
@@ -407,7 +202,7 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
-    rows = _check_rows(rows)
+    rows = checked_rows(rows)
     pieces = split_tracklets(rows, cfg)
     if not pieces:
         unchanged: np.ndarray = rows.copy()
@@ -443,8 +238,8 @@ def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfi
     at most the frames in which a target typically moves ``smooth_move`` box sizes (median step between
     consecutive rows; box sizes √(w·h)), so slow targets are smoothed long and fast ones briefly."""
     cfg = config or ClosedSetConfig()
-    steps = _steps(rows)
-    size = float(np.mean(_sizes(rows))) if len(rows) else 1.0
+    steps = row_steps(rows)
+    size = float(np.mean(row_sizes(rows))) if len(rows) else 1.0
     step = float(np.median(steps)) if len(steps) else 0.0
     frames = cfg.smooth_s * frame_rate
     if step > 0:
@@ -459,7 +254,7 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
     ``vel_noise``: ``boxtrack``'s velocity noise (fraction of the box size per frame) when not its default
     (:class:`~lookalike.trackers.boxtrack.BoxTrack`'s hook; points as boxes use
     :data:`lookalike.io.points.POINT_VEL_NOISE`)."""
-    det_rows = _check_rows(det_rows)
+    det_rows = checked_rows(det_rows)
     tracker_obj = make_tracker(tracker, **params)
     if vel_noise is not None:
         if not isinstance(tracker_obj, BoxTrack):
