@@ -51,6 +51,14 @@ def cxcywh_to_xywh(cxcywh: np.ndarray) -> np.ndarray:
 _P, _V = np.arange(4), np.arange(4, 8)  # the value and velocity rows of an 8-number box state
 
 
+def _blocks(cov: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(k, 4)`` views of ``cov (k, 8, 8)``'s value/value, value/velocity, velocity/value and
+    velocity/velocity diagonals (``cov[:, _P, _P]`` …) by strides, without fancy-indexing copies
+    (views of ``cov`` itself when it is C-contiguous, so writing them writes ``cov``)."""
+    flat = cov.reshape(len(cov), 64)
+    return flat[:, 0:28:9], flat[:, 4:32:9], flat[:, 32:60:9], flat[:, 36:64:9]
+
+
 class BoxXYSR:
     """SORT's ``[u, v, s, r, u', v', s']`` (centre, area, aspect; pixels and pixels/frame) with the
     reference noise: ``R = diag(1, 1, 10, 10)``, ``P0 = diag(10, 10, 10, 10, 1e4, 1e4, 1e4)``,
@@ -122,31 +130,33 @@ class BoxCXCYWH:
         mean[:, 6:8] = np.where(mean[:, 2:4] + mean[:, 6:8] * steps <= 1.0, 0.0, mean[:, 6:8])  # sizes stay > 1
         mean_p = mean.copy()
         mean_p[:, :4] += steps * mean[:, 4:]
-        p11, p12, p21, p22 = cov[:, _P, _P], cov[:, _P, _V], cov[:, _V, _P], cov[:, _V, _V]
-        cov_p = cov.copy()
+        p11, p12, p21, p22 = _blocks(cov)
+        cov_p = np.array(cov, order="C")
+        q11, q12, q21, q22 = _blocks(cov_p)
         a = p12 + steps * p22
-        cov_p[:, _P, _P] = p11 + steps * p21 + steps * a + self.pos_noise**2 * var
-        cov_p[:, _P, _V] = a
-        cov_p[:, _V, _P] = p21 + steps * p22
-        cov_p[:, _V, _V] = p22 + self.vel_noise**2 * var
+        q11[...] = p11 + steps * p21 + steps * a + self.pos_noise**2 * var
+        q21[...] = p21 + steps * p22
+        q22[...] = p22 + self.vel_noise**2 * var
+        q12[...] = a
         return mean_p, cov_p
 
     def update(self, mean: np.ndarray, cov: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Kalman update with measurements ``z (k, 4)`` (noise :meth:`R` of their sizes) on the 2×2
         blocks; the same posterior as :func:`lookalike.motion.kalman.update`, to rounding."""
         std = self.pos_noise * np.concatenate((z[:, 2:4], z[:, 2:4]), axis=1)
-        p11, p12, p21, p22 = cov[:, _P, _P], cov[:, _P, _V], cov[:, _V, _P], cov[:, _V, _V]
+        p11, p12, p21, p22 = _blocks(cov)
         s = p11 + std * std
         k1, k2 = p11 / s, p21 / s
         innovation = z - mean[:, :4]
         mean_u = mean.copy()
         mean_u[:, :4] += k1 * innovation
         mean_u[:, 4:] += k2 * innovation
-        cov_u = cov.copy()
-        cov_u[:, _P, _P] = p11 - k1 * p11
-        cov_u[:, _P, _V] = p12 - k1 * p21
-        cov_u[:, _V, _P] = p21 - k2 * p11
-        cov_u[:, _V, _V] = p22 - k2 * p21
+        cov_u = np.array(cov, order="C")
+        u11, u12, u21, u22 = _blocks(cov_u)
+        u11[...] = p11 - k1 * p11
+        u12[...] = p12 - k1 * p21
+        u21[...] = p21 - k2 * p11
+        u22[...] = p22 - k2 * p21
         return mean_u, cov_u
 
 
