@@ -77,6 +77,7 @@ class BoxTrack:
         self._clutter = ClutterShare(const.CLUTTER_IOU, const.CLUTTER_MIN_COUNT)
         self._coasting = Coasting(const.COAST_S, const.COAST_REPORT_PROB, const.COAST_MIN_COUNT)
         self._fit = MotionFit(const.FIT_BATCH)
+        self._scaled: tuple[float, BoxCXCYWH] | None = None  # (fit scale, the space with its noise)
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
@@ -172,15 +173,20 @@ class BoxTrack:
         """The motion model with its process noise scaled by :class:`MotionFit` (variance factor)."""
         if self._fit.scale == 1.0:
             return self._space
-        r = float(np.sqrt(self._fit.scale))
-        return BoxCXCYWH(self._space.pos_noise * r, self._space.vel_noise * r)
+        if self._scaled is None or self._scaled[0] != self._fit.scale:
+            r = float(np.sqrt(self._fit.scale))
+            self._scaled = (self._fit.scale, BoxCXCYWH(self._space.pos_noise * r, self._space.vel_noise * r))
+        return self._scaled[1]
 
     def _observe_fit(self, tracks: np.ndarray, z: np.ndarray) -> None:
         """Centre innovations of confirmed ``tracks`` against their detections ``z`` (cx, cy, w, h)."""
         if len(tracks):
-            mean, cov = self._tracks.mean[tracks], self._tracks.cov[tracks]
-            S = cov[:, :2, :2] + np.einsum("ki,ij->kij", (self._space.pos_noise * z[:, 2:4]) ** 2, np.eye(2))
-            self._fit.observe(z[:, :2] - mean[:, :2], S)
+            t = self._tracks
+            cov = t.cov[tracks, :2, :2]
+            noise = self._space.pos_noise * z[:, 2:4]
+            noise *= noise  # the measurement variances of cx and cy, the diagonal of R
+            self._fit.observe_parts(z[:, :2] - t.mean[tracks, :2], cov[:, 0, 0] + noise[:, 0],
+                                    cov[:, 0, 1] + 0.0, cov[:, 1, 1] + noise[:, 1])
 
     def _births(self, new: np.ndarray, det_box: np.ndarray) -> np.ndarray:
         """Start tentative tracks on detections ``new``; returns the detections used."""

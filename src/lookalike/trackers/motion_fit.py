@@ -37,7 +37,13 @@ class MotionFit:
         """Centre innovations ``(k, 2)`` (pixels) of matched confirmed tracks and their covariances ``(k, 2, 2)``."""
         if len(innovation) == 0:
             return
-        a, b, d = S[:, 0, 0], S[:, 0, 1], S[:, 1, 1]
+        self.observe_parts(innovation, S[:, 0, 0], S[:, 0, 1], S[:, 1, 1])
+
+    def observe_parts(self, innovation: np.ndarray, a: np.ndarray, b: np.ndarray, d: np.ndarray) -> None:
+        """:meth:`observe` with the covariances given by their entries ``a = S[:, 0, 0]``, ``b = S[:, 0, 1]``
+        (= ``S[:, 1, 0]``) and ``d = S[:, 1, 1]``, each ``(k,)`` (pixels²)."""
+        if len(innovation) == 0:
+            return
         x, y = innovation[:, 0], innovation[:, 1]
         nis = (d * x * x - 2.0 * b * x * y + a * y * y) / (a * d - b * b)  # innovation' S^-1 innovation
         self._pending.append(nis)
