@@ -11,6 +11,11 @@ entry (the "tuned on this data" row) also gets the parameters chosen on the scor
 dataset's :data:`~lookalike.bench.presets.TUNED_PARAMS`, then the sequence's
 :data:`~lookalike.bench.presets.SEQUENCE_PARAMS`.
 
+On blob detections (:data:`BLOB_DATASETS`: the HexBug clips) ``boxtrack`` gets what
+``lookalike track --video V --detector blob`` gives it (:func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config`):
+the blob parameters for every parameter the entry does not give, and a closed set of the number of
+targets inferred from the blob counts, so the bench and the tuning score what a user runs.
+
 ``boxtrack-closed-offline`` runs the offline closed set (:func:`lookalike.trackers.closed_set.track_closed_set`)
 on the detections with boxtrack's defaults, as ``lookalike track --targets N --offline`` does.
 """
@@ -35,8 +40,11 @@ from lookalike.trackers import make_tracker
 from lookalike.trackers.closed_set import track_closed_set
 from lookalike.trackers.offline import OfflineConfig, postprocess
 from lookalike.types.mot_table import detection_rows as mot_detection_rows
+from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
+from lookalike.vision.blob_boxtrack import blob_boxtrack_config
 
 HEXBUG_RADIUS_PX = 120.0  # a box centre lies about half a bug from its head (benchmarks/hexbug_blobs.py)
+BLOB_DATASETS = frozenset({"hexbug"})  # detections from the blob detector (module doc)
 
 
 @dataclass(frozen=True)
@@ -111,17 +119,31 @@ def track_rows(entry: Entry, seq: RealSequence) -> np.ndarray:
     An ``offline`` entry's rows are post-processed with :class:`OfflineConfig`'s defaults."""
     if entry.kind == "peer":
         return run_peer(entry.name, seq)
+    params = entry_params(entry, seq)
+    blob_boxtrack = entry.name == "boxtrack" and seq.dataset in BLOB_DATASETS
     if entry.closed_offline and seq.n_targets is not None:
-        online = {k: v for k, v in entry_params(entry, seq).items() if k != "max_targets"}
+        online = {k: v for k, v in params.items() if k != "max_targets"}
+        if blob_boxtrack:  # as lookalike track --detector blob --offline
+            online = {**BOX_TRACKER_PARAMS, **online}
         return track_closed_set(detection_rows(seq), seq.n_targets, seq.frame_rate, n_frames=seq.length,
                                 online=online)
-    tracker = make_tracker(entry.name, **entry_params(entry, seq))
+    tracker = make_tracker(entry.name, **params)
+    if blob_boxtrack:
+        tracker = type(tracker)(blob_tracker_config(tracker.config, seq, params))
     collect = RowCollector()
     run(tracker, seq.frames(), collect)
     rows = collect.rows()
     if entry.offline:
         rows = postprocess(rows, seq.frame_rate, OfflineConfig())
     return rows
+
+
+def blob_tracker_config(config: Any, seq: RealSequence, params: dict[str, Any]) -> Any:
+    """The ``boxtrack`` configuration ``lookalike track --detector blob`` runs on ``seq``'s blob
+    detections when the user gives ``params`` (:func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config`;
+    a sequence's documented count is the known number of targets)."""
+    counts = np.array([len(x) for x in seq.det_xywh], dtype=int)
+    return blob_boxtrack_config(config, counts, params.keys(), seq.n_targets).config
 
 
 def detection_rows(seq: RealSequence) -> np.ndarray:
@@ -186,7 +208,8 @@ def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, wor
         return [p.result() for p in [pool.submit(_run_pair, e, shared[id(s)]) for e, s in jobs]]
 
 
-__all__ = ["HEXBUG_RADIUS_PX", "SEQUENCE_PARAMS", "TUNED_LABEL", "TUNED_PARAMS",
-           "Entry", "base_name", "default_entries", "detection_rows", "entry_params", "params_entry", "job_pairs",
+__all__ = ["BLOB_DATASETS", "HEXBUG_RADIUS_PX", "SEQUENCE_PARAMS", "TUNED_LABEL", "TUNED_PARAMS",
+           "Entry", "base_name", "blob_tracker_config",
+           "default_entries", "detection_rows", "entry_params", "params_entry", "job_pairs",
            "map_jobs", "run_job", "run_jobs", "score_rows",
            "sequence_params", "track_rows"]

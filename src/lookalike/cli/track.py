@@ -263,8 +263,8 @@ def track(
                 from lookalike.cli.track_blobs import run_track_blobs
 
                 run_track_blobs(video, output, trk, tracker, detector or "", blob or [],
-                                n_targets=0 if open_set else targets,
-                                offline=online, **video_options)
+                                n_targets=0 if open_set else targets, offline=online,
+                                explicit=tracker_params(tracker, settings, params_file).keys(), **video_options)
             else:
                 det_path = detections or path
                 assert det_path is not None

@@ -9,15 +9,15 @@ file ``<output stem>.det.txt`` beside the result; that file feeds the ordinary `
 annotated video) or, with ``--offline``, the closed set (:func:`~lookalike.cli.track_closed.offline_video`).
 
 Blob detections are a different kind of input from a trained detector's (docs/blobs.md): ``boxtrack``
-gets :data:`~lookalike.vision.blob_auto.BOX_TRACKER_PARAMS` where the user set nothing else, and,
-without ``--targets``, a closed set of the number of targets inferred from the blob count per frame
-when one count holds in a majority of the frames (printed; ``--targets 0`` keeps the open set).
-Not a command of its own.
+gets :func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config` (the rule the benches share:
+:data:`~lookalike.vision.blob_auto.BOX_TRACKER_PARAMS` for every parameter the user did not give, and,
+without ``--targets``, a closed set of the number of targets inferred from the blob count per frame;
+the inference is printed, ``--targets 0`` keeps the open set). Not a command of its own.
 """
 
 from __future__ import annotations
 
-import dataclasses
+from collections.abc import Collection
 from pathlib import Path
 from typing import Any
 
@@ -25,7 +25,8 @@ from lookalike.cli.app import console, fail
 from lookalike.cli.track_closed import offline_video
 from lookalike.cli.track_video import run_track_onnx, run_track_video
 from lookalike.io import write_mot
-from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, frame_counts, infer_target_count
+from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, frame_counts
+from lookalike.vision.blob_boxtrack import blob_boxtrack_config
 from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows
 from lookalike.viz.overlay import source_frames
 
@@ -34,11 +35,12 @@ DETECTORS = ("blob",)
 
 def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, detector: str,
                     settings: list[str], *, n_targets: int | None = None, offline: dict[str, Any] | None = None,
-                    **options: Any) -> None:
+                    explicit: Collection[str] = (), **options: Any) -> None:
     """Detect blobs on ``video``, write them to ``<output stem>.det.txt``, then track them as
     :func:`~lookalike.cli.track_video.run_track_video` does (``options`` are passed on to it) or, with
     ``offline`` (the online pass's parameters), by the offline closed set of ``n_targets``.
-    ``n_targets`` None: inferred from the blob counts for ``boxtrack`` (module doc); 0: an open set."""
+    ``n_targets`` None: inferred from the blob counts for ``boxtrack`` (module doc); 0: an open set.
+    ``explicit``: the tracker parameters the user gave (``--set``, ``--params``), kept as given."""
     if detector.lower().endswith(".onnx"):
         return run_track_onnx(video, output, tracker, tracker_name, Path(detector), settings, n_targets=n_targets,
                               offline=offline, **options)
@@ -74,24 +76,11 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
         offline_video(det_path, output, n_targets, offline, float(frame_rate), frames, options["min_score"])
         return
     if tracker_name == "boxtrack":
-        if n_targets is None and tracker.config.max_targets is None:
-            count = infer_target_count(frame_counts(rows, frames))
-            console.print(count.summary, markup=False)
-            if count.closed:
-                n_targets = count.n
-                if options.get("team_size") is None:
-                    options["team_size"] = n_targets
-        tracker = blob_box_tracker(tracker, n_targets or None)
+        plan = blob_boxtrack_config(tracker.config, frame_counts(rows, frames), explicit, n_targets)
+        if plan.count is not None:
+            console.print(plan.count.summary, markup=False)
+        if plan.n_targets and options.get("team_size") is None:
+            options["team_size"] = plan.n_targets
+        if plan.config != tracker.config:
+            tracker = type(tracker)(plan.config)
     run_track_video(video, det_path, output, tracker, tracker_name, **options)
-
-
-def blob_box_tracker(tracker: Any, n_targets: int | None) -> Any:
-    """``tracker`` (a :class:`~lookalike.trackers.BoxTrack`) for blob detections: each parameter of
-    :data:`~lookalike.vision.blob_auto.BOX_TRACKER_PARAMS` replaces the default where the user left the
-    default, and ``n_targets`` (when given) becomes ``max_targets`` unless one is set."""
-    config = tracker.config
-    default = type(config)()
-    changes: dict[str, Any] = {k: v for k, v in BOX_TRACKER_PARAMS.items() if getattr(config, k) == getattr(default, k)}
-    if n_targets and config.max_targets is None:
-        changes["max_targets"] = n_targets
-    return type(tracker)(dataclasses.replace(config, **changes)) if changes else tracker
