@@ -109,10 +109,12 @@ class BoxTrack:
         matched = hit.nonzero()[0]
         if len(matched):
             d = det_of_track[matched]
-            self._observe_fit(matched[t.confirmed[matched]], det_box[d[t.confirmed[matched]]])
-            t.mean[matched], t.cov[matched] = self._space.update(t.mean[matched], t.cov[matched], det_box[d])
+            z = det_box[d]
+            conf = t.confirmed[matched]
+            self._observe_fit(matched[conf], z[conf])
+            t.mean[matched], t.cov[matched] = self._space.update(t.mean[matched], t.cov[matched], z)
             t.hits[matched] += 1
-            back = matched[t.confirmed[matched] & (t.misses[matched] > 0)]
+            back = matched[conf & (t.misses[matched] > 0)]
             if len(back):
                 self._coasting.observe(came_back=t.misses[back])
         t.hits[~hit] = 0
@@ -153,17 +155,16 @@ class BoxTrack:
         ], len(t), len(score))
         self._calibration.observe_continued(score, matching.det_of_track[matching.det_of_track >= 0])
         stages = [Stage(~t.confirmed, high, overlap(cfg.match_iou, False), name="tentative")]
-        if self._slots is not None:  # gates in track heights
-            gate = self._slots.gate(unseen_s)
-        else:  # in fitted standard deviations: a model that fits badly (MotionFit) widens the gate
-            gate = np.full((len(t), 1), const.REID_DISTANCE * np.sqrt(self._fit.scale))
-
-        track_box, box, scale = t.mean[:, :4], det_box, cfg.reid_scale
-        if self._slots is not None:  # closed set: sizes as sqrt(w·h), a turning target keeps its size
-            track_box, box = self._slots.squared(track_box), self._slots.squared(det_box)
-            scale = max(scale, const.CLOSED_SCALE)
+        slots = self._slots
 
         def reid(r: np.ndarray, c: np.ndarray) -> np.ndarray:
+            # built only when some lost track and confident detection are left
+            if slots is not None:  # closed set: sizes as sqrt(w·h), a turning target keeps its size; gates in heights
+                track_box, box = slots.squared(t.mean[:, :4]), slots.squared(det_box)
+                gate, scale = slots.gate(unseen_s), max(cfg.reid_scale, const.CLOSED_SCALE)
+            else:  # in fitted standard deviations: a model that fits badly (MotionFit) widens the gate
+                track_box, box, scale = t.mean[:, :4], det_box, cfg.reid_scale
+                gate = np.full((len(t), 1), const.REID_DISTANCE * np.sqrt(self._fit.scale))
             return centre_distance_cost(track_box[r], box[c], gate[r], scale)
 
         stages.append(Stage(t.confirmed, high, reid, name="re-identification"))
@@ -205,10 +206,9 @@ class BoxTrack:
         missed = (t.confirmed & (det_of_track < 0)).nonzero()[0]
         coasted = missed[self._coasting.decide(t.misses[missed])] if len(missed) else missed
         original = det_idx[det_of_track[shown]]
-        boxes = cxcywh_to_xywh(t.mean[shown, :4])
         if len(coasted):  # missed this frame but likely still there: the predicted box, no detection
             shown = np.concatenate([shown, coasted])
             original = np.concatenate([original, np.full(len(coasted), -1)])
-            boxes = np.vstack([boxes, cxcywh_to_xywh(t.mean[coasted, :4])])
+        boxes = cxcywh_to_xywh(t.mean[shown, :4])
         return Tracks.trusted(t.ids[shown], np.ones(len(shown), dtype=np.int8), boxes,
                               t.mean[shown, 4:6] / self._clock.interval, original)
