@@ -86,8 +86,12 @@ def assign_pairs(cost: np.ndarray, max_cost: float = np.inf) -> np.ndarray:
     return matches
 
 
+_NONE = np.zeros(0, dtype=int)
+_NONE.flags.writeable = False  # shared by every empty result
+
+
 def _solve(c: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray]:
-    none = np.zeros(0, dtype=int)
+    none = _NONE
     if c.size == 0:
         return none, none
     allowed = c <= max_cost if np.isfinite(max_cost) else c < np.inf

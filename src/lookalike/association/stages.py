@@ -84,9 +84,9 @@ def _eligible(selector: np.ndarray | None, allowed: np.ndarray) -> np.ndarray:
     if selector is None:
         out: np.ndarray = allowed.nonzero()[0]
         return out
-    sel = np.asarray(selector)
+    sel = selector if type(selector) is np.ndarray else np.asarray(selector)
     if sel.dtype == bool:
-        return (sel & allowed).nonzero()[0]  # type: ignore[no-any-return]
+        return np.logical_and(sel, allowed).nonzero()[0]  # type: ignore[no-any-return]
     idx: np.ndarray = sel.astype(int)
     out = idx[allowed[idx]]
     return out
