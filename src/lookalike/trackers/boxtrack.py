@@ -112,7 +112,10 @@ class BoxTrack:
             z = det_box[d]
             conf = t.confirmed[matched]
             self._observe_fit(matched[conf], z[conf])
-            t.mean[matched], t.cov[matched] = self._space.update(t.mean[matched], t.cov[matched], z)
+            if len(matched) == len(t):  # every track matched: no gather and scatter
+                t.mean, t.cov = self._space.update(t.mean, t.cov, z)
+            else:
+                t.mean[matched], t.cov[matched] = self._space.update(t.mean[matched], t.cov[matched], z)
             t.hits[matched] += 1
             back = matched[conf & (t.misses[matched] > 0)]
             if len(back):
