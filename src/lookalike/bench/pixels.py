@@ -27,6 +27,7 @@ The detector and heading models are those shipped in ``lookalike/vision/models_d
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -166,7 +167,8 @@ def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipel
             predicted.append(result.labels)
             positions.append(agent_positions(result.tracks, n_agents))
 
-        step = _Identify(RobotPipeline(pipe.detector, pipe.heading, camera, _identifier(name, p.sequence, camera)), p)
+        config = _identifier(name, p.sequence, camera)
+        step = _Identify(RobotPipeline(pipe.detector, pipe.heading, camera, config, pipe.probability), p)
         run(step, range(len(p.detections)), sink, stats=stats)
         truth.extend(p.truth)
     return IdentScore(identification_success_rate(predicted, truth), _localisation(positions, perceived),
@@ -193,6 +195,13 @@ def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camer
                       sum(len(t) for t in truth), stats.fps)
 
 
+def perception_pipeline(pipe: RobotPipeline, n_agents: int, max_detections: int) -> RobotPipeline:
+    """``pipe``'s detector, heading model, camera and detection probability, keeping up to the set-up's M
+    (``max_detections``) detections per frame for its N robots."""
+    config = dataclasses.replace(pipe.config, n_agents=n_agents, max_detections=max_detections)
+    return RobotPipeline(pipe.detector, pipe.heading, pipe.camera, config, pipe.probability)
+
+
 def pixels_table(setups: list[str], identifiers: list[str], sequences: int, frames: int, seed: int,
                  pipe: RobotPipeline, camera: Camera, min_iou: float,
                  progress: ProgressFactory | None = None
@@ -203,8 +212,9 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
     for setup in setups:
         cfg = world_for_camera(preset(setup), camera)
         advance = progress(f"{setup}: rendering + perception", sequences * frames) if progress else None
+        seeing = perception_pipeline(pipe, cfg.n_agents, cfg.max_detections)
         perceived = [
-            perceive_sequence(pipe, simulate_robots(cfg, frames, seed + 1000 * PRESET_NAMES.index(setup) + k),
+            perceive_sequence(seeing, simulate_robots(cfg, frames, seed + 1000 * PRESET_NAMES.index(setup) + k),
                               camera, min_iou, min_visible=0.5, advance=advance)
             for k in range(sequences)
         ]
@@ -254,4 +264,5 @@ def pixels_results(rows: list[dict[str, Any]], perception: list[dict[str, Any]],
 
 
 __all__ = ["DEFAULT_SEED", "PERCEPTION_COLUMNS", "PIXEL_COLUMNS", "PIXEL_KEYS", "IdentScore", "PerceivedSequence",
-           "match_truth", "perceive_sequence", "pixels_results", "pixels_table", "score_pixels", "score_simulated"]
+           "match_truth", "perceive_sequence", "perception_pipeline", "pixels_results", "pixels_table", "score_pixels",
+           "score_simulated"]

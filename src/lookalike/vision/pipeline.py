@@ -20,7 +20,7 @@ identifiers (as ``lookalike bench pixels`` does).
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
@@ -147,12 +147,20 @@ def check_image(image: np.ndarray, size: tuple[int, int] | None = None, name: st
 
 
 class RobotPipeline:
-    """Detector → heading classifier → ground projection → identifier, one frame at a time."""
+    """Detector → heading classifier → ground projection → identifier, one frame at a time.
+
+    ``probability``: a map from the detector's last-stage margins to the probability given to the
+    identifier (:class:`~lookalike.vision.detection_probability.DetectionProbability`), used when the
+    detector has ``boxes_and_margins`` (the HOG cascade); ``None`` keeps the detector's own score. Which
+    boxes are kept (``min_score`` on the detector's own score, the ``max_detections`` with the largest
+    margins) does not depend on it."""
 
     def __init__(self, detector: Detector, heading: HeadingModel, camera: Camera | None = None,
-                 config: PipelineConfig | None = None) -> None:
+                 config: PipelineConfig | None = None,
+                 probability: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
         self.detector = detector
         self.heading = heading
+        self.probability = probability
         self.camera = camera if camera is not None else Camera.default()
         if not isinstance(self.camera, Camera):
             raise ValueError(f"camera: expected a lookalike.geometry.Camera, got {type(self.camera).__name__}")
@@ -165,15 +173,23 @@ class RobotPipeline:
 
     @classmethod
     def from_files(cls, detector_path: str | Path | None = None, heading_path: str | Path | None = None,
-                   camera: Camera | None = None, config: PipelineConfig | None = None) -> RobotPipeline:
+                   camera: Camera | None = None, config: PipelineConfig | None = None,
+                   probability_path: str | Path | None = None) -> RobotPipeline:
         """A pipeline with models written by ``lookalike train-detector`` and ``lookalike train-heading``
-        (``None``: the models shipped with the package, see :func:`shipped_model_path`)."""
+        (``None``: the models shipped with the package, see :func:`shipped_model_path`). The detection
+        probability map is read from ``probability_path``; without one, the shipped map is used with the
+        shipped detector (its margins are that detector's), none with another detector."""
+        from lookalike.vision.detection_probability import DetectionProbability, shipped_detection_probability
         from lookalike.vision.heading import HeadingClassifier
         from lookalike.vision.hog_cascade import HogCascade
 
         det = HogCascade.load(detector_path if detector_path is not None else shipped_model_path("detector"))
         head = HeadingClassifier.load(heading_path if heading_path is not None else shipped_model_path("heading"))
-        return cls(det, head, camera, config)
+        if probability_path is not None:
+            probability: DetectionProbability | None = DetectionProbability.load(probability_path)
+        else:
+            probability = shipped_detection_probability() if detector_path is None else None
+        return cls(det, head, camera, config, probability)
 
     def reset(self) -> None:
         """Start a new video: the identifier forgets its tracks and the frame counter restarts."""
@@ -192,19 +208,20 @@ class RobotPipeline:
             raise ValueError(f"observer_yaw_rad: must be finite, got {observer_yaw_rad!r}")
         if cfg.detect_scale != 1.0:
             size = (round(k.width * cfg.detect_scale), round(k.height * cfg.detect_scale))
-            det = self.detector(cv2.resize(img, size, interpolation=cv2.INTER_LINEAR))
+            img_det = cv2.resize(img, size, interpolation=cv2.INTER_LINEAR)
         else:
-            det = self.detector(img)
-        assert det.xywh is not None and det.score is not None  # detectors fill boxes and scores
-        xywh = det.xywh / cfg.detect_scale if cfg.detect_scale != 1.0 else det.xywh
-        score = det.score
+            img_det = img
+        xywh, score, rank = self._detect(img_det)
+        xywh = xywh / cfg.detect_scale if cfg.detect_scale != 1.0 else xywh
         keep = (score >= cfg.min_score) & (xywh[:, 2] > 0) & (xywh[:, 3] > 0)
-        xywh, score = xywh[keep], score[keep]
+        xywh, score, rank = xywh[keep], score[keep], rank[keep]
         position = self.ground_positions(xywh)
         ok = np.isfinite(position).all(axis=1)
-        xywh, score, position = xywh[ok], score[ok], position[ok]
-        order = np.argsort(-score, kind="stable")[: cfg.max_detections]
-        xywh, score, position = xywh[order], score[order], position[order]
+        xywh, score, rank, position = xywh[ok], score[ok], rank[ok], position[ok]
+        order = np.lexsort((-rank, -score))[: cfg.max_detections]
+        xywh, score, rank, position = xywh[order], score[order], rank[order], position[order]
+        if self.probability is not None and self._has_margins():
+            score = np.asarray(self.probability(rank), float)
         if len(xywh):
             est = self.heading(img, xywh)
             heading = np.angle(np.exp(1j * (np.asarray(est.heading_rad, float) + observer_yaw_rad)))
@@ -212,6 +229,20 @@ class RobotPipeline:
         else:
             heading, heading_std = np.zeros(0), np.zeros(0)
         return Detections(xywh=xywh, score=score, position=position, heading=heading, heading_std=heading_std)
+
+    def _has_margins(self) -> bool:
+        return callable(getattr(self.detector, "boxes_and_margins", None))
+
+    def _detect(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Boxes ``(n, 4)`` px, the detector's own scores and a tie-breaking rank (the last-stage margin
+        when the detector gives one, else the score)."""
+        if self.probability is not None and self._has_margins():
+            boxes, margins = self.detector.boxes_and_margins(image)  # type: ignore[attr-defined]
+            own = self.detector.probability(margins)  # type: ignore[attr-defined]
+            return np.asarray(boxes, float).reshape(-1, 4), np.asarray(own, float), np.asarray(margins, float)
+        det = self.detector(image)
+        assert det.xywh is not None and det.score is not None  # detectors fill boxes and scores
+        return det.xywh, det.score, det.score
 
     def ground_positions(self, xywh: np.ndarray) -> np.ndarray:
         """Egocentric ground positions ``(n, 2)`` (m) of boxes ``(n, 4)`` (px): the bottom-centre on the

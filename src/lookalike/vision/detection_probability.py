@@ -1,0 +1,91 @@
+"""A detector's last-stage margin → the detection probability the identifiers were trained on.
+
+The HOG cascade's own probability (a logistic fit of its last-stage margin) rounds to 1 for nearly
+every box it keeps, while the simulator's detector score, which the learned identifiers read as an
+input, spreads over (0, 1). :class:`DetectionProbability` is a monotone piecewise-linear map from
+margin to probability (knots ``margin`` → ``probability``, clipped at both ends), so the order of the
+detections is kept and only the value given to the identifier changes. It is fitted by quantile
+mapping (:func:`fit_quantile_map`): the margin at quantile q of the pixel detections is mapped to the
+simulator's score at quantile q.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+SHIPPED_PROBABILITY = Path(__file__).resolve().parent / "models_data" / "robot_detection_probability.json"
+
+
+@dataclass(frozen=True)
+class DetectionProbability:
+    """Monotone map from last-stage margin (the cascade's unit) to a probability in [0, 1].
+
+    Attributes:
+        margin: ``(k,)`` increasing knot margins.
+        probability: ``(k,)`` non-decreasing probabilities at the knots.
+        fitted_on: how the knots were fitted (seeds, counts, command), kept in the file.
+    """
+
+    margin: tuple[float, ...]
+    probability: tuple[float, ...]
+    fitted_on: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        m, p = np.asarray(self.margin, float), np.asarray(self.probability, float)
+        if m.ndim != 1 or len(m) < 2 or m.shape != p.shape:
+            raise ValueError(f"DetectionProbability: need two equal-length lists of at least 2 knots, got "
+                             f"{m.shape} and {p.shape}")
+        if not (np.isfinite(m).all() and np.isfinite(p).all()) or (np.diff(m) < 0).any() or (np.diff(p) < 0).any():
+            raise ValueError("DetectionProbability: knots must be finite and non-decreasing")
+        if p[0] < 0 or p[-1] > 1:
+            raise ValueError(f"DetectionProbability: probabilities must be in [0, 1], got {p[0]}..{p[-1]}")
+
+    def __call__(self, margins: np.ndarray) -> np.ndarray:
+        """Probabilities ``(n,)`` of last-stage ``margins`` ``(n,)`` (linear between knots, clipped outside)."""
+        return np.interp(np.asarray(margins, float), np.asarray(self.margin), np.asarray(self.probability))
+
+    def save(self, path: str | Path) -> None:
+        """Write the knots and ``fitted_on`` as JSON."""
+        doc = {"margin": list(self.margin), "probability": list(self.probability), "fitted_on": self.fitted_on}
+        Path(path).write_text(json.dumps(doc, indent=1) + "\n")
+
+    @classmethod
+    def load(cls, path: str | Path) -> DetectionProbability:
+        """Read a file written by :meth:`save`; anything else raises ``ValueError`` naming ``path``."""
+        try:
+            doc = json.loads(Path(path).read_text())
+            return cls(tuple(map(float, doc["margin"])), tuple(map(float, doc["probability"])),
+                       dict(doc.get("fitted_on", {})))
+        except (OSError, json.JSONDecodeError, KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"{path}: not a detection-probability file ({exc})") from None
+
+
+def fit_quantile_map(margins: np.ndarray, target_scores: np.ndarray, knots: int = 101,
+                     fitted_on: dict[str, Any] | None = None) -> DetectionProbability:
+    """Quantile mapping: the margin at quantile q of ``margins`` → the value at quantile q of
+    ``target_scores`` (e.g. the simulator's detector scores), at ``knots`` evenly spaced quantiles.
+    Tied margin knots are merged (the highest probability kept) so the map stays a function."""
+    m, s = np.asarray(margins, float).ravel(), np.asarray(target_scores, float).ravel()
+    if len(m) < 2 or len(s) < 2:
+        raise ValueError(f"fit_quantile_map: need at least 2 margins and 2 target scores, got {len(m)}, {len(s)}")
+    q = np.linspace(0.0, 1.0, int(knots))
+    km, kp = np.quantile(m, q), np.clip(np.quantile(s, q), 0.0, 1.0)
+    km, first = np.unique(km, return_index=True)
+    last = np.append(first[1:] - 1, len(kp) - 1)
+    kp = kp[last]
+    if len(km) < 2:
+        raise ValueError("fit_quantile_map: all margins are equal")
+    return DetectionProbability(tuple(km.tolist()), tuple(kp.tolist()), dict(fitted_on or {}))
+
+
+def shipped_detection_probability() -> DetectionProbability | None:
+    """The map shipped beside the detector (``models_data/robot_detection_probability.json``), ``None`` if absent."""
+    return DetectionProbability.load(SHIPPED_PROBABILITY) if SHIPPED_PROBABILITY.is_file() else None
+
+
+__all__ = ["SHIPPED_PROBABILITY", "DetectionProbability", "fit_quantile_map", "shipped_detection_probability"]
