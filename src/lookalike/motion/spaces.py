@@ -126,16 +126,26 @@ class BoxCXCYWH:
         size = np.maximum(mean[:, 2:4], 1.0)
         sq = size * size
         var = np.concatenate((sq, sq), axis=1)  # (k, 4) for [cx, cy, w, h]
-        var *= max(steps, 0.0)
-        mean[:, 6:8] = np.where(mean[:, 2:4] + mean[:, 6:8] * steps <= 1.0, 0.0, mean[:, 6:8])  # sizes stay > 1
-        mean_p = mean.copy()
-        mean_p[:, :4] += steps * mean[:, 4:]
         p11, p12, p21, p22 = _blocks(cov)
+        if steps == 1.0:  # x * 1.0 == x exactly: the same numbers without the multiplications by steps
+            mean[:, 6:8][mean[:, 2:4] + mean[:, 6:8] <= 1.0] = 0.0  # sizes stay > 1
+            mean_p = mean.copy()
+            mean_p[:, :4] += mean[:, 4:]
+            a = p12 + p22
+            v11 = p11 + p21 + a
+            v21 = p21 + p22
+        else:
+            var *= max(steps, 0.0)
+            mean[:, 6:8][mean[:, 2:4] + mean[:, 6:8] * steps <= 1.0] = 0.0
+            mean_p = mean.copy()
+            mean_p[:, :4] += steps * mean[:, 4:]
+            a = p12 + steps * p22
+            v11 = p11 + steps * p21 + steps * a
+            v21 = p21 + steps * p22
         cov_p = np.array(cov, order="C")
         q11, q12, q21, q22 = _blocks(cov_p)
-        a = p12 + steps * p22
-        q11[...] = p11 + steps * p21 + steps * a + self.pos_noise**2 * var
-        q21[...] = p21 + steps * p22
+        q11[...] = v11 + self.pos_noise**2 * var
+        q21[...] = v21
         q22[...] = p22 + self.vel_noise**2 * var
         q12[...] = a
         return mean_p, cov_p
