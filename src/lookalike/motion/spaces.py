@@ -43,8 +43,9 @@ def xyah_to_xywh(xyah: np.ndarray) -> np.ndarray:
 def cxcywh_to_xywh(cxcywh: np.ndarray) -> np.ndarray:
     """``(n, 4)`` centre/size boxes to left/top/width/height, sizes floored at 1e-3 pixels."""
     out = np.array(cxcywh, dtype=float).reshape(-1, 4)
-    out[:, 2:] = np.maximum(out[:, 2:], 1e-3)
-    out[:, :2] -= out[:, 2:] / 2
+    size = out[:, 2:]
+    np.maximum(size, 1e-3, out=size)
+    out[:, :2] -= size / 2
     return out
 
 
