@@ -1,11 +1,12 @@
 """boxtrack's defaults by leave-one-dataset-out (issue 16): the candidates, the choice per fold, the choice on all.
 
 Datasets: MOT15's 7 sequences, the pigs, mot17-synth and the HexBug clips with videos (the blob
-detector's boxes, cached on disk after the first run). Criterion fixed before scoring: HOTA + IDF1 +
-MOTA summed, the mean over datasets of each dataset's combined sum. Candidates: ``clutter_factor``
-in {2, None, 1, 3, 4} x ``max_age_s`` in {1, 2, 3} x ``n_init`` in {3, 2}, each with the clutter
-share judged after each of ``--min-counts`` detections (a constant of the code, patched in this
-process). Every candidate is scored once per sequence;
+detector's boxes, cached on disk after the first run; boxtrack runs on them as ``lookalike track
+--detector blob`` does, :func:`lookalike.vision.blob_boxtrack.blob_boxtrack_config`). Criterion
+fixed before scoring: HOTA + IDF1 + MOTA summed, the mean over datasets of each dataset's combined
+sum. Candidates: ``clutter_factor`` in {2, None, 1, 3, 4} x ``max_age_s`` in {1, 2, 3} x ``n_init``
+in {3, 2}, each with the clutter share judged after each of ``--min-counts`` detections (a constant
+of the code, patched in this process). Every candidate is scored once per sequence;
 each fold's choice is the best candidate on the other datasets
 (:func:`lookalike.tune.select_from_table`) and is scored on the left-out one. The defaults boxtrack
 ships are the choice on all datasets; the left-out figures are the headline (docs/trackers/boxtrack.md).
