@@ -120,11 +120,13 @@ class BoxTrack:
             back = matched[conf & (t.misses[matched] > 0)]
             if len(back):
                 self._coasting.observe(came_back=t.misses[back])
-        t.hits[~hit] = 0
+        np.multiply(t.hits, hit, out=t.hits)  # a miss resets the hit count
         if self._slots is not None:
             self._slots.observe_speed(t, hit, self._clock.interval)
         t.record(hit, dt)
-        ready = (t.hits >= cfg.n_init) | ((self._frame_count == 1) & (t.hits > 0))
+        ready = t.hits >= cfg.n_init
+        if self._frame_count == 1:
+            ready |= t.hits > 0
         if self._slots is None:
             t.confirmed |= ready
         else:
