@@ -54,3 +54,10 @@ def test_map_changes_only_the_probability_not_the_detections():
     assert seen > 0
     wide = perception_pipeline(mapped, n_agents=7, max_detections=10)
     assert wide.config.max_detections == 10 and wide.config.n_agents == 7 and wide.probability is half
+
+
+def test_fit_command_refuses_an_unknown_preset(tmp_path, capsys):
+    from lookalike.bench.pixel_probability import main
+
+    assert main(["-o", str(tmp_path / "p.json"), "--pixel-setups", "nope"]) == 2
+    assert "nope" in capsys.readouterr().err and not (tmp_path / "p.json").exists()
