@@ -171,16 +171,12 @@ class MotWriter:
 
     def write_rows(self, rows: np.ndarray) -> None:
         """Append result rows ``(k, 10)``; ``ValueError`` naming the frame for a NaN or infinite frame,
-        id, box or score (a file :func:`~lookalike.io.read_mot` would refuse is never written)."""
+        id, box or score (a file :func:`~lookalike.io.read_mot` would refuse is never written; checked
+        a block at a time, when the block is written)."""
         if self._fh is None:
             raise ValueError(f"{self.path}: writer already closed")
         if len(rows):
-            rows = np.array(rows, dtype=float)  # a copy: the caller may reuse its array
-            bad = ~np.isfinite(rows[:, :7]).all(axis=1)
-            if bad.any():
-                raise ValueError(f"{self.path}: the tracker produced a NaN or infinite box at frame "
-                                 f"{rows[bad][0, 0]:g} (from a degenerate detection?); nothing written")
-            self._pending.append(rows)
+            self._pending.append(np.array(rows, dtype=float))  # a copy: the caller may reuse its array
             self._pending_rows += len(rows)
             if self._pending_rows >= WRITE_ROWS:
                 self._flush()
@@ -189,6 +185,10 @@ class MotWriter:
     def _flush(self) -> None:
         if self._fh is not None and self._pending:
             block = self._pending[0] if len(self._pending) == 1 else np.vstack(self._pending)
+            bad = ~np.isfinite(block[:, :7]).all(axis=1)
+            if bad.any():
+                raise ValueError(f"{self.path}: the tracker produced a NaN or infinite box at frame "
+                                 f"{block[bad][0, 0]:g} (from a degenerate detection?); nothing written")
             self._fh.write(format_rows(block))
         self._pending, self._pending_rows = [], 0
 
