@@ -95,19 +95,22 @@ def train(
         fail(f"--model: unknown model {model!r}; known: lstm, set")
     if recordings is not None and search is not None:
         fail("--recordings and --search: choose one")
+    run: dict[str, Any] = dict(  # the options every training run shares (cli.train_options.RunOptions)
+        steps=steps, minutes=minutes, batch_size=batch_size, sequence_length=sequence_length, seed=seed,
+        patience=patience, validate_every=validate_every, threads=threads, workers=workers, backend=backend,
+        address=address)
     if recordings is not None:
         from lookalike.cli.train_recordings import RecordingOptions, train_recordings
 
         train_recordings(recordings, output, RecordingOptions(
-            init_from, steps, minutes, batch_size, sequence_length, seed, patience, threads, learning_rate,
-            validation_fraction, validate_every, device, workers, backend, address, resume, test, mix_sim))
+            **run, init_from=init_from, learning_rate=learning_rate, validation_fraction=validation_fraction,
+            device=device, resume=resume, test=test, sim_fraction=mix_sim))
         return
     if search is not None:
         from lookalike.cli.train_search import SearchOptions, train_search
 
         train_search(search, output, preset_name, SearchOptions(
-            steps, minutes, batch_size, sequence_length, seed, patience, validate_every, cell, relative, workers,
-            backend, address, sampler, study, threads, space))
+            **run, cell=cell, relative=relative, sampler=sampler, study=study, space=space))
         return
     if model == "set":
         _train_set(output, steps, minutes, batch_size, seed, patience, threads, device, workers, backend, address,

@@ -6,30 +6,20 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lookalike.cli.app import console, fail
+from lookalike.cli.train_options import RunOptions
 from lookalike.sim import RobotSequence
 
 PATTERN = "*.labelled.jsonl"
 
 
 @dataclass(frozen=True)
-class RecordingOptions:
+class RecordingOptions(RunOptions):
     """The ``lookalike train`` options that apply with ``--recordings``."""
 
     init_from: Path | None
-    steps: int
-    minutes: float | None
-    batch_size: int
-    sequence_length: int
-    seed: int
-    patience: int
-    threads: int
     learning_rate: float | None
     validation_fraction: float
-    validate_every: int
     device: str
-    workers: int
-    backend: str
-    address: str | None
     resume: bool
     test: Path | None
     sim_fraction: float = 0.0

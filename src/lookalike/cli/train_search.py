@@ -10,27 +10,17 @@ from typing import Any
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from lookalike.cli.app import console, fail
+from lookalike.cli.train_options import RunOptions
 
 
 @dataclass(frozen=True)
-class SearchOptions:
+class SearchOptions(RunOptions):
     """The ``lookalike train`` options that apply with ``--search``."""
 
-    steps: int
-    minutes: float | None
-    batch_size: int
-    sequence_length: int
-    seed: int
-    patience: int
-    validate_every: int
     cell: str
     relative: bool
-    workers: int
-    backend: str
-    address: str | None
     sampler: str
     study: str | None
-    threads: int
     space: str
 
 
