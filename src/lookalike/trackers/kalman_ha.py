@@ -82,13 +82,13 @@ class WorldTracker:
         hit = det_of_track >= 0
         t["hit_bits"] = ((t["hit_bits"] << 1) | hit) & ((1 << 30) - 1)
         t.record(hit, dt)
-        for i in np.flatnonzero(hit):
-            self._identifier.observe(int(t.ids[i]), float(headings(det)[det_of_track[i]]))
+        if hit.any():
+            self._identifier.observe_many(t.ids[hit].tolist(), headings(det)[det_of_track[hit]])
         det_of_track = self._lifecycle(det_of_track)
         new = self._births(det, det_of_track)
         det_of_track = np.concatenate([det_of_track, new])
-        for row, k in zip(range(len(t) - len(new), len(t)), new):
-            self._identifier.observe(int(t.ids[row]), float(headings(det)[k]))
+        if len(new):
+            self._identifier.observe_many(t.ids[len(t) - len(new):].tolist(), headings(det)[new])
         return self._report(det, det_of_track)
 
     # -- steps -------------------------------------------------------------------------------
@@ -161,14 +161,10 @@ class WorldTracker:
 
     def _report(self, det: Detections, det_of_track: np.ndarray) -> Tracks:
         t = self._tracks
-        identity = self._identifier.assign([int(i) for i in t.ids[t.confirmed]])
         agent = np.full(len(t), -1, dtype=int)
         prob = np.full(len(t), np.nan)
-        for i, track_id in enumerate(t.ids.tolist()):
-            if track_id in identity:
-                a, p = identity[track_id]
-                agent[i] = -1 if a is None else int(a)
-                prob[i] = np.nan if p is None else p
+        confirmed = t.confirmed
+        agent[confirmed], prob[confirmed] = self._identifier.assign_arrays(t.ids[confirmed].tolist())
         seen = det_of_track >= 0
         heading = np.full(len(t), np.nan)
         if seen.any():

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.association.solver import assign
+from lookalike.association.solver import assign_pairs
 from lookalike.types import Beacons
 
 
@@ -55,56 +55,93 @@ class BeaconIdentifier:
         self._h = np.full((n, r), np.nan)
         self._times = np.full(w, np.nan)  # frame times of the ring
         self._slot = -1
-        self._samples: dict[int, np.ndarray] = {}
-        self._agent: dict[int, int] = {}
+        # Per-track heading samples as one table: row 0 stays all NaN (tracks never observed),
+        # ``_row`` maps a track id to its row, ``_current`` holds each row's agent (-1: none).
+        self._win = np.full((8, w), np.nan)
+        self._current = np.full(8, -1, dtype=int)
+        self._row: dict[int, int] = {}
+        self._free: list[int] = list(range(7, 0, -1))
 
     # -- inputs ------------------------------------------------------------------------------
 
     def begin_frame(self, time_s: float, beacons: Beacons) -> None:
         """Start a frame at ``time_s``: store its received reports and open a window slot."""
-        r = self.config.history
-        for a in np.unique(beacons.agent_id).tolist():
-            if a >= self.config.n_agents:
-                continue
-            rows = beacons.agent_id == a
-            new_t = beacons.t_sent[rows]
-            if len(new_t) == 1 and not new_t[0] <= self._t[a, -1]:
-                # (the common case: one report newer than every one kept, or the first: append it;
-                # the same result as the sort and de-duplication below)
-                self._t[a, :-1] = self._t[a, 1:]
-                self._h[a, :-1] = self._h[a, 1:]
-                self._t[a, -1], self._h[a, -1] = new_t[0], beacons.heading[rows][0]
-                continue
-            t = np.concatenate([self._t[a], new_t])
-            h = np.concatenate([self._h[a], beacons.heading[rows]])
-            known = np.isfinite(t)
-            t, h = t[known], h[known]
-            t, first = np.unique(t, return_index=True)  # sorted, duplicates dropped
-            h = h[first]
-            t, h = t[-r:], h[-r:]
-            self._t[a] = np.nan
-            self._h[a] = np.nan
-            self._t[a, r - len(t):] = t
-            self._h[a, r - len(h):] = h
+        r, n = self.config.history, self.config.n_agents
+        agent_id = beacons.agent_id
+        if len(agent_id):
+            ids = agent_id.tolist()
+            if len(set(ids)) == len(ids) and max(ids) < n:
+                # (the common case: one report per agent, each newer than every one kept of its
+                # agent or its first: shift them in, all agents at once; the same result as the
+                # sort and de-duplication below)
+                new_t = beacons.t_sent
+                if not (new_t <= self._t[agent_id, -1]).any():
+                    self._t[agent_id, :-1] = self._t[agent_id, 1:]
+                    self._h[agent_id, :-1] = self._h[agent_id, 1:]
+                    self._t[agent_id, -1] = new_t
+                    self._h[agent_id, -1] = beacons.heading
+                    ids = []
+            for a in sorted(set(ids)):
+                if a >= n:
+                    continue
+                self._store(a, beacons.t_sent[agent_id == a], beacons.heading[agent_id == a], r)
         self._slot = (self._slot + 1) % self.config.window_frames
         self._times[self._slot] = time_s
-        for samples in self._samples.values():
-            samples[self._slot] = np.nan
+        self._win[:, self._slot] = np.nan
+
+    def _store(self, a: int, new_t: np.ndarray, new_h: np.ndarray, r: int) -> None:
+        """Merge agent ``a``'s new reports into its history (sorted, duplicates dropped, last ``r``)."""
+        t = np.concatenate([self._t[a], new_t])
+        h = np.concatenate([self._h[a], new_h])
+        known = np.isfinite(t)
+        t, h = t[known], h[known]
+        t, first = np.unique(t, return_index=True)  # sorted, duplicates dropped
+        h = h[first]
+        t, h = t[-r:], h[-r:]
+        self._t[a] = np.nan
+        self._h[a] = np.nan
+        self._t[a, r - len(t):] = t
+        self._h[a, r - len(h):] = h
 
     def observe(self, track_id: int, heading_rad: float) -> None:
         """Record the visual heading of track ``track_id`` in the current frame."""
         if self._slot < 0:
             raise ValueError("observe() before begin_frame()")
-        samples = self._samples.get(track_id)
-        if samples is None:
-            samples = self._samples[track_id] = np.full(self.config.window_frames, np.nan)
-        samples[self._slot] = heading_rad
+        row = self._rows([track_id])[0]  # (may grow the table: before indexing it)
+        self._win[row, self._slot] = heading_rad
+
+    def observe_many(self, track_ids: list[int], headings_rad: np.ndarray) -> None:
+        """Record the visual headings ``(k,)`` of tracks ``track_ids`` in the current frame."""
+        if self._slot < 0:
+            raise ValueError("observe() before begin_frame()")
+        if track_ids:
+            rows = self._rows(track_ids)  # (may grow the table: before indexing it)
+            self._win[rows, self._slot] = headings_rad
+
+    def _rows(self, track_ids: list[int]) -> list[int]:
+        """The sample rows of ``track_ids``, new rows (all NaN) for tracks not seen before."""
+        rows = []
+        get = self._row.get
+        for track_id in track_ids:
+            row = get(track_id)
+            if row is None:
+                if not self._free:
+                    size = len(self._win)
+                    self._win = np.concatenate([self._win, np.full_like(self._win, np.nan)])
+                    self._current = np.concatenate([self._current, np.full(size, -1)])
+                    self._free = list(range(2 * size - 1, size - 1, -1))
+                row = self._row[track_id] = self._free.pop()
+                self._win[row] = np.nan
+                self._current[row] = -1
+            rows.append(row)
+        return rows
 
     def drop(self, track_ids: list[int] | np.ndarray) -> None:
         """Forget deleted tracks."""
-        for t in track_ids:
-            self._samples.pop(int(t), None)
-            self._agent.pop(int(t), None)
+        for t in np.asarray(track_ids).tolist():
+            row = self._row.pop(int(t), None)
+            if row is not None:
+                self._free.append(row)
 
     # -- outputs -----------------------------------------------------------------------------
 
@@ -153,10 +190,14 @@ class BeaconIdentifier:
 
     def costs(self, track_ids: list[int]) -> np.ndarray:
         """Cost matrix ``(len(track_ids), N)`` in [0, 1]; inf where no sample or no report."""
+        get = self._row.get
+        return self._costs([get(t, 0) for t in track_ids])
+
+    def _costs(self, rows: list[int]) -> np.ndarray:
         n = self.config.n_agents
-        if not track_ids or n == 0:
-            return np.zeros((len(track_ids), n))
-        samples = np.stack([self._samples.get(t, np.full(self.config.window_frames, np.nan)) for t in track_ids])
+        if not rows or n == 0:
+            return np.zeros((len(rows), n))
+        samples = self._win[rows]
         agent = self.agent_headings(self._times)  # (W, N)
         d = (1.0 - np.cos(samples[:, :, None] - agent[None])) / 2.0  # (k, W, N)
         valid = np.isfinite(d)
@@ -167,21 +208,34 @@ class BeaconIdentifier:
 
     def assign(self, track_ids: list[int]) -> dict[int, tuple[int, float]]:
         """Identities of ``track_ids``: ``{track_id: (agent_id, probability)}`` for those assigned."""
+        agent, prob = self.assign_arrays(track_ids)
+        return {t: (a, p) for t, a, p in zip(track_ids, agent.tolist(), prob.tolist()) if a >= 0}
+
+    def assign_arrays(self, track_ids: list[int]) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`assign` as columns: agent id per track (-1: none) and probability (NaN: none)."""
         cfg = self.config
-        cost = self.costs(track_ids)
+        k = len(track_ids)
+        agent_out = np.full(k, -1, dtype=int)
+        prob = np.full(k, np.nan)
+        if not k:
+            return agent_out, prob
+        get = self._row.get
+        rows = [get(t, 0) for t in track_ids]
+        cost = self._costs(rows)
         biased = cost.copy()
-        for row, t in enumerate(track_ids):
-            a = self._agent.get(t)
-            if a is not None and np.isfinite(biased[row, a]):
-                biased[row, a] = max(biased[row, a] - cfg.hysteresis, 0.0)
-        matches, _, _ = assign(biased, cfg.max_cost)
-        result = {}
-        for row, a in matches:
-            result[track_ids[row]] = (int(a), float(1.0 - cost[row, a]))
-        self._agent = {t: a for t, (a, _) in result.items()} | {
-            t: a for t, a in self._agent.items() if t not in track_ids
-        }
-        return result
+        current = self._current[rows]
+        held = np.flatnonzero(current >= 0)
+        if len(held):
+            a = current[held]
+            bias = biased[held, a]
+            ok = np.isfinite(bias)
+            biased[held[ok], a[ok]] = np.maximum(bias[ok] - cfg.hysteresis, 0.0)
+        matches = assign_pairs(biased, cfg.max_cost)
+        r, a = matches[:, 0], matches[:, 1]
+        agent_out[r] = a
+        prob[r] = 1.0 - cost[r, a]
+        self._current[rows] = agent_out  # (row 0, unobserved tracks, is never assigned: stays -1)
+        return agent_out, prob
 
 
 def _wrap(angle_rad: np.ndarray) -> np.ndarray:
