@@ -45,6 +45,11 @@ def train(
     init_from: Path | None = typer.Option(
         None, "--init-from",
         help="Start from these exported weights (.npz), e.g. the shipped ones, instead of random."),
+    init_transfer: bool = typer.Option(
+        False, "--init-transfer", help="With --init-from: the weights may be of another set-up (N, M) of the same "
+        "protocol; their input columns and output rows are mapped robot by robot and slot by slot (repeats get "
+        "small noise), the recurrent layers copied, the normalisation measured on this preset's data; "
+        "--hidden/--layers follow the weights."),
     device: str = typer.Option("cpu", help="Torch device for the network: cpu, cuda or auto."),
     workers: int = typer.Option(1, min=1, help="Processes (or Ray CPUs) generating batches ahead."),
     backend: str = typer.Option("local", help="Batch generation: local (processes) or ray."),
@@ -118,7 +123,6 @@ def train(
         return
     if learning_rate is None:
         learning_rate = 0.004
-    from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.encoding import EncodingSpec
     from lookalike.learn.paper_protocol import NoiseMixSampler, noise_worlds
     from lookalike.learn.sim_data import make_sim_sampler
@@ -149,14 +153,17 @@ def train(
         plain = noise == "ours" and protocol == "ours"
         sample = make_sim_sampler(world, relative, swap_prob) if plain else NoiseMixSampler(worlds, spec)
         validation = make_sim_sampler(world, relative) if plain else NoiseMixSampler(worlds, spec)
-        init = load_weights(init_from, world.n_agents, world.max_detections) if init_from else None
+        init = _initial_weights(init_from, init_transfer, spec, validation, sequence_length, seed)
+        if init_transfer and init is not None:
+            config = dataclasses.replace(config, hidden=init.hidden, num_layers=len(init.layers))
         pool = JobPool(workers, backend, address)
     except ValueError as exc:
         fail(str(exc))
     torch.set_num_threads(threads)
     result = _with_progress(f"training {preset_name}", steps, pool, lambda on_step: run_training(
         config, sample, output, resume=resume, on_step=on_step, device=device, pool=pool, init=init,
-        validation_sample=validation))
+        validation_sample=validation,
+        info={"transferred_from": init.info["transferred_from"]} if init is not None and init_transfer else None))
     png = plot_log(result.log_path, output / "training_log.png")
     console.print(
         f"best validation success rate [bold]{100 * result.best_success:.1f}%[/] at step {result.best_step} "
@@ -169,6 +176,24 @@ def train(
         shutil.copy(result.weights_path, target.with_suffix(".npz"))
         shutil.copy(result.weights_path.with_suffix(".json"), target.with_suffix(".json"))
         console.print(f"shipped as {target.with_suffix('.npz')}")
+
+
+def _initial_weights(init_from: Path | None, transfer: bool, spec: Any, sample: Any, length: int,
+                     seed: int) -> Any:
+    """The weights ``--init-from`` names (None without it); with ``--init-transfer`` mapped onto ``spec``'s
+    set-up and normalised on 8 sequences of ``sample`` (seeds just below the training seeds)."""
+    from lookalike.learn.checkpoint import load_weights
+    from lookalike.learn.training import TRAIN_SEED_BASE
+    from lookalike.learn.transfer import transfer_from_file
+
+    if transfer and init_from is None:
+        raise ValueError("--init-transfer needs --init-from")
+    if init_from is None:
+        return None
+    if transfer:
+        return transfer_from_file(str(init_from), spec, sample, [TRAIN_SEED_BASE - 1 - i for i in range(8)],
+                                  length, seed)
+    return load_weights(init_from, spec.n_agents, spec.n_slots)
 
 
 def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int, seed: int, patience: int,
