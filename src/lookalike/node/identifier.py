@@ -12,7 +12,7 @@ import math
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -25,6 +25,8 @@ from lookalike.node.messages import (
 )
 from lookalike.trackers.identity import labels_from_tracks
 from lookalike.types import Beacons, Detections, Frame, Tracks, TrackSnapshot
+
+_T = TypeVar("_T")
 
 
 @dataclass(frozen=True)
@@ -151,20 +153,36 @@ class TeamIdentifier:
         self.last_frame, self.last_time = None, -math.inf
 
     def _frame(self, message: DetectionsMessage) -> Frame:
+        """The tracker's frame: the message's detections and the queued reports.
+
+        What ``decode`` has checked (finite, bounded numbers; equal lengths) is not validated again:
+        the arrays are built straight into the frame's types; a message built some other way that
+        fails these checks goes through the validating constructors and their errors.
+        """
         n = len(message.position)
-        detections = Detections(
-            position=np.asarray(message.position, dtype=float).reshape(n, 2),
-            heading=np.asarray(message.heading, dtype=float),
-            score=np.asarray(message.score, dtype=float),
-            heading_std=None if message.heading_std is None else np.asarray(message.heading_std, dtype=float),
-        )
+        position = np.array(message.position, dtype=float).reshape(n, 2)
+        heading = np.array(message.heading, dtype=float)
+        score = np.array(message.score, dtype=float)
+        std = None if message.heading_std is None else np.array(message.heading_std, dtype=float)
+        total = float(position.sum()) + float(heading.sum()) + float(score.sum())
+        if std is not None:
+            total += float(std.sum()) if std.shape == (n,) and (not n or std.min() >= 0) else math.nan
+        checked = heading.shape == score.shape == (n,) and math.isfinite(total)
+        if checked:
+            detections = _trusted(Detections, xywh=np.zeros((n, 4)), score=score, position=position,
+                                  heading=heading, heading_std=std, feature=None, label=None)
+        else:
+            detections = Detections(position=position, heading=heading, score=score, heading_std=std)
         reports = self._take_reports()
-        beacons = Beacons(
-            agent_id=np.array([r.robot for r in reports], dtype=int),
-            t_sent=np.array([r.t_sent for r in reports], dtype=float),
-            t_received=np.full(len(reports), message.time),
-            heading=np.array([r.heading for r in reports], dtype=float),
-        )
+        if not reports:
+            beacons = Beacons.empty()
+        else:  # (reports were checked by add_report's callers: decode, or the types of HeadingReport)
+            beacons = Beacons(
+                agent_id=np.array([r.robot for r in reports], dtype=int),
+                t_sent=np.array([r.t_sent for r in reports], dtype=float),
+                t_received=np.full(len(reports), message.time),
+                heading=np.array([r.heading for r in reports], dtype=float),
+            )
         return Frame(index=message.frame, time=message.time, detections=detections, beacons=beacons)
 
     def _team_state(self, frame: Frame, snapshots: Sequence[TrackSnapshot]) -> TeamState:
@@ -214,6 +232,17 @@ def _rows(snapshots: Sequence[TrackSnapshot], n_robots: int) -> list[_Row]:
         pos = np.asarray(s.position, dtype=float)
         out.append((int(j), s.detection_index, s.identity_prob, float(pos[0]), float(pos[1]), s.heading))
     return out
+
+
+def _trusted(cls: type[_T], **fields: Any) -> _T:
+    """An instance of the frozen dataclass ``cls`` with ``fields`` set as given (read-only arrays),
+    without its validation: for data checked already."""
+    obj = object.__new__(cls)
+    for name, value in fields.items():
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+        object.__setattr__(obj, name, value)
+    return obj
 
 
 def _first(item: tuple[int, HeadingReport]) -> int:
