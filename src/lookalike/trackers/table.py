@@ -1,9 +1,10 @@
 """``TrackTable``: a tracker's tracks as named numpy columns, one row per track.
 
 Every table has the columns ``ids`` (1-based, from a per-table counter), ``mean`` ``(k, n)`` and
-``cov`` ``(k, n, n)`` of the motion state, ``hits`` (the tracker's hit count), ``misses`` (frames
-since the last update), ``unseen_s`` (seconds since the last update) and ``confirmed``. A tracker
-declares its extra columns (name → trailing shape and dtype) when it builds the table.
+``cov`` ``(k, n, n)`` of the motion state (or the compact form its motion space keeps), ``hits`` (the
+tracker's hit count), ``misses`` (frames since the last update), ``unseen_s`` (seconds since the last
+update) and ``confirmed``. A tracker declares its extra columns (name → trailing shape and dtype)
+when it builds the table.
 """
 
 from __future__ import annotations
@@ -34,10 +35,14 @@ class TrackTable:
     unseen_s: np.ndarray
     confirmed: np.ndarray
 
-    def __init__(self, state_dim: int, extra: dict[str, ColumnSpec] | None = None) -> None:
-        """A table for states of ``state_dim`` numbers plus ``extra`` columns (name → (trailing shape, dtype))."""
+    def __init__(self, state_dim: int, extra: dict[str, ColumnSpec] | None = None,
+                 cov_shape: tuple[int, ...] | None = None) -> None:
+        """A table for states of ``state_dim`` numbers plus ``extra`` columns (name → (trailing shape, dtype));
+        ``cov_shape``: the covariance's trailing shape when the motion space keeps it compact (default
+        ``(state_dim, state_dim)``)."""
+        cov = (state_dim, state_dim) if cov_shape is None else tuple(cov_shape)
         self._spec: dict[str, ColumnSpec] = {
-            **_CORE, "mean": ((state_dim,), float), "cov": ((state_dim, state_dim), float), **(extra or {})}
+            **_CORE, "mean": ((state_dim,), float), "cov": (cov, float), **(extra or {})}
         self.clear()
 
     def clear(self) -> None:
