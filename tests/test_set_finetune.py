@@ -41,3 +41,13 @@ def test_training_starts_from_init_weights(tmp_path):
         np.testing.assert_allclose(back.arrays[name], arr, rtol=1e-5, atol=1e-6)
     with pytest.raises(ValueError, match="widths"):
         train_set(SetTrainConfig(token=8, pair=10, memory=6, steps=0), tmp_path / "other", init=init)
+
+
+def test_focus_teams_of_a_run_weight_the_draws():
+    from lookalike.learn.set_finetune import FINETUNE_CONFIG
+
+    sizes = FINETUNE_CONFIG.batch_maker().sizes
+    draws = [sizes.draw(np.random.default_rng(s)) for s in range(600)]
+    small, mid, big = (draws.count(t) for t in ((2, 3, 0.5), (3, 5, 0.8), (7, 10, 1.5)))
+    assert small > mid > big > 0  # weighted 3 : 2 : 1
+    assert sum(1 for n, _, _ in draws if n >= 8) > 0  # the other batches still span every team size

@@ -66,13 +66,14 @@ class SetTrainConfig:
     swap_min_s: float = 1.0
     swap_max_s: float = 10.0
     swap_ends_s: float | None = None  # None: a swap may outlast the sequence (the first training's draws)
-    focus_prob: float = 0.0  # fraction of batches on FOCUS_TEAMS (the paper's set-ups)
+    focus_prob: float = 0.0  # fraction of batches on focus_teams (the paper's set-ups)
+    focus_teams: tuple[tuple[int, int, float], ...] = FOCUS_TEAMS  # (N, M, fp) drawn uniformly; repeat one to weight it
     keep_snapshots: bool = False  # also write set_step{N}.npz at every validation
 
     def batch_maker(self, swap: bool = True) -> SetBatchMaker:
         """The batch generator of this run (with identity-swap augmentation unless ``swap`` is False)."""
         sizes = TeamSizes(self.n_min, self.n_max, self.m_extra, (self.fp_min, self.fp_max),
-                          FOCUS_TEAMS if self.focus_prob > 0 else (), self.focus_prob)
+                          self.focus_teams if self.focus_prob > 0 else (), self.focus_prob)
         return SetBatchMaker(sizes, self.swap_prob if swap else 0.0, swap_s=(self.swap_min_s, self.swap_max_s),
                              swap_ends=self.swap_ends_s)
 

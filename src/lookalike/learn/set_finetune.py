@@ -1,0 +1,56 @@
+"""The fine-tuning of the shipped ``set`` weights towards the paper's small set-ups (issue 23).
+
+``python -m lookalike.learn.set_finetune OUT --minutes 80`` starts from the shipped weights and trains
+with :data:`FINETUNE_CONFIG`: a low, decaying learning rate, 60% of the batches on the paper's set-ups
+(M=3, N=2 three times as often as M=10, N=7, M=5, N=3 twice), the other 40% over every team size
+(N 1–12), identity swaps of 1–6 s that end inside the sequence, and a snapshot at every validation
+(``OUT/set_step{N}.npz``) to choose among on tuning sequences. Needs torch.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from lookalike.learn.set_training import SetTrainConfig
+
+FINETUNE_TEAMS: tuple[tuple[int, int, float], ...] = (
+    (2, 3, 0.5), (2, 3, 0.5), (2, 3, 0.5), (3, 5, 0.8), (3, 5, 0.8), (7, 10, 1.5),
+)
+FINETUNE_CONFIG = SetTrainConfig(
+    learning_rate=0.0002, lr_decay=0.001, steps=5000, minutes=80.0, patience=1000, seed=3,
+    swap_prob=0.3, swap_min_s=1.0, swap_max_s=6.0, swap_ends_s=2.0,
+    focus_prob=0.6, focus_teams=FINETUNE_TEAMS, keep_snapshots=True, validation_every=25,
+)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Run the fine-tuning into ``OUT`` from ``--init`` (default: the shipped set weights)."""
+    import dataclasses
+
+    import torch
+
+    from lookalike.learn.set_numpy import load_set_weights
+    from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+    from lookalike.learn.set_training import train_set
+
+    parser = argparse.ArgumentParser(prog="python -m lookalike.learn.set_finetune", description=__doc__)
+    parser.add_argument("out", type=Path, help="output folder (snapshots, log, best-validation weights)")
+    parser.add_argument("--minutes", type=float, default=FINETUNE_CONFIG.minutes, help="wall-clock limit")
+    parser.add_argument("--init", type=Path, default=SHIPPED_SET_WEIGHTS, help="weights to start from (.npz)")
+    args = parser.parse_args(argv)
+    torch.set_num_threads(1)
+    config = dataclasses.replace(FINETUNE_CONFIG, minutes=args.minutes)
+    started = time.monotonic()
+
+    def on_step(row: dict) -> None:
+        print(f"{row['step']} loss={row['loss']:.4f} lr={row['lr']:.2e} val={row['val_success']:.4f} "
+              f"N={row['n_agents']} t={time.monotonic() - started:.0f}s", flush=True)
+
+    result = train_set(config, args.out, on_step=on_step, init=load_set_weights(args.init))
+    print(f"done: best validation {result.best_success:.4f} at step {result.best_step} of {result.steps}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
