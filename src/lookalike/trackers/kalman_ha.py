@@ -27,12 +27,13 @@ from typing import ClassVar
 
 import numpy as np
 
-from lookalike.association.solver import assign
-from lookalike.motion import chi2_gate, gating_distance, kalman
+from lookalike.motion import chi2_gate, kalman
+from lookalike.motion.models import constant_acceleration
 from lookalike.motion.spaces import WorldCA
 from lookalike.trackers.identity import BeaconIdentifier, IdentifierConfig
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.table import TrackTable
+from lookalike.trackers.world_kernels import cholesky, pairs, solve
 from lookalike.trackers.world_rules import HeuristicsConfig, WorldConfig, WorldRules, headings, positions
 from lookalike.types import Detections, Frame, Tracks
 
@@ -61,6 +62,8 @@ class WorldTracker:
         cfg = self.config
         self._tracks = TrackTable(6, {"hit_bits": ((), np.int64)})  # hit history, bit 0 = this frame
         self._time: float | None = None
+        self._model_dt: float | None = None  # frame interval of the cached (F, Q)
+        self._model: tuple[np.ndarray, np.ndarray] = (np.eye(6), np.zeros((6, 6)))
         self._identifier = BeaconIdentifier(IdentifierConfig(
             n_agents=cfg.n_agents, window_frames=cfg.window_frames, max_cost=cfg.max_identity_cost,
             hysteresis=cfg.hysteresis))
@@ -102,25 +105,42 @@ class WorldTracker:
             if coasting.any():
                 t.mean[coasting, 2:4] *= np.exp(-dt / self.rules.coast_decay_s)
                 t.mean[coasting, 4:6] = 0.0
-        t.mean, t.cov = self._space.predict(t.mean, t.cov, dt)
+        if dt != self._model_dt:  # (WorldCA.predict's model, kept while the frame interval repeats)
+            self._model = constant_acceleration(2, dt, self.config.q_jerk)
+            self._model_dt = dt
+        t.mean, t.cov = kalman.predict(t.mean, t.cov, *self._model)
 
     def _noise(self, position: np.ndarray) -> np.ndarray:
         """Measurement covariances ``(k, 2, 2)`` for positions ``(k, 2)``."""
         return self._space.R(position)
 
     def _associate_and_update(self, det: Detections) -> np.ndarray:
-        """Hungarian on the gated squared Mahalanobis distance; Kalman update of matched tracks."""
+        """Hungarian on the gated squared Mahalanobis distance; Kalman update of matched tracks.
+
+        The arithmetic of ``motion.kalman.gating_distance`` and ``kalman.update`` on the whole
+        table at once: ``H`` picks the position, so ``H P Hᵀ`` and ``P Hᵀ`` are slices of ``P`` (the
+        same values), and the innovation covariances are formed once for gating and update.
+        """
         t = self._tracks
         det_of_track = np.full(len(t), -1, dtype=int)
-        if len(t) and len(det):
-            noise = self._noise(t.mean[:, :2])  # (row by row: the matched rows' noise is noise[rows])
-            d2 = gating_distance(t.mean, t.cov, positions(det), H, noise)
-            matches, _, _ = assign(np.where(d2 <= self._gate, d2, np.inf))
-            rows = matches[:, 0]
-            det_of_track[rows] = matches[:, 1]
-            if len(rows):
-                t.mean[rows], t.cov[rows] = kalman.update(t.mean[rows], t.cov[rows], positions(det)[matches[:, 1]],
-                                                          H, noise[rows])
+        if not (len(t) and len(det)):
+            return det_of_track
+        z = positions(det)
+        mean, cov = t.mean, t.cov
+        noise = self._noise(mean[:, :2])  # (row by row: the matched rows' noise is noise[rows])
+        S = cov[:, :2, :2] + noise
+        diff = z[None, :, :] - mean[:, None, :2]  # (k, d, 2)
+        y = solve(cholesky(S), np.swapaxes(diff, -1, -2))  # (k, 2, d)
+        d2 = np.sum(y * y, axis=1)
+        rows, cols = pairs(d2, d2 <= self._gate)
+        det_of_track[rows] = cols
+        if len(rows):
+            m, P = mean[rows], cov[rows]
+            PHt = np.ascontiguousarray(P[:, :, :2])  # (k, 6, 2), laid out as ``P @ H.T``
+            K = np.swapaxes(solve(S[rows], np.swapaxes(PHt, -1, -2)), -1, -2)
+            innovation = z[cols] - m[:, :2]
+            t.mean[rows] = m + np.einsum("kij,kj->ki", K, innovation)
+            t.cov[rows] = P - K @ np.swapaxes(PHt, -1, -2)
         return det_of_track
 
     def _lifecycle(self, det_of_track: np.ndarray) -> np.ndarray:

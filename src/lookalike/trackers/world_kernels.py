@@ -1,0 +1,69 @@
+"""Small batched kernels of the world trackers' per-frame path (Kalman-HA, its beacon identifier).
+
+Each returns what the general functions it stands in for return, bit for bit, with fewer calls:
+numpy's own LAPACK kernels without the wrappers' per-call checks (:func:`cholesky`, :func:`solve`),
+and :func:`pairs`, the pairs of :func:`lookalike.association.solver.assign_pairs` from the same
+matrix handed to the same solver.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lookalike.association.solver import linear_sum_assignment
+
+try:  # numpy's gufuncs behind np.linalg.cholesky / np.linalg.solve (the same kernels, no wrapper)
+    from numpy.linalg import _umath_linalg as _kernels
+except ImportError:  # pragma: no cover (a numpy without them: the public functions)
+    _kernels = None  # type: ignore[assignment]
+
+
+def cholesky(a: np.ndarray) -> np.ndarray:
+    """Lower Cholesky factors of the stacked float64 matrices ``a`` (positive definite: a
+    non-definite one gives NaN rather than ``LinAlgError``)."""
+    if _kernels is None:  # pragma: no cover
+        return np.linalg.cholesky(a)
+    out: np.ndarray = _kernels.cholesky_lo(a, signature="d->d")
+    return out
+
+
+def solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.linalg.solve(a, b)`` for stacked float64 ``a (..., m, m)`` and ``b (..., m, n)``."""
+    if _kernels is None:  # pragma: no cover
+        return np.linalg.solve(a, b)
+    out: np.ndarray = _kernels.solve(a, b, signature="dd->d")
+    return out
+
+
+_NONE = np.zeros(0, dtype=int)
+_NONE.flags.writeable = False
+
+
+def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns of :func:`~lookalike.association.solver.assign_pairs` on the float matrix
+    ``where(allowed, cost, inf)`` (no NaN) with ``max_cost``, where ``allowed`` is ``cost <= max_cost``
+    (finite ``max_cost``) or the pairs to consider (``max_cost = inf``)."""
+    if not cost.size or not allowed.any():
+        return _NONE, _NONE
+    most = np.maximum.reduce
+    if most(np.add.reduce(allowed, axis=0)) == 1 and most(np.add.reduce(allowed, axis=1)) == 1:
+        rows, cols = allowed.nonzero()
+        return rows, cols
+    if np.isfinite(max_cost):
+        scale = max(abs(max_cost - float(cost[allowed].min())), 1.0)
+        work = np.where(allowed, cost, max_cost + 1e-6 * scale)
+        big = max(abs(float(work.max())), abs(float(work.min())))
+        if big * min(cost.shape) > 1e300:
+            work = work / big
+    else:
+        low = float(cost[allowed].min())
+        work = np.where(allowed, cost - low, 0.0)
+        top = float(work.max())
+        if top > 0 and top * min(cost.shape) > 1e290:
+            work = work / top
+            top = 1.0
+        penalty = (top + 1.0) * (min(cost.shape) + 1)
+        work = np.where(allowed, work, penalty)
+    rows, cols = linear_sum_assignment(work)
+    keep = allowed[rows, cols]
+    return rows[keep], cols[keep]
