@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from lookalike.vision.hog_features import BINS, integral_maps, orientation_maps
+from lookalike.vision.hog_kernels import compiled
 
 
 def _output(k: int, n_blocks: int, columns: np.ndarray | None) -> tuple[np.ndarray | None, np.ndarray]:
@@ -119,6 +120,21 @@ def cumsum_rows(a: np.ndarray) -> np.ndarray:
     return out
 
 
+def cell_integral32(hist: np.ndarray) -> np.ndarray:
+    """``(ny + 1, nx + 1, bins)`` float32 integral of cell histograms ``hist (ny, nx, bins)`` float64, first row and
+    column zero: cumulative sums in float64 down the rows (:func:`cumsum_rows`), then along each row
+    (``np.cumsum``), rounded to float32 at the end; compiled when numba is there, the same sums in the same order."""
+    h = np.ascontiguousarray(hist, dtype=np.float64)
+    kernels = compiled()
+    if kernels is not None:
+        out = np.empty((h.shape[0] + 1, h.shape[1] + 1, h.shape[2]), np.float32)
+        kernels["integral32"](h, out)
+        return out
+    integral = np.zeros((h.shape[0] + 1, h.shape[1] + 1, h.shape[2]))
+    np.cumsum(cumsum_rows(h), axis=1, out=integral[1:, 1:])
+    return integral.astype(np.float32)
+
+
 def block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int, int], stride: int,
                          unit_px: int, columns: np.ndarray | None = None) -> np.ndarray:
     """:func:`block_features_rows` for every window of a ``grid`` (rows, columns) of windows ``stride`` corners
@@ -174,5 +190,5 @@ def window_features(windows: np.ndarray, blocks: np.ndarray) -> np.ndarray:
     return block_features(integral, blocks, ox, oy)
 
 
-__all__ = ["block_features", "block_features_grid", "block_features_rows", "block_pool", "cumsum_rows",
-           "window_features"]
+__all__ = ["block_features", "block_features_grid", "block_features_rows", "block_pool", "cell_integral32",
+           "cumsum_rows", "window_features"]

@@ -29,7 +29,7 @@ from lookalike.vision.hog_blocks import (  # noqa: F401  (block_pool, window_fea
     block_features_grid,
     block_features_rows,
     block_pool,
-    cumsum_rows,
+    cell_integral32,
     window_features,
 )
 from lookalike.vision.hog_features import BINS, as_bgr_image, cell_histograms, to_grey
@@ -154,12 +154,9 @@ class HogCascade:
                 grey, size, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
             # Integral over cells (corners lie on the grid), summed in float64 in (y, x, bin) order: the
             # histograms' own memory layout, and one row of BINS values per corner for the gathers.
-            hist = cell_histograms(level, cfg.cell_px).transpose(1, 2, 0)
-            integral = np.zeros((hist.shape[0] + 1, hist.shape[1] + 1, BINS))
-            np.cumsum(cumsum_rows(hist), axis=1, out=integral[1:, 1:])
             # float32 corners (faster gathers): on 640x480 the corner sums stay below ~1e7, so rounding moves a
             # block sum by a few gradient units at most, far below the block sums the stumps threshold.
-            rows = integral.astype(np.float32)
+            rows = cell_integral32(cell_histograms(level, cfg.cell_px).transpose(1, 2, 0))
             grid_y, grid_x = np.arange(0, size[1] - win_h + 1, step), np.arange(0, size[0] - win_w + 1, step)
             # The first stage sees every window of the grid: strided slices of the integral instead of gathers,
             # the same arithmetic.

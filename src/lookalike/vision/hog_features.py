@@ -11,7 +11,11 @@ resizing) is imported lazily.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
+
+from lookalike.vision.hog_kernels import compiled
 
 BINS = 9  # unsigned orientation bins over [0, π)
 
@@ -123,6 +127,10 @@ def cell_histograms(grey: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndar
     ny, nx = h // cell_px, w // cell_px
     hist = np.empty(ny * nx * bins)
     band = max(1, _BAND_PIXELS // max(1, w * cell_px))  # cell rows per band
+    kernels = compiled()
+    if kernels is not None:
+        _compiled_cell_histograms(kernels["cell_hist"], g, cell_px, bins, band, hist.reshape(ny, nx, bins))
+        return hist.reshape(ny, nx, bins).transpose(2, 0, 1)
     for r0 in range(0, ny, band):
         r1 = min(ny, r0 + band)
         y0, y1 = r0 * cell_px, r1 * cell_px
@@ -139,6 +147,28 @@ def cell_histograms(grey: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndar
         part += np.bincount(lo.ravel(), w_hi[crop].astype(np.float64).ravel(), n)
         hist[r0 * nx * bins : r1 * nx * bins] = part
     return hist.reshape(ny, nx, bins).transpose(2, 0, 1)
+
+
+def _compiled_cell_histograms(kernel: Callable[..., None], g: np.ndarray, cell_px: int, bins: int, band: int,
+                              out: np.ndarray) -> None:
+    """:func:`cell_histograms` into ``out (ny, nx, bins)`` with the compiled binning and sums: the gradients of each
+    band as :func:`_gradient_bins` computes them (OpenCV), the rest one pixel at a time."""
+    import cv2
+
+    h = g.shape[0]
+    ny, nx = out.shape[:2]
+    scale = np.float32(bins / np.pi)
+    for r0 in range(0, ny, band):
+        r1 = min(ny, r0 + band)
+        y0, y1 = r0 * cell_px, r1 * cell_px
+        top, bottom = max(0, y0 - 1), min(h, y1 + 1)
+        part = g[top:bottom]
+        gx = cv2.Sobel(part, cv2.CV_32F, 1, 0, ksize=1)
+        gy = cv2.Sobel(part, cv2.CV_32F, 0, 1, ksize=1)
+        gx[:, 0] = gx[:, -1] = 0.0
+        gy[0, :] = gy[-1, :] = 0.0
+        mag, ang = cv2.cartToPolar(gx, gy)
+        kernel(mag, ang, y0 - top, cell_px, bins, scale, out[r0:r1])
 
 
 _BAND_PIXELS = 1 << 15  # pixels per band of cell_histograms

@@ -1,0 +1,44 @@
+"""Optional compiled kernels (numba) for the HOG detector: cell histograms from gradient magnitude and angle, and
+the float32 integral of those histograms.
+
+Each kernel does the floating-point operations of the numpy path (:func:`~lookalike.vision.hog_features.cell_histograms`
+and the integral in :meth:`~lookalike.vision.hog_cascade.HogCascade.windows`) one pixel or one cell at a time, in
+the same order and precision (float32 binning, float64 sums in raster order, no fused multiply-adds), so the
+results are bit for bit the same; ``tests/test_hog_kernels.py`` compares both paths. They are used when numba is
+installed (the ``fast`` extra) unless ``LOOKALIKE_HOG_NUMBA=0``; compiling them costs about a second on the first
+call after installation, later processes load them from numba's cache.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from typing import Any
+
+_STATE: dict[str, Any] = {}
+
+
+def use_compiled(flag: bool | None) -> None:
+    """Force the compiled kernels on (``True``, if numba is installed) or off (``False``); ``None``: the default
+    (on when numba imports and ``LOOKALIKE_HOG_NUMBA`` is not ``0``)."""
+    _STATE.pop("forced", None)
+    if flag is not None:
+        _STATE["forced"] = bool(flag)
+
+
+def compiled() -> dict[str, Callable[..., None]] | None:
+    """The compiled kernels by name, or ``None`` when they are off or numba is not installed."""
+    forced = _STATE.get("forced")
+    if forced is False or (forced is None and os.environ.get("LOOKALIKE_HOG_NUMBA", "1") == "0"):
+        return None
+    if "kernels" not in _STATE:
+        _STATE["kernels"] = _build()
+    return _STATE["kernels"]  # type: ignore[no-any-return]
+
+
+def _build() -> dict[str, Callable[..., None]] | None:
+    try:
+        from lookalike.vision import hog_numba
+    except ImportError:
+        return None
+    return {"cell_hist": hog_numba.cell_hist, "integral32": hog_numba.integral32}

@@ -1,0 +1,78 @@
+"""The numba kernels of :mod:`lookalike.vision.hog_kernels` (imported only when numba is installed)."""
+
+from __future__ import annotations
+
+import numba  # type: ignore[import-untyped, import-not-found, unused-ignore]
+import numpy as np
+
+_jit = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy", boundscheck=False)
+
+
+@_jit  # type: ignore[misc]
+def cell_hist(mag: np.ndarray, ang: np.ndarray, row0: int, cell_px: int, bins: int, scale: np.float32,
+              out: np.ndarray) -> None:
+    """Cell histograms of one band: ``mag, ang`` float32 from ``cv2.cartToPolar``, rows ``row0`` onwards, into
+    ``out (cell rows, cell columns, bins)`` float64. Each cell's pixels are summed in raster order, the weights
+    to the lower and to the upper bin apart, then the two sums added (as two ``np.bincount`` calls do)."""
+    ny, nx = out.shape[0], out.shape[1]
+    rows, cols = ny * cell_px, nx * cell_px
+    pi = np.float32(np.pi)
+    half = np.float32(0.5)
+    # 1. binning, one row at a time (a plain loop the compiler vectorises)
+    w_lo = np.empty((rows, cols), np.float32)
+    w_hi = np.empty((rows, cols), np.float32)
+    lo = np.empty((rows, cols), np.int32)
+    for y in range(rows):
+        for x in range(cols):
+            a = ang[row0 + y, x]
+            a = a - pi if a >= pi else a
+            a = a * scale
+            a = a - half
+            f = np.floor(a)
+            a = a - f
+            m = mag[row0 + y, x]
+            w = m * a
+            w_hi[y, x] = w
+            w_lo[y, x] = m - w
+            lo[y, x] = int(f)
+    # 2. sums: for each cell row, pixel by pixel of the cells, the cells of the row side by side (consecutive
+    # additions go to different cells, so they do not wait for each other; each cell's order is unchanged)
+    lo_sum = np.empty((nx, bins))
+    hi_sum = np.empty((nx, bins))
+    for cy in range(ny):
+        lo_sum[:] = 0.0
+        hi_sum[:] = 0.0
+        for y in range(cy * cell_px, (cy + 1) * cell_px):
+            for dx in range(cell_px):
+                for cx in range(nx):
+                    x = cx * cell_px + dx
+                    b = lo[y, x]
+                    if b < 0:
+                        b = bins - 1
+                    lo_sum[cx, b] += np.float64(w_lo[y, x])
+                    b += 1
+                    if b == bins:
+                        b = 0
+                    hi_sum[cx, b] += np.float64(w_hi[y, x])
+        for cx in range(nx):
+            for b in range(bins):
+                out[cy, cx, b] = lo_sum[cx, b] + hi_sum[cx, b]
+
+
+@_jit  # type: ignore[misc]
+def integral32(hist: np.ndarray, out: np.ndarray) -> None:
+    """``out (ny + 1, nx + 1, bins)`` float32, first row and column zero: the float64 cumulative sums of
+    ``hist (ny, nx, bins)`` down the rows, then along each row, rounded to float32."""
+    ny, nx, bins = hist.shape
+    col = np.empty((nx, bins))
+    run = np.empty(bins)
+    out[0, :, :] = 0.0
+    for y in range(ny):
+        out[y + 1, 0, :] = 0.0
+        for x in range(nx):
+            for b in range(bins):
+                col[x, b] = hist[y, x, b] if y == 0 else col[x, b] + hist[y, x, b]
+        for x in range(nx):
+            for b in range(bins):
+                run[b] = col[x, b] if x == 0 else run[b] + col[x, b]
+                out[y + 1, x + 1, b] = np.float32(run[b])
