@@ -19,6 +19,19 @@ def test_localisation_error_columns_from_pixels_and_simulated():
     for key in ("Pixels loc. (m)", "Simulated loc. (m)"):
         assert math.isnan(row[key]) or 0 <= row[key] < 10
     assert row["Simulated loc. (m)"] >= 0  # the simulator's detections of visible robots give positions
+    for key in ("Pixels robots (%)", "Sim robots (%)"):  # true robots only: like for like
+        assert math.isnan(row[key]) or 0 <= row[key] <= 100
     doc = pixels_results(rows, perception, ["m3n2"], 1, 12)
     metrics = doc.tables["identification"][0]["metrics"]
     assert {PIXEL_KEYS["Pixels loc. (m)"], PIXEL_KEYS["Simulated loc. (m)"]} <= set(metrics)
+
+
+def test_robot_success_rate_leaves_false_positives_out():
+    import numpy as np
+
+    from lookalike.bench.pixels import robot_success_rate
+
+    truth = [np.array([0, 1, -1]), np.array([-1, 1])]
+    predicted = [np.array([0, 0, -1]), np.array([-1, 1])]
+    assert robot_success_rate(predicted, truth) == 2 / 3  # robots 0 ok, 1 wrong, 1 ok; the two -1 not counted
+    assert math.isnan(robot_success_rate([np.array([-1])], [np.array([-1])]))

@@ -108,3 +108,18 @@ def test_train_recordings_refuses_bad_input_in_one_line(app, tmp_path, case):
     assert r.exit_code == 2
     assert expected in r.output and "Traceback" not in r.output
     assert len(r.output.strip().splitlines()) == 1, r.output
+
+
+def test_train_recordings_simulates_the_measured_detector(app, tmp_path):
+    _recordings(tmp_path / "rec")
+    _recordings(tmp_path / "test", n=1)
+    out = tmp_path / "out"
+    args = ["train", "--recordings", str(tmp_path / "rec"), "-o", str(out), "--steps", "1",
+            "--sequence-length", "150", "--batch-size", "2", "--mix-sim-fit"]
+    r = runner.invoke(app, [*args, "--mix-sim", "0.5", "--test", str(tmp_path / "test")])
+    assert r.exit_code == 0, r.output
+    sensor = json.loads((out / "model.json").read_text())["info"]["recordings"]["sim_sensor"]
+    assert sensor["heading_classes"] == 0 and sensor["fp_per_frame"] >= 0
+    assert "detector measured on the training recordings" in r.output and "true robots" in r.output
+    bad = runner.invoke(app, [*args, "-o", str(tmp_path / "bad")])
+    assert bad.exit_code == 2 and "--mix-sim-fit needs" in bad.output

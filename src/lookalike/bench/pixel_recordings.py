@@ -82,10 +82,10 @@ def write_recording(recording: RobotSequence, folder: str | Path, setup: str) ->
     return write_robot_sequence(Path(folder) / f"pixels-{setup}-{recording.seed}{SUFFIX}", recording)
 
 
-def score_identifier(recordings: list[RobotSequence], name: str = "lstm", **params: object) -> tuple[float, int]:
-    """Identification success rate (a false positive labelled as such counts as correct, as in ``bench
-    pixels``) and the number of detections of identifier ``name`` run over every recording from its
-    first frame, with its N and M from the recording; ``params`` go to ``make_tracker`` (e.g. ``weights``)."""
+def identifier_labels(recordings: list[RobotSequence], name: str = "lstm", **params: object
+                      ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Per frame, the labels identifier ``name`` gives and the true labels, the identifier run over every
+    recording from its first frame with its N and M from the recording; ``params`` go to ``make_tracker``."""
     predicted: list[np.ndarray] = []
     truth: list[np.ndarray] = []
     for rec in recordings:
@@ -96,7 +96,16 @@ def score_identifier(recordings: list[RobotSequence], name: str = "lstm", **para
         for frame in rec.frames():
             predicted.append(labels_from_tracks(len(frame.detections), tracker.update(frame)))
         truth.extend(rec.true_labels())
+    return predicted, truth
+
+
+def score_identifier(recordings: list[RobotSequence], name: str = "lstm", **params: object) -> tuple[float, int]:
+    """Identification success rate (a false positive labelled as such counts as correct, as in ``bench
+    pixels``) and the number of detections of identifier ``name`` run over every recording from its
+    first frame, with its N and M from the recording; ``params`` go to ``make_tracker`` (e.g. ``weights``)."""
+    predicted, truth = identifier_labels(recordings, name, **params)
     return identification_success_rate(predicted, truth), sum(len(t) for t in truth)
 
 
-__all__ = ["SUFFIX", "record_pixels", "recording_seeds", "score_identifier", "to_recording", "write_recording"]
+__all__ = ["SUFFIX", "identifier_labels", "record_pixels", "recording_seeds", "score_identifier", "to_recording",
+           "write_recording"]

@@ -73,6 +73,10 @@ def train(
     mix_sim: float = typer.Option(
         0.0, "--mix-sim", min=0.0, max=1.0, help="With --recordings: share of the training sequences simulated "
         "in the recordings' own world (their header's set-up) instead of cut from the recordings."),
+    mix_sim_fit: bool = typer.Option(
+        False, "--mix-sim-fit", help="With --mix-sim: simulate that share with the detector measured on the "
+        "training recordings (false positives, detection probability, scores, position and heading noise) "
+        "instead of the header's."),
     validation_fraction: float = typer.Option(
         0.25, "--validation-fraction", help="With --recordings: share of the recordings held out for validation."),
     validate_every: int = typer.Option(50, "--validate-every", min=1, help="Steps between validations."),
@@ -109,7 +113,7 @@ def train(
 
         train_recordings(recordings, output, RecordingOptions(
             **run, init_from=init_from, learning_rate=learning_rate, validation_fraction=validation_fraction,
-            device=device, resume=resume, test=test, sim_fraction=mix_sim))
+            device=device, resume=resume, test=test, sim_fraction=mix_sim, sim_fit=mix_sim_fit))
         return
     if search is not None:
         from lookalike.cli.train_search import SearchOptions, train_search

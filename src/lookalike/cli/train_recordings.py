@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,6 +25,7 @@ class RecordingOptions(RunOptions):
     resume: bool
     test: Path | None
     sim_fraction: float = 0.0
+    sim_fit: bool = False
 
 
 def read_recordings(folder: Path, option: str) -> list[RobotSequence]:
@@ -81,8 +84,15 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
             learning_rate=0.001 if opt.learning_rate is None else opt.learning_rate, patience=opt.patience,
             init_from=str(init_path), protocol=spec.protocol, noise="recordings",
             validation_every=opt.validate_every)
-        sampler = RecordingSampler(spec, tuple(recordings[i].arrays for i in train_idx), recordings[0].config,
-                                   opt.sim_fraction)
+        world = recordings[0].config
+        if opt.sim_fit and opt.sim_fraction <= 0:
+            raise ValueError("--mix-sim-fit needs a simulated share (--mix-sim above 0)")
+        if opt.sim_fit:
+            from lookalike.learn.recording_sensor import fit_sensor
+
+            world = dataclasses.replace(world, sensor=fit_sensor([recordings[i].arrays for i in train_idx],
+                                                                 world.sensor, world.observer))
+        sampler = RecordingSampler(spec, tuple(recordings[i].arrays for i in train_idx), world, opt.sim_fraction)
         validation = validation_arrays(spec, [recordings[i].arrays for i in val_idx], config.bptt)
         pool = JobPool(opt.workers, opt.backend, opt.address)
     except ValueError as exc:
@@ -90,6 +100,10 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     held_out = [paths[i].name for i in val_idx]
     info = {"recordings": {"folder": str(folder), "training": [paths[i].name for i in train_idx],
                            "validation": held_out, "sim_fraction": opt.sim_fraction}}
+    if opt.sim_fit:
+        info["recordings"]["sim_sensor"] = dataclasses.asdict(world.sensor)
+        console.print(f"simulated share ({opt.sim_fraction:.0%}) with the detector measured on the training "
+                      f"recordings: {_sensor_line(world.sensor)}")
     console.print(f"fine-tuning {init_path} on {len(train_idx)} recordings, validating on {len(val_idx)}: "
                   f"{', '.join(held_out)}")
     torch.set_num_threads(opt.threads)
@@ -103,9 +117,30 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
         f"[bold]{100 * result.best_success:.1f}%[/] at step {result.best_step} of {result.steps}; weights "
         f"{result.weights_path}, log {result.log_path}, plot {png}")
     if tests:
-        from lookalike.bench.pixel_recordings import score_identifier
+        from lookalike.bench.pixel_recordings import identifier_labels
+        from lookalike.bench.pixels import robot_success_rate
+        from lookalike.eval import identification_success_rate
 
-        before, count = score_identifier(tests, "lstm", weights=str(init_path))
-        after, _ = score_identifier(tests, "lstm", weights=str(result.weights_path))
+        scores = []
+        for weights in (init_path, result.weights_path):
+            predicted, truth = identifier_labels(tests, "lstm", weights=str(weights))
+            scores.append((identification_success_rate(predicted, truth), robot_success_rate(predicted, truth)))
+        count = sum(len(t) for t in truth)
+        robots = sum(int((t >= 0).sum()) for t in truth)
+        (before, before_robots), (after, after_robots) = scores
         console.print(f"test recordings ({len(tests)}, {count} detections): LSTM identification success rate "
-                      f"{100 * before:.1f}% with {init_path.name}, [bold]{100 * after:.1f}%[/] fine-tuned")
+                      f"{100 * before:.1f}% with {init_path.name}, [bold]{100 * after:.1f}%[/] fine-tuned; on the "
+                      f"{robots} detections of true robots {100 * before_robots:.1f}% and "
+                      f"[bold]{100 * after_robots:.1f}%[/]")
+
+
+def _sensor_line(s: object) -> str:
+    """The fitted detector in one line (false positives, detection probability, noise, scores)."""
+    from lookalike.sim.robots_config import SensorConfig
+
+    assert isinstance(s, SensorConfig)
+    return (f"{s.fp_per_frame:.2f} false positives/frame, p_detect {s.p_detect:.2f} (near {s.p_detect_near:.2f}, "
+            f"far {s.p_detect_far:.2f}), position std x {s.std_x0_m:.2f} + {s.std_x_per_m:.3f}/m, y {s.std_y0_m:.2f} + "
+            f"{s.std_y_per_m:.3f}/m, heading noise {math.degrees(s.heading_noise_rad):.1f} deg, flips "
+            f"{s.heading_flip_prob:.1%}, score Beta {s.tp_score_beta[0]:.1f}, {s.tp_score_beta[1]:.1f} (true), "
+            f"{s.fp_score_beta[0]:.1f}, {s.fp_score_beta[1]:.1f} (false)")
