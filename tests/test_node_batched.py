@@ -103,3 +103,83 @@ def test_batched_association_equals_the_plain_one(name):
     for frame in seq.frames():
         tracker.update(frame)
     assert checked > 200
+
+
+class _PlainIdentity:
+    """The identifier's samples and hysteresis before the track table: a dict of sample windows per
+    track and a dict of held agents (its agent headings come from the identifier under test)."""
+
+    def __init__(self, ident):
+        self.ident, self.samples, self.agent = ident, {}, {}
+
+    def begin(self):
+        for samples in self.samples.values():
+            samples[self.ident._slot] = np.nan
+
+    def observe(self, track_id, heading):
+        w = self.ident.config.window_frames
+        self.samples.setdefault(track_id, np.full(w, np.nan))[self.ident._slot] = heading
+
+    def drop(self, ids):
+        for t in ids:
+            self.samples.pop(t, None)
+            self.agent.pop(t, None)
+
+    def assign(self, track_ids):
+        from lookalike.association.solver import assign
+
+        cfg, w = self.ident.config, self.ident.config.window_frames
+        if not track_ids:
+            return {}
+        samples = np.stack([self.samples.get(t, np.full(w, np.nan)) for t in track_ids])
+        agent = self.ident.agent_headings(self.ident._times)
+        d = (1.0 - np.cos(samples[:, :, None] - agent[None])) / 2.0
+        valid = np.isfinite(d)
+        count = valid.sum(axis=1)
+        total = np.where(valid, d, 0.0).sum(axis=1)
+        cost = np.divide(total, count, out=np.full(count.shape, np.inf), where=count > 0)
+        biased = cost.copy()
+        for row, t in enumerate(track_ids):
+            a = self.agent.get(t)
+            if a is not None and np.isfinite(biased[row, a]):
+                biased[row, a] = max(biased[row, a] - cfg.hysteresis, 0.0)
+        matches, _, _ = assign(biased, cfg.max_cost)
+        result = {track_ids[row]: (int(a), float(1.0 - cost[row, a])) for row, a in matches}
+        self.agent = {t: a for t, (a, _) in result.items()} | {
+            t: a for t, a in self.agent.items() if t not in track_ids}
+        return result
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_identifier_table_equals_the_plain_dicts(seed):
+    from lookalike.trackers.identity import BeaconIdentifier
+    from lookalike.trackers.identity import IdentifierConfig as BeaconConfig
+    from lookalike.types import Beacons
+
+    rng = np.random.default_rng(seed)
+    ident = BeaconIdentifier(BeaconConfig(n_agents=4, window_frames=6, max_cost=0.4, hysteresis=0.1))
+    plain = _PlainIdentity(ident)
+    alive, next_id, heading, assigned = [], 1, rng.uniform(-3, 3, 4), 0
+    for f in range(80):
+        heading += rng.normal(0, 0.2, 4)
+        ids = rng.choice(4, rng.integers(0, 5), replace=False)
+        ident.begin_frame(f / 10, Beacons(agent_id=ids, t_sent=np.full(len(ids), f / 10 - 0.05),
+                                          t_received=np.full(len(ids), f / 10), heading=heading[ids]))
+        plain.begin()
+        for _ in range(int(rng.integers(0, 4))):  # births (more than the table's first 7 rows in all)
+            alive.append(next_id)
+            next_id += 1
+        dead = [t for t in alive if rng.random() < 0.08]
+        ident.drop(dead)
+        plain.drop(dead)
+        alive = [t for t in alive if t not in dead]
+        for t in alive:
+            if rng.random() < 0.8:
+                h = float(heading[t % 4] + rng.normal(0, 0.3))
+                ident.observe(t, h)
+                plain.observe(t, h)
+        asked = [t for t in alive if rng.random() < 0.9] + [10_000]  # (one track never observed)
+        result = ident.assign(asked)
+        assert result == plain.assign(asked)
+        assigned += len(result)
+    assert next_id > 20 and assigned > 50

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.association.solver import assign_pairs
+from lookalike.trackers.world_kernels import pairs
 from lookalike.types import Beacons
 
 
@@ -51,9 +51,12 @@ class BeaconIdentifier:
     def reset(self) -> None:
         """Forget reports, windows and identities."""
         n, r, w = self.config.n_agents, self.config.history, self.config.window_frames
-        self._t = np.full((n, r), np.nan)  # report send times, sorted, NaN padded at the front
-        self._h = np.full((n, r), np.nan)
+        # report send times and headings, sorted by time, NaN padded at the front: _th[0] and _th[1]
+        self._th = np.full((2, n, r), np.nan)
+        self._t, self._h = self._th[0], self._th[1]  # (views)
+        self._offset = np.arange(n) * r  # flat index of each agent's row in _t / _h
         self._times = np.full(w, np.nan)  # frame times of the ring
+        self._times_count = np.full(w, np.inf)  # the same, +inf for no time (counts every report)
         self._slot = -1
         # Per-track heading samples as one table: row 0 stays all NaN (tracks never observed),
         # ``_row`` maps a track id to its row, ``_current`` holds each row's agent (-1: none).
@@ -76,17 +79,17 @@ class BeaconIdentifier:
                 # sort and de-duplication below)
                 new_t = beacons.t_sent
                 if not (new_t <= self._t[agent_id, -1]).any():
-                    self._t[agent_id, :-1] = self._t[agent_id, 1:]
-                    self._h[agent_id, :-1] = self._h[agent_id, 1:]
-                    self._t[agent_id, -1] = new_t
-                    self._h[agent_id, -1] = beacons.heading
+                    th = self._th
+                    th[:, agent_id, :-1] = th[:, agent_id, 1:]
+                    th[0, agent_id, -1] = new_t
+                    th[1, agent_id, -1] = beacons.heading
                     ids = []
             for a in sorted(set(ids)):
                 if a >= n:
                     continue
                 self._store(a, beacons.t_sent[agent_id == a], beacons.heading[agent_id == a], r)
         self._slot = (self._slot + 1) % self.config.window_frames
-        self._times[self._slot] = time_s
+        self._times[self._slot] = self._times_count[self._slot] = time_s
         self._win[:, self._slot] = np.nan
 
     def _store(self, a: int, new_t: np.ndarray, new_h: np.ndarray, r: int) -> None:
@@ -146,45 +149,53 @@ class BeaconIdentifier:
     # -- outputs -----------------------------------------------------------------------------
 
     def agent_headings(self, times_s: np.ndarray) -> np.ndarray:
-        """Report-based headings ``(len(times), N)`` of every agent at ``times_s``; NaN where unknown.
+        """Report-based headings ``(len(times), N)`` of every agent at ``times_s``; NaN where unknown."""
+        q = np.asarray(times_s, dtype=float)
+        return self._headings(q, np.where(np.isnan(q), np.inf, q))
+
+    def _headings(self, q: np.ndarray, q_count: np.ndarray) -> np.ndarray:
+        """:meth:`agent_headings` at times ``q``, given ``q_count``: ``q`` with NaN as +inf.
 
         All agents at once: each history row holds its ``k`` known reports in its last ``k``
-        columns (sorted send times), so indices into the known reports are offsets from ``r - k``.
+        columns (sorted send times), so indices into the known reports are offsets from ``r - k``;
+        both reports around each time are gathered from the flat histories in one take.
         """
         cfg = self.config
         n, r = self._t.shape
-        q = np.asarray(times_s, dtype=float)
-        out = np.full((len(q), n), np.nan)
         if n == 0 or not len(q):
-            return out
-        k = np.isfinite(self._t).sum(axis=1)  # known reports per agent
-        have = np.flatnonzero(k)
-        if not len(have):
-            return out
-        t, h, k = self._t[have], self._h[have], k[have]
-        first = r - k  # column of each agent's first known report
-        # i: reports at or before q (side="right"), per query and agent: (Q, A)
-        i = (t[None, :, :] <= q[:, None, None]).sum(axis=2)
-        i[np.isnan(q)] = k  # (a NaN time sorts after every report, as in np.searchsorted)
-        # (np.minimum/np.maximum instead of np.clip, and the wrap of angle_diff written out:
-        # the same arithmetic with less call overhead on these small arrays)
-        top = k - 1
-        rows = np.arange(len(have))
-        before = first + np.minimum(np.maximum(i - 1, 0), top)
-        after = first + np.minimum(i, top)
-        t_before, h_before = t[rows, before], h[rows, before]
-        span = t[rows, after] - t_before
+            return np.full((len(q), n), np.nan)
+        k = np.add.reduce(self._t == self._t, axis=1)  # known reports per agent (NaN != NaN)
+        if k.all():
+            have, th, offset = None, self._th, self._offset
+        else:
+            have = np.flatnonzero(k)
+            if not len(have):
+                return np.full((len(q), n), np.nan)
+            th, k, offset = self._th[:, have], k[have], self._offset[: len(have)]
+        t, h = th[0], th[1]
+        first = offset + (r - k)  # flat index of each agent's first known report
+        # i: reports at or before each time (side="right"; NaN counts all, as in np.searchsorted)
+        i = np.add.reduce(t[None, :, :] <= q_count[:, None, None], axis=2)  # (Q, A)
+        at = i + first
+        idx = np.empty((2,) + at.shape, dtype=np.intp)  # the reports before and after each time
+        np.maximum(np.subtract(at, 1, out=idx[0]), first, out=idx[0])
+        np.minimum(at, offset + (r - 1), out=idx[1])
+        (t_before, t_after), (h_before, h_after) = np.take(th.reshape(2, -1), idx, axis=1)
+        span = t_after - t_before  # > 0 only between two reports, where 0 <= frac <= 1
         frac = np.divide(q[:, None] - t_before, span, out=np.zeros_like(span), where=span > 0)
-        inter = h_before + np.minimum(np.maximum(frac, 0), 1) * _wrap(h[rows, after] - h_before)
-        t_last, h_last = t[:, -1], h[:, -1]
-        two = k >= 2
-        t_prev = np.where(two, t[:, -2], t_last)
-        turning = two & (t_last > t_prev)
+        inter = h_before + frac * _wrap(h_after - h_before)
+        # extrapolation from the latest report with the turn rate of the last two (none with one)
+        t_last, h_last, t_prev = t[:, -1], h[:, -1], t[:, -2]
+        turning = t_last > t_prev  # (False with fewer than two reports: NaN)
         gap = np.where(turning, t_last - t_prev, 1.0)
-        turn = _wrap(h_last - np.where(two, h[:, -2], h_last)) / gap
+        turn = _wrap(h_last - h[:, -2]) / gap
         rate = np.where(turning, np.minimum(np.maximum(turn, -cfg.max_turn_rate), cfg.max_turn_rate), 0.0)
         ahead = np.minimum(np.maximum(q[:, None] - t_last, 0.0), cfg.max_extrapolation_s)
-        value = np.where(i >= k, h_last + rate * ahead, np.where(i == 0, h[rows, first], inter))
+        value: np.ndarray = np.where(i >= k, h_last + rate * ahead,
+                                     np.where(i == 0, th.reshape(2, -1)[1, first], inter))
+        if have is None:
+            return value
+        out = np.full((len(q), n), np.nan)
         out[:, have] = value
         return out
 
@@ -198,11 +209,11 @@ class BeaconIdentifier:
         if not rows or n == 0:
             return np.zeros((len(rows), n))
         samples = self._win[rows]
-        agent = self.agent_headings(self._times)  # (W, N)
+        agent = self._headings(self._times, self._times_count)  # (W, N)
         d = (1.0 - np.cos(samples[:, :, None] - agent[None])) / 2.0  # (k, W, N)
         valid = np.isfinite(d)
-        count = valid.sum(axis=1)
-        total = np.where(valid, d, 0.0).sum(axis=1)
+        count = np.add.reduce(valid, axis=1)
+        total = np.add.reduce(np.where(valid, d, 0.0), axis=1)
         mean: np.ndarray = np.divide(total, count, out=np.full(count.shape, np.inf), where=count > 0)
         return mean
 
@@ -225,13 +236,10 @@ class BeaconIdentifier:
         biased = cost.copy()
         current = self._current[rows]
         held = np.flatnonzero(current >= 0)
-        if len(held):
+        if len(held):  # (an infinite cost stays infinite)
             a = current[held]
-            bias = biased[held, a]
-            ok = np.isfinite(bias)
-            biased[held[ok], a[ok]] = np.maximum(bias[ok] - cfg.hysteresis, 0.0)
-        matches = assign_pairs(biased, cfg.max_cost)
-        r, a = matches[:, 0], matches[:, 1]
+            biased[held, a] = np.maximum(biased[held, a] - cfg.hysteresis, 0.0)
+        r, a = pairs(biased, biased <= cfg.max_cost, cfg.max_cost)
         agent_out[r] = a
         prob[r] = 1.0 - cost[r, a]
         self._current[rows] = agent_out  # (row 0, unobserved tracks, is never assigned: stays -1)
