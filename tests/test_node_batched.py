@@ -183,3 +183,12 @@ def test_identifier_table_equals_the_plain_dicts(seed):
         assert result == plain.assign(asked)
         assigned += len(result)
     assert next_id > 20 and assigned > 50
+
+
+def test_reports_built_outside_decode_are_still_validated():
+    from lookalike.node import HeadingReport
+
+    node = _node()
+    assert node.add_report(HeadingReport(robot=0, seq=0, t_sent=0.0, heading=math.nan)) == "reports"
+    with pytest.raises(ValueError, match="heading"):
+        node.add_frame(DetectionsMessage(frame=0, time=0.1, position=(), heading=(), score=()))

@@ -176,13 +176,18 @@ class TeamIdentifier:
         reports = self._take_reports()
         if not reports:
             beacons = Beacons.empty()
-        else:  # (reports were checked by add_report's callers: decode, or the types of HeadingReport)
-            beacons = Beacons(
-                agent_id=np.array([r.robot for r in reports], dtype=int),
-                t_sent=np.array([r.t_sent for r in reports], dtype=float),
-                t_received=np.full(len(reports), message.time),
-                heading=np.array([r.heading for r in reports], dtype=float),
-            )
+        else:
+            agent_id = np.array([r.robot for r in reports], dtype=int)
+            t_sent = np.array([r.t_sent for r in reports], dtype=float)
+            heading = np.array([r.heading for r in reports], dtype=float)
+            t_received = np.full(len(reports), float(message.time))
+            if math.isfinite(float(t_sent.sum()) + float(heading.sum())) and agent_id.min() >= 0:
+                beacons = _trusted(Beacons, agent_id=agent_id, t_sent=t_sent, t_received=t_received, heading=heading)
+            else:
+                beacons = Beacons(agent_id=agent_id, t_sent=t_sent, t_received=t_received, heading=heading)
+        if isinstance(message.frame, int) and message.frame >= 0 and math.isfinite(message.time):
+            return _trusted(Frame, index=message.frame, time=message.time, detections=detections, beacons=beacons,
+                            image=None)
         return Frame(index=message.frame, time=message.time, detections=detections, beacons=beacons)
 
     def _team_state(self, frame: Frame, snapshots: Sequence[TrackSnapshot]) -> TeamState:
