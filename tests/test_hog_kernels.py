@@ -11,8 +11,9 @@ import pytest
 
 import lookalike.vision.hog_features as hf
 import lookalike.vision.hog_kernels as hk
-from lookalike.vision.hog_blocks import cell_integral32
+from lookalike.vision.hog_blocks import block_features_grid, block_features_rows, block_pool, cell_integral32
 from lookalike.vision.hog_cascade import HogCascade
+from lookalike.vision.hog_features import BINS
 from lookalike.vision.pipeline import shipped_model_path
 
 numba = pytest.importorskip("numba", reason="numba (the `fast` extra) is not installed: only the numpy path runs")
@@ -65,6 +66,35 @@ def test_compiled_integral_equals_numpys() -> None:
         assert fast.dtype == plain.dtype == np.float32
         assert np.array_equal(fast, plain)
         assert not fast[0].any() and not fast[:, 0].any()
+
+
+def test_compiled_block_columns_equal_numpys() -> None:
+    rng = np.random.default_rng(13)
+    blocks = block_pool((32, 64), 4)
+    stacked, ox, oy, width, offset, first = [], [], [], [], [], 0
+    for h, w in ((30, 40), (17, 20)):
+        hist = rng.uniform(0, 50, (h, w, BINS)) * np.exp(rng.uniform(-8, 3, (h, w, BINS)))
+        hist[rng.random(hist.shape) < 0.2] = 0.0
+        hist[: h // 3] = 0.0  # flat: zero blocks, norm = area
+        rows = cell_integral32(hist)
+        ys, xs = np.mgrid[0 : 4 * h - 64 + 1 : 8, 0 : 4 * w - 32 + 1 : 8]
+        columns = rng.choice(len(blocks) * 4 * BINS, 25, replace=False)
+        planes = np.ascontiguousarray(rows.transpose(2, 0, 1))
+        grid = block_features_grid(planes, blocks, xs.shape, 2, 4, columns)  # numpy only
+        fast, plain = both(block_features_rows, rows.reshape(-1, BINS), w + 1, blocks, xs.ravel(), ys.ravel(), 4,
+                           columns)
+        assert np.array_equal(fast, plain) and np.array_equal(fast, grid)
+        assert fast.flags.f_contiguous and plain.flags.f_contiguous
+        stacked.append(rows.reshape(-1, BINS))
+        ox.append(xs.ravel())
+        oy.append(ys.ravel())
+        width.append(np.full(xs.size, w + 1))
+        offset.append(np.full(xs.size, first))
+        first += len(stacked[-1])
+    args = (np.concatenate(stacked), np.concatenate(width), blocks[::3], np.concatenate(ox), np.concatenate(oy), 4)
+    columns = rng.choice(len(blocks[::3]) * 4 * BINS, 40, replace=False)
+    fast, plain = both(block_features_rows, *args, columns, np.concatenate(offset))
+    assert np.array_equal(fast, plain)
 
 
 def test_shipped_detector_is_the_same_with_and_without_the_kernels() -> None:

@@ -79,10 +79,20 @@ def block_features_rows(rows: np.ndarray, width: int | np.ndarray, blocks: np.nd
     only those columns of the result ``(k, len(columns))`` (each still normalised by its whole block).
 
     Several integrals stacked in ``rows`` (e.g. the levels of a pyramid) are read at once with a per-window
-    ``width (k,)`` (corners per integral row) and ``offset (k,)`` (the integral's first row in ``rows``)."""
+    ``width (k,)`` (corners per integral row) and ``offset (k,)`` (the integral's first row in ``rows``).
+    Selected columns of a float32 integral are computed by a compiled kernel when numba is there
+    (:mod:`lookalike.vision.hog_kernels`), with the same operations in the same order."""
     k, d = len(ox), 4 * BINS
     cols, out = _output(k, len(blocks), columns)
     ox, oy = np.asarray(ox, np.int64), np.asarray(oy, np.int64)
+    kernels = compiled() if cols is not None and rows.dtype == np.float32 else None
+    if kernels is not None and cols is not None:
+        kernels["block_columns"](
+            np.ascontiguousarray(rows), np.ascontiguousarray(np.broadcast_to(np.asarray(width, np.int64), (k,))),
+            np.zeros(k, np.int64) if offset is None else np.ascontiguousarray(offset, np.int64),
+            np.ascontiguousarray(ox), np.ascontiguousarray(oy), unit_px, np.ascontiguousarray(blocks, np.int64),
+            cols // d, cols % d, out)
+        return out
     per_window = np.ndim(width) > 0
     wide = np.asarray(width, np.int64)[:, None] if per_window else width
     chunk = max(1, 65536 // max(k, 1))  # blocks per gather: bounds the (3, 3, k, chunk, BINS) corner array

@@ -33,6 +33,7 @@ from lookalike.vision.hog_blocks import (  # noqa: F401  (block_pool, window_fea
     window_features,
 )
 from lookalike.vision.hog_features import BINS, as_bgr_image, cell_histograms, to_grey
+from lookalike.vision.hog_kernels import compiled
 from lookalike.vision.model_file import load_model_file, save_model_file
 from lookalike.vision.nms import merge_nms, nms  # noqa: F401  (nms is part of this module's API)
 
@@ -158,20 +159,25 @@ class HogCascade:
             # block sum by a few gradient units at most, far below the block sums the stumps threshold.
             rows = cell_integral32(cell_histograms(level, cfg.cell_px).transpose(1, 2, 0))
             grid_y, grid_x = np.arange(0, size[1] - win_h + 1, step), np.arange(0, size[0] - win_w + 1, step)
-            # The first stage sees every window of the grid: strided slices of the integral instead of gathers,
-            # the same arithmetic.
+            ox, oy = np.tile(grid_x, len(grid_y)), np.repeat(grid_y, len(grid_x))  # window origins (px), row by row
+            # The first stage sees every window of the grid: with numpy, strided slices of the integral instead of
+            # gathers (the same arithmetic); compiled, one pass over the windows.
             if self.stages:
                 stage, (used, columns) = self.stages[0], self._stage_blocks[0]
-                planes = np.ascontiguousarray(rows.transpose(2, 0, 1))
-                grid = (len(grid_y), len(grid_x))
-                margin = _margin(block_features_grid(planes, used, grid, cfg.stride_cells, cfg.cell_px, columns), stage)
+                if compiled() is not None:
+                    features = block_features_rows(rows.reshape(-1, BINS), rows.shape[1], used, ox, oy, cfg.cell_px,
+                                                   columns)
+                else:
+                    planes = np.ascontiguousarray(rows.transpose(2, 0, 1))
+                    features = block_features_grid(planes, used, (len(grid_y), len(grid_x)), cfg.stride_cells,
+                                                   cfg.cell_px, columns)
+                margin = _margin(features, stage)
                 alive = np.flatnonzero(margin >= stage.bias)
                 first.append(margin[alive])
             else:
-                alive = np.arange(len(grid_y) * len(grid_x))
+                alive = np.arange(len(ox))
                 first.append(np.zeros(len(alive)))
-            # window origins (px), row by row as the grid lists them
-            levels.append((scale, rows.shape[1], np.tile(grid_x, len(grid_y)), np.repeat(grid_y, len(grid_x)), alive))
+            levels.append((scale, rows.shape[1], ox, oy, alive))
             stacked.append(rows.reshape(-1, BINS))
             scale /= cfg.scale_step
         if not levels:

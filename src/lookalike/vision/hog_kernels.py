@@ -1,5 +1,5 @@
 """Optional compiled kernels (numba) for the HOG detector: cell histograms from gradient magnitude and angle, and
-the float32 integral of those histograms.
+the float32 integral of those histograms, and selected block-descriptor columns of many windows.
 
 Each kernel does the floating-point operations of the numpy path (:func:`~lookalike.vision.hog_features.cell_histograms`
 and the integral in :meth:`~lookalike.vision.hog_cascade.HogCascade.windows`) one pixel or one cell at a time, in
@@ -41,4 +41,5 @@ def _build() -> dict[str, Callable[..., None]] | None:
         from lookalike.vision import hog_numba
     except ImportError:
         return None
-    return {"cell_hist": hog_numba.cell_hist, "integral32": hog_numba.integral32}
+    return {"cell_hist": hog_numba.cell_hist, "integral32": hog_numba.integral32,
+            "block_columns": hog_numba.block_columns}

@@ -76,3 +76,46 @@ def integral32(hist: np.ndarray, out: np.ndarray) -> None:
             for b in range(bins):
                 run[b] = col[x, b] if x == 0 else run[b] + col[x, b]
                 out[y + 1, x + 1, b] = np.float32(run[b])
+
+
+@_jit  # type: ignore[misc]
+def block_columns(rows: np.ndarray, width: np.ndarray, offset: np.ndarray, ox: np.ndarray, oy: np.ndarray,
+                  unit_px: int, blocks: np.ndarray, col_block: np.ndarray, col_local: np.ndarray,
+                  out: np.ndarray) -> None:
+    """Selected block-descriptor columns ``out (k, columns)`` float32 of windows at ``ox, oy (k,)`` px, read from an
+    integral laid out as ``rows (corners, bins)`` float32 (``width (k,)`` corners per integral row, ``offset
+    (k,)`` its first row) for ``blocks (b, 4)`` px; column ``j`` is value ``col_local[j]`` (cell row, cell column,
+    bin) of block ``col_block[j]`` over the block's norm: the cell sums, squares, the pairwise sum of the 36
+    squares (numpy's order, as ``hog_blocks._block_norms``), square root, area and division of the numpy path."""
+    bins = rows.shape[1]
+    n = 4 * bins
+    cells = np.empty(n, np.float32)
+    acc = np.empty(8, np.float32)
+    for w in range(ox.shape[0]):
+        wide = width[w]
+        for i in range(blocks.shape[0]):
+            hw = blocks[i, 2] // 2 // unit_px
+            hh = blocks[i, 3] // 2 // unit_px
+            base = ((oy[w] + blocks[i, 1]) // unit_px) * wide + (ox[w] + blocks[i, 0]) // unit_px + offset[w]
+            down = hh * wide
+            for r in range(2):
+                for c in range(2):
+                    i00 = base + r * down + c * hw
+                    i01 = i00 + hw
+                    i10 = i00 + down
+                    i11 = i10 + hw
+                    for b in range(bins):
+                        cells[(2 * r + c) * bins + b] = ((rows[i11, b] - rows[i01, b]) - rows[i10, b]) + rows[i00, b]
+            for j in range(8):
+                acc[j] = cells[j] * cells[j] + cells[j + 8] * cells[j + 8]
+            for s in range(16, n - n % 8, 8):
+                for j in range(8):
+                    acc[j] += cells[s + j] * cells[s + j]
+            total = (acc[0] + acc[1]) + (acc[2] + acc[3])
+            total += (acc[4] + acc[5]) + (acc[6] + acc[7])
+            for j in range(n - n % 8, n):
+                total += cells[j] * cells[j]
+            norm = np.sqrt(total) + np.float32(blocks[i, 2] * blocks[i, 3])
+            for j in range(col_block.shape[0]):
+                if col_block[j] == i:
+                    out[w, j] = cells[col_local[j]] / norm
