@@ -192,3 +192,53 @@ def test_reports_built_outside_decode_are_still_validated():
     assert node.add_report(HeadingReport(robot=0, seq=0, t_sent=0.0, heading=math.nan)) == "reports"
     with pytest.raises(ValueError, match="heading"):
         node.add_frame(DetectionsMessage(frame=0, time=0.1, position=(), heading=(), score=()))
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_team_bytes_equal_json_dumps(seed):
+    import json
+
+    from lookalike.node import RobotEstimate, TeamState, decode, encode
+    from lookalike.node.messages import _team_bytes
+
+    rng = np.random.default_rng(seed)
+
+    def number():
+        scaled = float(rng.normal() * 10.0 ** rng.integers(-8, 8))
+        return float(rng.choice([0.0, -0.0, 1e-300, 1e12, -3.5, 1 / 3, scaled]))
+
+    robots = tuple(RobotEstimate(id=int(j), position=(number(), number()),
+                                 heading=None if rng.random() < 0.3 else number(),
+                                 confidence=None if rng.random() < 0.3 else number(), age=number())
+                   for j in range(int(rng.integers(0, 8))))
+    team = TeamState(frame=int(rng.integers(0, 2**62)), time=number(), robots=robots,
+                     labels=tuple(int(v) for v in rng.integers(-1, 7, int(rng.integers(0, 12)))))
+    body = {"v": 1, "type": "team", "frame": team.frame, "time": team.time, "labels": list(team.labels),
+            "robots": [{"id": r.id, "position": list(r.position), "heading": r.heading, "confidence": r.confidence,
+                        "age": r.age} for r in robots]}
+    expected = json.dumps(body, separators=(",", ":"), allow_nan=False).encode()
+    assert _team_bytes(team) == expected == encode(team)
+    assert decode(expected) == team
+
+
+@pytest.mark.parametrize("team", [
+    "TeamState(frame=0, time=math.nan, robots=())",
+    "TeamState(frame=0, time=0.0, robots=(RobotEstimate(id=0, position=(math.inf, 0.0), heading=None, "
+    "confidence=None, age=0.0),))",
+    "TeamState(frame=0, time=0.0, robots=(RobotEstimate(id=0, position=(0.0, 0.0), heading=math.nan, "
+    "confidence=None, age=0.0),))",
+])
+def test_team_encoding_still_refuses_non_finite_numbers(team):
+    from lookalike.node import RobotEstimate, TeamState, encode  # noqa: F401 (used by eval)
+
+    with pytest.raises(ValueError, match="non-finite"):
+        encode(eval(team))
+
+
+def test_team_encoding_of_other_number_types_goes_through_json():
+    from lookalike.node import RobotEstimate, TeamState, encode
+
+    team = TeamState(frame=3, time=1, robots=(RobotEstimate(id=0, position=(1, 2.5), heading=None, confidence=True,
+                                                            age=0.0),), labels=(0, -1))
+    assert encode(team) == (b'{"v":1,"type":"team","frame":3,"time":1,"labels":[0,-1],"robots":[{"id":0,'
+                            b'"position":[1,2.5],"heading":null,"confidence":true,"age":0.0}]}')
