@@ -59,6 +59,10 @@ def to_grey(image_bgr: np.ndarray) -> np.ndarray:
     img = np.ascontiguousarray(image_bgr)
     h, w = img.shape[:2]
     out = np.empty((h, w), np.float32)
+    kernels = compiled()
+    if kernels is not None and img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3:
+        kernels["grey"](img, out)
+        return out
     rows = max(1, _BAND_PIXELS // max(1, w))
     for y0 in range(0, h, rows):
         b, g, r = (c.astype(np.float32) for c in cv2.split(img[y0 : y0 + rows]))

@@ -119,3 +119,14 @@ def block_columns(rows: np.ndarray, width: np.ndarray, offset: np.ndarray, ox: n
             for j in range(col_block.shape[0]):
                 if col_block[j] == i:
                     out[w, j] = cells[col_local[j]] / norm
+
+
+@_jit  # type: ignore[misc]
+def grey(image: np.ndarray, out: np.ndarray) -> None:
+    """``out (h, w)`` float32 = ``(0.114 B + 0.587 G) + 0.299 R`` of ``image (h, w, 3)`` uint8 BGR, each product and
+    sum rounded to float32 (as the numpy path computes it)."""
+    cb, cg, cr = np.float32(0.114), np.float32(0.587), np.float32(0.299)
+    for y in range(image.shape[0]):
+        for x in range(image.shape[1]):
+            out[y, x] = (np.float32(image[y, x, 0]) * cb + np.float32(image[y, x, 1]) * cg) + \
+                np.float32(image[y, x, 2]) * cr
