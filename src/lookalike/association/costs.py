@@ -14,6 +14,24 @@ def iou_cost(track_xywh: np.ndarray, det_xywh: np.ndarray, min_iou: float = 0.0,
     return cost_from_iou(iou_matrix(track_xywh, det_xywh), min_iou, det_weight)
 
 
+def iou_columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:func:`~lookalike.geometry.boxes.iou_matrix` of boxes given as columns, ``a (4, m)`` and
+    ``b (4, n)`` (rows left, top, width, height; pixels): ``(m, n)``, the same numbers bit for bit, with
+    x and y handled together."""
+    lo_a, lo_b = a[0:2, :, None], b[0:2, None, :]
+    side = np.minimum(lo_a + a[2:4, :, None], lo_b + b[2:4, None, :])
+    side -= np.maximum(lo_a, lo_b)
+    np.maximum(side, 0.0, out=side)
+    inter = side[0] * side[1]
+    union = (a[2] * a[3])[:, None] + b[2] * b[3]
+    union -= inter
+    if union.min(initial=1.0) > 0:
+        out: np.ndarray = inter / union
+        return out
+    out = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
+    return out
+
+
 def cost_from_iou(iou: np.ndarray, min_iou: float = 0.0, det_weight: np.ndarray | None = None) -> np.ndarray:
     """:func:`iou_cost` from an IoU matrix ``(k, d)`` already computed (e.g. a block of a frame's
     whole track × detection matrix)."""

@@ -34,6 +34,11 @@ class Stage:
         max_cost: pairs costing more are forbidden (the solver's gate, see :func:`assign`).
         solve: a replacement solver taking the cost matrix (default: :func:`assign` with ``max_cost``).
         name: a label for diagnostics.
+        gate: when known before any cost is computed, the allowed pairs of all tracks and detections,
+            a boolean matrix ``(k, n)`` True exactly where the cost is at most ``max_cost`` (finite for
+            ``inf``), e.g. an IoU threshold. The stage then computes its costs only when its allowed
+            pairs share a track or a detection: disjoint pairs are every optimum's matches, as
+            :func:`assign` finds them. Ignored with ``solve``.
     """
 
     tracks: np.ndarray | None
@@ -42,6 +47,7 @@ class Stage:
     max_cost: float = np.inf
     solve: SolveFn | None = None
     name: str = ""
+    gate: np.ndarray | None = None
 
 
 @dataclass
@@ -92,14 +98,67 @@ def _eligible(selector: np.ndarray | None, allowed: np.ndarray) -> np.ndarray:
     return out
 
 
-def run_stage(stage: Stage, matching: Matching, index: int = 0) -> Matching:
+def _as_list(selector: np.ndarray | None) -> list[bool] | None:
+    """A boolean selector as a list (None: every row); None also for an index array, which the caller
+    leaves to the array path (its order and repeats matter there)."""
+    if selector is None or selector.dtype != bool:
+        return None
+    out: list[bool] = selector.tolist()
+    return out
+
+
+def _run_gated(stage: Stage, pairs: tuple[list[int], list[int]], matching: Matching, index: int) -> bool:
+    """Run a gated stage from its gate's allowed pairs ``pairs`` (track rows, detections) when those
+    still eligible (eligible track still unmatched, eligible detection still free) are disjoint: each
+    is then a match of every optimum. Returns False, having changed nothing, when they compete."""
+    det_of_track, free = matching.det_of_track, matching.free
+    taken, left = det_of_track.tolist(), free.tolist()
+    tracks, dets = _as_list(stage.tracks), _as_list(stage.detections)
+    rows, cols = [], []
+    for i, j in zip(*pairs):
+        if taken[i] < 0 and left[j] and (tracks is None or tracks[i]) and (dets is None or dets[j]):
+            rows.append(i)
+            cols.append(j)
+    if len(set(rows)) < len(rows) or len(set(cols)) < len(cols):
+        return False
+    stage_of_track = matching.stage_of_track
+    for i, j in zip(rows, cols):
+        det_of_track[i] = j
+        free[j] = False
+        stage_of_track[i] = index
+    return True
+
+
+def run_stage(stage: Stage, matching: Matching, index: int = 0,
+              _pairs: dict[int, tuple[list[int], list[int]]] | None = None) -> Matching:
     """Run one stage on what ``matching`` left over (updated in place and returned)."""
+    gate = stage.gate if stage.solve is None else None
+    if gate is not None and (stage.tracks is None or stage.tracks.dtype == bool) and (
+            stage.detections is None or stage.detections.dtype == bool):
+        pairs = None if _pairs is None else _pairs.get(id(gate))
+        if pairs is None:
+            ti, dj = gate.nonzero()
+            pairs = (ti.tolist(), dj.tolist())
+            if _pairs is not None:
+                _pairs[id(gate)] = pairs
+        if _run_gated(stage, pairs, matching, index):
+            return matching
     rows = _eligible(stage.tracks, matching.det_of_track < 0)
     if not len(rows):
         return matching
     cols = _eligible(stage.detections, matching.free)
     if not len(cols):
         return matching
+    if gate is not None:
+        i, j = gate[rows[:, None], cols].nonzero()  # row-major, as the solver lists them
+        if not len(i):
+            return matching
+        if len(i) == 1 or (len(set(i.tolist())) == len(i) and len(set(j.tolist())) == len(j)):
+            r, c = rows[i], cols[j]  # disjoint allowed pairs: the matches of every optimum
+            matching.det_of_track[r] = c
+            matching.free[c] = False
+            matching.stage_of_track[r] = index
+            return matching
     cost = stage.cost(rows, cols)
     found = stage.solve(cost) if stage.solve is not None else assign_pairs(cost, stage.max_cost)
     if len(found):
@@ -115,8 +174,9 @@ def run_plan(stages: list[Stage], n_tracks: int, n_detections: int,
     """Run ``stages`` in order on ``n_tracks`` tracks and ``n_detections`` detections (or on what
     ``start`` left over); return the matches and the left-overs."""
     matching = start if start is not None else Matching.empty(n_tracks, n_detections)
+    pairs: dict[int, tuple[list[int], list[int]]] = {}  # each gate's allowed pairs, found once per plan
     for i, stage in enumerate(stages):
-        run_stage(stage, matching, i)
+        run_stage(stage, matching, i, pairs)
     return matching
 
 

@@ -171,6 +171,94 @@ class BoxCXCYWH:
         return mean_u, cov_u
 
 
+    # Column form: every track's state in one quantity-major table ``(24, k)``, a column per track:
+    # rows 0-7 the mean ``[cx, cy, w, h, vx, vy, vw, vh]``, then the covariance as its four 2×2-block
+    # diagonals over ``[cx, cy, w, h]``: rows 8-11 value/value (p11), 12-15 value/velocity (p12), 16-19
+    # velocity/value (p21), 20-23 velocity/velocity (p22); the rest of the covariance stays 0 in this
+    # space. p12 and p21 are kept apart as the full form computes them (an update rounds them
+    # differently). Each operation then works on contiguous rows of all tracks at once; the numbers
+    # are those of the full-covariance methods above, bit for bit (tests/test_motion_columns.py).
+
+    @staticmethod
+    def to_columns(mean: np.ndarray, cov: np.ndarray) -> np.ndarray:
+        """The column table ``(24, k)`` of states ``mean (k, 8)`` and full covariances ``cov (k, 8, 8)``."""
+        p11, p12, p21, p22 = _blocks(np.ascontiguousarray(cov))
+        return np.concatenate((mean.T, p11.T, p12.T, p21.T, p22.T))
+
+    @staticmethod
+    def from_columns(columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """States ``(k, 8)`` and full covariances ``(k, 8, 8)`` of a column table ``(24, k)``."""
+        cov = np.zeros((columns.shape[1], 8, 8))
+        for b, view in enumerate(_blocks(cov)):
+            view[...] = columns[8 + 4 * b: 12 + 4 * b].T
+        return columns[:8].T.copy(), cov
+
+    def initial_rows(self, z: np.ndarray) -> np.ndarray:
+        """New tracks at measurements ``z (n, 4)`` as rows ``(n, 24)`` of the column table (its transpose)."""
+        n = len(z)
+        size = np.maximum(z[:, 2:4], 1.0)
+        p, v = self.pos_noise, self.vel_noise
+        rows = np.zeros((n, 24))
+        rows[:, :4] = z
+        rows[:, 8:10] = rows[:, 10:12] = (2 * p * size) ** 2
+        rows[:, 20:22] = rows[:, 22:24] = (10 * v * size) ** 2
+        return rows
+
+    def predict_columns(self, columns: np.ndarray, steps: float) -> None:
+        """:meth:`predict` on a column table ``(24, k)``, in place."""
+        x = columns
+        size = np.maximum(x[2:4], 1.0)
+        var = size * size  # the squared sizes w², h² (the variances' unit)
+        if steps == 1.0:  # x * 1.0 == x exactly: the same numbers without the multiplications by steps
+            x[6:8][x[2:4] + x[6:8] <= 1.0] = 0.0  # sizes stay > 1
+            x[0:4] += x[4:8]
+            x[8:12] += x[16:20]  # p11 + p21
+            x[12:16] += x[20:24]  # a = p12 + p22
+            x[16:20] += x[20:24]  # p21 + p22
+            x[8:12] += x[12:16]  # + a
+        else:
+            var *= max(steps, 0.0)
+            x[6:8][x[2:4] + x[6:8] * steps <= 1.0] = 0.0
+            x[0:4] += steps * x[4:8]
+            x[8:12] += steps * x[16:20]
+            p22 = steps * x[20:24]
+            x[12:16] += p22
+            x[16:20] += p22
+            x[8:12] += steps * x[12:16]
+        q = self.pos_noise**2 * var
+        x[8:10] += q
+        x[10:12] += q
+        q = self.vel_noise**2 * var
+        x[20:22] += q
+        x[22:24] += q
+
+    def innovation_columns(self, columns: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Innovations ``z - H x`` ``(4, m)`` of measurement columns ``z (4, m)`` (cx, cy, w, h) for the
+        tracks of ``columns (24, m)``, and their variances ``(4, m)`` (``H P Hᵀ + R`` is diagonal here)."""
+        std = self.pos_noise * z[2:4]
+        r = std * std
+        s = np.empty(z.shape)
+        np.add(columns[8:10], r, out=s[0:2])
+        np.add(columns[10:12], r, out=s[2:4])
+        return z - columns[0:4], s
+
+    @staticmethod
+    def correct_columns(columns: np.ndarray, innovation: np.ndarray, s: np.ndarray) -> None:
+        """The Kalman update of ``columns (24, m)``, in place, from :meth:`innovation_columns`."""
+        m = columns.shape[1]
+        x = columns
+        gain = np.empty((2, 4, m))
+        np.divide(x[8:12], s, out=gain[0])  # p11 / s
+        np.divide(x[16:20], s, out=gain[1])  # p21 / s
+        x[0:8] += (gain * innovation).reshape(8, m)
+        blocks = x[8:24].reshape(2, 2, 4, m)  # [[p11, p12], [p21, p22]]
+        blocks -= gain[:, None] * blocks[None, :, 0]  # - gain ⊗ [p11, p21]
+
+    def update_columns(self, columns: np.ndarray, z: np.ndarray) -> None:
+        """:meth:`update` on ``columns (24, m)`` with measurement columns ``z (4, m)``, in place."""
+        self.correct_columns(columns, *self.innovation_columns(columns, z))
+
+
 @dataclass(frozen=True)
 class BoxXYAH:
     """Deep SORT's ``[x, y, a, h]`` (centre pixels, aspect w/h, height pixels) plus velocities, noise

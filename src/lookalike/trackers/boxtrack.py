@@ -18,15 +18,21 @@ scoring at least the birth threshold start tentative tracks (in a closed set, on
 free or lost ``max_age_s``). Confirmed tracks matched this frame are reported with their filtered
 box, and confirmed tracks likely still present at their predicted box (``detection_index`` -1).
 The mechanisms and where every default comes from: docs/trackers/boxtrack.md.
+
+Speed (issue 18): the motion states live in the motion space's column form, one quantity-major
+``(24, k)`` table whose rows each hold one number of every track (the track table's ``mean`` and
+``cov`` are views of it), so a prediction or an update is a dozen operations on contiguous rows; one
+IoU matrix per frame serves every stage and the clutter share; the IoU stages compute costs only
+when their allowed pairs compete. The rows are those of the plain tracker this replaced, bit for bit
+(tests/boxtrack_oracle.py, tests/test_boxtrack_fast.py).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from lookalike.association.costs import centre_distance_cost, cost_from_iou
+from lookalike.association.costs import centre_distance_cost, cost_from_iou, iou_columns
 from lookalike.association.stages import CostFn, Matching, Stage, run_plan
-from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion.spaces import BoxCXCYWH, cxcywh_to_xywh
 from lookalike.trackers import boxtrack_config as const
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
@@ -68,7 +74,9 @@ class BoxTrack:
     def reset(self) -> None:
         """Forget every track; ids restart at 1."""
         cfg = self.config
-        self._tracks = TrackTable(8)
+        self._tracks = TrackTable(8, cov_shape=(4, 4))  # cov: the 2×2-block diagonals [p11, p12, p21, p22]
+        self._columns = np.zeros((24, 0))  # BoxCXCYWH's column form; mean and cov are its views (_state)
+        self._views: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
         self._frame_count = 0
         self._clock = FrameClock(cfg.frame_interval_s)
         self._calibration = ScoreCalibration(
@@ -81,48 +89,37 @@ class BoxTrack:
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
-        cfg, t = self.config, self._tracks
-        steps = self._clock.steps(frame.time)
-        dt = steps * self._clock.interval
+        cfg, t, clock = self.config, self._tracks, self._clock
+        steps = clock.steps(frame.time)
+        dt = steps * clock.interval
         self._frame_count += 1
         dets = frame.detections
-        keep = dets.score >= cfg.low_score
-        if keep.all():  # the read-only columns themselves, no copies
-            det_idx, det_xywh, score = np.arange(len(keep)), dets.xywh, dets.score
-        else:
-            det_idx = keep.nonzero()[0]
-            det_xywh, score = dets.xywh[det_idx], dets.score[det_idx]
-        det_box = self._space.measure(det_xywh)
+        det_xywh, score = dets.xywh, dets.score  # the read-only columns themselves, no copies
+        det_idx = None  # None: every detection kept, at its own index
+        if len(score) and not score.min() >= cfg.low_score:
+            det_idx = (score >= cfg.low_score).nonzero()[0]
+            det_xywh, score = det_xywh[det_idx], score[det_idx]
+        z = self._measure(det_xywh.T)
         self._calibration.observe_scores(score)
-        self._clutter.observe(det_xywh)
-        high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
+        x = self._state()
         was_tracked = t.unseen_s == 0
         if len(t):
             if self._slots is not None:
                 self._slots.freeze_shape(t)
-            t.mean[self._coasting.still(t.unseen_s), 4:] = 0.0  # a long-lost track waits where it was last seen
-            t.mean, t.cov = self._predict_space().predict(t.mean, t.cov, steps)
-        matching = self._associate(det_xywh, det_box, score, high_score, was_tracked,
-                                   t.unseen_s + dt)
+            x[4:8, self._coasting.still(t.unseen_s)] = 0.0  # a long-lost track waits where it was last seen
+            self._predict_space().predict_columns(x, steps)
+        iou = self._overlaps(x, det_xywh)
+        high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
+        matching = self._associate(iou, z.T, score, high_score, was_tracked, t.unseen_s + dt)
         det_of_track, free = matching.det_of_track, matching.free
         hit = det_of_track >= 0
         matched = hit.nonzero()[0]
         if len(matched):
-            d = det_of_track[matched]
-            z = det_box[d]
-            conf = t.confirmed[matched]
-            self._observe_fit(matched[conf], z[conf])
-            if len(matched) == len(t):  # every track matched: no gather and scatter
-                t.mean, t.cov = self._space.update(t.mean, t.cov, z)
-            else:
-                t.mean[matched], t.cov[matched] = self._space.update(t.mean[matched], t.cov[matched], z)
-            t.hits[matched] += 1
-            back = matched[conf & (t.misses[matched] > 0)]
-            if len(back):
-                self._coasting.observe(came_back=t.misses[back])
-        np.multiply(t.hits, hit, out=t.hits)  # a miss resets the hit count
+            self._correct(x, matched, z[:, det_of_track[matched]])
+        np.add(t.hits, hit, out=t.hits)
+        np.multiply(t.hits, hit, out=t.hits)  # one more hit for the matched tracks; a miss resets the count
         if self._slots is not None:
-            self._slots.observe_speed(t, hit, self._clock.interval)
+            self._slots.observe_speed(t, hit, clock.interval)
         t.record(hit, dt)
         ready = t.hits >= cfg.n_init
         if self._frame_count == 1:
@@ -131,35 +128,83 @@ class BoxTrack:
             t.confirmed |= ready
         else:
             det_of_track = self._slots.refill(t, ready, det_of_track)
-        born = self._births(np.flatnonzero(free & (score >= birth_score)), det_box)
-        out = self._report(np.concatenate([det_of_track, born]), det_idx, dets.xywh)
+        born = self._births((free & (score >= birth_score)).nonzero()[0], z)
+        out = self._report(np.concatenate((det_of_track, born)), det_idx)
         alive = self._lifecycle.alive(t)
         if not alive.all():
             self._coasting.observe(died=t.misses[~alive & t.confirmed])
             t.keep(alive)
         return out
 
-    def _associate(self, det_xywh: np.ndarray, det_box: np.ndarray, score: np.ndarray, high_score: float,
+    def _state(self) -> np.ndarray:
+        """The tracks' states as :class:`BoxCXCYWH`'s column table ``(24, k)``, of which the track table's
+        ``mean`` and ``cov`` are views; rebuilt from the table after it added or removed rows."""
+        t = self._tracks
+        if t.mean is not self._views[0] or t.cov is not self._views[1]:
+            k = len(t)
+            x = np.empty((24, k))
+            x[:8] = t.mean.T
+            x[8:] = t.cov.reshape(k, 16).T
+            t.mean, t.cov = x[:8].T, x[8:].T.reshape(k, 4, 4)
+            self._columns, self._views = x, (t.mean, t.cov)
+        return self._columns
+
+    @staticmethod
+    def _measure(xywh: np.ndarray) -> np.ndarray:
+        """Measurement columns ``(4, n)`` (cx, cy, w, h) of boxes given as columns ``xywh (4, n)``
+        (:meth:`BoxCXCYWH.measure`'s numbers)."""
+        z = np.empty(xywh.shape)
+        np.add(xywh[0:2], xywh[2:4] / 2.0, out=z[0:2])
+        z[2:4] = xywh[2:4]
+        return z
+
+    def _overlaps(self, x: np.ndarray, det_xywh: np.ndarray) -> np.ndarray | None:
+        """One IoU matrix of the predicted track boxes (state columns ``x``) and the previous frame's
+        detections (rows) against this frame's detections (columns): the clutter share counts from the
+        second block; returns the first ``(k, n)`` (None without tracks or detections)."""
+        clutter = self._clutter
+        previous = clutter.previous
+        k, n, p = x.shape[1], len(det_xywh), 0 if previous is None else len(previous)
+        if not n or not (k or p):
+            clutter.observe_best(det_xywh, None)
+            return None
+        boxes = np.empty((4, k + p))  # left, top, width, height as columns
+        if k:  # the predicted boxes, sizes floored at 1e-3 pixels (cxcywh_to_xywh)
+            size = np.maximum(x[2:4], 1e-3, out=boxes[2:4, :k])
+            np.subtract(x[0:2], size / 2, out=boxes[0:2, :k])
+        if p:
+            boxes[:, k:] = previous.T  # type: ignore[union-attr]
+        iou = iou_columns(boxes, det_xywh.T)
+        clutter.observe_best(det_xywh, np.maximum.reduce(iou[k:], axis=0) if p else None)
+        return iou[:k] if k else None
+
+    def _associate(self, iou: np.ndarray | None, det_box: np.ndarray, score: np.ndarray, high_score: float,
                    was_tracked: np.ndarray, unseen_s: np.ndarray) -> Matching:
         """The association plan: confident detections to confirmed tracks (recent ones first), low-score
         ones to tracks seen last frame, the rest to tentative tracks, then lost tracks by centre distance."""
         cfg, t = self.config, self._tracks
         high = score >= high_score
-        # one IoU matrix per frame; each stage takes its block of it
-        iou = iou_matrix(cxcywh_to_xywh(t.mean[:, :4]), det_xywh) if len(t) and len(score) else None
+        # each IoU stage takes its block of the frame's matrix; it allows the pairs reaching its IoU
+        match_gate = low_gate = None
+        if iou is not None:
+            low_gate = iou >= const.LOW_IOU
+            if cfg.match_iou > 0:  # else every pair is allowed: the costs decide
+                match_gate = low_gate if cfg.match_iou == const.LOW_IOU else iou >= cfg.match_iou
 
         def overlap(min_iou: float, weigh: bool) -> CostFn:
             return lambda r, c: cost_from_iou(iou[r[:, None], c], min_iou,  # type: ignore[index]
                                               score[c] if weigh else None)
 
+        confirmed = t.confirmed
         recent = t.misses <= const.RECENT_FRAMES
         matching = run_plan([
-            Stage(t.confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent"),
-            Stage(t.confirmed & ~recent, high, overlap(cfg.match_iou, True), name="confident, lost longer"),
-            Stage(t.confirmed & was_tracked, ~high, overlap(const.LOW_IOU, False), name="low score"),
+            Stage(confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent", gate=match_gate),
+            Stage(confirmed & ~recent, high, overlap(cfg.match_iou, True), name="confident, lost longer",
+                  gate=match_gate),
+            Stage(confirmed & was_tracked, ~high, overlap(const.LOW_IOU, False), name="low score", gate=low_gate),
         ], len(t), len(score))
         self._calibration.observe_continued(score, matching.det_of_track[matching.det_of_track >= 0])
-        stages = [Stage(~t.confirmed, high, overlap(cfg.match_iou, False), name="tentative")]
+        stages = [Stage(~confirmed, high, overlap(cfg.match_iou, False), name="tentative", gate=match_gate)]
         slots = self._slots
 
         def reid(r: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -172,8 +217,29 @@ class BoxTrack:
                 gate = np.full((len(t), 1), const.REID_DISTANCE * np.sqrt(self._fit.scale))
             return centre_distance_cost(track_box[r], box[c], gate[r], scale)
 
-        stages.append(Stage(t.confirmed, high, reid, name="re-identification"))
+        stages.append(Stage(confirmed, high, reid, name="re-identification"))
         return run_plan(stages, len(t), len(score), start=matching)
+
+    def _correct(self, x: np.ndarray, matched: np.ndarray, z: np.ndarray) -> None:
+        """Kalman update of the tracks ``matched`` (columns of ``x``) with their measurements ``z (4, m)``;
+        the centre innovations of the confirmed ones go to :class:`MotionFit`, their returns after misses
+        to :class:`Coasting`."""
+        t, space = self._tracks, self._space
+        every = len(matched) == x.shape[1]  # every track matched: no gather and scatter
+        sub = x if every else x[:, matched]
+        innovation, s = space.innovation_columns(sub, z)
+        confirmed = t.confirmed[matched]
+        if confirmed.all():
+            self._fit.observe_columns(innovation[0:2], s[0:2])
+        else:
+            self._fit.observe_columns(innovation[0:2, confirmed], s[0:2, confirmed])
+        space.correct_columns(sub, innovation, s)
+        if not every:
+            x[:, matched] = sub
+        misses = t.misses[matched]
+        back = confirmed & (misses > 0)
+        if back.any():
+            self._coasting.observe(came_back=misses[back])
 
     def _predict_space(self) -> BoxCXCYWH:
         """The motion model with its process noise scaled by :class:`MotionFit` (variance factor)."""
@@ -184,36 +250,39 @@ class BoxTrack:
             self._scaled = (self._fit.scale, BoxCXCYWH(self._space.pos_noise * r, self._space.vel_noise * r))
         return self._scaled[1]
 
-    def _observe_fit(self, tracks: np.ndarray, z: np.ndarray) -> None:
-        """Centre innovations of confirmed ``tracks`` against their detections ``z`` (cx, cy, w, h)."""
-        if len(tracks):
-            t = self._tracks
-            cov = t.cov[tracks, :2, :2]
-            noise = self._space.pos_noise * z[:, 2:4]
-            noise *= noise  # the measurement variances of cx and cy, the diagonal of R
-            self._fit.observe_parts(z[:, :2] - t.mean[tracks, :2], cov[:, 0, 0] + noise[:, 0],
-                                    cov[:, 0, 1] + 0.0, cov[:, 1, 1] + noise[:, 1])
-
-    def _births(self, new: np.ndarray, det_box: np.ndarray) -> np.ndarray:
-        """Start tentative tracks on detections ``new``; returns the detections used."""
+    def _births(self, new: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """Start tentative tracks on detections ``new`` (measurement columns ``z``); returns the
+        detections used."""
         cfg, t = self.config, self._tracks
         if self._slots is not None:
             new = new[: self._slots.room(t)]
         if len(new):
-            mean, cov = self._space.initial(det_box[new])
+            rows = self._space.initial_rows(z[:, new].T)
             first = self._frame_count == 1
-            t.add(mean, cov, hits=1, confirmed=first or (cfg.n_init <= 1 and self._slots is None))
+            t.add(rows[:, :8], rows[:, 8:].reshape(-1, 4, 4), hits=1,
+                  confirmed=first or (cfg.n_init <= 1 and self._slots is None))
         return new
 
-    def _report(self, det_of_track: np.ndarray, det_idx: np.ndarray, det_xywh: np.ndarray) -> Tracks:
+    def _report(self, det_of_track: np.ndarray, det_idx: np.ndarray | None) -> Tracks:
+        """Confirmed tracks matched this frame at their filtered box, then confirmed tracks likely still
+        present at their predicted box (detection index -1); ``det_idx``: the kept detections' indices
+        in the frame (None: all kept)."""
         t = self._tracks
-        shown = np.flatnonzero(t.confirmed & (t.unseen_s == 0) & (det_of_track >= 0))
-        missed = (t.confirmed & (det_of_track < 0)).nonzero()[0]
-        coasted = missed[self._coasting.decide(t.misses[missed])] if len(missed) else missed
-        original = det_idx[det_of_track[shown]]
-        if len(coasted):  # missed this frame but likely still there: the predicted box, no detection
-            shown = np.concatenate([shown, coasted])
-            original = np.concatenate([original, np.full(len(coasted), -1)])
-        boxes = cxcywh_to_xywh(t.mean[shown, :4])
-        return Tracks.trusted(t.ids[shown], np.ones(len(shown), dtype=np.int8), boxes,
-                              t.mean[shown, 4:6] / self._clock.interval, original)
+        confirmed = t.confirmed
+        shown = (confirmed & (t.unseen_s == 0) & (det_of_track >= 0)).nonzero()[0]
+        original = det_of_track[shown]
+        if det_idx is not None:
+            original = det_idx[original]
+        missed = (confirmed & (det_of_track < 0)).nonzero()[0]
+        if len(missed):
+            coasted = missed[self._coasting.decide(t.misses[missed])]
+            if len(coasted):  # missed this frame but likely still there: the predicted box, no detection
+                shown = np.concatenate((shown, coasted))
+                original = np.concatenate((original, np.full(len(coasted), -1)))
+        m = len(shown)
+        x = self._state()[:6, shown]
+        boxes, velocity = np.empty((m, 4)), np.empty((m, 2))
+        size = np.maximum(x[2:4], 1e-3, out=boxes.T[2:4])  # cxcywh_to_xywh's numbers
+        np.subtract(x[0:2], size / 2, out=boxes.T[0:2])
+        np.divide(x[4:6], self._clock.interval, out=velocity.T)
+        return Tracks.trusted(t.ids[shown], np.ones(m, dtype=np.int8), boxes, velocity, original)

@@ -24,16 +24,28 @@ class ClutterShare:
         self.flicker = 0
         self._previous: np.ndarray | None = None
 
+    @property
+    def previous(self) -> np.ndarray | None:
+        """The previous frame's boxes ``(p, 4)`` (pixels), None before the first frame."""
+        return self._previous
+
     def observe(self, xywh: np.ndarray) -> None:
         """Count this frame's boxes ``(k, 4)`` (pixels) against the previous frame's."""
         xywh = np.asarray(xywh, dtype=float).reshape(-1, 4)
-        if self._previous is not None and len(xywh):
-            if len(self._previous):
-                alone = iou_matrix(xywh, self._previous).max(axis=1) < self.min_iou
-            else:
-                alone = np.ones(len(xywh), dtype=bool)
-            self.seen += len(xywh)
-            self.flicker += int(alone.sum())
+        previous = self._previous
+        if previous is not None and len(previous) and len(xywh):
+            self.observe_best(xywh, iou_matrix(xywh, previous).max(axis=1))
+        else:
+            self.observe_best(xywh, None)
+
+    def observe_best(self, xywh: np.ndarray, best: np.ndarray | None) -> None:
+        """:meth:`observe` with each box's highest IoU with :attr:`previous`'s boxes, ``best (k,)``,
+        computed by the caller (e.g. within a larger IoU matrix); None when either frame has no boxes.
+        ``xywh`` must be a float ``(k, 4)`` array (it is kept as the next frame's previous boxes)."""
+        n = len(xywh)
+        if self._previous is not None and n:
+            self.seen += n
+            self.flicker += n if best is None else int(np.count_nonzero(best < self.min_iou))
         self._previous = xywh
 
     @property

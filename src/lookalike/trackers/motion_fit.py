@@ -39,13 +39,24 @@ class MotionFit:
             return
         self.observe_parts(innovation, S[:, 0, 0], S[:, 0, 1], S[:, 1, 1])
 
+    def observe_columns(self, innovation: np.ndarray, var: np.ndarray) -> None:
+        """:meth:`observe` for diagonal covariances: innovations ``(2, k)`` and their variances ``(2, k)``
+        as rows (x, y; pixels, pixels²). The same NIS as :meth:`observe_parts` with ``b = 0`` for finite
+        innovations, in fewer operations."""
+        if innovation.shape[1] == 0:
+            return
+        part = var[::-1] * innovation * innovation  # d·x·x, a·y·y
+        self._add((part[0] + part[1]) / (var[0] * var[1]))
+
     def observe_parts(self, innovation: np.ndarray, a: np.ndarray, b: np.ndarray, d: np.ndarray) -> None:
         """:meth:`observe` with the covariances given by their entries ``a = S[:, 0, 0]``, ``b = S[:, 0, 1]``
         (= ``S[:, 1, 0]``) and ``d = S[:, 1, 1]``, each ``(k,)`` (pixels²)."""
         if len(innovation) == 0:
             return
         x, y = innovation[:, 0], innovation[:, 1]
-        nis = (d * x * x - 2.0 * b * x * y + a * y * y) / (a * d - b * b)  # innovation' S^-1 innovation
+        self._add((d * x * x - 2.0 * b * x * y + a * y * y) / (a * d - b * b))  # innovation' S^-1 innovation
+
+    def _add(self, nis: np.ndarray) -> None:
         self._pending.append(nis)
         self._count += len(nis)
         if self._count >= self.batch:

@@ -94,7 +94,6 @@ class MissReturns:
     def likely_present(self, missed: np.ndarray, share: float, min_count: int) -> np.ndarray:
         """Per track missed ``missed`` frames: whether, for every miss length up to its own, at least
         ``share`` of at least ``min_count`` resolved tracks (came back or died) came back."""
-        missed = np.asarray(missed)
         key = (self._version, share, min_count)
         if self._ok is None or self._ok[0] != key:
             resolved = self.returned + self.ended
@@ -102,11 +101,10 @@ class MissReturns:
             ok[0] = True
             ok = np.logical_and.accumulate(ok)
             ok[0] = False
-            self._ok = (key, ok)
-        ok = self._ok[1]
-        out = np.zeros(len(missed), dtype=bool)
-        inside = (missed > 0) & (missed <= self.longest)
-        out[inside] = ok[missed[inside]]
+            self._ok = (key, np.append(ok, False))  # one more False: every length beyond ``longest``
+        # negative lengths seen as unsigned are beyond ``longest`` too
+        length = np.asarray(missed, dtype=np.int64).view(np.uint64)
+        out: np.ndarray = self._ok[1][np.minimum(length, self.longest + 1)]
         return out
 
 

@@ -1,0 +1,59 @@
+"""``BoxCXCYWH``'s column form (every track's state and covariance blocks as one quantity-major
+table) gives the same numbers as its full ``(k, 8)`` / ``(k, 8, 8)`` form, bit for bit, over chains
+of predictions and updates; ``MotionFit.observe_columns`` equals ``observe_parts`` with ``b = 0``."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lookalike.motion.spaces import BoxCXCYWH
+from lookalike.trackers.motion_fit import MotionFit
+
+
+def _boxes(rng: np.random.Generator, k: int) -> np.ndarray:
+    """``(k, 4)`` centre/size boxes, some sizes below one pixel."""
+    size = rng.uniform(0.3, 120.0, (k, 2))
+    return np.column_stack([rng.uniform(-50, 900, (k, 2)), size])
+
+
+@pytest.mark.parametrize("space", [BoxCXCYWH(1 / 20, 1 / 160), BoxCXCYWH(0.37, 0.09)])
+def test_column_form_equals_the_full_form(space: BoxCXCYWH) -> None:
+    rng = np.random.default_rng(0)
+    z0 = _boxes(rng, 12)
+    mean, cov = space.initial(z0)
+    columns = space.initial_rows(z0).T.copy()
+    assert np.array_equal(space.to_columns(mean, cov), columns)
+    for steps in [1.0, 2.0, 1.0, 0.5, 0.0, 3.0, 1.0, 1.0, 2.5, 1.0]:
+        mean[:, 4:] = rng.normal(0, 3, (12, 4))  # size velocities shrinking some boxes below 1 pixel
+        columns[4:8] = mean[:, 4:].T
+        mean, cov = space.predict(mean, cov, steps)
+        space.predict_columns(columns, steps)
+        m, c = space.from_columns(columns)
+        assert np.array_equal(mean, m) and np.array_equal(cov, c), steps
+        rows = np.flatnonzero(rng.random(12) < 0.7)
+        z = _boxes(rng, len(rows))
+        S = (space.H @ cov[rows] @ space.H.T) + space.R(z[:, 2:4])  # innovation covariances of the prior
+        mean[rows], cov[rows] = space.update(mean[rows], cov[rows], z)
+        sub = columns[:, rows]
+        innovation, s = space.innovation_columns(sub, np.ascontiguousarray(z.T))
+        assert np.array_equal(innovation, z.T - sub[:4])
+        assert np.allclose(s, np.diagonal(S, axis1=1, axis2=2).T, rtol=1e-12, atol=0)
+        space.correct_columns(sub, innovation, s)
+        columns[:, rows] = sub
+        m, c = space.from_columns(columns)
+        assert np.array_equal(mean, m) and np.array_equal(cov, c), steps
+
+
+def test_column_nis_equals_the_general_form() -> None:
+    rng = np.random.default_rng(1)
+    plain, fast = MotionFit(batch=25), MotionFit(batch=25)
+    for _ in range(40):
+        k = int(rng.integers(0, 9))
+        innovation = rng.normal(0, 20, (k, 2))
+        var = rng.uniform(0.1, 400, (k, 2))
+        plain.observe_parts(innovation, var[:, 0], np.zeros(k), var[:, 1])
+        fast.observe_columns(np.ascontiguousarray(innovation.T), np.ascontiguousarray(var.T))
+        assert plain.scale == fast.scale and plain._count == fast._count
+        assert all(np.array_equal(a, b) for a, b in zip(plain._pending, fast._pending))
+    assert plain.scale > 1.0
