@@ -223,10 +223,13 @@ def _rows(snapshots: Sequence[TrackSnapshot], n_robots: int) -> list[_Row]:
         t = snapshots
         if t.agent_id is None or t.position is None or not len(t):
             return []
-        rows = np.flatnonzero((t.agent_id >= 0) & (t.agent_id < n_robots)).tolist()
-        prob = [None] * len(t) if t.identity_prob is None else t.identity_prob.tolist()
+        agent = t.agent_id.tolist()
+        rows = [i for i, a in enumerate(agent) if 0 <= a < n_robots]
+        if not rows:
+            return []
+        prob: list[Any] = [None] * len(t) if t.identity_prob is None else t.identity_prob.tolist()
         heading = [None] * len(t) if t.heading is None else t.heading.tolist()
-        agent, det, pos = t.agent_id.tolist(), t.detection_index.tolist(), t.position.tolist()
+        det, pos = t.detection_index.tolist(), t.position.tolist()
         return [(agent[i], det[i], None if prob[i] is None or math.isnan(prob[i]) else prob[i],
                  float(pos[i][0]), float(pos[i][1]), heading[i]) for i in rows]
     out: list[_Row] = []

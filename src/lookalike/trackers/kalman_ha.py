@@ -163,14 +163,18 @@ class WorldTracker:
     def _birth_candidates(self, det: Detections, det_of_track: np.ndarray) -> np.ndarray:
         """Indices of detections that start tracks."""
         t, rules = self._tracks, self.rules
-        free = np.ones(len(det), dtype=bool)
-        free[det_of_track[det_of_track >= 0]] = False
+        free = np.ones(len(det) + 1, dtype=bool)  # (the extra last entry takes the misses' -1)
+        free[det_of_track] = False
+        free = free[:-1]
         if len(det) and rules.birth_min_score is not None:
             free &= det.score >= rules.birth_min_score
-        if len(det) and rules.birth_exclusion_m is not None and len(t):
-            gap = np.linalg.norm(positions(det)[:, None, :] - t.mean[None, :, :2], axis=2).min(axis=1)
-            free &= gap > rules.birth_exclusion_m
-        return np.flatnonzero(free)
+        new = np.flatnonzero(free)
+        if len(new) and rules.birth_exclusion_m is not None and len(t):
+            # distance to the nearest track, as np.linalg.norm computes it: sqrt of the summed squares
+            diff = positions(det)[new][:, None, :] - t.mean[None, :, :2]
+            gap = np.sqrt(np.add.reduce(diff * diff, axis=2))
+            new = new[np.minimum.reduce(gap, axis=1) > rules.birth_exclusion_m]
+        return new
 
     def _births(self, det: Detections, det_of_track: np.ndarray) -> np.ndarray:
         new = self._birth_candidates(det, det_of_track)
@@ -181,17 +185,20 @@ class WorldTracker:
 
     def _report(self, det: Detections, det_of_track: np.ndarray) -> Tracks:
         t = self._tracks
-        agent = np.full(len(t), -1, dtype=int)
-        prob = np.full(len(t), np.nan)
+        k = len(t)
+        agent = np.full(k, -1, dtype=int)
+        prob = np.full(k, np.nan)
         confirmed = t.confirmed
         agent[confirmed], prob[confirmed] = self._identifier.assign_arrays(t.ids[confirmed].tolist())
         seen = det_of_track >= 0
-        heading = np.full(len(t), np.nan)
-        if seen.any():
-            heading[seen] = headings(det)[det_of_track[seen]]
-        status = np.where(t.confirmed, np.where(seen, 1, 2), 0)
-        return Tracks(t.ids.copy(), status, position=t.mean[:, :2].copy(), velocity=t.mean[:, 2:4].copy(),
-                      heading=heading, agent_id=agent, identity_prob=prob, detection_index=det_of_track)
+        # (a miss's -1 reads the last heading, replaced by NaN)
+        heading = np.where(seen, headings(det)[det_of_track], np.nan) if len(det) else np.full(k, np.nan)
+        out = Tracks.__new__(Tracks)  # (columns built here: Tracks' checks skipped)
+        out.id, out.xywh, out.detection_index = t.ids.copy(), None, det_of_track
+        out.status = np.left_shift(confirmed, ~seen, dtype=np.int8)  # 0 tentative, 1 confirmed, 2 lost
+        out.position, out.velocity = t.mean[:, :2].copy(), t.mean[:, 2:4].copy()
+        out.heading, out.agent_id, out.identity_prob = heading, agent, prob
+        return out
 
 
 def bit_count(bits: np.ndarray) -> np.ndarray:

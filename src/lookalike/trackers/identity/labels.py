@@ -41,27 +41,28 @@ def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np
 
 
 def _labels_from_columns(n_detections: int, tracks: Tracks) -> np.ndarray:
-    """:func:`labels_from_tracks` on columns (same rule and result, without per-track snapshots)."""
-    label = np.full(n_detections, -1, dtype=int)
-    if tracks.agent_id is None or not len(tracks):
-        return label
-    det = tracks.detection_index
-    prob = (np.zeros(len(tracks)) if tracks.identity_prob is None
-            else np.where(np.isnan(tracks.identity_prob), 0.0, tracks.identity_prob))
-    rows = np.flatnonzero((tracks.agent_id >= 0) & (det >= 0))
-    rows = rows[np.argsort(-prob[rows], kind="stable")]
+    """:func:`labels_from_tracks` on columns (same rule and result, without per-track snapshots;
+    a frame holds a few tracks, so the columns are read as lists)."""
+    label = [-1] * n_detections
+    k = len(tracks)
+    if tracks.agent_id is None or not k:
+        return np.array(label, dtype=int)
+    agent, det = tracks.agent_id.tolist(), tracks.detection_index.tolist()
+    prob = [0.0] * k if tracks.identity_prob is None else [0.0 if p != p else p for p in tracks.identity_prob.tolist()]
+    rows = [i for i in range(k) if agent[i] >= 0 and det[i] >= 0]
+    rows.sort(key=prob.__getitem__, reverse=True)  # (stable: ties keep their order)
     best = [-np.inf] * n_detections
     claimed = set()
-    for i, agent, k, p in zip(rows.tolist(), tracks.agent_id[rows].tolist(), det[rows].tolist(),
-                              prob[rows].tolist()):
-        if k >= n_detections:
-            raise ValueError(f"track {int(tracks.id[i])}: detection_index {k} out of range for "
+    for i in rows:
+        a, d, p = agent[i], det[i], prob[i]
+        if d >= n_detections:
+            raise ValueError(f"track {int(tracks.id[i])}: detection_index {d} out of range for "
                              f"{n_detections} detections")
-        if agent in claimed or p <= best[k]:
+        if a in claimed or p <= best[d]:
             continue
-        label[k], best[k] = agent, p
-        claimed.add(agent)
-    return label
+        label[d], best[d] = a, p
+        claimed.add(a)
+    return np.array(label, dtype=int)
 
 
 def agent_positions(tracks: Sequence[TrackSnapshot], n_agents: int) -> np.ndarray:
