@@ -9,12 +9,15 @@ The LSTM has no weights for the latter ("-"). ``--weights W``: the ``set`` ident
 ``--select RUN`` chooses among the snapshots of a fine-tuning run (``RUN/set_step{k}.npz``, k a multiple
 of ``--every``) on tuning sequences only (:data:`TUNING_TEAMS`, seeds below 100000): eligible are the
 snapshots no worse than ``--baseline`` on any tuning team; of those, the best on M=3, N=2 (a tie within
-0.01 points goes to the best mean). ``--ship`` copies the chosen one into the package's shipped weights.
+0.01 points goes to the best mean). ``--average-from S`` adds one more candidate, ``RUN/set_avg.npz``: the
+mean of the weights of the snapshots from step S on. ``--ship`` copies the chosen one into the package's
+shipped weights.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import re
 import shutil
@@ -73,12 +76,26 @@ def choose(rows: dict[str, dict[str, float]], baseline: dict[str, float]) -> str
     return max(near, key=lambda p: float(np.mean([rows[p][k] for k in baseline])))
 
 
-def select(run_dir: Path, every: int, baseline: Path, ship: bool) -> None:
+def average_weights(paths: list[Path], out: Path) -> Path:
+    """Write the element-wise mean of the weights ``paths`` (same widths) to ``out``."""
+    ws = [load_set_weights(p) for p in paths]
+    arrays = {k: np.mean([w.arrays[k] for w in ws], axis=0) for k in ws[0].arrays}
+    info = {**ws[-1].info, "averaged": [p.name for p in paths]}
+    save_set_weights(dataclasses.replace(ws[-1], arrays=arrays, info=info), out)
+    return out
+
+
+def select(run_dir: Path, every: int, baseline: Path, ship: bool, average_from: int | None = None) -> None:
     """Score the baseline and the snapshots on the tuning sequences, print them and the choice."""
     steps = sorted(int(m.group(1)) for p in run_dir.glob("set_step*.npz")
                    if (m := re.fullmatch(r"set_step(\d+)\.npz", p.name)) and int(m.group(1)) % every == 0)
     if not steps:
         raise SystemExit(f"--select {run_dir}: no set_step{{k}}.npz with k a multiple of {every}")
+    candidates = [run_dir / f"set_step{k}.npz" for k in steps]
+    if average_from is not None:
+        late = [run_dir / f"set_step{k}.npz" for k in steps if k >= average_from]
+        if late:
+            candidates.append(average_weights(late, run_dir / "set_avg.npz"))
     seqs = tuning_sequences()
     names = [t[0] for t in TUNING_TEAMS]
     print("tuning success (%)          " + "".join(f"{n:>8s}" for n in names))
@@ -89,7 +106,7 @@ def select(run_dir: Path, every: int, baseline: Path, ship: bool) -> None:
         return row
 
     base = score(baseline)
-    rows = {str(run_dir / f"set_step{k}.npz"): score(run_dir / f"set_step{k}.npz") for k in steps}
+    rows = {str(p): score(p) for p in candidates}
     chosen = choose(rows, base)
     print(f"chosen: {chosen}" if chosen else "chosen: none (every snapshot is below the baseline on a tuning team)")
     if chosen and ship:
@@ -114,10 +131,12 @@ def main() -> None:
     parser.add_argument("--select", type=Path, default=None, help="a fine-tuning run's folder to choose from")
     parser.add_argument("--every", type=int, default=50, help="--select: snapshots at multiples of this step")
     parser.add_argument("--baseline", type=Path, default=SHIPPED_SET_WEIGHTS, help="--select: weights to beat")
+    parser.add_argument("--average-from", type=int, default=None,
+                        help="--select: also the mean of the snapshots' weights from this step on")
     parser.add_argument("--ship", action="store_true", help="--select: ship the chosen snapshot")
     args = parser.parse_args()
     if args.select is not None:
-        select(args.select, args.every, args.baseline, args.ship)
+        select(args.select, args.every, args.baseline, args.ship, args.average_from)
         return
     names = args.trackers.split(",")
     teams = []
