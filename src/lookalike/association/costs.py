@@ -47,7 +47,12 @@ def centre_distance_cost(track_cxcywh: np.ndarray, det_cxcywh: np.ndarray, gate:
     ``inf`` beyond ``gate`` (``(k, 1)`` or scalar, in heights) or where width or height differ by
     more than a factor ``max_scale``."""
     height = np.maximum(track_cxcywh[:, 3:4], 1.0)
-    dist = np.linalg.norm(track_cxcywh[:, None, :2] - det_cxcywh[None, :, :2], axis=2) / height
+    square = track_cxcywh[:, None, :2] - det_cxcywh[None, :, :2]
+    square *= square
+    dist = np.sqrt(square[:, :, 0] + square[:, :, 1])  # np.linalg.norm's numbers (sqrt of the summed squares)
+    dist /= height
     size_t = np.maximum(track_cxcywh[:, None, 2:4], 1.0)
-    ratio = np.abs(np.log(size_t / np.maximum(det_cxcywh[None, :, 2:4], 1.0))).max(axis=2)
-    return np.where((dist <= gate) & (ratio <= np.log(max_scale)), dist, np.inf)
+    ratio = np.abs(np.log(size_t / np.maximum(det_cxcywh[None, :, 2:4], 1.0)))
+    allowed = dist <= gate
+    allowed &= np.maximum(ratio[:, :, 0], ratio[:, :, 1]) <= np.log(max_scale)
+    return np.where(allowed, dist, np.inf)

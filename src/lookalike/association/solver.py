@@ -7,6 +7,7 @@ Rectangular, empty and all-forbidden matrices are legal.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -56,7 +57,7 @@ def _check(cost: np.ndarray) -> np.ndarray:
     c = np.asarray(cost, dtype=float)
     if c.ndim != 2:
         raise ValueError(f"cost: expected a 2-D matrix, got shape {c.shape}")
-    if c.size and not (c > -np.inf).all():  # one pass for both NaN and -inf
+    if c.size and np.count_nonzero(c > -np.inf) != c.size:  # one pass for both NaN and -inf
         if np.isnan(c).any():
             row, col = np.argwhere(np.isnan(c))[0]
             raise ValueError(f"cost: NaN at row {row}, column {col}; use inf to forbid a pair")
@@ -94,15 +95,15 @@ def _solve(c: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray]:
     none = _NONE
     if c.size == 0:
         return none, none
-    allowed = c <= max_cost if np.isfinite(max_cost) else c < np.inf
-    if not allowed.any():
+    finite = math.isfinite(max_cost)
+    allowed = c <= max_cost if finite else c < np.inf
+    rows, cols = allowed.nonzero()
+    if not len(rows):
         return none, none
-    most = np.maximum.reduce  # the ufunc methods themselves: the array methods add a Python layer per call
-    if most(np.add.reduce(allowed, axis=0)) == 1 and most(np.add.reduce(allowed, axis=1)) == 1:
+    if len(set(rows.tolist())) == len(rows) and len(set(cols.tolist())) == len(cols):
         # The allowed pairs are disjoint: every optimum holds all of them, nothing else is kept.
-        rows, cols = allowed.nonzero()
         return rows, cols
-    if np.isfinite(max_cost):
+    if finite:
         # Clip forbidden pairs to just above the limit; they are dropped after solving.
         scale = max(abs(max_cost - float(c[allowed].min())), 1.0)
         work = np.where(allowed, c, max_cost + 1e-6 * scale)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -23,9 +24,8 @@ SolveFn = Callable[[np.ndarray], np.ndarray]
 """``solve(cost) -> (k, 2)`` matched ``(row, column)`` positions in the cost matrix."""
 
 
-@dataclass(frozen=True)
-class Stage:
-    """One matching pass.
+class Stage(NamedTuple):
+    """One matching pass (immutable).
 
     Attributes:
         tracks: the eligible track rows, a boolean mask ``(k,)`` or an ordered index array (None: all).
@@ -111,9 +111,14 @@ def _run_gated(stage: Stage, pairs: tuple[list[int], list[int]], matching: Match
     """Run a gated stage from its gate's allowed pairs ``pairs`` (track rows, detections) when those
     still eligible (eligible track still unmatched, eligible detection still free) are disjoint: each
     is then a match of every optimum. Returns False, having changed nothing, when they compete."""
+    tracks = _as_list(stage.tracks)
+    if not pairs[0] or (tracks is not None and not any(tracks)):
+        return True
+    dets = _as_list(stage.detections)
+    if dets is not None and not any(dets):
+        return True
     det_of_track, free = matching.det_of_track, matching.free
     taken, left = det_of_track.tolist(), free.tolist()
-    tracks, dets = _as_list(stage.tracks), _as_list(stage.detections)
     rows, cols = [], []
     for i, j in zip(*pairs):
         if taken[i] < 0 and left[j] and (tracks is None or tracks[i]) and (dets is None or dets[j]):

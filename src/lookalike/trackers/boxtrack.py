@@ -96,7 +96,7 @@ class BoxTrack:
         dets = frame.detections
         det_xywh, score = dets.xywh, dets.score  # the read-only columns themselves, no copies
         det_idx = None  # None: every detection kept, at its own index
-        if len(score) and not score.min() >= cfg.low_score:
+        if len(score) and np.count_nonzero(score < cfg.low_score):
             det_idx = (score >= cfg.low_score).nonzero()[0]
             det_xywh, score = det_xywh[det_idx], score[det_idx]
         z = self._measure(det_xywh.T)
@@ -106,11 +106,13 @@ class BoxTrack:
         if len(t):
             if self._slots is not None:
                 self._slots.freeze_shape(t)
-            x[4:8, self._coasting.still(t.unseen_s)] = 0.0  # a long-lost track waits where it was last seen
+            still = self._coasting.still(t.unseen_s)
+            if np.count_nonzero(still):
+                x[4:8, still] = 0.0  # a long-lost track waits where it was last seen
             self._predict_space().predict_columns(x, steps)
         iou = self._overlaps(x, det_xywh)
         high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
-        matching = self._associate(iou, z.T, score, high_score, was_tracked, t.unseen_s + dt)
+        matching = self._associate(iou, z.T, score, high_score, was_tracked, dt)
         det_of_track, free = matching.det_of_track, matching.free
         hit = det_of_track >= 0
         matched = hit.nonzero()[0]
@@ -129,9 +131,9 @@ class BoxTrack:
         else:
             det_of_track = self._slots.refill(t, ready, det_of_track)
         born = self._births((free & (score >= birth_score)).nonzero()[0], z)
-        out = self._report(np.concatenate((det_of_track, born)), det_idx)
+        out = self._report(np.concatenate((det_of_track, born)) if len(born) else det_of_track, det_idx)
         alive = self._lifecycle.alive(t)
-        if not alive.all():
+        if np.count_nonzero(alive) < len(alive):
             self._coasting.observe(died=t.misses[~alive & t.confirmed])
             t.keep(alive)
         return out
@@ -179,7 +181,7 @@ class BoxTrack:
         return iou[:k] if k else None
 
     def _associate(self, iou: np.ndarray | None, det_box: np.ndarray, score: np.ndarray, high_score: float,
-                   was_tracked: np.ndarray, unseen_s: np.ndarray) -> Matching:
+                   was_tracked: np.ndarray, dt: float) -> Matching:
         """The association plan: confident detections to confirmed tracks (recent ones first), low-score
         ones to tracks seen last frame, the rest to tentative tracks, then lost tracks by centre distance."""
         cfg, t = self.config, self._tracks
@@ -199,8 +201,8 @@ class BoxTrack:
         recent = t.misses <= const.RECENT_FRAMES
         matching = run_plan([
             Stage(confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent", gate=match_gate),
-            Stage(confirmed & ~recent, high, overlap(cfg.match_iou, True), name="confident, lost longer",
-                  gate=match_gate),
+            Stage(confirmed > recent, high, overlap(cfg.match_iou, True), name="confident, lost longer",
+                  gate=match_gate),  # (confirmed and not recent)
             Stage(confirmed & was_tracked, ~high, overlap(const.LOW_IOU, False), name="low score", gate=low_gate),
         ], len(t), len(score))
         self._calibration.observe_continued(score, matching.det_of_track[matching.det_of_track >= 0])
@@ -211,11 +213,11 @@ class BoxTrack:
             # built only when some lost track and confident detection are left
             if slots is not None:  # closed set: sizes as sqrt(w·h), a turning target keeps its size; gates in heights
                 track_box, box = slots.squared(t.mean[:, :4]), slots.squared(det_box)
-                gate, scale = slots.gate(unseen_s), max(cfg.reid_scale, const.CLOSED_SCALE)
-            else:  # in fitted standard deviations: a model that fits badly (MotionFit) widens the gate
-                track_box, box, scale = t.mean[:, :4], det_box, cfg.reid_scale
-                gate = np.full((len(t), 1), const.REID_DISTANCE * np.sqrt(self._fit.scale))
-            return centre_distance_cost(track_box[r], box[c], gate[r], scale)
+                gate, scale = slots.gate(t.unseen_s + dt), max(cfg.reid_scale, const.CLOSED_SCALE)
+                return centre_distance_cost(track_box[r], box[c], gate[r], scale)
+            # in fitted standard deviations: a model that fits badly (MotionFit) widens the gate
+            gate_all = const.REID_DISTANCE * np.sqrt(self._fit.scale)
+            return centre_distance_cost(t.mean[r, :4], det_box[c], gate_all, cfg.reid_scale)
 
         stages.append(Stage(confirmed, high, reid, name="re-identification"))
         return run_plan(stages, len(t), len(score), start=matching)
@@ -226,20 +228,18 @@ class BoxTrack:
         to :class:`Coasting`."""
         t, space = self._tracks, self._space
         every = len(matched) == x.shape[1]  # every track matched: no gather and scatter
-        sub = x if every else x[:, matched]
+        sub = x if every else x.take(matched, axis=1)
         innovation, s = space.innovation_columns(sub, z)
         confirmed = t.confirmed[matched]
-        if confirmed.all():
-            self._fit.observe_columns(innovation[0:2], s[0:2])
-        else:
-            self._fit.observe_columns(innovation[0:2, confirmed], s[0:2, confirmed])
+        self._fit.observe_columns(innovation[0:2], s[0:2], confirmed)
         space.correct_columns(sub, innovation, s)
         if not every:
             x[:, matched] = sub
         misses = t.misses[matched]
-        back = confirmed & (misses > 0)
-        if back.any():
-            self._coasting.observe(came_back=misses[back])
+        if np.count_nonzero(misses):
+            back = confirmed & (misses > 0)
+            if np.count_nonzero(back):
+                self._coasting.observe(came_back=misses[back])
 
     def _predict_space(self) -> BoxCXCYWH:
         """The motion model with its process noise scaled by :class:`MotionFit` (variance factor)."""
@@ -268,21 +268,22 @@ class BoxTrack:
         present at their predicted box (detection index -1); ``det_idx``: the kept detections' indices
         in the frame (None: all kept)."""
         t = self._tracks
-        confirmed = t.confirmed
-        shown = (confirmed & (t.unseen_s == 0) & (det_of_track >= 0)).nonzero()[0]
+        confirmed, hit = t.confirmed, det_of_track >= 0  # (a track with a detection was seen this frame)
+        shown = (confirmed & hit).nonzero()[0]
         original = det_of_track[shown]
         if det_idx is not None:
             original = det_idx[original]
-        missed = (confirmed & (det_of_track < 0)).nonzero()[0]
+        missed = (confirmed > hit).nonzero()[0]  # confirmed and missed
         if len(missed):
             coasted = missed[self._coasting.decide(t.misses[missed])]
             if len(coasted):  # missed this frame but likely still there: the predicted box, no detection
                 shown = np.concatenate((shown, coasted))
                 original = np.concatenate((original, np.full(len(coasted), -1)))
         m = len(shown)
-        x = self._state()[:6, shown]
-        boxes, velocity = np.empty((m, 4)), np.empty((m, 2))
+        x = self._state().take(shown, axis=1)
+        boxes, velocity, status = np.empty((m, 4)), np.empty((m, 2)), np.empty(m, dtype=np.int8)
         size = np.maximum(x[2:4], 1e-3, out=boxes.T[2:4])  # cxcywh_to_xywh's numbers
         np.subtract(x[0:2], size / 2, out=boxes.T[0:2])
         np.divide(x[4:6], self._clock.interval, out=velocity.T)
-        return Tracks.trusted(t.ids[shown], np.ones(m, dtype=np.int8), boxes, velocity, original)
+        status.fill(1)
+        return Tracks.trusted(t.ids[shown], status, boxes, velocity, original)

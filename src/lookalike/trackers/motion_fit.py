@@ -30,7 +30,8 @@ class MotionFit:
         self.batch = batch
         self.max_scale = max_scale
         self.scale = 1.0
-        self._pending: list[np.ndarray] = []
+        # this batch's NIS, or (innovations, variances, columns) whose NIS is computed with the batch
+        self._pending: list[np.ndarray | tuple[np.ndarray, np.ndarray, np.ndarray | None]] = []
         self._count = 0
 
     def observe(self, innovation: np.ndarray, S: np.ndarray) -> None:
@@ -39,14 +40,17 @@ class MotionFit:
             return
         self.observe_parts(innovation, S[:, 0, 0], S[:, 0, 1], S[:, 1, 1])
 
-    def observe_columns(self, innovation: np.ndarray, var: np.ndarray) -> None:
+    def observe_columns(self, innovation: np.ndarray, var: np.ndarray, rows: np.ndarray | None = None) -> None:
         """:meth:`observe` for diagonal covariances: innovations ``(2, k)`` and their variances ``(2, k)``
-        as rows (x, y; pixels, pixels²). The same NIS as :meth:`observe_parts` with ``b = 0`` for finite
-        innovations, in fewer operations."""
-        if innovation.shape[1] == 0:
-            return
-        part = var[::-1] * innovation * innovation  # d·x·x, a·y·y
-        self._add((part[0] + part[1]) / (var[0] * var[1]))
+        as rows (x, y; pixels, pixels²), of the columns ``rows`` (mask; None: all). The same NIS as
+        :meth:`observe_parts` with ``b = 0`` for finite innovations; computed when the batch is complete
+        (the arrays are kept until then and must not change)."""
+        count = innovation.shape[1] if rows is None else np.count_nonzero(rows)
+        if count:
+            self._pending.append((innovation, var, rows))
+            self._count += count
+            if self._count >= self.batch:
+                self._update()
 
     def observe_parts(self, innovation: np.ndarray, a: np.ndarray, b: np.ndarray, d: np.ndarray) -> None:
         """:meth:`observe` with the covariances given by their entries ``a = S[:, 0, 0]``, ``b = S[:, 0, 1]``
@@ -60,6 +64,30 @@ class MotionFit:
         self._pending.append(nis)
         self._count += len(nis)
         if self._count >= self.batch:
-            median = float(np.median(np.concatenate(self._pending)))
-            self.scale = float(np.clip(self.scale * median / CHI2_2DOF_MEDIAN, 1.0, self.max_scale))
-            self._pending, self._count = [], 0
+            self._update()
+
+    def _update(self) -> None:
+        """Scale by the median NIS of the batch, then start a new one."""
+        pending = self._pending
+        if all(type(p) is tuple for p in pending):  # columns only: their NIS in one pass
+            items: list = pending  # type: ignore[type-arg]
+            rows = [p[2] for p in items]
+            nis = _nis_of_columns(np.concatenate([p[0] for p in items], axis=1),
+                                  np.concatenate([p[1] for p in items], axis=1),
+                                  None if all(r is None for r in rows) else np.concatenate(
+                                      [np.ones(p[0].shape[1], bool) if r is None else r for p, r in zip(items, rows)]))
+        else:
+            nis = np.concatenate([p if isinstance(p, np.ndarray) else _nis_of_columns(*p) for p in pending])
+        median = float(np.median(nis))
+        self.scale = float(np.clip(self.scale * median / CHI2_2DOF_MEDIAN, 1.0, self.max_scale))
+        self._pending, self._count = [], 0
+
+
+def _nis_of_columns(innovation: np.ndarray, var: np.ndarray, rows: np.ndarray | None) -> np.ndarray:
+    """NIS of the columns ``rows`` of innovations ``(2, k)`` with diagonal covariances ``var (2, k)``:
+    ``(d·x·x + a·y·y) / (a·d)``, :meth:`MotionFit.observe_parts`' numbers with ``b = 0``."""
+    if rows is not None:
+        innovation, var = innovation[:, rows], var[:, rows]
+    part = var[::-1] * innovation * innovation  # d·x·x, a·y·y
+    out: np.ndarray = (part[0] + part[1]) / (var[0] * var[1])
+    return out

@@ -34,9 +34,12 @@ class ScoreBands:
 
     def add(self, score: np.ndarray, continued: np.ndarray) -> None:
         """Count detections with ``score`` (in [0, 1]); ``continued`` indexes those that continued a track."""
-        b = _bin_of(np.asarray(score), self.bands)
-        self.seen += np.bincount(b, minlength=self.bands)
-        self.kept += np.bincount(b[continued], minlength=self.bands)
+        self.add_bands(_bin_of(np.asarray(score), self.bands), continued)
+
+    def add_bands(self, band: np.ndarray, continued: np.ndarray) -> None:
+        """:meth:`add` given each detection's band ``(n,)`` (``_bin_of(score, bands)``)."""
+        self.seen += np.bincount(band, minlength=self.bands)
+        self.kept += np.bincount(band[continued], minlength=self.bands)
 
     def threshold(self, ratio: float, min_count: int) -> float:
         """The lowest score the evidence supports as confident (1.0 before any band has ``min_count``).
@@ -131,6 +134,11 @@ class ScoreCalibration:
         self.clutter_factor, self.clutter_floor = clutter_factor, clutter_floor
         self.histogram = np.zeros(bins, dtype=np.int64)  # scores seen so far, binned on [0, 1]
         self.bands = ScoreBands(10)  # 0.1-wide bands: detections, and those that continued tracks
+        self._total = 0  # scores counted in the histogram
+        # each quantile's last [bin, scores in bins up to it]: decide walks from there (no cumulative sum)
+        self._at: dict[str, list[int]] = {}
+        self._scales = np.array([float(bins), float(self.bands.bands)])  # histogram bins and bands at once
+        self._last: tuple[np.ndarray, np.ndarray] | None = None  # (scores, their bands) of observe_scores
 
     @property
     def _quantiles(self) -> bool:
@@ -139,14 +147,53 @@ class ScoreCalibration:
 
     def observe_scores(self, score: np.ndarray) -> None:
         """Count this frame's scores (in [0, 1]) into the running distribution."""
-        if self._quantiles:
+        if not self._quantiles:
+            return
+        if self.high_match_ratio is not None:  # the bands observe_continued will want, in the same pass
+            both = (score[:, None] * self._scales).astype(int)  # _bin_of for both bin counts
+            np.minimum(both, self._scales.astype(int) - 1, out=both)
+            np.maximum(both, 0, out=both)
+            b, self._last = both[:, 0], (score, both[:, 1])
+        else:
             b = _bin_of(score, self.bins)
-            self.histogram += np.bincount(b, minlength=self.bins)
+        self.histogram += np.bincount(b, minlength=self.bins)
+        self._total += len(b)
+        if self._at:
+            new = b.tolist()
+            for at in self._at.values():
+                at[1] += sum(v <= at[0] for v in new)
 
     def observe_continued(self, score: np.ndarray, continued: np.ndarray) -> None:
         """Count this frame's detections by band; ``continued`` indexes those that continued a confirmed track."""
         if self.high_match_ratio is not None:
-            self.bands.add(score, continued)
+            last = self._last
+            if last is not None and last[0] is score:
+                self.bands.add_bands(last[1], continued)
+            else:
+                self.bands.add(score, continued)
+
+    def _edge(self, name: str, q: float) -> int:
+        """The first histogram bin whose cumulative count reaches ``q`` times the total (``searchsorted``
+        on the cumulative histogram, side left; ``bins`` if none), walked from where the quantile
+        ``name`` was last found: it moves a few bins between frames."""
+        target = q * self._total
+        hist = self.histogram
+        at = self._at.get(name)
+        if at is None:
+            at = self._at[name] = [0, hist.item(0)]
+        i, c = at
+        if c < target:
+            last = len(hist) - 1
+            while c < target and i < last:
+                i += 1
+                c += hist.item(i)
+            at[0], at[1] = i, c
+            return i if c >= target else len(hist)
+        while i > 0 and c - hist.item(i) >= target:
+            c -= hist.item(i)
+            i -= 1
+        at[0], at[1] = i, c
+        return i
 
     def decide(self, clutter_share: float | None = None) -> tuple[float, float, float]:
         """This frame's ``(high, birth, tentative)`` score thresholds; ``clutter_share`` (the share of
@@ -159,29 +206,17 @@ class ScoreCalibration:
         if not self._quantiles:
             return min(high, birth), birth, min(high, birth)
         tentative = 1.0
-        cum = np.cumsum(self.histogram)
-        total = int(cum[-1])
-        if total:
+        if self._total:
             # the lower edge of the bin holding each q-quantile: never above a score it stands for
-            wanted: dict[str, float] = {}
+            bins = self.bins
             if self.high_quantile is not None:
-                wanted["high"] = self.high_quantile
+                high = min(high, self._edge("high", self.high_quantile) / bins)
             if self.birth_quantile is not None:
-                wanted["birth"] = self.birth_quantile
+                birth = min(birth, self._edge("birth", self.birth_quantile) / bins)
             if self.clutter_factor is not None:  # before the share is judged: the median
                 q = 0.5 if clutter_share is None else max(self.clutter_factor * clutter_share, self.clutter_floor)
-                wanted["clutter"] = min(q, 0.5)  # never above the median, however much clutter
+                birth = min(birth, self._edge("clutter", min(q, 0.5)) / bins)  # never above the median
             if self.tentative_quantile is not None:
-                wanted["tentative"] = self.tentative_quantile
-            found = np.searchsorted(cum, np.array(list(wanted.values())) * total, side="left").tolist()
-            edge = {name: i / self.bins for name, i in zip(wanted, found)}
-            if "high" in edge:
-                high = min(high, edge["high"])
-            if "birth" in edge:
-                birth = min(birth, edge["birth"])
-            if "clutter" in edge:
-                birth = min(birth, edge["clutter"])
-            if "tentative" in edge:
-                tentative = edge["tentative"]
+                tentative = self._edge("tentative", self.tentative_quantile) / bins
         high = min(high, birth)
         return high, birth, min(high, tentative)
