@@ -37,6 +37,15 @@ Address = tuple[str, int]
 LOCALHOST = "127.0.0.1"
 
 
+def _preload() -> None:
+    """Import what the first frame would otherwise import: the assignment solver's scipy module."""
+    import numpy as np
+
+    from lookalike.association.solver import linear_sum_assignment
+
+    linear_sum_assignment(np.zeros((1, 1)))
+
+
 def parse_address(text: str, default_host: str = LOCALHOST) -> Address:
     """``HOST:PORT`` or ``PORT`` as ``(host, port)``; raises ``ValueError`` naming the text."""
     host, sep, port = text.rpartition(":")
@@ -157,9 +166,12 @@ class NodeServer:
     def serve(self, stop: Callable[[], bool], tick_s: float = 0.05) -> None:
         """Serve until ``stop()`` returns true (checked at least every ``tick_s`` seconds).
 
-        Objects alive at the start (modules, the tracker) are moved out of the garbage
-        collector's sight (``gc.freeze``), so its full collections stay short while serving.
+        The assignment solver is imported first (scipy.optimize, imported lazily, takes about half
+        a second: the first frame would wait for it), then objects alive at the start (modules, the
+        tracker) are moved out of the garbage collector's sight (``gc.freeze``), so its full
+        collections stay short while serving.
         """
+        _preload()
         gc.collect()
         gc.freeze()
         try:
