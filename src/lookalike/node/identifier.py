@@ -164,9 +164,12 @@ class TeamIdentifier:
         heading = np.array(message.heading, dtype=float)
         score = np.array(message.score, dtype=float)
         std = None if message.heading_std is None else np.array(message.heading_std, dtype=float)
-        total = float(position.sum()) + float(heading.sum()) + float(score.sum())
-        if std is not None:
-            total += float(std.sum()) if std.shape == (n,) and (not n or std.min() >= 0) else math.nan
+        try:  # (finite numbers sum to a finite total, barring overflow; anything else is checked below)
+            total = sum(message.heading) + sum(message.score) + sum(map(sum, message.position))
+            if std is not None:
+                total += sum(message.heading_std) if std.shape == (n,) and (not n or std.min() >= 0) else math.nan
+        except TypeError:
+            total = math.nan
         checked = heading.shape == score.shape == (n,) and math.isfinite(total)
         if checked:
             detections = _trusted(Detections, xywh=np.zeros((n, 4)), score=score, position=position,
@@ -181,7 +184,7 @@ class TeamIdentifier:
             t_sent = np.array([r.t_sent for r in reports], dtype=float)
             heading = np.array([r.heading for r in reports], dtype=float)
             t_received = np.full(len(reports), float(message.time))
-            if math.isfinite(float(t_sent.sum()) + float(heading.sum())) and agent_id.min() >= 0:
+            if math.isfinite(sum(r.t_sent + r.heading for r in reports)) and agent_id.min() >= 0:
                 beacons = _trusted(Beacons, agent_id=agent_id, t_sent=t_sent, t_received=t_received, heading=heading)
             else:
                 beacons = Beacons(agent_id=agent_id, t_sent=t_sent, t_received=t_received, heading=heading)

@@ -213,7 +213,7 @@ class BeaconIdentifier:
         d = (1.0 - np.cos(samples[:, :, None] - agent[None])) / 2.0  # (k, W, N)
         valid = np.isfinite(d)
         count = np.add.reduce(valid, axis=1)
-        total = np.add.reduce(np.where(valid, d, 0.0), axis=1)
+        total = np.add.reduce(np.fmax(d, 0.0), axis=1)  # (NaN -> 0; d >= 0 stays as it is)
         mean: np.ndarray = np.divide(total, count, out=np.full(count.shape, np.inf), where=count > 0)
         return mean
 
