@@ -98,27 +98,48 @@ def _eligible(selector: np.ndarray | None, allowed: np.ndarray) -> np.ndarray:
     return out
 
 
-def _as_list(selector: np.ndarray | None) -> list[bool] | None:
-    """A boolean selector as a list (None: every row); None also for an index array, which the caller
-    leaves to the array path (its order and repeats matter there)."""
-    if selector is None or selector.dtype != bool:
-        return None
-    out: list[bool] = selector.tolist()
-    return out
+class _PlanLists:
+    """What gated stages of one plan share as Python lists: each gate's allowed pairs and each boolean
+    selector (keyed by the arrays' ids, alive while the plan runs), and the matching's own columns
+    (kept in step with it; None when an array-path stage changed it)."""
+
+    def __init__(self) -> None:
+        self.pairs: dict[int, tuple[list[int], list[int]]] = {}
+        self.masks: dict[int, list[bool]] = {}
+        self.taken: list[int] | None = None
+        self.left: list[bool] | None = None
+
+    def gate_pairs(self, gate: np.ndarray) -> tuple[list[int], list[int]]:
+        found = self.pairs.get(id(gate))
+        if found is None:
+            ti, dj = gate.nonzero()
+            found = self.pairs[id(gate)] = (ti.tolist(), dj.tolist())
+        return found
+
+    def mask(self, selector: np.ndarray | None) -> list[bool] | None:
+        if selector is None:
+            return None
+        found = self.masks.get(id(selector))
+        if found is None:
+            found = self.masks[id(selector)] = selector.tolist()
+        return found
 
 
-def _run_gated(stage: Stage, pairs: tuple[list[int], list[int]], matching: Matching, index: int) -> bool:
-    """Run a gated stage from its gate's allowed pairs ``pairs`` (track rows, detections) when those
-    still eligible (eligible track still unmatched, eligible detection still free) are disjoint: each
-    is then a match of every optimum. Returns False, having changed nothing, when they compete."""
-    tracks = _as_list(stage.tracks)
+def _run_gated(stage: Stage, gate: np.ndarray, matching: Matching, index: int, lists: _PlanLists) -> bool:
+    """Run a stage with a gate (boolean selectors) from the gate's allowed pairs when those still
+    eligible (eligible track still unmatched, eligible detection still free) are disjoint: each is then
+    a match of every optimum. Returns False, having changed nothing, when they compete."""
+    pairs = lists.gate_pairs(gate)
+    tracks = lists.mask(stage.tracks)
     if not pairs[0] or (tracks is not None and not any(tracks)):
         return True
-    dets = _as_list(stage.detections)
+    dets = lists.mask(stage.detections)
     if dets is not None and not any(dets):
         return True
     det_of_track, free = matching.det_of_track, matching.free
-    taken, left = det_of_track.tolist(), free.tolist()
+    if lists.taken is None or lists.left is None:
+        lists.taken, lists.left = det_of_track.tolist(), free.tolist()
+    taken, left = lists.taken, lists.left
     rows, cols = [], []
     for i, j in zip(*pairs):
         if taken[i] < 0 and left[j] and (tracks is None or tracks[i]) and (dets is None or dets[j]):
@@ -128,26 +149,21 @@ def _run_gated(stage: Stage, pairs: tuple[list[int], list[int]], matching: Match
         return False
     stage_of_track = matching.stage_of_track
     for i, j in zip(rows, cols):
-        det_of_track[i] = j
-        free[j] = False
+        det_of_track[i] = taken[i] = j
+        free[j] = left[j] = False
         stage_of_track[i] = index
     return True
 
 
-def run_stage(stage: Stage, matching: Matching, index: int = 0,
-              _pairs: dict[int, tuple[list[int], list[int]]] | None = None) -> Matching:
+def run_stage(stage: Stage, matching: Matching, index: int = 0, _lists: _PlanLists | None = None) -> Matching:
     """Run one stage on what ``matching`` left over (updated in place and returned)."""
     gate = stage.gate if stage.solve is None else None
     if gate is not None and (stage.tracks is None or stage.tracks.dtype == bool) and (
             stage.detections is None or stage.detections.dtype == bool):
-        pairs = None if _pairs is None else _pairs.get(id(gate))
-        if pairs is None:
-            ti, dj = gate.nonzero()
-            pairs = (ti.tolist(), dj.tolist())
-            if _pairs is not None:
-                _pairs[id(gate)] = pairs
-        if _run_gated(stage, pairs, matching, index):
+        lists = _PlanLists() if _lists is None else _lists
+        if _run_gated(stage, gate, matching, index, lists):
             return matching
+        gate = None  # the allowed pairs compete: the costs decide
     rows = _eligible(stage.tracks, matching.det_of_track < 0)
     if not len(rows):
         return matching
@@ -171,6 +187,8 @@ def run_stage(stage: Stage, matching: Matching, index: int = 0,
         matching.det_of_track[r] = c
         matching.free[c] = False
         matching.stage_of_track[r] = index
+        if _lists is not None:
+            _lists.taken = _lists.left = None
     return matching
 
 
@@ -179,9 +197,9 @@ def run_plan(stages: list[Stage], n_tracks: int, n_detections: int,
     """Run ``stages`` in order on ``n_tracks`` tracks and ``n_detections`` detections (or on what
     ``start`` left over); return the matches and the left-overs."""
     matching = start if start is not None else Matching.empty(n_tracks, n_detections)
-    pairs: dict[int, tuple[list[int], list[int]]] = {}  # each gate's allowed pairs, found once per plan
+    lists = _PlanLists()  # what the gated stages share, found once per plan
     for i, stage in enumerate(stages):
-        run_stage(stage, matching, i, pairs)
+        run_stage(stage, matching, i, lists)
     return matching
 
 

@@ -110,9 +110,9 @@ class BoxTrack:
             if np.count_nonzero(still):
                 x[4:8, still] = 0.0  # a long-lost track waits where it was last seen
             self._predict_space().predict_columns(x, steps)
-        iou = self._overlaps(x, det_xywh)
+        iou, low_gate = self._overlaps(x, det_xywh)
         high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
-        matching = self._associate(iou, z.T, score, high_score, was_tracked, dt)
+        matching = self._associate(iou, low_gate, z.T, score, high_score, was_tracked, dt)
         det_of_track, free = matching.det_of_track, matching.free
         hit = det_of_track >= 0
         matched = hit.nonzero()[0]
@@ -160,16 +160,17 @@ class BoxTrack:
         z[2:4] = xywh[2:4]
         return z
 
-    def _overlaps(self, x: np.ndarray, det_xywh: np.ndarray) -> np.ndarray | None:
+    def _overlaps(self, x: np.ndarray, det_xywh: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
         """One IoU matrix of the predicted track boxes (state columns ``x``) and the previous frame's
         detections (rows) against this frame's detections (columns): the clutter share counts from the
-        second block; returns the first ``(k, n)`` (None without tracks or detections)."""
+        second block. Returns the first ``(k, n)`` (None without tracks or detections) and, when the
+        low-score stage and the clutter share use the same IoU, its pairs reaching it (else None)."""
         clutter = self._clutter
         previous = clutter.previous
         k, n, p = x.shape[1], len(det_xywh), 0 if previous is None else len(previous)
         if not n or not (k or p):
-            clutter.observe_best(det_xywh, None)
-            return None
+            clutter.observe_overlaps(det_xywh, None)
+            return None, None
         boxes = np.empty((4, k + p))  # left, top, width, height as columns
         if k:  # the predicted boxes, sizes floored at 1e-3 pixels (cxcywh_to_xywh)
             size = np.maximum(x[2:4], 1e-3, out=boxes[2:4, :k])
@@ -177,19 +178,24 @@ class BoxTrack:
         if p:
             boxes[:, k:] = previous.T  # type: ignore[union-attr]
         iou = iou_columns(boxes, det_xywh.T)
-        clutter.observe_best(det_xywh, np.maximum.reduce(iou[k:], axis=0) if p else None)
-        return iou[:k] if k else None
+        shared = const.LOW_IOU == clutter.min_iou
+        overlap = iou >= clutter.min_iou if p or shared else None
+        clutter.observe_overlaps(det_xywh, overlap[k:] if p else None)  # type: ignore[index]
+        if not k:
+            return None, None
+        return iou[:k], overlap[:k] if shared else None  # type: ignore[index]
 
-    def _associate(self, iou: np.ndarray | None, det_box: np.ndarray, score: np.ndarray, high_score: float,
-                   was_tracked: np.ndarray, dt: float) -> Matching:
+    def _associate(self, iou: np.ndarray | None, low_gate: np.ndarray | None, det_box: np.ndarray,
+                   score: np.ndarray, high_score: float, was_tracked: np.ndarray, dt: float) -> Matching:
         """The association plan: confident detections to confirmed tracks (recent ones first), low-score
         ones to tracks seen last frame, the rest to tentative tracks, then lost tracks by centre distance."""
         cfg, t = self.config, self._tracks
         high = score >= high_score
         # each IoU stage takes its block of the frame's matrix; it allows the pairs reaching its IoU
-        match_gate = low_gate = None
+        match_gate = None
         if iou is not None:
-            low_gate = iou >= const.LOW_IOU
+            if low_gate is None:
+                low_gate = iou >= const.LOW_IOU
             if cfg.match_iou > 0:  # else every pair is allowed: the costs decide
                 match_gate = low_gate if cfg.match_iou == const.LOW_IOU else iou >= cfg.match_iou
 

@@ -38,6 +38,16 @@ class ClutterShare:
         else:
             self.observe_best(xywh, None)
 
+    def observe_overlaps(self, xywh: np.ndarray, overlap: np.ndarray | None) -> None:
+        """:meth:`observe` given which pairs of :attr:`previous`'s boxes and this frame's overlap enough,
+        ``overlap (p, k)`` boolean (IoU ≥ ``min_iou``), computed by the caller; None when either frame
+        has no boxes. ``xywh`` must be a float ``(k, 4)`` array (kept as the next frame's previous boxes)."""
+        n = len(xywh)
+        if self._previous is not None and n:
+            self.seen += n
+            self.flicker += n if overlap is None else n - len(set(overlap.nonzero()[1].tolist()))
+        self._previous = xywh
+
     def observe_best(self, xywh: np.ndarray, best: np.ndarray | None) -> None:
         """:meth:`observe` with each box's highest IoU with :attr:`previous`'s boxes, ``best (k,)``,
         computed by the caller (e.g. within a larger IoU matrix); None when either frame has no boxes.

@@ -138,6 +138,7 @@ class ScoreCalibration:
         # each quantile's last [bin, scores in bins up to it]: decide walks from there (no cumulative sum)
         self._at: dict[str, list[int]] = {}
         self._scales = np.array([float(bins), float(self.bands.bands)])  # histogram bins and bands at once
+        self._top = np.array([bins - 1, self.bands.bands - 1])
         self._last: tuple[np.ndarray, np.ndarray] | None = None  # (scores, their bands) of observe_scores
 
     @property
@@ -151,7 +152,7 @@ class ScoreCalibration:
             return
         if self.high_match_ratio is not None:  # the bands observe_continued will want, in the same pass
             both = (score[:, None] * self._scales).astype(int)  # _bin_of for both bin counts
-            np.minimum(both, self._scales.astype(int) - 1, out=both)
+            np.minimum(both, self._top, out=both)
             np.maximum(both, 0, out=both)
             b, self._last = both[:, 0], (score, both[:, 1])
         else:
@@ -161,7 +162,8 @@ class ScoreCalibration:
         if self._at:
             new = b.tolist()
             for at in self._at.values():
-                at[1] += sum(v <= at[0] for v in new)
+                i = at[0]
+                at[1] += len([v for v in new if v <= i])
 
     def observe_continued(self, score: np.ndarray, continued: np.ndarray) -> None:
         """Count this frame's detections by band; ``continued`` indexes those that continued a confirmed track."""
