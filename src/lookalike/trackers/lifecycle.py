@@ -59,20 +59,22 @@ class Lifecycle:
         """``(k,)`` True for the tracks that survive this frame; ``max_unseen_s`` (per track or
         shared) overrides the policy's own limit."""
         limit_s = self.max_unseen_s if max_unseen_s is None else max_unseen_s
-        tentative = np.ones(len(table), dtype=bool)
-        if self.tentative_max_misses is not None:
-            tentative &= table.misses < self.tentative_max_misses
+        tentative: np.ndarray = np.ones(len(table), dtype=bool) if self.tentative_max_misses is None else (
+            table.misses < self.tentative_max_misses)
         if self.tentative_max_unseen_s is not None:
             tentative &= table.unseen_s <= self.tentative_max_unseen_s
         if self.closed:
-            return table.confirmed | tentative
-        if not table.confirmed.any():
+            out: np.ndarray = table.confirmed | tentative
+            return out
+        if not np.count_nonzero(table.confirmed):
             return tentative
-        confirmed = np.ones(len(table), dtype=bool)
-        if self.max_misses is not None:
-            confirmed &= table.misses <= self.max_misses
+        confirmed = None if self.max_misses is None else table.misses <= self.max_misses
         if limit_s is not None:
-            confirmed &= table.unseen_s <= limit_s
+            within = table.unseen_s <= limit_s
+            confirmed = within if confirmed is None else confirmed & within
+        if confirmed is None:  # confirmed tracks never die here
+            out = table.confirmed | tentative
+            return out
         return np.where(table.confirmed, confirmed, tentative)
 
     def status(self, table: TrackTable, rows: np.ndarray) -> np.ndarray:
