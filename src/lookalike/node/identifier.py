@@ -163,11 +163,12 @@ class TeamIdentifier:
         position = np.array(message.position, dtype=float).reshape(n, 2)
         heading = np.array(message.heading, dtype=float)
         score = np.array(message.score, dtype=float)
-        std = None if message.heading_std is None else np.array(message.heading_std, dtype=float)
+        spread = message.heading_std
+        std = None if spread is None else np.array(spread, dtype=float)
         try:  # (finite numbers sum to a finite total, barring overflow; anything else is checked below)
-            total = sum(message.heading) + sum(message.score) + sum(map(sum, message.position))
-            if std is not None:
-                total += sum(message.heading_std) if std.shape == (n,) and (not n or std.min() >= 0) else math.nan
+            total: float = sum(message.heading) + sum(message.score) + sum(map(sum, message.position))
+            if spread is not None and std is not None:
+                total += sum(spread) if std.shape == (n,) and (not n or std.min() >= 0) else math.nan
         except TypeError:
             total = math.nan
         checked = heading.shape == score.shape == (n,) and math.isfinite(total)
