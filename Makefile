@@ -2,7 +2,7 @@
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
-EXTRAS ?= test,vision,viz,train,docs,tune
+EXTRAS ?= test,vision,viz,train,docs,tune,fast
 comma := ,
 STAMP := $(VENV)/.installed-$(subst $(comma),-,$(EXTRAS))
 
@@ -48,7 +48,7 @@ BENCH_VENV := .venv-bench
 $(BENCH_VENV)/.installed: pyproject.toml constraints-bench.txt
 	$(PYTHON) -m venv $(BENCH_VENV)
 	$(BENCH_VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt -e ".[vision,viz,bench]"
+	$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt -e ".[vision,viz,bench,fast]"
 	touch $@
 
 # Peers whose declared requirements do not resolve next to numpy < 2 (trackers asks numpy >= 2, the packaged
