@@ -62,3 +62,15 @@ def test_column_nis_equals_the_general_form(mixed: bool) -> None:
             fast.observe_columns(np.ascontiguousarray(innovation.T), np.ascontiguousarray(var.T), rows)
         assert plain.scale == fast.scale and plain._count == fast._count
     assert plain.scale > 1.0
+
+
+def test_median_equals_numpys() -> None:
+    from lookalike.trackers.motion_fit import _median
+
+    rng = np.random.default_rng(2)
+    for n in range(1, 80):
+        values = rng.chisquare(2, n) * rng.choice([1e-3, 1.0, 1e3])
+        if n % 7 == 0:
+            values[rng.integers(0, n, 2)] = values[0]  # ties
+        assert _median(values) == float(np.median(values))
+    assert np.isnan(_median(np.array([1.0, np.nan, 2.0])))

@@ -29,6 +29,8 @@ when their allowed pairs compete. The rows are those of the plain tracker this r
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from lookalike.association.costs import centre_distance_cost, cost_from_iou, iou_columns
@@ -205,14 +207,6 @@ class BoxTrack:
 
         confirmed = t.confirmed
         recent = t.misses <= const.RECENT_FRAMES
-        matching = run_plan([
-            Stage(confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent", gate=match_gate),
-            Stage(confirmed > recent, high, overlap(cfg.match_iou, True), name="confident, lost longer",
-                  gate=match_gate),  # (confirmed and not recent)
-            Stage(confirmed & was_tracked, ~high, overlap(const.LOW_IOU, False), name="low score", gate=low_gate),
-        ], len(t), len(score))
-        self._calibration.observe_continued(score, matching.det_of_track[matching.det_of_track >= 0])
-        stages = [Stage(~confirmed, high, overlap(cfg.match_iou, False), name="tentative", gate=match_gate)]
         slots = self._slots
 
         def reid(r: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -222,11 +216,22 @@ class BoxTrack:
                 gate, scale = slots.gate(t.unseen_s + dt), max(cfg.reid_scale, const.CLOSED_SCALE)
                 return centre_distance_cost(track_box[r], box[c], gate[r], scale)
             # in fitted standard deviations: a model that fits badly (MotionFit) widens the gate
-            gate_all = const.REID_DISTANCE * np.sqrt(self._fit.scale)
+            gate_all = const.REID_DISTANCE * math.sqrt(self._fit.scale)
             return centre_distance_cost(t.mean[r, :4], det_box[c], gate_all, cfg.reid_scale)
 
-        stages.append(Stage(confirmed, high, reid, name="re-identification"))
-        return run_plan(stages, len(t), len(score), start=matching)
+        matching = run_plan([
+            Stage(confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent", gate=match_gate),
+            Stage(confirmed > recent, high, overlap(cfg.match_iou, True), name="confident, lost longer",
+                  gate=match_gate),  # (confirmed and not recent)
+            Stage(confirmed & was_tracked, ~high, overlap(const.LOW_IOU, False), name="low score", gate=low_gate),
+            Stage(~confirmed, high, overlap(cfg.match_iou, False), name="tentative", gate=match_gate),
+            Stage(confirmed, high, reid, name="re-identification"),
+        ], len(t), len(score))
+        # the detections that continued confirmed tracks in the first three stages (the later two
+        # change no earlier match)
+        by_stage = matching.stage_of_track
+        self._calibration.observe_continued(score, matching.det_of_track[(by_stage >= 0) & (by_stage < 3)])
+        return matching
 
     def _correct(self, x: np.ndarray, matched: np.ndarray, z: np.ndarray) -> None:
         """Kalman update of the tracks ``matched`` (columns of ``x``) with their measurements ``z (4, m)``;

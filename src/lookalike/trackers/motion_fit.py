@@ -78,9 +78,21 @@ class MotionFit:
                                       [np.ones(p[0].shape[1], bool) if r is None else r for p, r in zip(items, rows)]))
         else:
             nis = np.concatenate([p if isinstance(p, np.ndarray) else _nis_of_columns(*p) for p in pending])
-        median = float(np.median(nis))
+        median = _median(nis)
         self.scale = float(np.clip(self.scale * median / CHI2_2DOF_MEDIAN, 1.0, self.max_scale))
         self._pending, self._count = [], 0
+
+
+def _median(values: np.ndarray) -> float:
+    """``np.median`` of a non-empty 1-D float array: the middle of the sorted values, or the mean of the
+    two middle ones, ``(a + b) / 2`` as ``np.mean`` computes it (NaN if any value is NaN)."""
+    if np.count_nonzero(np.isnan(values)):
+        return float("nan")
+    ordered = np.sort(values)
+    n = len(ordered)
+    if n % 2:
+        return float(ordered[n // 2])
+    return float((ordered[n // 2 - 1] + ordered[n // 2]) / 2)
 
 
 def _nis_of_columns(innovation: np.ndarray, var: np.ndarray, rows: np.ndarray | None) -> np.ndarray:
