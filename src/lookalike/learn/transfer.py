@@ -30,7 +30,7 @@ from lookalike.learn.encoding import EncodingSpec
 
 def _input_map(source: EncodingSpec, target: EncodingSpec) -> np.ndarray:
     """For each input column of ``target``, the source column it copies, and whether it repeats one."""
-    cols = []
+    cols: list[int] = []
     aw, sw = target.agent_width, target.slot_width
     for j in range(target.n_agents):
         src = j % source.n_agents
@@ -81,7 +81,7 @@ def transfer_weights(
     def noisy(block: np.ndarray, repeat: np.ndarray, axis: int) -> np.ndarray:
         out = block.copy()
         scale = jitter * float(np.std(block)) if block.size else 0.0
-        index = [slice(None)] * out.ndim
+        index: list[Any] = [slice(None)] * out.ndim
         index[axis] = np.flatnonzero(repeat)
         sub = out[tuple(index)]
         out[tuple(index)] = sub + rng.normal(0.0, scale, size=sub.shape)
