@@ -25,7 +25,7 @@ def iou_columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     inter = side[0] * side[1]
     union = (a[2] * a[3])[:, None] + b[2] * b[3]
     union -= inter
-    if union.min(initial=1.0) > 0:
+    if np.count_nonzero(union > 0) == union.size:  # as iou_matrix: NaN takes the guarded division
         out: np.ndarray = inter / union
         return out
     out = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
@@ -51,8 +51,11 @@ def centre_distance_cost(track_cxcywh: np.ndarray, det_cxcywh: np.ndarray, gate:
     square *= square
     dist = np.sqrt(square[:, :, 0] + square[:, :, 1])  # np.linalg.norm's numbers (sqrt of the summed squares)
     dist /= height
+    allowed = dist <= gate
+    if not np.count_nonzero(allowed):  # every pair beyond the gate: the size ratios cannot matter
+        dist.fill(np.inf)
+        return dist
     size_t = np.maximum(track_cxcywh[:, None, 2:4], 1.0)
     ratio = np.abs(np.log(size_t / np.maximum(det_cxcywh[None, :, 2:4], 1.0)))
-    allowed = dist <= gate
     allowed &= np.maximum(ratio[:, :, 0], ratio[:, :, 1]) <= np.log(max_scale)
     return np.where(allowed, dist, np.inf)
