@@ -64,6 +64,7 @@ class WorldTracker:
         self._time: float | None = None
         self._model_dt: float | None = None  # frame interval of the cached (F, Q)
         self._model: tuple[np.ndarray, np.ndarray] = (np.eye(6), np.zeros((6, 6)))
+        self._decay: float | None = None  # velocity factor of a coasting track over that interval
         self._identifier = BeaconIdentifier(IdentifierConfig(
             n_agents=cfg.n_agents, window_frames=cfg.window_frames, max_cost=cfg.max_identity_cost,
             hysteresis=cfg.hysteresis))
@@ -85,14 +86,9 @@ class WorldTracker:
         hit = det_of_track >= 0
         t["hit_bits"] = ((t["hit_bits"] << 1) | hit) & ((1 << 30) - 1)
         t.record(hit, dt)
-        if hit.any():
-            self._identifier.observe_many(t.ids[hit].tolist(), headings(det)[det_of_track[hit]])
-        det_of_track = self._lifecycle(det_of_track)
+        det_of_track = self._lifecycle(det_of_track)  # (a track with a hit survives this)
         new = self._births(det, det_of_track)
-        det_of_track = np.concatenate([det_of_track, new])
-        if len(new):
-            self._identifier.observe_many(t.ids[len(t) - len(new):].tolist(), headings(det)[new])
-        return self._report(det, det_of_track)
+        return self._report(det, np.concatenate([det_of_track, new]))
 
     # -- steps -------------------------------------------------------------------------------
 
@@ -100,14 +96,16 @@ class WorldTracker:
         t = self._tracks
         if not len(t) or dt == 0:
             return
-        if self.rules.coast_decay_s is not None:
+        if dt != self._model_dt:  # (WorldCA.predict's model and the decay, kept while the interval repeats)
+            self._model = constant_acceleration(2, dt, self.config.q_jerk)
+            decay_s = self.rules.coast_decay_s
+            self._decay = None if decay_s is None else np.exp(-dt / decay_s)
+            self._model_dt = dt
+        if self._decay is not None:
             coasting = t.misses > 0
             if coasting.any():
-                t.mean[coasting, 2:4] *= np.exp(-dt / self.rules.coast_decay_s)
+                t.mean[coasting, 2:4] *= self._decay
                 t.mean[coasting, 4:6] = 0.0
-        if dt != self._model_dt:  # (WorldCA.predict's model, kept while the frame interval repeats)
-            self._model = constant_acceleration(2, dt, self.config.q_jerk)
-            self._model_dt = dt
         t.mean, t.cov = kalman.predict(t.mean, t.cov, *self._model)
 
     def _noise(self, position: np.ndarray) -> np.ndarray:
@@ -184,15 +182,22 @@ class WorldTracker:
         return new
 
     def _report(self, det: Detections, det_of_track: np.ndarray) -> Tracks:
+        """Identify (the visual headings of this frame's hits and births go to the identifier
+        first) and report every track."""
         t = self._tracks
         k = len(t)
+        seen = det_of_track >= 0
+        if len(det):
+            heading = headings(det)[det_of_track]  # (a miss's -1 reads the last heading: replaced by NaN)
+            if seen.any():
+                self._identifier.observe_many(t.ids[seen].tolist(), heading[seen])
+            heading = np.where(seen, heading, np.nan)
+        else:
+            heading = np.full(k, np.nan)
         agent = np.full(k, -1, dtype=int)
         prob = np.full(k, np.nan)
         confirmed = t.confirmed
         agent[confirmed], prob[confirmed] = self._identifier.assign_arrays(t.ids[confirmed].tolist())
-        seen = det_of_track >= 0
-        # (a miss's -1 reads the last heading, replaced by NaN)
-        heading = np.where(seen, headings(det)[det_of_track], np.nan) if len(det) else np.full(k, np.nan)
         out = Tracks.__new__(Tracks)  # (columns built here: Tracks' checks skipped)
         out.id, out.xywh, out.detection_index = t.ids.copy(), None, det_of_track
         out.status = np.left_shift(confirmed, ~seen, dtype=np.int8)  # 0 tentative, 1 confirmed, 2 lost
