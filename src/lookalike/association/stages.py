@@ -104,55 +104,46 @@ class _PlanLists:
     (kept in step with it; None when an array-path stage changed it)."""
 
     def __init__(self) -> None:
-        self.pairs: dict[int, tuple[list[int], list[int]]] = {}
+        self.pairs: dict[int, list[tuple[int, int]]] = {}
         self.masks: dict[int, list[bool]] = {}
         self.taken: list[int] | None = None
         self.left: list[bool] | None = None
 
-    def gate_pairs(self, gate: np.ndarray) -> tuple[list[int], list[int]]:
-        found = self.pairs.get(id(gate))
-        if found is None:
+    def run(self, stage: Stage, gate: np.ndarray, matching: Matching, index: int) -> bool:
+        """Run a stage with a gate (boolean selectors) from the gate's allowed pairs when those still
+        eligible (eligible track still unmatched, eligible detection still free) are disjoint: each is
+        then a match of every optimum. Returns False, having changed nothing, when they compete."""
+        masks = self.masks
+        pairs = self.pairs.get(id(gate))
+        if pairs is None:
             ti, dj = gate.nonzero()
-            found = self.pairs[id(gate)] = (ti.tolist(), dj.tolist())
-        return found
-
-    def mask(self, selector: np.ndarray | None) -> list[bool] | None:
-        if selector is None:
-            return None
-        found = self.masks.get(id(selector))
-        if found is None:
-            found = self.masks[id(selector)] = selector.tolist()
-        return found
-
-
-def _run_gated(stage: Stage, gate: np.ndarray, matching: Matching, index: int, lists: _PlanLists) -> bool:
-    """Run a stage with a gate (boolean selectors) from the gate's allowed pairs when those still
-    eligible (eligible track still unmatched, eligible detection still free) are disjoint: each is then
-    a match of every optimum. Returns False, having changed nothing, when they compete."""
-    pairs = lists.gate_pairs(gate)
-    tracks = lists.mask(stage.tracks)
-    if not pairs[0] or (tracks is not None and not any(tracks)):
+            pairs = self.pairs[id(gate)] = list(zip(ti.tolist(), dj.tolist()))
+        if not pairs:
+            return True
+        tracks = stage.tracks
+        if tracks is not None:
+            tracks = masks.get(id(tracks)) or masks.setdefault(id(tracks), tracks.tolist())
+            if not any(tracks):
+                return True
+        dets = stage.detections
+        if dets is not None:
+            dets = masks.get(id(dets)) or masks.setdefault(id(dets), dets.tolist())
+            if not any(dets):
+                return True
+        det_of_track, free = matching.det_of_track, matching.free
+        taken, left = self.taken, self.left
+        if taken is None or left is None:
+            taken, left = self.taken, self.left = det_of_track.tolist(), free.tolist()
+        found = [(i, j) for i, j in pairs
+                 if taken[i] < 0 and left[j] and (tracks is None or tracks[i]) and (dets is None or dets[j])]
+        if len({i for i, _ in found}) < len(found) or len({j for _, j in found}) < len(found):
+            return False
+        stage_of_track = matching.stage_of_track
+        for i, j in found:
+            det_of_track[i] = taken[i] = j
+            free[j] = left[j] = False
+            stage_of_track[i] = index
         return True
-    dets = lists.mask(stage.detections)
-    if dets is not None and not any(dets):
-        return True
-    det_of_track, free = matching.det_of_track, matching.free
-    if lists.taken is None or lists.left is None:
-        lists.taken, lists.left = det_of_track.tolist(), free.tolist()
-    taken, left = lists.taken, lists.left
-    rows, cols = [], []
-    for i, j in zip(*pairs):
-        if taken[i] < 0 and left[j] and (tracks is None or tracks[i]) and (dets is None or dets[j]):
-            rows.append(i)
-            cols.append(j)
-    if len(set(rows)) < len(rows) or len(set(cols)) < len(cols):
-        return False
-    stage_of_track = matching.stage_of_track
-    for i, j in zip(rows, cols):
-        det_of_track[i] = taken[i] = j
-        free[j] = left[j] = False
-        stage_of_track[i] = index
-    return True
 
 
 def run_stage(stage: Stage, matching: Matching, index: int = 0, _lists: _PlanLists | None = None) -> Matching:
@@ -161,7 +152,7 @@ def run_stage(stage: Stage, matching: Matching, index: int = 0, _lists: _PlanLis
     if gate is not None and (stage.tracks is None or stage.tracks.dtype == bool) and (
             stage.detections is None or stage.detections.dtype == bool):
         lists = _PlanLists() if _lists is None else _lists
-        if _run_gated(stage, gate, matching, index, lists):
+        if lists.run(stage, gate, matching, index):
             return matching
         gate = None  # the allowed pairs compete: the costs decide
     rows = _eligible(stage.tracks, matching.det_of_track < 0)
