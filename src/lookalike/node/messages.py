@@ -223,7 +223,10 @@ def decode(data: bytes) -> Message:
     if len(data) > MAX_DATAGRAM_BYTES:
         raise MessageError(TOO_LARGE, f"{len(data)} bytes exceeds {MAX_DATAGRAM_BYTES}")
     try:
-        body = json.loads(data.decode("utf-8"), parse_constant=_reject_constant)
+        text = data.decode("utf-8")
+        # (json.loads with parse_constant builds a decoder per call; one is kept. A leading BOM
+        # goes through json.loads for its own error message.)
+        body = json.loads(text, parse_constant=_reject_constant) if text.startswith("\ufeff") else _DECODER.decode(text)
     except (UnicodeDecodeError, ValueError, RecursionError) as exc:
         raise MessageError(MALFORMED, f"not UTF-8 JSON ({exc})") from None
     if not isinstance(body, dict):
@@ -240,6 +243,9 @@ def decode(data: bytes) -> Message:
 
 def _reject_constant(name: str) -> Any:
     raise ValueError(f"{name} is not allowed")
+
+
+_DECODER = json.JSONDecoder(parse_constant=_reject_constant)
 
 
 class _Fields:
