@@ -76,7 +76,7 @@ class TeamIdentifier:
         self._queued = 0  # reports in all the queues
         self._arrival = 0  # arrival number of the next report (keeps the frame's reports in arrival order)
         self.queue_dropped = 0
-        self._last_update = np.full(n, math.nan)  # frame time a detection last updated each robot
+        self._last_update = [math.nan] * n  # frame time a detection last updated each robot
         self.last_frame: int | None = None
         self.last_time = -math.inf
         self.camera_lost = False
@@ -147,7 +147,7 @@ class TeamIdentifier:
         self.tracker.reset()
         self.restarts += 1
         self._take_reports()
-        self._last_update[:] = math.nan
+        self._last_update = [math.nan] * self.config.n_robots
         self._last_sent[:] = -math.inf
         self._last_seq[:] = -1
         self.last_frame, self.last_time = None, -math.inf
@@ -202,15 +202,16 @@ class TeamIdentifier:
             if j not in best or _rank(row) > _rank(best[j]):
                 best[j] = row
         robots = []
+        last_update, time = self._last_update, float(frame.time)
         for j in sorted(best):
             _, det_index, prob, x, y, heading = best[j]
-            if det_index >= 0 or math.isnan(self._last_update[j]):
-                self._last_update[j] = frame.time
+            if det_index >= 0 or math.isnan(last_update[j]):
+                last_update[j] = time
             if not (math.isfinite(x) and math.isfinite(y)):
                 continue
             robots.append(RobotEstimate(
                 id=int(j), position=(x, y), heading=_finite_or_none(heading), confidence=_finite_or_none(prob),
-                age=float(frame.time - self._last_update[j]),
+                age=time - last_update[j],
             ))
         labels = labels_from_tracks(n, snapshots)
         return TeamState(frame=frame.index, time=frame.time, robots=tuple(robots), labels=tuple(labels.tolist()))
