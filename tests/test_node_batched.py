@@ -53,6 +53,11 @@ def test_pairs_equal_the_solver(seed):
         rows, cols = pairs(cost, allowed, max_cost)
         expected = assign_pairs(np.where(allowed, cost, np.inf), max_cost)
         np.testing.assert_array_equal(np.stack([rows, cols], axis=1).reshape(-1, 2), expected)
+        unit = np.minimum(cost, 1.0)  # (costs in [0, 1]: the unit shortcut)
+        allowed = unit <= max_cost
+        rows, cols = pairs(unit, allowed, min(max_cost, 1.0), unit=True)
+        expected = assign_pairs(np.where(allowed, unit, np.inf), min(max_cost, 1.0))
+        np.testing.assert_array_equal(np.stack([rows, cols], axis=1).reshape(-1, 2), expected)
 
 
 def _plain_associate(tracker, det):

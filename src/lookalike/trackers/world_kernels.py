@@ -39,17 +39,22 @@ _NONE = np.zeros(0, dtype=int)
 _NONE.flags.writeable = False
 
 
-def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
+def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf,
+          unit: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Rows and columns of :func:`~lookalike.association.solver.assign_pairs` on the float matrix
     ``where(allowed, cost, inf)`` (no NaN) with ``max_cost``, where ``allowed`` is ``cost <= max_cost``
-    (finite ``max_cost``) or the pairs to consider (``max_cost = inf``)."""
+    (finite ``max_cost``) or the pairs to consider (``max_cost = inf``). ``unit``: the allowed
+    costs are >= 0 and ``max_cost <= 1``, so the solver's scale is 1 and nothing needs rescaling
+    (those checks are skipped)."""
     if not cost.size or not allowed.any():
         return _NONE, _NONE
     most = np.maximum.reduce
     if most(np.add.reduce(allowed, axis=0)) == 1 and most(np.add.reduce(allowed, axis=1)) == 1:
         rows, cols = allowed.nonzero()
         return rows, cols
-    if np.isfinite(max_cost):
+    if unit and max_cost <= 1.0:  # (|max_cost - min| <= 1: scale 1; every entry within [0, 1 + 1e-6])
+        work = np.where(allowed, cost, max_cost + 1e-6)
+    elif np.isfinite(max_cost):
         scale = max(abs(max_cost - float(cost[allowed].min())), 1.0)
         work = np.where(allowed, cost, max_cost + 1e-6 * scale)
         big = max(abs(float(work.max())), abs(float(work.min())))

@@ -239,7 +239,7 @@ class BeaconIdentifier:
         if len(held):  # (an infinite cost stays infinite)
             a = current[held]
             biased[held, a] = np.maximum(biased[held, a] - cfg.hysteresis, 0.0)
-        r, a = pairs(biased, biased <= cfg.max_cost, cfg.max_cost)
+        r, a = pairs(biased, biased <= cfg.max_cost, cfg.max_cost, unit=True)  # (costs in [0, 1])
         agent_out[r] = a
         prob[r] = 1.0 - cost[r, a]
         self._current[rows] = agent_out  # (row 0, unobserved tracks, is never assigned: stays -1)
