@@ -210,10 +210,12 @@ class BeaconIdentifier:
             return np.zeros((len(rows), n))
         samples = self._win[rows]
         agent = self._headings(self._times, self._times_count)  # (W, N)
-        d = (1.0 - np.cos(samples[:, :, None] - agent[None])) / 2.0  # (k, W, N)
-        valid = np.isfinite(d)
-        count = np.add.reduce(valid, axis=1)
-        total = np.add.reduce(np.fmax(d, 0.0), axis=1)  # (NaN -> 0; d >= 0 stays as it is)
+        d = np.subtract(samples[:, :, None], agent[None])  # (k, W, N): (1 - cos(d)) / 2, in place
+        np.cos(d, out=d)
+        np.subtract(1.0, d, out=d)
+        np.divide(d, 2.0, out=d)
+        count = np.add.reduce(np.isfinite(d), axis=1)
+        total = np.add.reduce(np.fmax(d, 0.0, out=d), axis=1)  # (NaN -> 0; d >= 0 stays as it is)
         mean: np.ndarray = np.divide(total, count, out=np.full(count.shape, np.inf), where=count > 0)
         return mean
 
