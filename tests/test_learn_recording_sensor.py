@@ -49,3 +49,11 @@ def test_no_robot_detection_is_refused() -> None:
     a = dataclasses.replace(a, det_valid=np.zeros_like(a.det_valid))
     with pytest.raises(ValueError, match="no detection"):
         fit_sensor([a], cfg.sensor, cfg.observer)
+
+
+def test_recordings_without_truth_are_refused() -> None:
+    cfg = _world()
+    a = simulate_arrays(cfg, 50, 1)
+    a = dataclasses.replace(a, visible=np.zeros_like(a.visible))
+    with pytest.raises(ValueError, match="no usable truth"):
+        fit_sensor([a], cfg.sensor, cfg.observer)

@@ -106,6 +106,9 @@ def fit_sensor(recordings: Sequence[RobotArrays], base: SensorConfig, observer: 
     d_all = np.concatenate(dist)
     if not len(d_all):
         raise ValueError("the recordings hold no detection of a robot to measure the detector on")
+    if not sum(len(f) for f in features) or not np.isfinite(d_all).all():
+        raise ValueError("the recordings carry no usable truth (robot positions and visibility) to measure "
+                         "the detector on")
     X, y = np.concatenate(features), np.concatenate(detected)
     p = np.linalg.lstsq(X, y, rcond=None)[0] if len(y) else np.array([base.p_detect, base.p_detect_near,
                                                                        base.p_detect_far])
