@@ -30,8 +30,11 @@ class MotionFit:
         self.batch = batch
         self.max_scale = max_scale
         self.scale = 1.0
-        # this batch's NIS, or (innovations, variances, columns) whose NIS is computed with the batch
-        self._pending: list[np.ndarray | tuple[np.ndarray, np.ndarray, np.ndarray | None]] = []
+        self._pending: list[np.ndarray] = []  # this batch's NIS from observe / observe_parts
+        # this batch's innovations (rows 0-1) and variances (rows 2-3) from observe_columns, their NIS
+        # computed with the batch; a buffer of fixed size (grown only for a larger batch)
+        self._columns = np.empty((4, 2 * batch))
+        self._filled = 0
         self._count = 0
 
     def observe(self, innovation: np.ndarray, S: np.ndarray) -> None:
@@ -43,14 +46,23 @@ class MotionFit:
     def observe_columns(self, innovation: np.ndarray, var: np.ndarray, rows: np.ndarray | None = None) -> None:
         """:meth:`observe` for diagonal covariances: innovations ``(2, k)`` and their variances ``(2, k)``
         as rows (x, y; pixels, pixels²), of the columns ``rows`` (mask; None: all). The same NIS as
-        :meth:`observe_parts` with ``b = 0`` for finite innovations; computed when the batch is complete
-        (the arrays are kept until then and must not change)."""
-        count = innovation.shape[1] if rows is None else np.count_nonzero(rows)
-        if count:
-            self._pending.append((innovation, var, rows))
-            self._count += count
-            if self._count >= self.batch:
-                self._update()
+        :meth:`observe_parts` with ``b = 0`` for finite innovations, computed when the batch is complete."""
+        if rows is not None and np.count_nonzero(rows) < len(rows):
+            innovation, var = innovation[:, rows], var[:, rows]
+        k = innovation.shape[1]
+        if not k:
+            return
+        n = self._filled
+        if n + k > self._columns.shape[1]:
+            grown = np.empty((4, 2 * (n + k)))
+            grown[:, :n] = self._columns[:, :n]
+            self._columns = grown
+        self._columns[0:2, n:n + k] = innovation
+        self._columns[2:4, n:n + k] = var
+        self._filled = n + k
+        self._count += k
+        if self._count >= self.batch:
+            self._update()
 
     def observe_parts(self, innovation: np.ndarray, a: np.ndarray, b: np.ndarray, d: np.ndarray) -> None:
         """:meth:`observe` with the covariances given by their entries ``a = S[:, 0, 0]``, ``b = S[:, 0, 1]``
@@ -67,20 +79,15 @@ class MotionFit:
             self._update()
 
     def _update(self) -> None:
-        """Scale by the median NIS of the batch, then start a new one."""
-        pending = self._pending
-        if all(type(p) is tuple for p in pending):  # columns only: their NIS in one pass
-            items: list = pending  # type: ignore[type-arg]
-            rows = [p[2] for p in items]
-            nis = _nis_of_columns(np.concatenate([p[0] for p in items], axis=1),
-                                  np.concatenate([p[1] for p in items], axis=1),
-                                  None if all(r is None for r in rows) else np.concatenate(
-                                      [np.ones(p[0].shape[1], bool) if r is None else r for p, r in zip(items, rows)]))
-        else:
-            nis = np.concatenate([p if isinstance(p, np.ndarray) else _nis_of_columns(*p) for p in pending])
-        median = _median(nis)
+        """Scale by the median NIS of the batch (the median does not depend on the order), then start a
+        new batch."""
+        parts = self._pending
+        n = self._filled
+        if n:
+            parts = parts + [_nis_of_columns(self._columns[0:2, :n], self._columns[2:4, :n], None)]
+        median = _median(parts[0] if len(parts) == 1 else np.concatenate(parts))
         self.scale = float(np.clip(self.scale * median / CHI2_2DOF_MEDIAN, 1.0, self.max_scale))
-        self._pending, self._count = [], 0
+        self._pending, self._count, self._filled = [], 0, 0
 
 
 def _median(values: np.ndarray) -> float:
