@@ -41,7 +41,7 @@ def cost_from_iou(iou: np.ndarray, min_iou: float = 0.0, det_weight: np.ndarray 
     return cost
 
 
-def centre_distance_cost(track_cxcywh: np.ndarray, det_cxcywh: np.ndarray, gate: np.ndarray,
+def centre_distance_cost(track_cxcywh: np.ndarray, det_cxcywh: np.ndarray, gate: np.ndarray | float,
                          max_scale: float) -> np.ndarray:
     """Distance between box centres in track heights (heights floored at 1 pixel): ``(k, d)``;
     ``inf`` beyond ``gate`` (``(k, 1)`` or scalar, in heights) or where width or height differ by
@@ -49,7 +49,7 @@ def centre_distance_cost(track_cxcywh: np.ndarray, det_cxcywh: np.ndarray, gate:
     height = np.maximum(track_cxcywh[:, 3:4], 1.0)
     square = track_cxcywh[:, None, :2] - det_cxcywh[None, :, :2]
     square *= square
-    dist = np.sqrt(square[:, :, 0] + square[:, :, 1])  # np.linalg.norm's numbers (sqrt of the summed squares)
+    dist: np.ndarray = np.sqrt(square[:, :, 0] + square[:, :, 1])  # np.linalg.norm's numbers
     dist /= height
     allowed = dist <= gate
     if not np.count_nonzero(allowed):  # every pair beyond the gate: the size ratios cannot matter
@@ -58,4 +58,5 @@ def centre_distance_cost(track_cxcywh: np.ndarray, det_cxcywh: np.ndarray, gate:
     size_t = np.maximum(track_cxcywh[:, None, 2:4], 1.0)
     ratio = np.abs(np.log(size_t / np.maximum(det_cxcywh[None, :, 2:4], 1.0)))
     allowed &= np.maximum(ratio[:, :, 0], ratio[:, :, 1]) <= np.log(max_scale)
-    return np.where(allowed, dist, np.inf)
+    out: np.ndarray = np.where(allowed, dist, np.inf)
+    return out

@@ -120,14 +120,15 @@ class _PlanLists:
             pairs = self.pairs[id(gate)] = list(zip(ti.tolist(), dj.tolist()))
         if not pairs:
             return True
-        tracks = stage.tracks
-        if tracks is not None:
-            tracks = masks.get(id(tracks)) or masks.setdefault(id(tracks), tracks.tolist())
+        tracks: list[bool] | None = None
+        if stage.tracks is not None:
+            tracks = masks.get(id(stage.tracks)) or masks.setdefault(id(stage.tracks), stage.tracks.tolist())
             if not any(tracks):
                 return True
-        dets = stage.detections
-        if dets is not None:
-            dets = masks.get(id(dets)) or masks.setdefault(id(dets), dets.tolist())
+        dets: list[bool] | None = None
+        if stage.detections is not None:
+            dets = masks.get(id(stage.detections)) or masks.setdefault(id(stage.detections),
+                                                                       stage.detections.tolist())
             if not any(dets):
                 return True
         det_of_track, free = matching.det_of_track, matching.free
