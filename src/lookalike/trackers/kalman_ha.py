@@ -27,7 +27,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from lookalike.motion import chi2_gate, kalman
+from lookalike.motion import chi2_gate
 from lookalike.motion.models import constant_acceleration
 from lookalike.motion.spaces import WorldCA
 from lookalike.trackers.identity import BeaconIdentifier, IdentifierConfig
@@ -63,7 +63,7 @@ class WorldTracker:
         self._tracks = TrackTable(6, {"hit_bits": ((), np.int64)})  # hit history, bit 0 = this frame
         self._time: float | None = None
         self._model_dt: float | None = None  # frame interval of the cached (F, Q)
-        self._model: tuple[np.ndarray, np.ndarray] = (np.eye(6), np.zeros((6, 6)))
+        self._model: tuple[np.ndarray, np.ndarray, np.ndarray] = (np.eye(6), np.eye(6), np.zeros((6, 6)))
         self._decay: float | None = None  # velocity factor of a coasting track over that interval
         self._identifier = BeaconIdentifier(IdentifierConfig(
             n_agents=cfg.n_agents, window_frames=cfg.window_frames, max_cost=cfg.max_identity_cost,
@@ -97,7 +97,8 @@ class WorldTracker:
         if not len(t) or dt == 0:
             return
         if dt != self._model_dt:  # (WorldCA.predict's model and the decay, kept while the interval repeats)
-            self._model = constant_acceleration(2, dt, self.config.q_jerk)
+            F, Q = constant_acceleration(2, dt, self.config.q_jerk)
+            self._model = F, F.T, Q  # (F.T: the view kalman.predict multiplies by)
             decay_s = self.rules.coast_decay_s
             self._decay = None if decay_s is None else np.exp(-dt / decay_s)
             self._model_dt = dt
@@ -106,7 +107,8 @@ class WorldTracker:
             if coasting.any():
                 t.mean[coasting, 2:4] *= self._decay
                 t.mean[coasting, 4:6] = 0.0
-        t.mean, t.cov = kalman.predict(t.mean, t.cov, *self._model)
+        F, Ft, Q = self._model  # (kalman.predict's arithmetic, its transposes made once per interval)
+        t.mean, t.cov = t.mean @ Ft, F @ t.cov @ Ft + Q
 
     def _noise(self, position: np.ndarray) -> np.ndarray:
         """Measurement covariances ``(k, 2, 2)`` for positions ``(k, 2)``."""
@@ -128,17 +130,18 @@ class WorldTracker:
         noise = self._noise(mean[:, :2])  # (row by row: the matched rows' noise is noise[rows])
         S = cov[:, :2, :2] + noise
         diff = z[None, :, :] - mean[:, None, :2]  # (k, d, 2)
-        y = solve(cholesky(S), np.swapaxes(diff, -1, -2))  # (k, 2, d)
-        d2 = np.sum(y * y, axis=1)
+        y = solve(cholesky(S), diff.swapaxes(-1, -2))  # (k, 2, d)
+        d2 = np.add.reduce(y * y, axis=1)
         rows, cols = pairs(d2, d2 <= self._gate)
         det_of_track[rows] = cols
         if len(rows):
             m, P = mean[rows], cov[rows]
             PHt = np.ascontiguousarray(P[:, :, :2])  # (k, 6, 2), laid out as ``P @ H.T``
-            K = np.swapaxes(solve(S[rows], np.swapaxes(PHt, -1, -2)), -1, -2)
+            PHt_T = PHt.swapaxes(-1, -2)
+            K = solve(S[rows], PHt_T).swapaxes(-1, -2)
             innovation = z[cols] - m[:, :2]
             t.mean[rows] = m + np.einsum("kij,kj->ki", K, innovation)
-            t.cov[rows] = P - K @ np.swapaxes(PHt, -1, -2)
+            t.cov[rows] = P - K @ PHt_T
         return det_of_track
 
     def _lifecycle(self, det_of_track: np.ndarray) -> np.ndarray:
@@ -189,15 +192,21 @@ class WorldTracker:
         seen = det_of_track >= 0
         if len(det):
             heading = headings(det)[det_of_track]  # (a miss's -1 reads the last heading: replaced by NaN)
-            if seen.any():
-                self._identifier.observe_many(t.ids[seen].tolist(), heading[seen])
-            heading = np.where(seen, heading, np.nan)
+            if seen.all():
+                self._identifier.observe_many(t.ids.tolist(), heading)
+            else:
+                if seen.any():
+                    self._identifier.observe_many(t.ids[seen].tolist(), heading[seen])
+                heading[~seen] = np.nan  # (heading: a new array, from the fancy index)
         else:
             heading = np.full(k, np.nan)
-        agent = np.full(k, -1, dtype=int)
-        prob = np.full(k, np.nan)
         confirmed = t.confirmed
-        agent[confirmed], prob[confirmed] = self._identifier.assign_arrays(t.ids[confirmed].tolist())
+        if confirmed.all():
+            agent, prob = self._identifier.assign_arrays(t.ids.tolist())  # (new arrays)
+        else:
+            agent = np.full(k, -1, dtype=int)
+            prob = np.full(k, np.nan)
+            agent[confirmed], prob[confirmed] = self._identifier.assign_arrays(t.ids[confirmed].tolist())
         out = Tracks.__new__(Tracks)  # (columns built here: Tracks' checks skipped)
         out.id, out.xywh, out.detection_index = t.ids.copy(), None, det_of_track
         out.status = np.left_shift(confirmed, ~seen, dtype=np.int8)  # 0 tentative, 1 confirmed, 2 lost
