@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 _Z = 1.645  # one-sided 95% normal quantile of the Wilson lower bound
+_FEW = 32  # ScoreCalibration counts up to this many scores a frame as Python numbers (fewer numpy calls)
 
 
 def _bin_of(score: np.ndarray, bins: int) -> np.ndarray:
@@ -139,7 +140,7 @@ class ScoreCalibration:
         self._at: dict[str, list[int]] = {}
         self._scales = np.array([float(bins), float(self.bands.bands)])  # histogram bins and bands at once
         self._top = np.array([bins - 1, self.bands.bands - 1])
-        self._last: tuple[np.ndarray, np.ndarray] | None = None  # (scores, their bands) of observe_scores
+        self._last: tuple[np.ndarray, np.ndarray | list[int]] | None = None  # (scores, their bands) of observe_scores
 
     @property
     def _quantiles(self) -> bool:
@@ -149,6 +150,9 @@ class ScoreCalibration:
     def observe_scores(self, score: np.ndarray) -> None:
         """Count this frame's scores (in [0, 1]) into the running distribution."""
         if not self._quantiles:
+            return
+        if len(score) <= _FEW:  # a few scores: Python numbers (the same products and truncations)
+            self._observe_few(score)
             return
         if self.high_match_ratio is not None:  # the bands observe_continued will want, in the same pass
             both = (score[:, None] * self._scales).astype(int)  # _bin_of for both bin counts
@@ -165,12 +169,37 @@ class ScoreCalibration:
                 i = at[0]
                 at[1] += len([v for v in new if v <= i])
 
+    def _observe_few(self, score: np.ndarray) -> None:
+        """:meth:`observe_scores` for a few scores, one at a time: ``int`` truncates ``score · bins`` as
+        ``astype(int)`` does (scores are finite), then the same clipping to the end bins."""
+        values = score.tolist()
+        top, scale = self.bins - 1, float(self.bins)
+        hist_bins = [min(max(int(v * scale), 0), top) for v in values]
+        hist = self.histogram
+        for b in hist_bins:
+            hist[b] += 1
+        self._total += len(hist_bins)
+        if self.high_match_ratio is not None:
+            top_band, band_scale = self.bands.bands - 1, float(self.bands.bands)
+            self._last = (score, [min(max(int(v * band_scale), 0), top_band) for v in values])
+        for at in self._at.values():
+            i = at[0]
+            at[1] += len([v for v in hist_bins if v <= i])
+
     def observe_continued(self, score: np.ndarray, continued: np.ndarray) -> None:
         """Count this frame's detections by band; ``continued`` indexes those that continued a confirmed track."""
         if self.high_match_ratio is not None:
             last = self._last
             if last is not None and last[0] is score:
-                self.bands.add_bands(last[1], continued)
+                band = last[1]
+                if type(band) is list:  # observe_scores' few scores, counted one at a time
+                    seen, kept = self.bands.seen, self.bands.kept
+                    for b in band:
+                        seen[b] += 1
+                    for j in continued.tolist():
+                        kept[band[j]] += 1
+                else:
+                    self.bands.add_bands(band, continued)
             else:
                 self.bands.add(score, continued)
 
