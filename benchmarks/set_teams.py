@@ -9,9 +9,9 @@ The LSTM has no weights for the latter ("-"). ``--weights W``: the ``set`` ident
 ``--select RUN`` chooses among the snapshots of a fine-tuning run (``RUN/set_step{k}.npz``, k a multiple
 of ``--every``) on tuning sequences only (:data:`TUNING_TEAMS`, seeds below 100000): eligible are the
 snapshots no worse than ``--baseline`` on any tuning team; of those, the best on M=3, N=2 (a tie within
-0.01 points goes to the best mean). ``--average-from S`` adds one more candidate, ``RUN/set_avg.npz``: the
-mean of the weights of the snapshots from step S on. ``--ship`` copies the chosen one into the package's
-shipped weights.
+0.01 points goes to the best mean), or the baseline when none is. ``--average-from S`` adds one more
+candidate, ``RUN/set_avg.npz``: the mean of the weights of the snapshots from step S on. ``--ship`` copies
+the chosen one into the package's shipped weights.
 """
 
 from __future__ import annotations
@@ -109,16 +109,17 @@ def select(run_dir: Path, every: int, baseline: Path, ship: bool, average_from: 
     rows = {str(p): score(p) for p in candidates}
     chosen = choose(rows, base)
     print(f"chosen: {chosen}" if chosen else "chosen: none (every snapshot is below the baseline on a tuning team)")
-    if chosen and ship:
-        weights = load_set_weights(chosen)
+    if ship:  # the chosen snapshot, or the baseline when none is eligible
+        weights = load_set_weights(chosen or baseline)
         weights.info["chosen_on"] = {"rule": "no tuning team below the baseline, then best M=3, N=2",
-                                     "tuning_teams": [list(t) for t in TUNING_TEAMS], "tuning": rows[chosen],
+                                     "tuning_teams": [list(t) for t in TUNING_TEAMS],
+                                     "tuning": rows[chosen] if chosen else base,
                                      "baseline": {"path": str(baseline), **base}}
         save_set_weights(weights, SHIPPED_SET_WEIGHTS)
-        log = Path(chosen).parent / "training_log.csv"
-        if log.is_file():
-            shutil.copy(log, SHIPPED_SET_WEIGHTS.parent / "set_any_training_log.csv")
-        print(f"shipped as {SHIPPED_SET_WEIGHTS}: {json.dumps(rows[chosen])}")
+        log = run_dir / "training_log.csv"
+        if chosen and log.is_file():
+            shutil.copy(log, SHIPPED_SET_WEIGHTS.parent / "set_any_finetune_log.csv")
+        print(f"shipped {chosen or baseline} as {SHIPPED_SET_WEIGHTS}: {json.dumps(rows[chosen] if chosen else base)}")
 
 
 def main() -> None:
