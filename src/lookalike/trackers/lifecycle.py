@@ -59,10 +59,15 @@ class Lifecycle:
         """``(k,)`` True for the tracks that survive this frame; ``max_unseen_s`` (per track or
         shared) overrides the policy's own limit."""
         limit_s = self.max_unseen_s if max_unseen_s is None else max_unseen_s
-        tentative: np.ndarray = np.ones(len(table), dtype=bool) if self.tentative_max_misses is None else (
-            table.misses < self.tentative_max_misses)
-        if self.tentative_max_unseen_s is not None:
-            tentative &= table.unseen_s <= self.tentative_max_unseen_s
+        tentative: np.ndarray
+        if self.tentative_max_misses is not None:
+            tentative = table.misses < self.tentative_max_misses
+            if self.tentative_max_unseen_s is not None:
+                tentative &= table.unseen_s <= self.tentative_max_unseen_s
+        elif self.tentative_max_unseen_s is not None:  # (no all-True mask to narrow)
+            tentative = table.unseen_s <= self.tentative_max_unseen_s
+        else:
+            tentative = np.ones(len(table), dtype=bool)
         if self.closed:
             out: np.ndarray = table.confirmed | tentative
             return out
