@@ -291,7 +291,7 @@ class BoxTrack:
                 shown = np.concatenate((shown, coasted))
                 original = np.concatenate((original, np.full(len(coasted), -1)))
         m = len(shown)
-        x = self._state().take(shown, axis=1)
+        x = t.mean.T[:6].take(shown, axis=1)  # box and velocity rows (after births, not yet a view of _columns)
         boxes, velocity, status = np.empty((m, 4)), np.empty((m, 2)), np.empty(m, dtype=np.int8)
         size = np.maximum(x[2:4], 1e-3, out=boxes.T[2:4])  # cxcywh_to_xywh's numbers
         np.subtract(x[0:2], size / 2, out=boxes.T[0:2])
