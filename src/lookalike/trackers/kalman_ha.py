@@ -153,7 +153,7 @@ class WorldTracker:
         else:
             t.hits = bit_count(t["hit_bits"] & ((1 << rules.confirm_window) - 1))
             rules.lifecycle.confirm(t)
-            limit_s = np.where(rules.in_view(t.mean[:, :2]), rules.max_coast_s, rules.max_out_of_view_s) + 1e-9
+            limit_s = np.where(rules.in_view(t.mean[:, :2]), rules.max_coast_s + 1e-9, rules.max_out_of_view_s + 1e-9)
         keep = rules.lifecycle.alive(t, limit_s)
         if not keep.all():
             self._identifier.drop(t.ids[~keep])
@@ -215,10 +215,13 @@ class WorldTracker:
         return out
 
 
+_BITWISE_COUNT = getattr(np, "bitwise_count", None)
+
+
 def bit_count(bits: np.ndarray) -> np.ndarray:
     """Set bits of each non-negative integer below 2**32 (``np.bitwise_count``, which numpy < 2 lacks)."""
-    if hasattr(np, "bitwise_count"):
-        return np.asarray(np.bitwise_count(bits)).astype(int)
+    if _BITWISE_COUNT is not None:
+        return np.asarray(_BITWISE_COUNT(bits)).astype(int)
     as_bytes = np.ascontiguousarray(bits, dtype=np.uint32).view(np.uint8).reshape(len(bits), 4)
     counts: np.ndarray = np.unpackbits(as_bytes, axis=1).sum(axis=1).astype(int)
     return counts
