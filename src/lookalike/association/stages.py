@@ -156,7 +156,7 @@ class _PlanLists:
             taken, left = self.taken, self.left = det_of_track.tolist(), free.tolist()
         found = [(i, j) for i, j in pairs
                  if taken[i] < 0 and left[j] and (tracks is None or tracks[i]) and (dets is None or dets[j])]
-        if len({i for i, _ in found}) < len(found) or len({j for _, j in found}) < len(found):
+        if len(found) > 1 and (len({i for i, _ in found}) < len(found) or len({j for _, j in found}) < len(found)):
             return False
         stage_of_track = matching.stage_of_track
         for i, j in found:

@@ -229,8 +229,8 @@ class BoxTrack:
         ], len(t), len(score))
         # the detections that continued confirmed tracks in the first three stages (the later two
         # change no earlier match)
-        by_stage = matching.stage_of_track
-        self._calibration.observe_continued(score, matching.det_of_track[(by_stage >= 0) & (by_stage < 3)])
+        first_three = matching.stage_of_track.view(np.uint64) < 3  # stages 0-2 (unmatched -1: beyond, as unsigned)
+        self._calibration.observe_continued(score, matching.det_of_track[first_three])
         return matching
 
     def _correct(self, x: np.ndarray, matched: np.ndarray, z: np.ndarray) -> None:
