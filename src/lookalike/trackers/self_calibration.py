@@ -24,6 +24,13 @@ def _bin_of(score: np.ndarray, bins: int) -> np.ndarray:
     return b
 
 
+def _clipped(bins: list[int], top: int) -> list[int]:
+    """``bins`` clipped to [0, ``top``] (the list itself when all are inside)."""
+    if bins and (min(bins) < 0 or max(bins) > top):
+        return [min(max(b, 0), top) for b in bins]
+    return bins
+
+
 class ScoreBands:
     """Per score band (``bands`` equal bands on [0, 1]): detections seen and those that continued a
     confirmed track."""
@@ -174,14 +181,14 @@ class ScoreCalibration:
         ``astype(int)`` does (scores are finite), then the same clipping to the end bins."""
         values = score.tolist()
         top, scale = self.bins - 1, float(self.bins)
-        hist_bins = [min(max(int(v * scale), 0), top) for v in values]
+        hist_bins = _clipped([int(v * scale) for v in values], top)
         hist = self.histogram
         for b in hist_bins:
             hist[b] += 1
         self._total += len(hist_bins)
         if self.high_match_ratio is not None:
             top_band, band_scale = self.bands.bands - 1, float(self.bands.bands)
-            self._last = (score, [min(max(int(v * band_scale), 0), top_band) for v in values])
+            self._last = (score, _clipped([int(v * band_scale) for v in values], top_band))
         for at in self._at.values():
             i = at[0]
             at[1] += len([v for v in hist_bins if v <= i])
