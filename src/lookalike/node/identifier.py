@@ -23,7 +23,7 @@ from lookalike.node.messages import (
     RobotEstimate,
     TeamState,
 )
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.identity.labels import label_list
 from lookalike.types import Beacons, Detections, Frame, Tracks, TrackSnapshot
 
 _T = TypeVar("_T")
@@ -209,12 +209,12 @@ class TeamIdentifier:
                 last_update[j] = time
             if not (math.isfinite(x) and math.isfinite(y)):
                 continue
-            robots.append(RobotEstimate(
-                id=int(j), position=(x, y), heading=_finite_or_none(heading), confidence=_finite_or_none(prob),
-                age=time - last_update[j],
+            robots.append(_trusted(  # (RobotEstimate checks nothing: its fields set directly)
+                RobotEstimate, id=int(j), position=(x, y), heading=_finite_or_none(heading),
+                confidence=_finite_or_none(prob), age=time - last_update[j],
             ))
-        labels = labels_from_tracks(n, snapshots)
-        return TeamState(frame=frame.index, time=frame.time, robots=tuple(robots), labels=tuple(labels.tolist()))
+        labels = label_list(n, snapshots)
+        return TeamState(frame=frame.index, time=frame.time, robots=tuple(robots), labels=tuple(labels))
 
 
 # (agent id, detection index, identity probability, x, y, heading) of an identified track
@@ -251,10 +251,10 @@ def _trusted(cls: type[_T], **fields: Any) -> _T:
     """An instance of the frozen dataclass ``cls`` with ``fields`` set as given (read-only arrays),
     without its validation: for data checked already."""
     obj = object.__new__(cls)
-    for name, value in fields.items():
+    for value in fields.values():
         if isinstance(value, np.ndarray):
             value.flags.writeable = False
-        object.__setattr__(obj, name, value)
+    obj.__dict__.update(fields)  # (the fields a frozen dataclass's __init__ sets, in one call)
     return obj
 
 

@@ -40,13 +40,26 @@ def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np
     return label
 
 
+def label_list(n_detections: int, tracks: Sequence[TrackSnapshot]) -> list[int]:
+    """:func:`labels_from_tracks` as a list of ints (the columns of :class:`Tracks` are read without
+    building the array)."""
+    if isinstance(tracks, Tracks) and n_detections >= 0:
+        return _label_list(n_detections, tracks)
+    out: list[int] = labels_from_tracks(n_detections, tracks).tolist()
+    return out
+
+
 def _labels_from_columns(n_detections: int, tracks: Tracks) -> np.ndarray:
     """:func:`labels_from_tracks` on columns (same rule and result, without per-track snapshots;
     a frame holds a few tracks, so the columns are read as lists)."""
+    return np.array(_label_list(n_detections, tracks), dtype=int)
+
+
+def _label_list(n_detections: int, tracks: Tracks) -> list[int]:
     label = [-1] * n_detections
     k = len(tracks)
     if tracks.agent_id is None or not k:
-        return np.array(label, dtype=int)
+        return label
     agent, det = tracks.agent_id.tolist(), tracks.detection_index.tolist()
     prob = [0.0] * k if tracks.identity_prob is None else [0.0 if p != p else p for p in tracks.identity_prob.tolist()]
     rows = [i for i in range(k) if agent[i] >= 0 and det[i] >= 0]
@@ -62,7 +75,7 @@ def _labels_from_columns(n_detections: int, tracks: Tracks) -> np.ndarray:
             continue
         label[d], best[d] = a, p
         claimed.add(a)
-    return np.array(label, dtype=int)
+    return label
 
 
 def agent_positions(tracks: Sequence[TrackSnapshot], n_agents: int) -> np.ndarray:
