@@ -25,7 +25,7 @@ def iou_columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     inter = side[0] * side[1]
     union = (a[2] * a[3])[:, None] + b[2] * b[3]
     union -= inter
-    if np.count_nonzero(union > 0) == union.size:  # as iou_matrix: NaN takes the guarded division
+    if not union.size or np.minimum.reduce(union, axis=None) > 0:  # as iou_matrix: NaN takes the guarded division
         out: np.ndarray = inter / union
         return out
     out = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
