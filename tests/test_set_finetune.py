@@ -54,17 +54,11 @@ def test_focus_teams_of_a_run_weight_the_draws():
 
 
 def test_snapshot_choice_needs_every_tuning_team_at_the_baseline():
-    import importlib.util
-    from pathlib import Path
+    from lookalike.bench.set_select import choose
 
-    path = Path(__file__).parents[1] / "benchmarks" / "set_teams.py"
-    spec = importlib.util.spec_from_file_location("set_teams", path)
-    assert spec is not None and spec.loader is not None
-    set_teams = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(set_teams)
     base = {"m3n2": 98.0, "m5n3": 97.0}
     rows = {"a": {"m3n2": 99.0, "m5n3": 96.9},  # best small team, but below the baseline elsewhere
             "b": {"m3n2": 98.5, "m5n3": 97.0},
             "c": {"m3n2": 98.495, "m5n3": 98.0}}  # a tie on M=3, N=2 within 0.01: the better mean wins
-    assert set_teams.choose(rows, base) == "c"
-    assert set_teams.choose({"a": rows["a"]}, base) is None
+    assert choose(rows, base) == "c"
+    assert choose({"a": rows["a"]}, base) is None
