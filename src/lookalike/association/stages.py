@@ -109,25 +109,6 @@ class _PlanLists:
         self.taken: list[int] | None = None
         self.left: list[bool] | None = None
 
-    def _mask(self, selector: np.ndarray) -> list[bool]:
-        return self.masks.get(id(selector)) or self.masks.setdefault(id(selector), selector.tolist())
-
-    def eligible(self, stage: Stage, matching: Matching) -> tuple[list[int], list[int]]:
-        """The stage's (boolean selectors) track rows still unmatched and detections still free, in index
-        order, from the lists kept in step with ``matching`` (made from it when None)."""
-        taken, left = self.taken, self.left
-        if taken is None or left is None:
-            taken, left = self.taken, self.left = matching.det_of_track.tolist(), matching.free.tolist()
-        if stage.tracks is None:
-            rows = [i for i, d in enumerate(taken) if d < 0]
-        else:
-            rows = [i for i, (s, d) in enumerate(zip(self._mask(stage.tracks), taken)) if s and d < 0]
-        if not rows:
-            return rows, []
-        if stage.detections is None:
-            return rows, [j for j, f in enumerate(left) if f]
-        return rows, [j for j, (s, f) in enumerate(zip(self._mask(stage.detections), left)) if s and f]
-
     def run(self, stage: Stage, gate: np.ndarray, matching: Matching, index: int) -> bool:
         """Run a stage with a gate (boolean selectors) from the gate's allowed pairs when those still
         eligible (eligible track still unmatched, eligible detection still free) are disjoint: each is
@@ -175,19 +156,12 @@ def run_stage(stage: Stage, matching: Matching, index: int = 0, _lists: _PlanLis
         if lists.run(stage, gate, matching, index):
             return matching
         gate = None  # the allowed pairs compete: the costs decide
-    if _lists is not None and (stage.tracks is None or stage.tracks.dtype == bool) and (
-            stage.detections is None or stage.detections.dtype == bool):
-        found_rows, found_cols = _lists.eligible(stage, matching)  # from the plan's lists: no numpy call when none is left
-        if not found_rows or not found_cols:
-            return matching
-        rows, cols = np.array(found_rows, dtype=np.intp), np.array(found_cols, dtype=np.intp)
-    else:
-        rows = _eligible(stage.tracks, matching.det_of_track < 0)
-        if not len(rows):
-            return matching
-        cols = _eligible(stage.detections, matching.free)
-        if not len(cols):
-            return matching
+    rows = _eligible(stage.tracks, matching.det_of_track < 0)
+    if not len(rows):
+        return matching
+    cols = _eligible(stage.detections, matching.free)
+    if not len(cols):
+        return matching
     if gate is not None:
         i, j = gate[rows[:, None], cols].nonzero()  # row-major, as the solver lists them
         if not len(i):
