@@ -209,10 +209,10 @@ class TeamIdentifier:
                 last_update[j] = time
             if not (math.isfinite(x) and math.isfinite(y)):
                 continue
-            robots.append(_trusted(  # (RobotEstimate checks nothing: its fields set directly)
-                RobotEstimate, id=int(j), position=(x, y), heading=_finite_or_none(heading),
-                confidence=_finite_or_none(prob), age=time - last_update[j],
-            ))
+            robot = object.__new__(RobotEstimate)  # (RobotEstimate checks nothing: its fields set directly)
+            robot.__dict__.update(id=int(j), position=(x, y), heading=_finite_or_none(heading),
+                                  confidence=_finite_or_none(prob), age=time - last_update[j])
+            robots.append(robot)
         labels = label_list(n, snapshots)
         return TeamState(frame=frame.index, time=frame.time, robots=tuple(robots), labels=tuple(labels))
 
