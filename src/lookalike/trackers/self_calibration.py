@@ -199,7 +199,7 @@ class ScoreCalibration:
             last = self._last
             if last is not None and last[0] is score:
                 band = last[1]
-                if type(band) is list:  # observe_scores' few scores, counted one at a time
+                if isinstance(band, list):  # observe_scores' few scores, counted one at a time
                     seen, kept = self.bands.seen, self.bands.kept
                     for b in band:
                         seen[b] += 1
