@@ -33,7 +33,7 @@ from lookalike.motion.spaces import WorldCA
 from lookalike.trackers.identity import BeaconIdentifier, IdentifierConfig
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.table import TrackTable
-from lookalike.trackers.world_kernels import cholesky, pairs, solve
+from lookalike.trackers.world_kernels import cholesky, einsum, filled, pairs, solve
 from lookalike.trackers.world_rules import HeuristicsConfig, WorldConfig, WorldRules, headings, positions
 from lookalike.types import Detections, Frame, Tracks
 
@@ -122,7 +122,7 @@ class WorldTracker:
         same values), and the innovation covariances are formed once for gating and update.
         """
         t = self._tracks
-        det_of_track = np.full(len(t), -1, dtype=int)
+        det_of_track = filled(len(t), -1, int)
         if not (len(t) and len(det)):
             return det_of_track
         z = positions(det)
@@ -140,7 +140,7 @@ class WorldTracker:
             PHt_T = PHt.swapaxes(-1, -2)
             K = solve(S[rows], PHt_T).swapaxes(-1, -2)
             innovation = z[cols] - m[:, :2]
-            t.mean[rows] = m + np.einsum("kij,kj->ki", K, innovation)
+            t.mean[rows] = m + einsum("kij,kj->ki", K, innovation)
             t.cov[rows] = P - K @ PHt_T
         return det_of_track
 
@@ -204,8 +204,8 @@ class WorldTracker:
         if confirmed.all():
             agent, prob = self._identifier.assign_arrays(t.ids.tolist())  # (new arrays)
         else:
-            agent = np.full(k, -1, dtype=int)
-            prob = np.full(k, np.nan)
+            agent = filled(k, -1, int)
+            prob = filled(k, np.nan)
             agent[confirmed], prob[confirmed] = self._identifier.assign_arrays(t.ids[confirmed].tolist())
         out = Tracks.__new__(Tracks)  # (columns built here: Tracks' checks skipped)
         out.id, out.xywh, out.detection_index = t.ids.copy(), None, det_of_track

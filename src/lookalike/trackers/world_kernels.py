@@ -2,11 +2,14 @@
 
 Each returns what the general functions it stands in for return, bit for bit, with fewer calls:
 numpy's own LAPACK kernels without the wrappers' per-call checks (:func:`cholesky`, :func:`solve`),
-and :func:`pairs`, the pairs of :func:`lookalike.association.solver.assign_pairs` from the same
-matrix handed to the same solver.
+``einsum`` (``np.einsum``'s C kernel, which it calls unless asked to optimise), and :func:`pairs`,
+the pairs of :func:`lookalike.association.solver.assign_pairs` from the same matrix handed to the
+same solver.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 
@@ -16,6 +19,19 @@ try:  # numpy's gufuncs behind np.linalg.cholesky / np.linalg.solve (the same ke
     from numpy.linalg import _umath_linalg as _kernels
 except ImportError:  # pragma: no cover (a numpy without them: the public functions)
     _kernels = None  # type: ignore[assignment]
+
+try:  # the kernel np.einsum calls without path optimisation (the default), without its wrapper
+    from numpy._core.multiarray import c_einsum as _einsum_kernel
+except ImportError:  # pragma: no cover
+    _einsum_kernel = np.einsum  # type: ignore[assignment,unused-ignore]
+einsum: Callable[..., np.ndarray] = _einsum_kernel
+
+
+def filled(shape: int | tuple[int, ...], value: float, dtype: type = float) -> np.ndarray:
+    """``np.full(shape, value, dtype)`` without its Python wrapper."""
+    out: np.ndarray = np.empty(shape, dtype)
+    out.fill(value)
+    return out
 
 
 def cholesky(a: np.ndarray) -> np.ndarray:

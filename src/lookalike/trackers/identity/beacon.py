@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.trackers.world_kernels import pairs
+from lookalike.trackers.world_kernels import filled, pairs
 from lookalike.types import Beacons
 
 
@@ -216,7 +216,7 @@ class BeaconIdentifier:
         np.multiply(d, 0.5, out=d)  # (the same values as a division by 2: both exact scalings)
         count = np.add.reduce(np.isfinite(d), axis=1)
         total = np.add.reduce(np.fmax(d, 0.0, out=d), axis=1)  # (NaN -> 0; d >= 0 stays as it is)
-        mean: np.ndarray = np.divide(total, count, out=np.full(count.shape, np.inf), where=count > 0)
+        mean: np.ndarray = np.divide(total, count, out=filled(count.shape, np.inf), where=count > 0)
         return mean
 
     def assign(self, track_ids: list[int]) -> dict[int, tuple[int, float]]:
@@ -228,8 +228,8 @@ class BeaconIdentifier:
         """:meth:`assign` as columns: agent id per track (-1: none) and probability (NaN: none)."""
         cfg = self.config
         k = len(track_ids)
-        agent_out = np.full(k, -1, dtype=int)
-        prob = np.full(k, np.nan)
+        agent_out = filled(k, -1, int)
+        prob = filled(k, np.nan)
         if not k:
             return agent_out, prob
         get = self._row.get
