@@ -24,6 +24,7 @@ from lookalike.node.messages import (
     TeamState,
 )
 from lookalike.trackers.identity.labels import label_list
+from lookalike.trackers.world_kernels import filled
 from lookalike.types import Beacons, Detections, Frame, Tracks, TrackSnapshot
 
 _T = TypeVar("_T")
@@ -184,7 +185,7 @@ class TeamIdentifier:
             agent_id = np.array([r.robot for r in reports], dtype=int)
             t_sent = np.array([r.t_sent for r in reports], dtype=float)
             heading = np.array([r.heading for r in reports], dtype=float)
-            t_received = np.full(len(reports), float(message.time))
+            t_received = filled(len(reports), float(message.time))
             if math.isfinite(sum(r.t_sent + r.heading for r in reports)) and agent_id.min() >= 0:
                 beacons = _trusted(Beacons, agent_id=agent_id, t_sent=t_sent, t_received=t_received, heading=heading)
             else:

@@ -182,7 +182,7 @@ class BeaconIdentifier:
         np.minimum(at, offset + (r - 1), out=idx[1])
         (t_before, t_after), (h_before, h_after) = np.take(th.reshape(2, -1), idx, axis=1)
         span = t_after - t_before  # > 0 only between two reports, where 0 <= frac <= 1
-        frac = np.divide(q[:, None] - t_before, span, out=np.zeros_like(span), where=span > 0)
+        frac = np.divide(q[:, None] - t_before, span, out=filled(span.shape, 0.0), where=span > 0)
         inter = h_before + frac * _wrap(h_after - h_before)
         # extrapolation from the latest report with the turn rate of the last two (none with one)
         t_last, h_last, t_prev = t[:, -1], h[:, -1], t[:, -2]
