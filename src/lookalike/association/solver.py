@@ -103,7 +103,13 @@ def _solve(c: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray]:
     if len(set(rows.tolist())) == len(rows) and len(set(cols.tolist())) == len(cols):
         # The allowed pairs are disjoint: every optimum holds all of them, nothing else is kept.
         return rows, cols
-    if finite:
+    return solve_allowed(c, allowed, max_cost)
+
+
+def solve_allowed(c: np.ndarray, allowed: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray]:
+    """The minimum-cost matching of ``c`` over the ``allowed`` pairs (at least one), forbidden pairs
+    dropped: ``allowed`` is ``c <= max_cost`` (finite ``max_cost``) or the pairs to consider."""
+    if math.isfinite(max_cost):
         # Clip forbidden pairs to just above the limit; they are dropped after solving.
         scale = max(abs(max_cost - float(c[allowed].min())), 1.0)
         work = np.where(allowed, c, max_cost + 1e-6 * scale)

@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from lookalike.association.solver import linear_sum_assignment
+from lookalike.association.solver import linear_sum_assignment, solve_allowed
 
 try:  # numpy's gufuncs behind np.linalg.cholesky / np.linalg.solve (the same kernels, no wrapper)
     from numpy.linalg import _umath_linalg as _kernels
@@ -68,23 +68,9 @@ def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf,
     if most(np.add.reduce(allowed, axis=0)) == 1 and most(np.add.reduce(allowed, axis=1)) == 1:
         rows, cols = allowed.nonzero()
         return rows, cols
-    if unit and max_cost <= 1.0:  # (|max_cost - min| <= 1: scale 1; every entry within [0, 1 + 1e-6])
-        work = np.where(allowed, cost, max_cost + 1e-6)
-    elif np.isfinite(max_cost):
-        scale = max(abs(max_cost - float(cost[allowed].min())), 1.0)
-        work = np.where(allowed, cost, max_cost + 1e-6 * scale)
-        big = max(abs(float(work.max())), abs(float(work.min())))
-        if big * min(cost.shape) > 1e300:
-            work = work / big
-    else:
-        low = float(cost[allowed].min())
-        work = np.where(allowed, cost - low, 0.0)
-        top = float(work.max())
-        if top > 0 and top * min(cost.shape) > 1e290:
-            work = work / top
-            top = 1.0
-        penalty = (top + 1.0) * (min(cost.shape) + 1)
-        work = np.where(allowed, work, penalty)
-    rows, cols = linear_sum_assignment(work)
+    if not (unit and max_cost <= 1.0):
+        return solve_allowed(cost, allowed, max_cost)
+    # |max_cost - min| <= 1: the solver's scale is 1, every entry within [0, 1 + 1e-6]
+    rows, cols = linear_sum_assignment(np.where(allowed, cost, max_cost + 1e-6))
     keep = allowed[rows, cols]
     return rows[keep], cols[keep]
