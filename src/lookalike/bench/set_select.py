@@ -20,14 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.eval import identification_success_rate
+from lookalike.bench.pixel_recordings import score_identifier
 from lookalike.learn.set_data import world
 from lookalike.learn.set_numpy import load_set_weights, save_set_weights
 from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
-from lookalike.loop import run
 from lookalike.sim import PRESET_NAMES, RobotSequence, preset, simulate_robots
-from lookalike.trackers import make_tracker
-from lookalike.trackers.identity import labels_from_tracks
 
 # Tuning sequences for --select (name, (N, M, fp), first seed, sequences), 1000 frames each; apart from every bench.
 TUNING_TEAMS = (("m3n2", (2, 3, 0.5), 50_000, 20), ("m5n3", (3, 5, 0.8), 51_000, 10),
@@ -36,15 +33,7 @@ TUNING_TEAMS = (("m3n2", (2, 3, 0.5), 50_000, 20), ("m5n3", (3, 5, 0.8), 51_000,
 
 def set_success(weights: Path, sequences: list[RobotSequence]) -> float:
     """Identification success rate of ``set`` with ``weights`` over ``sequences`` (as ``bench ident`` runs it)."""
-    predicted: list[np.ndarray] = []
-    truth: list[np.ndarray] = []
-    for seq in sequences:
-        tracker = make_tracker("set", n_agents=seq.config.n_agents, n_slots=seq.config.max_detections,
-                               weights=str(weights))
-        run(tracker, seq.frames(), lambda frame, tracks: predicted.append(labels_from_tracks(len(frame.detections),
-                                                                                              tracks)))
-        truth.extend(seq.true_labels())
-    return identification_success_rate(predicted, truth)
+    return score_identifier(sequences, "set", weights=str(weights))[0]
 
 
 def tuning_sequences() -> dict[str, list[RobotSequence]]:
