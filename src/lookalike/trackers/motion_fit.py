@@ -84,7 +84,7 @@ class MotionFit:
         parts = self._pending
         n = self._filled
         if n:
-            parts = parts + [_nis_of_columns(self._columns[0:2, :n], self._columns[2:4, :n], None)]
+            parts = parts + [_nis_of_columns(self._columns[0:2, :n], self._columns[2:4, :n])]
         median = _median(parts[0] if len(parts) == 1 else np.concatenate(parts))
         self.scale = float(np.clip(self.scale * median / CHI2_2DOF_MEDIAN, 1.0, self.max_scale))
         self._pending, self._count, self._filled = [], 0, 0
@@ -102,11 +102,9 @@ def _median(values: np.ndarray) -> float:
     return float((ordered[n // 2 - 1] + ordered[n // 2]) / 2)
 
 
-def _nis_of_columns(innovation: np.ndarray, var: np.ndarray, rows: np.ndarray | None) -> np.ndarray:
-    """NIS of the columns ``rows`` of innovations ``(2, k)`` with diagonal covariances ``var (2, k)``:
+def _nis_of_columns(innovation: np.ndarray, var: np.ndarray) -> np.ndarray:
+    """NIS of innovations ``(2, k)`` with diagonal covariances ``var (2, k)``:
     ``(d·x·x + a·y·y) / (a·d)``, :meth:`MotionFit.observe_parts`' numbers with ``b = 0``."""
-    if rows is not None:
-        innovation, var = innovation[:, rows], var[:, rows]
     part = var[::-1] * innovation * innovation  # d·x·x, a·y·y
     out: np.ndarray = (part[0] + part[1]) / (var[0] * var[1])
     return out
