@@ -52,6 +52,13 @@ from lookalike.types import Frame, Tracks
 _to_xywh = cxcywh_to_xywh  # kept for callers of the old private helper
 
 
+def _xywh_columns(cxcywh: np.ndarray, out: np.ndarray) -> None:
+    """:func:`cxcywh_to_xywh`'s numbers on columns: boxes ``cxcywh`` (rows 0-3 cx, cy, w, h; pixels) written
+    into ``out (4, m)`` as left, top, width, height, sizes floored at 1e-3 pixels."""
+    size = np.maximum(cxcywh[2:4], 1e-3, out=out[2:4])
+    np.subtract(cxcywh[0:2], size / 2, out=out[0:2])
+
+
 @register_tracker("boxtrack")
 class BoxTrack:
     """Motion-only box tracker: score-split association, motion re-identification, closed sets."""
@@ -174,9 +181,8 @@ class BoxTrack:
             clutter.observe_overlaps(det_xywh, None)
             return None, None
         boxes = np.empty((4, k + p))  # left, top, width, height as columns
-        if k:  # the predicted boxes, sizes floored at 1e-3 pixels (cxcywh_to_xywh)
-            size = np.maximum(x[2:4], 1e-3, out=boxes[2:4, :k])
-            np.subtract(x[0:2], size / 2, out=boxes[0:2, :k])
+        if k:  # the predicted boxes
+            _xywh_columns(x, boxes[:, :k])
         if p:
             boxes[:, k:] = previous.T  # type: ignore[union-attr]
         iou = iou_columns(boxes, det_xywh.T)
@@ -293,8 +299,7 @@ class BoxTrack:
         m = len(shown)
         x = t.mean.T[:6].take(shown, axis=1)  # box and velocity rows (after births, not yet a view of _columns)
         boxes, velocity, status = np.empty((m, 4)), np.empty((m, 2)), np.empty(m, dtype=np.int8)
-        size = np.maximum(x[2:4], 1e-3, out=boxes.T[2:4])  # cxcywh_to_xywh's numbers
-        np.subtract(x[0:2], size / 2, out=boxes.T[0:2])
+        _xywh_columns(x, boxes.T)
         np.divide(x[4:6], self._clock.interval, out=velocity.T)
         status.fill(1)
         return Tracks.trusted(t.ids[shown], status, boxes, velocity, original)
