@@ -81,19 +81,26 @@ def hue_channel(image_bgr: np.ndarray) -> np.ndarray:
     return cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV_FULL)[..., 0].astype(np.float32)
 
 
-def _gradient_bins(grey: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Central-difference gradients of ``grey (h, w)`` (zero at the border) as ``(lower bin int32, weight to the
-    lower bin, weight to the next bin)``, all ``(h, w)``; bin centres sit at ``(k + 0.5) π / bins``."""
+def _polar_gradients(g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Magnitude and angle in [0, 2π) (accurate to about 0.3°), float32 ``(h, w)``, of the central-difference
+    gradients of float32 ``g (h, w)``, zero at the border."""
     import cv2
 
-    g = np.asarray(grey, dtype=np.float32)
-    if g.ndim != 2:
-        raise ValueError(f"grey: expected shape (h, w), got {g.shape}")
     gx = cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=1)  # kernel [-1, 0, 1]: the central difference
     gy = cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=1)
     gx[:, 0] = gx[:, -1] = 0.0
     gy[0, :] = gy[-1, :] = 0.0
-    mag, ang = cv2.cartToPolar(gx, gy)  # angle in [0, 2π), accurate to about 0.3°
+    mag, ang = cv2.cartToPolar(gx, gy)
+    return mag, ang
+
+
+def _gradient_bins(grey: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Central-difference gradients of ``grey (h, w)`` (zero at the border) as ``(lower bin int32, weight to the
+    lower bin, weight to the next bin)``, all ``(h, w)``; bin centres sit at ``(k + 0.5) π / bins``."""
+    g = np.asarray(grey, dtype=np.float32)
+    if g.ndim != 2:
+        raise ValueError(f"grey: expected shape (h, w), got {g.shape}")
+    mag, ang = _polar_gradients(g)
     ang -= np.float32(np.pi) * (ang >= np.pi)  # unsigned orientation in [0, π]
     ang *= np.float32(bins / np.pi)
     ang -= np.float32(0.5)  # bin centres at integers: ang in [-0.5, bins - 0.5]
@@ -156,9 +163,7 @@ def cell_histograms(grey: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndar
 def _compiled_cell_histograms(kernel: Callable[..., None], g: np.ndarray, cell_px: int, bins: int, band: int,
                               out: np.ndarray) -> None:
     """:func:`cell_histograms` into ``out (ny, nx, bins)`` with the compiled binning and sums: the gradients of each
-    band as :func:`_gradient_bins` computes them (OpenCV), the rest one pixel at a time."""
-    import cv2
-
+    band from :func:`_polar_gradients` (OpenCV), the rest one pixel at a time."""
     h = g.shape[0]
     ny, nx = out.shape[:2]
     scale = np.float32(bins / np.pi)
@@ -166,12 +171,7 @@ def _compiled_cell_histograms(kernel: Callable[..., None], g: np.ndarray, cell_p
         r1 = min(ny, r0 + band)
         y0, y1 = r0 * cell_px, r1 * cell_px
         top, bottom = max(0, y0 - 1), min(h, y1 + 1)
-        part = g[top:bottom]
-        gx = cv2.Sobel(part, cv2.CV_32F, 1, 0, ksize=1)
-        gy = cv2.Sobel(part, cv2.CV_32F, 0, 1, ksize=1)
-        gx[:, 0] = gx[:, -1] = 0.0
-        gy[0, :] = gy[-1, :] = 0.0
-        mag, ang = cv2.cartToPolar(gx, gy)
+        mag, ang = _polar_gradients(g[top:bottom])
         kernel(mag, ang, y0 - top, cell_px, bins, scale, out[r0:r1])
 
 
