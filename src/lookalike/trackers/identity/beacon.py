@@ -87,7 +87,8 @@ class BeaconIdentifier:
             for a in sorted(set(ids)):
                 if a >= n:
                     continue
-                self._store(a, beacons.t_sent[agent_id == a], beacons.heading[agent_id == a], r)
+                mine = agent_id == a
+                self._store(a, beacons.t_sent[mine], beacons.heading[mine], r)
         self._slot = (self._slot + 1) % self.config.window_frames
         self._times[self._slot] = self._times_count[self._slot] = time_s
         self._win[:, self._slot] = np.nan
@@ -180,7 +181,8 @@ class BeaconIdentifier:
         idx = np.empty((2,) + at.shape, dtype=np.intp)  # the reports before and after each time
         np.maximum(np.subtract(at, 1, out=idx[0]), first, out=idx[0])
         np.minimum(at, offset + (r - 1), out=idx[1])
-        (t_before, t_after), (h_before, h_after) = np.take(th.reshape(2, -1), idx, axis=1)
+        flat = th.reshape(2, -1)  # (a view: th is contiguous)
+        (t_before, t_after), (h_before, h_after) = np.take(flat, idx, axis=1)
         span = t_after - t_before  # > 0 only between two reports, where 0 <= frac <= 1
         frac = np.divide(q[:, None] - t_before, span, out=filled(span.shape, 0.0), where=span > 0)
         inter = h_before + frac * _wrap(h_after - h_before)
@@ -192,7 +194,7 @@ class BeaconIdentifier:
         rate = np.where(turning, np.minimum(np.maximum(turn, -cfg.max_turn_rate), cfg.max_turn_rate), 0.0)
         ahead = np.minimum(np.maximum(q[:, None] - t_last, 0.0), cfg.max_extrapolation_s)
         value: np.ndarray = np.where(i >= k, h_last + rate * ahead,
-                                     np.where(i == 0, th.reshape(2, -1)[1, first], inter))
+                                     np.where(i == 0, flat[1, first], inter))
         if have is None:
             return value
         out = np.full((len(q), n), np.nan)
