@@ -40,7 +40,7 @@ import numpy as np
 from lookalike.bench.ident import sequence_seeds
 from lookalike.bench.progress import ProgressFactory
 from lookalike.bench.results import Results, add_printed_rows
-from lookalike.eval import identification_success_rate, localisation_error
+from lookalike.eval import identification_success_rate, localisation_error, robot_success_rate
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.geometry.camera import Camera
 from lookalike.loop import RunStats, run
@@ -150,14 +150,6 @@ class IdentScore:
     detections: int
     fps: float
     robot_success: float = float("nan")
-
-
-def robot_success_rate(predicted: list[np.ndarray], truth: list[np.ndarray]) -> float:
-    """Correct labels / detections of true robots (truth >= 0), over all frames; NaN when there are none."""
-    p = np.concatenate(predicted) if predicted else np.zeros(0, dtype=int)
-    t = np.concatenate(truth) if truth else np.zeros(0, dtype=int)
-    robots = t >= 0
-    return float(np.mean(p[robots] == t[robots])) if robots.any() else float("nan")
 
 
 def _localisation(positions: list[np.ndarray], perceived: list[PerceivedSequence]) -> float:

@@ -118,8 +118,7 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
         f"{result.weights_path}, log {result.log_path}, plot {png}")
     if tests:
         from lookalike.bench.pixel_recordings import identifier_labels
-        from lookalike.bench.pixels import robot_success_rate
-        from lookalike.eval import identification_success_rate
+        from lookalike.eval import identification_success_rate, robot_success_rate
 
         scores = []
         for weights in (init_path, result.weights_path):

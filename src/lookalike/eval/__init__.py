@@ -12,6 +12,7 @@ from lookalike.eval.identification import (
     localisation_coverage,
     localisation_error,
     localisation_error_by_agent,
+    robot_success_rate,
 )
 from lookalike.eval.prepare import BENCHMARKS, prepare_boxes, prepare_points
 from lookalike.eval.selection import headline, leave_one_out
@@ -36,4 +37,5 @@ __all__ = [
     "point_similarity",
     "prepare_boxes",
     "prepare_points",
+    "robot_success_rate",
 ]

@@ -43,6 +43,15 @@ def identification_success_rate(
     return float(np.mean(p == t)) if p.size else float("nan")
 
 
+def robot_success_rate(predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]) -> float:
+    """Correct labels / detections of true robots (true label >= 0), over all frames: the success rate
+    without the false positives, which sides with different false-positive rates score unequally.
+    NaN when there are none."""
+    p, t = _flatten_labels(predicted_labels, true_labels)
+    robots = t >= 0
+    return float(np.mean(p[robots] == t[robots])) if robots.any() else float("nan")
+
+
 def identification_by_agent(
     predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]
 ) -> dict[int, float]:
