@@ -32,11 +32,14 @@ class ClutterShare:
     def observe(self, xywh: np.ndarray) -> None:
         """Count this frame's boxes ``(k, 4)`` (pixels) against the previous frame's."""
         xywh = np.asarray(xywh, dtype=float).reshape(-1, 4)
-        previous = self._previous
-        if previous is not None and len(previous) and len(xywh):
-            self.observe_best(xywh, iou_matrix(xywh, previous).max(axis=1))
-        else:
-            self.observe_best(xywh, None)
+        previous, n = self._previous, len(xywh)
+        if previous is not None and n:
+            self.seen += n
+            if len(previous):
+                self.flicker += int(np.count_nonzero(iou_matrix(xywh, previous).max(axis=1) < self.min_iou))
+            else:
+                self.flicker += n
+        self._previous = xywh
 
     def observe_overlaps(self, xywh: np.ndarray, overlap: np.ndarray | None) -> None:
         """:meth:`observe` given which pairs of :attr:`previous`'s boxes and this frame's overlap enough,
@@ -46,16 +49,6 @@ class ClutterShare:
         if self._previous is not None and n:
             self.seen += n
             self.flicker += n if overlap is None else n - len(set(overlap.nonzero()[1].tolist()))
-        self._previous = xywh
-
-    def observe_best(self, xywh: np.ndarray, best: np.ndarray | None) -> None:
-        """:meth:`observe` with each box's highest IoU with :attr:`previous`'s boxes, ``best (k,)``,
-        computed by the caller (e.g. within a larger IoU matrix); None when either frame has no boxes.
-        ``xywh`` must be a float ``(k, 4)`` array (it is kept as the next frame's previous boxes)."""
-        n = len(xywh)
-        if self._previous is not None and n:
-            self.seen += n
-            self.flicker += n if best is None else int(np.count_nonzero(best < self.min_iou))
         self._previous = xywh
 
     @property
