@@ -128,8 +128,7 @@ def train(
     if learning_rate is None:
         learning_rate = 0.004
     from lookalike.learn.encoding import EncodingSpec
-    from lookalike.learn.paper_protocol import NoiseMixSampler, noise_worlds
-    from lookalike.learn.sim_data import make_sim_sampler
+    from lookalike.learn.paper_protocol import noise_worlds
     from lookalike.learn.training import TrainConfig, plot_log
     from lookalike.learn.training import train as run_training
     from lookalike.learn.weights import WEIGHTS_DIR
@@ -154,9 +153,7 @@ def train(
             validation_every=validate_every,
         )
         spec = EncodingSpec(world.n_agents, world.max_detections, relative_headings=relative, protocol=protocol)
-        plain = noise == "ours" and protocol == "ours"
-        sample = make_sim_sampler(world, relative, swap_prob) if plain else NoiseMixSampler(worlds, spec)
-        validation = make_sim_sampler(world, relative) if plain else NoiseMixSampler(worlds, spec)
+        sample, validation = _sim_samplers(world, worlds, spec, noise, swap_prob)
         init = _initial_weights(init_from, init_transfer, spec, validation, sequence_length, seed)
         if init_transfer and init is not None:
             config = dataclasses.replace(config, hidden=init.hidden, num_layers=len(init.layers))
@@ -180,6 +177,22 @@ def train(
         shutil.copy(result.weights_path, target.with_suffix(".npz"))
         shutil.copy(result.weights_path.with_suffix(".json"), target.with_suffix(".json"))
         console.print(f"shipped as {target.with_suffix('.npz')}")
+
+
+def _sim_samplers(world: Any, worlds: Any, spec: Any, noise: str, swap_prob: float) -> tuple[Any, Any]:
+    """Training and validation samplers: ``world`` alone for our protocol on ``ours`` noise; for our
+    protocol on other noise, each sequence one of ``worlds`` (drawn from its seed) with identity swaps
+    in training; for seed A's protocol, its encoding of the drawn world, no swaps."""
+    from lookalike.learn.paper_protocol import NoiseMixSampler
+    from lookalike.learn.sim_data import WorldMixSampler, make_sim_sampler
+
+    relative = spec.relative_headings
+    if spec.protocol != "ours":
+        return NoiseMixSampler(worlds, spec), NoiseMixSampler(worlds, spec)
+    if noise == "ours":
+        return make_sim_sampler(world, relative, swap_prob), make_sim_sampler(world, relative)
+    return (WorldMixSampler(tuple(make_sim_sampler(w, relative, swap_prob) for w in worlds)),
+            WorldMixSampler(tuple(make_sim_sampler(w, relative) for w in worlds)))
 
 
 def _initial_weights(init_from: Path | None, transfer: bool, spec: Any, sample: Any, length: int,

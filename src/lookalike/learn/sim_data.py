@@ -129,6 +129,23 @@ class SimSampler:
         return arrays_to_training(spec, arrays, rng)
 
 
+@dataclasses.dataclass(frozen=True)
+class WorldMixSampler:
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler: each sequence is made by one of
+    ``samplers`` (e.g. one world per noise model, each with its identity swaps), chosen from its
+    seed uniformly, with the same draw as :class:`~lookalike.learn.paper_protocol.NoiseMixSampler`."""
+
+    samplers: tuple[SimSampler, ...]
+
+    def __post_init__(self) -> None:
+        if not self.samplers:
+            raise ValueError("WorldMixSampler needs at least one sampler")
+
+    def __call__(self, seed: int, n_frames: int, rng: np.random.Generator | None) -> tuple[np.ndarray, np.ndarray]:
+        pick = int(np.random.default_rng([seed, 0x401]).integers(len(self.samplers)))
+        return self.samplers[pick](seed, n_frames, rng)
+
+
 def make_sim_sampler(config: RobotWorldConfig, relative: bool = True, swap_prob: float = 0.0) -> SimSampler:
     """A ``(seed, n_frames, rng) -> (x, y)`` sampler over the robot world ``config``."""
     return SimSampler(config, relative, swap_prob)
