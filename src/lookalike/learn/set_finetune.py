@@ -4,7 +4,9 @@
 with :data:`FINETUNE_CONFIG`: a low, decaying learning rate, 60% of the batches on the paper's set-ups
 (M=3, N=2 three times as often as M=10, N=7, M=5, N=3 twice), the other 40% over every team size
 (N 1–12), identity swaps of 1–6 s that end inside the sequence, and a snapshot at every validation
-(``OUT/set_step{N}.npz``) to choose among on tuning sequences. Needs torch.
+(``OUT/set_step{N}.npz``) to choose among on tuning sequences. ``--stage 2`` runs
+:data:`FINETUNE2_CONFIG` instead: a second stage from the weights shipped after the first, with more
+M=3, N=2 batches and more, longer identity swaps. Needs torch.
 """
 
 from __future__ import annotations
@@ -23,6 +25,16 @@ FINETUNE_CONFIG = SetTrainConfig(
     swap_prob=0.3, swap_min_s=1.0, swap_max_s=6.0, swap_ends_s=2.0,
     focus_prob=0.6, focus_teams=FINETUNE_TEAMS, keep_snapshots=True, validation_every=25,
 )
+# The second stage: M=3, N=2 four times as often as M=5, N=3, M=10, N=7 twice.
+FINETUNE2_TEAMS: tuple[tuple[int, int, float], ...] = (
+    (2, 3, 0.5), (2, 3, 0.5), (2, 3, 0.5), (2, 3, 0.5), (3, 5, 0.8), (7, 10, 1.5), (7, 10, 1.5),
+)
+FINETUNE2_CONFIG = SetTrainConfig(
+    learning_rate=0.0001, lr_decay=0.001, steps=5000, minutes=55.0, patience=1000, seed=4,
+    swap_prob=0.5, swap_min_s=1.0, swap_max_s=10.0, swap_ends_s=3.0,
+    focus_prob=0.7, focus_teams=FINETUNE2_TEAMS, keep_snapshots=True, validation_every=25,
+)
+STAGES = {1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -37,11 +49,14 @@ def main(argv: list[str] | None = None) -> None:
 
     parser = argparse.ArgumentParser(prog="python -m lookalike.learn.set_finetune", description=__doc__)
     parser.add_argument("out", type=Path, help="output folder (snapshots, log, best-validation weights)")
-    parser.add_argument("--minutes", type=float, default=FINETUNE_CONFIG.minutes, help="wall-clock limit")
+    parser.add_argument("--stage", type=int, choices=sorted(STAGES), default=1,
+                        help="1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG (from the stage-1 weights)")
+    parser.add_argument("--minutes", type=float, default=None, help="wall-clock limit (default: the stage's)")
     parser.add_argument("--init", type=Path, default=SHIPPED_SET_WEIGHTS, help="weights to start from (.npz)")
     args = parser.parse_args(argv)
     torch.set_num_threads(1)
-    config = dataclasses.replace(FINETUNE_CONFIG, minutes=args.minutes)
+    stage = STAGES[args.stage]
+    config = dataclasses.replace(stage, minutes=stage.minutes if args.minutes is None else args.minutes)
     started = time.monotonic()
 
     def on_step(row: dict) -> None:
