@@ -88,3 +88,20 @@ def test_training_can_start_from_exported_weights(tmp_path):
     assert warm.best_success == pytest.approx(first.best_success, abs=1e-9)
     with pytest.raises(ValueError, match="do not fit"):
         AssociationNet(weights.spec, 8, 1).load_exported(weights)
+
+
+def test_noise_mix_keeps_identity_swaps_for_our_protocol():
+    from lookalike.learn.paper_protocol import NoiseMixSampler, noise_worlds
+    from lookalike.learn.sim_data import WorldMixSampler, make_sim_sampler
+
+    worlds = noise_worlds("m3n2", "mix")
+    plain = NoiseMixSampler(worlds, EncodingSpec(2, 3, relative_headings=False))
+    mixed = WorldMixSampler(tuple(make_sim_sampler(w, False) for w in worlds))
+    swapped = WorldMixSampler(tuple(make_sim_sampler(w, False, swap_prob=1.0) for w in worlds))
+    differs = 0
+    for seed in range(3):
+        x0, y0 = plain(seed, 300, np.random.default_rng([seed, 1]))
+        x1, y1 = mixed(seed, 300, np.random.default_rng([seed, 1]))
+        assert np.array_equal(x0, x1) and np.array_equal(y0, y1)  # without swaps: the same sequences
+        differs += not np.array_equal(swapped(seed, 300, np.random.default_rng([seed, 1]))[1], y0)
+    assert differs > 0

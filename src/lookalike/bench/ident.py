@@ -35,10 +35,17 @@ DEFAULT_SEED = 900_000
 NOT_TRAINED = "not trained"  # the cells of an LSTM row whose shipped weights do not exist for the set-up
 
 
-def weights_missing(name: str, n_agents: int, n_slots: int) -> bool:
-    """Whether identifier ``name`` is an LSTM using shipped weights and none ship for N, M."""
+def uses_weights(name: str) -> bool:
+    """Whether identifier ``name`` runs our protocol's LSTM (the rows that ``weights=`` replaces)."""
     base, extra = resolve_identifier(name)
-    if base != "lstm" or extra.get("weights"):
+    return base == "lstm" and extra.get("protocol", "ours") == "ours"
+
+
+def weights_missing(name: str, n_agents: int, n_slots: int, weights: str | None = None) -> bool:
+    """Whether identifier ``name`` is an LSTM using shipped weights and none ship for N, M
+    (never when ``weights`` names the weights of our protocol's rows)."""
+    base, extra = resolve_identifier(name)
+    if base != "lstm" or extra.get("weights") or (weights and uses_weights(name)):
         return False
     try:
         shipped_weights_path(n_agents, n_slots, "lstm_paper" if extra.get("protocol") == "paper" else "lstm")
@@ -47,10 +54,13 @@ def weights_missing(name: str, n_agents: int, n_slots: int) -> bool:
     return False
 
 
-def build_identifier(name: str, sequence: RobotSequence) -> Any:
+def build_identifier(name: str, sequence: RobotSequence, weights: str | None = None) -> Any:
     """Tracker ``name`` (or a variant of :data:`~lookalike.bench.ident_paper.IDENT_VARIANTS`)
-    configured for the sequence's N (and M for trackers with slots)."""
+    configured for the sequence's N (and M for trackers with slots); ``weights``: exported network
+    weights (.npz) for our protocol's LSTM rows instead of the shipped ones."""
     base, extra = resolve_identifier(name)
+    if weights and uses_weights(name):
+        extra["weights"] = weights
     known = {p.name for p in tracker_parameters(base)}
     cfg = sequence.config
     params = {k: v for k, v in (("n_agents", cfg.n_agents), ("n_slots", cfg.max_detections)) if k in known}
@@ -68,9 +78,10 @@ def identify(name: str, sequence: RobotSequence, frames: Sequence[Frame] | None 
     return labels
 
 
-def run_identifier(name: str, sequences: list[RobotSequence], step: Step | None = None) -> dict[str, float]:
+def run_identifier(name: str, sequences: list[RobotSequence], step: Step | None = None,
+                   weights: str | None = None) -> dict[str, float]:
     """Success rate, localisation error, frames/s and detection count of tracker ``name``
-    (``step()`` called after each sequence)."""
+    (``step()`` called after each sequence; ``weights`` as in :func:`build_identifier`)."""
     predicted: list[np.ndarray] = []
     truth: list[np.ndarray] = []
     est, true_pos = [], []
@@ -83,7 +94,7 @@ def run_identifier(name: str, sequences: list[RobotSequence], step: Step | None 
             positions[len(predicted) - k0] = agent_positions(tracks, positions.shape[1])
             predicted.append(labels_from_tracks(len(frame.detections), tracks))
 
-        run(build_identifier(name, seq), frames, sink, stats=stats)
+        run(build_identifier(name, seq, weights), frames, sink, stats=stats)
         truth.extend(seq.true_labels())
         est.append(positions)
         true_pos.append(seq.true_positions_visible())
@@ -104,23 +115,26 @@ def sequence_seeds(setups: list[str], sequences: int, seed: int = DEFAULT_SEED) 
 
 def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: int,
                 seed: int = DEFAULT_SEED, noise: str = DEFAULT_NOISE,
-                progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
+                progress: ProgressFactory = no_progress, weights: str | None = None) -> list[dict[str, Any]]:
     """Rows (keys :data:`IDENT_COLUMNS`) for every set-up and tracker, on identical sequences of the
     simulator with position-noise model ``noise`` (``"paper"`` or ``"ours"``); ``progress`` advances
-    once per sequence and tracker."""
+    once per sequence and tracker; ``weights``: exported weights (.npz) for our protocol's LSTM rows
+    instead of the shipped ones (one set-up: they are for one N, M)."""
+    if weights and len(setups) != 1:
+        raise ValueError(f"weights: {weights} are for one set-up; got {len(setups)} set-ups")
     rows = []
     step = progress("bench ident", len(setups) * len(trackers) * sequences)
     for setup in setups:
         cfg = preset(setup, noise)
         seqs = [simulate_robots(cfg, frames, s) for s in sequence_seeds([setup], sequences, seed)]
         for name in trackers:
-            if weights_missing(name, cfg.n_agents, cfg.max_detections):
+            if weights_missing(name, cfg.n_agents, cfg.max_detections, weights):
                 rows.append({"Setup": preset_label(setup), "Tracker": name, "Success rate (%)": NOT_TRAINED,
                              "Localisation error (m)": NOT_TRAINED, "Frames/s": NOT_TRAINED, "Detections": 0})
                 for _ in seqs:
                     step()
                 continue
-            r = run_identifier(name, seqs, step)
+            r = run_identifier(name, seqs, step, weights)
             rows.append({
                 "Setup": preset_label(setup), "Tracker": name, "Success rate (%)": round(100 * r["success"], 2),
                 "Localisation error (m)": round(r["loc_error"], 3), "Frames/s": round(r["fps"], 1),
@@ -130,14 +144,16 @@ def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: 
 
 
 def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int, frames: int,
-                  seed: int = DEFAULT_SEED, command: str = "", noise: str = DEFAULT_NOISE) -> Results:
+                  seed: int = DEFAULT_SEED, command: str = "", noise: str = DEFAULT_NOISE,
+                  weights: str | None = None) -> Results:
     """The rows of :func:`ident_table` as a results document (:mod:`lookalike.bench.results`):
-    table ``ident``, one row per set-up (dataset: the preset name) and identifier, over all its sequences."""
+    table ``ident``, one row per set-up (dataset: the preset name) and identifier, over all its sequences;
+    ``weights`` (the LSTM rows' weights when not the shipped ones) is recorded in its options."""
     names = {preset_label(s): s for s in setups}
     doc = Results("bench ident", command=command, seeds=sequence_seeds(setups, sequences, seed),
                   sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
                   options={"setups": setups, "sequences_per_setup": sequences, "frames_per_sequence": frames,
-                           "seed": seed, "noise": noise})
+                           "seed": seed, "noise": noise, **({"weights": weights} if weights else {})})
     for r in rows:
         doc.add("ident", dataset=names.get(r["Setup"], r["Setup"]), tracker=r["Tracker"],
                 metrics=percent_row_metrics(r, skip=("Setup", "Tracker")))
@@ -145,4 +161,5 @@ def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int,
 
 
 __all__ = ["DEFAULT_SEED", "IDENT_COLUMNS", "IDENT_TRACKERS", "NOT_TRAINED", "build_identifier", "ident_results",
-           "ident_table", "identify", "run_identifier", "sequence_seeds", "weights_missing"]
+           "ident_table", "identify", "run_identifier", "sequence_seeds", "uses_weights",
+           "weights_missing"]

@@ -85,6 +85,9 @@ def ident(
     human: Path | None = typer.Option(
         None, "--human", help="Table III: add a 'human' row from the result files (*.human-*.json) that "
         "`lookalike label --benchmark` wrote in this folder (default: the --recordings folder)."),
+    weights: Path | None = typer.Option(
+        None, "--weights", help="Exported weights (.npz) for the lstm and lstm-lowpass rows instead of the "
+        "shipped ones, e.g. a training run's model.npz (one set-up)."),
 ) -> None:
     """Seed A's Table I: identification success rate per set-up and identifier (+ error, speed).
     With --lengths or --recordings: seed A's Table III protocol."""
@@ -92,13 +95,16 @@ def ident(
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
     check_names("--trackers", tracker_list, [*tracker_names(), *IDENT_VARIANTS], "tracker")
     check_names("--noise", [noise], ("paper", "ours"), "noise model")
+    if weights is not None and (lengths is not None or recordings is not None or human is not None):
+        fail("--weights: for Table I only (not with --lengths, --recordings or --human)")
     if lengths is not None or recordings is not None or human is not None:
         table3_command(setup_list, tracker_list, sequences, frames, seed, noise, lengths, draws, recordings,
                        json_path, csv_path, human)
         return
     try:
         with progress_bars() as progress:
-            rows = ident_table(setup_list, tracker_list, sequences, frames, seed, noise, progress)
+            rows = ident_table(setup_list, tracker_list, sequences, frames, seed, noise, progress,
+                               str(weights) if weights else None)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     labels = [preset_label(s) for s in setup_list]
@@ -110,7 +116,8 @@ def ident(
     margins = margin_rows(rows, setup_list, labels)
     if margins:
         print_rows("LSTM margins over Kalman-HA on the same sequences, beside seed A's (Table I)", margins)
-    write_results(ident_results(rows, setup_list, sequences, frames, seed, command_line(), noise), json_path)
+    write_results(ident_results(rows, setup_list, sequences, frames, seed, command_line(), noise,
+                                str(weights) if weights else None), json_path)
     write_rows(rows, None, csv_path)
 
 
