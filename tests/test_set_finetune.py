@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from lookalike.learn.set_data import SetBatchMaker, TeamSizes
-from lookalike.learn.set_numpy import SetWeights
+from lookalike.learn.set_numpy import SetWeights, load_set_weights, save_set_weights
 
 
 def test_focus_teams_are_drawn_and_checked():
@@ -27,7 +27,6 @@ def test_a_swap_that_must_end_leaves_the_last_seconds_alone():
 
 def test_training_starts_from_init_weights(tmp_path):
     pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
-    from lookalike.learn.set_numpy import load_set_weights
     from lookalike.learn.set_training import SetTrainConfig, train_set
 
     shapes = SetWeights({}, 8, 12, 6).shapes()
@@ -62,3 +61,58 @@ def test_snapshot_choice_needs_every_tuning_team_at_the_baseline():
             "c": {"m3n2": 98.495, "m5n3": 98.0}}  # a tie on M=3, N=2 within 0.01: the better mean wins
     assert choose(rows, base) == "c"
     assert choose({"a": rows["a"]}, base) is None
+
+
+def test_the_second_stage_draws_more_small_teams_and_swaps():
+    from lookalike.learn.set_finetune import FINETUNE2_CONFIG, STAGES
+
+    assert STAGES[2] is FINETUNE2_CONFIG
+    sizes = FINETUNE2_CONFIG.batch_maker().sizes
+    draws = [sizes.draw(np.random.default_rng(s)) for s in range(600)]
+    small, mid, big = (draws.count(t) for t in ((2, 3, 0.5), (3, 5, 0.8), (7, 10, 1.5)))
+    assert small > big > mid > 0  # weighted 4 : 1 : 2
+    assert sum(1 for n, _, _ in draws if n >= 8) > 0
+    assert FINETUNE2_CONFIG.swap_prob > STAGES[1].swap_prob
+
+
+def test_stage2_choice_weighs_small_team_then_recovery_and_ships_only_when_better():
+    from lookalike.bench.set_select import better_than, choose_stage2
+
+    base = {"m3n2": 98.0, "m5n3": 97.0, "rec_m3n2": 0.5, "rec_m5n3": 0.5, "worst_m3n2": 1.0, "worst_m5n3": 1.0}
+    rows = {"slow": {**base, "m3n2": 99.0, "rec_m3n2": 0.6},  # best small team, but recovers slower
+            "low": {**base, "m3n2": 98.9, "m5n3": 96.6},  # more than 0.3 points lost elsewhere
+            "a": {**base, "m3n2": 98.5, "rec_m3n2": 0.4},
+            "b": {**base, "m3n2": 98.46, "rec_m3n2": 0.3},  # within 0.05 of the best: faster recovery wins
+            "never": {**base, "m3n2": 98.6, "worst_m5n3": float("inf")}}
+    assert choose_stage2(rows, base) == "b"
+    assert choose_stage2({"slow": rows["slow"], "low": rows["low"]}, base) is None
+    assert better_than(rows["b"], base)
+    assert not better_than({**base, "m3n2": 98.04, "rec_m3n2": 0.48}, base)
+    assert better_than({**base, "rec_m3n2": 0.4}, base)
+
+
+def test_stage2_candidates_are_the_hundreds_and_their_late_mean(tmp_path):
+    from lookalike.bench.set_select import _candidates
+
+    shapes = SetWeights({}, 8, 12, 6).shapes()
+    for k in (50, 100, 200, 300, 400):
+        w = SetWeights({n: np.full(s, float(k)) for n, s in shapes.items()}, 8, 12, 6)
+        save_set_weights(w, tmp_path / f"set_step{k}.npz")
+    got = _candidates(tmp_path, 100, 300)
+    assert [p.name for p in got] == ["set_step100.npz", "set_step200.npz", "set_step300.npz", "set_step400.npz",
+                                     "set_avg.npz"]
+    mean = load_set_weights(got[-1])
+    assert all(np.allclose(a, 350.0) for a in mean.arrays.values())
+    assert _candidates(tmp_path, 100, 400)[-1].name == "set_step400.npz"  # one late snapshot: no mean
+
+
+def test_tuning_recovery_is_bench_recoverys_measure():
+    from lookalike.bench.experiments import recovery_rows
+    from lookalike.bench.set_select import set_recovery_s
+    from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+    from lookalike.sim import preset, simulate_robots
+
+    seq = simulate_robots(preset("m3n2"), 300, 55_001)
+    mine = set_recovery_s(SHIPPED_SET_WEIGHTS, seq, swap_at_s=2.0, swap_s=3.0)
+    row = recovery_rows(["m3n2"], ["set"], 1, 300, 2.0, 3.0, seed=55_001)[0]
+    assert round(mine, 2) == row["Recovery, mean (s)"]

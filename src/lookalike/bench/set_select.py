@@ -7,6 +7,11 @@ worse than the baseline on any tuning team; of those, the best on M=3, N=2 (a ti
 goes to the best mean), or the baseline when none is. ``--average-from S`` adds one more candidate,
 ``RUN/set_avg.npz``, the mean of the weights of the snapshots from step S on. ``--ship`` copies the
 chosen weights into the package's shipped weights with what they were chosen on.
+
+``--stage 2`` applies the rule of the second fine-tuning stage (:func:`choose_stage2`): the candidates are
+the snapshots at multiples of 100 and the mean of those from step 300 on; each is also timed on
+``bench recovery``'s swap on tuning seeds (:data:`RECOVERY_SEED`), and a choice ships only when it is
+better than the baseline (:func:`better_than`).
 """
 
 from __future__ import annotations
@@ -20,15 +25,33 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike.bench.experiments import most_seen_pair, pair_hits, recovery_s, swap_reports
 from lookalike.bench.pixel_recordings import score_identifier
 from lookalike.learn.set_data import world
 from lookalike.learn.set_numpy import load_set_weights, save_set_weights
 from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+from lookalike.loop import run
 from lookalike.sim import PRESET_NAMES, RobotSequence, preset, simulate_robots
+from lookalike.trackers import make_tracker
+from lookalike.trackers.identity import labels_from_tracks
+from lookalike.types import Frame
 
 # Tuning sequences for --select (name, (N, M, fp), first seed, sequences), 1000 frames each; apart from every bench.
 TUNING_TEAMS = (("m3n2", (2, 3, 0.5), 50_000, 20), ("m5n3", (3, 5, 0.8), 51_000, 10),
                 ("m10n7", (7, 10, 1.5), 52_000, 10), ("m6n4", (4, 6, 1.0), 54_000, 10))
+# Recovery on tuning seeds (stage 2): ``bench recovery``'s sequences and swap with base seed 55000
+# (seeds 55000 + 1000·set-up + k), 10 per set-up; apart from every bench and the tuning teams above.
+RECOVERY_SEED = 55_000
+RECOVERY_SEQUENCES = 10
+RECOVERY_FRAMES = 900
+RECOVERY_SWAP = (5.0, 10.0)  # (start, duration) in seconds, as ``bench recovery``'s defaults
+STAGE2_EVERY = 100
+STAGE2_AVERAGE_FROM = 300
+STAGE2_RULE = ("candidates: snapshots at multiples of 100 and the mean of those from step 300 on; eligible: tuning "
+               "M=3, N=2 >= baseline, other tuning teams >= baseline - 0.3 points, tuning recovery mean <= baseline "
+               "+ 0.05 s on every set-up and always recovered; choice: best M=3, N=2, within 0.05 points the lowest "
+               "mean recovery, then the best mean success; shipped only if M=3, N=2 > baseline + 0.05 points or "
+               "the mean recovery < baseline's - 0.03 s")
 
 
 def set_success(weights: Path, sequences: list[RobotSequence]) -> float:
@@ -56,6 +79,65 @@ def choose(rows: dict[str, dict[str, float]], baseline: dict[str, float]) -> str
     return max(near, key=lambda p: float(np.mean([rows[p][k] for k in baseline])))
 
 
+def _labels(weights: Path, sequence: RobotSequence, frames: list[Frame]) -> list[np.ndarray]:
+    """Per frame, ``set``'s labels with ``weights`` over ``frames``, configured as ``bench ident`` does."""
+    cfg = sequence.config
+    tracker = make_tracker("set", n_agents=cfg.n_agents, n_slots=cfg.max_detections, weights=str(weights))
+    labels: list[np.ndarray] = []
+    run(tracker, frames, lambda f, tracks: labels.append(labels_from_tracks(len(f.detections), tracks)))
+    return labels
+
+
+def set_recovery_s(weights: Path, sequence: RobotSequence, swap_at_s: float = RECOVERY_SWAP[0],
+                   swap_s: float = RECOVERY_SWAP[1]) -> float:
+    """Seconds ``set`` with ``weights`` takes to recover after ``bench recovery``'s swap of the two
+    robots seen most (inf: never), measured as :func:`lookalike.bench.experiments.recovery_s` does."""
+    rate = sequence.config.frame_rate_hz
+    fs = list(sequence.frames())
+    truth = sequence.true_labels()
+    start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
+    pair = most_seen_pair(truth[start : restore + int(3 * rate)], sequence.config.n_agents)
+    clean = pair_hits(_labels(weights, sequence, fs), truth, pair)
+    swapped = pair_hits(_labels(weights, sequence, swap_reports(fs, swap_at_s, swap_at_s + swap_s, pair)), truth, pair)
+    return recovery_s(clean, swapped, restore, int(rate), rate)
+
+
+def recovery_sequences() -> dict[str, list[RobotSequence]]:
+    """``bench recovery``'s sequences on the tuning seeds :data:`RECOVERY_SEED` + 1000·set-up + k."""
+    return {p: [simulate_robots(preset(p), RECOVERY_FRAMES, RECOVERY_SEED + 1000 * i + k)
+                for k in range(RECOVERY_SEQUENCES)] for i, p in enumerate(PRESET_NAMES)}
+
+
+def choose_stage2(rows: dict[str, dict[str, float]], baseline: dict[str, float]) -> str | None:
+    """The stage-2 choice of ``rows`` (path -> tuning success per team in % and ``rec_<setup>`` /
+    ``worst_<setup>`` recovery seconds): see :data:`STAGE2_RULE`; None when none is eligible."""
+    teams = [k for k in baseline if not k.startswith(("rec_", "worst_"))]
+    recs = [k for k in baseline if k.startswith("rec_")]
+
+    def eligible(r: dict[str, float]) -> bool:
+        return (r["m3n2"] >= baseline["m3n2"]
+                and all(r[k] >= baseline[k] - 0.3 for k in teams if k != "m3n2")
+                and all(np.isfinite(r[k]) and r[k] <= baseline[k] + 0.05 for k in recs)
+                and all(np.isfinite(r[k]) for k in r if k.startswith("worst_")))
+
+    ok = [p for p, r in rows.items() if eligible(r)]
+    if not ok:
+        return None
+    top = max(rows[p]["m3n2"] for p in ok)
+    near = [p for p in ok if rows[p]["m3n2"] >= top - 0.05]
+    return min(near, key=lambda p: (float(np.mean([rows[p][k] for k in recs])),
+                                    -float(np.mean([rows[p][k] for k in teams]))))
+
+
+def better_than(row: dict[str, float], baseline: dict[str, float]) -> bool:
+    """Whether a stage-2 choice ships: M=3, N=2 more than 0.05 points above the baseline, or its mean
+    recovery over the set-ups more than 0.03 s below the baseline's."""
+    recs = [k for k in baseline if k.startswith("rec_")]
+    mean_rec = float(np.mean([row[k] for k in recs])) if recs else 0.0
+    base_rec = float(np.mean([baseline[k] for k in recs])) if recs else 0.0
+    return row["m3n2"] > baseline["m3n2"] + 0.05 or mean_rec < base_rec - 0.03
+
+
 def average_weights(paths: list[Path], out: Path) -> Path:
     """Write the element-wise mean of the weights ``paths`` (same widths) to ``out``."""
     ws = [load_set_weights(p) for p in paths]
@@ -65,9 +147,18 @@ def average_weights(paths: list[Path], out: Path) -> Path:
     return out
 
 
-def select(run_dir: Path, every: int = 50, baseline: Path = SHIPPED_SET_WEIGHTS, ship: bool = False,
-           average_from: int | None = None) -> None:
-    """Score the baseline and the snapshots on the tuning sequences, print them and the choice."""
+def tuning_row(weights: Path, seqs: dict[str, list[RobotSequence]],
+               rec_seqs: dict[str, list[RobotSequence]]) -> dict[str, float]:
+    """Tuning success (%) of ``weights`` per team of ``seqs`` and, per set-up of ``rec_seqs``, the mean
+    (``rec_<setup>``) and worst (``worst_<setup>``) recovery seconds."""
+    row = {name: round(100 * set_success(weights, sq), 3) for name, sq in seqs.items()}
+    for p, sq in rec_seqs.items():
+        times = [set_recovery_s(weights, q) for q in sq]
+        row[f"rec_{p}"], row[f"worst_{p}"] = round(float(np.mean(times)), 3), round(float(np.max(times)), 3)
+    return row
+
+
+def _candidates(run_dir: Path, every: int, average_from: int | None) -> list[Path]:
     steps = sorted(int(m.group(1)) for p in run_dir.glob("set_step*.npz")
                    if (m := re.fullmatch(r"set_step(\d+)\.npz", p.name)) and int(m.group(1)) % every == 0)
     if not steps:
@@ -75,31 +166,65 @@ def select(run_dir: Path, every: int = 50, baseline: Path = SHIPPED_SET_WEIGHTS,
     candidates = [run_dir / f"set_step{k}.npz" for k in steps]
     if average_from is not None:
         late = [run_dir / f"set_step{k}.npz" for k in steps if k >= average_from]
-        if late:
+        if len(late) >= 2:
             candidates.append(average_weights(late, run_dir / "set_avg.npz"))
+    return candidates
+
+
+def select(run_dir: Path, every: int = 50, baseline: Path = SHIPPED_SET_WEIGHTS, ship: bool = False,
+           average_from: int | None = None, stage: int = 1) -> None:
+    """Score the baseline and the snapshots on the tuning sequences, print them and the choice (stage 2:
+    also the tuning recovery, cached in ``RUN/set_select_stage2.json`` by file name; the mean is rescored)."""
+    if stage == 2:
+        every, average_from = STAGE2_EVERY, STAGE2_AVERAGE_FROM
+    candidates = _candidates(run_dir, every, average_from)
     seqs = tuning_sequences()
     names = [t[0] for t in TUNING_TEAMS]
-    print("tuning success (%)          " + "".join(f"{n:>8s}" for n in names))
+    cols = names + ([f"{c}_{p}" for c in ("rec", "worst") for p in PRESET_NAMES] if stage == 2 else [])
+    rec_seqs = recovery_sequences() if stage == 2 else {}
+    cache_path = run_dir / "set_select_stage2.json"
+    cache: dict[str, dict[str, float]] = {}
+    if stage == 2 and cache_path.is_file():
+        cache = json.loads(cache_path.read_text())
+    print("tuning success (%), recovery (s)" + "".join(f"{n:>12s}" for n in cols))
 
-    def score(path: Path) -> dict[str, float]:
-        row = {name: round(100 * set_success(path, seqs[name]), 3) for name in names}
-        print(f"{str(path)[-28:]:28s}" + "".join(f"{row[n]:8.3f}" for n in names), flush=True)
+    def score(path: Path, key: str | None) -> dict[str, float]:
+        if key is not None and key in cache:
+            row = cache[key]
+        else:
+            row = tuning_row(path, seqs, rec_seqs)
+            if stage == 2 and key is not None:
+                cache[key] = row
+                cache_path.write_text(json.dumps(cache, indent=1))
+        print(f"{str(path)[-32:]:32s}" + "".join(f"{row[n]:12.3f}" for n in cols), flush=True)
         return row
 
-    base = score(baseline)
-    rows = {str(p): score(p) for p in candidates}
-    chosen = choose(rows, base)
-    print(f"chosen: {chosen}" if chosen else "chosen: none (every snapshot is below the baseline on a tuning team)")
+    base = score(baseline, "baseline:" + str(baseline))
+    rows = {str(p): score(p, None if p.name == "set_avg.npz" else p.name) for p in candidates}
+    if stage == 2:
+        chosen = choose_stage2(rows, base)
+        if chosen and not better_than(rows[chosen], base):
+            print(f"choice {chosen} is not better than the baseline on tuning: nothing ships")
+            chosen = None
+    else:
+        chosen = choose(rows, base)
+    print(f"chosen: {chosen}" if chosen else "chosen: none (no eligible candidate better than the baseline)")
     if ship:  # the chosen snapshot, or the baseline when none is eligible
         weights = load_set_weights(chosen or baseline)
-        weights.info["chosen_on"] = {"rule": "no tuning team below the baseline, then best M=3, N=2",
-                                     "tuning_teams": [list(t) for t in TUNING_TEAMS],
-                                     "tuning": rows[chosen] if chosen else base,
-                                     "baseline": {"path": str(baseline), **base}}
+        rule = STAGE2_RULE if stage == 2 else "no tuning team below the baseline, then best M=3, N=2"
+        chosen_on = {"rule": rule, "tuning_teams": [list(t) for t in TUNING_TEAMS],
+                     "tuning": rows[chosen] if chosen else base, "baseline": {"path": str(baseline), **base}}
+        if stage == 2:
+            chosen_on["recovery"] = {"seed": RECOVERY_SEED, "sequences": RECOVERY_SEQUENCES, "frames": RECOVERY_FRAMES,
+                                     "swap_at_s": RECOVERY_SWAP[0], "swap_s": RECOVERY_SWAP[1]}
+            chosen_on["candidates"] = rows
+            weights.info["stage1"] = load_set_weights(baseline).info
+        weights.info["chosen_on"] = chosen_on
         save_set_weights(weights, SHIPPED_SET_WEIGHTS)
         log = run_dir / "training_log.csv"
         if chosen and log.is_file():
-            shutil.copy(log, SHIPPED_SET_WEIGHTS.parent / "set_any_finetune_log.csv")
+            name = "set_any_finetune2_log.csv" if stage == 2 else "set_any_finetune_log.csv"
+            shutil.copy(log, SHIPPED_SET_WEIGHTS.parent / name)
         print(f"shipped {chosen or baseline} as {SHIPPED_SET_WEIGHTS}: {json.dumps(rows[chosen] if chosen else base)}")
 
 
@@ -112,8 +237,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--average-from", type=int, default=None,
                         help="also the mean of the snapshots' weights from this step on")
     parser.add_argument("--ship", action="store_true", help="ship the chosen weights")
+    parser.add_argument("--stage", type=int, choices=(1, 2), default=1,
+                        help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from)")
     args = parser.parse_args(argv)
-    select(args.run, args.every, args.baseline, args.ship, args.average_from)
+    select(args.run, args.every, args.baseline, args.ship, args.average_from, args.stage)
 
 
 if __name__ == "__main__":
