@@ -30,13 +30,15 @@ when their allowed pairs compete. The rows are those of the plain tracker this r
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
 from lookalike.association.costs import centre_distance_cost, cost_from_iou, iou_columns
-from lookalike.association.stages import CostFn, Matching, Stage, run_plan
+from lookalike.association.stages import CostFn, Matching, Stage, run_plan, run_stage
 from lookalike.motion.spaces import BoxCXCYWH, cxcywh_to_xywh
 from lookalike.trackers import boxtrack_config as const
+from lookalike.trackers import boxtrack_kernels
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
 from lookalike.trackers.closed_slots import ClosedSlots
 from lookalike.trackers.clutter import ClutterShare
@@ -50,6 +52,8 @@ from lookalike.trackers.timing import FrameClock
 from lookalike.types import Frame, Tracks
 
 _to_xywh = cxcywh_to_xywh  # kept for callers of the old private helper
+_NO_BOXES = np.zeros((0, 4))
+_NO_INDEX = np.zeros(0, dtype=np.int64)
 
 
 def _xywh_columns(cxcywh: np.ndarray, out: np.ndarray) -> None:
@@ -78,6 +82,8 @@ class BoxTrack:
         self._lifecycle = lifecycle.closed_set() if cfg.max_targets is not None else lifecycle
         self._slots = None if cfg.max_targets is None else ClosedSlots(
             cfg.max_targets, cfg.closed_distance, const.CLOSED_GATE_GROWTH, refill_s=cfg.max_age_s)
+        # the compiled kernels (boxtrack_kernels; None: the numpy path), for this lifecycle's rules and IoU gates
+        self._kernels = boxtrack_kernels.compiled() if cfg.match_iou > 0 else None
         self.reset()
 
     def reset(self) -> None:
@@ -95,9 +101,18 @@ class BoxTrack:
         self._coasting = Coasting(const.COAST_S, const.COAST_REPORT_PROB, const.COAST_MIN_COUNT)
         self._fit = MotionFit(const.FIT_BATCH)
         self._scaled: tuple[float, BoxCXCYWH] | None = None  # (fit scale, the space with its noise)
+        self._buffers = (np.empty((4, 16)), np.empty(16, dtype=np.int64))  # the compiled update's outputs
+        self._never = np.zeros(self._coasting.returns.longest + 2, dtype=bool)  # no coasted report
+
+    @property
+    def compiled(self) -> bool:
+        """Whether this tracker runs the compiled kernels (:mod:`lookalike.trackers.boxtrack_kernels`)."""
+        return self._kernels is not None
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
+        if self._kernels is not None:
+            return self._update_compiled(frame, self._kernels)
         cfg, t, clock = self.config, self._tracks, self._clock
         steps = clock.steps(frame.time)
         dt = steps * clock.interval
@@ -146,6 +161,89 @@ class BoxTrack:
             self._coasting.observe(died=t.misses[~alive & t.confirmed])
             t.keep(alive)
         return out
+
+    def _update_compiled(self, frame: Frame, kern: Any) -> Tracks:
+        """:meth:`update` with the compiled kernels: the same steps and numbers as the numpy path."""
+        cfg, t, clock = self.config, self._tracks, self._clock
+        steps = clock.steps(frame.time)
+        dt = steps * clock.interval
+        self._frame_count += 1
+        dets = frame.detections
+        det_xywh, score = dets.xywh, dets.score
+        det_idx = None
+        if len(score) and np.count_nonzero(score < cfg.low_score):
+            det_idx = (score >= cfg.low_score).nonzero()[0]
+            det_xywh, score = det_xywh[det_idx], score[det_idx]
+        self._calibration.observe_scores(score)
+        x = self._state()
+        if self._slots is not None and len(t):
+            self._slots.freeze_shape(t)
+        space, clutter = self._predict_space(), self._clutter
+        previous = clutter.previous
+        iou, flicker = kern.advance(x, steps, max(steps, 0.0), t.unseen_s, self._coasting.coast_s,
+                                    space.pos_noise**2, space.vel_noise**2,
+                                    _NO_BOXES if previous is None else previous, det_xywh, clutter.min_iou)
+        clutter.observe_count(det_xywh, flicker)
+        high_score, birth_score, _ = self._calibration.decide(clutter.share)
+        k, n = iou.shape
+        matching = Matching.empty(k, n)
+        if k and n:
+            self._associate_compiled(kern, iou, det_xywh, score, high_score, dt, matching)
+        det_of_track = matching.det_of_track
+        self._calibration.observe_continued(score, det_of_track[matching.stage_of_track.view(np.uint64) < 3])
+        fit, back = self._buffers
+        if fit.shape[1] < k:
+            fit, back = self._buffers = (np.empty((4, 2 * k)), np.empty(2 * k, dtype=np.int64))
+        slots = self._slots
+        n_fit, n_back = kern.correct(x, det_of_track, det_xywh, self._space.pos_noise, t.confirmed, t.misses,
+                                     t.unseen_s, t.hits, slots is None, dt, cfg.n_init, self._frame_count == 1,
+                                     fit, back)
+        if n_fit:
+            self._fit.observe_columns(fit[0:2, :n_fit], fit[2:4, :n_fit])
+        if n_back:
+            self._coasting.observe(came_back=back[:n_back])
+        if slots is not None:
+            hit = det_of_track >= 0
+            slots.observe_speed(t, hit, clock.interval)
+            t.record(hit, dt)
+            ready = t.hits >= cfg.n_init
+            if self._frame_count == 1:
+                ready |= t.hits > 0
+            det_of_track = slots.refill(t, ready, det_of_track)
+        new = (matching.free & (score >= birth_score)).nonzero()[0]
+        born = self._births(new, self._measure(det_xywh.T) if len(new) else _NO_BOXES.T)
+        coasting, life = self._coasting, self._lifecycle
+        present = self._never if coasting.report_prob is None else coasting.returns.present_table(
+            coasting.report_prob, coasting.min_count)
+        alive = np.empty(len(t), dtype=bool)
+        ids, status, boxes, velocity, original, n_alive = kern.report(
+            t.mean, t.ids, t.confirmed, det_of_track, born, _NO_INDEX if det_idx is None else det_idx, t.misses,
+            present, clock.interval, t.unseen_s, life.tentative_max_unseen_s, life.max_unseen_s, life.closed, alive)
+        out = Tracks.trusted(ids, status, boxes, velocity, original)
+        if n_alive < len(alive):
+            coasting.observe(died=t.misses[~alive & t.confirmed])
+            t.keep(alive)
+        return out
+
+    def _associate_compiled(self, kern: Any, iou: np.ndarray, det_xywh: np.ndarray, score: np.ndarray,
+                            high_score: float, dt: float, matching: Matching) -> None:
+        """:meth:`_associate`'s plan with the IoU stages compiled; a stage whose allowed pairs compete, and
+        the re-identification stage when it has candidates, run as in the numpy path."""
+        cfg, t = self.config, self._tracks
+        args = (cfg.match_iou, const.LOW_IOU, t.confirmed, t.misses, const.RECENT_FRAMES, t.unseen_s, score,
+                high_score, matching.det_of_track, matching.free, matching.stage_of_track)
+        stage = kern.gated_stages(iou, 0, *args)
+        if stage > 4:
+            return
+        det_box = self._measure(det_xywh.T).T
+        if stage < 4:
+            stages = self._plan(iou, None, det_box, score, high_score, t.unseen_s == 0, dt)
+            while stage < 4:  # competing pairs: this stage's costs decide
+                run_stage(stages[stage]._replace(gate=None), matching, stage)
+                stage = kern.gated_stages(iou, stage + 1, *args)
+        if stage == 4:
+            run_stage(Stage(t.confirmed, score >= high_score, self._reid(det_box, dt), name="re-identification"),
+                      matching, 4)
 
     def _state(self) -> np.ndarray:
         """The tracks' states as :class:`BoxCXCYWH`'s column table ``(24, k)``, of which the track table's
@@ -197,6 +295,19 @@ class BoxTrack:
                    score: np.ndarray, high_score: float, was_tracked: np.ndarray, dt: float) -> Matching:
         """The association plan: confident detections to confirmed tracks (recent ones first), low-score
         ones to tracks seen last frame, the rest to tentative tracks, then lost tracks by centre distance."""
+        matching = run_plan(self._plan(iou, low_gate, det_box, score, high_score, was_tracked, dt),
+                            len(self._tracks), len(score))
+        # the detections that continued confirmed tracks in the first three stages (the later two
+        # change no earlier match)
+        first_three = matching.stage_of_track.view(np.uint64) < 3  # stages 0-2 (unmatched -1: beyond, as unsigned)
+        self._calibration.observe_continued(score, matching.det_of_track[first_three])
+        return matching
+
+    def _plan(self, iou: np.ndarray | None, low_gate: np.ndarray | None, det_box: np.ndarray, score: np.ndarray,
+              high_score: float, was_tracked: np.ndarray, dt: float) -> list[Stage]:
+        """:meth:`_associate`'s stages: IoU ``iou (k, n)`` of the predicted boxes and the detections (None
+        without either), ``low_gate`` its pairs reaching ``LOW_IOU`` (None: computed here), ``det_box (n, 4)``
+        the detections' cx, cy, w, h (pixels)."""
         cfg, t = self.config, self._tracks
         high = score >= high_score
         # each IoU stage takes its block of the frame's matrix; it allows the pairs reaching its IoU
@@ -213,7 +324,20 @@ class BoxTrack:
 
         confirmed = t.confirmed
         recent = t.misses <= const.RECENT_FRAMES
-        slots = self._slots
+        reid = self._reid(det_box, dt)
+        return [
+            Stage(confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent", gate=match_gate),
+            Stage(confirmed > recent, high, overlap(cfg.match_iou, True), name="confident, lost longer",
+                  gate=match_gate),  # (confirmed and not recent)
+            Stage(confirmed & was_tracked, ~high, overlap(const.LOW_IOU, False), name="low score", gate=low_gate),
+            Stage(~confirmed, high, overlap(cfg.match_iou, False), name="tentative", gate=match_gate),
+            Stage(confirmed, high, reid, name="re-identification"),
+        ]
+
+    def _reid(self, det_box: np.ndarray, dt: float) -> CostFn:
+        """The re-identification stage's cost of lost tracks and detections ``det_box (n, 4)`` (cx, cy, w, h;
+        pixels), ``dt`` seconds after the tracks' last frame."""
+        cfg, t, slots = self.config, self._tracks, self._slots
 
         def reid(r: np.ndarray, c: np.ndarray) -> np.ndarray:
             # built only when some lost track and confident detection are left
@@ -225,19 +349,7 @@ class BoxTrack:
             gate_all = const.REID_DISTANCE * math.sqrt(self._fit.scale)
             return centre_distance_cost(t.mean[r, :4], det_box[c], gate_all, cfg.reid_scale)
 
-        matching = run_plan([
-            Stage(confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent", gate=match_gate),
-            Stage(confirmed > recent, high, overlap(cfg.match_iou, True), name="confident, lost longer",
-                  gate=match_gate),  # (confirmed and not recent)
-            Stage(confirmed & was_tracked, ~high, overlap(const.LOW_IOU, False), name="low score", gate=low_gate),
-            Stage(~confirmed, high, overlap(cfg.match_iou, False), name="tentative", gate=match_gate),
-            Stage(confirmed, high, reid, name="re-identification"),
-        ], len(t), len(score))
-        # the detections that continued confirmed tracks in the first three stages (the later two
-        # change no earlier match)
-        first_three = matching.stage_of_track.view(np.uint64) < 3  # stages 0-2 (unmatched -1: beyond, as unsigned)
-        self._calibration.observe_continued(score, matching.det_of_track[first_three])
-        return matching
+        return reid
 
     def _correct(self, x: np.ndarray, matched: np.ndarray, z: np.ndarray) -> None:
         """Kalman update of the tracks ``matched`` (columns of ``x``) with their measurements ``z (4, m)``;

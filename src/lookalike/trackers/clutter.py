@@ -51,6 +51,15 @@ class ClutterShare:
             self.flicker += n if overlap is None else n - len(set(overlap.nonzero()[1].tolist()))
         self._previous = xywh
 
+    def observe_count(self, xywh: np.ndarray, flicker: int) -> None:
+        """:meth:`observe` given the number ``flicker`` of this frame's boxes ``xywh (k, 4)`` overlapping none of
+        :attr:`previous`'s (all ``k`` when there were none), counted by the caller."""
+        n = len(xywh)
+        if self._previous is not None and n:
+            self.seen += n
+            self.flicker += flicker
+        self._previous = xywh
+
     @property
     def share(self) -> float | None:
         """The share of flickering detections, or None before ``min_count`` detections were judged."""

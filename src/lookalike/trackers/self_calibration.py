@@ -105,6 +105,14 @@ class MissReturns:
     def likely_present(self, missed: np.ndarray, share: float, min_count: int) -> np.ndarray:
         """Per track missed ``missed`` frames: whether, for every miss length up to its own, at least
         ``share`` of at least ``min_count`` resolved tracks (came back or died) came back."""
+        # negative lengths seen as unsigned are beyond ``longest`` too
+        length = np.asarray(missed, dtype=np.int64).view(np.uint64)
+        out: np.ndarray = self.present_table(share, min_count)[np.minimum(length, self.longest + 1)]
+        return out
+
+    def present_table(self, share: float, min_count: int) -> np.ndarray:
+        """:meth:`likely_present` as a table ``(longest + 2,)`` over miss lengths 0 … ``longest + 1`` (the last
+        entry, False, stands for every longer or negative length; 0 is False). Cached until the counts change."""
         key = (self._version, share, min_count)
         if self._ok is None or self._ok[0] != key:
             resolved = self.returned + self.ended
@@ -113,10 +121,7 @@ class MissReturns:
             ok = np.logical_and.accumulate(ok)
             ok[0] = False
             self._ok = (key, np.append(ok, False))  # one more False: every length beyond ``longest``
-        # negative lengths seen as unsigned are beyond ``longest`` too
-        length = np.asarray(missed, dtype=np.int64).view(np.uint64)
-        out: np.ndarray = self._ok[1][np.minimum(length, self.longest + 1)]
-        return out
+        return self._ok[1]
 
 
 class ScoreCalibration:
