@@ -9,7 +9,7 @@ goes to the best mean), or the baseline when none is. ``--average-from S`` adds 
 chosen weights into the package's shipped weights with what they were chosen on.
 
 ``--stage 2`` applies the rule of the second fine-tuning stage (:func:`choose_stage2`): the candidates are
-the snapshots at multiples of 100 and the mean of those from step 300 on; each is also timed on
+the snapshots at multiples of 200 and the mean of those from step 300 on; each is also timed on
 ``bench recovery``'s swap on tuning seeds (:data:`RECOVERY_SEED`), and a choice ships only when it is
 better than the baseline (:func:`better_than`).
 """
@@ -45,9 +45,9 @@ RECOVERY_SEED = 55_000
 RECOVERY_SEQUENCES = 10
 RECOVERY_FRAMES = 900
 RECOVERY_SWAP = (5.0, 10.0)  # (start, duration) in seconds, as ``bench recovery``'s defaults
-STAGE2_EVERY = 100
+STAGE2_EVERY = 200
 STAGE2_AVERAGE_FROM = 300
-STAGE2_RULE = ("candidates: snapshots at multiples of 100 and the mean of those from step 300 on; eligible: tuning "
+STAGE2_RULE = ("candidates: snapshots at multiples of 200 and the mean of those from step 300 on; eligible: tuning "
                "M=3, N=2 >= baseline, other tuning teams >= baseline - 0.3 points, tuning recovery mean <= baseline "
                "+ 0.05 s on every set-up and always recovered; choice: best M=3, N=2, within 0.05 points the lowest "
                "mean recovery, then the best mean success; shipped only if M=3, N=2 > baseline + 0.05 points or "
