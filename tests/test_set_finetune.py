@@ -91,7 +91,7 @@ def test_stage2_choice_weighs_small_team_then_recovery_and_ships_only_when_bette
     assert better_than({**base, "rec_m3n2": 0.4}, base)
 
 
-def test_stage2_candidates_are_the_hundreds_and_their_late_mean(tmp_path):
+def test_stage2_candidates_are_step_multiples_and_their_late_mean(tmp_path):
     from lookalike.bench.set_select import _candidates
 
     shapes = SetWeights({}, 8, 12, 6).shapes()
