@@ -129,6 +129,23 @@ def test_compiled_rows_equal_the_numpy_paths_on_real_detections(shared_data) -> 
     assert _run_both(frames, BoxTrackConfig(max_targets=10)) > 500
 
 
+@numba_missing
+def test_a_copied_compiled_tracker_goes_on_as_the_original() -> None:
+    import copy
+    import pickle
+
+    frames = _awkward(4, frames=60)
+    bk.use_compiled(True)
+    tracker = BoxTrack()
+    for frame in frames[:30]:
+        tracker.update(frame)
+    twins = [copy.deepcopy(tracker), pickle.loads(pickle.dumps(tracker))]
+    for frame in frames[30:]:
+        want = _rows(tracker.update(frame))
+        for twin in twins:
+            assert twin.compiled and np.array_equal(_rows(twin.update(frame)), want)
+
+
 def _columns(rng: np.random.Generator, k: int) -> np.ndarray:
     space = BoxCXCYWH(1 / 20, 1 / 160)
     z = np.column_stack([rng.uniform(0, 600, (k, 2)), rng.uniform(0.2, 90, (k, 2))])

@@ -82,8 +82,8 @@ class BoxTrack:
         self._lifecycle = lifecycle.closed_set() if cfg.max_targets is not None else lifecycle
         self._slots = None if cfg.max_targets is None else ClosedSlots(
             cfg.max_targets, cfg.closed_distance, const.CLOSED_GATE_GROWTH, refill_s=cfg.max_age_s)
-        # the compiled kernels (boxtrack_kernels; None: the numpy path), for this lifecycle's rules and IoU gates
-        self._kernels = boxtrack_kernels.compiled() if cfg.match_iou > 0 else None
+        # the compiled kernels (boxtrack_kernels) when on; they need IoU gates (match_iou > 0)
+        self._compiled = cfg.match_iou > 0 and boxtrack_kernels.compiled() is not None
         self.reset()
 
     def reset(self) -> None:
@@ -107,12 +107,12 @@ class BoxTrack:
     @property
     def compiled(self) -> bool:
         """Whether this tracker runs the compiled kernels (:mod:`lookalike.trackers.boxtrack_kernels`)."""
-        return self._kernels is not None
+        return self._compiled
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
-        if self._kernels is not None:
-            return self._update_compiled(frame, self._kernels)
+        if self._compiled:  # (the module is looked up, not kept: the tracker stays picklable)
+            return self._update_compiled(frame, boxtrack_kernels.module())
         cfg, t, clock = self.config, self._tracks, self._clock
         steps = clock.steps(frame.time)
         dt = steps * clock.interval

@@ -32,6 +32,11 @@ def compiled() -> Any | None:
     forced = _STATE.get("forced")
     if forced is False or (forced is None and os.environ.get("LOOKALIKE_BOXTRACK_NUMBA", "1") == "0"):
         return None
+    return module()
+
+
+def module() -> Any | None:
+    """The kernels' module whatever the switch says (imported on first use), ``None`` when numba is not installed."""
     if "kernels" not in _STATE:
         try:
             from lookalike.trackers import boxtrack_numba
