@@ -16,7 +16,8 @@ import logging
 import selectors
 import socket
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from lookalike.node.counters import NodeCounters, log_event
@@ -38,12 +39,30 @@ LOCALHOST = "127.0.0.1"
 
 
 def _preload() -> None:
-    """Import what the first frame would otherwise import: the assignment solver's scipy module."""
+    """Import what the first frame would otherwise import, when the node is built: the assignment
+    solver's scipy module (about 0.5 s of CPU time) and the world trackers' compiled kernels (numba,
+    when installed: about 0.6 s; :func:`~lookalike.trackers.world_kernels.warm`)."""
     import numpy as np
 
     from lookalike.association.solver import linear_sum_assignment
+    from lookalike.trackers.world_kernels import warm
 
     linear_sum_assignment(np.zeros((1, 1)))
+    warm()
+
+
+@contextmanager
+def _one_blas_thread() -> Iterator[None]:
+    """BLAS and LAPACK on the calling thread only inside the block (threadpoolctl, when installed): a
+    frame's algebra is on 2×2 to 6×6 matrices, where handing work to BLAS's threads costs more than it
+    saves and waits for them when the machine is busy."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover (scikit-learn, a core dependency, requires it)
+        yield
+        return
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield
 
 
 def parse_address(text: str, default_host: str = LOCALHOST) -> Address:
@@ -143,6 +162,7 @@ class NodeServer:
         self._last_frame_wall: float | None = None
         self._next_status = time.monotonic() + self.config.status_interval_s
         self._cpu_received: float | None = None  # thread CPU time when the datagram being handled was read
+        _preload()  # (before the address is announced: the first frame does not wait for imports)
         log_event(self.log, "listening", address=list(self.address))
 
     @property
@@ -166,17 +186,16 @@ class NodeServer:
     def serve(self, stop: Callable[[], bool], tick_s: float = 0.05) -> None:
         """Serve until ``stop()`` returns true (checked at least every ``tick_s`` seconds).
 
-        The assignment solver is imported first (scipy.optimize, imported lazily, takes about half
-        a second: the first frame would wait for it), then objects alive at the start (modules, the
-        tracker) are moved out of the garbage collector's sight (``gc.freeze``), so its full
-        collections stay short while serving.
+        Objects alive at the start (modules, the tracker) are moved out of the garbage collector's
+        sight (``gc.freeze``), so its full collections stay short while serving. BLAS runs on the
+        serving thread only (:func:`_one_blas_thread`).
         """
-        _preload()
         gc.collect()
         gc.freeze()
         try:
-            while not stop():
-                self.poll(tick_s)
+            with _one_blas_thread():
+                while not stop():
+                    self.poll(tick_s)
         finally:
             gc.unfreeze()
 

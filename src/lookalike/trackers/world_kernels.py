@@ -5,11 +5,20 @@ numpy's own LAPACK kernels without the wrappers' per-call checks (:func:`cholesk
 ``einsum`` (``np.einsum``'s C kernel, which it calls unless asked to optimise), and :func:`pairs`,
 the pairs of :func:`lookalike.association.solver.assign_pairs` from the same matrix handed to the
 same solver.
+
+:func:`compiled` gives the optional numba kernels (:mod:`lookalike.trackers.world_numba`, the ``fast``
+extra): the beacon identifier's window costs in one call, value by value the operations of the numpy
+path in its order (no fused multiply-adds), so identities are bit for bit the same;
+``tests/test_world_numba.py`` compares both paths. They are used when numba is installed unless
+``LOOKALIKE_WORLD_NUMBA=0``. numba is imported at the first frame that needs them (``lookalike serve``
+does it before serving: :func:`warm`), not with ``import lookalike``.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -74,3 +83,48 @@ def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf,
     rows, cols = linear_sum_assignment(np.where(allowed, cost, max_cost + 1e-6))
     keep = allowed[rows, cols]
     return rows[keep], cols[keep]
+
+
+_STATE: dict[str, Any] = {}
+
+
+def use_compiled(flag: bool | None) -> None:
+    """Force the compiled kernels on (``True``, if numba is installed) or off (``False``); ``None``: the
+    default (on when numba imports and ``LOOKALIKE_WORLD_NUMBA`` is not ``0``)."""
+    _STATE.pop("forced", None)
+    if flag is not None:
+        _STATE["forced"] = bool(flag)
+
+
+def compiled() -> Any:
+    """The :mod:`~lookalike.trackers.world_numba` module, or ``None`` when the kernels are off or numba is
+    not installed (or its ``cos`` rounds differently from numpy's here)."""
+    forced = _STATE.get("forced")
+    if forced is False or (forced is None and os.environ.get("LOOKALIKE_WORLD_NUMBA", "1") == "0"):
+        return None
+    if "module" not in _STATE:
+        _STATE["module"] = _build()
+    return _STATE["module"]
+
+
+def warm() -> bool:
+    """Import and load (compiling at the first use after installation) the compiled kernels now, so that
+    the first frame does not wait for them; whether they are in use."""
+    kernels = compiled()
+    if kernels is None:
+        return False
+    out = np.empty((1, 2))
+    kernels.window_costs(np.full((2, 2, 2), np.nan), np.zeros(1), np.zeros(1), np.zeros((1, 1)), 1.0, 1.0, out)
+    return True
+
+
+def _build() -> Any:
+    try:
+        from lookalike.trackers import world_numba
+    except ImportError:
+        return None
+    # (the kernels' cos is libm's; numpy may use its own vector code: they must agree on every value here)
+    angles = np.linspace(-4.0 * np.pi, 4.0 * np.pi, 4099)
+    if not np.array_equal(world_numba.cosines(angles), np.cos(angles)):
+        return None
+    return world_numba

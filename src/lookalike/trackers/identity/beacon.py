@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.trackers.world_kernels import filled, pairs
+from lookalike.trackers.world_kernels import compiled, filled, pairs
 from lookalike.types import Beacons
 
 
@@ -211,6 +211,13 @@ class BeaconIdentifier:
         if not rows or n == 0:
             return np.zeros((len(rows), n))
         samples = self._win[rows]
+        kernels = compiled() if n > 1 else None  # (one agent: numpy sums the window pairwise)
+        if kernels is not None:
+            out = np.empty((len(rows), n))
+            cfg = self.config
+            kernels.window_costs(self._th, self._times, self._times_count, samples, cfg.max_turn_rate,
+                                 cfg.max_extrapolation_s, out)
+            return out
         agent = self._headings(self._times, self._times_count)  # (W, N)
         d = np.subtract(samples[:, :, None], agent[None])  # (k, W, N): (1 - cos(d)) / 2, in place
         np.cos(d, out=d)

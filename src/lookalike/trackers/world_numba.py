@@ -1,0 +1,107 @@
+"""The numba kernels of :mod:`lookalike.trackers.world_kernels` (imported only when numba is installed)."""
+
+from __future__ import annotations
+
+import math
+
+import numba  # type: ignore[import-untyped, import-not-found, unused-ignore]
+import numpy as np
+
+_jit = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy", boundscheck=False)
+
+
+@_jit
+def _maximum(x: float, y: float) -> float:
+    """``np.maximum`` of two floats (NaN wins)."""
+    return x if (x >= y or x != x) else y
+
+
+@_jit
+def _minimum(x: float, y: float) -> float:
+    """``np.minimum`` of two floats (NaN wins)."""
+    return x if (x <= y or x != x) else y
+
+
+@_jit
+def _wrap(x: float) -> float:
+    """``pi - np.mod(pi - x, 2 pi)``: numpy's float remainder (``fmod``, moved to the divisor's sign)."""
+    two_pi = 2.0 * np.pi
+    m: float = np.fmod(np.pi - x, two_pi)
+    if m != 0.0:
+        if m < 0.0:  # (NaN: no change, as in numpy)
+            m += two_pi
+    else:
+        m = 0.0
+    return np.pi - m
+
+
+@_jit
+def _agent_headings(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, max_turn_rate: float,
+                    max_extrapolation_s: float) -> np.ndarray:
+    """``BeaconIdentifier._headings``: the agents' headings ``(W, N)`` at the times ``q (W,)`` (``q_count``: ``q``
+    with NaN as +inf) from the report histories ``th (2, N, r)`` (send times, headings; NaN padded at the front)."""
+    n, r = th.shape[1], th.shape[2]
+    n_times = q.shape[0]
+    agent = np.full((n_times, n), np.nan)
+    for a in range(n):
+        k = 0
+        for j in range(r):
+            if th[0, a, j] == th[0, a, j]:
+                k += 1
+        if k == 0:
+            continue
+        first = r - k
+        t_last, h_last, t_prev = th[0, a, r - 1], th[1, a, r - 1], th[0, a, r - 2]
+        rate = 0.0
+        if t_last > t_prev:  # (turning: two reports or more)
+            turn = _wrap(h_last - th[1, a, r - 2]) / (t_last - t_prev)
+            rate = _minimum(_maximum(turn, -max_turn_rate), max_turn_rate)
+        for w in range(n_times):
+            at_or_before = 0
+            for j in range(r):
+                if th[0, a, j] <= q_count[w]:
+                    at_or_before += 1
+            if at_or_before >= k:
+                agent[w, a] = h_last + rate * _minimum(_maximum(q[w] - t_last, 0.0), max_extrapolation_s)
+            elif at_or_before == 0:
+                agent[w, a] = th[1, a, first]
+            else:
+                before = first + at_or_before - 1
+                t_before, h_before = th[0, a, before], th[1, a, before]
+                span = th[0, a, before + 1] - t_before
+                frac = (q[w] - t_before) / span if span > 0 else 0.0
+                agent[w, a] = h_before + frac * _wrap(th[1, a, before + 1] - h_before)
+    return agent
+
+
+@_jit
+def window_costs(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np.ndarray, max_turn_rate: float,
+                 max_extrapolation_s: float, out: np.ndarray) -> None:
+    """The beacon identifier's window costs into ``out (k, N)``: the mean ``(1 - cos)/2`` of each sample row
+    ``samples (k, W)`` against each agent's heading at the window times (:func:`_agent_headings`) over the finite
+    terms (``inf`` with none). The operations of ``BeaconIdentifier._headings`` and ``_costs``, value by value in
+    the same order (each sum runs over the window times in order, as numpy's reduction over that axis)."""
+    agent = _agent_headings(th, q, q_count, max_turn_rate, max_extrapolation_s)
+    n_times, n = agent.shape
+    for row in range(samples.shape[0]):
+        for a in range(n):
+            total = 0.0
+            count = 0
+            for w in range(n_times):
+                d = samples[row, w] - agent[w, a]
+                if d != d:  # (no sample or no heading: a NaN term, not counted)
+                    continue
+                c = (1.0 - math.cos(d)) * 0.5
+                if math.isfinite(c):
+                    count += 1
+                    total = c if count == 1 else total + c
+            out[row, a] = total / count if count > 0 else np.inf
+
+
+@_jit
+def cosines(x: np.ndarray) -> np.ndarray:
+    """The kernels' ``cos`` of each value of ``x`` (compared with numpy's before the kernels are used)."""
+    out = np.empty_like(x)
+    for i in range(x.shape[0]):
+        out[i] = math.cos(x[i])
+    return out

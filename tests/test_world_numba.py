@@ -1,0 +1,124 @@
+"""The compiled world kernels (numba, optional) give bit for bit what the numpy path gives: the beacon
+identifier's window costs on awkward report histories and samples, and whole Kalman-HA runs."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+
+import lookalike.trackers.world_kernels as wk
+from lookalike.node.teamsim import team_sequence
+from lookalike.trackers import make_tracker
+from lookalike.trackers.identity import BeaconIdentifier, IdentifierConfig
+from lookalike.types import Beacons
+
+numba = pytest.importorskip("numba", reason="numba (the `fast` extra) is not installed: only the numpy path runs")
+
+
+@pytest.fixture(autouse=True)
+def _default_switch() -> Iterator[None]:
+    yield
+    wk.use_compiled(None)
+
+
+def _compiled_or_skip() -> None:
+    wk.use_compiled(True)
+    if wk.compiled() is None:
+        pytest.skip("numba's cos differs from numpy's on this machine: the compiled kernels stay off")
+
+
+def both_costs(ident: BeaconIdentifier, track_ids: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    _compiled_or_skip()
+    fast = ident.costs(track_ids)
+    wk.use_compiled(False)
+    plain = ident.costs(track_ids)
+    return fast, plain
+
+
+def assert_same_bits(fast: np.ndarray, plain: np.ndarray) -> None:
+    assert fast.dtype == plain.dtype and fast.shape == plain.shape
+    assert np.array_equal(fast.view(np.int64), plain.view(np.int64))
+
+
+def random_beacons(rng: np.random.Generator, n_agents: int, t: float) -> Beacons:
+    """Reports of a random subset of agents (some never report), now and then late, repeated or out of order."""
+    agents = [a for a in range(n_agents) if a % 3 != 2 and rng.random() < 0.6]
+    ids, sent, heading = [], [], []
+    for a in agents:
+        for _ in range(1 + int(rng.random() < 0.2)):  # sometimes two reports of one agent
+            ids.append(a)
+            sent.append(t - rng.choice([0.0, 0.01, 0.05, 0.3, 1.5]))  # late ones, repeated times
+            heading.append(float(rng.choice([rng.uniform(-np.pi, np.pi), np.pi, -np.pi, rng.uniform(-20, 20)])))
+    return Beacons(agent_id=np.array(ids, dtype=int), t_sent=np.array(sent), t_received=np.full(len(ids), t),
+                   heading=np.array(heading))
+
+
+@pytest.mark.parametrize("n_agents", [1, 2, 3, 7, 10])
+@pytest.mark.parametrize("window", [1, 5, 30])
+def test_compiled_window_costs_equal_numpys(n_agents: int, window: int) -> None:
+    rng = np.random.default_rng(n_agents * 100 + window)
+    ident = BeaconIdentifier(IdentifierConfig(n_agents=n_agents, window_frames=window, history=4,
+                                              max_turn_rate=0.5, max_extrapolation_s=0.2))
+    checked = 0
+    for frame in range(3 * window + 12):
+        t = 0.1 * frame + rng.uniform(0, 0.02)
+        empty = rng.random() < 0.2
+        ident.begin_frame(t, Beacons.empty() if empty else random_beacons(rng, n_agents, t))
+        seen = [i for i in range(1, 9) if rng.random() < 0.7]
+        if seen:  # headings near the wrap, exactly opposite, or far outside [-pi, pi)
+            ident.observe_many(seen, rng.choice([0.0, np.pi, -np.pi, 3.0, rng.uniform(-50, 50)], size=len(seen)))
+        for ids in ([], [1], [99], list(range(1, 9)), [5, 99, 2, 5]):  # (99: never observed, row 0)
+            fast, plain = both_costs(ident, ids)
+            assert_same_bits(fast, plain)
+            checked += fast.size
+    assert checked > 0
+
+
+def test_compiled_costs_without_reports_or_samples() -> None:
+    ident = BeaconIdentifier(IdentifierConfig(n_agents=4, window_frames=3))
+    ident.begin_frame(0.0, Beacons.empty())
+    fast, plain = both_costs(ident, [1, 2])  # no reports, no samples: every cost infinite
+    assert_same_bits(fast, plain)
+    assert np.isinf(fast).all()
+    ident.observe_many([1], np.array([0.5]))
+    ident.begin_frame(0.1, Beacons(agent_id=np.array([3]), t_sent=np.array([0.05]), t_received=np.array([0.1]),
+                                   heading=np.array([1.0])))
+    fast, plain = both_costs(ident, [1, 2])  # one report of one agent, one sample of one track
+    assert_same_bits(fast, plain)
+    assert np.isfinite(fast[0, 3]) and np.isinf(fast[1]).all()
+
+
+def _tracks_columns(name: str, preset: str, seed: int, seconds: float, **network: float) -> list[tuple]:
+    sequence = team_sequence(preset, seed, seconds, **network)
+    tracker = make_tracker(name, n_agents=sequence.config.n_agents)
+    rows = []
+    for frame in sequence.frames():
+        t = tracker.update(frame)
+        rows.append(tuple(np.array(getattr(t, f)) for f in ("id", "status", "position", "heading", "agent_id",
+                                                              "identity_prob", "detection_index")))
+    return rows
+
+
+@pytest.mark.parametrize("name", ["kalman_ha", "kalman_ha2"])
+@pytest.mark.parametrize(("preset", "seed", "network"), [("m10n7", 0, {}), ("m3n2", 1, {"loss": 0.5, "jitter_s": 0.2})])
+def test_compiled_tracker_runs_equal_numpys(name: str, preset: str, seed: int, network: dict) -> None:
+    _compiled_or_skip()
+    fast = _tracks_columns(name, preset, seed, 3.0, **network)
+    wk.use_compiled(False)
+    plain = _tracks_columns(name, preset, seed, 3.0, **network)
+    assert len(fast) == len(plain)
+    for a, b in zip(fast, plain):
+        for x, y in zip(a, b):
+            assert x.dtype == y.dtype and np.array_equal(x, y, equal_nan=x.dtype.kind == "f")
+
+
+def test_switch_and_warm(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("LOOKALIKE_WORLD_NUMBA", "0")
+    assert wk.compiled() is None and wk.warm() is False
+    monkeypatch.delenv("LOOKALIKE_WORLD_NUMBA")
+    wk.use_compiled(False)
+    assert wk.compiled() is None
+    wk.use_compiled(None)
+    assert wk.warm() is (wk.compiled() is not None)
