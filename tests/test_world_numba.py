@@ -76,6 +76,37 @@ def test_compiled_window_costs_equal_numpys(n_agents: int, window: int) -> None:
     assert checked > 0
 
 
+@pytest.mark.parametrize("n_agents", [2, 3, 7])
+@pytest.mark.parametrize(("max_cost", "hysteresis"), [(0.3, 0.08), (1.0, 0.0), (0.05, 0.5), (0.0, 0.1)])
+def test_compiled_identities_equal_numpys(n_agents: int, max_cost: float, hysteresis: float) -> None:
+    _compiled_or_skip()
+    rng = np.random.default_rng(n_agents)
+    config = IdentifierConfig(n_agents=n_agents, window_frames=6, max_cost=max_cost, hysteresis=hysteresis)
+    fast, plain = BeaconIdentifier(config), BeaconIdentifier(config)  # (assigning changes the held agents)
+    assigned = 0
+    for frame in range(60):
+        t = 0.1 * frame
+        beacons = random_beacons(rng, n_agents, t)
+        tracks = [i for i in range(1, 12) if rng.random() < 0.6]
+        headings = rng.uniform(-np.pi, np.pi, size=len(tracks))
+        if frame % 7 == 3:  # every track near one agent's heading: several allowed pairs a row
+            headings[:] = beacons.heading[0] if len(beacons) else 0.0
+        results = []
+        for ident, compiled in ((fast, True), (plain, False)):
+            wk.use_compiled(compiled)
+            ident.begin_frame(t, beacons)
+            if tracks:
+                ident.observe_many(tracks, headings)
+            if frame % 5 == 4 and tracks:
+                ident.drop(tracks[:1])
+            results.append(ident.assign_arrays(tracks + [99]))  # (99: never observed)
+        (agent_f, prob_f), (agent_p, prob_p) = results
+        assert np.array_equal(agent_f, agent_p)
+        assert_same_bits(prob_f, prob_p)
+        assigned += int((agent_f >= 0).sum())
+    assert assigned > 0 or max_cost == 0.0
+
+
 def test_compiled_costs_without_reports_or_samples() -> None:
     ident = BeaconIdentifier(IdentifierConfig(n_agents=4, window_frames=3))
     ident.begin_frame(0.0, Beacons.empty())

@@ -80,7 +80,19 @@ def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf,
     if not (unit and max_cost <= 1.0):
         return solve_allowed(cost, allowed, max_cost)
     # |max_cost - min| <= 1: the solver's scale is 1, every entry within [0, 1 + 1e-6]
-    rows, cols = linear_sum_assignment(np.where(allowed, cost, max_cost + 1e-6))
+    return decided_pairs(2, np.where(allowed, cost, max_cost + 1e-6), allowed)
+
+
+def decided_pairs(decision: int, work: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`pairs` with ``unit`` once its checks are made: ``decision`` 0 (nothing allowed), 1 (the
+    ``allowed`` pairs are disjoint: they are the pairs) or 2 (solve ``work``, the costs with forbidden
+    pairs at ``max_cost + 1e-6``, and keep the allowed pairs)."""
+    if decision == 0:
+        return _NONE, _NONE
+    if decision == 1:
+        rows, cols = allowed.nonzero()
+        return rows, cols
+    rows, cols = linear_sum_assignment(work)
     keep = allowed[rows, cols]
     return rows[keep], cols[keep]
 

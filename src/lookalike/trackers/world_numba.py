@@ -99,6 +99,43 @@ def window_costs(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np
 
 
 @_jit
+def identity_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np.ndarray, current: np.ndarray,
+                  max_turn_rate: float, max_extrapolation_s: float, hysteresis: float,
+                  max_cost: float) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+    """``BeaconIdentifier.assign_arrays`` up to the solver: the window costs ``(k, N)`` (:func:`window_costs`),
+    each held agent's (``current (k,)``, -1: none) cost less ``hysteresis`` (not below 0), the pairs allowed
+    (``<= max_cost``, at most 1) and the solver's matrix (forbidden pairs at ``max_cost + 1e-6``), and what
+    ``world_kernels.pairs`` decides from them: 0 no pair allowed, 1 the allowed pairs are disjoint (they are
+    the answer), 2 the solver is needed. Returns ``(decision, cost, work, allowed)``."""
+    k, n = samples.shape[0], th.shape[1]
+    cost = np.empty((k, n))
+    window_costs(th, q, q_count, samples, max_turn_rate, max_extrapolation_s, cost)
+    work = np.empty((k, n))
+    allowed = np.zeros((k, n), np.bool_)
+    forbidden = max_cost + 1e-6
+    per_column = np.zeros(n, np.int64)
+    found, disjoint = False, True
+    for i in range(k):
+        per_row = 0
+        for j in range(n):
+            c = cost[i, j]
+            if j == current[i]:
+                c = _maximum(c - hysteresis, 0.0)
+            if c <= max_cost:
+                allowed[i, j] = True
+                work[i, j] = c
+                per_row += 1
+                per_column[j] += 1
+                found = True
+            else:
+                work[i, j] = forbidden
+        disjoint = disjoint and per_row <= 1
+    for j in range(n):
+        disjoint = disjoint and per_column[j] <= 1
+    return (0 if not found else 1 if disjoint else 2), cost, work, allowed
+
+
+@_jit
 def cosines(x: np.ndarray) -> np.ndarray:
     """The kernels' ``cos`` of each value of ``x`` (compared with numpy's before the kernels are used)."""
     out = np.empty_like(x)
