@@ -107,6 +107,29 @@ def test_compiled_identities_equal_numpys(n_agents: int, max_cost: float, hyster
     assert assigned > 0 or max_cost == 0.0
 
 
+def test_compiled_gate_pairs_equal_numpys() -> None:
+    _compiled_or_skip()
+    kernels = wk.compiled()
+    rng = np.random.default_rng(5)
+    solved = 0
+    for case in range(400):
+        k, d = int(rng.integers(1, 9)), int(rng.integers(1, 9))
+        y = rng.normal(0.0, [0.5, 1.0, 3.0, 1e146][case % 4], size=(k, 2, d))
+        if case % 5 == 1:
+            y = np.round(y)  # equal distances: ties for the solver
+        if case % 7 == 2:
+            y[0, 0, 0] = np.nan  # (a non-definite innovation covariance)
+        gate = [9.21, 0.5, 1e300, 0.0][case % 4]
+        d2 = np.add.reduce(y * y, axis=1)
+        rows, cols = wk.pairs(d2, d2 <= gate)
+        decision, work, allowed = kernels.gate_work(y, gate)
+        fast_rows, fast_cols = wk.decided_pairs(decision, work, allowed)
+        assert np.array_equal(rows, fast_rows) and np.array_equal(cols, fast_cols), case
+        assert np.array_equal(allowed, d2 <= gate)
+        solved += decision == 2
+    assert solved > 50
+
+
 def test_compiled_costs_without_reports_or_samples() -> None:
     ident = BeaconIdentifier(IdentifierConfig(n_agents=4, window_frames=3))
     ident.begin_frame(0.0, Beacons.empty())

@@ -33,7 +33,7 @@ from lookalike.motion.spaces import WorldCA
 from lookalike.trackers.identity import BeaconIdentifier, IdentifierConfig
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.table import TrackTable
-from lookalike.trackers.world_kernels import cholesky, einsum, filled, pairs, solve
+from lookalike.trackers.world_kernels import cholesky, compiled, decided_pairs, einsum, filled, pairs, solve
 from lookalike.trackers.world_rules import HeuristicsConfig, WorldConfig, WorldRules, headings, positions
 from lookalike.types import Detections, Frame, Tracks
 
@@ -131,8 +131,12 @@ class WorldTracker:
         S = cov[:, :2, :2] + noise
         diff = z[None, :, :] - mean[:, None, :2]  # (k, d, 2)
         y = solve(cholesky(S), diff.swapaxes(-1, -2))  # (k, 2, d)
-        d2 = np.add.reduce(y * y, axis=1)
-        rows, cols = pairs(d2, d2 <= self._gate)
+        kernels = compiled()
+        if kernels is not None:  # (the lines below and pairs' steps up to the solver, in one compiled call)
+            rows, cols = decided_pairs(*kernels.gate_work(y, self._gate))
+        else:
+            d2 = np.add.reduce(y * y, axis=1)
+            rows, cols = pairs(d2, d2 <= self._gate)
         det_of_track[rows] = cols
         if len(rows):
             m, P = mean[rows], cov[rows]

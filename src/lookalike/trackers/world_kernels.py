@@ -7,8 +7,9 @@ the pairs of :func:`lookalike.association.solver.assign_pairs` from the same mat
 same solver.
 
 :func:`compiled` gives the optional numba kernels (:mod:`lookalike.trackers.world_numba`, the ``fast``
-extra): the beacon identifier's window costs in one call, value by value the operations of the numpy
-path in its order (no fused multiply-adds), so identities are bit for bit the same;
+extra): the beacon identifier's window costs and assignment matrix, and the Kalman trackers' gate and
+assignment matrix, each in one call up to the solver, value by value the operations of the numpy path
+in its order (no fused multiply-adds), so tracks and identities are bit for bit the same;
 ``tests/test_world_numba.py`` compares both paths. They are used when numba is installed unless
 ``LOOKALIKE_WORLD_NUMBA=0``. numba is imported at the first frame that needs them (``lookalike serve``
 does it before serving: :func:`warm`), not with ``import lookalike``.
@@ -84,9 +85,9 @@ def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf,
 
 
 def decided_pairs(decision: int, work: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`pairs` with ``unit`` once its checks are made: ``decision`` 0 (nothing allowed), 1 (the
-    ``allowed`` pairs are disjoint: they are the pairs) or 2 (solve ``work``, the costs with forbidden
-    pairs at ``max_cost + 1e-6``, and keep the allowed pairs)."""
+    """:func:`pairs` once its checks are made: ``decision`` 0 (nothing allowed), 1 (the ``allowed`` pairs
+    are disjoint: they are the pairs) or 2 (solve ``work``, the matrix :func:`pairs` hands the solver,
+    and keep the allowed pairs)."""
     if decision == 0:
         return _NONE, _NONE
     if decision == 1:

@@ -136,6 +136,55 @@ def identity_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: n
 
 
 @_jit
+def gate_work(y: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
+    """The Kalman trackers' association up to the solver, from the whitened innovations ``y (k, 2, d)``: the
+    squared Mahalanobis distances ``y0² + y1²``, the pairs inside the ``gate`` (NaN: outside), and the matrix
+    ``solver.solve_allowed`` hands the solver for them without a cost limit (allowed costs less their minimum,
+    forbidden ones at ``(top + 1)(min(k, d) + 1)`` above the largest; rescaled when huge), with the decision of
+    ``world_kernels.pairs`` (0 nothing allowed, 1 disjoint pairs, 2 solve). Returns ``(decision, work, allowed)``."""
+    k, d = y.shape[0], y.shape[2]
+    work = np.empty((k, d))
+    allowed = np.zeros((k, d), np.bool_)
+    per_column = np.zeros(d, np.int64)
+    found, disjoint = False, True
+    low = np.inf
+    for i in range(k):
+        per_row = 0
+        for j in range(d):
+            a, b = y[i, 0, j], y[i, 1, j]
+            c = a * a + b * b
+            work[i, j] = c
+            if c <= gate:
+                allowed[i, j] = True
+                per_row += 1
+                per_column[j] += 1
+                found = True
+                low = _minimum(low, c)
+        disjoint = disjoint and per_row <= 1
+    for j in range(d):
+        disjoint = disjoint and per_column[j] <= 1
+    if not found or disjoint:
+        return (1 if found else 0), work, allowed
+    top = 0.0  # (the forbidden pairs' 0.0 takes part in the maximum)
+    for i in range(k):
+        for j in range(d):
+            work[i, j] = work[i, j] - low if allowed[i, j] else 0.0
+            top = _maximum(top, work[i, j])
+    shortest = min(k, d)
+    if top > 0 and top * shortest > 1e290:
+        for i in range(k):
+            for j in range(d):
+                work[i, j] = work[i, j] / top
+        top = 1.0
+    penalty = (top + 1.0) * (shortest + 1)
+    for i in range(k):
+        for j in range(d):
+            if not allowed[i, j]:
+                work[i, j] = penalty
+    return 2, work, allowed
+
+
+@_jit
 def cosines(x: np.ndarray) -> np.ndarray:
     """The kernels' ``cos`` of each value of ``x`` (compared with numpy's before the kernels are used)."""
     out = np.empty_like(x)
