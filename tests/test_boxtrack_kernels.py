@@ -5,7 +5,6 @@ kernel the numbers of the numpy operations it replaces. Without numba the switch
 
 from __future__ import annotations
 
-import importlib.util
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -42,7 +41,7 @@ def test_import_lookalike_does_not_import_numba() -> None:
 
 
 numba_missing = pytest.mark.skipif(
-    importlib.util.find_spec("numba") is None,
+    bk.module() is None,
     reason="numba (the `fast` extra) is not installed: only the numpy path runs")
 
 
