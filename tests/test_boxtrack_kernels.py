@@ -129,6 +129,15 @@ def test_compiled_rows_equal_the_numpy_paths_on_real_detections(shared_data) -> 
 
 
 @numba_missing
+def test_frames_with_other_float_columns_take_the_numpy_path() -> None:
+    frames = _awkward(5, frames=60)
+    for frame in frames[20:40]:  # float32 columns, as a caller building Detections without checks could leave
+        object.__setattr__(frame.detections, "xywh", frame.detections.xywh.astype(np.float32))
+        object.__setattr__(frame.detections, "score", frame.detections.score.astype(np.float32))
+    assert _run_both(frames) > 10
+
+
+@numba_missing
 def test_a_copied_compiled_tracker_goes_on_as_the_original() -> None:
     import copy
     import pickle

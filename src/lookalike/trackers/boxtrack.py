@@ -56,6 +56,7 @@ from lookalike.types import Frame, Tracks
 _to_xywh = cxcywh_to_xywh  # kept for callers of the old private helper
 _NO_BOXES = np.zeros((0, 4))
 _NO_INDEX = np.zeros(0, dtype=np.int64)
+_F64 = np.dtype(np.float64)
 
 
 def _xywh_columns(cxcywh: np.ndarray, out: np.ndarray) -> None:
@@ -113,7 +114,10 @@ class BoxTrack:
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
-        if self._compiled:  # (the module is looked up, not kept: the tracker stays picklable)
+        dets = frame.detections
+        if self._compiled and dets.xywh.dtype is _F64 and dets.score.dtype is _F64:
+            # (float64 columns, as Detections makes them: the kernels' arithmetic is the numpy path's; the
+            # module is looked up, not kept, so the tracker stays picklable)
             return self._update_compiled(frame, boxtrack_kernels.module())
         cfg, t, clock = self.config, self._tracks, self._clock
         steps = clock.steps(frame.time)
