@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from lookalike.eval.data import Pairs, SequenceData
-from lookalike.eval.matching import conflicted_frames, frame_bounds, hungarian
+from lookalike.eval.matching import conflicted_frames, negated_blocks, solve_blocks
 
 ALPHAS = np.arange(0.05, 0.99, 0.05)  # the exact float values TrackEval compares with
 LABELS = tuple(range(5, 100, 5))
@@ -69,29 +69,22 @@ def _match_frames(data: SequenceData, pairs: Pairs,
                   alignment: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per frame, the Hungarian matching maximising ``alignment * similarity``: matched ``(gt id, tracker id,
     similarity)`` in frame order, rows ascending within a frame (pairs of zero similarity included)."""
-    linear_sum_assignment = hungarian()
     n_frames = data.num_frames
     frame, gt_det, tr_det = pairs.frame, pairs.gt_det, pairs.tracker_det
     score = alignment[pairs.gt_id, pairs.tracker_id] * pairs.similarity
     hard = conflicted_frames(frame, gt_det, tr_det, n_frames, pairs.num_gt_dets, pairs.num_tracker_dets)
     # One-to-one frames: every pair is matched. Others: the Hungarian algorithm on the dense frame matrix.
     easy = ~hard[frame]
-    m_gt, m_tr = [gt_det[easy]], [tr_det[easy]]
     hard_frames = np.flatnonzero(hard)
-    counts = []
     gb, tb = data.gt_bounds, data.tracker_bounds
-    local_g, local_t = gt_det - gb[frame], tr_det - tb[frame]
-    cuts, g_cuts, t_cuts = frame_bounds(frame, n_frames).tolist(), gb.tolist(), tb.tolist()
-    for t in hard_frames.tolist():
-        a, b = cuts[t], cuts[t + 1]
-        mat = np.zeros((g_cuts[t + 1] - g_cuts[t], t_cuts[t + 1] - t_cuts[t]))
-        mat[local_g[a:b], local_t[a:b]] = score[a:b]
-        rows, cols = linear_sum_assignment(-mat)
-        m_gt.append(rows + g_cuts[t])
-        m_tr.append(cols + t_cuts[t])
-        counts.append(len(rows))
+    shapes = np.stack([np.diff(gb)[hard_frames], np.diff(tb)[hard_frames]], axis=1)
+    f = frame[~easy]
+    buffer, offsets = negated_blocks(shapes, (np.cumsum(hard) - 1)[f], gt_det[~easy] - gb[f], tr_det[~easy] - tb[f],
+                                     score[~easy])
+    rows, cols, counts = solve_blocks(buffer, offsets, shapes)
     mf = np.concatenate([frame[easy], np.repeat(hard_frames, counts)])
-    mg, mt = np.concatenate(m_gt), np.concatenate(m_tr)
+    mg = np.concatenate([gt_det[easy], rows + np.repeat(gb[hard_frames], counts)])
+    mt = np.concatenate([tr_det[easy], cols + np.repeat(tb[hard_frames], counts)])
     order = np.argsort(mf, kind="stable")
     mg, mt = mg[order], mt[order]
     # Similarity of each match: 0 unless it is a listed pair.

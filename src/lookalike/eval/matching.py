@@ -4,7 +4,8 @@ already form a one-to-one matching.
 A frame's score matrix is zero except at its listed pairs. When no detection appears in two of a
 frame's positive pairs, every maximum-score assignment contains all of them, so the Hungarian
 algorithm is only run on the other frames, on the same dense matrix as before (same result, same
-tie-breaking).
+tie-breaking). Those matrices are built all at once in one flat buffer (:func:`negated_blocks`) and
+solved one after another (:func:`solve_blocks`), instead of one allocation and scatter per frame.
 """
 
 from __future__ import annotations
@@ -40,8 +41,31 @@ def conflicted_frames(frame: np.ndarray, gt_det: np.ndarray, tracker_det: np.nda
     return result
 
 
-def dense(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """A ``shape`` float64 matrix, zero except ``values`` at ``(rows, cols)``."""
-    out = np.zeros(shape)
-    out[rows, cols] = values
-    return out
+def negated_blocks(shapes: np.ndarray, block: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                   values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``k`` dense matrices of ``shapes`` ``(k, 2)``, negated and stored row-major one after another in one
+    flat float64 buffer: ``-0.0`` everywhere (as ``-np.zeros(shape)``) except ``-values`` at ``(rows, cols)`` of
+    matrix ``block`` (one entry per value). Returns the buffer and the ``(k + 1,)`` offsets of the matrices."""
+    offsets = np.zeros(len(shapes) + 1, np.int64)
+    np.cumsum(shapes[:, 0] * shapes[:, 1], out=offsets[1:])
+    buffer = np.full(int(offsets[-1]), -0.0)
+    buffer[offsets[block] + rows * shapes[block, 1] + cols] = -values
+    return buffer, offsets
+
+
+def solve_blocks(buffer: np.ndarray, offsets: np.ndarray,
+                 shapes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The minimum-cost assignment of each matrix of :func:`negated_blocks` (the maximum one of the
+    un-negated matrix): its rows and columns (local indices) concatenated, and the number per matrix."""
+    linear_sum_assignment = hungarian()
+    rows, cols = [], []
+    for start, stop, n_rows, n_cols in zip(offsets[:-1].tolist(), offsets[1:].tolist(), shapes[:, 0].tolist(),
+                                           shapes[:, 1].tolist()):
+        r, c = linear_sum_assignment(buffer[start:stop].reshape(n_rows, n_cols))
+        rows.append(r)
+        cols.append(c)
+    if not rows:
+        empty = np.zeros(0, np.int64)
+        return empty, empty, empty
+    counts = np.fromiter((len(r) for r in rows), np.int64, len(rows))
+    return np.concatenate(rows), np.concatenate(cols), counts

@@ -20,7 +20,7 @@ from typing import Literal, Protocol
 import numpy as np
 
 from lookalike.eval.data import Pairs, SequenceData
-from lookalike.eval.matching import conflicted_frames, dense, frame_bounds, hungarian
+from lookalike.eval.matching import conflicted_frames, negated_blocks, solve_blocks
 from lookalike.eval.similarity import pair_iou, point_similarity
 from lookalike.types.mot_table import MotTable as MotTableData
 
@@ -217,7 +217,6 @@ def _drop_distractor_matches(keep_r: np.ndarray, gi: np.ndarray, ri: np.ndarray,
                              distractors: tuple[int, ...]) -> None:
     """Clear ``keep_r`` for tracker boxes that the per-frame Hungarian matching at IoU >= 0.5 pairs with a
     distractor-class ground-truth box (TrackEval's MOT16+ preprocessing)."""
-    linear_sum_assignment = hungarian()
     strong = sim >= 0.5 - _EPS
     gi, ri, sim = gi[strong], ri[strong], sim[strong]
     frame = g_frame[gi]
@@ -228,14 +227,17 @@ def _drop_distractor_matches(keep_r: np.ndarray, gi: np.ndarray, ri: np.ndarray,
     n = len(gb) - 1
     conflicted = conflicted_frames(frame, gi, ri, n, len(g_frame), len(keep_r))
     keep_r[ri[is_d & ~conflicted[frame]]] = False  # one-to-one frames: every strong pair is a match
-    bounds = frame_bounds(frame, n)
-    for t in np.unique(frame[is_d & conflicted[frame]]):
-        a, b = bounds[t], bounds[t + 1]
-        score = dense((int(gb[t + 1] - gb[t]), int(rb[t + 1] - rb[t])), gi[a:b] - gb[t], ri[a:b] - rb[t], sim[a:b])
-        rows, cols = linear_sum_assignment(-score)
-        ok = score[rows, cols] > _EPS
-        rows, cols = rows[ok], cols[ok]
-        keep_r[rb[t] + cols[distractor[gb[t] + rows]]] = False
+    solve = np.unique(frame[is_d & conflicted[frame]])  # frames to solve, each on its dense matrix
+    block = np.full(n, -1)
+    block[solve] = np.arange(len(solve))
+    inside = block[frame] >= 0
+    f = frame[inside]
+    shapes = np.stack([np.diff(gb)[solve], np.diff(rb)[solve]], axis=1)
+    cost, offsets = negated_blocks(shapes, block[f], gi[inside] - gb[f], ri[inside] - rb[f], sim[inside])
+    rows, cols, counts = solve_blocks(cost, offsets, shapes)
+    rows_at, cols_at = rows + np.repeat(gb[solve], counts), cols + np.repeat(rb[solve], counts)
+    ok = cost[np.repeat(offsets[:-1], counts) + rows * np.repeat(shapes[:, 1], counts) + cols] < -_EPS
+    keep_r[cols_at[ok & distractor[rows_at]]] = False
 
 
 def prepare_points(
