@@ -101,6 +101,7 @@ def test_compiled_identities_equal_numpys(n_agents: int, max_cost: float, hyster
                 ident.drop(tracks[:1])
             results.append(ident.assign_arrays(tracks + [99]))  # (99: never observed)
         (agent_f, prob_f), (agent_p, prob_p) = results
+        assert_same_bits(fast._th, plain._th)  # (the report histories, shifted or merged)
         assert np.array_equal(agent_f, agent_p)
         assert_same_bits(prob_f, prob_p)
         assigned += int((agent_f >= 0).sum())
@@ -170,6 +171,7 @@ def test_compiled_tracker_runs_equal_numpys(name: str, preset: str, seed: int, n
 
 def test_switch_and_warm(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("LOOKALIKE_WORLD_NUMBA", "0")
+    wk.use_compiled(None)  # (the environment is read again)
     assert wk.compiled() is None and wk.warm() is False
     monkeypatch.delenv("LOOKALIKE_WORLD_NUMBA")
     wk.use_compiled(False)

@@ -103,21 +103,31 @@ _STATE: dict[str, Any] = {}
 
 def use_compiled(flag: bool | None) -> None:
     """Force the compiled kernels on (``True``, if numba is installed) or off (``False``); ``None``: the
-    default (on when numba imports and ``LOOKALIKE_WORLD_NUMBA`` is not ``0``)."""
+    default (on when numba imports and ``LOOKALIKE_WORLD_NUMBA`` is not ``0``, read at the next call of
+    :func:`compiled`)."""
     _STATE.pop("forced", None)
+    _STATE.pop("active", None)
     if flag is not None:
         _STATE["forced"] = bool(flag)
 
 
 def compiled() -> Any:
     """The :mod:`~lookalike.trackers.world_numba` module, or ``None`` when the kernels are off or numba is
-    not installed (or its ``cos`` rounds differently from numpy's here)."""
+    not installed (or its ``cos`` rounds differently from numpy's here). Decided at the first call (a
+    frame's calls cost a dictionary lookup)."""
+    try:
+        return _STATE["active"]
+    except KeyError:
+        pass
     forced = _STATE.get("forced")
     if forced is False or (forced is None and os.environ.get("LOOKALIKE_WORLD_NUMBA", "1") == "0"):
-        return None
-    if "module" not in _STATE:
-        _STATE["module"] = _build()
-    return _STATE["module"]
+        active = None
+    else:
+        if "module" not in _STATE:
+            _STATE["module"] = _build()
+        active = _STATE["module"]
+    _STATE["active"] = active
+    return active
 
 
 def warm() -> bool:
@@ -126,8 +136,15 @@ def warm() -> bool:
     kernels = compiled()
     if kernels is None:
         return False
-    out = np.empty((1, 2))
-    kernels.window_costs(np.full((2, 2, 2), np.nan), np.zeros(1), np.zeros(1), np.zeros((1, 1)), 1.0, 1.0, out)
+    # (each kernel called with the argument types of the trackers' calls: float64 and int arrays, C order)
+    th, times, samples = np.full((2, 2, 2), np.nan), np.zeros(1), np.zeros((1, 1))
+    kernels.window_costs(th, times, times, samples, 1.0, 1.0, np.empty((1, 2)))
+    kernels.identity_work(th, times, times, samples, np.zeros(1, dtype=int), 1.0, 1.0, 0.1, 0.3)
+    kernels.gate_work(np.zeros((1, 2, 1)), 1.0)
+    ids, values = np.zeros(1, dtype=int), np.zeros(1)
+    for flag in (True, False):  # (the node's reports arrive read-only)
+        ids.flags.writeable = values.flags.writeable = flag
+        kernels.shift_reports(th, ids, values, values)
     return True
 
 

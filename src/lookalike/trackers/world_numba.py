@@ -185,6 +185,28 @@ def gate_work(y: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
 
 
 @_jit
+def shift_reports(th: np.ndarray, agent_id: np.ndarray, t_sent: np.ndarray, heading: np.ndarray) -> bool:
+    """``BeaconIdentifier.begin_frame``'s common case: when the reports are of distinct agents ``0 .. N-1``, each
+    sent after the latest kept of its agent (or its first), shift them into the histories ``th (2, N, r)`` and
+    return True; otherwise change nothing and return False."""
+    n, r = th.shape[1], th.shape[2]
+    seen = np.zeros(n, np.bool_)
+    for i in range(agent_id.shape[0]):
+        a = agent_id[i]
+        if a < 0 or a >= n or seen[a] or t_sent[i] <= th[0, a, r - 1]:
+            return False
+        seen[a] = True
+    for i in range(agent_id.shape[0]):
+        a = agent_id[i]
+        for j in range(r - 1):
+            th[0, a, j] = th[0, a, j + 1]
+            th[1, a, j] = th[1, a, j + 1]
+        th[0, a, r - 1] = t_sent[i]
+        th[1, a, r - 1] = heading[i]
+    return True
+
+
+@_jit
 def cosines(x: np.ndarray) -> np.ndarray:
     """The kernels' ``cos`` of each value of ``x`` (compared with numpy's before the kernels are used)."""
     out = np.empty_like(x)

@@ -72,8 +72,13 @@ class BeaconIdentifier:
         r, n = self.config.history, self.config.n_agents
         agent_id = beacons.agent_id
         if len(agent_id):
-            ids = agent_id.tolist()
-            if len(set(ids)) == len(ids) and max(ids) < n:
+            kernels = compiled()
+            if kernels is not None:  # (the common case below, checked and shifted in one compiled call)
+                shifted = kernels.shift_reports(self._th, agent_id, beacons.t_sent, beacons.heading)
+                ids = [] if shifted else agent_id.tolist()
+            else:
+                ids = agent_id.tolist()
+            if ids and len(set(ids)) == len(ids) and max(ids) < n:
                 # (the common case: one report per agent, each newer than every one kept of its
                 # agent or its first: shift them in, all agents at once; the same result as the
                 # sort and de-duplication below)
