@@ -3,6 +3,7 @@ identifier's window costs on awkward report histories and samples, and whole Kal
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 
 import numpy as np
@@ -129,6 +130,32 @@ def test_compiled_gate_pairs_equal_numpys() -> None:
         assert np.array_equal(allowed, d2 <= gate)
         solved += decision == 2
     assert solved > 50
+
+
+@pytest.mark.parametrize("name", ["kalman_ha", "kalman_ha2"])
+def test_compiled_birth_candidates_equal_numpys(name: str) -> None:
+    _compiled_or_skip()
+    sequence = team_sequence("m10n7", 2, 2.0)
+    tracker = make_tracker(name, n_agents=sequence.config.n_agents)
+    plain_candidates = tracker._birth_candidates
+    births = 0
+
+    def both(det, det_of_track):  # type: ignore[no-untyped-def]
+        nonlocal births
+        wk.use_compiled(False)
+        plain = plain_candidates(det, det_of_track)
+        wk.use_compiled(True)
+        fast = plain_candidates(det, det_of_track)
+        assert fast.dtype == plain.dtype and np.array_equal(fast, plain)
+        births += len(fast)
+        return fast
+
+    tracker._birth_candidates = both
+    for frame in sequence.frames():
+        tracker.update(frame)
+        tracker.update(dataclasses.replace(frame, index=frame.index, time=frame.time + 1e-3,
+                                           detections=frame.detections.select([])))  # (an empty frame between)
+    assert births > 0
 
 
 def test_compiled_costs_without_reports_or_samples() -> None:

@@ -168,6 +168,13 @@ class WorldTracker:
     def _birth_candidates(self, det: Detections, det_of_track: np.ndarray) -> np.ndarray:
         """Indices of detections that start tracks."""
         t, rules = self._tracks, self.rules
+        kernels = compiled()
+        if kernels is not None and len(det):  # (the lines below in one compiled call)
+            min_score, exclusion_m = rules.birth_min_score, rules.birth_exclusion_m
+            new_rows: np.ndarray = kernels.birth_candidates(
+                det_of_track, det.score, 0.0 if min_score is None else min_score, min_score is not None,
+                positions(det), t.mean, 0.0 if exclusion_m is None else exclusion_m, exclusion_m is not None)
+            return new_rows
         free = np.ones(len(det) + 1, dtype=bool)  # (the extra last entry takes the misses' -1)
         free[det_of_track] = False
         free = free[:-1]

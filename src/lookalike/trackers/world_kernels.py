@@ -141,10 +141,11 @@ def warm() -> bool:
     kernels.window_costs(th, times, times, samples, 1.0, 1.0, np.empty((1, 2)))
     kernels.identity_work(th, times, times, samples, np.zeros(1, dtype=int), 1.0, 1.0, 0.1, 0.3)
     kernels.gate_work(np.zeros((1, 2, 1)), 1.0)
-    ids, values = np.zeros(1, dtype=int), np.zeros(1)
-    for flag in (True, False):  # (the node's reports arrive read-only)
-        ids.flags.writeable = values.flags.writeable = flag
+    ids, values, pairs_ = np.zeros(1, dtype=int), np.zeros(1), np.zeros((1, 2))
+    for flag in (True, False):  # (the node's detections and reports arrive read-only)
+        ids.flags.writeable = values.flags.writeable = pairs_.flags.writeable = flag
         kernels.shift_reports(th, ids, values, values)
+        kernels.birth_candidates(np.zeros(1, dtype=int), values, 0.5, True, pairs_, np.zeros((1, 6)), 0.35, True)
     return True
 
 

@@ -207,6 +207,35 @@ def shift_reports(th: np.ndarray, agent_id: np.ndarray, t_sent: np.ndarray, head
 
 
 @_jit
+def birth_candidates(det_of_track: np.ndarray, score: np.ndarray, min_score: float, check_score: bool,
+                     position: np.ndarray, mean: np.ndarray, exclusion_m: float, check_exclusion: bool) -> np.ndarray:
+    """``WorldTracker._birth_candidates``: indices of the detections no track took (``det_of_track``, -1: a
+    miss), scoring at least ``min_score`` (when ``check_score``) and, when ``check_exclusion``, farther than
+    ``exclusion_m`` from every track's predicted position (``mean (k, 6)``; distances as ``np.linalg.norm``:
+    the square root of the summed squares)."""
+    n = position.shape[0]
+    free = np.ones(n + 1, np.bool_)  # (the extra last entry takes the misses' -1)
+    for i in range(det_of_track.shape[0]):
+        free[det_of_track[i]] = False
+    out = np.empty(n, np.int64)
+    found = 0
+    for i in range(n):
+        if not free[i] or (check_score and not score[i] >= min_score):
+            continue
+        if check_exclusion and mean.shape[0]:
+            nearest = 0.0
+            for j in range(mean.shape[0]):
+                dx, dy = position[i, 0] - mean[j, 0], position[i, 1] - mean[j, 1]
+                gap = np.sqrt(dx * dx + dy * dy)
+                nearest = gap if j == 0 else _minimum(nearest, gap)
+            if not nearest > exclusion_m:
+                continue
+        out[found] = i
+        found += 1
+    return out[:found]
+
+
+@_jit
 def cosines(x: np.ndarray) -> np.ndarray:
     """The kernels' ``cos`` of each value of ``x`` (compared with numpy's before the kernels are used)."""
     out = np.empty_like(x)
