@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from lookalike.eval.data import SequenceData
-from lookalike.eval.matching import conflicted_frames, frame_bounds, hungarian, negated_blocks
+from lookalike.eval.matching import conflicted_frames, frame_bounds, hungarian, negated_matrices
 
 _EPS = np.finfo(float).eps
 COUNTS = ("CLR_TP", "CLR_FN", "CLR_FP", "IDSW", "MT", "PT", "ML", "Frag", "MOTP_sum", "CLR_Frames")
@@ -101,21 +101,18 @@ def _solve_hard_frames(data: SequenceData, hard: np.ndarray, scored: np.ndarray,
     c_gt, c_tr = data.gt_id[gt_det], data.tracker_id[tr_det]
     local_g, local_t = gt_det - gb[frame], tr_det - tb[frame]
     planned = sim + 1000.0 * bonus
-    # Every hard frame's negated score matrix with the planned bonuses, in one buffer; a frame after a hard
+    # Every hard frame's negated score matrix with the planned bonuses; a frame after a hard
     # frame gets its bonuses from that frame's matches, written over its block before it is solved.
     shapes = np.stack([np.diff(gb)[hard], np.diff(tb)[hard]], axis=1)
     rank = np.cumsum(is_hard) - 1
-    buffer, offsets = negated_blocks(shapes, rank[frame[in_hard]], local_g[in_hard], local_t[in_hard],
-                                     planned[in_hard])
+    matrices = negated_matrices(shapes, rank[frame[in_hard]], local_g[in_hard], local_t[in_hard], planned[in_hard])
     prev = np.full(max(data.num_gt_ids, 1), -1)  # tracker id matched in the previous (hard) frame
     solved: dict[int, tuple[np.ndarray, np.ndarray]] = {}
     out_g, out_t, counts = [], [], []
     cuts, g_cuts, t_cuts = bounds.tolist(), gb.tolist(), tb.tolist()
     prev_list, next_list, hard_list = prev_of.tolist(), next_of.tolist(), is_hard.tolist()
-    for t, start, stop, n_rows, n_cols in zip(hard.tolist(), offsets[:-1].tolist(), offsets[1:].tolist(),
-                                              shapes[:, 0].tolist(), shapes[:, 1].tolist()):
+    for t, cost in zip(hard.tolist(), matrices):
         a, b = cuts[t], cuts[t + 1]
-        cost = buffer[start:stop].reshape(n_rows, n_cols)
         q = prev_list[t]
         if q in solved:
             q_gt, q_tr = solved.pop(q)

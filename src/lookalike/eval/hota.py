@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from lookalike.eval.data import Pairs, SequenceData
-from lookalike.eval.matching import conflicted_frames, negated_blocks, solve_blocks
+from lookalike.eval.matching import conflicted_frames, negated_matrices, solve_matrices
 
 ALPHAS = np.arange(0.05, 0.99, 0.05)  # the exact float values TrackEval compares with
 LABELS = tuple(range(5, 100, 5))
@@ -79,9 +79,8 @@ def _match_frames(data: SequenceData, pairs: Pairs,
     gb, tb = data.gt_bounds, data.tracker_bounds
     shapes = np.stack([np.diff(gb)[hard_frames], np.diff(tb)[hard_frames]], axis=1)
     f = frame[~easy]
-    buffer, offsets = negated_blocks(shapes, (np.cumsum(hard) - 1)[f], gt_det[~easy] - gb[f], tr_det[~easy] - tb[f],
-                                     score[~easy])
-    rows, cols, counts = solve_blocks(buffer, offsets, shapes)
+    rows, cols, counts = solve_matrices(negated_matrices(shapes, (np.cumsum(hard) - 1)[f], gt_det[~easy] - gb[f],
+                                                         tr_det[~easy] - tb[f], score[~easy]))
     mf = np.concatenate([frame[easy], np.repeat(hard_frames, counts)])
     mg = np.concatenate([gt_det[easy], rows + np.repeat(gb[hard_frames], counts)])
     mt = np.concatenate([tr_det[easy], cols + np.repeat(tb[hard_frames], counts)])

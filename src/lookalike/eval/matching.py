@@ -4,13 +4,14 @@ already form a one-to-one matching.
 A frame's score matrix is zero except at its listed pairs. When no detection appears in two of a
 frame's positive pairs, every maximum-score assignment contains all of them, so the Hungarian
 algorithm is only run on the other frames, on the same dense matrix as before (same result, same
-tie-breaking). Those matrices are built all at once in one flat buffer (:func:`negated_blocks`) and
-solved one after another (:func:`solve_blocks`), instead of one allocation and scatter per frame.
+tie-breaking). Those matrices are built many frames at a time in one reused buffer
+(:func:`negated_matrices`) and solved one after another (:func:`solve_matrices`), instead of one
+allocation and scatter per frame.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 import numpy as np
@@ -41,27 +42,46 @@ def conflicted_frames(frame: np.ndarray, gt_det: np.ndarray, tracker_det: np.nda
     return result
 
 
-def negated_blocks(shapes: np.ndarray, block: np.ndarray, rows: np.ndarray, cols: np.ndarray,
-                   values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``k`` dense matrices of ``shapes`` ``(k, 2)``, negated and stored row-major one after another in one
-    flat float64 buffer: ``-0.0`` everywhere (as ``-np.zeros(shape)``) except ``-values`` at ``(rows, cols)`` of
-    matrix ``block`` (one entry per value). Returns the buffer and the ``(k + 1,)`` offsets of the matrices."""
-    offsets = np.zeros(len(shapes) + 1, np.int64)
-    np.cumsum(shapes[:, 0] * shapes[:, 1], out=offsets[1:])
-    buffer = np.full(int(offsets[-1]), -0.0)
-    buffer[offsets[block] + rows * shapes[block, 1] + cols] = -values
-    return buffer, offsets
+_CHUNK = 1 << 15  # float64 entries (256 KiB) of the buffer that consecutive matrices are built in
 
 
-def solve_blocks(buffer: np.ndarray, offsets: np.ndarray,
-                 shapes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The minimum-cost assignment of each matrix of :func:`negated_blocks` (the maximum one of the
+def negated_matrices(shapes: np.ndarray, block: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                     values: np.ndarray) -> Iterator[np.ndarray]:
+    """``k`` dense matrices of ``shapes`` ``(k, 2)``, one after another, negated: ``-0.0`` everywhere (as
+    ``-np.zeros(shape)``) except ``-values`` at ``(rows, cols)`` of matrix ``block`` (ascending, one entry per
+    value). They are built a run of consecutive matrices at a time in one reused buffer (no fresh memory
+    pages per frame); each matrix is a view, valid until the next one is asked for."""
+    k = len(shapes)
+    if not k:
+        return
+    n_cols = shapes[:, 1]
+    sizes = shapes[:, 0] * n_cols
+    ends = np.cumsum(sizes)
+    starts = ends - sizes
+    where = starts[block] + rows * n_cols[block] + cols  # every entry's place in the matrices laid end to end
+    pair_at = np.searchsorted(block, np.arange(k + 1)).tolist()
+    buffer = np.empty(max(_CHUNK, int(sizes.max())))
+    starts_l, ends_l, shapes_l = starts.tolist(), ends.tolist(), shapes.tolist()
+    m = 0
+    while m < k:
+        base = starts_l[m]
+        stop = max(int(np.searchsorted(ends, base + len(buffer), "right")), m + 1)
+        buffer[:ends_l[stop - 1] - base] = -0.0
+        p0, p1 = pair_at[m], pair_at[stop]
+        buffer[where[p0:p1] - base] = -values[p0:p1]
+        for q in range(m, stop):
+            n_r, n_c = shapes_l[q]
+            yield buffer[starts_l[q] - base:ends_l[q] - base].reshape(n_r, n_c)
+        m = stop
+
+
+def solve_matrices(matrices: Iterable[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The minimum-cost assignment of each matrix (of :func:`negated_matrices`: the maximum one of the
     un-negated matrix): its rows and columns (local indices) concatenated, and the number per matrix."""
     linear_sum_assignment = hungarian()
     rows, cols = [], []
-    for start, stop, n_rows, n_cols in zip(offsets[:-1].tolist(), offsets[1:].tolist(), shapes[:, 0].tolist(),
-                                           shapes[:, 1].tolist()):
-        r, c = linear_sum_assignment(buffer[start:stop].reshape(n_rows, n_cols))
+    for cost in matrices:
+        r, c = linear_sum_assignment(cost)
         rows.append(r)
         cols.append(c)
     if not rows:

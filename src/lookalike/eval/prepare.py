@@ -20,7 +20,7 @@ from typing import Literal, Protocol
 import numpy as np
 
 from lookalike.eval.data import Pairs, SequenceData
-from lookalike.eval.matching import conflicted_frames, negated_blocks, solve_blocks
+from lookalike.eval.matching import conflicted_frames, negated_matrices, solve_matrices
 from lookalike.eval.similarity import pair_iou, point_similarity
 from lookalike.types.mot_table import MotTable as MotTableData
 
@@ -233,11 +233,14 @@ def _drop_distractor_matches(keep_r: np.ndarray, gi: np.ndarray, ri: np.ndarray,
     inside = block[frame] >= 0
     f = frame[inside]
     shapes = np.stack([np.diff(gb)[solve], np.diff(rb)[solve]], axis=1)
-    cost, offsets = negated_blocks(shapes, block[f], gi[inside] - gb[f], ri[inside] - rb[f], sim[inside])
-    rows, cols, counts = solve_blocks(cost, offsets, shapes)
+    local_g, local_r = gi[inside] - gb[f], ri[inside] - rb[f]
+    rows, cols, counts = solve_matrices(negated_matrices(shapes, block[f], local_g, local_r, sim[inside]))
+    # A match counts where its score is positive: at a listed pair.
+    max_r, max_c = (int(v) for v in shapes.max(axis=0)) if len(shapes) else (1, 1)
+    matrix = np.repeat(np.arange(len(solve)), counts)
+    listed = np.isin((matrix * max_r + rows) * max_c + cols, (block[f] * max_r + local_g) * max_c + local_r)
     rows_at, cols_at = rows + np.repeat(gb[solve], counts), cols + np.repeat(rb[solve], counts)
-    ok = cost[np.repeat(offsets[:-1], counts) + rows * np.repeat(shapes[:, 1], counts) + cols] < -_EPS
-    keep_r[cols_at[ok & distractor[rows_at]]] = False
+    keep_r[cols_at[listed & distractor[rows_at]]] = False
 
 
 def prepare_points(
