@@ -13,35 +13,18 @@ docs/experiments/speed.md (boxtrack).
 
 from __future__ import annotations
 
-import os
-from typing import Any
+from types import ModuleType
 
-_STATE: dict[str, Any] = {}
-
-
-def use_compiled(flag: bool | None) -> None:
-    """Force the compiled kernels on (``True``, if numba is installed) or off (``False``) for trackers built
-    from now on; ``None``: the default (on when numba imports and ``LOOKALIKE_BOXTRACK_NUMBA`` is not ``0``)."""
-    _STATE.pop("forced", None)
-    if flag is not None:
-        _STATE["forced"] = bool(flag)
+from lookalike._compiled import KernelSwitch
 
 
-def compiled() -> Any | None:
-    """The kernels' module, or ``None`` when they are off or numba is not installed."""
-    forced = _STATE.get("forced")
-    if forced is False or (forced is None and os.environ.get("LOOKALIKE_BOXTRACK_NUMBA", "1") == "0"):
-        return None
-    return module()
+def _load() -> ModuleType:
+    from lookalike.trackers import boxtrack_numba
+
+    return boxtrack_numba
 
 
-def module() -> Any | None:
-    """The kernels' module whatever the switch says (imported on first use), ``None`` when numba is not installed."""
-    if "kernels" not in _STATE:
-        try:
-            from lookalike.trackers import boxtrack_numba
-        except ImportError:
-            _STATE["kernels"] = None
-        else:
-            _STATE["kernels"] = boxtrack_numba
-    return _STATE["kernels"]
+_SWITCH: KernelSwitch[ModuleType] = KernelSwitch("LOOKALIKE_BOXTRACK_NUMBA", _load)
+use_compiled = _SWITCH.use_compiled  # (trackers built from now on)
+compiled = _SWITCH.compiled  # the kernels' module, or None when they are off or numba is not installed
+module = _SWITCH.kernels  # the kernels' module whatever the switch says, None when numba is not installed

@@ -17,12 +17,12 @@ does it before serving: :func:`warm`), not with ``import lookalike``.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable
-from typing import Any
+from types import ModuleType
 
 import numpy as np
 
+from lookalike._compiled import KernelSwitch
 from lookalike.association.solver import linear_sum_assignment, solve_allowed
 
 try:  # numpy's gufuncs behind np.linalg.cholesky / np.linalg.solve (the same kernels, no wrapper)
@@ -98,36 +98,22 @@ def decided_pairs(decision: int, work: np.ndarray, allowed: np.ndarray) -> tuple
     return rows[keep], cols[keep]
 
 
-_STATE: dict[str, Any] = {}
+def _load() -> ModuleType | None:
+    from lookalike.trackers import world_numba
+
+    # (the kernels' cos is libm's; numpy may use its own vector code: they must agree on every value here)
+    angles = np.linspace(-4.0 * np.pi, 4.0 * np.pi, 4099)
+    if not np.array_equal(world_numba.cosines(angles), np.cos(angles)):
+        return None
+    return world_numba
 
 
-def use_compiled(flag: bool | None) -> None:
-    """Force the compiled kernels on (``True``, if numba is installed) or off (``False``); ``None``: the
-    default (on when numba imports and ``LOOKALIKE_WORLD_NUMBA`` is not ``0``, read at the next call of
-    :func:`compiled`)."""
-    _STATE.pop("forced", None)
-    _STATE.pop("active", None)
-    if flag is not None:
-        _STATE["forced"] = bool(flag)
-
-
-def compiled() -> Any:
-    """The :mod:`~lookalike.trackers.world_numba` module, or ``None`` when the kernels are off or numba is
-    not installed (or its ``cos`` rounds differently from numpy's here). Decided at the first call (a
-    frame's calls cost a dictionary lookup)."""
-    try:
-        return _STATE["active"]
-    except KeyError:
-        pass
-    forced = _STATE.get("forced")
-    if forced is False or (forced is None and os.environ.get("LOOKALIKE_WORLD_NUMBA", "1") == "0"):
-        active = None
-    else:
-        if "module" not in _STATE:
-            _STATE["module"] = _build()
-        active = _STATE["module"]
-    _STATE["active"] = active
-    return active
+# (decided at the first call of compiled(): a frame's calls cost an attribute lookup)
+_SWITCH: KernelSwitch[ModuleType] = KernelSwitch("LOOKALIKE_WORLD_NUMBA", _load, decide_once=True)
+use_compiled = _SWITCH.use_compiled  # (None: the environment is read again at the next call of compiled)
+# the world_numba module, or None when the kernels are off, numba is not installed or its cos rounds
+# differently from numpy's here
+compiled = _SWITCH.compiled
 
 
 def warm() -> bool:
@@ -147,15 +133,3 @@ def warm() -> bool:
         kernels.shift_reports(th, ids, values, values)
         kernels.birth_candidates(np.zeros(1, dtype=int), values, 0.5, True, pairs_, np.zeros((1, 6)), 0.35, True)
     return True
-
-
-def _build() -> Any:
-    try:
-        from lookalike.trackers import world_numba
-    except ImportError:
-        return None
-    # (the kernels' cos is libm's; numpy may use its own vector code: they must agree on every value here)
-    angles = np.linspace(-4.0 * np.pi, 4.0 * np.pi, 4099)
-    if not np.array_equal(world_numba.cosines(angles), np.cos(angles)):
-        return None
-    return world_numba

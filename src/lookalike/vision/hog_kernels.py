@@ -12,35 +12,18 @@ of a process; right after installation the first call compiles them (about 6 s) 
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable
-from typing import Any
 
-_STATE: dict[str, Any] = {}
-
-
-def use_compiled(flag: bool | None) -> None:
-    """Force the compiled kernels on (``True``, if numba is installed) or off (``False``); ``None``: the default
-    (on when numba imports and ``LOOKALIKE_HOG_NUMBA`` is not ``0``)."""
-    _STATE.pop("forced", None)
-    if flag is not None:
-        _STATE["forced"] = bool(flag)
+from lookalike._compiled import KernelSwitch
 
 
-def compiled() -> dict[str, Callable[..., None]] | None:
-    """The compiled kernels by name, or ``None`` when they are off or numba is not installed."""
-    forced = _STATE.get("forced")
-    if forced is False or (forced is None and os.environ.get("LOOKALIKE_HOG_NUMBA", "1") == "0"):
-        return None
-    if "kernels" not in _STATE:
-        _STATE["kernels"] = _build()
-    return _STATE["kernels"]  # type: ignore[no-any-return]
+def _load() -> dict[str, Callable[..., None]]:
+    from lookalike.vision import hog_numba
 
-
-def _build() -> dict[str, Callable[..., None]] | None:
-    try:
-        from lookalike.vision import hog_numba
-    except ImportError:
-        return None
     return {"cell_hist": hog_numba.cell_hist, "integral32": hog_numba.integral32,
             "block_columns": hog_numba.block_columns, "grey": hog_numba.grey}
+
+
+_SWITCH: KernelSwitch[dict[str, Callable[..., None]]] = KernelSwitch("LOOKALIKE_HOG_NUMBA", _load)
+use_compiled = _SWITCH.use_compiled
+compiled = _SWITCH.compiled  # the compiled kernels by name, or None when they are off or numba is not installed
