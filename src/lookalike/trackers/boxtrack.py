@@ -26,7 +26,7 @@ IoU matrix per frame serves every stage and the clutter share; the IoU stages co
 when their allowed pairs compete. The rows are those of the plain tracker this replaced, bit for bit
 (tests/boxtrack_oracle.py, tests/test_boxtrack_fast.py). With numba installed (the ``fast`` extra) a frame
 runs four compiled kernels instead (:mod:`lookalike.trackers.boxtrack_kernels`; ``LOOKALIKE_BOXTRACK_NUMBA=0``
-switches them off): the same numbers (tests/test_boxtrack_kernels.py), about 2.5 times faster.
+switches them off): the same numbers (tests/test_boxtrack_kernels.py); figures in docs/experiments/speed.md.
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.self_calibration import ScoreCalibration
 from lookalike.trackers.table import TrackTable
 from lookalike.trackers.timing import FrameClock
-from lookalike.types import Frame, Tracks
+from lookalike.types import Detections, Frame, Tracks
 
 _to_xywh = cxcywh_to_xywh  # kept for callers of the old private helper
 _NO_BOXES = np.zeros((0, 4))
@@ -123,12 +123,7 @@ class BoxTrack:
         steps = clock.steps(frame.time)
         dt = steps * clock.interval
         self._frame_count += 1
-        dets = frame.detections
-        det_xywh, score = dets.xywh, dets.score  # the read-only columns themselves, no copies
-        det_idx = None  # None: every detection kept, at its own index
-        if len(score) and np.count_nonzero(score < cfg.low_score):
-            det_idx = (score >= cfg.low_score).nonzero()[0]
-            det_xywh, score = det_xywh[det_idx], score[det_idx]
+        det_xywh, score, det_idx = self._kept(dets)
         z = self._measure(det_xywh.T)
         self._calibration.observe_scores(score)
         x = self._state()
@@ -168,18 +163,24 @@ class BoxTrack:
             t.keep(alive)
         return out
 
+    def _kept(self, dets: Detections) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """The detections scoring at least ``low_score``: their boxes ``(n, 4)`` (left, top, width, height;
+        pixels), scores, and their indices in the frame (None: every detection kept, at its own index; then the
+        columns are the read-only ones of ``dets``, no copies)."""
+        det_xywh, score = dets.xywh, dets.score
+        det_idx = None
+        if len(score) and np.count_nonzero(score < self.config.low_score):
+            det_idx = (score >= self.config.low_score).nonzero()[0]
+            det_xywh, score = det_xywh[det_idx], score[det_idx]
+        return det_xywh, score, det_idx
+
     def _update_compiled(self, frame: Frame, kern: Any) -> Tracks:
         """:meth:`update` with the compiled kernels: the same steps and numbers as the numpy path."""
         cfg, t, clock = self.config, self._tracks, self._clock
         steps = clock.steps(frame.time)
         dt = steps * clock.interval
         self._frame_count += 1
-        dets = frame.detections
-        det_xywh, score = dets.xywh, dets.score
-        det_idx = None
-        if len(score) and np.count_nonzero(score < cfg.low_score):
-            det_idx = (score >= cfg.low_score).nonzero()[0]
-            det_xywh, score = det_xywh[det_idx], score[det_idx]
+        det_xywh, score, det_idx = self._kept(frame.detections)
         self._calibration.observe_scores(score)
         x = self._state()
         if self._slots is not None and len(t):
