@@ -1,4 +1,9 @@
-"""The numba kernels of :mod:`lookalike.trackers.world_kernels` (imported only when numba is installed)."""
+"""The numba kernels of :mod:`lookalike.trackers.world_kernels` (imported only when numba is installed).
+
+Each kernel does the floating-point operations of the world trackers' numpy path value by value, in the same
+order and precision (no fused multiply-adds: ``fastmath`` off), so tracks and identities are bit for bit the same.
+Times are in seconds, headings and turn rates in radians (per second), positions in metres (world frame).
+"""
 
 from __future__ import annotations
 
@@ -38,8 +43,10 @@ def _wrap(x: float) -> float:
 @_jit
 def _agent_headings(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, max_turn_rate: float,
                     max_extrapolation_s: float) -> np.ndarray:
-    """``BeaconIdentifier._headings``: the agents' headings ``(W, N)`` at the times ``q (W,)`` (``q_count``: ``q``
-    with NaN as +inf) from the report histories ``th (2, N, r)`` (send times, headings; NaN padded at the front)."""
+    """``BeaconIdentifier._headings``: the agents' headings ``(W, N)`` (radians) at the times ``q (W,)`` (seconds;
+    ``q_count``: ``q`` with NaN as +inf) from the report histories ``th (2, N, r)`` (send times in seconds,
+    headings in radians; NaN padded at the front), turning at most ``max_turn_rate`` radians/s, extrapolated at
+    most ``max_extrapolation_s`` seconds past the last report."""
     n, r = th.shape[1], th.shape[2]
     n_times = q.shape[0]
     agent = np.full((n_times, n), np.nan)
@@ -78,9 +85,10 @@ def _agent_headings(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, max_turn
 def window_costs(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np.ndarray, max_turn_rate: float,
                  max_extrapolation_s: float, out: np.ndarray) -> None:
     """The beacon identifier's window costs into ``out (k, N)``: the mean ``(1 - cos)/2`` of each sample row
-    ``samples (k, W)`` against each agent's heading at the window times (:func:`_agent_headings`) over the finite
-    terms (``inf`` with none). The operations of ``BeaconIdentifier._headings`` and ``_costs``, value by value in
-    the same order (each sum runs over the window times in order, as numpy's reduction over that axis)."""
+    ``samples (k, W)`` (track headings, radians; NaN: none) against each agent's heading at the window times
+    (:func:`_agent_headings`) over the finite terms (``inf`` with none). The operations of
+    ``BeaconIdentifier._headings`` and ``_costs``, value by value in the same order (each sum runs over the window
+    times in order, as numpy's reduction over that axis)."""
     agent = _agent_headings(th, q, q_count, max_turn_rate, max_extrapolation_s)
     n_times, n = agent.shape
     for row in range(samples.shape[0]):
@@ -186,9 +194,9 @@ def gate_work(y: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
 
 @_jit
 def shift_reports(th: np.ndarray, agent_id: np.ndarray, t_sent: np.ndarray, heading: np.ndarray) -> bool:
-    """``BeaconIdentifier.begin_frame``'s common case: when the reports are of distinct agents ``0 .. N-1``, each
-    sent after the latest kept of its agent (or its first), shift them into the histories ``th (2, N, r)`` and
-    return True; otherwise change nothing and return False."""
+    """``BeaconIdentifier.begin_frame``'s common case: when the reports (``t_sent`` seconds, ``heading`` radians)
+    are of distinct agents ``0 .. N-1``, each sent after the latest kept of its agent (or its first), shift them
+    into the histories ``th (2, N, r)`` and return True; otherwise change nothing and return False."""
     n, r = th.shape[1], th.shape[2]
     seen = np.zeros(n, np.bool_)
     for i in range(agent_id.shape[0]):
