@@ -1,13 +1,25 @@
-"""The switch of an optional set of compiled (numba) kernels: loaded on first use, never by ``import lookalike``;
-off when numba does not import, when an environment variable is ``0``, or when forced off."""
+"""Optional compiled (numba) kernels: their switch (loaded on first use, never by ``import lookalike``; off when
+numba does not import, when an environment variable is ``0``, or when forced off) and the compiler's settings."""
 
 from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from typing import Generic, TypeVar
+from typing import Any, Generic, TypeVar, cast
 
 K = TypeVar("K")
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def exact_jit() -> Callable[[F], F]:
+    """numba's ``njit`` decorator with the settings every kernel module uses: the numpy path's arithmetic kept
+    (``fastmath`` off: no fused multiply-adds or reordering; numpy's float error model: division by zero gives
+    inf/NaN), compiled code cached on disk, the GIL released, no bounds checks. Imports numba (an
+    ``ImportError`` without it): call it only from a kernel module."""
+    import numba  # type: ignore[import-untyped, import-not-found, unused-ignore]
+
+    jit = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy", boundscheck=False)
+    return cast("Callable[[F], F]", jit)
 
 
 class KernelSwitch(Generic[K]):

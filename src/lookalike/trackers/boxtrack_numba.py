@@ -8,10 +8,11 @@ pixels/frame).
 
 from __future__ import annotations
 
-import numba  # type: ignore[import-untyped, import-not-found, unused-ignore]
 import numpy as np
 
-_jit = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy", boundscheck=False)
+from lookalike._compiled import exact_jit
+
+_jit = exact_jit()
 
 
 @_jit
