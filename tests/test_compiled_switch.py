@@ -3,6 +3,8 @@ not import, when the environment variable is 0 or when forced off; decide_once r
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from collections.abc import Callable
 
 import pytest
@@ -58,3 +60,10 @@ def test_decide_once_reads_the_environment_until_use_compiled(monkeypatch: pytes
     assert every_call.compiled() is None
     monkeypatch.delenv(ENV)
     assert every_call.compiled() == "kernels"
+
+
+def test_importing_the_switches_does_not_import_numba() -> None:
+    code = ("import sys, lookalike, lookalike._compiled, lookalike.trackers.boxtrack_kernels, "
+            "lookalike.trackers.world_kernels, lookalike.vision.hog_kernels; print('numba' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
