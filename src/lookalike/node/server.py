@@ -40,8 +40,8 @@ LOCALHOST = "127.0.0.1"
 
 def _preload() -> None:
     """Import what the first frame would otherwise import, when the node is built: the assignment
-    solver's scipy module (about 0.5 s of CPU time) and the world trackers' compiled kernels (numba,
-    when installed: about 0.6 s; :func:`~lookalike.trackers.world_kernels.warm`)."""
+    solver's scipy module and the world trackers' compiled kernels (numba, when installed:
+    :func:`~lookalike.trackers.world_kernels.warm`); their cost: docs/experiments/speed.md (Observer node)."""
     import numpy as np
 
     from lookalike.association.solver import linear_sum_assignment

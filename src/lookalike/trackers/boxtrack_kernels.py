@@ -3,7 +3,7 @@
 the gated IoU stages of the association plan, the Kalman update with the track bookkeeping, and the report
 with the lifecycle's survivors.
 
-At ~6 detections a frame the numpy path's time is mostly the overhead of ~100 small numpy calls; the
+At a few detections a frame the numpy path's time is mostly the overhead of its many small numpy calls; the
 kernels do the same floating-point operations one track or pair at a time, in the same order and precision
 (no fused multiply-adds), so the rows are bit for bit those of the numpy path (``tests/test_boxtrack_kernels.py``
 compares both). They are used when numba is installed (the ``fast`` extra) unless ``LOOKALIKE_BOXTRACK_NUMBA=0``;

@@ -6,8 +6,8 @@ Each kernel does the floating-point operations of the numpy path one pixel, cell
 order and precision (float32 binning, float64 sums in each cell's raster order, the 36-term block norms in numpy's
 pairwise order, no fused multiply-adds), so detections are bit for bit the same; ``tests/test_hog_kernels.py``
 compares both paths. They are used when numba is installed (the ``fast`` extra) unless ``LOOKALIKE_HOG_NUMBA=0``.
-Start-up: importing numba and loading the cached kernels costs about 0.6 s of CPU time in the first detector call
-of a process; right after installation the first call compiles them (about 6 s) into numba's cache.
+Start-up: numba is imported and the cached kernels loaded in the first detector call of a process; right after
+installation that call compiles them into numba's cache (figures: docs/experiments/speed.md, HOG).
 """
 
 from __future__ import annotations
