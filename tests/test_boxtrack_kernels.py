@@ -222,3 +222,16 @@ def test_correct_equals_the_update_columns() -> None:
     assert np.array_equal(h2, (hits + hit) * hit)
     assert np.array_equal(m2, np.where(hit, 0, misses + 1)) and np.array_equal(u2, np.where(hit, 0.0, unseen + 0.04))
     assert np.array_equal(c2, confirmed | (h2 >= 2))
+
+
+@numba_missing
+def test_the_kernels_maximum_and_minimum_are_numpys() -> None:  # (NaN when either is NaN)
+    from lookalike.trackers import boxtrack_numba as bn
+
+    values = [np.nan, -np.inf, -1.5, -0.0, 0.0, 2.0, np.inf]
+    for a in values:
+        for b in values:
+            for mine, theirs in ((bn._maximum, np.maximum), (bn._minimum, np.minimum)):
+                got, want = np.float64(mine(a, b)), theirs(np.float64(a), np.float64(b))
+                # (equal values: of two zeros of opposite sign the kernels return the first, numpy may not)
+                assert got == want or (np.isnan(got) and np.isnan(want)), (a, b)

@@ -17,22 +17,14 @@ _jit = exact_jit()
 
 @_jit
 def _maximum(a: float, b: float) -> float:
-    """``np.maximum``'s number: NaN when either is NaN."""
-    if a != a:
-        return a
-    if b != b:
-        return b
-    return a if a >= b else b
+    """``np.maximum``'s number: NaN when either is NaN (the first when both are)."""
+    return a if (a >= b or a != a) else b
 
 
 @_jit
 def _minimum(a: float, b: float) -> float:
-    """``np.minimum``'s number: NaN when either is NaN."""
-    if a != a:
-        return a
-    if b != b:
-        return b
-    return a if a <= b else b
+    """``np.minimum``'s number: NaN when either is NaN (the first when both are)."""
+    return a if (a <= b or a != a) else b
 
 
 @_jit
