@@ -13,7 +13,7 @@ of the same run without the swap.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -121,17 +121,25 @@ def shuffle_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int,
     return rows
 
 
-def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float) -> tuple[float, float, float]:
-    """(success while swapped, same without the swap, recovery seconds) of one sequence."""
+def swap_recovery(labels: Callable[[RobotSequence, list[Frame]], list[np.ndarray]], seq: RobotSequence,
+                  swap_at_s: float, swap_s: float) -> tuple[float, float, float]:
+    """(success while swapped, same without the swap, recovery seconds; inf: never) of one sequence
+    whose two robots seen most swap reports from ``swap_at_s`` for ``swap_s`` seconds, ``labels``
+    giving an identifier's per-frame labels of a sequence's frames."""
     rate = seq.config.frame_rate_hz
     fs = list(seq.frames())
     truth = seq.true_labels()
     start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
     pair = most_seen_pair(truth[start : restore + int(3 * rate)], seq.config.n_agents)
-    clean = pair_hits(identify(name, seq, fs), truth, pair)
-    swapped = pair_hits(identify(name, seq, swap_reports(fs, swap_at_s, swap_at_s + swap_s, pair)), truth, pair)
+    clean = pair_hits(labels(seq, fs), truth, pair)
+    swapped = pair_hits(labels(seq, swap_reports(fs, swap_at_s, swap_at_s + swap_s, pair)), truth, pair)
     return (hit_rate(swapped[start:restore]), hit_rate(clean[start:restore]),
             recovery_s(clean, swapped, restore, int(rate), rate))
+
+
+def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float) -> tuple[float, float, float]:
+    """:func:`swap_recovery` of the registered identifier ``name``."""
+    return swap_recovery(lambda s, fs: identify(name, s, fs), seq, swap_at_s, swap_s)
 
 
 def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.bench.experiments import most_seen_pair, pair_hits, recovery_s, swap_reports
+from lookalike.bench.experiments import swap_recovery
 from lookalike.bench.pixel_recordings import score_identifier
 from lookalike.learn.set_data import world
 from lookalike.learn.set_numpy import load_set_weights, save_set_weights
@@ -91,15 +91,8 @@ def _labels(weights: Path, sequence: RobotSequence, frames: list[Frame]) -> list
 def set_recovery_s(weights: Path, sequence: RobotSequence, swap_at_s: float = RECOVERY_SWAP[0],
                    swap_s: float = RECOVERY_SWAP[1]) -> float:
     """Seconds ``set`` with ``weights`` takes to recover after ``bench recovery``'s swap of the two
-    robots seen most (inf: never), measured as :func:`lookalike.bench.experiments.recovery_s` does."""
-    rate = sequence.config.frame_rate_hz
-    fs = list(sequence.frames())
-    truth = sequence.true_labels()
-    start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
-    pair = most_seen_pair(truth[start : restore + int(3 * rate)], sequence.config.n_agents)
-    clean = pair_hits(_labels(weights, sequence, fs), truth, pair)
-    swapped = pair_hits(_labels(weights, sequence, swap_reports(fs, swap_at_s, swap_at_s + swap_s, pair)), truth, pair)
-    return recovery_s(clean, swapped, restore, int(rate), rate)
+    robots seen most (inf: never), measured as ``bench recovery`` does."""
+    return swap_recovery(lambda s, fs: _labels(weights, s, fs), sequence, swap_at_s, swap_s)[2]
 
 
 def recovery_sequences() -> dict[str, list[RobotSequence]]:
