@@ -74,3 +74,34 @@ def test_plugin_fallback_names_match_pyproject():
     project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
     declared = project["project"]["entry-points"]["lookalike.trackers"]
     assert {name: target.split(":")[0] for name, target in declared.items()} == registry.PLUGIN_TRACKERS
+
+
+@pytest.mark.parametrize(("given", "expected"), [(None, "1"), ("2", "2")])
+def test_the_program_runs_blas_on_one_thread_unless_told(given, expected):
+    import os
+    import subprocess
+    import sys
+
+    pytest.importorskip("threadpoolctl")
+    code = ("import os, sys; sys.argv = ['lookalike']; import lookalike.cli, numpy, threadpoolctl; "
+            "pools = [p['num_threads'] for p in threadpoolctl.threadpool_info() if p['internal_api'] == 'openblas']; "
+            "print(os.environ.get('OPENBLAS_NUM_THREADS'), pools[0] if pools else 'none')")
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
+    variable, pool = out.split()
+    assert variable == expected
+    if pool != "none":  # numpy's OpenBLAS read it: the variable was set before numpy was imported
+        assert int(pool) <= int(expected)
+
+
+def test_the_library_leaves_blas_threads_alone():
+    import os
+    import subprocess
+    import sys
+
+    code = "import os, lookalike.cli; print(os.environ.get('OPENBLAS_NUM_THREADS'))"
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "None"

@@ -9,10 +9,20 @@ with a command of :data:`COMMAND_MODULES`, it imports only that command's module
 from __future__ import annotations
 
 import importlib
+import os
 import sys
 from pathlib import Path
 
-from lookalike.cli.app import app
+SCRIPT_NAMES = ("lookalike", "__main__.py")
+"""``sys.argv[0]`` names of the ``lookalike`` script and of ``python -m lookalike``."""
+
+if sys.argv and Path(sys.argv[0]).name in SCRIPT_NAMES:
+    # Run as the program (before numpy is imported): lookalike's matrices are small, so OpenBLAS's
+    # thread pool only costs its start-up in every process and waits in the node; a value the user
+    # set is kept.
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from lookalike.cli.app import app  # noqa: E402
 
 MODULES = ("bench", "bench_divers", "bench_experiments", "bench_pixels", "bench_real", "demo", "eval", "label",
            "node", "record_pixels", "render", "report", "simulate", "track", "track_pixels", "trackers", "train",
@@ -26,7 +36,7 @@ COMMAND_MODULES = {"track": "track", "trackers": "trackers", "eval": "eval", "si
 
 def _script_command() -> str | None:
     """The command the ``lookalike`` script is running, or None (imported as a library, or no command)."""
-    if not sys.argv or Path(sys.argv[0]).name not in ("lookalike", "__main__.py"):
+    if not sys.argv or Path(sys.argv[0]).name not in SCRIPT_NAMES:
         return None
     return next((a for a in sys.argv[1:] if not a.startswith("-")), None)
 
