@@ -119,14 +119,9 @@ class BoxTrack:
             # (float64 columns, as Detections makes them: the kernels' arithmetic is the numpy path's; the
             # module is looked up, not kept, so the tracker stays picklable)
             return self._update_compiled(frame, boxtrack_kernels.module())
-        cfg, t, clock = self.config, self._tracks, self._clock
-        steps = clock.steps(frame.time)
-        dt = steps * clock.interval
-        self._frame_count += 1
-        det_xywh, score, det_idx = self._kept(dets)
+        t, clock = self._tracks, self._clock
+        steps, dt, det_xywh, score, det_idx, x = self._begin(frame)
         z = self._measure(det_xywh.T)
-        self._calibration.observe_scores(score)
-        x = self._state()
         was_tracked = t.unseen_s == 0
         if len(t):
             if self._slots is not None:
@@ -148,9 +143,7 @@ class BoxTrack:
         if self._slots is not None:
             self._slots.observe_speed(t, hit, clock.interval)
         t.record(hit, dt)
-        ready = t.hits >= cfg.n_init
-        if self._frame_count == 1:
-            ready |= t.hits > 0
+        ready = self._ready()
         if self._slots is None:
             t.confirmed |= ready
         else:
@@ -162,6 +155,29 @@ class BoxTrack:
             self._coasting.observe(died=t.misses[~alive & t.confirmed])
             t.keep(alive)
         return out
+
+    def _begin(self, frame: Frame) -> tuple[float, float, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray]:
+        """A frame's first steps on either path: its time steps and seconds since the last frame, the kept
+        detections (:meth:`_kept`, their scores observed) and the tracks' state table (:meth:`_state`)."""
+        steps = self._clock.steps(frame.time)
+        dt = steps * self._clock.interval
+        self._frame_count += 1
+        det_xywh, score, det_idx = self._kept(frame.detections)
+        self._calibration.observe_scores(score)
+        return steps, dt, det_xywh, score, det_idx, self._state()
+
+    def _ready(self) -> np.ndarray:
+        """The tracks with ``n_init`` hits in a row, or any hit in the first frame: ready to confirm."""
+        ready = self._tracks.hits >= self.config.n_init
+        if self._frame_count == 1:
+            ready |= self._tracks.hits > 0
+        return ready
+
+    def _observe_continued(self, score: np.ndarray, matching: Matching) -> None:
+        """Show the score calibration the detections that continued confirmed tracks in the first three
+        stages (the later two change no earlier match)."""
+        first_three = matching.stage_of_track.view(np.uint64) < 3  # stages 0-2 (unmatched -1: beyond, as unsigned)
+        self._calibration.observe_continued(score, matching.det_of_track[first_three])
 
     def _kept(self, dets: Detections) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         """The detections scoring at least ``low_score``: their boxes ``(n, 4)`` (left, top, width, height;
@@ -177,12 +193,7 @@ class BoxTrack:
     def _update_compiled(self, frame: Frame, kern: Any) -> Tracks:
         """:meth:`update` with the compiled kernels: the same steps and numbers as the numpy path."""
         cfg, t, clock = self.config, self._tracks, self._clock
-        steps = clock.steps(frame.time)
-        dt = steps * clock.interval
-        self._frame_count += 1
-        det_xywh, score, det_idx = self._kept(frame.detections)
-        self._calibration.observe_scores(score)
-        x = self._state()
+        steps, dt, det_xywh, score, det_idx, x = self._begin(frame)
         if self._slots is not None and len(t):
             self._slots.freeze_shape(t)
         space, clutter = self._predict_space(), self._clutter
@@ -196,8 +207,8 @@ class BoxTrack:
         matching = Matching.empty(k, n)
         if k and n:
             self._associate_compiled(kern, iou, det_xywh, score, high_score, dt, matching)
+        self._observe_continued(score, matching)
         det_of_track = matching.det_of_track
-        self._calibration.observe_continued(score, det_of_track[matching.stage_of_track.view(np.uint64) < 3])
         fit, back = self._buffers
         if fit.shape[1] < k:
             fit, back = self._buffers = (np.empty((4, 2 * k)), np.empty(2 * k, dtype=np.int64))
@@ -213,10 +224,7 @@ class BoxTrack:
             hit = det_of_track >= 0
             slots.observe_speed(t, hit, clock.interval)
             t.record(hit, dt)
-            ready = t.hits >= cfg.n_init
-            if self._frame_count == 1:
-                ready |= t.hits > 0
-            det_of_track = slots.refill(t, ready, det_of_track)
+            det_of_track = slots.refill(t, self._ready(), det_of_track)
         new = (matching.free & (score >= birth_score)).nonzero()[0]
         born = self._births(new, self._measure(det_xywh.T) if len(new) else _NO_BOXES.T)
         coasting, life = self._coasting, self._lifecycle
@@ -304,10 +312,7 @@ class BoxTrack:
         ones to tracks seen last frame, the rest to tentative tracks, then lost tracks by centre distance."""
         matching = run_plan(self._plan(iou, low_gate, det_box, score, high_score, was_tracked, dt),
                             len(self._tracks), len(score))
-        # the detections that continued confirmed tracks in the first three stages (the later two
-        # change no earlier match)
-        first_three = matching.stage_of_track.view(np.uint64) < 3  # stages 0-2 (unmatched -1: beyond, as unsigned)
-        self._calibration.observe_continued(score, matching.det_of_track[first_three])
+        self._observe_continued(score, matching)
         return matching
 
     def _plan(self, iou: np.ndarray | None, low_gate: np.ndarray | None, det_box: np.ndarray, score: np.ndarray,
