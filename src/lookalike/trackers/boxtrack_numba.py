@@ -45,6 +45,16 @@ def _iou(ax: float, ay: float, aw: float, ah: float, bx: float, by: float, bw: f
 
 
 @_jit
+def _add_noise(x: np.ndarray, i: int, row: int, q_w: float, q_h: float) -> None:
+    """Add the process noise ``q_w`` (to the x and width rows) and ``q_h`` (y and height) to the four
+    variance rows of track ``i`` of ``x`` from ``row`` on (pixels², per the rows' units)."""
+    x[row, i] += q_w
+    x[row + 1, i] += q_h
+    x[row + 2, i] += q_w
+    x[row + 3, i] += q_h
+
+
+@_jit
 def _predict_column(x: np.ndarray, i: int, steps: float, var_steps: float, still: bool, pos2: float,
                     vel2: float) -> None:
     """``BoxCXCYWH.predict_columns``' numbers for the track ``i`` of ``x``, its velocities dropped first when
@@ -83,18 +93,8 @@ def _predict_column(x: np.ndarray, i: int, steps: float, var_steps: float, still
             x[12 + r, i] += p22
             x[16 + r, i] += p22
             x[8 + r, i] += steps * x[12 + r, i]
-    q_w = pos2 * var_w
-    q_h = pos2 * var_h
-    x[8, i] += q_w
-    x[9, i] += q_h
-    x[10, i] += q_w
-    x[11, i] += q_h
-    q_w = vel2 * var_w
-    q_h = vel2 * var_h
-    x[20, i] += q_w
-    x[21, i] += q_h
-    x[22, i] += q_w
-    x[23, i] += q_h
+    _add_noise(x, i, 8, pos2 * var_w, pos2 * var_h)  # the positions' variances
+    _add_noise(x, i, 20, vel2 * var_w, vel2 * var_h)  # the velocities'
 
 
 @_jit
