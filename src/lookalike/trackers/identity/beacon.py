@@ -73,30 +73,32 @@ class BeaconIdentifier:
         agent_id = beacons.agent_id
         if len(agent_id):
             kernels = compiled()
-            if kernels is not None:  # (the common case below, checked and shifted in one compiled call)
-                shifted = kernels.shift_reports(self._th, agent_id, beacons.t_sent, beacons.heading)
-                ids = [] if shifted else agent_id.tolist()
+            if kernels is not None:  # (the common case, checked and shifted in one compiled call)
+                shifted = bool(kernels.shift_reports(self._th, agent_id, beacons.t_sent, beacons.heading))
             else:
-                ids = agent_id.tolist()
-            if ids and len(set(ids)) == len(ids) and max(ids) < n:
-                # (the common case: one report per agent, each newer than every one kept of its
-                # agent or its first: shift them in, all agents at once; the same result as the
-                # sort and de-duplication below)
-                new_t = beacons.t_sent
-                if not (new_t <= self._t[agent_id, -1]).any():
-                    th = self._th
-                    th[:, agent_id, :-1] = th[:, agent_id, 1:]
-                    th[0, agent_id, -1] = new_t
-                    th[1, agent_id, -1] = beacons.heading
-                    ids = []
-            for a in sorted(set(ids)):
-                if a >= n:
-                    continue
-                mine = agent_id == a
-                self._store(a, beacons.t_sent[mine], beacons.heading[mine], r)
+                shifted = self._shift_common(agent_id, beacons.t_sent, beacons.heading)
+            if not shifted:
+                for a in sorted(set(agent_id.tolist())):
+                    if a >= n:
+                        continue
+                    mine = agent_id == a
+                    self._store(a, beacons.t_sent[mine], beacons.heading[mine], r)
         self._slot = (self._slot + 1) % self.config.window_frames
         self._times[self._slot] = self._times_count[self._slot] = time_s
         self._win[:, self._slot] = np.nan
+
+    def _shift_common(self, agent_id: np.ndarray, new_t: np.ndarray, heading: np.ndarray) -> bool:
+        """The common case of :meth:`begin_frame`: one report per agent, each newer than every one kept
+        of its agent or its first: shift them in, all agents at once (the same result as :meth:`_store`
+        per agent). False, nothing changed, for reports of any other kind."""
+        ids = agent_id.tolist()
+        if len(set(ids)) < len(ids) or max(ids) >= self.config.n_agents or (new_t <= self._t[agent_id, -1]).any():
+            return False
+        th = self._th
+        th[:, agent_id, :-1] = th[:, agent_id, 1:]
+        th[0, agent_id, -1] = new_t
+        th[1, agent_id, -1] = heading
+        return True
 
     def _store(self, a: int, new_t: np.ndarray, new_h: np.ndarray, r: int) -> None:
         """Merge agent ``a``'s new reports into its history (sorted, duplicates dropped, last ``r``)."""
