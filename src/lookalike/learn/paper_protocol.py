@@ -13,7 +13,7 @@ import numpy as np
 
 from lookalike.learn.data import IGNORE
 from lookalike.learn.encoding import EncodingSpec, encode_agents_paper
-from lookalike.learn.sim_data import arrays_to_training, latest_reports, slot_order
+from lookalike.learn.sim_data import arrays_to_training, latest_reports, mix_pick, slot_order
 from lookalike.sim import RobotArrays, RobotWorldConfig, simulate_arrays
 
 NOISE_CHOICES = ("ours", "paper", "mix")
@@ -63,8 +63,7 @@ class NoiseMixSampler:
                                  f"N={self.spec.n_agents}, M={self.spec.n_slots}")
 
     def __call__(self, seed: int, n_frames: int, rng: np.random.Generator | None) -> tuple[np.ndarray, np.ndarray]:
-        pick = int(np.random.default_rng([seed, 0x401]).integers(len(self.worlds)))
-        arrays = simulate_arrays(self.worlds[pick], n_frames, seed)
+        arrays = simulate_arrays(self.worlds[mix_pick(seed, len(self.worlds))], n_frames, seed)
         if self.spec.protocol == "paper":
             return arrays_to_training_paper(self.spec, arrays, rng)
         return arrays_to_training(self.spec, arrays, rng)

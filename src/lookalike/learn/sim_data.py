@@ -129,6 +129,11 @@ class SimSampler:
         return arrays_to_training(spec, arrays, rng)
 
 
+def mix_pick(seed: int, count: int) -> int:
+    """Which of ``count`` worlds the sequence of ``seed`` is drawn from (uniform, fixed by the seed)."""
+    return int(np.random.default_rng([seed, 0x401]).integers(count))
+
+
 @dataclasses.dataclass(frozen=True)
 class WorldMixSampler:
     """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler: each sequence is made by one of
@@ -142,8 +147,7 @@ class WorldMixSampler:
             raise ValueError("WorldMixSampler needs at least one sampler")
 
     def __call__(self, seed: int, n_frames: int, rng: np.random.Generator | None) -> tuple[np.ndarray, np.ndarray]:
-        pick = int(np.random.default_rng([seed, 0x401]).integers(len(self.samplers)))
-        return self.samplers[pick](seed, n_frames, rng)
+        return self.samplers[mix_pick(seed, len(self.samplers))](seed, n_frames, rng)
 
 
 def make_sim_sampler(config: RobotWorldConfig, relative: bool = True, swap_prob: float = 0.0) -> SimSampler:
