@@ -123,3 +123,20 @@ def test_train_recordings_simulates_the_measured_detector(app, tmp_path):
     assert "detector measured on the training recordings" in r.output and "true robots" in r.output
     bad = runner.invoke(app, [*args, "-o", str(tmp_path / "bad")])
     assert bad.exit_code == 2 and "--mix-sim-fit needs" in bad.output
+
+
+def test_train_recordings_validates_on_a_folder_of_its_own(app, tmp_path):
+    _recordings(tmp_path / "rec", n=2)
+    val = tmp_path / "val"
+    val.mkdir()
+    write_robot_sequence(val / "held.labelled.jsonl", simulate_robots(preset("m3n2"), 60, 900))
+    out = tmp_path / "out"
+    r = runner.invoke(app, ["train", "--recordings", str(tmp_path / "rec"), "-o", str(out), "--steps", "1",
+                            "--sequence-length", "150", "--batch-size", "2", "--validation", str(val)])
+    assert r.exit_code == 0, r.output
+    split = json.loads((out / "model.json").read_text())["info"]["recordings"]
+    assert split["training"] == ["rec-0.labelled.jsonl", "rec-1.labelled.jsonl"]
+    assert split["validation"] == ["held.labelled.jsonl"] and split["validation_folder"] == str(val)
+    bad = runner.invoke(app, ["train", "--recordings", str(tmp_path / "rec"), "-o", str(tmp_path / "bad"),
+                              "--steps", "1", "--validation", str(tmp_path / "none")])
+    assert bad.exit_code == 2 and "--validation" in bad.output

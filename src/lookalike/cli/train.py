@@ -79,6 +79,9 @@ def train(
         "instead of the header's."),
     validation_fraction: float = typer.Option(
         0.25, "--validation-fraction", help="With --recordings: share of the recordings held out for validation."),
+    validation_folder: Path | None = typer.Option(
+        None, "--validation", help="With --recordings: validate on the recordings of this folder instead of a "
+        "share of --recordings (which then all train), e.g. to compare runs on the same validation recordings."),
     validate_every: int = typer.Option(50, "--validate-every", min=1, help="Steps between validations."),
     test: Path | None = typer.Option(
         None, "--test", help="With --recordings: after training, score the starting and the fine-tuned weights "
@@ -113,7 +116,8 @@ def train(
 
         train_recordings(recordings, output, RecordingOptions(
             **run, init_from=init_from, learning_rate=learning_rate, validation_fraction=validation_fraction,
-            device=device, resume=resume, test=test, sim_fraction=mix_sim, sim_fit=mix_sim_fit))
+            device=device, resume=resume, test=test, sim_fraction=mix_sim, sim_fit=mix_sim_fit,
+            validation=validation_folder))
         return
     if search is not None:
         from lookalike.cli.train_search import SearchOptions, train_search

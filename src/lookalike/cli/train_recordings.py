@@ -26,6 +26,7 @@ class RecordingOptions(RunOptions):
     test: Path | None
     sim_fraction: float = 0.0
     sim_fit: bool = False
+    validation: Path | None = None
 
 
 def read_recordings(folder: Path, option: str) -> list[RobotSequence]:
@@ -48,8 +49,9 @@ def read_recordings(folder: Path, option: str) -> list[RobotSequence]:
 
 
 def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
-    """Fine-tune on the recordings of ``folder`` (split by recording), write ``OUTPUT/model.npz``; with
-    ``opt.test``, print the starting and fine-tuned success rates on the test recordings."""
+    """Fine-tune on the recordings of ``folder`` (split by recording, or all of them with ``opt.validation``,
+    the folder of the validation recordings), write ``OUTPUT/model.npz``; with ``opt.test``, print the
+    starting and fine-tuned success rates on the test recordings."""
     import torch
 
     from lookalike.cli.train import _with_progress
@@ -63,6 +65,9 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     recordings = read_recordings(folder, "--recordings")
     tests = read_recordings(opt.test, "--test") if opt.test is not None else []
     paths = sorted(folder.glob(PATTERN))
+    if opt.validation is not None:  # every recording of the folder trains; these validate
+        recordings += read_recordings(opt.validation, "--validation")
+        paths += sorted(opt.validation.glob(PATTERN))
     names = [str(p) for p in paths]
     n, m = recordings[0].config.n_agents, recordings[0].config.max_detections
     device = opt.device
@@ -76,7 +81,11 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
         spec = init.spec
         check_recordings(spec, recordings, names)
         check_recordings(spec, tests, [str(p) for p in sorted(opt.test.glob(PATTERN))] if opt.test else [])
-        train_idx, val_idx = split_recordings(len(recordings), opt.validation_fraction, opt.seed)
+        if opt.validation is not None:
+            n_train = len(sorted(folder.glob(PATTERN)))
+            train_idx, val_idx = list(range(n_train)), list(range(n_train, len(recordings)))
+        else:
+            train_idx, val_idx = split_recordings(len(recordings), opt.validation_fraction, opt.seed)
         config = TrainConfig(
             n_agents=spec.n_agents, n_slots=spec.n_slots, relative_headings=spec.relative_headings, cell=init.cell,
             hidden=init.hidden, num_layers=len(init.layers), batch_size=opt.batch_size,
@@ -100,6 +109,8 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     held_out = [paths[i].name for i in val_idx]
     info = {"recordings": {"folder": str(folder), "training": [paths[i].name for i in train_idx],
                            "validation": held_out, "sim_fraction": opt.sim_fraction}}
+    if opt.validation is not None:
+        info["recordings"]["validation_folder"] = str(opt.validation)
     if opt.sim_fit:
         info["recordings"]["sim_sensor"] = dataclasses.asdict(world.sensor)
         console.print(f"simulated share ({opt.sim_fraction:.0%}) with the detector measured on the training "
