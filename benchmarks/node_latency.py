@@ -7,6 +7,10 @@ network) from this process, and prints:
 - the node's own figures: ``latency_ms`` of its counters (wall time from the frame's ``recvfrom``
   returning to its last ``sendto``; the time a datagram waited in the socket queue is not in it)
   and ``cpu_ms`` (the node thread's CPU time over the same span: decode, identify, encode, send),
+- the node's CPU time per frame with the work it does between frames: ``cpu_with_prepare_ms`` (the
+  frame plus the next frame's prediction made after its send, ``TeamIdentifier.prepare``) and the
+  node process's whole CPU time (user + system, Linux) from the first frame to the last, divided by
+  the frames (reports, the loop's waits, everything),
 - the round trip seen by a subscriber (camera ``sendto`` to the team state's arrival), and
 - without sockets, in this process: decode + identify + encode per frame, and the tracker's share
   (BLAS on one thread, as the node runs it).
@@ -117,6 +121,7 @@ def node_run(sequence, tracker: str, batched: bool) -> tuple[dict, np.ndarray]:
             time.sleep(0.05)
         host, port = port_file.read_text().strip().rsplit(":", 1)
     address = (host, int(port))
+    cpu_start = _process_cpu_s(node.pid)
 
     clock = SimClock(epoch=time.time() + 0.5, speed=1.0)
     robots = [lambda j=j: run_robot(Endpoint(address, group=group), j, sequence, clock, linger_s=0.1)
@@ -144,6 +149,7 @@ def node_run(sequence, tracker: str, batched: bool) -> tuple[dict, np.ndarray]:
     for t in threads:
         t.join()
     subscriber.close()
+    cpu_end = _process_cpu_s(node.pid)
     with Endpoint(address) as client:
         client.send(StatusRequest())
         status = client.receive(2.0)
@@ -152,7 +158,19 @@ def node_run(sequence, tracker: str, batched: bool) -> tuple[dict, np.ndarray]:
     if not isinstance(status, Status):
         raise SystemExit("no status from the node")
     round_trip = np.array([arrived_at[k] - sent_at[k] for k in arrived_at if k in sent_at]) * 1e3
-    return status.counters, round_trip
+    counters = dict(status.counters)
+    if cpu_start is not None and cpu_end is not None and counters.get("frames"):
+        counters["process_cpu_ms_per_frame"] = (cpu_end - cpu_start) * 1e3 / counters["frames"]
+    return counters, round_trip
+
+
+def _process_cpu_s(pid: int) -> float | None:
+    """User + system CPU seconds of process ``pid`` so far (Linux ``/proc``; None elsewhere)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return None
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def report_run(name: str, counters: dict, round_trip: np.ndarray, n_frames: int, targets: bool) -> None:
@@ -165,6 +183,10 @@ def report_run(name: str, counters: dict, round_trip: np.ndarray, n_frames: int,
           "frames")
     print(f"[{name}] node wall time per frame (the same span, with the waits for a core): median "
           f"{lat.get('median', nan):.3f} ms, p99 {lat.get('p99', nan):.3f} ms")
+    both = counters.get("cpu_with_prepare_ms", {})
+    print(f"[{name}] node CPU time per frame with the next frame's prediction made after the send (between "
+          f"frames): median {both.get('median', nan):.3f} ms, p99 {both.get('p99', nan):.3f} ms; node process CPU "
+          f"time (user + system, all its work) per frame {counters.get('process_cpu_ms_per_frame', nan):.3f} ms")
     if round_trip.size:
         print(f"[{name}] subscriber round trip (camera sendto -> team state received): median "
               f"{np.median(round_trip):.3f} ms, p99 {np.percentile(round_trip, 99):.3f} ms "

@@ -143,6 +143,13 @@ class TeamIdentifier:
         self.last_frame, self.last_time = message.frame, message.time
         return "frames", self._team_state(frame, snapshots)
 
+    def prepare(self) -> None:
+        """Between frames: let the tracker prepare the next frame now (its ``prepare()``, when it has one:
+        work that does not depend on the next frame's data, taken off that frame's path)."""
+        prepare = getattr(self.tracker, "prepare", None)
+        if prepare is not None:
+            prepare()
+
     def restart(self) -> None:
         """The camera came back with an earlier time: reset the tracker and the frame clock."""
         self.tracker.reset()

@@ -4,8 +4,9 @@ Each datagram is read, rate-limited by sender, decoded, and handed to the ``Team
 detections frame is tracked at once and its team state sent to every ``publish`` address and
 either once to the multicast ``group`` (the batched send: one datagram per frame reaches every
 robot that joined the group) or, when ``reply_to_robots`` is set and there is no group, to the
-address each robot last reported from. Nothing a peer sends can stop the loop: every failure is
-counted and logged (``handler_errors`` for a bug of the node itself). Default addresses are loopback.
+address each robot last reported from; after the send, the tracker prepares the next frame
+(``TeamIdentifier.prepare``). Nothing a peer sends can stop the loop: every failure is counted and
+logged (``handler_errors`` for a bug of the node itself). Default addresses are loopback.
 """
 
 from __future__ import annotations
@@ -269,8 +270,15 @@ class NodeServer:
             return
         self._publish(team)
         self.counters.latency_s.append(time.perf_counter() - t_received)
+        cpu_sent = time.thread_time()
+        try:  # (after the send: the next frame's prediction, off that frame's path)
+            self.identifier.prepare()
+        except Exception as exc:  # noqa: BLE001 (a tracker bug must not take the node down)
+            self.counters.add("tracker_errors")
+            log_event(self.log, "tracker_error", logging.ERROR, frame=message.frame, error=repr(exc))
         if self._cpu_received is not None:
-            self.counters.cpu_s.append(time.thread_time() - self._cpu_received)
+            self.counters.cpu_s.append(cpu_sent - self._cpu_received)
+            self.counters.cpu_with_prepare_s.append(time.thread_time() - self._cpu_received)
 
     def _publish(self, team: TeamState) -> None:
         try:

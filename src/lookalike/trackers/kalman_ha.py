@@ -23,7 +23,7 @@ identified track carries its agent id.
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 
@@ -65,6 +65,7 @@ class WorldTracker:
         self._model_dt: float | None = None  # frame interval of the cached (F, Q)
         self._model: tuple[np.ndarray, np.ndarray, np.ndarray] = (np.eye(6), np.eye(6), np.zeros((6, 6)))
         self._decay: float | None = None  # velocity factor of a coasting track over that interval
+        self._ready: _Prepared | None = None  # the next frame's prediction, made between frames (prepare)
         self._identifier = BeaconIdentifier(IdentifierConfig(
             n_agents=cfg.n_agents, window_frames=cfg.window_frames, max_cost=cfg.max_identity_cost,
             hysteresis=cfg.hysteresis))
@@ -81,21 +82,46 @@ class WorldTracker:
             raise ValueError(f"frame {frame.index}: time went backwards ({self._time} s then {frame.time} s)")
         self._time = frame.time
         self._identifier.begin_frame(frame.time, frame.beacons)
-        self._predict(dt)
-        det_of_track = self._associate_and_update(det)
-        hit = det_of_track >= 0
-        t["hit_bits"] = ((t["hit_bits"] << 1) | hit) & ((1 << 30) - 1)
-        t.record(hit, dt)
-        det_of_track = self._lifecycle(det_of_track)  # (a track with a hit survives this)
+        ready, self._ready = self._ready, None
+        if ready is not None and dt == ready.dt:  # (made for this interval from this table: prepare)
+            t.mean, t.cov = ready.mean, ready.cov
+        else:
+            self._predict(dt)
+            ready = None
+        det_of_track = self._associate_and_update(det) if ready is None else self._associate_and_update(det, ready)
+        det_of_track = self._lifecycle(det_of_track, dt, None if ready is None else ready.in_view)
         new = self._births(det, det_of_track)
         return self._report(det, np.concatenate([det_of_track, new]))
 
     # -- steps -------------------------------------------------------------------------------
 
+    def prepare(self) -> None:
+        """Between frames (optional; the node calls it after sending a frame's team state): predict the
+        tracks for the next frame assuming the last frame interval repeats, with what the next frame's
+        association needs that does not depend on its detections (innovation covariances, their Cholesky
+        factors, the gains, the updated covariances, which tracks are predicted in view). :meth:`update`
+        uses them when the interval is exactly the same (they are the same operations on the same
+        values, so the result is bit for bit the one it would compute) and otherwise computes its own. A
+        subclass with its own association (JPDA) prepares nothing."""
+        t, dt = self._tracks, self._model_dt
+        self._ready = None
+        if (self._time is None or dt is None or not len(t)
+                or type(self)._associate_and_update is not WorldTracker._associate_and_update):
+            return
+        mean, cov = self._predicted(t.mean.copy(), t.cov, dt)
+        S, L, gain, cov_hit = self._gains(mean, cov)
+        in_view = None if self.rules.confirm_window is None else self.rules.in_view(mean[:, :2])
+        self._ready = _Prepared(dt, mean, cov, S, L, gain, cov_hit, in_view)
+
     def _predict(self, dt: float) -> None:
         t = self._tracks
         if not len(t) or dt == 0:
             return
+        t.mean, t.cov = self._predicted(t.mean, t.cov, dt)
+
+    def _predicted(self, mean: np.ndarray, cov: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """The predicted means and covariances over ``dt`` > 0 seconds (``mean``'s coasting rows are
+        decayed in place first)."""
         if dt != self._model_dt:  # (WorldCA.predict's model and the decay, kept while the interval repeats)
             F, Q = constant_acceleration(2, dt, self.config.q_jerk)
             self._model = F, F.T, Q  # (F.T: the view kalman.predict multiplies by)
@@ -103,23 +129,33 @@ class WorldTracker:
             self._decay = None if decay_s is None else np.exp(-dt / decay_s)
             self._model_dt = dt
         if self._decay is not None:
-            coasting = t.misses > 0
+            coasting = self._tracks.misses > 0
             if coasting.any():
-                t.mean[coasting, 2:4] *= self._decay
-                t.mean[coasting, 4:6] = 0.0
+                mean[coasting, 2:4] *= self._decay
+                mean[coasting, 4:6] = 0.0
         F, Ft, Q = self._model  # (kalman.predict's arithmetic, its transposes made once per interval)
-        t.mean, t.cov = t.mean @ Ft, F @ t.cov @ Ft + Q
+        return mean @ Ft, F @ cov @ Ft + Q
+
+    def _gains(self, mean: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Every track's innovation covariance ``S (k, 2, 2)``, its lower Cholesky factor, the solve of
+        ``S K = H P`` (``(k, 2, 6)``: the Kalman gains transposed) and the covariance after an update."""
+        S = cov[:, :2, :2] + self._noise(mean[:, :2])
+        PHt_T = np.ascontiguousarray(cov[:, :, :2]).swapaxes(-1, -2)  # (``(P @ H.T).T``, (k, 2, 6))
+        gain = solve(S, PHt_T)
+        return S, cholesky(S), gain, cov - gain.swapaxes(-1, -2) @ PHt_T
 
     def _noise(self, position: np.ndarray) -> np.ndarray:
         """Measurement covariances ``(k, 2, 2)`` for positions ``(k, 2)``."""
         return self._space.R(position)
 
-    def _associate_and_update(self, det: Detections) -> np.ndarray:
+    def _associate_and_update(self, det: Detections, ready: _Prepared | None = None) -> np.ndarray:
         """Hungarian on the gated squared Mahalanobis distance; Kalman update of matched tracks.
 
         The arithmetic of ``motion.kalman.gating_distance`` and ``kalman.update`` on the whole
         table at once: ``H`` picks the position, so ``H P Hᵀ`` and ``P Hᵀ`` are slices of ``P`` (the
-        same values), and the innovation covariances are formed once for gating and update.
+        same values), and the innovation covariances are formed once for gating and update. With
+        ``ready`` (the table predicted by :meth:`prepare`) the covariances, factors, gains and updated
+        covariances are its own (the same values, computed between frames for every track).
         """
         t = self._tracks
         det_of_track = filled(len(t), -1, int)
@@ -127,10 +163,14 @@ class WorldTracker:
             return det_of_track
         z = positions(det)
         mean, cov = t.mean, t.cov
-        noise = self._noise(mean[:, :2])  # (row by row: the matched rows' noise is noise[rows])
-        S = cov[:, :2, :2] + noise
+        if ready is not None:
+            S, L = ready.S, ready.L
+        else:
+            noise = self._noise(mean[:, :2])  # (row by row: the matched rows' noise is noise[rows])
+            S = cov[:, :2, :2] + noise
+            L = cholesky(S)
         diff = z[None, :, :] - mean[:, None, :2]  # (k, d, 2)
-        y = solve(cholesky(S), diff.swapaxes(-1, -2))  # (k, 2, d)
+        y = solve(L, diff.swapaxes(-1, -2))  # (k, 2, d)
         kernels = compiled()
         if kernels is not None:  # (the lines below and pairs' steps up to the solver, in one compiled call)
             rows, cols = decided_pairs(*kernels.gate_work(y, self._gate))
@@ -138,7 +178,12 @@ class WorldTracker:
             d2 = np.add.reduce(y * y, axis=1)
             rows, cols = pairs(d2, d2 <= self._gate)
         det_of_track[rows] = cols
-        if len(rows):
+        if len(rows) and ready is not None:  # (the lines below, with the gains and covariances made ahead)
+            K = ready.gain[rows].swapaxes(-1, -2)
+            m = mean[rows]
+            t.mean[rows] = m + einsum("kij,kj->ki", K, z[cols] - m[:, :2])
+            t.cov[rows] = ready.cov_hit[rows]
+        elif len(rows):
             m, P = mean[rows], cov[rows]
             PHt = np.ascontiguousarray(P[:, :, :2])  # (k, 6, 2), laid out as ``P @ H.T``
             PHt_T = PHt.swapaxes(-1, -2)
@@ -148,17 +193,36 @@ class WorldTracker:
             t.cov[rows] = P - K @ PHt_T
         return det_of_track
 
-    def _lifecycle(self, det_of_track: np.ndarray) -> np.ndarray:
-        """Confirm and delete tracks; return ``det_of_track`` of the survivors."""
+    def _lifecycle(self, det_of_track: np.ndarray, dt: float, in_view: np.ndarray | None = None) -> np.ndarray:
+        """Record the frame's hits and misses (``dt`` seconds), confirm and delete tracks; return
+        ``det_of_track`` of the survivors. ``in_view``: which tracks were predicted in view (:meth:`prepare`);
+        their view only matters to the tracks that missed, whose positions are the predicted ones (a hit has
+        been unseen 0 s, within either limit)."""
         t, rules = self._tracks, self.rules
-        limit_s = None
-        if rules.confirm_window is None:
-            t.confirmed[:] = True
+        window = rules.confirm_window
+        if window is not None and in_view is None:
+            in_view = rules.in_view(t.mean[:, :2])
+        kernels, life = compiled(), rules.lifecycle
+        if kernels is not None and life.max_unseen_s is life.tentative_max_unseen_s is None and not life.closed:
+            # (the lines below and Lifecycle.alive's in one compiled call, in place on the columns)
+            keep = kernels.lifecycle_work(
+                det_of_track, t["hit_bits"], t.misses, t.unseen_s, t.hits, t.confirmed, dt,
+                0 if window is None else window, life.n_init,
+                -1 if life.tentative_max_misses is None else life.tentative_max_misses,
+                -1 if life.max_misses is None else life.max_misses, _NO_VIEW if in_view is None else in_view,
+                rules.max_coast_s + 1e-9, rules.max_out_of_view_s + 1e-9)
         else:
-            t.hits = bit_count(t["hit_bits"] & ((1 << rules.confirm_window) - 1))
-            rules.lifecycle.confirm(t)
-            limit_s = np.where(rules.in_view(t.mean[:, :2]), rules.max_coast_s + 1e-9, rules.max_out_of_view_s + 1e-9)
-        keep = rules.lifecycle.alive(t, limit_s)
+            hit = det_of_track >= 0
+            t["hit_bits"] = ((t["hit_bits"] << 1) | hit) & ((1 << 30) - 1)
+            t.record(hit, dt)
+            limit_s = None
+            if window is None:
+                t.confirmed[:] = True
+            else:
+                t.hits = bit_count(t["hit_bits"] & ((1 << window) - 1))
+                life.confirm(t)
+                limit_s = np.where(in_view, rules.max_coast_s + 1e-9, rules.max_out_of_view_s + 1e-9)
+            keep = life.alive(t, limit_s)
         if not keep.all():
             self._identifier.drop(t.ids[~keep])
             t.keep(keep)
@@ -225,6 +289,24 @@ class WorldTracker:
         out.heading, out.agent_id, out.identity_prob = heading, agent, prob
         return out
 
+
+class _Prepared(NamedTuple):
+    """The next frame's prediction made between frames (:meth:`WorldTracker.prepare`) for interval ``dt``:
+    means ``(k, 6)``, covariances ``(k, 6, 6)``, innovation covariances ``S (k, 2, 2)`` and their lower
+    Cholesky factors ``L``, the gains transposed ``(k, 2, 6)``, the covariances after an update ``(k, 6, 6)``
+    and which tracks are predicted in the camera's view (None without view rules)."""
+
+    dt: float
+    mean: np.ndarray
+    cov: np.ndarray
+    S: np.ndarray
+    L: np.ndarray
+    gain: np.ndarray
+    cov_hit: np.ndarray
+    in_view: np.ndarray | None
+
+
+_NO_VIEW = np.zeros(0, dtype=bool)  # (the compiled lifecycle's in-view argument when there are no view rules)
 
 _BITWISE_COUNT = getattr(np, "bitwise_count", None)
 

@@ -127,6 +127,9 @@ def warm() -> bool:
     kernels.window_costs(th, times, times, samples, 1.0, 1.0, np.empty((1, 2)))
     kernels.identity_work(th, times, times, samples, np.zeros(1, dtype=int), 1.0, 1.0, 0.1, 0.3)
     kernels.gate_work(np.zeros((1, 2, 1)), 1.0)
+    ints, flags = np.zeros(1, dtype=int), np.zeros(1, dtype=bool)
+    kernels.lifecycle_work(ints, ints.copy(), ints.copy(), np.zeros(1), ints.copy(), flags, 0.0, 5, 3, 2, -1,
+                           flags.copy(), 1.0, 1.0)
     ids, values, pairs_ = np.zeros(1, dtype=int), np.zeros(1), np.zeros((1, 2))
     for flag in (True, False):  # (the node's detections and reports arrive read-only)
         ids.flags.writeable = values.flags.writeable = pairs_.flags.writeable = flag

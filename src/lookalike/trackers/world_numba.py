@@ -245,6 +245,53 @@ def birth_candidates(det_of_track: np.ndarray, score: np.ndarray, min_score: flo
 
 
 @_jit
+def lifecycle_work(det_of_track: np.ndarray, hit_bits: np.ndarray, misses: np.ndarray, unseen_s: np.ndarray,
+                   hits: np.ndarray, confirmed: np.ndarray, dt: float, confirm_window: int, n_init: int,
+                   tentative_max_misses: int, max_misses: int, in_view: np.ndarray, limit_in_s: float,
+                   limit_out_s: float) -> np.ndarray:
+    """``WorldTracker``'s lifecycle after association, in place on the table's columns (``k`` tracks): the hit
+    history ``hit_bits`` (bit 0 this frame, 30 bits kept; a hit is ``det_of_track >= 0``), ``misses`` (frames)
+    and ``unseen_s`` (seconds, ``dt`` a frame) reset by a hit or grown; with ``confirm_window`` > 0, ``hits``
+    counts the hits of the last ``confirm_window`` frames and a track with ``n_init`` of them is confirmed (for
+    good), and a confirmed track survives while unseen at most ``limit_in_s`` (``in_view``) or ``limit_out_s``;
+    with ``confirm_window`` 0 every track is confirmed. A tentative track survives fewer than
+    ``tentative_max_misses`` misses (-1: no limit), a confirmed one at most ``max_misses`` (-1: no limit).
+    The operations of ``WorldTracker._lifecycle`` and ``Lifecycle.alive`` (no seconds limits of their own);
+    returns the survivors' mask."""
+    k = det_of_track.shape[0]
+    keep = np.empty(k, np.bool_)
+    window_mask = (1 << confirm_window) - 1 if confirm_window > 0 else 0
+    for i in range(k):
+        hit = det_of_track[i] >= 0
+        hit_bits[i] = ((hit_bits[i] << 1) | (1 if hit else 0)) & ((1 << 30) - 1)
+        if hit:
+            misses[i] = 0
+            unseen_s[i] = 0.0
+        else:
+            misses[i] = misses[i] + 1
+            unseen_s[i] = unseen_s[i] + dt
+        if confirm_window > 0:
+            bits = hit_bits[i] & window_mask
+            count = 0
+            while bits:
+                count += bits & 1
+                bits >>= 1
+            hits[i] = count
+            if count >= n_init:
+                confirmed[i] = True
+        else:
+            confirmed[i] = True
+        if confirmed[i]:
+            ok = max_misses < 0 or misses[i] <= max_misses
+            if confirm_window > 0:
+                ok = ok and unseen_s[i] <= (limit_in_s if in_view[i] else limit_out_s)
+            keep[i] = ok
+        else:
+            keep[i] = tentative_max_misses < 0 or misses[i] < tentative_max_misses
+    return keep
+
+
+@_jit
 def cosines(x: np.ndarray) -> np.ndarray:
     """The kernels' ``cos`` of each value of ``x`` (compared with numpy's before the kernels are used)."""
     out = np.empty_like(x)
