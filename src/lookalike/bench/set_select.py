@@ -12,6 +12,11 @@ chosen weights into the package's shipped weights with what they were chosen on.
 the snapshots at multiples of 200 and the mean of those from step 300 on; each is also timed on
 ``bench recovery``'s swap on tuning seeds (:data:`RECOVERY_SEED`), and a choice ships only when it is
 better than the baseline (:func:`better_than`).
+
+``--stage 3`` trains nothing: it chooses the identifier's inference options (:data:`STAGE3_OPTIONS`: the
+stale-report rule ``stale_s``/``stale_turn`` and ``on_jump``) for the shipped weights on more tuning teams
+(:data:`STAGE3_TEAMS`) and the tuning recovery, leaving out the sequences where the swapped pair is not
+seen while swapped or not after the restore (:func:`measurable`); see :func:`choose_stage3`.
 """
 
 from __future__ import annotations
@@ -25,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.bench.experiments import swap_recovery
+from lookalike.bench.experiments import most_seen_pair, swap_recovery
 from lookalike.bench.pixel_recordings import score_identifier
 from lookalike.learn.set_data import world
 from lookalike.learn.set_numpy import load_set_weights, save_set_weights
@@ -54,15 +59,31 @@ STAGE2_RULE = ("candidates: snapshots at multiples of 200 and the mean of those 
                "the mean recovery < baseline's - 0.03 s")
 
 
-def set_success(weights: Path, sequences: list[RobotSequence]) -> float:
-    """Identification success rate of ``set`` with ``weights`` over ``sequences`` (as ``bench ident`` runs it)."""
-    return score_identifier(sequences, "set", weights=str(weights))[0]
+# Stage 3: two more tuning teams (the unseen teams' N = 6 and 12 with their clutter; seeds apart from the others).
+STAGE3_TEAMS = TUNING_TEAMS + (("m8n6", (6, 8, 1.3), 58_000, 10), ("m14n12", (12, 14, 2.5), 59_000, 5))
+# Stage 3's candidates: the set identifier's inference options for the shipped weights; the first is the baseline.
+STAGE3_OPTIONS: tuple[dict[str, object], ...] = tuple(
+    {"stale_s": stale, "stale_turn": turn, "on_jump": jump} for jump in ("forget", "swap")
+    for stale, turn in ((None, 0.6), (0.5, 0.6), (0.5, 1.0), (1.0, 0.6), (1.0, 1.0), (2.0, 0.6), (2.0, 1.0)))
+STAGE3_RULE = ("candidates: stale_s in (off, 0.5, 1, 2 s) x stale_turn in (0.6, 1.0 rad) x on_jump in (forget, swap), "
+               "the shipped weights; eligible: tuning M=3, N=2 >= baseline + 0.1 points, the other five tuning teams "
+               ">= baseline - 0.05 points, tuning recovery mean <= baseline + 0.02 s on every set-up (sequences whose "
+               "swapped pair is not seen while swapped or after the restore left out); choice: best M=3, N=2, within "
+               "0.05 points the lowest mean recovery, then the best mean success of the other teams; shipped as the "
+               "identifier's defaults when one is eligible")
 
 
-def tuning_sequences() -> dict[str, list[RobotSequence]]:
-    """The tuning sequences of :data:`TUNING_TEAMS`, by name."""
+def set_success(weights: Path, sequences: list[RobotSequence], **options: object) -> float:
+    """Identification success rate of ``set`` with ``weights`` (and inference ``options``) over ``sequences``
+    (as ``bench ident`` runs it)."""
+    return score_identifier(sequences, "set", weights=str(weights), **options)[0]
+
+
+def tuning_sequences(teams: tuple[tuple[str, tuple[int, int, float], int, int], ...] = TUNING_TEAMS
+                     ) -> dict[str, list[RobotSequence]]:
+    """The tuning sequences of ``teams`` (default :data:`TUNING_TEAMS`), by name."""
     out = {}
-    for name, (n, m, fp), first, count in TUNING_TEAMS:
+    for name, (n, m, fp), first, count in teams:
         cfg = preset(name) if name in PRESET_NAMES else world(n, m, fp)
         out[name] = [simulate_robots(cfg, 1000, first + k) for k in range(count)]
     return out
@@ -79,20 +100,36 @@ def choose(rows: dict[str, dict[str, float]], baseline: dict[str, float]) -> str
     return max(near, key=lambda p: float(np.mean([rows[p][k] for k in baseline])))
 
 
-def _labels(weights: Path, sequence: RobotSequence, frames: list[Frame]) -> list[np.ndarray]:
-    """Per frame, ``set``'s labels with ``weights`` over ``frames``, configured as ``bench ident`` does."""
+def _labels(weights: Path, sequence: RobotSequence, frames: list[Frame], **options: object) -> list[np.ndarray]:
+    """Per frame, ``set``'s labels with ``weights`` (and ``options``) over ``frames``, configured as ``bench
+    ident`` does."""
     cfg = sequence.config
-    tracker = make_tracker("set", n_agents=cfg.n_agents, n_slots=cfg.max_detections, weights=str(weights))
+    tracker = make_tracker("set", n_agents=cfg.n_agents, n_slots=cfg.max_detections, weights=str(weights), **options)
     labels: list[np.ndarray] = []
     run(tracker, frames, lambda f, tracks: labels.append(labels_from_tracks(len(f.detections), tracks)))
     return labels
 
 
 def set_recovery_s(weights: Path, sequence: RobotSequence, swap_at_s: float = RECOVERY_SWAP[0],
-                   swap_s: float = RECOVERY_SWAP[1]) -> float:
-    """Seconds ``set`` with ``weights`` takes to recover after ``bench recovery``'s swap of the two
-    robots seen most (inf: never), measured as ``bench recovery`` does."""
-    return swap_recovery(lambda s, fs: _labels(weights, s, fs), sequence, swap_at_s, swap_s)[2]
+                   swap_s: float = RECOVERY_SWAP[1], **options: object) -> float:
+    """Seconds ``set`` with ``weights`` (and ``options``) takes to recover after ``bench recovery``'s swap
+    of the two robots seen most (inf: never), measured as ``bench recovery`` does."""
+    return swap_recovery(lambda s, fs: _labels(weights, s, fs, **options), sequence, swap_at_s, swap_s)[2]
+
+
+def measurable(sequence: RobotSequence, swap_at_s: float = RECOVERY_SWAP[0], swap_s: float = RECOVERY_SWAP[1]) -> bool:
+    """Whether ``bench recovery``'s swap in ``sequence`` can be recovered from at all: its swapped pair (the
+    two robots seen most, as :func:`~lookalike.bench.experiments.swap_recovery` picks it) has a detection
+    while swapped and one after the restore. From the truth alone: the same for every identifier."""
+    rate = sequence.config.frame_rate_hz
+    truth = sequence.true_labels()
+    start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
+    a, b = most_seen_pair(truth[start : restore + int(3 * rate)], sequence.config.n_agents)
+
+    def seen(frames: list[np.ndarray]) -> bool:
+        return any(((t == a) | (t == b)).any() for t in frames)
+
+    return seen(truth[start:restore]) and seen(truth[restore:])
 
 
 def recovery_sequences() -> dict[str, list[RobotSequence]]:
@@ -129,6 +166,66 @@ def better_than(row: dict[str, float], baseline: dict[str, float]) -> bool:
     mean_rec = float(np.mean([row[k] for k in recs])) if recs else 0.0
     base_rec = float(np.mean([baseline[k] for k in recs])) if recs else 0.0
     return row["m3n2"] > baseline["m3n2"] + 0.05 or mean_rec < base_rec - 0.03
+
+
+def choose_stage3(rows: dict[str, dict[str, float]], baseline: str) -> str | None:
+    """The stage-3 choice among ``rows`` (candidate -> tuning success per team in % and ``rec_<setup>`` /
+    ``worst_<setup>`` recovery seconds), ``baseline`` one of its keys: see :data:`STAGE3_RULE`; None
+    when none is eligible."""
+    base = rows[baseline]
+    teams = [k for k in base if not k.startswith(("rec_", "worst_"))]
+    others = [k for k in teams if k != "m3n2"]
+    recs = [k for k in base if k.startswith("rec_")]
+
+    def eligible(r: dict[str, float]) -> bool:
+        return (r["m3n2"] >= base["m3n2"] + 0.1 and all(r[k] >= base[k] - 0.05 for k in others)
+                and all(np.isfinite(r[k]) and r[k] <= base[k] + 0.02 for k in recs))
+
+    ok = [p for p, r in rows.items() if p != baseline and eligible(r)]
+    if not ok:
+        return None
+    top = max(rows[p]["m3n2"] for p in ok)
+    near = [p for p in ok if rows[p]["m3n2"] >= top - 0.05]
+    return min(near, key=lambda p: (float(np.mean([rows[p][k] for k in recs])),
+                                    -float(np.mean([rows[p][k] for k in others]))))
+
+
+def options_row(options: dict[str, object], seqs: dict[str, list[RobotSequence]],
+                rec_seqs: dict[str, list[RobotSequence]], weights: Path = SHIPPED_SET_WEIGHTS) -> dict[str, float]:
+    """Tuning success (%) of ``set`` with inference ``options`` per team of ``seqs`` and, per set-up of
+    ``rec_seqs``, the mean (``rec_<setup>``) and worst (``worst_<setup>``) recovery seconds over the
+    :func:`measurable` sequences."""
+    row = {name: round(100 * set_success(weights, sq, **options), 3) for name, sq in seqs.items()}
+    for p, sq in rec_seqs.items():
+        times = [set_recovery_s(weights, q, **options) for q in sq if measurable(q)]
+        row[f"rec_{p}"], row[f"worst_{p}"] = round(float(np.mean(times)), 3), round(float(np.max(times)), 3)
+    return row
+
+
+def option_name(options: dict[str, object]) -> str:
+    """A short name of a stage-3 candidate, e.g. ``stale=1.0/0.6,swap``."""
+    stale = "off" if options["stale_s"] is None else f"{options['stale_s']}/{options['stale_turn']}"
+    return f"stale={stale},{options['on_jump']}"
+
+
+def select_stage3(cache_path: Path) -> str | None:
+    """Score every :data:`STAGE3_OPTIONS` candidate on the tuning sequences (cached in ``cache_path``, JSON, by
+    name), print them and return the chosen candidate's name (None: nothing eligible)."""
+    seqs = tuning_sequences(STAGE3_TEAMS)
+    rec_seqs = recovery_sequences()
+    cols = [t[0] for t in STAGE3_TEAMS] + [f"{c}_{p}" for c in ("rec", "worst") for p in PRESET_NAMES]
+    cache: dict[str, dict[str, float]] = json.loads(cache_path.read_text()) if cache_path.is_file() else {}
+    print("tuning success (%), recovery (s)  " + "".join(f"{n:>12s}" for n in cols))
+    for options in STAGE3_OPTIONS:
+        name = option_name(options)
+        if name not in cache:
+            cache[name] = options_row(options, seqs, rec_seqs)
+            cache_path.write_text(json.dumps(cache, indent=1))
+        print(f"{name:32s}" + "".join(f"{cache[name][n]:12.3f}" for n in cols), flush=True)
+    chosen = choose_stage3({option_name(o): cache[option_name(o)] for o in STAGE3_OPTIONS},
+                           option_name(STAGE3_OPTIONS[0]))
+    print(f"chosen: {chosen}" if chosen else "chosen: none (nothing eligible; the defaults stay)")
+    return chosen
 
 
 def average_weights(paths: list[Path], out: Path) -> Path:
@@ -230,9 +327,15 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--average-from", type=int, default=None,
                         help="also the mean of the snapshots' weights from this step on")
     parser.add_argument("--ship", action="store_true", help="ship the chosen weights")
-    parser.add_argument("--stage", type=int, choices=(1, 2), default=1,
-                        help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from)")
+    parser.add_argument("--stage", type=int, choices=(1, 2, 3), default=1,
+                        help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from); "
+                        "3: the inference options of the shipped weights (RUN: where the scores are kept)")
+    parser.add_argument("--cache", type=Path, default=None,
+                        help="stage 3: the JSON file of scored candidates (default RUN/set_select_stage3.json)")
     args = parser.parse_args(argv)
+    if args.stage == 3:
+        select_stage3(args.cache or args.run / "set_select_stage3.json")
+        return
     select(args.run, args.every, args.baseline, args.ship, args.average_from, args.stage)
 
 

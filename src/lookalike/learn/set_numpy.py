@@ -127,6 +127,16 @@ class NumpySetAssociator:
         for state in (self.h, self.p, self.m, self.s):
             state[agents] = 0.0
 
+    def swap(self, a: int, b: int) -> None:
+        """Exchange the memories (state, remembered position, weight, staleness) of agents ``a`` and ``b``."""
+        for state in (self.h, self.p, self.m, self.s):
+            state[[a, b]] = state[[b, a]]
+
+    def remembers(self, threshold: float = 0.5) -> np.ndarray:
+        """``(N,)`` whether each agent's remembered position (``p``, metres) is held with weight above
+        ``threshold`` (0 after :meth:`reset` or :meth:`forget`, towards 1 as detections are attended)."""
+        return self.m[:, 0] > threshold
+
     def step(self, agents: np.ndarray, dets: np.ndarray, dt_s: float) -> np.ndarray:
         """Advance one frame; return ``(K, N+1)`` probabilities."""
         t, b = self._t, self._b

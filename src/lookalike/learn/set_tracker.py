@@ -61,6 +61,16 @@ class SetIdentifier:
             "turn_rate * (seconds between its reports) radians (a report from another robot; None: never)",
             range=(0.0, 10.0))
         turn_rate: float = param(3.0, "fastest plausible turn of a robot for report_jump, rad/s", range=(0.0, 100.0))
+        stale_s: float | None = param(
+            None, "hide an agent's reported heading from the network when the report is older than stale_s "
+            "seconds and a detection near the agent's remembered position (stale_radius_m) has turned away from it "
+            "by more than stale_turn radians (None: never)", range=(0.0, 100.0))
+        stale_turn: float = param(0.6, "heading disagreement for stale_s, radians", range=(0.0, 4.0))
+        stale_radius_m: float = param(0.5, "how near the remembered position a detection must be for stale_s, metres",
+                                      range=(0.0, 100.0))
+        on_jump: str = param("forget", "after a report jump (report_jump): forget the agent's memory, or swap "
+                             "it with the one other agent that reported the new heading just before (forget: "
+                             "no such agent or several)", choices=("forget", "swap"))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
                                choices=LOCALISERS)
 
@@ -83,6 +93,7 @@ class SetIdentifier:
         self.last_labels = np.zeros(0, dtype=int)
         self.last_probabilities = np.zeros(0)
         self._last_time = -np.inf
+        self._expected_jump: dict[int, float] = {}
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
@@ -102,13 +113,35 @@ class SetIdentifier:
         heading = det.heading if det.heading is not None and n else np.zeros(0)
         score = det.score if det.score is not None and n else np.zeros(0)
         used = np.argsort(-score, kind="stable")[: self.config.n_slots]
-        agents = agent_tokens(self._beacons.heading, self._beacons.age(frame.time), self.net.weights.max_age_s)
+        age = self._beacons.age(frame.time)
+        reported = self._beacons.heading
+        if self.config.stale_s is not None:
+            reported = self._hide_stale(reported, age, position, heading)
+        agents = agent_tokens(reported, age, self.net.weights.max_age_s)
         prob = self.net.step(agents, detection_tokens(position[used], heading[used], score[used]), dt)
         slot_label, slot_conf = decode(prob, len(used), self.config.one_to_one)
         labels, conf = np.full(n, -1), np.zeros(n)
         labels[used], conf[used] = slot_label, slot_conf
         self.last_labels, self.last_probabilities = labels, conf
         return self._snapshots(labels, conf, position, heading, frame)
+
+    def _hide_stale(self, reported: np.ndarray, age: np.ndarray, position: np.ndarray,
+                    heading: np.ndarray) -> np.ndarray:
+        """The reported headings (radians) with NaN (never heard, for the network) for every agent whose
+        report is older than ``stale_s`` while a detection within ``stale_radius_m`` of its remembered
+        position is more than ``stale_turn`` away from that report: the robot has turned since it last
+        reported, and only its remembered position still says which detection it is."""
+        cfg = self.config
+        stale = np.isfinite(age) & (age > cfg.stale_s) & self.net.remembers()
+        if not stale.any() or not len(position):
+            return reported
+        out = reported.copy()
+        for j in np.flatnonzero(stale):
+            near = np.linalg.norm(position - self.net.p[j], axis=1) < cfg.stale_radius_m
+            turned = np.abs(np.angle(np.exp(1j * (heading[near] - reported[j])))) > cfg.stale_turn
+            if turned.any():
+                out[j] = np.nan
+        return out
 
     def _forget_jumps(self, heading: np.ndarray, t_sent: np.ndarray, jump: float) -> None:
         """Forget the memory of every agent whose newest report turned farther from its previous one
@@ -121,7 +154,37 @@ class SetIdentifier:
             gap = np.where(fresh, self._beacons.t_sent - np.where(fresh, t_sent, 0.0), 0.0)
             jumped = fresh & (turn > jump + self.config.turn_rate * gap)
             if jumped.any():
-                self.net.forget(jumped)
+                if self.config.on_jump == "swap":
+                    self._swap_jumps(np.flatnonzero(jumped), old, t_sent, jump)
+                else:
+                    self.net.forget(jumped)
+
+    def _swap_jumps(self, jumped: np.ndarray, old: np.ndarray, t_sent: np.ndarray, jump: float) -> None:
+        """``on_jump="swap"``: an agent ``a`` whose reports jumped now reports for the robot that exactly
+        one other agent ``b`` reported for just before (within ``jump`` + ``turn_rate`` · the time between
+        the two reports): ids swapped, or a swap undone. The two agents' memories are exchanged, and
+        ``b``'s own jump, expected within a second, changes nothing more. An agent with no such partner,
+        or several, is forgotten."""
+        now = self._beacons.t_sent
+        done: set[int] = set()
+        for a in jumped.tolist():
+            if a in done:
+                continue
+            if now[a] - self._expected_jump.pop(a, -np.inf) <= 1.0:
+                continue  # the second half of a swap already made
+            turn = np.abs(np.angle(np.exp(1j * (self._beacons.heading[a] - old))))
+            match = np.isfinite(old) & (turn <= jump + self.config.turn_rate * np.abs(now[a] - t_sent))
+            match[a] = False
+            partners = np.flatnonzero(match)
+            if len(partners) != 1:
+                self.net.forget(np.array([a]))
+                continue
+            b = int(partners[0])
+            self.net.swap(a, b)
+            if b in jumped:
+                done.add(b)
+            else:
+                self._expected_jump[b] = now[a]
 
     def _snapshots(self, labels: np.ndarray, conf: np.ndarray, position: np.ndarray, heading: np.ndarray,
                    frame: Frame) -> list[TrackSnapshot]:
