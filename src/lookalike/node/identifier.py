@@ -22,6 +22,7 @@ from lookalike.node.messages import (
     HeadingReport,
     RobotEstimate,
     TeamState,
+    numbers_of,
 )
 from lookalike.trackers.identity.labels import label_list
 from lookalike.trackers.world_kernels import filled
@@ -168,18 +169,25 @@ class TeamIdentifier:
         fails these checks goes through the validating constructors and their errors.
         """
         n = len(message.position)
-        position = np.array(message.position, dtype=float).reshape(n, 2)
-        heading = np.array(message.heading, dtype=float)
-        score = np.array(message.score, dtype=float)
         spread = message.heading_std
-        std = None if spread is None else np.array(spread, dtype=float)
-        try:  # (finite numbers sum to a finite total, barring overflow; anything else is checked below)
-            total: float = sum(message.heading) + sum(message.score) + sum(map(sum, message.position))
-            if spread is not None and std is not None:
-                total += sum(spread) if std.shape == (n,) and (not n or std.min() >= 0) else math.nan
-        except TypeError:
-            total = math.nan
-        checked = heading.shape == score.shape == (n,) and math.isfinite(total)
+        decoded = numbers_of(message)
+        if decoded is not None:  # (decode's checks made: one array, the columns its views)
+            values = np.array(decoded)
+            position, heading, score = values[:2 * n].reshape(n, 2), values[2 * n:3 * n], values[3 * n:4 * n]
+            std = None if spread is None else values[4 * n:5 * n]
+            checked = True
+        else:
+            position = np.array(message.position, dtype=float).reshape(n, 2)
+            heading = np.array(message.heading, dtype=float)
+            score = np.array(message.score, dtype=float)
+            std = None if spread is None else np.array(spread, dtype=float)
+            try:  # (finite numbers sum to a finite total, barring overflow; anything else is checked below)
+                total: float = sum(message.heading) + sum(message.score) + sum(map(sum, message.position))
+                if spread is not None and std is not None:
+                    total += sum(spread) if std.shape == (n,) and (not n or std.min() >= 0) else math.nan
+            except TypeError:
+                total = math.nan
+            checked = heading.shape == score.shape == (n,) and math.isfinite(total)
         if checked:
             detections = _trusted(Detections, xywh=np.zeros((n, 4)), score=score, position=position,
                                   heading=heading, heading_std=std, feature=None, label=None)

@@ -345,7 +345,52 @@ def _report(f: _Fields) -> HeadingReport:
     return msg
 
 
+_DETECTION_FIELDS = frozenset({"v", "type", "frame", "time", "position", "heading", "score", "heading_std"})
+
+
+def numbers_of(message: DetectionsMessage) -> list[float] | None:
+    """The numbers of a ``decode``d detections message as one flat list (``x, y`` of every position, then
+    the headings, the scores and the heading spreads, then the time), or None for a message built any other
+    way. Only ``decode`` makes it, after its checks: finite floats within the bounds."""
+    flat: list[float] | None = message.__dict__.get("_numbers")
+    return flat
+
+
+def _plain_detections(body: dict[str, Any]) -> DetectionsMessage | None:
+    """The common detections message in few steps: known fields only, lists of the same length, every number
+    a JSON float (the frame an int) within the bounds; None for anything else (which the field-by-field
+    checks then take, with their errors). The message keeps its numbers as one list (:func:`numbers_of`)."""
+    if not body.keys() <= _DETECTION_FIELDS:
+        return None
+    frame, raw, heading, score = body.get("frame"), body.get("position"), body.get("heading"), body.get("score")
+    spread = body.get("heading_std")
+    if not (type(frame) is int and 0 <= frame <= MAX_INT and type(raw) is list and type(heading) is list
+            and type(score) is list and (spread is None or type(spread) is list)):
+        return None
+    n = len(raw)
+    if (n > MAX_DETECTIONS or len(heading) != n or len(score) != n or (spread is not None and len(spread) != n)
+            or not (set(map(type, raw)) <= _LIST and set(map(len, raw)) <= _PAIR)):
+        return None
+    flat = list(chain.from_iterable(raw))
+    flat += heading
+    flat += score
+    if spread is not None:
+        flat += spread
+    flat.append(body.get("time"))
+    if not (set(map(type, flat)) <= _FLOAT and -MAX_ABS_NUMBER <= min(flat) and max(flat) <= MAX_ABS_NUMBER
+            and (not spread or min(spread) >= 0.0)):
+        return None
+    msg = object.__new__(DetectionsMessage)  # (the fields set directly: checked above)
+    msg.__dict__.update(frame=frame, time=flat[-1], position=tuple(zip(flat[0:2 * n:2], flat[1:2 * n:2])),
+                        heading=tuple(heading),
+                        score=tuple(score), heading_std=None if spread is None else tuple(spread), _numbers=flat)
+    return msg
+
+
 def _detections(f: _Fields) -> DetectionsMessage:
+    fast = _plain_detections(f.body)
+    if fast is not None:
+        return fast
     frame, time = f.integer("frame"), f.number("time")
     raw = f._get("position")
     if not isinstance(raw, list) or len(raw) > MAX_DETECTIONS:
