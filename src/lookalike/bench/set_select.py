@@ -111,10 +111,10 @@ def _labels(weights: Path, sequence: RobotSequence, frames: list[Frame], **optio
 
 
 def set_recovery_s(weights: Path, sequence: RobotSequence, swap_at_s: float = RECOVERY_SWAP[0],
-                   swap_s: float = RECOVERY_SWAP[1], **options: object) -> float:
-    """Seconds ``set`` with ``weights`` (and ``options``) takes to recover after ``bench recovery``'s swap
-    of the two robots seen most (inf: never), measured as ``bench recovery`` does."""
-    return swap_recovery(lambda s, fs: _labels(weights, s, fs, **options), sequence, swap_at_s, swap_s)[2]
+                   swap_s: float = RECOVERY_SWAP[1], options: dict[str, object] | None = None) -> float:
+    """Seconds ``set`` with ``weights`` (and inference ``options``) takes to recover after ``bench
+    recovery``'s swap of the two robots seen most (inf: never), measured as ``bench recovery`` does."""
+    return swap_recovery(lambda s, fs: _labels(weights, s, fs, **(options or {})), sequence, swap_at_s, swap_s)[2]
 
 
 def measurable(sequence: RobotSequence, swap_at_s: float = RECOVERY_SWAP[0], swap_s: float = RECOVERY_SWAP[1]) -> bool:
@@ -197,7 +197,7 @@ def options_row(options: dict[str, object], seqs: dict[str, list[RobotSequence]]
     :func:`measurable` sequences."""
     row = {name: round(100 * set_success(weights, sq, **options), 3) for name, sq in seqs.items()}
     for p, sq in rec_seqs.items():
-        times = [set_recovery_s(weights, q, **options) for q in sq if measurable(q)]
+        times = [set_recovery_s(weights, q, options=options) for q in sq if measurable(q)]
         row[f"rec_{p}"], row[f"worst_{p}"] = round(float(np.mean(times)), 3), round(float(np.max(times)), 3)
     return row
 
