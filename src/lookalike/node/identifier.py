@@ -76,6 +76,10 @@ class TeamIdentifier:
         self._last_sent = np.full(n, -math.inf)
         self._pending: list[deque[tuple[int, HeadingReport]]] = [deque() for _ in range(n)]
         self._queued = 0  # reports in all the queues
+        # the queued reports as columns in arrival order (robot, send time, heading), made as they arrive;
+        # ``_columns_plain``: every one a finite report of a robot >= 0; ``_columns_whole``: no report dropped
+        self._columns: tuple[list[int], list[float], list[float]] = ([], [], [])
+        self._columns_plain = self._columns_whole = True
         self._arrival = 0  # arrival number of the next report (keeps the frame's reports in arrival order)
         self.queue_dropped = 0
         self._last_update = [math.nan] * n  # frame time a detection last updated each robot
@@ -104,12 +108,19 @@ class TeamIdentifier:
             queue.popleft()
             self._queued -= 1
             self.queue_dropped += 1
+            self._columns_whole = False
         elif self._queued >= self.config.max_queued:
             return "queue_full"
         self._last_seq[j], self._last_sent[j] = report.seq, report.t_sent
         queue.append((self._arrival, report))
         self._arrival += 1
         self._queued += 1
+        robots, sent, heading = self._columns
+        robots.append(j)
+        sent.append(report.t_sent)
+        heading.append(report.heading)
+        if not _plain_report(report):
+            self._columns_plain = False
         return "reports"
 
     @property
@@ -119,6 +130,8 @@ class TeamIdentifier:
 
     def _take_reports(self) -> list[HeadingReport]:
         """Empty the queues; the reports in arrival order."""
+        self._columns = ([], [], [])
+        self._columns_plain = self._columns_whole = True
         if self._queued == 0:
             return []
         items = [item for queue in self._pending if queue for item in queue]
@@ -193,15 +206,22 @@ class TeamIdentifier:
                                   heading=heading, heading_std=std, feature=None, label=None)
         else:
             detections = Detections(position=position, heading=heading, score=score, heading_std=std)
-        reports = self._take_reports()
-        if not reports:
+        (robots, sent, headings), plain = self._columns, self._columns_plain
+        if not self._columns_whole:  # (a report was dropped from a full queue: the columns of those left)
+            reports = self._take_reports()
+            robots, sent = [r.robot for r in reports], [r.t_sent for r in reports]
+            headings = [r.heading for r in reports]
+            plain = all(map(_plain_report, reports))
+        else:
+            self._take_reports()
+        if not robots:
             beacons = Beacons.empty()
         else:
-            agent_id = np.array([r.robot for r in reports], dtype=int)
-            t_sent = np.array([r.t_sent for r in reports], dtype=float)
-            heading = np.array([r.heading for r in reports], dtype=float)
-            t_received = filled(len(reports), float(message.time))
-            if math.isfinite(sum(r.t_sent + r.heading for r in reports)) and agent_id.min() >= 0:
+            agent_id = np.array(robots, dtype=int)
+            t_sent = np.array(sent, dtype=float)
+            heading = np.array(headings, dtype=float)
+            t_received = filled(len(robots), float(message.time))
+            if plain:  # (checked as the reports arrived)
                 beacons = _trusted(Beacons, agent_id=agent_id, t_sent=t_sent, t_received=t_received, heading=heading)
             else:
                 beacons = Beacons(agent_id=agent_id, t_sent=t_sent, t_received=t_received, heading=heading)
@@ -272,6 +292,14 @@ def _trusted(cls: type[_T], **fields: Any) -> _T:
             value.flags.writeable = False
     obj.__dict__.update(fields)  # (the fields a frozen dataclass's __init__ sets, in one call)
     return obj
+
+
+def _plain_report(report: HeadingReport) -> bool:
+    """Whether ``report`` has a robot id >= 0 and finite numbers (as every decoded report has)."""
+    try:
+        return report.robot >= 0 and math.isfinite(report.t_sent + report.heading)
+    except TypeError:
+        return False
 
 
 def _first(item: tuple[int, HeadingReport]) -> int:
