@@ -226,7 +226,10 @@ def decode(data: bytes) -> Message:
         text = data.decode("utf-8")
         # (json.loads with parse_constant builds a decoder per call; one is kept. A leading BOM
         # goes through json.loads for its own error message.)
-        body = json.loads(text, parse_constant=_reject_constant) if text.startswith("\ufeff") else _DECODER.decode(text)
+        if text.startswith("\ufeff"):
+            body = json.loads(text, parse_constant=_reject_constant)
+        else:
+            body = _scan_object(text)
     except (UnicodeDecodeError, ValueError, RecursionError) as exc:
         raise MessageError(MALFORMED, f"not UTF-8 JSON ({exc})") from None
     if not isinstance(body, dict):
@@ -246,6 +249,20 @@ def _reject_constant(name: str) -> Any:
 
 
 _DECODER = json.JSONDecoder(parse_constant=_reject_constant)
+_SCAN = _DECODER.scan_once
+
+
+def _scan_object(text: str) -> Any:
+    """``_DECODER.decode(text)``: a text that is one JSON object and nothing else (no whitespace around it) is
+    scanned directly; anything else goes through ``decode`` itself (its whitespace rules and errors)."""
+    if text.startswith("{"):
+        try:
+            body, end = _SCAN(text, 0)
+        except StopIteration:
+            end = -1
+        if end == len(text):
+            return body
+    return _DECODER.decode(text)
 
 
 class _Fields:

@@ -33,7 +33,16 @@ from lookalike.motion.spaces import WorldCA
 from lookalike.trackers.identity import BeaconIdentifier, IdentifierConfig
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.table import TrackTable
-from lookalike.trackers.world_kernels import cholesky, compiled, decided_pairs, einsum, filled, pairs, solve
+from lookalike.trackers.world_kernels import (
+    cholesky,
+    compiled,
+    decided_pairs,
+    einsum,
+    filled,
+    lower_solve_exact,
+    pairs,
+    solve,
+)
 from lookalike.trackers.world_rules import HeuristicsConfig, WorldConfig, WorldRules, headings, positions
 from lookalike.types import Detections, Frame, Tracks
 
@@ -169,12 +178,18 @@ class WorldTracker:
             noise = self._noise(mean[:, :2])  # (row by row: the matched rows' noise is noise[rows])
             S = cov[:, :2, :2] + noise
             L = cholesky(S)
-        diff = z[None, :, :] - mean[:, None, :2]  # (k, d, 2)
-        y = solve(L, diff.swapaxes(-1, -2))  # (k, 2, d)
         kernels = compiled()
-        if kernels is not None:  # (the lines below and pairs' steps up to the solver, in one compiled call)
+        # (with LAPACK's 2×2 solve replicated bit for bit (world_kernels.lower_solve_exact), the innovations,
+        # their whitening and pairs' steps up to the solver in one compiled call; -1: not plain numbers)
+        gated = kernels.gate_work_lower(L, z, mean, self._gate) if lower_solve_exact() else None
+        if gated is not None and gated[0] >= 0:
+            rows, cols = decided_pairs(*gated)
+        elif kernels is not None:  # (the lines below and pairs' steps up to the solver, in one compiled call)
+            y = solve(L, (z[None, :, :] - mean[:, None, :2]).swapaxes(-1, -2))  # (k, 2, d)
             rows, cols = decided_pairs(*kernels.gate_work(y, self._gate))
         else:
+            diff = z[None, :, :] - mean[:, None, :2]  # (k, d, 2)
+            y = solve(L, diff.swapaxes(-1, -2))  # (k, 2, d)
             d2 = np.add.reduce(y * y, axis=1)
             rows, cols = pairs(d2, d2 <= self._gate)
         det_of_track[rows] = cols

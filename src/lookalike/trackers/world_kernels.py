@@ -101,11 +101,45 @@ def decided_pairs(decision: int, work: np.ndarray, allowed: np.ndarray) -> tuple
 def _load() -> ModuleType | None:
     from lookalike.trackers import world_numba
 
+    global _lower_solve_exact
     # (the kernels' cos is libm's; numpy may use its own vector code: they must agree on every value here)
     angles = np.linspace(-4.0 * np.pi, 4.0 * np.pi, 4099)
     if not np.array_equal(world_numba.cosines(angles), np.cos(angles)):
         return None
+    _lower_solve_exact = _same_lower_solves(world_numba)
     return world_numba
+
+
+_lower_solve_exact = False
+
+
+def lower_solve_exact() -> bool:
+    """Whether the compiled kernels are in use and their 2×2 lower-triangular solve
+    (``world_numba.solve_lower``) gave numpy's ``solve`` bit for bit on the check systems when they loaded
+    (it does with the OpenBLAS of numpy 1.26; other BLAS builds may round otherwise: then the Kalman gate
+    whitens with numpy's ``solve``)."""
+    return compiled() is not None and _lower_solve_exact
+
+
+def _same_lower_solves(kernels: ModuleType) -> bool:
+    """Compare ``kernels.solve_lower`` with numpy's ``solve`` on 4,800 systems: the Cholesky factors of
+    random 2×2 covariances (strongly correlated ones among them, whose solve swaps rows) with 1 to 16
+    right-hand sides each, as the Kalman gate solves them."""
+    rng = np.random.default_rng(20261202)
+    for d in (1, 2, 5, 10, 16):
+        k = 960 // d
+        var = rng.uniform(1e-4, 4.0, (k, 2))
+        corr = rng.uniform(-0.999, 0.999, k)
+        S = np.empty((k, 2, 2))
+        S[:, 0, 0], S[:, 1, 1] = var[:, 0], var[:, 1]
+        S[:, 0, 1] = S[:, 1, 0] = corr * np.sqrt(var[:, 0] * var[:, 1])
+        factor = cholesky(S)
+        b = rng.normal(0.0, 2.0, (k, 2, d))
+        expected = solve(factor, b)  # (k, 2, d)
+        got = kernels.solve_lower_many(np.repeat(factor, d, axis=0), b.swapaxes(1, 2).reshape(k * d, 2), d == 1)
+        if not np.array_equal(got, expected.swapaxes(1, 2).reshape(k * d, 2)):
+            return False
+    return True
 
 
 # (decided at the first call of compiled(): a frame's calls cost an attribute lookup)
@@ -127,6 +161,7 @@ def warm() -> bool:
     kernels.window_costs(th, times, times, samples, 1.0, 1.0, np.empty((1, 2)))
     kernels.identity_work(th, times, times, samples, np.zeros(1, dtype=int), 1.0, 1.0, 0.1, 0.3)
     kernels.gate_work(np.zeros((1, 2, 1)), 1.0)
+    kernels.gate_work_lower(np.ones((1, 2, 2)), np.zeros((1, 2)), np.zeros((1, 6)), 1.0)
     ints, flags = np.zeros(1, dtype=int), np.zeros(1, dtype=bool)
     kernels.lifecycle_work(ints, ints.copy(), ints.copy(), np.zeros(1), ints.copy(), flags, 0.0, 5, 3, 2, -1,
                            flags.copy(), 1.0, 1.0)

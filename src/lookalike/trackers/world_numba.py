@@ -153,6 +153,61 @@ def gate_work(y: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
     ``world_kernels.pairs`` (0 nothing allowed, 1 disjoint pairs, 2 solve). Returns ``(decision, work, allowed)``."""
     k, d = y.shape[0], y.shape[2]
     work = np.empty((k, d))
+    for i in range(k):
+        for j in range(d):
+            a, b = y[i, 0, j], y[i, 1, j]
+            work[i, j] = a * a + b * b
+    return _gate_decision(work, gate)
+
+
+@_jit
+def _times_inverse(x: float, pivot: float, divide: bool) -> float:
+    """``x / pivot`` when ``divide``, else ``x`` times the reciprocal of ``pivot`` (LAPACK's two roundings)."""
+    return x / pivot if divide else x * (1.0 / pivot)
+
+
+@_jit
+def solve_lower(l00: float, l10: float, l11: float, b0: float, b1: float, divide: bool) -> tuple[float, float, bool]:
+    """``np.linalg.solve(L, b)`` for a lower-triangular ``L = [[l00, 0], [l10, l11]]`` as LAPACK's ``dgesv``
+    computes it in OpenBLAS: row pivoting, the reciprocal of the pivot multiplied in by the factorisation, and by
+    the substitutions too unless ``divide`` (OpenBLAS divides by the pivots for a single right-hand side), with
+    whether the inputs were plain (finite, non-zero pivots; otherwise the result is not LAPACK's and the caller
+    must not use it). ``world_kernels`` compares it with numpy's ``solve`` before using it: other BLAS builds
+    may round otherwise (fused multiply-adds)."""
+    if not (math.isfinite(l00) and math.isfinite(l10) and math.isfinite(l11) and math.isfinite(b0)
+            and math.isfinite(b1) and l00 != 0.0 and l11 != 0.0):
+        return 0.0, 0.0, False
+    if abs(l10) > abs(l00):  # (rows swapped: the pivot is l10)
+        m = l00 * (1.0 / l10)
+        x1 = _times_inverse(b0 - m * b1, -(m * l11), divide)
+        return _times_inverse(b1 - l11 * x1, l10, divide), x1, True
+    m = l10 * (1.0 / l00)
+    return _times_inverse(b0, l00, divide), _times_inverse(b1 - m * b0, l11, divide), True
+
+
+@_jit
+def gate_work_lower(factor: np.ndarray, z: np.ndarray, mean: np.ndarray,
+                    gate: float) -> tuple[int, np.ndarray, np.ndarray]:
+    """:func:`gate_work` from the lower Cholesky factors ``factor (k, 2, 2)`` of the innovation covariances, the
+    detections ``z (d, 2)`` and the predicted means ``mean (k, >= 2)`` (metres): the innovations and their
+    whitening (:func:`solve_lower`) in the same call. Decision -1 when a factor or an innovation is not plain
+    (the caller then whitens with numpy's solve)."""
+    k, d = factor.shape[0], z.shape[0]
+    work = np.empty((k, d))
+    for i in range(k):
+        l00, l10, l11 = factor[i, 0, 0], factor[i, 1, 0], factor[i, 1, 1]
+        for j in range(d):
+            a, b, plain = solve_lower(l00, l10, l11, z[j, 0] - mean[i, 0], z[j, 1] - mean[i, 1], d == 1)
+            if not plain:
+                return -1, work, np.zeros((k, d), np.bool_)
+            work[i, j] = a * a + b * b
+    return _gate_decision(work, gate)
+
+
+@_jit
+def _gate_decision(work: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
+    """The rest of :func:`gate_work`, in place on ``work``, the squared distances ``(k, d)``."""
+    k, d = work.shape
     allowed = np.zeros((k, d), np.bool_)
     per_column = np.zeros(d, np.int64)
     found, disjoint = False, True
@@ -160,9 +215,7 @@ def gate_work(y: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
     for i in range(k):
         per_row = 0
         for j in range(d):
-            a, b = y[i, 0, j], y[i, 1, j]
-            c = a * a + b * b
-            work[i, j] = c
+            c = work[i, j]
             if c <= gate:
                 allowed[i, j] = True
                 per_row += 1
@@ -191,6 +244,18 @@ def gate_work(y: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
             if not allowed[i, j]:
                 work[i, j] = penalty
     return 2, work, allowed
+
+
+@_jit
+def solve_lower_many(factor: np.ndarray, b: np.ndarray, divide: bool) -> np.ndarray:
+    """:func:`solve_lower` of each factor ``(k, 2, 2)`` and right-hand side ``b (k, 2)``, NaN where not plain
+    (for the check against numpy's ``solve``)."""
+    out = np.full((factor.shape[0], 2), np.nan)
+    for i in range(factor.shape[0]):
+        x0, x1, plain = solve_lower(factor[i, 0, 0], factor[i, 1, 0], factor[i, 1, 1], b[i, 0], b[i, 1], divide)
+        if plain:
+            out[i, 0], out[i, 1] = x0, x1
+    return out
 
 
 @_jit
