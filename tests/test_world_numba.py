@@ -189,6 +189,59 @@ def test_compiled_lifecycle_equals_numpys(name: str) -> None:
     assert deleted > 0
 
 
+def test_gate_with_the_replicated_solve_equals_numpys() -> None:
+    """Where the kernels' 2×2 lower-triangular solve replicates numpy's (checked at load: numpy 1.26's
+    OpenBLAS), the one-call gate gives gate_work's decision, matrix and pairs on numpy's whitened innovations
+    (elsewhere: on the replica's); factors or innovations that are not plain numbers (NaN, a zero pivot) make it
+    decline (-1)."""
+    _compiled_or_skip()
+    kernels = wk.compiled()
+    assert kernels is not None
+    exact = wk.lower_solve_exact()  # (else: the one-call gate against gate_work on the replica's whitening)
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        k, d = int(rng.integers(1, 9)), int(rng.integers(1, 12))
+        var = rng.uniform(1e-3, 2.0, (k, 2))
+        corr = rng.uniform(-0.99, 0.99, k)
+        S = np.empty((k, 2, 2))
+        S[:, 0, 0], S[:, 1, 1] = var[:, 0], var[:, 1]
+        S[:, 0, 1] = S[:, 1, 0] = corr * np.sqrt(var[:, 0] * var[:, 1])
+        L = wk.cholesky(S)
+        mean = rng.uniform(-3, 3, (k, 6))
+        z = mean[rng.integers(0, k, d), :2] + rng.normal(0, 0.3, (d, 2))
+        gate = float(rng.choice([0.5, 9.21, 1e9]))
+        b = z[None] - mean[:, None, :2]  # (k, d, 2)
+        y = wk.solve(L, b.swapaxes(-1, -2))
+        replica = kernels.solve_lower_many(np.repeat(L, d, axis=0), b.reshape(k * d, 2), d == 1)
+        if exact:
+            assert_same_bits(replica, y.swapaxes(-1, -2).reshape(k * d, 2))
+        else:
+            y = np.ascontiguousarray(replica.reshape(k, d, 2).swapaxes(-1, -2))
+        expected = kernels.gate_work(y, gate)
+        got = kernels.gate_work_lower(L, z, mean, gate)
+        assert got[0] == expected[0]
+        assert_same_bits(got[1], expected[1])
+        assert np.array_equal(got[2], expected[2])
+    L[0, 1, 1] = 0.0
+    assert kernels.gate_work_lower(L, z, mean, 9.21)[0] == -1
+    L[0, 1, 1], z[0, 0] = 1.0, np.nan
+    assert kernels.gate_work_lower(L, z, mean, 9.21)[0] == -1
+
+
+def test_replicated_solve_is_refused_when_it_rounds_otherwise() -> None:
+    _compiled_or_skip()
+    kernels = wk.compiled()
+
+    class Rounding:
+        @staticmethod
+        def solve_lower_many(factor, b, divide):  # type: ignore[no-untyped-def]
+            return np.nextafter(kernels.solve_lower_many(factor, b, divide), np.inf)  # (one unit off)
+
+    assert not wk._same_lower_solves(Rounding)
+    wk.use_compiled(False)
+    assert not wk.lower_solve_exact()
+
+
 def test_compiled_costs_without_reports_or_samples() -> None:
     ident = BeaconIdentifier(IdentifierConfig(n_agents=4, window_frames=3))
     ident.begin_frame(0.0, Beacons.empty())
