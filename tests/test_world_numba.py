@@ -228,6 +228,28 @@ def test_gate_with_the_replicated_solve_equals_numpys() -> None:
     assert kernels.gate_work_lower(L, z, mean, 9.21)[0] == -1
 
 
+def test_compiled_update_equals_einsums() -> None:
+    """The one-call Kalman update gives the einsum lines' means where its check passed at load (zeros and
+    negative zeros among the gains), and the covariances made beforehand."""
+    _compiled_or_skip()
+    kernels = wk.compiled()
+    assert kernels is not None and wk._same_updates(kernels) == wk.update_exact()
+    if not wk.update_exact():
+        pytest.skip("the einsum rounds otherwise here: the numpy lines are used")
+    rng = np.random.default_rng(5)
+    k, d = 9, 7
+    mean, gain = rng.normal(0, 2, (k, 6)), rng.normal(0, 1, (k, 2, 6)) * rng.choice([0.0, -0.0, 1.0], (k, 2, 6))
+    cov, cov_hit, z = rng.normal(0, 1, (k, 6, 6)), rng.normal(0, 1, (k, 6, 6)), rng.normal(0, 2, (d, 2))
+    rows, cols = np.array([4, 0, 7]), np.array([6, 2, 0])
+    expected_mean, expected_cov = mean.copy(), cov.copy()
+    m = mean[rows]
+    expected_mean[rows] = m + wk.einsum("kij,kj->ki", gain[rows].swapaxes(-1, -2), z[cols] - m[:, :2])
+    expected_cov[rows] = cov_hit[rows]
+    kernels.update_hits(mean, cov, rows, cols, gain, cov_hit, z)
+    assert_same_bits(mean, expected_mean)
+    assert_same_bits(cov, expected_cov)
+
+
 def test_replicated_solve_is_refused_when_it_rounds_otherwise() -> None:
     _compiled_or_skip()
     kernels = wk.compiled()

@@ -42,6 +42,7 @@ from lookalike.trackers.world_kernels import (
     lower_solve_exact,
     pairs,
     solve,
+    update_exact,
 )
 from lookalike.trackers.world_rules import HeuristicsConfig, WorldConfig, WorldRules, headings, positions
 from lookalike.types import Detections, Frame, Tracks
@@ -193,7 +194,9 @@ class WorldTracker:
             d2 = np.add.reduce(y * y, axis=1)
             rows, cols = pairs(d2, d2 <= self._gate)
         det_of_track[rows] = cols
-        if len(rows) and ready is not None:  # (the lines below, with the gains and covariances made ahead)
+        if len(rows) and ready is not None and kernels is not None and update_exact():  # (below, one call)
+            kernels.update_hits(t.mean, t.cov, rows, cols, ready.gain, ready.cov_hit, z)
+        elif len(rows) and ready is not None:  # (the lines below, with the gains and covariances made ahead)
             K = ready.gain[rows].swapaxes(-1, -2)
             m = mean[rows]
             t.mean[rows] = m + einsum("kij,kj->ki", K, z[cols] - m[:, :2])

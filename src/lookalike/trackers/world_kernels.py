@@ -101,16 +101,38 @@ def decided_pairs(decision: int, work: np.ndarray, allowed: np.ndarray) -> tuple
 def _load() -> ModuleType | None:
     from lookalike.trackers import world_numba
 
-    global _lower_solve_exact
+    global _lower_solve_exact, _update_exact
     # (the kernels' cos is libm's; numpy may use its own vector code: they must agree on every value here)
     angles = np.linspace(-4.0 * np.pi, 4.0 * np.pi, 4099)
     if not np.array_equal(world_numba.cosines(angles), np.cos(angles)):
         return None
     _lower_solve_exact = _same_lower_solves(world_numba)
+    _update_exact = _same_updates(world_numba)
     return world_numba
 
 
-_lower_solve_exact = False
+_lower_solve_exact = _update_exact = False
+
+
+def update_exact() -> bool:
+    """Whether the compiled kernels are in use and their Kalman mean update (``world_numba.update_hits``) gave
+    ``einsum``'s sums bit for bit on the check updates when they loaded."""
+    return compiled() is not None and _update_exact
+
+
+def _same_updates(kernels: ModuleType) -> bool:
+    """Compare ``kernels.update_hits`` with the numpy lines it stands for on 2,000 random updates (zeros and
+    negative zeros among the gains and innovations)."""
+    rng = np.random.default_rng(20261203)
+    k = 2000
+    gain = rng.normal(0.0, 1.0, (k, 2, 6)) * rng.choice([0.0, -0.0, 1e-3, 1.0, 1e3], (k, 2, 6))
+    mean = rng.normal(0.0, 3.0, (k, 6)) * rng.choice([0.0, -0.0, 1.0], (k, 6))
+    z = mean[:, :2] + rng.normal(0.0, 0.5, (k, 2)) * rng.choice([0.0, 1.0], (k, 1))
+    rows = rng.permutation(k)
+    expected = mean[rows] + einsum("kij,kj->ki", gain[rows].swapaxes(-1, -2), z - mean[rows, :2])
+    got, cov = mean.copy(), np.zeros((k, 6, 6))
+    kernels.update_hits(got, cov, rows, np.arange(k), gain, np.ones((k, 6, 6)), z)
+    return bool(np.array_equal(got[rows].view(np.int64), expected.view(np.int64)) and (cov == 1.0).all())
 
 
 def lower_solve_exact() -> bool:
@@ -162,6 +184,8 @@ def warm() -> bool:
     kernels.identity_work(th, times, times, samples, np.zeros(1, dtype=int), 1.0, 1.0, 0.1, 0.3)
     kernels.gate_work(np.zeros((1, 2, 1)), 1.0)
     kernels.gate_work_lower(np.ones((1, 2, 2)), np.zeros((1, 2)), np.zeros((1, 6)), 1.0)
+    kernels.update_hits(np.zeros((1, 6)), np.zeros((1, 6, 6)), np.zeros(1, dtype=int), np.zeros(1, dtype=int),
+                        np.zeros((1, 2, 6)), np.zeros((1, 6, 6)), np.zeros((1, 2)))
     ints, flags = np.zeros(1, dtype=int), np.zeros(1, dtype=bool)
     kernels.lifecycle_work(ints, ints.copy(), ints.copy(), np.zeros(1), ints.copy(), flags, 0.0, 5, 3, 2, -1,
                            flags.copy(), 1.0, 1.0)

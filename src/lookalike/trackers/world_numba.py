@@ -247,6 +247,27 @@ def _gate_decision(work: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.n
 
 
 @_jit
+def update_hits(mean: np.ndarray, cov: np.ndarray, rows: np.ndarray, cols: np.ndarray, gain: np.ndarray,
+                cov_hit: np.ndarray, z: np.ndarray) -> None:
+    """The Kalman update of the tracks ``rows`` by the detections ``cols`` (positions ``z (d, 2)``, metres), in
+    place: ``mean[i] += Kᵀ (z[j] - mean[i, :2])`` with the transposed gains ``gain (k, 2, n)`` (each entry the sum
+    of the two products from 0, as ``einsum("kij,kj->ki", ...)`` adds them) and ``cov[i] = cov_hit[i]``, the
+    covariances after an update made beforehand. ``world_kernels`` compares it with the einsum before using it."""
+    n = mean.shape[1]
+    for r in range(rows.shape[0]):
+        i, j = rows[r], cols[r]
+        v0, v1 = z[j, 0] - mean[i, 0], z[j, 1] - mean[i, 1]
+        for a in range(n):
+            total = 0.0
+            total = total + gain[i, 0, a] * v0
+            total = total + gain[i, 1, a] * v1
+            mean[i, a] = mean[i, a] + total
+        for a in range(cov.shape[1]):
+            for b in range(cov.shape[2]):
+                cov[i, a, b] = cov_hit[i, a, b]
+
+
+@_jit
 def solve_lower_many(factor: np.ndarray, b: np.ndarray, divide: bool) -> np.ndarray:
     """:func:`solve_lower` of each factor ``(k, 2, 2)`` and right-hand side ``b (k, 2)``, NaN where not plain
     (for the check against numpy's ``solve``)."""
