@@ -93,9 +93,23 @@ def decided_pairs(decision: int, work: np.ndarray, allowed: np.ndarray) -> tuple
     if decision == 1:
         rows, cols = allowed.nonzero()
         return rows, cols
-    rows, cols = linear_sum_assignment(work)
+    rows, cols = (_solver or _load_solver())(work)
     keep = allowed[rows, cols]
     return rows[keep], cols[keep]
+
+
+_solver: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None
+
+
+def _load_solver() -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """scipy's ``linear_sum_assignment``, the function ``association.solver.linear_sum_assignment`` calls,
+    kept after its first use (a frame calls it without the wrapper's import statement)."""
+    global _solver
+    linear_sum_assignment(np.zeros((1, 1)))  # (imports it, as the wrapper does)
+    from scipy.optimize import linear_sum_assignment as solver
+
+    _solver = solver
+    return solver
 
 
 def _load() -> ModuleType | None:
