@@ -38,7 +38,7 @@ def _frame(k, headings, reported):
 
 @pytest.mark.parametrize(("jump", "forgotten"), [(None, []), (0.5, [0])])
 def test_a_report_jump_forgets_that_agents_memory(jump, forgotten):
-    tracker = make_tracker("set", n_agents=2, report_jump=jump)
+    tracker = make_tracker("set", n_agents=2, report_jump=jump, on_jump="forget")
     for k in range(30):
         tracker.update(_frame(k, [0.0, 2.5], [0.0 + 0.01 * k, 2.5]))  # smooth turns: nothing forgotten
     assert tracker.net.m[:, 0].min() > 0.9  # both agents remembered

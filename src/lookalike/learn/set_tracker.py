@@ -9,8 +9,12 @@ localiser as the LSTM identifier's, fed with the detection labelled ``j`` and it
 ``T_j ← α·L_k + (1−α)·T_j`` (``"lowpass"``); see :mod:`lookalike.trackers.identity.localiser`.
 
 An agent whose reported heading jumps by more than a robot can turn between two of its reports
-(``report_jump`` + ``turn_rate`` · gap, radians) has its memory forgotten: its reports now come from
-another robot (ids swapped or restored), so what the network remembers of it follows the wrong one.
+(``report_jump`` + ``turn_rate`` · gap, radians) now reports for another robot (ids swapped or
+restored), so what the network remembers of it follows the wrong one: its memory is exchanged with
+the one other agent that reported that heading just before (``on_jump="swap"``), else forgotten.
+An agent whose report is older than ``stale_s`` seconds while a detection near its remembered
+position has turned away from that report is shown to the network as not heard from (its memory
+still places it). Both were chosen on tuning sequences (docs/experiments/any-team-size.md).
 """
 
 from __future__ import annotations
@@ -62,13 +66,13 @@ class SetIdentifier:
             range=(0.0, 10.0))
         turn_rate: float = param(3.0, "fastest plausible turn of a robot for report_jump, rad/s", range=(0.0, 100.0))
         stale_s: float | None = param(
-            None, "hide an agent's reported heading from the network when the report is older than stale_s "
+            0.5, "hide an agent's reported heading from the network when the report is older than stale_s "
             "seconds and a detection near the agent's remembered position (stale_radius_m) has turned away from it "
             "by more than stale_turn radians (None: never)", range=(0.0, 100.0))
         stale_turn: float = param(0.6, "heading disagreement for stale_s, radians", range=(0.0, 4.0))
         stale_radius_m: float = param(0.5, "how near the remembered position a detection must be for stale_s, metres",
                                       range=(0.0, 100.0))
-        on_jump: str = param("forget", "after a report jump (report_jump): forget the agent's memory, or swap "
+        on_jump: str = param("swap", "after a report jump (report_jump): forget the agent's memory, or swap "
                              "it with the one other agent that reported the new heading just before (forget: "
                              "no such agent or several)", choices=("forget", "swap"))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
