@@ -162,4 +162,4 @@ def test_server_prepares_the_next_frame_after_the_send() -> None:
         assert snap["frames"] == 3 and snap["tracker_errors"] == 0
         assert snap["cpu_with_prepare_ms"]["frames"] == 3
         assert snap["cpu_with_prepare_ms"]["median"] >= snap["cpu_ms"]["median"] - 1e-3
-        assert node.identifier.tracker._ready is not None  # (the next frame's prediction is ready)
+        assert node.identifier.tracker._ready  # (the next frame's prediction is ready)

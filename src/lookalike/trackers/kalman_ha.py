@@ -72,10 +72,12 @@ class WorldTracker:
         cfg = self.config
         self._tracks = TrackTable(6, {"hit_bits": ((), np.int64)})  # hit history, bit 0 = this frame
         self._time: float | None = None
-        self._model_dt: float | None = None  # frame interval of the cached (F, Q)
-        self._model: tuple[np.ndarray, np.ndarray, np.ndarray] = (np.eye(6), np.eye(6), np.zeros((6, 6)))
-        self._decay: float | None = None  # velocity factor of a coasting track over that interval
-        self._ready: _Prepared | None = None  # the next frame's prediction, made between frames (prepare)
+        # per frame interval (s): WorldCA.predict's F, F.T (the view kalman.predict multiplies by), Q, and the
+        # velocity factor of a coasting track (None: no decay); kept for the latest intervals
+        self._models: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray, float | None]] = {}
+        self._intervals: list[float] = []  # the last two distinct frame intervals (> 0 s), the latest first
+        self._repeated: set[float] = set()  # those of them that came again while in that list
+        self._ready: dict[float, _Prepared] = {}  # the next frame's prediction per interval (prepare)
         self._identifier = BeaconIdentifier(IdentifierConfig(
             n_agents=cfg.n_agents, window_frames=cfg.window_frames, max_cost=cfg.max_identity_cost,
             hysteresis=cfg.hysteresis))
@@ -91,13 +93,21 @@ class WorldTracker:
         if dt < 0:
             raise ValueError(f"frame {frame.index}: time went backwards ({self._time} s then {frame.time} s)")
         self._time = frame.time
+        if dt > 0:
+            if dt in self._intervals:
+                self._repeated.add(dt)
+            if not self._intervals or dt != self._intervals[0]:
+                self._intervals = [dt, *self._intervals[:1]]
+                self._repeated.intersection_update(self._intervals)
         self._identifier.begin_frame(frame.time, frame.beacons)
-        ready, self._ready = self._ready, None
-        if ready is not None and dt == ready.dt:  # (made for this interval from this table: prepare)
+        ready = None
+        if self._ready:
+            ready = self._ready.get(dt)  # (made for this interval from this table: prepare)
+            self._ready = {}
+        if ready is not None:
             t.mean, t.cov = ready.mean, ready.cov
         else:
             self._predict(dt)
-            ready = None
         det_of_track = self._associate_and_update(det) if ready is None else self._associate_and_update(det, ready)
         det_of_track = self._lifecycle(det_of_track, dt, None if ready is None else ready.in_view)
         new = self._births(det, det_of_track)
@@ -107,21 +117,26 @@ class WorldTracker:
 
     def prepare(self) -> None:
         """Between frames (optional; the node calls it after sending a frame's team state): predict the
-        tracks for the next frame assuming the last frame interval repeats, with what the next frame's
+        tracks for the next frame for each of the last two distinct frame intervals that has come more than
+        once (a camera stamping frames on a fixed period gives few distinct intervals in floating point; a
+        jittered clock none that repeat, and then nothing is prepared), with what the next frame's
         association needs that does not depend on its detections (innovation covariances, their Cholesky
         factors, the gains, the updated covariances, which tracks are predicted in view). :meth:`update`
-        uses them when the interval is exactly the same (they are the same operations on the same
-        values, so the result is bit for bit the one it would compute) and otherwise computes its own. A
-        subclass with its own association (JPDA) prepares nothing."""
-        t, dt = self._tracks, self._model_dt
-        self._ready = None
-        if (self._time is None or dt is None or not len(t)
+        uses them when the frame's interval is exactly one of them (they are the same operations on the
+        same values, so the result is bit for bit the one it would compute) and otherwise computes its own.
+        A subclass with its own association (JPDA) prepares nothing."""
+        t = self._tracks
+        self._ready = {}
+        if (self._time is None or not len(t)
                 or type(self)._associate_and_update is not WorldTracker._associate_and_update):
             return
-        mean, cov = self._predicted(t.mean.copy(), t.cov, dt)
-        S, L, gain, cov_hit = self._gains(mean, cov)
-        in_view = None if self.rules.confirm_window is None else self.rules.in_view(mean[:, :2])
-        self._ready = _Prepared(dt, mean, cov, S, L, gain, cov_hit, in_view)
+        for dt in self._intervals:
+            if dt not in self._repeated:
+                continue
+            mean, cov = self._predicted(t.mean.copy(), t.cov, dt)
+            S, L, gain, cov_hit = self._gains(mean, cov)
+            in_view = None if self.rules.confirm_window is None else self.rules.in_view(mean[:, :2])
+            self._ready[dt] = _Prepared(dt, mean, cov, S, L, gain, cov_hit, in_view)
 
     def _predict(self, dt: float) -> None:
         t = self._tracks
@@ -132,18 +147,20 @@ class WorldTracker:
     def _predicted(self, mean: np.ndarray, cov: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """The predicted means and covariances over ``dt`` > 0 seconds (``mean``'s coasting rows are
         decayed in place first)."""
-        if dt != self._model_dt:  # (WorldCA.predict's model and the decay, kept while the interval repeats)
+        model = self._models.get(dt)
+        if model is None:  # (WorldCA.predict's model and the decay, kept for the latest intervals)
             F, Q = constant_acceleration(2, dt, self.config.q_jerk)
-            self._model = F, F.T, Q  # (F.T: the view kalman.predict multiplies by)
             decay_s = self.rules.coast_decay_s
-            self._decay = None if decay_s is None else np.exp(-dt / decay_s)
-            self._model_dt = dt
-        if self._decay is not None:
+            model = F, F.T, Q, None if decay_s is None else np.exp(-dt / decay_s)
+            if len(self._models) > 3:
+                self._models = {k: v for k, v in self._models.items() if k in self._intervals}
+            self._models[dt] = model
+        F, Ft, Q, decay = model  # (kalman.predict's arithmetic, its transposes made once per interval)
+        if decay is not None:
             coasting = self._tracks.misses > 0
             if coasting.any():
-                mean[coasting, 2:4] *= self._decay
+                mean[coasting, 2:4] *= decay
                 mean[coasting, 4:6] = 0.0
-        F, Ft, Q = self._model  # (kalman.predict's arithmetic, its transposes made once per interval)
         return mean @ Ft, F @ cov @ Ft + Q
 
     def _gains(self, mean: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -7,12 +7,15 @@ the pairs of :func:`lookalike.association.solver.assign_pairs` from the same mat
 same solver.
 
 :func:`compiled` gives the optional numba kernels (:mod:`lookalike.trackers.world_numba`, the ``fast``
-extra): the beacon identifier's window costs and assignment matrix, and the Kalman trackers' gate and
-assignment matrix, each in one call up to the solver, value by value the operations of the numpy path
-in its order (no fused multiply-adds), so tracks and identities are bit for bit the same;
-``tests/test_world_numba.py`` compares both paths. They are used when numba is installed unless
-``LOOKALIKE_WORLD_NUMBA=0``. numba is imported at the first frame that needs them (``lookalike serve``
-does it before serving: :func:`warm`), not with ``import lookalike``.
+extra): the beacon identifier's window costs and assignment matrix, the Kalman trackers' gate and
+assignment matrix, each in one call up to the solver, and their lifecycle rules, value by value the
+operations of the numpy path in its order (no fused multiply-adds), so tracks and identities are bit for
+bit the same; ``tests/test_world_numba.py`` compares both paths. Two kernels stand for BLAS/LAPACK or
+``einsum`` calls whose rounding depends on the build: the gate's 2×2 triangular solve
+(:func:`lower_solve_exact`) and the update of matched tracks (:func:`update_exact`); each is compared with
+numpy's call on check data when the kernels load and used only where it gives the same bits. They are
+used when numba is installed unless ``LOOKALIKE_WORLD_NUMBA=0``. numba is imported at the first frame that
+needs them (``lookalike serve`` does it before serving: :func:`warm`), not with ``import lookalike``.
 """
 
 from __future__ import annotations
