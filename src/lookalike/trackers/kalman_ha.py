@@ -78,6 +78,7 @@ class WorldTracker:
         self._intervals: list[float] = []  # the last two distinct frame intervals (> 0 s), the latest first
         self._repeated: set[float] = set()  # those of them that came again while in that list
         self._ready: dict[float, _Prepared] = {}  # the next frame's prediction per interval (prepare)
+        self._frame_ready: _Prepared | None = None  # the one this frame uses
         self._identifier = BeaconIdentifier(IdentifierConfig(
             n_agents=cfg.n_agents, window_frames=cfg.window_frames, max_cost=cfg.max_identity_cost,
             hysteresis=cfg.hysteresis))
@@ -108,7 +109,8 @@ class WorldTracker:
             t.mean, t.cov = ready.mean, ready.cov
         else:
             self._predict(dt)
-        det_of_track = self._associate_and_update(det) if ready is None else self._associate_and_update(det, ready)
+        self._frame_ready = ready
+        det_of_track = self._associate_and_update(det)
         det_of_track = self._lifecycle(det_of_track, dt, None if ready is None else ready.in_view)
         new = self._births(det, det_of_track)
         return self._report(det, np.concatenate([det_of_track, new]))
@@ -175,16 +177,16 @@ class WorldTracker:
         """Measurement covariances ``(k, 2, 2)`` for positions ``(k, 2)``."""
         return self._space.R(position)
 
-    def _associate_and_update(self, det: Detections, ready: _Prepared | None = None) -> np.ndarray:
+    def _associate_and_update(self, det: Detections) -> np.ndarray:
         """Hungarian on the gated squared Mahalanobis distance; Kalman update of matched tracks.
 
         The arithmetic of ``motion.kalman.gating_distance`` and ``kalman.update`` on the whole
         table at once: ``H`` picks the position, so ``H P Hᵀ`` and ``P Hᵀ`` are slices of ``P`` (the
-        same values), and the innovation covariances are formed once for gating and update. With
-        ``ready`` (the table predicted by :meth:`prepare`) the covariances, factors, gains and updated
-        covariances are its own (the same values, computed between frames for every track).
+        same values), and the innovation covariances are formed once for gating and update. When the frame
+        found its prediction made by :meth:`prepare` (``_frame_ready``), the covariances, factors, gains and
+        updated covariances are its own (the same values, computed between frames for every track).
         """
-        t = self._tracks
+        t, ready = self._tracks, self._frame_ready
         det_of_track = filled(len(t), -1, int)
         if not (len(t) and len(det)):
             return det_of_track
@@ -199,7 +201,7 @@ class WorldTracker:
         kernels = compiled()
         # (with LAPACK's 2×2 solve replicated bit for bit (world_kernels.lower_solve_exact), the innovations,
         # their whitening and pairs' steps up to the solver in one compiled call; -1: not plain numbers)
-        gated = kernels.gate_work_lower(L, z, mean, self._gate) if lower_solve_exact() else None
+        gated = kernels.gate_work_lower(L, z, mean, self._gate) if kernels and lower_solve_exact() else None
         if gated is not None and gated[0] >= 0:
             rows, cols = decided_pairs(*gated)
         elif kernels is not None:  # (the lines below and pairs' steps up to the solver, in one compiled call)
@@ -256,6 +258,7 @@ class WorldTracker:
             else:
                 t.hits = bit_count(t["hit_bits"] & ((1 << window) - 1))
                 life.confirm(t)
+                assert in_view is not None  # (made above when there is a confirmation window)
                 limit_s = np.where(in_view, rules.max_coast_s + 1e-9, rules.max_out_of_view_s + 1e-9)
             keep = life.alive(t, limit_s)
         if not keep.all():

@@ -111,8 +111,9 @@ def _load_solver() -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
     linear_sum_assignment(np.zeros((1, 1)))  # (imports it, as the wrapper does)
     from scipy.optimize import linear_sum_assignment as solver
 
-    _solver = solver
-    return solver
+    found: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] = solver
+    _solver = found
+    return found
 
 
 def _load() -> ModuleType | None:
