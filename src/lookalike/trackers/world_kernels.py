@@ -200,6 +200,10 @@ def warm() -> bool:
     th, times, samples = np.full((2, 2, 2), np.nan), np.zeros(1), np.zeros((1, 1))
     kernels.window_costs(th, times, times, samples, 1.0, 1.0, np.empty((1, 2)))
     kernels.identity_work(th, times, times, samples, np.zeros(1, dtype=int), 1.0, 1.0, 0.1, 0.3)
+    _, cost, _, _ = kernels.identity_rows_work(th, times, times, np.full((2, 1), np.nan), np.full(2, -1),
+                                               np.zeros(1, dtype=int), 1.0, 1.0, 0.1, 0.3)
+    kernels.identity_results(np.zeros(0, dtype=int), np.zeros(0, dtype=int), cost, np.full(2, -1),
+                             np.zeros(1, dtype=int))
     kernels.gate_work(np.zeros((1, 2, 1)), 1.0)
     kernels.gate_work_lower(np.ones((1, 2, 2)), np.zeros((1, 2)), np.zeros((1, 6)), 1.0)
     kernels.update_hits(np.zeros((1, 6)), np.zeros((1, 6, 6)), np.zeros(1, dtype=int), np.zeros(1, dtype=int),

@@ -145,6 +145,40 @@ def identity_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: n
 
 
 @_jit
+def identity_rows_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, win: np.ndarray, current: np.ndarray,
+                       rows: np.ndarray, max_turn_rate: float, max_extrapolation_s: float, hysteresis: float,
+                       max_cost: float) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`identity_work` on the rows ``rows (k,)`` of the identifier's sample table ``win`` and of its
+    agents per row ``current`` (the gathers ``win[rows]``, ``current[rows]`` made here)."""
+    k, w = rows.shape[0], win.shape[1]
+    samples = np.empty((k, w))
+    held = np.empty(k, np.int64)
+    for i in range(k):
+        held[i] = current[rows[i]]
+        for j in range(w):
+            samples[i, j] = win[rows[i], j]
+    return identity_work(th, q, q_count, samples, held, max_turn_rate, max_extrapolation_s, hysteresis, max_cost)
+
+
+@_jit
+def identity_results(pair_rows: np.ndarray, pair_agents: np.ndarray, cost: np.ndarray, current: np.ndarray,
+                     rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``BeaconIdentifier.assign_arrays``'s results from the assigned pairs (index into ``rows``, agent): the
+    agent per row (-1: none) and the probability ``1 - cost`` (NaN: none), each row's agent kept in
+    ``current[rows]`` (in order: a repeated row keeps the last)."""
+    k = rows.shape[0]
+    agent = np.full(k, -1, np.int64)
+    prob = np.full(k, np.nan)
+    for p in range(pair_rows.shape[0]):
+        i, a = pair_rows[p], pair_agents[p]
+        agent[i] = a
+        prob[i] = 1.0 - cost[i, a]
+    for i in range(k):
+        current[rows[i]] = agent[i]
+    return agent, prob
+
+
+@_jit
 def gate_work(y: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
     """The Kalman trackers' association up to the solver, from the whitened innovations ``y (k, 2, d)``: the
     squared Mahalanobis distances ``y0² + y1²``, the pairs inside the ``gate`` (NaN: outside), and the matrix

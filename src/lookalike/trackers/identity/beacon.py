@@ -244,27 +244,29 @@ class BeaconIdentifier:
         """:meth:`assign` as columns: agent id per track (-1: none) and probability (NaN: none)."""
         cfg = self.config
         k = len(track_ids)
-        agent_out = filled(k, -1, int)
-        prob = filled(k, np.nan)
         if not k:
-            return agent_out, prob
+            return filled(0, -1, int), filled(0, np.nan)
         get = self._row.get
         rows = [get(t, 0) for t in track_ids]
         kernels = compiled() if cfg.n_agents > 1 and cfg.max_cost <= 1.0 else None
-        if kernels is not None:  # (the steps below in one compiled call, up to the solver)
-            decision, cost, work, allowed = kernels.identity_work(
-                self._th, self._times, self._times_count, self._win[rows], self._current[rows], cfg.max_turn_rate,
+        if kernels is not None:  # (the steps below in one compiled call up to the solver, one after it)
+            index = np.array(rows)
+            decision, cost, work, allowed = kernels.identity_rows_work(
+                self._th, self._times, self._times_count, self._win, self._current, index, cfg.max_turn_rate,
                 cfg.max_extrapolation_s, cfg.hysteresis, cfg.max_cost)
             r, a = decided_pairs(decision, work, allowed)
-        else:
-            cost = self._costs(rows)
-            biased = cost.copy()
-            current = self._current[rows]
-            held = np.flatnonzero(current >= 0)
-            if len(held):  # (an infinite cost stays infinite)
-                a = current[held]
-                biased[held, a] = np.maximum(biased[held, a] - cfg.hysteresis, 0.0)
-            r, a = pairs(biased, biased <= cfg.max_cost, cfg.max_cost, unit=True)  # (costs in [0, 1])
+            found: tuple[np.ndarray, np.ndarray] = kernels.identity_results(r, a, cost, self._current, index)
+            return found
+        cost = self._costs(rows)
+        biased = cost.copy()
+        current = self._current[rows]
+        held = np.flatnonzero(current >= 0)
+        if len(held):  # (an infinite cost stays infinite)
+            a = current[held]
+            biased[held, a] = np.maximum(biased[held, a] - cfg.hysteresis, 0.0)
+        r, a = pairs(biased, biased <= cfg.max_cost, cfg.max_cost, unit=True)  # (costs in [0, 1])
+        agent_out = filled(k, -1, int)
+        prob = filled(k, np.nan)
         agent_out[r] = a
         prob[r] = 1.0 - cost[r, a]
         self._current[rows] = agent_out  # (row 0, unobserved tracks, is never assigned: stays -1)
