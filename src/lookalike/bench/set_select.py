@@ -150,7 +150,12 @@ def choose_stage2(rows: dict[str, dict[str, float]], baseline: dict[str, float])
                 and all(np.isfinite(r[k]) and r[k] <= baseline[k] + 0.05 for k in recs)
                 and all(np.isfinite(r[k]) for k in r if k.startswith("worst_")))
 
-    ok = [p for p, r in rows.items() if eligible(r)]
+    return _best(rows, [p for p, r in rows.items() if eligible(r)], recs, teams)
+
+
+def _best(rows: dict[str, dict[str, float]], ok: list[str], recs: list[str], teams: list[str]) -> str | None:
+    """Among the eligible ``ok``: the best M=3, N=2 tuning success; within 0.05 points of it, the lowest
+    mean of the ``recs`` recovery times; then the best mean success over ``teams``. None when ``ok`` is empty."""
     if not ok:
         return None
     top = max(rows[p]["m3n2"] for p in ok)
@@ -181,13 +186,7 @@ def choose_stage3(rows: dict[str, dict[str, float]], baseline: str) -> str | Non
         return (r["m3n2"] >= base["m3n2"] + 0.1 and all(r[k] >= base[k] - 0.05 for k in others)
                 and all(np.isfinite(r[k]) and r[k] <= base[k] + 0.02 for k in recs))
 
-    ok = [p for p, r in rows.items() if p != baseline and eligible(r)]
-    if not ok:
-        return None
-    top = max(rows[p]["m3n2"] for p in ok)
-    near = [p for p in ok if rows[p]["m3n2"] >= top - 0.05]
-    return min(near, key=lambda p: (float(np.mean([rows[p][k] for k in recs])),
-                                    -float(np.mean([rows[p][k] for k in others]))))
+    return _best(rows, [p for p, r in rows.items() if p != baseline and eligible(r)], recs, others)
 
 
 def options_row(options: dict[str, object], seqs: dict[str, list[RobotSequence]],
