@@ -260,6 +260,7 @@ def test_replicated_solve_is_refused_when_it_rounds_otherwise() -> None:
             return np.nextafter(kernels.solve_lower_many(factor, b, divide), np.inf)  # (one unit off)
 
     assert not wk._same_lower_solves(Rounding)
+    assert not wk.lower_solve_exact(wk.CHECKED_RHS + 1)  # (more right-hand sides than were checked)
     wk.use_compiled(False)
     assert not wk.lower_solve_exact()
 

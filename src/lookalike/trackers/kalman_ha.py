@@ -201,7 +201,7 @@ class WorldTracker:
         kernels = compiled()
         # (with LAPACK's 2×2 solve replicated bit for bit (world_kernels.lower_solve_exact), the innovations,
         # their whitening and pairs' steps up to the solver in one compiled call; -1: not plain numbers)
-        gated = kernels.gate_work_lower(L, z, mean, self._gate) if kernels and lower_solve_exact() else None
+        gated = kernels.gate_work_lower(L, z, mean, self._gate) if kernels and lower_solve_exact(len(z)) else None
         if gated is not None and gated[0] >= 0:
             rows, cols = decided_pairs(*gated)
         elif kernels is not None:  # (the lines below and pairs' steps up to the solver, in one compiled call)

@@ -130,6 +130,7 @@ def _load() -> ModuleType | None:
 
 
 _lower_solve_exact = _update_exact = False
+CHECKED_RHS = 16  # the most right-hand sides (detections) the 2×2 solve replica is checked with
 
 
 def update_exact() -> bool:
@@ -153,12 +154,13 @@ def _same_updates(kernels: ModuleType) -> bool:
     return bool(np.array_equal(got[rows].view(np.int64), expected.view(np.int64)) and (cov == 1.0).all())
 
 
-def lower_solve_exact() -> bool:
+def lower_solve_exact(n_rhs: int = 1) -> bool:
     """Whether the compiled kernels are in use and their 2×2 lower-triangular solve
-    (``world_numba.solve_lower``) gave numpy's ``solve`` bit for bit on the check systems when they loaded
-    (it does with the OpenBLAS of numpy 1.26; other BLAS builds may round otherwise: then the Kalman gate
-    whitens with numpy's ``solve``)."""
-    return compiled() is not None and _lower_solve_exact
+    (``world_numba.solve_lower``) gave numpy's ``solve`` bit for bit on the check systems when they loaded,
+    for ``n_rhs`` right-hand sides (the checks cover 1 to :data:`CHECKED_RHS`; the BLAS may take other code
+    for more). It does with the OpenBLAS of numpy 1.26; other BLAS builds may round otherwise: then the
+    Kalman gate whitens with numpy's ``solve``."""
+    return n_rhs <= CHECKED_RHS and compiled() is not None and _lower_solve_exact
 
 
 def _same_lower_solves(kernels: ModuleType) -> bool:
@@ -166,7 +168,7 @@ def _same_lower_solves(kernels: ModuleType) -> bool:
     random 2×2 covariances (strongly correlated ones among them, whose solve swaps rows) with 1 to 16
     right-hand sides each, as the Kalman gate solves them."""
     rng = np.random.default_rng(20261202)
-    for d in (1, 2, 5, 10, 16):
+    for d in (1, 2, 5, 10, CHECKED_RHS):
         k = 960 // d
         var = rng.uniform(1e-4, 4.0, (k, 2))
         corr = rng.uniform(-0.999, 0.999, k)
