@@ -116,3 +116,66 @@ def test_tuning_recovery_is_bench_recoverys_measure():
     mine = set_recovery_s(SHIPPED_SET_WEIGHTS, seq, swap_at_s=2.0, swap_s=3.0)
     row = recovery_rows(["m3n2"], ["set"], 1, 300, 2.0, 3.0, seed=55_001)[0]
     assert round(mine, 2) == row["Recovery, mean (s)"]
+
+
+def test_the_noise_mix_draws_both_noise_models_per_sequence():
+    from lookalike.learn.set_finetune import FINETUNE4_CONFIG, STAGES
+    from lookalike.sim import noise_sensor
+
+    assert STAGES[4] is FINETUNE4_CONFIG
+    maker = FINETUNE4_CONFIG.batch_maker()
+    assert set(maker.noises) == {"ours", "paper"}
+    base = SetBatchMaker(fixed=(2, 3, 0.5)).world_of
+    from lookalike.learn.set_data import world
+
+    cfg = world(2, 3, 0.5)
+    assert base(cfg, 7) is cfg  # no noise mix: the default world
+    sensors = {maker.world_of(cfg, s).sensor for s in range(40)}
+    assert sensors == {noise_sensor(n, cfg.sensor) for n in ("ours", "paper")}
+    assert all(s.fp_per_frame == 0.5 for s in sensors)  # the team's clutter is kept
+    # one model alone (the default world's, "ours") makes the batches made without the option
+    plain = SetBatchMaker(fixed=(2, 3, 0.5))(5, 2, 60)
+    ours = SetBatchMaker(fixed=(2, 3, 0.5), noises=("ours",))(5, 2, 60)
+    for a, b in zip(plain[:4], ours[:4]):
+        np.testing.assert_array_equal(a, b)
+    paper = SetBatchMaker(fixed=(2, 3, 0.5), noises=("paper",))(5, 2, 60)
+    assert not np.array_equal(plain[1], paper[1])  # other position noise, other detections
+    with pytest.raises(ValueError, match="noise"):
+        SetBatchMaker(noises=("loud",))
+
+
+def test_close_heading_swaps_pick_the_pair_of_closest_headings():
+    from lookalike.learn.set_data import closest_headings, world
+    from lookalike.sim import simulate_arrays
+
+    arrays = simulate_arrays(world(4, 6, 0.5), 90, 11)
+    h = arrays.true_heading[30]
+    i, j = closest_headings(arrays, arrays.time[30])
+    gap = lambda a, b: abs(np.angle(np.exp(1j * (h[a] - h[b]))))  # noqa: E731
+    assert i < j and all(gap(i, j) <= gap(a, b) for a in range(4) for b in range(a + 1, 4))
+    plain = SetBatchMaker(fixed=(4, 6, 0.5), swap_prob=1.0, swap_ends=1.0)(3, 2, 90)
+    close = SetBatchMaker(fixed=(4, 6, 0.5), swap_prob=1.0, swap_ends=1.0, close_swap_prob=1.0)(3, 2, 90)
+    assert plain[0].shape == close[0].shape and (plain[3] != close[3]).any()  # other pairs swapped
+    with pytest.raises(ValueError, match="close_swap_prob"):
+        SetBatchMaker(close_swap_prob=1.5)
+
+
+def test_stage4_candidates_and_choice(tmp_path):
+    from lookalike.bench.set_select_stage4 import BASELINE, choose_stage4, stage4_candidates
+
+    for k in (25, 500, 750, 1000):
+        (tmp_path / f"set_step{k}.npz").write_bytes(b"")
+    names = list(stage4_candidates(tmp_path))
+    assert names[0] == BASELINE and len(names) == 9  # shipped, steps 500 and 1000, each off / 1.5 / 1.0 rad
+    assert stage4_candidates(tmp_path)["step1000,pair=1.5"][1] == {"pair_swap": 1.5}
+    base = {"m3n2": 98.0, "m5n3": 97.0, "rec_m3n2": 0.4, "rec_m10n7": 0.6, "worst_m3n2": 1.0}
+    rows = {BASELINE: base,
+            "up": {**base, "m3n2": 98.06},  # M=3, N=2 gain alone
+            "fast": {**base, "m3n2": 98.02, "rec_m10n7": 0.5},  # recovery gain (mean of the means 0.05 s lower)
+            "lost": {**base, "m3n2": 98.3, "m5n3": 96.9},  # another team 0.1 points down
+            "slow": {**base, "m3n2": 98.3, "rec_m3n2": 0.43},  # a set-up's recovery 0.03 s slower
+            "same": {**base, "m3n2": 98.04, "rec_m10n7": 0.56}}  # neither gain large enough
+    assert choose_stage4(rows) == "fast"  # within 0.05 points of "up" on M=3, N=2 and faster to recover
+    del rows["fast"]
+    assert choose_stage4(rows) == "up"
+    assert choose_stage4({BASELINE: base, "same": rows["same"], "lost": rows["lost"]}) is None

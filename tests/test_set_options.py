@@ -129,3 +129,30 @@ def test_unmeasurable_recoveries_are_those_whose_pair_is_not_seen_both_times():
     for labels in (gone_after, gone_during):
         blind = SimpleNamespace(config=seq.config, true_labels=lambda labels=labels: labels)
         assert not measurable(blind, 2.0, 3.0)
+
+
+def test_pair_swap_exchanges_the_memories_of_a_swap_no_report_jump_shows(shipped):
+    from lookalike.trackers import make_tracker
+
+    heading = {0: 0.0, 1: 0.7}  # close headings: the exchange is no report jump (report_jump off anyway)
+    swapped = lambda a, t: heading[1 - a] if t >= 1.5 else heading[a]  # noqa: E731  ids exchanged from 1.5 s
+    labels = {}
+    for pair_swap in (None, 2.0):
+        tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, pair_swap=pair_swap)
+        out = []
+        for f in frames(120, swapped, lambda r, t: heading[r]):
+            tracker.update(f)
+            out.append(tracker.last_labels.copy())
+        labels[pair_swap] = np.array(out)
+        if pair_swap is None:
+            assert tracker.pair_swaps == 0
+        else:
+            assert tracker.pair_swaps == 1
+    late = int(3.0 * RATE)
+    # robot 0 (detection 0) now reports as agent 1: with the rule its label follows the reports
+    assert (labels[2.0][late:, 0] == 1).all() and (labels[2.0][late:, 1] == 0).all()
+    assert (labels[2.0][: int(1.4 * RATE)] == [0, 1]).all()  # and before the swap nothing changed
+    quiet = make_tracker("set", n_agents=2, n_slots=2, pair_swap=0.5)
+    quiet.net.swap = lambda *a: pytest.fail("no swap, no exchange")
+    for f in frames(120, lambda a, t: heading[a], lambda r, t: heading[r]):
+        quiet.update(f)

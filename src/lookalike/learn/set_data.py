@@ -15,8 +15,8 @@ import dataclasses
 import numpy as np
 
 from lookalike.learn.data import IGNORE
-from lookalike.learn.sim_data import latest_reports, slot_order, swap_identities
-from lookalike.sim import RobotArrays, RobotWorldConfig, simulate_arrays
+from lookalike.learn.sim_data import latest_reports, mix_pick, slot_order, swap_identities
+from lookalike.sim import NOISE_MODELS, RobotArrays, RobotWorldConfig, noise_sensor, simulate_arrays
 from lookalike.sim.robots_config import SensorConfig
 
 AGENT_FEATURES = 4
@@ -107,6 +107,17 @@ def world(n_agents: int, n_slots: int, fp_per_frame: float, frame_rate_hz: float
 Batch = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]
 
 
+def closest_headings(arrays: RobotArrays, at_s: float) -> tuple[int, int]:
+    """The two robots (lower id first) whose true headings are closest at the first frame at or after
+    ``at_s`` seconds (the last frame if none)."""
+    t = min(int(np.searchsorted(arrays.time, at_s)), len(arrays) - 1)
+    h = arrays.true_heading[t]
+    gap = np.abs(np.angle(np.exp(1j * (h[:, None] - h[None, :]))))
+    gap[np.diag_indices_from(gap)] = np.inf
+    i, j = np.unravel_index(int(np.argmin(gap)), gap.shape)
+    return int(min(i, j)), int(max(i, j))
+
+
 @dataclasses.dataclass(frozen=True)
 class SetBatchMaker:
     """A picklable ``(seed, batch_size, n_frames) -> batch`` over team sizes ``sizes``.
@@ -118,6 +129,12 @@ class SetBatchMaker:
     seconds before the sequence does (the network sees the identities come back), else it starts in the
     first 80% of the sequence and may outlast it. ``fixed``: one ``(N, M, fp)`` for every batch instead
     of drawing from ``sizes``.
+
+    ``noises``: position-noise models (:data:`~lookalike.sim.NOISE_MODELS`, e.g. ``("ours", "paper")``),
+    one drawn per sequence from its seed (:func:`~lookalike.learn.sim_data.mix_pick`, as the LSTM's noise
+    mix); empty: the default world's noise. ``close_swap_prob``: the fraction of the swaps made between
+    the two robots whose true headings are closest when the swap starts (the pairs a heading report
+    hardly tells apart), instead of two random robots. Their defaults draw the same batches as before.
     """
 
     sizes: TeamSizes = TeamSizes()
@@ -125,6 +142,22 @@ class SetBatchMaker:
     fixed: tuple[int, int, float] | None = None
     swap_s: tuple[float, float] = (1.0, 10.0)
     swap_ends: float | None = None
+    noises: tuple[str, ...] = ()
+    close_swap_prob: float = 0.0
+
+    def __post_init__(self) -> None:
+        unknown = [x for x in self.noises if x not in NOISE_MODELS]
+        if unknown:
+            raise ValueError(f"SetBatchMaker: unknown noise models {unknown}; known: {', '.join(NOISE_MODELS)}")
+        if not 0.0 <= self.close_swap_prob <= 1.0:
+            raise ValueError(f"SetBatchMaker: close_swap_prob must lie in [0, 1], got {self.close_swap_prob}")
+
+    def world_of(self, cfg: RobotWorldConfig, seed: int) -> RobotWorldConfig:
+        """The world of the sequence of ``seed``: ``cfg`` with the noise model :attr:`noises` draws for it."""
+        if not self.noises:
+            return cfg
+        noise = self.noises[mix_pick(seed, len(self.noises))]
+        return dataclasses.replace(cfg, sensor=noise_sensor(noise, cfg.sensor))
 
     def __call__(self, seed: int, batch_size: int, n_frames: int) -> Batch:
         n, m, fp = self.fixed or self.sizes.draw(np.random.default_rng([seed, 0x5E7]))
@@ -132,7 +165,7 @@ class SetBatchMaker:
         out = []
         for b in range(batch_size):
             s = seed * 1000 + b
-            arrays = simulate_arrays(cfg, n_frames, s)
+            arrays = simulate_arrays(self.world_of(cfg, s), n_frames, s)
             aug = np.random.default_rng([s, 0x5A5])
             if n >= 2 and aug.random() < self.swap_prob:
                 i, j = aug.choice(n, 2, replace=False)
@@ -144,6 +177,8 @@ class SetBatchMaker:
                     duration = min(aug.uniform(*self.swap_s), max(length_s - self.swap_ends - 1.0, 0.5))
                     start = aug.uniform(0.5, max(length_s - self.swap_ends - duration, 0.5))
                     stop = start + duration
+                if self.close_swap_prob > 0 and aug.random() < self.close_swap_prob:
+                    i, j = closest_headings(arrays, start)
                 arrays = swap_identities(arrays, int(i), int(j), start, stop)
             out.append(arrays_to_tokens(arrays, n, np.random.default_rng([s, 1])))
         a, d, v, y = (np.stack(parts) for parts in zip(*out))

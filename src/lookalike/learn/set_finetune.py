@@ -6,7 +6,8 @@ with :data:`FINETUNE_CONFIG`: a low, decaying learning rate, 60% of the batches 
 (N 1–12), identity swaps of 1–6 s that end inside the sequence, and a snapshot at every validation
 (``OUT/set_step{N}.npz``) to choose among on tuning sequences. ``--stage 2`` runs
 :data:`FINETUNE2_CONFIG` instead: a second stage from the weights shipped after the first, with more
-M=3, N=2 batches and more, longer identity swaps. Needs torch.
+M=3, N=2 batches and more, longer identity swaps. ``--stage 4`` runs :data:`FINETUNE4_CONFIG`: the
+noise mix (ours + paper position noise) and swaps between robots of close headings. Needs torch.
 """
 
 from __future__ import annotations
@@ -34,7 +35,16 @@ FINETUNE2_CONFIG = SetTrainConfig(
     swap_prob=0.5, swap_min_s=1.0, swap_max_s=10.0, swap_ends_s=3.0,
     focus_prob=0.7, focus_teams=FINETUNE2_TEAMS, keep_snapshots=True, validation_every=25,
 )
-STAGES = {1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG}
+# The fourth stage (issue 23): the noise mix (ours + paper position noise, one per sequence, as the LSTM's
+# fine-tune), the first stage's team weights with more focus, swaps that end inside the sequence, half of
+# them between the two robots of closest headings (so the memory learns to yield to the reports there).
+FINETUNE4_CONFIG = SetTrainConfig(
+    learning_rate=0.0002, lr_decay=0.001, steps=5000, minutes=48.0, patience=1000, seed=5,
+    swap_prob=0.5, swap_min_s=1.0, swap_max_s=10.0, swap_ends_s=3.0, close_swap_prob=0.5,
+    focus_prob=0.7, focus_teams=FINETUNE_TEAMS, keep_snapshots=True, validation_every=25,
+    noises=("ours", "paper"),
+)
+STAGES = {1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG, 4: FINETUNE4_CONFIG}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -50,7 +60,8 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(prog="python -m lookalike.learn.set_finetune", description=__doc__)
     parser.add_argument("out", type=Path, help="output folder (snapshots, log, best-validation weights)")
     parser.add_argument("--stage", type=int, choices=sorted(STAGES), default=1,
-                        help="1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG (from the stage-1 weights)")
+                        help="1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG (from the stage-1 weights), "
+                        "4: FINETUNE4_CONFIG (the noise mix and close-heading swaps, from the shipped weights)")
     parser.add_argument("--minutes", type=float, default=None, help="wall-clock limit (default: the stage's)")
     parser.add_argument("--init", type=Path, default=SHIPPED_SET_WEIGHTS, help="weights to start from (.npz)")
     args = parser.parse_args(argv)

@@ -15,6 +15,8 @@ the one other agent that reported that heading just before (``on_jump="swap"``),
 An agent whose report is older than ``stale_s`` seconds while a detection near its remembered
 position has turned away from that report is shown to the network as not heard from (its memory
 still places it). Both were chosen on tuning sequences (docs/experiments/any-team-size.md).
+With ``pair_swap``, two agents whose detections keep fitting each other's fresh reports better than
+their own (a swap undone while their headings stay too close for a report jump) exchange memories.
 """
 
 from __future__ import annotations
@@ -75,6 +77,12 @@ class SetIdentifier:
         on_jump: str = param("swap", "after a report jump (report_jump): forget the agent's memory, or swap "
                              "it with the one other agent that reported the new heading just before (forget: "
                              "no such agent or several)", choices=("forget", "swap"))
+        pair_swap: float | None = param(
+            None, "exchange two agents' memories (and this frame's labels) when the evidence that each one's "
+            "detection fits the other's fresh report better than its own, summed over frames with decay "
+            "pair_swap_s, passes this many radians (None: never)", range=(0.0, 1000.0))
+        pair_swap_s: float = param(0.5, "time constant of pair_swap's evidence decay, seconds", range=(0.01, 100.0))
+        pair_fresh_s: float = param(0.3, "reports younger than this count for pair_swap, seconds", range=(0.0, 100.0))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
                                choices=LOCALISERS)
 
@@ -98,6 +106,8 @@ class SetIdentifier:
         self.last_probabilities = np.zeros(0)
         self._last_time = -np.inf
         self._expected_jump: dict[int, float] = {}
+        self._pair_evidence = np.zeros((n, n))
+        self.pair_swaps = 0  # memories exchanged by pair_swap so far (for tests and analysis)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
@@ -126,6 +136,8 @@ class SetIdentifier:
         slot_label, slot_conf = decode(prob, len(used), self.config.one_to_one)
         labels, conf = np.full(n, -1), np.zeros(n)
         labels[used], conf[used] = slot_label, slot_conf
+        if self.config.pair_swap is not None:
+            labels = self._pair_swaps(labels, conf, heading, frame.time, dt)
         self.last_labels, self.last_probabilities = labels, conf
         return self._snapshots(labels, conf, position, heading, frame)
 
@@ -190,14 +202,44 @@ class SetIdentifier:
             else:
                 self._expected_jump[b] = now[a]
 
+    def _pair_swaps(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, time_s: float,
+                    dt: float) -> np.ndarray:
+        """``pair_swap``: for every two agents ``j, k`` holding a detection and a report younger than
+        ``pair_fresh_s``, the frame's evidence that they are exchanged is how much better each detection's
+        visual heading fits the other's report than its own (differences clipped at π/2, so a front/back
+        flip counts little); it is summed with decay ``exp(-dt / pair_swap_s)`` and never below 0. When it
+        passes ``pair_swap`` radians, the two memories and this frame's labels are exchanged (the largest
+        first; an agent at most once per frame). Returns the labels."""
+        cfg = self.config
+        evidence = self._pair_evidence
+        evidence *= np.exp(-dt / cfg.pair_swap_s)
+        det = _agent_detections(labels, conf, cfg.n_agents)
+        fresh = (det >= 0) & (self._beacons.age(time_s) <= cfg.pair_fresh_s)
+        live = np.flatnonzero(fresh)
+        if len(live) < 2:
+            return labels
+        psi = self._beacons.heading[live]
+        phi = heading[det[live]]
+        misfit = np.minimum(np.abs(np.angle(np.exp(1j * (phi[None, :] - psi[:, None])))), np.pi / 2)
+        own = np.diag(misfit)
+        gain = own[:, None] + own[None, :] - misfit - misfit.T
+        block = evidence[np.ix_(live, live)]
+        evidence[np.ix_(live, live)] = np.maximum(block + gain, 0.0)
+        np.fill_diagonal(evidence, 0.0)
+        out = labels
+        while evidence.max() > cfg.pair_swap:
+            j, k = np.unravel_index(int(np.argmax(evidence)), evidence.shape)
+            self.net.swap(int(j), int(k))
+            self.pair_swaps += 1
+            out = np.where(labels == j, k, np.where(labels == k, j, out))
+            evidence[[j, k], :] = 0.0
+            evidence[:, [j, k]] = 0.0
+        return out
+
     def _snapshots(self, labels: np.ndarray, conf: np.ndarray, position: np.ndarray, heading: np.ndarray,
                    frame: Frame) -> list[TrackSnapshot]:
         n_agents = self.config.n_agents
-        det_of_agent = np.full(n_agents, -1)
-        for k in np.argsort(-conf):  # the most confident detection of an agent updates it
-            j = labels[k]
-            if j >= 0 and det_of_agent[j] < 0:
-                det_of_agent[j] = k
+        det_of_agent = _agent_detections(labels, conf, n_agents)
         assigned = det_of_agent >= 0
         measured = np.full((n_agents, 2), np.nan)
         weight = np.zeros(n_agents)
@@ -223,3 +265,13 @@ class SetIdentifier:
                 detection_index=int(k),
             ))
         return snapshots
+
+
+def _agent_detections(labels: np.ndarray, conf: np.ndarray, n_agents: int) -> np.ndarray:
+    """``(n_agents,)`` each agent's most confident detection (index into ``labels``), -1 for none."""
+    det_of_agent = np.full(n_agents, -1)
+    for k in np.argsort(-conf):
+        j = labels[k]
+        if j >= 0 and det_of_agent[j] < 0:
+            det_of_agent[j] = k
+    return det_of_agent
