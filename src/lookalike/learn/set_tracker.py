@@ -29,12 +29,12 @@ import numpy as np
 from lookalike.learn.checkpoint import CheckpointError
 from lookalike.learn.set_data import agent_tokens, detection_tokens
 from lookalike.learn.set_numpy import NumpySetAssociator, load_set_weights
-from lookalike.learn.tracker import BeaconMemory, decode
+from lookalike.learn.tracker import BeaconMemory, agent_detections, agent_snapshots, decode
 from lookalike.learn.weights import WEIGHTS_DIR
 from lookalike.trackers.base import check_params, param
 from lookalike.trackers.identity.localiser import LOCALISERS, make_localiser
 from lookalike.trackers.registry import register_tracker
-from lookalike.types import Frame, TrackSnapshot, TrackStatus
+from lookalike.types import Frame, TrackSnapshot
 
 SHIPPED_SET_WEIGHTS = WEIGHTS_DIR / "set_any.npz"
 
@@ -139,7 +139,7 @@ class SetIdentifier:
         if self.config.pair_swap is not None:
             labels = self._pair_swaps(labels, conf, heading, frame.time, dt)
         self.last_labels, self.last_probabilities = labels, conf
-        return self._snapshots(labels, conf, position, heading, frame)
+        return agent_snapshots(labels, conf, position, heading, self._localiser, self._last_seen, frame)
 
     def _hide_stale(self, reported: np.ndarray, age: np.ndarray, position: np.ndarray,
                     heading: np.ndarray) -> np.ndarray:
@@ -213,7 +213,7 @@ class SetIdentifier:
         cfg = self.config
         evidence = self._pair_evidence
         evidence *= np.exp(-dt / cfg.pair_swap_s)
-        det = _agent_detections(labels, conf, cfg.n_agents)
+        det = agent_detections(labels, conf, cfg.n_agents)
         fresh = (det >= 0) & (self._beacons.age(time_s) <= cfg.pair_fresh_s)
         live = np.flatnonzero(fresh)
         if len(live) < 2:
@@ -235,43 +235,3 @@ class SetIdentifier:
             evidence[[j, k], :] = 0.0
             evidence[:, [j, k]] = 0.0
         return out
-
-    def _snapshots(self, labels: np.ndarray, conf: np.ndarray, position: np.ndarray, heading: np.ndarray,
-                   frame: Frame) -> list[TrackSnapshot]:
-        n_agents = self.config.n_agents
-        det_of_agent = _agent_detections(labels, conf, n_agents)
-        assigned = det_of_agent >= 0
-        measured = np.full((n_agents, 2), np.nan)
-        weight = np.zeros(n_agents)
-        measured[assigned] = position[det_of_agent[assigned]]
-        weight[assigned] = conf[det_of_agent[assigned]]
-        located = self._localiser.update(frame.time, measured, weight)
-        fallback = assigned & ~np.isfinite(located).all(axis=1)  # an assigned agent always has a position
-        located[fallback] = measured[fallback]
-        snapshots = []
-        for j in range(n_agents):
-            k = det_of_agent[j]
-            if k >= 0:
-                self._last_seen[j] = frame.index
-            if self._last_seen[j] < 0 or not np.isfinite(located[j]).all():
-                continue  # never seen, or lost for longer than the localiser keeps a position
-            snapshots.append(TrackSnapshot(
-                track_id=j + 1,
-                status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
-                position=located[j].copy(),
-                heading=float(heading[k]) if k >= 0 else None,
-                agent_id=j,
-                identity_prob=float(conf[k]) if k >= 0 else None,
-                detection_index=int(k),
-            ))
-        return snapshots
-
-
-def _agent_detections(labels: np.ndarray, conf: np.ndarray, n_agents: int) -> np.ndarray:
-    """``(n_agents,)`` each agent's most confident detection (index into ``labels``), -1 for none."""
-    det_of_agent = np.full(n_agents, -1)
-    for k in np.argsort(-conf):
-        j = labels[k]
-        if j >= 0 and det_of_agent[j] < 0:
-            det_of_agent[j] = k
-    return det_of_agent

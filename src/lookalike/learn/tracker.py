@@ -20,7 +20,7 @@ from lookalike.learn.encoding import PROTOCOLS, EncodingSpec, encode_frame
 from lookalike.learn.numpy_net import NumpyAssociationNet
 from lookalike.learn.weights import shipped_weights_path
 from lookalike.trackers.base import check_params, param
-from lookalike.trackers.identity.localiser import LOCALISERS, make_localiser
+from lookalike.trackers.identity.localiser import LOCALISERS, KalmanLocaliser, LowPassLocaliser, make_localiser
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
@@ -115,40 +115,54 @@ class LstmIdentifier:
         labels, conf = np.full(n, -1), np.zeros(n)
         labels[used], conf[used] = slot_label, slot_conf
         self.last_labels, self.last_probabilities = labels, conf
-        det_of_agent = np.full(self.config.n_agents, -1)
-        for k in np.argsort(-conf):  # the most confident detection of an agent updates it
-            j = labels[k]
-            if j >= 0 and det_of_agent[j] < 0:
-                det_of_agent[j] = k
         if n and (det.position is None or det.heading is None):
             raise ValueError("lstm: frame.detections need position (m) and heading (rad) columns")
         position = det.position if det.position is not None else np.zeros((0, 2))
         heading = det.heading if det.heading is not None else np.zeros(0)
-        assigned = det_of_agent >= 0
-        measured = np.full((self.config.n_agents, 2), np.nan)
-        weight = np.zeros(self.config.n_agents)
-        measured[assigned] = position[det_of_agent[assigned]]
-        weight[assigned] = conf[det_of_agent[assigned]]
-        located = self._localiser.update(frame.time, measured, weight)
-        fallback = assigned & ~np.isfinite(located).all(axis=1)  # labels never depend on the localiser
-        located[fallback] = measured[fallback]
-        snapshots = []
-        for j in range(self.config.n_agents):
-            k = det_of_agent[j]
-            if k >= 0:
-                self._last_seen[j] = frame.index
-            if self._last_seen[j] < 0 or not np.isfinite(located[j]).all():
-                continue  # never seen, or lost for longer than the localiser keeps a position
-            snapshots.append(
-                TrackSnapshot(
-                    track_id=j + 1,
-                    status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
-                    position=located[j].copy(),
-                    heading=float(heading[k]) if k >= 0 else None,
-                    agent_id=j,
-                    identity_prob=float(conf[k]) if k >= 0 else None,
-                    detection_index=int(k),
-                )
-            )
-        return snapshots
+        return agent_snapshots(labels, conf, position, heading, self._localiser, self._last_seen, frame)
 
+
+def agent_detections(labels: np.ndarray, conf: np.ndarray, n_agents: int) -> np.ndarray:
+    """``(n_agents,)`` each agent's most confident detection (index into ``labels``), -1 for none."""
+    det_of_agent = np.full(n_agents, -1)
+    for k in np.argsort(-conf):
+        j = labels[k]
+        if j >= 0 and det_of_agent[j] < 0:
+            det_of_agent[j] = k
+    return det_of_agent
+
+
+def agent_snapshots(labels: np.ndarray, conf: np.ndarray, position: np.ndarray, heading: np.ndarray,
+                    localiser: LowPassLocaliser | KalmanLocaliser, last_seen: np.ndarray,
+                    frame: Frame) -> list[TrackSnapshot]:
+    """One snapshot per agent seen so far, from the frame's detection labels (-1: false positive) and
+    their probabilities ``conf``; ``position`` ``(n, 2)`` m and ``heading`` ``(n,)`` rad of the detections.
+    Each agent's most confident detection updates ``localiser``; ``last_seen`` (the frame index each
+    agent last took a detection, -1 never) is updated in place."""
+    n_agents = len(last_seen)
+    det_of_agent = agent_detections(labels, conf, n_agents)
+    assigned = det_of_agent >= 0
+    measured = np.full((n_agents, 2), np.nan)
+    weight = np.zeros(n_agents)
+    measured[assigned] = position[det_of_agent[assigned]]
+    weight[assigned] = conf[det_of_agent[assigned]]
+    located = localiser.update(frame.time, measured, weight)
+    fallback = assigned & ~np.isfinite(located).all(axis=1)  # labels never depend on the localiser
+    located[fallback] = measured[fallback]
+    snapshots = []
+    for j in range(n_agents):
+        k = det_of_agent[j]
+        if k >= 0:
+            last_seen[j] = frame.index
+        if last_seen[j] < 0 or not np.isfinite(located[j]).all():
+            continue  # never seen, or lost for longer than the localiser keeps a position
+        snapshots.append(TrackSnapshot(
+            track_id=j + 1,
+            status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
+            position=located[j].copy(),
+            heading=float(heading[k]) if k >= 0 else None,
+            agent_id=j,
+            identity_prob=float(conf[k]) if k >= 0 else None,
+            detection_index=int(k),
+        ))
+    return snapshots
