@@ -8,6 +8,7 @@ PyAV, OpenCV and Pillow are imported lazily inside the functions that need them.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from contextlib import contextmanager
 from fractions import Fraction
 from pathlib import Path
 from types import TracebackType
@@ -139,8 +140,9 @@ def write_gif(path: Path | str, images: list[np.ndarray], fps: float) -> Path:
     return out
 
 
-def read_frames(path: Path | str) -> Iterator[np.ndarray]:
-    """The frames of a video file, ``(h, w, 3)`` uint8 BGR, in order."""
+@contextmanager
+def _capture(path: Path | str) -> Iterator[Any]:
+    """An open ``cv2.VideoCapture`` of ``path``, released on exit; a clear error when it cannot open."""
     import cv2
 
     p = Path(path)
@@ -150,29 +152,27 @@ def read_frames(path: Path | str) -> Iterator[np.ndarray]:
     if not cap.isOpened():
         raise ValueError(f"video: OpenCV cannot open {p}")
     try:
+        yield cap
+    finally:
+        cap.release()
+
+
+def read_frames(path: Path | str) -> Iterator[np.ndarray]:
+    """The frames of a video file, ``(h, w, 3)`` uint8 BGR, in order."""
+    with _capture(path) as cap:
         while True:
             ok, img = cap.read()
             if not ok:
                 break
             yield img
-    finally:
-        cap.release()
 
 
 def video_info(path: Path | str) -> tuple[int, float, tuple[int, int]]:
     """Frame count (as the container says), frames per second and ``(width, height)`` of a video."""
     import cv2
 
-    p = Path(path)
-    if not p.is_file():
-        raise ValueError(f"video: no such file {p}")
-    cap = cv2.VideoCapture(str(p))
-    if not cap.isOpened():
-        raise ValueError(f"video: OpenCV cannot open {p}")
-    try:
+    with _capture(path) as cap:
         n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
         fps = float(cap.get(cv2.CAP_PROP_FPS)) or 30.0
         size = (int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT)))
-    finally:
-        cap.release()
     return n, fps, size
