@@ -141,6 +141,23 @@ def recovery_sequences() -> dict[str, list[RobotSequence]]:
                 for k in range(RECOVERY_SEQUENCES)] for i, p in enumerate(PRESET_NAMES)}
 
 
+def score_columns(teams: tuple[tuple[str, tuple[int, int, float], int, int], ...], recovery: bool = True) -> list[str]:
+    """The printed columns: the ``teams``' names, then (with ``recovery``) ``rec_<setup>`` and ``worst_<setup>``."""
+    return [t[0] for t in teams] + ([f"{c}_{p}" for c in ("rec", "worst") for p in PRESET_NAMES] if recovery else [])
+
+
+def recovery_info() -> dict[str, object]:
+    """What the tuning recovery was, as recorded with shipped weights."""
+    return {"seed": RECOVERY_SEED, "sequences": RECOVERY_SEQUENCES, "frames": RECOVERY_FRAMES,
+            "swap_at_s": RECOVERY_SWAP[0], "swap_s": RECOVERY_SWAP[1]}
+
+
+def snapshot_steps(run_dir: Path, every: int) -> list[int]:
+    """The steps ``k`` of the snapshots ``RUN/set_step{k}.npz`` with ``k`` a multiple of ``every``, ascending."""
+    return sorted(int(m.group(1)) for p in run_dir.glob("set_step*.npz")
+                  if (m := re.fullmatch(r"set_step(\d+)\.npz", p.name)) and int(m.group(1)) % every == 0)
+
+
 def choose_stage2(rows: dict[str, dict[str, float]], baseline: dict[str, float]) -> str | None:
     """The stage-2 choice of ``rows`` (path -> tuning success per team in % and ``rec_<setup>`` /
     ``worst_<setup>`` recovery seconds): see :data:`STAGE2_RULE`; None when none is eligible."""
@@ -153,10 +170,10 @@ def choose_stage2(rows: dict[str, dict[str, float]], baseline: dict[str, float])
                 and all(np.isfinite(r[k]) and r[k] <= baseline[k] + 0.05 for k in recs)
                 and all(np.isfinite(r[k]) for k in r if k.startswith("worst_")))
 
-    return _best(rows, [p for p, r in rows.items() if eligible(r)], recs, teams)
+    return best_choice(rows, [p for p, r in rows.items() if eligible(r)], recs, teams)
 
 
-def _best(rows: dict[str, dict[str, float]], ok: list[str], recs: list[str], teams: list[str]) -> str | None:
+def best_choice(rows: dict[str, dict[str, float]], ok: list[str], recs: list[str], teams: list[str]) -> str | None:
     """Among the eligible ``ok``: the best M=3, N=2 tuning success; within 0.05 points of it, the lowest
     mean of the ``recs`` recovery times; then the best mean success over ``teams``. None when ``ok`` is empty."""
     if not ok:
@@ -189,7 +206,7 @@ def choose_stage3(rows: dict[str, dict[str, float]], baseline: str) -> str | Non
         return (r["m3n2"] >= base["m3n2"] + 0.1 and all(r[k] >= base[k] - 0.05 for k in others)
                 and all(np.isfinite(r[k]) and r[k] <= base[k] + 0.02 for k in recs))
 
-    return _best(rows, [p for p, r in rows.items() if p != baseline and eligible(r)], recs, others)
+    return best_choice(rows, [p for p, r in rows.items() if p != baseline and eligible(r)], recs, others)
 
 
 def options_row(options: dict[str, object], seqs: dict[str, list[RobotSequence]],
@@ -215,7 +232,7 @@ def select_stage3(cache_path: Path) -> str | None:
     name), print them and return the chosen candidate's name (None: nothing eligible)."""
     seqs = tuning_sequences(STAGE3_TEAMS)
     rec_seqs = recovery_sequences()
-    cols = [t[0] for t in STAGE3_TEAMS] + [f"{c}_{p}" for c in ("rec", "worst") for p in PRESET_NAMES]
+    cols = score_columns(STAGE3_TEAMS)
     cache: dict[str, dict[str, float]] = json.loads(cache_path.read_text()) if cache_path.is_file() else {}
     print("tuning success (%), recovery (s)  " + "".join(f"{n:>12s}" for n in cols))
     for options in STAGE3_OPTIONS:
@@ -251,8 +268,7 @@ def tuning_row(weights: Path, seqs: dict[str, list[RobotSequence]],
 
 
 def _candidates(run_dir: Path, every: int, average_from: int | None) -> list[Path]:
-    steps = sorted(int(m.group(1)) for p in run_dir.glob("set_step*.npz")
-                   if (m := re.fullmatch(r"set_step(\d+)\.npz", p.name)) and int(m.group(1)) % every == 0)
+    steps = snapshot_steps(run_dir, every)
     if not steps:
         raise SystemExit(f"{run_dir}: no set_step{{k}}.npz with k a multiple of {every}")
     candidates = [run_dir / f"set_step{k}.npz" for k in steps]
@@ -271,8 +287,7 @@ def select(run_dir: Path, every: int = 50, baseline: Path = SHIPPED_SET_WEIGHTS,
         every, average_from = STAGE2_EVERY, STAGE2_AVERAGE_FROM
     candidates = _candidates(run_dir, every, average_from)
     seqs = tuning_sequences()
-    names = [t[0] for t in TUNING_TEAMS]
-    cols = names + ([f"{c}_{p}" for c in ("rec", "worst") for p in PRESET_NAMES] if stage == 2 else [])
+    cols = score_columns(TUNING_TEAMS, recovery=stage == 2)
     rec_seqs = recovery_sequences() if stage == 2 else {}
     cache_path = run_dir / "set_select_stage2.json"
     cache: dict[str, dict[str, float]] = {}
@@ -307,8 +322,7 @@ def select(run_dir: Path, every: int = 50, baseline: Path = SHIPPED_SET_WEIGHTS,
         chosen_on = {"rule": rule, "tuning_teams": [list(t) for t in TUNING_TEAMS],
                      "tuning": rows[chosen] if chosen else base, "baseline": {"path": str(baseline), **base}}
         if stage == 2:
-            chosen_on["recovery"] = {"seed": RECOVERY_SEED, "sequences": RECOVERY_SEQUENCES, "frames": RECOVERY_FRAMES,
-                                     "swap_at_s": RECOVERY_SWAP[0], "swap_s": RECOVERY_SWAP[1]}
+            chosen_on["recovery"] = recovery_info()
             chosen_on["candidates"] = rows
             weights.info["stage1"] = load_set_weights(baseline).info
         weights.info["chosen_on"] = chosen_on

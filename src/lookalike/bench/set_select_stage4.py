@@ -12,26 +12,23 @@ written in docs/experiments/any-team-size.md ("A fourth stage") before any candi
 from __future__ import annotations
 
 import json
-import re
 import shutil
 from pathlib import Path
 
 import numpy as np
 
 from lookalike.bench.set_select import (
-    RECOVERY_FRAMES,
-    RECOVERY_SEED,
-    RECOVERY_SEQUENCES,
-    RECOVERY_SWAP,
     STAGE3_TEAMS,
-    _best,
+    best_choice,
     options_row,
+    recovery_info,
     recovery_sequences,
+    score_columns,
+    snapshot_steps,
     tuning_sequences,
 )
 from lookalike.learn.set_numpy import load_set_weights, save_set_weights
 from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
-from lookalike.sim import PRESET_NAMES
 
 STAGE4_EVERY = 500
 STAGE4_PAIR_SWAP: tuple[float | None, ...] = (None, 1.5, 1.0)
@@ -53,8 +50,7 @@ def candidate_name(weights: str, pair_swap: float | None) -> str:
 def stage4_candidates(run_dir: Path) -> dict[str, tuple[Path, dict[str, object]]]:
     """Candidate name -> (weights, inference options): the shipped weights and the snapshots at multiples of
     :data:`STAGE4_EVERY`, each with every :data:`STAGE4_PAIR_SWAP`."""
-    steps = sorted(int(m.group(1)) for p in run_dir.glob("set_step*.npz")
-                   if (m := re.fullmatch(r"set_step(\d+)\.npz", p.name)) and int(m.group(1)) % STAGE4_EVERY == 0)
+    steps = snapshot_steps(run_dir, STAGE4_EVERY)
     weights = {"shipped": SHIPPED_SET_WEIGHTS, **{f"step{k}": run_dir / f"set_step{k}.npz" for k in steps}}
     return {candidate_name(w, ps): (path, {"pair_swap": ps}) for w, path in weights.items() for ps in STAGE4_PAIR_SWAP}
 
@@ -76,7 +72,7 @@ def choose_stage4(rows: dict[str, dict[str, float]], baseline: str = BASELINE) -
                 and all(np.isfinite(r[k]) and r[k] <= base[k] + 0.02 for k in recs))
         return kept and (r["m3n2"] >= base["m3n2"] + 0.05 or mean_rec(r) <= mean_rec(base) - 0.03)
 
-    return _best(rows, [p for p, r in rows.items() if p != baseline and eligible(r)], recs, others)
+    return best_choice(rows, [p for p, r in rows.items() if p != baseline and eligible(r)], recs, others)
 
 
 def select_stage4(run_dir: Path, only: str | None = None, ship: bool = False) -> str | None:
@@ -97,7 +93,7 @@ def select_stage4(run_dir: Path, only: str | None = None, ship: bool = False) ->
             cache = json.loads(cache_path.read_text()) if cache_path.is_file() else {}  # others may have added
             cache[name] = row
             cache_path.write_text(json.dumps(cache, indent=1))
-    cols = [t[0] for t in STAGE3_TEAMS] + [f"{c}_{p}" for c in ("rec", "worst") for p in PRESET_NAMES]
+    cols = score_columns(STAGE3_TEAMS)
     print("tuning success (%), recovery (s)  " + "".join(f"{n:>12s}" for n in cols))
     rows = {n: cache[n] for n in candidates if n in cache}
     for name, row in rows.items():
@@ -112,8 +108,7 @@ def select_stage4(run_dir: Path, only: str | None = None, ship: bool = False) ->
         chosen_weights.info["chosen_on"] = {
             "rule": STAGE4_RULE, "tuning_teams": [list(t) for t in STAGE3_TEAMS], "candidate": chosen,
             "tuning": rows[chosen], "baseline": rows[BASELINE], "candidates": rows,
-            "recovery": {"seed": RECOVERY_SEED, "sequences": RECOVERY_SEQUENCES, "frames": RECOVERY_FRAMES,
-                         "swap_at_s": RECOVERY_SWAP[0], "swap_s": RECOVERY_SWAP[1]},
+            "recovery": recovery_info(),
             "before": load_set_weights(SHIPPED_SET_WEIGHTS).info,
         }
         save_set_weights(chosen_weights, SHIPPED_SET_WEIGHTS)

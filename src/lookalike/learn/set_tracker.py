@@ -137,7 +137,7 @@ class SetIdentifier:
         labels, conf = np.full(n, -1), np.zeros(n)
         labels[used], conf[used] = slot_label, slot_conf
         if self.config.pair_swap is not None:
-            labels = self._pair_swaps(labels, conf, heading, frame.time, dt)
+            labels = self._pair_swaps(labels, conf, heading, age, dt)
         self.last_labels, self.last_probabilities = labels, conf
         return agent_snapshots(labels, conf, position, heading, self._localiser, self._last_seen, frame)
 
@@ -202,7 +202,7 @@ class SetIdentifier:
             else:
                 self._expected_jump[b] = now[a]
 
-    def _pair_swaps(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, time_s: float,
+    def _pair_swaps(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, age: np.ndarray,
                     dt: float) -> np.ndarray:
         """``pair_swap``: for every two agents ``j, k`` holding a detection and a report younger than
         ``pair_fresh_s``, the frame's evidence that they are exchanged is how much better each detection's
@@ -214,7 +214,7 @@ class SetIdentifier:
         evidence = self._pair_evidence
         evidence *= np.exp(-dt / cfg.pair_swap_s)
         det = agent_detections(labels, conf, cfg.n_agents)
-        fresh = (det >= 0) & (self._beacons.age(time_s) <= cfg.pair_fresh_s)
+        fresh = (det >= 0) & (age <= cfg.pair_fresh_s)
         live = np.flatnonzero(fresh)
         if len(live) < 2:
             return labels
