@@ -8,7 +8,8 @@ learn wrong identities, then restored. The two are, per sequence, the robots det
 from the swap's start to 3 s after the restore (so that there is something to recover). Reported:
 the success rate on those two robots' detections while swapped (without the swap, for comparison),
 and how long after the restore their success rate over a one-second window is back within 5 points
-of the same run without the swap.
+of the same run without the swap. :func:`recovery_differences` compares each identifier's mean recovery
+time with the first one's on the same sequences (95% interval over sequences; :mod:`lookalike.bench.paired`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.bench.ident import identify
+from lookalike.bench.paired import Comparison, add_comparisons, mean_difference
 from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.bench.results import Results, add_printed_rows
 from lookalike.eval import identification_success_rate
@@ -147,7 +149,16 @@ def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int
                   progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
     """Per set-up and identifier: success on the swapped pair while swapped (and without the swap),
     and the mean and worst recovery time (s) (``progress`` advanced once per set-up and identifier)."""
+    return recovery_runs(setups, trackers, sequences, frames, swap_at_s, swap_s, seed, progress)[0]
+
+
+def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,
+                  swap_s: float, seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress
+                  ) -> tuple[list[dict[str, Any]], dict[tuple[str, str], list[float]]]:
+    """:func:`recovery_rows`'s rows and, per (set-up, identifier), the recovery seconds of each sequence
+    (inf: never), for :func:`recovery_differences`."""
     rows = []
+    seconds: dict[tuple[str, str], list[float]] = {}
     for setup in setups:
         preset(setup)
     step = progress("bench recovery", len(setups) * len(trackers))
@@ -155,6 +166,7 @@ def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int
         for name in trackers:
             runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s)
                              for seq in _sequences(setup, sequences, frames, seed)]).reshape(-1, 3)
+            seconds[(setup, name)] = [float(v) for v in runs[:, 2]]
             rows.append({
                 "Setup": preset_label(setup), "Tracker": name,
                 "Swapped robots while swapped (%)": round(100 * float(np.mean(runs[:, 0])), 1),
@@ -163,7 +175,27 @@ def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int
                 "Recovery, worst (s)": round(float(np.max(runs[:, 2])), 2),
             })
             step()
-    return rows
+    return rows, seconds
+
+
+def recovery_differences(seconds: dict[tuple[str, str], list[float]], setups: Sequence[str],
+                         trackers: Sequence[str]) -> list[Comparison]:
+    """Per set-up and identifier after the first: its mean recovery seconds minus the first identifier's
+    on the same sequences, with the 95% interval over sequences (:func:`~lookalike.bench.paired.mean_difference`;
+    no interval, note ``"never"``, when either never recovers in some sequence); none with fewer than two
+    identifiers or two sequences."""
+    if len(trackers) < 2:
+        return []
+    baseline, out = trackers[0], []
+    for setup in setups:
+        base = seconds.get((setup, baseline))
+        if base is None or len(base) < 2:
+            continue
+        for name in dict.fromkeys(trackers[1:]):
+            if name != baseline and (setup, name) in seconds:
+                result = mean_difference(seconds[(setup, name)], base)
+                out.append(Comparison(setup, preset_label(setup), name, baseline, result))
+    return out
 
 
 EXPERIMENT_KEYS = {"In order (%)": "success_rate_in_order", "Random order (%)": "success_rate_random_order",
@@ -172,9 +204,11 @@ EXPERIMENT_KEYS = {"In order (%)": "success_rate_in_order", "Random order (%)": 
 
 
 def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[str], sequences: int, frames: int,
-                       seed: int = DEFAULT_SEED, command: str = "", options: dict[str, Any] | None = None) -> Results:
+                       seed: int = DEFAULT_SEED, command: str = "", options: dict[str, Any] | None = None,
+                       differences: Sequence[Comparison] = ()) -> Results:
     """Rows of :func:`shuffle_rows` or :func:`recovery_rows` as a results document (table ``kind``,
-    e.g. ``"shuffle"``; success rates as fractions, recovery times in seconds, ``null`` when never)."""
+    e.g. ``"shuffle"``; success rates as fractions, recovery times in seconds, ``null`` when never);
+    ``differences`` (:func:`recovery_differences`, if any) go in table ``<kind>_difference`` (seconds)."""
     names = {preset_label(s): s for s in setups}
     seeds = [seed + 1000 * PRESET_NAMES.index(s) + k for s in setups for k in range(sequences)]
     doc = Results(f"bench {kind}", command=command, seeds=seeds, sequences=len(setups) * sequences,
@@ -182,8 +216,10 @@ def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[s
                   options={"setups": list(setups), "sequences_per_setup": sequences, "frames_per_sequence": frames,
                            "seed": seed, **(options or {})})
     add_printed_rows(doc, kind, rows, datasets=names, rename=EXPERIMENT_KEYS)
+    add_comparisons(doc, f"{kind}_difference", differences, "recovery_mean_s", suffix="_s")
     return doc
 
 
 __all__ = ["DEFAULT_SEED", "EXPERIMENT_KEYS", "experiment_results", "hit_rate", "most_seen_pair", "pair_hits",
-           "recovery_rows", "recovery_s", "reindex", "shuffle_rows", "swap_reports"]
+           "recovery_differences", "recovery_rows", "recovery_runs", "recovery_s", "reindex", "shuffle_rows",
+           "swap_reports"]

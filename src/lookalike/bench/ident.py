@@ -7,6 +7,8 @@ labelled as such counting as correct), the localisation error (mean distance in 
 agent's identified position and its true position while in view) and frames/s (tracking only).
 An LSTM identifier whose shipped weights do not exist for a set-up (seed A's protocol is not trained
 for every set-up) gets a row saying so (:data:`NOT_TRAINED` in its cells) instead of stopping the run.
+:func:`ident_differences` compares each identifier with the first on the same sequences (success rate
+difference in points, 95% interval over sequences; :mod:`lookalike.bench.paired`).
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.bench.ident_paper import resolve_identifier
+from lookalike.bench.paired import Comparison, add_comparisons, rate_difference
 from lookalike.bench.progress import ProgressFactory, Step, no_progress
 from lookalike.bench.results import Results, percent_row_metrics
 from lookalike.eval import identification_success_rate, localisation_error
@@ -33,6 +36,7 @@ IDENT_TRACKERS = ("lstm", "lstm-paper", "set", "kalman_ha", "kalman_ha2", "jpda"
 IDENT_COLUMNS = ("Setup", "Tracker", "Success rate (%)", "Localisation error (m)", "Frames/s", "Detections")
 DEFAULT_SEED = 900_000
 NOT_TRAINED = "not trained"  # the cells of an LSTM row whose shipped weights do not exist for the set-up
+SequenceCounts = dict[tuple[str, str], list[tuple[int, int]]]  # (preset, identifier) -> [(correct, detections)]
 
 
 def uses_weights(name: str) -> bool:
@@ -82,13 +86,22 @@ def run_identifier(name: str, sequences: list[RobotSequence], step: Step | None 
                    weights: str | None = None) -> dict[str, float]:
     """Success rate, localisation error, frames/s and detection count of tracker ``name``
     (``step()`` called after each sequence; ``weights`` as in :func:`build_identifier`)."""
+    return run_identifier_by_sequence(name, sequences, step, weights)[0]
+
+
+def run_identifier_by_sequence(name: str, sequences: list[RobotSequence], step: Step | None = None,
+                               weights: str | None = None) -> tuple[dict[str, float], list[tuple[int, int]]]:
+    """:func:`run_identifier`'s figures and, per sequence, (correct labels, detections): the counts
+    that the success rate pools (for paired comparisons, :mod:`lookalike.bench.paired`)."""
     predicted: list[np.ndarray] = []
     truth: list[np.ndarray] = []
     est, true_pos = [], []
+    counts: list[tuple[int, int]] = []
     stats = RunStats()
     for seq in sequences:
         frames = list(seq.frames())
         positions = np.full((len(frames), seq.config.n_agents, 2), np.nan)
+        k_seq = len(predicted)
 
         def sink(frame: Frame, tracks: Any, positions: np.ndarray = positions, k0: int = len(predicted)) -> None:
             positions[len(predicted) - k0] = agent_positions(tracks, positions.shape[1])
@@ -96,6 +109,7 @@ def run_identifier(name: str, sequences: list[RobotSequence], step: Step | None 
 
         run(build_identifier(name, seq, weights), frames, sink, stats=stats)
         truth.extend(seq.true_labels())
+        counts.append(_sequence_counts(predicted[k_seq:], truth[k_seq:]))
         est.append(positions)
         true_pos.append(seq.true_positions_visible())
         if step is not None:
@@ -105,7 +119,14 @@ def run_identifier(name: str, sequences: list[RobotSequence], step: Step | None 
         "loc_error": localisation_error(np.concatenate(est), np.concatenate(true_pos)),
         "fps": stats.fps,
         "detections": float(sum(len(p) for p in predicted)),
-    }
+    }, counts
+
+
+def _sequence_counts(predicted: list[np.ndarray], truth: list[np.ndarray]) -> tuple[int, int]:
+    """(correct labels, detections) of one sequence's frames (as :func:`identification_success_rate` counts)."""
+    detections = sum(len(p) for p in predicted)
+    correct = sum(int(np.sum(np.asarray(p) == np.asarray(t))) for p, t in zip(predicted, truth))
+    return correct, detections
 
 
 def sequence_seeds(setups: list[str], sequences: int, seed: int = DEFAULT_SEED) -> list[int]:
@@ -120,9 +141,18 @@ def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: 
     simulator with position-noise model ``noise`` (``"paper"`` or ``"ours"``); ``progress`` advances
     once per sequence and tracker; ``weights``: exported weights (.npz) for our protocol's LSTM rows
     instead of the shipped ones (one set-up: they are for one N, M)."""
+    return ident_runs(setups, trackers, sequences, frames, seed, noise, progress, weights)[0]
+
+
+def ident_runs(setups: list[str], trackers: list[str], sequences: int, frames: int,
+               seed: int = DEFAULT_SEED, noise: str = DEFAULT_NOISE, progress: ProgressFactory = no_progress,
+               weights: str | None = None) -> tuple[list[dict[str, Any]], SequenceCounts]:
+    """:func:`ident_table`'s rows and, per (set-up, identifier) that ran (not :data:`NOT_TRAINED`), the
+    per-sequence (correct labels, detections) behind its success rate, for :func:`ident_differences`."""
     if weights and len(setups) != 1:
         raise ValueError(f"weights: {weights} are for one set-up; got {len(setups)} set-ups")
     rows = []
+    counts: SequenceCounts = {}
     step = progress("bench ident", len(setups) * len(trackers) * sequences)
     for setup in setups:
         cfg = preset(setup, noise)
@@ -134,21 +164,43 @@ def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: 
                 for _ in seqs:
                     step()
                 continue
-            r = run_identifier(name, seqs, step, weights)
+            r, counts[(setup, name)] = run_identifier_by_sequence(name, seqs, step, weights)
             rows.append({
                 "Setup": preset_label(setup), "Tracker": name, "Success rate (%)": round(100 * r["success"], 2),
                 "Localisation error (m)": round(r["loc_error"], 3), "Frames/s": round(r["fps"], 1),
                 "Detections": int(r["detections"]),
             })
-    return rows
+    return rows, counts
+
+
+def ident_differences(counts: SequenceCounts, setups: list[str], trackers: list[str]) -> list[Comparison]:
+    """Per set-up and identifier after the first: its success rate minus the first identifier's on the
+    same sequences, in points, with the 95% interval over sequences (:func:`~lookalike.bench.paired.rate_difference`);
+    none with fewer than two identifiers or two sequences, nor for identifiers (or a first one) that did
+    not run (:data:`NOT_TRAINED`)."""
+    if len(trackers) < 2:
+        return []
+    baseline, out = trackers[0], []
+    for setup in setups:
+        base = counts.get((setup, baseline))
+        if base is None or len(base) < 2:
+            continue
+        for name in dict.fromkeys(trackers[1:]):
+            other = counts.get((setup, name))
+            if other is None or name == baseline:
+                continue
+            result = rate_difference([c for c, _ in other], [c for c, _ in base], [n for _, n in base])
+            out.append(Comparison(setup, preset_label(setup), name, baseline, result))
+    return out
 
 
 def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int, frames: int,
                   seed: int = DEFAULT_SEED, command: str = "", noise: str = DEFAULT_NOISE,
-                  weights: str | None = None) -> Results:
+                  weights: str | None = None, differences: Sequence[Comparison] = ()) -> Results:
     """The rows of :func:`ident_table` as a results document (:mod:`lookalike.bench.results`):
     table ``ident``, one row per set-up (dataset: the preset name) and identifier, over all its sequences;
-    ``weights`` (the LSTM rows' weights when not the shipped ones) is recorded in its options."""
+    ``weights`` (the LSTM rows' weights when not the shipped ones) is recorded in its options;
+    ``differences`` (:func:`ident_differences`, if any) go in table ``ident_difference`` (fractions)."""
     names = {preset_label(s): s for s in setups}
     doc = Results("bench ident", command=command, seeds=sequence_seeds(setups, sequences, seed),
                   sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
@@ -157,9 +209,10 @@ def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int,
     for r in rows:
         doc.add("ident", dataset=names.get(r["Setup"], r["Setup"]), tracker=r["Tracker"],
                 metrics=percent_row_metrics(r, skip=("Setup", "Tracker")))
+    add_comparisons(doc, "ident_difference", differences, "success_rate", scale=0.01)
     return doc
 
 
-__all__ = ["DEFAULT_SEED", "IDENT_COLUMNS", "IDENT_TRACKERS", "NOT_TRAINED", "build_identifier", "ident_results",
-           "ident_table", "identify", "run_identifier", "sequence_seeds", "uses_weights",
-           "weights_missing"]
+__all__ = ["DEFAULT_SEED", "IDENT_COLUMNS", "IDENT_TRACKERS", "NOT_TRAINED", "SequenceCounts", "build_identifier",
+           "ident_differences", "ident_results", "ident_runs", "ident_table", "identify", "run_identifier",
+           "run_identifier_by_sequence", "sequence_seeds", "uses_weights", "weights_missing"]

@@ -11,8 +11,16 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from lookalike.bench.ident import DEFAULT_SEED, IDENT_COLUMNS, IDENT_TRACKERS, ident_results, ident_table
+from lookalike.bench.ident import (
+    DEFAULT_SEED,
+    IDENT_COLUMNS,
+    IDENT_TRACKERS,
+    ident_differences,
+    ident_results,
+    ident_runs,
+)
 from lookalike.bench.ident_paper import IDENT_VARIANTS, margin_rows
+from lookalike.bench.paired import comparison_rows, difference_title
 from lookalike.bench.results import Results
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import SortedGroup, app, command_line, console, fail, split_list
@@ -103,8 +111,8 @@ def ident(
         return
     try:
         with progress_bars() as progress:
-            rows = ident_table(setup_list, tracker_list, sequences, frames, seed, noise, progress,
-                               str(weights) if weights else None)
+            rows, counts = ident_runs(setup_list, tracker_list, sequences, frames, seed, noise, progress,
+                                      str(weights) if weights else None)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     labels = [preset_label(s) for s in setup_list]
@@ -116,8 +124,11 @@ def ident(
     margins = margin_rows(rows, setup_list, labels)
     if margins:
         print_rows("LSTM margins over Kalman-HA on the same sequences, beside seed A's (Table I)", margins)
+    differences = ident_differences(counts, setup_list, tracker_list)
+    if differences:
+        print_rows(difference_title(tracker_list[0], "points"), comparison_rows(differences, "points"))
     write_results(ident_results(rows, setup_list, sequences, frames, seed, command_line(), noise,
-                                str(weights) if weights else None), json_path)
+                                str(weights) if weights else None, differences), json_path)
     write_rows(rows, None, csv_path)
 
 

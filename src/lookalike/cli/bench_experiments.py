@@ -7,7 +7,14 @@ from pathlib import Path
 
 import typer
 
-from lookalike.bench.experiments import DEFAULT_SEED, experiment_results, recovery_rows, shuffle_rows
+from lookalike.bench.experiments import (
+    DEFAULT_SEED,
+    experiment_results,
+    recovery_differences,
+    recovery_runs,
+    shuffle_rows,
+)
+from lookalike.bench.paired import comparison_rows, difference_title
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import command_line, fail, split_list
 from lookalike.cli.bench import bench_app, print_rows, write_results
@@ -52,14 +59,18 @@ def recovery(
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
 ) -> None:
     """Recovery experiment: swap two robots' reports, restore them, time the return to normal."""
+    setup_list, tracker_list = split_list(setups), split_list(trackers)
     try:
         with progress_bars() as progress:
-            rows = recovery_rows(split_list(setups), split_list(trackers), sequences, frames, swap_at_s, swap_s, seed,
-                                 progress)
+            rows, seconds = recovery_runs(setup_list, tracker_list, sequences, frames, swap_at_s, swap_s, seed,
+                                          progress)
     except ValueError as exc:
         fail(str(exc))
     print_rows(f"Recovery after {swap_s:g} s of swapped reports", rows)
+    differences = recovery_differences(seconds, setup_list, tracker_list)
+    if differences:
+        print_rows(difference_title(tracker_list[0], "s", "Mean recovery time"), comparison_rows(differences, "s"))
     options = {"swap_at_s": swap_at_s, "swap_s": swap_s}
-    write_results(experiment_results("recovery", rows, split_list(setups), sequences, frames, seed, command_line(),
-                                     options), json_path)
+    write_results(experiment_results("recovery", rows, setup_list, sequences, frames, seed, command_line(),
+                                     options, differences), json_path)
     write_rows(rows, None, csv_path)
