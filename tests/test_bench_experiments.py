@@ -61,3 +61,40 @@ def test_swapped_pair_is_the_two_most_seen_robots():
     truth = [np.array([2, -1, 3]), np.array([3, 0]), np.array([3, 2, 1])]
     assert most_seen_pair(truth, 4) == (3, 2)
     assert most_seen_pair([np.array([-1])], 3) == (0, 1)
+
+
+def test_unmeasurable_recoveries_are_those_whose_pair_is_not_seen_both_times():
+    from types import SimpleNamespace
+
+    from lookalike.bench.experiments import measurable
+    from lookalike.sim import preset, simulate_robots
+
+    seq = simulate_robots(preset("m3n2"), 300, 55_001)
+    assert measurable(seq, 2.0, 3.0)
+    truth = seq.true_labels()
+    gone_after = [t if k < 150 else np.full_like(t, -1) for k, t in enumerate(truth)]  # restore at frame 150
+    gone_during = [np.full_like(t, -1) if 60 <= k < 150 else t for k, t in enumerate(truth)]
+    for labels in (gone_after, gone_during):
+        blind = SimpleNamespace(config=seq.config, true_labels=lambda labels=labels: labels)
+        assert not measurable(blind, 2.0, 3.0)
+
+
+def test_recovery_leaves_out_sequences_with_nothing_to_measure(monkeypatch):
+    from lookalike.bench import experiments
+
+    real = experiments._sequences
+    kept: list[object] = []
+
+    def two_sequences(setup, sequences, frames, seed):
+        out = real(setup, sequences, frames, seed)
+        kept.append(out[0])
+        return out
+
+    monkeypatch.setattr(experiments, "_sequences", two_sequences)
+    monkeypatch.setattr(experiments, "measurable", lambda q, *a: q is kept[-1])
+    rows, seconds = experiments.recovery_runs(["m3n2"], ["kalman_ha"], 2, 300, 2.0, 3.0)
+    assert rows[0]["Sequences measured"] == 1
+    assert len(seconds[("m3n2", "kalman_ha")]) == 1
+    monkeypatch.setattr(experiments, "measurable", lambda q, *a: False)
+    rows, _ = experiments.recovery_runs(["m3n2"], ["kalman_ha"], 2, 300, 2.0, 3.0)
+    assert rows[0]["Sequences measured"] == 0 and np.isnan(rows[0]["Recovery, mean (s)"])

@@ -115,22 +115,6 @@ def test_stage3_choice_needs_the_small_team_up_and_nothing_else_down():
     assert choose_stage3({"base": base, "small": rows["small"], "slow": rows["slow"]}, "base") is None
 
 
-def test_unmeasurable_recoveries_are_those_whose_pair_is_not_seen_both_times():
-    from types import SimpleNamespace
-
-    from lookalike.bench.set_select import measurable
-    from lookalike.sim import preset, simulate_robots
-
-    seq = simulate_robots(preset("m3n2"), 300, 55_001)
-    assert measurable(seq, 2.0, 3.0)
-    truth = seq.true_labels()
-    gone_after = [t if k < 150 else np.full_like(t, -1) for k, t in enumerate(truth)]  # restore at frame 150
-    gone_during = [np.full_like(t, -1) if 60 <= k < 150 else t for k, t in enumerate(truth)]
-    for labels in (gone_after, gone_during):
-        blind = SimpleNamespace(config=seq.config, true_labels=lambda labels=labels: labels)
-        assert not measurable(blind, 2.0, 3.0)
-
-
 def test_pair_swap_exchanges_the_memories_of_a_swap_no_report_jump_shows(shipped):
     from lookalike.trackers import make_tracker
 

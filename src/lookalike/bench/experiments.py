@@ -8,7 +8,9 @@ learn wrong identities, then restored. The two are, per sequence, the robots det
 from the swap's start to 3 s after the restore (so that there is something to recover). Reported:
 the success rate on those two robots' detections while swapped (without the swap, for comparison),
 and how long after the restore their success rate over a one-second window is back within 5 points
-of the same run without the swap. :func:`recovery_differences` compares each identifier's mean recovery
+of the same run without the swap. A sequence whose pair is not detected while swapped or not after the
+restore (:func:`measurable`, from the truth alone) has nothing to recover from and is left out; the
+table says how many sequences were measured. :func:`recovery_differences` compares each identifier's mean recovery
 time with the first one's on the same sequences (95% interval over sequences; :mod:`lookalike.bench.paired`).
 """
 
@@ -139,6 +141,21 @@ def swap_recovery(labels: Callable[[RobotSequence, list[Frame]], list[np.ndarray
             recovery_s(clean, swapped, restore, int(rate), rate))
 
 
+def measurable(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 10.0) -> bool:
+    """Whether the swap of :func:`swap_recovery` in ``sequence`` can be recovered from at all: its swapped
+    pair (the two robots seen most) has a detection while swapped and one after the restore. From the
+    truth alone: the same for every identifier."""
+    rate = sequence.config.frame_rate_hz
+    truth = sequence.true_labels()
+    start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
+    a, b = most_seen_pair(truth[start : restore + int(3 * rate)], sequence.config.n_agents)
+
+    def seen(frames: list[np.ndarray]) -> bool:
+        return any(((t == a) | (t == b)).any() for t in frames)
+
+    return seen(truth[start:restore]) and seen(truth[restore:])
+
+
 def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float) -> tuple[float, float, float]:
     """:func:`swap_recovery` of the registered identifier ``name``."""
     return swap_recovery(lambda s, fs: identify(name, s, fs), seq, swap_at_s, swap_s)
@@ -148,7 +165,8 @@ def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int
                   swap_s: float, seed: int = DEFAULT_SEED,
                   progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
     """Per set-up and identifier: success on the swapped pair while swapped (and without the swap),
-    and the mean and worst recovery time (s) (``progress`` advanced once per set-up and identifier)."""
+    the mean and worst recovery time (s) over the :func:`measurable` sequences and how many there were
+    (``progress`` advanced once per set-up and identifier)."""
     return recovery_runs(setups, trackers, sequences, frames, swap_at_s, swap_s, seed, progress)[0]
 
 
@@ -163,16 +181,18 @@ def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int
         preset(setup)
     step = progress("bench recovery", len(setups) * len(trackers))
     for setup in setups:
+        measured = [q for q in _sequences(setup, sequences, frames, seed) if measurable(q, swap_at_s, swap_s)]
         for name in trackers:
-            runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s)
-                             for seq in _sequences(setup, sequences, frames, seed)]).reshape(-1, 3)
+            runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s) for seq in measured]).reshape(-1, 3)
             seconds[(setup, name)] = [float(v) for v in runs[:, 2]]
+            nan = float("nan")
             rows.append({
                 "Setup": preset_label(setup), "Tracker": name,
-                "Swapped robots while swapped (%)": round(100 * float(np.mean(runs[:, 0])), 1),
-                "Same without swap (%)": round(100 * float(np.mean(runs[:, 1])), 1),
-                "Recovery, mean (s)": round(float(np.mean(runs[:, 2])), 2),
-                "Recovery, worst (s)": round(float(np.max(runs[:, 2])), 2),
+                "Swapped robots while swapped (%)": round(100 * float(np.mean(runs[:, 0])), 1) if len(runs) else nan,
+                "Same without swap (%)": round(100 * float(np.mean(runs[:, 1])), 1) if len(runs) else nan,
+                "Recovery, mean (s)": round(float(np.mean(runs[:, 2])), 2) if len(runs) else nan,
+                "Recovery, worst (s)": round(float(np.max(runs[:, 2])), 2) if len(runs) else nan,
+                "Sequences measured": len(measured),
             })
             step()
     return rows, seconds
@@ -200,7 +220,7 @@ def recovery_differences(seconds: dict[tuple[str, str], list[float]], setups: Se
 
 EXPERIMENT_KEYS = {"In order (%)": "success_rate_in_order", "Random order (%)": "success_rate_random_order",
                    "Swapped robots while swapped (%)": "success_rate_while_swapped",
-                   "Same without swap (%)": "success_rate_without_swap"}
+                   "Same without swap (%)": "success_rate_without_swap", "Sequences measured": "sequences_measured"}
 
 
 def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[str], sequences: int, frames: int,

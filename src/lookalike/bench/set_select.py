@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.bench.experiments import most_seen_pair, swap_recovery
+from lookalike.bench.experiments import measurable, swap_recovery
 from lookalike.bench.pixel_recordings import score_identifier
 from lookalike.learn.set_data import world
 from lookalike.learn.set_numpy import load_set_weights, save_set_weights
@@ -118,21 +118,6 @@ def set_recovery_s(weights: Path, sequence: RobotSequence, swap_at_s: float = RE
     """Seconds ``set`` with ``weights`` (and inference ``options``) takes to recover after ``bench
     recovery``'s swap of the two robots seen most (inf: never), measured as ``bench recovery`` does."""
     return swap_recovery(lambda s, fs: _labels(weights, s, fs, **(options or {})), sequence, swap_at_s, swap_s)[2]
-
-
-def measurable(sequence: RobotSequence, swap_at_s: float = RECOVERY_SWAP[0], swap_s: float = RECOVERY_SWAP[1]) -> bool:
-    """Whether ``bench recovery``'s swap in ``sequence`` can be recovered from at all: its swapped pair (the
-    two robots seen most, as :func:`~lookalike.bench.experiments.swap_recovery` picks it) has a detection
-    while swapped and one after the restore. From the truth alone: the same for every identifier."""
-    rate = sequence.config.frame_rate_hz
-    truth = sequence.true_labels()
-    start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
-    a, b = most_seen_pair(truth[start : restore + int(3 * rate)], sequence.config.n_agents)
-
-    def seen(frames: list[np.ndarray]) -> bool:
-        return any(((t == a) | (t == b)).any() for t in frames)
-
-    return seen(truth[start:restore]) and seen(truth[restore:])
 
 
 def recovery_sequences() -> dict[str, list[RobotSequence]]:
