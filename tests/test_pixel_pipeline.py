@@ -167,3 +167,25 @@ def test_bench_pixels_tiny(models, tmp_path):
     assert "Perception" in res.output
     res = runner.invoke(app, ["bench", "pixels", "--setups", "m9n9"])
     assert res.exit_code != 0 and "m9n9" in res.output
+
+
+def test_bench_pixels_weights_replace_the_lstms_on_both_sides(models, tmp_path):
+    from lookalike.learn.weights import shipped_weights_path
+
+    _, _, det_path, head_path = models
+    base = ["bench", "pixels", "--setups", "m3n2", "--identifiers", "lstm", "--sequences", "1", "--frames", "10",
+            "--detector-model", str(det_path), "--heading-model", str(head_path)]
+    docs = []
+    for extra in ([], ["--weights", str(shipped_weights_path(2, 3))]):
+        out = tmp_path / f"rows{len(extra)}.json"
+        res = runner.invoke(app, base + extra + ["--json", str(out)])
+        assert res.exit_code == 0, res.output
+        docs.append(json.loads(out.read_text()))
+    same = [d["tables"]["identification"][0]["metrics"] for d in docs]
+    for key in ("success_rate_pixels", "success_rate_simulated"):
+        assert same[0][key] == same[1][key]  # the shipped weights by path: the same labels
+    assert docs[1]["header"]["options"]["weights"] == str(shipped_weights_path(2, 3))
+    res = runner.invoke(app, base + ["--weights", str(shipped_weights_path(7, 10))])  # weights for another team
+    assert res.exit_code != 0 and "lstm_m10_n7" in res.output
+    res = runner.invoke(app, base[:3] + ["m3n2,m5n3"] + base[4:] + ["--weights", str(shipped_weights_path(2, 3))])
+    assert res.exit_code != 0 and "one set-up" in res.output

@@ -123,10 +123,12 @@ def perceive_sequence(pipe: RobotPipeline, seq: RobotSequence, camera: Camera, m
     return out
 
 
-def _identifier(name: str, seq: RobotSequence, camera: Camera) -> PipelineConfig:
-    """The identification settings of ``name`` for the sequence's N and M and the camera's field of view."""
+def _identifier(name: str, seq: RobotSequence, camera: Camera, weights: str | None = None) -> PipelineConfig:
+    """The identification settings of ``name`` for the sequence's N and M and the camera's field of view;
+    ``weights`` (exported .npz) replace the shipped ones of the ``lstm`` identifier."""
+    params = identifier_settings(name, camera) + ((("weights", weights),) if weights and name == "lstm" else ())
     return PipelineConfig(identifier=name, n_agents=seq.config.n_agents, max_detections=seq.config.max_detections,
-                          identifier_params=identifier_settings(name, camera))
+                          identifier_params=params)
 
 
 class _Identify:
@@ -160,8 +162,9 @@ def _localisation(positions: list[np.ndarray], perceived: list[PerceivedSequence
     return localisation_error(np.stack(positions), np.concatenate(truth))
 
 
-def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipeline, camera: Camera) -> IdentScore:
-    """Identifier ``name`` on the pixel detections."""
+def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipeline, camera: Camera,
+                 weights: str | None = None) -> IdentScore:
+    """Identifier ``name`` on the pixel detections (``weights``: as in :func:`pixels_table`)."""
     predicted: list[np.ndarray] = []
     positions: list[np.ndarray] = []
     truth: list[np.ndarray] = []
@@ -173,7 +176,7 @@ def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipel
             predicted.append(result.labels)
             positions.append(agent_positions(result.tracks, n_agents))
 
-        config = _identifier(name, p.sequence, camera)
+        config = _identifier(name, p.sequence, camera, weights)
         step = _Identify(RobotPipeline(pipe.detector, pipe.heading, camera, config, pipe.probability), p)
         run(step, range(len(p.detections)), sink, stats=stats)
         truth.extend(p.truth)
@@ -181,14 +184,16 @@ def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipel
                       sum(len(t) for t in truth), stats.fps, robot_success_rate(predicted, truth))
 
 
-def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camera) -> IdentScore:
-    """Identifier ``name`` on the simulator's own detections of the same sequences."""
+def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camera,
+                    weights: str | None = None) -> IdentScore:
+    """Identifier ``name`` on the simulator's own detections of the same sequences (``weights``: as in
+    :func:`pixels_table`)."""
     predicted: list[np.ndarray] = []
     positions: list[np.ndarray] = []
     truth: list[np.ndarray] = []
     stats = RunStats()
     for p in perceived:
-        cfg = _identifier(name, p.sequence, camera)
+        cfg = _identifier(name, p.sequence, camera, weights)
         n_agents = p.sequence.config.n_agents
 
         def sink(frame: Any, tracks: Any, n_agents: int = n_agents) -> None:
@@ -210,10 +215,14 @@ def perception_pipeline(pipe: RobotPipeline, n_agents: int, max_detections: int)
 
 def pixels_table(setups: list[str], identifiers: list[str], sequences: int, frames: int, seed: int,
                  pipe: RobotPipeline, camera: Camera, min_iou: float,
-                 progress: ProgressFactory | None = None
+                 progress: ProgressFactory | None = None, weights: str | None = None
                  ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Rows of the identification table (:data:`PIXEL_COLUMNS`) and of the perception table
-    (:data:`PERCEPTION_COLUMNS`). ``progress(description, total)`` returns a callable advanced once per frame."""
+    (:data:`PERCEPTION_COLUMNS`). ``progress(description, total)`` returns a callable advanced once per frame.
+    ``weights``: exported LSTM weights (.npz, e.g. a fine-tuning run's ``model.npz``) for the ``lstm`` rows,
+    on both sides, instead of the shipped ones (one set-up: they are for one N, M)."""
+    if weights and len(setups) != 1:
+        raise ValueError(f"weights: {weights} are for one set-up; got {len(setups)} set-ups")
     rows, perception = [], []
     for setup in setups:
         cfg = world_for_camera(preset(setup), camera)
@@ -236,8 +245,8 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
             "Perception frames/s": round(sequences * frames / seconds, 1) if seconds > 0 else float("inf"),
         })
         for name in identifiers:
-            pix = score_pixels(name, perceived, pipe, camera)
-            sim = score_simulated(name, perceived, camera)
+            pix = score_pixels(name, perceived, pipe, camera, weights)
+            sim = score_simulated(name, perceived, camera, weights)
             rows.append({
                 "Setup": preset_label(setup), "Identifier": name, "Pixels (%)": round(100 * pix.success, 2),
                 "Simulated (%)": round(100 * sim.success, 2), "Gap (pp)": round(100 * (pix.success - sim.success), 2),

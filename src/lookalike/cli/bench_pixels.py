@@ -34,6 +34,8 @@ def pixels(
     min_iou: float = typer.Option(0.3, "--min-iou", min=0.0, max=1.0, help="IoU for a detection to be a robot."),
     json_path: Path | None = typer.Option(None, "--json", help="Also write both tables as JSON (results schema)."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the identification rows as CSV."),
+    weights: Path | None = typer.Option(None, "--weights", help="Exported weights (.npz) for the lstm rows instead "
+                                        "of the shipped ones, e.g. `train --recordings`' model.npz (one set-up)."),
 ) -> None:
     """Identification success rate from rendered pixels next to the simulator's own detections, per identifier."""
     setup_list, ident_list = split_list(setups), split_list(identifiers)
@@ -47,14 +49,14 @@ def pixels(
                                         PipelineConfig(detect_scale=detect_scale))
         with progress_bars() as progress, one_blas_thread():
             rows, perception = pixels_table(setup_list, ident_list, sequences, frames, seed, pipe, camera, min_iou,
-                                            progress)
+                                            progress, str(weights) if weights else None)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
     print_rows(f"Perception on rendered robots, {sequences} × {frames} frames per set-up", perception,
                PERCEPTION_COLUMNS)
     print_rows("Identification success rate: from pixels vs the simulator's detections", rows, PIXEL_COLUMNS)
     options = {"detect_scale": detect_scale, "min_iou": min_iou, "detector_model": detector_model,
-               "heading_model": heading_model}
+               "heading_model": heading_model, **({"weights": weights} if weights else {})}
     write_results(pixels_results(rows, perception, setup_list, sequences, frames, seed, command_line(), options),
                   json_path)
     write_rows(rows, None, csv_path)
