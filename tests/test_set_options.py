@@ -140,3 +140,36 @@ def test_pair_swap_exchanges_the_memories_of_a_swap_no_report_jump_shows(shipped
     quiet.net.swap = lambda *a: pytest.fail("no swap, no exchange")
     for f in frames(120, lambda a, t: heading[a], lambda r, t: heading[r]):
         quiet.update(f)
+
+
+def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
+    """fp_prior_ref: the running false-positive rate starts at the reference, falls in a world without false
+    positives (so a robot's detection is less readily called one), and the correction is off by default."""
+    from lookalike.trackers import make_tracker
+
+    clip = frames(90, lambda a, t: 0.3 + 2.0 * a, lambda r, t: 0.3 + 2.0 * r)
+    plain = make_tracker("set", n_agents=2, weights=str(shipped))
+    adapted = make_tracker("set", n_agents=2, weights=str(shipped), fp_prior_ref=1.0, fp_prior_s=1.0)
+    assert plain.fp_rate is None and adapted.fp_rate == 1.0
+    for f in clip:
+        adapted.update(f)
+    assert np.array_equal(adapted.last_labels, [0, 1])
+    assert 0.0 <= adapted.fp_rate < 0.1  # three seconds of frames without a false positive, time constant 1 s
+    prob = np.array([[0.2, 0.2, 0.6], [0.5, 0.1, 0.4]])
+    scaled = adapted._fp_prior(prob)
+    assert np.allclose(scaled.sum(axis=1), 1.0) and np.all(scaled[:, -1] < prob[:, -1])
+    assert np.allclose(scaled[:, 0] / scaled[:, 1], prob[:, 0] / prob[:, 1])  # agents' odds kept
+    adapted.reset()
+    assert adapted.fp_rate == 1.0
+
+
+def test_stage5_candidates_and_choice():
+    from lookalike.bench.set_select_stage4 import choose_stage4
+    from lookalike.bench.set_select_stage5 import STAGE5_BASELINE, stage5_candidates
+
+    cands = stage5_candidates()
+    assert STAGE5_BASELINE in cands and cands[STAGE5_BASELINE][1] == {"fp_prior_ref": None}
+    assert all(o["fp_prior_ref"] is None or o["fp_prior_ref"] > 0 for _, o in cands.values())
+    base = {"m3n2": 98.0, "m5n3": 98.0, "rec_m3n2": 0.3, "worst_m3n2": 1.0}
+    rows = {STAGE5_BASELINE: base, "up": {**base, "m3n2": 98.06}, "down": {**base, "m3n2": 98.2, "m5n3": 97.9}}
+    assert choose_stage4(rows, STAGE5_BASELINE) == "up"

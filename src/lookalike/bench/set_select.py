@@ -19,7 +19,8 @@ stale-report rule ``stale_s``/``stale_turn`` and ``on_jump``) for the shipped we
 seen while swapped or not after the restore (:func:`measurable`); see :func:`choose_stage3`.
 
 ``--stage 4`` chooses among a fourth fine-tuning's snapshots and the pair-swap rule
-(:mod:`lookalike.bench.set_select_stage4`).
+(:mod:`lookalike.bench.set_select_stage4`); ``--stage 5`` whether to correct the false-positive probability
+for the world's false-positive rate (:mod:`lookalike.bench.set_select_stage5`).
 """
 
 from __future__ import annotations
@@ -328,11 +329,13 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--average-from", type=int, default=None,
                         help="also the mean of the snapshots' weights from this step on")
     parser.add_argument("--ship", action="store_true", help="ship the chosen weights")
-    parser.add_argument("--stage", type=int, choices=(1, 2, 3, 4), default=1,
+    parser.add_argument("--stage", type=int, choices=(1, 2, 3, 4, 5), default=1,
                         help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from); "
                         "3: the inference options of the shipped weights (RUN: where the scores are kept); "
-                        "4: the fourth stage's snapshots x the pair-swap rule (lookalike.bench.set_select_stage4)")
-    parser.add_argument("--only", default=None, help="stage 4: score this candidate only (e.g. step300,pair=off)")
+                        "4: the fourth stage's snapshots x the pair-swap rule (lookalike.bench.set_select_stage4); "
+                        "5: the false-positive prior correction (lookalike.bench.set_select_stage5)")
+    parser.add_argument("--only", default=None,
+                        help="stages 4 and 5: score this candidate only (e.g. step300,pair=off)")
     parser.add_argument("--cache", type=Path, default=None,
                         help="stage 3: the JSON file of scored candidates (default RUN/set_select_stage3.json)")
     args = parser.parse_args(argv)
@@ -343,6 +346,11 @@ def main(argv: list[str] | None = None) -> None:
         from lookalike.bench.set_select_stage4 import select_stage4
 
         select_stage4(args.run, args.only, args.ship)
+        return
+    if args.stage == 5:
+        from lookalike.bench.set_select_stage5 import select_stage5
+
+        select_stage5(args.run, args.only)
         return
     select(args.run, args.every, args.baseline, args.ship, args.average_from, args.stage)
 

@@ -75,14 +75,13 @@ def choose_stage4(rows: dict[str, dict[str, float]], baseline: str = BASELINE) -
     return best_choice(rows, [p for p, r in rows.items() if p != baseline and eligible(r)], recs, others)
 
 
-def select_stage4(run_dir: Path, only: str | None = None, ship: bool = False) -> str | None:
-    """Score the candidates (all, or ``only``) on the tuning sequences, cached in ``RUN/set_select_stage4.json``;
-    print them and the choice among those scored; with ``ship``, copy chosen weights that are a snapshot into
-    the package with what they were chosen on (a chosen ``pair_swap`` is made the identifier's default by hand)."""
-    candidates = stage4_candidates(run_dir)
+def score_candidates(candidates: dict[str, tuple[Path, dict[str, object]]], cache_path: Path,
+                     only: str | None = None) -> dict[str, dict[str, float]]:
+    """Score ``candidates`` (name -> (weights, inference options); all, or ``only``) on the third stage's tuning
+    sequences and tuning recovery, kept in the JSON file ``cache_path``; print every scored candidate and return
+    their rows (name -> tuning success per team in %, ``rec_<setup>`` / ``worst_<setup>`` seconds)."""
     if only is not None and only not in candidates:
         raise SystemExit(f"--only {only}: not a candidate; candidates: {', '.join(candidates)}")
-    cache_path = run_dir / "set_select_stage4.json"
     cache: dict[str, dict[str, float]] = json.loads(cache_path.read_text()) if cache_path.is_file() else {}
     todo = [n for n in ([only] if only else candidates) if n not in cache]
     if todo:
@@ -98,6 +97,15 @@ def select_stage4(run_dir: Path, only: str | None = None, ship: bool = False) ->
     rows = {n: cache[n] for n in candidates if n in cache}
     for name, row in rows.items():
         print(f"{name:24s}" + "".join(f"{row[n]:12.3f}" for n in cols), flush=True)
+    return rows
+
+
+def select_stage4(run_dir: Path, only: str | None = None, ship: bool = False) -> str | None:
+    """Score the candidates (all, or ``only``) on the tuning sequences, cached in ``RUN/set_select_stage4.json``;
+    print them and the choice among those scored; with ``ship``, copy chosen weights that are a snapshot into
+    the package with what they were chosen on (a chosen ``pair_swap`` is made the identifier's default by hand)."""
+    candidates = stage4_candidates(run_dir)
+    rows = score_candidates(candidates, run_dir / "set_select_stage4.json", only)
     if BASELINE not in rows:
         print("the baseline is not scored yet: no choice")
         return None

@@ -17,6 +17,9 @@ position has turned away from that report is shown to the network as not heard f
 still places it). Both were chosen on tuning sequences (docs/experiments/any-team-size.md).
 With ``pair_swap``, two agents whose detections keep fitting each other's fresh reports better than
 their own (a swap undone while their headings stay too close for a report jump) exchange memories.
+With ``fp_prior_ref``, the false-positive probability is corrected for the world's false-positive rate
+(running mean of the detections labelled false positive per frame over ``fp_prior_ref``): the network
+was trained over 0.3-2.5 false positives per frame and cannot tell the rate from one frame.
 """
 
 from __future__ import annotations
@@ -83,6 +86,11 @@ class SetIdentifier:
             "pair_swap_s, passes this many radians (None: never)", range=(0.0, 1000.0))
         pair_swap_s: float = param(0.5, "time constant of pair_swap's evidence decay, seconds", range=(0.01, 100.0))
         pair_fresh_s: float = param(0.3, "reports younger than this count for pair_swap, seconds", range=(0.0, 100.0))
+        fp_prior_ref: float | None = param(
+            None, "adapt the false-positive probability to this world's rate: scale it by (running mean of the "
+            "detections labelled false positive per frame) / fp_prior_ref before decoding, clipped to 0.2-5 "
+            "(None: never)", range=(0.01, 100.0))
+        fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
                                choices=LOCALISERS)
 
@@ -108,6 +116,7 @@ class SetIdentifier:
         self._expected_jump: dict[int, float] = {}
         self._pair_evidence = np.zeros((n, n))
         self.pair_swaps = 0  # memories exchanged by pair_swap so far (for tests and analysis)
+        self.fp_rate = self.config.fp_prior_ref  # running mean of false positives per frame (fp_prior_ref)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
@@ -133,13 +142,26 @@ class SetIdentifier:
             reported = self._hide_stale(reported, age, position, heading)
         agents = agent_tokens(reported, age, self.net.weights.max_age_s)
         prob = self.net.step(agents, detection_tokens(position[used], heading[used], score[used]), dt)
+        if self.fp_rate is not None:
+            prob = self._fp_prior(prob)
         slot_label, slot_conf = decode(prob, len(used), self.config.one_to_one)
+        if self.fp_rate is not None:
+            self.fp_rate += (1.0 - np.exp(-dt / self.config.fp_prior_s)) * (int((slot_label < 0).sum()) - self.fp_rate)
         labels, conf = np.full(n, -1), np.zeros(n)
         labels[used], conf[used] = slot_label, slot_conf
         if self.config.pair_swap is not None:
             labels = self._pair_swaps(labels, conf, heading, age, dt)
         self.last_labels, self.last_probabilities = labels, conf
         return agent_snapshots(labels, conf, position, heading, self._localiser, self._last_seen, frame)
+
+    def _fp_prior(self, prob: np.ndarray) -> np.ndarray:
+        """``prob`` (slots x N+1, false positive last) with the false-positive column scaled by the world's
+        running false-positive rate over ``fp_prior_ref`` (the prior-shift correction of a posterior trained on
+        another mix of false positives) and the rows normalised again."""
+        assert self.fp_rate is not None and self.config.fp_prior_ref is not None
+        out = prob.copy()
+        out[:, -1] *= float(np.clip(self.fp_rate / self.config.fp_prior_ref, 0.2, 5.0))
+        return out / np.maximum(out.sum(axis=1, keepdims=True), 1e-12)
 
     def _hide_stale(self, reported: np.ndarray, age: np.ndarray, position: np.ndarray,
                     heading: np.ndarray) -> np.ndarray:
