@@ -144,11 +144,11 @@ def test_pair_swap_exchanges_the_memories_of_a_swap_no_report_jump_shows(shipped
 
 def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
     """fp_prior_ref: the running false-positive rate starts at the reference, falls in a world without false
-    positives (so a robot's detection is less readily called one), and the correction is off by default."""
+    positives (so a robot's detection is less readily called one); None turns the correction off."""
     from lookalike.trackers import make_tracker
 
     clip = frames(90, lambda a, t: 0.3 + 2.0 * a, lambda r, t: 0.3 + 2.0 * r)
-    plain = make_tracker("set", n_agents=2, weights=str(shipped))
+    plain = make_tracker("set", n_agents=2, weights=str(shipped), fp_prior_ref=None)
     adapted = make_tracker("set", n_agents=2, weights=str(shipped), fp_prior_ref=1.0, fp_prior_s=1.0)
     assert plain.fp_rate is None and adapted.fp_rate == 1.0
     for f in clip:

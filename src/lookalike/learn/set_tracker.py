@@ -17,9 +17,9 @@ position has turned away from that report is shown to the network as not heard f
 still places it). Both were chosen on tuning sequences (docs/experiments/any-team-size.md).
 With ``pair_swap``, two agents whose detections keep fitting each other's fresh reports better than
 their own (a swap undone while their headings stay too close for a report jump) exchange memories.
-With ``fp_prior_ref``, the false-positive probability is corrected for the world's false-positive rate
-(running mean of the detections labelled false positive per frame over ``fp_prior_ref``): the network
-was trained over 0.3-2.5 false positives per frame and cannot tell the rate from one frame.
+The false-positive probability is corrected for the world's false-positive rate (``fp_prior_ref``: the
+running mean of the detections labelled false positive per frame over 1.4, chosen on tuning sequences):
+the network was trained over 0.3-2.5 false positives per frame and cannot tell the rate from one frame.
 """
 
 from __future__ import annotations
@@ -87,7 +87,7 @@ class SetIdentifier:
         pair_swap_s: float = param(0.5, "time constant of pair_swap's evidence decay, seconds", range=(0.01, 100.0))
         pair_fresh_s: float = param(0.3, "reports younger than this count for pair_swap, seconds", range=(0.0, 100.0))
         fp_prior_ref: float | None = param(
-            None, "adapt the false-positive probability to this world's rate: scale it by (running mean of the "
+            1.4, "adapt the false-positive probability to this world's rate: scale it by (running mean of the "
             "detections labelled false positive per frame) / fp_prior_ref before decoding, clipped to 0.2-5 "
             "(None: never)", range=(0.01, 100.0))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
