@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.bench.ident import identify
-from lookalike.bench.paired import Comparison, add_comparisons, mean_difference
+from lookalike.bench.paired import Comparison, add_comparisons, compare_to_first, mean_difference
 from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.bench.results import Results, add_printed_rows
 from lookalike.eval import identification_success_rate
@@ -204,18 +204,7 @@ def recovery_differences(seconds: dict[tuple[str, str], list[float]], setups: Se
     on the same sequences, with the 95% interval over sequences (:func:`~lookalike.bench.paired.mean_difference`;
     no interval, note ``"never"``, when either never recovers in some sequence); none with fewer than two
     identifiers or two sequences."""
-    if len(trackers) < 2:
-        return []
-    baseline, out = trackers[0], []
-    for setup in setups:
-        base = seconds.get((setup, baseline))
-        if base is None or len(base) < 2:
-            continue
-        for name in dict.fromkeys(trackers[1:]):
-            if name != baseline and (setup, name) in seconds:
-                result = mean_difference(seconds[(setup, name)], base)
-                out.append(Comparison(setup, preset_label(setup), name, baseline, result))
-    return out
+    return compare_to_first(seconds, setups, trackers, mean_difference, preset_label)
 
 
 EXPERIMENT_KEYS = {"In order (%)": "success_rate_in_order", "Random order (%)": "success_rate_random_order",

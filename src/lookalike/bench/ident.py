@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.bench.ident_paper import resolve_identifier
-from lookalike.bench.paired import Comparison, add_comparisons, rate_difference
+from lookalike.bench.paired import Comparison, PairedDifference, add_comparisons, compare_to_first, rate_difference
 from lookalike.bench.progress import ProgressFactory, Step, no_progress
 from lookalike.bench.results import Results, percent_row_metrics
 from lookalike.eval import identification_success_rate, localisation_error
@@ -178,20 +178,10 @@ def ident_differences(counts: SequenceCounts, setups: list[str], trackers: list[
     same sequences, in points, with the 95% interval over sequences (:func:`~lookalike.bench.paired.rate_difference`);
     none with fewer than two identifiers or two sequences, nor for identifiers (or a first one) that did
     not run (:data:`NOT_TRAINED`)."""
-    if len(trackers) < 2:
-        return []
-    baseline, out = trackers[0], []
-    for setup in setups:
-        base = counts.get((setup, baseline))
-        if base is None or len(base) < 2:
-            continue
-        for name in dict.fromkeys(trackers[1:]):
-            other = counts.get((setup, name))
-            if other is None or name == baseline:
-                continue
-            result = rate_difference([c for c, _ in other], [c for c, _ in base], [n for _, n in base])
-            out.append(Comparison(setup, preset_label(setup), name, baseline, result))
-    return out
+    def difference(other: Sequence[tuple[int, int]], base: Sequence[tuple[int, int]]) -> PairedDifference:
+        return rate_difference([c for c, _ in other], [c for c, _ in base], [n for _, n in base])
+
+    return compare_to_first(counts, setups, trackers, difference, preset_label)
 
 
 def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int, frames: int,

@@ -17,7 +17,7 @@ does a figure that is infinite in some sequence (``note`` ``"never"``: an identi
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -116,6 +116,27 @@ class Comparison:
     tracker: str
     baseline: str
     result: PairedDifference
+
+
+def compare_to_first(runs: Mapping[tuple[str, str], Sequence[Any]], datasets: Sequence[str],
+                     trackers: Sequence[str], difference: Callable[[Sequence[Any], Sequence[Any]], PairedDifference],
+                     label: Callable[[str], str] = str) -> list[Comparison]:
+    """Per data set and identifier after the first: ``difference(its per-sequence figures, the first's)``
+    on the same sequences (``runs``: (data set, identifier) -> per-sequence figures; ``label``: the data
+    set as printed). None with fewer than two identifiers, for a data set whose first identifier has fewer
+    than two sequences or did not run, nor for identifiers that did not run."""
+    if len(trackers) < 2:
+        return []
+    baseline, out = trackers[0], []
+    for dataset in datasets:
+        base = runs.get((dataset, baseline))
+        if base is None or len(base) < 2:
+            continue
+        for name in dict.fromkeys(trackers[1:]):
+            other = runs.get((dataset, name))
+            if other is not None and name != baseline:
+                out.append(Comparison(dataset, label(dataset), name, baseline, difference(other, base)))
+    return out
 
 
 def interval_text(result: PairedDifference, digits: int = 2) -> str:
