@@ -24,6 +24,7 @@ the network was trained over 0.3-2.5 false positives per frame and cannot tell t
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -146,7 +147,8 @@ class SetIdentifier:
             prob = self._fp_prior(prob)
         slot_label, slot_conf = decode(prob, len(used), self.config.one_to_one)
         if self.fp_rate is not None:
-            self.fp_rate += (1.0 - np.exp(-dt / self.config.fp_prior_s)) * (int((slot_label < 0).sum()) - self.fp_rate)
+            weight = 1.0 - math.exp(-dt / self.config.fp_prior_s)
+            self.fp_rate += weight * (int((slot_label < 0).sum()) - self.fp_rate)
         labels, conf = np.full(n, -1), np.zeros(n)
         labels[used], conf[used] = slot_label, slot_conf
         if self.config.pair_swap is not None:
@@ -160,7 +162,7 @@ class SetIdentifier:
         another mix of false positives) and the rows normalised again."""
         assert self.fp_rate is not None and self.config.fp_prior_ref is not None
         out = prob.copy()
-        out[:, -1] *= float(np.clip(self.fp_rate / self.config.fp_prior_ref, 0.2, 5.0))
+        out[:, -1] *= min(max(self.fp_rate / self.config.fp_prior_ref, 0.2), 5.0)
         return out / np.maximum(out.sum(axis=1, keepdims=True), 1e-12)
 
     def _hide_stale(self, reported: np.ndarray, age: np.ndarray, position: np.ndarray,
