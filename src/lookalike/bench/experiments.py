@@ -185,13 +185,14 @@ def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int
         for name in trackers:
             runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s) for seq in measured]).reshape(-1, 3)
             seconds[(setup, name)] = [float(v) for v in runs[:, 2]]
-            nan = float("nan")
+            if not len(runs):  # nothing measurable: NaN figures, said by the count
+                runs = np.full((1, 3), np.nan)
             rows.append({
                 "Setup": preset_label(setup), "Tracker": name,
-                "Swapped robots while swapped (%)": round(100 * float(np.mean(runs[:, 0])), 1) if len(runs) else nan,
-                "Same without swap (%)": round(100 * float(np.mean(runs[:, 1])), 1) if len(runs) else nan,
-                "Recovery, mean (s)": round(float(np.mean(runs[:, 2])), 2) if len(runs) else nan,
-                "Recovery, worst (s)": round(float(np.max(runs[:, 2])), 2) if len(runs) else nan,
+                "Swapped robots while swapped (%)": round(100 * float(np.mean(runs[:, 0])), 1),
+                "Same without swap (%)": round(100 * float(np.mean(runs[:, 1])), 1),
+                "Recovery, mean (s)": round(float(np.mean(runs[:, 2])), 2),
+                "Recovery, worst (s)": round(float(np.max(runs[:, 2])), 2),
                 "Sequences measured": len(measured),
             })
             step()

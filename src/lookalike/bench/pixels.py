@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.bench.ident import sequence_seeds
+from lookalike.bench.ident import sequence_seeds, uses_weights
 from lookalike.bench.progress import ProgressFactory
 from lookalike.bench.results import Results, add_printed_rows
 from lookalike.eval import identification_success_rate, localisation_error, robot_success_rate
@@ -126,7 +126,7 @@ def perceive_sequence(pipe: RobotPipeline, seq: RobotSequence, camera: Camera, m
 def _identifier(name: str, seq: RobotSequence, camera: Camera, weights: str | None = None) -> PipelineConfig:
     """The identification settings of ``name`` for the sequence's N and M and the camera's field of view;
     ``weights`` (exported .npz) replace the shipped ones of the ``lstm`` identifier."""
-    params = identifier_settings(name, camera) + ((("weights", weights),) if weights and name == "lstm" else ())
+    params = identifier_settings(name, camera) + ((("weights", weights),) if weights and uses_weights(name) else ())
     return PipelineConfig(identifier=name, n_agents=seq.config.n_agents, max_detections=seq.config.max_detections,
                           identifier_params=params)
 

@@ -100,17 +100,24 @@ def score_candidates(candidates: dict[str, tuple[Path, dict[str, object]]], cach
     return rows
 
 
+def print_choice(rows: dict[str, dict[str, float]], baseline: str) -> str | None:
+    """Print and return the choice of :func:`choose_stage4` among the scored ``rows`` against ``baseline``
+    (None, said so, when the baseline is not scored yet or nothing is eligible)."""
+    if baseline not in rows:
+        print("the baseline is not scored yet: no choice")
+        return None
+    chosen = choose_stage4(rows, baseline)
+    print(f"chosen: {chosen}" if chosen else "chosen: none (nothing eligible; nothing ships)")
+    return chosen
+
+
 def select_stage4(run_dir: Path, only: str | None = None, ship: bool = False) -> str | None:
     """Score the candidates (all, or ``only``) on the tuning sequences, cached in ``RUN/set_select_stage4.json``;
     print them and the choice among those scored; with ``ship``, copy chosen weights that are a snapshot into
     the package with what they were chosen on (a chosen ``pair_swap`` is made the identifier's default by hand)."""
     candidates = stage4_candidates(run_dir)
     rows = score_candidates(candidates, run_dir / "set_select_stage4.json", only)
-    if BASELINE not in rows:
-        print("the baseline is not scored yet: no choice")
-        return None
-    chosen = choose_stage4(rows)
-    print(f"chosen: {chosen}" if chosen else "chosen: none (nothing eligible; nothing ships)")
+    chosen = print_choice(rows, BASELINE)
     if ship and chosen and not chosen.startswith("shipped,"):
         chosen_weights = load_set_weights(candidates[chosen][0])
         chosen_weights.info["chosen_on"] = {

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from lookalike.bench.set_select_stage4 import choose_stage4, score_candidates
+from lookalike.bench.set_select_stage4 import print_choice, score_candidates
 from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
 
 STAGE5_FP_PRIOR: tuple[float | None, ...] = (None, 0.7, 1.0, 1.4)
@@ -28,10 +28,5 @@ def stage5_candidates() -> dict[str, tuple[Path, dict[str, object]]]:
 def select_stage5(run_dir: Path, only: str | None = None) -> str | None:
     """Score the candidates (all, or ``only``), print them and the choice (None: nothing eligible); a chosen
     ``fp_prior_ref`` is made the identifier's default by hand."""
-    rows = score_candidates(stage5_candidates(), run_dir / "set_select_stage5.json", only)
-    if STAGE5_BASELINE not in rows:
-        print("the baseline is not scored yet: no choice")
-        return None
-    chosen = choose_stage4(rows, STAGE5_BASELINE)
-    print(f"chosen: {chosen}" if chosen else "chosen: none (nothing eligible; nothing ships)")
-    return chosen
+    return print_choice(score_candidates(stage5_candidates(), run_dir / "set_select_stage5.json", only),
+                        STAGE5_BASELINE)

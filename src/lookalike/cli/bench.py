@@ -20,7 +20,7 @@ from lookalike.bench.ident import (
     ident_runs,
 )
 from lookalike.bench.ident_paper import IDENT_VARIANTS, margin_rows
-from lookalike.bench.paired import comparison_rows, difference_title
+from lookalike.bench.paired import Comparison, comparison_rows, difference_title
 from lookalike.bench.results import Results
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import SortedGroup, app, command_line, console, fail, split_list
@@ -53,6 +53,12 @@ def print_rows(title: str | None, rows: list[dict[str, Any]], columns: Sequence[
     table = rich_table(title, rows, columns)
     size = Console(width=10_000).measure(table)  # minimum: every cell whole, headers wrapped at spaces
     (console if size.minimum <= console.width else Console(width=size.maximum)).print(table)
+
+
+def print_differences(differences: Sequence[Comparison], baseline: str, unit: str, figure: str = "") -> None:
+    """Print the difference table of :mod:`lookalike.bench.paired` comparisons (nothing when there are none)."""
+    if differences:
+        print_rows(difference_title(baseline, unit, figure), comparison_rows(differences, unit))
 
 
 def write_results(doc: Results, path: Path | None) -> None:
@@ -125,8 +131,7 @@ def ident(
     if margins:
         print_rows("LSTM margins over Kalman-HA on the same sequences, beside seed A's (Table I)", margins)
     differences = ident_differences(counts, setup_list, tracker_list)
-    if differences:
-        print_rows(difference_title(tracker_list[0], "points"), comparison_rows(differences, "points"))
+    print_differences(differences, tracker_list[0], "points")
     write_results(ident_results(rows, setup_list, sequences, frames, seed, command_line(), noise,
                                 str(weights) if weights else None, differences), json_path)
     write_rows(rows, None, csv_path)

@@ -14,10 +14,9 @@ from lookalike.bench.experiments import (
     recovery_runs,
     shuffle_rows,
 )
-from lookalike.bench.paired import comparison_rows, difference_title
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import command_line, fail, split_list
-from lookalike.cli.bench import bench_app, print_rows, write_results
+from lookalike.cli.bench import bench_app, print_differences, print_rows, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
 
@@ -68,8 +67,7 @@ def recovery(
         fail(str(exc))
     print_rows(f"Recovery after {swap_s:g} s of swapped reports", rows)
     differences = recovery_differences(seconds, setup_list, tracker_list)
-    if differences:
-        print_rows(difference_title(tracker_list[0], "s", "Mean recovery time"), comparison_rows(differences, "s"))
+    print_differences(differences, tracker_list[0], "s", "Mean recovery time")
     options = {"swap_at_s": swap_at_s, "swap_s": swap_s}
     write_results(experiment_results("recovery", rows, setup_list, sequences, frames, seed, command_line(),
                                      options, differences), json_path)
