@@ -173,3 +173,11 @@ def test_stage5_candidates_and_choice():
     base = {"m3n2": 98.0, "m5n3": 98.0, "rec_m3n2": 0.3, "worst_m3n2": 1.0}
     rows = {STAGE5_BASELINE: base, "up": {**base, "m3n2": 98.06}, "down": {**base, "m3n2": 98.2, "m5n3": 97.9}}
     assert choose_stage4(rows, STAGE5_BASELINE) == "up"
+
+
+def test_stage6_candidates():
+    from lookalike.bench.set_select_stage6 import STAGE6_BASELINE, stage6_candidates
+
+    cands = stage6_candidates()
+    assert cands[STAGE6_BASELINE][1] == {"exchange_llr": None}
+    assert sorted(o["exchange_llr"] for n, (_, o) in cands.items() if n != STAGE6_BASELINE) == [6.0, 8.0, 12.0]

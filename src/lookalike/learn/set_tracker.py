@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.learn.checkpoint import CheckpointError
+from lookalike.learn.report_exchange import ReportExchange
 from lookalike.learn.set_data import agent_tokens, detection_tokens
 from lookalike.learn.set_numpy import NumpySetAssociator, load_set_weights
 from lookalike.learn.tracker import BeaconMemory, agent_detections, agent_snapshots, decode
@@ -91,6 +92,16 @@ class SetIdentifier:
             1.4, "adapt the false-positive probability to this world's rate: scale it by (running mean of the "
             "detections labelled false positive per frame) / fp_prior_ref before decoding, clipped to 0.2-5 "
             "(None: never)", range=(0.01, 100.0))
+        exchange_llr: float | None = param(
+            None, "exchange two agents' memories when each one's heading reports continue the other's report track "
+            "(a swap of ids, or its undoing, too small for report_jump): the log-likelihood ratio each stream must "
+            "pass (None: never)", range=(0.0, 1000.0))
+        exchange_accel: float = param(0.1, "exchange_llr's angular-acceleration spectral density of a robot's "
+                                      "heading, rad^2/s^3", range=(1e-6, 100.0))
+        exchange_lag_s: float = param(0.4, "how far exchange_llr's report tracks run behind the newest report, "
+                                      "seconds", range=(0.0, 10.0))
+        exchange_noise_rad: float = param(0.035, "a heading report's noise for exchange_llr (standard deviation), "
+                                          "radians", range=(1e-4, 3.0))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
                                choices=LOCALISERS)
@@ -118,6 +129,10 @@ class SetIdentifier:
         self._pair_evidence = np.zeros((n, n))
         self.pair_swaps = 0  # memories exchanged by pair_swap so far (for tests and analysis)
         self.fp_rate = self.config.fp_prior_ref  # running mean of false positives per frame (fp_prior_ref)
+        cfg = self.config
+        self._exchange = None if cfg.exchange_llr is None else ReportExchange(
+            n, cfg.exchange_llr, cfg.exchange_accel, cfg.exchange_lag_s, cfg.exchange_noise_rad)
+        self.exchanges = 0  # memories exchanged by exchange_llr so far (for tests and analysis)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
@@ -129,6 +144,8 @@ class SetIdentifier:
         self._beacons.add(frame)
         if self.config.report_jump is not None:
             self._forget_jumps(*before, self.config.report_jump)
+        if self._exchange is not None:
+            self._report_exchanges(frame)
         det = frame.detections
         n = len(det)
         if n and (det.position is None or det.heading is None or det.score is None):
@@ -221,10 +238,29 @@ class SetIdentifier:
                 continue
             b = int(partners[0])
             self.net.swap(a, b)
+            if self._exchange is not None:
+                self._exchange.swap(a, b)
             if b in jumped:
                 done.add(b)
             else:
                 self._expected_jump[b] = now[a]
+
+    def _report_exchanges(self, frame: Frame) -> None:
+        """``exchange_llr``: feed the frame's reports to the exchange detector
+        (:class:`~lookalike.learn.report_exchange.ReportExchange`) and exchange the memories of each pair it
+        finds; a report jump of either agent within the next second is then the same exchange
+        (``report_jump`` does nothing more)."""
+        assert self._exchange is not None
+        b = frame.beacons
+        for agent, t_sent, heading in zip(b.agent_id.tolist(), b.t_sent.tolist(), b.heading.tolist()):
+            if not 0 <= agent < self.config.n_agents:
+                continue
+            pair = self._exchange.add(agent, t_sent, heading)
+            if pair is not None:
+                self.net.swap(*pair)
+                self.exchanges += 1
+                for j in pair:
+                    self._expected_jump[j] = t_sent
 
     def _pair_swaps(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, age: np.ndarray,
                     dt: float) -> np.ndarray:
