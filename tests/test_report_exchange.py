@@ -67,3 +67,17 @@ def test_set_exchanges_memories_at_a_swap_the_report_jump_misses():
     for f in seq.frames():
         clean.update(f)
     assert runs[None] == 0 and runs[8.0] >= 1 and clean.exchanges == 0
+
+
+def test_evidence_decays_with_its_time_constant():
+    reports = list(_streams(0.0, None, seconds=8.0))  # two robots heading alike: little evidence either way
+    left = {}
+    for memory_s in (1.0, None):
+        det = ReportExchange(2, threshold=8.0, memory_s=memory_s)
+        for a, t, h in reports[:40]:
+            det.add(a, t, h)
+        det.evidence[0, 1] = 30.0  # one stream's evidence, seconds before the other's
+        for a, t, h in reports[40:140]:
+            det.add(a, t, h)
+        left[memory_s] = det.evidence[0, 1]
+    assert left[1.0] < 30.0 * np.exp(-4.0) + 2.0 < left[None]

@@ -175,9 +175,11 @@ def test_stage5_candidates_and_choice():
     assert choose_stage4(rows, STAGE5_BASELINE) == "up"
 
 
-def test_stage6_candidates():
-    from lookalike.bench.set_select_stage6 import STAGE6_BASELINE, stage6_candidates
+def test_exchange_stages_candidates():
+    from lookalike.bench.set_select_exchange import EXCHANGE_BASELINE, exchange_candidates
 
-    cands = stage6_candidates()
-    assert cands[STAGE6_BASELINE][1] == {"exchange_llr": None}
-    assert sorted(o["exchange_llr"] for n, (_, o) in cands.items() if n != STAGE6_BASELINE) == [6.0, 8.0, 12.0]
+    for stage, memory in ((6, None), (7, 1.0)):
+        cands = exchange_candidates(stage)
+        assert cands[EXCHANGE_BASELINE][1]["exchange_llr"] is None
+        assert all(o["exchange_memory_s"] == memory for _, o in cands.values())
+        assert all(o["exchange_llr"] is None or o["exchange_llr"] > 0 for _, o in cands.values())

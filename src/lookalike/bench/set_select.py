@@ -329,14 +329,15 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--average-from", type=int, default=None,
                         help="also the mean of the snapshots' weights from this step on")
     parser.add_argument("--ship", action="store_true", help="ship the chosen weights")
-    parser.add_argument("--stage", type=int, choices=(1, 2, 3, 4, 5, 6), default=1,
+    parser.add_argument("--stage", type=int, choices=(1, 2, 3, 4, 5, 6, 7), default=1,
                         help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from); "
                         "3: the inference options of the shipped weights (RUN: where the scores are kept); "
                         "4: the fourth stage's snapshots x the pair-swap rule (lookalike.bench.set_select_stage4); "
                         "5: the false-positive prior correction (lookalike.bench.set_select_stage5); "
-                        "6: the report-exchange detector (lookalike.bench.set_select_stage6)")
+                        "6 and 7: the report-exchange detector without and with its evidence's decay "
+                        "(lookalike.bench.set_select_exchange)")
     parser.add_argument("--only", default=None,
-                        help="stages 4-6: score this candidate only (e.g. step300,pair=off)")
+                        help="stages 4-7: score this candidate only (e.g. step300,pair=off)")
     parser.add_argument("--cache", type=Path, default=None,
                         help="stage 3: the JSON file of scored candidates (default RUN/set_select_stage3.json)")
     args = parser.parse_args(argv)
@@ -353,10 +354,10 @@ def main(argv: list[str] | None = None) -> None:
 
         select_stage5(args.run, args.only)
         return
-    if args.stage == 6:
-        from lookalike.bench.set_select_stage6 import select_stage6
+    if args.stage in (6, 7):
+        from lookalike.bench.set_select_exchange import select_exchange
 
-        select_stage6(args.run, args.only)
+        select_exchange(args.run, args.stage, args.only)
         return
     select(args.run, args.every, args.baseline, args.ship, args.average_from, args.stage)
 

@@ -5,11 +5,12 @@ Each agent's reports (absolute heading, radians, at their send time) feed a cons
 filter that runs ``lag_s`` seconds behind that agent's newest report, so that the reports just after an
 exchange are compared with heading tracks that have not absorbed them yet. For every new report of agent
 ``a`` and every other agent ``b``, the log-likelihood ratio of "this report continues b's track" over "it
-continues a's own" is summed (a CUSUM: never below 0). When the sums of ``(a, b)`` and of ``(b, a)``
-together pass twice ``threshold`` and each passes a quarter of it, each stream continues the other's track
-(a robot that starts to turn just then may fit neither, so one stream can carry most of the evidence): the
-two tracks are exchanged and the pair is returned. One stream alone (a robot turning fast) does not pass,
-as the other keeps fitting its own track.
+continues a's own" is summed (a CUSUM: never below 0) and decays with time constant ``memory_s``, so that
+evidence one stream left long ago (two robots heading alike) does not complete an exchange later. When the
+sums of ``(a, b)`` and of ``(b, a)`` together pass twice ``threshold`` and each passes a quarter of it,
+each stream continues the other's track (a robot that starts to turn just then may fit neither, so one
+stream can carry most of the evidence): the two tracks are exchanged and the pair is returned. One stream
+alone (a robot turning fast) does not pass, as the other keeps fitting its own track.
 """
 
 from __future__ import annotations
@@ -27,11 +28,13 @@ class ReportExchange:
     """Exchange detector over ``n`` agents' heading reports (see the module)."""
 
     def __init__(self, n: int, threshold: float, accel_psd: float = 0.1, lag_s: float = 0.4,
-                 noise_rad: float = float(np.radians(2.0))) -> None:
+                 noise_rad: float = float(np.radians(2.0)), memory_s: float | None = 1.0) -> None:
         """``threshold``: the log-likelihood ratio each of the two streams must pass; ``accel_psd``: spectral
         density of the heading's angular acceleration, rad²/s³; ``lag_s``: how far the tracks run behind the
         newest report, seconds; ``noise_rad``: a report's heading noise (standard deviation), radians."""
         self.n, self.threshold, self.q, self.lag_s, self.r = n, threshold, accel_psd, lag_s, noise_rad ** 2
+        self.memory_s = memory_s
+        self.clock = -np.inf  # newest send time seen, seconds
         self.x = np.zeros((n, 2))  # heading (rad), turn rate (rad/s) at self.t
         self.p = np.zeros((n, 2, 2))
         self.t = np.full(n, np.nan)  # time of each track's state; NaN: no track yet
@@ -68,6 +71,10 @@ class ReportExchange:
         if not (t_sent > self.newest[a] and np.isfinite(heading)):
             return None
         self.newest[a] = t_sent
+        if t_sent > self.clock:
+            if np.isfinite(self.clock) and self.memory_s is not None:
+                self.evidence *= np.exp(-(t_sent - self.clock) / self.memory_s)
+            self.clock = t_sent
         for c in range(self.n):
             queue = self.queue[c]
             while queue and queue[0][0] < t_sent - self.lag_s:

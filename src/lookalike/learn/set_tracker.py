@@ -100,6 +100,9 @@ class SetIdentifier:
                                       "heading, rad^2/s^3", range=(1e-6, 100.0))
         exchange_lag_s: float = param(0.4, "how far exchange_llr's report tracks run behind the newest report, "
                                       "seconds", range=(0.0, 10.0))
+        exchange_memory_s: float | None = param(
+            1.0, "time constant of the decay of exchange_llr's evidence, seconds (None: no decay, the sixth stage's "
+            "detector)", range=(0.01, 1e4))
         exchange_noise_rad: float = param(0.035, "a heading report's noise for exchange_llr (standard deviation), "
                                           "radians", range=(1e-4, 3.0))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
@@ -131,7 +134,8 @@ class SetIdentifier:
         self.fp_rate = self.config.fp_prior_ref  # running mean of false positives per frame (fp_prior_ref)
         cfg = self.config
         self._exchange = None if cfg.exchange_llr is None else ReportExchange(
-            n, cfg.exchange_llr, cfg.exchange_accel, cfg.exchange_lag_s, cfg.exchange_noise_rad)
+            n, cfg.exchange_llr, cfg.exchange_accel, cfg.exchange_lag_s, cfg.exchange_noise_rad,
+            cfg.exchange_memory_s)
         self.exchanges = 0  # memories exchanged by exchange_llr so far (for tests and analysis)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:

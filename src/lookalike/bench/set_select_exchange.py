@@ -1,0 +1,37 @@
+"""The sixth and seventh stages' choices for the ``set`` identifier (issue 23): the report-exchange detector.
+
+``python -m lookalike.bench.set_select RUN --stage 6`` (or ``7``) scores the shipped weights and options with
+``exchange_llr`` off and at each of the stage's thresholds (stage 6: :data:`STAGE6_EXCHANGE_LLR` without the
+evidence's decay; stage 7: :data:`STAGE7_EXCHANGE_LLR` with ``exchange_memory_s`` 1 s) on the third stage's tuning
+sequences and tuning recovery (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in
+``RUN/set_select_stage<k>.json``) and applies the fourth stage's rule against the candidate with the detector
+off, as written in docs/experiments/any-team-size.md before any of the stage's candidates was scored.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from lookalike.bench.set_select_stage4 import print_choice, score_candidates
+from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+
+STAGE6_EXCHANGE_LLR: tuple[float | None, ...] = (None, 6.0, 8.0, 12.0)
+STAGE7_EXCHANGE_LLR: tuple[float | None, ...] = (None, 6.0, 8.0, 10.0)
+EXCHANGE_BASELINE = "exchange=off"
+_MEMORY_S = {6: None, 7: 1.0}
+
+
+def exchange_candidates(stage: int) -> dict[str, tuple[Path, dict[str, object]]]:
+    """Stage 6 or 7's candidates: name (``exchange=off``, ``exchange=8.0``, ...) -> (the shipped weights,
+    inference options)."""
+    thresholds = STAGE6_EXCHANGE_LLR if stage == 6 else STAGE7_EXCHANGE_LLR
+    return {f"exchange={'off' if llr is None else llr}":
+            (SHIPPED_SET_WEIGHTS, {"exchange_llr": llr, "exchange_memory_s": _MEMORY_S[stage]})
+            for llr in thresholds}
+
+
+def select_exchange(run_dir: Path, stage: int, only: str | None = None) -> str | None:
+    """Score stage ``stage``'s candidates (all, or ``only``), print them and the choice (None: nothing eligible);
+    a chosen ``exchange_llr`` is made the identifier's default by hand."""
+    return print_choice(score_candidates(exchange_candidates(stage), run_dir / f"set_select_stage{stage}.json", only),
+                        EXCHANGE_BASELINE)
