@@ -81,3 +81,13 @@ def test_evidence_decays_with_its_time_constant():
             det.add(a, t, h)
         left[memory_s] = det.evidence[0, 1]
     assert left[1.0] < 30.0 * np.exp(-4.0) + 2.0 < left[None]
+
+
+def test_a_track_silent_for_a_lost_burst_takes_no_part():
+    det = ReportExchange(2, threshold=8.0)
+    for a, t, h in _streams(0.0, None, seconds=6.0):
+        if a == 1 and t > 2.0:
+            continue  # agent 1's reports lost from 2 s on
+        det.add(a, t, h)
+        if t > 2.0 + det.lag_s + 0.6 + 0.2:
+            assert det.evidence[0, 1] == 0.0

@@ -178,8 +178,8 @@ def test_stage5_candidates_and_choice():
 def test_exchange_stages_candidates():
     from lookalike.bench.set_select_exchange import EXCHANGE_BASELINE, exchange_candidates
 
-    for stage, memory in ((6, None), (7, 1.0)):
+    for stage, memory, fresh in ((6, None, None), (7, 1.0, None), (8, 1.0, 0.6)):
         cands = exchange_candidates(stage)
         assert cands[EXCHANGE_BASELINE][1]["exchange_llr"] is None
-        assert all(o["exchange_memory_s"] == memory for _, o in cands.values())
+        assert all(o["exchange_memory_s"] == memory and o["exchange_fresh_s"] == fresh for _, o in cands.values())
         assert all(o["exchange_llr"] is None or o["exchange_llr"] > 0 for _, o in cands.values())

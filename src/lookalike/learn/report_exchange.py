@@ -6,7 +6,8 @@ filter that runs ``lag_s`` seconds behind that agent's newest report, so that th
 exchange are compared with heading tracks that have not absorbed them yet. For every new report of agent
 ``a`` and every other agent ``b``, the log-likelihood ratio of "this report continues b's track" over "it
 continues a's own" is summed (a CUSUM: never below 0) and decays with time constant ``memory_s``, so that
-evidence one stream left long ago (two robots heading alike) does not complete an exchange later. When the
+evidence one stream left long ago (two robots heading alike) does not complete an exchange later; a track
+that has had no report for a while (a lost burst) takes no part. When the
 sums of ``(a, b)`` and of ``(b, a)`` together pass twice ``threshold`` and each passes a quarter of it,
 each stream continues the other's track (a robot that starts to turn just then may fit neither, so one
 stream can carry most of the evidence): the two tracks are exchanged and the pair is returned. One stream
@@ -28,12 +29,14 @@ class ReportExchange:
     """Exchange detector over ``n`` agents' heading reports (see the module)."""
 
     def __init__(self, n: int, threshold: float, accel_psd: float = 0.1, lag_s: float = 0.4,
-                 noise_rad: float = float(np.radians(2.0)), memory_s: float | None = 1.0) -> None:
-        """``threshold``: the log-likelihood ratio each of the two streams must pass; ``accel_psd``: spectral
+                 noise_rad: float = float(np.radians(2.0)), memory_s: float | None = 1.0,
+                 fresh_s: float | None = 0.6) -> None:
+        """``threshold``: half the log-likelihood ratio the two streams must pass together; ``accel_psd``: spectral
         density of the heading's angular acceleration, rad²/s³; ``lag_s``: how far the tracks run behind the
         newest report, seconds; ``noise_rad``: a report's heading noise (standard deviation), radians."""
         self.n, self.threshold, self.q, self.lag_s, self.r = n, threshold, accel_psd, lag_s, noise_rad ** 2
         self.memory_s = memory_s
+        self.oldest = np.inf if fresh_s is None else lag_s + fresh_s  # oldest usable track, seconds
         self.clock = -np.inf  # newest send time seen, seconds
         self.x = np.zeros((n, 2))  # heading (rad), turn rate (rad/s) at self.t
         self.p = np.zeros((n, 2, 2))
@@ -85,7 +88,9 @@ class ReportExchange:
         mean, var = self._predict(t_sent)
         nu2 = _wrap(heading - mean) ** 2 / var
         gain = 0.5 * (nu2[a] - nu2) - 0.5 * np.log(var / var[a])
-        known = ~np.isnan(self.t)
+        known = t_sent - self.t <= self.oldest  # NaN (no track yet): False
+        if not known[a]:
+            return None
         known[a] = False
         row = self.evidence[a]
         row[known] = np.maximum(row[known] + gain[known], 0.0)

@@ -103,6 +103,9 @@ class SetIdentifier:
         exchange_memory_s: float | None = param(
             1.0, "time constant of the decay of exchange_llr's evidence, seconds (None: no decay, the sixth stage's "
             "detector)", range=(0.01, 1e4))
+        exchange_fresh_s: float | None = param(
+            0.6, "exchange_llr leaves out an agent whose report track has had no report for exchange_lag_s + this "
+            "many seconds (a lost burst; None: never, the sixth and seventh stages' detector)", range=(0.0, 1e4))
         exchange_noise_rad: float = param(0.035, "a heading report's noise for exchange_llr (standard deviation), "
                                           "radians", range=(1e-4, 3.0))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
@@ -135,7 +138,7 @@ class SetIdentifier:
         cfg = self.config
         self._exchange = None if cfg.exchange_llr is None else ReportExchange(
             n, cfg.exchange_llr, cfg.exchange_accel, cfg.exchange_lag_s, cfg.exchange_noise_rad,
-            cfg.exchange_memory_s)
+            cfg.exchange_memory_s, cfg.exchange_fresh_s)
         self.exchanges = 0  # memories exchanged by exchange_llr so far (for tests and analysis)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
