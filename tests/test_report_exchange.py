@@ -91,3 +91,12 @@ def test_a_track_silent_for_a_lost_burst_takes_no_part():
         det.add(a, t, h)
         if t > 2.0 + det.lag_s + 0.6 + 0.2:
             assert det.evidence[0, 1] == 0.0
+
+
+def test_set_exchange_variant_is_set_with_the_detector_on():
+    from lookalike.bench.ident import build_identifier
+
+    seq = simulate_robots(preset("m5n3"), 30, 1)
+    tracker = build_identifier("set-exchange", seq)
+    assert tracker.config.exchange_llr == 8.0 and tracker.config.n_agents == 3
+    assert build_identifier("set", seq).config.exchange_llr is None
