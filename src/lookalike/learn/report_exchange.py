@@ -7,11 +7,11 @@ exchange are compared with heading tracks that have not absorbed them yet. For e
 ``a`` and every other agent ``b``, the log-likelihood ratio of "this report continues b's track" over "it
 continues a's own" is summed (a CUSUM: never below 0) and decays with time constant ``memory_s``, so that
 evidence one stream left long ago (two robots heading alike) does not complete an exchange later; a track
-that has had no report for a while (a lost burst) takes no part. When the
-sums of ``(a, b)`` and of ``(b, a)`` together pass twice ``threshold`` and each passes a quarter of it,
-each stream continues the other's track (a robot that starts to turn just then may fit neither, so one
-stream can carry most of the evidence): the two tracks are exchanged and the pair is returned. One stream
-alone (a robot turning fast) does not pass, as the other keeps fitting its own track.
+that has had no report for a while (a lost burst) takes no part. When the sums of ``(a, b)`` and of
+``(b, a)`` together pass twice ``threshold`` and each passes a quarter of it, each stream continues the
+other's track (a robot that starts to turn just then may fit neither, so one stream can carry most of the
+evidence): the two tracks are exchanged and the pair is returned. One stream alone (a robot turning fast)
+does not pass, as the other keeps fitting its own track.
 """
 
 from __future__ import annotations
@@ -33,7 +33,9 @@ class ReportExchange:
                  fresh_s: float | None = 0.6) -> None:
         """``threshold``: half the log-likelihood ratio the two streams must pass together; ``accel_psd``: spectral
         density of the heading's angular acceleration, rad²/s³; ``lag_s``: how far the tracks run behind the
-        newest report, seconds; ``noise_rad``: a report's heading noise (standard deviation), radians."""
+        newest report, seconds; ``noise_rad``: a report's heading noise (standard deviation), radians;
+        ``memory_s``: time constant of the evidence's decay, seconds (None: no decay); ``fresh_s``: a track
+        whose newest report is older than ``lag_s`` + ``fresh_s`` seconds takes no part (None: every track)."""
         self.n, self.threshold, self.q, self.lag_s, self.r = n, threshold, accel_psd, lag_s, noise_rad ** 2
         self.memory_s = memory_s
         self.oldest = np.inf if fresh_s is None else lag_s + fresh_s  # oldest usable track, seconds

@@ -20,6 +20,8 @@ their own (a swap undone while their headings stay too close for a report jump) 
 The false-positive probability is corrected for the world's false-positive rate (``fp_prior_ref``: the
 running mean of the detections labelled false positive per frame over 1.4, chosen on tuning sequences):
 the network was trained over 0.3-2.5 false positives per frame and cannot tell the rate from one frame.
+With ``exchange_llr`` (off by default), two agents whose heading reports each continue the other's report track
+exchange memories (:mod:`lookalike.learn.report_exchange`): an exchange too small for a report jump.
 """
 
 from __future__ import annotations
@@ -94,8 +96,8 @@ class SetIdentifier:
             "(None: never)", range=(0.01, 100.0))
         exchange_llr: float | None = param(
             None, "exchange two agents' memories when each one's heading reports continue the other's report track "
-            "(a swap of ids, or its undoing, too small for report_jump): the log-likelihood ratio each stream must "
-            "pass (None: never)", range=(0.0, 1000.0))
+            "(a swap of ids, or its undoing, too small for report_jump): half the log-likelihood ratio the two "
+            "streams must pass together, each at least a quarter of it (None: never)", range=(0.0, 1000.0))
         exchange_accel: float = param(0.1, "exchange_llr's angular-acceleration spectral density of a robot's "
                                       "heading, rad^2/s^3", range=(1e-6, 100.0))
         exchange_lag_s: float = param(0.4, "how far exchange_llr's report tracks run behind the newest report, "
