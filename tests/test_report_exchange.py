@@ -84,13 +84,17 @@ def test_evidence_decays_with_its_time_constant():
 
 
 def test_a_track_silent_for_a_lost_burst_takes_no_part():
-    det = ReportExchange(2, threshold=8.0)
-    for a, t, h in _streams(0.0, None, seconds=6.0):
-        if a == 1 and t > 2.0:
-            continue  # agent 1's reports lost from 2 s on
-        det.add(a, t, h)
-        if t > 2.0 + det.lag_s + 0.6 + 0.2:
-            assert det.evidence[0, 1] == 0.0
+    reports = [(a, t, h) for a, t, h in _streams(0.0, None, seconds=6.0) if not (a == 1 and t > 2.0)]
+    fired = {}
+    for fresh_s in (0.6, None):
+        det = ReportExchange(2, threshold=8.0, fresh_s=fresh_s)
+        for a, t, h in reports:
+            if a == 0 and t > 4.0:  # agent 1 silent for 2 s: its track predicts little
+                det.evidence[:] = [[0.0, 20.0], [20.0, 0.0]]
+                fired[fresh_s] = det.add(a, t, h)
+                break
+            det.add(a, t, h)
+    assert fired[0.6] is None and fired[None] == (0, 1)
 
 
 def test_set_exchange_variant_is_set_with_the_detector_on():
