@@ -104,3 +104,9 @@ def test_set_exchange_variant_is_set_with_the_detector_on():
     tracker = build_identifier("set-exchange", seq)
     assert tracker.config.exchange_llr == 8.0 and tracker.config.n_agents == 3
     assert build_identifier("set", seq).config.exchange_llr is None
+
+
+def test_exchange_max_agents_leaves_larger_teams_without_the_detector():
+    small = make_tracker("set", n_agents=7, exchange_llr=8.0, exchange_max_agents=7)
+    large = make_tracker("set", n_agents=8, exchange_llr=8.0, exchange_max_agents=7)
+    assert small._exchange is not None and large._exchange is None

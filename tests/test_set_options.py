@@ -183,3 +183,8 @@ def test_exchange_stages_candidates():
         assert cands[EXCHANGE_BASELINE][1]["exchange_llr"] is None
         assert all(o["exchange_memory_s"] == memory and o["exchange_fresh_s"] == fresh for _, o in cands.values())
         assert all(o["exchange_llr"] is None or o["exchange_llr"] > 0 for _, o in cands.values())
+
+    from lookalike.bench.set_select_exchange import stage9_candidates
+
+    options = stage9_candidates()["exchange=8.0,max_agents=7"][1]
+    assert options["exchange_llr"] == 8.0 and options["exchange_max_agents"] == 7

@@ -329,16 +329,16 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--average-from", type=int, default=None,
                         help="also the mean of the snapshots' weights from this step on")
     parser.add_argument("--ship", action="store_true", help="ship the chosen weights")
-    parser.add_argument("--stage", type=int, choices=(1, 2, 3, 4, 5, 6, 7, 8), default=1,
+    parser.add_argument("--stage", type=int, choices=(1, 2, 3, 4, 5, 6, 7, 8, 9), default=1,
                         help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from); "
                         "3: the inference options of the shipped weights (RUN: where the scores are kept); "
                         "4: the fourth stage's snapshots x the pair-swap rule (lookalike.bench.set_select_stage4); "
                         "5: the false-positive prior correction (lookalike.bench.set_select_stage5); "
-                        "6-8: the report-exchange detector (7: its evidence decays; 8: and lost bursts leave a "
-                        "track out) "
+                        "6-9: the report-exchange detector (7: its evidence decays; 8: and lost bursts leave a "
+                        "track out; 9: for teams of up to seven) "
                         "(lookalike.bench.set_select_exchange)")
     parser.add_argument("--only", default=None,
-                        help="stages 4-8: score this candidate only (e.g. step300,pair=off)")
+                        help="stages 4-9: score this candidate only (e.g. step300,pair=off)")
     parser.add_argument("--cache", type=Path, default=None,
                         help="stage 3: the JSON file of scored candidates (default RUN/set_select_stage3.json)")
     args = parser.parse_args(argv)
@@ -355,7 +355,7 @@ def main(argv: list[str] | None = None) -> None:
 
         select_stage5(args.run, args.only)
         return
-    if args.stage in (6, 7, 8):
+    if args.stage in (6, 7, 8, 9):
         from lookalike.bench.set_select_exchange import select_exchange
 
         select_exchange(args.run, args.stage, args.only)

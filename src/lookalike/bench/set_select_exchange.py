@@ -1,4 +1,4 @@
-"""The sixth to eighth stages' choices for the ``set`` identifier (issue 23): the report-exchange detector.
+"""The sixth to ninth stages' choices for the ``set`` identifier (issue 23): the report-exchange detector.
 
 ``python -m lookalike.bench.set_select RUN --stage 6`` (7, 8) scores the shipped weights and options with
 ``exchange_llr`` off and at each of the stage's thresholds (stage 6: :data:`STAGE6_EXCHANGE_LLR` without the
@@ -6,7 +6,8 @@ evidence's decay; stage 7: :data:`STAGE7_EXCHANGE_LLR` with ``exchange_memory_s`
 :data:`STAGE8_EXCHANGE_LLR` with that and ``exchange_fresh_s`` 0.6 s) on the third stage's tuning
 sequences and tuning recovery (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in
 ``RUN/set_select_stage<k>.json``) and applies the fourth stage's rule against the candidate with the detector
-off, as written in docs/experiments/any-team-size.md before any of the stage's candidates was scored.
+off (stage 9: :func:`stage9_candidates`), as written in docs/experiments/any-team-size.md before any of the
+stage's candidates was scored.
 """
 
 from __future__ import annotations
@@ -34,8 +35,16 @@ def exchange_candidates(stage: int) -> dict[str, tuple[Path, dict[str, object]]]
             for llr in thresholds}
 
 
+def stage9_candidates() -> dict[str, tuple[Path, dict[str, object]]]:
+    """The ninth stage's candidates: the detector off, or at 8 for teams of up to seven agents."""
+    return {EXCHANGE_BASELINE: (SHIPPED_SET_WEIGHTS, {"exchange_llr": None}),
+            "exchange=8.0,max_agents=7": (SHIPPED_SET_WEIGHTS, {"exchange_llr": 8.0, "exchange_memory_s": 1.0,
+                                                                "exchange_fresh_s": 0.6, "exchange_max_agents": 7})}
+
+
 def select_exchange(run_dir: Path, stage: int, only: str | None = None) -> str | None:
     """Score stage ``stage``'s candidates (all, or ``only``), print them and the choice (None: nothing eligible);
     a chosen ``exchange_llr`` is made the identifier's default by hand."""
-    return print_choice(score_candidates(exchange_candidates(stage), run_dir / f"set_select_stage{stage}.json", only),
-                        EXCHANGE_BASELINE)
+    candidates = stage9_candidates() if stage == 9 else exchange_candidates(stage)
+    rows = score_candidates(candidates, run_dir / f"set_select_stage{stage}.json", only)
+    return print_choice(rows, EXCHANGE_BASELINE)

@@ -98,6 +98,8 @@ class SetIdentifier:
             None, "exchange two agents' memories when each one's heading reports continue the other's report track "
             "(a swap of ids, or its undoing, too small for report_jump): half the log-likelihood ratio the two "
             "streams must pass together, each at least a quarter of it (None: never)", range=(0.0, 1000.0))
+        exchange_max_agents: int | None = param(
+            None, "run exchange_llr only for teams of at most this many agents (None: any)", range=(1, 1000))
         exchange_accel: float = param(0.1, "exchange_llr's angular-acceleration spectral density of a robot's "
                                       "heading, rad^2/s^3", range=(1e-6, 100.0))
         exchange_lag_s: float = param(0.4, "how far exchange_llr's report tracks run behind the newest report, "
@@ -138,7 +140,8 @@ class SetIdentifier:
         self.pair_swaps = 0  # memories exchanged by pair_swap so far (for tests and analysis)
         self.fp_rate = self.config.fp_prior_ref  # running mean of false positives per frame (fp_prior_ref)
         cfg = self.config
-        self._exchange = None if cfg.exchange_llr is None else ReportExchange(
+        too_many = cfg.exchange_max_agents is not None and n > cfg.exchange_max_agents
+        self._exchange = None if cfg.exchange_llr is None or too_many else ReportExchange(
             n, cfg.exchange_llr, cfg.exchange_accel, cfg.exchange_lag_s, cfg.exchange_noise_rad,
             cfg.exchange_memory_s, cfg.exchange_fresh_s)
         self.exchanges = 0  # memories exchanged by exchange_llr so far (for tests and analysis)
