@@ -59,7 +59,7 @@ def test_set_exchanges_memories_at_a_swap_the_report_jump_misses():
     frames = swap_reports(list(seq.frames()), 5.0, 15.0, pair)
     runs = {}
     for llr in (None, 8.0):
-        tracker = make_tracker("set", n_agents=2, n_slots=3, exchange_llr=llr)
+        tracker = make_tracker("set", n_agents=2, n_slots=3, exchange_llr=llr)  # 8.0: the default
         for f in frames:
             tracker.update(f)
         runs[llr] = tracker.exchanges
@@ -97,13 +97,13 @@ def test_a_track_silent_for_a_lost_burst_takes_no_part():
     assert fired[0.6] is None and fired[None] == (0, 1)
 
 
-def test_set_exchange_variant_is_set_with_the_detector_on():
+def test_set_exchange_variant_is_set_with_the_detector_on_for_any_team():
     from lookalike.bench.ident import build_identifier
 
     seq = simulate_robots(preset("m5n3"), 30, 1)
     tracker = build_identifier("set-exchange", seq)
-    assert tracker.config.exchange_llr == 8.0 and tracker.config.n_agents == 3
-    assert build_identifier("set", seq).config.exchange_llr is None
+    assert tracker.config.exchange_llr == 8.0 and tracker.config.exchange_max_agents is None
+    assert build_identifier("set", seq).config.exchange_max_agents == 7
 
 
 def test_exchange_max_agents_leaves_larger_teams_without_the_detector():

@@ -70,14 +70,15 @@ def test_a_stale_report_whose_robot_turned_is_hidden_only_with_stale_s(shipped):
     assert all(a[0, 3] == 1 for a in tokens_seen(tracker, same_heading)[1:])  # stale but not turned: shown
 
 
+@pytest.mark.parametrize("exchange_llr", [None, 8.0])  # the exchange detector adds nothing to a report jump
 @pytest.mark.parametrize("on_jump", ["forget", "swap"])
-def test_a_report_swap_exchanges_or_forgets_the_memories(shipped, on_jump):
+def test_a_report_swap_exchanges_or_forgets_the_memories(shipped, on_jump, exchange_llr):
     from lookalike.trackers import make_tracker
 
     heading = {0: 0.0, 1: 2.0}
     swapped = lambda a, t: heading[1 - a] if t >= 1.5 else heading[a]  # noqa: E731  ids exchanged from 1.5 s
     fs = frames(60, swapped, lambda r, t: heading[r])
-    tracker = make_tracker("set", n_agents=2, n_slots=2, on_jump=on_jump)
+    tracker = make_tracker("set", n_agents=2, n_slots=2, on_jump=on_jump, exchange_llr=exchange_llr)
     calls = []
     for name in ("swap", "forget"):
         method = getattr(tracker.net, name)
@@ -122,7 +123,7 @@ def test_pair_swap_exchanges_the_memories_of_a_swap_no_report_jump_shows(shipped
     swapped = lambda a, t: heading[1 - a] if t >= 1.5 else heading[a]  # noqa: E731  ids exchanged from 1.5 s
     labels = {}
     for pair_swap in (None, 2.0):
-        tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, pair_swap=pair_swap)
+        tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, exchange_llr=None, pair_swap=pair_swap)
         out = []
         for f in frames(120, swapped, lambda r, t: heading[r]):
             tracker.update(f)

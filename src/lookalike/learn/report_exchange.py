@@ -114,3 +114,11 @@ class ReportExchange:
         self.queue[b].clear()
         self.evidence[[a, b], :] = 0.0
         self.evidence[:, [a, b]] = 0.0
+
+    def forget(self, a: int) -> None:
+        """Start agent ``a``'s track afresh from its next report (its reports now come from a robot no other
+        agent reported for) and clear its evidence."""
+        self.t[a] = np.nan
+        self.queue[a].clear()
+        self.evidence[a, :] = 0.0
+        self.evidence[:, a] = 0.0

@@ -20,8 +20,9 @@ their own (a swap undone while their headings stay too close for a report jump) 
 The false-positive probability is corrected for the world's false-positive rate (``fp_prior_ref``: the
 running mean of the detections labelled false positive per frame over 1.4, chosen on tuning sequences):
 the network was trained over 0.3-2.5 false positives per frame and cannot tell the rate from one frame.
-With ``exchange_llr`` (off by default), two agents whose heading reports each continue the other's report track
-exchange memories (:mod:`lookalike.learn.report_exchange`): an exchange too small for a report jump.
+With ``exchange_llr`` (8, for teams of up to ``exchange_max_agents`` = 7; chosen on tuning sequences), two agents
+whose heading reports each continue the other's report track exchange memories
+(:mod:`lookalike.learn.report_exchange`): an exchange too small for a report jump.
 """
 
 from __future__ import annotations
@@ -95,11 +96,11 @@ class SetIdentifier:
             "detections labelled false positive per frame) / fp_prior_ref before decoding, clipped to 0.2-5 "
             "(None: never)", range=(0.01, 100.0))
         exchange_llr: float | None = param(
-            None, "exchange two agents' memories when each one's heading reports continue the other's report track "
+            8.0, "exchange two agents' memories when each one's heading reports continue the other's report track "
             "(a swap of ids, or its undoing, too small for report_jump): half the log-likelihood ratio the two "
             "streams must pass together, each at least a quarter of it (None: never)", range=(0.0, 1000.0))
         exchange_max_agents: int | None = param(
-            None, "run exchange_llr only for teams of at most this many agents (None: any)", range=(1, 1000))
+            7, "run exchange_llr only for teams of at most this many agents (None: any)", range=(1, 1000))
         exchange_accel: float = param(0.1, "exchange_llr's angular-acceleration spectral density of a robot's "
                                       "heading, rad^2/s^3", range=(1e-6, 100.0))
         exchange_lag_s: float = param(0.4, "how far exchange_llr's report tracks run behind the newest report, "
@@ -226,7 +227,14 @@ class SetIdentifier:
                 if self.config.on_jump == "swap":
                     self._swap_jumps(np.flatnonzero(jumped), old, t_sent, jump)
                 else:
-                    self.net.forget(jumped)
+                    self._forget(np.flatnonzero(jumped))
+
+    def _forget(self, agents: np.ndarray) -> None:
+        """Forget the network's memory of ``agents`` (indices) and restart their report tracks (exchange_llr)."""
+        self.net.forget(np.isin(np.arange(self.config.n_agents), agents))
+        if self._exchange is not None:
+            for a in agents.tolist():
+                self._exchange.forget(a)
 
     def _swap_jumps(self, jumped: np.ndarray, old: np.ndarray, t_sent: np.ndarray, jump: float) -> None:
         """``on_jump="swap"``: an agent ``a`` whose reports jumped now reports for the robot that exactly
@@ -246,7 +254,7 @@ class SetIdentifier:
             match[a] = False
             partners = np.flatnonzero(match)
             if len(partners) != 1:
-                self.net.forget(np.array([a]))
+                self._forget(np.array([a]))
                 continue
             b = int(partners[0])
             self.net.swap(a, b)
