@@ -165,8 +165,8 @@ def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
 
 
 def test_stage5_candidates_and_choice():
+    from lookalike.bench.set_select_options import STAGE5_BASELINE, stage5_candidates
     from lookalike.bench.set_select_stage4 import choose_stage4
-    from lookalike.bench.set_select_stage5 import STAGE5_BASELINE, stage5_candidates
 
     cands = stage5_candidates()
     assert STAGE5_BASELINE in cands and cands[STAGE5_BASELINE][1] == {"fp_prior_ref": None}
@@ -177,7 +177,7 @@ def test_stage5_candidates_and_choice():
 
 
 def test_exchange_stages_candidates():
-    from lookalike.bench.set_select_exchange import EXCHANGE_BASELINE, exchange_candidates
+    from lookalike.bench.set_select_options import EXCHANGE_BASELINE, exchange_candidates
 
     for stage, memory, fresh in ((6, None, None), (7, 1.0, None), (8, 1.0, 0.6)):
         cands = exchange_candidates(stage)
@@ -185,7 +185,7 @@ def test_exchange_stages_candidates():
         assert all(o["exchange_memory_s"] == memory and o["exchange_fresh_s"] == fresh for _, o in cands.values())
         assert all(o["exchange_llr"] is None or o["exchange_llr"] > 0 for _, o in cands.values())
 
-    from lookalike.bench.set_select_exchange import stage9_candidates
+    from lookalike.bench.set_select_options import stage9_candidates
 
     options = stage9_candidates()["exchange=8.0,max_agents=7"][1]
     assert options["exchange_llr"] == 8.0 and options["exchange_max_agents"] == 7

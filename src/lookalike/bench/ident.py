@@ -22,7 +22,7 @@ from lookalike.bench.ident_paper import resolve_identifier
 from lookalike.bench.paired import Comparison, PairedDifference, add_comparisons, compare_to_first, rate_difference
 from lookalike.bench.progress import ProgressFactory, Step, no_progress
 from lookalike.bench.results import Results, percent_row_metrics
-from lookalike.eval import identification_success_rate, localisation_error
+from lookalike.eval import identification_counts, identification_success_rate, localisation_error
 from lookalike.learn.checkpoint import CheckpointError
 from lookalike.learn.weights import shipped_weights_path
 from lookalike.loop import RunStats, run
@@ -109,7 +109,7 @@ def run_identifier_by_sequence(name: str, sequences: list[RobotSequence], step: 
 
         run(build_identifier(name, seq, weights), frames, sink, stats=stats)
         truth.extend(seq.true_labels())
-        counts.append(_sequence_counts(predicted[k_seq:], truth[k_seq:]))
+        counts.append(identification_counts(predicted[k_seq:], truth[k_seq:]))
         est.append(positions)
         true_pos.append(seq.true_positions_visible())
         if step is not None:
@@ -120,13 +120,6 @@ def run_identifier_by_sequence(name: str, sequences: list[RobotSequence], step: 
         "fps": stats.fps,
         "detections": float(sum(len(p) for p in predicted)),
     }, counts
-
-
-def _sequence_counts(predicted: list[np.ndarray], truth: list[np.ndarray]) -> tuple[int, int]:
-    """(correct labels, detections) of one sequence's frames (as :func:`identification_success_rate` counts)."""
-    detections = sum(len(p) for p in predicted)
-    correct = sum(int(np.sum(np.asarray(p) == np.asarray(t))) for p, t in zip(predicted, truth))
-    return correct, detections
 
 
 def sequence_seeds(setups: list[str], sequences: int, seed: int = DEFAULT_SEED) -> list[int]:

@@ -20,7 +20,8 @@ seen while swapped or not after the restore (:func:`measurable`); see :func:`cho
 
 ``--stage 4`` chooses among a fourth fine-tuning's snapshots and the pair-swap rule
 (:mod:`lookalike.bench.set_select_stage4`); ``--stage 5`` whether to correct the false-positive probability
-for the world's false-positive rate (:mod:`lookalike.bench.set_select_stage5`).
+for the world's false-positive rate, ``--stage 6`` to ``9`` the report-exchange detector
+(:mod:`lookalike.bench.set_select_options`).
 """
 
 from __future__ import annotations
@@ -333,10 +334,10 @@ def main(argv: list[str] | None = None) -> None:
                         help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from); "
                         "3: the inference options of the shipped weights (RUN: where the scores are kept); "
                         "4: the fourth stage's snapshots x the pair-swap rule (lookalike.bench.set_select_stage4); "
-                        "5: the false-positive prior correction (lookalike.bench.set_select_stage5); "
+                        "5: the false-positive prior correction; "
                         "6-9: the report-exchange detector (7: its evidence decays; 8: and lost bursts leave a "
                         "track out; 9: for teams of up to seven) "
-                        "(lookalike.bench.set_select_exchange)")
+                        "(5-9: lookalike.bench.set_select_options)")
     parser.add_argument("--only", default=None,
                         help="stages 4-9: score this candidate only (e.g. step300,pair=off)")
     parser.add_argument("--cache", type=Path, default=None,
@@ -350,15 +351,10 @@ def main(argv: list[str] | None = None) -> None:
 
         select_stage4(args.run, args.only, args.ship)
         return
-    if args.stage == 5:
-        from lookalike.bench.set_select_stage5 import select_stage5
+    if args.stage >= 5:
+        from lookalike.bench.set_select_options import select_options
 
-        select_stage5(args.run, args.only)
-        return
-    if args.stage in (6, 7, 8, 9):
-        from lookalike.bench.set_select_exchange import select_exchange
-
-        select_exchange(args.run, args.stage, args.only)
+        select_options(args.run, args.stage, args.only)
         return
     select(args.run, args.every, args.baseline, args.ship, args.average_from, args.stage)
 

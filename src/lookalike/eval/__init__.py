@@ -8,6 +8,7 @@ from lookalike.eval.api import METRICS, combine, evaluate_data, evaluate_points,
 from lookalike.eval.data import SequenceData
 from lookalike.eval.identification import (
     identification_by_agent,
+    identification_counts,
     identification_success_rate,
     localisation_coverage,
     localisation_error,
@@ -29,6 +30,7 @@ __all__ = [
     "evaluate_sequence",
     "headline",
     "identification_by_agent",
+    "identification_counts",
     "identification_success_rate",
     "leave_one_out",
     "localisation_coverage",

@@ -32,6 +32,14 @@ def _flatten_labels(predicted: Sequence[np.ndarray], true: Sequence[np.ndarray])
     return cat(p_parts), cat(t_parts)
 
 
+def identification_counts(
+    predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]
+) -> tuple[int, int]:
+    """(correct labels, detections) over all frames: the counts :func:`identification_success_rate` divides."""
+    p, t = _flatten_labels(predicted_labels, true_labels)
+    return int(np.sum(p == t)), int(p.size)
+
+
 def identification_success_rate(
     predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]
 ) -> float:
@@ -39,8 +47,8 @@ def identification_success_rate(
 
     A false positive (true label -1) labelled -1 is correct. NaN when there are no detections.
     """
-    p, t = _flatten_labels(predicted_labels, true_labels)
-    return float(np.mean(p == t)) if p.size else float("nan")
+    correct, detections = identification_counts(predicted_labels, true_labels)
+    return correct / detections if detections else float("nan")
 
 
 def robot_success_rate(predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]) -> float:

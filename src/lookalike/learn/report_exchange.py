@@ -2,7 +2,7 @@
 two headings differ by less than a robot can turn between two reports.
 
 Each agent's reports (absolute heading, radians, at their send time) feed a constant-turn-rate Kalman
-filter that runs ``lag_s`` seconds behind that agent's newest report, so that the reports just after an
+filter that runs ``lag_s`` seconds behind the newest report of any agent, so that the reports just after an
 exchange are compared with heading tracks that have not absorbed them yet. For every new report of agent
 ``a`` and every other agent ``b``, the log-likelihood ratio of "this report continues b's track" over "it
 continues a's own" is summed (a CUSUM: never below 0) and decays with time constant ``memory_s``, so that
@@ -33,7 +33,7 @@ class ReportExchange:
                  fresh_s: float | None = 0.6) -> None:
         """``threshold``: half the log-likelihood ratio the two streams must pass together; ``accel_psd``: spectral
         density of the heading's angular acceleration, rad²/s³; ``lag_s``: how far the tracks run behind the
-        newest report, seconds; ``noise_rad``: a report's heading noise (standard deviation), radians;
+        newest report of any agent, seconds; ``noise_rad``: a report's heading noise (standard deviation), radians;
         ``memory_s``: time constant of the evidence's decay, seconds (None: no decay); ``fresh_s``: a track
         whose newest report is older than ``lag_s`` + ``fresh_s`` seconds takes no part (None: every track)."""
         self.n, self.threshold, self.q, self.lag_s, self.r = n, threshold, accel_psd, lag_s, noise_rad ** 2

@@ -1,0 +1,71 @@
+"""The fifth to ninth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+weights, each stage scored against its candidate with the option off.
+
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 9) scores stage K's candidates
+(:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
+(:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
+and applies the fourth stage's rule against the stage's baseline, as written in
+docs/experiments/any-team-size.md before any of the stage's candidates was scored:
+
+- stage 5: the false-positive prior ``fp_prior_ref`` at each of :data:`STAGE5_FP_PRIOR`;
+- stages 6-8: the report-exchange detector ``exchange_llr`` (6: :data:`STAGE6_EXCHANGE_LLR` without the
+  evidence's decay; 7: :data:`STAGE7_EXCHANGE_LLR` with ``exchange_memory_s`` 1 s; 8: :data:`STAGE8_EXCHANGE_LLR`
+  with that and ``exchange_fresh_s`` 0.6 s);
+- stage 9: the detector at 8 for teams of up to seven agents (``exchange_max_agents``).
+
+A chosen option is made the identifier's default by hand.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from lookalike.bench.set_select_stage4 import print_choice, score_candidates
+from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+
+Candidates = dict[str, tuple[Path, dict[str, object]]]  # name -> (weights, inference options)
+
+STAGE5_FP_PRIOR: tuple[float | None, ...] = (None, 0.7, 1.0, 1.4)
+STAGE5_BASELINE = "fp_prior=off"
+STAGE6_EXCHANGE_LLR: tuple[float | None, ...] = (None, 6.0, 8.0, 12.0)
+STAGE7_EXCHANGE_LLR: tuple[float | None, ...] = (None, 6.0, 8.0, 10.0)
+STAGE8_EXCHANGE_LLR: tuple[float | None, ...] = (None, 8.0, 10.0, 12.0)
+EXCHANGE_BASELINE = "exchange=off"
+# Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
+_EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
+    6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
+
+
+def stage5_candidates() -> Candidates:
+    """Candidate name (``fp_prior=off``, ``fp_prior=1.0``, ...) -> (the shipped weights, inference options)."""
+    return {f"fp_prior={'off' if ref is None else ref}": (SHIPPED_SET_WEIGHTS, {"fp_prior_ref": ref})
+            for ref in STAGE5_FP_PRIOR}
+
+
+def exchange_candidates(stage: int) -> Candidates:
+    """Stage 6, 7 or 8's candidates: name (``exchange=off``, ``exchange=8.0``, ...) -> (the shipped weights,
+    inference options)."""
+    thresholds, memory_s, fresh_s = _EXCHANGE_STAGES[stage]
+    return {f"exchange={'off' if llr is None else llr}":
+            (SHIPPED_SET_WEIGHTS, {"exchange_llr": llr, "exchange_memory_s": memory_s, "exchange_fresh_s": fresh_s})
+            for llr in thresholds}
+
+
+def stage9_candidates() -> Candidates:
+    """The ninth stage's candidates: the detector off, or at 8 for teams of up to seven agents."""
+    return {EXCHANGE_BASELINE: (SHIPPED_SET_WEIGHTS, {"exchange_llr": None}),
+            "exchange=8.0,max_agents=7": (SHIPPED_SET_WEIGHTS, {"exchange_llr": 8.0, "exchange_memory_s": 1.0,
+                                                                "exchange_fresh_s": 0.6, "exchange_max_agents": 7})}
+
+
+def stage_candidates(stage: int) -> tuple[Candidates, str]:
+    """Stage ``stage``'s (5 … 9) candidates and the name of its baseline (the option off)."""
+    if stage == 5:
+        return stage5_candidates(), STAGE5_BASELINE
+    return (stage9_candidates() if stage == 9 else exchange_candidates(stage)), EXCHANGE_BASELINE
+
+
+def select_options(run_dir: Path, stage: int, only: str | None = None) -> str | None:
+    """Score stage ``stage``'s candidates (all, or ``only``), print them and the choice (None: nothing eligible)."""
+    candidates, baseline = stage_candidates(stage)
+    return print_choice(score_candidates(candidates, run_dir / f"set_select_stage{stage}.json", only), baseline)
