@@ -1,0 +1,74 @@
+"""Is ``set``'s recovery after a forced swap no worse than the LSTM's? A non-inferiority test on a large sample.
+
+Runs ``bench recovery``'s experiment (two robots' reports swapped from 5 s for 10 s, the time until the swapped
+run's success on the pair is back within 5% of the clean run's) on ``--sequences`` sequences per set-up, and per
+set-up prints the mean recovery of each identifier and the 95% interval of the mean of candidate − reference
+(seconds, over sequences). The candidate is no worse when the interval's upper end is at most ``--margin``
+seconds (a TARGET line per set-up). A sequence in which an identifier never recovers counts, for that identifier,
+as the longest recovery the sequence can measure (from the restore to the last one-second window). The
+per-sequence seconds are kept in ``--out`` per set-up, so that an interrupted run resumes. The test, its sample
+(seeds 3200000+) and margin are in docs/experiments/any-team-size.md.
+
+    python benchmarks/set_recovery_sample.py --sequences 400 --setups m10n7
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+from _common import report_target
+
+from lookalike.bench.experiments import recovery_runs
+from lookalike.bench.paired import interval_text, mean_difference
+from lookalike.sim import preset, preset_label
+
+
+def censored(seconds: list[float], frames: int, rate_hz: float, swap_at_s: float, swap_s: float) -> list[float]:
+    """Recovery seconds with "never" (inf) replaced by the longest recovery a sequence of ``frames`` frames at
+    ``rate_hz`` can measure: from the restore to the start of its last one-second window."""
+    restore = int(np.ceil((swap_at_s + swap_s) * rate_hz))
+    longest = (frames - int(rate_hz) - restore) / rate_hz
+    return [min(float(s), longest) for s in seconds]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--setups", default="m3n2,m5n3,m10n7")
+    parser.add_argument("--candidate", default="set")
+    parser.add_argument("--reference", default="lstm")
+    parser.add_argument("--sequences", type=int, default=20, help="Per set-up (the test in the docs: 400).")
+    parser.add_argument("--frames", type=int, default=900)
+    parser.add_argument("--seed", type=int, default=3200000)
+    parser.add_argument("--margin", type=float, default=0.15, help="Seconds the candidate may be slower.")
+    parser.add_argument("--out", type=Path, default=Path("runs/set-recovery-sample"))
+    args = parser.parse_args()
+    swap_at_s, swap_s = 5.0, 10.0
+    trackers = [args.candidate, args.reference]
+    args.out.mkdir(parents=True, exist_ok=True)
+    for setup in args.setups.split(","):
+        cache = args.out / f"{setup}-{args.seed}-{args.sequences}x{args.frames}-{'-'.join(trackers)}.json"
+        if cache.exists():
+            seconds = json.loads(cache.read_text())
+        else:
+            _, runs = recovery_runs([setup], trackers, args.sequences, args.frames, swap_at_s, swap_s, args.seed)
+            seconds = {name: runs[(setup, name)] for name in trackers}
+            cache.write_text(json.dumps(seconds))
+        rate = preset(setup).frame_rate_hz
+        values = {name: censored(seconds[name], args.frames, rate, swap_at_s, swap_s) for name in trackers}
+        never = {name: int(np.isinf(seconds[name]).sum()) for name in trackers}
+        diff = mean_difference(values[args.candidate], values[args.reference])
+        label = preset_label(setup)
+        print(f"{label}: {len(values[args.candidate])} sequences measured; mean recovery (s) "
+              + ", ".join(f"{n} {np.mean(values[n]):.3f} (worst {max(values[n]):.2f}, never {never[n]})"
+                          for n in trackers)
+              + f"; {args.candidate} - {args.reference} {diff.difference:+.3f} s ({interval_text(diff, 3)})", flush=True)
+        report_target(f"{args.candidate} recovery no worse than {args.reference}, {label} "
+                      f"(upper end of the 95% interval of the mean difference)", diff.high, args.margin,
+                      higher_is_better=False, unit=" s")
+
+
+if __name__ == "__main__":
+    main()
