@@ -52,7 +52,33 @@ def test_commands_print_and_write_tables(tmp_path):
     r = runner.invoke(app, ["bench", "recovery", "--setups", "m3n2", "--trackers", "kalman_ha2", "--sequences", "1",
                             "--frames", "450", "--swap-at-s", "3", "--swap-s", "5", "--json", str(out)])
     assert r.exit_code == 0, r.output
-    assert "recovery_mean_s" in json.loads(out.read_text())["tables"]["recovery"][0]["metrics"]
+    metrics = json.loads(out.read_text())["tables"]["recovery"][0]["metrics"]
+    assert {"recovery_mean_s", "success_rate_after_restore", "success_rate_after_restore_without_swap"} <= set(metrics)
+
+
+def test_success_after_the_restore_says_how_right_an_identifier_is_not_how_it_compares_with_itself():
+    from lookalike.bench.experiments import swap_recovery
+    from lookalike.sim import preset, simulate_robots
+
+    seq = simulate_robots(preset("m3n2"), 300, 55_001)
+    original = [f.beacons.agent_id for f in seq.frames()]
+
+    def keeps_the_swap(s, frames):  # right without the swap; with it, the pair's labels exchanged from then on
+        truth = s.true_labels()
+        moved = [k for k, f in enumerate(frames) if (f.beacons.agent_id != original[k]).any()]
+        if not moved:
+            return truth
+        a, b = sorted(set().union(*(original[k][frames[k].beacons.agent_id != original[k]].tolist() for k in moved)))
+        return [t if k < moved[0] else np.where(t == a, b, np.where(t == b, a, t)) for k, t in enumerate(truth)]
+
+    def confused(s, frames):  # every robot labelled as the next one, with or without the swap
+        return [np.where(t >= 0, (t + 1) % s.config.n_agents, t) for t in s.true_labels()]
+
+    run = swap_recovery(keeps_the_swap, seq, 2.0, 3.0)
+    assert run.while_swapped < 0.1 and run.clean_while_swapped == 1.0  # from the first swapped report on
+    assert run.after_restore == 0.0 and run.clean_after_restore == 1.0 and run.recovery_s == float("inf")
+    run = swap_recovery(confused, seq, 2.0, 3.0)
+    assert run.recovery_s == 0.0 and run.after_restore == 0.0 == run.clean_after_restore
 
 
 def test_swapped_pair_is_the_two_most_seen_robots():

@@ -6,18 +6,21 @@ Shuffle: the identifiers on frames fed in random order. A method that really use
 Recovery: the heading reports of two robots are swapped for ``swap_s`` seconds, so the identifiers
 learn wrong identities, then restored. The two are, per sequence, the robots detected most often
 from the swap's start to 3 s after the restore (so that there is something to recover). Reported:
-the success rate on those two robots' detections while swapped (without the swap, for comparison),
-and how long after the restore their success rate over a one-second window is back within 5 points
-of the same run without the swap. A sequence whose pair is not detected while swapped or not after the
-restore (:func:`measurable`, from the truth alone) has nothing to recover from and is left out; the
-table says how many sequences were measured. :func:`recovery_differences` compares each identifier's mean recovery
-time with the first one's on the same sequences (95% interval over sequences; :mod:`lookalike.bench.paired`).
+the success rate on those two robots' detections while swapped and in the 3 s after the restore (each
+also without the swap, for comparison), and how long after the restore their success rate over a
+one-second window is back within 5 points of the same run without the swap. The recovery time compares
+each identifier with itself: one that confuses the pair without the swap too recovers at once; the
+success after the restore says how right it is. A sequence whose pair is not detected while swapped or
+not after the restore (:func:`measurable`, from the truth alone) has nothing to recover from and is left
+out; the table says how many sequences were measured. :func:`recovery_differences` compares each
+identifier's mean recovery time with the first one's on the same sequences (95% interval over sequences;
+:mod:`lookalike.bench.paired`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -125,20 +128,36 @@ def shuffle_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int,
     return rows
 
 
+class SwapRun(NamedTuple):
+    """One sequence of :func:`swap_recovery`: success on the swapped pair (fractions; NaN: the pair unseen)
+    while swapped and in the :data:`AFTER_S` seconds after the restore, each also without the swap, and the
+    recovery seconds (inf: never)."""
+
+    while_swapped: float
+    clean_while_swapped: float
+    recovery_s: float
+    after_restore: float
+    clean_after_restore: float
+
+
+AFTER_S = 3.0  # seconds after the restore that pick the pair and give the success after the restore
+
+
 def swap_recovery(labels: Callable[[RobotSequence, list[Frame]], list[np.ndarray]], seq: RobotSequence,
-                  swap_at_s: float, swap_s: float) -> tuple[float, float, float]:
-    """(success while swapped, same without the swap, recovery seconds; inf: never) of one sequence
-    whose two robots seen most swap reports from ``swap_at_s`` for ``swap_s`` seconds, ``labels``
-    giving an identifier's per-frame labels of a sequence's frames."""
+                  swap_at_s: float, swap_s: float) -> SwapRun:
+    """:class:`SwapRun` of one sequence whose two robots seen most swap reports from ``swap_at_s`` for
+    ``swap_s`` seconds, ``labels`` giving an identifier's per-frame labels of a sequence's frames."""
     rate = seq.config.frame_rate_hz
     fs = list(seq.frames())
     truth = seq.true_labels()
     start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
-    pair = most_seen_pair(truth[start : restore + int(3 * rate)], seq.config.n_agents)
+    after = restore + int(AFTER_S * rate)
+    pair = most_seen_pair(truth[start:after], seq.config.n_agents)
     clean = pair_hits(labels(seq, fs), truth, pair)
     swapped = pair_hits(labels(seq, swap_reports(fs, swap_at_s, swap_at_s + swap_s, pair)), truth, pair)
-    return (hit_rate(swapped[start:restore]), hit_rate(clean[start:restore]),
-            recovery_s(clean, swapped, restore, int(rate), rate))
+    return SwapRun(hit_rate(swapped[start:restore]), hit_rate(clean[start:restore]),
+                   recovery_s(clean, swapped, restore, int(rate), rate),
+                   hit_rate(swapped[restore:after]), hit_rate(clean[restore:after]))
 
 
 def measurable(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 10.0) -> bool:
@@ -148,7 +167,7 @@ def measurable(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 
     rate = sequence.config.frame_rate_hz
     truth = sequence.true_labels()
     start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
-    a, b = most_seen_pair(truth[start : restore + int(3 * rate)], sequence.config.n_agents)
+    a, b = most_seen_pair(truth[start : restore + int(AFTER_S * rate)], sequence.config.n_agents)
 
     def seen(frames: list[np.ndarray]) -> bool:
         return any(((t == a) | (t == b)).any() for t in frames)
@@ -156,9 +175,15 @@ def measurable(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 
     return seen(truth[start:restore]) and seen(truth[restore:])
 
 
-def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float) -> tuple[float, float, float]:
+def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float) -> SwapRun:
     """:func:`swap_recovery` of the registered identifier ``name``."""
     return swap_recovery(lambda s, fs: identify(name, s, fs), seq, swap_at_s, swap_s)
+
+
+def _seen_mean(rates: np.ndarray) -> float:
+    """Mean of the sequences' success rates where the pair was seen (NaN: nowhere)."""
+    seen = rates[np.isfinite(rates)]
+    return float(seen.mean()) if seen.size else float("nan")
 
 
 def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,
@@ -183,14 +208,17 @@ def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int
     for setup in setups:
         measured = [q for q in _sequences(setup, sequences, frames, seed) if measurable(q, swap_at_s, swap_s)]
         for name in trackers:
-            runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s) for seq in measured]).reshape(-1, 3)
+            width = len(SwapRun._fields)
+            runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s) for seq in measured]).reshape(-1, width)
             seconds[(setup, name)] = [float(v) for v in runs[:, 2]]
             if not len(runs):  # nothing measurable: NaN figures, said by the count
-                runs = np.full((1, 3), np.nan)
+                runs = np.full((1, width), np.nan)
             rows.append({
                 "Setup": preset_label(setup), "Tracker": name,
                 "Swapped robots while swapped (%)": round(100 * float(np.mean(runs[:, 0])), 1),
                 "Same without swap (%)": round(100 * float(np.mean(runs[:, 1])), 1),
+                "After the restore, 3 s (%)": round(100 * _seen_mean(runs[:, 3]), 1),
+                "Same without swap, after (%)": round(100 * _seen_mean(runs[:, 4]), 1),
                 "Recovery, mean (s)": round(float(np.mean(runs[:, 2])), 2),
                 "Recovery, worst (s)": round(float(np.max(runs[:, 2])), 2),
                 "Sequences measured": len(measured),
@@ -210,7 +238,10 @@ def recovery_differences(seconds: dict[tuple[str, str], list[float]], setups: Se
 
 EXPERIMENT_KEYS = {"In order (%)": "success_rate_in_order", "Random order (%)": "success_rate_random_order",
                    "Swapped robots while swapped (%)": "success_rate_while_swapped",
-                   "Same without swap (%)": "success_rate_without_swap", "Sequences measured": "sequences_measured"}
+                   "Same without swap (%)": "success_rate_without_swap",
+                   "After the restore, 3 s (%)": "success_rate_after_restore",
+                   "Same without swap, after (%)": "success_rate_after_restore_without_swap",
+                   "Sequences measured": "sequences_measured"}
 
 
 def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[str], sequences: int, frames: int,
@@ -230,6 +261,6 @@ def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[s
     return doc
 
 
-__all__ = ["DEFAULT_SEED", "EXPERIMENT_KEYS", "experiment_results", "hit_rate", "most_seen_pair", "pair_hits",
-           "recovery_differences", "recovery_rows", "recovery_runs", "recovery_s", "reindex", "shuffle_rows",
-           "swap_reports"]
+__all__ = ["AFTER_S", "DEFAULT_SEED", "EXPERIMENT_KEYS", "SwapRun", "experiment_results", "hit_rate",
+           "most_seen_pair", "pair_hits", "recovery_differences", "recovery_rows", "recovery_runs", "recovery_s",
+           "reindex", "shuffle_rows", "swap_recovery", "swap_reports"]

@@ -119,7 +119,8 @@ def set_recovery_s(weights: Path, sequence: RobotSequence, swap_at_s: float = RE
                    swap_s: float = RECOVERY_SWAP[1], options: dict[str, object] | None = None) -> float:
     """Seconds ``set`` with ``weights`` (and inference ``options``) takes to recover after ``bench
     recovery``'s swap of the two robots seen most (inf: never), measured as ``bench recovery`` does."""
-    return swap_recovery(lambda s, fs: _labels(weights, s, fs, **(options or {})), sequence, swap_at_s, swap_s)[2]
+    return swap_recovery(lambda s, fs: _labels(weights, s, fs, **(options or {})), sequence, swap_at_s,
+                         swap_s).recovery_s
 
 
 def recovery_sequences() -> dict[str, list[RobotSequence]]:
