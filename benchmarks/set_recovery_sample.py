@@ -21,17 +21,9 @@ from pathlib import Path
 import numpy as np
 from _common import report_target
 
-from lookalike.bench.experiments import recovery_runs
+from lookalike.bench.experiments import longest_recovery_s, recovery_runs
 from lookalike.bench.paired import interval_text, mean_difference
 from lookalike.sim import preset, preset_label
-
-
-def censored(seconds: list[float], frames: int, rate_hz: float, swap_at_s: float, swap_s: float) -> list[float]:
-    """Recovery seconds with "never" (inf) replaced by the longest recovery a sequence of ``frames`` frames at
-    ``rate_hz`` can measure: from the restore to the start of its last one-second window."""
-    restore = int(np.ceil((swap_at_s + swap_s) * rate_hz))
-    longest = (frames - int(rate_hz) - restore) / rate_hz
-    return [min(float(s), longest) for s in seconds]
 
 
 def main() -> None:
@@ -57,8 +49,8 @@ def main() -> None:
             kept = {"seconds": {name: runs[(setup, name)] for name in trackers}, "rows": rows}
             cache.write_text(json.dumps(kept))
         seconds = kept["seconds"]
-        rate = preset(setup).frame_rate_hz
-        values = {name: censored(seconds[name], args.frames, rate, swap_at_s, swap_s) for name in trackers}
+        longest = longest_recovery_s(args.frames, preset(setup).frame_rate_hz, swap_at_s, swap_s)
+        values = {name: [min(s, longest) for s in seconds[name]] for name in trackers}  # never: the longest
         never = {name: int(np.isinf(seconds[name]).sum()) for name in trackers}
         diff = mean_difference(values[args.candidate], values[args.reference])
         label = preset_label(setup)

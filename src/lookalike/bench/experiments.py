@@ -143,6 +143,18 @@ class SwapRun(NamedTuple):
 AFTER_S = 3.0  # seconds after the restore that pick the pair and give the success after the restore
 
 
+def swap_frames(rate_hz: float, swap_at_s: float, swap_s: float) -> tuple[int, int, int]:
+    """Frame indices of the swap's start, of the restore and :data:`AFTER_S` seconds after it."""
+    restore = int(np.ceil((swap_at_s + swap_s) * rate_hz))
+    return int(swap_at_s * rate_hz), restore, restore + int(AFTER_S * rate_hz)
+
+
+def longest_recovery_s(frames: int, rate_hz: float, swap_at_s: float, swap_s: float) -> float:
+    """The longest finite recovery (seconds) :func:`swap_recovery` can measure in a sequence of ``frames``
+    frames: from the restore to the start of its last one-second window."""
+    return (frames - int(rate_hz) - swap_frames(rate_hz, swap_at_s, swap_s)[1]) / rate_hz
+
+
 def swap_recovery(labels: Callable[[RobotSequence, list[Frame]], list[np.ndarray]], seq: RobotSequence,
                   swap_at_s: float, swap_s: float) -> SwapRun:
     """:class:`SwapRun` of one sequence whose two robots seen most swap reports from ``swap_at_s`` for
@@ -150,8 +162,7 @@ def swap_recovery(labels: Callable[[RobotSequence, list[Frame]], list[np.ndarray
     rate = seq.config.frame_rate_hz
     fs = list(seq.frames())
     truth = seq.true_labels()
-    start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
-    after = restore + int(AFTER_S * rate)
+    start, restore, after = swap_frames(rate, swap_at_s, swap_s)
     pair = most_seen_pair(truth[start:after], seq.config.n_agents)
     clean = pair_hits(labels(seq, fs), truth, pair)
     swapped = pair_hits(labels(seq, swap_reports(fs, swap_at_s, swap_at_s + swap_s, pair)), truth, pair)
@@ -166,8 +177,8 @@ def measurable(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 
     truth alone: the same for every identifier."""
     rate = sequence.config.frame_rate_hz
     truth = sequence.true_labels()
-    start, restore = int(swap_at_s * rate), int(np.ceil((swap_at_s + swap_s) * rate))
-    a, b = most_seen_pair(truth[start : restore + int(AFTER_S * rate)], sequence.config.n_agents)
+    start, restore, after = swap_frames(rate, swap_at_s, swap_s)
+    a, b = most_seen_pair(truth[start:after], sequence.config.n_agents)
 
     def seen(frames: list[np.ndarray]) -> bool:
         return any(((t == a) | (t == b)).any() for t in frames)
@@ -207,20 +218,21 @@ def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int
     step = progress("bench recovery", len(setups) * len(trackers))
     for setup in setups:
         measured = [q for q in _sequences(setup, sequences, frames, seed) if measurable(q, swap_at_s, swap_s)]
+        width = len(SwapRun._fields)
         for name in trackers:
-            width = len(SwapRun._fields)
             runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s) for seq in measured]).reshape(-1, width)
-            seconds[(setup, name)] = [float(v) for v in runs[:, 2]]
+            seconds[(setup, name)] = [float(v) for v in runs[:, SwapRun._fields.index("recovery_s")]]
             if not len(runs):  # nothing measurable: NaN figures, said by the count
                 runs = np.full((1, width), np.nan)
+            run = dict(zip(SwapRun._fields, runs.T))  # field -> its value in each sequence
             rows.append({
                 "Setup": preset_label(setup), "Tracker": name,
-                "Swapped robots while swapped (%)": round(100 * float(np.mean(runs[:, 0])), 1),
-                "Same without swap (%)": round(100 * float(np.mean(runs[:, 1])), 1),
-                "After the restore, 3 s (%)": round(100 * _seen_mean(runs[:, 3]), 1),
-                "Same without swap, after (%)": round(100 * _seen_mean(runs[:, 4]), 1),
-                "Recovery, mean (s)": round(float(np.mean(runs[:, 2])), 2),
-                "Recovery, worst (s)": round(float(np.max(runs[:, 2])), 2),
+                "Swapped robots while swapped (%)": round(100 * float(np.mean(run["while_swapped"])), 1),
+                "Same without swap (%)": round(100 * float(np.mean(run["clean_while_swapped"])), 1),
+                "After the restore, 3 s (%)": round(100 * _seen_mean(run["after_restore"]), 1),
+                "Same without swap, after (%)": round(100 * _seen_mean(run["clean_after_restore"]), 1),
+                "Recovery, mean (s)": round(float(np.mean(run["recovery_s"])), 2),
+                "Recovery, worst (s)": round(float(np.max(run["recovery_s"])), 2),
                 "Sequences measured": len(measured),
             })
             step()
@@ -262,5 +274,5 @@ def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[s
 
 
 __all__ = ["AFTER_S", "DEFAULT_SEED", "EXPERIMENT_KEYS", "SwapRun", "experiment_results", "hit_rate",
-           "most_seen_pair", "pair_hits", "recovery_differences", "recovery_rows", "recovery_runs", "recovery_s",
-           "reindex", "shuffle_rows", "swap_recovery", "swap_reports"]
+           "longest_recovery_s", "most_seen_pair", "pair_hits", "recovery_differences", "recovery_rows",
+           "recovery_runs", "recovery_s", "reindex", "shuffle_rows", "swap_frames", "swap_recovery", "swap_reports"]
