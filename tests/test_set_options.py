@@ -102,6 +102,48 @@ def test_a_report_swap_exchanges_or_forgets_the_memories(shipped, on_jump, excha
         quiet.update(f)
 
 
+def three_robot_frames(report_heading, n_frames: int = 120) -> list[Frame]:
+    """Three robots standing apart, seen with headings 0, 2.0 and 2.3 rad; agent ``a`` reports
+    ``report_heading(a, t)`` at 10 Hz in frames ``k % 3 == a`` (so no two agents report in one frame)."""
+    places, seen = np.array([[2.0, 0.5], [3.0, -1.0], [4.0, 1.0]]), np.array([0.0, 2.0, 2.3])
+    out = []
+    for k in range(n_frames):
+        t, a = k / RATE, k % 3
+        beacons = Beacons(agent_id=np.array([a]), t_sent=np.array([t]), t_received=np.array([t]),
+                          heading=np.array([report_heading(a, t)]))
+        out.append(Frame(index=k, time=t, detections=Detections(position=places.copy(), heading=seen.copy(),
+                                                                score=np.full(3, 0.9)), beacons=beacons))
+    return out
+
+
+def test_jump_pair_s_pairs_two_ambiguous_jumps_that_mirror_each_other(shipped):
+    """Agents 0 and 1 swap ids at 1.5 s; agent 0's jump to 2.0 rad could be for robot 1 or 2 (2.3 rad): at
+    once it is forgotten, with jump_pair_s it waits for agent 1's mirroring jump and the two swap memories.
+    A lone jump with no mirror is forgotten once jump_pair_s has passed."""
+    from lookalike.trackers import make_tracker
+
+    own = np.array([0.0, 2.0, 2.3])
+    swapped = lambda a, t: own[{0: 1, 1: 0}.get(a, a)] if t >= 1.5 else own[a]  # noqa: E731
+    lone = lambda a, t: 2.15 if a == 0 and t >= 1.5 else own[a]  # noqa: E731
+    for report, wait, expected in ((swapped, None, ["forget", "forget"]), (swapped, 1.0, ["swap"]),
+                                   (lone, 1.0, ["forget"])):
+        tracker = make_tracker("set", n_agents=3, n_slots=3, exchange_llr=None, jump_pair_s=wait)
+        calls = []
+        for name in ("swap", "forget"):
+            method = getattr(tracker.net, name)
+            setattr(tracker.net, name, lambda *a, m=method, n=name: (calls.append((n, tracker._last_time)), m(*a)))
+        before = None
+        for f in three_robot_frames(report):
+            if before is None and f.time >= 1.5:
+                before = tracker.net.p.copy()
+            tracker.update(f)
+        assert [n for n, _ in calls] == expected
+        if expected == ["swap"]:  # agent 0 now remembers where robot 1 stands, and agent 1 robot 0
+            assert np.allclose(tracker.net.p[[0, 1]], before[[1, 0]], atol=0.3)
+        if report is lone:
+            assert calls[0][1] > 1.5 + wait  # forgotten only when no mirroring jump came in time
+
+
 def test_stage3_choice_needs_the_small_team_up_and_nothing_else_down():
     from lookalike.bench.set_select import choose_stage3
 

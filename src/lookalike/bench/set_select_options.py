@@ -1,7 +1,7 @@
-"""The fifth to ninth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+"""The fifth to tenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 9) scores stage K's candidates
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
 (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
@@ -11,7 +11,8 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
 - stages 6-8: the report-exchange detector ``exchange_llr`` (6: :data:`STAGE6_EXCHANGE_LLR` without the
   evidence's decay; 7: :data:`STAGE7_EXCHANGE_LLR` with ``exchange_memory_s`` 1 s; 8: :data:`STAGE8_EXCHANGE_LLR`
   with that and ``exchange_fresh_s`` 0.6 s);
-- stage 9: the detector at 8 for teams of up to seven agents (``exchange_max_agents``).
+- stage 9: the detector at 8 for teams of up to seven agents (``exchange_max_agents``);
+- stage 10: pairing two report jumps that mirror each other (``jump_pair_s`` at each of :data:`STAGE10_JUMP_PAIR`).
 
 A chosen option is made the identifier's default by hand.
 """
@@ -31,6 +32,8 @@ STAGE6_EXCHANGE_LLR: tuple[float | None, ...] = (None, 6.0, 8.0, 12.0)
 STAGE7_EXCHANGE_LLR: tuple[float | None, ...] = (None, 6.0, 8.0, 10.0)
 STAGE8_EXCHANGE_LLR: tuple[float | None, ...] = (None, 8.0, 10.0, 12.0)
 EXCHANGE_BASELINE = "exchange=off"
+STAGE10_JUMP_PAIR: tuple[float | None, ...] = (None, 1.0)
+STAGE10_BASELINE = "jump_pair=off"
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -58,10 +61,18 @@ def stage9_candidates() -> Candidates:
                                                                 "exchange_fresh_s": 0.6, "exchange_max_agents": 7})}
 
 
+def stage10_candidates() -> Candidates:
+    """The tenth stage's candidates: name (``jump_pair=off``, ``jump_pair=1.0``) -> (the shipped weights, options)."""
+    return {f"jump_pair={'off' if s is None else s}": (SHIPPED_SET_WEIGHTS, {"jump_pair_s": s})
+            for s in STAGE10_JUMP_PAIR}
+
+
 def stage_candidates(stage: int) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 9) candidates and the name of its baseline (the option off)."""
+    """Stage ``stage``'s (5 … 10) candidates and the name of its baseline (the option off)."""
     if stage == 5:
         return stage5_candidates(), STAGE5_BASELINE
+    if stage == 10:
+        return stage10_candidates(), STAGE10_BASELINE
     return (stage9_candidates() if stage == 9 else exchange_candidates(stage)), EXCHANGE_BASELINE
 
 

@@ -85,6 +85,11 @@ class SetIdentifier:
         on_jump: str = param("swap", "after a report jump (report_jump): forget the agent's memory, or swap "
                              "it with the one other agent that reported the new heading just before (forget: "
                              "no such agent or several)", choices=("forget", "swap"))
+        jump_pair_s: float | None = param(
+            None, "on_jump=swap: an agent whose report jump has no single partner waits this many seconds for a "
+            "jump that mirrors it (another agent now reporting the heading it reported before, and the reverse), "
+            "then exchanges memories with that agent; forgotten when none comes (None: forgotten at once)",
+            range=(0.0, 100.0))
         pair_swap: float | None = param(
             None, "exchange two agents' memories (and this frame's labels) when the evidence that each one's "
             "detection fits the other's fresh report better than its own, summed over frames with decay "
@@ -137,6 +142,7 @@ class SetIdentifier:
         self.last_probabilities = np.zeros(0)
         self._last_time = -np.inf
         self._expected_jump: dict[int, float] = {}
+        self._pending: dict[int, tuple[float, float, float]] = {}  # jump_pair_s: agent -> (old, new heading, time)
         self._pair_evidence = np.zeros((n, n))
         self.pair_swaps = 0  # memories exchanged by pair_swap so far (for tests and analysis)
         self.fp_rate = self.config.fp_prior_ref  # running mean of false positives per frame (fp_prior_ref)
@@ -228,6 +234,13 @@ class SetIdentifier:
                     self._swap_jumps(np.flatnonzero(jumped), old, t_sent, jump)
                 else:
                     self._forget(np.flatnonzero(jumped))
+        if self._pending:
+            assert self.config.jump_pair_s is not None
+            expired = [a for a, (_, _, t) in self._pending.items() if self._last_time - t > self.config.jump_pair_s]
+            for a in expired:
+                del self._pending[a]
+            if expired:
+                self._forget(np.array(expired))
 
     def _forget(self, agents: np.ndarray) -> None:
         """Forget the network's memory of ``agents`` (indices) and restart their report tracks (exchange_llr)."""
@@ -249,21 +262,48 @@ class SetIdentifier:
                 continue
             if now[a] - self._expected_jump.pop(a, -np.inf) <= 1.0:
                 continue  # the second half of a swap already made
-            turn = np.abs(np.angle(np.exp(1j * (self._beacons.heading[a] - old))))
+            new = float(self._beacons.heading[a])
+            self._pending.pop(a, None)
+            b = self._mirror(a, float(old[a]), new, float(now[a]), jump)
+            if b is not None:
+                self._exchange_memories(a, b)
+                continue
+            turn = np.abs(np.angle(np.exp(1j * (new - old))))
             match = np.isfinite(old) & (turn <= jump + self.config.turn_rate * np.abs(now[a] - t_sent))
             match[a] = False
             partners = np.flatnonzero(match)
             if len(partners) != 1:
-                self._forget(np.array([a]))
+                if self.config.jump_pair_s is None:
+                    self._forget(np.array([a]))
+                else:
+                    self._pending[a] = (float(old[a]), new, float(now[a]))
                 continue
             b = int(partners[0])
-            self.net.swap(a, b)
-            if self._exchange is not None:
-                self._exchange.swap(a, b)
+            self._exchange_memories(a, b)
             if b in jumped:
                 done.add(b)
             else:
                 self._expected_jump[b] = now[a]
+
+    def _mirror(self, a: int, old: float, new: float, t: float, jump: float) -> int | None:
+        """``jump_pair_s``: the waiting agent whose jump mirrors agent ``a``'s jump from heading ``old`` to
+        ``new`` (radians) at ``t`` seconds: it now reports ``old`` and reported ``new`` before, each within
+        ``jump`` + ``turn_rate`` · the time between the two jumps (the closest of several; None: none)."""
+        best, best_error = None, np.inf
+        for c, (old_c, new_c, t_c) in self._pending.items():
+            tolerance = jump + self.config.turn_rate * abs(t - t_c)
+            errors = np.abs(np.angle(np.exp(1j * np.array([new - old_c, new_c - old]))))
+            if errors.max() <= tolerance and errors.sum() < best_error:
+                best, best_error = c, float(errors.sum())
+        if best is not None:
+            del self._pending[best]
+        return best
+
+    def _exchange_memories(self, a: int, b: int) -> None:
+        """Exchange agents ``a`` and ``b``'s memories (the network's and the exchange detector's tracks)."""
+        self.net.swap(a, b)
+        if self._exchange is not None:
+            self._exchange.swap(a, b)
 
     def _report_exchanges(self, frame: Frame) -> None:
         """``exchange_llr``: feed the frame's reports to the exchange detector
@@ -281,6 +321,7 @@ class SetIdentifier:
                 self.exchanges += 1
                 for j in pair:
                     self._expected_jump[j] = t_sent
+                    self._pending.pop(j, None)
 
     def _pair_swaps(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, age: np.ndarray,
                     dt: float) -> np.ndarray:
