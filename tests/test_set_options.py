@@ -131,7 +131,8 @@ def test_jump_pair_s_pairs_two_ambiguous_jumps_that_mirror_each_other(shipped):
         calls = []
         for name in ("swap", "forget"):
             method = getattr(tracker.net, name)
-            setattr(tracker.net, name, lambda *a, m=method, n=name: (calls.append((n, tracker._last_time)), m(*a)))
+            setattr(tracker.net, name,
+                    lambda *a, m=method, n=name, c=calls, t=tracker: (c.append((n, t._last_time)), m(*a)))
         before = None
         for f in three_robot_frames(report):
             if before is None and f.time >= 1.5:
@@ -231,3 +232,11 @@ def test_exchange_stages_candidates():
 
     options = stage9_candidates()["exchange=8.0,max_agents=7"][1]
     assert options["exchange_llr"] == 8.0 and options["exchange_max_agents"] == 7
+
+
+def test_stage10_candidates():
+    from lookalike.bench.set_select_options import STAGE10_BASELINE, stage_candidates
+
+    cands, baseline = stage_candidates(10)
+    assert baseline == STAGE10_BASELINE and cands[baseline][1] == {"jump_pair_s": None}
+    assert {o["jump_pair_s"] for _, o in cands.values()} == {None, 1.0}

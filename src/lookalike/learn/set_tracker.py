@@ -11,7 +11,8 @@ localiser as the LSTM identifier's, fed with the detection labelled ``j`` and it
 An agent whose reported heading jumps by more than a robot can turn between two of its reports
 (``report_jump`` + ``turn_rate`` · gap, radians) now reports for another robot (ids swapped or
 restored), so what the network remembers of it follows the wrong one: its memory is exchanged with
-the one other agent that reported that heading just before (``on_jump="swap"``), else forgotten.
+the one other agent that reported that heading just before (``on_jump="swap"``), else forgotten, or with
+``jump_pair_s`` exchanged with the agent whose jump mirrors it (the second half of a swap) when that comes in time.
 An agent whose report is older than ``stale_s`` seconds while a detection near its remembered
 position has turned away from that report is shown to the network as not heard from (its memory
 still places it). Both were chosen on tuning sequences (docs/experiments/any-team-size.md).
