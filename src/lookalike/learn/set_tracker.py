@@ -12,7 +12,8 @@ An agent whose reported heading jumps by more than a robot can turn between two 
 (``report_jump`` + ``turn_rate`` · gap, radians) now reports for another robot (ids swapped or
 restored), so what the network remembers of it follows the wrong one: its memory is exchanged with
 the one other agent that reported that heading just before (``on_jump="swap"``), else forgotten, or with
-``jump_pair_s`` exchanged with the agent whose jump mirrors it (the second half of a swap) when that comes in time.
+``jump_pair_s`` (1 s) exchanged with the agent whose jump mirrors it (the second half of a swap) when that comes in
+time (chosen on a development sample, docs/experiments/any-team-size.md, "An eleventh stage").
 An agent whose report is older than ``stale_s`` seconds while a detection near its remembered
 position has turned away from that report is shown to the network as not heard from (its memory
 still places it). Both were chosen on tuning sequences (docs/experiments/any-team-size.md).
@@ -87,7 +88,7 @@ class SetIdentifier:
                              "it with the one other agent that reported the new heading just before (forget: "
                              "no such agent or several)", choices=("forget", "swap"))
         jump_pair_s: float | None = param(
-            None, "on_jump=swap: an agent whose report jump has no single partner waits this many seconds for a "
+            1.0, "on_jump=swap: an agent whose report jump has no single partner waits this many seconds for a "
             "jump that mirrors it (another agent now reporting the heading it reported before, and the reverse), "
             "then exchanges memories with that agent; forgotten when none comes (None: forgotten at once)",
             range=(0.0, 100.0))
