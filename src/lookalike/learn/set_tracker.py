@@ -256,7 +256,8 @@ class SetIdentifier:
         one other agent ``b`` reported for just before (within ``jump`` + ``turn_rate`` · the time between
         the two reports): ids swapped, or a swap undone. The two agents' memories are exchanged, and
         ``b``'s own jump, expected within a second, changes nothing more. An agent with no such partner,
-        or several, is forgotten."""
+        or several, is forgotten; with ``jump_pair_s`` it waits that long for a jump that mirrors its own
+        (:meth:`_mirror`, looked for before the partner), and exchanges memories with that agent."""
         now = self._beacons.t_sent
         done: set[int] = set()
         for a in jumped.tolist():
