@@ -7,9 +7,10 @@ the swap), and the 95% interval of the mean of candidate − reference (seconds,
 no worse when the interval's upper end is at most ``--margin`` seconds (a TARGET line per set-up). A sequence in
 which an identifier never recovers counts, for that identifier, as the longest recovery the sequence can measure
 (from the restore to the last one-second window). The figures are kept in ``--out`` per set-up, so that an
-interrupted run resumes. The test, its sample (seeds 3200000+) and margin are in docs/experiments/any-team-size.md.
+interrupted run resumes. The test, its samples (seeds 3200000+, and 3300000+ for the identifier of the eleventh
+stage) and margin are in docs/experiments/any-team-size.md.
 
-    python benchmarks/set_recovery_sample.py --sequences 400 --setups m10n7
+    python benchmarks/set_recovery_sample.py --sequences 400 --seed 3300000 --setups m10n7
 """
 
 from __future__ import annotations
