@@ -35,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike.geometry.angles import wrap_angle
 from lookalike.learn.checkpoint import CheckpointError
 from lookalike.learn.report_exchange import ReportExchange
 from lookalike.learn.set_data import agent_tokens, detection_tokens
@@ -239,9 +240,9 @@ class SetIdentifier:
         if self._pending:
             assert self.config.jump_pair_s is not None
             expired = [a for a, (_, _, t) in self._pending.items() if self._last_time - t > self.config.jump_pair_s]
-            for a in expired:
-                del self._pending[a]
             if expired:
+                for a in expired:
+                    del self._pending[a]
                 self._forget(np.array(expired))
 
     def _forget(self, agents: np.ndarray) -> None:
@@ -295,7 +296,7 @@ class SetIdentifier:
         best, best_error = None, np.inf
         for c, (old_c, new_c, t_c) in self._pending.items():
             tolerance = jump + self.config.turn_rate * abs(t - t_c)
-            errors = np.abs(np.angle(np.exp(1j * np.array([new - old_c, new_c - old]))))
+            errors = np.abs(wrap_angle(np.array([new - old_c, new_c - old])))
             if errors.max() <= tolerance and errors.sum() < best_error:
                 best, best_error = c, float(errors.sum())
         if best is not None:
