@@ -1,7 +1,7 @@
-"""The fifth to tenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+"""The fifth to twelfth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10) scores stage K's candidates
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
 (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
@@ -12,7 +12,10 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
   evidence's decay; 7: :data:`STAGE7_EXCHANGE_LLR` with ``exchange_memory_s`` 1 s; 8: :data:`STAGE8_EXCHANGE_LLR`
   with that and ``exchange_fresh_s`` 0.6 s);
 - stage 9: the detector at 8 for teams of up to seven agents (``exchange_max_agents``);
-- stage 10: pairing two report jumps that mirror each other (``jump_pair_s`` at each of :data:`STAGE10_JUMP_PAIR`).
+- stage 10: pairing two report jumps that mirror each other (``jump_pair_s`` at each of :data:`STAGE10_JUMP_PAIR`);
+- stage 12: the exchange detector's heading model (``exchange_accel``, ``exchange_lag_s`` at each of
+  :data:`STAGE12_EXCHANGE_MOTION`); its rule keeps only the fourth stage's guard on the tuning sequences
+  (:func:`passes_guard`) and chooses on a development sample (``benchmarks/set_recovery_sample.py``).
 
 A chosen option is made the identifier's default by hand.
 """
@@ -20,6 +23,8 @@ A chosen option is made the identifier's default by hand.
 from __future__ import annotations
 
 from pathlib import Path
+
+import numpy as np
 
 from lookalike.bench.set_select_stage4 import print_choice, score_candidates
 from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
@@ -34,6 +39,9 @@ STAGE8_EXCHANGE_LLR: tuple[float | None, ...] = (None, 8.0, 10.0, 12.0)
 EXCHANGE_BASELINE = "exchange=off"
 STAGE10_JUMP_PAIR: tuple[float | None, ...] = (None, 1.0)
 STAGE10_BASELINE = "jump_pair=off"
+# Stage 12: (exchange_accel rad^2/s^3, exchange_lag_s s); the first is the shipped detector's.
+STAGE12_EXCHANGE_MOTION: tuple[tuple[float, float], ...] = ((0.1, 0.4), (0.03, 0.3), (0.05, 0.2), (0.03, 0.2))
+STAGE12_BASELINE = "exchange_motion=0.1/0.4"
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -67,8 +75,26 @@ def stage10_candidates() -> Candidates:
             for s in STAGE10_JUMP_PAIR}
 
 
+def stage12_candidates() -> Candidates:
+    """The twelfth stage's candidates: name (``exchange_motion=0.03/0.3``: angular-acceleration density and lag)
+    -> (the shipped weights, inference options)."""
+    return {f"exchange_motion={accel}/{lag}": (SHIPPED_SET_WEIGHTS, {"exchange_accel": accel, "exchange_lag_s": lag})
+            for accel, lag in STAGE12_EXCHANGE_MOTION}
+
+
+def passes_guard(row: dict[str, float], base: dict[str, float]) -> bool:
+    """The fourth stage's guard: every tuning team at least the baseline's success less 0.05 points, and every
+    tuning recovery mean at most the baseline's plus 0.02 s."""
+    teams = [k for k in base if not k.startswith(("rec_", "worst_"))]
+    recs = [k for k in base if k.startswith("rec_")]
+    return (all(row[k] >= base[k] - 0.05 for k in teams)
+            and all(np.isfinite(row[k]) and row[k] <= base[k] + 0.02 for k in recs))
+
+
 def stage_candidates(stage: int) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 10) candidates and the name of its baseline (the option off)."""
+    """Stage ``stage``'s (5 … 10, 12) candidates and the name of its baseline (the option off)."""
+    if stage == 12:
+        return stage12_candidates(), STAGE12_BASELINE
     if stage == 5:
         return stage5_candidates(), STAGE5_BASELINE
     if stage == 10:
@@ -79,4 +105,12 @@ def stage_candidates(stage: int) -> tuple[Candidates, str]:
 def select_options(run_dir: Path, stage: int, only: str | None = None) -> str | None:
     """Score stage ``stage``'s candidates (all, or ``only``), print them and the choice (None: nothing eligible)."""
     candidates, baseline = stage_candidates(stage)
-    return print_choice(score_candidates(candidates, run_dir / f"set_select_stage{stage}.json", only), baseline)
+    rows = score_candidates(candidates, run_dir / f"set_select_stage{stage}.json", only)
+    if stage != 12:
+        return print_choice(rows, baseline)
+    if baseline not in rows:
+        print("the baseline is not scored yet")
+        return None
+    kept = [name for name, row in rows.items() if name != baseline and passes_guard(row, rows[baseline])]
+    print("pass the tuning guard (the development sample decides among them): " + (", ".join(kept) or "none"))
+    return None
