@@ -6,11 +6,13 @@ set-up prints each identifier's mean recovery, its success on the pair in the 3 
 the swap), and the 95% interval of the mean of candidate − reference (seconds, over sequences). The candidate is
 no worse when the interval's upper end is at most ``--margin`` seconds (a TARGET line per set-up). A sequence in
 which an identifier never recovers counts, for that identifier, as the longest recovery the sequence can measure
-(from the restore to the last one-second window). The figures are kept in ``--out`` per set-up, so that an
-interrupted run resumes. The test, its samples (seeds 3200000+, and 3300000+ for the identifier of the eleventh
-stage) and margin are in docs/experiments/any-team-size.md.
+(from the restore to the last one-second window). ``--candidate-options`` (JSON) gives the candidate parameters
+other than its defaults (a development sample's candidates). The figures are kept in ``--out`` per set-up and
+identifier, so that an interrupted run resumes and a reference runs once for several candidates. The test, its
+samples (seeds 3200000+, 3300000+ for the identifier of the eleventh stage, 3400000+ for the twelfth's) and
+margin are in docs/experiments/any-team-size.md.
 
-    python benchmarks/set_recovery_sample.py --sequences 400 --seed 3300000 --setups m10n7
+    python benchmarks/set_recovery_sample.py --sequences 400 --seed 3400000 --setups m10n7
 """
 
 from __future__ import annotations
@@ -31,6 +33,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--setups", default="m3n2,m5n3,m10n7")
     parser.add_argument("--candidate", default="set")
+    parser.add_argument("--candidate-options", type=json.loads, default={},
+                        help='JSON of the candidate\'s parameters, e.g. \'{"exchange_lag_s": 0.3}\'')
     parser.add_argument("--reference", default="lstm")
     parser.add_argument("--sequences", type=int, default=20, help="Per set-up (the test in the docs: 400).")
     parser.add_argument("--frames", type=int, default=900)
@@ -41,15 +45,19 @@ def main() -> None:
     swap_at_s, swap_s = 5.0, 10.0
     trackers = [args.candidate, args.reference]
     args.out.mkdir(parents=True, exist_ok=True)
+    options = {args.candidate: args.candidate_options}
     for setup in args.setups.split(","):
-        cache = args.out / f"{setup}-{args.seed}-{args.sequences}x{args.frames}-{'-'.join(trackers)}.json"
-        if cache.exists():
-            kept = json.loads(cache.read_text())
-        else:
-            rows, runs = recovery_runs([setup], trackers, args.sequences, args.frames, swap_at_s, swap_s, args.seed)
-            kept = {"seconds": {name: runs[(setup, name)] for name in trackers}, "rows": rows}
-            cache.write_text(json.dumps(kept))
-        seconds = kept["seconds"]
+        kept: dict[str, dict] = {}  # identifier -> its recovery seconds per sequence and its row
+        for name in trackers:
+            tag = "".join(f",{k}={v}" for k, v in sorted((options.get(name) or {}).items()))
+            cache = args.out / f"{setup}-{args.seed}-{args.sequences}x{args.frames}-{name}{tag}.json"
+            if not cache.exists():
+                rows, runs = recovery_runs([setup], [name], args.sequences, args.frames, swap_at_s, swap_s,
+                                           args.seed, options=options)
+                cache.write_text(json.dumps({"seconds": runs[(setup, name)], "row": rows[0],
+                                             "options": options.get(name) or {}}))
+            kept[name] = json.loads(cache.read_text())
+        seconds = {name: kept[name]["seconds"] for name in trackers}
         longest = longest_recovery_s(args.frames, preset(setup).frame_rate_hz, swap_at_s, swap_s)
         values = {name: [min(s, longest) for s in seconds[name]] for name in trackers}  # never: the longest
         never = {name: int(np.isinf(seconds[name]).sum()) for name in trackers}
@@ -60,7 +68,7 @@ def main() -> None:
                           for n in trackers)
               + f"; {args.candidate} - {args.reference} {diff.difference:+.3f} s ({interval_text(diff, 3)})",
               flush=True)
-        for row in kept["rows"]:
+        for row in (kept[name]["row"] for name in trackers):
             print(f"  {row['Tracker']}: success on the pair in the 3 s after the restore "
                   f"{row['After the restore, 3 s (%)']}% ({row['Same without swap, after (%)']}% without the swap)")
         report_target(f"{args.candidate} recovery no worse than {args.reference}, {label} "

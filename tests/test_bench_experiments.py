@@ -121,6 +121,11 @@ def test_recovery_leaves_out_sequences_with_nothing_to_measure(monkeypatch):
     rows, seconds = experiments.recovery_runs(["m3n2"], ["kalman_ha"], 2, 300, 2.0, 3.0)
     assert rows[0]["Sequences measured"] == 1
     assert len(seconds[("m3n2", "kalman_ha")]) == 1
+    built: list[dict] = []
+    monkeypatch.setattr(experiments, "identify", lambda name, s, fs, options=None: (
+        built.append({"name": name, **(options or {})}), [np.full(len(f.detections), -1) for f in fs])[1])
+    experiments.recovery_runs(["m3n2"], ["kalman_ha", "lstm"], 2, 300, 2.0, 3.0, options={"kalman_ha": {"gate": 2}})
+    assert {"name": "kalman_ha", "gate": 2} in built and {"name": "lstm"} in built  # options go to their identifier
     monkeypatch.setattr(experiments, "measurable", lambda q, *a: False)
     rows, _ = experiments.recovery_runs(["m3n2"], ["kalman_ha"], 2, 300, 2.0, 3.0)
     assert rows[0]["Sequences measured"] == 0 and np.isnan(rows[0]["Recovery, mean (s)"])

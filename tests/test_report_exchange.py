@@ -106,6 +106,16 @@ def test_set_exchange_variant_is_set_with_the_detector_on_for_any_team():
     assert build_identifier("set", seq).config.exchange_max_agents == 7
 
 
+def test_options_override_an_identifiers_parameters():
+    from lookalike.bench.ident import build_identifier
+
+    seq = simulate_robots(preset("m5n3"), 30, 1)
+    tracker = build_identifier("set-exchange", seq, options={"exchange_llr": 6.0, "exchange_lag_s": 0.3})
+    assert tracker.config.exchange_llr == 6.0 and tracker.config.exchange_lag_s == 0.3
+    assert tracker.config.exchange_max_agents is None  # the variant's own, kept
+    assert build_identifier("set-exchange", seq).config.exchange_llr == 8.0  # the variant is unchanged
+
+
 def test_exchange_max_agents_leaves_larger_teams_without_the_detector():
     small = make_tracker("set", n_agents=7, exchange_llr=8.0, exchange_max_agents=7)
     large = make_tracker("set", n_agents=8, exchange_llr=8.0, exchange_max_agents=7)

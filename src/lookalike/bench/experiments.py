@@ -19,7 +19,7 @@ identifier's mean recovery time with the first one's on the same sequences (95% 
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -186,9 +186,10 @@ def measurable(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 
     return seen(truth[start:restore]) and seen(truth[restore:])
 
 
-def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float) -> SwapRun:
-    """:func:`swap_recovery` of the registered identifier ``name``."""
-    return swap_recovery(lambda s, fs: identify(name, s, fs), seq, swap_at_s, swap_s)
+def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float,
+                  options: Mapping[str, Any] | None = None) -> SwapRun:
+    """:func:`swap_recovery` of the registered identifier ``name`` (with ``options``, its parameters)."""
+    return swap_recovery(lambda s, fs: identify(name, s, fs, options=options), seq, swap_at_s, swap_s)
 
 
 def _seen_mean(rates: np.ndarray) -> float:
@@ -207,10 +208,11 @@ def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int
 
 
 def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,
-                  swap_s: float, seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress
+                  swap_s: float, seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress,
+                  options: Mapping[str, Mapping[str, Any]] | None = None
                   ) -> tuple[list[dict[str, Any]], dict[tuple[str, str], list[float]]]:
     """:func:`recovery_rows`'s rows and, per (set-up, identifier), the recovery seconds of each sequence
-    (inf: never), for :func:`recovery_differences`."""
+    (inf: never), for :func:`recovery_differences`; ``options``: identifier -> its parameters (default: none)."""
     rows = []
     seconds: dict[tuple[str, str], list[float]] = {}
     for setup in setups:
@@ -220,7 +222,8 @@ def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int
         measured = [q for q in _sequences(setup, sequences, frames, seed) if measurable(q, swap_at_s, swap_s)]
         width = len(SwapRun._fields)
         for name in trackers:
-            runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s) for seq in measured]).reshape(-1, width)
+            runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s, (options or {}).get(name))
+                             for seq in measured]).reshape(-1, width)
             seconds[(setup, name)] = [float(v) for v in runs[:, SwapRun._fields.index("recovery_s")]]
             if not len(runs):  # nothing measurable: NaN figures, said by the count
                 runs = np.full((1, width), np.nan)

@@ -13,7 +13,7 @@ difference in points, 95% interval over sequences; :mod:`lookalike.bench.paired`
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -58,11 +58,14 @@ def weights_missing(name: str, n_agents: int, n_slots: int, weights: str | None 
     return False
 
 
-def build_identifier(name: str, sequence: RobotSequence, weights: str | None = None) -> Any:
+def build_identifier(name: str, sequence: RobotSequence, weights: str | None = None,
+                     options: Mapping[str, Any] | None = None) -> Any:
     """Tracker ``name`` (or a variant of :data:`~lookalike.bench.ident_paper.IDENT_VARIANTS`)
     configured for the sequence's N (and M for trackers with slots); ``weights``: exported network
-    weights (.npz) for our protocol's LSTM rows instead of the shipped ones."""
+    weights (.npz) for our protocol's LSTM rows instead of the shipped ones; ``options``: more of the
+    tracker's parameters (they override the variant's)."""
     base, extra = resolve_identifier(name)
+    extra.update(options or {})
     if weights and uses_weights(name):
         extra["weights"] = weights
     known = {p.name for p in tracker_parameters(base)}
@@ -72,11 +75,11 @@ def build_identifier(name: str, sequence: RobotSequence, weights: str | None = N
 
 
 def identify(name: str, sequence: RobotSequence, frames: Sequence[Frame] | None = None,
-             stats: RunStats | None = None) -> list[np.ndarray]:
+             stats: RunStats | None = None, options: Mapping[str, Any] | None = None) -> list[np.ndarray]:
     """Per frame, the agent label of each detection (-1: false positive) given by identifier ``name``
-    run over ``frames`` (default: the sequence's own)."""
+    (with ``options`` as in :func:`build_identifier`) run over ``frames`` (default: the sequence's own)."""
     labels: list[np.ndarray] = []
-    tracker = build_identifier(name, sequence)
+    tracker = build_identifier(name, sequence, options=options)
     run(tracker, sequence.frames() if frames is None else frames,
         lambda f, tracks: labels.append(labels_from_tracks(len(f.detections), tracks)), stats=stats)
     return labels
