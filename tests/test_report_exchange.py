@@ -33,6 +33,28 @@ def test_an_exchange_too_small_for_a_report_jump_is_found_soon(gap):
     assert 5.0 <= t < 6.0 and set(pair) == {0, 1}
 
 
+def _crossing(seconds: float = 10.0, seed: int = 0, rate: float = 0.5, gap: float = 0.25):
+    """Reports of two robots (10 Hz, 2° noise) that from 5 s turn smoothly at ``rate`` rad/s onto each other's
+    heading, ``gap`` rad apart: no exchange of ids. Yields (agent, t_sent, heading) in send order."""
+    rng = np.random.default_rng(seed)
+    for k in range(int(seconds * 10)):
+        for robot in (0, 1):
+            t = 0.1 * k + 0.03 * robot
+            turned = rate * np.clip(t - 5.0, 0.0, gap / rate)
+            yield robot, t, (turned if robot == 0 else gap - turned) + rng.normal(0.0, np.radians(2.0))
+
+
+def test_a_step_gate_tells_an_exchange_from_a_smooth_crossing():
+    def detector(step_rad):
+        return ReportExchange(2, threshold=8.0, accel_psd=0.03, lag_s=0.3, step_rad=step_rad)
+
+    for seed in (1, 2, 3):  # a model tight enough to take these smooth crossings for exchanges
+        assert len(_firings(detector(None), _crossing(seed=seed))) == 1
+        assert _firings(detector(0.12), _crossing(seed=seed)) == []
+    fired = _firings(detector(0.12), _streams(0.25, exchange_at=5.0))
+    assert len(fired) == 1 and 5.0 <= fired[0][0] < 6.0
+
+
 def test_no_exchange_no_firing_and_a_lone_jump_is_not_an_exchange():
     assert _firings(ReportExchange(2, threshold=8.0), _streams(0.25, exchange_at=None)) == []
     det = ReportExchange(2, threshold=8.0)

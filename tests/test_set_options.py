@@ -240,3 +240,16 @@ def test_stage10_candidates():
     cands, baseline = stage_candidates(10)
     assert baseline == STAGE10_BASELINE and cands[baseline][1] == {"jump_pair_s": None}
     assert {o["jump_pair_s"] for _, o in cands.values()} == {None, 1.0}
+
+
+def test_stage12_and_13_candidates_and_the_guard():
+    from lookalike.bench.set_select_options import passes_guard, stage_candidates
+
+    cands, baseline = stage_candidates(12)
+    assert cands[baseline][1] == {"exchange_accel": 0.1, "exchange_lag_s": 0.4}  # the shipped detector's
+    cands, baseline = stage_candidates(13)
+    assert cands[baseline][1] == {} and {o.get("exchange_step_rad") for _, o in cands.values()} == {None, 0.08, 0.12}
+    base = {"m3n2": 98.9, "m5n3": 98.2, "rec_m3n2": 0.1, "worst_m3n2": 0.3}
+    assert passes_guard({**base, "m3n2": 98.86, "rec_m3n2": 0.12}, base)
+    assert not passes_guard({**base, "m3n2": 98.84}, base)  # a team more than 0.05 points below
+    assert not passes_guard({**base, "rec_m3n2": 0.13}, base)  # recovery more than 0.02 s slower

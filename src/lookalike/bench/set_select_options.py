@@ -1,7 +1,7 @@
-"""The fifth to twelfth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+"""The fifth to thirteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12) scores stage K's candidates
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12, 13) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
 (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
@@ -15,7 +15,9 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
 - stage 10: pairing two report jumps that mirror each other (``jump_pair_s`` at each of :data:`STAGE10_JUMP_PAIR`);
 - stage 12: the exchange detector's heading model (``exchange_accel``, ``exchange_lag_s`` at each of
   :data:`STAGE12_EXCHANGE_MOTION`); its rule keeps only the fourth stage's guard on the tuning sequences
-  (:func:`passes_guard`) and chooses on a development sample (``benchmarks/set_recovery_sample.py``).
+  (:func:`passes_guard`) and chooses on a development sample (``benchmarks/set_recovery_sample.py``);
+- stage 13: the same with the tighter heading model and a step gate (``exchange_step_rad`` at each of
+  :data:`STAGE13_EXCHANGE_STEP`), the same rule.
 
 A chosen option is made the identifier's default by hand.
 """
@@ -42,6 +44,9 @@ STAGE10_BASELINE = "jump_pair=off"
 # Stage 12: (exchange_accel rad^2/s^3, exchange_lag_s s); the first is the shipped detector's.
 STAGE12_EXCHANGE_MOTION: tuple[tuple[float, float], ...] = ((0.1, 0.4), (0.03, 0.3), (0.05, 0.2), (0.03, 0.2))
 STAGE12_BASELINE = "exchange_motion=0.1/0.4"
+# Stage 13: exchange_step_rad (rad) with exchange_accel 0.03 rad^2/s^3 and exchange_lag_s 0.3 s, against the shipped.
+STAGE13_EXCHANGE_STEP: tuple[float, ...] = (0.08, 0.12)
+STAGE13_BASELINE = "shipped"
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -82,6 +87,15 @@ def stage12_candidates() -> Candidates:
             for accel, lag in STAGE12_EXCHANGE_MOTION}
 
 
+def stage13_candidates() -> Candidates:
+    """The thirteenth stage's candidates: the shipped identifier, and name (``exchange=0.03/0.3,step=0.08``) ->
+    (the shipped weights, inference options)."""
+    options = {f"exchange=0.03/0.3,step={step}": {"exchange_accel": 0.03, "exchange_lag_s": 0.3,
+                                                   "exchange_step_rad": step} for step in STAGE13_EXCHANGE_STEP}
+    return {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, {})} | {
+        name: (SHIPPED_SET_WEIGHTS, extra) for name, extra in options.items()}
+
+
 def passes_guard(row: dict[str, float], base: dict[str, float]) -> bool:
     """The fourth stage's guard: every tuning team at least the baseline's success less 0.05 points, and every
     tuning recovery mean at most the baseline's plus 0.02 s."""
@@ -92,9 +106,11 @@ def passes_guard(row: dict[str, float], base: dict[str, float]) -> bool:
 
 
 def stage_candidates(stage: int) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 10, 12) candidates and the name of its baseline (the option off)."""
+    """Stage ``stage``'s (5 … 10, 12, 13) candidates and the name of its baseline (the option off)."""
     if stage == 12:
         return stage12_candidates(), STAGE12_BASELINE
+    if stage == 13:
+        return stage13_candidates(), STAGE13_BASELINE
     if stage == 5:
         return stage5_candidates(), STAGE5_BASELINE
     if stage == 10:
@@ -106,7 +122,7 @@ def select_options(run_dir: Path, stage: int, only: str | None = None) -> str | 
     """Score stage ``stage``'s candidates (all, or ``only``), print them and the choice (None: nothing eligible)."""
     candidates, baseline = stage_candidates(stage)
     rows = score_candidates(candidates, run_dir / f"set_select_stage{stage}.json", only)
-    if stage != 12:
+    if stage < 12:
         return print_choice(rows, baseline)
     if baseline not in rows:
         print("the baseline is not scored yet")

@@ -11,7 +11,10 @@ that has had no report for a while (a lost burst) takes no part. When the sums o
 ``(b, a)`` together pass twice ``threshold`` and each passes a quarter of it, each stream continues the
 other's track (a robot that starts to turn just then may fit neither, so one stream can carry most of the
 evidence): the two tracks are exchanged and the pair is returned. One stream alone (a robot turning fast)
-does not pass, as the other keeps fitting its own track.
+does not pass, as the other keeps fitting its own track. With ``step_rad``, an exchange also needs both
+streams to have stepped within the last ``step_window_s`` seconds: a report that departs by more than
+``step_rad`` from the agent's previous report carried on at its track's turn rate. An exchange of ids is such a
+step in both streams at once; two robots that turn smoothly onto each other's headings are not.
 """
 
 from __future__ import annotations
@@ -30,12 +33,13 @@ class ReportExchange:
 
     def __init__(self, n: int, threshold: float, accel_psd: float = 0.1, lag_s: float = 0.4,
                  noise_rad: float = float(np.radians(2.0)), memory_s: float | None = 1.0,
-                 fresh_s: float | None = 0.6) -> None:
+                 fresh_s: float | None = 0.6, step_rad: float | None = None, step_window_s: float = 1.0) -> None:
         """``threshold``: half the log-likelihood ratio the two streams must pass together; ``accel_psd``: spectral
         density of the heading's angular acceleration, rad²/s³; ``lag_s``: how far the tracks run behind the
         newest report of any agent, seconds; ``noise_rad``: a report's heading noise (standard deviation), radians;
         ``memory_s``: time constant of the evidence's decay, seconds (None: no decay); ``fresh_s``: a track
-        whose newest report is older than ``lag_s`` + ``fresh_s`` seconds takes no part (None: every track)."""
+        whose newest report is older than ``lag_s`` + ``fresh_s`` seconds takes no part (None: every track);
+        ``step_rad``: the step both streams need within ``step_window_s`` seconds, radians (None: none needed)."""
         self.n, self.threshold, self.q, self.lag_s, self.r = n, threshold, accel_psd, lag_s, noise_rad ** 2
         self.memory_s = memory_s
         self.oldest = np.inf if fresh_s is None else lag_s + fresh_s  # oldest usable track, seconds
@@ -46,6 +50,9 @@ class ReportExchange:
         self.newest = np.full(n, -np.inf)  # send time of each agent's newest report
         self.queue: list[deque[tuple[float, float]]] = [deque() for _ in range(n)]
         self.evidence = np.zeros((n, n))  # [a, b]: evidence that a's reports continue b's track
+        self.step_rad, self.step_window_s = step_rad, step_window_s
+        self.last = np.full((n, 2), np.nan)  # each agent's newest report: send time (s), heading (rad)
+        self.stepped = np.full(n, -np.inf)  # send time of each agent's newest step
 
     def _predict(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Every track's heading (rad) and its variance plus the report noise at time ``t`` (NaN: none)."""
@@ -76,6 +83,7 @@ class ReportExchange:
         if not (t_sent > self.newest[a] and np.isfinite(heading)):
             return None
         self.newest[a] = t_sent
+        self._note_step(a, t_sent, heading)
         if t_sent > self.clock:
             if np.isfinite(self.clock) and self.memory_s is not None:
                 self.evidence *= np.exp(-(t_sent - self.clock) / self.memory_s)
@@ -98,11 +106,22 @@ class ReportExchange:
         row[known] = np.maximum(row[known] + gain[known], 0.0)
         col = self.evidence[:, a]
         both = known & (row + col > 2 * self.threshold) & (np.minimum(row, col) > self.threshold / 4)
+        if self.step_rad is not None:
+            both &= (t_sent - self.stepped <= self.step_window_s) & (t_sent - self.stepped[a] <= self.step_window_s)
         if not both.any():
             return None
         b = int(np.argmax(np.where(both, row + col, -np.inf)))
         self.swap(a, b)
         return a, b
+
+    def _note_step(self, a: int, t_sent: float, heading: float) -> None:
+        """Keep agent ``a``'s newest report and note a step (see the module) at ``t_sent``."""
+        t_last, h_last = self.last[a]
+        if self.step_rad is not None and np.isfinite(t_last):
+            rate = 0.0 if np.isnan(self.t[a]) else self.x[a, 1]
+            if abs(float(_wrap(np.asarray(heading - h_last - rate * (t_sent - t_last))))) > self.step_rad:
+                self.stepped[a] = t_sent
+        self.last[a] = t_sent, heading
 
     def swap(self, a: int, b: int) -> None:
         """Exchange the tracks of agents ``a`` and ``b`` and clear their evidence: their report streams now
@@ -114,6 +133,7 @@ class ReportExchange:
         self.queue[b].clear()
         self.evidence[[a, b], :] = 0.0
         self.evidence[:, [a, b]] = 0.0
+        self.stepped[[a, b]] = -np.inf
 
     def forget(self, a: int) -> None:
         """Start agent ``a``'s track afresh from its next report (its reports now come from a robot no other
@@ -122,3 +142,4 @@ class ReportExchange:
         self.queue[a].clear()
         self.evidence[a, :] = 0.0
         self.evidence[:, a] = 0.0
+        self.last[a], self.stepped[a] = np.nan, -np.inf

@@ -119,6 +119,10 @@ class SetIdentifier:
         exchange_fresh_s: float | None = param(
             0.6, "exchange_llr leaves out an agent whose report track has had no report for exchange_lag_s + this "
             "many seconds (a lost burst; None: never, the sixth and seventh stages' detector)", range=(0.0, 1e4))
+        exchange_step_rad: float | None = param(
+            None, "exchange_llr exchanges two agents only when both their report streams stepped by more than this "
+            "within the last second (a report off the previous one carried on at the track's turn rate), radians "
+            "(None: no step needed)", range=(0.0, 3.2))
         exchange_noise_rad: float = param(0.035, "a heading report's noise for exchange_llr (standard deviation), "
                                           "radians", range=(1e-4, 3.0))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
@@ -153,7 +157,7 @@ class SetIdentifier:
         too_many = cfg.exchange_max_agents is not None and n > cfg.exchange_max_agents
         self._exchange = None if cfg.exchange_llr is None or too_many else ReportExchange(
             n, cfg.exchange_llr, cfg.exchange_accel, cfg.exchange_lag_s, cfg.exchange_noise_rad,
-            cfg.exchange_memory_s, cfg.exchange_fresh_s)
+            cfg.exchange_memory_s, cfg.exchange_fresh_s, cfg.exchange_step_rad)
         self.exchanges = 0  # memories exchanged by exchange_llr so far (for tests and analysis)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
