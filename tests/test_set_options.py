@@ -243,7 +243,8 @@ def test_stage10_candidates():
 
 
 def test_stage12_and_13_candidates_and_the_guard():
-    from lookalike.bench.set_select_options import passes_guard, stage_candidates
+    from lookalike.bench.set_select_options import stage_candidates
+    from lookalike.bench.set_select_stage4 import passes_guard
 
     cands, baseline = stage_candidates(12)
     assert cands[baseline][1] == {"exchange_accel": 0.1, "exchange_lag_s": 0.4}  # the shipped detector's

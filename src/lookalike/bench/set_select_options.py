@@ -26,9 +26,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
-from lookalike.bench.set_select_stage4 import print_choice, score_candidates
+from lookalike.bench.set_select_stage4 import passes_guard, print_choice, score_candidates
 from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
 
 Candidates = dict[str, tuple[Path, dict[str, object]]]  # name -> (weights, inference options)
@@ -90,19 +88,11 @@ def stage12_candidates() -> Candidates:
 def stage13_candidates() -> Candidates:
     """The thirteenth stage's candidates: the shipped identifier, and name (``exchange=0.03/0.3,step=0.08``) ->
     (the shipped weights, inference options)."""
-    options = {f"exchange=0.03/0.3,step={step}": {"exchange_accel": 0.03, "exchange_lag_s": 0.3,
-                                                   "exchange_step_rad": step} for step in STAGE13_EXCHANGE_STEP}
-    return {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, {})} | {
-        name: (SHIPPED_SET_WEIGHTS, extra) for name, extra in options.items()}
-
-
-def passes_guard(row: dict[str, float], base: dict[str, float]) -> bool:
-    """The fourth stage's guard: every tuning team at least the baseline's success less 0.05 points, and every
-    tuning recovery mean at most the baseline's plus 0.02 s."""
-    teams = [k for k in base if not k.startswith(("rec_", "worst_"))]
-    recs = [k for k in base if k.startswith("rec_")]
-    return (all(row[k] >= base[k] - 0.05 for k in teams)
-            and all(np.isfinite(row[k]) and row[k] <= base[k] + 0.02 for k in recs))
+    candidates: Candidates = {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, {})}
+    for step in STAGE13_EXCHANGE_STEP:
+        candidates[f"exchange=0.03/0.3,step={step}"] = (
+            SHIPPED_SET_WEIGHTS, {"exchange_accel": 0.03, "exchange_lag_s": 0.3, "exchange_step_rad": step})
+    return candidates
 
 
 def stage_candidates(stage: int) -> tuple[Candidates, str]:

@@ -55,6 +55,15 @@ def stage4_candidates(run_dir: Path) -> dict[str, tuple[Path, dict[str, object]]
     return {candidate_name(w, ps): (path, {"pair_swap": ps}) for w, path in weights.items() for ps in STAGE4_PAIR_SWAP}
 
 
+def passes_guard(row: dict[str, float], base: dict[str, float]) -> bool:
+    """The fourth stage's guard: every tuning team at least the baseline's success less 0.05 points, and every
+    tuning recovery mean at most the baseline's plus 0.02 s (rows as in :func:`choose_stage4`)."""
+    teams = [k for k in base if not k.startswith(("rec_", "worst_"))]
+    recs = [k for k in base if k.startswith("rec_")]
+    return (all(row[k] >= base[k] - 0.05 for k in teams)
+            and all(np.isfinite(row[k]) and row[k] <= base[k] + 0.02 for k in recs))
+
+
 def choose_stage4(rows: dict[str, dict[str, float]], baseline: str = BASELINE) -> str | None:
     """The stage-4 choice among ``rows`` (candidate -> tuning success per team in % and ``rec_<setup>`` /
     ``worst_<setup>`` recovery seconds), ``baseline`` one of its keys: see :data:`STAGE4_RULE`; None when
@@ -68,9 +77,7 @@ def choose_stage4(rows: dict[str, dict[str, float]], baseline: str = BASELINE) -
         return float(np.mean([r[k] for k in recs]))
 
     def eligible(r: dict[str, float]) -> bool:
-        kept = (all(r[k] >= base[k] - 0.05 for k in teams)
-                and all(np.isfinite(r[k]) and r[k] <= base[k] + 0.02 for k in recs))
-        return kept and (r["m3n2"] >= base["m3n2"] + 0.05 or mean_rec(r) <= mean_rec(base) - 0.03)
+        return passes_guard(r, base) and (r["m3n2"] >= base["m3n2"] + 0.05 or mean_rec(r) <= mean_rec(base) - 0.03)
 
     return best_choice(rows, [p for p, r in rows.items() if p != baseline and eligible(r)], recs, others)
 
