@@ -4,6 +4,7 @@ and the third stage's rule that chooses them on tuning sequences."""
 import numpy as np
 import pytest
 
+from lookalike.trackers import make_tracker
 from lookalike.types import Beacons, Detections, Frame
 
 RATE = 30.0
@@ -254,3 +255,11 @@ def test_stage12_and_13_candidates_and_the_guard():
     assert passes_guard({**base, "m3n2": 98.86, "rec_m3n2": 0.12}, base)
     assert not passes_guard({**base, "m3n2": 98.84}, base)  # a team more than 0.05 points below
     assert not passes_guard({**base, "rec_m3n2": 0.13}, base)  # recovery more than 0.02 s slower
+
+
+def test_exchange_tight_agents_changes_the_detector_of_larger_teams_only():
+    small = make_tracker("set", n_agents=4, exchange_tight_agents=5)
+    large = make_tracker("set", n_agents=5, exchange_tight_agents=5)
+    assert (small._exchange.q, small._exchange.lag_s) == (0.1, 0.4)  # exchange_accel, exchange_lag_s
+    assert (large._exchange.q, large._exchange.lag_s) == (0.03, 0.3)  # exchange_tight_accel, exchange_tight_lag_s
+    assert make_tracker("set", n_agents=8, exchange_tight_agents=5)._exchange is None  # exchange_max_agents 7

@@ -1,7 +1,7 @@
-"""The fifth to thirteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+"""The fifth to fourteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12, 13) scores stage K's candidates
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 14) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
 (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
@@ -17,7 +17,9 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
   :data:`STAGE12_EXCHANGE_MOTION`); its rule keeps only the fourth stage's guard on the tuning sequences
   (:func:`passes_guard`) and chooses on a development sample (``benchmarks/set_recovery_sample.py``);
 - stage 13: the same with the tighter heading model and a step gate (``exchange_step_rad`` at each of
-  :data:`STAGE13_EXCHANGE_STEP`), the same rule.
+  :data:`STAGE13_EXCHANGE_STEP`), the same rule;
+- stage 14: the tighter heading model for teams of at least :data:`STAGE14_TIGHT_AGENTS` agents only
+  (``exchange_tight_agents``), the same rule.
 
 A chosen option is made the identifier's default by hand.
 """
@@ -45,6 +47,7 @@ STAGE12_BASELINE = "exchange_motion=0.1/0.4"
 # Stage 13: exchange_step_rad (rad) with exchange_accel 0.03 rad^2/s^3 and exchange_lag_s 0.3 s, against the shipped.
 STAGE13_EXCHANGE_STEP: tuple[float, ...] = (0.08, 0.12)
 STAGE13_BASELINE = "shipped"
+STAGE14_TIGHT_AGENTS = 5  # exchange_tight_agents: teams of 5-7 agents use exchange_accel 0.03, exchange_lag_s 0.3
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -96,11 +99,14 @@ def stage13_candidates() -> Candidates:
 
 
 def stage_candidates(stage: int) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 10, 12, 13) candidates and the name of its baseline (the option off)."""
+    """Stage ``stage``'s (5 … 10, 12 … 14) candidates and the name of its baseline (the option off)."""
     if stage == 12:
         return stage12_candidates(), STAGE12_BASELINE
     if stage == 13:
         return stage13_candidates(), STAGE13_BASELINE
+    if stage == 14:
+        return {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, {}), f"exchange_tight_agents={STAGE14_TIGHT_AGENTS}": (
+            SHIPPED_SET_WEIGHTS, {"exchange_tight_agents": STAGE14_TIGHT_AGENTS})}, STAGE13_BASELINE
     if stage == 5:
         return stage5_candidates(), STAGE5_BASELINE
     if stage == 10:

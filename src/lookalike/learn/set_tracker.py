@@ -119,6 +119,13 @@ class SetIdentifier:
         exchange_fresh_s: float | None = param(
             0.6, "exchange_llr leaves out an agent whose report track has had no report for exchange_lag_s + this "
             "many seconds (a lost burst; None: never, the sixth and seventh stages' detector)", range=(0.0, 1e4))
+        exchange_tight_agents: int | None = param(
+            None, "teams of at least this many agents run exchange_llr with exchange_tight_accel and "
+            "exchange_tight_lag_s instead of exchange_accel and exchange_lag_s (None: never)", range=(1, 1000))
+        exchange_tight_accel: float = param(0.03, "exchange_accel for teams of exchange_tight_agents or more, "
+                                            "rad^2/s^3", range=(1e-6, 100.0))
+        exchange_tight_lag_s: float = param(0.3, "exchange_lag_s for teams of exchange_tight_agents or more, "
+                                            "seconds", range=(0.0, 10.0))
         exchange_step_rad: float | None = param(
             None, "exchange_llr exchanges two agents only when both their report streams stepped by more than this "
             "within the last second (a report off the previous one carried on at the track's turn rate), radians "
@@ -155,9 +162,12 @@ class SetIdentifier:
         self.fp_rate = self.config.fp_prior_ref  # running mean of false positives per frame (fp_prior_ref)
         cfg = self.config
         too_many = cfg.exchange_max_agents is not None and n > cfg.exchange_max_agents
+        tight = cfg.exchange_tight_agents is not None and n >= cfg.exchange_tight_agents
+        accel, lag = (cfg.exchange_tight_accel, cfg.exchange_tight_lag_s) if tight else (cfg.exchange_accel,
+                                                                                          cfg.exchange_lag_s)
         self._exchange = None if cfg.exchange_llr is None or too_many else ReportExchange(
-            n, cfg.exchange_llr, cfg.exchange_accel, cfg.exchange_lag_s, cfg.exchange_noise_rad,
-            cfg.exchange_memory_s, cfg.exchange_fresh_s, cfg.exchange_step_rad)
+            n, cfg.exchange_llr, accel, lag, cfg.exchange_noise_rad, cfg.exchange_memory_s, cfg.exchange_fresh_s,
+            cfg.exchange_step_rad)
         self.exchanges = 0  # memories exchanged by exchange_llr so far (for tests and analysis)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
