@@ -243,14 +243,18 @@ def test_stage10_candidates():
     assert {o["jump_pair_s"] for _, o in cands.values()} == {None, 1.0}
 
 
-def test_stage12_and_13_candidates_and_the_guard():
+def test_stage12_to_14_candidates_and_the_guard():
     from lookalike.bench.set_select_options import stage_candidates
     from lookalike.bench.set_select_stage4 import passes_guard
 
     cands, baseline = stage_candidates(12)
-    assert cands[baseline][1] == {"exchange_accel": 0.1, "exchange_lag_s": 0.4}  # the shipped detector's
+    before = {"exchange_tight_agents": None}  # the identifier shipped before the fourteenth stage
+    assert cands[baseline][1] == {"exchange_accel": 0.1, "exchange_lag_s": 0.4, **before}  # its detector
     cands, baseline = stage_candidates(13)
-    assert cands[baseline][1] == {} and {o.get("exchange_step_rad") for _, o in cands.values()} == {None, 0.08, 0.12}
+    assert cands[baseline][1] == before
+    assert {o.get("exchange_step_rad") for _, o in cands.values()} == {None, 0.08, 0.12}
+    cands, baseline = stage_candidates(14)
+    assert cands[baseline][1] == before and {"exchange_tight_agents": 5} in [o for _, o in cands.values()]
     base = {"m3n2": 98.9, "m5n3": 98.2, "rec_m3n2": 0.1, "worst_m3n2": 0.3}
     assert passes_guard({**base, "m3n2": 98.86, "rec_m3n2": 0.12}, base)
     assert not passes_guard({**base, "m3n2": 98.84}, base)  # a team more than 0.05 points below
@@ -258,8 +262,10 @@ def test_stage12_and_13_candidates_and_the_guard():
 
 
 def test_exchange_tight_agents_changes_the_detector_of_larger_teams_only():
-    small = make_tracker("set", n_agents=4, exchange_tight_agents=5)
-    large = make_tracker("set", n_agents=5, exchange_tight_agents=5)
+    small = make_tracker("set", n_agents=4)  # exchange_tight_agents 5, the default
+    large = make_tracker("set", n_agents=5)
     assert (small._exchange.q, small._exchange.lag_s) == (0.1, 0.4)  # exchange_accel, exchange_lag_s
     assert (large._exchange.q, large._exchange.lag_s) == (0.03, 0.3)  # exchange_tight_accel, exchange_tight_lag_s
-    assert make_tracker("set", n_agents=8, exchange_tight_agents=5)._exchange is None  # exchange_max_agents 7
+    assert make_tracker("set", n_agents=8)._exchange is None  # exchange_max_agents 7
+    off = make_tracker("set", n_agents=5, exchange_tight_agents=None)
+    assert (off._exchange.q, off._exchange.lag_s) == (0.1, 0.4)

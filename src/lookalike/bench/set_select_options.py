@@ -48,6 +48,7 @@ STAGE12_BASELINE = "exchange_motion=0.1/0.4"
 STAGE13_EXCHANGE_STEP: tuple[float, ...] = (0.08, 0.12)
 STAGE13_BASELINE = "shipped"
 STAGE14_TIGHT_AGENTS = 5  # exchange_tight_agents: teams of 5-7 agents use exchange_accel 0.03, exchange_lag_s 0.3
+BEFORE_STAGE14 = {"exchange_tight_agents": None}  # the identifier shipped before the fourteenth stage's choice
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -84,17 +85,17 @@ def stage10_candidates() -> Candidates:
 def stage12_candidates() -> Candidates:
     """The twelfth stage's candidates: name (``exchange_motion=0.03/0.3``: angular-acceleration density and lag)
     -> (the shipped weights, inference options)."""
-    return {f"exchange_motion={accel}/{lag}": (SHIPPED_SET_WEIGHTS, {"exchange_accel": accel, "exchange_lag_s": lag})
-            for accel, lag in STAGE12_EXCHANGE_MOTION}
+    return {f"exchange_motion={accel}/{lag}": (SHIPPED_SET_WEIGHTS, {
+        "exchange_accel": accel, "exchange_lag_s": lag, **BEFORE_STAGE14}) for accel, lag in STAGE12_EXCHANGE_MOTION}
 
 
 def stage13_candidates() -> Candidates:
     """The thirteenth stage's candidates: the shipped identifier, and name (``exchange=0.03/0.3,step=0.08``) ->
     (the shipped weights, inference options)."""
-    candidates: Candidates = {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, {})}
+    candidates: Candidates = {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, dict(BEFORE_STAGE14))}
     for step in STAGE13_EXCHANGE_STEP:
-        candidates[f"exchange=0.03/0.3,step={step}"] = (
-            SHIPPED_SET_WEIGHTS, {"exchange_accel": 0.03, "exchange_lag_s": 0.3, "exchange_step_rad": step})
+        candidates[f"exchange=0.03/0.3,step={step}"] = (SHIPPED_SET_WEIGHTS, {
+            "exchange_accel": 0.03, "exchange_lag_s": 0.3, "exchange_step_rad": step, **BEFORE_STAGE14})
     return candidates
 
 
@@ -105,8 +106,9 @@ def stage_candidates(stage: int) -> tuple[Candidates, str]:
     if stage == 13:
         return stage13_candidates(), STAGE13_BASELINE
     if stage == 14:
-        return {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, {}), f"exchange_tight_agents={STAGE14_TIGHT_AGENTS}": (
-            SHIPPED_SET_WEIGHTS, {"exchange_tight_agents": STAGE14_TIGHT_AGENTS})}, STAGE13_BASELINE
+        tight: dict[str, object] = {"exchange_tight_agents": STAGE14_TIGHT_AGENTS}
+        return {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, dict(BEFORE_STAGE14)),
+                f"exchange_tight_agents={STAGE14_TIGHT_AGENTS}": (SHIPPED_SET_WEIGHTS, tight)}, STAGE13_BASELINE
     if stage == 5:
         return stage5_candidates(), STAGE5_BASELINE
     if stage == 10:

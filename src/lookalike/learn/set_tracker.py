@@ -24,7 +24,9 @@ running mean of the detections labelled false positive per frame over 1.4, chose
 the network was trained over 0.3-2.5 false positives per frame and cannot tell the rate from one frame.
 With ``exchange_llr`` (8, for teams of up to ``exchange_max_agents`` = 7; chosen on tuning sequences), two agents
 whose heading reports each continue the other's report track exchange memories
-(:mod:`lookalike.learn.report_exchange`): an exchange too small for a report jump.
+(:mod:`lookalike.learn.report_exchange`): an exchange too small for a report jump. Teams of
+``exchange_tight_agents`` (5) agents or more run it with a report model that expects smoother turning
+(``exchange_tight_accel``, ``exchange_tight_lag_s``), which finds exchanges between robots heading alike.
 """
 
 from __future__ import annotations
@@ -120,8 +122,9 @@ class SetIdentifier:
             0.6, "exchange_llr leaves out an agent whose report track has had no report for exchange_lag_s + this "
             "many seconds (a lost burst; None: never, the sixth and seventh stages' detector)", range=(0.0, 1e4))
         exchange_tight_agents: int | None = param(
-            None, "teams of at least this many agents run exchange_llr with exchange_tight_accel and "
-            "exchange_tight_lag_s instead of exchange_accel and exchange_lag_s (None: never)", range=(1, 1000))
+            5, "teams of at least this many agents run exchange_llr with exchange_tight_accel and "
+            "exchange_tight_lag_s instead of exchange_accel and exchange_lag_s (None: never; chosen on tuning "
+            "sequences)", range=(1, 1000))
         exchange_tight_accel: float = param(0.03, "exchange_accel for teams of exchange_tight_agents or more, "
                                             "rad^2/s^3", range=(1e-6, 100.0))
         exchange_tight_lag_s: float = param(0.3, "exchange_lag_s for teams of exchange_tight_agents or more, "
