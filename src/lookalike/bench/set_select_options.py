@@ -99,6 +99,14 @@ def stage13_candidates() -> Candidates:
     return candidates
 
 
+def stage14_candidates() -> Candidates:
+    """The fourteenth stage's candidates: the identifier shipped before it, and the tighter report model for teams
+    of at least :data:`STAGE14_TIGHT_AGENTS` agents."""
+    tight: dict[str, object] = {"exchange_tight_agents": STAGE14_TIGHT_AGENTS}
+    return {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, dict(BEFORE_STAGE14)),
+            f"exchange_tight_agents={STAGE14_TIGHT_AGENTS}": (SHIPPED_SET_WEIGHTS, tight)}
+
+
 def stage_candidates(stage: int) -> tuple[Candidates, str]:
     """Stage ``stage``'s (5 … 10, 12 … 14) candidates and the name of its baseline (the option off)."""
     if stage == 12:
@@ -106,9 +114,7 @@ def stage_candidates(stage: int) -> tuple[Candidates, str]:
     if stage == 13:
         return stage13_candidates(), STAGE13_BASELINE
     if stage == 14:
-        tight: dict[str, object] = {"exchange_tight_agents": STAGE14_TIGHT_AGENTS}
-        return {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, dict(BEFORE_STAGE14)),
-                f"exchange_tight_agents={STAGE14_TIGHT_AGENTS}": (SHIPPED_SET_WEIGHTS, tight)}, STAGE13_BASELINE
+        return stage14_candidates(), STAGE13_BASELINE
     if stage == 5:
         return stage5_candidates(), STAGE5_BASELINE
     if stage == 10:

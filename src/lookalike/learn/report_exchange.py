@@ -115,9 +115,11 @@ class ReportExchange:
         return a, b
 
     def _note_step(self, a: int, t_sent: float, heading: float) -> None:
-        """Keep agent ``a``'s newest report and note a step (see the module) at ``t_sent``."""
+        """Keep agent ``a``'s newest report and note a step (see the module) at ``t_sent`` (only with ``step_rad``)."""
+        if self.step_rad is None:
+            return
         t_last, h_last = self.last[a]
-        if self.step_rad is not None and np.isfinite(t_last):
+        if np.isfinite(t_last):
             rate = 0.0 if np.isnan(self.t[a]) else self.x[a, 1]
             if abs(float(_wrap(np.asarray(heading - h_last - rate * (t_sent - t_last))))) > self.step_rad:
                 self.stepped[a] = t_sent

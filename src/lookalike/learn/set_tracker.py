@@ -165,9 +165,9 @@ class SetIdentifier:
         self.fp_rate = self.config.fp_prior_ref  # running mean of false positives per frame (fp_prior_ref)
         cfg = self.config
         too_many = cfg.exchange_max_agents is not None and n > cfg.exchange_max_agents
-        tight = cfg.exchange_tight_agents is not None and n >= cfg.exchange_tight_agents
-        accel, lag = (cfg.exchange_tight_accel, cfg.exchange_tight_lag_s) if tight else (cfg.exchange_accel,
-                                                                                          cfg.exchange_lag_s)
+        accel, lag = cfg.exchange_accel, cfg.exchange_lag_s
+        if cfg.exchange_tight_agents is not None and n >= cfg.exchange_tight_agents:
+            accel, lag = cfg.exchange_tight_accel, cfg.exchange_tight_lag_s
         self._exchange = None if cfg.exchange_llr is None or too_many else ReportExchange(
             n, cfg.exchange_llr, accel, lag, cfg.exchange_noise_rad, cfg.exchange_memory_s, cfg.exchange_fresh_s,
             cfg.exchange_step_rad)
