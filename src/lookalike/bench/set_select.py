@@ -22,7 +22,8 @@ seen while swapped or not after the restore (:func:`measurable`); see :func:`cho
 (:mod:`lookalike.bench.set_select_stage4`); ``--stage 5`` whether to correct the false-positive probability
 for the world's false-positive rate, ``--stage 6`` to ``9`` the report-exchange detector, ``--stage 10``
 the pairing of mirroring report jumps, ``--stage 12`` the exchange detector's heading model, ``--stage 13``
-that and a step gate, ``--stage 14`` that model for larger teams (:mod:`lookalike.bench.set_select_options`).
+that and a step gate, ``--stage 14`` that model for larger teams, ``--stage 15`` pairing jumps after silences
+(:mod:`lookalike.bench.set_select_options`).
 """
 
 from __future__ import annotations
@@ -332,7 +333,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--average-from", type=int, default=None,
                         help="also the mean of the snapshots' weights from this step on")
     parser.add_argument("--ship", action="store_true", help="ship the chosen weights")
-    parser.add_argument("--stage", type=int, choices=(*range(1, 11), 12, 13, 14), default=1,
+    parser.add_argument("--stage", type=int, choices=(*range(1, 11), 12, 13, 14, 15), default=1,
                         help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from); "
                         "3: the inference options of the shipped weights (RUN: where the scores are kept); "
                         "4: the fourth stage's snapshots x the pair-swap rule (lookalike.bench.set_select_stage4); "

@@ -1,7 +1,7 @@
-"""The fifth to fourteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+"""The fifth to fifteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 14) scores stage K's candidates
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 15) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
 (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
@@ -19,7 +19,9 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
 - stage 13: the same with the tighter heading model and a step gate (``exchange_step_rad`` at each of
   :data:`STAGE13_EXCHANGE_STEP`), the same rule;
 - stage 14: the tighter heading model for teams of at least :data:`STAGE14_TIGHT_AGENTS` agents only
-  (``exchange_tight_agents``), the same rule.
+  (``exchange_tight_agents``), the same rule;
+- stage 15: pairing a report jump with another agent's first report after a silence (``jump_silent``), alone and
+  with the exchange detector keeping silent tracks (``exchange_fresh_s`` off), the same rule.
 
 A chosen option is made the identifier's default by hand.
 """
@@ -49,6 +51,10 @@ STAGE13_EXCHANGE_STEP: tuple[float, ...] = (0.08, 0.12)
 STAGE13_BASELINE = "shipped"
 STAGE14_TIGHT_AGENTS = 5  # exchange_tight_agents: teams of 5-7 agents use exchange_accel 0.03, exchange_lag_s 0.3
 BEFORE_STAGE14 = {"exchange_tight_agents": None}  # the identifier shipped before the fourteenth stage's choice
+# Stage 15: its candidates' options against the identifier shipped before it (all defaults).
+STAGE15_OPTIONS: tuple[dict[str, object], ...] = ({"jump_silent": True},
+                                                   {"jump_silent": True, "exchange_fresh_s": None})
+STAGE15_BASELINE = "shipped-before-15"
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -107,8 +113,19 @@ def stage14_candidates() -> Candidates:
             f"exchange_tight_agents={STAGE14_TIGHT_AGENTS}": (SHIPPED_SET_WEIGHTS, tight)}
 
 
+def stage15_candidates() -> Candidates:
+    """The fifteenth stage's candidates: the identifier shipped before it and :data:`STAGE15_OPTIONS`."""
+    candidates: Candidates = {STAGE15_BASELINE: (SHIPPED_SET_WEIGHTS, {"jump_silent": False})}
+    for options in STAGE15_OPTIONS:
+        name = ",".join(f"{k}={'off' if v is None else v}" for k, v in options.items())
+        candidates[name] = (SHIPPED_SET_WEIGHTS, dict(options))
+    return candidates
+
+
 def stage_candidates(stage: int) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 10, 12 … 14) candidates and the name of its baseline (the option off)."""
+    """Stage ``stage``'s (5 … 10, 12 … 15) candidates and the name of its baseline (the option off)."""
+    if stage == 15:
+        return stage15_candidates(), STAGE15_BASELINE
     if stage == 12:
         return stage12_candidates(), STAGE12_BASELINE
     if stage == 13:

@@ -95,6 +95,10 @@ class SetIdentifier:
             "jump that mirrors it (another agent now reporting the heading it reported before, and the reverse), "
             "then exchanges memories with that agent; forgotten when none comes (None: forgotten at once)",
             range=(0.0, 100.0))
+        jump_silent: bool = param(
+            False, "jump_pair_s also pairs a jump with an agent's first report after a silence too long to judge "
+            "as a jump (more than report_jump off its previous one, within report_jump + turn_rate * the silence) "
+            "when the two mirror each other; such a report alone changes nothing")
         pair_swap: float | None = param(
             None, "exchange two agents' memories (and this frame's labels) when the evidence that each one's "
             "detection fits the other's fresh report better than its own, summed over frames with decay "
@@ -160,6 +164,7 @@ class SetIdentifier:
         self._last_time = -np.inf
         self._expected_jump: dict[int, float] = {}
         self._pending: dict[int, tuple[float, float, float]] = {}  # jump_pair_s: agent -> (old, new heading, time)
+        self._silent: dict[int, tuple[float, float, float]] = {}  # jump_silent: the same, never forgotten
         self._pair_evidence = np.zeros((n, n))
         self.pair_swaps = 0  # memories exchanged by pair_swap so far (for tests and analysis)
         self.fp_rate = self.config.fp_prior_ref  # running mean of false positives per frame (fp_prior_ref)
@@ -254,6 +259,12 @@ class SetIdentifier:
                     self._swap_jumps(np.flatnonzero(jumped), old, t_sent, jump)
                 else:
                     self._forget(np.flatnonzero(jumped))
+            if self.config.jump_silent and self.config.on_jump == "swap" and self.config.jump_pair_s is not None:
+                self._silent_jumps(np.flatnonzero(fresh & ~jumped & (turn > jump)), old, jump)
+        if self._silent:
+            wait = self.config.jump_pair_s
+            assert wait is not None
+            self._silent = {a: v for a, v in self._silent.items() if self._last_time - v[2] <= wait}
         if self._pending:
             assert self.config.jump_pair_s is not None
             expired = [a for a, (_, _, t) in self._pending.items() if self._last_time - t > self.config.jump_pair_s]
@@ -285,7 +296,9 @@ class SetIdentifier:
                 continue  # the second half of a swap already made
             new = float(self._beacons.heading[a])
             self._pending.pop(a, None)
-            b = self._mirror(a, float(old[a]), new, float(now[a]), jump)
+            b = self._mirror(a, float(old[a]), new, float(now[a]), jump, self._pending)
+            if b is None and self._silent:
+                b = self._mirror(a, float(old[a]), new, float(now[a]), jump, self._silent)
             if b is not None:
                 self._exchange_memories(a, b)
                 continue
@@ -306,18 +319,38 @@ class SetIdentifier:
             else:
                 self._expected_jump[b] = now[a]
 
-    def _mirror(self, a: int, old: float, new: float, t: float, jump: float) -> int | None:
-        """``jump_pair_s``: the waiting agent whose jump mirrors agent ``a``'s jump from heading ``old`` to
-        ``new`` (radians) at ``t`` seconds: it now reports ``old`` and reported ``new`` before, each within
-        ``jump`` + ``turn_rate`` · the time between the two jumps (the closest of several; None: none)."""
+    def _silent_jumps(self, agents: np.ndarray, old: np.ndarray, jump: float) -> None:
+        """``jump_silent``: each of ``agents`` reports, after a silence, a heading more than ``jump`` off its
+        previous report, too long after it to call a jump. When a waiting jump (``jump_pair_s``) mirrors it, the
+        two agents exchange memories; otherwise it waits as well, for a jump that mirrors it, and is dropped
+        without forgetting anything."""
+        now = self._beacons.t_sent
+        for c in agents.tolist():
+            if c in self._pending:
+                continue
+            new = float(self._beacons.heading[c])
+            b = self._mirror(c, float(old[c]), new, float(now[c]), jump, self._pending)
+            if b is not None:
+                self._exchange_memories(c, b)
+            else:
+                self._silent[c] = (float(old[c]), new, float(now[c]))
+
+    def _mirror(self, a: int, old: float, new: float, t: float, jump: float,
+                waiting: dict[int, tuple[float, float, float]]) -> int | None:
+        """``jump_pair_s``: the agent in ``waiting`` (agent -> its old and new heading, radians, and the time of its
+        jump, seconds; the match is removed) whose jump mirrors agent ``a``'s jump from heading ``old`` to ``new``
+        at ``t`` seconds: it now reports ``old`` and reported ``new`` before, each within ``jump`` + ``turn_rate`` ·
+        the time between the two jumps (the closest of several; None: none)."""
         best, best_error = None, np.inf
-        for c, (old_c, new_c, t_c) in self._pending.items():
+        for c, (old_c, new_c, t_c) in waiting.items():
+            if c == a:
+                continue
             tolerance = jump + self.config.turn_rate * abs(t - t_c)
             errors = np.abs(wrap_angle(np.array([new - old_c, new_c - old])))
             if errors.max() <= tolerance and errors.sum() < best_error:
                 best, best_error = c, float(errors.sum())
         if best is not None:
-            del self._pending[best]
+            del waiting[best]
         return best
 
     def _exchange_memories(self, a: int, b: int) -> None:
@@ -343,6 +376,7 @@ class SetIdentifier:
                 for j in pair:
                     self._expected_jump[j] = t_sent
                     self._pending.pop(j, None)
+                    self._silent.pop(j, None)
 
     def _pair_swaps(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, age: np.ndarray,
                     dt: float) -> np.ndarray:
