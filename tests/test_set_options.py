@@ -105,13 +105,15 @@ def test_a_report_swap_exchanges_or_forgets_the_memories(shipped, on_jump, excha
 
 def three_robot_frames(report_heading, n_frames: int = 120) -> list[Frame]:
     """Three robots standing apart, seen with headings 0, 2.0 and 2.3 rad; agent ``a`` reports
-    ``report_heading(a, t)`` at 10 Hz in frames ``k % 3 == a`` (so no two agents report in one frame)."""
+    ``report_heading(a, t)`` at 10 Hz in frames ``k % 3 == a`` (so no two agents report in one frame; a NaN
+    heading: no report)."""
     places, seen = np.array([[2.0, 0.5], [3.0, -1.0], [4.0, 1.0]]), np.array([0.0, 2.0, 2.3])
     out = []
     for k in range(n_frames):
         t, a = k / RATE, k % 3
-        beacons = Beacons(agent_id=np.array([a]), t_sent=np.array([t]), t_received=np.array([t]),
-                          heading=np.array([report_heading(a, t)]))
+        sent = np.isfinite([report_heading(a, t)])
+        beacons = Beacons(agent_id=np.array([a])[sent], t_sent=np.array([t])[sent], t_received=np.array([t])[sent],
+                          heading=np.array([report_heading(a, t)])[sent])
         out.append(Frame(index=k, time=t, detections=Detections(position=places.copy(), heading=seen.copy(),
                                                                 score=np.full(3, 0.9)), beacons=beacons))
     return out
@@ -144,6 +146,38 @@ def test_jump_pair_s_pairs_two_ambiguous_jumps_that_mirror_each_other(shipped):
             assert np.allclose(tracker.net.p[[0, 1]], before[[1, 0]], atol=0.3)
         if report is lone:
             assert calls[0][1] > 1.5 + wait  # forgotten only when no mirroring jump came in time
+
+
+def test_jump_silent_pairs_a_jump_with_the_first_report_after_a_silence(shipped):
+    """Agent 1 is silent from 0.6 s until the ids of agents 0 and 1 swap: its first report, 2 rad off its
+    last one but a second later, is no jump, and agent 0's jump could be for robot 1 or 2. Without jump_silent
+    agent 0 is forgotten; with it the two exchange memories, whichever of the two reports comes first. A silence
+    with no swap changes nothing."""
+    own = np.array([0.0, 2.0, 2.3])
+    for swap_at, quiet_to in ((1.5, 1.6), (1.51, 1.5)):  # agent 0's jump first (1.6 s); agent 1's report (1.53 s)
+        def report(a: int, t: float, at: float = swap_at, to: float = quiet_to) -> float:
+            if a == 1 and 0.6 <= t < to:
+                return float("nan")  # silent: no report
+            return float(own[{0: 1, 1: 0}.get(a, a)] if t >= at else own[a])
+
+        assert ("swap", {0, 1}) not in silent_calls(report, False)  # forgotten, or swapped with agent 2
+        assert silent_calls(report, True) == [("swap", {0, 1})]
+    assert silent_calls(lambda a, t: float("nan") if a == 1 and 0.6 <= t < 1.6 else float(own[a]), True) == []
+
+
+def silent_calls(report, silent: bool) -> list[tuple[str, set[int]]]:
+    """The memory changes (``("swap", {a, b})``, ``("forget", agents)``) of a three-agent set identifier
+    (jump_silent ``silent``) on :func:`three_robot_frames` with ``report``."""
+    from lookalike.trackers import make_tracker
+
+    tracker = make_tracker("set", n_agents=3, n_slots=3, exchange_llr=None, jump_silent=silent)
+    calls: list[tuple[str, set[int]]] = []
+    tracker.net.swap = lambda a, b, m=tracker.net.swap: (calls.append(("swap", {a, b})), m(a, b))[1]
+    tracker.net.forget = lambda mask, m=tracker.net.forget: (calls.append(("forget", set(np.flatnonzero(mask)))),
+                                                             m(mask))[1]
+    for f in three_robot_frames(report):
+        tracker.update(f)
+    return calls
 
 
 def test_stage3_choice_needs_the_small_team_up_and_nothing_else_down():
