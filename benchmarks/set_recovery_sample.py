@@ -9,10 +9,10 @@ which an identifier never recovers counts, for that identifier, as the longest r
 (from the restore to the last one-second window). ``--candidate-options`` (JSON) gives the candidate parameters
 other than its defaults (a development sample's candidates). The figures are kept in ``--out`` per set-up and
 identifier, so that an interrupted run resumes and a reference runs once for several candidates. The test, its
-samples (seeds 3200000+, 3300000+ for the identifier of the eleventh stage; 3400000+ is kept for the next test)
-and margin are in docs/experiments/any-team-size.md.
+samples (seeds 3200000+; 3300000+, 3400000+ and 3500000+ for the identifiers of the eleventh, fourteenth and fifteenth
+stages) and margin are in docs/experiments/any-team-size.md.
 
-    python benchmarks/set_recovery_sample.py --sequences 400 --seed 3400000 --setups m10n7
+    python benchmarks/set_recovery_sample.py --sequences 400 --seed 3500000 --setups m10n7
 """
 
 from __future__ import annotations

@@ -277,7 +277,7 @@ def test_stage10_candidates():
     assert {o["jump_pair_s"] for _, o in cands.values()} == {None, 1.0}
 
 
-def test_stage12_to_14_candidates_and_the_guard():
+def test_stage12_to_15_candidates_and_the_guard():
     from lookalike.bench.set_select_options import stage_candidates
     from lookalike.bench.set_select_stage4 import passes_guard
 
@@ -289,6 +289,10 @@ def test_stage12_to_14_candidates_and_the_guard():
     assert {o.get("exchange_step_rad") for _, o in cands.values()} == {None, 0.08, 0.12}
     cands, baseline = stage_candidates(14)
     assert cands[baseline][1] == before and {"exchange_tight_agents": 5} in [o for _, o in cands.values()]
+    cands, baseline = stage_candidates(15)
+    assert cands[baseline][1] == {"jump_silent": False}  # stays the identifier before the stage, whatever ships
+    assert [o for n, (_, o) in cands.items() if n != baseline] == [
+        {"jump_silent": True}, {"jump_silent": True, "exchange_fresh_s": None}]
     base = {"m3n2": 98.9, "m5n3": 98.2, "rec_m3n2": 0.1, "worst_m3n2": 0.3}
     assert passes_guard({**base, "m3n2": 98.86, "rec_m3n2": 0.12}, base)
     assert not passes_guard({**base, "m3n2": 98.84}, base)  # a team more than 0.05 points below
