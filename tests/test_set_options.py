@@ -4,6 +4,7 @@ and the third stage's rule that chooses them on tuning sequences."""
 import numpy as np
 import pytest
 
+from lookalike.learn.set_tracker import SetIdentifier
 from lookalike.trackers import make_tracker
 from lookalike.types import Beacons, Detections, Frame
 
@@ -282,17 +283,20 @@ def test_stage12_to_15_candidates_and_the_guard():
     from lookalike.bench.set_select_stage4 import passes_guard
 
     cands, baseline = stage_candidates(12)
-    before = {"exchange_tight_agents": None}  # the identifier shipped before the fourteenth stage
+    before = {"exchange_tight_agents": None, "jump_silent": False, "exchange_fresh_s": 0.6}  # before stage 14
     assert cands[baseline][1] == {"exchange_accel": 0.1, "exchange_lag_s": 0.4, **before}  # its detector
     cands, baseline = stage_candidates(13)
     assert cands[baseline][1] == before
     assert {o.get("exchange_step_rad") for _, o in cands.values()} == {None, 0.08, 0.12}
     cands, baseline = stage_candidates(14)
-    assert cands[baseline][1] == before and {"exchange_tight_agents": 5} in [o for _, o in cands.values()]
+    before15 = {"jump_silent": False, "exchange_fresh_s": 0.6}  # the identifier shipped before stage 15
+    assert cands[baseline][1] == before and {"exchange_tight_agents": 5, **before15} in [o for _, o in cands.values()]
     cands, baseline = stage_candidates(15)
-    assert cands[baseline][1] == {"jump_silent": False}  # stays the identifier before the stage, whatever ships
+    assert cands[baseline][1] == before15
     assert [o for n, (_, o) in cands.items() if n != baseline] == [
-        {"jump_silent": True}, {"jump_silent": True, "exchange_fresh_s": None}]
+        {"jump_silent": True, "exchange_fresh_s": 0.6}, {"jump_silent": True, "exchange_fresh_s": None}]
+    shipped = SetIdentifier.Config()  # the fifteenth stage's choice
+    assert shipped.jump_silent and shipped.exchange_fresh_s is None
     base = {"m3n2": 98.9, "m5n3": 98.2, "rec_m3n2": 0.1, "worst_m3n2": 0.3}
     assert passes_guard({**base, "m3n2": 98.86, "rec_m3n2": 0.12}, base)
     assert not passes_guard({**base, "m3n2": 98.84}, base)  # a team more than 0.05 points below

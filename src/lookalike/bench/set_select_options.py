@@ -50,8 +50,10 @@ STAGE12_BASELINE = "exchange_motion=0.1/0.4"
 STAGE13_EXCHANGE_STEP: tuple[float, ...] = (0.08, 0.12)
 STAGE13_BASELINE = "shipped"
 STAGE14_TIGHT_AGENTS = 5  # exchange_tight_agents: teams of 5-7 agents use exchange_accel 0.03, exchange_lag_s 0.3
-BEFORE_STAGE14 = {"exchange_tight_agents": None}  # the identifier shipped before the fourteenth stage's choice
-# Stage 15: its candidates' options against the identifier shipped before it (all defaults).
+# The identifiers shipped before the fifteenth and fourteenth stages' choices (a stage scores what it scored).
+BEFORE_STAGE15: dict[str, object] = {"jump_silent": False, "exchange_fresh_s": 0.6}
+BEFORE_STAGE14: dict[str, object] = {"exchange_tight_agents": None, **BEFORE_STAGE15}
+# Stage 15: its candidates' options against the identifier shipped before it.
 STAGE15_OPTIONS: tuple[dict[str, object], ...] = ({"jump_silent": True},
                                                    {"jump_silent": True, "exchange_fresh_s": None})
 STAGE15_BASELINE = "shipped-before-15"
@@ -108,17 +110,17 @@ def stage13_candidates() -> Candidates:
 def stage14_candidates() -> Candidates:
     """The fourteenth stage's candidates: the identifier shipped before it, and the tighter report model for teams
     of at least :data:`STAGE14_TIGHT_AGENTS` agents."""
-    tight: dict[str, object] = {"exchange_tight_agents": STAGE14_TIGHT_AGENTS}
+    tight: dict[str, object] = {"exchange_tight_agents": STAGE14_TIGHT_AGENTS, **BEFORE_STAGE15}
     return {STAGE13_BASELINE: (SHIPPED_SET_WEIGHTS, dict(BEFORE_STAGE14)),
             f"exchange_tight_agents={STAGE14_TIGHT_AGENTS}": (SHIPPED_SET_WEIGHTS, tight)}
 
 
 def stage15_candidates() -> Candidates:
     """The fifteenth stage's candidates: the identifier shipped before it and :data:`STAGE15_OPTIONS`."""
-    candidates: Candidates = {STAGE15_BASELINE: (SHIPPED_SET_WEIGHTS, {"jump_silent": False})}
+    candidates: Candidates = {STAGE15_BASELINE: (SHIPPED_SET_WEIGHTS, dict(BEFORE_STAGE15))}
     for options in STAGE15_OPTIONS:
         name = ",".join(f"{k}={'off' if v is None else v}" for k, v in options.items())
-        candidates[name] = (SHIPPED_SET_WEIGHTS, dict(options))
+        candidates[name] = (SHIPPED_SET_WEIGHTS, {**BEFORE_STAGE15, **options})
     return candidates
 
 

@@ -96,9 +96,9 @@ class SetIdentifier:
             "then exchanges memories with that agent; forgotten when none comes (None: forgotten at once)",
             range=(0.0, 100.0))
         jump_silent: bool = param(
-            False, "jump_pair_s also pairs a jump with an agent's first report after a silence too long to judge "
+            True, "jump_pair_s also pairs a jump with an agent's first report after a silence too long to judge "
             "as a jump (more than report_jump off its previous one, within report_jump + turn_rate * the silence) "
-            "when the two mirror each other; such a report alone changes nothing")
+            "when the two mirror each other; such a report alone changes nothing (chosen on tuning sequences)")
         pair_swap: float | None = param(
             None, "exchange two agents' memories (and this frame's labels) when the evidence that each one's "
             "detection fits the other's fresh report better than its own, summed over frames with decay "
@@ -123,8 +123,9 @@ class SetIdentifier:
             1.0, "time constant of the decay of exchange_llr's evidence, seconds (None: no decay, the sixth stage's "
             "detector)", range=(0.01, 1e4))
         exchange_fresh_s: float | None = param(
-            0.6, "exchange_llr leaves out an agent whose report track has had no report for exchange_lag_s + this "
-            "many seconds (a lost burst; None: never, the sixth and seventh stages' detector)", range=(0.0, 1e4))
+            None, "exchange_llr leaves out an agent whose report track has had no report for exchange_lag_s + this "
+            "many seconds (a lost burst; None: never, as shipped since the fifteenth stage; the eighth to "
+            "fourteenth stages' detector: 0.6)", range=(0.0, 1e4))
         exchange_tight_agents: int | None = param(
             5, "teams of at least this many agents run exchange_llr with exchange_tight_accel and "
             "exchange_tight_lag_s instead of exchange_accel and exchange_lag_s (None: never; chosen on tuning "
