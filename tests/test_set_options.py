@@ -112,9 +112,10 @@ def three_robot_frames(report_heading, n_frames: int = 120) -> list[Frame]:
     out = []
     for k in range(n_frames):
         t, a = k / RATE, k % 3
-        sent = np.isfinite([report_heading(a, t)])
+        heading = np.array([report_heading(a, t)])
+        sent = np.isfinite(heading)
         beacons = Beacons(agent_id=np.array([a])[sent], t_sent=np.array([t])[sent], t_received=np.array([t])[sent],
-                          heading=np.array([report_heading(a, t)])[sent])
+                          heading=heading[sent])
         out.append(Frame(index=k, time=t, detections=Detections(position=places.copy(), heading=seen.copy(),
                                                                 score=np.full(3, 0.9)), beacons=beacons))
     return out
@@ -152,8 +153,8 @@ def test_jump_pair_s_pairs_two_ambiguous_jumps_that_mirror_each_other(shipped):
 def test_jump_silent_pairs_a_jump_with_the_first_report_after_a_silence(shipped):
     """Agent 1 is silent from 0.6 s until the ids of agents 0 and 1 swap: its first report, 2 rad off its
     last one but a second later, is no jump, and agent 0's jump could be for robot 1 or 2. Without jump_silent
-    agent 0 is forgotten; with it the two exchange memories, whichever of the two reports comes first. A silence
-    with no swap changes nothing."""
+    agent 0 is forgotten (or, when agent 1's report comes first, exchanged with agent 2); with it agents 0 and 1
+    exchange memories, whichever of the two reports comes first. A silence with no swap changes nothing."""
     own = np.array([0.0, 2.0, 2.3])
     for swap_at, quiet_to in ((1.5, 1.6), (1.51, 1.5)):  # agent 0's jump first (1.6 s); agent 1's report (1.53 s)
         def report(a: int, t: float, at: float = swap_at, to: float = quiet_to) -> float:
@@ -169,8 +170,6 @@ def test_jump_silent_pairs_a_jump_with_the_first_report_after_a_silence(shipped)
 def silent_calls(report, silent: bool) -> list[tuple[str, set[int]]]:
     """The memory changes (``("swap", {a, b})``, ``("forget", agents)``) of a three-agent set identifier
     (jump_silent ``silent``) on :func:`three_robot_frames` with ``report``."""
-    from lookalike.trackers import make_tracker
-
     tracker = make_tracker("set", n_agents=3, n_slots=3, exchange_llr=None, jump_silent=silent)
     calls: list[tuple[str, set[int]]] = []
     tracker.net.swap = lambda a, b, m=tracker.net.swap: (calls.append(("swap", {a, b})), m(a, b))[1]
