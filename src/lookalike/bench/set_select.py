@@ -341,9 +341,9 @@ def main(argv: list[str] | None = None) -> None:
                         "6-9: the report-exchange detector (7: its evidence decays; 8: and lost bursts leave a "
                         "track out; 9: for teams of up to seven); 10: mirroring report jumps paired; "
                         "12: the exchange detector's heading model; 13: and a step gate; 14: that model for "
-                        "larger teams (5-14: lookalike.bench.set_select_options)")
+                        "larger teams; 15: jumps paired across silences (5-15: lookalike.bench.set_select_options)")
     parser.add_argument("--only", default=None,
-                        help="stages 4-14: score this candidate only (e.g. step300,pair=off)")
+                        help="stages 4-15: score this candidate only (e.g. step300,pair=off)")
     parser.add_argument("--cache", type=Path, default=None,
                         help="stage 3: the JSON file of scored candidates (default RUN/set_select_stage3.json)")
     args = parser.parse_args(argv)

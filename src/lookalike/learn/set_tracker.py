@@ -262,13 +262,11 @@ class SetIdentifier:
                     self._forget(np.flatnonzero(jumped))
             if self.config.jump_silent and self.config.on_jump == "swap" and self.config.jump_pair_s is not None:
                 self._silent_jumps(np.flatnonzero(fresh & ~jumped & (turn > jump)), old, jump)
-        if self._silent:
+        if self._pending or self._silent:  # waiting jumps expire after jump_pair_s: forgotten, or (silent) dropped
             wait = self.config.jump_pair_s
             assert wait is not None
             self._silent = {a: v for a, v in self._silent.items() if self._last_time - v[2] <= wait}
-        if self._pending:
-            assert self.config.jump_pair_s is not None
-            expired = [a for a, (_, _, t) in self._pending.items() if self._last_time - t > self.config.jump_pair_s]
+            expired = [a for a, (_, _, t) in self._pending.items() if self._last_time - t > wait]
             if expired:
                 for a in expired:
                     del self._pending[a]
