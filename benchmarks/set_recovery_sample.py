@@ -12,6 +12,13 @@ identifier, so that an interrupted run resumes and a reference runs once for sev
 samples (seeds 3200000+; 3300000+, 3400000+ and 3500000+ for the identifiers of the eleventh, fourteenth and fifteenth
 stages) and margin are in docs/experiments/any-team-size.md.
 
+Two further figures per set-up (each sequence's runs are kept for them): the same difference on the restores whose
+pair's reports differ by at least ``--gap`` radians in the second after the restore and on the others
+(:func:`~lookalike.bench.experiments.restore_gap`: how much the reports can tell the two robots apart there), and
+the difference in plain success on the pair in the 3 s after the restore (percentage points, 95% interval; no
+worse when its lower end is at least ``-success-margin``). They were added after the fifteenth stage's test
+(docs/experiments/any-team-size.md, "What the remaining gap is made of").
+
     python benchmarks/set_recovery_sample.py --sequences 400 --seed 3500000 --setups m10n7
 """
 
@@ -24,9 +31,25 @@ from pathlib import Path
 import numpy as np
 from _common import report_target
 
-from lookalike.bench.experiments import longest_recovery_s, recovery_runs
-from lookalike.bench.paired import interval_text, mean_difference
+from lookalike.bench.experiments import SwapRun, longest_recovery_s, measured_sequences, restore_gap, swap_runs
+from lookalike.bench.paired import PairedDifference, interval_text, mean_difference
 from lookalike.sim import preset, preset_label
+
+AFTER = SwapRun._fields.index("after_restore")
+
+
+def gaps(setup: str, sequences: int, frames: int, seed: int, out: Path, swap_at_s: float, swap_s: float) -> np.ndarray:
+    """:func:`restore_gap` of each measured sequence (radians; NaN: a pair member sent nothing), kept in ``out``."""
+    cache = out / f"{setup}-{seed}-{sequences}x{frames}-gaps.json"
+    if not cache.exists():
+        measured = measured_sequences(setup, sequences, frames, seed, swap_at_s, swap_s)
+        cache.write_text(json.dumps([restore_gap(q, swap_at_s, swap_s) for q in measured]))
+    return np.array(json.loads(cache.read_text()), dtype=float)
+
+
+def line(name: str, diff: PairedDifference, unit: str) -> str:
+    """One printed figure: ``name``, its sequences and the difference with its interval."""
+    return f"{name}: {diff.n_sequences} sequences, {diff.difference:+.3f}{unit} ({interval_text(diff, 3)})"
 
 
 def main() -> None:
@@ -41,6 +64,10 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=3200000)
     parser.add_argument("--margin", type=float, default=0.15, help="Seconds the candidate may be slower.")
     parser.add_argument("--out", type=Path, default=Path("runs/set-recovery-sample"))
+    parser.add_argument("--gap", type=float, default=0.2, help="Radians between the pair's reports after the restore "
+                        "that split the sequences for the further figures.")
+    parser.add_argument("--success-margin", type=float, default=2.0,
+                        help="Percentage points of success after the restore the candidate may be lower.")
     args = parser.parse_args()
     swap_at_s, swap_s = 5.0, 10.0
     trackers = [args.candidate, args.reference]
@@ -52,9 +79,11 @@ def main() -> None:
             tag = "".join(f",{k}={v}" for k, v in sorted((options.get(name) or {}).items()))
             cache = args.out / f"{setup}-{args.seed}-{args.sequences}x{args.frames}-{name}{tag}.json"
             if not cache.exists():
-                rows, runs = recovery_runs([setup], [name], args.sequences, args.frames, swap_at_s, swap_s,
-                                           args.seed, options=options)
-                cache.write_text(json.dumps({"seconds": runs[(setup, name)], "row": rows[0],
+                rows, runs = swap_runs([setup], [name], args.sequences, args.frames, swap_at_s, swap_s,
+                                       args.seed, options=options)
+                run = runs[(setup, name)]
+                cache.write_text(json.dumps({"seconds": run[:, SwapRun._fields.index("recovery_s")].tolist(),
+                                             "row": rows[0], "runs": run.tolist(),
                                              "options": options.get(name) or {}}))
             kept[name] = json.loads(cache.read_text())
         seconds = {name: kept[name]["seconds"] for name in trackers}
@@ -74,6 +103,23 @@ def main() -> None:
         report_target(f"{args.candidate} recovery no worse than {args.reference}, {label} "
                       f"(upper end of the 95% interval of the mean difference)", diff.high, args.margin,
                       higher_is_better=False, unit=" s")
+        if not all("runs" in kept[name] for name in trackers):
+            print("  (no per-sequence runs in the cache: the further figures need a fresh run)")
+            continue
+        gap = gaps(setup, args.sequences, args.frames, args.seed, args.out, swap_at_s, swap_s)
+        cand, ref = (np.array(values[n]) for n in trackers)
+        for text, part in ((f"reports >= {args.gap} rad apart after the restore", gap >= args.gap),
+                           (f"reports < {args.gap} rad apart", gap < args.gap),
+                           ("a pair member silent in the second after the restore", np.isnan(gap))):
+            print(f"  {line(text, mean_difference(cand[part], ref[part]), ' s')}")
+        after = [np.array(kept[n]["runs"], dtype=float).reshape(-1, len(SwapRun._fields))[:, AFTER] * 100
+                 for n in trackers]
+        seen = np.isfinite(after[0]) & np.isfinite(after[1])
+        success = mean_difference(after[0][seen], after[1][seen])
+        print(f"  {line('success on the pair in the 3 s after the restore', success, ' points')}")
+        report_target(f"{args.candidate} success after the restore no worse than {args.reference}, {label} "
+                      f"(lower end of the 95% interval of the mean difference)", success.low, -args.success_margin,
+                      unit=" points")
 
 
 if __name__ == "__main__":

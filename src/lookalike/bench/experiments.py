@@ -186,6 +186,12 @@ def measurable(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 
     return seen(truth[start:restore]) and seen(truth[restore:])
 
 
+def measured_sequences(setup: str, sequences: int, frames: int, seed: int, swap_at_s: float = 5.0,
+                       swap_s: float = 10.0) -> list[RobotSequence]:
+    """The :func:`measurable` ones of set-up ``setup``'s ``sequences`` sequences from ``seed``, in order."""
+    return [q for q in _sequences(setup, sequences, frames, seed) if measurable(q, swap_at_s, swap_s)]
+
+
 def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float,
                   options: Mapping[str, Any] | None = None) -> SwapRun:
     """:func:`swap_recovery` of the registered identifier ``name`` (with ``options``, its parameters)."""
@@ -213,18 +219,29 @@ def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int
                   ) -> tuple[list[dict[str, Any]], dict[tuple[str, str], list[float]]]:
     """:func:`recovery_rows`'s rows and, per (set-up, identifier), the recovery seconds of each sequence
     (inf: never), for :func:`recovery_differences`; ``options``: identifier -> its parameters (default: none)."""
+    rows, runs = swap_runs(setups, trackers, sequences, frames, swap_at_s, swap_s, seed, progress, options)
+    recovery = SwapRun._fields.index("recovery_s")
+    return rows, {key: [float(v) for v in run[:, recovery]] for key, run in runs.items()}
+
+
+def swap_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,
+              swap_s: float, seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress,
+              options: Mapping[str, Mapping[str, Any]] | None = None
+              ) -> tuple[list[dict[str, Any]], dict[tuple[str, str], np.ndarray]]:
+    """:func:`recovery_rows`'s rows and, per (set-up, identifier), one :class:`SwapRun` per measured sequence
+    (an array, sequences x its fields; ``options`` as for :func:`recovery_runs`)."""
     rows = []
-    seconds: dict[tuple[str, str], list[float]] = {}
+    runs_of: dict[tuple[str, str], np.ndarray] = {}
     for setup in setups:
         preset(setup)
     step = progress("bench recovery", len(setups) * len(trackers))
     for setup in setups:
-        measured = [q for q in _sequences(setup, sequences, frames, seed) if measurable(q, swap_at_s, swap_s)]
+        measured = measured_sequences(setup, sequences, frames, seed, swap_at_s, swap_s)
         width = len(SwapRun._fields)
         for name in trackers:
             runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s, (options or {}).get(name))
                              for seq in measured]).reshape(-1, width)
-            seconds[(setup, name)] = [float(v) for v in runs[:, SwapRun._fields.index("recovery_s")]]
+            runs_of[(setup, name)] = runs
             if not len(runs):  # nothing measurable: NaN figures, said by the count
                 runs = np.full((1, width), np.nan)
             run = dict(zip(SwapRun._fields, runs.T))  # field -> its value in each sequence
@@ -239,7 +256,28 @@ def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int
                 "Sequences measured": len(measured),
             })
             step()
-    return rows, seconds
+    return rows, runs_of
+
+
+def restore_gap(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 10.0, window_s: float = 1.0) -> float:
+    """How far apart (radians, 0 to π) the headings of :func:`swap_recovery`'s pair are just after the restore:
+    the difference of the circular means of each one's own reports sent in the ``window_s`` seconds from the
+    restore (NaN: either sent none). From the data alone: how much the reports can tell the two apart there."""
+    truth = sequence.true_labels()
+    start, _, after = swap_frames(sequence.config.frame_rate_hz, swap_at_s, swap_s)
+    pair = most_seen_pair(truth[start:after], sequence.config.n_agents)
+    restore_s = swap_at_s + swap_s
+    sums, counts = np.zeros(2, dtype=complex), np.zeros(2, dtype=int)
+    for f in sequence.frames():
+        b = f.beacons
+        window = (b.t_sent >= restore_s) & (b.t_sent < restore_s + window_s)
+        for i, agent in enumerate(pair):
+            mine = window & (b.agent_id == agent)
+            sums[i] += np.exp(1j * b.heading[mine]).sum()
+            counts[i] += int(mine.sum())
+    if not counts.all():
+        return float("nan")
+    return float(abs(np.angle(sums[0] / sums[1])))
 
 
 def recovery_differences(seconds: dict[tuple[str, str], list[float]], setups: Sequence[str],
@@ -277,5 +315,6 @@ def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[s
 
 
 __all__ = ["AFTER_S", "DEFAULT_SEED", "EXPERIMENT_KEYS", "SwapRun", "experiment_results", "hit_rate",
-           "longest_recovery_s", "most_seen_pair", "pair_hits", "recovery_differences", "recovery_rows",
-           "recovery_runs", "recovery_s", "reindex", "shuffle_rows", "swap_frames", "swap_recovery", "swap_reports"]
+           "longest_recovery_s", "measured_sequences", "most_seen_pair", "pair_hits", "recovery_differences",
+           "recovery_rows", "recovery_runs", "recovery_s", "reindex", "restore_gap", "shuffle_rows", "swap_frames",
+           "swap_recovery", "swap_reports", "swap_runs"]
