@@ -1,6 +1,7 @@
 import json
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from lookalike.bench.experiments import pair_hits, recovery_s, reindex, swap_reports
@@ -129,3 +130,54 @@ def test_recovery_leaves_out_sequences_with_nothing_to_measure(monkeypatch):
     monkeypatch.setattr(experiments, "measurable", lambda q, *a: False)
     rows, _ = experiments.recovery_runs(["m3n2"], ["kalman_ha"], 2, 300, 2.0, 3.0)
     assert rows[0]["Sequences measured"] == 0 and np.isnan(rows[0]["Recovery, mean (s)"])
+
+
+def _with_pair_reports(seq, headings):
+    """``seq`` whose swapped pair (for a swap from 2 s for 3 s) reports ``headings[i]`` (radians; None: nothing)
+    from 5 s on, its other reports as they were."""
+    from types import SimpleNamespace
+
+    from lookalike.bench.experiments import most_seen_pair, swap_frames
+    from lookalike.types import Beacons, Frame
+
+    start, _, after = swap_frames(seq.config.frame_rate_hz, 2.0, 3.0)
+    pair = most_seen_pair(seq.true_labels()[start:after], seq.config.n_agents)
+    frames = []
+    for f in seq.frames():
+        b = f.beacons
+        keep = np.ones(len(b), dtype=bool)
+        heading = b.heading.copy()
+        for agent, value in zip(pair, headings):
+            mine = (b.agent_id == agent) & (b.t_sent >= 5.0)
+            if value is None:
+                keep &= ~mine
+            else:
+                heading[mine] = value
+        beacons = Beacons(agent_id=b.agent_id[keep], t_sent=b.t_sent[keep], t_received=b.t_received[keep],
+                          heading=heading[keep])
+        frames.append(Frame(index=f.index, time=f.time, detections=f.detections, beacons=beacons))
+    return SimpleNamespace(config=seq.config, true_labels=seq.true_labels, frames=lambda: iter(frames))
+
+
+def test_restore_gap_is_how_far_apart_the_pairs_reports_are_after_the_restore():
+    from lookalike.bench.experiments import restore_gap
+
+    seq = simulate_robots(preset("m3n2"), 300, seed=3)
+    assert 0.0 <= restore_gap(seq, 2.0, 3.0) <= np.pi
+    assert restore_gap(_with_pair_reports(seq, (1.0, 1.3)), 2.0, 3.0) == pytest.approx(0.3)
+    across = _with_pair_reports(seq, (np.pi - 0.05, -np.pi + 0.05))  # either side of ±π: 0.1 rad apart
+    assert restore_gap(across, 2.0, 3.0) == pytest.approx(0.1)
+    assert np.isnan(restore_gap(_with_pair_reports(seq, (1.0, None)), 2.0, 3.0))  # one of them silent
+
+
+def test_swap_runs_keep_each_sequences_figures(monkeypatch):
+    from lookalike.bench import experiments
+
+    monkeypatch.setattr(experiments, "identify", lambda name, s, fs, options=None: [
+        np.where(t >= 0, t, -1) for t in s.true_labels()])  # always right: recovers at once
+    rows, runs = experiments.swap_runs(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)
+    run = runs[("m3n2", "perfect")]
+    assert run.shape == (rows[0]["Sequences measured"], len(experiments.SwapRun._fields))
+    assert (run[:, experiments.SwapRun._fields.index("recovery_s")] == 0.0).all()
+    _, seconds = experiments.recovery_runs(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)
+    assert seconds[("m3n2", "perfect")] == [0.0] * len(run)
