@@ -54,7 +54,8 @@ def test_commands_print_and_write_tables(tmp_path):
                             "--frames", "450", "--swap-at-s", "3", "--swap-s", "5", "--json", str(out)])
     assert r.exit_code == 0, r.output
     metrics = json.loads(out.read_text())["tables"]["recovery"][0]["metrics"]
-    assert {"recovery_mean_s", "success_rate_after_restore", "success_rate_after_restore_without_swap"} <= set(metrics)
+    assert {"recovery_mean_s", "success_rate_after_restore", "success_rate_after_restore_without_swap",
+            "recovery_mean_apart_s", "sequences_apart"} <= set(metrics)
 
 
 def test_success_after_the_restore_says_how_right_an_identifier_is_not_how_it_compares_with_itself():
@@ -181,3 +182,17 @@ def test_swap_runs_keep_each_sequences_figures(monkeypatch):
     assert (run[:, experiments.SwapRun._fields.index("recovery_s")] == 0.0).all()
     _, seconds = experiments.recovery_runs(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)
     assert seconds[("m3n2", "perfect")] == [0.0] * len(run)
+
+
+def test_recovery_rows_give_the_recovery_where_the_reports_tell_the_pair_apart(monkeypatch):
+    from lookalike.bench import experiments
+
+    monkeypatch.setattr(experiments, "identify", lambda name, s, fs, options=None: [
+        np.where(t >= 0, t, -1) for t in s.true_labels()])
+    key, count = "Recovery, reports >= 0.2 rad apart, mean (s)", "Sequences with reports >= 0.2 rad apart"
+    monkeypatch.setattr(experiments, "restore_gap", lambda q, *a: 1.0)
+    row = experiments.recovery_rows(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)[0]
+    assert row[count] == row["Sequences measured"] > 0 and row[key] == row["Recovery, mean (s)"]
+    monkeypatch.setattr(experiments, "restore_gap", lambda q, *a: float("nan"))  # a pair member silent: not apart
+    row = experiments.recovery_rows(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)[0]
+    assert row[count] == 0 and np.isnan(row[key])

@@ -12,7 +12,10 @@ one-second window is back within 5 points of the same run without the swap. The 
 each identifier with itself: one that confuses the pair without the swap too recovers at once; the
 success after the restore says how right it is. A sequence whose pair is not detected while swapped or
 not after the restore (:func:`measurable`, from the truth alone) has nothing to recover from and is left
-out; the table says how many sequences were measured. :func:`recovery_differences` compares each
+out; the table says how many sequences were measured. The mean recovery is also given over the sequences whose
+pair heads at least :data:`APART_RAD` apart just after the restore (:func:`restore_gap`): where the two head
+closer, the reports hardly tell them apart, and an identifier that kept them apart without the swap has the most
+to make up (docs/experiments/any-team-size.md). :func:`recovery_differences` compares each
 identifier's mean recovery time with the first one's on the same sequences (95% interval over sequences;
 :mod:`lookalike.bench.paired`).
 """
@@ -141,6 +144,7 @@ class SwapRun(NamedTuple):
 
 
 AFTER_S = 3.0  # seconds after the restore that pick the pair and give the success after the restore
+APART_RAD = 0.2  # restore_gap from which the pair's reports tell the two robots apart (about 6 report noises)
 
 
 def swap_frames(rate_hz: float, swap_at_s: float, swap_s: float) -> tuple[int, int, int]:
@@ -237,6 +241,7 @@ def swap_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, fr
     step = progress("bench recovery", len(setups) * len(trackers))
     for setup in setups:
         measured = measured_sequences(setup, sequences, frames, seed, swap_at_s, swap_s)
+        apart = np.array([restore_gap(q, swap_at_s, swap_s) >= APART_RAD for q in measured], dtype=bool)
         width = len(SwapRun._fields)
         for name in trackers:
             runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s, (options or {}).get(name))
@@ -254,6 +259,9 @@ def swap_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, fr
                 "Recovery, mean (s)": round(float(np.mean(run["recovery_s"])), 2),
                 "Recovery, worst (s)": round(float(np.max(run["recovery_s"])), 2),
                 "Sequences measured": len(measured),
+                f"Recovery, reports >= {APART_RAD:g} rad apart, mean (s)": round(
+                    float(np.mean(run["recovery_s"][apart])) if apart.any() else float("nan"), 2),
+                f"Sequences with reports >= {APART_RAD:g} rad apart": int(apart.sum()),
             })
             step()
     return rows, runs_of
@@ -294,7 +302,9 @@ EXPERIMENT_KEYS = {"In order (%)": "success_rate_in_order", "Random order (%)": 
                    "Same without swap (%)": "success_rate_without_swap",
                    "After the restore, 3 s (%)": "success_rate_after_restore",
                    "Same without swap, after (%)": "success_rate_after_restore_without_swap",
-                   "Sequences measured": "sequences_measured"}
+                   "Sequences measured": "sequences_measured",
+                   f"Recovery, reports >= {APART_RAD:g} rad apart, mean (s)": "recovery_mean_apart_s",
+                   f"Sequences with reports >= {APART_RAD:g} rad apart": "sequences_apart"}
 
 
 def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[str], sequences: int, frames: int,
@@ -314,7 +324,7 @@ def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[s
     return doc
 
 
-__all__ = ["AFTER_S", "DEFAULT_SEED", "EXPERIMENT_KEYS", "SwapRun", "experiment_results", "hit_rate",
+__all__ = ["AFTER_S", "APART_RAD", "DEFAULT_SEED", "EXPERIMENT_KEYS", "SwapRun", "experiment_results", "hit_rate",
            "longest_recovery_s", "measured_sequences", "most_seen_pair", "pair_hits", "recovery_differences",
            "recovery_rows", "recovery_runs", "recovery_s", "reindex", "restore_gap", "shuffle_rows", "swap_frames",
            "swap_recovery", "swap_reports", "swap_runs"]
