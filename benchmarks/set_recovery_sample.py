@@ -31,7 +31,14 @@ from pathlib import Path
 import numpy as np
 from _common import report_target
 
-from lookalike.bench.experiments import SwapRun, longest_recovery_s, measured_sequences, restore_gap, swap_runs
+from lookalike.bench.experiments import (
+    APART_RAD,
+    SwapRun,
+    longest_recovery_s,
+    measured_sequences,
+    restore_gap,
+    swap_runs,
+)
 from lookalike.bench.paired import PairedDifference, interval_text, mean_difference
 from lookalike.sim import preset, preset_label
 
@@ -64,8 +71,8 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=3200000)
     parser.add_argument("--margin", type=float, default=0.15, help="Seconds the candidate may be slower.")
     parser.add_argument("--out", type=Path, default=Path("runs/set-recovery-sample"))
-    parser.add_argument("--gap", type=float, default=0.2, help="Radians between the pair's reports after the restore "
-                        "that split the sequences for the further figures.")
+    parser.add_argument("--gap", type=float, default=APART_RAD,
+                        help="Radians between the pair's reports after the restore that split the further figures.")
     parser.add_argument("--success-margin", type=float, default=2.0,
                         help="Percentage points of success after the restore the candidate may be lower.")
     args = parser.parse_args()
