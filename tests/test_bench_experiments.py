@@ -138,11 +138,10 @@ def _with_pair_reports(seq, headings):
     from 5 s on, its other reports as they were."""
     from types import SimpleNamespace
 
-    from lookalike.bench.experiments import most_seen_pair, swap_frames
+    from lookalike.bench.experiments import swapped_pair
     from lookalike.types import Beacons, Frame
 
-    start, _, after = swap_frames(seq.config.frame_rate_hz, 2.0, 3.0)
-    pair = most_seen_pair(seq.true_labels()[start:after], seq.config.n_agents)
+    pair = swapped_pair(seq, 2.0, 3.0)
     frames = []
     for f in seq.frames():
         b = f.beacons

@@ -159,6 +159,13 @@ def longest_recovery_s(frames: int, rate_hz: float, swap_at_s: float, swap_s: fl
     return (frames - int(rate_hz) - swap_frames(rate_hz, swap_at_s, swap_s)[1]) / rate_hz
 
 
+def swapped_pair(sequence: RobotSequence, swap_at_s: float, swap_s: float) -> tuple[int, int]:
+    """The two robots whose reports :func:`swap_recovery` swaps: those seen most from ``swap_at_s`` to
+    :data:`AFTER_S` seconds after the restore (from the truth alone)."""
+    start, _, after = swap_frames(sequence.config.frame_rate_hz, swap_at_s, swap_s)
+    return most_seen_pair(sequence.true_labels()[start:after], sequence.config.n_agents)
+
+
 def swap_recovery(labels: Callable[[RobotSequence, list[Frame]], list[np.ndarray]], seq: RobotSequence,
                   swap_at_s: float, swap_s: float) -> SwapRun:
     """:class:`SwapRun` of one sequence whose two robots seen most swap reports from ``swap_at_s`` for
@@ -167,7 +174,7 @@ def swap_recovery(labels: Callable[[RobotSequence, list[Frame]], list[np.ndarray
     fs = list(seq.frames())
     truth = seq.true_labels()
     start, restore, after = swap_frames(rate, swap_at_s, swap_s)
-    pair = most_seen_pair(truth[start:after], seq.config.n_agents)
+    pair = swapped_pair(seq, swap_at_s, swap_s)
     clean = pair_hits(labels(seq, fs), truth, pair)
     swapped = pair_hits(labels(seq, swap_reports(fs, swap_at_s, swap_at_s + swap_s, pair)), truth, pair)
     return SwapRun(hit_rate(swapped[start:restore]), hit_rate(clean[start:restore]),
@@ -181,8 +188,8 @@ def measurable(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 
     truth alone: the same for every identifier."""
     rate = sequence.config.frame_rate_hz
     truth = sequence.true_labels()
-    start, restore, after = swap_frames(rate, swap_at_s, swap_s)
-    a, b = most_seen_pair(truth[start:after], sequence.config.n_agents)
+    start, restore, _ = swap_frames(rate, swap_at_s, swap_s)
+    a, b = swapped_pair(sequence, swap_at_s, swap_s)
 
     def seen(frames: list[np.ndarray]) -> bool:
         return any(((t == a) | (t == b)).any() for t in frames)
@@ -271,9 +278,7 @@ def restore_gap(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float =
     """How far apart (radians, 0 to π) the headings of :func:`swap_recovery`'s pair are just after the restore:
     the difference of the circular means of each one's own reports sent in the ``window_s`` seconds from the
     restore (NaN: either sent none). From the data alone: how much the reports can tell the two apart there."""
-    truth = sequence.true_labels()
-    start, _, after = swap_frames(sequence.config.frame_rate_hz, swap_at_s, swap_s)
-    pair = most_seen_pair(truth[start:after], sequence.config.n_agents)
+    pair = swapped_pair(sequence, swap_at_s, swap_s)
     restore_s = swap_at_s + swap_s
     sums, counts = np.zeros(2, dtype=complex), np.zeros(2, dtype=int)
     for f in sequence.frames():
@@ -327,4 +332,4 @@ def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[s
 __all__ = ["AFTER_S", "APART_RAD", "DEFAULT_SEED", "EXPERIMENT_KEYS", "SwapRun", "experiment_results", "hit_rate",
            "longest_recovery_s", "measured_sequences", "most_seen_pair", "pair_hits", "recovery_differences",
            "recovery_rows", "recovery_runs", "recovery_s", "reindex", "restore_gap", "shuffle_rows", "swap_frames",
-           "swap_recovery", "swap_reports", "swap_runs"]
+           "swap_recovery", "swap_reports", "swap_runs", "swapped_pair"]
