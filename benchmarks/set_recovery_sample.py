@@ -83,7 +83,7 @@ def main() -> None:
     for setup in args.setups.split(","):
         kept: dict[str, dict] = {}  # identifier -> its recovery seconds per sequence and its row
         for name in trackers:
-            tag = "".join(f",{k}={v}" for k, v in sorted((options.get(name) or {}).items()))
+            tag = "".join(f",{k}={v}".replace("/", "_") for k, v in sorted((options.get(name) or {}).items()))
             cache = args.out / f"{setup}-{args.seed}-{args.sequences}x{args.frames}-{name}{tag}.json"
             if not cache.exists():
                 rows, runs = swap_runs([setup], [name], args.sequences, args.frames, swap_at_s, swap_s,

@@ -22,6 +22,8 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
   (``exchange_tight_agents``), the same rule;
 - stage 15: pairing a report jump with another agent's first report after a silence (``jump_silent``), alone and
   with the exchange detector keeping silent tracks (``exchange_fresh_s`` off), the same rule.
+- stage 16: trains: the snapshots of ``python -m lookalike.learn.set_finetune RUN --stage 16`` (swaps that end in
+  a silence) at multiples of :data:`STAGE16_EVERY` steps, with the shipped inference options, the same rule.
 
 A chosen option is made the identifier's default by hand.
 """
@@ -30,6 +32,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from lookalike.bench.set_select import snapshot_steps
 from lookalike.bench.set_select_stage4 import passes_guard, print_choice, score_candidates
 from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
 
@@ -57,6 +60,8 @@ BEFORE_STAGE14: dict[str, object] = {"exchange_tight_agents": None, **BEFORE_STA
 STAGE15_OPTIONS: tuple[dict[str, object], ...] = ({"jump_silent": True},
                                                    {"jump_silent": True, "exchange_fresh_s": None})
 STAGE15_BASELINE = "shipped-before-15"
+STAGE16_EVERY = 250  # stage 16: the fine-tuning's snapshots at multiples of this step
+STAGE16_BASELINE = "shipped"
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -124,8 +129,18 @@ def stage15_candidates() -> Candidates:
     return candidates
 
 
-def stage_candidates(stage: int) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 10, 12 … 15) candidates and the name of its baseline (the option off)."""
+def stage16_candidates(run_dir: Path) -> Candidates:
+    """The sixteenth stage's candidates: the shipped identifier and ``step{k}``, the snapshots of ``run_dir`` at
+    multiples of :data:`STAGE16_EVERY`, with the shipped inference options."""
+    snapshots = {f"step{k}": (run_dir / f"set_step{k}.npz", {}) for k in snapshot_steps(run_dir, STAGE16_EVERY)}
+    return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, {}), **snapshots}
+
+
+def stage_candidates(stage: int, run_dir: Path | None = None) -> tuple[Candidates, str]:
+    """Stage ``stage``'s (5 … 10, 12 … 16; 16: the snapshots in ``run_dir``) candidates and the name of its
+    baseline."""
+    if stage == 16:
+        return stage16_candidates(run_dir or Path(".")), STAGE16_BASELINE
     if stage == 15:
         return stage15_candidates(), STAGE15_BASELINE
     if stage == 12:
@@ -143,7 +158,7 @@ def stage_candidates(stage: int) -> tuple[Candidates, str]:
 
 def select_options(run_dir: Path, stage: int, only: str | None = None) -> str | None:
     """Score stage ``stage``'s candidates (all, or ``only``), print them and the choice (None: nothing eligible)."""
-    candidates, baseline = stage_candidates(stage)
+    candidates, baseline = stage_candidates(stage, run_dir)
     rows = score_candidates(candidates, run_dir / f"set_select_stage{stage}.json", only)
     if stage < 12:
         return print_choice(rows, baseline)

@@ -15,7 +15,7 @@ import dataclasses
 import numpy as np
 
 from lookalike.learn.data import IGNORE
-from lookalike.learn.sim_data import latest_reports, mix_pick, slot_order, swap_identities
+from lookalike.learn.sim_data import latest_reports, mix_pick, silence_agent, slot_order, swap_identities
 from lookalike.sim import NOISE_MODELS, RobotArrays, RobotWorldConfig, noise_sensor, simulate_arrays
 from lookalike.sim.robots_config import SensorConfig
 
@@ -134,7 +134,11 @@ class SetBatchMaker:
     one drawn per sequence from its seed (:func:`~lookalike.learn.sim_data.mix_pick`, as the LSTM's noise
     mix); empty: the default world's noise. ``close_swap_prob``: the fraction of the swaps made between
     the two robots whose true headings are closest when the swap starts (the pairs a heading report
-    hardly tells apart), instead of two random robots. Their defaults draw the same batches as before.
+    hardly tells apart), instead of two random robots. ``silent_swap_prob``: the fraction of the swaps
+    (drawn after the pair) whose end falls inside a silence of one of the two agents: its reports sent from
+    0.2–1.5 s before the swap ends, for 1–3 s, are dropped (:func:`~lookalike.learn.sim_data.silence_agent`),
+    so that the network learns to move an agent's memory when it reports again. Their defaults draw the same
+    batches as before.
     """
 
     sizes: TeamSizes = TeamSizes()
@@ -144,6 +148,7 @@ class SetBatchMaker:
     swap_ends: float | None = None
     noises: tuple[str, ...] = ()
     close_swap_prob: float = 0.0
+    silent_swap_prob: float = 0.0
 
     def __post_init__(self) -> None:
         unknown = [x for x in self.noises if x not in NOISE_MODELS]
@@ -151,6 +156,8 @@ class SetBatchMaker:
             raise ValueError(f"SetBatchMaker: unknown noise models {unknown}; known: {', '.join(NOISE_MODELS)}")
         if not 0.0 <= self.close_swap_prob <= 1.0:
             raise ValueError(f"SetBatchMaker: close_swap_prob must lie in [0, 1], got {self.close_swap_prob}")
+        if not 0.0 <= self.silent_swap_prob <= 1.0:
+            raise ValueError(f"SetBatchMaker: silent_swap_prob must lie in [0, 1], got {self.silent_swap_prob}")
 
     def world_of(self, cfg: RobotWorldConfig, seed: int) -> RobotWorldConfig:
         """The world of the sequence of ``seed``: ``cfg`` with the noise model :attr:`noises` draws for it."""
@@ -180,6 +187,10 @@ class SetBatchMaker:
                 if self.close_swap_prob > 0 and aug.random() < self.close_swap_prob:
                     i, j = closest_headings(arrays, start)
                 arrays = swap_identities(arrays, int(i), int(j), start, stop)
+                if self.silent_swap_prob > 0 and aug.random() < self.silent_swap_prob:
+                    quiet = int(i if aug.random() < 0.5 else j)
+                    begin = stop - aug.uniform(0.2, 1.5)
+                    arrays = silence_agent(arrays, quiet, begin, begin + aug.uniform(1.0, 3.0))
             out.append(arrays_to_tokens(arrays, n, np.random.default_rng([s, 1])))
         a, d, v, y = (np.stack(parts) for parts in zip(*out))
         k = max(int(v.sum(-1).max()), 1)  # occupied slots come first: drop the columns empty everywhere

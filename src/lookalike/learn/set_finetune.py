@@ -7,7 +7,8 @@ with :data:`FINETUNE_CONFIG`: a low, decaying learning rate, 60% of the batches 
 (``OUT/set_step{N}.npz``) to choose among on tuning sequences. ``--stage 2`` runs
 :data:`FINETUNE2_CONFIG` instead: a second stage from the weights shipped after the first, with more
 M=3, N=2 batches and more, longer identity swaps. ``--stage 4`` runs :data:`FINETUNE4_CONFIG`: the
-noise mix (ours + paper position noise) and swaps between robots of close headings. Needs torch.
+noise mix (ours + paper position noise) and swaps between robots of close headings. ``--stage 16`` runs
+:data:`FINETUNE16_CONFIG`: swaps whose end falls inside one agent's silence. Needs torch.
 """
 
 from __future__ import annotations
@@ -44,7 +45,14 @@ FINETUNE4_CONFIG = SetTrainConfig(
     focus_prob=0.7, focus_teams=FINETUNE_TEAMS, keep_snapshots=True, validation_every=25,
     noises=("ours", "paper"),
 )
-STAGES = {1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG, 4: FINETUNE4_CONFIG}
+# The sixteenth stage (issue 23): the first stage's mix (what ships) at half its learning rate, swaps in half of
+# the sequences (a quarter of them between the closest headings), half of the swaps ending inside one agent's silence.
+FINETUNE16_CONFIG = SetTrainConfig(
+    learning_rate=0.0001, lr_decay=0.001, steps=5000, minutes=40.0, patience=1000, seed=16,
+    swap_prob=0.5, swap_min_s=1.0, swap_max_s=10.0, swap_ends_s=3.0, close_swap_prob=0.25, silent_swap_prob=0.5,
+    focus_prob=0.6, focus_teams=FINETUNE_TEAMS, keep_snapshots=True, validation_every=25,
+)
+STAGES = {1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG, 4: FINETUNE4_CONFIG, 16: FINETUNE16_CONFIG}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -61,7 +69,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("out", type=Path, help="output folder (snapshots, log, best-validation weights)")
     parser.add_argument("--stage", type=int, choices=sorted(STAGES), default=1,
                         help="1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG (from the stage-1 weights), "
-                        "4: FINETUNE4_CONFIG (the noise mix and close-heading swaps, from the shipped weights)")
+                        "4: FINETUNE4_CONFIG (the noise mix and close-heading swaps, from the shipped weights), "
+                        "16: FINETUNE16_CONFIG (swaps that end in a silence, from the shipped weights)")
     parser.add_argument("--minutes", type=float, default=None, help="wall-clock limit (default: the stage's)")
     parser.add_argument("--init", type=Path, default=SHIPPED_SET_WEIGHTS, help="weights to start from (.npz)")
     args = parser.parse_args(argv)

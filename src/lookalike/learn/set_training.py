@@ -71,6 +71,7 @@ class SetTrainConfig:
     keep_snapshots: bool = False  # also write set_step{N}.npz at every validation
     noises: tuple[str, ...] = ()  # position-noise models drawn per sequence (("ours", "paper"): the noise mix)
     close_swap_prob: float = 0.0  # fraction of the swaps between the two robots of closest headings
+    silent_swap_prob: float = 0.0  # fraction of the swaps that end inside a silence of one of the pair
 
     def batch_maker(self, swap: bool = True) -> SetBatchMaker:
         """The batch generator of this run (with identity-swap augmentation unless ``swap`` is False)."""
@@ -78,7 +79,7 @@ class SetTrainConfig:
                           self.focus_teams if self.focus_prob > 0 else (), self.focus_prob)
         return SetBatchMaker(sizes, self.swap_prob if swap else 0.0, swap_s=(self.swap_min_s, self.swap_max_s),
                              swap_ends=self.swap_ends_s, noises=tuple(self.noises),
-                             close_swap_prob=self.close_swap_prob)
+                             close_swap_prob=self.close_swap_prob, silent_swap_prob=self.silent_swap_prob)
 
 
 def _to_torch(batch: tuple, device: str) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor, float]:

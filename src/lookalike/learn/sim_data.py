@@ -100,6 +100,18 @@ def swap_identities(arrays: RobotArrays, a: int, b: int, start_s: float, stop_s:
     return dataclasses.replace(swapped, det_label=label)
 
 
+def silence_agent(arrays: RobotArrays, agent: int, start_s: float, stop_s: float) -> RobotArrays:
+    """``arrays`` without the reports ``agent`` sent from ``start_s`` to ``stop_s`` (seconds): a lost burst
+    of one agent's reports. Detections and their labels are unchanged."""
+    r = arrays.reports
+    keep = ~((r.agent_id == agent) & (r.t_sent >= start_s) & (r.t_sent < stop_s))
+    kept_before = np.concatenate([[0], np.cumsum(keep)])  # rows kept among the first k
+    reports = dataclasses.replace(r, agent_id=r.agent_id[keep], t_sent=r.t_sent[keep],
+                                  t_received=r.t_received[keep], heading=r.heading[keep],
+                                  frame_offsets=kept_before[r.frame_offsets])
+    return dataclasses.replace(arrays, reports=reports)
+
+
 @dataclasses.dataclass(frozen=True)
 class SimSampler:
     """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler over the robot world ``config``.
