@@ -51,6 +51,27 @@ def test_identity_swap_moves_reports_and_targets_together():
         np.testing.assert_array_equal(h1[k], h0[k])
 
 
+def test_silence_agent_drops_one_agents_reports_in_the_window_only():
+    from lookalike.learn.sim_data import latest_reports, silence_agent
+
+    arrays = simulate_robots(preset("m5n3"), 300, seed=5).arrays
+    quiet = silence_agent(arrays, 1, 3.0, 6.0)
+    r, q = arrays.reports, quiet.reports
+    dropped = (r.agent_id == 1) & (r.t_sent >= 3.0) & (r.t_sent < 6.0)
+    assert dropped.any() and len(q.agent_id) == len(r.agent_id) - dropped.sum()
+    assert not ((q.agent_id == 1) & (q.t_sent >= 3.0) & (q.t_sent < 6.0)).any()
+    for k in range(len(arrays)):  # every frame still carries the same reports, less the dropped ones
+        rows = slice(r.frame_offsets[k], r.frame_offsets[k + 1])
+        np.testing.assert_array_equal(q.t_sent[q.frame_offsets[k]:q.frame_offsets[k + 1]],
+                                      r.t_sent[rows][~dropped[rows]])
+    h0, s0 = latest_reports(arrays, 3)
+    h1, s1 = latest_reports(quiet, 3)
+    k = int(5.5 * 30)  # inside the silence: agent 1's newest report is older, the others' unchanged
+    assert s1[k, 1] < 3.0 <= s0[k, 1]
+    np.testing.assert_array_equal(h1[k][[0, 2]], h0[k][[0, 2]])
+    np.testing.assert_array_equal(quiet.det_label, arrays.det_label)
+
+
 def test_sim_sampler_is_picklable_and_swaps_only_when_asked():
     import pickle
 

@@ -160,6 +160,21 @@ def test_close_heading_swaps_pick_the_pair_of_closest_headings():
         SetBatchMaker(close_swap_prob=1.5)
 
 
+def test_silent_swaps_drop_one_pair_members_reports_near_the_swaps_end():
+    from lookalike.learn.set_finetune import FINETUNE16_CONFIG, STAGES
+
+    assert STAGES[16] is FINETUNE16_CONFIG and FINETUNE16_CONFIG.silent_swap_prob > 0
+    assert FINETUNE16_CONFIG.batch_maker().silent_swap_prob == FINETUNE16_CONFIG.silent_swap_prob
+    plain = SetBatchMaker(fixed=(3, 5, 0.5), swap_prob=1.0, swap_ends=1.0)(3, 2, 240)
+    silent = SetBatchMaker(fixed=(3, 5, 0.5), swap_prob=1.0, swap_ends=1.0, silent_swap_prob=1.0)(3, 2, 240)
+    np.testing.assert_array_equal(plain[1], silent[1])  # the same detections
+    assert (plain[0] != silent[0]).any()  # fewer reports: other agent tokens
+    np.testing.assert_array_equal(SetBatchMaker(fixed=(3, 5, 0.5), swap_prob=1.0, swap_ends=1.0,
+                                                silent_swap_prob=0.0)(3, 2, 240)[0], plain[0])  # off: as before
+    with pytest.raises(ValueError, match="silent_swap_prob"):
+        SetBatchMaker(silent_swap_prob=-0.1)
+
+
 def test_stage4_candidates_and_choice(tmp_path):
     from lookalike.bench.set_select_stage4 import BASELINE, choose_stage4, stage4_candidates
 

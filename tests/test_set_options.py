@@ -302,6 +302,18 @@ def test_stage12_to_15_candidates_and_the_guard():
     assert not passes_guard({**base, "rec_m3n2": 0.13}, base)  # recovery more than 0.02 s slower
 
 
+def test_stage16_candidates_are_the_snapshots_at_its_steps(tmp_path):
+    from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
+    from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+
+    for k in (25, 250, 400, 500):
+        (tmp_path / f"set_step{k}.npz").write_bytes(b"")
+    cands, baseline = stage_candidates(16, tmp_path)
+    assert baseline == STAGE16_BASELINE and cands[baseline] == (SHIPPED_SET_WEIGHTS, {})
+    assert {n: w for n, (w, _) in cands.items() if n != baseline} == {
+        "step250": tmp_path / "set_step250.npz", "step500": tmp_path / "set_step500.npz"}
+
+
 def test_exchange_tight_agents_changes_the_detector_of_larger_teams_only():
     small = make_tracker("set", n_agents=4)  # exchange_tight_agents 5, the default
     large = make_tracker("set", n_agents=5)

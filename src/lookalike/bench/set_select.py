@@ -341,8 +341,8 @@ def main(argv: list[str] | None = None) -> None:
                         "6-9: the report-exchange detector (7: its evidence decays; 8: and lost bursts leave a "
                         "track out; 9: for teams of up to seven); 10: mirroring report jumps paired; "
                         "12: the exchange detector's heading model; 13: and a step gate; 14: that model for "
-                        "larger teams; 15: jumps paired across silences; 16: a fine-tuning with swaps that end in a silence "
-                        "(5-16: lookalike.bench.set_select_options)")
+                        "larger teams; 15: jumps paired across silences; 16: a fine-tuning with swaps that end "
+                        "in a silence (5-16: lookalike.bench.set_select_options)")
     parser.add_argument("--only", default=None,
                         help="stages 4-16: score this candidate only (e.g. step300,pair=off)")
     parser.add_argument("--cache", type=Path, default=None,
