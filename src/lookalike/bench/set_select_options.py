@@ -132,7 +132,8 @@ def stage15_candidates() -> Candidates:
 def stage16_candidates(run_dir: Path) -> Candidates:
     """The sixteenth stage's candidates: the shipped identifier and ``step{k}``, the snapshots of ``run_dir`` at
     multiples of :data:`STAGE16_EVERY`, with the shipped inference options."""
-    snapshots = {f"step{k}": (run_dir / f"set_step{k}.npz", {}) for k in snapshot_steps(run_dir, STAGE16_EVERY)}
+    snapshots: Candidates = {f"step{k}": (run_dir / f"set_step{k}.npz", {})
+                             for k in snapshot_steps(run_dir, STAGE16_EVERY)}
     return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, {}), **snapshots}
 
 
