@@ -42,6 +42,23 @@ def test_training_starts_from_init_weights(tmp_path):
         train_set(SetTrainConfig(token=8, pair=10, memory=6, steps=0), tmp_path / "other", init=init)
 
 
+def test_training_only_the_named_layers_leaves_the_others_as_they_were(tmp_path):
+    pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
+    from lookalike.learn.set_training import SetTrainConfig, train_set
+
+    shapes = SetWeights({}, 8, 12, 6).shapes()
+    rng = np.random.default_rng(0)
+    init = SetWeights({k: 0.3 * rng.normal(size=s) for k, s in shapes.items()}, 8, 12, 6)
+    config = SetTrainConfig(token=8, pair=12, memory=6, n_max=2, batch_size=2, sequence_length=20, bptt=20, steps=2,
+                            validation_sequences=1, validation_length=20, validation_every=1, trainable=("gru",),
+                            learning_rate=0.01)
+    back = load_set_weights(train_set(config, tmp_path, init=init).weights_path)
+    moved = {name for name, arr in init.arrays.items() if not np.allclose(back.arrays[name], arr, atol=1e-6)}
+    assert moved and all(name.startswith("gru") for name in moved)
+    with pytest.raises(ValueError, match="no parameter"):
+        train_set(SetTrainConfig(token=8, pair=12, memory=6, steps=0, trainable=("lstm",)), tmp_path / "x", init=init)
+
+
 def test_focus_teams_of_a_run_weight_the_draws():
     from lookalike.learn.set_finetune import FINETUNE_CONFIG
 

@@ -73,10 +73,17 @@ def main(argv: list[str] | None = None) -> None:
                         "16: FINETUNE16_CONFIG (swaps that end in a silence, from the shipped weights)")
     parser.add_argument("--minutes", type=float, default=None, help="wall-clock limit (default: the stage's)")
     parser.add_argument("--init", type=Path, default=SHIPPED_SET_WEIGHTS, help="weights to start from (.npz)")
+    parser.add_argument("--trainable", default=None,
+                        help="comma-separated layers to train, the rest frozen (e.g. gru; default: all)")
+    parser.add_argument("--learning-rate", type=float, default=None,
+                        help="initial learning rate (default: the stage's)")
     args = parser.parse_args(argv)
     torch.set_num_threads(1)
     stage = STAGES[args.stage]
-    config = dataclasses.replace(stage, minutes=stage.minutes if args.minutes is None else args.minutes)
+    config = dataclasses.replace(
+        stage, minutes=stage.minutes if args.minutes is None else args.minutes,
+        learning_rate=stage.learning_rate if args.learning_rate is None else args.learning_rate,
+        trainable=tuple(args.trainable.split(",")) if args.trainable else stage.trainable)
     started = time.monotonic()
 
     def on_step(row: dict) -> None:

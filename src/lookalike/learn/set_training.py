@@ -72,6 +72,7 @@ class SetTrainConfig:
     noises: tuple[str, ...] = ()  # position-noise models drawn per sequence (("ours", "paper"): the noise mix)
     close_swap_prob: float = 0.0  # fraction of the swaps between the two robots of closest headings
     silent_swap_prob: float = 0.0  # fraction of the swaps that end inside a silence of one of the pair
+    trainable: tuple[str, ...] = ()  # names (prefixes) of the parameters to train, e.g. ("gru",); empty: all
 
     def batch_maker(self, swap: bool = True) -> SetBatchMaker:
         """The batch generator of this run (with identity-swap augmentation unless ``swap`` is False)."""
@@ -135,6 +136,23 @@ def _new_model(config: SetTrainConfig, init: SetWeights | None) -> SetAssociator
     return model
 
 
+def _trained(model: nn.Module, prefixes: tuple[str, ...]) -> list[nn.Parameter]:
+    """The parameters of ``model`` whose names start with one of ``prefixes`` (all when empty); the others are
+    frozen (``requires_grad`` off)."""
+    if not prefixes:
+        return list(model.parameters())
+    kept = []
+    for name, param in model.named_parameters():
+        param.requires_grad_(name.startswith(tuple(prefixes)))
+        if param.requires_grad:
+            kept.append(param)
+    if not kept:
+        names = sorted({n.split(".")[0] for n, _ in model.named_parameters()})
+        raise ValueError(f"trainable {list(prefixes)}: no parameter of the set associator matches; its layers: "
+                         f"{', '.join(names)}")
+    return kept
+
+
 def train_set(
     config: SetTrainConfig,
     out_dir: str | Path,
@@ -153,7 +171,8 @@ def train_set(
         raise ValueError(f"sequence_length {config.sequence_length} must be a multiple of bptt {config.bptt}")
     torch.manual_seed(config.seed)
     model = _new_model(config, init).to(device)
-    optimiser = torch.optim.Adam(model.parameters(), lr=config.learning_rate, weight_decay=config.weight_decay)
+    optimiser = torch.optim.Adam(_trained(model, config.trainable), lr=config.learning_rate,
+                                 weight_decay=config.weight_decay)
     schedule = torch.optim.lr_scheduler.LambdaLR(optimiser, lambda t: 1.0 / (1.0 + config.lr_decay * t))
     loss_fn = nn.NLLLoss(ignore_index=IGNORE)
     ckpt_path, log_path, weights_path = out / "checkpoint.pt", out / "training_log.csv", out / "set.npz"
