@@ -25,13 +25,17 @@ def test_a_swap_that_must_end_leaves_the_last_seconds_alone():
     np.testing.assert_array_equal(y0[:, -30:], y1[:, -30:])  # but not in the last second
 
 
+def _random_weights() -> SetWeights:
+    """Small random set-associator weights (token 8, pair 12, memory 6) to start a training from."""
+    rng = np.random.default_rng(0)
+    return SetWeights({k: 0.3 * rng.normal(size=s) for k, s in SetWeights({}, 8, 12, 6).shapes().items()}, 8, 12, 6)
+
+
 def test_training_starts_from_init_weights(tmp_path):
     pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
     from lookalike.learn.set_training import SetTrainConfig, train_set
 
-    shapes = SetWeights({}, 8, 12, 6).shapes()
-    rng = np.random.default_rng(0)
-    init = SetWeights({k: 0.3 * rng.normal(size=s) for k, s in shapes.items()}, 8, 12, 6)
+    init = _random_weights()
     config = SetTrainConfig(token=8, pair=12, memory=6, n_max=2, batch_size=1, sequence_length=10, bptt=10, steps=0,
                             validation_sequences=1, validation_length=10)
     result = train_set(config, tmp_path, init=init)  # no step: the saved weights are the initial ones
@@ -46,9 +50,7 @@ def test_training_only_the_named_layers_leaves_the_others_as_they_were(tmp_path)
     pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
     from lookalike.learn.set_training import SetTrainConfig, train_set
 
-    shapes = SetWeights({}, 8, 12, 6).shapes()
-    rng = np.random.default_rng(0)
-    init = SetWeights({k: 0.3 * rng.normal(size=s) for k, s in shapes.items()}, 8, 12, 6)
+    init = _random_weights()
     config = SetTrainConfig(token=8, pair=12, memory=6, n_max=2, batch_size=2, sequence_length=20, bptt=20, steps=2,
                             validation_sequences=1, validation_length=20, validation_every=1, trainable=("gru",),
                             learning_rate=0.01)
