@@ -43,7 +43,7 @@ from lookalike.bench.experiments import (
 from lookalike.bench.paired import PairedDifference, interval_text, mean_difference
 from lookalike.sim import preset, preset_label
 
-AFTER = SwapRun._fields.index("after_restore")
+AFTER, RECOVERY = SwapRun._fields.index("after_restore"), SwapRun._fields.index("recovery_s")
 
 
 def gaps(setup: str, sequences: int, frames: int, seed: int, out: Path, swap_at_s: float, swap_s: float) -> np.ndarray:
@@ -90,7 +90,7 @@ def main() -> None:
                 rows, runs = swap_runs([setup], [name], args.sequences, args.frames, swap_at_s, swap_s,
                                        args.seed, options=options)
                 run = runs[(setup, name)]
-                cache.write_text(json.dumps({"seconds": run[:, SwapRun._fields.index("recovery_s")].tolist(),
+                cache.write_text(json.dumps({"seconds": run[:, RECOVERY].tolist(),
                                              "row": rows[0], "runs": run.tolist(),
                                              "options": options.get(name) or {}}))
             kept[name] = json.loads(cache.read_text())

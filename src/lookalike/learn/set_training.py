@@ -143,7 +143,7 @@ def _trained(model: nn.Module, prefixes: tuple[str, ...]) -> list[nn.Parameter]:
         return list(model.parameters())
     kept = []
     for name, param in model.named_parameters():
-        param.requires_grad_(name.startswith(tuple(prefixes)))
+        param.requires_grad_(name.startswith(prefixes))
         if param.requires_grad:
             kept.append(param)
     if not kept:
