@@ -221,6 +221,29 @@ def test_pair_swap_exchanges_the_memories_of_a_swap_no_report_jump_shows(shipped
         quiet.update(f)
 
 
+def test_visual_exchange_follows_visual_headings_that_fit_the_other_agents_reports(shipped):
+    heading = {0: 0.0, 1: 0.3}  # too close for a report jump; both detectors' rules off
+    swapped = lambda a, t: heading[1 - a] if t >= 1.5 else heading[a]  # noqa: E731  ids exchanged from 1.5 s
+    labels = {}
+    for threshold in (None, 6.0):
+        tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, exchange_llr=None,
+                               visual_exchange=threshold)
+        out = []
+        for f in frames(150, swapped, lambda r, t: heading[r]):
+            tracker.update(f)
+            out.append(tracker.last_labels.copy())
+        labels[threshold] = np.array(out)
+        assert tracker.visual_exchanges == (0 if threshold is None else 1)
+    late = int(3.0 * RATE)
+    assert (labels[6.0][late:] == [1, 0]).all()  # robot 0 now reports as agent 1, and is labelled so
+    assert (labels[6.0][: int(1.4 * RATE)] == [0, 1]).all()  # before the swap nothing changed
+    assert (labels[None][late:] == [0, 1]).all()  # without the rule the memory holds the old labels
+    quiet = make_tracker("set", n_agents=2, n_slots=2, visual_exchange=2.0)
+    quiet.net.swap = lambda *a: pytest.fail("no swap, no exchange")
+    for f in frames(150, lambda a, t: heading[a], lambda r, t: heading[r]):
+        quiet.update(f)
+
+
 def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
     """fp_prior_ref: the running false-positive rate starts at the reference, falls in a world without false
     positives (so a robot's detection is less readily called one); None turns the correction off."""
@@ -312,6 +335,15 @@ def test_stage16_candidates_are_the_snapshots_at_its_steps(tmp_path):
     assert baseline == STAGE16_BASELINE and cands[baseline] == (SHIPPED_SET_WEIGHTS, {})
     assert {n: w for n, (w, _) in cands.items() if n != baseline} == {
         "step250": tmp_path / "set_step250.npz", "step500": tmp_path / "set_step500.npz"}
+
+
+def test_stage17_candidates_are_the_visual_detector_at_each_threshold_against_the_shipped_identifier():
+    from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
+
+    cands, baseline = stage_candidates(17)
+    assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"visual_exchange": None}
+    assert sorted(o["visual_exchange"] for n, (_, o) in cands.items() if n != baseline) == [8.0, 10.0, 12.0]
+    assert {o["visual_memory_s"] for n, (_, o) in cands.items() if n != baseline} == {10.0}
 
 
 def test_exchange_tight_agents_changes_the_detector_of_larger_teams_only():

@@ -1,7 +1,7 @@
-"""The fifth to fifteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+"""The fifth to seventeenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 15) scores stage K's candidates
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 17) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
 (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
@@ -24,6 +24,8 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
   with the exchange detector keeping silent tracks (``exchange_fresh_s`` off), the same rule.
 - stage 16: trains: the snapshots of ``python -m lookalike.learn.set_finetune RUN --stage 16`` (swaps that end in
   a silence) at multiples of :data:`STAGE16_EVERY` steps, with the shipped inference options, the same rule.
+- stage 17: exchanging two agents whose detections' visual headings, gathered over seconds, fit each other's reports
+  (``visual_exchange`` at each of :data:`STAGE17_VISUAL`, ``visual_memory_s`` :data:`STAGE17_MEMORY_S`), the same rule.
 
 A chosen option is made the identifier's default by hand.
 """
@@ -62,6 +64,8 @@ STAGE15_OPTIONS: tuple[dict[str, object], ...] = ({"jump_silent": True},
 STAGE15_BASELINE = "shipped-before-15"
 STAGE16_EVERY = 250  # stage 16: the fine-tuning's snapshots at multiples of this step
 STAGE16_BASELINE = "shipped"
+STAGE17_VISUAL: tuple[float, ...] = (8.0, 10.0, 12.0)  # stage 17: visual_exchange's log-likelihood ratios
+STAGE17_MEMORY_S = 10.0  # and the time constant of its evidence's decay, seconds
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -137,9 +141,19 @@ def stage16_candidates(run_dir: Path) -> Candidates:
     return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, {}), **snapshots}
 
 
+def stage17_candidates() -> Candidates:
+    """The seventeenth stage's candidates: the identifier shipped before it and ``visual=h``, the visual exchange
+    detector at each of :data:`STAGE17_VISUAL`."""
+    return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, {"visual_exchange": None}),
+            **{f"visual={h}": (SHIPPED_SET_WEIGHTS, {"visual_exchange": h, "visual_memory_s": STAGE17_MEMORY_S})
+               for h in STAGE17_VISUAL}}
+
+
 def stage_candidates(stage: int, run_dir: Path | None = None) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 10, 12 … 16; 16: the snapshots in ``run_dir``) candidates and the name of its
+    """Stage ``stage``'s (5 … 10, 12 … 17; 16: the snapshots in ``run_dir``) candidates and the name of its
     baseline."""
+    if stage == 17:
+        return stage17_candidates(), STAGE16_BASELINE
     if stage == 16:
         return stage16_candidates(run_dir or Path(".")), STAGE16_BASELINE
     if stage == 15:

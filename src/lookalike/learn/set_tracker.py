@@ -43,6 +43,7 @@ from lookalike.learn.report_exchange import ReportExchange
 from lookalike.learn.set_data import agent_tokens, detection_tokens
 from lookalike.learn.set_numpy import NumpySetAssociator, load_set_weights
 from lookalike.learn.tracker import BeaconMemory, agent_detections, agent_snapshots, decode
+from lookalike.learn.visual_exchange import VisualExchange
 from lookalike.learn.weights import WEIGHTS_DIR
 from lookalike.trackers.base import check_params, param
 from lookalike.trackers.identity.localiser import LOCALISERS, make_localiser
@@ -140,6 +141,15 @@ class SetIdentifier:
             "(None: no step needed)", range=(0.0, 3.2))
         exchange_noise_rad: float = param(0.035, "a heading report's noise for exchange_llr (standard deviation), "
                                           "radians", range=(1e-4, 3.0))
+        visual_exchange: float | None = param(
+            None, "exchange two agents' memories (and this frame's labels) when their detections' visual headings, "
+            "gathered over seconds, fit each other's fresh reports better than their own by this log-likelihood "
+            "ratio (:mod:`lookalike.learn.visual_exchange`; None: never)", range=(0.0, 1e4))
+        visual_memory_s: float = param(3.0, "time constant of visual_exchange's evidence decay, seconds",
+                                       range=(0.01, 1e4))
+        visual_noise_rad: float = param(0.28, "a detection's visual heading noise around its robot's heading for "
+                                        "visual_exchange (standard deviation; 10 heading classes with 12 degrees of "
+                                        "noise), radians", range=(1e-3, 3.0))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
                                choices=LOCALISERS)
@@ -178,6 +188,9 @@ class SetIdentifier:
             n, cfg.exchange_llr, accel, lag, cfg.exchange_noise_rad, cfg.exchange_memory_s, cfg.exchange_fresh_s,
             cfg.exchange_step_rad)
         self.exchanges = 0  # memories exchanged by exchange_llr so far (for tests and analysis)
+        self._visual = None if cfg.visual_exchange is None else VisualExchange(
+            n, cfg.visual_exchange, cfg.visual_memory_s, cfg.visual_noise_rad)
+        self.visual_exchanges = 0  # memories exchanged by visual_exchange so far (for tests and analysis)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
@@ -215,6 +228,8 @@ class SetIdentifier:
         labels[used], conf[used] = slot_label, slot_conf
         if self.config.pair_swap is not None:
             labels = self._pair_swaps(labels, conf, heading, age, dt)
+        if self._visual is not None:
+            labels = self._visual_exchanges(labels, conf, heading, age, dt)
         self.last_labels, self.last_probabilities = labels, conf
         return agent_snapshots(labels, conf, position, heading, self._localiser, self._last_seen, frame)
 
@@ -376,6 +391,20 @@ class SetIdentifier:
                     self._expected_jump[j] = t_sent
                     self._pending.pop(j, None)
                     self._silent.pop(j, None)
+
+    def _visual_exchanges(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, age: np.ndarray,
+                          dt: float) -> np.ndarray:
+        """``visual_exchange``: exchange the memories, and this frame's labels, of the pairs of agents whose
+        detections' visual headings ``heading`` (radians) fit each other's reports better
+        (:class:`~lookalike.learn.visual_exchange.VisualExchange`). Returns the labels."""
+        assert self._visual is not None
+        held = agent_detections(labels, conf, self.config.n_agents)
+        out = labels
+        for j, k in self._visual.update(held, heading, self._beacons.heading, age, dt):
+            self.net.swap(j, k)
+            self.visual_exchanges += 1
+            out = np.where(labels == j, k, np.where(labels == k, j, out))
+        return out
 
     def _pair_swaps(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, age: np.ndarray,
                     dt: float) -> np.ndarray:

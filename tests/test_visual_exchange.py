@@ -1,0 +1,68 @@
+"""The visual exchange detector: which two agents hold each other's robots, from visual headings over frames."""
+
+import numpy as np
+import pytest
+
+from lookalike.learn.visual_exchange import VisualExchange
+
+DT = 1 / 30
+
+
+def feed(detector: VisualExchange, frames: int, visual, reported, age=(0.0, 0.0), seed: int = 0) -> list:
+    """``frames`` frames of two agents each holding one detection (agent i holds detection i) whose visual headings
+    are ``visual`` plus the classifier's noise; the pairs found, per frame."""
+    rng = np.random.default_rng(seed)
+    found = []
+    for _ in range(frames):
+        seen = np.asarray(visual, dtype=float) + rng.normal(0.0, 0.28, 2)
+        found.append(detector.update(np.array([0, 1]), seen, np.asarray(reported, dtype=float),
+                                     np.asarray(age, dtype=float), DT))
+    return found
+
+
+def test_detections_that_fit_each_others_reports_make_an_exchange_after_enough_frames():
+    detector = VisualExchange(2, threshold=6.0)
+    found = feed(detector, 90, visual=[0.2, 0.0], reported=[0.0, 0.2])  # robots 0.2 rad apart, ids exchanged
+    first = next(k for k, pairs in enumerate(found) if pairs)
+    assert found[first] == [(0, 1)]
+    assert first > 2  # one frame is not enough: the evidence is gathered
+    assert detector.evidence[0, 1] < 6.0  # and starts again after the exchange
+
+
+def test_detections_that_fit_their_own_reports_keep_the_evidence_at_zero():
+    detector = VisualExchange(2, threshold=6.0)
+    assert not any(feed(detector, 300, visual=[0.0, 0.5], reported=[0.0, 0.5]))
+    assert detector.evidence.max() < 6.0
+
+
+def test_robots_heading_alike_give_no_exchange_either_way():
+    """Two robots 0.02 rad apart: a frame says almost nothing, and the decay keeps chance from adding up."""
+    for visual in ([0.0, 0.02], [0.02, 0.0]):
+        detector = VisualExchange(2, threshold=6.0, memory_s=1.0)
+        assert not any(feed(detector, 600, visual=visual, reported=[0.0, 0.02], seed=3))
+
+
+def test_a_flipped_heading_counts_little():
+    detector = VisualExchange(2, threshold=4.0)
+    pairs = detector.update(np.array([0, 1]), np.array([np.pi, np.pi + 3.0]), np.array([0.0, 3.0]),
+                            np.zeros(2), DT)  # both detections turned front to back at once
+    assert pairs == [] and detector.evidence[0, 1] == pytest.approx(1.5)  # at most max_step in one frame
+
+
+def test_stale_or_missing_reports_and_agents_without_a_detection_take_no_part():
+    detector = VisualExchange(3, threshold=1.0, fresh_s=0.5)
+    reported = np.array([0.0, 0.5, np.nan])
+    for held, age in ((np.array([0, 1, -1]), np.array([0.0, 0.9, np.nan])),  # agent 1's report is stale
+                      (np.array([0, -1, 1]), np.zeros(3)),  # agent 1 holds nothing, agent 2 never reported
+                      (np.array([0, 1, 2]), np.array([0.0, np.nan, 0.0]))):
+        assert detector.update(held, np.array([0.5, 0.0, 0.0]), reported, age, DT) == []
+    assert detector.evidence.max() == 0.0
+
+
+@pytest.mark.parametrize("kwargs", [dict(threshold=0.0), dict(threshold=1.0, memory_s=0.0),
+                                    dict(threshold=1.0, noise_rad=-0.1), dict(threshold=1.0, max_step=0.0),
+                                    dict(threshold=1.0, flip_prob=0.6,
+                                                                              outlier_prob=0.5)])
+def test_bad_settings_are_refused(kwargs):
+    with pytest.raises(ValueError, match="VisualExchange"):
+        VisualExchange(2, **kwargs)
