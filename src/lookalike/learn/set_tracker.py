@@ -27,6 +27,9 @@ whose heading reports each continue the other's report track exchange memories
 (:mod:`lookalike.learn.report_exchange`): an exchange too small for a report jump. Teams of
 ``exchange_tight_agents`` (5) agents or more run it with a report model that expects smoother turning
 (``exchange_tight_accel``, ``exchange_tight_lag_s``), which finds exchanges between robots heading alike.
+With ``visual_exchange`` (8, chosen on tuning sequences), two agents whose detections' visual headings, gathered
+over seconds, fit each other's reports better than their own exchange memories
+(:mod:`lookalike.learn.visual_exchange`).
 """
 
 from __future__ import annotations
@@ -142,10 +145,11 @@ class SetIdentifier:
         exchange_noise_rad: float = param(0.035, "a heading report's noise for exchange_llr (standard deviation), "
                                           "radians", range=(1e-4, 3.0))
         visual_exchange: float | None = param(
-            None, "exchange two agents' memories (and this frame's labels) when their detections' visual headings, "
+            8.0, "exchange two agents' memories (and this frame's labels) when their detections' visual headings, "
             "gathered over seconds, fit each other's fresh reports better than their own by this log-likelihood "
-            "ratio (:mod:`lookalike.learn.visual_exchange`; None: never)", range=(0.0, 1e4))
-        visual_memory_s: float = param(3.0, "time constant of visual_exchange's evidence decay, seconds",
+            "ratio (:mod:`lookalike.learn.visual_exchange`; None: never; chosen on tuning sequences)",
+            range=(0.0, 1e4))
+        visual_memory_s: float = param(10.0, "time constant of visual_exchange's evidence decay, seconds",
                                        range=(0.01, 1e4))
         visual_noise_rad: float = param(0.28, "a detection's visual heading noise around its robot's heading for "
                                         "visual_exchange (standard deviation; 10 heading classes with 12 degrees of "
