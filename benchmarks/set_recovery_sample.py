@@ -10,8 +10,8 @@ which an identifier never recovers counts, for that identifier, as the longest r
 other than its defaults (a development sample's candidates). The figures are kept in ``--out`` per set-up and
 identifier, so that an interrupted run resumes and a reference runs once for several candidates. The test, its
 samples (seeds 3200000+; 3300000+, 3400000+ and 3500000+ for the identifiers of the eleventh, fourteenth and fifteenth
-stages; 3600000+ for the check of where the gap sits; 3700000+ kept for a later test, only the LSTM's runs made) and
-margin are in docs/experiments/any-team-size.md.
+stages; 3600000+ for the check of where the gap sits; 3700000+ for the seventeenth stage's) and margin are in
+docs/experiments/any-team-size.md.
 
 Two further figures per set-up (each sequence's runs are kept for them): the same difference on the restores whose
 pair's reports differ by at least ``--gap`` radians in the second after the restore and on the others
