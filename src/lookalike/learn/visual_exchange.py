@@ -22,7 +22,7 @@ import numpy as np
 class VisualExchange:
     """Exchange detector over ``n`` agents from their detections' visual headings (see the module)."""
 
-    def __init__(self, n: int, threshold: float, memory_s: float = 3.0, noise_rad: float = 0.28,
+    def __init__(self, n: int, threshold: float, memory_s: float = 10.0, noise_rad: float = 0.28,
                  flip_prob: float = 0.03, outlier_prob: float = 0.02, fresh_s: float = 0.5,
                  max_step: float = 1.5) -> None:
         """``threshold``: log-likelihood ratio a pair must pass; ``memory_s``: time constant of the evidence's
