@@ -59,7 +59,26 @@ def test_stale_or_missing_reports_and_agents_without_a_detection_take_no_part():
     assert detector.evidence.max() == 0.0
 
 
+def test_with_stale_rad_s_a_silent_agent_takes_part_and_the_reporting_one_carries_the_evidence():
+    """Agent 1 went silent 2 s ago while still reporting robot 0's heading (ids exchanged, then restored while it
+    was silent); agent 0 reports its robot again. Agent 0's fresh report fits agent 1's detection, not its own."""
+    found = []
+    for stale in (None, 0.5):
+        detector = VisualExchange(2, threshold=6.0, stale_rad_s=stale)
+        found.append(feed(detector, 90, visual=[1.0, 0.0], reported=[0.0, 0.0], age=(0.05, 2.0)))
+    assert not any(found[0])  # fresh reports only: agent 1 takes no part
+    assert [(0, 1)] in found[1]
+
+
+def test_with_stale_rad_s_a_silent_agent_whose_robot_may_have_turned_gives_no_exchange_alone():
+    """Agent 1's old report no longer fits its detection (its robot turned while silent) while agent 0's fresh report
+    fits its own: the widened noise keeps that from looking like an exchange."""
+    detector = VisualExchange(2, threshold=6.0, stale_rad_s=0.5)
+    assert not any(feed(detector, 300, visual=[0.0, 1.5], reported=[0.0, 0.5], age=(0.05, 3.0)))
+
+
 @pytest.mark.parametrize("kwargs", [dict(threshold=0.0), dict(threshold=1.0, memory_s=0.0),
+                                    dict(threshold=1.0, stale_rad_s=0.0),
                                     dict(threshold=1.0, noise_rad=-0.1), dict(threshold=1.0, max_step=0.0),
                                     dict(threshold=1.0, flip_prob=0.6,
                                                                               outlier_prob=0.5)])

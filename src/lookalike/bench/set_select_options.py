@@ -1,7 +1,7 @@
-"""The fifth to seventeenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+"""The fifth to eighteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 17) scores stage K's candidates
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 18) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
 (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
@@ -26,6 +26,8 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
   a silence) at multiples of :data:`STAGE16_EVERY` steps, with the shipped inference options, the same rule.
 - stage 17: exchanging two agents whose detections' visual headings, gathered over seconds, fit each other's reports
   (``visual_exchange`` at each of :data:`STAGE17_VISUAL`, ``visual_memory_s`` :data:`STAGE17_MEMORY_S`), the same rule.
+- stage 18: that detector counting silent agents' older reports too, their noise widened (``visual_stale_rad_s`` at
+  each of :data:`STAGE18_STALE`), the same rule.
 
 A chosen option is made the identifier's default by hand.
 """
@@ -66,6 +68,7 @@ STAGE16_EVERY = 250  # stage 16: the fine-tuning's snapshots at multiples of thi
 STAGE16_BASELINE = "shipped"
 STAGE17_VISUAL: tuple[float, ...] = (8.0, 10.0, 12.0)  # stage 17: visual_exchange's log-likelihood ratios
 STAGE17_MEMORY_S = 10.0  # and the time constant of its evidence's decay, seconds
+STAGE18_STALE: tuple[float, ...] = (0.25, 0.5)  # stage 18: visual_stale_rad_s, radians per second of a report's age
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -149,9 +152,18 @@ def stage17_candidates() -> Candidates:
                for h in STAGE17_VISUAL}}
 
 
+def stage18_candidates() -> Candidates:
+    """The eighteenth stage's candidates: the shipped identifier and ``visual_stale=r``, its visual exchange detector
+    counting older reports with their noise widened by each of :data:`STAGE18_STALE`."""
+    return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, {}),
+            **{f"visual_stale={r}": (SHIPPED_SET_WEIGHTS, {"visual_stale_rad_s": r}) for r in STAGE18_STALE}}
+
+
 def stage_candidates(stage: int, run_dir: Path | None = None) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 10, 12 … 17; 16: the snapshots in ``run_dir``) candidates and the name of its
+    """Stage ``stage``'s (5 … 10, 12 … 18; 16: the snapshots in ``run_dir``) candidates and the name of its
     baseline."""
+    if stage == 18:
+        return stage18_candidates(), STAGE16_BASELINE
     if stage == 17:
         return stage17_candidates(), STAGE16_BASELINE
     if stage == 16:

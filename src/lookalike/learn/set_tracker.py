@@ -154,6 +154,10 @@ class SetIdentifier:
         visual_noise_rad: float = param(0.28, "a detection's visual heading noise around its robot's heading for "
                                         "visual_exchange (standard deviation; 10 heading classes with 12 degrees of "
                                         "noise), radians", range=(1e-3, 3.0))
+        visual_stale_rad_s: float | None = param(
+            None, "visual_exchange also counts reports older than 0.5 s, their noise widened by this many radians "
+            "per second of age beyond that (a silent robot may have turned; None: fresh reports only)",
+            range=(1e-3, 100.0))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
                                choices=LOCALISERS)
@@ -193,7 +197,7 @@ class SetIdentifier:
             cfg.exchange_step_rad)
         self.exchanges = 0  # memories exchanged by exchange_llr so far (for tests and analysis)
         self._visual = None if cfg.visual_exchange is None else VisualExchange(
-            n, cfg.visual_exchange, cfg.visual_memory_s, cfg.visual_noise_rad)
+            n, cfg.visual_exchange, cfg.visual_memory_s, cfg.visual_noise_rad, stale_rad_s=cfg.visual_stale_rad_s)
         self.visual_exchanges = 0  # memories exchanged by visual_exchange so far (for tests and analysis)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:

@@ -11,7 +11,10 @@ frame adds at most ``max_step`` either way (both detections seen front to back i
 add about 7 for two robots heading opposite ways), so an exchange needs consistent evidence over several frames. The
 evidence is summed over frames, decays with time constant ``memory_s`` and never drops below zero (a CUSUM), so
 that two robots whose headings stay apart keep it at zero; when a pair's passes ``threshold`` the two agents
-are said to be exchanged and their evidence starts again.
+are said to be exchanged and their evidence starts again. With ``stale_rad_s``, an agent whose report is older than
+``fresh_s`` (its robot silent for a while) takes part too, its robot's heading modelled as its last report with the
+noise widened by ``stale_rad_s`` radians per second beyond ``fresh_s`` (how far a robot may have turned since): the
+pair's evidence then comes mostly from the agent that still reports.
 """
 
 from __future__ import annotations
@@ -24,32 +27,37 @@ class VisualExchange:
 
     def __init__(self, n: int, threshold: float, memory_s: float = 10.0, noise_rad: float = 0.28,
                  flip_prob: float = 0.03, outlier_prob: float = 0.02, fresh_s: float = 0.5,
-                 max_step: float = 1.5) -> None:
+                 max_step: float = 1.5, stale_rad_s: float | None = None) -> None:
         """``threshold``: log-likelihood ratio a pair must pass; ``memory_s``: time constant of the evidence's
         decay, seconds; ``noise_rad``: a visual heading's noise around its robot's heading (standard deviation),
         radians; ``flip_prob``: probability that a visual heading is turned by π; ``outlier_prob``: probability that
         it says nothing of the robot (uniform); ``fresh_s``: only reports younger than this count, seconds;
-        ``max_step``: the most one frame adds or takes."""
-        if n < 0 or min(threshold, memory_s, noise_rad, max_step) <= 0:
+        ``max_step``: the most one frame adds or takes; ``stale_rad_s``: older reports count with their noise
+        widened by this many radians per second beyond ``fresh_s`` (None: only fresh reports count)."""
+        if n < 0 or min(threshold, memory_s, noise_rad, max_step) <= 0 or (stale_rad_s is not None
+                                                                          and stale_rad_s <= 0):
             raise ValueError(f"VisualExchange needs n >= 0 and positive threshold, memory_s, noise_rad and max_step, "
                              f"got n={n}, threshold={threshold}, memory_s={memory_s}, noise_rad={noise_rad}, "
-                             f"max_step={max_step}")
+                             f"max_step={max_step}, stale_rad_s={stale_rad_s}")
         if not (0 <= flip_prob and 0 <= outlier_prob and flip_prob + outlier_prob < 1):
             raise ValueError(f"VisualExchange: flip_prob and outlier_prob must be >= 0 with a sum below 1, got "
                              f"{flip_prob} and {outlier_prob}")
         self.threshold, self.memory_s, self.fresh_s, self.max_step = threshold, memory_s, fresh_s, max_step
+        self.stale_rad_s = stale_rad_s
         self.sigma = noise_rad
         self.weights = (1.0 - flip_prob - outlier_prob, flip_prob, outlier_prob / (2 * np.pi))
         self.evidence = np.zeros((n, n))  # symmetric: [a, b] the evidence that a and b hold each other's robots
 
-    def log_likelihood(self, visual: np.ndarray, reported: np.ndarray) -> np.ndarray:
-        """Log-likelihood of visual headings ``visual`` (radians) given robot headings ``reported`` (radians);
-        the two broadcast."""
+    def log_likelihood(self, visual: np.ndarray, reported: np.ndarray, sigma: np.ndarray | float | None = None
+                       ) -> np.ndarray:
+        """Log-likelihood of visual headings ``visual`` (radians) given robot headings ``reported`` (radians) with
+        noise ``sigma`` (radians; None: ``noise_rad``); the three broadcast."""
+        sigma = self.sigma if sigma is None else np.asarray(sigma)
         d = np.angle(np.exp(1j * (np.asarray(visual) - np.asarray(reported))))
         flipped = np.pi - np.abs(d)
-        norm = 1.0 / (np.sqrt(2 * np.pi) * self.sigma)
+        norm = 1.0 / (np.sqrt(2 * np.pi) * sigma)
         keep, flip, uniform = self.weights
-        z, zf = d / self.sigma, flipped / self.sigma
+        z, zf = d / sigma, flipped / sigma
         density = norm * (keep * np.exp(-0.5 * z * z) + flip * np.exp(-0.5 * zf * zf))
         return np.log(density + uniform)
 
@@ -60,10 +68,17 @@ class VisualExchange:
         (seconds; NaN: never heard), ``dt`` seconds since the last frame. Returns the pairs found exchanged
         (the strongest first, each agent at most once)."""
         self.evidence *= np.exp(-max(dt, 0.0) / self.memory_s)
-        live = np.flatnonzero((held >= 0) & np.isfinite(reported) & (np.nan_to_num(age, nan=np.inf) <= self.fresh_s))
+        age = np.nan_to_num(age, nan=np.inf)
+        usable = (held >= 0) & np.isfinite(reported) & np.isfinite(age)
+        if self.stale_rad_s is None:
+            usable &= age <= self.fresh_s
+        live = np.flatnonzero(usable)
         if len(live) < 2:
             return []
-        fit = self.log_likelihood(visual[held[live]][:, None], reported[live][None, :])  # [i, j]: i's detection, j
+        sigma = self.sigma
+        if self.stale_rad_s is not None:
+            sigma = np.hypot(self.sigma, self.stale_rad_s * np.maximum(age[live] - self.fresh_s, 0.0))[None, :]
+        fit = self.log_likelihood(visual[held[live]][:, None], reported[live][None, :], sigma)  # [i, j]: i's det., j
         own = np.diag(fit)
         gain = np.clip(fit + fit.T - own[:, None] - own[None, :], -self.max_step, self.max_step)
         block = np.maximum(self.evidence[np.ix_(live, live)] + gain, 0.0)
