@@ -8,12 +8,10 @@ localiser as the LSTM identifier's, fed with the detection labelled ``j`` and it
 ``α``: the per-agent Kalman filter by default (``localiser="kalman"``), or seed A's Eq. 3
 ``T_j ← α·L_k + (1−α)·T_j`` (``"lowpass"``); see :mod:`lookalike.trackers.identity.localiser`.
 
-An agent whose reported heading jumps by more than a robot can turn between two of its reports
-(``report_jump`` + ``turn_rate`` · gap, radians) now reports for another robot (ids swapped or
-restored), so what the network remembers of it follows the wrong one: its memory is exchanged with
-the one other agent that reported that heading just before (``on_jump="swap"``), else forgotten, or with
-``jump_pair_s`` (1 s) exchanged with the agent whose jump mirrors it (the second half of a swap) when that comes in
-time (chosen on a development sample, docs/experiments/any-team-size.md, "An eleventh stage").
+An agent whose reports jump to another robot (ids swapped or restored; ``report_jump``, ``on_jump``,
+``jump_pair_s``, ``jump_silent``: :mod:`lookalike.learn.report_jumps`) has its memory exchanged with the agent it
+swapped with, else forgotten (``jump_pair_s`` 1 s chosen on a development sample, docs/experiments/any-team-size.md,
+"An eleventh stage").
 An agent whose report is older than ``stale_s`` seconds while a detection near its remembered
 position has turned away from that report is shown to the network as not heard from (its memory
 still places it). Both were chosen on tuning sequences (docs/experiments/any-team-size.md).
@@ -40,9 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.geometry.angles import wrap_angle
 from lookalike.learn.checkpoint import CheckpointError
 from lookalike.learn.report_exchange import ReportExchange
+from lookalike.learn.report_jumps import ReportJumps
 from lookalike.learn.set_data import agent_tokens, detection_tokens
 from lookalike.learn.set_numpy import NumpySetAssociator, load_set_weights
 from lookalike.learn.tracker import BeaconMemory, agent_detections, agent_snapshots, decode
@@ -181,13 +179,12 @@ class SetIdentifier:
         self.last_labels = np.zeros(0, dtype=int)
         self.last_probabilities = np.zeros(0)
         self._last_time = -np.inf
-        self._expected_jump: dict[int, float] = {}
-        self._pending: dict[int, tuple[float, float, float]] = {}  # jump_pair_s: agent -> (old, new heading, time)
-        self._silent: dict[int, tuple[float, float, float]] = {}  # jump_silent: the same, never forgotten
+        cfg = self.config
+        self._jumps = None if cfg.report_jump is None else ReportJumps(
+            cfg.report_jump, cfg.turn_rate, cfg.on_jump, cfg.jump_pair_s, cfg.jump_silent)
         self._pair_evidence = np.zeros((n, n))
         self.pair_swaps = 0  # memories exchanged by pair_swap so far (for tests and analysis)
         self.fp_rate = self.config.fp_prior_ref  # running mean of false positives per frame (fp_prior_ref)
-        cfg = self.config
         too_many = cfg.exchange_max_agents is not None and n > cfg.exchange_max_agents
         accel, lag = cfg.exchange_accel, cfg.exchange_lag_s
         if cfg.exchange_tight_agents is not None and n >= cfg.exchange_tight_agents:
@@ -208,8 +205,8 @@ class SetIdentifier:
         self._last_time = frame.time
         before = (self._beacons.heading.copy(), self._beacons.t_sent.copy())
         self._beacons.add(frame)
-        if self.config.report_jump is not None:
-            self._forget_jumps(*before, self.config.report_jump)
+        if self._jumps is not None:
+            self._report_jumps(*before)
         if self._exchange is not None:
             self._report_exchanges(frame)
         det = frame.detections
@@ -268,32 +265,15 @@ class SetIdentifier:
                 out[j] = np.nan
         return out
 
-    def _forget_jumps(self, heading: np.ndarray, t_sent: np.ndarray, jump: float) -> None:
-        """Forget the memory of every agent whose newest report turned farther from its previous one
-        than a robot can turn in between: the reports now come from another robot, the memory
-        follows the wrong one."""
-        new, old = self._beacons.heading, heading
-        fresh = np.isfinite(old) & np.isfinite(new) & (self._beacons.t_sent > t_sent)
-        if fresh.any():
-            turn = np.abs(np.angle(np.exp(1j * (new - old))))
-            gap = np.where(fresh, self._beacons.t_sent - np.where(fresh, t_sent, 0.0), 0.0)
-            jumped = fresh & (turn > jump + self.config.turn_rate * gap)
-            if jumped.any():
-                if self.config.on_jump == "swap":
-                    self._swap_jumps(np.flatnonzero(jumped), old, t_sent, jump)
-                else:
-                    self._forget(np.flatnonzero(jumped))
-            if self.config.jump_silent and self.config.on_jump == "swap" and self.config.jump_pair_s is not None:
-                self._silent_jumps(np.flatnonzero(fresh & ~jumped & (turn > jump)), old, jump)
-        if self._pending or self._silent:  # waiting jumps expire after jump_pair_s: forgotten, or (silent) dropped
-            wait = self.config.jump_pair_s
-            assert wait is not None
-            self._silent = {a: v for a, v in self._silent.items() if self._last_time - v[2] <= wait}
-            expired = [a for a, (_, _, t) in self._pending.items() if self._last_time - t > wait]
-            if expired:
-                for a in expired:
-                    del self._pending[a]
-                self._forget(np.array(expired))
+    def _report_jumps(self, heading: np.ndarray, t_sent: np.ndarray) -> None:
+        """Exchange or forget the memories of the agents whose reports jumped to another robot since their previous
+        newest report (``heading``, radians, sent at ``t_sent`` seconds; :mod:`lookalike.learn.report_jumps`)."""
+        assert self._jumps is not None
+        for action in self._jumps.find(heading, t_sent, self._beacons.heading, self._beacons.t_sent, self._last_time):
+            if isinstance(action, tuple):
+                self._exchange_memories(*action)
+            else:
+                self._forget(action)
 
     def _forget(self, agents: np.ndarray) -> None:
         """Forget the network's memory of ``agents`` (indices) and restart their report tracks (exchange_llr)."""
@@ -301,79 +281,6 @@ class SetIdentifier:
         if self._exchange is not None:
             for a in agents.tolist():
                 self._exchange.forget(a)
-
-    def _swap_jumps(self, jumped: np.ndarray, old: np.ndarray, t_sent: np.ndarray, jump: float) -> None:
-        """``on_jump="swap"``: an agent ``a`` whose reports jumped now reports for the robot that exactly
-        one other agent ``b`` reported for just before (within ``jump`` + ``turn_rate`` · the time between
-        the two reports): ids swapped, or a swap undone. The two agents' memories are exchanged, and
-        ``b``'s own jump, expected within a second, changes nothing more. An agent with no such partner,
-        or several, is forgotten; with ``jump_pair_s`` it waits that long for a jump that mirrors its own
-        (:meth:`_mirror`, looked for before the partner), and exchanges memories with that agent."""
-        now = self._beacons.t_sent
-        done: set[int] = set()
-        for a in jumped.tolist():
-            if a in done:
-                continue
-            if now[a] - self._expected_jump.pop(a, -np.inf) <= 1.0:
-                continue  # the second half of a swap already made
-            new = float(self._beacons.heading[a])
-            self._pending.pop(a, None)
-            b = self._mirror(a, float(old[a]), new, float(now[a]), jump, self._pending)
-            if b is None and self._silent:
-                b = self._mirror(a, float(old[a]), new, float(now[a]), jump, self._silent)
-            if b is not None:
-                self._exchange_memories(a, b)
-                continue
-            turn = np.abs(np.angle(np.exp(1j * (new - old))))
-            match = np.isfinite(old) & (turn <= jump + self.config.turn_rate * np.abs(now[a] - t_sent))
-            match[a] = False
-            partners = np.flatnonzero(match)
-            if len(partners) != 1:
-                if self.config.jump_pair_s is None:
-                    self._forget(np.array([a]))
-                else:
-                    self._pending[a] = (float(old[a]), new, float(now[a]))
-                continue
-            b = int(partners[0])
-            self._exchange_memories(a, b)
-            if b in jumped:
-                done.add(b)
-            else:
-                self._expected_jump[b] = now[a]
-
-    def _silent_jumps(self, agents: np.ndarray, old: np.ndarray, jump: float) -> None:
-        """``jump_silent``: each of ``agents`` reports, after a silence, a heading more than ``jump`` off its
-        previous report, too long after it to call a jump. When a waiting jump (``jump_pair_s``) mirrors it, the
-        two agents exchange memories; otherwise it waits as well, for a jump that mirrors it, and is dropped
-        without forgetting anything."""
-        now = self._beacons.t_sent
-        for c in agents.tolist():
-            if c in self._pending:
-                continue
-            new = float(self._beacons.heading[c])
-            b = self._mirror(c, float(old[c]), new, float(now[c]), jump, self._pending)
-            if b is not None:
-                self._exchange_memories(c, b)
-            else:
-                self._silent[c] = (float(old[c]), new, float(now[c]))
-
-    def _mirror(self, a: int, old: float, new: float, t: float, jump: float,
-                waiting: dict[int, tuple[float, float, float]]) -> int | None:
-        """``jump_pair_s``: the agent in ``waiting`` (agent -> its old and new heading, radians, and the time of its
-        jump, seconds; the match is removed) whose jump mirrors agent ``a``'s jump from heading ``old`` to ``new``
-        at ``t`` seconds: it now reports ``old`` and reported ``new`` before, each within ``jump`` + ``turn_rate`` ·
-        the time between the two jumps (the closest of several; None: none)."""
-        best, best_error = None, np.inf
-        for c, (old_c, new_c, t_c) in waiting.items():
-            if c == a:
-                continue
-            tolerance = jump + self.config.turn_rate * abs(t - t_c)
-            errors = np.abs(wrap_angle(np.array([new - old_c, new_c - old])))
-            if errors.max() <= tolerance and errors.sum() < best_error:
-                best, best_error = c, float(errors.sum())
-        if best is not None:
-            del waiting[best]
-        return best
 
     def _exchange_memories(self, a: int, b: int) -> None:
         """Exchange agents ``a`` and ``b``'s memories (the network's and the exchange detector's tracks)."""
@@ -395,10 +302,8 @@ class SetIdentifier:
             if pair is not None:
                 self.net.swap(*pair)
                 self.exchanges += 1
-                for j in pair:
-                    self._expected_jump[j] = t_sent
-                    self._pending.pop(j, None)
-                    self._silent.pop(j, None)
+                if self._jumps is not None:
+                    self._jumps.exchanged(pair, t_sent)
 
     def _visual_exchanges(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, age: np.ndarray,
                           dt: float) -> np.ndarray:

@@ -1,0 +1,143 @@
+"""Which agents' heading reports jumped to another robot, and with which agent they exchanged robots.
+
+An agent whose reported heading jumps by more than a robot can turn between two of its reports (``jump`` +
+``turn_rate`` · the time between them, radians) now reports for another robot: ids swapped, or a swap undone.
+With ``on_jump="swap"`` it has exchanged robots with the one other agent that reported the new heading just
+before; with none or several, it is forgotten at once, or with ``jump_pair_s`` it waits that long for a jump that
+mirrors its own (another agent now reporting the heading it reported before, and the reverse) and exchanges with
+that agent, forgotten when none comes. With ``jump_silent``, an agent's first report after a silence too long to
+call a jump (more than ``jump`` off its previous one, within ``jump`` + ``turn_rate`` · the silence) is paired
+with such a waiting jump when the two mirror each other; alone it changes nothing. :meth:`ReportJumps.find`
+returns what the identifier must do to the agents' memories, in order.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lookalike.geometry.angles import wrap_angle
+
+Waiting = dict[int, tuple[float, float, float]]  # agent -> (old heading, new heading (radians), time of its jump, s)
+Action = tuple[int, int] | np.ndarray  # (a, b): exchange the two agents' memories; an array: forget these agents
+
+
+class ReportJumps:
+    """Report jumps over the agents' newest reports (see the module)."""
+
+    def __init__(self, jump: float, turn_rate: float, on_jump: str = "swap", jump_pair_s: float | None = 1.0,
+                 jump_silent: bool = True) -> None:
+        """``jump``: radians a report may turn beyond ``turn_rate`` (rad/s) times the time since the agent's previous
+        one; ``on_jump``: ``"swap"`` or ``"forget"``; ``jump_pair_s``: how long a jump without a partner waits for
+        its mirror, seconds (None: forgotten at once); ``jump_silent``: pair jumps with first reports after a
+        silence."""
+        self.jump, self.turn_rate, self.on_jump = jump, turn_rate, on_jump
+        self.jump_pair_s, self.jump_silent = jump_pair_s, jump_silent
+        self.expected: dict[int, float] = {}  # agent -> send time of the exchange whose second half it awaits
+        self.pending: Waiting = {}  # jump_pair_s: jumps waiting for their mirror
+        self.silent: Waiting = {}  # jump_silent: the same, never forgotten
+
+    def find(self, old: np.ndarray, t_old: np.ndarray, new: np.ndarray, t_new: np.ndarray,
+             now: float) -> list[Action]:
+        """The actions on the agents' memories, in order, given each agent's previous newest report (``old``
+        heading, radians, sent at ``t_old`` seconds) and its newest now (``new``, ``t_new``), at frame time ``now``
+        (seconds)."""
+        actions: list[Action] = []
+        fresh = np.isfinite(old) & np.isfinite(new) & (t_new > t_old)
+        if fresh.any():
+            turn = np.abs(np.angle(np.exp(1j * (new - old))))
+            gap = np.where(fresh, t_new - np.where(fresh, t_old, 0.0), 0.0)
+            jumped = fresh & (turn > self.jump + self.turn_rate * gap)
+            if jumped.any():
+                if self.on_jump == "swap":
+                    self._swap(np.flatnonzero(jumped), old, t_old, new, t_new, actions)
+                else:
+                    actions.append(np.flatnonzero(jumped))
+            if self.jump_silent and self.on_jump == "swap" and self.jump_pair_s is not None:
+                self._after_silence(np.flatnonzero(fresh & ~jumped & (turn > self.jump)), old, new, t_new, actions)
+        if self.pending or self.silent:  # waiting jumps expire after jump_pair_s: forgotten, or (silent) dropped
+            wait = self.jump_pair_s
+            assert wait is not None
+            self.silent = {a: v for a, v in self.silent.items() if now - v[2] <= wait}
+            expired = [a for a, (_, _, t) in self.pending.items() if now - t > wait]
+            if expired:
+                for a in expired:
+                    del self.pending[a]
+                actions.append(np.array(expired))
+        return actions
+
+    def exchanged(self, pair: tuple[int, int], t_sent: float) -> None:
+        """Another rule exchanged ``pair`` on a report sent at ``t_sent`` seconds: a jump of either agent within the
+        next second is the same exchange, and neither waits any more."""
+        for j in pair:
+            self.expected[j] = t_sent
+            self.pending.pop(j, None)
+            self.silent.pop(j, None)
+
+    def _swap(self, jumped: np.ndarray, old: np.ndarray, t_old: np.ndarray, new: np.ndarray, t_new: np.ndarray,
+              actions: list[Action]) -> None:
+        """``on_jump="swap"``: an agent ``a`` whose reports jumped now reports for the robot that exactly one other
+        agent ``b`` reported for just before (within ``jump`` + ``turn_rate`` · the time between the two reports):
+        the two exchange memories, and ``b``'s own jump, expected within a second, changes nothing more. An agent
+        with no such partner, or several, is forgotten, or waits for its mirror (``jump_pair_s``, looked for
+        before the partner)."""
+        done: set[int] = set()
+        for a in jumped.tolist():
+            if a in done:
+                continue
+            if t_new[a] - self.expected.pop(a, -np.inf) <= 1.0:
+                continue  # the second half of a swap already made
+            heading = float(new[a])
+            self.pending.pop(a, None)
+            b = self._mirror(a, float(old[a]), heading, float(t_new[a]), self.pending)
+            if b is None and self.silent:
+                b = self._mirror(a, float(old[a]), heading, float(t_new[a]), self.silent)
+            if b is not None:
+                actions.append((a, b))
+                continue
+            turn = np.abs(np.angle(np.exp(1j * (heading - old))))
+            match = np.isfinite(old) & (turn <= self.jump + self.turn_rate * np.abs(t_new[a] - t_old))
+            match[a] = False
+            partners = np.flatnonzero(match)
+            if len(partners) != 1:
+                if self.jump_pair_s is None:
+                    actions.append(np.array([a]))
+                else:
+                    self.pending[a] = (float(old[a]), heading, float(t_new[a]))
+                continue
+            b = int(partners[0])
+            actions.append((a, b))
+            if b in jumped:
+                done.add(b)
+            else:
+                self.expected[b] = t_new[a]
+
+    def _after_silence(self, agents: np.ndarray, old: np.ndarray, new: np.ndarray, t_new: np.ndarray,
+                       actions: list[Action]) -> None:
+        """``jump_silent``: each of ``agents`` reports, after a silence, a heading more than ``jump`` off its
+        previous report, too long after it to call a jump. When a waiting jump mirrors it, the two exchange
+        memories; otherwise it waits as well, and is dropped without forgetting anything."""
+        for c in agents.tolist():
+            if c in self.pending:
+                continue
+            heading = float(new[c])
+            b = self._mirror(c, float(old[c]), heading, float(t_new[c]), self.pending)
+            if b is not None:
+                actions.append((c, b))
+            else:
+                self.silent[c] = (float(old[c]), heading, float(t_new[c]))
+
+    def _mirror(self, a: int, old: float, new: float, t: float, waiting: Waiting) -> int | None:
+        """The agent in ``waiting`` (its match removed) whose jump mirrors agent ``a``'s jump from heading ``old`` to
+        ``new`` at ``t`` seconds: it now reports ``old`` and reported ``new`` before, each within ``jump`` +
+        ``turn_rate`` · the time between the two jumps (the closest of several; None: none)."""
+        best, best_error = None, np.inf
+        for c, (old_c, new_c, t_c) in waiting.items():
+            if c == a:
+                continue
+            tolerance = self.jump + self.turn_rate * abs(t - t_c)
+            errors = np.abs(wrap_angle(np.array([new - old_c, new_c - old])))
+            if errors.max() <= tolerance and errors.sum() < best_error:
+                best, best_error = c, float(errors.sum())
+        if best is not None:
+            del waiting[best]
+        return best
