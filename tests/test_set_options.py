@@ -346,14 +346,14 @@ def test_stage17_candidates_are_the_visual_detector_at_each_threshold_against_th
     assert {o["visual_memory_s"] for n, (_, o) in cands.items() if n != baseline} == {10.0}
 
 
-def test_stage18_candidates_widen_the_shipped_detectors_stale_reports_against_the_shipped_identifier():
+def test_stage18_candidates_widen_the_visual_detectors_stale_reports_against_the_identifier_before_it():
     from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
 
     cands, baseline = stage_candidates(18)
-    assert baseline == STAGE16_BASELINE and cands[baseline][1] == {}
+    assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"visual_stale_rad_s": None}
     assert sorted(o["visual_stale_rad_s"] for n, (_, o) in cands.items() if n != baseline) == [0.25, 0.5]
-    assert make_tracker("set", n_agents=3)._visual.stale_rad_s is None  # shipped: fresh reports only
-    assert make_tracker("set", n_agents=3, visual_stale_rad_s=0.5)._visual.stale_rad_s == 0.5
+    assert make_tracker("set", n_agents=3)._visual.stale_rad_s == 0.5  # shipped since the stage
+    assert make_tracker("set", n_agents=3, visual_stale_rad_s=None)._visual.stale_rad_s is None
 
 
 def test_exchange_tight_agents_changes_the_detector_of_larger_teams_only():

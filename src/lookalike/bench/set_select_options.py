@@ -69,6 +69,7 @@ STAGE16_BASELINE = "shipped"
 STAGE17_VISUAL: tuple[float, ...] = (8.0, 10.0, 12.0)  # stage 17: visual_exchange's log-likelihood ratios
 STAGE17_MEMORY_S = 10.0  # and the time constant of its evidence's decay, seconds
 STAGE18_STALE: tuple[float, ...] = (0.25, 0.5)  # stage 18: visual_stale_rad_s, radians per second of a report's age
+BEFORE_STAGE18: dict[str, object] = {"visual_stale_rad_s": None}  # the visual detector before the eighteenth stage
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -148,14 +149,14 @@ def stage17_candidates() -> Candidates:
     """The seventeenth stage's candidates: the identifier shipped before it and ``visual=h``, the visual exchange
     detector at each of :data:`STAGE17_VISUAL`."""
     return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, {"visual_exchange": None}),
-            **{f"visual={h}": (SHIPPED_SET_WEIGHTS, {"visual_exchange": h, "visual_memory_s": STAGE17_MEMORY_S})
-               for h in STAGE17_VISUAL}}
+            **{f"visual={h}": (SHIPPED_SET_WEIGHTS, {"visual_exchange": h, "visual_memory_s": STAGE17_MEMORY_S,
+                                                     **BEFORE_STAGE18}) for h in STAGE17_VISUAL}}
 
 
 def stage18_candidates() -> Candidates:
-    """The eighteenth stage's candidates: the shipped identifier and ``visual_stale=r``, its visual exchange detector
-    counting older reports with their noise widened by each of :data:`STAGE18_STALE`."""
-    return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, {}),
+    """The eighteenth stage's candidates: the identifier shipped before it and ``visual_stale=r``, its visual
+    exchange detector counting older reports with their noise widened by each of :data:`STAGE18_STALE`."""
+    return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, dict(BEFORE_STAGE18)),
             **{f"visual_stale={r}": (SHIPPED_SET_WEIGHTS, {"visual_stale_rad_s": r}) for r in STAGE18_STALE}}
 
 

@@ -27,7 +27,8 @@ whose heading reports each continue the other's report track exchange memories
 (``exchange_tight_accel``, ``exchange_tight_lag_s``), which finds exchanges between robots heading alike.
 With ``visual_exchange`` (8, chosen on tuning sequences), two agents whose detections' visual headings, gathered
 over seconds, fit each other's reports better than their own exchange memories
-(:mod:`lookalike.learn.visual_exchange`).
+(:mod:`lookalike.learn.visual_exchange`); with ``visual_stale_rad_s`` (0.5 rad/s, chosen the same way) an agent
+silent for a while takes part too.
 """
 
 from __future__ import annotations
@@ -153,8 +154,9 @@ class SetIdentifier:
                                         "visual_exchange (standard deviation; 10 heading classes with 12 degrees of "
                                         "noise), radians", range=(1e-3, 3.0))
         visual_stale_rad_s: float | None = param(
-            None, "visual_exchange also counts reports older than 0.5 s, their noise widened by this many radians "
-            "per second of age beyond that (a silent robot may have turned; None: fresh reports only)",
+            0.5, "visual_exchange also counts reports older than 0.5 s, their noise widened by this many radians "
+            "per second of age beyond that (a silent robot may have turned; None: fresh reports only; chosen on "
+            "tuning sequences and a development sample)",
             range=(1e-3, 100.0))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
