@@ -36,7 +36,8 @@ class VisualExchange:
         widened by this many radians per second beyond ``fresh_s`` (None: only fresh reports count)."""
         if n < 0 or min(threshold, memory_s, noise_rad, max_step) <= 0 or (stale_rad_s is not None
                                                                           and stale_rad_s <= 0):
-            raise ValueError(f"VisualExchange needs n >= 0 and positive threshold, memory_s, noise_rad and max_step, "
+            raise ValueError(f"VisualExchange needs n >= 0 and positive threshold, memory_s, noise_rad, max_step and "
+                             f"stale_rad_s (or None), "
                              f"got n={n}, threshold={threshold}, memory_s={memory_s}, noise_rad={noise_rad}, "
                              f"max_step={max_step}, stale_rad_s={stale_rad_s}")
         if not (0 <= flip_prob and 0 <= outlier_prob and flip_prob + outlier_prob < 1):
