@@ -76,7 +76,7 @@ class VisualExchange:
         live = np.flatnonzero(usable)
         if len(live) < 2:
             return []
-        sigma = self.sigma
+        sigma: np.ndarray | float = self.sigma
         if self.stale_rad_s is not None:
             sigma = np.hypot(self.sigma, self.stale_rad_s * np.maximum(age[live] - self.fresh_s, 0.0))[None, :]
         fit = self.log_likelihood(visual[held[live]][:, None], reported[live][None, :], sigma)  # [i, j]: i's det., j
