@@ -244,6 +244,19 @@ def test_visual_exchange_follows_visual_headings_that_fit_the_other_agents_repor
         quiet.update(f)
 
 
+def test_visual_stale_rad_s_lets_the_agent_still_reporting_carry_an_exchange_with_a_silent_one(shipped):
+    heading = {0: 0.0, 1: 0.3}
+    swapped = lambda a, t: heading[1 - a] if t >= 1.5 else heading[a]  # noqa: E731  ids exchanged from 1.5 s
+    silent = lambda a, t: a == 0 or t < 1.4  # noqa: E731  and agent 1 silent from just before
+    for stale, exchanges, late_labels in ((None, 0, [0, 1]), (0.5, 1, [1, 0])):
+        tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, exchange_llr=None,
+                               visual_exchange=6.0, visual_stale_rad_s=stale)
+        for f in frames(150, swapped, lambda r, t: heading[r], reports_from=silent):
+            tracker.update(f)
+        assert tracker.visual_exchanges == exchanges
+        assert tracker.last_labels.tolist() == late_labels
+
+
 def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
     """fp_prior_ref: the running false-positive rate starts at the reference, falls in a world without false
     positives (so a robot's detection is less readily called one); None turns the correction off."""
