@@ -18,7 +18,9 @@ pair's reports differ by at least ``--gap`` radians in the second after the rest
 (:func:`~lookalike.bench.experiments.restore_gap`: how much the reports can tell the two robots apart there), and
 the difference in plain success on the pair in the 3 s after the restore (percentage points, 95% interval; no
 worse when its lower end is at least ``-success-margin``). They were added after the fifteenth stage's test
-(docs/experiments/any-team-size.md, "What the remaining gap is made of").
+(docs/experiments/any-team-size.md, "What the remaining gap is made of"). After the eighteenth stage's test, the
+difference on the restores whose reports differ by less than ``--unobservable`` radians (under twice the simulated
+IMU's noise: the identifiers' data barely tells the pair apart) and on all the others.
 
     python benchmarks/set_recovery_sample.py --sequences 400 --seed 3500000 --setups m10n7
 """
@@ -74,6 +76,8 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("runs/set-recovery-sample"))
     parser.add_argument("--gap", type=float, default=APART_RAD,
                         help="Radians between the pair's reports after the restore that split the further figures.")
+    parser.add_argument("--unobservable", type=float, default=0.05,
+                        help="Radians between the pair's reports under which no identifier can tell the two apart.")
     parser.add_argument("--success-margin", type=float, default=2.0,
                         help="Percentage points of success after the restore the candidate may be lower.")
     args = parser.parse_args()
@@ -118,7 +122,9 @@ def main() -> None:
         cand, ref = (np.array(values[n]) for n in trackers)
         for text, part in ((f"reports >= {args.gap} rad apart after the restore", gap >= args.gap),
                            (f"reports < {args.gap} rad apart", gap < args.gap),
-                           ("a pair member silent in the second after the restore", np.isnan(gap))):
+                           ("a pair member silent in the second after the restore", np.isnan(gap)),
+                           (f"reports < {args.unobservable} rad apart (unobservable)", gap < args.unobservable),
+                           ("all but those", ~(gap < args.unobservable))):
             print(f"  {line(text, mean_difference(cand[part], ref[part]), ' s')}")
         after = [np.array(kept[n]["runs"], dtype=float).reshape(-1, len(SwapRun._fields))[:, AFTER] * 100
                  for n in trackers]
