@@ -45,7 +45,7 @@ from lookalike.learn.report_jumps import ReportJumps
 from lookalike.learn.set_data import agent_tokens, detection_tokens
 from lookalike.learn.set_numpy import NumpySetAssociator, load_set_weights
 from lookalike.learn.tracker import BeaconMemory, agent_detections, agent_snapshots, decode
-from lookalike.learn.visual_exchange import VisualExchange
+from lookalike.learn.visual_exchange import VisualExchange, take_pairs
 from lookalike.learn.weights import WEIGHTS_DIR
 from lookalike.trackers.base import check_params, param
 from lookalike.trackers.identity.localiser import LOCALISERS, make_localiser
@@ -314,10 +314,15 @@ class SetIdentifier:
         (:class:`~lookalike.learn.visual_exchange.VisualExchange`). Returns the labels."""
         assert self._visual is not None
         held = agent_detections(labels, conf, self.config.n_agents)
+        pairs = self._visual.update(held, heading, self._beacons.heading, age, dt)
+        self.visual_exchanges += len(pairs)
+        return self._exchange_pairs(labels, pairs)
+
+    def _exchange_pairs(self, labels: np.ndarray, pairs: list[tuple[int, int]]) -> np.ndarray:
+        """Exchange the network's memories and this frame's ``labels`` of each of ``pairs`` (no agent twice)."""
         out = labels
-        for j, k in self._visual.update(held, heading, self._beacons.heading, age, dt):
+        for j, k in pairs:
             self.net.swap(j, k)
-            self.visual_exchanges += 1
             out = np.where(labels == j, k, np.where(labels == k, j, out))
         return out
 
@@ -330,6 +335,7 @@ class SetIdentifier:
         passes ``pair_swap`` radians, the two memories and this frame's labels are exchanged (the largest
         first; an agent at most once per frame). Returns the labels."""
         cfg = self.config
+        assert cfg.pair_swap is not None
         evidence = self._pair_evidence
         evidence *= np.exp(-dt / cfg.pair_swap_s)
         det = agent_detections(labels, conf, cfg.n_agents)
@@ -345,12 +351,6 @@ class SetIdentifier:
         block = evidence[np.ix_(live, live)]
         evidence[np.ix_(live, live)] = np.maximum(block + gain, 0.0)
         np.fill_diagonal(evidence, 0.0)
-        out = labels
-        while evidence.max() > cfg.pair_swap:
-            j, k = np.unravel_index(int(np.argmax(evidence)), evidence.shape)
-            self.net.swap(int(j), int(k))
-            self.pair_swaps += 1
-            out = np.where(labels == j, k, np.where(labels == k, j, out))
-            evidence[[j, k], :] = 0.0
-            evidence[:, [j, k]] = 0.0
-        return out
+        pairs = take_pairs(evidence, cfg.pair_swap)
+        self.pair_swaps += len(pairs)
+        return self._exchange_pairs(labels, pairs)

@@ -22,6 +22,18 @@ from __future__ import annotations
 import numpy as np
 
 
+def take_pairs(evidence: np.ndarray, threshold: float) -> list[tuple[int, int]]:
+    """The pairs ``(a, b)``, ``a < b``, whose symmetric ``evidence`` passes ``threshold``, the strongest first and each
+    agent at most once; their rows and columns are cleared in place (their evidence starts again)."""
+    pairs = []
+    while evidence.max(initial=0.0) > threshold:
+        a, b = np.unravel_index(int(np.argmax(evidence)), evidence.shape)
+        pairs.append((int(min(a, b)), int(max(a, b))))
+        evidence[[a, b], :] = 0.0
+        evidence[:, [a, b]] = 0.0
+    return pairs
+
+
 class VisualExchange:
     """Exchange detector over ``n`` agents from their detections' visual headings (see the module)."""
 
@@ -69,7 +81,6 @@ class VisualExchange:
         (seconds; NaN: never heard), ``dt`` seconds since the last frame. Returns the pairs found exchanged
         (the strongest first, each agent at most once)."""
         self.evidence *= np.exp(-max(dt, 0.0) / self.memory_s)
-        age = np.nan_to_num(age, nan=np.inf)
         usable = (held >= 0) & np.isfinite(reported) & np.isfinite(age)
         if self.stale_rad_s is None:
             usable &= age <= self.fresh_s
@@ -85,10 +96,4 @@ class VisualExchange:
         block = np.maximum(self.evidence[np.ix_(live, live)] + gain, 0.0)
         np.fill_diagonal(block, 0.0)
         self.evidence[np.ix_(live, live)] = block
-        pairs = []
-        while self.evidence.max(initial=0.0) > self.threshold:
-            a, b = np.unravel_index(int(np.argmax(self.evidence)), self.evidence.shape)
-            pairs.append((int(min(a, b)), int(max(a, b))))
-            self.evidence[[a, b], :] = 0.0
-            self.evidence[:, [a, b]] = 0.0
-        return pairs
+        return take_pairs(self.evidence, self.threshold)
