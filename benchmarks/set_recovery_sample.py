@@ -2,16 +2,16 @@
 
 Runs ``bench recovery``'s experiment (two robots' reports swapped from 5 s for 10 s, the time until the swapped
 run's success on the pair is back within 5% of the clean run's) on ``--sequences`` sequences per set-up, and per
-set-up prints each identifier's mean recovery, its success on the pair in the 3 s after the restore (and without
-the swap), and the 95% interval of the mean of candidate − reference (seconds, over sequences). The candidate is
-no worse when the interval's upper end is at most ``--margin`` seconds (a TARGET line per set-up). A sequence in
-which an identifier never recovers counts, for that identifier, as the longest recovery the sequence can measure
-(from the restore to the last one-second window). ``--candidate-options`` (JSON) gives the candidate parameters
-other than its defaults (a development sample's candidates). The figures are kept in ``--out`` per set-up and
-identifier, so that an interrupted run resumes and a reference runs once for several candidates. The test, its
-samples (seeds 3200000+; 3300000+, 3400000+ and 3500000+ for the identifiers of the eleventh, fourteenth and fifteenth
-stages; 3600000+ for the check of where the gap sits; 3700000+ for the seventeenth stage's) and margin are in
-docs/experiments/any-team-size.md.
+set-up prints each identifier's mean recovery, its success on the pair in the 3 s after the restore and while
+swapped (each also without the swap), and the 95% interval of the mean of candidate − reference (seconds, over
+sequences). The candidate is no worse when the interval's upper end is at most ``--margin`` seconds (a TARGET line
+per set-up). A sequence in which an identifier never recovers counts, for that identifier, as the longest recovery
+the sequence can measure (from the restore to the last one-second window). ``--candidate-options`` (JSON) gives the
+candidate parameters other than its defaults (a development sample's candidates). The figures are kept in ``--out``
+per set-up and identifier, so that an interrupted run resumes and a reference runs once for several candidates. The
+test, its samples (seeds 3200000+; 3300000+, 3400000+ and 3500000+ for the identifiers of the eleventh, fourteenth
+and fifteenth stages; 3600000+ for the check of where the gap sits; 3700000+ for the seventeenth stage's) and
+margin are in docs/experiments/any-team-size.md.
 
 Two further figures per set-up (each sequence's runs are kept for them): the same difference on the restores whose
 pair's reports differ by at least ``--gap`` radians in the second after the restore and on the others
@@ -111,7 +111,8 @@ def main() -> None:
               flush=True)
         for row in (kept[name]["row"] for name in trackers):
             print(f"  {row['Tracker']}: success on the pair in the 3 s after the restore "
-                  f"{row['After the restore, 3 s (%)']}% ({row['Same without swap, after (%)']}% without the swap)")
+                  f"{row['After the restore, 3 s (%)']}% ({row['Same without swap, after (%)']}% without the swap), "
+                  f"while swapped {row['Swapped robots while swapped (%)']}% ({row['Same without swap (%)']}%)")
         report_target(f"{args.candidate} recovery no worse than {args.reference}, {label} "
                       f"(upper end of the 95% interval of the mean difference)", diff.high, args.margin,
                       higher_is_better=False, unit=" s")

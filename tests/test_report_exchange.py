@@ -62,6 +62,18 @@ def test_no_exchange_no_firing_and_a_lone_jump_is_not_an_exchange():
     assert _firings(det, jumped) == []
 
 
+def test_a_scale_on_a_pairs_threshold_finds_a_smaller_exchange():
+    """Reports 0.12 rad apart exchanged at 5 s: too small for the threshold, found with the pair's threshold halved."""
+    def firings(scale):
+        det = ReportExchange(2, threshold=8.0, accel_psd=0.03, lag_s=0.3)
+        return [(t, pair) for a, t, h in _streams(0.12, exchange_at=5.0, seed=3)
+                if (pair := det.add(a, t, h, scale)) is not None]
+
+    assert firings(None) == []
+    fired = firings(np.array([0.5, 0.5]))
+    assert len(fired) == 1 and 5.0 <= fired[0][0] < 6.0
+
+
 def test_old_and_nan_reports_are_ignored_and_swap_exchanges_the_tracks():
     det = ReportExchange(2, threshold=8.0)
     for a, t, h in _streams(1.0, None, seconds=2.0):

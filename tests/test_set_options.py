@@ -257,6 +257,32 @@ def test_visual_stale_rad_s_lets_the_agent_still_reporting_carry_an_exchange_wit
         assert tracker.last_labels.tolist() == late_labels
 
 
+def test_undo_factor_undoes_a_recent_exchange_on_less_evidence(shipped):
+    heading = {0: 0.0, 1: 0.25}  # too close for a report jump: the visual detector alone finds both exchanges
+    swapped = lambda a, t: heading[1 - a] if 1.5 <= t < 5.0 else heading[a]  # noqa: E731  ids exchanged 1.5-5 s
+    found = {}
+    for undo, undo_s in ((None, 30.0), (0.25, 30.0), (0.25, 2.0)):
+        tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, exchange_llr=None,
+                               visual_exchange=8.0, undo_factor=undo, undo_s=undo_s)
+        times, scales = [], []
+        swap = tracker.net.swap
+        tracker.net.swap = lambda a, b, s=swap, t=tracker, out=times: (out.append(t._last_time), s(a, b))
+        for f in frames(240, swapped, lambda r, t: heading[r]):
+            tracker.update(f)
+            if f.index in (int(4.5 * RATE), 239):  # between the two exchanges, and at the end
+                scales.append(tracker._threshold_scale())
+        found[(undo, undo_s)] = times
+        assert len(times) == 2 and tracker.last_labels.tolist() == [0, 1]  # the swap, then its undoing
+        if undo is None:
+            assert scales == [None, None]
+        else:  # the pair's thresholds scaled until the undo (or undo_s), then as any other pair's
+            assert scales[0][0, 1] == scales[0][1, 0] == (undo if undo_s == 30.0 else 1.0)
+            assert (scales[1] == 1.0).all() and scales[0][0, 0] == 1.0
+    plain, undone, expired = found[(None, 30.0)], found[(0.25, 30.0)], found[(0.25, 2.0)]
+    assert plain[0] == undone[0] == expired[0]  # the first exchange needs the full evidence either way
+    assert 5.0 < undone[1] < plain[1] == expired[1]  # undone sooner, unless more than undo_s after the first
+
+
 def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
     """fp_prior_ref: the running false-positive rate starts at the reference, falls in a world without false
     positives (so a robot's detection is less readily called one); None turns the correction off."""
@@ -367,6 +393,15 @@ def test_stage18_candidates_widen_the_visual_detectors_stale_reports_against_the
     assert sorted(o["visual_stale_rad_s"] for n, (_, o) in cands.items() if n != baseline) == [0.25, 0.5]
     assert make_tracker("set", n_agents=3)._visual.stale_rad_s == 0.5  # shipped since the stage
     assert make_tracker("set", n_agents=3, visual_stale_rad_s=None)._visual.stale_rad_s is None
+
+
+def test_stage19_candidates_undo_a_recent_exchange_on_less_evidence_against_the_identifier_before_it():
+    from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
+
+    cands, baseline = stage_candidates(19)
+    assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"undo_factor": None}
+    assert sorted(o["undo_factor"] for n, (_, o) in cands.items() if n != baseline) == [0.25, 0.5]
+    assert {o["undo_s"] for n, (_, o) in cands.items() if n != baseline} == {30.0}
 
 
 def test_exchange_tight_agents_changes_the_detector_of_larger_teams_only():

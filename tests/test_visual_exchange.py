@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from lookalike.learn.visual_exchange import VisualExchange
+from lookalike.learn.visual_exchange import VisualExchange, take_pairs
 
 DT = 1 / 30
 
@@ -75,6 +75,34 @@ def test_with_stale_rad_s_a_silent_agent_whose_robot_may_have_turned_gives_no_ex
     fits its own: the widened noise keeps that from looking like an exchange."""
     detector = VisualExchange(2, threshold=6.0, stale_rad_s=0.5)
     assert not any(feed(detector, 300, visual=[0.0, 1.5], reported=[0.0, 0.5], age=(0.05, 3.0)))
+
+
+def test_a_pairs_scale_lowers_its_threshold_only():
+    """Three agents; 0 and 1 hold each other's robots. With the pair's threshold scaled by 0.25 the exchange comes
+    sooner; a scale on another pair changes nothing."""
+    def first_exchange(scale) -> int:
+        detector, rng = VisualExchange(3, threshold=8.0), np.random.default_rng(4)
+        for k in range(300):
+            seen = np.array([0.3, 0.0, 2.0]) + rng.normal(0.0, 0.28, 3)
+            if detector.update(np.arange(3), seen, np.array([0.0, 0.3, 2.0]), np.zeros(3), DT, scale):
+                return k
+        return 300
+
+    other = np.ones((3, 3))
+    other[0, 2] = other[2, 0] = 0.25
+    mine = np.ones((3, 3))
+    mine[0, 1] = mine[1, 0] = 0.25
+    plain = first_exchange(None)
+    assert first_exchange(other) == plain < 300
+    assert first_exchange(mine) < plain
+
+
+def test_take_pairs_with_one_threshold_per_pair():
+    evidence = np.array([[0.0, 5.0, 3.0], [5.0, 0.0, 0.0], [3.0, 0.0, 0.0]])
+    threshold = np.full((3, 3), 6.0)
+    threshold[0, 2] = threshold[2, 0] = 2.0
+    assert take_pairs(evidence.copy(), threshold) == [(0, 2)]  # only (0, 2) passes its own threshold
+    assert take_pairs(evidence.copy(), 4.0) == [(0, 1)]
 
 
 @pytest.mark.parametrize("kwargs", [dict(threshold=0.0), dict(threshold=1.0, memory_s=0.0),

@@ -1,7 +1,7 @@
-"""The fifth to eighteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+"""The fifth to nineteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 18) scores stage K's candidates
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 19) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
 (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
@@ -28,6 +28,8 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
   (``visual_exchange`` at each of :data:`STAGE17_VISUAL`, ``visual_memory_s`` :data:`STAGE17_MEMORY_S`), the same rule.
 - stage 18: that detector counting silent agents' older reports too, their noise widened (``visual_stale_rad_s`` at
   each of :data:`STAGE18_STALE`), the same rule.
+- stage 19: a pair exchanged within the last :data:`STAGE19_UNDO_S` seconds exchanged again on less evidence
+  (``undo_factor`` at each of :data:`STAGE19_UNDO`), the same rule.
 
 A chosen option is made the identifier's default by hand.
 """
@@ -70,6 +72,9 @@ STAGE17_VISUAL: tuple[float, ...] = (8.0, 10.0, 12.0)  # stage 17: visual_exchan
 STAGE17_MEMORY_S = 10.0  # and the time constant of its evidence's decay, seconds
 STAGE18_STALE: tuple[float, ...] = (0.25, 0.5)  # stage 18: visual_stale_rad_s, radians per second of a report's age
 BEFORE_STAGE18: dict[str, object] = {"visual_stale_rad_s": None}  # the visual detector before the eighteenth stage
+STAGE19_UNDO: tuple[float, ...] = (0.25, 0.5)  # stage 19: undo_factor, the fraction of the evidence an undo needs
+STAGE19_UNDO_S = 30.0  # and how long after a pair's exchange it holds, seconds
+BEFORE_STAGE19: dict[str, object] = {"undo_factor": None}  # the identifier before the nineteenth stage
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -160,9 +165,18 @@ def stage18_candidates() -> Candidates:
             **{f"visual_stale={r}": (SHIPPED_SET_WEIGHTS, {"visual_stale_rad_s": r}) for r in STAGE18_STALE}}
 
 
+def stage19_candidates() -> Candidates:
+    """The nineteenth stage's candidates: the identifier shipped before it and ``undo=f``, a pair exchanged within
+    :data:`STAGE19_UNDO_S` seconds needing the fraction ``f`` of the evidence, for each of :data:`STAGE19_UNDO`."""
+    return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, dict(BEFORE_STAGE19)),
+            **{f"undo={f}": (SHIPPED_SET_WEIGHTS, {"undo_factor": f, "undo_s": STAGE19_UNDO_S}) for f in STAGE19_UNDO}}
+
+
 def stage_candidates(stage: int, run_dir: Path | None = None) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 10, 12 … 18; 16: the snapshots in ``run_dir``) candidates and the name of its
+    """Stage ``stage``'s (5 … 10, 12 … 19; 16: the snapshots in ``run_dir``) candidates and the name of its
     baseline."""
+    if stage == 19:
+        return stage19_candidates(), STAGE16_BASELINE
     if stage == 18:
         return stage18_candidates(), STAGE16_BASELINE
     if stage == 17:

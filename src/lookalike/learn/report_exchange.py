@@ -75,10 +75,11 @@ class ReportExchange:
         self.x[a] = (float(_wrap(np.asarray(x[0]))), x[1])
         self.p[a], self.t[a] = p - np.outer(gain, p[0]), t
 
-    def add(self, agent: int, t_sent: float, heading: float) -> tuple[int, int] | None:
+    def add(self, agent: int, t_sent: float, heading: float, scale: np.ndarray | None = None) -> tuple[int, int] | None:
         """Take one report (send time in seconds, absolute heading in radians); a report not newer than the
-        agent's newest is ignored. Returns the exchanged pair ``(agent, other)`` when this report completes
-        an exchange (the two tracks are exchanged already), else None."""
+        agent's newest is ignored; ``scale`` (n) a factor on the threshold of the agent's pair with each other agent
+        (None: 1). Returns the exchanged pair ``(agent, other)`` when this report completes an exchange (the two
+        tracks are exchanged already), else None."""
         a = agent
         if not (t_sent > self.newest[a] and np.isfinite(heading)):
             return None
@@ -105,7 +106,8 @@ class ReportExchange:
         row = self.evidence[a]
         row[known] = np.maximum(row[known] + gain[known], 0.0)
         col = self.evidence[:, a]
-        both = known & (row + col > 2 * self.threshold) & (np.minimum(row, col) > self.threshold / 4)
+        threshold = self.threshold if scale is None else self.threshold * scale
+        both = known & (row + col > 2 * threshold) & (np.minimum(row, col) > threshold / 4)
         if self.step_rad is not None:
             both &= (t_sent - self.stepped <= self.step_window_s) & (t_sent - self.stepped[a] <= self.step_window_s)
         if not both.any():

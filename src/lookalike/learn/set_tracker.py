@@ -28,7 +28,8 @@ whose heading reports each continue the other's report track exchange memories
 With ``visual_exchange`` (8, chosen on tuning sequences), two agents whose detections' visual headings, gathered
 over seconds, fit each other's reports better than their own exchange memories
 (:mod:`lookalike.learn.visual_exchange`); with ``visual_stale_rad_s`` (0.5 rad/s, chosen the same way) an agent
-silent for a while takes part too.
+silent for a while takes part too. With ``undo_factor``, a pair exchanged within the last ``undo_s`` seconds needs
+that fraction of those two detectors' evidence to be exchanged again (a swap of ids is often undone).
 """
 
 from __future__ import annotations
@@ -158,6 +159,11 @@ class SetIdentifier:
             "per second of age beyond that (a silent robot may have turned; None: fresh reports only; chosen on "
             "tuning sequences and a development sample)",
             range=(1e-3, 100.0))
+        undo_factor: float | None = param(
+            None, "a pair of agents exchanged (by any rule) within the last undo_s seconds needs this fraction of "
+            "exchange_llr's and visual_exchange's evidence to be exchanged again: a swap of ids is often undone, and "
+            "a false exchange is better undone soon (None: the same evidence as any pair)", range=(1e-3, 1.0))
+        undo_s: float = param(30.0, "how long undo_factor holds after a pair's exchange, seconds", range=(0.0, 1e4))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
                                choices=LOCALISERS)
@@ -198,6 +204,7 @@ class SetIdentifier:
         self._visual = None if cfg.visual_exchange is None else VisualExchange(
             n, cfg.visual_exchange, cfg.visual_memory_s, cfg.visual_noise_rad, stale_rad_s=cfg.visual_stale_rad_s)
         self.visual_exchanges = 0  # memories exchanged by visual_exchange so far (for tests and analysis)
+        self._exchanged_at = np.full((n, n), -np.inf)  # frame time (s) of each pair's latest exchange (undo_factor)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
@@ -286,9 +293,23 @@ class SetIdentifier:
 
     def _exchange_memories(self, a: int, b: int) -> None:
         """Exchange agents ``a`` and ``b``'s memories (the network's and the exchange detector's tracks)."""
-        self.net.swap(a, b)
+        self._swap_network(a, b)
         if self._exchange is not None:
             self._exchange.swap(a, b)
+
+    def _swap_network(self, a: int, b: int) -> None:
+        """Exchange agents ``a`` and ``b``'s memories in the network. For ``undo_factor``, note when; an exchange that
+        undoes one made within ``undo_s`` seconds leaves the pair as any other (a third one needs the full evidence)."""
+        self.net.swap(a, b)
+        undone = self._last_time - self._exchanged_at[a, b] <= self.config.undo_s
+        self._exchanged_at[a, b] = self._exchanged_at[b, a] = -np.inf if undone else self._last_time
+
+    def _threshold_scale(self) -> np.ndarray | None:
+        """``undo_factor``: per pair of agents, the factor on the exchange detectors' thresholds (None: off)."""
+        cfg = self.config
+        if cfg.undo_factor is None:
+            return None
+        return np.where(self._last_time - self._exchanged_at <= cfg.undo_s, cfg.undo_factor, 1.0)
 
     def _report_exchanges(self, frame: Frame) -> None:
         """``exchange_llr``: feed the frame's reports to the exchange detector
@@ -300,9 +321,10 @@ class SetIdentifier:
         for agent, t_sent, heading in zip(b.agent_id.tolist(), b.t_sent.tolist(), b.heading.tolist()):
             if not 0 <= agent < self.config.n_agents:
                 continue
-            pair = self._exchange.add(agent, t_sent, heading)
+            scale = self._threshold_scale()
+            pair = self._exchange.add(agent, t_sent, heading, None if scale is None else scale[agent])
             if pair is not None:
-                self.net.swap(*pair)
+                self._swap_network(*pair)
                 self.exchanges += 1
                 if self._jumps is not None:
                     self._jumps.exchanged(pair, t_sent)
@@ -314,7 +336,7 @@ class SetIdentifier:
         (:class:`~lookalike.learn.visual_exchange.VisualExchange`). Returns the labels."""
         assert self._visual is not None
         held = agent_detections(labels, conf, self.config.n_agents)
-        pairs = self._visual.update(held, heading, self._beacons.heading, age, dt)
+        pairs = self._visual.update(held, heading, self._beacons.heading, age, dt, self._threshold_scale())
         self.visual_exchanges += len(pairs)
         return self._exchange_pairs(labels, pairs)
 
@@ -322,7 +344,7 @@ class SetIdentifier:
         """Exchange the network's memories and this frame's ``labels`` of each of ``pairs`` (no agent twice)."""
         out = labels
         for j, k in pairs:
-            self.net.swap(j, k)
+            self._swap_network(j, k)
             out = np.where(labels == j, k, np.where(labels == k, j, out))
         return out
 

@@ -22,12 +22,13 @@ from __future__ import annotations
 import numpy as np
 
 
-def take_pairs(evidence: np.ndarray, threshold: float) -> list[tuple[int, int]]:
-    """The pairs ``(a, b)``, ``a < b``, whose symmetric ``evidence`` passes ``threshold``, the strongest first and each
-    agent at most once; their rows and columns are cleared in place (their evidence starts again)."""
+def take_pairs(evidence: np.ndarray, threshold: float | np.ndarray) -> list[tuple[int, int]]:
+    """The pairs ``(a, b)``, ``a < b``, whose symmetric ``evidence`` passes ``threshold`` (one for all, or one per
+    pair), the strongest first and each agent at most once; their rows and columns are cleared in place (their
+    evidence starts again)."""
     pairs = []
-    while evidence.max(initial=0.0) > threshold:
-        a, b = np.unravel_index(int(np.argmax(evidence)), evidence.shape)
+    while (passing := evidence > threshold).any():
+        a, b = np.unravel_index(int(np.argmax(np.where(passing, evidence, -np.inf))), evidence.shape)
         pairs.append((int(min(a, b)), int(max(a, b))))
         evidence[[a, b], :] = 0.0
         evidence[:, [a, b]] = 0.0
@@ -75,11 +76,12 @@ class VisualExchange:
         return np.log(density + uniform)
 
     def update(self, held: np.ndarray, visual: np.ndarray, reported: np.ndarray, age: np.ndarray,
-               dt: float) -> list[tuple[int, int]]:
+               dt: float, scale: np.ndarray | None = None) -> list[tuple[int, int]]:
         """One frame: ``held`` (n) each agent's detection index (-1: none), ``visual`` each detection's visual
         heading (radians), ``reported`` and ``age`` each agent's newest reported heading (radians) and its age
-        (seconds; NaN: never heard), ``dt`` seconds since the last frame. Returns the pairs found exchanged
-        (the strongest first, each agent at most once)."""
+        (seconds; NaN: never heard), ``dt`` seconds since the last frame, ``scale`` (n x n, symmetric) a factor on
+        each pair's threshold (None: 1). Returns the pairs found exchanged (the strongest first, each agent at most
+        once)."""
         self.evidence *= np.exp(-max(dt, 0.0) / self.memory_s)
         usable = (held >= 0) & np.isfinite(reported) & np.isfinite(age)
         if self.stale_rad_s is None:
@@ -96,4 +98,4 @@ class VisualExchange:
         block = np.maximum(self.evidence[np.ix_(live, live)] + gain, 0.0)
         np.fill_diagonal(block, 0.0)
         self.evidence[np.ix_(live, live)] = block
-        return take_pairs(self.evidence, self.threshold)
+        return take_pairs(self.evidence, self.threshold if scale is None else self.threshold * scale)
