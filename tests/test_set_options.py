@@ -283,6 +283,19 @@ def test_undo_factor_undoes_a_recent_exchange_on_less_evidence(shipped):
     assert 5.0 < undone[1] < plain[1] == expired[1]  # undone sooner, unless more than undo_s after the first
 
 
+def test_undo_factor_holds_for_an_agents_latest_exchange_only(shipped):
+    tracker = make_tracker("set", n_agents=3, undo_factor=0.5)
+    tracker._last_time = 1.0
+    tracker._swap_network(0, 1)
+    assert tracker._threshold_scale()[0, 1] == 0.5
+    tracker._last_time = 2.0
+    tracker._swap_network(1, 2)  # agent 1 exchanges again, with a third agent: only that exchange may be undone
+    scale = tracker._threshold_scale()
+    assert scale[0, 1] == 1.0 and scale[1, 2] == scale[2, 1] == 0.5
+    tracker._swap_network(2, 1)  # undone: the pair is as any other again
+    assert (tracker._threshold_scale() == 1.0).all()
+
+
 def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
     """fp_prior_ref: the running false-positive rate starts at the reference, falls in a world without false
     positives (so a robot's detection is less readily called one); None turns the correction off."""
@@ -399,6 +412,7 @@ def test_stage19_candidates_undo_a_recent_exchange_on_less_evidence_against_the_
     from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
 
     cands, baseline = stage_candidates(19)
+    assert stage_candidates(20) == (cands, baseline)  # the same candidates, judged again after a change of the rule
     assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"undo_factor": None}
     assert sorted(o["undo_factor"] for n, (_, o) in cands.items() if n != baseline) == [0.25, 0.5]
     assert {o["undo_s"] for n, (_, o) in cands.items() if n != baseline} == {30.0}

@@ -24,8 +24,8 @@ for the world's false-positive rate, ``--stage 6`` to ``9`` the report-exchange 
 the pairing of mirroring report jumps, ``--stage 12`` the exchange detector's heading model, ``--stage 13``
 that and a step gate, ``--stage 14`` that model for larger teams, ``--stage 15`` pairing jumps after silences,
 ``--stage 16`` a fine-tuning's snapshots with swaps that end in a silence, ``--stage 17`` exchanges found in the
-detections' visual headings, ``--stage 18`` the same counting silent agents' older
-reports, ``--stage 19`` a recent exchange undone on less evidence (:mod:`lookalike.bench.set_select_options`).
+detections' visual headings, ``--stage 18`` the same counting silent agents' older reports, ``--stage 19`` and
+``20`` a recent exchange undone on less evidence (:mod:`lookalike.bench.set_select_options`).
 """
 
 from __future__ import annotations
@@ -335,7 +335,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--average-from", type=int, default=None,
                         help="also the mean of the snapshots' weights from this step on")
     parser.add_argument("--ship", action="store_true", help="ship the chosen weights")
-    parser.add_argument("--stage", type=int, choices=(*range(1, 11), *range(12, 20)), default=1,
+    parser.add_argument("--stage", type=int, choices=(*range(1, 11), *range(12, 21)), default=1,
                         help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from); "
                         "3: the inference options of the shipped weights (RUN: where the scores are kept); "
                         "4: the fourth stage's snapshots x the pair-swap rule (lookalike.bench.set_select_stage4); "
@@ -345,9 +345,9 @@ def main(argv: list[str] | None = None) -> None:
                         "12: the exchange detector's heading model; 13: and a step gate; 14: that model for "
                         "larger teams; 15: jumps paired across silences; 16: a fine-tuning with swaps that end "
                         "in a silence; 17: exchanges in the visual headings; 18: and silent agents' older reports; "
-                        "19: a recent exchange undone on less evidence (5-19: lookalike.bench.set_select_options)")
+                        "19, 20: a recent exchange undone on less evidence (5-20: lookalike.bench.set_select_options)")
     parser.add_argument("--only", default=None,
-                        help="stages 4-19: score this candidate only (e.g. step300,pair=off)")
+                        help="stages 4-20: score this candidate only (e.g. step300,pair=off)")
     parser.add_argument("--cache", type=Path, default=None,
                         help="stage 3: the JSON file of scored candidates (default RUN/set_select_stage3.json)")
     args = parser.parse_args(argv)

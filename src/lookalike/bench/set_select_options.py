@@ -1,7 +1,7 @@
-"""The fifth to nineteenth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
+"""The fifth to twentieth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 19) scores stage K's candidates
+``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 20) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
 (:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
@@ -29,7 +29,9 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
 - stage 18: that detector counting silent agents' older reports too, their noise widened (``visual_stale_rad_s`` at
   each of :data:`STAGE18_STALE`), the same rule.
 - stage 19: a pair exchanged within the last :data:`STAGE19_UNDO_S` seconds exchanged again on less evidence
-  (``undo_factor`` at each of :data:`STAGE19_UNDO`), the same rule.
+  (``undo_factor`` at each of :data:`STAGE19_UNDO`), the same rule; scored at a1eef66, before an agent's newer
+  exchange ended the undo of its older one. Stage 20: the same candidates with that, judged on a new development
+  sample.
 
 A chosen option is made the identifier's default by hand.
 """
@@ -173,9 +175,9 @@ def stage19_candidates() -> Candidates:
 
 
 def stage_candidates(stage: int, run_dir: Path | None = None) -> tuple[Candidates, str]:
-    """Stage ``stage``'s (5 … 10, 12 … 19; 16: the snapshots in ``run_dir``) candidates and the name of its
+    """Stage ``stage``'s (5 … 10, 12 … 20; 16: the snapshots in ``run_dir``) candidates and the name of its
     baseline."""
-    if stage == 19:
+    if stage in (19, 20):
         return stage19_candidates(), STAGE16_BASELINE
     if stage == 18:
         return stage18_candidates(), STAGE16_BASELINE

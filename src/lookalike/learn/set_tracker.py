@@ -298,11 +298,15 @@ class SetIdentifier:
             self._exchange.swap(a, b)
 
     def _swap_network(self, a: int, b: int) -> None:
-        """Exchange agents ``a`` and ``b``'s memories in the network. For ``undo_factor``, note when; an exchange that
-        undoes one made within ``undo_s`` seconds leaves the pair as any other (a third one needs the full evidence)."""
+        """Exchange agents ``a`` and ``b``'s memories in the network. For ``undo_factor``, note when: an agent may undo
+        only its latest exchange, and an exchange that undoes one leaves the pair as any other (a third exchange needs
+        the full evidence)."""
         self.net.swap(a, b)
         undone = self._last_time - self._exchanged_at[a, b] <= self.config.undo_s
-        self._exchanged_at[a, b] = self._exchanged_at[b, a] = -np.inf if undone else self._last_time
+        self._exchanged_at[[a, b], :] = -np.inf
+        self._exchanged_at[:, [a, b]] = -np.inf
+        if not undone:
+            self._exchanged_at[a, b] = self._exchanged_at[b, a] = self._last_time
 
     def _threshold_scale(self) -> np.ndarray | None:
         """``undo_factor``: per pair of agents, the factor on the exchange detectors' thresholds (None: off)."""
