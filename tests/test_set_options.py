@@ -402,8 +402,9 @@ def test_stage18_candidates_widen_the_visual_detectors_stale_reports_against_the
     from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
 
     cands, baseline = stage_candidates(18)
-    assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"visual_stale_rad_s": None}
+    assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"visual_stale_rad_s": None, "undo_factor": None}
     assert sorted(o["visual_stale_rad_s"] for n, (_, o) in cands.items() if n != baseline) == [0.25, 0.5]
+    assert {o["undo_factor"] for o in (o for _, o in cands.values())} == {None}  # as before the twentieth stage
     assert make_tracker("set", n_agents=3)._visual.stale_rad_s == 0.5  # shipped since the stage
     assert make_tracker("set", n_agents=3, visual_stale_rad_s=None)._visual.stale_rad_s is None
 
@@ -416,6 +417,7 @@ def test_stage19_candidates_undo_a_recent_exchange_on_less_evidence_against_the_
     assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"undo_factor": None}
     assert sorted(o["undo_factor"] for n, (_, o) in cands.items() if n != baseline) == [0.25, 0.5]
     assert {o["undo_s"] for n, (_, o) in cands.items() if n != baseline} == {30.0}
+    assert make_tracker("set", n_agents=3).config.undo_factor == 0.5  # shipped since the twentieth stage
 
 
 def test_exchange_tight_agents_changes_the_detector_of_larger_teams_only():

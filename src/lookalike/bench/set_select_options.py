@@ -73,10 +73,11 @@ STAGE16_BASELINE = "shipped"
 STAGE17_VISUAL: tuple[float, ...] = (8.0, 10.0, 12.0)  # stage 17: visual_exchange's log-likelihood ratios
 STAGE17_MEMORY_S = 10.0  # and the time constant of its evidence's decay, seconds
 STAGE18_STALE: tuple[float, ...] = (0.25, 0.5)  # stage 18: visual_stale_rad_s, radians per second of a report's age
-BEFORE_STAGE18: dict[str, object] = {"visual_stale_rad_s": None}  # the visual detector before the eighteenth stage
 STAGE19_UNDO: tuple[float, ...] = (0.25, 0.5)  # stage 19: undo_factor, the fraction of the evidence an undo needs
 STAGE19_UNDO_S = 30.0  # and how long after a pair's exchange it holds, seconds
-BEFORE_STAGE19: dict[str, object] = {"undo_factor": None}  # the identifier before the nineteenth stage
+BEFORE_STAGE19: dict[str, object] = {"undo_factor": None}  # the identifier before the nineteenth and twentieth stages
+# The visual detector before the eighteenth stage (and the identifier before the twentieth's choice).
+BEFORE_STAGE18: dict[str, object] = {"visual_stale_rad_s": None, **BEFORE_STAGE19}
 # Stages 6-8: the thresholds, exchange_memory_s and exchange_fresh_s of the candidates.
 _EXCHANGE_STAGES: dict[int, tuple[tuple[float | None, ...], float | None, float | None]] = {
     6: (STAGE6_EXCHANGE_LLR, None, None), 7: (STAGE7_EXCHANGE_LLR, 1.0, None), 8: (STAGE8_EXCHANGE_LLR, 1.0, 0.6)}
@@ -164,7 +165,8 @@ def stage18_candidates() -> Candidates:
     """The eighteenth stage's candidates: the identifier shipped before it and ``visual_stale=r``, its visual
     exchange detector counting older reports with their noise widened by each of :data:`STAGE18_STALE`."""
     return {STAGE16_BASELINE: (SHIPPED_SET_WEIGHTS, dict(BEFORE_STAGE18)),
-            **{f"visual_stale={r}": (SHIPPED_SET_WEIGHTS, {"visual_stale_rad_s": r}) for r in STAGE18_STALE}}
+            **{f"visual_stale={r}": (SHIPPED_SET_WEIGHTS, {"visual_stale_rad_s": r, **BEFORE_STAGE19})
+               for r in STAGE18_STALE}}
 
 
 def stage19_candidates() -> Candidates:

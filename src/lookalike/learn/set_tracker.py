@@ -160,9 +160,10 @@ class SetIdentifier:
             "tuning sequences and a development sample)",
             range=(1e-3, 100.0))
         undo_factor: float | None = param(
-            None, "a pair of agents exchanged (by any rule) within the last undo_s seconds needs this fraction of "
+            0.5, "a pair of agents exchanged (by any rule) within the last undo_s seconds needs this fraction of "
             "exchange_llr's and visual_exchange's evidence to be exchanged again: a swap of ids is often undone, and "
-            "a false exchange is better undone soon (None: the same evidence as any pair)", range=(1e-3, 1.0))
+            "a false exchange is better undone soon; an agent undoes only its latest exchange (None: the same "
+            "evidence as any pair; chosen on tuning sequences and a development sample)", range=(1e-3, 1.0))
         undo_s: float = param(30.0, "how long undo_factor holds after a pair's exchange, seconds", range=(0.0, 1e4))
         fp_prior_s: float = param(10.0, "time constant of fp_prior_ref's running mean, seconds", range=(0.1, 1e4))
         localiser: str = param("kalman", "agent positions: kalman (ours, as the lstm) or lowpass (seed A's Eq. 3)",
