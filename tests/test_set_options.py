@@ -404,7 +404,7 @@ def test_stage18_candidates_widen_the_visual_detectors_stale_reports_against_the
     cands, baseline = stage_candidates(18)
     assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"visual_stale_rad_s": None, "undo_factor": None}
     assert sorted(o["visual_stale_rad_s"] for n, (_, o) in cands.items() if n != baseline) == [0.25, 0.5]
-    assert {o["undo_factor"] for o in (o for _, o in cands.values())} == {None}  # as before the twentieth stage
+    assert {o["undo_factor"] for _, o in cands.values()} == {None}  # as before the twentieth stage
     assert make_tracker("set", n_agents=3)._visual.stale_rad_s == 0.5  # shipped since the stage
     assert make_tracker("set", n_agents=3, visual_stale_rad_s=None)._visual.stale_rad_s is None
 
