@@ -28,8 +28,9 @@ whose heading reports each continue the other's report track exchange memories
 With ``visual_exchange`` (8, chosen on tuning sequences), two agents whose detections' visual headings, gathered
 over seconds, fit each other's reports better than their own exchange memories
 (:mod:`lookalike.learn.visual_exchange`); with ``visual_stale_rad_s`` (0.5 rad/s, chosen the same way) an agent
-silent for a while takes part too. With ``undo_factor``, a pair exchanged within the last ``undo_s`` seconds needs
-that fraction of those two detectors' evidence to be exchanged again (a swap of ids is often undone).
+silent for a while takes part too. With ``undo_factor`` (0.5, chosen on tuning sequences and a development sample),
+a pair exchanged within the last ``undo_s`` seconds needs that fraction of the two exchange detectors' evidence to be
+exchanged back (a swap of ids is often undone); an agent undoes only its latest exchange.
 """
 
 from __future__ import annotations
