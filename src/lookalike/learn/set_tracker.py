@@ -310,12 +310,14 @@ class SetIdentifier:
         if not undone:
             self._exchanged_at[a, b] = self._exchanged_at[b, a] = self._last_time
 
-    def _threshold_scale(self) -> np.ndarray | None:
-        """``undo_factor``: per pair of agents, the factor on the exchange detectors' thresholds (None: off)."""
+    def _threshold_scale(self, agent: int | None = None) -> np.ndarray | None:
+        """``undo_factor``: the factor on the exchange detectors' thresholds per pair of agents, or of ``agent`` with
+        each other agent (None: off)."""
         cfg = self.config
         if cfg.undo_factor is None:
             return None
-        return np.where(self._last_time - self._exchanged_at <= cfg.undo_s, cfg.undo_factor, 1.0)
+        since = self._last_time - (self._exchanged_at if agent is None else self._exchanged_at[agent])
+        return np.where(since <= cfg.undo_s, cfg.undo_factor, 1.0)
 
     def _report_exchanges(self, frame: Frame) -> None:
         """``exchange_llr``: feed the frame's reports to the exchange detector
@@ -327,8 +329,7 @@ class SetIdentifier:
         for agent, t_sent, heading in zip(b.agent_id.tolist(), b.t_sent.tolist(), b.heading.tolist()):
             if not 0 <= agent < self.config.n_agents:
                 continue
-            scale = self._threshold_scale()
-            pair = self._exchange.add(agent, t_sent, heading, None if scale is None else scale[agent])
+            pair = self._exchange.add(agent, t_sent, heading, self._threshold_scale(agent))
             if pair is not None:
                 self._swap_network(*pair)
                 self.exchanges += 1
