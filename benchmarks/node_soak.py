@@ -1,4 +1,4 @@
-"""Node soak (issue 19): 60 s of a random mix of valid and invalid datagrams on loopback, then a
+"""Node soak: 60 s of a random mix of valid and invalid datagrams on loopback, then a
 clean final frame. Prints the figures and whether the node stayed alive, bounded and consistent.
 
     .venv/bin/python benchmarks/node_soak.py [--seconds 60] [--seed 0]
@@ -10,8 +10,7 @@ import argparse
 import json
 
 from _common import report_target
-
-from lookalike.node.soak import soak
+from _soak import soak
 
 
 def main() -> None:

@@ -5,6 +5,8 @@ messages round-trip."""
 from __future__ import annotations
 
 import json
+import sys
+from pathlib import Path
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -19,7 +21,9 @@ from lookalike.node import (
     encode,
 )
 from lookalike.node import messages as m
-from lookalike.node.soak import EXCLUSIVE, LatestHeadingMatcher
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from _soak import EXCLUSIVE, LatestHeadingMatcher  # noqa: E402  (the soak benchmark's helpers)
 
 scalars = (st.none() | st.booleans() | st.integers(min_value=-(2**80), max_value=2**80)
            | st.floats(allow_nan=False, allow_infinity=False) | st.text(max_size=10))

@@ -1,5 +1,5 @@
 """A soak run of the node on loopback: a random mix of valid and invalid datagrams for a while,
-then a clean final frame whose team state is known (issue 19).
+then a clean final frame whose team state is known (``node_soak.py`` runs it; the tests import it too).
 
 The node runs in a thread of this process with :class:`LatestHeadingMatcher` as its tracker (each
 detection goes to the robot whose latest reported heading is closest), so the final team state
