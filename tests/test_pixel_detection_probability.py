@@ -57,7 +57,14 @@ def test_map_changes_only_the_probability_not_the_detections():
 
 
 def test_fit_command_refuses_an_unknown_preset(tmp_path, capsys):
-    from lookalike.bench.pixel_probability import main
+    import importlib.util
+    from pathlib import Path
 
+    script = Path(__file__).resolve().parents[1] / "research" / "pixel_probability" / "fit.py"
+    spec = importlib.util.spec_from_file_location("pixel_probability_fit", script)
+    assert spec is not None and spec.loader is not None
+    fit = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(fit)
+    main = fit.main
     assert main(["-o", str(tmp_path / "p.json"), "--pixel-setups", "nope"]) == 2
     assert "nope" in capsys.readouterr().err and not (tmp_path / "p.json").exists()

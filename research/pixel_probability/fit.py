@@ -6,9 +6,12 @@ The margins are those of the detections the pipeline keeps (``min_score``, up to
 frame) on sequences of ``pixel_setups`` rendered from seeds ``seed + 1000·setup + k``; the target is the
 simulator's own detector scores on ``sim_sequences`` sequences of each of ``sim_setups`` from the same
 seeds. The default ``seed`` 800000 keeps clear of the bench's held-out 700000+ and of the models'
-training renders (below 400000). Refit the shipped map with::
+training renders (below 400000). Fit a map with (none is shipped: see research/README.md)::
 
-    python -m lookalike.bench.pixel_probability -o src/lookalike/vision/models_data/robot_detection_probability.json
+    python research/pixel_probability/fit.py -o FILE
+
+Writing it to ``src/lookalike/vision/models_data/robot_detection_probability.json`` makes the pipeline read
+it by default.
 """
 
 from __future__ import annotations
@@ -79,14 +82,14 @@ def fit_pixel_probability(pipe: RobotPipeline, camera: Camera, pixel_setups: lis
         "pixel_setups": pixel_setups, "frames": frames, "pixel_detections": int(len(margins)),
         "sim_seeds": [_seed(s, seed, k) for s in sim_setups for k in range(sim_sequences)],
         "sim_setups": sim_setups, "sim_detections": int(len(target)),
-        "command": "python -m lookalike.bench.pixel_probability " + " ".join(sys.argv[1:]),
+        "command": "python research/pixel_probability/fit.py " + " ".join(sys.argv[1:]),
     }
     return fit_quantile_map(margins, target, fitted_on=fitted)
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m lookalike.bench.pixel_probability -o FILE``: fit and write the map."""
-    ap = argparse.ArgumentParser(prog="python -m lookalike.bench.pixel_probability", description=__doc__)
+    """``python research/pixel_probability/fit.py -o FILE``: fit and write the map."""
+    ap = argparse.ArgumentParser(prog="python research/pixel_probability/fit.py", description=__doc__)
     ap.add_argument("-o", "--output", required=True, help="JSON file to write")
     ap.add_argument("--pixel-setups", default="m10n7", help="presets rendered for the margins")
     ap.add_argument("--sequences", type=int, default=2, help="rendered sequences per pixel set-up")
