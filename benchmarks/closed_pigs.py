@@ -2,7 +2,7 @@
 --offline`` runs it (boxtrack's defaults online, the closed set's defaults offline), on the video's first
 half (where closed-set choices may be made), second half (unseen by them) and the whole dev video.
 
-``--set KEY=VALUE`` overrides a :class:`~lookalike.trackers.closed_set.ClosedSetConfig` field, to compare
+``--set KEY=VALUE`` overrides a :class:`~lookalike.trackers.offline.closed_set.ClosedSetConfig` field, to compare
 variants; say which half a choice was made on. Run::
 
     python benchmarks/closed_pigs.py [--data ../shared/data] [--parts first,second,full] [--set jump=4]
@@ -19,7 +19,7 @@ import numpy as np
 
 from lookalike.bench.datasets import cut_sequence, load_boxes, resolve_data_root
 from lookalike.bench.runner import score_rows
-from lookalike.trackers.closed_set import ClosedSetConfig, assign_identities, online_rows
+from lookalike.trackers.offline.closed_set import ClosedSetConfig, assign_identities, online_rows
 
 
 def det_rows(seq: object) -> np.ndarray:

@@ -20,7 +20,7 @@ from closed_pigs import parse_overrides
 
 from lookalike.eval import combine, evaluate_points
 from lookalike.io.points import POINT_VEL_NOISE, PointFrames, points_to_rows, rows_to_points
-from lookalike.trackers.closed_set import ClosedSetConfig, assign_identities, online_rows
+from lookalike.trackers.offline.closed_set import ClosedSetConfig, assign_identities, online_rows
 
 FPS = 25.0
 RADIUS_PX = 10.0

@@ -22,7 +22,7 @@ import numpy as np
 from lookalike.bench.datasets import read_hexbug_points, resolve_data_root
 from lookalike.eval import combine, evaluate_points
 from lookalike.io.points import POINT_VEL_NOISE, PointFrames, points_to_rows, rows_to_points
-from lookalike.trackers.closed_set import assign_identities, online_rows
+from lookalike.trackers.offline.closed_set import assign_identities, online_rows
 
 FPS = 25.0  # lookalike track --points' default frame rate (no --fps)
 

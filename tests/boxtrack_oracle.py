@@ -15,14 +15,14 @@ from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion.spaces import BoxCXCYWH, cxcywh_to_xywh
 from lookalike.trackers import boxtrack_config as const
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
-from lookalike.trackers.closed_slots import ClosedSlots
-from lookalike.trackers.clutter import ClutterShare
-from lookalike.trackers.coasting import Coasting
-from lookalike.trackers.lifecycle import Lifecycle
-from lookalike.trackers.motion_fit import MotionFit
-from lookalike.trackers.self_calibration import ScoreCalibration
-from lookalike.trackers.table import TrackTable
-from lookalike.trackers.timing import FrameClock
+from lookalike.trackers.parts.closed_slots import ClosedSlots
+from lookalike.trackers.parts.clutter import ClutterShare
+from lookalike.trackers.parts.coasting import Coasting
+from lookalike.trackers.parts.lifecycle import Lifecycle
+from lookalike.trackers.parts.motion_fit import MotionFit
+from lookalike.trackers.parts.self_calibration import ScoreCalibration
+from lookalike.trackers.parts.table import TrackTable
+from lookalike.trackers.parts.timing import FrameClock
 from lookalike.types import Frame, Tracks
 
 

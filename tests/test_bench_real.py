@@ -25,7 +25,7 @@ from lookalike.bench.runner import (
 from lookalike.cli import app
 from lookalike.io import MotTable
 from lookalike.trackers import make_tracker
-from lookalike.trackers.offline import OfflineConfig, postprocess
+from lookalike.trackers.offline.gap_fill import OfflineConfig, postprocess
 from lookalike.types import Detections, Frame
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"

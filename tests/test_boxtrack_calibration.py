@@ -12,7 +12,7 @@ import pytest
 
 from lookalike.trackers import boxtrack_config, make_tracker
 from lookalike.trackers.boxtrack_config import CALIB_MIN_COUNT
-from lookalike.trackers.self_calibration import MissReturns, ScoreBands
+from lookalike.trackers.parts.self_calibration import MissReturns, ScoreBands
 from lookalike.types import Detections, Frame
 
 FPS = 10.0

@@ -9,8 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from lookalike.trackers import make_tracker
-from lookalike.trackers.closed_slots import ClosedSlots
-from lookalike.trackers.table import TrackTable
+from lookalike.trackers.parts.closed_slots import ClosedSlots
+from lookalike.trackers.parts.table import TrackTable
 from lookalike.types import Detections, Frame
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from lookalike.trackers import make_tracker
-from lookalike.trackers.clutter import ClutterShare
+from lookalike.trackers.parts.clutter import ClutterShare
 from lookalike.types import Detections, Frame
 
 FPS = 10.0

@@ -12,7 +12,7 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-import lookalike.trackers.boxtrack_kernels as bk
+import lookalike.trackers.kernels.boxtrack as bk
 from lookalike.association.costs import iou_columns
 from lookalike.motion.spaces import BoxCXCYWH
 from lookalike.sim import BoxSceneConfig, simulate_boxes
@@ -226,7 +226,7 @@ def test_correct_equals_the_update_columns() -> None:
 
 @numba_missing
 def test_the_kernels_maximum_and_minimum_are_numpys() -> None:  # (NaN when either is NaN)
-    from lookalike.trackers import boxtrack_numba as bn
+    from lookalike.trackers.kernels import boxtrack_numba as bn
 
     values = [np.nan, -np.inf, -1.5, -0.0, 0.0, 2.0, np.inf]
     for a in values:

@@ -9,7 +9,7 @@ import pytest
 
 from lookalike.association.costs import centre_distance_cost
 from lookalike.association.solver import assign_pairs
-from lookalike.trackers.self_calibration import ScoreCalibration
+from lookalike.trackers.parts.self_calibration import ScoreCalibration
 from tests.test_self_calibration_fast import plain_decide
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from lookalike.eval import evaluate_sequence
 from lookalike.io import MotTable
-from lookalike.trackers.closed_set import (
+from lookalike.trackers.offline.closed_set import (
     ClosedSetConfig,
     assign_identities,
     online_rows,

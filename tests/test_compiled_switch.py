@@ -63,7 +63,7 @@ def test_decide_once_reads_the_environment_until_use_compiled(monkeypatch: pytes
 
 
 def test_importing_the_switches_does_not_import_numba() -> None:
-    code = ("import sys, lookalike, lookalike._compiled, lookalike.trackers.boxtrack_kernels, "
-            "lookalike.trackers.world_kernels, lookalike.vision.hog_kernels; print('numba' in sys.modules)")
+    code = ("import sys, lookalike, lookalike._compiled, lookalike.trackers.kernels.boxtrack, "
+            "lookalike.trackers.kernels.world, lookalike.vision.hog_kernels; print('numba' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from lookalike.trackers import HealthConfig, HealthMonitor, HealthStatus
-from lookalike.trackers.health import (
+from lookalike.trackers.parts.health import (
     DROPPED,
     EMPTY,
     SCORE_COLLAPSE,

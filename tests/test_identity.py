@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.trackers.identity import (
+from lookalike.trackers.parts.identity import (
     BeaconIdentifier,
     IdentifierConfig,
     labels_from_tracks,

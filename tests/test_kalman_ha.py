@@ -9,7 +9,7 @@ import pytest
 
 from lookalike.sim import preset, simulate_robots
 from lookalike.trackers import make_tracker, tracker_names
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.parts.identity import labels_from_tracks
 from lookalike.types import Beacons, Detections, Frame, TrackStatus
 
 TRACKERS = ("kalman_ha", "kalman_ha2", "jpda")

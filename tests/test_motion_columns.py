@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from lookalike.motion.spaces import BoxCXCYWH
-from lookalike.trackers.motion_fit import MotionFit
+from lookalike.trackers.parts.motion_fit import MotionFit
 
 
 def _boxes(rng: np.random.Generator, k: int) -> np.ndarray:
@@ -65,7 +65,7 @@ def test_column_nis_equals_the_general_form(mixed: bool) -> None:
 
 
 def test_median_equals_numpys() -> None:
-    from lookalike.trackers.motion_fit import _median
+    from lookalike.trackers.parts.motion_fit import _median
 
     rng = np.random.default_rng(2)
     for n in range(1, 80):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.trackers.motion_fit import CHI2_2DOF_MEDIAN, MotionFit
+from lookalike.trackers.parts.motion_fit import CHI2_2DOF_MEDIAN, MotionFit
 
 
 def _feed(fit: MotionFit, rng: np.random.Generator, true_var: float, rounds: int) -> None:

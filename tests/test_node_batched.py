@@ -43,7 +43,7 @@ def test_trusted_frame_arrays_are_read_only_and_typed():
 @pytest.mark.parametrize("seed", range(30))
 def test_pairs_equal_the_solver(seed):
     from lookalike.association.solver import assign_pairs
-    from lookalike.trackers.world_kernels import pairs
+    from lookalike.trackers.kernels.world import pairs
 
     rng = np.random.default_rng(seed)
     k, d = int(rng.integers(0, 9)), int(rng.integers(0, 9))
@@ -64,7 +64,7 @@ def _plain_associate(tracker, det):
     """The association and update before the batched path: motion.kalman's functions, the solver."""
     from lookalike.association.solver import assign
     from lookalike.motion import gating_distance, kalman
-    from lookalike.trackers.kalman_ha import H
+    from lookalike.trackers.parts.world_tracker import H
 
     t = tracker._tracks
     det_of_track = np.full(len(t), -1, dtype=int)
@@ -157,8 +157,8 @@ class _PlainIdentity:
 
 @pytest.mark.parametrize("seed", range(6))
 def test_identifier_table_equals_the_plain_dicts(seed):
-    from lookalike.trackers.identity import BeaconIdentifier
-    from lookalike.trackers.identity import IdentifierConfig as BeaconConfig
+    from lookalike.trackers.parts.identity import BeaconIdentifier
+    from lookalike.trackers.parts.identity import IdentifierConfig as BeaconConfig
     from lookalike.types import Beacons
 
     rng = np.random.default_rng(seed)

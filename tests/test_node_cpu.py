@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from lookalike.node.counters import NodeCounters
-from lookalike.trackers import kalman_ha
+from lookalike.trackers.parts import world_tracker as kalman_ha
 
 
 def test_counters_report_cpu_time_beside_latency():

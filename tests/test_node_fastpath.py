@@ -13,8 +13,8 @@ from lookalike.geometry import angle_diff
 from lookalike.node import IdentifierConfig, TeamIdentifier, encode
 from lookalike.node.teamsim import camera_messages, robot_reports, team_sequence
 from lookalike.trackers import make_tracker
-from lookalike.trackers.identity import BeaconIdentifier, labels_from_tracks
-from lookalike.trackers.identity import IdentifierConfig as BeaconConfig
+from lookalike.trackers.parts.identity import BeaconIdentifier, labels_from_tracks
+from lookalike.trackers.parts.identity import IdentifierConfig as BeaconConfig
 from lookalike.types import Beacons, Tracks
 
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from lookalike.trackers.identity import labels_from_tracks
-from lookalike.trackers.identity.labels import label_list
+from lookalike.trackers.parts.identity import labels_from_tracks
+from lookalike.trackers.parts.identity.labels import label_list
 from lookalike.types import Tracks
 
 

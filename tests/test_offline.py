@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.trackers.offline import (
+from lookalike.trackers.offline.gap_fill import (
     OfflineConfig,
     fill_gaps,
     link_tracks,

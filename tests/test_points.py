@@ -14,7 +14,7 @@ from lookalike.io.points import (
     rows_to_points,
     typical_spacing,
 )
-from lookalike.trackers.closed_set import online_rows, track_closed_set
+from lookalike.trackers.offline.closed_set import online_rows, track_closed_set
 
 
 def test_read_points_csv_with_and_without_header(tmp_path: Path) -> None:

@@ -17,7 +17,7 @@ from lookalike.learn.tracker import BeaconMemory, decode
 from lookalike.sim import NOISE_MODELS, noise_sensor, preset, simulate_arrays, simulate_robots
 from lookalike.sim.robots_sensors import position_noise_std
 from lookalike.trackers import make_tracker
-from lookalike.trackers.identity.localiser import KalmanLocaliser, LowPassLocaliser, make_localiser
+from lookalike.trackers.parts.identity.localiser import KalmanLocaliser, LowPassLocaliser, make_localiser
 
 runner = CliRunner()
 

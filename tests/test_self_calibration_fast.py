@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lookalike.trackers.self_calibration import _Z, MissReturns, ScoreBands, ScoreCalibration
+from lookalike.trackers.parts.self_calibration import _Z, MissReturns, ScoreBands, ScoreCalibration
 
 
 def plain_threshold(bands: ScoreBands, ratio: float, min_count: int) -> float:

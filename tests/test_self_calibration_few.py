@@ -4,8 +4,8 @@ its array path."""
 import numpy as np
 import pytest
 
-from lookalike.trackers import self_calibration
-from lookalike.trackers.self_calibration import ScoreCalibration
+from lookalike.trackers.parts import self_calibration
+from lookalike.trackers.parts.self_calibration import ScoreCalibration
 
 
 def _run(frames: list[np.ndarray], few: int, monkeypatch: pytest.MonkeyPatch) -> tuple:

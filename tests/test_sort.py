@@ -156,7 +156,7 @@ def _crowd(n_targets, frames, seed):
 
 
 def test_sparse_matching_equals_plain_oracle_with_100_detections_a_frame(monkeypatch):
-    import lookalike.trackers.sort_core as core
+    import lookalike.trackers.parts.sort_tracks as core
 
     monkeypatch.setattr(core, "SPARSE_FROM", 1)  # the sparse path on every frame
     _run_both(_crowd(100, 25, seed=1))
@@ -167,7 +167,7 @@ def test_dense_matching_equals_plain_oracle_with_100_detections_a_frame():
 
 
 def test_sparse_matching_equals_dense_with_1000_detections_a_frame(monkeypatch):
-    import lookalike.trackers.sort_core as core
+    import lookalike.trackers.parts.sort_tracks as core
 
     frames = _crowd(1000, 6, seed=2)
     a, b = Sort(), Sort()

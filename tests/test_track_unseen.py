@@ -75,7 +75,7 @@ def test_offline_needs_targets_in_one_line(tmp_path):
 
 def test_offline_writes_the_closed_set_of_the_whole_sequence(tmp_path):
     """``--targets N --offline`` writes exactly :func:`track_closed_set` of the file's detections (ids 1..N)."""
-    from lookalike.trackers.closed_set import track_closed_set
+    from lookalike.trackers.offline.closed_set import track_closed_set
 
     det_rows = _crossing_rows()
     det = _write_det(tmp_path, det_rows)

@@ -10,10 +10,10 @@ from lookalike.association.solver import assign
 from lookalike.association.stages import Stage, cascade, run_plan
 from lookalike.motion.models import constant_velocity, kinematic_transition
 from lookalike.motion.spaces import BoxCXCYWH, BoxXYAH, BoxXYSR, CentreCV, WorldCA, xyah_to_xywh, xywh_to_xyah
-from lookalike.trackers.coasting import Coasting
-from lookalike.trackers.lifecycle import Lifecycle
-from lookalike.trackers.self_calibration import ScoreCalibration
-from lookalike.trackers.table import TrackTable
+from lookalike.trackers.parts.coasting import Coasting
+from lookalike.trackers.parts.lifecycle import Lifecycle
+from lookalike.trackers.parts.self_calibration import ScoreCalibration
+from lookalike.trackers.parts.table import TrackTable
 from lookalike.types import TrackStatus
 
 

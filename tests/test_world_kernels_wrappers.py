@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from lookalike.trackers.world_kernels import einsum, filled
+from lookalike.trackers.kernels.world import einsum, filled
 
 
 @pytest.mark.parametrize(("shape", "value", "dtype"), [(0, np.nan, float), (5, -1, int), ((3, 4), np.inf, float)])

@@ -10,10 +10,10 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-import lookalike.trackers.world_kernels as wk
+import lookalike.trackers.kernels.world as wk
 from lookalike.node.teamsim import team_sequence
 from lookalike.trackers import make_tracker
-from lookalike.trackers.identity import BeaconIdentifier, IdentifierConfig
+from lookalike.trackers.parts.identity import BeaconIdentifier, IdentifierConfig
 from lookalike.types import Beacons
 
 numba = pytest.importorskip("numba", reason="numba (the `fast` extra) is not installed: only the numpy path runs")

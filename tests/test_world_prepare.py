@@ -10,7 +10,7 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-import lookalike.trackers.world_kernels as wk
+import lookalike.trackers.kernels.world as wk
 from lookalike.node.teamsim import team_sequence
 from lookalike.trackers import make_tracker
 from lookalike.types import Frame

@@ -21,14 +21,14 @@ import numpy as np
 from lookalike.bench.ident_paper import resolve_identifier
 from lookalike.bench.paired import Comparison, PairedDifference, add_comparisons, compare_to_first, rate_difference
 from lookalike.bench.progress import ProgressFactory, Step, no_progress
-from lookalike.bench.results import Results, percent_row_metrics
 from lookalike.eval import identification_counts, identification_success_rate, localisation_error
+from lookalike.io.results import Results, percent_row_metrics
 from lookalike.learn.checkpoint import CheckpointError
 from lookalike.learn.weights import shipped_weights_path
 from lookalike.loop import RunStats, run
 from lookalike.sim import DEFAULT_NOISE, PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
 from lookalike.trackers import make_tracker, tracker_parameters
-from lookalike.trackers.identity import agent_positions, labels_from_tracks
+from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
 from lookalike.types import Frame
 
 # lstm: seed A's method, our inputs; lstm-paper: seed A's protocol; set: any team size
@@ -183,7 +183,7 @@ def ident_differences(counts: SequenceCounts, setups: list[str], trackers: list[
 def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int, frames: int,
                   seed: int = DEFAULT_SEED, command: str = "", noise: str = DEFAULT_NOISE,
                   weights: str | None = None, differences: Sequence[Comparison] = ()) -> Results:
-    """The rows of :func:`ident_table` as a results document (:mod:`lookalike.bench.results`):
+    """The rows of :func:`ident_table` as a results document (:mod:`lookalike.io.results`):
     table ``ident``, one row per set-up (dataset: the preset name) and identifier, over all its sequences;
     ``weights`` (the LSTM rows' weights when not the shipped ones) is recorded in its options;
     ``differences`` (:func:`ident_differences`, if any) go in table ``ident_difference`` (fractions)."""

@@ -27,7 +27,7 @@ from lookalike.geometry.camera import Camera
 from lookalike.io.robot_sequences import write_robot_sequence
 from lookalike.sim import PRESET_NAMES, RobotSequence, preset, simulate_robots
 from lookalike.trackers import make_tracker
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.parts.identity import labels_from_tracks
 from lookalike.vision.pipeline import RobotPipeline
 from lookalike.viz.robot_pixels import world_for_camera
 

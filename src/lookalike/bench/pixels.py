@@ -39,10 +39,10 @@ import numpy as np
 
 from lookalike.bench.ident import sequence_seeds, uses_weights
 from lookalike.bench.progress import ProgressFactory
-from lookalike.bench.results import Results, add_printed_rows
 from lookalike.eval import identification_success_rate, localisation_error, robot_success_rate
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.geometry.camera import Camera
+from lookalike.io.results import Results, add_printed_rows
 from lookalike.loop import RunStats, run
 from lookalike.sim import (
     PRESET_NAMES,
@@ -52,7 +52,7 @@ from lookalike.sim import (
     simulate_robots,
 )
 from lookalike.trackers import make_tracker
-from lookalike.trackers.identity import agent_positions, labels_from_tracks
+from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
 from lookalike.types import Beacons, Detections
 from lookalike.vision.pipeline import PipelineConfig, PipelineResult, RobotPipeline
 from lookalike.viz.robot_pixels import identifier_settings, render_robot_frames, world_for_camera

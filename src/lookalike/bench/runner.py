@@ -16,7 +16,7 @@ On blob detections (:data:`BLOB_DATASETS`: the HexBug clips) ``boxtrack`` gets w
 the blob parameters for every parameter the entry does not give, and a closed set of the number of
 targets inferred from the blob counts, so the bench and the tuning score what a user runs.
 
-``boxtrack-closed-offline`` runs the offline closed set (:func:`lookalike.trackers.closed_set.track_closed_set`)
+``boxtrack-closed-offline`` runs the offline closed set (:func:`lookalike.trackers.offline.closed_set.track_closed_set`)
 on the detections with boxtrack's defaults, as ``lookalike track --targets N --offline`` does.
 """
 
@@ -37,8 +37,8 @@ from lookalike.io import MotTable
 from lookalike.loop import RowCollector, run
 from lookalike.parallel import JobPool
 from lookalike.trackers import make_tracker
-from lookalike.trackers.closed_set import track_closed_set
-from lookalike.trackers.offline import OfflineConfig, postprocess
+from lookalike.trackers.offline.closed_set import track_closed_set
+from lookalike.trackers.offline.gap_fill import OfflineConfig, postprocess
 from lookalike.types.mot_table import detection_rows as mot_detection_rows
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
 from lookalike.vision.blob_boxtrack import blob_boxtrack_config
@@ -66,7 +66,7 @@ TUNED_LABEL = "tuned on this data"
 
 def default_entries(trackers: Sequence[str], peers: Sequence[str], closed_set: bool = True) -> list[Entry]:
     """lookalike trackers and peers, all with their defaults; with ``boxtrack`` also ``boxtrack-offline``
-    (its result post-processed offline, :mod:`lookalike.trackers.offline`), ``boxtrack (tuned on this
+    (its result post-processed offline, :mod:`lookalike.trackers.offline.gap_fill`), ``boxtrack (tuned on this
     data)`` (where parameters were chosen on the scored data), and, where the count is known,
     ``boxtrack-closed`` (online) and ``boxtrack-closed-offline`` (the offline closed set)."""
     entries = [Entry(t, t) for t in trackers]

@@ -27,7 +27,7 @@ from lookalike.eval import identification_success_rate, localisation_error
 from lookalike.io.robot_sequences import read_robot_sequence
 from lookalike.loop import run
 from lookalike.sim import RobotSequence, preset, preset_label, simulate_robots
-from lookalike.trackers.identity import agent_positions, labels_from_tracks
+from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
 from lookalike.types import Frame
 from lookalike.viz.label.human import HumanResult, read_human_results
 

@@ -2,7 +2,7 @@
 branch and the point-input branch of ``lookalike track``. Not commands of their own.
 
 ``--offline`` hands the whole sequence's detections to
-:func:`lookalike.trackers.closed_set.track_closed_set` (an open-set online ``boxtrack`` pass with the
+:func:`lookalike.trackers.offline.closed_set.track_closed_set` (an open-set online ``boxtrack`` pass with the
 user's parameters, then one global assignment of its tracklets to N identities) and writes the result
 atomically. ``--points`` reads anonymous points (:mod:`lookalike.io.points`), turns them into small
 boxes (:func:`~lookalike.io.points.points_to_rows`) and tracks them online or offline.
@@ -21,7 +21,7 @@ from lookalike.io.outputs import ensure_writable, result_paths
 from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv, read_points_mot, typical_spacing
 from lookalike.io.stream import track_to_file
 from lookalike.trackers.boxtrack import BoxTrack
-from lookalike.trackers.closed_set import track_closed_set
+from lookalike.trackers.offline.closed_set import track_closed_set
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import detection_rows
 

@@ -18,7 +18,7 @@ from lookalike.cli.app import console, fail
 from lookalike.cli.track_closed import offline_video
 from lookalike.io import read_mot, write_mot
 from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
-from lookalike.trackers.health import HealthConfig
+from lookalike.trackers.parts.health import HealthConfig
 from lookalike.viz.overlay import source_frames
 from lookalike.viz.video_tracking import (
     fit_video_features,

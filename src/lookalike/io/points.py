@@ -13,7 +13,7 @@ positions (pixels, or whatever unit the file uses). Malformed input raises ``Val
 file and the 1-based line; frame numbers follow :mod:`lookalike.io.rules` (integers >= 1, no stray jump).
 
 :func:`points_to_rows` turns points into MOTChallenge detection rows of small square boxes centred on
-them (side ``box_px``), so that box trackers and :func:`lookalike.trackers.closed_set.track_closed_set`
+them (side ``box_px``), so that box trackers and :func:`lookalike.trackers.offline.closed_set.track_closed_set`
 track them; :func:`rows_to_points` takes result rows back to centres for
 :func:`lookalike.eval.evaluate_points`.
 """

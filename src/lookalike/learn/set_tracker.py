@@ -6,7 +6,7 @@ reports, with :class:`~lookalike.learn.set_numpy.NumpySetAssociator`; decoded on
 LSTM (Hungarian on ``-log p``, false positives allowed). Agent positions come from the same
 localiser as the LSTM identifier's, fed with the detection labelled ``j`` and its class probability
 ``α``: the per-agent Kalman filter by default (``localiser="kalman"``), or seed A's Eq. 3
-``T_j ← α·L_k + (1−α)·T_j`` (``"lowpass"``); see :mod:`lookalike.trackers.identity.localiser`.
+``T_j ← α·L_k + (1−α)·T_j`` (``"lowpass"``); see :mod:`lookalike.trackers.parts.identity.localiser`.
 
 An agent whose reports jump to another robot (ids swapped or restored; ``report_jump``, ``on_jump``,
 ``jump_pair_s``, ``jump_silent``: :mod:`lookalike.learn.report_jumps`) has its memory exchanged with the agent it
@@ -50,7 +50,7 @@ from lookalike.learn.tracker import BeaconMemory, agent_detections, agent_snapsh
 from lookalike.learn.visual_exchange import VisualExchange, take_pairs
 from lookalike.learn.weights import WEIGHTS_DIR
 from lookalike.trackers.base import check_params, param
-from lookalike.trackers.identity.localiser import LOCALISERS, make_localiser
+from lookalike.trackers.parts.identity.localiser import LOCALISERS, make_localiser
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot
 

@@ -3,7 +3,7 @@
 
 Tracks are the agents themselves, positioned by a localiser fed with the detection labelled ``j``
 and its class probability ``α``: seed A's Eq. 3 ``T_j ← α·L_k + (1−α)·T_j`` (``localiser="lowpass"``)
-or our per-agent Kalman filter (``"kalman"``, see :mod:`lookalike.trackers.identity.localiser`).
+or our per-agent Kalman filter (``"kalman"``, see :mod:`lookalike.trackers.parts.identity.localiser`).
 
 With ``protocol="paper"`` the shipped weights are those of seed A's input protocol (``N + 4·M``
 inputs, ``lstm_paper_m{M}_n{N}``); decode them per slot (``one_to_one=False``) as the paper does.
@@ -20,7 +20,7 @@ from lookalike.learn.encoding import PROTOCOLS, EncodingSpec, encode_frame
 from lookalike.learn.numpy_net import NumpyAssociationNet
 from lookalike.learn.weights import shipped_weights_path
 from lookalike.trackers.base import check_params, param
-from lookalike.trackers.identity.localiser import LOCALISERS, KalmanLocaliser, LowPassLocaliser, make_localiser
+from lookalike.trackers.parts.identity.localiser import LOCALISERS, KalmanLocaliser, LowPassLocaliser, make_localiser
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 

@@ -24,8 +24,8 @@ from lookalike.node.messages import (
     TeamState,
     numbers_of,
 )
-from lookalike.trackers.identity.labels import label_list
-from lookalike.trackers.world_kernels import filled
+from lookalike.trackers.kernels.world import filled
+from lookalike.trackers.parts.identity.labels import label_list
 from lookalike.types import Beacons, Detections, Frame, Tracks, TrackSnapshot
 
 _T = TypeVar("_T")

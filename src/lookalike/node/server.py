@@ -42,11 +42,11 @@ LOCALHOST = "127.0.0.1"
 def _preload() -> None:
     """Import what the first frame would otherwise import, when the node is built: the assignment
     solver's scipy module and the world trackers' compiled kernels (numba, when installed:
-    :func:`~lookalike.trackers.world_kernels.warm`); their cost: docs/experiments/speed.md (Observer node)."""
+    :func:`~lookalike.trackers.kernels.world.warm`); their cost: docs/experiments/speed.md (Observer node)."""
     import numpy as np
 
     from lookalike.association.solver import linear_sum_assignment
-    from lookalike.trackers.world_kernels import warm
+    from lookalike.trackers.kernels.world import warm
 
     linear_sum_assignment(np.zeros((1, 1)))
     warm()

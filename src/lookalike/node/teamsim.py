@@ -26,7 +26,7 @@ from lookalike.node.client import Endpoint
 from lookalike.node.messages import DetectionsMessage, HeadingReport, TeamState
 from lookalike.sim.presets import preset
 from lookalike.sim.robots import RobotSequence, simulate_robots
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.parts.identity import labels_from_tracks
 
 
 @dataclass(frozen=True)

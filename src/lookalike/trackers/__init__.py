@@ -15,9 +15,9 @@ if TYPE_CHECKING:
     from lookalike.trackers.boxtrack import BoxTrack
     from lookalike.trackers.deepsort import DeepSort
     from lookalike.trackers.diversort import DiverSort
-    from lookalike.trackers.health import HealthConfig, HealthMonitor, HealthStatus
     from lookalike.trackers.jpda import JpdaTracker
     from lookalike.trackers.kalman_ha import KalmanHA, KalmanHA2
+    from lookalike.trackers.parts.health import HealthConfig, HealthMonitor, HealthStatus
     from lookalike.trackers.registry import (
         ParameterInfo,
         make_tracker,
@@ -34,9 +34,9 @@ _HOME = {
     "BoxTrack": "lookalike.trackers.boxtrack",
     "DeepSort": "lookalike.trackers.deepsort",
     "DiverSort": "lookalike.trackers.diversort",
-    "HealthConfig": "lookalike.trackers.health",
-    "HealthMonitor": "lookalike.trackers.health",
-    "HealthStatus": "lookalike.trackers.health",
+    "HealthConfig": "lookalike.trackers.parts.health",
+    "HealthMonitor": "lookalike.trackers.parts.health",
+    "HealthStatus": "lookalike.trackers.parts.health",
     "JpdaTracker": "lookalike.trackers.jpda",
     "KalmanHA": "lookalike.trackers.kalman_ha",
     "KalmanHA2": "lookalike.trackers.kalman_ha",

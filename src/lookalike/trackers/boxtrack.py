@@ -1,14 +1,14 @@
 """BoxTrack: a motion-only box tracker for look-alike targets (lookalike's own, no appearance).
 
-A composition of shared parts: a :class:`~lookalike.trackers.table.TrackTable` of
+A composition of shared parts: a :class:`~lookalike.trackers.parts.table.TrackTable` of
 :class:`~lookalike.motion.spaces.BoxCXCYWH` states (box centre and size in pixels, their velocities
 in pixels/frame), an association plan of IoU and centre-distance stages split by detection score
-(:mod:`lookalike.association.stages`), a :class:`~lookalike.trackers.lifecycle.Lifecycle` (confirmed
+(:mod:`lookalike.association.stages`), a :class:`~lookalike.trackers.parts.lifecycle.Lifecycle` (confirmed
 after ``n_init`` hits, deleted after ``max_age_s`` seconds, never in a closed set), score thresholds
-that calibrate themselves on the sequence (:class:`~lookalike.trackers.self_calibration.ScoreCalibration`),
-coasting (:class:`~lookalike.trackers.coasting.Coasting`), a birth threshold that follows the
-detector's clutter (:class:`~lookalike.trackers.clutter.ClutterShare`) and, with ``max_targets``,
-closed-set slots (:class:`~lookalike.trackers.closed_slots.ClosedSlots`).
+that calibrate themselves on the sequence (:class:`~lookalike.trackers.parts.self_calibration.ScoreCalibration`),
+coasting (:class:`~lookalike.trackers.parts.coasting.Coasting`), a birth threshold that follows the
+detector's clutter (:class:`~lookalike.trackers.parts.clutter.ClutterShare`) and, with ``max_targets``,
+closed-set slots (:class:`~lookalike.trackers.parts.closed_slots.ClosedSlots`).
 
 Each frame: detections below ``low_score`` are dropped; confirmed tracks take confident detections
 on ``1 - IoU·score`` (those missed at most 2 frames first), tracks updated in the previous frame
@@ -25,7 +25,7 @@ Speed (issue 18): the motion states live in the motion space's column form, one 
 IoU matrix per frame serves every stage and the clutter share; the IoU stages compute costs only
 when their allowed pairs compete. The rows are those of the plain tracker this replaced, bit for bit
 (tests/boxtrack_oracle.py, tests/test_boxtrack_fast.py). With numba installed (the ``fast`` extra) a frame
-runs four compiled kernels instead (:mod:`lookalike.trackers.boxtrack_kernels`; ``LOOKALIKE_BOXTRACK_NUMBA=0``
+runs four compiled kernels instead (:mod:`lookalike.trackers.kernels.boxtrack`; ``LOOKALIKE_BOXTRACK_NUMBA=0``
 switches them off): the same numbers (tests/test_boxtrack_kernels.py); figures in docs/experiments/speed.md.
 """
 
@@ -40,17 +40,17 @@ from lookalike.association.costs import centre_distance_cost, cost_from_iou, iou
 from lookalike.association.stages import CostFn, Matching, Stage, run_plan, run_stage
 from lookalike.motion.spaces import BoxCXCYWH, cxcywh_to_xywh
 from lookalike.trackers import boxtrack_config as const
-from lookalike.trackers import boxtrack_kernels
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
-from lookalike.trackers.closed_slots import ClosedSlots
-from lookalike.trackers.clutter import ClutterShare
-from lookalike.trackers.coasting import Coasting
-from lookalike.trackers.lifecycle import Lifecycle
-from lookalike.trackers.motion_fit import MotionFit
+from lookalike.trackers.kernels import boxtrack as boxtrack_kernels
+from lookalike.trackers.parts.closed_slots import ClosedSlots
+from lookalike.trackers.parts.clutter import ClutterShare
+from lookalike.trackers.parts.coasting import Coasting
+from lookalike.trackers.parts.lifecycle import Lifecycle
+from lookalike.trackers.parts.motion_fit import MotionFit
+from lookalike.trackers.parts.self_calibration import ScoreCalibration
+from lookalike.trackers.parts.table import TrackTable
+from lookalike.trackers.parts.timing import FrameClock
 from lookalike.trackers.registry import register_tracker
-from lookalike.trackers.self_calibration import ScoreCalibration
-from lookalike.trackers.table import TrackTable
-from lookalike.trackers.timing import FrameClock
 from lookalike.types import Detections, Frame, Tracks
 
 _to_xywh = cxcywh_to_xywh  # kept for callers of the old private helper
@@ -109,7 +109,7 @@ class BoxTrack:
 
     @property
     def compiled(self) -> bool:
-        """Whether this tracker runs the compiled kernels (:mod:`lookalike.trackers.boxtrack_kernels`)."""
+        """Whether this tracker runs the compiled kernels (:mod:`lookalike.trackers.kernels.boxtrack`)."""
         return self._compiled
 
     def update(self, frame: Frame) -> Tracks:

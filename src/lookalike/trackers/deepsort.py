@@ -1,6 +1,6 @@
 """Deep SORT style tracker (Wojke et al., 2017; the baseline of seed B), with any appearance feature.
 
-A composition of shared parts: a :class:`~lookalike.trackers.table.TrackTable` of
+A composition of shared parts: a :class:`~lookalike.trackers.parts.table.TrackTable` of
 :class:`~lookalike.motion.spaces.BoxXYAH` states (box centre in pixels, aspect ``w/h``, height in
 pixels, and their velocities; noise proportional to the height), per-track feature galleries and an
 association plan (:mod:`lookalike.association.stages`). Each frame:
@@ -33,10 +33,10 @@ from lookalike.motion import kalman
 from lookalike.motion.gating import chi2_gate
 from lookalike.motion.spaces import BoxXYAH, xyah_to_xywh, xywh_to_xyah
 from lookalike.trackers.base import COUNT, POSITIVE, PROBABILITY, Range, check_params, param
-from lookalike.trackers.lifecycle import Lifecycle
+from lookalike.trackers.parts.lifecycle import Lifecycle
+from lookalike.trackers.parts.table import TrackTable
+from lookalike.trackers.parts.timing import FrameClock
 from lookalike.trackers.registry import register_tracker
-from lookalike.trackers.table import TrackTable
-from lookalike.trackers.timing import FrameClock
 from lookalike.types import Frame, Tracks, TrackStatus
 
 __all__ = ["DeepSort", "require_features", "xyah_to_xywh", "xywh_to_xyah"]

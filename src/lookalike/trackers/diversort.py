@@ -36,10 +36,10 @@ from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion import kalman
 from lookalike.motion.spaces import CentreCV
 from lookalike.trackers.diversort_config import DiverSortConfig, Merge
-from lookalike.trackers.lifecycle import Lifecycle
+from lookalike.trackers.parts.lifecycle import Lifecycle
+from lookalike.trackers.parts.table import TrackTable
+from lookalike.trackers.parts.timing import FrameClock
 from lookalike.trackers.registry import register_tracker
-from lookalike.trackers.table import TrackTable
-from lookalike.trackers.timing import FrameClock
 from lookalike.types import Frame, Tracks, TrackStatus
 
 __all__ = ["DiverSort", "DiverSortConfig", "Merge"]

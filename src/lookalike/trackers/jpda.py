@@ -23,9 +23,9 @@ from lookalike.association.jpda import jpda_marginals
 from lookalike.association.solver import assign
 from lookalike.motion import kalman
 from lookalike.trackers.base import COUNT, POSITIVE, UNIT, Range, param
-from lookalike.trackers.kalman_ha import H, WorldTracker
+from lookalike.trackers.parts.world_rules import HeuristicsConfig, WorldRules, positions
+from lookalike.trackers.parts.world_tracker import H, WorldTracker
 from lookalike.trackers.registry import register_tracker
-from lookalike.trackers.world_rules import HeuristicsConfig, WorldRules, positions
 from lookalike.types import Detections
 
 

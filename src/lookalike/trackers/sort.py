@@ -8,7 +8,7 @@ below ``iou_threshold`` rejected afterwards; a track is reported in a frame when
 in it and has ``min_hits`` consecutive hits (or during the first ``min_hits`` frames), with its
 filtered box; it is deleted after more than ``max_age`` frames without update. New tracks take
 ids in detection order. All tracks are predicted and updated together as arrays
-(:mod:`lookalike.trackers.sort_core`: the filter's covariance is block-diagonal, so a track is 20
+(:mod:`lookalike.trackers.parts.sort_tracks`: the filter's covariance is block-diagonal, so a track is 20
 numbers); with many boxes only overlapping ones are compared.
 """
 
@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.trackers.base import COUNT0, POSITIVE, UNIT, check_params, param
+from lookalike.trackers.parts.sort_tracks import SortTracks
+from lookalike.trackers.parts.timing import FrameClock
 from lookalike.trackers.registry import register_tracker
-from lookalike.trackers.sort_core import SortTracks
-from lookalike.trackers.timing import FrameClock
 from lookalike.types import Frame, Tracks
 
 

@@ -28,7 +28,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from lookalike.geometry.camera import Camera
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.parts.identity import labels_from_tracks
 from lookalike.trackers.registry import make_tracker, tracker_class
 from lookalike.types import Beacons, Detections, Frame, TrackSnapshot
 

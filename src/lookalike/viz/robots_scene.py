@@ -27,7 +27,7 @@ from lookalike.sim.render_robots import (
     RobotRenderer,
 )
 from lookalike.trackers import make_tracker, tracker_parameters
-from lookalike.trackers.identity import agent_positions, labels_from_tracks
+from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
 from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_caption, draw_label, draw_legend, draw_tail
 from lookalike.viz.colors import identity_colour
 from lookalike.viz.plots import birdseye_plot

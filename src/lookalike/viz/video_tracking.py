@@ -26,7 +26,7 @@ from lookalike.association.solver import assign
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.io import MotTable, frames_from_table, read_seqinfo, tracks_to_rows
 from lookalike.loop import run
-from lookalike.trackers.health import (
+from lookalike.trackers.parts.health import (
     HEALTH_CSV_HEADER,
     HealthConfig,
     HealthMonitor,
@@ -278,7 +278,7 @@ def write_merges_csv(path: Path | str, merges: list[tuple[int, int, int]]) -> Pa
 
 
 def write_health_csv(path: Path | str, statuses: list[HealthStatus]) -> Path:
-    """One row per frame, columns :data:`~lookalike.trackers.health.HEALTH_CSV_HEADER`."""
+    """One row per frame, columns :data:`~lookalike.trackers.parts.health.HEALTH_CSV_HEADER`."""
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     with p.open("w", newline="") as fh:

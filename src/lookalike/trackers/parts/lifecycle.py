@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from lookalike.trackers.table import TrackTable
+from lookalike.trackers.parts.table import TrackTable
 from lookalike.types.tracks import TrackStatus
 
 __all__ = ["Lifecycle", "TrackStatus"]

@@ -1,4 +1,4 @@
-"""The numba kernels of :mod:`lookalike.trackers.boxtrack_kernels` (imported only when numba is installed).
+"""The numba kernels of :mod:`lookalike.trackers.kernels.boxtrack` (imported only when numba is installed).
 
 Each kernel does the floating-point operations of BoxTrack's numpy path one track or one pair at a time,
 in the same order and precision (no fused multiply-adds: ``fastmath`` off), so the rows are bit for bit the

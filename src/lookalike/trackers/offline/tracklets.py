@@ -1,6 +1,6 @@
 """Tracklets for the offline closed set: an online result cut into reliable pieces
 (:func:`split_tracklets`) and the links between the end of one piece and the start of a later one
-scored under two motion hypotheses (:func:`link_costs`); :mod:`lookalike.trackers.closed_set` says
+scored under two motion hypotheses (:func:`link_costs`); :mod:`lookalike.trackers.offline.closed_set` says
 how both are used. Positions in pixels, sizes √(w·h) in pixels, times in frames.
 """
 
@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.geometry.boxes import iou_matrix
-from lookalike.trackers.closed_set_config import ClosedSetConfig
+from lookalike.trackers.offline.closed_set_config import ClosedSetConfig
 
 __all__ = ["Tracklet", "checked_rows", "link_costs", "motion_scale", "row_centres", "row_sizes", "row_steps",
            "split_tracklets"]

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.trackers.world_kernels import compiled, decided_pairs, filled, pairs
+from lookalike.trackers.kernels.world import compiled, decided_pairs, filled, pairs
 from lookalike.types import Beacons
 
 

@@ -1,4 +1,4 @@
-"""The offline closed set's parameters (:func:`lookalike.trackers.closed_set.assign_identities`)."""
+"""The offline closed set's parameters (:func:`lookalike.trackers.offline.closed_set.assign_identities`)."""
 
 from __future__ import annotations
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.trackers.base import COUNT, NON_NEGATIVE, POSITIVE, PROBABILITY, UNIT, Range, check_params, param
-from lookalike.trackers.lifecycle import Lifecycle
+from lookalike.trackers.parts.lifecycle import Lifecycle
 from lookalike.types import Detections
 
 

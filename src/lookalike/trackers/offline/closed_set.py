@@ -53,11 +53,9 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.trackers.boxtrack import BoxTrack
-from lookalike.trackers.closed_set_config import ClosedSetConfig
-from lookalike.trackers.offline import fill_gaps, smooth_boxes
-from lookalike.trackers.registry import make_tracker
-from lookalike.trackers.tracklets import (
+from lookalike.trackers.offline.closed_set_config import ClosedSetConfig
+from lookalike.trackers.offline.gap_fill import fill_gaps, smooth_boxes
+from lookalike.trackers.offline.tracklets import (
     Tracklet,
     checked_rows,
     link_costs,
@@ -67,6 +65,7 @@ from lookalike.trackers.tracklets import (
     row_steps,
     split_tracklets,
 )
+from lookalike.trackers.registry import make_tracker, tracker_class
 from lookalike.types import Detections, Frame
 
 __all__ = ["ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale", "place_short",
@@ -257,9 +256,10 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
     det_rows = checked_rows(det_rows)
     tracker_obj = make_tracker(tracker, **params)
     if vel_noise is not None:
-        if not isinstance(tracker_obj, BoxTrack):
+        if tracker != "boxtrack":
             raise ValueError(f"vel_noise is a boxtrack setting, not one of {tracker!r}")
-        tracker_obj = BoxTrack(tracker_obj.config, vel_noise=vel_noise)
+        boxtrack: Any = tracker_class(tracker)
+        tracker_obj = boxtrack(tracker_obj.config, vel_noise=vel_noise)
     n_frames = int(det_rows[:, 0].max()) if n_frames is None and len(det_rows) else int(n_frames or 0)
     order = np.argsort(det_rows[:, 0], kind="stable")
     det_rows = det_rows[order]

@@ -3,14 +3,14 @@
 :class:`Coasting` owns both decisions: a track lost for ``coast_s`` seconds or more stops
 extrapolating its velocity (it waits where it was last seen), and a track missed ``j`` frames is
 reported at its predicted box while this sequence's tracks missed ``j`` frames came back at least
-``report_prob`` of the time (:class:`lookalike.trackers.self_calibration.MissReturns`).
+``report_prob`` of the time (:class:`lookalike.trackers.parts.self_calibration.MissReturns`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from lookalike.trackers.self_calibration import MissReturns
+from lookalike.trackers.parts.self_calibration import MissReturns
 
 MAX_COAST_FRAMES = 10  # longest miss (frames) after which a track may still be reported at its prediction
 

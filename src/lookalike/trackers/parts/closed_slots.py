@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lookalike.trackers.table import TrackTable
+from lookalike.trackers.parts.table import TrackTable
 
 
 class ClosedSlots:

@@ -1,5 +1,5 @@
 """Optional compiled kernels (numba) for :class:`~lookalike.trackers.boxtrack.BoxTrack`
-(:mod:`lookalike.trackers.boxtrack_numba`): the prediction with the frame's IoU matrix and clutter count,
+(:mod:`lookalike.trackers.kernels.boxtrack_numba`): the prediction with the frame's IoU matrix and clutter count,
 the gated IoU stages of the association plan, the Kalman update with the track bookkeeping, and the report
 with the lifecycle's survivors.
 
@@ -19,7 +19,7 @@ from lookalike._compiled import KernelSwitch
 
 
 def _load() -> ModuleType:
-    from lookalike.trackers import boxtrack_numba
+    from lookalike.trackers.kernels import boxtrack_numba
 
     return boxtrack_numba
 

@@ -1,4 +1,4 @@
-"""The numba kernels of :mod:`lookalike.trackers.world_kernels` (imported only when numba is installed).
+"""The numba kernels of :mod:`lookalike.trackers.kernels.world` (imported only when numba is installed).
 
 Each kernel does the floating-point operations of the world trackers' numpy path value by value, in the same
 order and precision (no fused multiply-adds: ``fastmath`` off), so tracks and identities are bit for bit the same.

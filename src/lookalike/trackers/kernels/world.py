@@ -6,7 +6,7 @@ numpy's own LAPACK kernels without the wrappers' per-call checks (:func:`cholesk
 the pairs of :func:`lookalike.association.solver.assign_pairs` from the same matrix handed to the
 same solver.
 
-:func:`compiled` gives the optional numba kernels (:mod:`lookalike.trackers.world_numba`, the ``fast``
+:func:`compiled` gives the optional numba kernels (:mod:`lookalike.trackers.kernels.world_numba`, the ``fast``
 extra): the beacon identifier's window costs and assignment matrix, the Kalman trackers' gate and
 assignment matrix, each in one call up to the solver, and their lifecycle rules, value by value the
 operations of the numpy path in its order (no fused multiply-adds), so tracks and identities are bit for
@@ -117,7 +117,7 @@ def _load_solver() -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
 
 
 def _load() -> ModuleType | None:
-    from lookalike.trackers import world_numba
+    from lookalike.trackers.kernels import world_numba
 
     global _lower_solve_exact, _update_exact
     # (the kernels' cos is libm's; numpy may use its own vector code: they must agree on every value here)

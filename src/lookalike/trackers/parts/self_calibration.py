@@ -240,7 +240,7 @@ class ScoreCalibration:
 
     def decide(self, clutter_share: float | None = None) -> tuple[float, float, float]:
         """This frame's ``(high, birth, tentative)`` score thresholds; ``clutter_share`` (the share of
-        detections that are likely clutter, :class:`~lookalike.trackers.clutter.ClutterShare`) with
+        detections that are likely clutter, :class:`~lookalike.trackers.parts.clutter.ClutterShare`) with
         ``clutter_factor`` set lowers the birth one to the quantile ``clutter_factor·clutter_share``
         (at least ``clutter_floor``) of the scores seen; to the median while the share is None."""
         high, birth = self.high_score, self.birth_score

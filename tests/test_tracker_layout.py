@@ -1,0 +1,48 @@
+"""The trackers package's layout: every tracker module sits under the independence contract (trackers are
+compositions of shared parts, never forks of one another), and the shared parts, compiled kernels and
+offline processing live in their own subpackages."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+tomllib = pytest.importorskip("tomllib", reason="reading pyproject.toml needs Python 3.11's tomllib")
+ROOT = Path(__file__).resolve().parents[1]
+TRACKERS = ROOT / "src" / "lookalike" / "trackers"
+
+
+def _independent_modules() -> list[str]:
+    contracts = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"]
+    return [m for c in contracts if c["type"] == "independence" for m in c["modules"]]
+
+
+def _module(path: Path) -> str:
+    parts = path.relative_to(ROOT / "src").with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def test_every_registered_tracker_is_under_the_independence_contract() -> None:
+    listed = _independent_modules()
+    registering = [_module(p) for p in TRACKERS.rglob("*.py") if "@register_tracker(" in p.read_text()]
+    assert registering, "no module registers a tracker"
+    for module in registering:
+        assert any(module == m or module.startswith(m + ".") for m in listed), (
+            f"{module} registers a tracker but is not in the independence contract")
+
+
+def test_the_offline_closed_set_is_independent_of_the_online_trackers() -> None:
+    assert "lookalike.trackers.offline" in _independent_modules()
+
+
+def test_parts_kernels_and_offline_are_separate_subpackages() -> None:
+    top = {p.stem for p in TRACKERS.glob("*.py")} - {"__init__", "base", "registry"}
+    for name in top:
+        text = (TRACKERS / f"{name}.py").read_text()
+        is_tracker = "@register_tracker(" in text or name.endswith("_config")
+        assert is_tracker, f"trackers/{name}.py is neither a tracker nor a tracker's config: move it to a subpackage"
+    for sub in ("parts", "kernels", "offline"):
+        assert (TRACKERS / sub / "__init__.py").exists()
+    compiled = [p.name for p in (TRACKERS / "parts").rglob("*.py") if "import numba" in p.read_text()]
+    assert not compiled, f"compiled code belongs in trackers/kernels/, not in parts: {compiled}"
