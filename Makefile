@@ -110,8 +110,8 @@ train-set: venv
 	OMP_NUM_THREADS=1 $(VENV)/bin/lookalike train --model set -o runs/set --minutes 65
 	OMP_NUM_THREADS=1 $(VENV)/bin/lookalike train --model set -o runs/set --resume --minutes 8 --learning-rate 0.0008
 	rm -rf runs/set-finetune
-	OMP_NUM_THREADS=1 $(PY) -m lookalike.learn.set_finetune runs/set-finetune --init runs/set/set.npz --minutes 67
-	OMP_NUM_THREADS=1 $(PY) -m lookalike.bench.set_select runs/set-finetune --baseline runs/set/set.npz \
+	OMP_NUM_THREADS=1 $(PY) research/set/set_finetune.py runs/set-finetune --init runs/set/set.npz --minutes 67
+	OMP_NUM_THREADS=1 $(PY) research/set/set_select.py runs/set-finetune --baseline runs/set/set.npz \
 	    --average-from 300 --ship
 
 clean:

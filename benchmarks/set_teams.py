@@ -6,7 +6,7 @@ Prints the identification success rate (%) of each identifier on the paper's set
 (N = 4, 6, 12 with M = N + 2; seeds 950000 + 1000·N + k), all disjoint from the training seeds.
 The LSTM has no weights for the latter ("-"). ``--weights W``: the ``set`` identifier with these weights.
 
-Choosing a fine-tuning snapshot on tuning sequences: ``python -m lookalike.bench.set_select``.
+Choosing a fine-tuning snapshot on tuning sequences: ``python research/set/set_select.py``.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import argparse
 from pathlib import Path
 
 from lookalike.bench.ident import DEFAULT_SEED, run_identifier
-from lookalike.bench.set_select import set_success
+from lookalike.bench.pixel_recordings import score_identifier
 from lookalike.learn.set_data import world
 from lookalike.sim import PRESET_NAMES, preset, simulate_robots
 
@@ -50,7 +50,7 @@ def main() -> None:
                 cells.append(f"{'-':>18s}")
                 continue
             if name == "set" and args.weights is not None:
-                cells.append(f"{100 * set_success(args.weights, seqs):9.2f} {'':>8s}")
+                cells.append(f"{100 * score_identifier(seqs, 'set', weights=str(args.weights))[0]:9.2f} {'':>8s}")
                 continue
             r = run_identifier(name, seqs)
             cells.append(f"{100 * r['success']:9.2f} {r['fps']:6.0f}/s")

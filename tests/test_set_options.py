@@ -4,7 +4,6 @@ and the third stage's rule that chooses them on tuning sequences."""
 import numpy as np
 import pytest
 
-from lookalike.learn.set_tracker import SetIdentifier
 from lookalike.trackers import make_tracker
 from lookalike.types import Beacons, Detections, Frame
 
@@ -180,20 +179,6 @@ def silent_calls(report, silent: bool) -> list[tuple[str, set[int]]]:
     return calls
 
 
-def test_stage3_choice_needs_the_small_team_up_and_nothing_else_down():
-    from lookalike.bench.set_select import choose_stage3
-
-    base = {"m3n2": 98.0, "m5n3": 97.0, "rec_m3n2": 0.3, "worst_m3n2": 1.0}
-    rows = {"base": base,
-            "a": {**base, "m3n2": 98.3, "m5n3": 96.9},  # best small team, but another team lost 0.1
-            "b": {**base, "m3n2": 98.2, "rec_m3n2": 0.31},
-            "c": {**base, "m3n2": 98.18, "rec_m3n2": 0.2},  # within 0.05 of b and faster to recover
-            "slow": {**base, "m3n2": 98.5, "rec_m3n2": 0.4},
-            "small": {**base, "m3n2": 98.05}}  # not 0.1 points up
-    assert choose_stage3(rows, "base") == "c"
-    assert choose_stage3({"base": base, "small": rows["small"], "slow": rows["slow"]}, "base") is None
-
-
 def test_pair_swap_exchanges_the_memories_of_a_swap_no_report_jump_shows(shipped):
     from lookalike.trackers import make_tracker
 
@@ -315,109 +300,6 @@ def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
     assert np.allclose(scaled[:, 0] / scaled[:, 1], prob[:, 0] / prob[:, 1])  # agents' odds kept
     adapted.reset()
     assert adapted.fp_rate == 1.0
-
-
-def test_stage5_candidates_and_choice():
-    from lookalike.bench.set_select_options import STAGE5_BASELINE, stage5_candidates
-    from lookalike.bench.set_select_stage4 import choose_stage4
-
-    cands = stage5_candidates()
-    assert STAGE5_BASELINE in cands and cands[STAGE5_BASELINE][1] == {"fp_prior_ref": None}
-    assert all(o["fp_prior_ref"] is None or o["fp_prior_ref"] > 0 for _, o in cands.values())
-    base = {"m3n2": 98.0, "m5n3": 98.0, "rec_m3n2": 0.3, "worst_m3n2": 1.0}
-    rows = {STAGE5_BASELINE: base, "up": {**base, "m3n2": 98.06}, "down": {**base, "m3n2": 98.2, "m5n3": 97.9}}
-    assert choose_stage4(rows, STAGE5_BASELINE) == "up"
-
-
-def test_exchange_stages_candidates():
-    from lookalike.bench.set_select_options import EXCHANGE_BASELINE, exchange_candidates
-
-    for stage, memory, fresh in ((6, None, None), (7, 1.0, None), (8, 1.0, 0.6)):
-        cands = exchange_candidates(stage)
-        assert cands[EXCHANGE_BASELINE][1]["exchange_llr"] is None
-        assert all(o["exchange_memory_s"] == memory and o["exchange_fresh_s"] == fresh for _, o in cands.values())
-        assert all(o["exchange_llr"] is None or o["exchange_llr"] > 0 for _, o in cands.values())
-
-    from lookalike.bench.set_select_options import stage9_candidates
-
-    options = stage9_candidates()["exchange=8.0,max_agents=7"][1]
-    assert options["exchange_llr"] == 8.0 and options["exchange_max_agents"] == 7
-
-
-def test_stage10_candidates():
-    from lookalike.bench.set_select_options import STAGE10_BASELINE, stage_candidates
-
-    cands, baseline = stage_candidates(10)
-    assert baseline == STAGE10_BASELINE and cands[baseline][1] == {"jump_pair_s": None}
-    assert {o["jump_pair_s"] for _, o in cands.values()} == {None, 1.0}
-
-
-def test_stage12_to_15_candidates_and_the_guard():
-    from lookalike.bench.set_select_options import stage_candidates
-    from lookalike.bench.set_select_stage4 import passes_guard
-
-    cands, baseline = stage_candidates(12)
-    before = {"exchange_tight_agents": None, "jump_silent": False, "exchange_fresh_s": 0.6}  # before stage 14
-    assert cands[baseline][1] == {"exchange_accel": 0.1, "exchange_lag_s": 0.4, **before}  # its detector
-    cands, baseline = stage_candidates(13)
-    assert cands[baseline][1] == before
-    assert {o.get("exchange_step_rad") for _, o in cands.values()} == {None, 0.08, 0.12}
-    cands, baseline = stage_candidates(14)
-    before15 = {"jump_silent": False, "exchange_fresh_s": 0.6}  # the identifier shipped before stage 15
-    assert cands[baseline][1] == before and {"exchange_tight_agents": 5, **before15} in [o for _, o in cands.values()]
-    cands, baseline = stage_candidates(15)
-    assert cands[baseline][1] == before15
-    assert [o for n, (_, o) in cands.items() if n != baseline] == [
-        {"jump_silent": True, "exchange_fresh_s": 0.6}, {"jump_silent": True, "exchange_fresh_s": None}]
-    shipped = SetIdentifier.Config()  # the fifteenth stage's choice
-    assert shipped.jump_silent and shipped.exchange_fresh_s is None
-    base = {"m3n2": 98.9, "m5n3": 98.2, "rec_m3n2": 0.1, "worst_m3n2": 0.3}
-    assert passes_guard({**base, "m3n2": 98.86, "rec_m3n2": 0.12}, base)
-    assert not passes_guard({**base, "m3n2": 98.84}, base)  # a team more than 0.05 points below
-    assert not passes_guard({**base, "rec_m3n2": 0.13}, base)  # recovery more than 0.02 s slower
-
-
-def test_stage16_candidates_are_the_snapshots_at_its_steps(tmp_path):
-    from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
-    from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
-
-    for k in (25, 250, 400, 500):
-        (tmp_path / f"set_step{k}.npz").write_bytes(b"")
-    cands, baseline = stage_candidates(16, tmp_path)
-    assert baseline == STAGE16_BASELINE and cands[baseline] == (SHIPPED_SET_WEIGHTS, {})
-    assert {n: w for n, (w, _) in cands.items() if n != baseline} == {
-        "step250": tmp_path / "set_step250.npz", "step500": tmp_path / "set_step500.npz"}
-
-
-def test_stage17_candidates_are_the_visual_detector_at_each_threshold_against_the_shipped_identifier():
-    from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
-
-    cands, baseline = stage_candidates(17)
-    assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"visual_exchange": None}
-    assert sorted(o["visual_exchange"] for n, (_, o) in cands.items() if n != baseline) == [8.0, 10.0, 12.0]
-    assert {o["visual_memory_s"] for n, (_, o) in cands.items() if n != baseline} == {10.0}
-
-
-def test_stage18_candidates_widen_the_visual_detectors_stale_reports_against_the_identifier_before_it():
-    from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
-
-    cands, baseline = stage_candidates(18)
-    assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"visual_stale_rad_s": None, "undo_factor": None}
-    assert sorted(o["visual_stale_rad_s"] for n, (_, o) in cands.items() if n != baseline) == [0.25, 0.5]
-    assert {o["undo_factor"] for _, o in cands.values()} == {None}  # as before the twentieth stage
-    assert make_tracker("set", n_agents=3)._visual.stale_rad_s == 0.5  # shipped since the stage
-    assert make_tracker("set", n_agents=3, visual_stale_rad_s=None)._visual.stale_rad_s is None
-
-
-def test_stage19_candidates_undo_a_recent_exchange_on_less_evidence_against_the_identifier_before_it():
-    from lookalike.bench.set_select_options import STAGE16_BASELINE, stage_candidates
-
-    cands, baseline = stage_candidates(19)
-    assert stage_candidates(20) == (cands, baseline)  # the same candidates, judged again after a change of the rule
-    assert baseline == STAGE16_BASELINE and cands[baseline][1] == {"undo_factor": None}
-    assert sorted(o["undo_factor"] for n, (_, o) in cands.items() if n != baseline) == [0.25, 0.5]
-    assert {o["undo_s"] for n, (_, o) in cands.items() if n != baseline} == {30.0}
-    assert make_tracker("set", n_agents=3).config.undo_factor == 0.5  # shipped since the twentieth stage
 
 
 def test_exchange_tight_agents_changes_the_detector_of_larger_teams_only():

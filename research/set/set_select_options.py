@@ -1,9 +1,9 @@
 """The fifth to twentieth stages' choices for the ``set`` identifier (issue 23): inference options of the shipped
 weights, each stage scored against its candidate with the option off.
 
-``python -m lookalike.bench.set_select RUN --stage K`` (K = 5 … 10, 12 … 20) scores stage K's candidates
+``python research/set/set_select.py RUN --stage K`` (K = 5 … 10, 12 … 20) scores stage K's candidates
 (:func:`stage_candidates`) on the third stage's tuning sequences and tuning recovery
-(:func:`~lookalike.bench.set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
+(:func:`~set_select_stage4.score_candidates`; scores kept in ``RUN/set_select_stage<K>.json``)
 and applies the fourth stage's rule against the stage's baseline, as written in
 docs/experiments/any-team-size.md before any of the stage's candidates was scored:
 
@@ -22,7 +22,7 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
   (``exchange_tight_agents``), the same rule;
 - stage 15: pairing a report jump with another agent's first report after a silence (``jump_silent``), alone and
   with the exchange detector keeping silent tracks (``exchange_fresh_s`` off), the same rule.
-- stage 16: trains: the snapshots of ``python -m lookalike.learn.set_finetune RUN --stage 16`` (swaps that end in
+- stage 16: trains: the snapshots of ``python research/set/set_finetune.py RUN --stage 16`` (swaps that end in
   a silence) at multiples of :data:`STAGE16_EVERY` steps, with the shipped inference options, the same rule.
 - stage 17: exchanging two agents whose detections' visual headings, gathered over seconds, fit each other's reports
   (``visual_exchange`` at each of :data:`STAGE17_VISUAL`, ``visual_memory_s`` :data:`STAGE17_MEMORY_S`), the same rule.
@@ -40,8 +40,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from lookalike.bench.set_select import snapshot_steps
-from lookalike.bench.set_select_stage4 import passes_guard, print_choice, score_candidates
+from set_select import snapshot_steps
+from set_select_stage4 import passes_guard, print_choice, score_candidates
+
 from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
 
 Candidates = dict[str, tuple[Path, dict[str, object]]]  # name -> (weights, inference options)

@@ -1,6 +1,6 @@
 """The fine-tuning of the shipped ``set`` weights towards the paper's small set-ups (issue 23).
 
-``python -m lookalike.learn.set_finetune OUT --minutes 80`` starts from the shipped weights and trains
+``python research/set/set_finetune.py OUT --minutes 80`` starts from the shipped weights and trains
 with :data:`FINETUNE_CONFIG`: a low, decaying learning rate, 60% of the batches on the paper's set-ups
 (M=3, N=2 three times as often as M=10, N=7, M=5, N=3 twice), the other 40% over every team size
 (N 1–12), identity swaps of 1–6 s that end inside the sequence, and a snapshot at every validation
@@ -65,7 +65,7 @@ def main(argv: list[str] | None = None) -> None:
     from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
     from lookalike.learn.set_training import train_set
 
-    parser = argparse.ArgumentParser(prog="python -m lookalike.learn.set_finetune", description=__doc__)
+    parser = argparse.ArgumentParser(prog="python research/set/set_finetune.py", description=__doc__)
     parser.add_argument("out", type=Path, help="output folder (snapshots, log, best-validation weights)")
     parser.add_argument("--stage", type=int, choices=sorted(STAGES), default=1,
                         help="1: FINETUNE_CONFIG, 2: FINETUNE2_CONFIG (from the stage-1 weights), "

@@ -1,7 +1,7 @@
 """The fourth stage's choice for the ``set`` identifier (issue 23): fine-tuned snapshots x the pair-swap rule.
 
-``python -m lookalike.bench.set_select RUN --stage 4 [--ship]`` scores, on the tuning sequences of the third
-stage (:data:`~lookalike.bench.set_select.STAGE3_TEAMS` and the tuning recovery, unmeasurable sequences left
+``python research/set/set_select.py RUN --stage 4 [--ship]`` scores, on the tuning sequences of the third
+stage (:data:`~set_select.STAGE3_TEAMS` and the tuning recovery, unmeasurable sequences left
 out), every candidate of :func:`stage4_candidates`: the shipped weights and the snapshots ``RUN/set_step{k}.npz``
 at multiples of :data:`STAGE4_EVERY`, each with the pair-swap rule off and at :data:`STAGE4_PAIR_SWAP`
 (the other inference options at the shipped defaults). Scores are kept in ``RUN/set_select_stage4.json``
@@ -16,8 +16,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
-
-from lookalike.bench.set_select import (
+from set_select import (
     STAGE3_TEAMS,
     best_choice,
     options_row,
@@ -27,6 +26,7 @@ from lookalike.bench.set_select import (
     snapshot_steps,
     tuning_sequences,
 )
+
 from lookalike.learn.set_numpy import load_set_weights, save_set_weights
 from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
 

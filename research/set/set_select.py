@@ -1,6 +1,6 @@
 """Choosing among a ``set`` fine-tuning run's snapshots on tuning sequences, and shipping the choice.
 
-``python -m lookalike.bench.set_select RUN [--baseline B] [--average-from S] [--ship]`` scores the
+``python research/set/set_select.py RUN [--baseline B] [--average-from S] [--ship]`` scores the
 snapshots ``RUN/set_step{k}.npz`` (k a multiple of ``--every``) and the baseline on tuning sequences
 only (:data:`TUNING_TEAMS`, seeds below 100000, apart from every bench): eligible are the snapshots no
 worse than the baseline on any tuning team; of those, the best on M=3, N=2 (a tie within 0.01 points
@@ -19,13 +19,13 @@ stale-report rule ``stale_s``/``stale_turn`` and ``on_jump``) for the shipped we
 seen while swapped or not after the restore (:func:`measurable`); see :func:`choose_stage3`.
 
 ``--stage 4`` chooses among a fourth fine-tuning's snapshots and the pair-swap rule
-(:mod:`lookalike.bench.set_select_stage4`); ``--stage 5`` whether to correct the false-positive probability
+(:mod:`set_select_stage4`); ``--stage 5`` whether to correct the false-positive probability
 for the world's false-positive rate, ``--stage 6`` to ``9`` the report-exchange detector, ``--stage 10``
 the pairing of mirroring report jumps, ``--stage 12`` the exchange detector's heading model, ``--stage 13``
 that and a step gate, ``--stage 14`` that model for larger teams, ``--stage 15`` pairing jumps after silences,
 ``--stage 16`` a fine-tuning's snapshots with swaps that end in a silence, ``--stage 17`` exchanges found in the
 detections' visual headings, ``--stage 18`` the same counting silent agents' older reports, ``--stage 19`` and
-``20`` a recent exchange undone on less evidence (:mod:`lookalike.bench.set_select_options`).
+``20`` a recent exchange undone on less evidence (:mod:`set_select_options`).
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
 from lookalike.loop import run
 from lookalike.sim import PRESET_NAMES, RobotSequence, preset, simulate_robots
 from lookalike.trackers import make_tracker
-from lookalike.trackers.identity import labels_from_tracks
+from lookalike.trackers.parts.identity import labels_from_tracks
 from lookalike.types import Frame
 
 # Tuning sequences for --select (name, (N, M, fp), first seed, sequences), 1000 frames each; apart from every bench.
@@ -328,7 +328,7 @@ def select(run_dir: Path, every: int = 50, baseline: Path = SHIPPED_SET_WEIGHTS,
 
 def main(argv: list[str] | None = None) -> None:
     """Parse the command line and run :func:`select`."""
-    parser = argparse.ArgumentParser(prog="python -m lookalike.bench.set_select", description=__doc__)
+    parser = argparse.ArgumentParser(prog="python research/set/set_select.py", description=__doc__)
     parser.add_argument("run", type=Path, help="a fine-tuning run's folder (set_step{k}.npz snapshots)")
     parser.add_argument("--every", type=int, default=50, help="snapshots at multiples of this step")
     parser.add_argument("--baseline", type=Path, default=SHIPPED_SET_WEIGHTS, help="weights to beat (.npz)")
@@ -338,14 +338,14 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--stage", type=int, choices=(*range(1, 11), *range(12, 21)), default=1,
                         help="2: the second stage's rule (tuning recovery too; fixes --every and --average-from); "
                         "3: the inference options of the shipped weights (RUN: where the scores are kept); "
-                        "4: the fourth stage's snapshots x the pair-swap rule (lookalike.bench.set_select_stage4); "
+                        "4: the fourth stage's snapshots x the pair-swap rule (set_select_stage4); "
                         "5: the false-positive prior correction; "
                         "6-9: the report-exchange detector (7: its evidence decays; 8: and lost bursts leave a "
                         "track out; 9: for teams of up to seven); 10: mirroring report jumps paired; "
                         "12: the exchange detector's heading model; 13: and a step gate; 14: that model for "
                         "larger teams; 15: jumps paired across silences; 16: a fine-tuning with swaps that end "
                         "in a silence; 17: exchanges in the visual headings; 18: and silent agents' older reports; "
-                        "19, 20: a recent exchange undone on less evidence (5-20: lookalike.bench.set_select_options)")
+                        "19, 20: a recent exchange undone on less evidence (5-20: set_select_options)")
     parser.add_argument("--only", default=None,
                         help="stages 4-20: score this candidate only (e.g. step300,pair=off)")
     parser.add_argument("--cache", type=Path, default=None,
@@ -355,12 +355,12 @@ def main(argv: list[str] | None = None) -> None:
         select_stage3(args.cache or args.run / "set_select_stage3.json")
         return
     if args.stage == 4:
-        from lookalike.bench.set_select_stage4 import select_stage4
+        from set_select_stage4 import select_stage4
 
         select_stage4(args.run, args.only, args.ship)
         return
     if args.stage >= 5:
-        from lookalike.bench.set_select_options import select_options
+        from set_select_options import select_options
 
         select_options(args.run, args.stage, args.only)
         return
