@@ -15,7 +15,7 @@ docs/experiments/any-team-size.md before any of the stage's candidates was score
 - stage 10: pairing two report jumps that mirror each other (``jump_pair_s`` at each of :data:`STAGE10_JUMP_PAIR`);
 - stage 12: the exchange detector's heading model (``exchange_accel``, ``exchange_lag_s`` at each of
   :data:`STAGE12_EXCHANGE_MOTION`); its rule keeps only the fourth stage's guard on the tuning sequences
-  (:func:`passes_guard`) and chooses on a development sample (``benchmarks/set_recovery_sample.py``);
+  (:func:`passes_guard`) and chooses on a development sample (``research/set/recovery_sample.py``);
 - stage 13: the same with the tighter heading model and a step gate (``exchange_step_rad`` at each of
   :data:`STAGE13_EXCHANGE_STEP`), the same rule;
 - stage 14: the tighter heading model for teams of at least :data:`STAGE14_TIGHT_AGENTS` agents only

@@ -22,7 +22,7 @@ worse when its lower end is at least ``-success-margin``). They were added after
 difference on the restores whose reports differ by less than ``--unobservable`` radians (under twice the simulated
 IMU's noise: the identifiers' data barely tells the pair apart) and on all the others.
 
-    python benchmarks/set_recovery_sample.py --sequences 400 --seed 3500000 --setups m10n7
+    python research/set/recovery_sample.py --sequences 400 --seed 3500000 --setups m10n7
 """
 
 from __future__ import annotations
@@ -32,7 +32,6 @@ import json
 from pathlib import Path
 
 import numpy as np
-from _common import report_target
 
 from lookalike.bench.experiments import (
     APART_RAD,
@@ -44,6 +43,15 @@ from lookalike.bench.experiments import (
 )
 from lookalike.bench.paired import PairedDifference, interval_text, mean_difference
 from lookalike.sim import preset, preset_label
+
+
+def report_target(name: str, value: float, target: float, *, higher_is_better: bool = True, unit: str = "") -> bool:
+    """Print one target line, ``TARGET <name>: <value> (target >= or <= <target>) PASS|FAIL``; whether it passed."""
+    passed = value >= target if higher_is_better else value <= target
+    op = ">=" if higher_is_better else "<="
+    print(f"TARGET {name}: {value:.3g}{unit} (target {op} {target:g}{unit}) {'PASS' if passed else 'FAIL'}", flush=True)
+    return passed
+
 
 AFTER, RECOVERY = SwapRun._fields.index("after_restore"), SwapRun._fields.index("recovery_s")
 
