@@ -7,7 +7,8 @@ stand for a value that parses. Blocks preceded by the line ``<!-- doc-test: run 
 in document order, in one temporary folder beside a link to ``../shared/data`` and to the
 repository's ``demo-out/`` (commands needing either skip when it is absent); blocks marked
 ``<!-- doc-test: run slow -->`` run only with ``LOOKALIKE_DOC_TEST_SLOW=1``. Commands run in-process
-through typer's test runner.
+through typer's test runner. Python blocks preceded by the same marker run too, in the same folder
+(``exec``, after the shell blocks of the same documents).
 """
 
 from __future__ import annotations
@@ -51,6 +52,11 @@ class Command:
 
 def shell_blocks(doc: Path) -> list[tuple[int, str, str]]:
     """``(first line, text, mode)`` of every shell code block in ``doc``."""
+    return code_blocks(doc, SHELL_LANGS)
+
+
+def code_blocks(doc: Path, langs: set[str]) -> list[tuple[int, str, str]]:
+    """``(first line, text, mode)`` of every code block of a language in ``langs`` in ``doc``."""
     lines = doc.read_text(encoding="utf-8").splitlines()
     blocks, i = [], 0
     while i < len(lines):
@@ -63,7 +69,7 @@ def shell_blocks(doc: Path) -> list[tuple[int, str, str]]:
         while j < len(lines) and not lines[j].strip().startswith(ticks):
             body.append(lines[j][len(indent):] if lines[j].startswith(indent) else lines[j])
             j += 1
-        if lang in SHELL_LANGS:
+        if lang in langs:
             k = i - 1
             while k >= 0 and not lines[k].strip():
                 k -= 1
@@ -242,3 +248,25 @@ def test_command_runs(cmd: Command, tmp_path_factory: pytest.TempPathFactory, mo
             detail += "".join(traceback.format_exception(result.exception))[-3000:]
         pytest.fail(f"{cmd} exited with {result.exit_code} in {Path.cwd()}:\n{detail}")
     _DONE.add(cmd.args)
+
+
+PYTHON_BLOCKS = [(doc, line, text, mode) for doc in DOC_FILES for line, text, mode in code_blocks(doc, {"python"})
+                 if mode in ("run", "slow")]
+
+
+@pytest.mark.parametrize("doc, line, text, mode", PYTHON_BLOCKS,
+                         ids=[f"{d.relative_to(REPO)}:{n}" for d, n, _, _ in PYTHON_BLOCKS])
+def test_python_block_runs(doc: Path, line: int, text: str, mode: str, tmp_path_factory: pytest.TempPathFactory,
+                           monkeypatch: pytest.MonkeyPatch):
+    """A marked Python block runs as written, in the folder where the marked shell blocks run."""
+    if mode == "slow" and not RUN_SLOW:
+        pytest.skip("a slow documented block: set LOOKALIKE_DOC_TEST_SLOW=1 to run it")
+    if "../shared/" in text and not (SHARED / "data").is_dir():
+        pytest.skip(f"needs {SHARED / 'data'}, which is absent")
+    monkeypatch.chdir(_workdir(tmp_path_factory))
+    exec(compile(text, f"{doc.relative_to(REPO)}:{line}", "exec"), {"__name__": "__doc_test__"})
+
+
+def test_readme_python_example_is_run():
+    """The README's Python example is marked to run (so it cannot rot unnoticed)."""
+    assert any(doc.name == "README.md" for doc, _, _, _ in PYTHON_BLOCKS)
