@@ -47,7 +47,7 @@ def _lengths() -> dict[str, int]:
 
 
 def run_lookalike(repeats: int) -> tuple[list[float], dict[str, dict[str, float]]]:
-    from lookalike.bench.folders import evaluate_folders
+    from lookalike.eval.folders import evaluate_folders
 
     times, result = [], {}
     for _ in range(repeats):

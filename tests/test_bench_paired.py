@@ -15,8 +15,8 @@ from typer.testing import CliRunner
 from lookalike.bench.experiments import experiment_results, recovery_differences
 from lookalike.bench.ident import IDENT_COLUMNS, ident_differences, ident_runs
 from lookalike.bench.paired import NEVER, ONE_SEQUENCE, interval_text, mean_difference, rate_difference
-from lookalike.bench.results import validate
 from lookalike.cli import app
+from lookalike.io.results import validate
 
 pytest.importorskip("jsonschema", reason="jsonschema is in the test extra")
 runner = CliRunner()

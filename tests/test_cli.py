@@ -64,7 +64,7 @@ def test_demo_runs(tmp_path):
 
 
 def test_version_and_sorted_commands():
-    from lookalike.bench.results import lookalike_version
+    from lookalike.io.results import lookalike_version
 
     r = runner.invoke(app, ["--version"])
     assert r.exit_code == 0 and r.output.strip() == f"lookalike {lookalike_version()}"

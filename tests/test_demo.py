@@ -13,9 +13,9 @@ pytest.importorskip("matplotlib")
 
 from typer.testing import CliRunner
 
-from lookalike.bench.demo import QUICK, lstm_status
-from lookalike.bench.results import validate
 from lookalike.cli import app
+from lookalike.demo import QUICK, lstm_status
+from lookalike.io.results import validate
 from lookalike.viz import read_frames, video_info
 
 runner = CliRunner()

@@ -58,7 +58,7 @@ def test_command_writes_results_csv_png(tmp_path) -> None:
     doc = json.loads((tmp_path / "t.json").read_text())
     assert doc["schema"] == "lookalike-results/1"
     jsonschema = pytest.importorskip("jsonschema", reason="jsonschema is in the test extra")
-    from lookalike.bench.results import schema
+    from lookalike.io.results import schema
 
     jsonschema.validate(doc, schema())
     rows = doc["tables"]["divers"]

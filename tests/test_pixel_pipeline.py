@@ -7,10 +7,10 @@ import pytest
 from typer.testing import CliRunner
 
 from lookalike.bench.pixels import match_truth
-from lookalike.bench.results import validate
 from lookalike.cli import app
 from lookalike.eval import identification_success_rate
 from lookalike.geometry.camera import Camera, Pose2D
+from lookalike.io.results import validate
 from lookalike.sim.render_robots import ROBOT_HEIGHT_M, ROBOT_WIDTH_M, RobotRenderer, random_walk_poses
 from lookalike.types import Beacons, Detections
 from lookalike.vision.heading import HeadingClassifier

@@ -1,4 +1,4 @@
-"""Every ``--json`` validates against the shipped results schema (lookalike/bench/results.schema.json)."""
+"""Every ``--json`` validates against the shipped results schema (lookalike/io/results.schema.json)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from lookalike.bench.results import SCHEMA_ID, Results, metric_key, percent_row_metrics, schema
 from lookalike.cli import app
+from lookalike.io.results import SCHEMA_ID, Results, metric_key, percent_row_metrics, schema
 
 jsonschema = pytest.importorskip("jsonschema", reason="jsonschema is in the test extra")
 runner = CliRunner()

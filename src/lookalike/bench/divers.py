@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.bench.results import Results
 from lookalike.eval.api import combine, evaluate_sequence
+from lookalike.io.results import Results
 from lookalike.sim.divers import SCENARIOS, detection_quality, scenario
 from lookalike.sim.divers_paper import redraw, with_detections
 from lookalike.sim.divers_run import diver_extractor, matched_thresholds, prepare_features, run_tracker

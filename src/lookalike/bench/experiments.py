@@ -30,8 +30,8 @@ import numpy as np
 from lookalike.bench.ident import identify
 from lookalike.bench.paired import Comparison, add_comparisons, compare_to_first, mean_difference
 from lookalike.bench.progress import ProgressFactory, no_progress
-from lookalike.bench.results import Results, add_printed_rows
 from lookalike.eval import identification_success_rate
+from lookalike.io.results import Results, add_printed_rows
 from lookalike.sim import PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
 from lookalike.types import Beacons, Frame
 

@@ -16,9 +16,9 @@ import numpy as np
 
 from lookalike.bench.datasets import RealSequence
 from lookalike.bench.progress import ProgressFactory, no_progress
-from lookalike.bench.results import Results
 from lookalike.bench.runner import Entry, job_pairs, run_jobs
 from lookalike.eval import combine
+from lookalike.io.results import Results
 
 COLUMNS = ("Dataset", "Tracker", "HOTA", "IDF1", "MOTA", "IDSW", "Frames/s", "Rank")
 METRICS = ("HOTA", "IDF1", "MOTA")
@@ -143,7 +143,7 @@ def leaderboard_results(part: str, rows: list[dict[str, Any]], combined: list[di
                         per_seq: list[dict[str, Any]], skipped: dict[str, str | None],
                         sequences: Sequence[RealSequence], command: str = "",
                         options: dict[str, Any] | None = None) -> Results:
-    """The leaderboard as a results document (:mod:`lookalike.bench.results`): tables ``datasets``
+    """The leaderboard as a results document (:mod:`lookalike.io.results`): tables ``datasets``
     (one combined row per dataset and entry, with its ``rank``), ``sequences`` (one row per sequence
     and entry) and ``ranking`` (``dataset`` None: ``mean_rank`` over the ``datasets`` it ran on)."""
     doc = Results("bench real", command=command, sequences=len(sequences),

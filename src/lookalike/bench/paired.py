@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from lookalike.bench.results import Results
+from lookalike.io.results import Results
 
 CONFIDENCE = 0.95
 RESAMPLES = 9999

@@ -51,7 +51,7 @@ err_console = Console(stderr=True, soft_wrap=True)  # an error stays one line
 
 def _version(value: bool) -> None:
     if value:
-        from lookalike.bench.results import lookalike_version
+        from lookalike.io.results import lookalike_version
 
         console.print(f"lookalike {lookalike_version()}", highlight=False)
         raise typer.Exit()

@@ -21,10 +21,10 @@ from lookalike.bench.ident import (
 )
 from lookalike.bench.ident_paper import IDENT_VARIANTS, margin_rows
 from lookalike.bench.paired import Comparison, comparison_rows, difference_title
-from lookalike.bench.results import Results
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import SortedGroup, app, command_line, console, fail, split_list
 from lookalike.cli.progress import progress_bars
+from lookalike.io.results import Results
 from lookalike.sim import PRESET_NAMES, preset_label
 from lookalike.trackers import tracker_names
 

@@ -1,4 +1,4 @@
-"""``lookalike demo``: the whole system on built-in simulated data (:mod:`lookalike.bench.demo`),
+"""``lookalike demo``: the whole system on built-in simulated data (:mod:`lookalike.demo`),
 with videos, plots and a report in ``demo-out/``. ``--quick`` runs a reduced version (seconds)."""
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from lookalike.bench.demo import DIVER_COLS, IDENT_COLS, QUICK, DemoSize, lstm_status, run_demo
 from lookalike.cli.app import app, command_line, console, fail
 from lookalike.cli.bench import rich_table
+from lookalike.demo import DIVER_COLS, IDENT_COLS, QUICK, DemoSize, lstm_status, run_demo
 from lookalike.sim import PRESET_NAMES, preset_label
 
 __all__ = ["QUICK", "demo", "lstm_status", "run_demo"]

@@ -9,9 +9,9 @@ import typer
 from rich import box
 from rich.table import Table
 
-from lookalike.bench.folders import COMBINED, evaluate_folders, folder_results
 from lookalike.cli.app import app, command_line, console, fail, split_list
 from lookalike.eval import BENCHMARKS, METRICS
+from lookalike.eval.folders import COMBINED, evaluate_folders, folder_results
 
 HEADLINE = {
     "HOTA": ("HOTA", "DetA", "AssA"),

@@ -1,7 +1,8 @@
 """Evaluation: CLEAR MOT, identity and HOTA (TrackEval's definitions), and the identification
 metrics of seed A (identification success rate, localisation error).
 
-Values are fractions (0.73 for 73 %), named as in TrackEval.
+Values are fractions (0.73 for 73 %), named as in TrackEval. :mod:`lookalike.eval.folders` scores
+folders of result files against ground-truth sequence folders (``lookalike eval``).
 """
 
 from lookalike.eval.api import METRICS, combine, evaluate_data, evaluate_points, evaluate_sequence

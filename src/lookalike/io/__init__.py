@@ -1,5 +1,6 @@
-"""Reading and writing tracking data: MOTChallenge text files, sequence folders, and streaming
-input/output for the frame loop (:mod:`lookalike.io.stream`)."""
+"""Reading and writing tracking data: MOTChallenge text files, sequence folders, streaming
+input/output for the frame loop (:mod:`lookalike.io.stream`), and the results documents that every
+``--json`` writes (:mod:`lookalike.io.results`, with its JSON schema)."""
 
 from lookalike.io.motchallenge import (
     MotTable,

@@ -1,7 +1,7 @@
 """Reading ``eval``/``bench`` JSON outputs and adding them to an :class:`HtmlReport` as tables and charts.
 
 Recognised files: results documents (``"schema": "lookalike-results/1"``, see
-:mod:`lookalike.bench.results`) with a table ``ident`` (``bench ident --json``, the demo's
+:mod:`lookalike.io.results`) with a table ``ident`` (``bench ident --json``, the demo's
 ``robots-ident.json``), ``divers`` (``bench divers --json``, the demo's ``divers.json``) or ``scores``
 (``eval --json``); and the older files: rows with ``Setup`` and ``Success rate (%)``, rows with
 ``Scenario`` and ``IDF1``, ``{tracker: {sequence: {metric: fraction}}}``. Values are shown in %.
@@ -13,11 +13,11 @@ import json
 from pathlib import Path
 from typing import Any
 
+from lookalike.io.results import SCHEMA_ID
 from lookalike.viz.plots import grouped_bar_chart
 from lookalike.viz.report import HtmlReport
 
 EVAL_COLUMNS = ("IDF1", "HOTA", "MOTA", "IDSW")
-SCHEMA_ID = "lookalike-results/1"  # lookalike.bench.results.SCHEMA_ID (bench sits above viz)
 
 
 def _percent(metrics: dict[str, Any], key: str) -> float | None:

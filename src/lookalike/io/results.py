@@ -13,7 +13,7 @@ described by ``results.schema.json`` beside this module (:data:`SCHEMA_PATH`, sh
 
 Usage::
 
-    from lookalike.bench.results import Results
+    from lookalike.io.results import Results
 
     doc = Results("bench divers", command=command_line, seeds=seeds, sequences=len(scenarios),
                   frames=total_frames, options={"frames": frames})

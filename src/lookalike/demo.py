@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from lookalike.bench.ident import ident_results, ident_table
-from lookalike.bench.results import Results
+from lookalike.io.results import Results
 from lookalike.sim import PRESET_NAMES, preset, preset_label
 from lookalike.sim.divers import SCENARIOS, VALIDATION_SCENARIOS, scenario
 from lookalike.sim.divers_run import fit_diver_features

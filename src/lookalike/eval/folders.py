@@ -11,7 +11,7 @@ from lookalike.eval import METRICS, combine, evaluate_sequence
 from lookalike.io import MotSequence, find_sequences, read_mot
 
 if TYPE_CHECKING:
-    from lookalike.bench.results import Results
+    from lookalike.io.results import Results
 
 COMBINED = "COMBINED"
 
@@ -71,7 +71,7 @@ def folder_results(scores: dict[str, dict[str, dict[str, float]]], gt_root: str 
     results document: table ``scores``, one row per tracker and sequence (dataset: the ground-truth
     folder's name) and the combined row (``sequence`` None, ``combined`` True); TrackEval's metric
     names as machine keys (``HOTA`` -> ``hota``, ``CLR_FP`` -> ``clr_fp``, ``HOTA___AUC`` -> ``hota_auc``)."""
-    from lookalike.bench.results import Results, metric_key  # imported when used: a short start-up
+    from lookalike.io.results import Results, metric_key  # imported when used: a short start-up
 
     dataset = Path(gt_root).name or str(gt_root)
     seqs = {s for per in scores.values() for s in per if s != COMBINED}
