@@ -143,10 +143,8 @@ def check_value(owner: str, key: str, value: Any, hint: Any, bounds: Range | Non
 
 
 def check_params(config: Any) -> None:
-    """Check every field of the config dataclass ``config`` against its declaration (:func:`param`:
-    type, finiteness, range, choices); the first bad one raises ``TypeError``/``ValueError`` in one line,
-    e.g. ``tracker 'sort': iou_threshold=7 is out of range [0, 1]``. Every tracker config calls this
-    first in its ``__post_init__``, so direct construction is checked too."""
+    """Check every field of the config dataclass against its :func:`param` declaration; the first bad one
+    raises ``TypeError``/``ValueError`` in one line. Tracker configs call this in ``__post_init__``."""
     owner = _owner(type(config))
     for name, hint, bounds, choices in _field_specs(type(config)):
         check_value(owner, name, getattr(config, name), hint, bounds, choices)

@@ -1,32 +1,21 @@
-"""BoxTrack: a motion-only box tracker for look-alike targets (lookalike's own, no appearance).
+"""BoxTrack: a motion-only box tracker for look-alike targets (no appearance).
 
-A composition of shared parts: a :class:`~lookalike.trackers.parts.table.TrackTable` of
-:class:`~lookalike.motion.spaces.BoxCXCYWH` states (box centre and size in pixels, their velocities
-in pixels/frame), an association plan of IoU and centre-distance stages split by detection score
-(:mod:`lookalike.association.stages`), a :class:`~lookalike.trackers.parts.lifecycle.Lifecycle` (confirmed
-after ``n_init`` hits, deleted after ``max_age_s`` seconds, never in a closed set), score thresholds
-that calibrate themselves on the sequence (:class:`~lookalike.trackers.parts.self_calibration.ScoreCalibration`),
-coasting (:class:`~lookalike.trackers.parts.coasting.Coasting`), a birth threshold that follows the
-detector's clutter (:class:`~lookalike.trackers.parts.clutter.ClutterShare`) and, with ``max_targets``,
-closed-set slots (:class:`~lookalike.trackers.parts.closed_slots.ClosedSlots`).
+A composition of shared parts: a track table of :class:`~lookalike.motion.spaces.BoxCXCYWH` states
+(pixels, pixels/frame), a score-split association plan (:mod:`lookalike.association.stages`), a lifecycle,
+self-calibrating score thresholds, coasting, a clutter-following birth threshold and, with ``max_targets``,
+closed-set slots (all in :mod:`lookalike.trackers.parts`).
 
-Each frame: detections below ``low_score`` are dropped; confirmed tracks take confident detections
-on ``1 - IoU·score`` (those missed at most 2 frames first), tracks updated in the previous frame
-take low-score ones on IoU, tentative tracks take the rest on IoU, and lost confirmed tracks take
-what confident detections remain on centre distance (re-identification). Left-over detections
-scoring at least the birth threshold start tentative tracks (in a closed set, only where a slot is
-free or lost ``max_age_s``). Confirmed tracks matched this frame are reported with their filtered
-box, and confirmed tracks likely still present at their predicted box (``detection_index`` -1).
-The mechanisms and where every default comes from: docs/trackers/boxtrack.md.
+Each frame: detections below ``low_score`` are dropped; confirmed tracks take confident detections on
+``1 - IoU·score`` (recently seen first), tracks seen last frame take low-score ones on IoU, tentative tracks
+take the rest on IoU, and lost tracks take what confident detections remain on centre distance. Left-over
+detections above the birth threshold start tentative tracks. Reported: confirmed tracks matched this frame
+(filtered box) and confirmed tracks likely still present (predicted box, ``detection_index`` -1).
+Mechanisms and defaults: docs/trackers/boxtrack.md.
 
-Speed (issue 18): the motion states live in the motion space's column form, one quantity-major
-``(24, k)`` table whose rows each hold one number of every track (the track table's ``mean`` and
-``cov`` are views of it), so a prediction or an update is a dozen operations on contiguous rows; one
-IoU matrix per frame serves every stage and the clutter share; the IoU stages compute costs only
-when their allowed pairs compete. The rows are those of the plain tracker this replaced, bit for bit
-(tests/boxtrack_oracle.py, tests/test_boxtrack_fast.py). With numba installed (the ``fast`` extra) a frame
-runs four compiled kernels instead (:mod:`lookalike.trackers.kernels.boxtrack`; ``LOOKALIKE_BOXTRACK_NUMBA=0``
-switches them off): the same numbers (tests/test_boxtrack_kernels.py); figures in docs/experiments/speed.md.
+States live in one quantity-major ``(24, k)`` column table (the track table's ``mean`` and ``cov`` are
+views of it). With numba installed a frame runs the compiled kernels of
+:mod:`lookalike.trackers.kernels.boxtrack` (``LOOKALIKE_BOXTRACK_NUMBA=0`` switches them off), with the same
+numbers as the numpy path.
 """
 
 from __future__ import annotations
@@ -38,7 +27,7 @@ import numpy as np
 
 from lookalike.association.costs import centre_distance_cost, cost_from_iou, iou_columns
 from lookalike.association.stages import CostFn, Matching, Stage, run_plan, run_stage
-from lookalike.motion.spaces import BoxCXCYWH, cxcywh_to_xywh
+from lookalike.motion.spaces import BoxCXCYWH
 from lookalike.trackers import boxtrack_config as const
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
 from lookalike.trackers.kernels import boxtrack as boxtrack_kernels
@@ -53,7 +42,6 @@ from lookalike.trackers.parts.timing import FrameClock
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Detections, Frame, Tracks
 
-_to_xywh = cxcywh_to_xywh  # kept for callers of the old private helper
 _NO_BOXES = np.zeros((0, 4))
 _NO_INDEX = np.zeros(0, dtype=np.int64)
 _F64 = np.dtype(np.float64)

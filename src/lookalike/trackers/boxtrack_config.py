@@ -1,7 +1,5 @@
-"""BoxTrack's configuration: every public parameter with its default and description, its
-validation, and the constants that were parameters before (issue 16: fewer, stronger parameters).
-
-Where the defaults come from is docs/trackers/boxtrack.md.
+"""BoxTrack's configuration: its public parameters with defaults and descriptions, and its fixed constants.
+Where the defaults come from: docs/trackers/boxtrack.md.
 """
 
 from __future__ import annotations
@@ -10,8 +8,7 @@ from dataclasses import dataclass
 
 from lookalike.trackers.base import COUNT, POSITIVE, UNIT, check_params, param
 
-# Former parameters, now constants: their whole range moved the left-out criterion little, or tuning
-# them did not beat the noise between folds (docs/tuning.md, "Which parameters earn their place").
+# Fixed constants (docs/tuning.md, "Which parameters earn their place").
 LOW_IOU = 0.5  # minimum IoU of a low-score detection with a track updated in the previous frame
 RECENT_FRAMES = 2  # confirmed tracks missed at most this many frames take confident detections first
 COAST_S = 0.5  # seconds a lost track keeps extrapolating its velocity (then waits where it was seen)
@@ -20,8 +17,6 @@ COAST_REPORT_PROB = 0.7  # missed tracks are reported at their prediction while 
 CALIB_MIN_COUNT = 100  # detections a score band needs before the self-calibration judges it
 COAST_MIN_COUNT = 30  # resolved misses of a length before the coast report judges that length
 POS_NOISE = 1 / 20  # position (and measurement) noise per frame, as a fraction of the box size
-# Constants since the four-dataset leave-one-out (issue 16 item 3): MotionFit measures the process noise
-# on the sequence itself (it only raises it), and the re-identification gate is in those fitted deviations
 VEL_NOISE = 1 / 160  # velocity noise per frame, as a fraction of the box size (before MotionFit's scale)
 REID_DISTANCE = 0.5  # re-identification gate: centre distance in track heights x sqrt(MotionFit's scale)
 CLUTTER_FLOOR = 0.1  # the birth threshold is never below this quantile of the scores seen

@@ -1,23 +1,12 @@
-"""Deep SORT style tracker (Wojke et al., 2017; the baseline of seed B), with any appearance feature.
+"""Deep SORT (Wojke et al., 2017) with any appearance feature.
 
-A composition of shared parts: a :class:`~lookalike.trackers.parts.table.TrackTable` of
-:class:`~lookalike.motion.spaces.BoxXYAH` states (box centre in pixels, aspect ``w/h``, height in
-pixels, and their velocities; noise proportional to the height), per-track feature galleries and an
-association plan (:mod:`lookalike.association.stages`). Each frame:
-
-1. predict every track;
-2. matching cascade over confirmed tracks, most recently seen first, up to ``max_age`` frames:
-   cost = minimum cosine distance between the detection's feature and the track's gallery of its
-   last ``gallery_size`` features, forbidden beyond ``max_cosine_distance`` or outside the
-   chi-square Mahalanobis gate on ``[x, y, a, h]`` (``gate_probability``);
-3. IoU fallback for tentative tracks and for confirmed ones missed only in the last frame:
-   ``1 - IoU`` up to ``max_iou_distance``;
-4. lifecycle: tentative tracks are confirmed after ``n_init`` consecutive hits and deleted at their
-   first miss; confirmed tracks are deleted after more than ``max_age`` frames without a match.
-
-Confirmed tracks matched in the frame are reported with their filtered box. Detections must carry
-``feature`` (rows L2-normalised, e.g. from ``lookalike.vision.appearance``). Where the defaults
-come from: docs/trackers/deepsort.md.
+A track table of :class:`~lookalike.motion.spaces.BoxXYAH` states (pixels, aspect ``w/h``), per-track
+feature galleries and an association plan (:mod:`lookalike.association.stages`). Each frame: predict;
+matching cascade over confirmed tracks (most recently seen first) on the minimum cosine distance to the
+track's gallery, gated by ``max_cosine_distance`` and the chi-square Mahalanobis gate; ``1 - IoU`` fallback
+for tentative tracks and those missed one frame; confirm after ``n_init`` hits, delete tentative tracks at
+their first miss and confirmed ones after ``max_age`` frames. Detections must carry L2-normalised
+``feature`` rows. Defaults: docs/trackers/deepsort.md.
 """
 
 from __future__ import annotations

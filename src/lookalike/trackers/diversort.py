@@ -1,29 +1,20 @@
-"""Diver SORT (seed B): appearance-first tracking of look-alike divers with long-term re-identification.
+"""DiverSORT: appearance-first tracking of look-alike divers with long-term re-identification.
 
-The seven mechanisms of the paper, each a step of :meth:`DiverSort.update`:
+The diver-tracking paper's seven mechanisms, each a step of :meth:`DiverSort.update`:
 
-1. **IoU shortcut**: a detection whose IoU with a track's detection of the previous frame is at
-   least ``iou_shortcut`` (0.75) joins that track (one-to-one) before anything else is computed.
-2. **Centre-only Kalman filter** on ``(x, y, vx, vy)`` in pixels; box size and aspect are taken
-   from the latest detection because swimming strokes make them oscillate.
-3. **Cost** = minimum cosine distance between the detection's feature and the track's gallery of
-   its last ``gallery_size`` features. When several tracks are within ``tie_margin`` of a
-   detection's best one, the location term ``location_weight · d²/location_gate`` is added to that
-   detection's costs (d² the squared Mahalanobis distance of the centre). Pairs are unacceptable
-   when d² > ``location_gate`` (paper: 25) or the appearance cost exceeds ``appearance_threshold``.
-4. **Tentative tracks**: a new track becomes an identity after ``n_init`` (3) consecutive matches;
-   a tentative track that misses a frame is deleted and never reported.
-5. **Long-term re-identification**: a track unseen for more than ``long_term_after`` (5) frames is
-   matched on appearance alone, with the looser ``long_term_threshold``.
-6. **Identity recovery**: a confirmed track alive for at most ``recovery_window`` (15) frames is
-   merged into a confirmed track unseen since its birth when more than ``recovery_fraction``
-   (25%) of their pairwise gallery distances are below ``recovery_threshold``. Every merge is
-   recorded in :attr:`DiverSort.merges` (frame index, source id, target id); the target id is
-   reported from that frame on.
-7. **Persistent identities**: confirmed tracks are not deleted for being unseen (``max_age = None``),
-   but at most ``max_lost`` (200) unseen ones are kept; beyond it the longest unseen is forgotten (ours).
+1. IoU shortcut: a detection overlapping a track's previous detection by ``iou_shortcut`` joins it first.
+2. Centre-only Kalman filter on ``(x, y, vx, vy)`` (pixels); box size from the latest detection.
+3. Cost: minimum cosine distance to the track's gallery of ``gallery_size`` features, plus a location
+   term ``location_weight · d²/location_gate`` where tracks tie within ``tie_margin``; pairs beyond
+   ``location_gate`` (squared Mahalanobis) or ``appearance_threshold`` are not allowed.
+4. Tentative tracks: confirmed after ``n_init`` consecutive matches, deleted at their first miss.
+5. Long-term re-identification: tracks unseen over ``long_term_after`` frames match on appearance alone
+   (``long_term_threshold``).
+6. Identity recovery: a young confirmed track merges into an older lost one when enough gallery
+   distances are below ``recovery_threshold`` (:attr:`DiverSort.merges` records each merge).
+7. Persistent identities: at most ``max_lost`` unseen confirmed tracks are kept.
 
-Where the defaults come from: docs/trackers/diversort.md.
+Defaults and their sources: docs/trackers/diversort.md.
 """
 
 from __future__ import annotations

@@ -1,16 +1,11 @@
-"""JPDA tracker (seed A's third baseline): joint probabilistic data association in world coordinates.
+"""JPDA tracker (a baseline of the robot-identification paper): joint probabilistic data association in world
+coordinates (metres).
 
-Every track is updated with all gated detections weighted by the exact JPDA marginals
-(:func:`lookalike.association.jpda.jpda_marginals`): hypothesis weights ``1 - P_D·P_G`` for a
-miss and ``P_D·N(z; ẑ, S)/λ`` for a gated detection, then the mixture-reduced Kalman update
-
-    x⁺ = x + K Σ_j β_j ν_j,
-    P⁺ = β_0 P + (1 - β_0)(P - K S Kᵀ) + K (Σ_j β_j ν_j ν_jᵀ - ν̄ ν̄ᵀ) Kᵀ.
-
-For identification and labels, the one-to-one detection of each track is found by the Hungarian
-method on ``1 - β`` (pairs with ``β < min_assignment_prob`` are not assigned); that pair counts
-as the track's hit. Detections that no track explains (``Σ_i β_ij < 0.5``) may start tracks. The
-lifecycle, births and identification are Kalman-HA2's (:mod:`lookalike.trackers.kalman_ha`).
+Each track is updated with all gated detections weighted by the exact JPDA marginals
+(:func:`lookalike.association.jpda.jpda_marginals`) by the mixture-reduced Kalman update. For identification
+and labels each track's one detection is found by the Hungarian method on ``1 - β`` (none below
+``min_assignment_prob``); detections no track explains (``Σ_i β_ij < 0.5``) may start tracks. Lifecycle,
+births and identification are Kalman-HA2's.
 """
 
 from __future__ import annotations

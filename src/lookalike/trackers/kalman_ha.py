@@ -1,24 +1,13 @@
-"""Kalman-HA and Kalman-HA2 (seed A's baselines): world-frame trackers identified by beacons.
+"""Kalman-HA and Kalman-HA2, the robot-identification paper's baselines: world-frame trackers identified by beacons.
 
-Both track ground positions (observer frame, metres) with one constant-acceleration Kalman filter
-per track (state ``[x, y, vx, vy, ax, ay]``, the frames' real time steps), measurement noise
-``std = meas_std0_m + meas_std_per_m · distance`` and Hungarian association on the squared
-Mahalanobis distance inside a chi-square gate. Tracks are identified with the N reporting agents
-by the beacon identifier (:mod:`lookalike.trackers.parts.identity`), and every detection taken by an
-identified track carries its agent id.
+Both track ground positions (observer frame, metres) with a constant-acceleration Kalman filter per track,
+distance-dependent measurement noise and Hungarian association inside a chi-square gate, and identify
+tracks with the N reporting agents by the beacon identifier (:mod:`lookalike.trackers.parts.identity`).
 
-- **Kalman-HA** (no heuristics): a track starts at every unmatched detection and ends at its
-  first miss; every track is identified.
-- **Kalman-HA2** (our heuristics; seed A cites them without listing them):
-  1. births only from detections scoring at least ``birth_min_score`` and farther than
-     ``birth_exclusion_m`` from every existing track's prediction (clutter and duplicates);
-  2. a tentative track is confirmed after ``confirm_hits`` hits in its last ``confirm_window``
-     frames and deleted after ``tentative_max_misses`` consecutive misses;
-  3. a confirmed track coasts on its prediction (acceleration dropped, velocity decaying with
-     ``coast_velocity_decay_s``) for up to ``max_coast_s`` while predicted inside the camera's
-     view and ``max_out_of_view_s`` while predicted outside it (a robot that walked out of the
-     view is expected back where it left);
-  4. only confirmed tracks are identified and label detections.
+- Kalman-HA: a track starts at every unmatched detection and ends at its first miss.
+- Kalman-HA2 (heuristics the paper cites without listing; ours): births gated by score and distance to
+  existing tracks, confirmation by hits in a window, coasting limits inside and outside the camera's view,
+  and only confirmed tracks identified (:class:`~lookalike.trackers.parts.world_rules.WorldRules`).
 """
 
 from __future__ import annotations

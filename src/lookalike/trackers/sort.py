@@ -1,15 +1,9 @@
 """SORT (Bewley et al., 2016): Kalman filter on ``[u, v, s, r]``, IoU cost, Hungarian matching.
 
-The behaviour follows the reference implementation: state ``[u, v, s, r, u', v', s']`` with
-``R = diag(1, 1, 10, 10)``, ``P0 = diag(10, 10, 10, 10, 1e4, 1e4, 1e4)``,
-``Q = diag(1, 1, 1, 1, 0.01, 0.01, 1e-4)`` per frame; association by maximum total IoU (a
-direct match when every detection and track has at most one pair above the threshold), pairs
-below ``iou_threshold`` rejected afterwards; a track is reported in a frame when it was updated
-in it and has ``min_hits`` consecutive hits (or during the first ``min_hits`` frames), with its
-filtered box; it is deleted after more than ``max_age`` frames without update. New tracks take
-ids in detection order. All tracks are predicted and updated together as arrays
-(:mod:`lookalike.trackers.parts.sort_tracks`: the filter's covariance is block-diagonal, so a track is 20
-numbers); with many boxes only overlapping ones are compared.
+Follows the reference implementation (its ``R``, ``P0`` and per-frame ``Q``; maximum-IoU association with
+pairs below ``iou_threshold`` rejected; reported after ``min_hits`` hits or in the first ``min_hits`` frames;
+deleted after ``max_age`` frames unseen). Tracks are updated together as arrays
+(:mod:`lookalike.trackers.parts.sort_tracks`).
 """
 
 from __future__ import annotations

@@ -1,14 +1,10 @@
-"""Optional compiled kernels (numba) for :class:`~lookalike.trackers.boxtrack.BoxTrack`
-(:mod:`lookalike.trackers.kernels.boxtrack_numba`): the prediction with the frame's IoU matrix and clutter count,
-the gated IoU stages of the association plan, the Kalman update with the track bookkeeping, and the report
-with the lifecycle's survivors.
+"""Optional numba kernels for :class:`~lookalike.trackers.boxtrack.BoxTrack`
+(:mod:`lookalike.trackers.kernels.boxtrack_numba`): prediction with the IoU matrix, the gated IoU stages, the
+Kalman update with bookkeeping, and the report with the lifecycle.
 
-At a few detections a frame the numpy path's time is mostly the overhead of its many small numpy calls; the
-kernels do the same floating-point operations one track or pair at a time, in the same order and precision
-(no fused multiply-adds), so the rows are bit for bit those of the numpy path (``tests/test_boxtrack_kernels.py``
-compares both). They are used when numba is installed (the ``fast`` extra) unless ``LOOKALIKE_BOXTRACK_NUMBA=0``;
-numba is imported when the first BoxTrack is built, never by ``import lookalike``. Start-up cost:
-docs/experiments/speed.md (boxtrack).
+They do the numpy path's operations one track or pair at a time in the same order, so rows are bit for bit
+the same (``tests/test_boxtrack_kernels.py``). Used when numba is installed unless
+``LOOKALIKE_BOXTRACK_NUMBA=0``; numba loads when the first BoxTrack is built.
 """
 
 from __future__ import annotations

@@ -1,9 +1,8 @@
 """The numba kernels of :mod:`lookalike.trackers.kernels.boxtrack` (imported only when numba is installed).
 
-Each kernel does the floating-point operations of BoxTrack's numpy path one track or one pair at a time,
-in the same order and precision (no fused multiply-adds: ``fastmath`` off), so the rows are bit for bit the
-same. State columns ``x (24, k)`` are :class:`~lookalike.motion.spaces.BoxCXCYWH`'s column form (pixels,
-pixels/frame).
+Each does BoxTrack's numpy-path operations one track or pair at a time in the same order (``fastmath``
+off), so rows are bit for bit the same. State columns ``x (24, k)``: :class:`~lookalike.motion.spaces.BoxCXCYWH`'s
+column form (pixels, pixels/frame).
 """
 
 from __future__ import annotations
@@ -203,12 +202,12 @@ def gated_stages(iou: np.ndarray, start: int, match_iou: float, low_iou: float, 
 def correct(x: np.ndarray, det_of_track: np.ndarray, det: np.ndarray, pos_noise: float, confirmed: np.ndarray,
             misses: np.ndarray, unseen_s: np.ndarray, hits: np.ndarray, record: bool, dt: float, n_init: int,
             first: bool, fit: np.ndarray, back: np.ndarray) -> tuple[int, int]:
-    """The Kalman update of every track of ``x`` matched to a detection of ``det (n, 4)`` (left, top, width,
-    height; pixels) by ``det_of_track``, in place; one more hit for the matched tracks, a miss resets the count,
-    and with ``record`` the tracks' ``misses`` and ``unseen_s`` (+ ``dt`` seconds) recorded and the tracks with
-    ``n_init`` hits (any hit in the ``first`` frame) confirmed. Writes the centre
-    innovations and their variances of the matched confirmed tracks into ``fit (4, k)`` (rows x, y, var x,
-    var y) and the misses of the confirmed ones coming back into ``back (k,)``; returns both counts."""
+    """Kalman update in place of the tracks of ``x`` matched (``det_of_track``) to detections ``det (n, 4)``
+    (xywh, pixels), with hit counts; with ``record`` also ``misses``, ``unseen_s`` (+ ``dt`` seconds) and
+    confirmation (``n_init`` hits, any hit in the ``first`` frame). Writes the confirmed matched tracks' centre
+    innovations and variances into ``fit (4, k)`` and returning tracks' misses into ``back (k,)``; returns both
+    counts.
+    """
     k = x.shape[1]
     n_fit = 0
     n_back = 0
@@ -276,14 +275,13 @@ def report(mean: np.ndarray, ids: np.ndarray, confirmed: np.ndarray, det_of_trac
            det_idx: np.ndarray, misses: np.ndarray, present: np.ndarray, interval: float, unseen_s: np.ndarray,
            tentative_s: float, limit_s: float, closed: bool, alive: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
-    """The frame's report: confirmed tracks matched this frame (``det_of_track``, then ``born`` for the rows
-    after it) at their filtered box, then confirmed tracks missed ``m`` frames with ``present[min(m, L)]`` (the
-    coasting table, ``L`` its last index; beyond it for negative ``m``) at their box, detection index -1;
-    ``det_idx`` maps kept detections to the frame's (empty: kept at their own index). Returns ids, status
-    (int8, all 1), boxes ``(m, 4)`` (left, top, width, height; sizes floored at 1e-3 pixels), velocities
-    ``(m, 2)`` (pixels/``interval`` seconds) and detection indices, and the number of tracks alive (``alive``
-    written): tentative ones unseen at most ``tentative_s`` seconds, confirmed ones at most ``limit_s`` (all of
-    them when ``closed``)."""
+    """The frame's report: confirmed tracks matched this frame (then ``born`` rows) at their filtered box, then
+    confirmed tracks missed ``m`` frames with ``present[min(m, L)]`` (the coasting table) at their box, detection
+    index -1; ``det_idx`` maps kept detections to the frame's (empty: identity). Returns ids, status, boxes ``(m,
+    4)`` (xywh, sizes floored at 1e-3 pixels), velocities ``(m, 2)`` (pixels per ``interval``), detection indices
+    and the number alive (``alive`` written: tentative unseen <= ``tentative_s``, confirmed <= ``limit_s`` or all
+    when ``closed``).
+    """
     k = len(ids)
     n_old = len(det_of_track)
     last = len(present) - 1

@@ -1,21 +1,13 @@
-"""Small batched kernels of the world trackers' per-frame path (Kalman-HA, its beacon identifier).
+"""Small batched kernels of the world trackers' per-frame path (Kalman-HA and its beacon identifier).
 
-Each returns what the general functions it stands in for return, bit for bit, with fewer calls:
-numpy's own LAPACK kernels without the wrappers' per-call checks (:func:`cholesky`, :func:`solve`),
-``einsum`` (``np.einsum``'s C kernel, which it calls unless asked to optimise), and :func:`pairs`,
-the pairs of :func:`lookalike.association.solver.assign_pairs` from the same matrix handed to the
-same solver.
+Each returns what the general function it stands in for returns, bit for bit, with fewer calls: numpy's
+LAPACK kernels without per-call checks (:func:`cholesky`, :func:`solve`), ``einsum``, and :func:`pairs`
+(:func:`lookalike.association.solver.assign_pairs`'s pairs).
 
-:func:`compiled` gives the optional numba kernels (:mod:`lookalike.trackers.kernels.world_numba`, the ``fast``
-extra): the beacon identifier's window costs and assignment matrix, the Kalman trackers' gate and
-assignment matrix, each in one call up to the solver, and their lifecycle rules, value by value the
-operations of the numpy path in its order (no fused multiply-adds), so tracks and identities are bit for
-bit the same; ``tests/test_world_numba.py`` compares both paths. Two kernels stand for BLAS/LAPACK or
-``einsum`` calls whose rounding depends on the build: the gate's 2×2 triangular solve
-(:func:`lower_solve_exact`) and the update of matched tracks (:func:`update_exact`); each is compared with
-numpy's call on check data when the kernels load and used only where it gives the same bits. They are
-used when numba is installed unless ``LOOKALIKE_WORLD_NUMBA=0``. numba is imported at the first frame that
-needs them (``lookalike serve`` does it before serving: :func:`warm`), not with ``import lookalike``.
+:func:`compiled` gives the optional numba kernels (:mod:`lookalike.trackers.kernels.world_numba`), used unless
+``LOOKALIKE_WORLD_NUMBA=0``; ``tests/test_world_numba.py`` compares both paths. The two whose rounding depends
+on the BLAS build (:func:`lower_solve_exact`, :func:`update_exact`) are checked against numpy when the kernels
+load and used only where they agree. numba loads at the first frame that needs it (or :func:`warm`).
 """
 
 from __future__ import annotations
@@ -155,18 +147,15 @@ def _same_updates(kernels: ModuleType) -> bool:
 
 
 def lower_solve_exact(n_rhs: int = 1) -> bool:
-    """Whether the compiled kernels are in use and their 2×2 lower-triangular solve
-    (``world_numba.solve_lower``) gave numpy's ``solve`` bit for bit on the check systems when they loaded,
-    for ``n_rhs`` right-hand sides (the checks cover 1 to :data:`CHECKED_RHS`; the BLAS may take other code
-    for more). It does with the OpenBLAS of numpy 1.26; other BLAS builds may round otherwise: then the
-    Kalman gate whitens with numpy's ``solve``."""
+    """Whether the compiled 2×2 lower-triangular solve is in use and matched numpy's ``solve`` bit for bit on the
+    check systems for ``n_rhs`` right-hand sides (checked up to :data:`CHECKED_RHS`); otherwise the Kalman gate
+    uses numpy's ``solve``."""
     return n_rhs <= CHECKED_RHS and compiled() is not None and _lower_solve_exact
 
 
 def _same_lower_solves(kernels: ModuleType) -> bool:
-    """Compare ``kernels.solve_lower`` with numpy's ``solve`` on 4,800 systems: the Cholesky factors of
-    random 2×2 covariances (strongly correlated ones among them, whose solve swaps rows) with 1 to 16
-    right-hand sides each, as the Kalman gate solves them."""
+    """Compare ``kernels.solve_lower`` with numpy's ``solve`` on 4,800 random 2×2 Cholesky systems with 1 to 16
+    right-hand sides each."""
     rng = np.random.default_rng(20261202)
     for d in (1, 2, 5, 10, CHECKED_RHS):
         k = 960 // d

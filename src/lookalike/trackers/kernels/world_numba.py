@@ -1,8 +1,7 @@
 """The numba kernels of :mod:`lookalike.trackers.kernels.world` (imported only when numba is installed).
 
-Each kernel does the floating-point operations of the world trackers' numpy path value by value, in the same
-order and precision (no fused multiply-adds: ``fastmath`` off), so tracks and identities are bit for bit the same.
-Times are in seconds, headings and turn rates in radians (per second), positions in metres (world frame).
+Each does the numpy path's floating-point operations value by value in the same order (``fastmath`` off), so
+results are bit for bit the same. Seconds, radians, metres (world frame).
 """
 
 from __future__ import annotations
@@ -111,11 +110,11 @@ def window_costs(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np
 def identity_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np.ndarray, current: np.ndarray,
                   max_turn_rate: float, max_extrapolation_s: float, hysteresis: float,
                   max_cost: float) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-    """``BeaconIdentifier.assign_arrays`` up to the solver: the window costs ``(k, N)`` (:func:`window_costs`),
-    each held agent's (``current (k,)``, -1: none) cost less ``hysteresis`` (not below 0), the pairs allowed
-    (``<= max_cost``, at most 1) and the solver's matrix (forbidden pairs at ``max_cost + 1e-6``), and what
-    ``world_kernels.pairs`` decides from them: 0 no pair allowed, 1 the allowed pairs are disjoint (they are
-    the answer), 2 the solver is needed. Returns ``(decision, cost, work, allowed)``."""
+    """``BeaconIdentifier.assign_arrays`` up to the solver: window costs ``(k, N)``, each held agent's
+    (``current (k,)``, -1: none) cost less ``hysteresis`` (floored at 0), the allowed pairs (``<= max_cost``) and
+    the solver's matrix. Returns ``(decision, cost, work, allowed)``; decision as in ``world_kernels.pairs``
+    (0 none allowed, 1 disjoint pairs, 2 solve).
+    """
     k, n = samples.shape[0], th.shape[1]
     cost = np.empty((k, n))
     window_costs(th, q, q_count, samples, max_turn_rate, max_extrapolation_s, cost)
@@ -202,12 +201,9 @@ def _times_inverse(x: float, pivot: float, divide: bool) -> float:
 
 @_jit
 def solve_lower(l00: float, l10: float, l11: float, b0: float, b1: float, divide: bool) -> tuple[float, float, bool]:
-    """``np.linalg.solve(L, b)`` for a lower-triangular ``L = [[l00, 0], [l10, l11]]`` as LAPACK's ``dgesv``
-    computes it in OpenBLAS: row pivoting, the reciprocal of the pivot multiplied in by the factorisation, and by
-    the substitutions too unless ``divide`` (OpenBLAS divides by the pivots for a single right-hand side), with
-    whether the inputs were plain (finite, non-zero pivots; otherwise the result is not LAPACK's and the caller
-    must not use it). ``world_kernels`` compares it with numpy's ``solve`` before using it: other BLAS builds
-    may round otherwise (fused multiply-adds)."""
+    """``np.linalg.solve(L, b)`` for ``L = [[l00, 0], [l10, l11]]`` as OpenBLAS's ``dgesv`` rounds it (row pivoting,
+    reciprocal pivots multiplied in, divided instead when ``divide``), with whether the inputs were plain (finite,
+    non-zero pivots); otherwise the result must not be used. ``world_kernels`` checks it against numpy first."""
     if not (math.isfinite(l00) and math.isfinite(l10) and math.isfinite(l11) and math.isfinite(b0)
             and math.isfinite(b1) and l00 != 0.0 and l11 != 0.0):
         return 0.0, 0.0, False
@@ -283,10 +279,9 @@ def _gate_decision(work: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.n
 @_jit
 def update_hits(mean: np.ndarray, cov: np.ndarray, rows: np.ndarray, cols: np.ndarray, gain: np.ndarray,
                 cov_hit: np.ndarray, z: np.ndarray) -> None:
-    """The Kalman update of the tracks ``rows`` by the detections ``cols`` (positions ``z (d, 2)``, metres), in
-    place: ``mean[i] += Kᵀ (z[j] - mean[i, :2])`` with the transposed gains ``gain (k, 2, n)`` (each entry the sum
-    of the two products from 0, as ``einsum("kij,kj->ki", ...)`` adds them) and ``cov[i] = cov_hit[i]``, the
-    covariances after an update made beforehand. ``world_kernels`` compares it with the einsum before using it."""
+    """Kalman update of tracks ``rows`` by detections ``cols`` (``z (d, 2)``, metres), in place: ``mean[i] += Kᵀ
+    (z[j] - mean[i, :2])`` with transposed gains ``gain (k, 2, n)`` summed as ``einsum`` does, and ``cov[i] =
+    cov_hit[i]``. ``world_kernels`` checks it against the einsum first."""
     n = mean.shape[1]
     for r in range(rows.shape[0]):
         i, j = rows[r], cols[r]
@@ -369,15 +364,12 @@ def lifecycle_work(det_of_track: np.ndarray, hit_bits: np.ndarray, misses: np.nd
                    hits: np.ndarray, confirmed: np.ndarray, dt: float, confirm_window: int, n_init: int,
                    tentative_max_misses: int, max_misses: int, in_view: np.ndarray, limit_in_s: float,
                    limit_out_s: float) -> np.ndarray:
-    """``WorldTracker``'s lifecycle after association, in place on the table's columns (``k`` tracks): the hit
-    history ``hit_bits`` (bit 0 this frame, 30 bits kept; a hit is ``det_of_track >= 0``), ``misses`` (frames)
-    and ``unseen_s`` (seconds, ``dt`` a frame) reset by a hit or grown; with ``confirm_window`` > 0, ``hits``
-    counts the hits of the last ``confirm_window`` frames and a track with ``n_init`` of them is confirmed (for
-    good), and a confirmed track survives while unseen at most ``limit_in_s`` (``in_view``) or ``limit_out_s``;
-    with ``confirm_window`` 0 every track is confirmed. A tentative track survives fewer than
-    ``tentative_max_misses`` misses (-1: no limit), a confirmed one at most ``max_misses`` (-1: no limit).
-    The operations of ``WorldTracker._lifecycle`` and ``Lifecycle.alive`` (no seconds limits of their own);
-    returns the survivors' mask."""
+    """``WorldTracker._lifecycle`` and ``Lifecycle.alive`` in place on the table's columns (``k`` tracks): hit
+    history ``hit_bits`` (bit 0 this frame, 30 kept), ``misses`` (frames) and ``unseen_s`` (seconds, ``dt`` a
+    frame) reset by a hit or grown; with ``confirm_window`` > 0, ``n_init`` hits in the window confirm a track, and
+    a confirmed track survives unseen at most ``limit_in_s`` (``in_view``) or ``limit_out_s``; with 0 every track
+    is confirmed. Miss limits ``tentative_max_misses`` and ``max_misses`` (-1: none). Returns the survivors' mask.
+    """
     k = det_of_track.shape[0]
     keep = np.empty(k, np.bool_)
     window_mask = (1 << confirm_window) - 1 if confirm_window > 0 else 0

@@ -1,49 +1,18 @@
 """Offline closed-set identity: a whole result's tracklets assigned to N identities in one optimisation.
 
-When the number of targets N is known (23 pigs, 8 fish, 3 bugs) and the whole video is available,
-the identities need not be decided frame by frame. :func:`assign_identities` takes the result of an
-online pass (MOTChallenge rows, any ids) and:
+:func:`assign_identities` takes the rows of an online pass (any ids) and
 
-1. **Cuts it into reliable tracklets** (:func:`split_tracklets`): a track is cut wherever it has
-   missing frames (an online closed set re-assigns lost slots there), wherever it jumps (a step between
-   consecutive rows longer than ``jump`` times the sequence's 90th-percentile step, and at least
-   ``jump_floor`` box sizes) and, if ``contact_iou`` is set, around frames where its box overlaps
-   another track's box by that IoU. Each piece is a tracklet; pieces of fewer than ``min_rows`` rows
-   are set aside (step 4).
-2. **Scores links** between the end of one tracklet and the start of a later one, ``g`` frames on
-   (:func:`link_costs`), under two motion hypotheses: the target kept its velocity (mean over the last /
-   first ``velocity_frames`` rows; miss ``d`` = mean of the forward and backward extrapolation misses,
-   spread ``σ = pos_sigma·size + jitter·g``) or it went anywhere at its usual speed (miss = distance,
-   ``σ = pos_sigma·size + speed·g``). ``size`` (mean √(w·h)), ``speed`` (90th-percentile step, px/frame)
-   and ``jitter`` (median second difference of centres, px/frame²) are measured on the input. Each is
-   scored as a 2-D Gaussian negative log-likelihood ``½ (d/σ)² + 2 ln(σ / (pos_sigma·size))`` (the log
-   term makes the vague hypothesis pay for its spread) and the cheaper one is kept, plus ``link_cost``.
-   Pairs beyond ``max_z`` spreads are not candidates, and only the ``candidates`` cheapest successors of
-   every end and predecessors of every start are kept, so the problem stays small. Consecutive pieces
-   of one input track (cut by a contact) link at ``-tracklet_cost``, so a cut alone changes nothing.
-3. **Solves one integer programme** with scipy's HiGHS MILP (:func:`scipy.optimize.milp`): at most N
-   chains (a min-cost flow of N units from a source through tracklets to a sink), each tracklet on at
-   most one chain, each chain one identity. Links only go forward in time, so two tracklets that
-   overlap in time can never share an identity. A tracklet on no chain is clutter; using one earns
-   its number of rows minus ``tracklet_cost``, so short tracklets that need implausible links are
-   left out while long ones are kept even across long gaps. A chain that starts after the sequence's
-   first ``velocity_frames`` frames, or ends before its last, pays ``edge_cost``: a closed set's
-   targets are there all along, so when N exceeds the targets actually seen, a spare identity is not
-   a free way around a link.
-4. **Places the short pieces** (:func:`place_short`): a second HiGHS MILP assigns each to at most one
-   chain, near the chain's interpolated position, never two overlapping pieces to one chain, and only
-   where its rows outweigh a link's cost (so a stray row far past a chain's end is not bridged).
-5. **Writes ids 1..N** (chains ordered by their first frame), fills gaps of at most ``fill_gap_s``
-   seconds inside each identity by linear interpolation (:func:`lookalike.trackers.offline.fill_gaps`)
-   and smooths each identity's boxes by a running median (:func:`lookalike.trackers.offline.smooth_boxes`)
-   over :func:`smoothing_window` frames: at most ``smooth_s`` seconds and at most the time a target
-   typically takes to move ``smooth_move`` box sizes.
+1. cuts each track into tracklets at missing frames, jumps and (with ``contact_iou``) contacts
+   (:func:`split_tracklets`); pieces under ``min_rows`` rows are set aside;
+2. scores links between tracklet ends and later starts under a constant-velocity and a go-anywhere
+   hypothesis, as Gaussian negative log-likelihoods, keeping the ``candidates`` cheapest (:func:`link_costs`);
+3. picks at most N chains of tracklets with one HiGHS MILP (:func:`solve_chains`): a tracklet on no
+   chain is clutter;
+4. places the short pieces on the chains with a second MILP (:func:`place_short`);
+5. writes ids 1..N, fills gaps up to ``fill_gap_s`` seconds and smooths boxes by a running median.
 
-:func:`track_closed_set` runs the online pass itself on detection rows (``boxtrack`` in an *open* set
-with ``n_init=1``, reporting only detected boxes: a closed online set leaves detections that no slot
-takes out of every tracklet), then :func:`assign_identities`.
-
-All positions are pixels; times are converted with the sequence's frame rate (frames/s).
+:func:`track_closed_set` first runs the online pass (open-set ``boxtrack``, ``n_init=1``). Positions are
+pixels. The method and its parameters: docs/closed-set.md.
 """
 
 from __future__ import annotations

@@ -1,24 +1,12 @@
-"""Offline post-processing of a finished tracking result: link broken tracks, fill short gaps.
+"""Offline post-processing of a finished result (never inside an online ``update``): link broken tracks,
+fill short gaps, smooth boxes. Rows are MOTChallenge results ``(k, 10)`` (1-based frame, id, xywh in pixels, ...).
 
-This is *offline*: it needs the whole result (every frame) before it can change anything, so it is
-never part of an online tracker's ``update``. ``lookalike bench real`` runs it as its own entry
-(``boxtrack-offline``) beside the online trackers, clearly labelled.
-
-Input and output are MOTChallenge result rows ``(k, 10)``: 1-based frame, id, left, top, width,
-height (pixels), confidence, x, y, z.
-
-- **Linking** (:func:`link_tracks`): a track that ends at frame ``a`` and a track that starts at frame
-  ``b`` with ``0 < b - a ≤ link_gap_s`` seconds are candidates for one identity. Each end is extrapolated
-  forward and each start backward at its own mean velocity (over its last/first ``velocity_frames``
-  boxes, for at most ``coast_s`` seconds); the cost is the mean of the two centre misses in
-  heights of the box they are measured against. Pairs within ``link_distance`` heights whose widths and
-  heights differ by less than a factor ``scale`` are linked by a minimum-cost assignment (an end links
-  to one start at most, and vice versa), so chains form: the later track takes the earlier one's id.
-- **Filling** (:func:`fill_gaps`): frames missing inside one id's span, in runs of at most
-  ``fill_gap_s`` seconds, get boxes interpolated linearly between the boxes on either side.
-- **Smoothing** (:func:`smooth_boxes`): each id's box centres and sizes replaced by their running
-  median over a window of frames (a median keeps a steady motion where it is and removes single-frame
-  detector errors).
+- :func:`link_tracks`: a track ending at frame ``a`` and one starting at ``b``, ``0 < b - a <= link_gap_s``
+  seconds, are extrapolated towards each other at their mean velocities; pairs whose mean centre miss is
+  within ``link_distance`` box heights and sizes within a factor ``scale`` are linked by a minimum-cost
+  assignment (the later track takes the earlier id).
+- :func:`fill_gaps`: gaps of at most ``fill_gap_s`` seconds inside one id are interpolated linearly.
+- :func:`smooth_boxes`: each id's centres and sizes replaced by their running median.
 """
 
 from __future__ import annotations

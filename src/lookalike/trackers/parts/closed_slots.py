@@ -1,19 +1,10 @@
 """Closed-set slots: N identities (``max_targets``) that are never lost for good.
 
-A tracker with a known number of targets keeps at most N confirmed tracks (slots), which never
-die. Three rules keep a slot recoverable however long it is lost:
-
-- while a slot coasts, its box shape is frozen (no size velocity), so the shape gate keeps
-  accepting ordinary detections (:meth:`ClosedSlots.freeze_shape`);
-- the recovery gate (centre distance in the slot's size) grows with the time lost, by one size per
-  second or twice the targets' typical speed, whichever is more (:meth:`ClosedSlots.gate`;
-  :meth:`ClosedSlots.observe_speed` measures it on the tracked slots); sizes are ``sqrt(w·h)``, so
-  a target that turns (a fish bending, a wide box becoming tall) keeps passing the shape gate
-  (:meth:`ClosedSlots.squared`);
-- a slot lost for ``refill_s`` seconds or more is re-assigned to a candidate: a tentative track
-  started on left-over confident detections that persisted for ``n_init`` frames (the evidence a
-  target is there that no slot recovered). The slot keeps its id and takes the candidate's state
-  (:meth:`ClosedSlots.refill`).
+A tracker with a known number of targets keeps at most N confirmed tracks (slots), which never die. A
+coasting slot's box shape is frozen (:meth:`ClosedSlots.freeze_shape`); its recovery gate grows with the
+time lost (:meth:`ClosedSlots.gate`, sizes ``sqrt(w·h)``: :meth:`ClosedSlots.squared`); a slot lost
+``refill_s`` seconds or more is re-assigned to a persistent tentative track, keeping its id
+(:meth:`ClosedSlots.refill`).
 """
 
 from __future__ import annotations

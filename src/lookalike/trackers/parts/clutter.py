@@ -1,11 +1,8 @@
 """Clutter share: how many of a detector's detections are one-frame flickers, without ground truth.
 
-A target is seen in consecutive frames, so its detection overlaps one of the previous frame's;
-most clutter does not. :class:`ClutterShare` counts, over the sequence so far, the detections that
-overlap none of the previous frame's detections (IoU below ``min_iou``). Their share estimates the
-fraction of a detector's detections that are clutter: low for a detector of large, slow animals
-that sees every target in every frame, higher for a pedestrian detector in a busy street. A birth
-threshold set at that quantile of the score distribution adapts to both (docs/trackers/boxtrack.md).
+A target's detection usually overlaps one of the previous frame's; most clutter does not.
+:class:`ClutterShare` counts the detections overlapping none of the previous frame's (IoU below
+``min_iou``); their share sets the birth threshold's quantile (docs/trackers/boxtrack.md).
 """
 
 from __future__ import annotations

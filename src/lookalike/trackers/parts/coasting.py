@@ -1,9 +1,5 @@
-"""Coasting: what a tracker does with a confirmed track that missed its detection.
-
-:class:`Coasting` owns both decisions: a track lost for ``coast_s`` seconds or more stops
-extrapolating its velocity (it waits where it was last seen), and a track missed ``j`` frames is
-reported at its predicted box while this sequence's tracks missed ``j`` frames came back at least
-``report_prob`` of the time (:class:`lookalike.trackers.parts.self_calibration.MissReturns`).
+"""Coasting: a confirmed track lost ``coast_s`` seconds stops extrapolating, and a track missed ``j`` frames is
+reported while tracks missed ``j`` frames came back at least ``report_prob`` of the time (:class:`Coasting`).
 """
 
 from __future__ import annotations

@@ -1,25 +1,11 @@
 """Tracking-health monitor: is the detector failing, so that identities should not be relied on?
 
-Seed B's future work. The monitor sees only the detections (and timing) of each frame, so it can
-run beside any tracker. Per frame it flags
-
-- ``dropped``: frames missing before this one (a jump in ``Frame.index``, or a time step longer
-  than ``gap_factor`` × the usual frame interval);
-- ``empty``: no detections at all;
-- ``too_many``: more detections than the known team size (+ ``extra_allowed``): false positives
-  that a closed-set tracker must give someone's identity;
-- ``score_collapse``: the frame's mean detection score fell below ``collapse_ratio`` × the
-  baseline (the median per-frame mean score of earlier, non-collapsed frames);
-- ``too_few`` (informational, not unhealthy by itself: targets do leave the view).
-
-and per sliding window of the last ``window`` frames
-
-- ``unhealthy_frames``: more than ``max_bad_fraction`` of the window's frames are unhealthy;
-- ``undercount``: the mean detection count is below ``min_count_fraction`` × the team size;
-- ``score_collapse``: the window's mean score is below ``collapse_ratio`` × the baseline;
-- ``dropped``: more than ``max_dropped`` frames were dropped within the window.
-
-Scores are expected to be confidences (>= 0); with a baseline <= 0 the score checks are skipped.
+It sees only each frame's detections and time, so it runs beside any tracker. Per frame it flags
+``dropped`` (frames missing before this one), ``empty``, ``too_many`` (more detections than the team size
+plus ``extra_allowed``), ``score_collapse`` (mean score below ``collapse_ratio`` × the baseline median) and
+``too_few`` (informational). Over the last ``window`` frames it flags ``unhealthy_frames``, ``undercount``,
+``score_collapse`` and ``dropped``. Scores are confidences (>= 0); with a baseline <= 0 score checks are
+skipped.
 """
 
 from __future__ import annotations
@@ -70,11 +56,8 @@ class HealthConfig:
 
 @dataclass(frozen=True)
 class HealthStatus:
-    """The detector's health at one frame: its own flags and those of the window ending there.
-
-    ``reasons`` and ``window_reasons`` explain each flag in words; ``mean_score`` is NaN without
-    detections; ``dropped`` is the number of frames missing just before this one.
-    """
+    """The detector's health at one frame: its own flags and those of the window ending there (``reasons``,
+    ``window_reasons`` in words; ``mean_score`` NaN without detections; ``dropped`` frames missing before it)."""
 
     frame_index: int
     n_detections: int

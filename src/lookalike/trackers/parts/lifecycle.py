@@ -1,11 +1,4 @@
-"""Track lifecycle policy: when a track is confirmed, how long it coasts, when it is deleted.
-
-A tentative track becomes confirmed after ``n_init`` hits (confirmation is sticky). A tentative
-track dies once it has missed ``tentative_max_misses`` frames (or any time at all, with
-``tentative_max_unseen_s = 0``); a confirmed one after more than ``max_misses`` frames or
-``max_unseen_s`` seconds without an update. A closed set (the number of targets is known) never
-deletes confirmed tracks: :meth:`Lifecycle.closed_set`.
-"""
+"""Track lifecycle policy: when a track is confirmed and when it is deleted (:class:`Lifecycle`)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,7 @@
 """How well a motion model fits the targets, judged on the tracker's own matches (no ground truth).
 
-A constant-velocity filter tuned for walking people lags behind targets that turn and dart (toy
-robots, insects): its innovations are then much larger than its covariance says. :class:`MotionFit`
-compares the normalised innovation squared (NIS) of confirmed tracks' centres with its distribution
-under the model (chi-square, 2 degrees of freedom) and scales the process noise until their medians
-agree. It only ever raises the noise (scale >= 1), so targets the model already fits keep it.
+:class:`MotionFit` compares the normalised innovation squared (NIS) of confirmed tracks' centres with its
+chi-square (2 dof) distribution and raises the process noise until their medians agree (never lowers it).
 """
 
 from __future__ import annotations

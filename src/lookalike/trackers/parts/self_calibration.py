@@ -1,9 +1,7 @@
 """Statistics a tracker gathers on its own tracks to calibrate itself to a detector, without ground truth.
 
-:class:`ScoreBands` says which score band a detector's confident detections start at (by how often
-each band continues confirmed tracks); :class:`MissReturns` says how long a missed track is still
-likely present (by how often tracks missed that long came back). Both only count; the tracker
-decides what to do with the answers.
+:class:`ScoreBands`: the score band where confident detections start; :class:`MissReturns`: how long a
+missed track is likely still present. Both only count; the tracker decides.
 """
 
 from __future__ import annotations
@@ -52,11 +50,9 @@ class ScoreBands:
     def threshold(self, ratio: float, min_count: int) -> float:
         """The lowest score the evidence supports as confident (1.0 before any band has ``min_count``).
 
-        A band is judged once it holds ``min_count`` detections. Going down from the highest judged
-        band, each band whose share of continued detections (its one-sided 95% Wilson lower bound, so
-        a band is trusted only as far as its evidence goes) is at least ``ratio`` times the best judged
-        share lowers the threshold to its lower edge; the first band that fails, or is not judged,
-        stops the descent.
+        Going down from the highest judged band (``min_count`` detections), each band whose share of continued
+        detections (one-sided 95% Wilson lower bound) is at least ``ratio`` times the best judged share lowers the
+        threshold to its lower edge; the first band that fails or is not judged stops the descent.
         """
         # Only the bands the descent visits are computed, one at a time (the same float operations as the
         # whole-array form, so the same threshold to the last bit).
@@ -125,14 +121,12 @@ class MissReturns:
 
 
 class ScoreCalibration:
-    """Owner of a tracker's score thresholds: observes the sequence's scores and which detections
-    continued confirmed tracks, and decides this frame's high, birth and tentative thresholds.
+    """Owner of a tracker's score thresholds: observes scores and which detections continued confirmed tracks,
+    and decides each frame's high, birth and tentative thresholds.
 
-    The absolute ``high_score`` and ``birth_score`` are ceilings; each is lowered to a quantile of
-    every score seen so far (a histogram of ``bins`` bins on [0, 1]) when its quantile is set, the
-    high one also to the :class:`ScoreBands` threshold when ``high_match_ratio`` is set. The high
-    threshold never exceeds the birth threshold; the tentative one (``tentative_quantile``) never
-    exceeds the high one.
+    ``high_score`` and ``birth_score`` are ceilings, lowered to a quantile of the scores seen (``bins`` bins on
+    [0, 1]) when their quantile is set, the high one also to the :class:`ScoreBands` threshold with
+    ``high_match_ratio``. Always tentative <= high <= birth.
     """
 
     def __init__(self, high_score: float, birth_score: float, *, high_quantile: float | None = None,

@@ -1,19 +1,13 @@
 """SORT's tracks as one array, updated with a few array operations per frame.
 
-SORT's Kalman filter (state ``[u, v, s, r, u', v', s']``, constant velocity, diagonal ``Q``, ``R``
-and ``P0``, all four box numbers measured) never couples two coordinates: its covariance stays
-block-diagonal, a 2×2 block for each of ``(u, u')``, ``(v, v')``, ``(s, s')`` and a scalar for
-``r``. A track is therefore the 20 numbers ``[x1 (4) | x2 (4) | p11 (4) | p12 (4) | p22 (4)]``
-(position-like value, velocity, the block's three covariance entries; ``r`` has no velocity, so
-its ``x2``, ``p12`` and ``p22`` stay 0), the prediction is one matrix product and the update a
-handful of element-wise operations over the matched tracks. This is the same filter as the full
-7×7 one, to rounding (tests/test_sort.py compares it with a plain one-track-at-a-time oracle).
+SORT's Kalman filter (state ``[u, v, s, r, u', v', s']``, constant velocity, diagonal noises) keeps a
+block-diagonal covariance, so a track is 20 numbers ``[x1 (4) | x2 (4) | p11 (4) | p12 (4) | p22 (4)]``
+and the update is element-wise: the full 7×7 filter to rounding (tests/test_sort.py compares it with a
+one-track-at-a-time oracle).
 
-Association is the reference's: IoU between detections and predicted boxes in ``xyxy``; direct
-matches when every detection and track has at most one pair above the threshold, else a maximum-IoU
-matching, and pairs below the threshold dropped. With many boxes (:data:`SPARSE_FROM` pairs or
-more) only boxes whose x-ranges overlap are compared, and the matching is solved per connected
-component of the overlap graph: the same matches wherever the maximum-IoU matching is unique.
+Association is the reference's: IoU on ``xyxy``, direct matches when pairs above the threshold are
+disjoint, else a maximum-IoU matching. From :data:`SPARSE_FROM` pairs only boxes whose x-ranges overlap
+are compared, solved per connected component (the same matches wherever the matching is unique).
 """
 
 from __future__ import annotations

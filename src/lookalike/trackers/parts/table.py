@@ -1,10 +1,7 @@
 """``TrackTable``: a tracker's tracks as named numpy columns, one row per track.
 
-Every table has the columns ``ids`` (1-based, from a per-table counter), ``mean`` ``(k, n)`` and
-``cov`` ``(k, n, n)`` of the motion state (or the compact form its motion space keeps), ``hits`` (the
-tracker's hit count), ``misses`` (frames since the last update), ``unseen_s`` (seconds since the last
-update) and ``confirmed``. A tracker declares its extra columns (name → trailing shape and dtype)
-when it builds the table.
+Standard columns: ``ids`` (1-based, per table), ``mean (k, n)`` and ``cov`` of the motion state, ``hits``,
+``misses`` (frames), ``unseen_s`` (seconds) and ``confirmed``; a tracker declares extra columns.
 """
 
 from __future__ import annotations

@@ -97,15 +97,11 @@ class WorldTracker:
     # -- steps -------------------------------------------------------------------------------
 
     def prepare(self) -> None:
-        """Between frames (optional; the node calls it after sending a frame's team state): predict the
-        tracks for the next frame for each of the last two distinct frame intervals that has come more than
-        once (a camera stamping frames on a fixed period gives few distinct intervals in floating point; a
-        jittered clock none that repeat, and then nothing is prepared), with what the next frame's
-        association needs that does not depend on its detections (innovation covariances, their Cholesky
-        factors, the gains, the updated covariances, which tracks are predicted in view). :meth:`update`
-        uses them when the frame's interval is exactly one of them (they are the same operations on the
-        same values, so the result is bit for bit the one it would compute) and otherwise computes its own.
-        A subclass with its own association (JPDA) prepares nothing."""
+        """Between frames (optional; the node calls it): predict the tracks for each of the last two distinct frame
+        intervals seen more than once, with the detection-independent parts of the next association (innovation
+        covariances, Cholesky factors, gains, updated covariances, in-view flags). :meth:`update` uses them when
+        its interval matches exactly (same operations, same bits). JPDA prepares nothing.
+        """
         t = self._tracks
         self._ready = {}
         if (self._time is None or not len(t)
@@ -159,11 +155,8 @@ class WorldTracker:
     def _associate_and_update(self, det: Detections) -> np.ndarray:
         """Hungarian on the gated squared Mahalanobis distance; Kalman update of matched tracks.
 
-        The arithmetic of ``motion.kalman.gating_distance`` and ``kalman.update`` on the whole
-        table at once: ``H`` picks the position, so ``H P Hᵀ`` and ``P Hᵀ`` are slices of ``P`` (the
-        same values), and the innovation covariances are formed once for gating and update. When the frame
-        found its prediction made by :meth:`prepare` (``_frame_ready``), the covariances, factors, gains and
-        updated covariances are its own (the same values, computed between frames for every track).
+        ``motion.kalman``'s arithmetic on the whole table at once (``H`` picks the position, so ``H P Hᵀ`` and ``P
+        Hᵀ`` are slices of ``P``); uses :meth:`prepare`'s values when the frame found them.
         """
         t, ready = self._tracks, self._frame_ready
         det_of_track = filled(len(t), -1, int)
@@ -210,10 +203,8 @@ class WorldTracker:
         return det_of_track
 
     def _lifecycle(self, det_of_track: np.ndarray, dt: float, in_view: np.ndarray | None = None) -> np.ndarray:
-        """Record the frame's hits and misses (``dt`` seconds), confirm and delete tracks; return
-        ``det_of_track`` of the survivors. ``in_view``: which tracks were predicted in view (:meth:`prepare`);
-        their view only matters to the tracks that missed, whose positions are the predicted ones (a hit has
-        been unseen 0 s, within either limit)."""
+        """Record the frame's hits and misses (``dt`` seconds), confirm and delete tracks; return ``det_of_track`` of
+        the survivors. ``in_view``: which tracks were predicted in view (:meth:`prepare`)."""
         t, rules = self._tracks, self.rules
         window = rules.confirm_window
         if window is not None and in_view is None:

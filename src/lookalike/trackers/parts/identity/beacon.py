@@ -1,14 +1,11 @@
-"""The beacon identifier: which of the N reporting agents each track is (DESIGN §5).
+"""The beacon identifier: which of the N reporting agents each track is.
 
-Each frame, tracks are assigned to agents by the Hungarian method. The cost of track ``i`` and
-agent ``j`` is the mean over the last ``window_frames`` frames (where the track had a visual
-heading) of ``(1 - cos(φ_i(t) - ψ_j(t))) / 2`` in [0, 1], where ``ψ_j(t)`` is agent ``j``'s
-reported heading *at that frame's time*: interpolated between the reports sent around it, or
-extrapolated from the latest report with the agent's turn rate (estimated from its last two
-reports, clipped to ``max_turn_rate``) for at most ``max_extrapolation_s`` — this compensates for
-report age. Agents never heard from cannot be assigned. Hysteresis: a track's current agent costs
-``hysteresis`` less, so identities do not flicker; pairs costing more than ``max_cost`` are not
-assigned. The identity probability reported is ``1 - cost``.
+Each frame, tracks are assigned to agents by the Hungarian method on the cost ``(1 - cos(φ_i(t) -
+ψ_j(t))) / 2`` in [0, 1] averaged over the last ``window_frames`` frames with a visual heading ``φ_i``;
+``ψ_j(t)`` is agent ``j``'s reported heading at that frame's time, interpolated between its reports or
+extrapolated at its turn rate (clipped to ``max_turn_rate``) for at most ``max_extrapolation_s``.
+Agents never heard from cannot be assigned; a track's current agent costs ``hysteresis`` less; pairs
+above ``max_cost`` are not assigned. The identity probability is ``1 - cost``.
 """
 
 from __future__ import annotations
@@ -88,9 +85,8 @@ class BeaconIdentifier:
         self._win[:, self._slot] = np.nan
 
     def _shift_common(self, agent_id: np.ndarray, new_t: np.ndarray, heading: np.ndarray) -> bool:
-        """The common case of :meth:`begin_frame`: one report per agent, each newer than every one kept
-        of its agent or its first: shift them in, all agents at once (the same result as :meth:`_store`
-        per agent). False, nothing changed, for reports of any other kind."""
+        """:meth:`begin_frame`'s common case (one report per agent, each newer than those kept): shift all in at
+        once, as :meth:`_store` would. False, nothing changed, otherwise."""
         ids = agent_id.tolist()
         if len(set(ids)) < len(ids) or max(ids) >= self.config.n_agents or (new_t <= self._t[agent_id, -1]).any():
             return False
@@ -162,12 +158,7 @@ class BeaconIdentifier:
         return self._headings(q, np.where(np.isnan(q), np.inf, q))
 
     def _headings(self, q: np.ndarray, q_count: np.ndarray) -> np.ndarray:
-        """:meth:`agent_headings` at times ``q``, given ``q_count``: ``q`` with NaN as +inf.
-
-        All agents at once: each history row holds its ``k`` known reports in its last ``k``
-        columns (sorted send times), so indices into the known reports are offsets from ``r - k``;
-        both reports around each time are gathered from the flat histories in one take.
-        """
+        """:meth:`agent_headings` at times ``q`` for all agents at once; ``q_count``: ``q`` with NaN as +inf."""
         cfg = self.config
         n, r = self._t.shape
         if n == 0 or not len(q):

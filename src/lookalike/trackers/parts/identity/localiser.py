@@ -1,17 +1,13 @@
 """Agent positions from the detections an identifier assigns to each agent (observer frame, metres).
 
-Two localisers with one interface, ``update(time_s, measured (N, 2), weight (N,)) -> (N, 2)``
-(a row of NaN in ``measured``: no detection of that agent this frame; output NaN until an agent's
-first detection):
+Both localisers have ``update(time_s, measured (N, 2), weight (N,)) -> (N, 2)`` (NaN rows: not detected;
+NaN output until an agent's first detection):
 
-- :class:`LowPassLocaliser` — seed A's Eq. 3, ``T_j ← α·L_k + (1 − α)·T_j`` with ``α`` the class
-  probability of the assigned detection; an agent not detected keeps its last position.
-- :class:`KalmanLocaliser` — ours: one constant-velocity Kalman filter per agent whose velocity
-  relaxes to 0 with time constant ``velocity_decay_s`` (robots stop and turn), measurement noise
-  ``std = std0_m + std_per_m · distance`` divided by ``sqrt(α)`` (a doubtful assignment counts
-  less; below ``ignore_below`` not at all), a chi-square gate (a detection farther than the gate is
-  ignored, unless ``max_rejects`` in a row were, then the filter restarts there: the identifier was
-  right), and no position once an agent has gone ``max_coast_s`` without a detection.
+- :class:`LowPassLocaliser`: the robot-identification paper's low-pass filter ``T_j ← α·L_k + (1 − α)·T_j``
+  (``α`` the assignment's class probability).
+- :class:`KalmanLocaliser`: a constant-velocity Kalman filter per agent with decaying velocity, noise growing
+  with distance and shrinking with ``α``, a chi-square gate with restarts, and no position after
+  ``max_coast_s`` without detections.
 """
 
 from __future__ import annotations
@@ -26,7 +22,7 @@ LOCALISERS = ("lowpass", "kalman")
 
 
 class LowPassLocaliser:
-    """Seed A's first-order low-pass filter with the class probability as smoothing factor."""
+    """The robot-identification paper's first-order low-pass filter (class probability as smoothing factor)."""
 
     def __init__(self, n_agents: int) -> None:
         self.n_agents = n_agents
@@ -50,9 +46,7 @@ class LowPassLocaliser:
 
 @dataclass(frozen=True)
 class KalmanLocaliserConfig:
-    """Parameters of :class:`KalmanLocaliser` (metres, seconds). The defaults were chosen by a random
-    search on the shipped LSTM's assignments on tuning seeds (below 100000), see
-    docs/experiments/robot-identification.md."""
+    """Parameters of :class:`KalmanLocaliser` (metres, seconds); defaults: docs/experiments/robot-identification.md."""
 
     accel_std: float = 1.4  # m/s², white acceleration of the velocity model
     velocity_decay_s: float = 0.6  # velocity relaxes to 0 with this time constant
