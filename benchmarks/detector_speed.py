@@ -40,8 +40,8 @@ import numpy as np
 from _common import report_target
 
 from lookalike.association import assign
-from lookalike.bench.training_data import negative_sampler, rendered_detector_data
 from lookalike.geometry.boxes import iou_matrix
+from lookalike.learn.vision_train import negative_sampler, rendered_detector_data
 from lookalike.vision.hog_cascade import CascadeConfig, HogCascade, train_cascade
 from lookalike.vision.hog_features import augment_windows
 from lookalike.vision.hog_kernels import compiled, use_compiled

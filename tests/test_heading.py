@@ -3,6 +3,7 @@ import json
 import numpy as np
 import pytest
 
+from lookalike.learn.vision_train import rendered_heading_samples
 from lookalike.vision.heading import (
     HeadingClassifier,
     HeadingConfig,
@@ -10,7 +11,6 @@ from lookalike.vision.heading import (
     heading_class,
     heading_features,
     mean_abs_error_deg,
-    rendered_heading_samples,
     train_heading,
 )
 

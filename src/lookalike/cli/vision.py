@@ -22,8 +22,8 @@ from rich.progress import (
     TimeElapsedColumn,
 )
 
-from lookalike.bench.training_data import train_robot_detector
 from lookalike.cli.app import app, console, fail
+from lookalike.learn.vision_train import train_robot_detector
 
 
 def _progress() -> Progress:
@@ -75,12 +75,8 @@ def train_heading_command(
     seed: int = typer.Option(0, help="Seed of the training renders; held-out renders use seed + 1000003."),
 ) -> None:
     """Train the heading classifier on rendered robots, report its held-out error and save it."""
-    from lookalike.vision.heading import (
-        HeadingConfig,
-        mean_abs_error_deg,
-        rendered_heading_samples,
-        train_heading,
-    )
+    from lookalike.learn.vision_train import rendered_heading_samples
+    from lookalike.vision.heading import HeadingConfig, mean_abs_error_deg, train_heading
 
     try:
         config = HeadingConfig(folds=folds)

@@ -19,15 +19,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from lookalike.vision.hog_features import as_bgr_image, dense_hog, hue_channel, to_grey
 from lookalike.vision.model_file import load_model_file, save_model_file
-
-if TYPE_CHECKING:
-    from lookalike.geometry.camera import Camera
 
 FORMAT = "lookalike-heading-svm"
 VERSION = 1
@@ -100,13 +96,18 @@ def heading_features(image: np.ndarray, xywh: np.ndarray, config: HeadingConfig 
         centre = ((x + w / 2) / width, (y + h / 2) / height)
         out.append(np.concatenate([dense_hog(to_grey(patch), config.cell_px),
                                    dense_hog(hue_channel(patch), config.cell_px), centre]))
-    d = 2 * _hog_len(config) + 2
+    d = feature_length(config)
     return np.array(out, dtype=np.float32).reshape(-1, d)
 
 
 def _hog_len(config: HeadingConfig) -> int:
     nx, ny = config.patch_px[0] // config.cell_px, config.patch_px[1] // config.cell_px
     return (nx - 1) * (ny - 1) * 4 * 9
+
+
+def feature_length(config: HeadingConfig) -> int:
+    """Length of a row of :func:`heading_features`: two dense HOG blocks (grey, hue) and the box centre."""
+    return 2 * _hog_len(config) + 2
 
 
 @dataclass(frozen=True)
@@ -232,7 +233,7 @@ _ARRAYS = ("mean", "scale", "classes", "support", "n_support", "dual_coef", "int
 def _check_shapes(m: HeadingClassifier, d: int) -> None:
     k, s = len(m.classes), int(m.n_support.sum())
     pairs = k * (k - 1) // 2
-    if d != 2 * _hog_len(m.config) + 2 or m.mean.shape != (d,) or m.scale.shape != (d,):
+    if d != feature_length(m.config) or m.mean.shape != (d,) or m.scale.shape != (d,):
         raise ValueError(f"feature size {d} does not match the configuration")
     if m.support.shape != (s, d) or m.dual_coef.shape != (max(k - 1, 0), s) or len(m.n_support) != k:
         raise ValueError("support vector arrays disagree")
@@ -260,7 +261,7 @@ def train_heading(
 
     f = np.asarray(features, dtype=np.float64)
     h = np.asarray(heading_rad, dtype=float).reshape(-1)
-    d = 2 * _hog_len(config) + 2
+    d = feature_length(config)
     if f.ndim != 2 or f.shape[1] != d:
         raise ValueError(f"features: expected shape (n, {d}) for this configuration, got {f.shape}")
     if len(h) != len(f) or not np.isfinite(h).all() or not np.isfinite(f).all():
@@ -338,46 +339,3 @@ def mean_abs_error_deg(estimate_rad: np.ndarray, truth_rad: np.ndarray) -> float
     """Mean absolute angular difference in degrees."""
     diff = np.angle(np.exp(1j * (np.asarray(estimate_rad, float) - np.asarray(truth_rad, float))))
     return float(np.degrees(np.abs(diff)).mean())
-
-
-def rendered_heading_samples(
-    n_frames: int,
-    seed: int,
-    config: HeadingConfig = HeadingConfig(),
-    robots_per_frame: int = 4,
-    range_m: tuple[float, float] = (1.0, 5.0),
-    min_visible: float = 0.8,
-    box_jitter: float = 0.05,
-    camera: Camera | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
-    """Features ``(n, d)`` and true egocentric headings ``(n,)`` (rad) of robots rendered by
-    :class:`lookalike.sim.render_robots.RobotRenderer` at random places ``range_m`` (m) ahead inside the
-    field of view with random headings. Robots less than ``min_visible`` visible are skipped; boxes get a
-    Gaussian jitter of ``box_jitter`` × their size, as a detector's would. Deterministic by ``seed``."""
-    from lookalike.geometry.camera import Camera
-    from lookalike.sim.render_robots import RobotRenderer
-
-    if n_frames < 1 or robots_per_frame < 1:
-        raise ValueError(f"n_frames/robots_per_frame: need >= 1, got {n_frames}, {robots_per_frame}")
-    cam = camera if camera is not None else Camera.default()
-    renderer = RobotRenderer(camera=cam, seed=seed)
-    rng = np.random.default_rng(seed)
-    k = cam.intrinsics
-    half_fov = np.arctan(0.5 * k.width / k.fx)
-    feats, heads = [], []
-    for _ in range(n_frames):
-        depth = rng.uniform(*range_m, robots_per_frame)
-        lateral = depth * np.tan(rng.uniform(-half_fov, half_fov, robots_per_frame))
-        frame = renderer.render(np.column_stack([depth, lateral]), rng.uniform(-np.pi, np.pi, robots_per_frame))
-        keep = frame.visible >= min_visible
-        if not keep.any():
-            continue
-        boxes = frame.xywh[keep].copy()
-        boxes += rng.normal(0.0, box_jitter, boxes.shape) * boxes[:, [2, 3, 2, 3]]
-        boxes[:, 2:] = np.maximum(boxes[:, 2:], 4.0)
-        feats.append(heading_features(frame.image, boxes, config))
-        heads.append(frame.heading_rad[keep])
-    d = 2 * _hog_len(config) + 2
-    if not feats:
-        return np.zeros((0, d), np.float32), np.zeros(0)
-    return np.concatenate(feats), np.concatenate(heads)

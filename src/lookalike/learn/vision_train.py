@@ -1,5 +1,7 @@
-"""Training data for the robot detector (``lookalike train-detector``): windows of rendered robots
-(:mod:`lookalike.sim.render_robots`) or of a folder of images, negative sampling and held-out scenes."""
+"""Training data for the robot vision models: for the detector (``lookalike train-detector``), windows
+of rendered robots (:mod:`lookalike.sim.render_robots`) or of a folder of images, negative sampling and
+held-out scenes; for the heading classifier (``lookalike train-heading``), features and true headings of
+rendered robots (:func:`rendered_heading_samples`)."""
 
 from __future__ import annotations
 
@@ -10,10 +12,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from lookalike.vision.heading import HeadingConfig, feature_length, heading_features
+
 if TYPE_CHECKING:
     from lookalike.geometry.camera import Camera
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+HEADING_CONFIG = HeadingConfig()  # the heading classifier's default settings
 
 
 def rendered_detector_data(
@@ -177,5 +182,48 @@ def train_robot_detector(data: Path | None, frames: int, stages: int, negatives:
     return model, trained, tried
 
 
+def rendered_heading_samples(
+    n_frames: int,
+    seed: int,
+    config: HeadingConfig = HEADING_CONFIG,
+    robots_per_frame: int = 4,
+    range_m: tuple[float, float] = (1.0, 5.0),
+    min_visible: float = 0.8,
+    box_jitter: float = 0.05,
+    camera: Camera | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Features ``(n, d)`` and true egocentric headings ``(n,)`` (rad) of robots rendered by
+    :class:`lookalike.sim.render_robots.RobotRenderer` at random places ``range_m`` (m) ahead inside the
+    field of view with random headings. Robots less than ``min_visible`` visible are skipped; boxes get a
+    Gaussian jitter of ``box_jitter`` × their size, as a detector's would. Deterministic by ``seed``."""
+    from lookalike.geometry.camera import Camera
+    from lookalike.sim.render_robots import RobotRenderer
+
+    if n_frames < 1 or robots_per_frame < 1:
+        raise ValueError(f"n_frames/robots_per_frame: need >= 1, got {n_frames}, {robots_per_frame}")
+    cam = camera if camera is not None else Camera.default()
+    renderer = RobotRenderer(camera=cam, seed=seed)
+    rng = np.random.default_rng(seed)
+    k = cam.intrinsics
+    half_fov = np.arctan(0.5 * k.width / k.fx)
+    feats, heads = [], []
+    for _ in range(n_frames):
+        depth = rng.uniform(*range_m, robots_per_frame)
+        lateral = depth * np.tan(rng.uniform(-half_fov, half_fov, robots_per_frame))
+        frame = renderer.render(np.column_stack([depth, lateral]), rng.uniform(-np.pi, np.pi, robots_per_frame))
+        keep = frame.visible >= min_visible
+        if not keep.any():
+            continue
+        boxes = frame.xywh[keep].copy()
+        boxes += rng.normal(0.0, box_jitter, boxes.shape) * boxes[:, [2, 3, 2, 3]]
+        boxes[:, 2:] = np.maximum(boxes[:, 2:], 4.0)
+        feats.append(heading_features(frame.image, boxes, config))
+        heads.append(frame.heading_rad[keep])
+    d = feature_length(config)
+    if not feats:
+        return np.zeros((0, d), np.float32), np.zeros(0)
+    return np.concatenate(feats), np.concatenate(heads)
+
+
 __all__ = ["IMAGE_SUFFIXES", "folder_detector_data", "negative_sampler", "rendered_detector_data",
-           "rendered_held_out_scenes", "train_robot_detector"]
+           "rendered_heading_samples", "rendered_held_out_scenes", "train_robot_detector"]
