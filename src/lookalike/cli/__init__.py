@@ -1,9 +1,7 @@
-"""The ``lookalike`` command line (typer). Each command lives in its own module of this package.
+"""The ``lookalike`` command line (typer); each command lives in its own module of this package.
 
-Importing a command module registers its commands on ``app``. Imported by anything else, this
-package imports every command module; run as the ``lookalike`` script (or ``python -m lookalike``)
-with a command of :data:`COMMAND_MODULES`, it imports only that command's module, so
-``lookalike trackers --names`` does not load the benchmarks' or the video pipeline's dependencies.
+Run as the ``lookalike`` script, only the module of the command given (:data:`COMMAND_MODULES`) is imported;
+imported by anything else, this package imports them all.
 """
 
 from __future__ import annotations

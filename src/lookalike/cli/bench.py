@@ -1,5 +1,4 @@
-"""``lookalike bench``: benchmarks that print tables; ``bench ident`` is seed A's Table I
-(:mod:`lookalike.bench.ident`). Table printing shared by the bench commands lives here."""
+"""``lookalike bench``: benchmarks that print tables, and the table printing they share."""
 
 from __future__ import annotations
 
@@ -88,9 +87,10 @@ def ident(
     seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the test sequences."),
     json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
-    noise: str = typer.Option("ours", "--noise", help="Simulator position noise: paper (seed A's) or ours."),
+    noise: str = typer.Option("ours", "--noise",
+                              help="Simulator position noise: paper (the robot-identification paper's) or ours."),
     lengths: str | None = typer.Option(
-        None, "--lengths", help="Seed A's Table III instead: success rate on random windows of these lengths "
+        None, "--lengths", help="The paper's Table III instead: success rate on random windows of these lengths "
         "(frames, comma-separated, e.g. 200,400,800) and on the whole recordings."),
     draws: int = typer.Option(4, "--draws", min=1, help="Random windows per length (Table III)."),
     recordings: Path | None = typer.Option(
@@ -103,8 +103,8 @@ def ident(
         None, "--weights", help="Exported weights (.npz) for the lstm and lstm-lowpass rows instead of the "
         "shipped ones, e.g. a training run's model.npz (one set-up)."),
 ) -> None:
-    """Seed A's Table I: identification success rate per set-up and identifier (+ error, speed).
-    With --lengths or --recordings: seed A's Table III protocol."""
+    """The robot-identification paper's Table I: identification success rate per set-up and identifier (+ error, speed).
+    With --lengths or --recordings: the paper's Table III protocol."""
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
     check_names("--trackers", tracker_list, [*tracker_names(), *IDENT_VARIANTS], "tracker")
@@ -129,7 +129,7 @@ def ident(
     print_rows("Per set-up details", rows, IDENT_COLUMNS)
     margins = margin_rows(rows, setup_list, labels)
     if margins:
-        print_rows("LSTM margins over Kalman-HA on the same sequences, beside seed A's (Table I)", margins)
+        print_rows("LSTM margins over Kalman-HA on the same sequences, beside the paper's (Table I)", margins)
     differences = ident_differences(counts, setup_list, tracker_list)
     print_differences(differences, tracker_list[0], "points")
     write_results(ident_results(rows, setup_list, sequences, frames, seed, command_line(), noise,
@@ -140,7 +140,7 @@ def ident(
 def table3_command(setups: list[str], trackers: list[str], sequences: int, frames: int, seed: int, noise: str,
                    lengths: str | None, draws: int, recordings: Path | None, json_path: Path | None,
                    csv_path: Path | None, human: Path | None = None) -> None:
-    """``bench ident --lengths/--recordings/--human``: seed A's Table III per set-up (or on the recordings),
+    """``bench ident --lengths/--recordings/--human``: the paper's Table III per set-up (or on the recordings),
     with the human benchmark's sessions when there are result files."""
     from lookalike.bench.table3 import DEFAULT_LENGTHS, table3_table
 
@@ -155,7 +155,7 @@ def table3_command(setups: list[str], trackers: list[str], sequences: int, frame
                                 progress, human, sessions)
     except (ValueError, FileNotFoundError) as exc:
         fail(str(exc))
-    print_rows(f"Success rate by sequence length (seed A's Table III protocol: {draws} random windows per "
+    print_rows(f"Success rate by sequence length (the paper's Table III protocol: {draws} random windows per "
                "length, then whole recordings)", rows)
     if sessions:
         print_rows("Human benchmark sessions (lookalike label --benchmark): the 'human' rows", sessions)

@@ -28,7 +28,7 @@ def divers(
                                               "learned or FILE.onnx; deep SORT and diver SORT run with each "
                                               "(default: handcrafted and learned, the entries above)."),
     detections: str = typer.Option("sim", "--detections", help="Detector level: 'sim' (the scenarios' own), "
-                                   "'paper' (seed B's DP/DR per video) or 'both' (one table each)."),
+                                   "'paper' (the diver-tracking paper's DP/DR per video) or 'both' (one table each)."),
     seed: int = typer.Option(0, min=0, help="Scenario draw: 0 the published scenarios, others new draws."),
     png: Path | None = typer.Option(None, "--png", help="Write the IDF1 bar chart here (of the last table)."),
     json_path: Path | None = typer.Option(None, "--json", help="Write the results document (JSON)."),

@@ -1,5 +1,5 @@
-"""``lookalike bench shuffle`` and ``bench recovery``: seed A's control and recovery experiments
-(:mod:`lookalike.bench.experiments`)."""
+"""``lookalike bench shuffle`` and ``bench recovery``: the robot-identification paper's control and recovery
+experiments (:mod:`lookalike.bench.experiments`)."""
 
 from __future__ import annotations
 

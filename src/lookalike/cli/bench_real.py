@@ -1,9 +1,5 @@
 """``lookalike bench real``: a leaderboard on real data, lookalike's box trackers against the peers.
-
 Datasets, runners and ranking live in :mod:`lookalike.bench`; this module parses options and prints.
-``--part first|second`` scores the first or second half of every sequence (boxtrack's bench presets
-were chosen on first halves); ``--workers N`` runs jobs in N processes, ``--backend ray`` as Ray
-tasks (tables identical).
 """
 
 from __future__ import annotations

@@ -1,16 +1,9 @@
 """Option values converted without pydantic where typer's own conversion would give the same value.
 
-typer 0.29 (pinned in constraints.txt) converts every option value with a pydantic ``TypeAdapter``
-built for each parameter of the command being run, even for an option left at its default (and for
-``--help``): importing pydantic and building the adapters is a fifth of a short command's CPU time.
-:func:`install` makes typer build each parameter's converter on first use and convert the common
-plain cases directly, with typer's own rules: a ``str`` (kept as it is), a ``list[str]``, a default
-already of its ``int``/``float`` type within the option's bounds, and a ``Path`` (or ``list[Path]``)
-given as text (``Path(text)``, then typer's own existence/readability checks, which need no pydantic). Anything
-else (every number typed on the command line, every value typer would reject, custom parsers,
-choices, files) goes to typer's pydantic converter, so values and error messages are typer's.
-``tests/test_cli_coercion.py`` checks both give the same value or the same error for every option
-of every command on a set of awkward inputs.
+typer (pinned in constraints.txt) builds a pydantic ``TypeAdapter`` per parameter even for defaults and
+``--help``, a fifth of a short command's CPU time. :func:`install` converts the plain cases directly with
+typer's rules (``str``, ``list[str]``, in-bounds defaults of their type, ``Path`` text) and hands everything
+else to typer, so values and errors are typer's (``tests/test_cli_coercion.py`` checks this).
 """
 
 from __future__ import annotations
@@ -52,8 +45,8 @@ def _plain_value(annotation: Any, info: Any, value: Any, param: Any, ctx: Any) -
 
 
 def install() -> bool:
-    """Make typer convert plain option values without pydantic (see the module's docstring); returns
-    False, changing nothing, where typer's internals are not the ones this was written for."""
+    """Make typer convert plain option values without pydantic; False, changing nothing, where typer's
+    internals are not the expected ones."""
     try:
         import typer.core as core
         from typer._coercion import RuntimeParam

@@ -1,9 +1,5 @@
-"""``lookalike eval --points``: score results against point ground truth (anonymous animals, robots' heads).
-
-Ground truth: a text file with ``frame, id, x, y`` per line (1-based frames, positions in pixels; an
-optional header line and extra columns are ignored). Results: MOTChallenge result files (``lookalike
-track`` output, e.g. of ``--points``), scored by their box centres, or ``frame, id, x, y`` files. Objects
-match within ``--radius`` pixels (:func:`lookalike.eval.evaluate_points`). Not a command of its own.
+"""The ``--points`` branch of ``lookalike eval``: results scored against point ground truth (``frame, id, x, y``
+per line, pixels), matched within ``--radius`` pixels (:func:`lookalike.eval.evaluate_points`).
 """
 
 from __future__ import annotations

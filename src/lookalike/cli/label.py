@@ -58,7 +58,7 @@ def label(
     button or --export) writes STEM.labelled.jsonl (simulator truth format) and
     STEM.labels.mot.txt (MOTChallenge, positions in the world columns); with --benchmark, --export
     also (re)writes the finished session's result file. `bench ident --lengths ... --human DIR`
-    puts the result files beside the identifiers (seed A's Table III).
+    puts the result files beside the identifiers (the robot-identification paper's Table III).
     """
     from lookalike.io.robot_sequences import read_robot_sequence
     from lookalike.viz.label import load_labels, make_server, open_label_app

@@ -1,12 +1,5 @@
-"""Progress bars with time left for the long commands (``bench ...``, ``tune``).
-
-Usage in a command::
-
-    with progress_bars() as progress:      # a lookalike.bench.progress.ProgressFactory
-        rows = ident_table(..., progress=progress)
-
-Bars go to stderr, so ``--json -`` style output and piped tables stay clean; they vanish when done
-and are not drawn when stderr is not a terminal (tests, logs).
+"""Progress bars with time left for the long commands (``bench ...``, ``tune``), drawn on stderr and only
+when it is a terminal: ``with progress_bars() as progress: ...``.
 """
 
 from __future__ import annotations

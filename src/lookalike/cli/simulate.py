@@ -19,8 +19,8 @@ def simulate(
     seed: int = typer.Option(0, "--seed", help="Seed of the first sequence."),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for the .jsonl files."),
     noise: str = typer.Option(DEFAULT_NOISE, "--noise",
-                              help="Position-noise model: paper (seed A's, larger across the image) or ours "
-                              "(larger in depth)."),
+                              help="Position-noise model: paper (the robot-identification paper's, larger across the "
+                              "image) or ours (larger in depth)."),
 ) -> None:
     """Simulate identical robots seen by an observer, with heading reports; write JSON Lines files.
 

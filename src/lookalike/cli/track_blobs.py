@@ -1,18 +1,9 @@
-"""``lookalike track --video FILE --detector blob``: detections from the blob detector instead of a det.txt.
+"""The ``--video FILE --detector blob`` branch of ``lookalike track`` (not a command of its own).
 
-The blob settings are estimated from the video itself (:func:`~lookalike.viz.blob_video.auto_blob_config`,
-with ``--targets N`` when given) and printed, one ``KEY=VALUE`` per decision; ``--blob KEY=VALUE`` wins
-over the estimate. The detections are cached on disk (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``,
-keyed by the video's content, the settings and the version) and written as a MOTChallenge detection
-file ``<output stem>.det.txt`` beside the result; that file feeds the ordinary ``--video`` branch
-(:func:`~lookalike.cli.track_video.run_track_video`: any registered tracker, health monitor, optional
-annotated video) or, with ``--offline``, the closed set (:func:`~lookalike.cli.track_closed.offline_video`).
-
-Blob detections are a different kind of input from a trained detector's (docs/blobs.md): ``boxtrack``
-gets :func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config` (the rule the benches share:
-:data:`~lookalike.vision.blob_auto.BOX_TRACKER_PARAMS` for every parameter the user did not give, and,
-without ``--targets``, a closed set of the number of targets inferred from the blob count per frame;
-the inference is printed, ``--targets 0`` keeps the open set). Not a command of its own.
+Blob settings are estimated from the video (:func:`~lookalike.viz.blob_video.auto_blob_config`) and printed;
+``--blob KEY=VALUE`` overrides them. Detections are cached (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``),
+written to ``<output stem>.det.txt`` and tracked as the ``--video`` branch does, or by the offline closed set.
+``boxtrack`` gets :func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config` (docs/blobs.md).
 """
 
 from __future__ import annotations

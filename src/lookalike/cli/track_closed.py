@@ -1,11 +1,6 @@
-"""``lookalike track --targets N --offline`` and ``lookalike track --points FILE``: the closed-set offline
-branch and the point-input branch of ``lookalike track``. Not commands of their own.
-
-``--offline`` hands the whole sequence's detections to
-:func:`lookalike.trackers.offline.closed_set.track_closed_set` (an open-set online ``boxtrack`` pass with the
-user's parameters, then one global assignment of its tracklets to N identities) and writes the result
-atomically. ``--points`` reads anonymous points (:mod:`lookalike.io.points`), turns them into small
-boxes (:func:`~lookalike.io.points.points_to_rows`) and tracks them online or offline.
+"""The ``--targets N --offline`` and ``--points FILE`` branches of ``lookalike track`` (not commands of their own):
+the offline closed set (:func:`lookalike.trackers.offline.closed_set.track_closed_set`) and anonymous points
+tracked as small boxes (:mod:`lookalike.io.points`).
 """
 
 from __future__ import annotations

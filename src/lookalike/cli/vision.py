@@ -1,10 +1,8 @@
-"""``lookalike train-detector`` and ``lookalike train-heading``: train the vision models of DESIGN §6.
+"""``lookalike train-detector`` and ``lookalike train-heading``: train the vision models.
 
-Both train from rendered robots (:mod:`lookalike.sim.render_robots`) by default; the detector also
-trains from a folder with ``positives/`` (images each showing one target filling the window, any
-size) and ``negatives/`` (images without targets, from which windows are sampled). A detector trained on
-rendered robots is then cut to the cascade prefix (and pyramid start) with the best F1 on held-out
-renders, whose detections also calibrate its probability (:mod:`lookalike.vision.hog_select`).
+Both train from rendered robots by default; the detector also from a folder of ``positives/`` (one target
+filling each image) and ``negatives/``. A detector trained on renders is cut to the cascade prefix with
+the best F1 on held-out renders (:mod:`lookalike.vision.hog_select`).
 """
 
 from __future__ import annotations
