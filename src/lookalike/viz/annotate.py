@@ -1,9 +1,5 @@
-"""Drawing tracking results on frames: identity-coloured boxes, labels, tails, a caption and a legend.
-
-Every coloured mark has a dark outline (:data:`~lookalike.viz.colors.OUTLINE`) so that it stands out
-on any scene; labels placed through a :class:`LabelSpace` avoid each other; tails keep a limited
-number of points and break at gaps and jumps. All coordinates are pixels of the image being drawn
-on; images are ``(h, w, 3)`` uint8 BGR and are modified in place. OpenCV is imported lazily.
+"""Drawing tracking results on frames: identity-coloured outlined boxes, labels that avoid each other, tails,
+a caption and a legend. Coordinates are pixels; images ``(h, w, 3)`` uint8 BGR, modified in place.
 """
 
 from __future__ import annotations
@@ -161,10 +157,9 @@ class Tails:
 def draw_box_tracks(image: np.ndarray, frame: int, ids: np.ndarray, xywh: np.ndarray, tails: Tails,
                     prefix: str = "id ", max_gap: int = 5, labels: LabelSpace | None = None,
                     dashed: np.ndarray | None = None) -> None:
-    """Boxes ``xywh (n, 4)`` (px) of tracks ``ids (n,)`` in their identity colours, with tails of
-    their bottom-centres (``tails`` is updated with this frame's points; tails of tracks unseen for
-    more than ``max_gap`` frames are dropped; a jump of more than the box's height breaks a tail);
-    labels avoid each other (and those already in ``labels``); ``dashed (n,)`` marks boxes drawn dashed."""
+    """Boxes ``xywh (n, 4)`` (px) of tracks ``ids (n,)`` in their identity colours, with tails of their
+    bottom-centres (``tails`` updated; dropped after ``max_gap`` frames unseen; broken by a jump over the box's
+    height); labels avoid each other and ``labels``; ``dashed (n,)`` marks boxes drawn dashed."""
     boxes = np.asarray(xywh, dtype=float).reshape(-1, 4)
     ids = np.asarray(ids).reshape(-1).astype(int)
     if len(ids) != len(boxes):

@@ -1,13 +1,9 @@
 """Blob detections of a whole video as MOTChallenge rows (``lookalike track --video V --detector blob``).
 
-The video is read twice: once to fit the median background on ``history`` frames spread evenly over
-it (the ``median`` method; ``mog2`` learns online and skips this pass), once to detect.
-
-:func:`auto_blob_config` is the settings ``track --detector blob`` uses: those estimated from the video
-(:func:`lookalike.vision.blob_auto.estimate_blob_config`), overridden by the user's ``--blob KEY=VALUE``.
-:func:`cached_blob_detection_rows` keeps the detections on disk (``$LOOKALIKE_CACHE`` or
-``~/.cache/lookalike``, under ``blobs/``), keyed by the video's content hash, every setting of the
-configuration, the lookalike version and the detector's code, so a cached result is only served for the same inputs.
+The ``median`` method reads the video twice (background from ``history`` frames, then detection).
+:func:`auto_blob_config` gives the estimated settings with the user's overrides;
+:func:`cached_blob_detection_rows` caches detections on disk (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``),
+keyed by the video's content, every setting, the version and the detector's code.
 """
 
 from __future__ import annotations
@@ -76,10 +72,9 @@ def blob_settings(settings: list[str]) -> dict[str, Any]:
 
 def auto_blob_config(video: Path | str, settings: list[str], n_targets: int | None = None,
                      cache: Path | None | bool = True) -> tuple[BlobConfig, BlobEstimate | None]:
-    """The blob settings for ``video``: estimated from the video (``n_targets`` when known), then the
-    ``KEY=VALUE`` ``settings`` on top (they win). No estimate is made when ``settings`` give the
-    threshold, polarity and both areas; the estimate is returned (None then) so it can be printed.
-    The estimate is cached as the detections are (``cache``: see :func:`cached_blob_detection_rows`)."""
+    """The blob settings for ``video``: estimated (with ``n_targets`` when known), then ``KEY=VALUE`` ``settings``
+    on top. Skips the estimate when ``settings`` give threshold, polarity and both areas; returns the estimate
+    (or None) so it can be printed. Cached like the detections."""
     given = blob_settings(settings)
     if {"threshold", "polarity", "min_area_px", "max_area_px"} <= set(given):
         return BlobConfig(**given), None

@@ -1,10 +1,6 @@
-"""The demo's diver scenes: render each frame once, extract appearance features, run every box
-tracker online, score them (IDF1, HOTA, MOTA, ID switches, frames/s) and optionally write an
-annotated video, the raw video, a still and the MOTChallenge files.
-
-The annotated video tells true, false and missed apart against the ground truth: a track on a diver
-is a solid box in its identity colour, a track on no diver a dashed red box labelled "false", a
-visible diver without a track a dashed white box labelled "missed"; a legend says so.
+"""The demo's diver scenes: render, extract features, run every box tracker, score them (IDF1, HOTA, MOTA, ID
+switches, frames/s) and optionally write videos, a still and MOTChallenge files. The annotated video marks
+tracks on a diver (solid), false tracks (dashed red) and missed divers (dashed white).
 """
 
 from __future__ import annotations
@@ -37,8 +33,6 @@ from lookalike.viz.video import VideoWriter
 FALSE_TRACK: BGR = (40, 40, 235)  # red: a track on no diver
 MISSED: BGR = (255, 255, 255)  # white: a visible diver without a track
 MATCH_IOU = 0.3  # a track box on a diver (coasting boxes lag a little)
-
-Extractor = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
 def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *,

@@ -1,8 +1,5 @@
-"""A single self-contained HTML report: headings, text, tables, embedded images (base64), links.
-
-Images (PNG, GIF, JPEG) are read when added and embedded as ``data:`` URIs, so the file can be
-mailed on its own; videos are shown inline by a ``<video>`` element (and linked) by a path relative
-to the report.
+"""A single self-contained HTML report: headings, text, tables, images embedded as ``data:`` URIs, and videos
+linked by relative path.
 """
 
 from __future__ import annotations

@@ -1,7 +1,5 @@
-"""Optional live view: frames, boxes and world positions logged to the Rerun viewer (``rerun-sdk``).
-
-``rerun-sdk`` is an optional extra, imported lazily; :func:`open_rerun` raises a ``ValueError``
-naming the package when it is missing. Colours are the identity colours used everywhere else.
+"""Optional live view: frames, boxes and world positions logged to the Rerun viewer (the optional ``rerun-sdk``,
+imported lazily; :func:`open_rerun` raises ``ValueError`` when it is missing).
 """
 
 from __future__ import annotations

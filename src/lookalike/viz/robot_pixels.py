@@ -1,12 +1,9 @@
-"""Robots identified from a video's pixels (``lookalike track --video V --pipeline robots``) and
-robot sequences drawn through the robot camera (``lookalike render-robots``).
+"""Robots identified from a video's pixels (``lookalike track --video V --pipeline robots``) and robot
+sequences drawn through the robot camera (``lookalike render-robots``).
 
-The pipeline (:class:`lookalike.vision.pipeline.RobotPipeline`) detects robots with the HOG cascade,
-estimates their headings, projects the boxes to the ground through the default robot camera
-(:meth:`lookalike.geometry.Camera.default`: 640×480, 70° field of view, 0.9 m high, 25° down) and
-identifies them with the heading reports of a ``lookalike simulate`` file (its received beacons,
-frame times and observer yaw; frame k of the file belongs to frame k of the video). The frames go
-through :func:`lookalike.loop.run`; rows stream to the result file.
+The pipeline (:class:`lookalike.vision.pipeline.RobotPipeline`) detects robots, estimates their headings,
+projects boxes to the ground through :meth:`lookalike.geometry.Camera.default` and identifies them with the
+heading reports of a ``lookalike simulate`` file (frame k of the file is frame k of the video).
 """
 
 from __future__ import annotations

@@ -1,10 +1,5 @@
-"""The demo's robot scene: simulate a preset, render it through the camera, run identifiers frame
-by frame, and write an annotated video (identity colours, tails, false-positive labels), a still
-and a bird's-eye plot of true vs estimated paths.
-
-Detections come from the robot world simulator (observer-frame positions, metres); they are drawn
-as the box an upright robot at that ground position would have. Identities are those of the
-``video_tracker``; every tracker is scored (success rate, localisation error, frames/s).
+"""The demo's robot scene: simulate a preset, render it through the camera, run identifiers frame by frame,
+and write an annotated video, a still and a bird's-eye plot of true vs estimated paths.
 """
 
 from __future__ import annotations
@@ -59,13 +54,9 @@ def _to_fixed(ego: np.ndarray, pose: np.ndarray) -> np.ndarray:
 def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 300, seed: int = 0,
                     trackers: list[str], video_tracker: str, render_width: int = 320, scale: int = 2,
                     advance: Callable[[], None] | None = None, rerun: Any = None) -> RobotSceneResult:
-    """Simulate ``frames`` frames of preset ``preset_name``, run ``trackers`` and write
-    ``robots.mp4``, ``robots.gif``, ``robots-still.png`` and ``robots-birdseye.png`` in ``out_dir``.
-
-    The scene is rendered ``render_width`` pixels wide (4:3) and annotated at ``scale`` times that
-    size. ``advance`` is called after every frame (progress bars). ``rerun`` (a
-    :class:`~lookalike.viz.rerun_log.RerunLogger`) also receives frames, boxes and world positions.
-    """
+    """Simulate ``frames`` frames of ``preset_name``, run ``trackers`` and write ``robots.mp4``, ``robots.gif``,
+    ``robots-still.png`` and ``robots-birdseye.png`` in ``out_dir`` (rendered ``render_width`` pixels wide,
+    annotated at ``scale`` times; ``advance`` called every frame; ``rerun`` also receives the frames)."""
     import cv2
 
     if video_tracker not in trackers:

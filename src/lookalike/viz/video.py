@@ -1,8 +1,5 @@
-"""Writing annotated videos and short animated GIFs (Pillow), reading videos (OpenCV).
-
-MP4s are H.264 (yuv420p, ``+faststart``) through PyAV (the ``viz`` extra), so that every browser
-plays them inline; without PyAV they fall back to OpenCV's ``mp4v``, which browsers refuse.
-PyAV, OpenCV and Pillow are imported lazily inside the functions that need them.
+"""Writing annotated videos and animated GIFs, reading videos. MP4s are H.264 through PyAV (the ``viz`` extra)
+so browsers play them, else OpenCV's ``mp4v``; PyAV, OpenCV and Pillow are imported lazily.
 """
 
 from __future__ import annotations
@@ -18,13 +15,9 @@ import numpy as np
 
 
 class VideoWriter:
-    """An MP4 file (H.264) written frame by frame (``(h, w, 3)`` uint8 BGR, every frame the same size;
-    an odd width or height is padded by one black pixel).
-
-    Use as a context manager so the file is finalised even when interrupted. ``gif`` also keeps
-    every ``gif_every``-th of the first ``gif_frames`` frames, scaled to ``gif_width`` pixels (640 by
-    default, so that labels stay readable), and writes them as an animated GIF when closed.
-    """
+    """An MP4 file (H.264) written frame by frame (``(h, w, 3)`` uint8 BGR, same size; odd sizes padded by one
+    pixel). A context manager. ``gif`` also writes every ``gif_every``-th of the first ``gif_frames`` frames,
+    ``gif_width`` pixels wide, as an animated GIF."""
 
     def __init__(self, path: Path | str, fps: float, gif: Path | str | None = None, gif_every: int = 2,
                  gif_frames: int = 120, gif_width: int = 640) -> None:

@@ -1,14 +1,9 @@
-"""Tracking on real video: detections from a MOTChallenge file, appearance features from the frames'
-pixels, any registered tracker, the detector-health monitor, and an optional annotated video.
+"""Tracking on real video: detections from a MOTChallenge file, appearance features from the pixels, any
+registered tracker, the detector-health monitor, and an optional annotated video.
 
-In the annotated video a track whose identity is not settled is drawn with a dashed box and a
-``?`` after its id: a tentative track, a track the tracker itself calls uncertain (diver SORT's
-:meth:`~lookalike.trackers.DiverSort.uncertain`: young enough to be merged into an earlier
-identity), or, for trackers without such a method, a track first reported fewer than
-``new_frames`` frames ago. A track that just absorbed another by identity recovery is labelled
-``id T<-S`` for ``new_frames`` frames. Detections no track took are thin grey dashed boxes. When
-the health monitor finds the frame or its window unhealthy, a red banner at the bottom gives the
-reasons. OpenCV is imported lazily.
+In the annotated video, unsettled identities (tentative, the tracker's ``uncertain``, or reported fewer
+than ``new_frames`` frames) are dashed with a ``?``; a recovery is labelled ``id T<-S``; untaken detections
+are thin grey dashed boxes; an unhealthy frame gets a red banner with the reasons.
 """
 
 from __future__ import annotations
@@ -88,14 +83,9 @@ def source_frame_rate(source: Path | str) -> float | None:
 
 def fit_video_features(source: Path | str, detections: MotTable, *, min_score: float = -np.inf,
                        max_crops: int = 3000, crop_px: int = 32, link_iou: float = 0.6) -> HandcraftedFeatures:
-    """Hand-crafted features standardised on this video's own detections, without ground truth.
-
-    Raw features of up to ``max_crops`` boxes (blocks of 10 consecutive frames, evenly spread) are
-    linked into short chains: a box joins the box of the previous frame it overlaps with IoU >=
-    ``link_iou`` (one-to-one), which almost surely shows the same target. The chains serve as
-    identity labels for :func:`~lookalike.vision.appearance.fit_stats` (within-chain spread as the
-    scale, discriminant weights); with fewer than two chains the plain mean and spread are used.
-    """
+    """Hand-crafted features standardised on this video's own detections, without ground truth: boxes of up to
+    ``max_crops`` crops are chained frame to frame by IoU >= ``link_iou`` and the chains serve as identity
+    labels for :func:`~lookalike.vision.appearance.fit_stats` (plain mean and spread with fewer than two)."""
     if max_crops < 2:
         raise ValueError(f"max_crops: must be >= 2, got {max_crops}")
     keep = detections.conf >= min_score

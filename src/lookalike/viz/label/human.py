@@ -1,18 +1,10 @@
-"""Human-benchmark result files: what a finished ``lookalike label --benchmark`` session writes, read
-back by seed A's Table III (``lookalike bench ident --lengths``) to put people beside the identifiers.
+"""Human-benchmark result files: what a finished ``lookalike label --benchmark`` session writes, read back by
+``lookalike bench ident --lengths`` to put people beside the identifiers.
 
-One JSON file per session, ``<sequence stem>.human-<labeller>.json`` (beside the sequence unless
-another folder is chosen)::
-
-    {"format": "lookalike-human-benchmark", "version": 1, "sequence": "m3n2-000000.jsonl",
-     "labeller": "alice", "n_agents": 2, "max_detections": 3, "n_frames": 1000,
-     "started_at": 1796172000.0, "finished_at": 1796172600.0, "duration_s": 600.0,
-     "frames_scored": 400, "detections_scored": 690, "correct": 640, "unset": 2,
-     "success_rate": 0.9275, "success_rate_all": 0.371}
-
-Times are Unix seconds; ``success_rate`` covers the frames the person worked through (frames
-``0 .. frames_scored - 1``, unset labels counting as wrong), ``success_rate_all`` the whole sequence
-(see :func:`~lookalike.viz.label.store.score_labels`).
+One JSON file per session, ``<sequence stem>.human-<labeller>.json`` (format ``lookalike-human-benchmark``,
+version 1), holding the sequence, labeller, times (Unix seconds), counts and ``success_rate`` (frames
+worked through, unset labels wrong) and ``success_rate_all`` (the whole sequence; see
+:func:`~lookalike.viz.label.store.score_labels`).
 """
 
 from __future__ import annotations

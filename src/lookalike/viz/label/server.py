@@ -7,18 +7,13 @@ Routes (JSON unless stated)::
     GET  /api/frames?start=&count=   frames' detections and latest reports (truth unless benchmark)
     GET  /api/labels             all labels and the benchmark state
     POST /api/label              {"frame", "detection", "label"}: set one label (saved at once)
-    POST /api/benchmark/start    start timing;  POST /api/benchmark/finish  stop, score and write the
-                                 result file (<stem>.human-<labeller>.json, :mod:`lookalike.viz.label.human`)
+    POST /api/benchmark/start    start timing;  POST /api/benchmark/finish  stop, score, write the result file
     GET  /api/score              success rate against the truth (benchmark mode: after finishing)
     POST /api/export             write <stem>.labelled.jsonl and <stem>.labels.mot.txt beside the sequence
-    GET  /files/<path>           a file inside the sequence's folder (video frames); others are refused;
-                                 in benchmark mode only the frame images (nothing that holds the truth)
+    GET  /files/<path>           a file inside the sequence's folder (benchmark mode: frame images only)
 
-Requests with a foreign ``Host`` header (DNS rebinding) or POSTs that are not
-``application/json`` (cross-site forms) are refused; malformed requests get 400 and the server
-keeps serving. Every connection has its own thread; a connection silent for ``IDLE_TIMEOUT_S``
-is closed, and a request body not complete within ``BODY_TIMEOUT_S`` gets 408, so one slow
-client holds up nobody else. Pending connections queue up to ``LISTEN_BACKLOG``.
+Foreign ``Host`` headers and non-JSON POSTs are refused; malformed requests get 400. Each connection has a
+thread, idle ones close after ``IDLE_TIMEOUT_S``, slow bodies get 408 after ``BODY_TIMEOUT_S``.
 """
 
 from __future__ import annotations

@@ -1,15 +1,8 @@
-"""The labels a person gives a robot sequence's detections, saved continuously next to it.
+"""The labels a person gives a robot sequence's detections, saved atomically after every change.
 
-Label values per detection: an agent id ``0 .. N-1``, ``-1`` for a false positive, or ``-2``
-(:data:`UNSET`) while nobody has labelled it yet. The label file (``<sequence stem>.labels.json``
-beside the sequence) is JSON::
-
-    {"format": "lookalike-labels", "version": 1, "sequence": "m5n3-000000.jsonl",
-     "n_frames": 1000, "n_agents": 3, "counts": [3, 2, ...], "labels": [[0, -1, 2], [-2, 1], ...],
-     "source": "empty" | "tracker kalman_ha" | "file <name>", "benchmark": null | {...}}
-
-Every change rewrites the file atomically (a temporary file in the same folder, then
-``os.replace``), so a crash loses at most the change being written.
+Per detection: an agent id ``0 .. N-1``, ``-1`` for a false positive, or :data:`UNSET` (-2). The file
+``<sequence stem>.labels.json`` holds ``format``, ``version``, ``sequence``, ``n_frames``, ``n_agents``,
+``counts``, ``labels``, ``source`` and ``benchmark``.
 """
 
 from __future__ import annotations
@@ -182,12 +175,11 @@ class LabelStore:
 
 
 def score_labels(labels: Sequence[Sequence[int]], truth: Sequence[np.ndarray], n_agents: int) -> dict[str, Any]:
-    """Identification success rate of ``labels`` against ``truth`` (seed A's metric).
+    """Identification success rate of ``labels`` against ``truth``.
 
-    ``success_rate`` covers frames ``0 .. last`` where ``last`` is the last frame with any label
-    set (the part of the sequence the person worked through); unset labels count as wrong.
-    ``success_rate_all`` covers the whole sequence. Also: counts of detections scored, correct and
-    unset. Rates are None where there are no detections.
+    ``success_rate`` covers frames up to the last with any label set (unset labels count as wrong),
+    ``success_rate_all`` the whole sequence; also the counts scored, correct and unset. Rates are None
+    without detections.
     """
     if len(labels) != len(truth):
         raise ValueError(f"labels has {len(labels)} frames, truth {len(truth)}")
