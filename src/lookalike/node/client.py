@@ -12,12 +12,9 @@ Address = tuple[str, int]
 
 
 class Endpoint:
-    """A UDP socket bound to ``bind`` (default: an ephemeral loopback port) that sends messages
-    to ``peer`` and receives decoded messages. Use as a context manager.
-
-    With ``group`` (an IPv4 multicast ``(address, port)``, joined on the interface ``interface``),
-    a second socket also receives what the node sends to the group: its batched team states.
-    """
+    """A UDP socket bound to ``bind`` (default: an ephemeral loopback port) that sends messages to ``peer`` and
+    receives decoded ones; a context manager. With ``group`` (IPv4 multicast ``(address, port)`` joined on
+    ``interface``) a second socket receives the node's batched team states."""
 
     def __init__(self, peer: Address, bind: Address = ("127.0.0.1", 0), group: Address | None = None,
                  interface: str = "127.0.0.1") -> None:

@@ -33,11 +33,8 @@ EVENTS = (
 
 
 class NodeCounters:
-    """Counts of every event, rejections by reason, and the latest publish latencies.
-
-    Latency: seconds from reading a detections datagram to having sent its team state, kept for
-    the last ``window`` frames.
-    """
+    """Counts of every event, rejections by reason, and the publish latencies (seconds from reading a
+    detections datagram to sending its team state) of the last ``window`` frames."""
 
     def __init__(self, window: int = 1000) -> None:
         self.events: Counter[str] = Counter({name: 0 for name in EVENTS})
@@ -58,9 +55,8 @@ class NodeCounters:
         self.rejected[reason] += 1
 
     def snapshot(self) -> dict[str, Any]:
-        """All counters as a JSON-ready dict (latency and CPU-time figures in milliseconds: ``latency_ms``
-        is wall time from reading a frame to its last send, ``cpu_ms`` the node thread's CPU time for it,
-        ``cpu_with_prepare_ms`` that plus the CPU time of preparing the next frame after the send)."""
+        """All counters as a JSON-ready dict; ``latency_ms`` (wall time from reading a frame to its last send),
+        ``cpu_ms`` and ``cpu_with_prepare_ms`` (also preparing the next frame) in milliseconds."""
         out: dict[str, Any] = dict(self.events)
         out["rejected"] = dict(sorted(self.rejected.items()))
         out["rejected_total"] = sum(self.rejected.values())

@@ -1,9 +1,7 @@
 """Socket-free core of the node: checks reports and frames, runs the tracker, builds team states.
 
-Clocks: every time here is *simulated* time carried by the messages (``t_sent`` of a report,
-``time`` of a frame); the node never reads a clock of its own for them. A report is delivered to
-the tracker with the next frame and stamped ``t_received`` = that frame's time. Simulated time may
-therefore run faster than wall time, as long as every process scales it the same way.
+Every time is simulated time carried by the messages (a report's ``t_sent``, a frame's ``time``); a report
+reaches the tracker with the next frame, stamped ``t_received`` = that frame's time.
 """
 
 from __future__ import annotations
@@ -62,10 +60,9 @@ class IdentifierConfig:
 class TeamIdentifier:
     """Accepts heading reports and detection frames in arrival order and identifies the team.
 
-    ``add_report`` and ``add_frame`` return the name of the counter the message falls under
-    (``"reports"``/``"frames"`` when accepted); ``add_frame`` also returns the team state.
-    Accepted reports wait for the next frame in bounded queues (``IdentifierConfig``);
-    ``queue_dropped`` counts the reports pushed out of a full robot queue since construction.
+    ``add_report`` and ``add_frame`` return the counter the message falls under (``"reports"``/``"frames"``
+    when accepted); ``add_frame`` also returns the team state. Reports wait for the next frame in bounded
+    queues (:class:`IdentifierConfig`).
     """
 
     def __init__(self, tracker: Any, config: IdentifierConfig | None = None) -> None:
@@ -175,12 +172,8 @@ class TeamIdentifier:
         self.last_frame, self.last_time = None, -math.inf
 
     def _frame(self, message: DetectionsMessage) -> Frame:
-        """The tracker's frame: the message's detections and the queued reports.
-
-        What ``decode`` has checked (finite, bounded numbers; equal lengths) is not validated again:
-        the arrays are built straight into the frame's types; a message built some other way that
-        fails these checks goes through the validating constructors and their errors.
-        """
+        """The tracker's frame: the message's detections and the queued reports. A ``decode``d message's arrays go
+        straight into the frame's types; others through the validating constructors."""
         n = len(message.position)
         spread = message.heading_std
         decoded = numbers_of(message)

@@ -1,18 +1,9 @@
-"""The node's wire format: versioned, validated messages encoded as compact UTF-8 JSON.
+"""The node's wire format: versioned, validated messages as compact UTF-8 JSON, one per UDP datagram.
 
-Every message is one UDP datagram holding a JSON object with ``"v"`` (the schema version) and
-``"type"``. Inbound: ``report`` (a robot's heading report), ``detections`` (a camera frame) and
-``status_request``. Outbound: ``team`` (identified positions of every robot, per camera frame)
-and ``status`` (the node's counters). Times are simulated seconds, positions metres in the
-observer frame, headings radians. ``decode`` never raises anything but ``MessageError``, whose
-``reason`` is a short stable code that the node counts.
-
-Bounds (checked on every field of every message, docs/howto/robot-team.md lists them): integers
-in ``[minimum, 2**63 - 1]`` (64-bit signed; ``bool`` is not an integer), numbers finite with
-``|x| <= MAX_ABS_NUMBER``, at most ``MAX_DETECTIONS`` detections or labels and ``MAX_ROBOTS``
-robot estimates per message, status counters at most ``MAX_COUNTERS`` entries with keys of at most
-``MAX_KEY_CHARS`` characters, no unknown fields, datagrams of at most ``MAX_DATAGRAM_BYTES``. The messages and
-these bounds are defined in :mod:`lookalike.node.schema` (and importable from here).
+Each holds ``"v"`` (schema version) and ``"type"``: inbound ``report``, ``detections``, ``status_request``;
+outbound ``team`` and ``status``. ``decode`` raises only ``MessageError``, whose ``reason`` is a stable code
+the node counts. Messages, units and bounds: :mod:`lookalike.node.schema` (listed in
+docs/howto/robot-team.md).
 """
 
 from __future__ import annotations
@@ -306,17 +297,15 @@ _DETECTION_FIELDS = frozenset({"v", "type", "frame", "time", "position", "headin
 
 
 def numbers_of(message: DetectionsMessage) -> list[float] | None:
-    """The numbers of a ``decode``d detections message as one flat list (``x, y`` of every position, then
-    the headings, the scores and the heading spreads, then the time), or None for a message built any other
-    way. Only ``decode`` makes it, after its checks: finite floats within the bounds."""
+    """A ``decode``d detections message's numbers as one flat list (positions ``x, y``, headings, scores,
+    heading spreads, time), or None for a message built otherwise."""
     flat: list[float] | None = message.__dict__.get("_numbers")
     return flat
 
 
 def _plain_detections(body: dict[str, Any]) -> DetectionsMessage | None:
-    """The common detections message in few steps: known fields only, lists of the same length, every number
-    a JSON float (the frame an int) within the bounds; None for anything else (which the field-by-field
-    checks then take, with their errors). The message keeps its numbers as one list (:func:`numbers_of`)."""
+    """The common detections message in few steps (known fields, equal lengths, JSON floats within bounds);
+    None for anything else, which the field-by-field checks then take."""
     if not body.keys() <= _DETECTION_FIELDS:
         return None
     frame, raw, heading, score = body.get("frame"), body.get("position"), body.get("heading"), body.get("score")

@@ -1,12 +1,9 @@
 """The observer node's UDP server: one socket, a selector loop, per-sender rate limits.
 
-Each datagram is read, rate-limited by sender, decoded, and handed to the ``TeamIdentifier``. A
-detections frame is tracked at once and its team state sent to every ``publish`` address and
-either once to the multicast ``group`` (the batched send: one datagram per frame reaches every
-robot that joined the group) or, when ``reply_to_robots`` is set and there is no group, to the
-address each robot last reported from; after the send, the tracker prepares the next frame
-(``TeamIdentifier.prepare``). Nothing a peer sends can stop the loop: every failure is counted and
-logged (``handler_errors`` for a bug of the node itself). Default addresses are loopback.
+Each datagram is rate-limited by sender, decoded and handed to the ``TeamIdentifier``. A frame's team state
+goes to every ``publish`` address and either to the multicast ``group`` or (``reply_to_robots``) to each
+robot's last address; then the tracker prepares the next frame. Every failure is counted and logged,
+never stops the loop. Default addresses are loopback.
 """
 
 from __future__ import annotations
@@ -40,9 +37,8 @@ LOCALHOST = "127.0.0.1"
 
 
 def _preload() -> None:
-    """Import what the first frame would otherwise import, when the node is built: the assignment
-    solver's scipy module and the world trackers' compiled kernels (numba, when installed:
-    :func:`~lookalike.trackers.kernels.world.warm`); their cost: docs/experiments/speed.md (Observer node)."""
+    """Import what the first frame would otherwise import (the solver's scipy module, the world trackers' numba
+    kernels: :func:`~lookalike.trackers.kernels.world.warm`)."""
     import numpy as np
 
     from lookalike.association.solver import linear_sum_assignment
@@ -54,9 +50,8 @@ def _preload() -> None:
 
 @contextmanager
 def _one_blas_thread() -> Iterator[None]:
-    """BLAS and LAPACK on the calling thread only inside the block (threadpoolctl, when installed): a
-    frame's algebra is on 2×2 to 6×6 matrices, where handing work to BLAS's threads costs more than it
-    saves and waits for them when the machine is busy."""
+    """BLAS and LAPACK on the calling thread only inside the block (threadpoolctl, when installed): a frame's
+    matrices are too small for BLAS threads to pay."""
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:  # pragma: no cover (scikit-learn, a core dependency, requires it)
@@ -185,12 +180,8 @@ class NodeServer:
             self.sock.close()
 
     def serve(self, stop: Callable[[], bool], tick_s: float = 0.05) -> None:
-        """Serve until ``stop()`` returns true (checked at least every ``tick_s`` seconds).
-
-        Objects alive at the start (modules, the tracker) are moved out of the garbage collector's
-        sight (``gc.freeze``), so its full collections stay short while serving. BLAS runs on the
-        serving thread only (:func:`_one_blas_thread`).
-        """
+        """Serve until ``stop()`` returns true (checked every ``tick_s`` seconds at least), with objects alive at
+        the start frozen out of the garbage collector (``gc.freeze``) and BLAS on this thread only."""
         gc.collect()
         gc.freeze()
         try:

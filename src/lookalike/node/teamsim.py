@@ -1,14 +1,8 @@
 """Simulated robot and camera processes that talk to the node, on top of the robot-world simulator.
 
-Every process of a team builds the *same* sequence from ``(preset, seed, duration, network)``
-with :func:`team_sequence`, so no truth needs to travel: the camera sends the detections (without
-their labels), each robot sends its own heading reports, and all of them keep the truth locally.
-
-Clocks: a :class:`SimClock` maps simulated time ``t`` to wall time ``epoch + t / speed``. All
-processes of a team share ``epoch`` and ``speed``, so simulated time may run faster than real
-time (``speed > 1``). A robot sends each report when the simulated network delivers it (its
-``t_received`` in the sequence) with its simulated send time ``t_sent``; reports the simulated
-network loses are never sent. The loopback network adds its own (sub-millisecond) delay.
+Every process builds the same sequence from ``(preset, seed, duration, network)`` (:func:`team_sequence`),
+so no truth travels: the camera sends detections, each robot its heading reports when the simulated network
+delivers them. A :class:`SimClock` maps simulated time ``t`` to wall time ``epoch + t / speed``.
 """
 
 from __future__ import annotations
