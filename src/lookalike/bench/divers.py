@@ -1,7 +1,7 @@
 """The diver bench (``lookalike bench divers``): the paper's Table 2 and Figure 5 on the rendered diver scenarios.
 
 Every scenario is rendered, passed through the detector model (``detections``: ``sim``, the
-scenario's own, or ``paper``, :data:`~lookalike.sim.divers_paper.PAPER_DETECTORS` with seed B's
+scenario's own, or ``paper``, :data:`~lookalike.sim.divers_paper.PAPER_DETECTORS` with de Langis and Sattar's
 detection precision and recall), and its detections' appearance features are extracted once per
 feature set (``handcrafted``, standardised on the validation scenarios; ``learned``, the shipped ONNX
 embedding trained on other divers). The entries (:data:`ENTRIES`) then run on identical detections:

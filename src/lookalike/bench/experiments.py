@@ -1,4 +1,4 @@
-"""Seed A's control and recovery experiments (``lookalike bench shuffle`` / ``bench recovery``).
+"""Farazi and Behnke's control and recovery experiments (``lookalike bench shuffle`` / ``bench recovery``).
 
 Shuffle: the identifiers on frames fed in random order. A method that really uses the sequence
 (motion, report history) must collapse; one that only matched single frames would not.

@@ -1,11 +1,11 @@
-"""Seed A's Table I: robot identification on simulated sequences (``lookalike bench ident``).
+"""Farazi and Behnke's Table I: robot identification on simulated sequences (``lookalike bench ident``).
 
 The same test sequences for every identifier (seeds ``seed + 1000·setup + sequence``; the default
 ``seed`` 900000 is disjoint from the seeds below 100000 used for tuning and training); per set-up
 and identifier: the identification success rate (correct labels / all detections, a false positive
 labelled as such counting as correct), the localisation error (mean distance in metres between each
 agent's identified position and its true position while in view) and frames/s (tracking only).
-An LSTM identifier whose shipped weights do not exist for a set-up (seed A's protocol is not trained
+An LSTM identifier whose shipped weights do not exist for a set-up (the paper's protocol is not trained
 for every set-up) gets a row saying so (:data:`NOT_TRAINED` in its cells) instead of stopping the run.
 :func:`ident_differences` compares each identifier with the first on the same sequences (success rate
 difference in points, 95% interval over sequences; :mod:`lookalike.bench.paired`).
@@ -31,7 +31,7 @@ from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
 from lookalike.types import Frame
 
-# lstm: seed A's method, our inputs; lstm-paper: seed A's protocol; set: any team size
+# lstm: the paper's method, our inputs; lstm-paper: the paper's protocol; set: any team size
 IDENT_TRACKERS = ("lstm", "lstm-paper", "set", "kalman_ha", "kalman_ha2", "jpda")
 IDENT_COLUMNS = ("Setup", "Tracker", "Success rate (%)", "Localisation error (m)", "Frames/s", "Detections")
 DEFAULT_SEED = 900_000

@@ -1,8 +1,8 @@
-"""Seed A's own figures beside ours: identifier variants for ``bench ident``, the paper's Tables I–III
-and the margins over Kalman-HA.
+"""The robot paper's own figures (Farazi and Behnke, IROS 2017) beside ours: identifier variants for
+``bench ident``, the paper's Tables I–III and the margins over Kalman-HA.
 
-Variants name an identifier with parameters: ``lstm-paper`` is the LSTM with seed A's input
-protocol (``N + 4·M`` inputs) decoded per slot, ``lstm-lowpass`` the shipped LSTM with seed A's
+Variants name an identifier with parameters: ``lstm-paper`` is the LSTM with the paper's input
+protocol (``N + 4·M`` inputs) decoded per slot, ``lstm-lowpass`` the shipped LSTM with the paper's
 Eq. 3 low-pass filter instead of our Kalman localiser, ``set-exchange`` the set identifier with its
 report-exchange detector on for any team size (the default runs it for teams of up to seven).
 
@@ -24,15 +24,15 @@ IDENT_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "set-exchange": ("set", {"exchange_llr": 8.0, "exchange_max_agents": None}),
 }
 
-# Seed A, Table I: success rate (%) on its synthetic dataset, per set-up.
+# Farazi and Behnke, Table I: success rate (%) on its synthetic dataset, per set-up.
 PAPER_TABLE1: dict[str, dict[str, float]] = {
     "m3n2": {"human": 94.3, "kalman_ha": 75.6, "lstm": 96.2},
     "m5n3": {"human": 86.3, "kalman_ha": 72.2, "lstm": 87.1},
     "m10n7": {"human": 67.3, "kalman_ha": 53.1, "lstm": 66.5},
 }
-# Seed A, Table II: average localisation error (m) on its real dataset.
+# Farazi and Behnke, Table II: average localisation error (m) on its real dataset.
 PAPER_TABLE2: dict[str, float] = {"kalman_ha": 0.67, "kalman_ha2": 0.30, "jpda": 0.29, "lstm": 0.22}
-# Seed A, Table III: success rate (%) on its real dataset by sequence length (frames; 0 = the total, 3140).
+# Farazi and Behnke, Table III: success rate (%) on its real dataset by sequence length (frames; 0 = the total, 3140).
 PAPER_TABLE3: dict[str, dict[int, float]] = {
     "kalman_ha": {200: 73.2, 400: 75.5, 800: 72.1, 0: 73.8},
     "kalman_ha2": {200: 87.2, 400: 84.0, 800: 86.3, 0: 85.5},
@@ -50,7 +50,7 @@ def resolve_identifier(name: str) -> tuple[str, dict[str, Any]]:
 def margin_rows(rows: Sequence[dict[str, Any]], setups: Sequence[str], labels: Sequence[str],
                 baseline: str = "kalman_ha") -> list[dict[str, Any]]:
     """Per set-up and LSTM row of ``rows`` (``bench ident`` rows), the margin in points of its success
-    rate over ``baseline`` on the same sequences, beside seed A's margin of its LSTM over Kalman-HA."""
+    rate over ``baseline`` on the same sequences, beside the paper's margin of its LSTM over Kalman-HA."""
     out = []
     for setup, label in zip(setups, labels):
         mine = {r["Tracker"]: r["Success rate (%)"] for r in rows if r["Setup"] == label}

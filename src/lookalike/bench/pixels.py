@@ -16,7 +16,7 @@ Identification table: ``Pixels (%)`` and ``Simulated (%)`` success rates, ``Gap 
 ``Pixels robots (%)`` and ``Sim robots (%)``: the same on the detections of true robots only — the like-for-like
 comparison, since the two sides make false positives at very different rates (an identifier calls most false
 positives correctly, so a side with more of them scores higher on all detections);
-seed A's Table II localisation error on each side (``Pixels loc. (m)``, ``Simulated loc. (m)``: mean distance
+Farazi and Behnke's Table II localisation error on each side (``Pixels loc. (m)``, ``Simulated loc. (m)``: mean distance
 in metres between each robot's identified position and its true observer-frame position over the frames where
 it is in view and has a position), the detections scored on each side, and the identifier's own frames/s on
 the pixel detections.

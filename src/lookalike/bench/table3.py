@@ -1,4 +1,4 @@
-"""Seed A's Table III protocol on recordings: success rate by sequence length.
+"""Farazi and Behnke's Table III protocol on recordings: success rate by sequence length.
 
 For each length (frames), ``draws`` windows of that length are drawn at random (seeded) from the
 recordings, each identifier runs on every window from a fresh state, and the success rate is

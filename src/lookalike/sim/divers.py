@@ -1,5 +1,5 @@
-"""Look-alike divers seen by an underwater robot's camera (seed B, DESIGN §8): scenarios, motion,
-rendered frames, ground truth (MOTChallenge rows) and a detector model.
+"""Look-alike divers seen by an underwater robot's camera (de Langis and Sattar, ICRA 2020; DESIGN §8):
+scenarios, motion, rendered frames, ground truth (MOTChallenge rows) and a detector model.
 
 Divers swim with strokes (kick phase, arm pose), drift in distance (2.5–9 m), leave the view for
 long periods and come back at an edge; the camera drifts. A :class:`DiverScenario` is a frozen,

@@ -1,6 +1,6 @@
 """Paper-hard detections for the diver scenarios (``bench divers --detections paper``), and new draws.
 
-Seed B's real diver detector found far fewer divers, and far more false boxes, than the default
+de Langis and Sattar's real diver detector found far fewer divers, and far more false boxes, than the default
 detector model of :data:`~lookalike.sim.divers.SCENARIOS` (DP 80.5 / DR 66.8 overall). Its per-video
 detection precision and recall (Table 2: DP 30.5–81.6, DR 25.0–60.3) are :data:`PAPER_DETECTION`,
 matched to our scenarios in order (six ocean, then two pool, as in the paper). :data:`PAPER_DETECTORS`
@@ -16,7 +16,7 @@ import dataclasses
 
 from lookalike.sim.divers import DetectorModel, DiverScenario
 
-#: Seed B Table 2, detector precision and recall per video (percent), in our scenario order.
+#: de Langis and Sattar, Table 2: detector precision and recall per video (percent), in our scenario order.
 PAPER_DETECTION: dict[str, tuple[float, float]] = {
     "ocean_pair_clear": (49.7, 38.7),
     "ocean_trio": (59.0, 35.9),

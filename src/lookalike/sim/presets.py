@@ -3,7 +3,7 @@ with one of two position-noise models.
 
 Noise models (observer frame: x forward = depth = image rows, y left = across the image = columns):
 
-* ``"paper"`` — seed A's: "more perception noise in the x direction than in the y", where the
+* ``"paper"`` — Farazi and Behnke's: "more perception noise in the x direction than in the y", where the
   paper's x runs across the image and its y (image rows) is the better estimated one. Here: the
   lateral (observer y) std is ``0.05 + 0.04·d`` metres, the depth (observer x) std ``0.03 +
   0.015·d`` at distance ``d`` metres.

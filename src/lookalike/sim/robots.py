@@ -1,4 +1,4 @@
-"""The robot world of seed A (DESIGN §8): identical robots seen by an observer, heading reports.
+"""The robot world of Farazi and Behnke (IROS 2017; DESIGN §8): identical robots seen by an observer, heading reports.
 
 :func:`simulate_arrays` makes a whole sequence with array operations over time (tens of
 thousands of frames per second) and returns :class:`RobotArrays`: detections padded to the

@@ -86,8 +86,8 @@ class SensorConfig:
 
     Position noise is Gaussian in the observer frame, ``std = std0 + std_per_m · distance``. The
     defaults make it larger along x (depth) than along y (across the image): our noise model, the
-    reverse of seed A's, which is larger across the image (:func:`lookalike.sim.presets.noise_sensor`
-    makes either; ``preset(name, noise="paper")`` is seed A's). The visual
+    reverse of Farazi and Behnke's, which is larger across the image (:func:`lookalike.sim.presets.noise_sensor`
+    makes either; ``preset(name, noise="paper")`` is Farazi and Behnke's). The visual
     heading behaves like a 10-class classifier: with probability ``heading_flip_prob`` the front
     and back are confused (+π); the relative heading gets Gaussian noise ``heading_noise_rad`` and
     is then snapped to the centre of its ``heading_classes`` bin (mean error ≈ 17° by default).

@@ -1,4 +1,5 @@
-"""Hand-crafted appearance features for look-alike targets (seed B, DESIGN §6), and the extractor protocol.
+"""Hand-crafted appearance features for look-alike targets (de Langis and Sattar, DESIGN §6) and the extractor
+protocol.
 
 Each detection box is cropped from the frame and resized to a ``crop_px`` square; all crops of a
 frame are then processed together as one ``(n, s, s, 3)`` array. The raw vector concatenates five

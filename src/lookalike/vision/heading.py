@@ -1,4 +1,5 @@
-"""Visual heading classifier (seed A, DESIGN §6): dense HOG of a robot's torso into an RBF SVM over 10 classes.
+"""Visual heading classifier (Farazi and Behnke, DESIGN §6): dense HOG of a robot's torso into an RBF SVM over
+10 classes.
 
 Per box, the upper half (the torso, invariant to the legs) is cut out of the image and resized to
 ``patch_px``; dense HOG of its grey channel and of its HSV hue channel plus the box centre

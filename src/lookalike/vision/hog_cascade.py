@@ -1,4 +1,5 @@
-"""HOG cascade detector (seed A, DESIGN §6): variable-size HOG blocks, boosted stages, a cascade of rejectors.
+"""HOG cascade detector (Farazi and Behnke, DESIGN §6): variable-size HOG blocks, boosted stages, a cascade of
+rejectors.
 
 A window of ``window_px`` (width, height) is described by a pool of rectangular blocks of several
 sizes and aspect ratios; each block is split into 2×2 cells and gives an L2-normalised 36-value

@@ -3,7 +3,7 @@
 The orientation histogram of an image is a stack of ``bins`` gradient-magnitude maps, one per
 unsigned orientation bin (0..π), soft-assigned between the two nearest bins. Its integral image
 (summed-area table) lets the descriptor of any rectangle be read in four look-ups per bin, which
-is what makes variable-size HOG blocks cheap (Zhu et al., as used by seed A). For detection, where every
+is what makes variable-size HOG blocks cheap (Zhu et al., as used by Farazi and Behnke). For detection, where every
 rectangle corner lies on the cell grid, :func:`cell_histograms` gives the same sums per cell in one pass,
 so the integral image is built over cells instead of pixels. OpenCV (gradients, colour conversion,
 resizing) is imported lazily.

@@ -1,4 +1,4 @@
-"""From pixels to robot identities (DESIGN §1.3, §6; seed A's full chain).
+"""From pixels to robot identities (DESIGN §1.3, §6; Farazi and Behnke's full chain).
 
 :class:`RobotPipeline` runs, per camera frame: the HOG-cascade detector → the visual heading
 classifier on each box → the ground position of each box through the calibrated camera → an
