@@ -164,9 +164,8 @@ def write_mot(path: str | os.PathLike[str], rows: Iterable[np.ndarray] | np.ndar
 
 
 def format_rows(rows: np.ndarray) -> str:
-    """Result rows ``(k, >= 10)`` as lines of a MOTChallenge file, newlines included: the text of
-    :func:`~lookalike.types.mot_table.format_row` for each row (boxes to 1/1000 px), formatted a block
-    of rows at a time instead of one Python call per row."""
+    """Result rows ``(k, >= 10)`` as MOTChallenge lines, newlines included
+    (:func:`~lookalike.types.mot_table.format_row`'s text), formatted a block at a time."""
     data = np.asarray(rows, dtype=float)
     if data.ndim != 2 or data.shape[1] < ROW_WIDTH:
         raise ValueError(f"result rows need shape (k, {ROW_WIDTH}) or wider, got {data.shape}")

@@ -1,8 +1,5 @@
-"""What a tracker needs from its input beyond boxes and scores, so that a command can refuse early
-with one line instead of failing inside the tracker.
-
-A tracker class may declare ``needs`` (a short phrase); the built-in trackers that cannot run on
-boxes alone are listed in :data:`BUILTIN_NEEDS`.
+"""What a tracker needs beyond boxes and scores (its ``needs`` phrase, or :data:`BUILTIN_NEEDS`), so a command
+can refuse early in one line.
 """
 
 from __future__ import annotations

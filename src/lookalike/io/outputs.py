@@ -1,7 +1,5 @@
-"""Where results go, decided before anything runs: one result file per sequence, never onto an input,
-never two sequences onto one file, and a folder that can be written.
-
-Every function raises ``ValueError`` with one line naming the output (and the input it would hit).
+"""Where results go, decided before anything runs: one file per sequence, never onto an input, never two
+sequences onto one file, a writable folder. Refusals are one-line ``ValueError``s.
 """
 
 from __future__ import annotations

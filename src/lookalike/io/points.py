@@ -1,21 +1,10 @@
 """Anonymous points per frame as tracker input: readers, and points as small boxes for the box trackers.
 
-Two text formats are read, both comma-separated with 1-based frames:
-
-- **point CSV**: ``frame,x,y`` per line, optionally more columns (ignored) and an optional header
-  line whose first field is not a number (e.g. ``frame,x,y``); :func:`read_points_csv`.
-- **MOTChallenge rows with a point per row**: ``frame, id, x, y[, ...]`` where columns 3-4 hold the
-  point (id ignored, usually -1); or, with ``centre=True``, a box ``left, top, width, height`` whose
-  centre is the point; :func:`read_points_mot`.
-
-Both return :class:`PointFrames`: per frame (0-based list index = frame − 1) an ``(n, 2)`` array of
-positions (pixels, or whatever unit the file uses). Malformed input raises ``ValueError`` naming the
-file and the 1-based line; frame numbers follow :mod:`lookalike.io.rules` (integers >= 1, no stray jump).
-
-:func:`points_to_rows` turns points into MOTChallenge detection rows of small square boxes centred on
-them (side ``box_px``), so that box trackers and :func:`lookalike.trackers.offline.closed_set.track_closed_set`
-track them; :func:`rows_to_points` takes result rows back to centres for
-:func:`lookalike.eval.evaluate_points`.
+Formats (comma-separated, 1-based frames): point CSV ``frame,x,y[,...]`` with an optional header
+(:func:`read_points_csv`), and MOTChallenge rows with the point in columns 3-4, or a box whose centre is the
+point with ``centre=True`` (:func:`read_points_mot`). Both give :class:`PointFrames`; bad input raises
+``ValueError`` naming file and line. :func:`points_to_rows` makes square boxes for the trackers;
+:func:`rows_to_points` takes result rows back to centres.
 """
 
 from __future__ import annotations
@@ -164,11 +153,9 @@ def typical_step(points: PointFrames | list[np.ndarray]) -> float:
 
 def points_to_rows(points: PointFrames | list[np.ndarray], box_px: float | None = None,
                    score: float = 1.0) -> np.ndarray:
-    """MOTChallenge detection rows ``(k, 10)`` (1-based frames, id -1) of square boxes of side ``box_px``
-    centred on the points. By default the side is half the :func:`typical_spacing` of the points (so
-    neighbours' boxes rarely overlap, yet a point moving less than a side keeps overlapping its box);
-    when no frame holds two points (a single target), twice the :func:`typical_step`, so that a typical
-    step keeps half a box of overlap; 1 when there is neither."""
+    """MOTChallenge detection rows ``(k, 10)`` (1-based frames, id -1) of square boxes of side ``box_px`` centred
+    on the points. Default side: half the :func:`typical_spacing`; with never two points in a frame, twice the
+    :func:`typical_step`; else 1."""
     per_frame = points.points if isinstance(points, PointFrames) else points
     if box_px is None:
         spacing = typical_spacing(per_frame)

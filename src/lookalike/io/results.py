@@ -1,30 +1,18 @@
 """One results schema for every ``--json`` (``eval``, ``bench ...``, the demo's data files).
 
 A document is ``{"schema": "lookalike-results/1", "header": {...}, "tables": {name: [row, ...]}}``,
-described by ``results.schema.json`` beside this module (:data:`SCHEMA_PATH`, shipped as package data).
-
-- header: ``lookalike_version``, ``command`` (the command line), ``kind`` (``"bench ident"``, ...),
-  ``seeds`` (of every simulated sequence; empty for recorded data), ``sequences`` and ``frames``
-  (counts, all sequences together), ``created_utc``, and free-form ``options`` and ``notes``;
-- row: ``dataset`` (``m3n2``, ``mot15``; ``None`` across data sets), ``sequence`` (``None`` across
-  sequences), ``tracker``, ``combined`` (``True`` for a row combining other rows of its table, e.g.
-  eval's combined row or the divers' ALL row), ``metrics`` (machine keys, see :func:`metric_key`;
-  fractions in [0, 1], never percent), optional ``info`` (text fields) and ``error``.
+described by ``results.schema.json`` (:data:`SCHEMA_PATH`). The header holds ``lookalike_version``,
+``command``, ``kind``, ``seeds``, ``sequences``, ``frames``, ``created_utc``, ``options`` and ``notes``;
+a row holds ``dataset``, ``sequence`` (None across sequences), ``tracker``, ``combined``, ``metrics``
+(machine keys, :func:`metric_key`; fractions in [0, 1]) and optional ``info`` and ``error``.
 
 Usage::
 
-    from lookalike.io.results import Results
-
-    doc = Results("bench divers", command=command_line, seeds=seeds, sequences=len(scenarios),
-                  frames=total_frames, options={"frames": frames})
-    doc.add("divers", dataset="divers", sequence="pool-1", tracker="sort",
-            metrics={"idf1": 0.81, "idsw": 3}, info={"location": "pool"})
-    doc.add("divers", dataset="divers", sequence=None, tracker="sort", combined=True, metrics={...})
+    doc = Results("bench divers", command=command_line, seeds=seeds, sequences=3, frames=900)
+    doc.add("divers", dataset="divers", sequence="pool-1", tracker="sort", metrics={"idf1": 0.81})
     doc.write(path)   # or doc.to_dict() / doc.dumps()
 
-:meth:`Results.add` refuses keys that are not machine keys and fractions outside [0, 1] (NaN and
-infinities are written as ``null``). :func:`percent_row_metrics` turns a printed row (``"Success rate
-(%)": 93.1``) into metrics (``{"success_rate": 0.931}``). :func:`load_results` reads a document back.
+:meth:`Results.add` refuses non-machine keys and fractions outside [0, 1] (NaN written as ``null``).
 """
 
 from __future__ import annotations

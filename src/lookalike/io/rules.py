@@ -1,10 +1,8 @@
 """The input rules every reader in :mod:`lookalike.io` applies, and file creation with the user's umask.
 
-Frame numbers in files are integers >= 1. A frame may not jump past the frames seen so far by more
-than ``max(MIN_GAP, GAP_FACTOR × the largest frame so far)``: one stray frame number such as 1e8 in a
-short file is an error, not a run over 10^8 empty frames. With a declared length (``seqLength`` in
-``seqinfo.ini``, ``n_frames``) frames past it are an error and the jump rule is not needed.
-docs/concepts/data-formats.md lists the rules and what each bad input gets.
+Frame numbers are integers >= 1 and may not jump past the largest so far by more than
+``max(MIN_GAP, GAP_FACTOR × that frame)``, unless a declared length bounds them
+(docs/concepts/data-formats.md).
 """
 
 from __future__ import annotations

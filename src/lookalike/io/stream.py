@@ -1,11 +1,9 @@
-"""Streaming MOTChallenge input and output for :func:`lookalike.loop.run`: frames read lazily from a
-detection file, and result rows written as they come to a file that appears atomically at the end.
+"""Streaming MOTChallenge input and output for :func:`lookalike.loop.run`.
 
-:class:`DetectionStream` checks the whole file first (chunk by chunk, constant memory: the same
-errors as :func:`~lookalike.io.read_mot`, frame rules included, before any frame is produced), then yields one
-:class:`~lookalike.types.Frame` per frame, parsing the file again a chunk at a time. A file whose
-frame numbers ever decrease (allowed, but unusual) or whose lines have differing column counts is
-read whole instead; either way the frames equal :func:`~lookalike.io.frames_from_table`'s.
+:class:`DetectionStream` checks the whole file first in chunks (the errors of :func:`~lookalike.io.read_mot`),
+then yields frames parsing a chunk at a time (files with decreasing frames or uneven columns are read
+whole); frames equal :func:`~lookalike.io.frames_from_table`'s. :class:`MotWriter` writes rows as they come
+to a file that appears atomically at the end.
 """
 
 from __future__ import annotations
