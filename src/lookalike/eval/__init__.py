@@ -1,8 +1,6 @@
-"""Evaluation: CLEAR MOT, identity and HOTA (TrackEval's definitions), and the identification
-metrics of seed A (identification success rate, localisation error).
-
-Values are fractions (0.73 for 73 %), named as in TrackEval. :mod:`lookalike.eval.folders` scores
-folders of result files against ground-truth sequence folders (``lookalike eval``).
+"""Evaluation: CLEAR MOT, identity and HOTA (TrackEval's definitions, values as fractions), and the
+robot-identification paper's metrics (identification success rate, localisation error).
+:mod:`lookalike.eval.folders` scores folders of results (``lookalike eval``).
 """
 
 from lookalike.eval.api import METRICS, combine, evaluate_data, evaluate_points, evaluate_sequence

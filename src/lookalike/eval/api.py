@@ -1,7 +1,5 @@
-"""Scoring one sequence, from tables or in-memory arrays, and combining sequences.
-
-Every value is a fraction (0.73, not 73 %), as in TrackEval's CSV output; counts are plain
-numbers. A result dict holds the metrics and the counts needed to combine it with others.
+"""Scoring one sequence, from tables or in-memory arrays, and combining sequences. Values are fractions (0.73,
+not 73 %) as in TrackEval; a result dict also holds the counts needed to combine it with others.
 """
 
 from __future__ import annotations

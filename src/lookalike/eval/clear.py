@@ -1,11 +1,6 @@
-"""CLEAR MOT metrics (Bernardin & Stiefelhagen 2008) with TrackEval's conventions.
-
-Per frame, ground truth and tracker objects are matched by the Hungarian algorithm on similarity,
-only pairs with similarity >= ``threshold`` allowed, and a pair that was matched in the previous
-*scored* frame (a frame with both ground truth and tracker objects) preferred over any other.
-An ID switch is a ground-truth object matched to a tracker id different from its last match
-(from any earlier frame); a fragment starts each time an object becomes tracked after not being
-tracked in the previous scored frame. MT: tracked > 80 % of its frames, ML: < 20 %.
+"""CLEAR MOT metrics (Bernardin & Stiefelhagen 2008) with TrackEval's conventions: per frame, Hungarian
+matching on similarity >= ``threshold``, preferring the previous scored frame's pairs; an ID switch is a
+ground-truth object matched to another tracker id than its last match; MT > 80 % tracked, ML < 20 %.
 """
 
 from __future__ import annotations
@@ -74,9 +69,8 @@ def clear_counts(data: SequenceData, threshold: float = 0.5) -> dict[str, float]
 def _solve_hard_frames(data: SequenceData, hard: np.ndarray, scored: np.ndarray, bounds: np.ndarray,
                        gt_det: np.ndarray, tr_det: np.ndarray,
                        sim: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Matches ``(frame, gt det, tracker det, similarity)`` of the ``hard`` frames, in frame order: the
-    Hungarian algorithm on the thresholded similarity plus 1000 for a pair matched in the previous scored
-    frame (which is either one-to-one, so all its candidate pairs match, or an earlier hard frame)."""
+    """Matches ``(frame, gt det, tracker det, similarity)`` of the ``hard`` frames in frame order: Hungarian on
+    the thresholded similarity plus 1000 for a pair matched in the previous scored frame."""
     linear_sum_assignment = hungarian()
     n_frames = len(scored)
     is_hard = np.zeros(n_frames, bool)

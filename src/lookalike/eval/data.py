@@ -1,9 +1,5 @@
-"""One sequence prepared for scoring: detections per frame and their positive-similarity pairs.
-
-Ground-truth and tracker ids are relabelled ``0 .. n-1`` (in increasing order of the original ids)
-so that metrics can index dense arrays with them. Detections are stored flat in frame order (frame
-``t`` holds ground-truth detections ``gt_bounds[t]:gt_bounds[t + 1]``), and only the pairs with a
-positive similarity are kept: every other entry of a frame's similarity matrix is exactly 0.
+"""One sequence prepared for scoring: detections per frame (flat, in frame order) with ids relabelled
+``0 .. n-1``, and their positive-similarity pairs (every other similarity is exactly 0).
 """
 
 from __future__ import annotations

@@ -1,10 +1,6 @@
-"""HOTA (Luiten et al. 2021) over the 19 localisation thresholds alpha = 0.05, 0.10, ..., 0.95.
-
-Per frame, objects are matched once by the Hungarian algorithm maximising
-``global_alignment(gt_id, tracker_id) * similarity``; the match is then counted at every alpha
-its similarity reaches. Everything after that matching is vectorised over the 19 alphas.
-Results are stored flat as ``FIELD___5`` ... ``FIELD___95`` and ``FIELD___AUC`` (the mean over
-alphas); ``FIELD`` alone is the same mean.
+"""HOTA (Luiten et al. 2021) over the 19 thresholds alpha = 0.05, ..., 0.95: one Hungarian matching per frame
+on ``global_alignment * similarity``, counted at every alpha its similarity reaches. Stored as
+``FIELD___5`` ... ``FIELD___95`` and ``FIELD___AUC`` (= ``FIELD``, the mean over alphas).
 """
 
 from __future__ import annotations

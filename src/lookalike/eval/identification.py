@@ -1,9 +1,8 @@
-"""Seed A's identification metrics: how often a detection carries the right agent label, and how
-far estimated agent positions are from the true ones.
+"""The robot-identification paper's metrics: how often a detection carries the right agent label, and how far
+estimated agent positions are from the true ones.
 
-Labels are agent ids (``>= 0``) or ``-1`` for a false positive (a detection of no agent).
-Positions are ``(n_frames, n_agents, 2)`` arrays in metres, agent ``k`` in column ``k``, NaN where
-the agent is absent (truth) or has no estimate (estimated).
+Labels are agent ids (``>= 0``) or ``-1`` (false positive). Positions are ``(n_frames, n_agents, 2)`` arrays
+in metres, NaN where the agent is absent (truth) or not estimated.
 """
 
 from __future__ import annotations

@@ -1,12 +1,6 @@
-"""Per-frame Hungarian matching over sparse pairs, with the exact shortcut for frames whose pairs
-already form a one-to-one matching.
-
-A frame's score matrix is zero except at its listed pairs. When no detection appears in two of a
-frame's positive pairs, every maximum-score assignment contains all of them, so the Hungarian
-algorithm is only run on the other frames, on the same dense matrix as before (same result, same
-tie-breaking). Those matrices are built many frames at a time in one reused buffer
-(:func:`negated_matrices`) and solved one after another (:func:`solve_matrices`), instead of one
-allocation and scatter per frame.
+"""Per-frame Hungarian matching over sparse pairs, skipping frames whose pairs are already one-to-one (every
+maximum-score assignment contains them); the other frames' dense matrices are built in one reused buffer
+(:func:`negated_matrices`) and solved in turn (:func:`solve_matrices`).
 """
 
 from __future__ import annotations
@@ -47,10 +41,8 @@ _CHUNK = 1 << 15  # float64 entries (256 KiB) of the buffer that consecutive mat
 
 def negated_matrices(shapes: np.ndarray, block: np.ndarray, rows: np.ndarray, cols: np.ndarray,
                      values: np.ndarray) -> Iterator[np.ndarray]:
-    """``k`` dense matrices of ``shapes`` ``(k, 2)``, one after another, negated: ``-0.0`` everywhere (as
-    ``-np.zeros(shape)``) except ``-values`` at ``(rows, cols)`` of matrix ``block`` (ascending, one entry per
-    value). They are built a run of consecutive matrices at a time in one reused buffer (no fresh memory
-    pages per frame); each matrix is a view, valid until the next one is asked for."""
+    """``k`` dense negated matrices of ``shapes (k, 2)``: ``-0.0`` except ``-values`` at ``(rows, cols)`` of
+    matrix ``block``. Built a run at a time in one reused buffer; each is a view valid until the next is asked for."""
     k = len(shapes)
     if not k:
         return

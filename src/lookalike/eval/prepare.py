@@ -1,13 +1,8 @@
-"""Turn ground-truth and result tables into :class:`SequenceData`, applying benchmark rules.
+"""Turn ground-truth and result tables into :class:`SequenceData`, applying benchmark rules (``benchmark``):
 
-Rules (``benchmark``):
-
-- ``"MOT16"``, ``"MOT17"``, ``"MOT20"``: MOTChallenge preprocessing. Per frame, tracker boxes are
-  matched to *all* ground-truth boxes (Hungarian on IoU, IoU >= 0.5); tracker boxes matched to a
-  distractor class (person on vehicle 2, static person 7, distractor 8, reflection 12, and for
-  MOT20 non-MOT vehicle 6) are removed. Then only ground truth with a non-zero consider flag
-  (column 7) and class pedestrian (column 8 = 1) is kept.
-- ``"MOT15"``: ground truth with a zero consider flag is dropped; nothing else.
+- ``"MOT16"``, ``"MOT17"``, ``"MOT20"``: tracker boxes matched (IoU >= 0.5) to distractor classes are
+  removed, then only ground truth with a non-zero consider flag and class pedestrian is kept;
+- ``"MOT15"``: ground truth with a zero consider flag is dropped;
 - ``"custom"``: everything is kept.
 """
 
@@ -161,11 +156,8 @@ def _relabel_flat(ids: np.ndarray) -> tuple[np.ndarray, int]:
 def _overlapping_pairs(a: np.ndarray, a_frame: np.ndarray, b: np.ndarray,
                        b_frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every same-frame pair ``(i, j)`` of boxes ``a[i]``, ``b[j]`` (``(n, 4)`` xywh px, 0-based frames sorted)
-    with a positive IoU, sorted by ``i`` then ``j``, and that IoU (bit for bit :func:`box_iou`'s).
-
-    Boxes whose x ranges overlap have one left edge inside the other box's x range: ``b``'s left edge at or
-    right of ``a``'s and before its right edge, or ``a``'s strictly right of ``b``'s and before its right edge.
-    Both are sorted-range look-ups (with a pixel to spare); every other pair has IoU exactly 0."""
+    with a positive IoU, sorted by ``i`` then ``j``, and that IoU (bit for bit :func:`box_iou`'s), found by
+    sorted-range look-ups of left edges."""
     empty = np.zeros(0, np.int64)
     if not len(a) or not len(b):
         return empty, empty, np.zeros(0)

@@ -1,9 +1,5 @@
-"""Similarity between ground-truth and tracker objects of one frame, in ``[0, 1]``.
-
-Boxes use IoU computed through corner coordinates (left, top, right, bottom) so that values agree
-bit for bit with TrackEval's, which matters for matches that sit exactly at a threshold. Points use
-a linear distance score: ``max(0, 1 - d / (2 * radius))``, so a similarity of 0.5 (the default
-match threshold) is a distance of exactly ``radius``.
+"""Similarity in ``[0, 1]`` between one frame's ground-truth and tracker objects: box IoU through corner
+coordinates (bit for bit TrackEval's), or the point score ``max(0, 1 - d / (2 * radius))``.
 """
 
 from __future__ import annotations
