@@ -1,18 +1,8 @@
-"""Choosing a tracker's parameters on labelled data, and saying honestly how well that carries over.
-
-- :mod:`lookalike.tune.space`: search spaces (declared for ``sort`` and ``boxtrack``, built from the
-  defaults for other trackers, overridable by JSON),
-- :mod:`lookalike.tune.study`: an Optuna study (TPE or random search) over sequences, parallel
-  locally or on Ray, saved and resumable (``lookalike tune``),
-- :mod:`lookalike.tune.folds` and :mod:`lookalike.tune.selection`: leave-one-sequence/dataset-out
-  and K folds; the left-out score of the whole selection procedure,
-- :mod:`lookalike.tune.ablation`: the left-out gain of tuning each parameter against fixing it,
-- :mod:`lookalike.tune.params_file`: the parameter file that ``track --params`` and
-  ``bench real --params`` read (:func:`load_params`),
-- :mod:`lookalike.tune.data`: labelled data (bench datasets by name, MOTChallenge folders).
-
-Optuna is needed for studies only (``pip install 'lookalike[tune]'``); parameter files, spaces,
-folds and table selection work without it.
+"""Choosing a tracker's parameters on labelled data, and the left-out score of that choice: search spaces
+(:mod:`~lookalike.tune.space`), Optuna studies (:mod:`~lookalike.tune.study`), folds and left-out selection
+(:mod:`~lookalike.tune.folds`, :mod:`~lookalike.tune.selection`), ablation (:mod:`~lookalike.tune.ablation`),
+parameter files (:mod:`~lookalike.tune.params_file`) and data (:mod:`~lookalike.tune.data`). Optuna (the
+``tune`` extra) is needed for studies only.
 """
 
 from __future__ import annotations

@@ -1,11 +1,9 @@
 """Which parameters earn their place: the left-out gain of tuning one parameter against fixing it.
 
-For each searched parameter, the candidates are the tracker's defaults and the defaults with that
-one parameter moved over its range (:func:`lookalike.tune.space.grid`). Every candidate is scored
-once on every sequence (:func:`lookalike.tune.objective.evaluate_table`); per fold, the best of a
-parameter's candidates on the training sequences is scored on the left-out ones and compared with
-the defaults there (a paired difference per fold, in criterion points x 100). A parameter is worth
-tuning when the mean gain exceeds twice its standard error over the folds.
+Candidates are the defaults and the defaults with one parameter moved over its range
+(:func:`lookalike.tune.space.grid`), each scored once per sequence; per fold, a parameter's best candidate
+on the training sequences is compared with the defaults on the left-out ones. Worth tuning when the mean
+gain exceeds twice its standard error over the folds.
 """
 
 from __future__ import annotations

@@ -1,7 +1,5 @@
-"""Labelled data to tune on: the bench datasets by name, or MOTChallenge sequence folders.
-
-This module is the one place where :mod:`lookalike.tune` reaches into the benches' data and
-runner (:mod:`lookalike.bench.datasets`, :mod:`lookalike.bench.runner`).
+"""Labelled data to tune on: the bench datasets by name, or MOTChallenge sequence folders (the one place
+:mod:`lookalike.tune` reaches into :mod:`lookalike.bench`).
 """
 
 from __future__ import annotations

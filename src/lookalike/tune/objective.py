@@ -1,9 +1,6 @@
-"""What a choice maximises, and evaluating parameter sets on sequences (serially, in processes, on Ray).
-
-The criterion is fixed before anything is run: ``hota+idf1+mota`` (the sum of the three, as
-:func:`lookalike.eval.headline`), ``hota`` or ``idf1``. Over several sequences the scores are
-combined as TrackEval combines (counts summed); over several *groups* (datasets) the objective is
-the mean of each group's combined criterion, so a large dataset does not outweigh a small one.
+"""What a choice maximises (``hota+idf1+mota``, ``hota`` or ``idf1``), and evaluating parameter sets on
+sequences. Scores combine as TrackEval's over sequences; over groups (datasets) the objective is the mean
+of each group's criterion.
 """
 
 from __future__ import annotations

@@ -1,13 +1,8 @@
-"""The honest figure: the left-out score of the whole selection procedure.
+"""The left-out score of the whole selection procedure.
 
-Tuning maximises the score on the sequences it is given; that score says nothing about a sequence
-outside them. :func:`leave_one_out_selection` answers that: for each fold it runs a study on the
-*other* sequences only and scores the chosen parameters on the left-out ones, which the choice
-never saw. :func:`select_from_table` does the same from a table of stored per-sequence scores
-(every candidate scored once on every sequence): the choice of each fold is then an argmax over
-the stored scores of its training sequences. With candidates drawn at random (independently of any
-score) this is exactly the left-out figure of random search with that budget, for every fold at
-the cost of one pass.
+:func:`leave_one_out_selection` runs a study per fold on the other sequences and scores the choice on the
+left-out ones; :func:`select_from_table` does the same from stored per-sequence scores of every candidate
+(an argmax per fold: with random candidates, random search's left-out figure in one pass).
 """
 
 from __future__ import annotations

@@ -80,9 +80,7 @@ def _i(low: int, high: int, log: bool = False, optional: bool = False) -> Dim:
     return Dim("int", low, high, log=log, optional=optional)
 
 
-# The default spaces. Ranges bracket the defaults widely; the closed-set parameters (max_targets,
-# closed_distance) do nothing on open-set data and are left out. boxtrack's space is its whole public
-# parameter set but those (issue 16: 10 tunable parameters; the others are constants).
+# The default spaces: ranges bracket the defaults widely; closed-set parameters are left out.
 DEFAULT_SPACES: dict[str, Space] = {
     "sort": {
         "max_age": _i(1, 30, log=True),

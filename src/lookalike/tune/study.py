@@ -1,13 +1,9 @@
 """An Optuna study that chooses a tracker's parameters on labelled sequences.
 
-Each trial draws parameters from the search space (TPE or random search), runs the tracker on
-every sequence and scores it; the trial's value is the criterion of the combined scores
-(:func:`lookalike.tune.objective.objective`). The first trial of a new study is the tracker's
-defaults, so the choice is never worse than them *on the sequences it was made on*. Trials run in
-batches of ``workers`` on :class:`lookalike.parallel.JobPool` (local processes or Ray), one job
-per (trial, sequence). With ``storage`` (an Optuna RDB URL such as ``sqlite:///study.db``) every
-finished trial is saved with its parameters and per-sequence scores, and ``resume=True`` continues
-the study up to ``trials`` trials in all (trials cut short by an interruption are run again).
+Each trial (TPE or random) runs the tracker on every sequence; its value is the combined criterion
+(:func:`lookalike.tune.objective.objective`). The first trial is the defaults. Trials run in batches on
+:class:`lookalike.parallel.JobPool`; with ``storage`` (an Optuna RDB URL) trials are saved and ``resume=True``
+continues up to ``trials`` in all.
 """
 
 from __future__ import annotations
