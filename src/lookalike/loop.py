@@ -1,10 +1,6 @@
-"""The one frame loop: feed frames to a tracker in order and hand each frame's tracks to a sink.
-
-``run(tracker, frames, sink)`` pulls frames one at a time from any iterable (a generator reading a
-file lazily, a simulated sequence, a list) and passes ``(frame, tracks)`` to ``sink`` at once, so
-nothing is kept per frame here: memory stays constant in the number of frames when the frames are
-produced lazily and the sink streams (e.g. :class:`lookalike.io.stream.MotWriter`). It times the
-tracker's ``update`` calls alone.
+"""The one frame loop: ``run(tracker, frames, sink)`` feeds frames from any iterable to a tracker in order and
+hands each ``(frame, tracks)`` to ``sink`` at once, keeping nothing per frame (constant memory with lazy
+frames and a streaming sink such as :class:`lookalike.io.stream.MotWriter`). It times ``update`` alone.
 """
 
 from __future__ import annotations

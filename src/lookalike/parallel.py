@@ -1,9 +1,6 @@
-"""Independent jobs run serially, in local processes, or as Ray tasks, with identical results.
-
-:class:`JobPool` is the one place where lookalike chooses how to spread work: benchmarks map jobs
-over sequences, and training prefetches simulated batches. ``backend="ray"`` uses Ray's own task
-API (``ray.remote`` / ``ray.get``) on the cluster at ``address``, or on a local ``ray.init()``.
-Jobs must be picklable top-level callables whose result depends only on their arguments.
+"""Independent jobs run serially, in local processes, or as Ray tasks (``backend="ray"``, on the cluster at
+``address`` or a local ``ray.init()``), with identical results. Jobs must be picklable top-level callables
+whose result depends only on their arguments.
 """
 
 from __future__ import annotations

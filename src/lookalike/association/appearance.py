@@ -1,6 +1,4 @@
-"""Appearance association shared by the appearance trackers: cosine distances, per-track feature
-galleries and the matching cascade (deep SORT, seed B).
-
+"""Appearance association: cosine distances, per-track feature galleries and deep SORT's matching cascade.
 Features are L2-normalised rows, so the cosine distance ``1 - f·g`` lies in ``[0, 2]``.
 """
 

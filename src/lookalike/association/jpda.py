@@ -1,16 +1,9 @@
-"""Joint probabilistic data association (DESIGN §4): exact marginal association probabilities.
+"""Joint probabilistic data association: exact marginal association probabilities.
 
-A joint event gives each track either "missed" or one detection, no detection shared by two
-tracks. Its weight is the product of the per-track hypothesis weights: ``miss[i]`` for a missed
-track (usually ``1 - P_D·P_G``) and ``likelihood[i, j]`` for track ``i`` taking detection ``j``
-(usually ``P_D·N(z_j; ẑ_i, S_i)/λ``; 0 outside the gate). The marginals are
-
-    β_ij = Σ_{events with i→j} weight / Σ_{events} weight.
-
-Tracks and detections are split into independent clusters (connected by gated pairs). A cluster
-whose event count is at most ``max_events`` is enumerated explicitly; a larger one is solved by
-an exact dynamic programme over subsets of the cluster's detections (``O(k·m·2^m)``), which
-handles up to ``MAX_DP_DETECTIONS`` detections per cluster. Both give the exact marginals.
+A joint event gives each track "missed" (weight ``miss[i]``) or one detection (``likelihood[i, j]``), no
+detection shared; ``β_ij`` is the weight of the events with ``i→j`` over the total. Tracks and detections
+split into independent clusters; a cluster of at most ``max_events`` events is enumerated, a larger one
+solved exactly by a dynamic programme over detection subsets (up to ``MAX_DP_DETECTIONS`` detections).
 """
 
 from __future__ import annotations

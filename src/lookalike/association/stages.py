@@ -1,10 +1,6 @@
-"""Association as data: an ordered plan of stages, each a track set, a detection set, a cost and a
-gate, run by one function.
-
-A stage only sees tracks still unmatched and detections still free when it runs, in the order it
-gives them (a boolean mask selects in index order; an index array keeps its own order, which
-decides the solver's tie-breaking). Each stage solves its own assignment; later stages take what
-is left.
+"""Association as data: an ordered plan of stages (track set, detection set, cost, gate) run by one function.
+Each stage sees only the tracks still unmatched and detections still free, in the order it gives them (an
+index array's order decides the solver's tie-breaking), and solves its own assignment.
 """
 
 from __future__ import annotations
@@ -34,11 +30,9 @@ class Stage(NamedTuple):
         max_cost: pairs costing more are forbidden (the solver's gate, see :func:`assign`).
         solve: a replacement solver taking the cost matrix (default: :func:`assign` with ``max_cost``).
         name: a label for diagnostics.
-        gate: when known before any cost is computed, the allowed pairs of all tracks and detections,
-            a boolean matrix ``(k, n)`` True exactly where the cost is at most ``max_cost`` (finite for
-            ``inf``), e.g. an IoU threshold. The stage then computes its costs only when its allowed
-            pairs share a track or a detection: disjoint pairs are every optimum's matches, as
-            :func:`assign` finds them. Ignored with ``solve``.
+        gate: optional boolean ``(k, n)``, True exactly where the cost is allowed, known before any cost is
+            computed (e.g. an IoU threshold); costs are then computed only when allowed pairs compete.
+            Ignored with ``solve``.
     """
 
     tracks: np.ndarray | None
@@ -99,9 +93,8 @@ def _eligible(selector: np.ndarray | None, allowed: np.ndarray) -> np.ndarray:
 
 
 class _PlanLists:
-    """What gated stages of one plan share as Python lists: each gate's allowed pairs and each boolean
-    selector (keyed by the arrays' ids, alive while the plan runs), and the matching's own columns
-    (kept in step with it; None when an array-path stage changed it)."""
+    """What a plan's gated stages share as Python lists: each gate's allowed pairs, each boolean selector (by
+    array id) and the matching's columns (None once an array-path stage changed them)."""
 
     def __init__(self) -> None:
         self.pairs: dict[int, list[tuple[int, int]]] = {}

@@ -1,16 +1,9 @@
-"""Pinhole camera over a flat ground plane, and observer odometry (DESIGN §6).
+"""Pinhole camera over a flat ground plane, and observer odometry.
 
-Frames:
-
-- **egocentric** (observer) frame: metres, origin on the ground below the camera, x forward,
-  y left, z up (DESIGN §3);
-- **camera** (optical) frame: x right, y down, z along the optical axis;
-- **image**: pixels, u to the right, v down, origin at the top-left corner of the top-left pixel.
-
-Extrinsics are the camera's height above the ground and its orientation in the egocentric frame:
-``yaw`` turns the camera to the left about z, ``pitch`` tilts it down (positive = looking towards
-the ground), ``roll`` turns the image clockwise about the optical axis as seen by the camera.
-Lens distortion is not modelled (rectify images first).
+Frames: egocentric (observer; metres, origin on the ground below the camera, x forward, y left, z up),
+camera (x right, y down, z along the optical axis) and image (pixels, u right, v down, origin at the
+top-left pixel's corner). Extrinsics: height, ``yaw`` (left about z), ``pitch`` (positive looks down) and
+``roll`` (image clockwise). No lens distortion.
 """
 
 from __future__ import annotations

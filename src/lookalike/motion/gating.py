@@ -1,9 +1,5 @@
-"""Chi-square gating thresholds for squared Mahalanobis distances.
-
-The quantile is found without scipy: the chi-square CDF with ``dof`` degrees of freedom is the
-regularised lower incomplete gamma function ``P(dof/2, x/2)``, which has a closed form for integer
-and half-integer orders (a finite sum after ``1 - e^-x`` or ``erf(√x)``), inverted by bisection to
-the last bit.
+"""Chi-square gating thresholds for squared Mahalanobis distances, without scipy: the closed-form CDF for
+integer and half-integer orders, inverted by bisection to the last bit.
 """
 
 from __future__ import annotations

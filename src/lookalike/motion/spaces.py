@@ -1,8 +1,6 @@
-"""State spaces: one per parametrisation of a track, each with its box↔state converters, its
-transition ``F``, process noise ``Q``, measurement model ``H``/``R`` and initial covariance ``P0``.
-
-Every space is batched over tracks (``mean (k, n)``, ``cov (k, n, n)``) and stateless; steps are
-nominal frame intervals (per-frame models) or seconds (``WorldCA``).
+"""State spaces: one per track parametrisation, each with box↔state converters, ``F``, ``Q``, ``H``/``R`` and
+``P0``; batched over tracks (``mean (k, n)``, ``cov (k, n, n)``) and stateless. Steps are nominal frame
+intervals, or seconds for ``WorldCA``.
 """
 
 from __future__ import annotations
@@ -303,9 +301,8 @@ class BoxXYAH:
 
 @dataclass(frozen=True)
 class CentreCV:
-    """Diver SORT's centre-only ``[x, y, vx, vy]`` (pixels, pixels/frame); box size comes from the
-    latest detection. Acceleration noise ``accel_std_frac`` and measurement noise
-    ``position_std_frac`` of the box height."""
+    """DiverSORT's centre-only ``[x, y, vx, vy]`` (pixels, pixels/frame); box size from the latest detection.
+    Noises ``accel_std_frac`` and ``position_std_frac`` are fractions of the box height."""
 
     position_std_frac: float
     accel_std_frac: float

@@ -1,9 +1,6 @@
-"""MOTChallenge rows in memory: the :class:`MotTable` of columns, the rows of one frame's tracks,
-and the text form of a row. Shared by io (files), eval (scoring) and sim (simulated results).
-
-A row is ``frame, id, left, top, width, height, conf, x, y, z`` (1-based frame and id, box in
-pixels); results use ``conf`` = the identity confidence (1 when the tracker gives none) and
-``x, y, z`` = -1.
+"""MOTChallenge rows in memory: the :class:`MotTable` of columns, one frame's tracks as rows, and a row's text.
+A row is ``frame, id, left, top, width, height, conf, x, y, z`` (1-based, pixels); results write ``conf`` =
+the identity confidence (1 without one) and ``x, y, z`` = -1.
 """
 
 from __future__ import annotations
