@@ -1,7 +1,5 @@
-"""The LSTM association network of seed A: input encoding, numpy inference, checkpoints.
-
-Torch is needed only for training (``lookalike.learn.model`` and ``lookalike.learn.training``);
-everything imported here runs on numpy alone.
+"""The LSTM association network of the robot-identification paper: input encoding, numpy inference,
+checkpoints. Torch is needed only for training (``model``, ``training``).
 """
 
 from lookalike.learn.checkpoint import CheckpointError, NetworkWeights, load_weights, save_weights

@@ -1,16 +1,10 @@
 """Training the learned diver appearance model (torch; training only) and exporting it to ONNX.
 
-The network (:class:`EmbeddingNet`) maps a ``(n, 3, 32, 64)`` float32 BGR crop in ``[0, 1]`` to a
-32-dimensional L2-normalised embedding: four 3×3 convolution blocks (batch norm, ReLU, 2×2 max
-pooling after the first three), global average pooling and a linear layer. It is trained as an
-identity classifier with an additive cosine margin (normalised softmax, "ArcFace-lite"): logits
-``s · (cos θ_j − m·[j = label])`` over the training identities, so that same-identity embeddings
-gather on the sphere. Augmentation per batch: horizontal flip, scale and shift (affine
-resampling), colour gains, brightness and contrast, murk (blend towards a random water colour
-plus noise) and Gaussian blur. Identities come from :func:`~lookalike.sim.divers_train.training_scenarios`
-(new divers; none of the test team). Each epoch is scored on the validation scenarios (the test
-team, seeds 901–904) by the ROC AUC of cosine similarity for same- vs different-diver pairs;
-the best epoch is kept and exported (:func:`export_onnx`) with its training configuration as JSON.
+:class:`EmbeddingNet` maps ``(n, 3, 32, 64)`` float32 BGR crops in ``[0, 1]`` to 32-dimensional
+L2-normalised embeddings (four conv blocks, global pooling, a linear layer), trained as an identity
+classifier with an additive cosine margin and heavy augmentation on
+:func:`~lookalike.sim.divers_train.training_scenarios`. The epoch with the best validation ROC AUC (same vs
+different diver) is exported (:func:`export_onnx`) with its configuration.
 """
 
 from __future__ import annotations

@@ -1,23 +1,13 @@
-"""Input encoding of one frame for the association network (DESIGN §7).
+"""Input encoding of one frame for the association network.
 
-Layout of the input vector (length ``3·N + 5·M``):
+Our layout (length ``3·N + 5·M``): per agent ``cos ψ_j, sin ψ_j, age_j`` (latest reported heading and its
+age in seconds, clipped to ``max_age_s``; ``(0, 0, max_age_s)`` if never heard), then per detection slot
+``x, y, cos φ, sin φ, γ`` (ground position in metres, visual heading, detector probability), with
+``relative_headings`` followed by ``cos(φ − ψ_j), sin(φ − ψ_j)`` per agent. Empty slots are zeros; with
+more than M detections the M most probable are kept.
 
-* per agent ``j`` (N blocks): ``cos ψ_j, sin ψ_j, age_j`` — the latest reported absolute heading
-  ``ψ_j`` as a unit vector (periodic angles never jump) and the report's age in seconds at this
-  frame (clipped to ``max_age_s``; an agent never heard from has ``(0, 0, max_age_s)``);
-* per detection slot (M blocks): ``x, y, cos φ, sin φ, γ`` — ground position in metres, absolute
-  visual heading ``φ`` as a unit vector, detector probability ``γ``; with ``relative_headings``
-  (our addition, not in the paper) followed by ``cos(φ − ψ_j), sin(φ − ψ_j)`` for every agent j
-  (zeros for an agent never heard from), which spares the network learning N angle comparisons.
-  Empty slots are all zeros.
-
-When a frame has more than M detections, the M most probable are kept.
-
-The paper's protocol (``EncodingSpec(protocol="paper")``, seed A's ``Q = N + M·(D + 1)`` with
-``D = 3``; length ``N + 4·M``): per agent its latest reported absolute heading ``ψ_j / π`` (0 for
-an agent never heard from), per slot ``x, y`` (metres), ``φ / π`` and ``γ``; empty slots all
-zeros. No report ages, no relative headings; the network standardises every input (zero mean,
-unit variance), as the paper does.
+The robot-identification paper's layout (``protocol="paper"``, length ``N + 4·M``): per agent ``ψ_j / π``,
+per slot ``x, y, φ / π, γ``; no ages or relative headings.
 """
 
 from __future__ import annotations
@@ -39,7 +29,7 @@ PROTOCOLS = ("ours", "paper")
 @dataclass(frozen=True)
 class EncodingSpec:
     """Sizes of the encoding: ``n_agents`` (N) reporting agents, ``n_slots`` (M) detection slots;
-    ``protocol`` ``"ours"`` (default) or ``"paper"`` (seed A's ``N + 4·M`` inputs)."""
+    ``protocol`` ``"ours"`` (default) or ``"paper"`` (the paper's ``N + 4·M`` inputs)."""
 
     n_agents: int
     n_slots: int

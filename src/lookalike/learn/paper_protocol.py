@@ -1,8 +1,5 @@
-"""Training arrays in seed A's input layout (``N + 4·M``, see :mod:`lookalike.learn.encoding`) and a
-sampler that draws each training sequence's noise model from its seed.
-
-The paper's protocol adds no augmentation beyond slot shuffling: no identity swaps, no report ages,
-no relative headings; the network is decoded per slot (argmax), as in the paper.
+"""Training arrays in the robot-identification paper's input layout (``N + 4·M``, :mod:`lookalike.learn.encoding`;
+no augmentation beyond slot shuffling) and a sampler drawing each sequence's noise model from its seed.
 """
 
 from __future__ import annotations

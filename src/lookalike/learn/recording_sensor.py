@@ -1,22 +1,9 @@
 """The simulator's detector model measured on labelled recordings, so that simulated sequences look like them.
 
-Fine-tuning on a few recordings learns those recordings by heart; simulated sequences whose detections
-behave like the recordings' (same false-positive rate, detection probability, scores, position and
-heading noise) give unlimited pixel-like training data instead. :func:`fit_sensor` measures, on
-recordings that carry the simulator's truth (``true_position``, ``true_heading``, ``visible``,
-``occlusion`` — the pixel pipeline's recordings do), the parameters of
-:class:`~lookalike.sim.robots_config.SensorConfig`:
-
-* ``fp_per_frame``: false positives per frame;
-* ``p_detect``, ``p_detect_near``, ``p_detect_far``: least squares of "detected" over the visible robots
-  on the simulator's piecewise-linear range profile times its occlusion factor (``best_range_m`` and
-  ``occlusion_hide`` kept from ``base``);
-* position noise ``std = std0 + std_per_m · distance`` along observer x and y: weighted least squares
-  of the root-mean-square error (bias included) of matched detections in 1-metre range bins;
-* headings: ``heading_flip_prob`` = share of errors beyond 90°, ``heading_noise_rad`` = robust standard
-  deviation (1.4826 · median absolute error) of the others, continuous (``heading_classes`` 0);
-* scores: Beta parameters of true and false positives by the method of moments (a saturated detector
-  gives a Beta concentrated at its mean, capped at 0.999 as the simulator clips).
+:func:`fit_sensor` measures :class:`~lookalike.sim.robots_config.SensorConfig`'s false positives per frame,
+detection probabilities over range, position noise ``std0 + std_per_m · distance``, heading flips and
+noise, and score distributions (Beta, by moments) on recordings that carry the simulator's truth
+(``true_position``, ``true_heading``, ``visible``, ``occlusion``).
 """
 
 from __future__ import annotations

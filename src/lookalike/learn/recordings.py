@@ -1,15 +1,7 @@
-"""Training arrays from labelled recordings (a team's own, or the pixel pipeline's), for fine-tuning.
-
-A recording is a :class:`~lookalike.sim.RobotSequence` read from the labelling page's export
-(``.labelled.jsonl``, the simulator's format): detections with their labels (agent id, -1 false
-positive) and the heading reports received per frame. The validation split is by recording, never by
-frame: frames of one recording are strongly correlated, so validating on frames of a training
-recording would reward memorising it.
-
-Training windows: the sequence seed picks a recording (in proportion to its length) and a start
-frame; the whole recording is encoded with the reports received since its first frame (the network's
-memory of the reports carries into the window), slots shuffled with ``rng``, then cut to the window.
-Recordings shorter than a window are padded with empty frames (zero inputs, ignored targets).
+"""Training arrays from labelled recordings (``.labelled.jsonl`` exports, the simulator's format), for
+fine-tuning. Validation splits by recording, never by frame. A training window: the seed picks a recording
+(by length) and a start; the whole recording is encoded, slots shuffled, then cut to the window (short
+recordings padded with ignored empty frames).
 """
 
 from __future__ import annotations

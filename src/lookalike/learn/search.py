@@ -1,17 +1,10 @@
-"""Hyper-parameter search for the LSTM associator (seed A's: random search in log space over the network's
-size, depth and learning rate, chosen on held-out data), with Optuna.
+"""Hyper-parameter search for the LSTM associator with Optuna: ``hidden``, ``num_layers`` and
+``learning_rate`` drawn in log space (TPE or random), each trial one training run scored on the validation
+seeds. The chosen network is scored again on other held-out seeds (:data:`CHECK_SEED_BASE`), the figure
+that estimates how the choice does on new sequences.
 
-Each trial is one training run (:func:`lookalike.learn.training.train`) of the base configuration with
-the trial's ``hidden``, ``num_layers`` and ``learning_rate``, drawn in log space (TPE or random search);
-every trial trains on the same simulated sequences (the base configuration's seed) and its value is its
-best success rate on the training's fixed held-out validation seeds. Because the choice is made on those
-seeds, the chosen network is then scored again on other held-out seeds (:data:`CHECK_SEED_BASE`): that
-figure, not the study's best value, estimates how well the choice does on new sequences.
-
-Trials run ``workers`` at a time on :class:`lookalike.parallel.JobPool` (local processes or Ray), each
-a picklable job writing into its own folder ``trial-NNNN``. The study lives in an Optuna storage (an
-RDB URL such as ``sqlite:///search.db``): running the search again with the same storage continues it
-up to the requested number of trials, and trials cut short by an interruption are run again.
+Trials run on :class:`lookalike.parallel.JobPool`, each in its own ``trial-NNNN`` folder; with an Optuna
+storage URL a rerun continues the study up to the requested trials.
 """
 
 from __future__ import annotations

@@ -1,14 +1,9 @@
 """Training the association network on simulated sequences (needs torch).
 
-Adam with the paper's schedule (learning rate 0.004, decay ``lr_t = lr / (1 + 1e-4·t)``), L2
-weight decay, truncated back-propagation through time over 150 steps, recurrent state reset
-between sequences, slot shuffling, validation on fixed held-out seeds, early stopping on the
-validation success rate, resumable checkpoints and a CSV log.
-
-Each training sequence is a pure function of its seed (slot shuffling included), so batches can be
-generated ahead of time in worker processes or as Ray tasks (:class:`~lookalike.parallel.JobPool`)
-with the same result as in this process. The network runs on ``device`` (``"cpu"`` or ``"cuda"``);
-training may start from exported weights (``init``) instead of random ones.
+Adam with the paper's schedule (``lr_t = lr / (1 + 1e-4·t)``), L2 weight decay, truncated BPTT over 150
+steps, slot shuffling, validation on fixed held-out seeds, early stopping, resumable checkpoints and a CSV
+log. Each sequence is a pure function of its seed, so batches can be made ahead in worker processes
+(:class:`~lookalike.parallel.JobPool`) with the same result.
 """
 
 from __future__ import annotations
@@ -59,7 +54,7 @@ class TrainConfig:
     seed: int = 0
     swap_prob: float = 0.0  # recorded here; the sampler applies it (sim_data.SimSampler)
     init_from: str | None = None  # weights the run started from (recorded; passed as ``init``)
-    protocol: str = "ours"  # input layout: "ours" or "paper" (seed A's N + 4M inputs)
+    protocol: str = "ours"  # input layout: "ours" or "paper" (the paper's N + 4M inputs)
     noise: str = "ours"  # simulator noise model(s) of the sampler (recorded): ours, paper or mix
 
 
@@ -123,12 +118,9 @@ def train(
 ) -> TrainResult:
     """Train on sequences from ``sample(seed, n_frames, rng)``; write weights, checkpoint and log to ``out_dir``.
 
-    ``pool`` generates batches ahead (two per worker); ``init`` starts from exported weights of
-    the same shape (normalisation statistics included) instead of random ones.
-    ``validation_sample`` (default ``sample``) makes the validation sequences, e.g. without augmentation;
-    ``validation`` gives the validation batch ``(B, T, n_inputs), (B, T, M)`` itself instead (e.g. held-out
-    recordings). With ``init``, the starting weights are validated first (step 0), so the weights kept are
-    never worse on validation than those the run started from. ``info`` is added to the exported metadata.
+    ``pool`` generates batches ahead; ``init`` starts from exported weights of the same shape (validated
+    first, so the weights kept are never worse than them); ``validation_sample`` or ``validation`` (a batch
+    ``(B, T, n_inputs), (B, T, M)``) set the validation data; ``info`` is added to the exported metadata.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -1,20 +1,9 @@
 """Warm start across set-ups: weights trained for (N, M) mapped onto a network for (N', M').
 
-The recurrent layers above the first are copied unchanged; the first layer's input columns and the
-output head are mapped block by block:
-
-* agent ``j`` of the new network takes the columns of source agent ``j mod N`` (seed A's layout has
-  one input per agent; ours three);
-* slot ``k`` takes the columns of source slot ``k mod M`` (slots are shuffled in training, so every
-  source slot has learnt the same job);
-* head rows: slot ``k``'s robot class ``c`` takes source slot ``k mod M``'s robot ``c mod N``, the
-  false-positive class the source's false-positive class.
-
-Copied columns and rows of a block that repeats a source block get small Gaussian noise (``jitter``
-times the source block's standard deviation) so that repeated slots and robots can tell themselves
-apart. The input normalisation is taken from ``mean``/``std`` measured on the new set-up's data:
-the copied weights act on standardised inputs, which the two worlds share. The cell, hidden size,
-depth and protocol stay the source's.
+Layers above the first are copied; the first layer's input columns and the output head are mapped block by
+block (new agent ``j`` from source agent ``j mod N``, slot ``k`` from ``k mod M``, the false-positive class
+from the source's), repeated blocks jittered by ``jitter`` times the block's spread. Input normalisation
+comes from the new set-up's ``mean``/``std``.
 """
 
 from __future__ import annotations

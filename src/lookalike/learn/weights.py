@@ -11,7 +11,7 @@ WEIGHTS_DIR = Path(__file__).with_name("weights_data")
 
 def shipped_weights_path(n_agents: int, n_slots: int, stem: str = "lstm") -> Path:
     """The shipped ``model.npz`` for set-up (M=n_slots, N=n_agents); a clear error when none ships.
-    ``stem``: ``"lstm"`` (our input protocol) or ``"lstm_paper"`` (seed A's)."""
+    ``stem``: ``"lstm"`` (our input protocol) or ``"lstm_paper"`` (the robot-identification paper's)."""
     path = WEIGHTS_DIR / f"{stem}_m{n_slots}_n{n_agents}.npz"
     if not path.is_file():
         available = sorted(p.stem for p in WEIGHTS_DIR.glob("*.npz"))
