@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from lookalike.learn.report_jumps import ReportJumps
+from lookalike.trackers.set.report_jumps import ReportJumps
 
 
 def step(jumps: ReportJumps, old, new, t_old: float, t_new: float) -> list:
@@ -18,7 +18,7 @@ def test_two_agents_that_swap_headings_exchange_memories_once():
 
 
 def test_a_jump_with_no_partner_waits_for_its_mirror_and_is_forgotten_when_none_comes():
-    jumps = ReportJumps(jump=0.5, turn_rate=3.0, jump_pair_s=1.0)
+    jumps = ReportJumps(jump=0.5, turn_rate=3.0)
     assert step(jumps, [0.0, 2.0], [-2.0, 2.0], 10.0, 10.1) == []  # no agent reported -2 before: it waits
     assert 0 in jumps.pending
     actions = step(jumps, [-2.0, 2.0], [-2.0, 2.0], 10.1, 11.2)
@@ -26,17 +26,10 @@ def test_a_jump_with_no_partner_waits_for_its_mirror_and_is_forgotten_when_none_
 
 
 def test_mirroring_jumps_are_paired_while_one_waits():
-    jumps = ReportJumps(jump=0.5, turn_rate=0.0, jump_pair_s=1.0)
+    jumps = ReportJumps(jump=0.5, turn_rate=0.0)
     old = [0.0, 2.0, 0.1]  # two agents reported about 0 before: agent 1's jump to 0 has no single partner
     assert step(jumps, old, [0.0, 0.0, 0.1], 10.0, 10.1) == []
     assert step(jumps, [0.0, 0.0, 0.1], [2.0, 0.0, 0.1], 10.1, 10.4) == [(0, 1)]  # agent 0 now reports 1's old
-
-
-def test_forget_mode_and_no_waiting_forget_at_once():
-    for jumps in (ReportJumps(jump=0.5, turn_rate=3.0, on_jump="forget"),
-                  ReportJumps(jump=0.5, turn_rate=3.0, jump_pair_s=None)):
-        actions = step(jumps, [0.0, 2.0], [-2.0, 2.0], 10.0, 10.1)
-        assert len(actions) == 1 and actions[0].tolist() == [0]
 
 
 def test_an_exchange_found_elsewhere_makes_the_agents_jumps_its_second_half():

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from lookalike.learn.set_data import SetBatchMaker, TeamSizes
-from lookalike.learn.set_numpy import SetWeights, load_set_weights
+from lookalike.trackers.set.network import SetWeights, load_set_weights
 
 
 def test_focus_teams_are_drawn_and_checked():

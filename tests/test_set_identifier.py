@@ -5,9 +5,9 @@ import pytest
 
 from lookalike.learn import CheckpointError
 from lookalike.learn.set_data import SetBatchMaker, agent_tokens, detection_tokens
-from lookalike.learn.set_numpy import NumpySetAssociator, SetWeights, load_set_weights, save_set_weights
 from lookalike.sim import simulate_robots
 from lookalike.trackers import make_tracker
+from lookalike.trackers.set.network import NumpySetAssociator, SetWeights, load_set_weights, save_set_weights
 
 
 def random_weights(seed=0, token=8, pair=12, memory=6):
@@ -102,7 +102,7 @@ def test_registered_identifier_labels_a_simulated_sequence(tmp_path, n_agents, n
 
 def test_shipped_weights_load_for_sizes_never_trained_separately():
     from lookalike.learn.set_data import world
-    from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+    from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS
 
     if not SHIPPED_SET_WEIGHTS.is_file():
         pytest.skip("no shipped set weights")

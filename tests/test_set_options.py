@@ -1,5 +1,5 @@
-"""The set identifier's inference options: hiding stale reports, exchanging memories at a report jump,
-and the third stage's rule that chooses them on tuning sequences."""
+"""The set identifier's mechanisms, each on frames made for it: hiding stale reports, the false-positive prior,
+report jumps, the report- and visual-exchange detectors and the undo window."""
 
 import numpy as np
 import pytest
@@ -28,7 +28,7 @@ def frames(n_frames: int, report_heading, visual_heading, reports_from=lambda ag
 
 @pytest.fixture(scope="module")
 def shipped():
-    from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+    from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS
 
     if not SHIPPED_SET_WEIGHTS.is_file():
         pytest.skip("no shipped set weights")
@@ -59,7 +59,7 @@ def test_a_stale_report_whose_robot_turned_is_hidden_only_with_stale_s(shipped):
                 reports_from=lambda a, t: a == 1 or t < 0.5)
     known = {}
     for stale_s in (None, 1.0):
-        tracker = make_tracker("set", n_agents=2, n_slots=2, stale_s=stale_s, stale_turn=0.6)
+        tracker = make_tracker("set", n_agents=2, n_slots=2, stale_s=stale_s)
         known[stale_s] = np.array([a[:, 3] for a in tokens_seen(tracker, fs)])  # column 3: "heard from"
     assert (known[None][1:] == 1).all()  # without the option every heard agent stays heard
     late = int(1.6 * RATE)  # the report is older than 1 s and the robot has turned
@@ -67,19 +67,18 @@ def test_a_stale_report_whose_robot_turned_is_hidden_only_with_stale_s(shipped):
     assert (known[1.0][1:int(1.4 * RATE), 0] == 1).all()  # before it is 1 s old it is shown
     same_heading = frames(90, lambda a, t: heading[a], lambda r, t: heading[r],
                           reports_from=lambda a, t: a == 1 or t < 0.5)
-    tracker = make_tracker("set", n_agents=2, n_slots=2, stale_s=1.0, stale_turn=0.6)
+    tracker = make_tracker("set", n_agents=2, n_slots=2, stale_s=1.0)
     assert all(a[0, 3] == 1 for a in tokens_seen(tracker, same_heading)[1:])  # stale but not turned: shown
 
 
 @pytest.mark.parametrize("exchange_llr", [None, 8.0])  # the exchange detector adds nothing to a report jump
-@pytest.mark.parametrize("on_jump", ["forget", "swap"])
-def test_a_report_swap_exchanges_or_forgets_the_memories(shipped, on_jump, exchange_llr):
+def test_a_report_swap_exchanges_the_memories(shipped, exchange_llr):
     from lookalike.trackers import make_tracker
 
     heading = {0: 0.0, 1: 2.0}
     swapped = lambda a, t: heading[1 - a] if t >= 1.5 else heading[a]  # noqa: E731  ids exchanged from 1.5 s
     fs = frames(60, swapped, lambda r, t: heading[r])
-    tracker = make_tracker("set", n_agents=2, n_slots=2, on_jump=on_jump, exchange_llr=exchange_llr)
+    tracker = make_tracker("set", n_agents=2, n_slots=2, exchange_llr=exchange_llr)
     calls = []
     for name in ("swap", "forget"):
         method = getattr(tracker.net, name)
@@ -92,12 +91,9 @@ def test_a_report_swap_exchanges_or_forgets_the_memories(shipped, on_jump, excha
             after_jump = tracker.net.p.copy()
         else:
             tracker.update(f)
-    if on_jump == "swap":
-        assert calls == ["swap"]  # one exchange; the partner's own jump changes nothing more
-        assert np.linalg.norm(after_jump[0] - before[1]) < np.linalg.norm(after_jump[0] - before[0])
-    else:
-        assert calls and set(calls) == {"forget"}
-    quiet = make_tracker("set", n_agents=2, n_slots=2, on_jump="swap")
+    assert calls == ["swap"]  # one exchange; the partner's own jump changes nothing more
+    assert np.linalg.norm(after_jump[0] - before[1]) < np.linalg.norm(after_jump[0] - before[0])
+    quiet = make_tracker("set", n_agents=2, n_slots=2)
     quiet.net.swap = quiet.net.forget = lambda *a: pytest.fail("no jump, no change")
     for f in frames(60, lambda a, t: heading[a], lambda r, t: heading[r]):
         quiet.update(f)
@@ -120,18 +116,18 @@ def three_robot_frames(report_heading, n_frames: int = 120) -> list[Frame]:
     return out
 
 
-def test_jump_pair_s_pairs_two_ambiguous_jumps_that_mirror_each_other(shipped):
-    """Agents 0 and 1 swap ids at 1.5 s; agent 0's jump to 2.0 rad could be for robot 1 or 2 (2.3 rad): at
-    once it is forgotten, with jump_pair_s it waits for agent 1's mirroring jump and the two swap memories.
-    A lone jump with no mirror is forgotten once jump_pair_s has passed."""
+def test_two_ambiguous_jumps_that_mirror_each_other_are_paired(shipped):
+    """Agents 0 and 1 swap ids at 1.5 s; agent 0's jump to 2.0 rad could be for robot 1 or 2 (2.3 rad): it waits
+    for agent 1's mirroring jump and the two swap memories. A lone jump with no mirror is forgotten once
+    PAIR_WAIT_S has passed."""
     from lookalike.trackers import make_tracker
+    from lookalike.trackers.set.report_jumps import PAIR_WAIT_S
 
     own = np.array([0.0, 2.0, 2.3])
     swapped = lambda a, t: own[{0: 1, 1: 0}.get(a, a)] if t >= 1.5 else own[a]  # noqa: E731
     lone = lambda a, t: 2.15 if a == 0 and t >= 1.5 else own[a]  # noqa: E731
-    for report, wait, expected in ((swapped, None, ["forget", "forget"]), (swapped, 1.0, ["swap"]),
-                                   (lone, 1.0, ["forget"])):
-        tracker = make_tracker("set", n_agents=3, n_slots=3, exchange_llr=None, jump_pair_s=wait)
+    for report, expected in ((swapped, ["swap"]), (lone, ["forget"])):
+        tracker = make_tracker("set", n_agents=3, n_slots=3, exchange_llr=None)
         calls = []
         for name in ("swap", "forget"):
             method = getattr(tracker.net, name)
@@ -146,13 +142,12 @@ def test_jump_pair_s_pairs_two_ambiguous_jumps_that_mirror_each_other(shipped):
         if expected == ["swap"]:  # agent 0 now remembers where robot 1 stands, and agent 1 robot 0
             assert np.allclose(tracker.net.p[[0, 1]], before[[1, 0]], atol=0.3)
         if report is lone:
-            assert calls[0][1] > 1.5 + wait  # forgotten only when no mirroring jump came in time
+            assert calls[0][1] > 1.5 + PAIR_WAIT_S  # forgotten only when no mirroring jump came in time
 
 
-def test_jump_silent_pairs_a_jump_with_the_first_report_after_a_silence(shipped):
+def test_a_jump_is_paired_with_the_first_report_after_a_silence(shipped):
     """Agent 1 is silent from 0.6 s until the ids of agents 0 and 1 swap: its first report, 2 rad off its
-    last one but a second later, is no jump, and agent 0's jump could be for robot 1 or 2. Without jump_silent
-    agent 0 is forgotten (or, when agent 1's report comes first, exchanged with agent 2); with it agents 0 and 1
+    last one but a second later, is no jump, and agent 0's jump could be for robot 1 or 2. Agents 0 and 1
     exchange memories, whichever of the two reports comes first. A silence with no swap changes nothing."""
     own = np.array([0.0, 2.0, 2.3])
     for swap_at, quiet_to in ((1.5, 1.6), (1.51, 1.5)):  # agent 0's jump first (1.6 s); agent 1's report (1.53 s)
@@ -161,15 +156,14 @@ def test_jump_silent_pairs_a_jump_with_the_first_report_after_a_silence(shipped)
                 return float("nan")  # silent: no report
             return float(own[{0: 1, 1: 0}.get(a, a)] if t >= at else own[a])
 
-        assert ("swap", {0, 1}) not in silent_calls(report, False)  # forgotten, or swapped with agent 2
-        assert silent_calls(report, True) == [("swap", {0, 1})]
-    assert silent_calls(lambda a, t: float("nan") if a == 1 and 0.6 <= t < 1.6 else float(own[a]), True) == []
+        assert silent_calls(report) == [("swap", {0, 1})]
+    assert silent_calls(lambda a, t: float("nan") if a == 1 and 0.6 <= t < 1.6 else float(own[a])) == []
 
 
-def silent_calls(report, silent: bool) -> list[tuple[str, set[int]]]:
+def silent_calls(report) -> list[tuple[str, set[int]]]:
     """The memory changes (``("swap", {a, b})``, ``("forget", agents)``) of a three-agent set identifier
-    (jump_silent ``silent``) on :func:`three_robot_frames` with ``report``."""
-    tracker = make_tracker("set", n_agents=3, n_slots=3, exchange_llr=None, jump_silent=silent)
+    on :func:`three_robot_frames` with ``report``."""
+    tracker = make_tracker("set", n_agents=3, n_slots=3, exchange_llr=None)
     calls: list[tuple[str, set[int]]] = []
     tracker.net.swap = lambda a, b, m=tracker.net.swap: (calls.append(("swap", {a, b})), m(a, b))[1]
     tracker.net.forget = lambda mask, m=tracker.net.forget: (calls.append(("forget", set(np.flatnonzero(mask)))),
@@ -177,33 +171,6 @@ def silent_calls(report, silent: bool) -> list[tuple[str, set[int]]]:
     for f in three_robot_frames(report):
         tracker.update(f)
     return calls
-
-
-def test_pair_swap_exchanges_the_memories_of_a_swap_no_report_jump_shows(shipped):
-    from lookalike.trackers import make_tracker
-
-    heading = {0: 0.0, 1: 0.7}  # close headings: the exchange is no report jump (report_jump off anyway)
-    swapped = lambda a, t: heading[1 - a] if t >= 1.5 else heading[a]  # noqa: E731  ids exchanged from 1.5 s
-    labels = {}
-    for pair_swap in (None, 2.0):
-        tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, exchange_llr=None, pair_swap=pair_swap)
-        out = []
-        for f in frames(120, swapped, lambda r, t: heading[r]):
-            tracker.update(f)
-            out.append(tracker.last_labels.copy())
-        labels[pair_swap] = np.array(out)
-        if pair_swap is None:
-            assert tracker.pair_swaps == 0
-        else:
-            assert tracker.pair_swaps == 1
-    late = int(3.0 * RATE)
-    # robot 0 (detection 0) now reports as agent 1: with the rule its label follows the reports
-    assert (labels[2.0][late:, 0] == 1).all() and (labels[2.0][late:, 1] == 0).all()
-    assert (labels[2.0][: int(1.4 * RATE)] == [0, 1]).all()  # and before the swap nothing changed
-    quiet = make_tracker("set", n_agents=2, n_slots=2, pair_swap=0.5)
-    quiet.net.swap = lambda *a: pytest.fail("no swap, no exchange")
-    for f in frames(120, lambda a, t: heading[a], lambda r, t: heading[r]):
-        quiet.update(f)
 
 
 def test_visual_exchange_follows_visual_headings_that_fit_the_other_agents_reports(shipped):
@@ -229,26 +196,27 @@ def test_visual_exchange_follows_visual_headings_that_fit_the_other_agents_repor
         quiet.update(f)
 
 
-def test_visual_stale_rad_s_lets_the_agent_still_reporting_carry_an_exchange_with_a_silent_one(shipped):
+def test_the_agent_still_reporting_carries_a_visual_exchange_with_a_silent_one(shipped):
     heading = {0: 0.0, 1: 0.3}
     swapped = lambda a, t: heading[1 - a] if t >= 1.5 else heading[a]  # noqa: E731  ids exchanged from 1.5 s
     silent = lambda a, t: a == 0 or t < 1.4  # noqa: E731  and agent 1 silent from just before
-    for stale, exchanges, late_labels in ((None, 0, [0, 1]), (0.5, 1, [1, 0])):
-        tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, exchange_llr=None,
-                               visual_exchange=6.0, visual_stale_rad_s=stale)
-        for f in frames(150, swapped, lambda r, t: heading[r], reports_from=silent):
-            tracker.update(f)
-        assert tracker.visual_exchanges == exchanges
-        assert tracker.last_labels.tolist() == late_labels
+    tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, exchange_llr=None, visual_exchange=6.0)
+    for f in frames(150, swapped, lambda r, t: heading[r], reports_from=silent):
+        tracker.update(f)
+    assert tracker.visual_exchanges == 1
+    assert tracker.last_labels.tolist() == [1, 0]
 
 
-def test_undo_factor_undoes_a_recent_exchange_on_less_evidence(shipped):
+def test_undo_factor_undoes_a_recent_exchange_on_less_evidence(shipped, monkeypatch):
+    from lookalike.trackers.set import tracker as set_tracker
+
     heading = {0: 0.0, 1: 0.25}  # too close for a report jump: the visual detector alone finds both exchanges
     swapped = lambda a, t: heading[1 - a] if 1.5 <= t < 5.0 else heading[a]  # noqa: E731  ids exchanged 1.5-5 s
     found = {}
     for undo, undo_s in ((None, 30.0), (0.25, 30.0), (0.25, 2.0)):
+        monkeypatch.setattr(set_tracker, "UNDO_S", undo_s)
         tracker = make_tracker("set", n_agents=2, n_slots=2, report_jump=None, exchange_llr=None,
-                               visual_exchange=8.0, undo_factor=undo, undo_s=undo_s)
+                               visual_exchange=8.0, undo_factor=undo)
         times, scales = [], []
         swap = tracker.net.swap
         tracker.net.swap = lambda a, b, s=swap, t=tracker, out=times: (out.append(t._last_time), s(a, b))
@@ -281,14 +249,16 @@ def test_undo_factor_holds_for_an_agents_latest_exchange_only(shipped):
     assert (tracker._threshold_scale() == 1.0).all()
 
 
-def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
+def test_fp_prior_follows_the_worlds_false_positive_rate(shipped, monkeypatch):
     """fp_prior_ref: the running false-positive rate starts at the reference, falls in a world without false
     positives (so a robot's detection is less readily called one); None turns the correction off."""
     from lookalike.trackers import make_tracker
+    from lookalike.trackers.set import tracker as set_tracker
 
+    monkeypatch.setattr(set_tracker, "FP_PRIOR_S", 1.0)
     clip = frames(90, lambda a, t: 0.3 + 2.0 * a, lambda r, t: 0.3 + 2.0 * r)
     plain = make_tracker("set", n_agents=2, weights=str(shipped), fp_prior_ref=None)
-    adapted = make_tracker("set", n_agents=2, weights=str(shipped), fp_prior_ref=1.0, fp_prior_s=1.0)
+    adapted = make_tracker("set", n_agents=2, weights=str(shipped), fp_prior_ref=1.0)
     assert plain.fp_rate is None and adapted.fp_rate == 1.0
     for f in clip:
         adapted.update(f)
@@ -302,11 +272,12 @@ def test_fp_prior_follows_the_worlds_false_positive_rate(shipped):
     assert adapted.fp_rate == 1.0
 
 
-def test_exchange_tight_agents_changes_the_detector_of_larger_teams_only():
-    small = make_tracker("set", n_agents=4)  # exchange_tight_agents 5, the default
-    large = make_tracker("set", n_agents=5)
-    assert (small._exchange.q, small._exchange.lag_s) == (0.1, 0.4)  # exchange_accel, exchange_lag_s
-    assert (large._exchange.q, large._exchange.lag_s) == (0.03, 0.3)  # exchange_tight_accel, exchange_tight_lag_s
-    assert make_tracker("set", n_agents=8)._exchange is None  # exchange_max_agents 7
-    off = make_tracker("set", n_agents=5, exchange_tight_agents=None)
-    assert (off._exchange.q, off._exchange.lag_s) == (0.1, 0.4)
+def test_larger_teams_run_the_smoother_report_exchange_model_and_the_largest_none():
+    from lookalike.trackers.set import report_exchange as rx
+
+    small = make_tracker("set", n_agents=rx.TIGHT_TEAM - 1)
+    large = make_tracker("set", n_agents=rx.TIGHT_TEAM)
+    assert (small._exchange.q, small._exchange.lag_s) == (rx.ACCEL_PSD, rx.LAG_S)
+    assert (large._exchange.q, large._exchange.lag_s) == (rx.TIGHT_ACCEL_PSD, rx.TIGHT_LAG_S)
+    assert make_tracker("set", n_agents=rx.MAX_AGENTS + 1)._exchange is None
+    assert make_tracker("set", n_agents=3, exchange_llr=None)._exchange is None

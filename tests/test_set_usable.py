@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
 from lookalike.sim import preset, simulate_robots
 from lookalike.trackers import make_tracker
+from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS
 from lookalike.types import Beacons, Detections, Frame
 
 pytestmark = pytest.mark.skipif(not SHIPPED_SET_WEIGHTS.is_file(), reason="no shipped set weights")
@@ -36,17 +36,17 @@ def _frame(k, headings, reported):
     return Frame(index=k, time=t, detections=det, beacons=beacons)
 
 
-@pytest.mark.parametrize(("jump", "forgotten"), [(None, []), (0.5, [0])])
-def test_a_report_jump_forgets_that_agents_memory(jump, forgotten):
-    tracker = make_tracker("set", n_agents=2, report_jump=jump, on_jump="forget")
+@pytest.mark.parametrize(("jump", "exchanged"), [(None, []), (0.5, [(0, 1)])])
+def test_a_report_jump_exchanges_memories_with_the_agent_that_reported_the_new_heading(jump, exchanged):
+    tracker = make_tracker("set", n_agents=2, report_jump=jump)
     for k in range(30):
-        tracker.update(_frame(k, [0.0, 2.5], [0.0 + 0.01 * k, 2.5]))  # smooth turns: nothing forgotten
+        tracker.update(_frame(k, [0.0, 2.5], [0.0 + 0.01 * k, 2.5]))  # smooth turns: nothing exchanged
     assert tracker.net.m[:, 0].min() > 0.9  # both agents remembered
     calls = []
-    forget = tracker.net.forget
-    tracker.net.forget = lambda agents: (calls.append(list(np.flatnonzero(agents))), forget(agents))
-    tracker.update(_frame(30, [0.0, 2.5], [2.5, 2.5]))  # agent 0's report turns 2.2 rad in 1/30 s
-    assert calls == ([forgotten] if forgotten else [])
+    swap = tracker.net.swap
+    tracker.net.swap = lambda a, b: (calls.append((a, b)), swap(a, b))
+    tracker.update(_frame(30, [0.0, 2.5], [2.5, 2.5]))  # agent 0's report turns 2.2 rad in 1/30 s, onto agent 1's
+    assert calls == exchanged
 
 
 def test_node_core_identifies_with_set():

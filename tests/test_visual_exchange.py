@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from lookalike.learn.visual_exchange import VisualExchange, take_pairs
+from lookalike.trackers.set.visual_exchange import VisualExchange, take_pairs
 
 DT = 1 / 30
 
@@ -49,31 +49,26 @@ def test_a_flipped_heading_counts_little():
     assert pairs == [] and detector.evidence[0, 1] == pytest.approx(1.5)  # at most max_step in one frame
 
 
-def test_stale_or_missing_reports_and_agents_without_a_detection_take_no_part():
+def test_missing_reports_and_agents_without_a_detection_take_no_part():
     detector = VisualExchange(3, threshold=1.0, fresh_s=0.5)
     reported = np.array([0.0, 0.5, np.nan])
-    for held, age in ((np.array([0, 1, -1]), np.array([0.0, 0.9, np.nan])),  # agent 1's report is stale
-                      (np.array([0, -1, 1]), np.zeros(3)),  # agent 1 holds nothing, agent 2 never reported
+    for held, age in ((np.array([0, -1, 1]), np.zeros(3)),  # agent 1 holds nothing, agent 2 never reported
                       (np.array([0, 1, 2]), np.array([0.0, np.nan, 0.0]))):
         assert detector.update(held, np.array([0.5, 0.0, 0.0]), reported, age, DT) == []
     assert detector.evidence.max() == 0.0
 
 
-def test_with_stale_rad_s_a_silent_agent_takes_part_and_the_reporting_one_carries_the_evidence():
+def test_a_silent_agent_takes_part_and_the_reporting_one_carries_the_evidence():
     """Agent 1 went silent 2 s ago while still reporting robot 0's heading (ids exchanged, then restored while it
     was silent); agent 0 reports its robot again. Agent 0's fresh report fits agent 1's detection, not its own."""
-    found = []
-    for stale in (None, 0.5):
-        detector = VisualExchange(2, threshold=6.0, stale_rad_s=stale)
-        found.append(feed(detector, 90, visual=[1.0, 0.0], reported=[0.0, 0.0], age=(0.05, 2.0)))
-    assert not any(found[0])  # fresh reports only: agent 1 takes no part
-    assert [(0, 1)] in found[1]
+    detector = VisualExchange(2, threshold=6.0)
+    assert [(0, 1)] in feed(detector, 90, visual=[1.0, 0.0], reported=[0.0, 0.0], age=(0.05, 2.0))
 
 
-def test_with_stale_rad_s_a_silent_agent_whose_robot_may_have_turned_gives_no_exchange_alone():
+def test_a_silent_agent_whose_robot_may_have_turned_gives_no_exchange_alone():
     """Agent 1's old report no longer fits its detection (its robot turned while silent) while agent 0's fresh report
     fits its own: the widened noise keeps that from looking like an exchange."""
-    detector = VisualExchange(2, threshold=6.0, stale_rad_s=0.5)
+    detector = VisualExchange(2, threshold=6.0)
     assert not any(feed(detector, 300, visual=[0.0, 1.5], reported=[0.0, 0.5], age=(0.05, 3.0)))
 
 

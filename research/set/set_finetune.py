@@ -61,9 +61,8 @@ def main(argv: list[str] | None = None) -> None:
 
     import torch
 
-    from lookalike.learn.set_numpy import load_set_weights
-    from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
     from lookalike.learn.set_training import train_set
+    from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS, load_set_weights
 
     parser = argparse.ArgumentParser(prog="python research/set/set_finetune.py", description=__doc__)
     parser.add_argument("out", type=Path, help="output folder (snapshots, log, best-validation weights)")

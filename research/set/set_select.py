@@ -42,12 +42,11 @@ import numpy as np
 from lookalike.bench.experiments import measurable, swap_recovery
 from lookalike.bench.pixel_recordings import score_identifier
 from lookalike.learn.set_data import world
-from lookalike.learn.set_numpy import load_set_weights, save_set_weights
-from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
 from lookalike.loop import run
 from lookalike.sim import PRESET_NAMES, RobotSequence, preset, simulate_robots
 from lookalike.trackers import make_tracker
 from lookalike.trackers.parts.identity import labels_from_tracks
+from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS, load_set_weights, save_set_weights
 from lookalike.types import Frame
 
 # Tuning sequences for --select (name, (N, M, fp), first seed, sequences), 1000 frames each; apart from every bench.

@@ -43,7 +43,7 @@ from pathlib import Path
 from set_select import snapshot_steps
 from set_select_stage4 import passes_guard, print_choice, score_candidates
 
-from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS
 
 Candidates = dict[str, tuple[Path, dict[str, object]]]  # name -> (weights, inference options)
 

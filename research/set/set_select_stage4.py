@@ -27,8 +27,7 @@ from set_select import (
     tuning_sequences,
 )
 
-from lookalike.learn.set_numpy import load_set_weights, save_set_weights
-from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
+from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS, load_set_weights, save_set_weights
 
 STAGE4_EVERY = 500
 STAGE4_PAIR_SWAP: tuple[float | None, ...] = (None, 1.5, 1.0)

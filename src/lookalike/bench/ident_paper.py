@@ -3,8 +3,7 @@
 
 Variants name an identifier with parameters: ``lstm-paper`` is the LSTM with the paper's input
 protocol (``N + 4·M`` inputs) decoded per slot, ``lstm-lowpass`` the shipped LSTM with the paper's
-Eq. 3 low-pass filter instead of our Kalman localiser, ``set-exchange`` the set identifier with its
-report-exchange detector on for any team size (the default runs it for teams of up to seven).
+Eq. 3 low-pass filter instead of our Kalman localiser.
 
 Only margins over the same-world Kalman-HA compare like for like: the paper's simulator and ours
 differ, so absolute rates do not.
@@ -20,8 +19,6 @@ IDENT_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "lstm-paper": ("lstm", {"protocol": "paper", "one_to_one": False}),
     "lstm-paper-lowpass": ("lstm", {"protocol": "paper", "one_to_one": False, "localiser": "lowpass"}),
     "lstm-lowpass": ("lstm", {"localiser": "lowpass"}),
-    # set with the report-exchange detector for any team size (its default: teams of up to seven only)
-    "set-exchange": ("set", {"exchange_llr": 8.0, "exchange_max_agents": None}),
 }
 
 # Farazi and Behnke, Table I: success rate (%) on its synthetic dataset, per set-up.

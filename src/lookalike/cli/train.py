@@ -223,10 +223,10 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
     """``lookalike train --model set``: the set associator over every team size (issue 23)."""
     import torch
 
-    from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
     from lookalike.learn.set_training import SetTrainConfig, train_set
     from lookalike.learn.training import plot_log
     from lookalike.parallel import JobPool
+    from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS
 
     if device == "auto":
         device = "cuda" if torch.cuda.is_available() else "cpu"

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from lookalike.learn.encoding import EncodingSpec, encode_agents, encode_slots
-from lookalike.learn.tracker import BeaconMemory
+from lookalike.trackers.set.agents import BeaconMemory
 from lookalike.types import Frame
 
 IGNORE = -100  # target of an empty slot (ignored by the loss)

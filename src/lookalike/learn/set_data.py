@@ -18,32 +18,7 @@ from lookalike.learn.data import IGNORE
 from lookalike.learn.sim_data import latest_reports, mix_pick, silence_agent, slot_order, swap_identities
 from lookalike.sim import NOISE_MODELS, RobotArrays, RobotWorldConfig, noise_sensor, simulate_arrays
 from lookalike.sim.robots_config import SensorConfig
-
-AGENT_FEATURES = 4
-DET_FEATURES = 5
-MAX_AGE_S = 5.0
-
-
-def agent_tokens(heading_rad: np.ndarray, age_s: np.ndarray, max_age_s: float = MAX_AGE_S) -> np.ndarray:
-    """Agent tokens ``(..., N, 4)`` from latest headings and report ages ``(..., N)`` (NaN: never heard)."""
-    heading = np.asarray(heading_rad, dtype=float)
-    age = np.asarray(age_s, dtype=float)
-    known = np.isfinite(heading) & np.isfinite(age)
-    h = np.where(known, heading, 0.0)
-    return np.stack([
-        np.where(known, np.cos(h), 0.0),
-        np.where(known, np.sin(h), 0.0),
-        np.where(known, np.clip(age, 0.0, max_age_s) / max_age_s, 1.0),
-        known.astype(float),
-    ], axis=-1)
-
-
-def detection_tokens(position_m: np.ndarray, heading_rad: np.ndarray, probability: np.ndarray) -> np.ndarray:
-    """Detection tokens ``(..., K, 5)``: ``x, y`` (metres), ``cos φ, sin φ``, ``γ``."""
-    phi = np.asarray(heading_rad, dtype=float)
-    pos = np.asarray(position_m, dtype=float)
-    return np.concatenate([pos, np.cos(phi)[..., None], np.sin(phi)[..., None],
-                           np.asarray(probability, dtype=float)[..., None]], axis=-1)
+from lookalike.trackers.set.network import agent_tokens, detection_tokens
 
 
 def arrays_to_tokens(

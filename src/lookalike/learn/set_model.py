@@ -7,7 +7,7 @@ the offset from the agent's remembered position), every detection gets a learned
 logit from its token and its best pair, and a softmax over "agent 1..N or false positive" gives the
 output. Each agent token then attends to the detections with those probabilities: its remembered
 position moves towards the attended positions and a GRU cell per agent (shared weights) takes the
-attended pair features. :mod:`lookalike.learn.set_numpy` evaluates the same maths with numpy.
+attended pair features. :mod:`lookalike.trackers.set.network` evaluates the same maths with numpy.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from lookalike.learn.set_data import AGENT_FEATURES, DET_FEATURES
+from lookalike.trackers.set.network import AGENT_FEATURES, DET_FEATURES
 
 PAIR_FEATURES = 6
 POSITION_SCALE_M = 4.0  # positions are divided by this before entering the network
@@ -115,7 +115,7 @@ class SetAssociator(nn.Module):
         return torch.stack(out, dim=1), state
 
     def export(self) -> dict[str, np.ndarray]:
-        """The parameters as float64 numpy arrays, by PyTorch name (for :mod:`lookalike.learn.set_numpy`)."""
+        """The parameters as float64 numpy arrays, by PyTorch name (for :mod:`lookalike.trackers.set.network`)."""
         return {k: v.detach().cpu().double().numpy().copy() for k, v in self.state_dict().items()}
 
     def load_exported(self, arrays: dict[str, np.ndarray]) -> None:

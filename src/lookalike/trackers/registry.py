@@ -164,6 +164,7 @@ BUILTIN_TRACKERS = {
     "jpda": "lookalike.trackers.jpda",
     "kalman_ha": "lookalike.trackers.kalman_ha",
     "kalman_ha2": "lookalike.trackers.kalman_ha",
+    "set": "lookalike.trackers.set.tracker",
     "sort": "lookalike.trackers.sort",
 }
 """The trackers of this layer and the module that registers each (tests check the list is complete),
@@ -171,7 +172,7 @@ so that :func:`tracker_names` needs no tracker module imported."""
 
 # Trackers defined above the trackers layer (they need the learned network); imported by name
 # so that this layer never imports upwards.
-PLUGIN_TRACKERS = {"lstm": "lookalike.learn.tracker", "set": "lookalike.learn.set_tracker"}
+PLUGIN_TRACKERS = {"lstm": "lookalike.learn.tracker"}
 """The plugins pyproject.toml declares (entry points of group ``lookalike.trackers``), used where the
 installed metadata does not list them (an install older than the entry points)."""
 PLUGIN_MODULES = tuple(PLUGIN_TRACKERS.values())

@@ -11,15 +11,19 @@ frame adds at most ``max_step`` either way (both detections seen front to back i
 add about 7 for two robots heading opposite ways), so an exchange needs consistent evidence over several frames. The
 evidence is summed over frames, decays with time constant ``memory_s`` and never drops below zero (a CUSUM), so
 that two robots whose headings stay apart keep it at zero; when a pair's passes ``threshold`` the two agents
-are said to be exchanged and their evidence starts again. With ``stale_rad_s``, an agent whose report is older than
-``fresh_s`` (its robot silent for a while) takes part too, its robot's heading modelled as its last report with the
-noise widened by ``stale_rad_s`` radians per second beyond ``fresh_s`` (how far a robot may have turned since): the
-pair's evidence then comes mostly from the agent that still reports.
+are said to be exchanged and their evidence starts again. An agent whose report is older than ``fresh_s`` (its robot
+silent for a while) takes part too, its robot's heading modelled as its last report with the noise widened by
+``stale_rad_s`` radians per second beyond ``fresh_s`` (how far a robot may have turned since): the pair's evidence
+then comes mostly from the agent that still reports.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+MEMORY_S = 10.0  # time constant of the evidence's decay, seconds
+NOISE_RAD = 0.28  # a visual heading's noise around its robot's heading (10 classes, 12 degrees of noise), radians
+STALE_RAD_S = 0.5  # widening of an older report's noise, radians per second of age beyond fresh_s
 
 
 def take_pairs(evidence: np.ndarray, threshold: float | np.ndarray) -> list[tuple[int, int]]:
@@ -38,19 +42,18 @@ def take_pairs(evidence: np.ndarray, threshold: float | np.ndarray) -> list[tupl
 class VisualExchange:
     """Exchange detector over ``n`` agents from their detections' visual headings (see the module)."""
 
-    def __init__(self, n: int, threshold: float, memory_s: float = 10.0, noise_rad: float = 0.28,
+    def __init__(self, n: int, threshold: float, memory_s: float = MEMORY_S, noise_rad: float = NOISE_RAD,
                  flip_prob: float = 0.03, outlier_prob: float = 0.02, fresh_s: float = 0.5,
-                 max_step: float = 1.5, stale_rad_s: float | None = None) -> None:
+                 max_step: float = 1.5, stale_rad_s: float = STALE_RAD_S) -> None:
         """``threshold``: log-likelihood ratio a pair must pass; ``memory_s``: time constant of the evidence's
         decay, seconds; ``noise_rad``: a visual heading's noise around its robot's heading (standard deviation),
         radians; ``flip_prob``: probability that a visual heading is turned by π; ``outlier_prob``: probability that
         it says nothing of the robot (uniform); ``fresh_s``: only reports younger than this count, seconds;
         ``max_step``: the most one frame adds or takes; ``stale_rad_s``: older reports count with their noise
-        widened by this many radians per second beyond ``fresh_s`` (None: only fresh reports count)."""
-        if n < 0 or min(threshold, memory_s, noise_rad, max_step) <= 0 or (stale_rad_s is not None
-                                                                          and stale_rad_s <= 0):
+        widened by this many radians per second beyond ``fresh_s``."""
+        if n < 0 or min(threshold, memory_s, noise_rad, max_step, stale_rad_s) <= 0:
             raise ValueError(f"VisualExchange needs n >= 0 and positive threshold, memory_s, noise_rad, max_step and "
-                             f"stale_rad_s (or None), "
+                             f"stale_rad_s, "
                              f"got n={n}, threshold={threshold}, memory_s={memory_s}, noise_rad={noise_rad}, "
                              f"max_step={max_step}, stale_rad_s={stale_rad_s}")
         if not (0 <= flip_prob and 0 <= outlier_prob and flip_prob + outlier_prob < 1):
@@ -73,7 +76,7 @@ class VisualExchange:
         keep, flip, uniform = self.weights
         z, zf = d / sigma, flipped / sigma
         density = norm * (keep * np.exp(-0.5 * z * z) + flip * np.exp(-0.5 * zf * zf))
-        return np.log(density + uniform)
+        return np.asarray(np.log(density + uniform))
 
     def update(self, held: np.ndarray, visual: np.ndarray, reported: np.ndarray, age: np.ndarray,
                dt: float, scale: np.ndarray | None = None) -> list[tuple[int, int]]:
@@ -84,14 +87,10 @@ class VisualExchange:
         once)."""
         self.evidence *= np.exp(-max(dt, 0.0) / self.memory_s)
         usable = (held >= 0) & np.isfinite(reported) & np.isfinite(age)
-        if self.stale_rad_s is None:
-            usable &= age <= self.fresh_s
         live = np.flatnonzero(usable)
         if len(live) < 2:
             return []
-        sigma: np.ndarray | float = self.sigma
-        if self.stale_rad_s is not None:
-            sigma = np.hypot(self.sigma, self.stale_rad_s * np.maximum(age[live] - self.fresh_s, 0.0))[None, :]
+        sigma = np.hypot(self.sigma, self.stale_rad_s * np.maximum(age[live] - self.fresh_s, 0.0))[None, :]
         fit = self.log_likelihood(visual[held[live]][:, None], reported[live][None, :], sigma)  # [i, j]: i's det., j
         own = np.diag(fit)
         gain = np.clip(fit + fit.T - own[:, None] - own[None, :], -self.max_step, self.max_step)

@@ -2,13 +2,12 @@
 
 An agent whose reported heading jumps by more than a robot can turn between two of its reports (``jump`` +
 ``turn_rate`` · the time between them, radians) now reports for another robot: ids swapped, or a swap undone.
-With ``on_jump="swap"`` it has exchanged robots with the one other agent that reported the new heading just
-before; with none or several, it is forgotten at once, or with ``jump_pair_s`` it waits that long for a jump that
-mirrors its own (another agent now reporting the heading it reported before, and the reverse) and exchanges with
-that agent, forgotten when none comes. With ``jump_silent``, an agent's first report after a silence too long to
-call a jump (more than ``jump`` off its previous one, within ``jump`` + ``turn_rate`` · the silence) is paired
-with such a waiting jump when the two mirror each other; alone it changes nothing. :meth:`ReportJumps.find`
-returns what the identifier must do to the agents' memories, in order.
+It has exchanged robots with the one other agent that reported the new heading just before. With none or several,
+it waits :data:`PAIR_WAIT_S` seconds for a jump that mirrors its own (another agent now reporting the heading it
+reported before, and the reverse) and exchanges with that agent, forgotten when none comes. An agent's first
+report after a silence too long to call a jump (more than ``jump`` off its previous one, within ``jump`` +
+``turn_rate`` · the silence) is paired with such a waiting jump when the two mirror each other; alone it changes
+nothing. :meth:`ReportJumps.find` returns what the identifier must do to the agents' memories, in order.
 """
 
 from __future__ import annotations
@@ -17,6 +16,9 @@ import numpy as np
 
 from lookalike.geometry.angles import wrap_angle
 
+PAIR_WAIT_S = 1.0  # how long a jump without a partner waits for its mirror, seconds
+SAME_EXCHANGE_S = 1.0  # a partner's own jump within this long after an exchange is the same exchange, seconds
+
 Waiting = dict[int, tuple[float, float, float]]  # agent -> (old heading, new heading (radians), time of its jump, s)
 Action = tuple[int, int] | np.ndarray  # (a, b): exchange the two agents' memories; an array: forget these agents
 
@@ -24,17 +26,13 @@ Action = tuple[int, int] | np.ndarray  # (a, b): exchange the two agents' memori
 class ReportJumps:
     """Report jumps over the agents' newest reports (see the module)."""
 
-    def __init__(self, jump: float, turn_rate: float, on_jump: str = "swap", jump_pair_s: float | None = 1.0,
-                 jump_silent: bool = True) -> None:
+    def __init__(self, jump: float, turn_rate: float) -> None:
         """``jump``: radians a report may turn beyond ``turn_rate`` (rad/s) times the time since the agent's previous
-        one; ``on_jump``: ``"swap"`` or ``"forget"``; ``jump_pair_s``: how long a jump without a partner waits for
-        its mirror, seconds (None: forgotten at once); ``jump_silent``: pair jumps with first reports after a
-        silence."""
-        self.jump, self.turn_rate, self.on_jump = jump, turn_rate, on_jump
-        self.jump_pair_s, self.jump_silent = jump_pair_s, jump_silent
+        one."""
+        self.jump, self.turn_rate = jump, turn_rate
         self.expected: dict[int, float] = {}  # agent -> send time of the exchange whose second half it awaits
-        self.pending: Waiting = {}  # jump_pair_s: jumps waiting for their mirror
-        self.silent: Waiting = {}  # jump_silent: the same, never forgotten
+        self.pending: Waiting = {}  # jumps waiting for their mirror
+        self.silent: Waiting = {}  # first reports after a silence waiting for their mirror, never forgotten
 
     def find(self, old: np.ndarray, t_old: np.ndarray, new: np.ndarray, t_new: np.ndarray,
              now: float) -> list[Action]:
@@ -48,15 +46,10 @@ class ReportJumps:
             gap = np.where(fresh, t_new - np.where(fresh, t_old, 0.0), 0.0)
             jumped = fresh & (turn > self.jump + self.turn_rate * gap)
             if jumped.any():
-                if self.on_jump == "swap":
-                    self._swap(np.flatnonzero(jumped), old, t_old, new, t_new, actions)
-                else:
-                    actions.append(np.flatnonzero(jumped))
-            if self.jump_silent and self.on_jump == "swap" and self.jump_pair_s is not None:
-                self._after_silence(np.flatnonzero(fresh & ~jumped & (turn > self.jump)), old, new, t_new, actions)
-        if self.pending or self.silent:  # waiting jumps expire after jump_pair_s: forgotten, or (silent) dropped
-            wait = self.jump_pair_s
-            assert wait is not None
+                self._swap(np.flatnonzero(jumped), old, t_old, new, t_new, actions)
+            self._after_silence(np.flatnonzero(fresh & ~jumped & (turn > self.jump)), old, new, t_new, actions)
+        if self.pending or self.silent:  # waiting jumps expire after PAIR_WAIT_S: forgotten, or (silent) dropped
+            wait = PAIR_WAIT_S
             self.silent = {a: v for a, v in self.silent.items() if now - v[2] <= wait}
             expired = [a for a, (_, _, t) in self.pending.items() if now - t > wait]
             if expired:
@@ -75,16 +68,15 @@ class ReportJumps:
 
     def _swap(self, jumped: np.ndarray, old: np.ndarray, t_old: np.ndarray, new: np.ndarray, t_new: np.ndarray,
               actions: list[Action]) -> None:
-        """``on_jump="swap"``: an agent ``a`` whose reports jumped now reports for the robot that exactly one other
+        """An agent ``a`` whose reports jumped now reports for the robot that exactly one other
         agent ``b`` reported for just before (within ``jump`` + ``turn_rate`` · the time between the two reports):
         the two exchange memories, and ``b``'s own jump, expected within a second, changes nothing more. An agent
-        with no such partner, or several, is forgotten, or waits for its mirror (``jump_pair_s``, looked for
-        before the partner)."""
+        with no such partner, or several, waits for its mirror (looked for before the partner)."""
         done: set[int] = set()
         for a in jumped.tolist():
             if a in done:
                 continue
-            if t_new[a] - self.expected.pop(a, -np.inf) <= 1.0:
+            if t_new[a] - self.expected.pop(a, -np.inf) <= SAME_EXCHANGE_S:
                 continue  # the second half of a swap already made
             heading = float(new[a])
             self.pending.pop(a, None)
@@ -99,10 +91,7 @@ class ReportJumps:
             match[a] = False
             partners = np.flatnonzero(match)
             if len(partners) != 1:
-                if self.jump_pair_s is None:
-                    actions.append(np.array([a]))
-                else:
-                    self.pending[a] = (float(old[a]), heading, float(t_new[a]))
+                self.pending[a] = (float(old[a]), heading, float(t_new[a]))
                 continue
             b = int(partners[0])
             actions.append((a, b))
@@ -113,7 +102,7 @@ class ReportJumps:
 
     def _after_silence(self, agents: np.ndarray, old: np.ndarray, new: np.ndarray, t_new: np.ndarray,
                        actions: list[Action]) -> None:
-        """``jump_silent``: each of ``agents`` reports, after a silence, a heading more than ``jump`` off its
+        """Each of ``agents`` reports, after a silence, a heading more than ``jump`` off its
         previous report, too long after it to call a jump. When a waiting jump mirrors it, the two exchange
         memories; otherwise it waits as well, and is dropped without forgetting anything."""
         for c in agents.tolist():

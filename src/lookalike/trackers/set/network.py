@@ -1,7 +1,8 @@
-"""The set associator evaluated with numpy only, and its weight files (``.npz`` + ``.json``).
+"""The set associator evaluated with numpy only, its input tokens and its weight files (``.npz`` + ``.json``).
 
-Same maths as :class:`lookalike.learn.set_model.SetAssociator` for one sequence: any number of
-agents N and detections K per frame, no padding (absent detections simply are not passed).
+Same maths as the training model (``lookalike.learn.set_model.SetAssociator``) for one sequence: any number of
+agents N and detections K per frame, no padding (absent detections simply are not passed). The shipped weights
+(:data:`SHIPPED_SET_WEIGHTS`, one file for every N and M) sit beside this module.
 """
 
 from __future__ import annotations
@@ -14,12 +15,66 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.learn.checkpoint import CheckpointError, read_metadata
-
 FORMAT = "lookalike-set-associator"
 FORMAT_VERSION = 1
 POSITION_SCALE_M = 4.0
 OFFSET_SCALE_M = 2.0
+AGENT_FEATURES = 4
+DET_FEATURES = 5
+MAX_AGE_S = 5.0  # report age at which an agent token's age feature saturates, seconds
+SHIPPED_SET_WEIGHTS = Path(__file__).with_name("weights") / "set_any.npz"
+
+
+class CheckpointError(ValueError):
+    """A weights file that is corrupt, of another version, or does not fit the requested set-up."""
+
+
+def read_metadata(path: str | os.PathLike[str], fmt: str, what: str) -> tuple[Path, Path, dict[str, Any]]:
+    """``(weights .npz path, metadata .json path, parsed metadata)`` of weights stored as an ``.npz``
+    with a ``.json`` beside it; :class:`CheckpointError` naming the file when either is missing, the
+    JSON is invalid or its ``format`` is not ``fmt`` (``what`` names the expected kind in the message)."""
+    path = Path(path).with_suffix(".npz")
+    meta_path = path.with_suffix(".json")
+    if not path.is_file() or not meta_path.is_file():
+        raise CheckpointError(f"{path}: expected {path.name} and {meta_path.name} side by side")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except json.JSONDecodeError as exc:
+        raise CheckpointError(f"{meta_path}: not valid JSON ({exc})") from None
+    if not isinstance(meta, dict) or meta.get("format") != fmt:
+        found = meta.get("format") if isinstance(meta, dict) else None
+        raise CheckpointError(f"{meta_path}: not a {what} (format {found!r})")
+    return path, meta_path, meta
+
+
+def shipped_set_weights_path() -> Path:
+    """The shipped set-associator weights (one file for every N and M)."""
+    if not SHIPPED_SET_WEIGHTS.is_file():
+        raise CheckpointError(f"{SHIPPED_SET_WEIGHTS}: the shipped set-associator weights are missing; "
+                              "train some with `lookalike train --model set` and pass weights=PATH")
+    return SHIPPED_SET_WEIGHTS
+
+
+def agent_tokens(heading_rad: np.ndarray, age_s: np.ndarray, max_age_s: float = MAX_AGE_S) -> np.ndarray:
+    """Agent tokens ``(..., N, 4)`` from latest headings and report ages ``(..., N)`` (NaN: never heard)."""
+    heading = np.asarray(heading_rad, dtype=float)
+    age = np.asarray(age_s, dtype=float)
+    known = np.isfinite(heading) & np.isfinite(age)
+    h = np.where(known, heading, 0.0)
+    return np.stack([
+        np.where(known, np.cos(h), 0.0),
+        np.where(known, np.sin(h), 0.0),
+        np.where(known, np.clip(age, 0.0, max_age_s) / max_age_s, 1.0),
+        known.astype(float),
+    ], axis=-1)
+
+
+def detection_tokens(position_m: np.ndarray, heading_rad: np.ndarray, probability: np.ndarray) -> np.ndarray:
+    """Detection tokens ``(..., K, 5)``: ``x, y`` (metres), ``cos φ, sin φ``, ``γ``."""
+    phi = np.asarray(heading_rad, dtype=float)
+    pos = np.asarray(position_m, dtype=float)
+    return np.concatenate([pos, np.cos(phi)[..., None], np.sin(phi)[..., None],
+                           np.asarray(probability, dtype=float)[..., None]], axis=-1)
 
 
 @dataclass(frozen=True)
@@ -87,7 +142,7 @@ def load_set_weights(path: str | os.PathLike[str]) -> SetWeights:
 
 
 def _relu(x: np.ndarray) -> np.ndarray:
-    return np.maximum(x, 0.0)
+    return np.asarray(np.maximum(x, 0.0))
 
 
 def _sigmoid(x: np.ndarray) -> np.ndarray:
@@ -186,4 +241,4 @@ class NumpySetAssociator:
         z = _sigmoid(gi[:, hd : 2 * hd] + gh[:, hd : 2 * hd])
         cand = np.tanh(gi[:, 2 * hd :] + r * (gh[:, 2 * hd :] + b["gru.bias_hh"][2 * hd :]))
         self.h = (1.0 - z) * cand + z * self.h
-        return prob
+        return np.asarray(prob)

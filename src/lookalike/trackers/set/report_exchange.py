@@ -6,15 +6,15 @@ filter that runs ``lag_s`` seconds behind the newest report of any agent, so tha
 exchange are compared with heading tracks that have not absorbed them yet. For every new report of agent
 ``a`` and every other agent ``b``, the log-likelihood ratio of "this report continues b's track" over "it
 continues a's own" is summed (a CUSUM: never below 0) and decays with time constant ``memory_s``, so that
-evidence one stream left long ago (two robots heading alike) does not complete an exchange later; a track
-that has had no report for a while (a lost burst) takes no part. When the sums of ``(a, b)`` and of
-``(b, a)`` together pass twice ``threshold`` and each passes a quarter of it, each stream continues the
-other's track (a robot that starts to turn just then may fit neither, so one stream can carry most of the
-evidence): the two tracks are exchanged and the pair is returned. One stream alone (a robot turning fast)
-does not pass, as the other keeps fitting its own track. With ``step_rad``, an exchange also needs both
-streams to have stepped within the last ``step_window_s`` seconds: a report that departs by more than
-``step_rad`` from the agent's previous report carried on at its track's turn rate. An exchange of ids is such a
-step in both streams at once; two robots that turn smoothly onto each other's headings are not.
+evidence one stream left long ago (two robots heading alike) does not complete an exchange later. When the sums
+of ``(a, b)`` and of ``(b, a)`` together pass twice ``threshold`` and each passes a quarter of it, each stream
+continues the other's track (a robot that starts to turn just then may fit neither, so one stream can carry most
+of the evidence): the two tracks are exchanged and the pair is returned. One stream alone (a robot turning fast)
+does not pass, as the other keeps fitting its own track.
+
+:func:`for_team` builds the detector ``set`` runs: teams of :data:`TIGHT_TEAM` agents or more expect smoother
+turning (:data:`TIGHT_ACCEL_PSD`, :data:`TIGHT_LAG_S`), which finds exchanges between robots heading alike, and
+teams of more than :data:`MAX_AGENTS` run none.
 """
 
 from __future__ import annotations
@@ -22,6 +22,15 @@ from __future__ import annotations
 from collections import deque
 
 import numpy as np
+
+ACCEL_PSD = 0.1  # spectral density of a robot heading's angular acceleration, rad²/s³
+LAG_S = 0.4  # how far the report tracks run behind the newest report, seconds
+TIGHT_TEAM = 5  # teams of at least this many agents use the smoother model below
+TIGHT_ACCEL_PSD = 0.03  # rad²/s³
+TIGHT_LAG_S = 0.3  # seconds
+NOISE_RAD = 0.035  # a heading report's noise (standard deviation), radians
+MEMORY_S = 1.0  # time constant of the evidence's decay, seconds
+MAX_AGENTS = 7  # larger teams run no report-exchange detector
 
 
 def _wrap(angle: np.ndarray) -> np.ndarray:
@@ -31,18 +40,14 @@ def _wrap(angle: np.ndarray) -> np.ndarray:
 class ReportExchange:
     """Exchange detector over ``n`` agents' heading reports (see the module)."""
 
-    def __init__(self, n: int, threshold: float, accel_psd: float = 0.1, lag_s: float = 0.4,
-                 noise_rad: float = float(np.radians(2.0)), memory_s: float | None = 1.0,
-                 fresh_s: float | None = 0.6, step_rad: float | None = None, step_window_s: float = 1.0) -> None:
+    def __init__(self, n: int, threshold: float, accel_psd: float = ACCEL_PSD, lag_s: float = LAG_S,
+                 noise_rad: float = NOISE_RAD, memory_s: float = MEMORY_S) -> None:
         """``threshold``: half the log-likelihood ratio the two streams must pass together; ``accel_psd``: spectral
         density of the heading's angular acceleration, rad²/s³; ``lag_s``: how far the tracks run behind the
         newest report of any agent, seconds; ``noise_rad``: a report's heading noise (standard deviation), radians;
-        ``memory_s``: time constant of the evidence's decay, seconds (None: no decay); ``fresh_s``: a track
-        whose newest report is older than ``lag_s`` + ``fresh_s`` seconds takes no part (None: every track);
-        ``step_rad``: the step both streams need within ``step_window_s`` seconds, radians (None: none needed)."""
+        ``memory_s``: time constant of the evidence's decay, seconds."""
         self.n, self.threshold, self.q, self.lag_s, self.r = n, threshold, accel_psd, lag_s, noise_rad ** 2
         self.memory_s = memory_s
-        self.oldest = np.inf if fresh_s is None else lag_s + fresh_s  # oldest usable track, seconds
         self.clock = -np.inf  # newest send time seen, seconds
         self.x = np.zeros((n, 2))  # heading (rad), turn rate (rad/s) at self.t
         self.p = np.zeros((n, 2, 2))
@@ -50,9 +55,6 @@ class ReportExchange:
         self.newest = np.full(n, -np.inf)  # send time of each agent's newest report
         self.queue: list[deque[tuple[float, float]]] = [deque() for _ in range(n)]
         self.evidence = np.zeros((n, n))  # [a, b]: evidence that a's reports continue b's track
-        self.step_rad, self.step_window_s = step_rad, step_window_s
-        self.last = np.full((n, 2), np.nan)  # each agent's newest report: send time (s), heading (rad)
-        self.stepped = np.full(n, -np.inf)  # send time of each agent's newest step
 
     def _predict(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Every track's heading (rad) and its variance plus the report noise at time ``t`` (NaN: none)."""
@@ -84,9 +86,8 @@ class ReportExchange:
         if not (t_sent > self.newest[a] and np.isfinite(heading)):
             return None
         self.newest[a] = t_sent
-        self._note_step(a, t_sent, heading)
         if t_sent > self.clock:
-            if np.isfinite(self.clock) and self.memory_s is not None:
+            if np.isfinite(self.clock):
                 self.evidence *= np.exp(-(t_sent - self.clock) / self.memory_s)
             self.clock = t_sent
         for c in range(self.n):
@@ -99,33 +100,18 @@ class ReportExchange:
         mean, var = self._predict(t_sent)
         nu2 = _wrap(heading - mean) ** 2 / var
         gain = 0.5 * (nu2[a] - nu2) - 0.5 * np.log(var / var[a])
-        known = t_sent - self.t <= self.oldest  # NaN (no track yet): False
-        if not known[a]:
-            return None
+        known = ~np.isnan(self.t)  # agents with a track
         known[a] = False
         row = self.evidence[a]
         row[known] = np.maximum(row[known] + gain[known], 0.0)
         col = self.evidence[:, a]
         threshold = self.threshold if scale is None else self.threshold * scale
         both = known & (row + col > 2 * threshold) & (np.minimum(row, col) > threshold / 4)
-        if self.step_rad is not None:
-            both &= (t_sent - self.stepped <= self.step_window_s) & (t_sent - self.stepped[a] <= self.step_window_s)
         if not both.any():
             return None
         b = int(np.argmax(np.where(both, row + col, -np.inf)))
         self.swap(a, b)
         return a, b
-
-    def _note_step(self, a: int, t_sent: float, heading: float) -> None:
-        """Keep agent ``a``'s newest report and note a step (see the module) at ``t_sent`` (only with ``step_rad``)."""
-        if self.step_rad is None:
-            return
-        t_last, h_last = self.last[a]
-        if np.isfinite(t_last):
-            rate = 0.0 if np.isnan(self.t[a]) else self.x[a, 1]
-            if abs(float(_wrap(np.asarray(heading - h_last - rate * (t_sent - t_last))))) > self.step_rad:
-                self.stepped[a] = t_sent
-        self.last[a] = t_sent, heading
 
     def swap(self, a: int, b: int) -> None:
         """Exchange the tracks of agents ``a`` and ``b`` and clear their evidence: their report streams now
@@ -137,7 +123,6 @@ class ReportExchange:
         self.queue[b].clear()
         self.evidence[[a, b], :] = 0.0
         self.evidence[:, [a, b]] = 0.0
-        self.stepped[[a, b]] = -np.inf
 
     def forget(self, a: int) -> None:
         """Start agent ``a``'s track afresh from its next report (its reports now come from a robot no other
@@ -146,4 +131,12 @@ class ReportExchange:
         self.queue[a].clear()
         self.evidence[a, :] = 0.0
         self.evidence[:, a] = 0.0
-        self.last[a], self.stepped[a] = np.nan, -np.inf
+
+
+def for_team(n: int, threshold: float) -> ReportExchange | None:
+    """The detector ``set`` runs for a team of ``n`` agents (None: none, a team of more than :data:`MAX_AGENTS`)."""
+    if n > MAX_AGENTS:
+        return None
+    if n >= TIGHT_TEAM:
+        return ReportExchange(n, threshold, TIGHT_ACCEL_PSD, TIGHT_LAG_S)
+    return ReportExchange(n, threshold)
