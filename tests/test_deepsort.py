@@ -5,11 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.association.appearance import (
-    FeatureGallery,
-    cosine_distance,
-    matching_cascade,
-)
+from lookalike.association.appearance import FeatureGallery, cosine_distance
+from lookalike.association.stages import cascade, run_plan
 from lookalike.trackers import make_tracker
 from lookalike.trackers.deepsort import DeepSort, xyah_to_xywh, xywh_to_xyah
 from lookalike.types import Detections, Frame
@@ -87,8 +84,8 @@ def test_gallery_and_cascade() -> None:
     assert np.allclose(cosine_distance(np.eye(2), np.eye(2)), 1 - np.eye(2))
     # Level 1 tracks choose first even when an older track is cheaper.
     cost = np.array([[0.3, 0.9], [0.1, 0.2]])
-    result = matching_cascade(lambda r, c: cost[np.ix_(r, c)], np.array([1, 2]), np.arange(2), 3, 0.5)
-    assert result.matches.tolist() == [[0, 0], [1, 1]]
+    stages = cascade(np.array([1, 2]), 3, np.ones(2, bool), np.ones(2, bool), lambda r, c: cost[np.ix_(r, c)], 0.5)
+    assert run_plan(stages, 2, 2).pairs.tolist() == [[0, 0], [1, 1]]
 
 
 def test_missing_features_raise() -> None:

@@ -1,15 +1,11 @@
-"""Appearance association: cosine distances, per-track feature galleries and deep SORT's matching cascade.
+"""Appearance association: cosine distances and per-track feature galleries (deep SORT's).
 Features are L2-normalised rows, so the cosine distance ``1 - f·g`` lies in ``[0, 2]``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
-from lookalike.association.solver import Assignment
-from lookalike.association.stages import cascade, run_plan
 from lookalike.types import Detections
 
 
@@ -91,38 +87,3 @@ class FeatureGallery:
         if not len(fa) or not len(fb):
             return 0.0
         return float((cosine_distance(fa, fb) < threshold).mean())
-
-
-def matching_cascade(
-    cost_fn: Callable[[np.ndarray, np.ndarray], np.ndarray],
-    track_age: np.ndarray,
-    detections: np.ndarray,
-    max_age: int,
-    max_cost: float,
-) -> Assignment:
-    """Match tracks to detections level by level, most recently updated tracks first.
-
-    Args:
-        cost_fn: ``cost_fn(track_rows, det_cols) -> (len(track_rows), len(det_cols))`` costs,
-            ``inf`` forbidden.
-        track_age: ``(k,)`` frames since each track's last update (1 = updated last frame).
-        detections: ``(n,)`` indices of the detections to match.
-        max_age: deepest level; tracks older than this are not matched.
-        max_cost: pairs costing more are forbidden.
-
-    Returns:
-        An :class:`Assignment` whose matches are ``(track_row, detection_index)`` pairs.
-    """
-    track_age = np.asarray(track_age, dtype=int)
-    detections = np.asarray(detections, dtype=int)
-    n_det = int(detections.max()) + 1 if len(detections) else 0
-    allowed = np.zeros(n_det, dtype=bool)
-    allowed[detections] = True
-    stages = cascade(track_age, max_age, np.ones(len(track_age), dtype=bool), allowed, cost_fn, max_cost)
-    found = run_plan(stages, len(track_age), n_det)
-    matched = found.det_of_track >= 0
-    return Assignment(
-        matches=found.pairs,
-        unmatched_rows=np.flatnonzero(~matched),
-        unmatched_cols=np.flatnonzero(found.free & allowed),
-    )

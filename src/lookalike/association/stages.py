@@ -69,11 +69,6 @@ class Matching:
         return cls(det_of_track, free, stage_of_track)
 
     @property
-    def unmatched_tracks(self) -> np.ndarray:
-        """``(k,)`` True for track rows without a detection."""
-        return self.det_of_track < 0
-
-    @property
     def pairs(self) -> np.ndarray:
         """``(m, 2)`` matched ``(track row, detection)`` pairs, by track row."""
         rows = np.flatnonzero(self.det_of_track >= 0)
