@@ -1,9 +1,9 @@
-"""Step time of the set identifier (issue 23: <= 1 ms per frame for N = 7 on one core).
+"""Step time of the set identifier (target: <= 1 ms per frame for N = 7 on one core).
 
 Run: ``python benchmarks/set_speed.py [--frames 2000]``. Runs the registered ``set`` identifier
 (numpy network, one-to-one decoding and the agents' positions from the shared Kalman localiser) and
 the ``lstm`` identifier (same localiser) over a simulated M=10, N=7 sequence, interleaved frame by
-frame, and prints the median CPU time per frame of the network step alone (the issue's target) and of
+frame, and prints the median CPU time per frame of the network step alone (the target) and of
 the whole identifier update beside the LSTM's and beside ``set`` without its report-exchange detector.
 Set ``OMP_NUM_THREADS=1`` for one core.
 """
@@ -17,9 +17,9 @@ import time
 import numpy as np
 from _common import report_target
 
-from lookalike.learn.set_data import agent_tokens, detection_tokens
 from lookalike.sim import preset, simulate_robots
 from lookalike.trackers import make_tracker
+from lookalike.trackers.set.network import agent_tokens, detection_tokens
 
 
 def main() -> None:

@@ -9,7 +9,9 @@ within 5% of the clean run's, as ``bench recovery``; never: the longest the sequ
 
 Sequences are interleaved (sequence k of every set-up and candidate before sequence k + 1), one line of JSON per
 (set-up, sequence, identifier) in ``--out``, so that a stopped run resumes and a cut-off one has the same sequences
-for every candidate. ``--report`` prints the table and the rule's decision from ``--out``.
+for every candidate. ``--report`` prints the table and the rule's decision from ``--out``; ``--markdown`` the tables
+of docs/experiments/any-team-size.md. ``--extra NAME=JSON`` scores one more ``set`` configuration on the same
+sequences after the decision (the identifier that ships when several groups were dropped); it decides nothing.
 
     OMP_NUM_THREADS=1 python research/set/simplify.py --out runs/set-simplify/runs.jsonl
     python research/set/simplify.py --out runs/set-simplify/runs.jsonl --report
@@ -42,6 +44,7 @@ CANDIDATES: dict[str, dict[str, Any]] = {
     "no-visual-exchange": {"visual_exchange": None},
     "no-corrections": {"stale_s": None, "fp_prior_ref": None, "undo_factor": None},
 }
+RULE_CANDIDATES = tuple(CANDIDATES)
 REFERENCES = ("lstm",)  # shipped for the paper's set-ups only
 
 
@@ -66,7 +69,7 @@ def score(name: str, options: dict[str, Any], seq: Any) -> dict[str, float]:
     return {"correct": int(correct), "detections": int(detections), **{k: float(v) for k, v in run._asdict().items()}}
 
 
-def collect(out: Path, sequences: int) -> None:
+def collect(out: Path, sequences: int, only: set[str] | None = None) -> None:
     done = set()
     if out.exists():
         for line in out.read_text().splitlines():
@@ -87,7 +90,7 @@ def collect(out: Path, sequences: int) -> None:
                         break
                 ids = list(CANDIDATES) + [r for r in REFERENCES if has_lstm]
                 for ident in ids:
-                    if (name, k, ident) in done:
+                    if (name, k, ident) in done or (only is not None and ident not in only):
                         continue
                     tracker, options = ("set", CANDIDATES[ident]) if ident in CANDIDATES else (ident, {})
                     row = {"setup": name, "k": k, "seed": seed, "id": ident, **score(tracker, options, seq)}
@@ -102,17 +105,21 @@ def text(d: PairedDifference, unit: str) -> str:
 
 def report(out: Path) -> None:
     rows = [json.loads(line) for line in out.read_text().splitlines()]
-    keep: dict[str, list[str]] = {c: [] for c in CANDIDATES if c != "full"}
+    keep: dict[str, list[str]] = {c: [] for c in RULE_CANDIDATES if c != "full"}
     for name, cfg, _ in setups():
         longest = longest_recovery_s(FRAMES, cfg.frame_rate_hz, SWAP_AT_S, SWAP_S)
         by_id: dict[str, dict[int, dict]] = {}
         for r in rows:
             if r["setup"] == name:
                 by_id.setdefault(r["id"], {})[r["k"]] = r
-        ks = sorted(set.intersection(*(set(v) for v in by_id.values())))
+        ruled = [v for i, v in by_id.items() if i in RULE_CANDIDATES or i in REFERENCES]
+        ks = sorted(set.intersection(*(set(v) for v in ruled)))
         print(f"\n{name}: {len(ks)} sequences (every identifier)")
         full = [by_id["full"][k] for k in ks]
         for ident, per_k in by_id.items():
+            if any(k not in per_k for k in ks):
+                print(f"  {ident}: {len(per_k)} sequences only, left out")
+                continue
             rs = [per_k[k] for k in ks]
             ident_pct = 100 * sum(r["correct"] for r in rs) / max(1, sum(r["detections"] for r in rs))
             rec = [min(r["recovery_s"], longest) for r in rs]
@@ -136,14 +143,66 @@ def report(out: Path) -> None:
         print(f"  {ident:20s} {'KEEP (' + ', '.join(why) + ')' if why else 'DROP'}")
 
 
+def markdown(out: Path, shipped: str) -> None:
+    """The docs' tables: ``shipped`` (a candidate or extra) against the LSTM, and each group switched off against
+    ``full``; paired 95% intervals over the sequences every identifier of the row completed."""
+    rows = [json.loads(line) for line in out.read_text().splitlines()]
+    per: dict[tuple[str, str], dict[int, dict]] = {}
+    for r in rows:
+        per.setdefault((r["setup"], r["id"]), {})[r["k"]] = r
+    label = {"m3n2": "M=3, N=2", "m5n3": "M=5, N=3", "m10n7": "M=10, N=7", "m6n4": "M=6, N=4 (unseen)",
+             "m8n6": "M=8, N=6 (unseen)", "m14n12": "M=14, N=12 (unseen)"}
+
+    def pair(setup: str, a: str, b: str, longest: float) -> tuple[str, str, str, str, int]:
+        ka, kb = per.get((setup, a), {}), per.get((setup, b), {})
+        ks = sorted(set(ka) & set(kb))
+        ra, rb = [ka[k] for k in ks], [kb[k] for k in ks]
+        rate = [100 * sum(r["correct"] for r in x) / sum(r["detections"] for r in x) for x in (ra, rb)]
+        rec = [[min(r["recovery_s"], longest) for r in x] for x in (ra, rb)]
+        di = rate_difference([r["correct"] for r in ra], [r["correct"] for r in rb], [r["detections"] for r in ra])
+        dr = mean_difference(rec[0], rec[1])
+        return (f"{rate[0]:.2f} / {rate[1]:.2f}", text(di, ""), f"{np.mean(rec[0]):.2f} / {np.mean(rec[1]):.2f}",
+                text(dr, ""), len(ks))
+
+    print(f"| set-up | identification %, {shipped} / lstm | difference, points [95%] | recovery s, {shipped} / lstm "
+          "| difference, s [95%] | sequences |\n|---|---|---|---|---|---|")
+    for name, cfg, has_lstm in setups():
+        longest = longest_recovery_s(FRAMES, cfg.frame_rate_hz, SWAP_AT_S, SWAP_S)
+        if has_lstm:
+            a, b, c, d, n = pair(name, shipped, "lstm", longest)
+            print(f"| {label[name]} | {a} | {b} | {c} | {d} | {n} |")
+        else:
+            ks = sorted(per.get((name, shipped), {}))
+            rs = [per[(name, shipped)][k] for k in ks]
+            rate = 100 * sum(r["correct"] for r in rs) / sum(r["detections"] for r in rs)
+            rec = [min(r["recovery_s"], longest) for r in rs]
+            print(f"| {label[name]} | {rate:.2f} / - | - | {np.mean(rec):.2f} / - | - | {len(ks)} |")
+    groups = [c for c in RULE_CANDIDATES if c != "full"]
+    print("\n| set-up | " + " | ".join(groups) + " |\n|---|" + "---|" * len(groups))
+    for name, cfg, _ in setups():
+        longest = longest_recovery_s(FRAMES, cfg.frame_rate_hz, SWAP_AT_S, SWAP_S)
+        cells = []
+        for g in groups:
+            _, b, _, d, _ = pair(name, g, "full", longest)
+            cells.append(f"{b} pts; {d} s")
+        print(f"| {label[name]} | " + " | ".join(cells) + " |")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("runs/set-simplify/runs.jsonl"))
     parser.add_argument("--sequences", type=int, default=100, help="measurable sequences per set-up")
     parser.add_argument("--report", action="store_true", help="print the table and the decision only")
+    parser.add_argument("--extra", action="append", default=[], help="NAME=JSON: one more set configuration")
+    parser.add_argument("--markdown", default=None, help="print the docs' tables for this identifier and stop")
     args = parser.parse_args()
+    if args.markdown:
+        markdown(args.out, args.markdown)
+        return
+    extras = dict(e.split("=", 1) for e in args.extra)
+    CANDIDATES.update({name: json.loads(options) for name, options in extras.items()})
     if not args.report:
-        collect(args.out, args.sequences)
+        collect(args.out, args.sequences, set(extras) or None)
     report(args.out)
 
 
