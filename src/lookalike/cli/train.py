@@ -57,7 +57,8 @@ def train(
     resume: bool = typer.Option(False, help="Continue from OUTPUT/checkpoint.pt."),
     ship: bool = typer.Option(False, help="Copy the best weights into the package's shipped weights."),
     protocol: str = typer.Option(
-        "ours", help="Input layout: ours, or paper (seed A's N + 4M inputs, no ages, no relative headings, "
+        "ours", help="Input layout: ours, or paper (the robot-identification paper's N + 4M inputs, no ages, no "
+        "relative headings, "
         "no augmentation beyond slot shuffling; shipped as lstm_paper_*)."),
     noise: str = typer.Option("ours", help="Simulator noise model of the training sequences: ours, paper or mix "
                               "(each sequence draws one from its seed)."),
@@ -184,9 +185,8 @@ def train(
 
 
 def _sim_samplers(world: Any, worlds: Any, spec: Any, noise: str, swap_prob: float) -> tuple[Any, Any]:
-    """Training and validation samplers: ``world`` alone for our protocol on ``ours`` noise; for our
-    protocol on other noise, each sequence one of ``worlds`` (drawn from its seed) with identity swaps
-    in training; for seed A's protocol, its encoding of the drawn world, no swaps."""
+    """Training and validation samplers: ``world`` alone for our protocol on ``ours`` noise; on other noise,
+    each sequence from one of ``worlds`` with swaps in training; for the paper's protocol, its encoding, no swaps."""
     from lookalike.learn.paper_protocol import NoiseMixSampler
     from lookalike.learn.sim_data import WorldMixSampler, make_sim_sampler
 
@@ -220,7 +220,7 @@ def _initial_weights(init_from: Path | None, transfer: bool, spec: Any, sample: 
 def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int, seed: int, patience: int,
                threads: int, device: str, workers: int, backend: str, address: str | None, resume: bool,
                ship: bool, learning_rate: float | None) -> None:
-    """``lookalike train --model set``: the set associator over every team size (issue 23)."""
+    """``lookalike train --model set``: the set associator over every team size."""
     import torch
 
     from lookalike.learn.set_training import SetTrainConfig, train_set
