@@ -1,9 +1,6 @@
-"""Labelled diver crops for the learned appearance model (numpy; no torch).
-
-Crops are cut from rendered frames at the ground-truth boxes, jittered like a detector's boxes
-(shift and scale, fractions of the box size), and resized to ``(width, height)`` pixels. A label
-is one diver of one scenario (``seed · 10 + diver id``), so identities never repeat across
-scenarios.
+"""Labelled diver crops for the learned appearance model (numpy): cut from rendered frames at jittered
+ground-truth boxes and resized to ``(width, height)`` pixels; a label is one diver of one scenario
+(``seed · 10 + diver id``).
 """
 
 from __future__ import annotations

@@ -1,10 +1,7 @@
 """Training arrays straight from the robot simulator's arrays (vectorised over time).
 
-Optional augmentation (ours, not the paper's): in a fraction of the training sequences two robots
-exchange identities for a while, as in the recovery experiment: robot ``a`` broadcasts ``b``'s
-reports and the reverse. Identity follows the reports, so the targets swap too, from the first
-frame that holds a swapped report. The network so learns to re-identify quickly when the reports
-contradict what it remembers, instead of trusting a wrong memory.
+Optional augmentation (ours): in a share of the sequences two robots exchange reports for a while and the
+targets swap with them, so the network learns to re-identify when reports contradict its memory.
 """
 
 from __future__ import annotations

@@ -1,12 +1,10 @@
-"""The LSTM identifier (seed A) as a registered tracker: labels every detection "agent j" or
-"false positive" from the detections and the agents' heading reports, with the numpy network.
+"""The LSTM identifier of the robot-identification paper as a registered tracker: labels every detection
+"agent j" or "false positive" from the detections and the agents' heading reports (numpy network).
 
-Tracks are the agents themselves, positioned by a localiser fed with the detection labelled ``j``
-and its class probability ``α``: seed A's Eq. 3 ``T_j ← α·L_k + (1−α)·T_j`` (``localiser="lowpass"``)
-or our per-agent Kalman filter (``"kalman"``, see :mod:`lookalike.trackers.parts.identity.localiser`).
-
-With ``protocol="paper"`` the shipped weights are those of seed A's input protocol (``N + 4·M``
-inputs, ``lstm_paper_m{M}_n{N}``); decode them per slot (``one_to_one=False``) as the paper does.
+Tracks are the agents, positioned by a localiser (:mod:`lookalike.trackers.parts.identity.localiser`): the
+paper's low-pass filter (``localiser="lowpass"``) or a per-agent Kalman filter (``"kalman"``). With
+``protocol="paper"`` the shipped weights use the paper's ``N + 4·M`` inputs (``lstm_paper_m{M}_n{N}``);
+decode them per slot (``one_to_one=False``) as the paper does.
 """
 
 from __future__ import annotations
@@ -36,9 +34,9 @@ class LstmIdentifier:
         n_slots: int = param(5, "detection slots M of the network", range=(1, 1000))
         weights: str | None = param(None, "path of model.npz (None: the shipped weights for N, M)")
         one_to_one: bool = param(True, "decode with Hungarian on -log p (else per-slot argmax, as the paper)")
-        localiser: str = param("kalman", "agent positions: kalman (ours) or lowpass (seed A's Eq. 3)",
+        localiser: str = param("kalman", "agent positions: kalman (ours) or lowpass (the paper's Eq. 3)",
                                choices=LOCALISERS)
-        protocol: str = param("ours", "shipped weights when weights is None: ours, or paper (seed A's N + 4M "
+        protocol: str = param("ours", "shipped weights when weights is None: ours, or paper (the paper's N + 4M "
                               "inputs)", choices=PROTOCOLS)
 
         def __post_init__(self) -> None:
