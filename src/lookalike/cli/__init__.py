@@ -1,8 +1,7 @@
 """The ``lookalike`` command line (typer); each command lives in its own module of this package.
 
-Run as the ``lookalike`` script, only the module of the command given (:data:`COMMAND_MODULES`) is imported;
-imported by anything else, this package imports them all.
-"""
+Run as the ``lookalike`` script, only the module of the command given (:data:`COMMAND_MODULES`) is imported; imported by
+anything else, this package imports them all."""
 
 from __future__ import annotations
 

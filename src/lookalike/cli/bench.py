@@ -34,8 +34,7 @@ TEXT_COLUMNS = ("Setup", "Tracker", "Identifier", "Scenario", "Labeller", "Seque
 
 
 def rich_table(title: str | None, rows: list[dict[str, Any]], columns: Sequence[str] | None = None) -> Table:
-    """Table rows (dicts) as a rich table: text columns left and never cut, numbers right with thousands
-    separators."""
+    """Table rows (dicts) as a rich table: text columns left and never cut, numbers right with thousands separators."""
     columns = list(columns if columns is not None else (rows[0] if rows else []))
     table = Table(title=title)
     cells = [[f"{r[c]:,}" if isinstance(r[c], (int, float)) else str(r[c]) for c in columns] for r in rows]

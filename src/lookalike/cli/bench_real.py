@@ -1,6 +1,5 @@
-"""``lookalike bench real``: a leaderboard on real data, lookalike's box trackers against the peers.
-Datasets, runners and ranking live in :mod:`lookalike.bench`; this module parses options and prints.
-"""
+"""``lookalike bench real``: a leaderboard on real data, lookalike's box trackers against the peers. Datasets, runners
+and ranking live in :mod:`lookalike.bench`; this module parses options and prints."""
 
 from __future__ import annotations
 

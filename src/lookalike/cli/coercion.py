@@ -1,10 +1,9 @@
 """Option values converted without pydantic where typer's own conversion would give the same value.
 
-typer (pinned in constraints.txt) builds a pydantic ``TypeAdapter`` per parameter even for defaults and
-``--help``, a fifth of a short command's CPU time. :func:`install` converts the plain cases directly with
-typer's rules (``str``, ``list[str]``, in-bounds defaults of their type, ``Path`` text) and hands everything
-else to typer, so values and errors are typer's (``tests/test_cli_coercion.py`` checks this).
-"""
+typer (pinned in constraints.txt) builds a pydantic ``TypeAdapter`` per parameter even for defaults and ``--help``, a
+fifth of a short command's CPU time. :func:`install` converts the plain cases directly with typer's rules (``str``,
+``list[str]``, in-bounds defaults of their type, ``Path`` text) and hands everything else to typer, so values and errors
+are typer's (``tests/test_cli_coercion.py`` checks this)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
-"""The ``--points`` branch of ``lookalike eval``: results scored against point ground truth (``frame, id, x, y``
-per line, pixels), matched within ``--radius`` pixels (:func:`lookalike.eval.evaluate_points`).
-"""
+"""The ``--points`` branch of ``lookalike eval``: results scored against point ground truth (``frame, id, x, y`` per
+line, pixels), matched within ``--radius`` pixels (:func:`lookalike.eval.evaluate_points`)."""
 
 from __future__ import annotations
 

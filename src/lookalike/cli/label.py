@@ -54,12 +54,10 @@ def label(
 ) -> None:
     """Serve the labelling page: click detections to cycle their robot (left forward, right back).
 
-    Labels are saved after every click to STEM.labels.json beside the sequence. Export (the
-    button or --export) writes STEM.labelled.jsonl (simulator truth format) and
-    STEM.labels.mot.txt (MOTChallenge, positions in the world columns); with --benchmark, --export
-    also (re)writes the finished session's result file. `bench ident --lengths ... --human DIR`
-    puts the result files beside the identifiers (the robot-identification paper's Table III).
-    """
+    Labels are saved after every click to STEM.labels.json beside the sequence. Export (the button or --export) writes
+    STEM.labelled.jsonl (simulator truth format) and STEM.labels.mot.txt (MOTChallenge, positions in the world columns);
+    with --benchmark, --export also (re)writes the finished session's result file. `bench ident --lengths ... --human
+    DIR` puts the result files beside the identifiers (the robot-identification paper's Table III)."""
     from lookalike.io.robot_sequences import read_robot_sequence
     from lookalike.viz.label import load_labels, make_server, open_label_app
 

@@ -1,6 +1,5 @@
-"""Progress bars with time left for the long commands (``bench ...``, ``tune``), drawn on stderr and only
-when it is a terminal: ``with progress_bars() as progress: ...``.
-"""
+"""Progress bars with time left for the long commands (``bench ...``, ``tune``), drawn on stderr and only when it is a
+terminal: ``with progress_bars() as progress: ...``."""
 
 from __future__ import annotations
 

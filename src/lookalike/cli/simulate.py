@@ -24,9 +24,8 @@ def simulate(
 ) -> None:
     """Simulate identical robots seen by an observer, with heading reports; write JSON Lines files.
 
-    Format: see ``lookalike.io.robot_sequences`` (a header line, then one object per frame with
-    detections, received reports and the truth).
-    """
+    Format: see ``lookalike.io.robot_sequences`` (a header line, then one object per frame with detections, received
+    reports and the truth)."""
     if preset_name not in PRESET_NAMES:
         fail(f"--preset: unknown preset {preset_name!r}; known: {', '.join(PRESET_NAMES)}")
     if noise not in NOISE_MODELS:

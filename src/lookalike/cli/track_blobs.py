@@ -1,10 +1,9 @@
 """The ``--video FILE --detector blob`` branch of ``lookalike track`` (not a command of its own).
 
-Blob settings are estimated from the video (:func:`~lookalike.viz.blob_video.auto_blob_config`) and printed;
-``--blob KEY=VALUE`` overrides them. Detections are cached (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``),
-written to ``<output stem>.det.txt`` and tracked as the ``--video`` branch does, or by the offline closed set.
-``boxtrack`` gets :func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config` (docs/blobs.md).
-"""
+Blob settings are estimated from the video (:func:`~lookalike.viz.blob_video.auto_blob_config`) and printed; ``--blob
+KEY=VALUE`` overrides them. Detections are cached (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``), written to ``<output
+stem>.det.txt`` and tracked as the ``--video`` branch does, or by the offline closed set. ``boxtrack`` gets
+:func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config` (docs/blobs.md)."""
 
 from __future__ import annotations
 

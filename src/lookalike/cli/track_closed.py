@@ -1,7 +1,6 @@
-"""The ``--targets N --offline`` and ``--points FILE`` branches of ``lookalike track`` (not commands of their own):
-the offline closed set (:func:`lookalike.trackers.offline.closed_set.track_closed_set`) and anonymous points
-tracked as small boxes (:mod:`lookalike.io.points`).
-"""
+"""The ``--targets N --offline`` and ``--points FILE`` branches of ``lookalike track`` (not commands of their own): the
+offline closed set (:func:`lookalike.trackers.offline.closed_set.track_closed_set`) and anonymous points tracked as
+small boxes (:mod:`lookalike.io.points`)."""
 
 from __future__ import annotations
 

@@ -34,11 +34,10 @@ FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
 def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, tracker_name: str, *,
                     annotate: Path | None, team_size: int | None, health_window: int,
                     min_score: float, fps: float | None, features: str = "video") -> None:
-    """Track ``detections`` on ``video`` and write ``output``, its ``.health.csv`` (and ``.merges.csv`` for
-    trackers that merge identities) and, with ``annotate``, the annotated MP4. ``features``: ``video``
-    (standardised on this video), ``divers``/``handcrafted`` (statistics of the rendered validation divers),
-    ``learned`` (the shipped ONNX embedding) or ``FILE.onnx``.
-    """
+    """Track ``detections`` on ``video`` and write ``output``, its ``.health.csv`` (and ``.merges.csv`` for trackers
+    that merge identities) and, with ``annotate``, the annotated MP4. ``features``: ``video`` (standardised on this
+    video), ``divers``/``handcrafted`` (statistics of the rendered validation divers), ``learned`` (the shipped ONNX
+    embedding) or ``FILE.onnx``."""
     if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
         fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
     if output.is_dir():

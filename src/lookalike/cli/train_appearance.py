@@ -22,8 +22,7 @@ def train_appearance(
 ) -> None:
     """Train the small CNN embedding on crops of new rendered divers and export it to ONNX.
 
-    The shipped model (lookalike/vision/models_data/diver_reid.onnx) is this command's defaults.
-    """
+    The shipped model (lookalike/vision/models_data/diver_reid.onnx) is this command's defaults."""
     if output.exists() and not output.is_dir():
         fail(f"-o/--output: {output} is a file; give a folder")
     try:

@@ -1,9 +1,8 @@
 """``lookalike train-detector`` and ``lookalike train-heading``: train the vision models.
 
-Both train from rendered robots by default; the detector also from a folder of ``positives/`` (one target
-filling each image) and ``negatives/``. A detector trained on renders is cut to the cascade prefix with
-the best F1 on held-out renders (:mod:`lookalike.vision.hog_select`).
-"""
+Both train from rendered robots by default; the detector also from a folder of ``positives/`` (one target filling each
+image) and ``negatives/``. A detector trained on renders is cut to the cascade prefix with the best F1 on held-out
+renders (:mod:`lookalike.vision.hog_select`)."""
 
 from __future__ import annotations
 
