@@ -1,6 +1,5 @@
-"""Visual output: drawing on frames, videos and GIFs, plots, the HTML report and the demo scenes (OpenCV,
-matplotlib and Pillow imported lazily).
-"""
+"""Visual output: drawing on frames, videos and GIFs, plots, the HTML report and the demo scenes (OpenCV, matplotlib and
+Pillow imported lazily)."""
 
 from lookalike.viz.annotate import (
     LabelSpace,

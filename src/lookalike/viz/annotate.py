@@ -1,6 +1,5 @@
-"""Drawing tracking results on frames: identity-coloured outlined boxes, labels that avoid each other, tails,
-a caption and a legend. Coordinates are pixels; images ``(h, w, 3)`` uint8 BGR, modified in place.
-"""
+"""Drawing tracking results on frames: identity-coloured outlined boxes, labels that avoid each other, tails, a caption
+and a legend. Coordinates are pixels; images ``(h, w, 3)`` uint8 BGR, modified in place."""
 
 from __future__ import annotations
 

@@ -1,10 +1,9 @@
 """Blob detections of a whole video as MOTChallenge rows (``lookalike track --video V --detector blob``).
 
 The ``median`` method reads the video twice (background from ``history`` frames, then detection).
-:func:`auto_blob_config` gives the estimated settings with the user's overrides;
-:func:`cached_blob_detection_rows` caches detections on disk (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``),
-keyed by the video's content, every setting, the version and the detector's code.
-"""
+:func:`auto_blob_config` gives the estimated settings with the user's overrides; :func:`cached_blob_detection_rows`
+caches detections on disk (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``), keyed by the video's content, every setting,
+the version and the detector's code."""
 
 from __future__ import annotations
 

@@ -1,7 +1,6 @@
-"""The demo's diver scenes: render, extract features, run every box tracker, score them (IDF1, HOTA, MOTA, ID
-switches, frames/s) and optionally write videos, a still and MOTChallenge files. The annotated video marks
-tracks on a diver (solid), false tracks (dashed red) and missed divers (dashed white).
-"""
+"""The demo's diver scenes: render, extract features, run every box tracker, score them (IDF1, HOTA, MOTA, ID switches,
+frames/s) and optionally write videos, a still and MOTChallenge files. The annotated video marks tracks on a diver
+(solid), false tracks (dashed red) and missed divers (dashed white)."""
 
 from __future__ import annotations
 

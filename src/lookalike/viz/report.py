@@ -1,6 +1,5 @@
-"""A single self-contained HTML report: headings, text, tables, images embedded as ``data:`` URIs, and videos
-linked by relative path.
-"""
+"""A single self-contained HTML report: headings, text, tables, images embedded as ``data:`` URIs, and videos linked by
+relative path."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
 """Optional live view: frames, boxes and world positions logged to the Rerun viewer (the optional ``rerun-sdk``,
-imported lazily; :func:`open_rerun` raises ``ValueError`` when it is missing).
-"""
+imported lazily; :func:`open_rerun` raises ``ValueError`` when it is missing)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,9 @@
-"""Robots identified from a video's pixels (``lookalike track --video V --pipeline robots``) and robot
-sequences drawn through the robot camera (``lookalike render-robots``).
+"""Robots identified from a video's pixels (``lookalike track --video V --pipeline robots``) and robot sequences drawn
+through the robot camera (``lookalike render-robots``).
 
-The pipeline (:class:`lookalike.vision.pipeline.RobotPipeline`) detects robots, estimates their headings,
-projects boxes to the ground through :meth:`lookalike.geometry.Camera.default` and identifies them with the
-heading reports of a ``lookalike simulate`` file (frame k of the file is frame k of the video).
-"""
+The pipeline (:class:`lookalike.vision.pipeline.RobotPipeline`) detects robots, estimates their headings, projects boxes
+to the ground through :meth:`lookalike.geometry.Camera.default` and identifies them with the heading reports of a
+``lookalike simulate`` file (frame k of the file is frame k of the video)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
-"""The demo's robot scene: simulate a preset, render it through the camera, run identifiers frame by frame,
-and write an annotated video, a still and a bird's-eye plot of true vs estimated paths.
-"""
+"""The demo's robot scene: simulate a preset, render it through the camera, run identifiers frame by frame, and write an
+annotated video, a still and a bird's-eye plot of true vs estimated paths."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
-"""Writing annotated videos and animated GIFs, reading videos. MP4s are H.264 through PyAV (the ``viz`` extra)
-so browsers play them, else OpenCV's ``mp4v``; PyAV, OpenCV and Pillow are imported lazily.
-"""
+"""Writing annotated videos and animated GIFs, reading videos. MP4s are H.264 through PyAV (the ``viz`` extra) so
+browsers play them, else OpenCV's ``mp4v``; PyAV, OpenCV and Pillow are imported lazily."""
 
 from __future__ import annotations
 

@@ -1,10 +1,9 @@
-"""Tracking on real video: detections from a MOTChallenge file, appearance features from the pixels, any
-registered tracker, the detector-health monitor, and an optional annotated video.
+"""Tracking on real video: detections from a MOTChallenge file, appearance features from the pixels, any registered
+tracker, the detector-health monitor, and an optional annotated video.
 
-In the annotated video, unsettled identities (tentative, the tracker's ``uncertain``, or reported fewer
-than ``new_frames`` frames) are dashed with a ``?``; a recovery is labelled ``id T<-S``; untaken detections
-are thin grey dashed boxes; an unhealthy frame gets a red banner with the reasons.
-"""
+In the annotated video, unsettled identities (tentative, the tracker's ``uncertain``, or reported fewer than
+``new_frames`` frames) are dashed with a ``?``; a recovery is labelled ``id T<-S``; untaken detections are thin grey
+dashed boxes; an unhealthy frame gets a red banner with the reasons."""
 
 from __future__ import annotations
 

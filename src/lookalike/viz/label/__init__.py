@@ -1,6 +1,5 @@
-"""The labelling page: people label robot detections with identities in a browser, to correct a tracker's
-labels, make ground truth, or measure their own identification success rate ("human benchmark").
-"""
+"""The labelling page: people label robot detections with identities in a browser, to correct a tracker's labels, make
+ground truth, or measure their own identification success rate ("human benchmark")."""
 
 from lookalike.viz.label.exports import export_mot, export_truth, load_labels
 from lookalike.viz.label.human import HumanResult, human_result_path, read_human_results, write_human_result

@@ -1,8 +1,7 @@
 """Labels in and out: export to the simulator's truth format and to MOTChallenge, and load starting labels.
 
-MOTChallenge rows: ``frame (1-based), agent id + 1, 0, 0, 0, 0, score, x, y, -1`` with the observer-frame
-position in metres and a zero-size box; false positives and unlabelled detections are left out.
-"""
+MOTChallenge rows: ``frame (1-based), agent id + 1, 0, 0, 0, 0, score, x, y, -1`` with the observer-frame position in
+metres and a zero-size box; false positives and unlabelled detections are left out."""
 
 from __future__ import annotations
 

@@ -1,11 +1,9 @@
 """Human-benchmark result files: what a finished ``lookalike label --benchmark`` session writes, read back by
 ``lookalike bench ident --lengths`` to put people beside the identifiers.
 
-One JSON file per session, ``<sequence stem>.human-<labeller>.json`` (format ``lookalike-human-benchmark``,
-version 1), holding the sequence, labeller, times (Unix seconds), counts and ``success_rate`` (frames
-worked through, unset labels wrong) and ``success_rate_all`` (the whole sequence; see
-:func:`~lookalike.viz.label.store.score_labels`).
-"""
+One JSON file per session, ``<sequence stem>.human-<labeller>.json`` (format ``lookalike-human-benchmark``, version 1),
+holding the sequence, labeller, times (Unix seconds), counts and ``success_rate`` (frames worked through, unset labels
+wrong) and ``success_rate_all`` (the whole sequence; see :func:`~lookalike.viz.label.store.score_labels`)."""
 
 from __future__ import annotations
 

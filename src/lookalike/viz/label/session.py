@@ -17,11 +17,9 @@ def open_label_app(sequence_path: str | Path, initial: Sequence[Sequence[int]] |
                    labeller: str = "anonymous", results_dir: str | Path | None = None) -> LabelApp:
     """A :class:`LabelApp` for the robot sequence at ``sequence_path``.
 
-    Saved labels (``<stem>.labels.json``) win over ``initial``; ``fresh=True`` first moves them to ``.bak``.
-    Benchmark mode starts from no labels and refuses ``initial``, and writes ``<stem>.human-<labeller>.json`` to
-    ``results_dir`` (default: beside the sequence). Raises ``ValueError`` for unreadable or mismatched files or
-    a bad labeller id.
-    """
+    Saved labels (``<stem>.labels.json``) win over ``initial``; ``fresh=True`` first moves them to ``.bak``. Benchmark
+    mode starts from no labels and refuses ``initial``, and writes ``<stem>.human-<labeller>.json`` to ``results_dir``
+    (default: beside the sequence). Raises ``ValueError`` for unreadable or mismatched files or a bad labeller id."""
     sequence_path = Path(sequence_path)
     check_labeller(labeller)
     if not sequence_path.is_file():

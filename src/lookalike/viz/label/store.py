@@ -1,9 +1,8 @@
 """The labels a person gives a robot sequence's detections, saved atomically after every change.
 
-Per detection: an agent id ``0 .. N-1``, ``-1`` for a false positive, or :data:`UNSET` (-2). The file
-``<sequence stem>.labels.json`` holds ``format``, ``version``, ``sequence``, ``n_frames``, ``n_agents``,
-``counts``, ``labels``, ``source`` and ``benchmark``.
-"""
+Per detection: an agent id ``0 .. N-1``, ``-1`` for a false positive, or :data:`UNSET` (-2). The file ``<sequence
+stem>.labels.json`` holds ``format``, ``version``, ``sequence``, ``n_frames``, ``n_agents``, ``counts``, ``labels``,
+``source`` and ``benchmark``."""
 
 from __future__ import annotations
 
@@ -47,9 +46,8 @@ def current_umask() -> int:
 
 
 def atomic_write_text(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same folder and ``os.replace``.
-    The file gets the mode a plain ``open(path, "w")`` would give: 0o666 less the user's umask
-    (``mkstemp`` alone would make it 0o600)."""
+    """Write ``text`` to ``path`` through a temporary file in the same folder and ``os.replace``. The file gets the mode
+    a plain ``open(path, "w")`` would give: 0o666 less the user's umask (``mkstemp`` alone would make it 0o600)."""
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         os.fchmod(fd, 0o666 & ~current_umask())
@@ -177,10 +175,8 @@ class LabelStore:
 def score_labels(labels: Sequence[Sequence[int]], truth: Sequence[np.ndarray], n_agents: int) -> dict[str, Any]:
     """Identification success rate of ``labels`` against ``truth``.
 
-    ``success_rate`` covers frames up to the last with any label set (unset labels count as wrong),
-    ``success_rate_all`` the whole sequence; also the counts scored, correct and unset. Rates are None
-    without detections.
-    """
+    ``success_rate`` covers frames up to the last with any label set (unset labels count as wrong), ``success_rate_all``
+    the whole sequence; also the counts scored, correct and unset. Rates are None without detections."""
     if len(labels) != len(truth):
         raise ValueError(f"labels has {len(labels)} frames, truth {len(truth)}")
     touched = [k for k, row in enumerate(labels) if any(v != UNSET for v in row)]
