@@ -1,6 +1,5 @@
-"""The observer node: a UDP service that receives robots' heading reports and a camera's detections,
-identifies the robots with any registered tracker, and publishes their positions at the camera rate.
-"""
+"""The observer node: a UDP service that receives robots' heading reports and a camera's detections, identifies the
+robots with any registered tracker, and publishes their positions at the camera rate."""
 
 from lookalike.node.client import Endpoint
 from lookalike.node.counters import EVENTS, NodeCounters, log_event

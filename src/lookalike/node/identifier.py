@@ -1,8 +1,7 @@
 """Socket-free core of the node: checks reports and frames, runs the tracker, builds team states.
 
-Every time is simulated time carried by the messages (a report's ``t_sent``, a frame's ``time``); a report
-reaches the tracker with the next frame, stamped ``t_received`` = that frame's time.
-"""
+Every time is simulated time carried by the messages (a report's ``t_sent``, a frame's ``time``); a report reaches the
+tracker with the next frame, stamped ``t_received`` = that frame's time."""
 
 from __future__ import annotations
 
@@ -60,10 +59,9 @@ class IdentifierConfig:
 class TeamIdentifier:
     """Accepts heading reports and detection frames in arrival order and identifies the team.
 
-    ``add_report`` and ``add_frame`` return the counter the message falls under (``"reports"``/``"frames"``
-    when accepted); ``add_frame`` also returns the team state. Reports wait for the next frame in bounded
-    queues (:class:`IdentifierConfig`).
-    """
+    ``add_report`` and ``add_frame`` return the counter the message falls under (``"reports"``/``"frames"`` when
+    accepted); ``add_frame`` also returns the team state. Reports wait for the next frame in bounded queues
+    (:class:`IdentifierConfig`)."""
 
     def __init__(self, tracker: Any, config: IdentifierConfig | None = None) -> None:
         self.tracker = tracker

@@ -1,10 +1,8 @@
 """The node's wire format: versioned, validated messages as compact UTF-8 JSON, one per UDP datagram.
 
-Each holds ``"v"`` (schema version) and ``"type"``: inbound ``report``, ``detections``, ``status_request``;
-outbound ``team`` and ``status``. ``decode`` raises only ``MessageError``, whose ``reason`` is a stable code
-the node counts. Messages, units and bounds: :mod:`lookalike.node.schema` (listed in
-docs/howto/robot-team.md).
-"""
+Each holds ``"v"`` (schema version) and ``"type"``: inbound ``report``, ``detections``, ``status_request``; outbound
+``team`` and ``status``. ``decode`` raises only ``MessageError``, whose ``reason`` is a stable code the node counts.
+Messages, units and bounds: :mod:`lookalike.node.schema` (listed in docs/howto/robot-team.md)."""
 
 from __future__ import annotations
 
@@ -118,10 +116,9 @@ def encode(message: Message) -> bytes:
 
 
 def _team_bytes(message: TeamState) -> bytes | None:
-    """The datagram ``encode`` writes for a team state, written directly when every number is a
-    plain finite ``float`` (ids and labels plain ``int``): the same bytes as ``json.dumps`` with
-    compact separators (``repr`` of each number, ``null`` for None); None for anything else, which
-    then goes through ``json.dumps`` and its errors."""
+    """The datagram ``encode`` writes for a team state, written directly when every number is a plain finite ``float``
+    (ids and labels plain ``int``): the same bytes as ``json.dumps`` with compact separators (``repr`` of each number,
+    ``null`` for None); None for anything else, which then goes through ``json.dumps`` and its errors."""
     robots = []
     for r in message.robots:
         if len(r.position) != 2:

@@ -1,7 +1,6 @@
-"""The node's messages and their bounds: what each message holds (units: simulated seconds, metres in the
-observer frame, radians), the limits every field is checked against, and the stable rejection codes.
-The wire format that encodes and checks them is :mod:`lookalike.node.messages`.
-"""
+"""The node's messages and their bounds: what each message holds (units: simulated seconds, metres in the observer
+frame, radians), the limits every field is checked against, and the stable rejection codes. The wire format that encodes
+and checks them is :mod:`lookalike.node.messages`."""
 
 from __future__ import annotations
 

@@ -1,10 +1,9 @@
 """The observer node's UDP server: one socket, a selector loop, per-sender rate limits.
 
-Each datagram is rate-limited by sender, decoded and handed to the ``TeamIdentifier``. A frame's team state
-goes to every ``publish`` address and either to the multicast ``group`` or (``reply_to_robots``) to each
-robot's last address; then the tracker prepares the next frame. Every failure is counted and logged,
-never stops the loop. Default addresses are loopback.
-"""
+Each datagram is rate-limited by sender, decoded and handed to the ``TeamIdentifier``. A frame's team state goes to
+every ``publish`` address and either to the multicast ``group`` or (``reply_to_robots``) to each robot's last address;
+then the tracker prepares the next frame. Every failure is counted and logged, never stops the loop. Default addresses
+are loopback."""
 
 from __future__ import annotations
 

@@ -1,9 +1,8 @@
 """Simulated robot and camera processes that talk to the node, on top of the robot-world simulator.
 
-Every process builds the same sequence from ``(preset, seed, duration, network)`` (:func:`team_sequence`),
-so no truth travels: the camera sends detections, each robot its heading reports when the simulated network
-delivers them. A :class:`SimClock` maps simulated time ``t`` to wall time ``epoch + t / speed``.
-"""
+Every process builds the same sequence from ``(preset, seed, duration, network)`` (:func:`team_sequence`), so no truth
+travels: the camera sends detections, each robot its heading reports when the simulated network delivers them. A
+:class:`SimClock` maps simulated time ``t`` to wall time ``epoch + t / speed``."""
 
 from __future__ import annotations
 
@@ -50,9 +49,8 @@ class SimClock:
 
 def team_sequence(preset_name: str, seed: int, duration_s: float, loss: float | None = None,
                   delay_s: float | None = None, jitter_s: float | None = None) -> RobotSequence:
-    """The sequence every process of a simulated team shares: ``duration_s`` seconds of preset
-    ``preset_name`` with seed ``seed``, the network's loss probability, delay and mean jitter
-    (seconds) replaced where given."""
+    """The sequence every process of a simulated team shares: ``duration_s`` seconds of preset ``preset_name`` with seed
+    ``seed``, the network's loss probability, delay and mean jitter (seconds) replaced where given."""
     if not duration_s > 0:
         raise ValueError(f"duration_s must be > 0, got {duration_s!r}")
     config = preset(preset_name)
