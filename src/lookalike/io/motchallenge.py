@@ -1,8 +1,7 @@
 """MOTChallenge text files: ``frame, id, left, top, width, height, conf, x, y, z[, ...]``.
 
-Frames and ids are 1-based in files; in memory ``MotTable.frame`` keeps the file's 1-based
-numbers and :func:`frames_from_table` yields 0-based :class:`Frame` objects.
-"""
+Frames and ids are 1-based in files; in memory ``MotTable.frame`` keeps the file's 1-based numbers and
+:func:`frames_from_table` yields 0-based :class:`Frame` objects."""
 
 from __future__ import annotations
 
@@ -25,11 +24,10 @@ def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | N
              length_name: str = "the length", positive_size: bool = False) -> MotTable:
     """Read a MOTChallenge text file (UTF-8).
 
-    Raises ``ValueError`` naming the file and 1-based line number of a malformed line: too few
-    columns, a non-number, NaN or infinity in the first 7 columns (frame, id, box, score), a negative
-    size (with ``positive_size``, as detections need: a zero one too), a frame number that is not an
-    integer >= 1, past ``length`` (named ``length_name``), or that jumps too far
-    (:mod:`lookalike.io.rules`); or naming the file when it is not UTF-8 text.
+    Raises ``ValueError`` naming the file and 1-based line number of a malformed line: too few columns, a non-number,
+    NaN or infinity in the first 7 columns (frame, id, box, score), a negative size (with ``positive_size``, as
+    detections need: a zero one too), a frame number that is not an integer >= 1, past ``length`` (named
+    ``length_name``), or that jumps too far (:mod:`lookalike.io.rules`); or naming the file when it is not UTF-8 text.
     """
     path = Path(path)
     if not path.is_file():
@@ -125,9 +123,8 @@ def frames_from_table(
 ) -> Iterator[Frame]:
     """Yield one :class:`Frame` per frame ``0 .. length-1`` (file frame ``k`` is index ``k-1``).
 
-    Frames without boxes are yielded empty; ``time = index / frame_rate``. Boxes whose score is
-    below ``min_score`` are dropped.
-    """
+    Frames without boxes are yielded empty; ``time = index / frame_rate``. Boxes whose score is below ``min_score`` are
+    dropped."""
     if frame_rate <= 0:
         raise ValueError(f"frame_rate must be positive, got {frame_rate}")
     if length is None:

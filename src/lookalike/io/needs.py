@@ -1,6 +1,5 @@
-"""What a tracker needs beyond boxes and scores (its ``needs`` phrase, or :data:`BUILTIN_NEEDS`), so a command
-can refuse early in one line.
-"""
+"""What a tracker needs beyond boxes and scores (its ``needs`` phrase, or :data:`BUILTIN_NEEDS`), so a command can
+refuse early in one line."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
-"""Where results go, decided before anything runs: one file per sequence, never onto an input, never two
-sequences onto one file, a writable folder. Refusals are one-line ``ValueError``s.
-"""
+"""Where results go, decided before anything runs: one file per sequence, never onto an input, never two sequences onto
+one file, a writable folder. Refusals are one-line ``ValueError``s."""
 
 from __future__ import annotations
 

@@ -1,11 +1,10 @@
 """Anonymous points per frame as tracker input: readers, and points as small boxes for the box trackers.
 
 Formats (comma-separated, 1-based frames): point CSV ``frame,x,y[,...]`` with an optional header
-(:func:`read_points_csv`), and MOTChallenge rows with the point in columns 3-4, or a box whose centre is the
-point with ``centre=True`` (:func:`read_points_mot`). Both give :class:`PointFrames`; bad input raises
-``ValueError`` naming file and line. :func:`points_to_rows` makes square boxes for the trackers;
-:func:`rows_to_points` takes result rows back to centres.
-"""
+(:func:`read_points_csv`), and MOTChallenge rows with the point in columns 3-4, or a box whose centre is the point with
+``centre=True`` (:func:`read_points_mot`). Both give :class:`PointFrames`; bad input raises ``ValueError`` naming file
+and line. :func:`points_to_rows` makes square boxes for the trackers; :func:`rows_to_points` takes result rows back to
+centres."""
 
 from __future__ import annotations
 
@@ -171,7 +170,6 @@ def points_to_rows(points: PointFrames | list[np.ndarray], box_px: float | None 
 
 
 def rows_to_points(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(frame (k,), id (k,), centre (k, 2))`` of result rows, as :func:`lookalike.eval.evaluate_points`
-    takes them."""
+    """``(frame (k,), id (k,), centre (k, 2))`` of result rows, as :func:`lookalike.eval.evaluate_points` takes them."""
     rows = np.asarray(rows, dtype=float).reshape(-1, np.shape(rows)[-1] if np.size(rows) else 10)
     return rows[:, 0].astype(int), rows[:, 1].astype(int), rows[:, 2:4] + rows[:, 4:6] / 2

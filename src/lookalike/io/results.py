@@ -110,9 +110,8 @@ def clean_metrics(metrics: Mapping[str, Any]) -> dict[str, float | int | None]:
 
 def percent_row_metrics(row: Mapping[str, Any], skip: Iterable[str] = (),
                         rename: Mapping[str, str] | None = None) -> dict[str, float | int | None]:
-    """Metrics of a printed table row: numeric cells under machine keys (:func:`metric_key`, or
-    ``rename[column]``), cells marked ``(%)`` or ``(pp)`` divided by 100; text cells and the columns
-    in ``skip`` left out."""
+    """Metrics of a printed table row: numeric cells under machine keys (:func:`metric_key`, or ``rename[column]``),
+    cells marked ``(%)`` or ``(pp)`` divided by 100; text cells and the columns in ``skip`` left out."""
     skipped, names = set(skip), dict(rename or {})
     out: dict[str, Any] = {}
     for name, value in row.items():

@@ -1,9 +1,7 @@
 """The input rules every reader in :mod:`lookalike.io` applies, and file creation with the user's umask.
 
-Frame numbers are integers >= 1 and may not jump past the largest so far by more than
-``max(MIN_GAP, GAP_FACTOR × that frame)``, unless a declared length bounds them
-(docs/concepts/data-formats.md).
-"""
+Frame numbers are integers >= 1 and may not jump past the largest so far by more than ``max(MIN_GAP, GAP_FACTOR × that
+frame)``, unless a declared length bounds them (docs/concepts/data-formats.md)."""
 
 from __future__ import annotations
 

@@ -114,8 +114,7 @@ def _is_sequence(folder: Path) -> bool:
 def find_sequences(path: str | os.PathLike[str]) -> list[MotSequence]:
     """Sequences at ``path``: a detection file, one sequence folder, or a folder of them.
 
-    A bare ``det.txt`` inside ``<seq>/det/`` picks up that sequence's ``seqinfo.ini``.
-    """
+    A bare ``det.txt`` inside ``<seq>/det/`` picks up that sequence's ``seqinfo.ini``."""
     path = Path(path)
     if path.is_file():
         parent = path.parent.parent if path.parent.name == "det" else None

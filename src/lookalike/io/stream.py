@@ -1,10 +1,9 @@
 """Streaming MOTChallenge input and output for :func:`lookalike.loop.run`.
 
-:class:`DetectionStream` checks the whole file first in chunks (the errors of :func:`~lookalike.io.read_mot`),
-then yields frames parsing a chunk at a time (files with decreasing frames or uneven columns are read
-whole); frames equal :func:`~lookalike.io.frames_from_table`'s. :class:`MotWriter` writes rows as they come
-to a file that appears atomically at the end.
-"""
+:class:`DetectionStream` checks the whole file first in chunks (the errors of :func:`~lookalike.io.read_mot`), then
+yields frames parsing a chunk at a time (files with decreasing frames or uneven columns are read whole); frames equal
+:func:`~lookalike.io.frames_from_table`'s. :class:`MotWriter` writes rows as they come to a file that appears atomically
+at the end."""
 
 from __future__ import annotations
 
@@ -151,9 +150,8 @@ class DetectionStream:
 class MotWriter:
     """A sink for :func:`lookalike.loop.run` that writes MOTChallenge result rows as they come.
 
-    Rows go to a temporary file beside ``path``; :meth:`close` renames it to ``path`` (atomic), and
-    leaving a ``with`` block on an exception deletes it, so a failed run never leaves a half file.
-    """
+    Rows go to a temporary file beside ``path``; :meth:`close` renames it to ``path`` (atomic), and leaving a ``with``
+    block on an exception deletes it, so a failed run never leaves a half file."""
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
