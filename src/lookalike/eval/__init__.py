@@ -1,7 +1,6 @@
-"""Evaluation: CLEAR MOT, identity and HOTA (TrackEval's definitions, values as fractions), and the
-robot-identification paper's metrics (identification success rate, localisation error).
-:mod:`lookalike.eval.folders` scores folders of results (``lookalike eval``).
-"""
+"""Evaluation: CLEAR MOT, identity and HOTA (TrackEval's definitions, values as fractions), and the robot-identification
+paper's metrics (identification success rate, localisation error). :mod:`lookalike.eval.folders` scores folders of
+results (``lookalike eval``)."""
 
 from lookalike.eval.api import METRICS, combine, evaluate_data, evaluate_points, evaluate_sequence
 from lookalike.eval.data import SequenceData

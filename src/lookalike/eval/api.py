@@ -1,6 +1,5 @@
-"""Scoring one sequence, from tables or in-memory arrays, and combining sequences. Values are fractions (0.73,
-not 73 %) as in TrackEval; a result dict also holds the counts needed to combine it with others.
-"""
+"""Scoring one sequence, from tables or in-memory arrays, and combining sequences. Values are fractions (0.73, not 73 %)
+as in TrackEval; a result dict also holds the counts needed to combine it with others."""
 
 from __future__ import annotations
 
@@ -64,15 +63,13 @@ def evaluate_sequence(
     metrics: Sequence[str] = METRICS,
     num_frames: int | None = None,
 ) -> dict[str, float]:
-    """CLEAR, identity and HOTA of tracker boxes ``result`` against ground truth ``gt``
-    (:class:`lookalike.io.MotTable`, or anything with its columns).
+    """CLEAR, identity and HOTA of tracker boxes ``result`` against ground truth ``gt`` (:class:`lookalike.io.MotTable`,
+    or anything with its columns).
 
-    ``benchmark`` picks the ground-truth rules (see :mod:`lookalike.eval.prepare`): ``"MOT17"``
-    (also MOT16/MOT20) for MOTChallenge preprocessing, ``"MOT15"`` or ``"custom"`` for plain.
-    ``num_frames`` is the sequence length (``seqLength``); by default the last frame present.
-    Returns TrackEval-named values as fractions (MOTA, MOTP = mean IoU of matches, IDF1, HOTA,
-    ``HOTA___50``, ...) and the counts (CLR_TP, IDSW, IDTP, HOTA_TP___50, ...).
-    """
+    ``benchmark`` picks the ground-truth rules (see :mod:`lookalike.eval.prepare`): ``"MOT17"`` (also MOT16/MOT20) for
+    MOTChallenge preprocessing, ``"MOT15"`` or ``"custom"`` for plain. ``num_frames`` is the sequence length
+    (``seqLength``); by default the last frame present. Returns TrackEval-named values as fractions (MOTA, MOTP = mean
+    IoU of matches, IDF1, HOTA, ``HOTA___50``, ...) and the counts (CLR_TP, IDSW, IDTP, HOTA_TP___50, ...)."""
     _check_threshold(iou_threshold)
     data = prepare_boxes(gt, result, num_frames=num_frames, benchmark=benchmark)
     return evaluate_data(data, threshold=iou_threshold, metrics=metrics)
@@ -90,10 +87,9 @@ def evaluate_points(
     metrics: Sequence[str] = METRICS,
     num_frames: int | None = None,
 ) -> dict[str, float]:
-    """The same metrics for point data: ``(n,)`` 1-based frames and ids, ``(n, 2)`` positions
-    (pixels or metres). Objects match within ``radius`` (same unit); the similarity is
-    ``max(0, 1 - d / (2 * radius))`` so MOTP and LocA are mean scores, and HOTA's alphas sweep
-    distances from 1.9 to 0.1 times ``radius``."""
+    """The same metrics for point data: ``(n,)`` 1-based frames and ids, ``(n, 2)`` positions (pixels or metres).
+    Objects match within ``radius`` (same unit); the similarity is ``max(0, 1 - d / (2 * radius))`` so MOTP and LocA are
+    mean scores, and HOTA's alphas sweep distances from 1.9 to 0.1 times ``radius``."""
     data = prepare_points(gt_frame, gt_id, gt_xy, result_frame, result_id, result_xy,
                           radius=radius, num_frames=num_frames)
     return evaluate_data(data, threshold=0.5, metrics=metrics)

@@ -1,7 +1,6 @@
-"""CLEAR MOT metrics (Bernardin & Stiefelhagen 2008) with TrackEval's conventions: per frame, Hungarian
-matching on similarity >= ``threshold``, preferring the previous scored frame's pairs; an ID switch is a
-ground-truth object matched to another tracker id than its last match; MT > 80 % tracked, ML < 20 %.
-"""
+"""CLEAR MOT metrics (Bernardin & Stiefelhagen 2008) with TrackEval's conventions: per frame, Hungarian matching on
+similarity >= ``threshold``, preferring the previous scored frame's pairs; an ID switch is a ground-truth object matched
+to another tracker id than its last match; MT > 80 % tracked, ML < 20 %."""
 
 from __future__ import annotations
 
@@ -17,9 +16,8 @@ COUNTS = ("CLR_TP", "CLR_FN", "CLR_FP", "IDSW", "MT", "PT", "ML", "Frag", "MOTP_
 def clear_counts(data: SequenceData, threshold: float = 0.5) -> dict[str, float]:
     """The summable CLEAR counts of one sequence (see :data:`COUNTS`).
 
-    Frames whose pairs at ``threshold`` are one-to-one are matched without the Hungarian algorithm
-    (every such pair is a match whatever the previous frame did); the rest are solved in frame order.
-    """
+    Frames whose pairs at ``threshold`` are one-to-one are matched without the Hungarian algorithm (every such pair is a
+    match whatever the previous frame did); the rest are solved in frame order."""
     n_gt, n_frames = data.num_gt_ids, data.num_frames
     p = data.pairs()
     cand = np.flatnonzero(p.similarity >= threshold - _EPS)

@@ -1,6 +1,5 @@
-"""One sequence prepared for scoring: detections per frame (flat, in frame order) with ids relabelled
-``0 .. n-1``, and their positive-similarity pairs (every other similarity is exactly 0).
-"""
+"""One sequence prepared for scoring: detections per frame (flat, in frame order) with ids relabelled ``0 .. n-1``, and
+their positive-similarity pairs (every other similarity is exactly 0)."""
 
 from __future__ import annotations
 

@@ -41,9 +41,8 @@ def evaluate_folders(
 ) -> dict[str, dict[str, float]]:
     """Per-sequence results (sequence name -> metrics) and their combination under ``"COMBINED"``.
 
-    Every ground-truth sequence needs a result file; sequence lengths come from ``seqinfo.ini``
-    (else the last frame present). ``workers > 1`` scores sequences in that many processes.
-    """
+    Every ground-truth sequence needs a result file; sequence lengths come from ``seqinfo.ini`` (else the last frame
+    present). ``workers > 1`` scores sequences in that many processes."""
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
     sequences = [s for s in find_sequences(gt_root) if s.gt_path is not None]

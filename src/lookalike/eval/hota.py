@@ -1,7 +1,6 @@
-"""HOTA (Luiten et al. 2021) over the 19 thresholds alpha = 0.05, ..., 0.95: one Hungarian matching per frame
-on ``global_alignment * similarity``, counted at every alpha its similarity reaches. Stored as
-``FIELD___5`` ... ``FIELD___95`` and ``FIELD___AUC`` (= ``FIELD``, the mean over alphas).
-"""
+"""HOTA (Luiten et al. 2021) over the 19 thresholds alpha = 0.05, ..., 0.95: one Hungarian matching per frame on
+``global_alignment * similarity``, counted at every alpha its similarity reaches. Stored as ``FIELD___5`` ...
+``FIELD___95`` and ``FIELD___AUC`` (= ``FIELD``, the mean over alphas)."""
 
 from __future__ import annotations
 

@@ -1,9 +1,8 @@
-"""The robot-identification paper's metrics: how often a detection carries the right agent label, and how far
-estimated agent positions are from the true ones.
+"""The robot-identification paper's metrics: how often a detection carries the right agent label, and how far estimated
+agent positions are from the true ones.
 
-Labels are agent ids (``>= 0``) or ``-1`` (false positive). Positions are ``(n_frames, n_agents, 2)`` arrays
-in metres, NaN where the agent is absent (truth) or not estimated.
-"""
+Labels are agent ids (``>= 0``) or ``-1`` (false positive). Positions are ``(n_frames, n_agents, 2)`` arrays in metres,
+NaN where the agent is absent (truth) or not estimated."""
 
 from __future__ import annotations
 
@@ -44,16 +43,14 @@ def identification_success_rate(
 ) -> float:
     """Correct labels / all detections, over all frames (lists of ``(n_t,)`` int arrays).
 
-    A false positive (true label -1) labelled -1 is correct. NaN when there are no detections.
-    """
+    A false positive (true label -1) labelled -1 is correct. NaN when there are no detections."""
     correct, detections = identification_counts(predicted_labels, true_labels)
     return correct / detections if detections else float("nan")
 
 
 def robot_success_rate(predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]) -> float:
-    """Correct labels / detections of true robots (true label >= 0), over all frames: the success rate
-    without the false positives, which sides with different false-positive rates score unequally.
-    NaN when there are none."""
+    """Correct labels / detections of true robots (true label >= 0), over all frames: the success rate without the false
+    positives, which sides with different false-positive rates score unequally. NaN when there are none."""
     p, t = _flatten_labels(predicted_labels, true_labels)
     robots = t >= 0
     return float(np.mean(p[robots] == t[robots])) if robots.any() else float("nan")

@@ -1,7 +1,6 @@
 """Per-frame Hungarian matching over sparse pairs, skipping frames whose pairs are already one-to-one (every
 maximum-score assignment contains them); the other frames' dense matrices are built in one reused buffer
-(:func:`negated_matrices`) and solved in turn (:func:`solve_matrices`).
-"""
+(:func:`negated_matrices`) and solved in turn (:func:`solve_matrices`)."""
 
 from __future__ import annotations
 

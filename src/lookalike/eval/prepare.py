@@ -23,10 +23,8 @@ from lookalike.types.mot_table import MotTable as MotTableData
 class MotTable(Protocol):
     """What scoring needs of a table of boxes; :class:`lookalike.io.MotTable` has it.
 
-    ``frame`` ``(n,)`` 1-based, ``track_id`` ``(n,)``, ``xywh`` ``(n, 4)`` pixels, ``conf`` ``(n,)``
-    (the ground truth's consider flag), ``extra`` ``(n, k)`` (class in column 0 for MOT16+ gt),
-    ``path`` the source file or None.
-    """
+    ``frame`` ``(n,)`` 1-based, ``track_id`` ``(n,)``, ``xywh`` ``(n, 4)`` pixels, ``conf`` ``(n,)`` (the ground truth's
+    consider flag), ``extra`` ``(n, k)`` (class in column 0 for MOT16+ gt), ``path`` the source file or None."""
 
     @property
     def frame(self) -> np.ndarray: ...
@@ -103,8 +101,7 @@ def prepare_boxes(
 ) -> SequenceData:
     """Box sequences (IoU similarity) with ``benchmark`` rules; frames ``1 .. num_frames``.
 
-    ``num_frames`` defaults to the last frame of either table.
-    """
+    ``num_frames`` defaults to the last frame of either table."""
     if benchmark not in BENCHMARKS:
         raise ValueError(f"benchmark must be one of {BENCHMARKS}, got {benchmark!r}")
     n = _num_frames(gt, result, num_frames)

@@ -1,6 +1,5 @@
-"""Similarity in ``[0, 1]`` between one frame's ground-truth and tracker objects: box IoU through corner
-coordinates (bit for bit TrackEval's), or the point score ``max(0, 1 - d / (2 * radius))``.
-"""
+"""Similarity in ``[0, 1]`` between one frame's ground-truth and tracker objects: box IoU through corner coordinates
+(bit for bit TrackEval's), or the point score ``max(0, 1 - d / (2 * radius))``."""
 
 from __future__ import annotations
 
@@ -12,8 +11,7 @@ _EPS = np.finfo(float).eps
 def box_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
     """IoU ``(n, m)`` of ``(n, 4)`` and ``(m, 4)`` boxes (left, top, width, height; pixels).
 
-    Boxes of zero area, and pairs with no union, get 0.
-    """
+    Boxes of zero area, and pairs with no union, get 0."""
     return _corner_iou(gt_xywh, tr_xywh, outer=True)
 
 
@@ -49,8 +47,7 @@ def _corner_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray, outer: bool) -> np.nda
 def point_similarity(gt_xy: np.ndarray, tr_xy: np.ndarray, radius: float) -> np.ndarray:
     """Distance score ``(n, m)`` of ``(n, 2)`` and ``(m, 2)`` points (pixels or metres).
 
-    ``max(0, 1 - d / (2 * radius))``: 1 at the same place, 0.5 at ``radius``, 0 from ``2 * radius``.
-    """
+    ``max(0, 1 - d / (2 * radius))``: 1 at the same place, 0.5 at ``radius``, 0 from ``2 * radius``."""
     if not radius > 0:
         raise ValueError(f"radius must be positive, got {radius}")
     a = np.asarray(gt_xy, dtype=float).reshape(-1, 2)
