@@ -1,10 +1,9 @@
 """Which parameters earn their place: the left-out gain of tuning one parameter against fixing it.
 
 Candidates are the defaults and the defaults with one parameter moved over its range
-(:func:`lookalike.tune.space.grid`), each scored once per sequence; per fold, a parameter's best candidate
-on the training sequences is compared with the defaults on the left-out ones. Worth tuning when the mean
-gain exceeds twice its standard error over the folds.
-"""
+(:func:`lookalike.tune.space.grid`), each scored once per sequence; per fold, a parameter's best candidate on the
+training sequences is compared with the defaults on the left-out ones. Worth tuning when the mean gain exceeds twice its
+standard error over the folds."""
 
 from __future__ import annotations
 

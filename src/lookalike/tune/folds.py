@@ -18,9 +18,8 @@ class Fold:
 def leave_one_group_out(groups: Sequence[str]) -> list[Fold]:
     """One fold per distinct group (in first-seen order): that group's sequences left out.
 
-    ``groups[i]`` is sequence ``i``'s group: its own name for leave-one-sequence-out, its
-    dataset for leave-one-dataset-out. Needs at least two groups.
-    """
+    ``groups[i]`` is sequence ``i``'s group: its own name for leave-one-sequence-out, its dataset for
+    leave-one-dataset-out. Needs at least two groups."""
     names = list(dict.fromkeys(groups))
     if len(names) < 2:
         raise ValueError(f"folds: leaving one out needs at least two sequences/groups, got {len(names)}")

@@ -1,7 +1,6 @@
-"""What a choice maximises (``hota+idf1+mota``, ``hota`` or ``idf1``), and evaluating parameter sets on
-sequences. Scores combine as TrackEval's over sequences; over groups (datasets) the objective is the mean
-of each group's criterion.
-"""
+"""What a choice maximises (``hota+idf1+mota``, ``hota`` or ``idf1``), and evaluating parameter sets on sequences.
+Scores combine as TrackEval's over sequences; over groups (datasets) the objective is the mean of each group's
+criterion."""
 
 from __future__ import annotations
 
@@ -35,8 +34,7 @@ def criterion(name: str) -> Callable[[Scores], float]:
 
 
 def objective(per_sequence: Sequence[Scores], groups: Sequence[str], crit: Callable[[Scores], float]) -> float:
-    """Mean over the groups of ``crit`` of the group's combined scores (one group: the combined
-    criterion)."""
+    """Mean over the groups of ``crit`` of the group's combined scores (one group: the combined criterion)."""
     if len(per_sequence) != len(groups) or not groups:
         raise ValueError("objective: need one group per sequence, at least one sequence")
     values = []

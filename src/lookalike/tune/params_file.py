@@ -105,10 +105,9 @@ def read_params(path: str | Path) -> TunedParams:
 def load_params(path: str | Path, tracker: str | None = None) -> dict[str, Any]:
     """The parameters in the file at ``path``, checked against the tracker they are for.
 
-    ``tracker``: the tracker the caller will build; a file written for another tracker is refused.
-    Raises ``ValueError`` with a message naming the file and what is wrong (not found, not a
-    parameter file, another tracker, unknown tracker or parameter, values the tracker refuses).
-    """
+    ``tracker``: the tracker the caller will build; a file written for another tracker is refused. Raises ``ValueError``
+    with a message naming the file and what is wrong (not found, not a parameter file, another tracker, unknown tracker
+    or parameter, values the tracker refuses)."""
     content = read_params(path)
     if tracker is not None and content.tracker != tracker:
         raise ValueError(f"{path}: these parameters are for tracker {content.tracker!r}, not {tracker!r} "

@@ -1,9 +1,8 @@
 """The left-out score of the whole selection procedure.
 
-:func:`leave_one_out_selection` runs a study per fold on the other sequences and scores the choice on the
-left-out ones; :func:`select_from_table` does the same from stored per-sequence scores of every candidate
-(an argmax per fold: with random candidates, random search's left-out figure in one pass).
-"""
+:func:`leave_one_out_selection` runs a study per fold on the other sequences and scores the choice on the left-out ones;
+:func:`select_from_table` does the same from stored per-sequence scores of every candidate (an argmax per fold: with
+random candidates, random search's left-out figure in one pass)."""
 
 from __future__ import annotations
 
@@ -54,13 +53,12 @@ def select_from_table(table: Sequence[Sequence[Scores | None]], folds: Sequence[
                       groups: Sequence[str] | None = None, metric: str = "hota+idf1+mota",
                       candidates: Sequence[dict[str, Any]] | None = None,
                       allowed: Sequence[int] | None = None) -> list[FoldChoice]:
-    """Per fold, the candidate with the best objective on the fold's training sequences (first on
-    ties; candidates failing on any of them excluded) and its scores on the left-out ones.
+    """Per fold, the candidate with the best objective on the fold's training sequences (first on ties; candidates
+    failing on any of them excluded) and its scores on the left-out ones.
 
-    ``table[k][i]``: candidate ``k``'s scores on sequence ``i`` (None: failed); ``allowed``: only
-    these candidate indices may be chosen (default all). Only ``table[k][j]`` for ``j`` in a fold's
-    training sequences enter that fold's choice.
-    """
+    ``table[k][i]``: candidate ``k``'s scores on sequence ``i`` (None: failed); ``allowed``: only these candidate
+    indices may be chosen (default all). Only ``table[k][j]`` for ``j`` in a fold's training sequences enter that fold's
+    choice."""
     crit = criterion(metric)
     groups = list(keys) if groups is None else list(groups)
     pool = list(range(len(table))) if allowed is None else list(allowed)
@@ -89,14 +87,12 @@ def leave_one_out_selection(tracker: str, sequences: Sequence[Any], *, folds: st
                             backend: str = "local", address: str | None = None, evaluator: Evaluator = score_params,
                             progress: Callable[[str, int, int, float | None], None] | None = None
                             ) -> list[FoldChoice]:
-    """For each fold, :func:`lookalike.tune.study.run_study` on the other sequences, then the chosen
-    parameters scored on the left-out ones (the only time they are run).
+    """For each fold, :func:`lookalike.tune.study.run_study` on the other sequences, then the chosen parameters scored
+    on the left-out ones (the only time they are run).
 
     ``folds``: ``"loso"`` (one per sequence), ``"lodo"`` (one per dataset), K, or explicit
-    :class:`~lookalike.tune.folds.Fold` objects. The study of a fold is named
-    ``<study_name or tracker>/<fold>`` in ``storage``. Other arguments as for ``run_study``;
-    ``progress(fold, done, trials, best)``.
-    """
+    :class:`~lookalike.tune.folds.Fold` objects. The study of a fold is named ``<study_name or tracker>/<fold>`` in
+    ``storage``. Other arguments as for ``run_study``; ``progress(fold, done, trials, best)``."""
     keys = [sequence_key(s) for s in sequences] if keys is None else list(keys)
     groups = [str(getattr(s, "dataset", "")) for s in sequences] if groups is None else list(groups)
     fold_list = make_folds(keys, folds, groups) if isinstance(folds, (str, int)) else list(folds)

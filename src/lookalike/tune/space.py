@@ -164,8 +164,7 @@ def default_space(tracker: str) -> Space:
 def space_from_json(spec: Mapping[str, Any], tracker: str) -> Space:
     """A space from its JSON form (module docstring), checked against ``tracker``'s parameters.
 
-    Raises ``ValueError`` naming an unknown parameter or a malformed entry.
-    """
+    Raises ``ValueError`` naming an unknown parameter or a malformed entry."""
     hints = config_hints(tracker)
     out: Space = {}
     for name, entry in spec.items():
@@ -212,8 +211,7 @@ def _cast(dim: Dim, value: float) -> Any:
 def suggest(trial: Any, space: Space) -> dict[str, Any]:
     """Tracker parameters drawn by an Optuna ``trial`` from ``space`` (fixed values included).
 
-    An optional dimension is drawn as ``<name>:on`` (bool) and, when on, ``<name>``.
-    """
+    An optional dimension is drawn as ``<name>:on`` (bool) and, when on, ``<name>``."""
     params = dict(fixed(space))
     for name, dim in searched(space).items():
         if dim.optional and not trial.suggest_categorical(f"{name}:on", [True, False]):

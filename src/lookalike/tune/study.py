@@ -2,9 +2,8 @@
 
 Each trial (TPE or random) runs the tracker on every sequence; its value is the combined criterion
 (:func:`lookalike.tune.objective.objective`). The first trial is the defaults. Trials run in batches on
-:class:`lookalike.parallel.JobPool`; with ``storage`` (an Optuna RDB URL) trials are saved and ``resume=True``
-continues up to ``trials`` in all.
-"""
+:class:`lookalike.parallel.JobPool`; with ``storage`` (an Optuna RDB URL) trials are saved and ``resume=True`` continues
+up to ``trials`` in all."""
 
 from __future__ import annotations
 
