@@ -1,6 +1,5 @@
-"""Appearance association: cosine distances and per-track feature galleries (deep SORT's).
-Features are L2-normalised rows, so the cosine distance ``1 - f·g`` lies in ``[0, 2]``.
-"""
+"""Appearance association: cosine distances and per-track feature galleries (deep SORT's). Features are L2-normalised
+rows, so the cosine distance ``1 - f·g`` lies in ``[0, 2]``."""
 
 from __future__ import annotations
 
@@ -69,8 +68,7 @@ class FeatureGallery:
     def min_distance(self, track_ids: list[int] | np.ndarray, features: np.ndarray) -> np.ndarray:
         """``(k, n)``: for each track, the smallest cosine distance of each feature ``(n, d)`` to its gallery.
 
-        A track without stored features gets ``inf``.
-        """
+        A track without stored features gets ``inf``."""
         feats = np.asarray(features, dtype=float)
         out = np.full((len(track_ids), len(feats)), np.inf)
         if not len(feats):

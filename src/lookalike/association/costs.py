@@ -15,9 +15,8 @@ def iou_cost(track_xywh: np.ndarray, det_xywh: np.ndarray, min_iou: float = 0.0,
 
 
 def iou_columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """:func:`~lookalike.geometry.boxes.iou_matrix` of boxes given as columns, ``a (4, m)`` and
-    ``b (4, n)`` (rows left, top, width, height; pixels): ``(m, n)``, the same numbers bit for bit, with
-    x and y handled together."""
+    """:func:`~lookalike.geometry.boxes.iou_matrix` of boxes given as columns, ``a (4, m)`` and ``b (4, n)`` (rows left,
+    top, width, height; pixels): ``(m, n)``, the same numbers bit for bit, with x and y handled together."""
     lo_a, lo_b = a[0:2, :, None], b[0:2, None, :]
     side = np.minimum(lo_a + a[2:4, :, None], lo_b + b[2:4, None, :])
     side -= np.maximum(lo_a, lo_b)
@@ -43,9 +42,8 @@ def cost_from_iou(iou: np.ndarray, min_iou: float = 0.0, det_weight: np.ndarray 
 
 def centre_distance_cost(track_cxcywh: np.ndarray, det_cxcywh: np.ndarray, gate: np.ndarray | float,
                          max_scale: float) -> np.ndarray:
-    """Distance between box centres in track heights (heights floored at 1 pixel): ``(k, d)``;
-    ``inf`` beyond ``gate`` (``(k, 1)`` or scalar, in heights) or where width or height differ by
-    more than a factor ``max_scale``."""
+    """Distance between box centres in track heights (heights floored at 1 pixel): ``(k, d)``; ``inf`` beyond ``gate``
+    (``(k, 1)`` or scalar, in heights) or where width or height differ by more than a factor ``max_scale``."""
     height = np.maximum(track_cxcywh[:, 3:4], 1.0)
     square = track_cxcywh[:, None, :2] - det_cxcywh[None, :, :2]
     square *= square

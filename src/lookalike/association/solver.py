@@ -1,9 +1,8 @@
 """The assignment solver contract, with scipy's ``linear_sum_assignment`` behind it.
 
-``assign(cost, max_cost)`` matches rows (e.g. tracks) to columns (e.g. detections) so that no
-pair costs more than ``max_cost``: ``inf`` (or anything above ``max_cost``) forbids a pair.
-Rectangular, empty and all-forbidden matrices are legal.
-"""
+``assign(cost, max_cost)`` matches rows (e.g. tracks) to columns (e.g. detections) so that no pair costs more than
+``max_cost``: ``inf`` (or anything above ``max_cost``) forbids a pair. Rectangular, empty and all-forbidden matrices are
+legal."""
 
 from __future__ import annotations
 
@@ -69,10 +68,9 @@ def _check(cost: np.ndarray) -> np.ndarray:
 def assign(cost: np.ndarray, max_cost: float = np.inf) -> Assignment:
     """Minimum-cost assignment where pairs costing more than ``max_cost`` (or ``inf``) are forbidden.
 
-    With a finite ``max_cost``, leaving a row unmatched costs as much as a pair at ``max_cost``
-    (deep SORT's convention). With ``max_cost = inf`` the solver first maximises the number of
-    allowed pairs, then minimises their total cost.
-    """
+    With a finite ``max_cost``, leaving a row unmatched costs as much as a pair at ``max_cost`` (deep SORT's
+    convention). With ``max_cost = inf`` the solver first maximises the number of allowed pairs, then minimises their
+    total cost."""
     c = _check(cost)
     rows, cols = _solve(c, max_cost)
     return _result(rows, cols, c.shape)
@@ -134,8 +132,7 @@ def solve_allowed(c: np.ndarray, allowed: np.ndarray, max_cost: float) -> tuple[
 def max_weight_complete(weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Rows and columns of a maximum-weight complete matching (no gating), as SORT solves it.
 
-    The caller filters the pairs afterwards; this is the reference SORT's "solve then gate" order.
-    """
+    The caller filters the pairs afterwards; this is the reference SORT's "solve then gate" order."""
     w = _check(weight)
     if w.size == 0:
         return np.zeros(0, int), np.zeros(0, int)

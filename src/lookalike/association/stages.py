@@ -1,7 +1,6 @@
-"""Association as data: an ordered plan of stages (track set, detection set, cost, gate) run by one function.
-Each stage sees only the tracks still unmatched and detections still free, in the order it gives them (an
-index array's order decides the solver's tie-breaking), and solves its own assignment.
-"""
+"""Association as data: an ordered plan of stages (track set, detection set, cost, gate) run by one function. Each stage
+sees only the tracks still unmatched and detections still free, in the order it gives them (an index array's order
+decides the solver's tie-breaking), and solves its own assignment."""
 
 from __future__ import annotations
 
