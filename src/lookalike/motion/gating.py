@@ -1,6 +1,5 @@
-"""Chi-square gating thresholds for squared Mahalanobis distances, without scipy: the closed-form CDF for
-integer and half-integer orders, inverted by bisection to the last bit.
-"""
+"""Chi-square gating thresholds for squared Mahalanobis distances, without scipy: the closed-form CDF for integer and
+half-integer orders, inverted by bisection to the last bit."""
 
 from __future__ import annotations
 
@@ -32,8 +31,7 @@ def chi2_cdf(x: float, dof: int) -> float:
 def chi2_gate(dof: int, probability: float = 0.95) -> float:
     """The ``probability`` quantile of the chi-square distribution with ``dof`` degrees of freedom.
 
-    ``chi2_gate(4) == 9.4877…``: a squared Mahalanobis distance above it is outside the gate.
-    """
+    ``chi2_gate(4) == 9.4877…``: a squared Mahalanobis distance above it is outside the gate."""
     if dof < 1:
         raise ValueError(f"dof must be at least 1, got {dof}")
     if not 0.0 < probability < 1.0:

@@ -1,9 +1,8 @@
 """A stateless linear Kalman filter, vectorised over tracks.
 
-Shapes: ``mean (k, n)``, ``cov (k, n, n)``, measurement ``z (k, m)``, ``H (m, n)``; the model
-matrices ``F``, ``Q``, ``R`` are either shared ``(n, n)`` / ``(m, m)`` or per track
-``(k, n, n)`` / ``(k, m, m)``. State lives with the caller; these functions never mutate input.
-"""
+Shapes: ``mean (k, n)``, ``cov (k, n, n)``, measurement ``z (k, m)``, ``H (m, n)``; the model matrices ``F``, ``Q``,
+``R`` are either shared ``(n, n)`` / ``(m, m)`` or per track ``(k, n, n)`` / ``(k, m, m)``. State lives with the caller;
+these functions never mutate input."""
 
 from __future__ import annotations
 
@@ -31,8 +30,7 @@ def update(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Measurement update with ``z (k, m)``; returns the posterior ``(mean, cov)``.
 
-    Uses the Joseph-free form ``P' = (I - K H) P`` with ``K = P Hᵀ S⁻¹`` computed by a solve.
-    """
+    Uses the Joseph-free form ``P' = (I - K H) P`` with ``K = P Hᵀ S⁻¹`` computed by a solve."""
     z_hat, S = project(mean, cov, H, R)
     PHt = cov @ H.T  # (k, n, m)
     # K = PHt S^-1  <=>  S K^T = PHt^T (S symmetric)

@@ -1,7 +1,6 @@
-"""State spaces: one per track parametrisation, each with box↔state converters, ``F``, ``Q``, ``H``/``R`` and
-``P0``; batched over tracks (``mean (k, n)``, ``cov (k, n, n)``) and stateless. Steps are nominal frame
-intervals, or seconds for ``WorldCA``.
-"""
+"""State spaces: one per track parametrisation, each with box↔state converters, ``F``, ``Q``, ``H``/``R`` and ``P0``;
+batched over tracks (``mean (k, n)``, ``cov (k, n, n)``) and stateless. Steps are nominal frame intervals, or seconds
+for ``WorldCA``."""
 
 from __future__ import annotations
 
