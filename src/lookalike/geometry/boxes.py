@@ -1,9 +1,8 @@
 """Box format conversions and the vectorised IoU matrix.
 
-Formats are named by their columns: ``xywh`` (left, top, width, height), ``xyxy`` (left, top,
-right, bottom), ``cxcywh`` (centre x, centre y, width, height) and ``xysr`` (centre x, centre y,
-area, aspect ratio width/height, as in SORT). All in pixels; arrays are ``(n, 4)``.
-"""
+Formats are named by their columns: ``xywh`` (left, top, width, height), ``xyxy`` (left, top, right, bottom), ``cxcywh``
+(centre x, centre y, width, height) and ``xysr`` (centre x, centre y, area, aspect ratio width/height, as in SORT). All
+in pixels; arrays are ``(n, 4)``."""
 
 from __future__ import annotations
 
@@ -61,8 +60,7 @@ def xysr_to_xywh(xysr: np.ndarray) -> np.ndarray:
 def iou_matrix(xywh_a: np.ndarray, xywh_b: np.ndarray) -> np.ndarray:
     """Intersection over union of every box in ``a`` with every box in ``b``: ``(n, m)``.
 
-    Boxes of zero area that do not overlap anything give 0, never NaN.
-    """
+    Boxes of zero area that do not overlap anything give 0, never NaN."""
     a = np.asarray(xywh_a, dtype=float).reshape(-1, 4)
     b = np.asarray(xywh_b, dtype=float).reshape(-1, 4)
     ax1, ay1 = a[:, 0:1], a[:, 1:2]

@@ -1,10 +1,9 @@
 """Pinhole camera over a flat ground plane, and observer odometry.
 
-Frames: egocentric (observer; metres, origin on the ground below the camera, x forward, y left, z up),
-camera (x right, y down, z along the optical axis) and image (pixels, u right, v down, origin at the
-top-left pixel's corner). Extrinsics: height, ``yaw`` (left about z), ``pitch`` (positive looks down) and
-``roll`` (image clockwise). No lens distortion.
-"""
+Frames: egocentric (observer; metres, origin on the ground below the camera, x forward, y left, z up), camera (x right,
+y down, z along the optical axis) and image (pixels, u right, v down, origin at the top-left pixel's corner).
+Extrinsics: height, ``yaw`` (left about z), ``pitch`` (positive looks down) and ``roll`` (image clockwise). No lens
+distortion."""
 
 from __future__ import annotations
 
@@ -254,8 +253,7 @@ class Pose2D:
 def integrate_odometry(steps: np.ndarray, start: Pose2D | None = None) -> list[Pose2D]:
     """Poses after each odometry step ``(n, 3)`` of ``(dx_m, dy_m, dheading_rad)`` in the robot frame.
 
-    Returns ``n + 1`` poses, the first being ``start`` (origin by default).
-    """
+    Returns ``n + 1`` poses, the first being ``start`` (origin by default)."""
     d = _rows("steps", steps, 3)
     poses = [start if start is not None else Pose2D()]
     for dx, dy, dh in d:
