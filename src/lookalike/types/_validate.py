@@ -12,8 +12,7 @@ def as_column(
 ) -> np.ndarray:
     """Convert ``value`` to a read-only array of shape ``(n,)`` or ``(n, width)``.
 
-    Raises ``ValueError`` naming ``owner.name`` when the shape does not fit.
-    """
+    Raises ``ValueError`` naming ``owner.name`` when the shape does not fit."""
     try:
         arr: np.ndarray = np.array(value, dtype=dtype, copy=True)
     except (TypeError, ValueError) as exc:

@@ -1,7 +1,6 @@
-"""MOTChallenge rows in memory: the :class:`MotTable` of columns, one frame's tracks as rows, and a row's text.
-A row is ``frame, id, left, top, width, height, conf, x, y, z`` (1-based, pixels); results write ``conf`` =
-the identity confidence (1 without one) and ``x, y, z`` = -1.
-"""
+"""MOTChallenge rows in memory: the :class:`MotTable` of columns, one frame's tracks as rows, and a row's text. A row is
+``frame, id, left, top, width, height, conf, x, y, z`` (1-based, pixels); results write ``conf`` = the identity
+confidence (1 without one) and ``x, y, z`` = -1."""
 
 from __future__ import annotations
 
