@@ -1,8 +1,7 @@
 """Trackers: the protocol, the registry by name and the implementations.
 
-Names are imported on first use (``from lookalike.trackers import Sort`` imports only
-:mod:`lookalike.trackers.sort`), so that listing or building one tracker does not load the others.
-"""
+Names are imported on first use (``from lookalike.trackers import Sort`` imports only :mod:`lookalike.trackers.sort`),
+so that listing or building one tracker does not load the others."""
 
 from __future__ import annotations
 

@@ -112,10 +112,9 @@ def _type_name(kind: type) -> str:
 
 def check_value(owner: str, key: str, value: Any, hint: Any, bounds: Range | None = None,
                 choices: Sequence[Any] | None = None) -> None:
-    """``TypeError``/``ValueError`` in one line when ``value`` does not fit parameter ``key``: of the
-    declared kind (``bool`` is not a number; an ``int`` is accepted for a ``float``), finite, inside
-    ``bounds``, one of ``choices``, or None where the parameter is optional. ``owner``: the tracker's name.
-    """
+    """``TypeError``/``ValueError`` in one line when ``value`` does not fit parameter ``key``: of the declared kind
+    (``bool`` is not a number; an ``int`` is accepted for a ``float``), finite, inside ``bounds``, one of ``choices``,
+    or None where the parameter is optional. ``owner``: the tracker's name."""
     args = typing.get_args(hint)
     optional = type(None) in args
     kinds = [a for a in args if a is not type(None)]

@@ -1,22 +1,19 @@
 """BoxTrack: a motion-only box tracker for look-alike targets (no appearance).
 
-A composition of shared parts: a track table of :class:`~lookalike.motion.spaces.BoxCXCYWH` states
-(pixels, pixels/frame), a score-split association plan (:mod:`lookalike.association.stages`), a lifecycle,
-self-calibrating score thresholds, coasting, a clutter-following birth threshold and, with ``max_targets``,
-closed-set slots (all in :mod:`lookalike.trackers.parts`).
+A composition of shared parts: a track table of :class:`~lookalike.motion.spaces.BoxCXCYWH` states (pixels,
+pixels/frame), a score-split association plan (:mod:`lookalike.association.stages`), a lifecycle, self-calibrating score
+thresholds, coasting, a clutter-following birth threshold and, with ``max_targets``, closed-set slots (all in
+:mod:`lookalike.trackers.parts`).
 
-Each frame: detections below ``low_score`` are dropped; confirmed tracks take confident detections on
-``1 - IoU·score`` (recently seen first), tracks seen last frame take low-score ones on IoU, tentative tracks
-take the rest on IoU, and lost tracks take what confident detections remain on centre distance. Left-over
-detections above the birth threshold start tentative tracks. Reported: confirmed tracks matched this frame
-(filtered box) and confirmed tracks likely still present (predicted box, ``detection_index`` -1).
-Mechanisms and defaults: docs/trackers/boxtrack.md.
+Each frame: detections below ``low_score`` are dropped; confirmed tracks take confident detections on ``1 - IoU·score``
+(recently seen first), tracks seen last frame take low-score ones on IoU, tentative tracks take the rest on IoU, and
+lost tracks take what confident detections remain on centre distance. Left-over detections above the birth threshold
+start tentative tracks. Reported: confirmed tracks matched this frame (filtered box) and confirmed tracks likely still
+present (predicted box, ``detection_index`` -1). Mechanisms and defaults: docs/trackers/boxtrack.md.
 
-States live in one quantity-major ``(24, k)`` column table (the track table's ``mean`` and ``cov`` are
-views of it). With numba installed a frame runs the compiled kernels of
-:mod:`lookalike.trackers.kernels.boxtrack` (``LOOKALIKE_BOXTRACK_NUMBA=0`` switches them off), with the same
-numbers as the numpy path.
-"""
+States live in one quantity-major ``(24, k)`` column table (the track table's ``mean`` and ``cov`` are views of it).
+With numba installed a frame runs the compiled kernels of :mod:`lookalike.trackers.kernels.boxtrack`
+(``LOOKALIKE_BOXTRACK_NUMBA=0`` switches them off), with the same numbers as the numpy path."""
 
 from __future__ import annotations
 
@@ -352,9 +349,8 @@ class BoxTrack:
         return reid
 
     def _correct(self, x: np.ndarray, matched: np.ndarray, z: np.ndarray) -> None:
-        """Kalman update of the tracks ``matched`` (columns of ``x``) with their measurements ``z (4, m)``;
-        the centre innovations of the confirmed ones go to :class:`MotionFit`, their returns after misses
-        to :class:`Coasting`."""
+        """Kalman update of the tracks ``matched`` (columns of ``x``) with their measurements ``z (4, m)``; the centre
+        innovations of the confirmed ones go to :class:`MotionFit`, their returns after misses to :class:`Coasting`."""
         t, space = self._tracks, self._space
         every = len(matched) == x.shape[1]  # every track matched: no gather and scatter
         sub = x if every else x.take(matched, axis=1)
@@ -380,8 +376,7 @@ class BoxTrack:
         return self._scaled[1]
 
     def _births(self, new: np.ndarray, z: np.ndarray) -> np.ndarray:
-        """Start tentative tracks on detections ``new`` (measurement columns ``z``); returns the
-        detections used."""
+        """Start tentative tracks on detections ``new`` (measurement columns ``z``); returns the detections used."""
         cfg, t = self.config, self._tracks
         if self._slots is not None:
             new = new[: self._slots.room(t)]

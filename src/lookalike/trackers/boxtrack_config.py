@@ -1,6 +1,5 @@
-"""BoxTrack's configuration: its public parameters with defaults and descriptions, and its fixed constants.
-Where the defaults come from: docs/trackers/boxtrack.md.
-"""
+"""BoxTrack's configuration: its public parameters with defaults and descriptions, and its fixed constants. Where the
+defaults come from: docs/trackers/boxtrack.md."""
 
 from __future__ import annotations
 

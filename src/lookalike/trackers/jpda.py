@@ -2,11 +2,10 @@
 coordinates (metres).
 
 Each track is updated with all gated detections weighted by the exact JPDA marginals
-(:func:`lookalike.association.jpda.jpda_marginals`) by the mixture-reduced Kalman update. For identification
-and labels each track's one detection is found by the Hungarian method on ``1 - β`` (none below
-``min_assignment_prob``); detections no track explains (``Σ_i β_ij < 0.5``) may start tracks. Lifecycle,
-births and identification are Kalman-HA2's.
-"""
+(:func:`lookalike.association.jpda.jpda_marginals`) by the mixture-reduced Kalman update. For identification and labels
+each track's one detection is found by the Hungarian method on ``1 - β`` (none below ``min_assignment_prob``);
+detections no track explains (``Σ_i β_ij < 0.5``) may start tracks. Lifecycle, births and identification are
+Kalman-HA2's."""
 
 from __future__ import annotations
 

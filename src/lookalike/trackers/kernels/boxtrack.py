@@ -1,11 +1,10 @@
 """Optional numba kernels for :class:`~lookalike.trackers.boxtrack.BoxTrack`
-(:mod:`lookalike.trackers.kernels.boxtrack_numba`): prediction with the IoU matrix, the gated IoU stages, the
-Kalman update with bookkeeping, and the report with the lifecycle.
+(:mod:`lookalike.trackers.kernels.boxtrack_numba`): prediction with the IoU matrix, the gated IoU stages, the Kalman
+update with bookkeeping, and the report with the lifecycle.
 
-They do the numpy path's operations one track or pair at a time in the same order, so rows are bit for bit
-the same (``tests/test_boxtrack_kernels.py``). Used when numba is installed unless
-``LOOKALIKE_BOXTRACK_NUMBA=0``; numba loads when the first BoxTrack is built.
-"""
+They do the numpy path's operations one track or pair at a time in the same order, so rows are bit for bit the same
+(``tests/test_boxtrack_kernels.py``). Used when numba is installed unless ``LOOKALIKE_BOXTRACK_NUMBA=0``; numba loads
+when the first BoxTrack is built."""
 
 from __future__ import annotations
 

@@ -1,9 +1,8 @@
 """The numba kernels of :mod:`lookalike.trackers.kernels.boxtrack` (imported only when numba is installed).
 
-Each does BoxTrack's numpy-path operations one track or pair at a time in the same order (``fastmath``
-off), so rows are bit for bit the same. State columns ``x (24, k)``: :class:`~lookalike.motion.spaces.BoxCXCYWH`'s
-column form (pixels, pixels/frame).
-"""
+Each does BoxTrack's numpy-path operations one track or pair at a time in the same order (``fastmath`` off), so rows are
+bit for bit the same. State columns ``x (24, k)``: :class:`~lookalike.motion.spaces.BoxCXCYWH`'s column form (pixels,
+pixels/frame)."""
 
 from __future__ import annotations
 
@@ -99,11 +98,10 @@ def _predict_column(x: np.ndarray, i: int, steps: float, var_steps: float, still
 @_jit
 def advance(x: np.ndarray, steps: float, var_steps: float, unseen_s: np.ndarray, coast_s: float, pos2: float,
             vel2: float, prev: np.ndarray, det: np.ndarray, min_iou: float) -> tuple[np.ndarray, int]:
-    """Predict the tracks of ``x`` by ``steps`` frames in place (velocities of tracks unseen
-    ``coast_s`` seconds or more dropped first; ``var_steps = max(steps, 0)``; ``pos2``, ``vel2`` the squared
-    noise fractions), then the IoU matrix ``(k, n)`` of the predicted boxes against the detections ``det (n, 4)``
-    and the number of detections overlapping (IoU >= ``min_iou``) none of the previous frame's ``prev (p, 4)``
-    (all of them when ``p`` is 0)."""
+    """Predict the tracks of ``x`` by ``steps`` frames in place (velocities of tracks unseen ``coast_s`` seconds or more
+    dropped first; ``var_steps = max(steps, 0)``; ``pos2``, ``vel2`` the squared noise fractions), then the IoU matrix
+    ``(k, n)`` of the predicted boxes against the detections ``det (n, 4)`` and the number of detections overlapping
+    (IoU >= ``min_iou``) none of the previous frame's ``prev (p, 4)`` (all of them when ``p`` is 0)."""
     k = x.shape[1]
     for i in range(k):
         _predict_column(x, i, steps, var_steps, unseen_s[i] >= coast_s, pos2, vel2)
@@ -149,11 +147,10 @@ def _eligible(stage: int, confirmed: bool, recent: bool, was_tracked: bool) -> b
 def gated_stages(iou: np.ndarray, start: int, match_iou: float, low_iou: float, confirmed: np.ndarray,
                  misses: np.ndarray, recent: int, unseen_s: np.ndarray, score: np.ndarray, high_score: float,
                  det_of_track: np.ndarray, free: np.ndarray, stage_of_track: np.ndarray) -> int:
-    """BoxTrack's four IoU stages from ``start`` on, each gated by its IoU (``match_iou``; ``low_iou`` for the
-    low-score stage): a stage whose allowed pairs (eligible track unmatched, eligible detection free) are
-    disjoint takes them all, as ``run_stage`` does. Returns the first stage whose pairs compete (its costs
-    decide; nothing of it done), else 4 when the re-identification stage has an unmatched confirmed track and
-    a free confident detection, else 5."""
+    """BoxTrack's four IoU stages from ``start`` on, each gated by its IoU (``match_iou``; ``low_iou`` for the low-score
+    stage): a stage whose allowed pairs (eligible track unmatched, eligible detection free) are disjoint takes them all,
+    as ``run_stage`` does. Returns the first stage whose pairs compete (its costs decide; nothing of it done), else 4
+    when the re-identification stage has an unmatched confirmed track and a free confident detection, else 5."""
     k, n = iou.shape
     rows = np.empty(min(k, n), np.int64)
     cols = np.empty(min(k, n), np.int64)
@@ -202,12 +199,10 @@ def gated_stages(iou: np.ndarray, start: int, match_iou: float, low_iou: float, 
 def correct(x: np.ndarray, det_of_track: np.ndarray, det: np.ndarray, pos_noise: float, confirmed: np.ndarray,
             misses: np.ndarray, unseen_s: np.ndarray, hits: np.ndarray, record: bool, dt: float, n_init: int,
             first: bool, fit: np.ndarray, back: np.ndarray) -> tuple[int, int]:
-    """Kalman update in place of the tracks of ``x`` matched (``det_of_track``) to detections ``det (n, 4)``
-    (xywh, pixels), with hit counts; with ``record`` also ``misses``, ``unseen_s`` (+ ``dt`` seconds) and
-    confirmation (``n_init`` hits, any hit in the ``first`` frame). Writes the confirmed matched tracks' centre
-    innovations and variances into ``fit (4, k)`` and returning tracks' misses into ``back (k,)``; returns both
-    counts.
-    """
+    """Kalman update in place of the tracks of ``x`` matched (``det_of_track``) to detections ``det (n, 4)`` (xywh,
+    pixels), with hit counts; with ``record`` also ``misses``, ``unseen_s`` (+ ``dt`` seconds) and confirmation
+    (``n_init`` hits, any hit in the ``first`` frame). Writes the confirmed matched tracks' centre innovations and
+    variances into ``fit (4, k)`` and returning tracks' misses into ``back (k,)``; returns both counts."""
     k = x.shape[1]
     n_fit = 0
     n_back = 0
@@ -276,12 +271,10 @@ def report(mean: np.ndarray, ids: np.ndarray, confirmed: np.ndarray, det_of_trac
            tentative_s: float, limit_s: float, closed: bool, alive: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int]:
     """The frame's report: confirmed tracks matched this frame (then ``born`` rows) at their filtered box, then
-    confirmed tracks missed ``m`` frames with ``present[min(m, L)]`` (the coasting table) at their box, detection
-    index -1; ``det_idx`` maps kept detections to the frame's (empty: identity). Returns ids, status, boxes ``(m,
-    4)`` (xywh, sizes floored at 1e-3 pixels), velocities ``(m, 2)`` (pixels per ``interval``), detection indices
-    and the number alive (``alive`` written: tentative unseen <= ``tentative_s``, confirmed <= ``limit_s`` or all
-    when ``closed``).
-    """
+    confirmed tracks missed ``m`` frames with ``present[min(m, L)]`` (the coasting table) at their box, detection index
+    -1; ``det_idx`` maps kept detections to the frame's (empty: identity). Returns ids, status, boxes ``(m, 4)`` (xywh,
+    sizes floored at 1e-3 pixels), velocities ``(m, 2)`` (pixels per ``interval``), detection indices and the number
+    alive (``alive`` written: tentative unseen <= ``tentative_s``, confirmed <= ``limit_s`` or all when ``closed``)."""
     k = len(ids)
     n_old = len(det_of_track)
     last = len(present) - 1

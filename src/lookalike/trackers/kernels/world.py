@@ -1,14 +1,13 @@
 """Small batched kernels of the world trackers' per-frame path (Kalman-HA and its beacon identifier).
 
-Each returns what the general function it stands in for returns, bit for bit, with fewer calls: numpy's
-LAPACK kernels without per-call checks (:func:`cholesky`, :func:`solve`), ``einsum``, and :func:`pairs`
+Each returns what the general function it stands in for returns, bit for bit, with fewer calls: numpy's LAPACK kernels
+without per-call checks (:func:`cholesky`, :func:`solve`), ``einsum``, and :func:`pairs`
 (:func:`lookalike.association.solver.assign_pairs`'s pairs).
 
 :func:`compiled` gives the optional numba kernels (:mod:`lookalike.trackers.kernels.world_numba`), used unless
-``LOOKALIKE_WORLD_NUMBA=0``; ``tests/test_world_numba.py`` compares both paths. The two whose rounding depends
-on the BLAS build (:func:`lower_solve_exact`, :func:`update_exact`) are checked against numpy when the kernels
-load and used only where they agree. numba loads at the first frame that needs it (or :func:`warm`).
-"""
+``LOOKALIKE_WORLD_NUMBA=0``; ``tests/test_world_numba.py`` compares both paths. The two whose rounding depends on the
+BLAS build (:func:`lower_solve_exact`, :func:`update_exact`) are checked against numpy when the kernels load and used
+only where they agree. numba loads at the first frame that needs it (or :func:`warm`)."""
 
 from __future__ import annotations
 
@@ -62,11 +61,10 @@ _NONE.flags.writeable = False
 
 def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf,
           unit: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Rows and columns of :func:`~lookalike.association.solver.assign_pairs` on the float matrix
-    ``where(allowed, cost, inf)`` (no NaN) with ``max_cost``, where ``allowed`` is ``cost <= max_cost``
-    (finite ``max_cost``) or the pairs to consider (``max_cost = inf``). ``unit``: the allowed
-    costs are >= 0 and ``max_cost <= 1``, so the solver's scale is 1 and nothing needs rescaling
-    (those checks are skipped)."""
+    """Rows and columns of :func:`~lookalike.association.solver.assign_pairs` on the float matrix ``where(allowed, cost,
+    inf)`` (no NaN) with ``max_cost``, where ``allowed`` is ``cost <= max_cost`` (finite ``max_cost``) or the pairs to
+    consider (``max_cost = inf``). ``unit``: the allowed costs are >= 0 and ``max_cost <= 1``, so the solver's scale is
+    1 and nothing needs rescaling (those checks are skipped)."""
     if not cost.size or not allowed.any():
         return _NONE, _NONE
     most = np.maximum.reduce
@@ -80,9 +78,8 @@ def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf,
 
 
 def decided_pairs(decision: int, work: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`pairs` once its checks are made: ``decision`` 0 (nothing allowed), 1 (the ``allowed`` pairs
-    are disjoint: they are the pairs) or 2 (solve ``work``, the matrix :func:`pairs` hands the solver,
-    and keep the allowed pairs)."""
+    """:func:`pairs` once its checks are made: ``decision`` 0 (nothing allowed), 1 (the ``allowed`` pairs are disjoint:
+    they are the pairs) or 2 (solve ``work``, the matrix :func:`pairs` hands the solver, and keep the allowed pairs)."""
     if decision == 0:
         return _NONE, _NONE
     if decision == 1:

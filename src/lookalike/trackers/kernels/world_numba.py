@@ -1,8 +1,7 @@
 """The numba kernels of :mod:`lookalike.trackers.kernels.world` (imported only when numba is installed).
 
-Each does the numpy path's floating-point operations value by value in the same order (``fastmath`` off), so
-results are bit for bit the same. Seconds, radians, metres (world frame).
-"""
+Each does the numpy path's floating-point operations value by value in the same order (``fastmath`` off), so results are
+bit for bit the same. Seconds, radians, metres (world frame)."""
 
 from __future__ import annotations
 
@@ -110,11 +109,10 @@ def window_costs(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np
 def identity_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np.ndarray, current: np.ndarray,
                   max_turn_rate: float, max_extrapolation_s: float, hysteresis: float,
                   max_cost: float) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-    """``BeaconIdentifier.assign_arrays`` up to the solver: window costs ``(k, N)``, each held agent's
-    (``current (k,)``, -1: none) cost less ``hysteresis`` (floored at 0), the allowed pairs (``<= max_cost``) and
-    the solver's matrix. Returns ``(decision, cost, work, allowed)``; decision as in ``world_kernels.pairs``
-    (0 none allowed, 1 disjoint pairs, 2 solve).
-    """
+    """``BeaconIdentifier.assign_arrays`` up to the solver: window costs ``(k, N)``, each held agent's (``current
+    (k,)``, -1: none) cost less ``hysteresis`` (floored at 0), the allowed pairs (``<= max_cost``) and the solver's
+    matrix. Returns ``(decision, cost, work, allowed)``; decision as in ``world_kernels.pairs`` (0 none allowed, 1
+    disjoint pairs, 2 solve)."""
     k, n = samples.shape[0], th.shape[1]
     cost = np.empty((k, n))
     window_costs(th, q, q_count, samples, max_turn_rate, max_extrapolation_s, cost)
@@ -364,12 +362,11 @@ def lifecycle_work(det_of_track: np.ndarray, hit_bits: np.ndarray, misses: np.nd
                    hits: np.ndarray, confirmed: np.ndarray, dt: float, confirm_window: int, n_init: int,
                    tentative_max_misses: int, max_misses: int, in_view: np.ndarray, limit_in_s: float,
                    limit_out_s: float) -> np.ndarray:
-    """``WorldTracker._lifecycle`` and ``Lifecycle.alive`` in place on the table's columns (``k`` tracks): hit
-    history ``hit_bits`` (bit 0 this frame, 30 kept), ``misses`` (frames) and ``unseen_s`` (seconds, ``dt`` a
-    frame) reset by a hit or grown; with ``confirm_window`` > 0, ``n_init`` hits in the window confirm a track, and
-    a confirmed track survives unseen at most ``limit_in_s`` (``in_view``) or ``limit_out_s``; with 0 every track
-    is confirmed. Miss limits ``tentative_max_misses`` and ``max_misses`` (-1: none). Returns the survivors' mask.
-    """
+    """``WorldTracker._lifecycle`` and ``Lifecycle.alive`` in place on the table's columns (``k`` tracks): hit history
+    ``hit_bits`` (bit 0 this frame, 30 kept), ``misses`` (frames) and ``unseen_s`` (seconds, ``dt`` a frame) reset by a
+    hit or grown; with ``confirm_window`` > 0, ``n_init`` hits in the window confirm a track, and a confirmed track
+    survives unseen at most ``limit_in_s`` (``in_view``) or ``limit_out_s``; with 0 every track is confirmed. Miss
+    limits ``tentative_max_misses`` and ``max_misses`` (-1: none). Returns the survivors' mask."""
     k = det_of_track.shape[0]
     keep = np.empty(k, np.bool_)
     window_mask = (1 << confirm_window) - 1 if confirm_window > 0 else 0

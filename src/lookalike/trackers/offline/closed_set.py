@@ -44,13 +44,12 @@ __all__ = ["ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "mo
 def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
                  tracklet_cost: float, time_limit_s: float = 60.0, start_cost: np.ndarray | None = None,
                  end_cost: np.ndarray | None = None) -> list[list[int]]:
-    """At most ``n_chains`` disjoint chains of tracklets (lists of indices in time order) maximising the
-    rows covered minus ``tracklet_cost`` per tracklet used minus the link costs and the costs of starting
-    (``start_cost[i]``) or ending (``end_cost[i]``) a chain at tracklet ``i``, by HiGHS MILP.
+    """At most ``n_chains`` disjoint chains of tracklets (lists of indices in time order) maximising the rows covered
+    minus ``tracklet_cost`` per tracklet used minus the link costs and the costs of starting (``start_cost[i]``) or
+    ending (``end_cost[i]``) a chain at tracklet ``i``, by HiGHS MILP.
 
-    Variables: ``x`` (tracklet used), ``y`` (link used), ``a`` (chain starts here), ``b`` (chain ends
-    here); flow conservation ``a_i + Σ_j y_ji = x_i = b_i + Σ_j y_ij`` and ``Σ a_i ≤ n_chains``.
-    """
+    Variables: ``x`` (tracklet used), ``y`` (link used), ``a`` (chain starts here), ``b`` (chain ends here); flow
+    conservation ``a_i + Σ_j y_ji = x_i = b_i + Σ_j y_ij`` and ``Σ a_i ≤ n_chains``."""
     n = len(lengths)
     src, dst, cost = links
     m = len(src)
@@ -105,12 +104,11 @@ def _chain_position(block: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, 
 
 def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[float, float, float],
                 config: ClosedSetConfig | None = None) -> np.ndarray:
-    """Chain index (or -1, clutter) of every short tracklet: an assignment of the short tracklets to the
-    chains' gaps by HiGHS MILP. A piece costs ``link_cost + ½ z² + 2 ln(σ / (pos_sigma·size))`` minus its
-    rows (a link's negative log-likelihood), ``z`` its mean miss from the chain's interpolated centre over
-    ``σ = pos_sigma·size + speed·g`` (``g`` frames to the chain's nearest row); only pieces that earn more
-    than they cost are placed; pieces overlapping in time never go to the same chain, nor to frames where
-    the chain has rows."""
+    """Chain index (or -1, clutter) of every short tracklet: an assignment of the short tracklets to the chains' gaps by
+    HiGHS MILP. A piece costs ``link_cost + ½ z² + 2 ln(σ / (pos_sigma·size))`` minus its rows (a link's negative
+    log-likelihood), ``z`` its mean miss from the chain's interpolated centre over ``σ = pos_sigma·size + speed·g``
+    (``g`` frames to the chain's nearest row); only pieces that earn more than they cost are placed; pieces overlapping
+    in time never go to the same chain, nor to frames where the chain has rows."""
     cfg = config or ClosedSetConfig()
     out = np.full(len(short), -1, dtype=int)
     if not short or not chains:

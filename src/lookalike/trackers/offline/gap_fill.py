@@ -130,9 +130,8 @@ def fill_gaps(rows: np.ndarray, max_gap: int) -> np.ndarray:
 
 
 def smooth_boxes(rows: np.ndarray, window: int) -> np.ndarray:
-    """``rows`` with each id's box centres and widths/heights replaced by their running median over
-    ``window`` consecutive rows of that id (1 or less: unchanged; the first and last rows repeated beyond
-    the ends)."""
+    """``rows`` with each id's box centres and widths/heights replaced by their running median over ``window``
+    consecutive rows of that id (1 or less: unchanged; the first and last rows repeated beyond the ends)."""
     rows = _check_rows(rows)
     half = int(window) // 2
     out: np.ndarray = rows.copy()

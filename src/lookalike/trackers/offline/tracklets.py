@@ -1,8 +1,7 @@
-"""Tracklets for the offline closed set: an online result cut into reliable pieces
-(:func:`split_tracklets`) and the links between the end of one piece and the start of a later one
-scored under two motion hypotheses (:func:`link_costs`); :mod:`lookalike.trackers.offline.closed_set` says
-how both are used. Positions in pixels, sizes √(w·h) in pixels, times in frames.
-"""
+"""Tracklets for the offline closed set: an online result cut into reliable pieces (:func:`split_tracklets`) and the
+links between the end of one piece and the start of a later one scored under two motion hypotheses (:func:`link_costs`);
+:mod:`lookalike.trackers.offline.closed_set` says how both are used. Positions in pixels, sizes √(w·h) in pixels, times
+in frames."""
 
 from __future__ import annotations
 

@@ -1,11 +1,9 @@
 """Closed-set slots: N identities (``max_targets``) that are never lost for good.
 
-A tracker with a known number of targets keeps at most N confirmed tracks (slots), which never die. A
-coasting slot's box shape is frozen (:meth:`ClosedSlots.freeze_shape`); its recovery gate grows with the
-time lost (:meth:`ClosedSlots.gate`, sizes ``sqrt(w·h)``: :meth:`ClosedSlots.squared`); a slot lost
-``refill_s`` seconds or more is re-assigned to a persistent tentative track, keeping its id
-(:meth:`ClosedSlots.refill`).
-"""
+A tracker with a known number of targets keeps at most N confirmed tracks (slots), which never die. A coasting slot's
+box shape is frozen (:meth:`ClosedSlots.freeze_shape`); its recovery gate grows with the time lost
+(:meth:`ClosedSlots.gate`, sizes ``sqrt(w·h)``: :meth:`ClosedSlots.squared`); a slot lost ``refill_s`` seconds or more
+is re-assigned to a persistent tentative track, keeping its id (:meth:`ClosedSlots.refill`)."""
 
 from __future__ import annotations
 

@@ -1,9 +1,8 @@
 """Clutter share: how many of a detector's detections are one-frame flickers, without ground truth.
 
-A target's detection usually overlaps one of the previous frame's; most clutter does not.
-:class:`ClutterShare` counts the detections overlapping none of the previous frame's (IoU below
-``min_iou``); their share sets the birth threshold's quantile (docs/trackers/boxtrack.md).
-"""
+A target's detection usually overlaps one of the previous frame's; most clutter does not. :class:`ClutterShare` counts
+the detections overlapping none of the previous frame's (IoU below ``min_iou``); their share sets the birth threshold's
+quantile (docs/trackers/boxtrack.md)."""
 
 from __future__ import annotations
 

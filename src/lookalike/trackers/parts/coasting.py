@@ -1,6 +1,5 @@
-"""Coasting: a confirmed track lost ``coast_s`` seconds stops extrapolating, and a track missed ``j`` frames is
-reported while tracks missed ``j`` frames came back at least ``report_prob`` of the time (:class:`Coasting`).
-"""
+"""Coasting: a confirmed track lost ``coast_s`` seconds stops extrapolating, and a track missed ``j`` frames is reported
+while tracks missed ``j`` frames came back at least ``report_prob`` of the time (:class:`Coasting`)."""
 
 from __future__ import annotations
 

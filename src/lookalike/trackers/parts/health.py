@@ -1,12 +1,10 @@
 """Tracking-health monitor: is the detector failing, so that identities should not be relied on?
 
-It sees only each frame's detections and time, so it runs beside any tracker. Per frame it flags
-``dropped`` (frames missing before this one), ``empty``, ``too_many`` (more detections than the team size
-plus ``extra_allowed``), ``score_collapse`` (mean score below ``collapse_ratio`` × the baseline median) and
-``too_few`` (informational). Over the last ``window`` frames it flags ``unhealthy_frames``, ``undercount``,
-``score_collapse`` and ``dropped``. Scores are confidences (>= 0); with a baseline <= 0 score checks are
-skipped.
-"""
+It sees only each frame's detections and time, so it runs beside any tracker. Per frame it flags ``dropped`` (frames
+missing before this one), ``empty``, ``too_many`` (more detections than the team size plus ``extra_allowed``),
+``score_collapse`` (mean score below ``collapse_ratio`` × the baseline median) and ``too_few`` (informational). Over the
+last ``window`` frames it flags ``unhealthy_frames``, ``undercount``, ``score_collapse`` and ``dropped``. Scores are
+confidences (>= 0); with a baseline <= 0 score checks are skipped."""
 
 from __future__ import annotations
 

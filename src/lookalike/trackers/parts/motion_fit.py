@@ -1,8 +1,7 @@
 """How well a motion model fits the targets, judged on the tracker's own matches (no ground truth).
 
-:class:`MotionFit` compares the normalised innovation squared (NIS) of confirmed tracks' centres with its
-chi-square (2 dof) distribution and raises the process noise until their medians agree (never lowers it).
-"""
+:class:`MotionFit` compares the normalised innovation squared (NIS) of confirmed tracks' centres with its chi-square (2
+dof) distribution and raises the process noise until their medians agree (never lowers it)."""
 
 from __future__ import annotations
 
@@ -16,10 +15,9 @@ CHI2_2DOF_MEDIAN = 2.0 * math.log(2.0)  # median of the chi-square distribution 
 class MotionFit:
     """Process-noise scale (variance factor, >= 1) learnt from centre innovations, ``batch`` at a time.
 
-    Each time ``batch`` innovations have been seen, the scale is multiplied by their median NIS over
-    the chi-square median (the innovations were measured with the scale in force, so the factor
-    converges to the one that makes the model's median fit), clipped to [1, ``max_scale``].
-    """
+    Each time ``batch`` innovations have been seen, the scale is multiplied by their median NIS over the chi-square
+    median (the innovations were measured with the scale in force, so the factor converges to the one that makes the
+    model's median fit), clipped to [1, ``max_scale``]."""
 
     def __init__(self, batch: int = 30, max_scale: float = 1e4) -> None:
         if batch < 1 or not max_scale >= 1.0:
@@ -76,8 +74,7 @@ class MotionFit:
             self._update()
 
     def _update(self) -> None:
-        """Scale by the median NIS of the batch (the median does not depend on the order), then start a
-        new batch."""
+        """Scale by the median NIS of the batch (the median does not depend on the order), then start a new batch."""
         parts = self._pending
         n = self._filled
         if n:

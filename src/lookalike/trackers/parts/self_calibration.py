@@ -1,8 +1,7 @@
 """Statistics a tracker gathers on its own tracks to calibrate itself to a detector, without ground truth.
 
-:class:`ScoreBands`: the score band where confident detections start; :class:`MissReturns`: how long a
-missed track is likely still present. Both only count; the tracker decides.
-"""
+:class:`ScoreBands`: the score band where confident detections start; :class:`MissReturns`: how long a missed track is
+likely still present. Both only count; the tracker decides."""
 
 from __future__ import annotations
 
@@ -30,8 +29,7 @@ def _clipped(bins: list[int], top: int) -> list[int]:
 
 
 class ScoreBands:
-    """Per score band (``bands`` equal bands on [0, 1]): detections seen and those that continued a
-    confirmed track."""
+    """Per score band (``bands`` equal bands on [0, 1]): detections seen and those that continued a confirmed track."""
 
     def __init__(self, bands: int = 10) -> None:
         self.bands = bands
@@ -52,8 +50,7 @@ class ScoreBands:
 
         Going down from the highest judged band (``min_count`` detections), each band whose share of continued
         detections (one-sided 95% Wilson lower bound) is at least ``ratio`` times the best judged share lowers the
-        threshold to its lower edge; the first band that fails or is not judged stops the descent.
-        """
+        threshold to its lower edge; the first band that fails or is not judged stops the descent."""
         # Only the bands the descent visits are computed, one at a time (the same float operations as the
         # whole-array form, so the same threshold to the last bit).
         seen, kept = self.seen.tolist(), self.kept.tolist()
@@ -121,13 +118,12 @@ class MissReturns:
 
 
 class ScoreCalibration:
-    """Owner of a tracker's score thresholds: observes scores and which detections continued confirmed tracks,
-    and decides each frame's high, birth and tentative thresholds.
+    """Owner of a tracker's score thresholds: observes scores and which detections continued confirmed tracks, and
+    decides each frame's high, birth and tentative thresholds.
 
-    ``high_score`` and ``birth_score`` are ceilings, lowered to a quantile of the scores seen (``bins`` bins on
-    [0, 1]) when their quantile is set, the high one also to the :class:`ScoreBands` threshold with
-    ``high_match_ratio``. Always tentative <= high <= birth.
-    """
+    ``high_score`` and ``birth_score`` are ceilings, lowered to a quantile of the scores seen (``bins`` bins on [0, 1])
+    when their quantile is set, the high one also to the :class:`ScoreBands` threshold with ``high_match_ratio``. Always
+    tentative <= high <= birth."""
 
     def __init__(self, high_score: float, birth_score: float, *, high_quantile: float | None = None,
                  birth_quantile: float | None = None, tentative_quantile: float | None = None,

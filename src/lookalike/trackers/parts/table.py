@@ -1,8 +1,7 @@
 """``TrackTable``: a tracker's tracks as named numpy columns, one row per track.
 
-Standard columns: ``ids`` (1-based, per table), ``mean (k, n)`` and ``cov`` of the motion state, ``hits``,
-``misses`` (frames), ``unseen_s`` (seconds) and ``confirmed``; a tracker declares extra columns.
-"""
+Standard columns: ``ids`` (1-based, per table), ``mean (k, n)`` and ``cov`` of the motion state, ``hits``, ``misses``
+(frames), ``unseen_s`` (seconds) and ``confirmed``; a tracker declares extra columns."""
 
 from __future__ import annotations
 
@@ -69,8 +68,7 @@ class TrackTable:
     def add(self, mean: np.ndarray, cov: np.ndarray, **values: Any) -> np.ndarray:
         """Append tracks with new ids; columns not given start at zero (scalars broadcast).
 
-        Returns the row indices of the new tracks.
-        """
+        Returns the row indices of the new tracks."""
         n = len(mean)
         unknown = set(values) - set(self._spec)
         if unknown:

@@ -8,10 +8,9 @@ import math
 class FrameClock:
     """Turns time stamps (seconds) into a number of nominal frame intervals.
 
-    Per-frame models (SORT's noise is defined per frame) use ``steps(t)``: 1.0 for a regular
-    frame, 2.0 after a skipped frame. The nominal interval is given, or the smallest positive
-    step seen so far (1.0 s until a second frame arrives).
-    """
+    Per-frame models (SORT's noise is defined per frame) use ``steps(t)``: 1.0 for a regular frame, 2.0 after a skipped
+    frame. The nominal interval is given, or the smallest positive step seen so far (1.0 s until a second frame
+    arrives)."""
 
     def __init__(self, interval_s: float | None = None) -> None:
         self._fixed = interval_s

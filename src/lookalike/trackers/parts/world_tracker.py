@@ -99,9 +99,8 @@ class WorldTracker:
     def prepare(self) -> None:
         """Between frames (optional; the node calls it): predict the tracks for each of the last two distinct frame
         intervals seen more than once, with the detection-independent parts of the next association (innovation
-        covariances, Cholesky factors, gains, updated covariances, in-view flags). :meth:`update` uses them when
-        its interval matches exactly (same operations, same bits). JPDA prepares nothing.
-        """
+        covariances, Cholesky factors, gains, updated covariances, in-view flags). :meth:`update` uses them when its
+        interval matches exactly (same operations, same bits). JPDA prepares nothing."""
         t = self._tracks
         self._ready = {}
         if (self._time is None or not len(t)
@@ -155,9 +154,8 @@ class WorldTracker:
     def _associate_and_update(self, det: Detections) -> np.ndarray:
         """Hungarian on the gated squared Mahalanobis distance; Kalman update of matched tracks.
 
-        ``motion.kalman``'s arithmetic on the whole table at once (``H`` picks the position, so ``H P Hᵀ`` and ``P
-        Hᵀ`` are slices of ``P``); uses :meth:`prepare`'s values when the frame found them.
-        """
+        ``motion.kalman``'s arithmetic on the whole table at once (``H`` picks the position, so ``H P Hᵀ`` and ``P Hᵀ``
+        are slices of ``P``); uses :meth:`prepare`'s values when the frame found them."""
         t, ready = self._tracks, self._frame_ready
         det_of_track = filled(len(t), -1, int)
         if not (len(t) and len(det)):

@@ -12,9 +12,8 @@ from lookalike.types import Tracks, TrackSnapshot
 def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np.ndarray:
     """``(n_detections,)`` agent id of the identified track that took each detection, else -1.
 
-    A detection claimed by several identified tracks goes to the most confident one
-    (``identity_prob``); an agent claimed for several detections keeps the most confident.
-    """
+    A detection claimed by several identified tracks goes to the most confident one (``identity_prob``); an agent
+    claimed for several detections keeps the most confident."""
     if n_detections < 0:
         raise ValueError(f"n_detections must be >= 0, got {n_detections}")
     if isinstance(tracks, Tracks):
