@@ -1,6 +1,5 @@
-"""The LSTM association network of the robot-identification paper: input encoding, numpy inference,
-checkpoints. Torch is needed only for training (``model``, ``training``).
-"""
+"""The LSTM association network of the robot-identification paper: input encoding, numpy inference, checkpoints. Torch
+is needed only for training (``model``, ``training``)."""
 
 from lookalike.learn.checkpoint import CheckpointError, NetworkWeights, load_weights, save_weights
 from lookalike.learn.encoding import EncodingSpec, encode_frame

@@ -1,7 +1,5 @@
-"""Labelled diver crops for the learned appearance model (numpy): cut from rendered frames at jittered
-ground-truth boxes and resized to ``(width, height)`` pixels; a label is one diver of one scenario
-(``seed · 10 + diver id``).
-"""
+"""Labelled diver crops for the learned appearance model (numpy): cut from rendered frames at jittered ground-truth
+boxes and resized to ``(width, height)`` pixels; a label is one diver of one scenario (``seed · 10 + diver id``)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,8 @@
 """Exported network weights: a ``.npz`` of arrays plus a JSON metadata file beside it.
 
-``model.npz`` holds ``layer{i}.w_ih``, ``layer{i}.w_hh``, ``layer{i}.b_ih``, ``layer{i}.b_hh``
-(PyTorch's gate order: LSTM ``i, f, g, o``; GRU ``r, z, n``), ``head.weight``, ``head.bias``,
-``input_mean`` and ``input_std``. ``model.json`` records the format version, cell type, sizes,
-the encoding version and free-form training information.
-"""
+``model.npz`` holds ``layer{i}.w_ih``, ``layer{i}.w_hh``, ``layer{i}.b_ih``, ``layer{i}.b_hh`` (PyTorch's gate order:
+LSTM ``i, f, g, o``; GRU ``r, z, n``), ``head.weight``, ``head.bias``, ``input_mean`` and ``input_std``. ``model.json``
+records the format version, cell type, sizes, the encoding version and free-form training information."""
 
 from __future__ import annotations
 
@@ -106,10 +104,8 @@ def load_weights(
 ) -> NetworkWeights:
     """Load weights saved by :func:`save_weights`, refusing files that do not fit.
 
-    Raises :class:`CheckpointError` naming the file when the metadata is missing or of another
-    version, when N or M differ from the requested ``n_agents``/``n_slots``, or when an array
-    has the wrong shape.
-    """
+    Raises :class:`CheckpointError` naming the file when the metadata is missing or of another version, when N or M
+    differ from the requested ``n_agents``/``n_slots``, or when an array has the wrong shape."""
     path, meta_path, meta = read_metadata(path, "lookalike-association-net", "lookalike association network")
     for key, current in (("format_version", FORMAT_VERSION), ("encoding_version", ENCODING_VERSION)):
         if meta.get(key) != current:

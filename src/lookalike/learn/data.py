@@ -18,10 +18,8 @@ def frames_to_arrays(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Inputs ``(T, n_inputs)`` and slot targets ``(T, M)`` from frames with ``Detections.label``.
 
-    Targets are the agent id, N for a false positive (label -1) and ``IGNORE`` for empty slots.
-    Detections are put into slots in random order when ``rng`` is given (slot shuffling, as in
-    training), else most probable first.
-    """
+    Targets are the agent id, N for a false positive (label -1) and ``IGNORE`` for empty slots. Detections are put into
+    slots in random order when ``rng`` is given (slot shuffling, as in training), else most probable first."""
     T = len(frames)
     x = np.zeros((T, spec.n_inputs))
     y = np.full((T, spec.n_slots), IGNORE, dtype=np.int64)

@@ -1,14 +1,12 @@
 """Input encoding of one frame for the association network.
 
-Our layout (length ``3·N + 5·M``): per agent ``cos ψ_j, sin ψ_j, age_j`` (latest reported heading and its
-age in seconds, clipped to ``max_age_s``; ``(0, 0, max_age_s)`` if never heard), then per detection slot
-``x, y, cos φ, sin φ, γ`` (ground position in metres, visual heading, detector probability), with
-``relative_headings`` followed by ``cos(φ − ψ_j), sin(φ − ψ_j)`` per agent. Empty slots are zeros; with
-more than M detections the M most probable are kept.
+Our layout (length ``3·N + 5·M``): per agent ``cos ψ_j, sin ψ_j, age_j`` (latest reported heading and its age in
+seconds, clipped to ``max_age_s``; ``(0, 0, max_age_s)`` if never heard), then per detection slot ``x, y, cos φ, sin φ,
+γ`` (ground position in metres, visual heading, detector probability), with ``relative_headings`` followed by ``cos(φ −
+ψ_j), sin(φ − ψ_j)`` per agent. Empty slots are zeros; with more than M detections the M most probable are kept.
 
-The robot-identification paper's layout (``protocol="paper"``, length ``N + 4·M``): per agent ``ψ_j / π``,
-per slot ``x, y, φ / π, γ``; no ages or relative headings.
-"""
+The robot-identification paper's layout (``protocol="paper"``, length ``N + 4·M``): per agent ``ψ_j / π``, per slot ``x,
+y, φ / π, γ``; no ages or relative headings."""
 
 from __future__ import annotations
 
@@ -94,8 +92,7 @@ def encode_slots(
 ) -> np.ndarray:
     """Slot blocks ``(slot_width·M,)`` for up to M detections given in slot order.
 
-    ``agent_heading_rad (N,)`` (NaN = never heard) is needed with ``spec.relative_headings``.
-    """
+    ``agent_heading_rad (N,)`` (NaN = never heard) is needed with ``spec.relative_headings``."""
     n = len(probability)
     if n > spec.n_slots:
         raise ValueError(f"{n} detections for {spec.n_slots} slots; select the most probable first")
@@ -160,11 +157,10 @@ def encode_frame(
     latest_heading_rad: np.ndarray,
     report_age_s: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """One frame's input ``(n_inputs,)`` and the detection index of each used slot ``(k,)``, in the
-    layout of ``spec.protocol`` (the paper's ignores ``report_age_s``).
+    """One frame's input ``(n_inputs,)`` and the detection index of each used slot ``(k,)``, in the layout of
+    ``spec.protocol`` (the paper's ignores ``report_age_s``).
 
-    ``detections`` must carry ``position`` (metres) and ``heading`` (radians).
-    """
+    ``detections`` must carry ``position`` (metres) and ``heading`` (radians)."""
     if detections.position is None or detections.heading is None or detections.score is None:
         raise ValueError("the LSTM encoding needs Detections.position, Detections.heading and Detections.score")
     used = select_slots(detections.score, spec.n_slots)

@@ -1,8 +1,7 @@
 """The association network in PyTorch (training only; import needs torch).
 
-Stacked recurrent layers (LSTM by default, GRU as the paper's comparison) followed by one linear
-layer that holds the M output heads: its ``M·(N+1)`` outputs are read as M softmax groups.
-"""
+Stacked recurrent layers (LSTM by default, GRU as the paper's comparison) followed by one linear layer that holds the M
+output heads: its ``M·(N+1)`` outputs are read as M softmax groups."""
 
 from __future__ import annotations
 

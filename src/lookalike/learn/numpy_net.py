@@ -14,10 +14,9 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 class NumpyAssociationNet:
     """Step-by-step evaluation of the stacked recurrent network.
 
-    ``step(x)`` takes one frame's raw input ``(n_inputs,)`` (or a batch ``(b, n_inputs)``),
-    standardises it with the saved statistics and returns class probabilities ``(M, N+1)``
-    (or ``(b, M, N+1)``); the recurrent state is kept inside until :meth:`reset`.
-    """
+    ``step(x)`` takes one frame's raw input ``(n_inputs,)`` (or a batch ``(b, n_inputs)``), standardises it with the
+    saved statistics and returns class probabilities ``(M, N+1)`` (or ``(b, M, N+1)``); the recurrent state is kept
+    inside until :meth:`reset`."""
 
     def __init__(self, weights: NetworkWeights) -> None:
         self.weights = weights

@@ -1,6 +1,5 @@
-"""Training arrays in the robot-identification paper's input layout (``N + 4·M``, :mod:`lookalike.learn.encoding`;
-no augmentation beyond slot shuffling) and a sampler drawing each sequence's noise model from its seed.
-"""
+"""Training arrays in the robot-identification paper's input layout (``N + 4·M``, :mod:`lookalike.learn.encoding`; no
+augmentation beyond slot shuffling) and a sampler drawing each sequence's noise model from its seed."""
 
 from __future__ import annotations
 

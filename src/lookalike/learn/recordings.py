@@ -1,8 +1,7 @@
-"""Training arrays from labelled recordings (``.labelled.jsonl`` exports, the simulator's format), for
-fine-tuning. Validation splits by recording, never by frame. A training window: the seed picks a recording
-(by length) and a start; the whole recording is encoded, slots shuffled, then cut to the window (short
-recordings padded with ignored empty frames).
-"""
+"""Training arrays from labelled recordings (``.labelled.jsonl`` exports, the simulator's format), for fine-tuning.
+Validation splits by recording, never by frame. A training window: the seed picks a recording (by length) and a start;
+the whole recording is encoded, slots shuffled, then cut to the window (short recordings padded with ignored empty
+frames)."""
 
 from __future__ import annotations
 
@@ -63,9 +62,8 @@ def _pad(x: np.ndarray, y: np.ndarray, length: int) -> tuple[np.ndarray, np.ndar
 class RecordingSampler:
     """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler of windows of ``recordings`` (see the module).
 
-    ``sim_fraction``: share of the sequences simulated in ``world`` instead (drawn from the seed; rehearsal of
-    the simulator's sequences, which keeps a few recordings from being learnt by heart).
-    """
+    ``sim_fraction``: share of the sequences simulated in ``world`` instead (drawn from the seed; rehearsal of the
+    simulator's sequences, which keeps a few recordings from being learnt by heart)."""
 
     spec: EncodingSpec
     recordings: tuple[RobotArrays, ...]

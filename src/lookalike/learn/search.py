@@ -1,11 +1,9 @@
-"""Hyper-parameter search for the LSTM associator with Optuna: ``hidden``, ``num_layers`` and
-``learning_rate`` drawn in log space (TPE or random), each trial one training run scored on the validation
-seeds. The chosen network is scored again on other held-out seeds (:data:`CHECK_SEED_BASE`), the figure
-that estimates how the choice does on new sequences.
+"""Hyper-parameter search for the LSTM associator with Optuna: ``hidden``, ``num_layers`` and ``learning_rate`` drawn in
+log space (TPE or random), each trial one training run scored on the validation seeds. The chosen network is scored
+again on other held-out seeds (:data:`CHECK_SEED_BASE`), the figure that estimates how the choice does on new sequences.
 
-Trials run on :class:`lookalike.parallel.JobPool`, each in its own ``trial-NNNN`` folder; with an Optuna
-storage URL a rerun continues the study up to the requested trials.
-"""
+Trials run on :class:`lookalike.parallel.JobPool`, each in its own ``trial-NNNN`` folder; with an Optuna storage URL a
+rerun continues the study up to the requested trials."""
 
 from __future__ import annotations
 

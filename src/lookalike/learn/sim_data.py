@@ -1,8 +1,7 @@
 """Training arrays straight from the robot simulator's arrays (vectorised over time).
 
-Optional augmentation (ours): in a share of the sequences two robots exchange reports for a while and the
-targets swap with them, so the network learns to re-identify when reports contradict its memory.
-"""
+Optional augmentation (ours): in a share of the sequences two robots exchange reports for a while and the targets swap
+with them, so the network learns to re-identify when reports contradict its memory."""
 
 from __future__ import annotations
 
@@ -53,9 +52,8 @@ def arrays_to_training(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Inputs ``(T, n_inputs)`` and targets ``(T, M)`` from a simulated sequence.
 
-    Equal to :func:`lookalike.learn.data.frames_to_arrays` on the same sequence's frames; with
-    ``rng`` the occupied slots are shuffled per frame, else ordered most probable first.
-    """
+    Equal to :func:`lookalike.learn.data.frames_to_arrays` on the same sequence's frames; with ``rng`` the occupied
+    slots are shuffled per frame, else ordered most probable first."""
     T, M = arrays.det_valid.shape
     if M != spec.n_slots:
         raise ValueError(f"the sequence has {M} detection slots, the encoding {spec.n_slots}")
@@ -114,8 +112,7 @@ class SimSampler:
     """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler over the robot world ``config``.
 
     ``swap_prob``: fraction of sequences in which two random robots swap identities for 1–10 s
-    (:func:`swap_identities`), drawn from the sequence's seed.
-    """
+    (:func:`swap_identities`), drawn from the sequence's seed."""
 
     config: RobotWorldConfig
     relative: bool = True

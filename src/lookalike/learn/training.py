@@ -1,10 +1,9 @@
 """Training the association network on simulated sequences (needs torch).
 
-Adam with the paper's schedule (``lr_t = lr / (1 + 1e-4·t)``), L2 weight decay, truncated BPTT over 150
-steps, slot shuffling, validation on fixed held-out seeds, early stopping, resumable checkpoints and a CSV
-log. Each sequence is a pure function of its seed, so batches can be made ahead in worker processes
-(:class:`~lookalike.parallel.JobPool`) with the same result.
-"""
+Adam with the paper's schedule (``lr_t = lr / (1 + 1e-4·t)``), L2 weight decay, truncated BPTT over 150 steps, slot
+shuffling, validation on fixed held-out seeds, early stopping, resumable checkpoints and a CSV log. Each sequence is a
+pure function of its seed, so batches can be made ahead in worker processes (:class:`~lookalike.parallel.JobPool`) with
+the same result."""
 
 from __future__ import annotations
 
@@ -118,10 +117,9 @@ def train(
 ) -> TrainResult:
     """Train on sequences from ``sample(seed, n_frames, rng)``; write weights, checkpoint and log to ``out_dir``.
 
-    ``pool`` generates batches ahead; ``init`` starts from exported weights of the same shape (validated
-    first, so the weights kept are never worse than them); ``validation_sample`` or ``validation`` (a batch
-    ``(B, T, n_inputs), (B, T, M)``) set the validation data; ``info`` is added to the exported metadata.
-    """
+    ``pool`` generates batches ahead; ``init`` starts from exported weights of the same shape (validated first, so the
+    weights kept are never worse than them); ``validation_sample`` or ``validation`` (a batch ``(B, T, n_inputs), (B, T,
+    M)``) set the validation data; ``info`` is added to the exported metadata."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(config.seed)

@@ -1,10 +1,9 @@
 """Warm start across set-ups: weights trained for (N, M) mapped onto a network for (N', M').
 
-Layers above the first are copied; the first layer's input columns and the output head are mapped block by
-block (new agent ``j`` from source agent ``j mod N``, slot ``k`` from ``k mod M``, the false-positive class
-from the source's), repeated blocks jittered by ``jitter`` times the block's spread. Input normalisation
-comes from the new set-up's ``mean``/``std``.
-"""
+Layers above the first are copied; the first layer's input columns and the output head are mapped block by block (new
+agent ``j`` from source agent ``j mod N``, slot ``k`` from ``k mod M``, the false-positive class from the source's),
+repeated blocks jittered by ``jitter`` times the block's spread. Input normalisation comes from the new set-up's
+``mean``/``std``."""
 
 from __future__ import annotations
 

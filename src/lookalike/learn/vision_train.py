@@ -138,11 +138,10 @@ def _no_step(description: str, total: int) -> Callable[[int, str], None]:
 
 def train_robot_detector(data: Path | None, frames: int, stages: int, negatives: int, copies: int, seed: int,
                          validation_frames: int, step: Step = _no_step) -> tuple[Any, int, list[Any]]:
-    """Train the HOG cascade on ``data`` (``positives/`` and ``negatives/``) or ``frames`` rendered frames
-    (``copies`` augmented copies per positive), then keep the cascade prefix with the best held-out F1 on
-    ``validation_frames`` renders (0: keep all). ``step(description, total)`` gives each phase's
-    ``progress(done, note)``. Returns ``(model, stages trained, candidates tried)``.
-    """
+    """Train the HOG cascade on ``data`` (``positives/`` and ``negatives/``) or ``frames`` rendered frames (``copies``
+    augmented copies per positive), then keep the cascade prefix with the best held-out F1 on ``validation_frames``
+    renders (0: keep all). ``step(description, total)`` gives each phase's ``progress(done, note)``. Returns ``(model,
+    stages trained, candidates tried)``."""
     from lookalike.vision.hog_cascade import CascadeConfig, train_cascade
     from lookalike.vision.hog_features import augment_windows
     from lookalike.vision.hog_select import select_stages
