@@ -1,7 +1,6 @@
-"""The one frame loop: ``run(tracker, frames, sink)`` feeds frames from any iterable to a tracker in order and
-hands each ``(frame, tracks)`` to ``sink`` at once, keeping nothing per frame (constant memory with lazy
-frames and a streaming sink such as :class:`lookalike.io.stream.MotWriter`). It times ``update`` alone.
-"""
+"""The one frame loop: ``run(tracker, frames, sink)`` feeds frames from any iterable to a tracker in order and hands
+each ``(frame, tracks)`` to ``sink`` at once, keeping nothing per frame (constant memory with lazy frames and a
+streaming sink such as :class:`lookalike.io.stream.MotWriter`). It times ``update`` alone."""
 
 from __future__ import annotations
 
@@ -45,9 +44,8 @@ def run(tracker: Updating, frames: Iterable[Any], sink: Sink | None = None, *,
         stats: RunStats | None = None) -> RunStats:
     """Run ``tracker`` over ``frames`` in order, calling ``sink(frame, tracks)`` after every frame.
 
-    ``stats``: accumulate into an existing :class:`RunStats` (several sequences, one total).
-    Returns the stats (frames, tracker seconds).
-    """
+    ``stats``: accumulate into an existing :class:`RunStats` (several sequences, one total). Returns the stats (frames,
+    tracker seconds)."""
     stats = RunStats() if stats is None else stats
     for frame in frames:
         t0 = time.perf_counter()

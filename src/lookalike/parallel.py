@@ -1,7 +1,6 @@
-"""Independent jobs run serially, in local processes, or as Ray tasks (``backend="ray"``, on the cluster at
-``address`` or a local ``ray.init()``), with identical results. Jobs must be picklable top-level callables
-whose result depends only on their arguments.
-"""
+"""Independent jobs run serially, in local processes, or as Ray tasks (``backend="ray"``, on the cluster at ``address``
+or a local ``ray.init()``), with identical results. Jobs must be picklable top-level callables whose result depends only
+on their arguments."""
 
 from __future__ import annotations
 
@@ -26,9 +25,8 @@ class Pending:
 class JobPool:
     """``submit(fn, *args)`` and ``map(fn, items)`` over ``workers`` processes or a Ray cluster.
 
-    With ``workers=1`` and the local backend, jobs run in this process when their result is asked
-    for. Use as a context manager (or call :meth:`close`) to release the processes.
-    """
+    With ``workers=1`` and the local backend, jobs run in this process when their result is asked for. Use as a context
+    manager (or call :meth:`close`) to release the processes."""
 
     def __init__(self, workers: int = 1, backend: str = "local", address: str | None = None) -> None:
         if backend not in BACKENDS:
