@@ -28,8 +28,7 @@ class Assignment:
     Attributes:
         matches: ``(k, 2)`` int array of ``(row, col)`` pairs, sorted by row.
         unmatched_rows: ``(r,)`` sorted row indices without a match.
-        unmatched_cols: ``(c,)`` sorted column indices without a match.
-    """
+        unmatched_cols: ``(c,)`` sorted column indices without a match."""
 
     matches: np.ndarray
     unmatched_rows: np.ndarray

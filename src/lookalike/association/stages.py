@@ -31,8 +31,7 @@ class Stage(NamedTuple):
         name: a label for diagnostics.
         gate: optional boolean ``(k, n)``, True exactly where the cost is allowed, known before any cost is
             computed (e.g. an IoU threshold); costs are then computed only when allowed pairs compete.
-            Ignored with ``solve``.
-    """
+            Ignored with ``solve``."""
 
     tracks: np.ndarray | None
     detections: np.ndarray | None
@@ -50,8 +49,7 @@ class Matching:
     Attributes:
         det_of_track: ``(k,)`` detection index per track row, -1 when unmatched.
         free: ``(n,)`` True for detections no stage took.
-        stage_of_track: ``(k,)`` index of the stage that matched each track row, -1 when unmatched.
-    """
+        stage_of_track: ``(k,)`` index of the stage that matched each track row, -1 when unmatched."""
 
     det_of_track: np.ndarray
     free: np.ndarray

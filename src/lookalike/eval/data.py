@@ -36,8 +36,7 @@ class SequenceData:
         pairs: every same-frame (ground truth, tracker) pair with similarity > 0 (in ``[0, 1]``:
             IoU or distance score).
         num_gt_ids: number of distinct ground-truth ids.
-        num_tracker_ids: number of distinct tracker ids.
-    """
+        num_tracker_ids: number of distinct tracker ids."""
 
     gt_bounds: np.ndarray
     gt_id: np.ndarray

@@ -3,8 +3,7 @@
 - ``"MOT16"``, ``"MOT17"``, ``"MOT20"``: tracker boxes matched (IoU >= 0.5) to distractor classes are
   removed, then only ground truth with a non-zero consider flag and class pedestrian is kept;
 - ``"MOT15"``: ground truth with a zero consider flag is dropped;
-- ``"custom"``: everything is kept.
-"""
+- ``"custom"``: everything is kept."""
 
 from __future__ import annotations
 

@@ -35,8 +35,7 @@ class PointFrames:
 
     Attributes:
         points: per frame (index = frame − 1), an ``(n, 2)`` float array of positions.
-        path: the file it came from, if any.
-    """
+        path: the file it came from, if any."""
 
     points: list[np.ndarray]
     path: Path | None = None

@@ -22,8 +22,7 @@ class MotSequence:
         gt_path: the ground-truth file, or None.
         frame_rate: frames per second (30 when unknown).
         length: number of frames, or None when unknown (then the last detected frame).
-        image_size: ``(width, height)`` in pixels, or None.
-    """
+        image_size: ``(width, height)`` in pixels, or None."""
 
     name: str
     root: Path | None

@@ -54,8 +54,7 @@ class DetectionStream:
         frame_rate: frames per second (``time = index / frame_rate``).
         min_score: boxes with a lower score are dropped.
         chunk_lines: lines parsed at a time.
-        length_name: what ``length`` is, for error messages (e.g. ``seqLength in X/seqinfo.ini``).
-    """
+        length_name: what ``length`` is, for error messages (e.g. ``seqLength in X/seqinfo.ini``)."""
 
     def __init__(self, path: str | os.PathLike[str], length: int | None = None, frame_rate: float = 30.0,
                  min_score: float = -np.inf, chunk_lines: int = CHUNK_LINES, length_name: str = "the length") -> None:

@@ -38,8 +38,7 @@ class IdentifierConfig:
         max_queued_per_robot: reports of one robot kept for the next frame; beyond it the oldest
             is dropped (counted ``queue_dropped``).
         max_queued: reports of all robots kept for the next frame; beyond it a new report is
-            dropped (counted ``queue_full``).
-    """
+            dropped (counted ``queue_full``)."""
 
     n_robots: int = 3
     max_report_age_s: float = 1.0

@@ -43,8 +43,7 @@ class HeadingReport:
         robot: robot id, 0-based.
         seq: the robot's message counter, increasing by one per report sent.
         t_sent: simulated time the robot sent the report, seconds.
-        heading: the robot's absolute heading, radians.
-    """
+        heading: the robot's absolute heading, radians."""
 
     robot: int
     seq: int
@@ -62,8 +61,7 @@ class DetectionsMessage:
         position: ``n`` pairs ``[x, y]`` in metres.
         heading: ``n`` visual headings in radians.
         score: ``n`` detector confidences.
-        heading_std: ``n`` spreads of the visual headings in radians, or None.
-    """
+        heading_std: ``n`` spreads of the visual headings in radians, or None."""
 
     frame: int
     time: float
@@ -82,8 +80,7 @@ class RobotEstimate:
         position: ``[x, y]`` metres.
         heading: radians, or None when unknown.
         confidence: identification confidence in [0, 1], or None.
-        age: seconds since a detection last updated the estimate.
-    """
+        age: seconds since a detection last updated the estimate."""
 
     id: int
     position: tuple[float, float]
@@ -100,8 +97,7 @@ class TeamState:
         frame: the camera frame index.
         time: its simulated time, seconds.
         robots: one estimate per identified robot.
-        labels: per detection of the frame, the robot id it was identified as (-1: none).
-    """
+        labels: per detection of the frame, the robot id it was identified as (-1: none)."""
 
     frame: int
     time: float

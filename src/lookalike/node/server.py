@@ -102,8 +102,7 @@ class NodeConfig:
         camera_timeout_s: wall seconds without frames after which the camera counts as lost.
         status_interval_s: wall seconds between status log lines (0: never).
         recv_buffer_bytes: socket receive buffer asked of the OS.
-        batch: datagrams read per loop iteration before timers are checked.
-    """
+        batch: datagrams read per loop iteration before timers are checked."""
 
     listen: Address = (LOCALHOST, 0)
     publish: tuple[Address, ...] = ()

@@ -14,8 +14,7 @@ The diver-tracking paper's seven mechanisms, each a step of :meth:`DiverSort.upd
    distances are below ``recovery_threshold`` (:attr:`DiverSort.merges` records each merge).
 7. Persistent identities: at most ``max_lost`` unseen confirmed tracks are kept.
 
-Defaults and their sources: docs/trackers/diversort.md.
-"""
+Defaults and their sources: docs/trackers/diversort.md."""
 
 from __future__ import annotations
 

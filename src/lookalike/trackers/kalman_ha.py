@@ -7,8 +7,7 @@ tracks with the N reporting agents by the beacon identifier (:mod:`lookalike.tra
 - Kalman-HA: a track starts at every unmatched detection and ends at its first miss.
 - Kalman-HA2 (heuristics the paper cites without listing; ours): births gated by score and distance to
   existing tracks, confirmation by hits in a window, coasting limits inside and outside the camera's view,
-  and only confirmed tracks identified (:class:`~lookalike.trackers.parts.world_rules.WorldRules`).
-"""
+  and only confirmed tracks identified (:class:`~lookalike.trackers.parts.world_rules.WorldRules`)."""
 
 from __future__ import annotations
 

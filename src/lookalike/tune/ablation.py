@@ -55,8 +55,7 @@ class ParameterGain:
         se: its standard error (``sd / sqrt(folds)``).
         spread: the largest change the parameter's range makes to any fold's training objective.
         chosen: per fold, the chosen value (``"default"`` when the defaults won).
-        verdict: ``"keep"`` (gain > 2 se), ``"drop"`` (inert: spread < :data:`INERT_POINTS`) or ``"fix"``.
-    """
+        verdict: ``"keep"`` (gain > 2 se), ``"drop"`` (inert: spread < :data:`INERT_POINTS`) or ``"fix"``."""
 
     name: str
     gains: list[float]

@@ -34,8 +34,7 @@ class TunedParams:
         criterion: what was maximised (e.g. ``"hota+idf1+mota"``).
         trials: number of trials of the study.
         lookalike_version: the version that chose them.
-        extra: any other keys of the file.
-    """
+        extra: any other keys of the file."""
 
     tracker: str
     params: dict[str, Any]

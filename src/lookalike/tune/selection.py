@@ -31,8 +31,7 @@ class FoldChoice:
         train_value: the objective on ``chosen_on``.
         test_scores: left-out scores, combined over ``left_out``.
         test_value: the criterion of ``test_scores``.
-        per_sequence: left-out scores per left-out sequence (same order as ``left_out``).
-    """
+        per_sequence: left-out scores per left-out sequence (same order as ``left_out``)."""
 
     fold: str
     chosen_on: list[str]

@@ -32,8 +32,7 @@ class StudyResult:
         chosen_on: the sequences (``dataset/name``) the choice was made on.
         criterion: the criterion's name.
         default_value: the objective of the tracker's defaults (the first trial), if it completed.
-        failed: finished trials that failed (parameters the tracker refused, or an error).
-    """
+        failed: finished trials that failed (parameters the tracker refused, or an error)."""
 
     params: dict[str, Any]
     value: float
@@ -136,8 +135,7 @@ def run_study(tracker: str, sequences: Sequence[Any], *, space: Space | None = N
         resume: continue an existing study (it must have been run with the same settings).
         workers, backend, address: where trials run (:class:`lookalike.parallel.JobPool`).
         evaluator: ``(tracker, params, sequence) -> scores`` (tests replace it).
-        progress: called after each finished trial with ``(done, trials, best value so far)``.
-    """
+        progress: called after each finished trial with ``(done, trials, best value so far)``."""
     optuna = _import_optuna()
     crit = criterion(metric)
     if trials < 1:

@@ -22,8 +22,7 @@ class Beacons:
         agent_id: ``(n,)`` integer id of the reporting agent (0-based).
         t_sent: ``(n,)`` time the agent sent the report, seconds.
         t_received: ``(n,)`` time the observer received it, seconds.
-        heading: ``(n,)`` the agent's own absolute heading in radians.
-    """
+        heading: ``(n,)`` the agent's own absolute heading in radians."""
 
     agent_id: np.ndarray
     t_sent: np.ndarray

@@ -29,8 +29,7 @@ class Detections:
         heading: ``(n,)`` absolute visual heading in radians, or None.
         heading_std: ``(n,)`` spread of the visual heading in radians, or None.
         feature: ``(n, d)`` appearance features, or None.
-        label: ``(n,)`` integer labels (agent id, -1 for false positive), or None.
-    """
+        label: ``(n,)`` integer labels (agent id, -1 for false positive), or None."""
 
     # Always arrays after construction; None (the default) is accepted and filled in.
     xywh: np.ndarray = None  # type: ignore[assignment]

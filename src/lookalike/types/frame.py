@@ -20,8 +20,7 @@ class Frame:
         time: time stamp in seconds.
         detections: the frame's detections (may be empty).
         beacons: reports received since the previous frame (may be empty).
-        image: optional ``(h, w, 3)`` uint8 BGR image.
-    """
+        image: optional ``(h, w, 3)`` uint8 BGR image."""
 
     index: int
     time: float

@@ -25,8 +25,7 @@ class MotTable:
         xywh: ``(n, 4)`` boxes in pixels.
         conf: ``(n,)`` detector score, or the ground truth's consider flag.
         extra: ``(n, k)`` the remaining columns (world xyz, or class and visibility in MOT16+ gt).
-        path: the file it came from, if any.
-    """
+        path: the file it came from, if any."""
 
     frame: np.ndarray
     track_id: np.ndarray

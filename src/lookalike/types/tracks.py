@@ -32,8 +32,7 @@ class TrackSnapshot:
         heading: absolute heading in radians, or None.
         agent_id: identified agent (0-based), or None.
         identity_prob: confidence of ``agent_id`` in [0, 1], or None.
-        detection_index: index of the detection that updated the track this frame, or -1.
-    """
+        detection_index: index of the detection that updated the track this frame, or -1."""
 
     track_id: int
     status: TrackStatus
@@ -63,8 +62,7 @@ class Tracks(Sequence[TrackSnapshot]):
         heading: ``(k,)`` headings in radians (NaN: none), or None.
         agent_id: ``(k,)`` identified agents (-1: none), or None.
         identity_prob: ``(k,)`` confidences of ``agent_id`` (NaN: none), or None.
-        detection_index: ``(k,)`` index of the detection that updated each track this frame, or -1.
-    """
+        detection_index: ``(k,)`` index of the detection that updated each track this frame, or -1."""
 
     __slots__ = ("id", "status", "xywh", "position", "velocity", "heading", "agent_id", "identity_prob",
                  "detection_index")

@@ -29,8 +29,7 @@ def birdseye_plot(path: Path | str, truth: np.ndarray, estimated: np.ndarray, *,
         truth: ``(T, N, 2)`` true positions (m); NaN where not to draw.
         estimated: ``(T, N, 2)`` estimated positions (m) of each agent; NaN where none.
         field_m: ``(length, width)`` of a field centred at the origin to outline, or None.
-        observer: ``(2,)`` position of the observer to mark, or None.
-    """
+        observer: ``(2,)`` position of the observer to mark, or None."""
     t, e = np.asarray(truth, dtype=float), np.asarray(estimated, dtype=float)
     if t.ndim != 3 or t.shape[2] != 2 or e.shape != t.shape:
         raise ValueError(f"truth/estimated: need equal (T, N, 2) shapes, got {t.shape} and {e.shape}")

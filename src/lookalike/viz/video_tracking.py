@@ -54,8 +54,7 @@ class VideoTrackingResult:
         health: one :class:`HealthStatus` per frame.
         uncertain: ``(frame, track id)`` pairs drawn as uncertain (frames 1-based).
         ignored_rows: detection rows whose frame is past the video's end.
-        tracker_s, feature_s: seconds spent in the tracker and in the feature extractor.
-    """
+        tracker_s, feature_s: seconds spent in the tracker and in the feature extractor."""
 
     frames: int
     rows: np.ndarray

@@ -12,8 +12,7 @@
 5. writes ids 1..N, fills gaps up to ``fill_gap_s`` seconds and smooths boxes by a running median.
 
 :func:`track_closed_set` first runs the online pass (open-set ``boxtrack``, ``n_init=1``). Positions are
-pixels. The method and its parameters: docs/closed-set.md.
-"""
+pixels. The method and its parameters: docs/closed-set.md."""
 
 from __future__ import annotations
 

@@ -6,8 +6,7 @@ fill short gaps, smooth boxes. Rows are MOTChallenge results ``(k, 10)`` (1-base
   within ``link_distance`` box heights and sizes within a factor ``scale`` are linked by a minimum-cost
   assignment (the later track takes the earlier id).
 - :func:`fill_gaps`: gaps of at most ``fill_gap_s`` seconds inside one id are interpolated linearly.
-- :func:`smooth_boxes`: each id's centres and sizes replaced by their running median.
-"""
+- :func:`smooth_boxes`: each id's centres and sizes replaced by their running median."""
 
 from __future__ import annotations
 

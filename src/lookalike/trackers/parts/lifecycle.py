@@ -22,8 +22,7 @@ class Lifecycle:
         tentative_max_unseen_s: seconds unseen beyond which a tentative track is deleted (None: no limit).
         max_misses: frames a confirmed track survives without an update (None: no limit).
         max_unseen_s: seconds a confirmed track survives without an update (None: no limit).
-        closed: confirmed tracks are never deleted (a closed set of targets).
-    """
+        closed: confirmed tracks are never deleted (a closed set of targets)."""
 
     n_init: int = 1
     tentative_max_misses: int | None = 1

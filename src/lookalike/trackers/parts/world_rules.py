@@ -72,8 +72,7 @@ class WorldRules:
         birth_min_score: lowest score that starts a track (None: any).
         birth_exclusion_m: no birth this close to a track's prediction (m), None: anywhere.
         view: ``(fov_deg, min_range_m, max_range_m)`` of the camera, None: no coasting limits by view.
-        max_coast_s: longest coasting while predicted in view, and ``max_out_of_view_s`` out of it (s).
-    """
+        max_coast_s: longest coasting while predicted in view, and ``max_out_of_view_s`` out of it (s)."""
 
     lifecycle: Lifecycle
     born_confirmed: bool = True

@@ -54,8 +54,7 @@ class LabelApp:
         store: its labels.
         benchmark: human-benchmark mode (truth never sent to the page; timed; scored at the end).
         labeller: who labels (an id for the benchmark's result file, :mod:`lookalike.viz.label.human`).
-        results_dir: folder of the benchmark's result file (default: the sequence's).
-    """
+        results_dir: folder of the benchmark's result file (default: the sequence's)."""
 
     def __init__(self, sequence_path: str | Path, sequence: RobotSequence, store: LabelStore,
                  benchmark: bool = False, labeller: str = "anonymous", results_dir: str | Path | None = None) -> None:

@@ -84,8 +84,7 @@ class LabelStore:
         counts: detections per frame, ``(T,)``.
         n_agents: N, the number of robots.
         initial: labels to start from when ``path`` does not exist yet (default: all unset).
-        source: where ``initial`` came from (recorded in the file).
-    """
+        source: where ``initial`` came from (recorded in the file)."""
 
     def __init__(self, path: str | Path, sequence_name: str, counts: Sequence[int], n_agents: int,
                  initial: Sequence[Sequence[int]] | None = None, source: str = "empty") -> None:

@@ -7,8 +7,7 @@ NaN output until an agent's first detection):
   (``α`` the assignment's class probability).
 - :class:`KalmanLocaliser`: a constant-velocity Kalman filter per agent with decaying velocity, noise growing
   with distance and shrinking with ``α``, a chi-square gate with restarts, and no position after
-  ``max_coast_s`` without detections.
-"""
+  ``max_coast_s`` without detections."""
 
 from __future__ import annotations
 
