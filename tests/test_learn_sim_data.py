@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
 
-from lookalike.learn.data import frames_to_arrays
 from lookalike.learn.encoding import EncodingSpec
 from lookalike.learn.sim_data import arrays_to_training
 from lookalike.sim import preset, simulate_robots
+from tests.learn_oracle import frames_to_arrays
 
 
 @pytest.mark.parametrize("name, relative", [("m3n2", False), ("m10n7", False), ("m5n3", True), ("m10n7", True)])

@@ -5,9 +5,9 @@ from lookalike.types import Beacons, Detections, Frame
 
 torch = pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
 
-from lookalike.learn.data import frames_to_arrays  # noqa: E402
 from lookalike.learn.encoding import EncodingSpec  # noqa: E402
 from lookalike.learn.training import TrainConfig, plot_log, train  # noqa: E402
+from tests.learn_oracle import frames_to_arrays  # noqa: E402
 
 
 def toy_frames(seed: int, n_frames: int):

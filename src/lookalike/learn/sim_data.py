@@ -52,7 +52,7 @@ def arrays_to_training(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Inputs ``(T, n_inputs)`` and targets ``(T, M)`` from a simulated sequence.
 
-    Equal to :func:`lookalike.learn.data.frames_to_arrays` on the same sequence's frames; with ``rng`` the occupied
+    Equal to the frame-by-frame oracle (tests/learn_oracle.py) on the same sequence's frames; with ``rng`` the occupied
     slots are shuffled per frame, else ordered most probable first."""
     T, M = arrays.det_valid.shape
     if M != spec.n_slots:
