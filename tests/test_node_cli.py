@@ -22,12 +22,9 @@ from pathlib import Path
 import pytest
 
 from lookalike.node import Endpoint, Status, StatusRequest, TeamState
-from lookalike.node.teamsim import (
-    offline_identification,
-    online_identification,
-    team_sequence,
-)
+from lookalike.node.teamsim import team_sequence
 from lookalike.trackers import make_tracker
+from tests.node_scoring import offline_identification, online_identification
 
 PRESET, SEED, DURATION_S, SPEED, LOSS, JITTER_S = "m5n3", 0, 20.0, 2.0, 0.2, 0.1
 CLI = [sys.executable, "-c", "from lookalike.cli import main; main()"]

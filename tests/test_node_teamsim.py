@@ -6,13 +6,8 @@ import numpy as np
 import pytest
 
 from lookalike.node import TeamState, decode, encode
-from lookalike.node.teamsim import (
-    SimClock,
-    camera_messages,
-    online_identification,
-    robot_reports,
-    team_sequence,
-)
+from lookalike.node.teamsim import SimClock, camera_messages, robot_reports, team_sequence
+from tests.node_scoring import online_identification
 
 
 @pytest.fixture(scope="module")

@@ -14,12 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.eval import identification_success_rate
 from lookalike.node.client import Endpoint
 from lookalike.node.messages import DetectionsMessage, HeadingReport, TeamState
 from lookalike.sim.presets import preset
 from lookalike.sim.robots import RobotSequence, simulate_robots
-from lookalike.trackers.parts.identity import labels_from_tracks
 
 
 @dataclass(frozen=True)
@@ -158,23 +156,3 @@ def run_robot(endpoint: Endpoint, robot: int, sequence: RobotSequence, clock: Si
                         on_position(message, error)
     return log
 
-
-def online_identification(sequence: RobotSequence, teams: Sequence[TeamState]) -> tuple[float, int]:
-    """Identification success rate of the team states' labels against the truth, over the frames
-    that have a team state, and how many frames that is."""
-    truth = sequence.true_labels()
-    by_frame = {t.frame: t for t in teams if 0 <= t.frame < len(truth) and len(t.labels) == len(truth[t.frame])}
-    frames = sorted(by_frame)
-    rate = identification_success_rate([np.asarray(by_frame[k].labels, dtype=int) for k in frames],
-                                       [truth[k] for k in frames])
-    return rate, len(frames)
-
-
-def offline_identification(sequence: RobotSequence, tracker: object) -> float:
-    """Identification success rate of ``tracker`` run directly on ``sequence`` (the same labelling
-    rule as the node: ``labels_from_tracks``)."""
-    predicted = []
-    for frame in sequence.frames():
-        snapshots = tracker.update(frame)  # type: ignore[attr-defined]
-        predicted.append(labels_from_tracks(len(frame.detections), snapshots))
-    return identification_success_rate(predicted, sequence.true_labels())
