@@ -9,7 +9,7 @@ import pytest
 from lookalike.association.solver import assign
 from lookalike.association.stages import Stage, cascade, run_plan
 from lookalike.motion.models import constant_velocity, kinematic_transition
-from lookalike.motion.spaces import BoxCXCYWH, BoxXYAH, BoxXYSR, CentreCV, WorldCA, xyah_to_xywh, xywh_to_xyah
+from lookalike.motion.spaces import BoxCXCYWH, BoxXYAH, CentreCV, WorldCA, xyah_to_xywh, xywh_to_xyah
 from lookalike.trackers.parts.coasting import Coasting
 from lookalike.trackers.parts.lifecycle import Lifecycle
 from lookalike.trackers.parts.self_calibration import ScoreCalibration
@@ -94,10 +94,6 @@ def test_cascade_matches_recent_tracks_first() -> None:
 def test_state_spaces_round_trip_boxes_and_share_the_transition() -> None:
     xywh = np.array([[10.0, 20.0, 30.0, 60.0]])
     np.testing.assert_allclose(xyah_to_xywh(xywh_to_xyah(xywh)), xywh)
-    sort = BoxXYSR()
-    mean, cov = sort.initial(sort.measure(xywh))
-    np.testing.assert_allclose(sort.box(mean), xywh)
-    assert sort.F(2.0)[0, 4] == 2.0 and sort.F(2.0).shape == (7, 7)
     for space in (BoxCXCYWH(0.05, 0.01), BoxXYAH(0.05, 0.01, 0.01)):
         mean, cov = space.initial(space.measure(xywh))
         np.testing.assert_allclose(space.box(mean), xywh)

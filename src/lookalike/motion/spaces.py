@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.geometry.boxes import xysr_to_xywh, xywh_to_cxcywh, xywh_to_xysr
+from lookalike.geometry.boxes import xywh_to_cxcywh
 from lookalike.motion import kalman
 from lookalike.motion.models import constant_acceleration, constant_velocity, kinematic_transition
 
@@ -55,37 +55,6 @@ def _blocks(cov: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nda
     (views of ``cov`` itself when it is C-contiguous, so writing them writes ``cov``)."""
     flat = cov.reshape(len(cov), 64)
     return flat[:, 0:28:9], flat[:, 4:32:9], flat[:, 32:60:9], flat[:, 36:64:9]
-
-
-class BoxXYSR:
-    """SORT's ``[u, v, s, r, u', v', s']`` (centre, area, aspect; pixels and pixels/frame) with the
-    reference noise: ``R = diag(1, 1, 10, 10)``, ``P0 = diag(10, 10, 10, 10, 1e4, 1e4, 1e4)``,
-    ``Q = diag(1, 1, 1, 1, 0.01, 0.01, 1e-4)`` per frame."""
-
-    H = _observe_first(4, 7)
-    R = np.diag([1.0, 1.0, 10.0, 10.0])
-    P0 = np.diag([10.0, 10.0, 10.0, 10.0, 1e4, 1e4, 1e4])
-    Q = np.diag([1.0, 1.0, 1.0, 1.0, 1e-2, 1e-2, 1e-4])
-
-    @staticmethod
-    def measure(xywh: np.ndarray) -> np.ndarray:
-        return xywh_to_xysr(xywh)
-
-    @staticmethod
-    def box(mean: np.ndarray) -> np.ndarray:
-        return xysr_to_xywh(mean[:, :4])
-
-    @staticmethod
-    def F(steps: float) -> np.ndarray:
-        return kinematic_transition(4, 1, steps)[:7, :7]  # the aspect has no velocity
-
-    def initial(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        n = len(z)
-        return np.hstack([z, np.zeros((n, 3))]), np.broadcast_to(self.P0, (n, 7, 7))
-
-    def predict(self, mean: np.ndarray, cov: np.ndarray, steps: float) -> tuple[np.ndarray, np.ndarray]:
-        mean[mean[:, 6] + mean[:, 2] <= 0, 6] = 0.0  # keep the predicted area positive, as the reference
-        return kalman.predict(mean, cov, self.F(steps), self.Q * steps)
 
 
 @dataclass(frozen=True)
