@@ -7,7 +7,6 @@ their mean rank over the datasets (entries on more datasets first).
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -121,13 +120,6 @@ def run_with_progress(entries: Sequence[Entry], sequences: Sequence[RealSequence
     return results
 
 
-def leaderboard_json(part: str, rows: list[dict[str, Any]], combined: list[dict[str, Any]],
-                     per_seq: list[dict[str, Any]], skipped: dict[str, str | None]) -> str:
-    """The JSON document ``bench real --json`` writes."""
-    return json.dumps({"part": part, "datasets": rows, "combined": combined, "sequences": per_seq,
-                       "skipped": {k: v for k, v in skipped.items() if v}}, indent=2) + "\n"
-
-
 def _metrics(row: dict[str, Any]) -> dict[str, Any]:
     out: dict[str, Any] = {k.lower(): row[k] / 100 for k in METRICS if k in row}
     if "IDSW" in row and row["IDSW"] >= 0:
@@ -189,6 +181,5 @@ def plot_leaderboard(rows: list[dict[str, Any]], folder: Path) -> list[Path]:
     return paths
 
 
-__all__ = ["COLUMNS", "METRICS", "combined_ranking", "dataset_row", "leaderboard", "leaderboard_json",
-           "leaderboard_results", "run_with_progress",
-           "plot_leaderboard", "rank_rows", "ranks", "sequence_rows"]
+__all__ = ["COLUMNS", "METRICS", "combined_ranking", "dataset_row", "leaderboard", "leaderboard_results",
+           "plot_leaderboard", "rank_rows", "ranks", "run_with_progress", "sequence_rows"]
