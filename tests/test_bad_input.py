@@ -7,6 +7,8 @@ import time
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from lookalike.cli import app
@@ -193,3 +195,32 @@ def test_result_files_get_the_users_umask(tmp_path, mask):
         os.umask(old)
     assert (tmp_path / "o.txt").stat().st_mode & 0o777 == 0o666 & ~mask
     assert written.stat().st_mode & 0o777 == 0o666 & ~mask
+
+
+# Errors as plain text: quoted input that looks like rich markup is printed as given, never parsed.
+_MARKUP = st.text(alphabet="[]/ab =#@\\", min_size=1, max_size=12) | st.sampled_from(
+    ["[/]", "[bold red]", "[bold red]x[/]", "[link=x]", "\\[/]", "[/bold]", "[@click]"])
+
+
+def _literal_error(r, text: str) -> None:
+    line = _one_error_line(r)
+    assert "MarkupError" not in r.output
+    assert text in line or repr(text)[1:-1] in line, (text, line)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(text=_MARKUP)
+def test_markup_in_quoted_input_is_printed_literally(tmp_path, text):
+    det = _det(tmp_path / "det.txt")
+    _literal_error(_track(det, "-o", tmp_path / "o.txt", "-t", text), text)
+    key = text.replace("=", "")
+    if key.strip():
+        _literal_error(_track(det, "-o", tmp_path / "o.txt", "--set", f"{key}=1"), key.strip())
+    _literal_error(runner.invoke(app, ["serve", "--log-level", text]), text)
+    _literal_error(runner.invoke(app, ["eval", "--gt", str(tmp_path), "--results", str(tmp_path), "--metrics",
+                                       text.replace(",", "")]), text.replace(",", "").strip())
+    bad = _det(tmp_path / "bad" / "det.txt", extra=f"22,{text},1,1,1,1,1,-1,-1,-1\n")
+    r = _track(bad, "-o", tmp_path / "o.txt")
+    _one_error_line(r, "det.txt")
+    assert "MarkupError" not in r.output
+    assert not (tmp_path / "o.txt").exists()

@@ -60,4 +60,4 @@ def divers(
     all_rows = [{"Detections": level, **r} for level, rows in tables.items() for r in rows]
     write_rows(all_rows, None, csv_path, ("Detections", *COLUMNS))
     if png:
-        console.print(f"bar chart → {bar_chart(tables[levels[-1]], png)}")
+        console.print(f"bar chart → {bar_chart(tables[levels[-1]], png)}", markup=False)

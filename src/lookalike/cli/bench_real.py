@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from lookalike.bench.datasets import DATASETS, PARTS, cut_sequence, load_datasets, resolve_data_root
@@ -60,7 +61,8 @@ def print_leaderboard(rows: list[dict[str, Any]], combined: list[dict[str, Any]]
     console.print(table)
     for r in rows:
         if "Error" in r:
-            console.print(f"[red]{r['Dataset']} / {r['Tracker']} failed: {r['Error']}[/red]")
+            failed = escape(f"{r['Dataset']} / {r['Tracker']} failed: {r['Error']}")
+            console.print(f"[red]{failed}[/red]")
 
 
 @bench_app.command("real")
@@ -99,7 +101,7 @@ def real(
     seqs = [cut_sequence(s, part) for s in seqs]
     for name, why in status.items():
         if why is not None:
-            console.print(f"[yellow]skipped peer {name}: {why}[/yellow]")
+            console.print(f"[yellow]skipped peer {escape(name)}: {escape(str(why))}[/yellow]")
     entries = default_entries(tracker_list, [p for p, why in status.items() if why is None])
     if params_file is not None:
         try:
@@ -125,7 +127,7 @@ def real(
     write_rows(rows, None, csv_path, [*COLUMNS, "Error"])
     if plots is not None:
         for p in plot_leaderboard([r for r in rows if "Error" not in r], plots):
-            console.print(f"plot: {p}")
+            console.print(f"plot: {p}", markup=False)
 
 
 __all__ = ["BOX_TRACKERS", "print_leaderboard", "real"]

@@ -8,6 +8,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import typer
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -42,7 +43,7 @@ def _run(output: Path, seed: int, size: DemoSize, robot_preset: str, logger: obj
     for s in PRESET_NAMES:
         why = lstm_status(s)
         if why:
-            console.print(f"[yellow]LSTM left out for {preset_label(s)}:[/] {why}")
+            console.print(f"[yellow]LSTM left out for {preset_label(s)}:[/] {escape(str(why))}")
     with Progress(TextColumn("{task.description:<42}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                   TimeRemainingColumn(), console=console, transient=False) as progress:
         def step(description: str, total: int) -> Callable[[], None]:
@@ -77,12 +78,12 @@ def demo(
     try:
         files = _run(output, seed, QUICK if quick else DemoSize(), robot_preset, logger)
     except KeyboardInterrupt:
-        console.print(f"\n[yellow]Interrupted.[/] Files finished so far are in {output}/.")
+        console.print(f"\n[yellow]Interrupted.[/] Files finished so far are in {escape(str(output))}/.")
         raise typer.Exit(130) from None
     finally:
         if logger is not None:
             logger.close()  # type: ignore[attr-defined]
-    console.print(f"\nDone in {time.perf_counter() - t0:.0f} s. Results are in [bold]{output}/[/]:")
+    console.print(f"\nDone in {time.perf_counter() - t0:.0f} s. Results are in [bold]{escape(str(output))}/[/]:")
     console.print(f"  report      {files['report']}   (open it in a browser: tables, pictures, videos)")
     console.print(f"  videos      {files['robots-video']}, {files['divers-video']} (and .gif)")
     console.print(f"  plots       {files['robots-birdseye']}, {files['idf1']}")

@@ -8,6 +8,7 @@ import re
 from pathlib import Path
 
 import typer
+from rich.markup import escape
 
 from lookalike.bench.ident import identify
 from lookalike.cli.app import app, console, fail
@@ -76,7 +77,7 @@ def label(
             if Path(tracks).is_file():
                 initial, source = load_labels(tracks, seq), f"file {Path(tracks).name}"
             else:
-                console.print(f"running {tracks} on {sequence.name} …")
+                console.print(f"running {tracks} on {sequence.name} …", markup=False)
                 initial, source = tracker_labels(tracks, seq), f"tracker {tracks}"
         label_app = open_label_app(sequence, initial, source, benchmark, fresh,
                                    labeller if labeller is not None else login_name(), results)
@@ -85,10 +86,10 @@ def label(
     if export:
         r = label_app.export()
         console.print(f"wrote {r['truth']} and {r['mot']} ({r['mot_rows']} rows, {r['unset']} not labelled) "
-                      f"in {label_app.folder}")
+                      f"in {label_app.folder}", markup=False)
         if benchmark:
             try:
-                console.print(f"wrote {label_app.write_result()}")
+                console.print(f"wrote {label_app.write_result()}", markup=False)
             except (ValueError, OSError) as exc:
                 fail(f"--benchmark: {exc}")
         return
@@ -98,7 +99,7 @@ def label(
         fail(f"cannot listen on {host}:{port}: {exc}")
     try:
         if not ipaddress.ip_address(str(server.server_address[0])).is_loopback:
-            console.print(f"[yellow]warning:[/] {host} is reachable from other machines")
+            console.print(f"[yellow]warning:[/] {escape(host)} is reachable from other machines")
     except ValueError:
         pass
     url = f"http://{host if ':' not in host else f'[{host}]'}:{server.server_address[1]}/"

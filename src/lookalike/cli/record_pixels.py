@@ -45,10 +45,11 @@ def record_pixels(
         with progress_bars() as progress, one_blas_thread():
             for rec in record(preset_name, sequences, frames, seed, pipe, camera, min_iou, progress):
                 recordings.append(rec)
-                console.print(f"wrote {write_recording(rec, output, preset_name)}")
+                console.print(f"wrote {write_recording(rec, output, preset_name)}", markup=False)
     except (ValueError, FileNotFoundError, OSError) as exc:
         fail(str(exc))
     n_det = sum(int(r.arrays.det_valid.sum()) for r in recordings)
     n_fp = sum(int(((r.arrays.det_label < 0) & r.arrays.det_valid).sum()) for r in recordings)
     console.print(f"wrote {len(recordings)} recordings to {output} ({sequences} × {frames} frames, {n_det} pixel "
-                  f"detections, {n_fp} false positives; seeds {recordings[0].seed}–{recordings[-1].seed})")
+                  f"detections, {n_fp} false positives; seeds {recordings[0].seed}–{recordings[-1].seed})",
+                  markup=False)

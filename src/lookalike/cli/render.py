@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -54,6 +55,6 @@ def render(
     except ValueError as exc:
         fail(str(exc))
     except KeyboardInterrupt:
-        console.print(f"\n[yellow]Interrupted.[/] {output} holds the frames written so far.")
+        console.print(f"\n[yellow]Interrupted.[/] {escape(str(output))} holds the frames written so far.")
         raise typer.Exit(130) from None
-    console.print(f"wrote {output} ({n} frames)" + (f" and {gif}" if gif else ""))
+    console.print(f"wrote {output} ({n} frames)" + (f" and {gif}" if gif else ""), markup=False)

@@ -30,4 +30,4 @@ def report(
             out = doc.write(output)
     except ValueError as exc:
         fail(str(exc))
-    console.print(f"wrote {out} ({len(loaded)} result file(s))")
+    console.print(f"wrote {out} ({len(loaded)} result file(s))", markup=False)

@@ -36,4 +36,4 @@ def simulate(
         path = write_robot_sequence(output / f"{preset_name}-{seed + k:06d}.jsonl", seq)
         a = seq.arrays
         console.print(f"wrote {path}: {frames} frames, {int(a.det_valid.sum())} detections, "
-                      f"{len(a.reports.agent_id)} reports")
+                      f"{len(a.reports.agent_id)} reports", markup=False)

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import typer
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 
 from lookalike.cli.app import app, console, err_console, fail
@@ -99,7 +100,8 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float,
         fail(_input_error(exc))
     for (seq, frames), target in zip(streams, targets):
         if frames.rows == 0:
-            err_console.print(f"[yellow]warning:[/] {seq.det_path}: no detections; {target} will hold no tracks")
+            what = escape(f"{seq.det_path}: no detections; {target} will hold no tracks")
+            err_console.print(f"[yellow]warning:[/] {what}")
     stats = RunStats()
     with _progress_bars(len(streams)) as (progress, overall):
         for (seq, frames), target in zip(streams, targets):
@@ -284,12 +286,12 @@ def track(
 
             assert path is not None
             count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length)
-            where = output if path.is_file() else f"{output}/<sequence>.txt"
+            where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
             console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
         else:
             assert path is not None
             count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length)
-            where = output if path.is_file() else f"{output}/<sequence>.txt"
+            where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
             console.print(f"[green]{tracker}[/]: {count} sequence(s), {_speed(stats)} → {where}")
 
     except OSError as exc:  # an output that cannot be written, an input that cannot be read

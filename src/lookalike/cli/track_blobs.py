@@ -56,7 +56,7 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
     except (ValueError, OSError) as exc:
         fail(str(exc))
     det_path = write_mot(output.with_name(output.stem + ".det.txt"), rows)
-    console.print(f"blob detector: {len(rows)} boxes in {frames} frames → {det_path}")
+    console.print(f"blob detector: {len(rows)} boxes in {frames} frames → {det_path}", markup=False)
     if len(rows) < 2:
         fail(f"{video}: the blob detector found {len(rows)} box(es); try a lower --blob threshold=... "
              "or min_area_px=..., or polarity=dark/bright")

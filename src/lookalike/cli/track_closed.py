@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from rich.markup import escape
 
 from lookalike.cli.app import console, fail
 from lookalike.io import find_sequences, read_mot, write_mot
@@ -135,7 +136,7 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
         table = read_mot(output)
         rows = np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
     what = f"offline closed set of {n_targets}" if offline else "online"
-    console.print(f"[green]{tracker_name}[/], {what}: {len(np.unique(rows[:, 1]))} identities → {output}")
+    console.print(f"[green]{tracker_name}[/], {what}: {len(np.unique(rows[:, 1]))} identities → {escape(str(output))}")
 
 
 __all__ = ["POINTS_FPS", "closed_set_rows", "offline_files", "offline_video", "point_tracker", "read_points",

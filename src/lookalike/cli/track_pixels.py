@@ -109,4 +109,4 @@ def render_robots(
         for frame in render_robot_frames(seq, pixel_camera(), seed):
             writer.write(frame.image)
             progress.advance(task)
-    console.print(f"wrote {output} ({len(seq)} frames)")
+    console.print(f"wrote {output} ({len(seq)} frames)", markup=False)

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -67,7 +68,7 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
         fail(str(exc))
     except KeyboardInterrupt:
         console.print("\n[yellow]Interrupted.[/]"
-                      + (f" {annotate} holds the frames written so far." if annotate else ""))
+                      + (f" {escape(str(annotate))} holds the frames written so far." if annotate else ""))
         raise SystemExit(130) from None
     write_mot(output, result.rows)
     written = [output, write_health_csv(side_file(output, "health"), result.health)]

@@ -181,7 +181,7 @@ def train(
         target = WEIGHTS_DIR / f"{stem}_m{world.max_detections}_n{world.n_agents}"
         shutil.copy(result.weights_path, target.with_suffix(".npz"))
         shutil.copy(result.weights_path.with_suffix(".json"), target.with_suffix(".json"))
-        console.print(f"shipped as {target.with_suffix('.npz')}")
+        console.print(f"shipped as {target.with_suffix('.npz')}", markup=False)
 
 
 def _sim_samplers(world: Any, worlds: Any, spec: Any, noise: str, swap_prob: float) -> tuple[Any, Any]:
@@ -252,7 +252,7 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
         SHIPPED_SET_WEIGHTS.parent.mkdir(exist_ok=True)
         shutil.copy(result.weights_path, SHIPPED_SET_WEIGHTS)
         shutil.copy(result.weights_path.with_suffix(".json"), SHIPPED_SET_WEIGHTS.with_suffix(".json"))
-        console.print(f"shipped as {SHIPPED_SET_WEIGHTS}")
+        console.print(f"shipped as {SHIPPED_SET_WEIGHTS}", markup=False)
 
 
 def _with_progress(description: str, steps: int, pool: JobPool,

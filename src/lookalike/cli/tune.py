@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 import typer
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -187,7 +188,7 @@ def _print_results(tracker: str, metric: str, folds: str, seqs: Any, result: Any
     console.print(f"best {metric} on the {len(seqs)} sequence(s) it was chosen on: {100 * result.value:.2f} "
                   f"(defaults {default}); {result.failed} failed trial(s)")
     if result.errors:
-        console.print(f"[yellow]first failure: {result.errors[0]}[/yellow]")
+        console.print(f"[yellow]first failure: {escape(str(result.errors[0]))}[/yellow]")
     table = Table(title=f"{tracker} parameters → {path}")
     table.add_column("Parameter")
     table.add_column("Value", justify="right")

@@ -60,7 +60,8 @@ def train_detector(
         console.print(f"held-out ({validation_frames} frames): kept {len(model.stages)} of {trained} stages, pyramid "
                       f"from {model.config.min_height_px:g} px; precision {best.precision:.3f}, recall "
                       f"{best.recall:.3f}")
-    console.print(f"wrote {output}: {len(model.stages)} stages, {sum(len(s.index) for s in model.stages)} stumps")
+    stumps = sum(len(s.index) for s in model.stages)
+    console.print(f"wrote {output}: {len(model.stages)} stages, {stumps} stumps", markup=False)
 
 
 @app.command("train-heading")
@@ -100,4 +101,4 @@ def train_heading_command(
     if len(ft):
         err = mean_abs_error_deg(model.estimate(ft).heading_rad, ht)
         console.print(f"held-out mean absolute heading error: {err:.1f} deg on {len(ft)} robots")
-    console.print(f"wrote {output} (C={model.c:g}, {len(model.support)} support vectors)")
+    console.print(f"wrote {output} (C={model.c:g}, {len(model.support)} support vectors)", markup=False)
