@@ -6,7 +6,7 @@ EXTRAS ?= test,vision,viz,train,docs,tune,fast
 comma := ,
 STAMP := $(VENV)/.installed-$(subst $(comma),-,$(EXTRAS))
 
-.PHONY: venv demo test lint docs bench clean browser train train-base train-refine train-mix train-set
+.PHONY: venv demo test lint docs bench bench-test clean browser train train-base train-refine train-mix train-set
 
 venv: $(STAMP)
 
@@ -51,12 +51,20 @@ $(BENCH_VENV)/.installed: pyproject.toml constraints-bench.txt
 	$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt -e ".[vision,viz,bench,fast]"
 	touch $@
 
-# Peers whose declared requirements do not resolve next to numpy < 2 (trackers asks numpy >= 2, the packaged
-# reference SORT pins lap 0.4.0) go in without them; what they import is installed beside them.
-BENCH_PEERS_NODEPS := trackers pyDeprecate simple-online-realtime-tracking
-bench: $(BENCH_VENV)/.installed
-	@$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt filterpy lap
-	@$(BENCH_VENV)/bin/python -m pip install --quiet --no-deps -c constraints-bench.txt $(BENCH_PEERS_NODEPS)
+# Peers whose declared requirements do not resolve next to numpy < 2 (trackers and boxmot ask numpy >= 2,
+# boxmot rich >= 15, the packaged reference SORT pins lap 0.4.0) go in without them; what they import is
+# installed beside them (boxmot's motion-only trackers import torch, CPU-only here, PyYAML, tqdm and lap).
+BENCH_PEERS_NODEPS := trackers pyDeprecate simple-online-realtime-tracking boxmot
+$(BENCH_VENV)/.peers: $(BENCH_VENV)/.installed constraints-bench.txt
+	$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt filterpy lap torch pyyaml tqdm pytest
+	$(BENCH_VENV)/bin/python -m pip install --quiet --no-deps -c constraints-bench.txt $(BENCH_PEERS_NODEPS)
+	touch $@
+
+# pytest -m bench (the peer adapters, the ranking checks on ../shared/data) in the bench environment.
+bench-test: $(BENCH_VENV)/.peers
+	$(BENCH_VENV)/bin/python -m pytest -q -m bench tests/test_bench_real.py tests/test_bench_ranking.py
+
+bench: $(BENCH_VENV)/.peers
 	@log=$$(mktemp); failed=""; \
 	for script in benchmarks/[a-z]*.py; do \
 		echo "== $$script" | tee -a $$log; \

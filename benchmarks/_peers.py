@@ -10,6 +10,10 @@ Peers (installed into .venv-bench by ``make bench``; a missing one is skipped wi
   ``sort.sort``; it wants a sixth input column, the detection index), with filterpy and lap as its
   requirements list them;
 - ``trackers`` (Roboflow): ``SORTTracker`` and ``ByteTrackTracker``.
+
+:func:`score_peers` runs the accuracy peers of ``lookalike bench real`` (:mod:`lookalike.bench.peers`:
+norfair, supervision, ``trackers``, BoxMOT's motion-only trackers with their default presets) once on
+the dev sequences, for the leave-out scripts to print beside their left-out figures.
 """
 
 from __future__ import annotations
@@ -117,3 +121,31 @@ def reference_rows(result: list[np.ndarray]) -> list[tuple[int, np.ndarray]]:
         pairs = sorted((int(r[4]), np.array([r[0], r[1], r[2] - r[0], r[3] - r[1]])) for r in out)
         frames.append(pairs)
     return frames  # type: ignore[return-value]
+
+
+def score_peers(seqs: list[Any], wanted: str, workers: int = 1) -> dict[str, dict[str, dict[str, float]]]:
+    """Each installed peer named in ``wanted`` (comma-separated names of ``lookalike.bench.peers.PEERS``,
+    ``all`` or ``none``) run once on ``seqs`` (``RealSequence``) with its own defaults: dataset -> peer ->
+    scores combined over the dataset's sequences. A peer not installed is skipped with a printed line;
+    one that fails on a dataset is left out of it with a printed line."""
+    from lookalike.bench.peers import PEERS, peer_status
+    from lookalike.bench.runner import Entry, run_jobs
+    from lookalike.eval import combine
+
+    names = list(PEERS) if wanted == "all" else [] if wanted == "none" else \
+        [p.strip() for p in wanted.split(",") if p.strip()]
+    status = peer_status(names) if names else {}
+    for name, why in status.items():
+        if why is not None:
+            print(f"skipped peer {name}: {why}")
+    entries = [Entry(p, p, kind="peer") for p, why in status.items() if why is None]
+    results = run_jobs(entries, seqs, workers=workers) if entries else []
+    out: dict[str, dict[str, dict[str, float]]] = {}
+    for k, e in enumerate(entries):
+        for d in dict.fromkeys(s.dataset for s in seqs):
+            runs = [results[i * len(entries) + k] for i, s in enumerate(seqs) if s.dataset == d]
+            if all("scores" in r for r in runs):
+                out.setdefault(d, {})[e.label] = combine([r["scores"] for r in runs])
+            else:
+                print(f"peer {e.label} failed on {d}: {next(r['error'] for r in runs if 'error' in r)}")
+    return out

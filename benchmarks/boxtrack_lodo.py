@@ -10,6 +10,8 @@ of the code, patched in this process). Every candidate is scored once per sequen
 each fold's choice is the best candidate on the other datasets
 (:func:`lookalike.tune.select_from_table`) and is scored on the left-out one. The defaults boxtrack
 ships are the choice on all datasets; the left-out figures are the headline (docs/trackers/boxtrack.md).
+Printed after them: every installed peer of ``bench real`` (BoxMOT's trackers with their default presets
+included) once per dataset with its own defaults, and the best peer per column (``--peers none``: none).
 
     .venv/bin/python benchmarks/boxtrack_lodo.py                    # ~20 min on one core
     .venv/bin/python benchmarks/boxtrack_lodo.py --min-counts 10    # the current constant only
@@ -32,6 +34,7 @@ from lookalike.tune.folds import Fold
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA
+from _peers import score_peers
 
 CRITERION = "hota+idf1+mota"
 
@@ -80,6 +83,7 @@ def main() -> None:
                         help="patch a constant of trackers/boxtrack_config in this process (a mechanism on/off)")
     parser.add_argument("--save", type=Path, default=None, help="pickle the scores table here (for --load)")
     parser.add_argument("--load", type=Path, default=None, help="a table saved by --save: select, do not run")
+    parser.add_argument("--peers", default="all", help="peers run beside: 'all' installed, 'none', or names")
     args = parser.parse_args()
     for spec in args.set:
         name, value = spec.split("=", 1)
@@ -111,6 +115,20 @@ def main() -> None:
     for d in dict.fromkeys(groups):
         idx = [i for i, g in enumerate(groups) if g == d]
         print(f"  {d:12s} {_fmt(combine([table[best.candidate][i] for i in idx]))}")
+    if args.peers != "none":
+        _print_peers(score_peers(load_datasets(SHARED_DATA, list(dict.fromkeys(groups))), args.peers))
+
+
+def _print_peers(scores: dict[str, dict[str, dict[str, float]]]) -> None:
+    """Each peer's figures per dataset (its own defaults, chosen on none of it) and the best per column."""
+    print("peers, each with its own defaults (whole datasets):")
+    for d, by_peer in scores.items():
+        for name, s in sorted(by_peer.items(), key=lambda t: -headline(t[1])):
+            print(f"  {d:12s} {name:24s} {_fmt(s)}")
+        best = {m: max(by_peer.items(), key=lambda t: t[1][m]) for m in ("HOTA", "IDF1", "MOTA")}
+        print(f"  {d:12s} best peer per column: " + ", ".join(f"{m} {100 * s[m]:.2f} ({name})"
+                                                             for m, (name, s) in best.items()))
+
 
 if __name__ == "__main__":
     main()

@@ -3,6 +3,7 @@ leaderboard on real data (skipped without ../shared/data)."""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 from pathlib import Path
 
@@ -12,6 +13,7 @@ from typer.testing import CliRunner
 
 from lookalike.bench.datasets import RealSequence, cut_sequence
 from lookalike.bench.leaderboard import leaderboard
+from lookalike.bench.peers import PEERS, peer_status, run_peer
 from lookalike.bench.runner import (
     SEQUENCE_PARAMS,
     Entry,
@@ -19,6 +21,7 @@ from lookalike.bench.runner import (
     job_pairs,
     map_jobs,
     run_jobs,
+    score_rows,
     sequence_params,
     track_rows,
 )
@@ -140,6 +143,34 @@ def test_unknown_peer_is_reported_not_fatal() -> None:
         track_rows(Entry("x", "no-such-peer", kind="peer"), seq)
     (result,) = run_jobs([Entry("x", "no-such-peer", kind="peer")], [seq])
     assert "unknown peer" in result["error"]
+
+
+BOXMOT_TRACKERS = ("botsort", "bytetrack", "ocsort", "deepocsort", "hybridsort", "boosttrack", "occluboost", "sfsort")
+
+
+def test_boxmot_peers_are_listed_and_skipped_with_a_reason_when_absent() -> None:
+    names = [f"boxmot-{t}" for t in BOXMOT_TRACKERS]
+    assert set(names) <= set(PEERS)
+    status = peer_status(names)
+    if importlib.util.find_spec("boxmot") is None:
+        assert status == dict.fromkeys(names, "boxmot not installed")
+    else:
+        assert status == dict.fromkeys(names)
+
+
+@pytest.mark.bench
+@pytest.mark.parametrize("tracker", BOXMOT_TRACKERS)
+def test_boxmot_peer_runs_on_boxes_alone(tracker: str) -> None:
+    """Its default preset, no appearance model, no image content (``make bench-test`` runs it in .venv-bench)."""
+    name = f"boxmot-{tracker}"
+    why = peer_status([name])[name]
+    if why is not None:
+        pytest.skip(f"{name}: {why} (make bench-test installs it in .venv-bench)")
+    seq = _synthetic(3, n_frames=60, n_targets=4)
+    rows = run_peer(name, seq)
+    assert rows.shape[1] == 10 and len(rows) > 0
+    assert 1 <= rows[:, 0].min() and rows[:, 0].max() <= seq.length and (rows[:, 1] >= 1).all()
+    assert score_rows(seq, rows)["MOTA"] > 0.7  # 4 straight walkers, 10 % missed: every preset follows them
 
 
 def test_ray_backend_gives_the_local_tables() -> None:

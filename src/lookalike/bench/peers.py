@@ -7,8 +7,11 @@ nothing else is changed from the library's defaults, except where a library has 
 
 - norfair needs a distance and a threshold: ``distance_function="iou"`` (1 − IoU, the box
   distance of its documentation) with ``distance_threshold=0.7`` as in its box demos;
-- BoxMOT's trackers take an image; they get a black image of the sequence's size (they do not
-  look at it), and frame indices follow the sequence.
+- BoxMOT's trackers are built by its own factory from its default preset (the tracker's
+  ``configs/trackers/NAME.yaml``, as ``boxmot track --tracker NAME`` builds them) with only the
+  appearance model and camera-motion compensation switched off (:data:`BOXMOT_CHANGES`); they get
+  a black image of the sequence's size (the detections' extent where it is unknown; only the size
+  is read), one call per frame.
 
 A peer whose package is not installed is reported as skipped by :func:`peer_status`.
 """
@@ -101,31 +104,57 @@ def norfair_iou(seq: RealSequence) -> np.ndarray:
     return _stack(out)
 
 
-def _boxmot(module: str, cls_name: str) -> PeerFn:
+# BoxMOT tracker -> the options changed from its default preset: no appearance model (embeddings off),
+# no camera-motion compensation (it needs real images). StrongSORT is absent: it cannot run without
+# appearance embeddings.
+BOXMOT_CHANGES: dict[str, dict[str, bool | None]] = {
+    "botsort": {"use_embeddings": False, "use_cmc": False},
+    "bytetrack": {},
+    "ocsort": {},
+    "deepocsort": {"use_embeddings": False, "cmc_off": True},
+    "hybridsort": {"use_embeddings": False, "cmc_method": None},
+    "boosttrack": {"use_embeddings": False, "use_cmc": False},
+    "occluboost": {"use_embeddings": False, "use_cmc": False},
+    "sfsort": {},
+}
+
+
+def _extent(seq: RealSequence) -> tuple[int, int]:
+    """``(width, height)`` px reaching the right and bottom edges of every detection (a sequence of unknown size)."""
+    xyxy = _xyxy(np.vstack([np.zeros((1, 4)), *seq.det_xywh]))
+    return int(np.ceil(max(xyxy[:, 2].max(), 1.0))), int(np.ceil(max(xyxy[:, 3].max(), 1.0)))
+
+
+def _boxmot(name: str) -> PeerFn:
     def run(seq: RealSequence) -> np.ndarray:
         import logging
 
-        mod = importlib.import_module(module)
+        from boxmot import create_tracker  # type: ignore[import-not-found,import-untyped,unused-ignore]
+        from boxmot.trackers import TrackerSpec  # type: ignore[import-not-found,import-untyped,unused-ignore]
         from boxmot.utils import logger as boxmot_logger  # type: ignore[import-not-found,import-untyped,unused-ignore]
 
         level = boxmot_logger.level
         boxmot_logger.setLevel(logging.WARNING)  # it logs every tracker's settings at INFO
         try:
-            tracker = getattr(mod, cls_name)()
+            tracker = create_tracker(TrackerSpec(name=name, options=tuple(sorted(BOXMOT_CHANGES[name].items()))))
         finally:
             boxmot_logger.setLevel(level)
-        width, height = seq.image_size or (1920, 1080)
+        needs = tracker.requirements
+        if needs.embeddings or (needs.frame and not needs.frame_dimensions_only):
+            raise RuntimeError(f"boxmot {name}: the preset still needs appearance or image content")
+        width, height = seq.image_size or _extent(seq)
         image = np.zeros((height, width, 3), dtype=np.uint8)
         out = []
         for k in range(seq.length):
             xyxy = _xyxy(seq.det_xywh[k])
-            dets = np.hstack([xyxy, np.asarray(seq.det_score[k], float)[:, None], np.zeros((len(xyxy), 1))])
+            dets = np.hstack([xyxy, np.asarray(seq.det_score[k], float).reshape(-1, 1), np.zeros((len(xyxy), 1))])
             res = np.asarray(tracker.update(dets, image), dtype=float).reshape(-1, 8)
             if len(res):
-                out.append(_rows(k, res[:, 4].astype(int), res[:, :4]))
+                out.append(_rows(k, res[:, 4].astype(int) + 1, res[:, :4]))  # BoxMOT counts ids from 0
         return _stack(out)
 
-    run.__doc__ = f"BoxMOT's ``{cls_name}`` (defaults)."
+    changed = ", ".join(f"{k}={v}" for k, v in BOXMOT_CHANGES[name].items()) or "nothing"
+    run.__doc__ = f"BoxMOT's ``{name}`` with its default preset; changed: {changed}."
     return run
 
 
@@ -136,8 +165,7 @@ PEERS: dict[str, tuple[str, PeerFn]] = {
     "trackers-sort": ("trackers", _roboflow("SORTTracker")),
     "trackers-bytetrack": ("trackers", _roboflow("ByteTrackTracker")),
     "trackers-ocsort": ("trackers", _roboflow("OCSORTTracker")),
-    "boxmot-bytetrack": ("boxmot", _boxmot("boxmot.trackers.bytetrack.bytetrack", "ByteTrack")),
-    "boxmot-ocsort": ("boxmot", _boxmot("boxmot.trackers.ocsort.ocsort", "OcSort")),
+    **{f"boxmot-{name}": ("boxmot.trackers.factory", _boxmot(name)) for name in BOXMOT_CHANGES},
 }
 
 
@@ -151,7 +179,7 @@ def peer_status(names: list[str] | None = None) -> dict[str, str | None]:
         try:
             importlib.import_module(package)
         except ModuleNotFoundError:
-            out[name] = f"{package} not installed"
+            out[name] = f"{package.split('.')[0]} not installed"
         except Exception as exc:  # noqa: BLE001 - an installed package can fail to import (numpy ABI, ...)
             out[name] = f"{package} not importable ({type(exc).__name__}: {exc})"[:200]
         else:
@@ -166,4 +194,4 @@ def run_peer(name: str, seq: RealSequence) -> np.ndarray:
     return PEERS[name][1](seq)
 
 
-__all__ = ["PEERS", "PeerFn", "peer_status", "run_peer"]
+__all__ = ["BOXMOT_CHANGES", "PEERS", "PeerFn", "peer_status", "run_peer"]
