@@ -13,9 +13,9 @@ import time
 
 import numpy as np
 
-from lookalike.learn import EncodingSpec, NetworkWeights, NumpyAssociationNet, load_weights
-from lookalike.learn.checkpoint import CheckpointError
-from lookalike.learn.weights import shipped_weights_path
+from lookalike.trackers.lstm import EncodingSpec, NetworkWeights, NumpyAssociationNet, load_weights
+from lookalike.trackers.lstm.checkpoint import CheckpointError
+from lookalike.trackers.lstm.weights import shipped_weights_path
 
 
 def _weights(n_agents: int, n_slots: int) -> NetworkWeights:

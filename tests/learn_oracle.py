@@ -7,8 +7,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from lookalike.learn.data import IGNORE
-from lookalike.learn.encoding import EncodingSpec, encode_agents, encode_slots
-from lookalike.trackers.set.agents import BeaconMemory
+from lookalike.trackers.lstm.encoding import EncodingSpec, encode_agents, encode_slots
+from lookalike.trackers.parts.agents import BeaconMemory
 from lookalike.types import Frame
 
 

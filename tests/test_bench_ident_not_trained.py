@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typer.testing import CliRunner
 
-import lookalike.learn.weights as weights
+import lookalike.trackers.lstm.weights as weights
 from lookalike.bench.ident import NOT_TRAINED, ident_table, weights_missing
 from lookalike.bench.ident_paper import margin_rows
 from lookalike.cli import app

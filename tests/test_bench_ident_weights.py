@@ -7,7 +7,7 @@ import shutil
 import pytest
 from typer.testing import CliRunner
 
-import lookalike.learn.weights as weights
+import lookalike.trackers.lstm.weights as weights
 from lookalike.bench.ident import ident_table, uses_weights, weights_missing
 from lookalike.cli import app
 

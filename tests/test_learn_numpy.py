@@ -5,8 +5,8 @@ import sys
 import numpy as np
 import pytest
 
-from lookalike.learn import CheckpointError, EncodingSpec, NumpyAssociationNet, load_weights, save_weights
-from lookalike.learn.encoding import encode_frame
+from lookalike.trackers.lstm import CheckpointError, EncodingSpec, NumpyAssociationNet, load_weights, save_weights
+from lookalike.trackers.lstm.encoding import encode_frame
 from lookalike.types import Detections
 
 torch = pytest.importorskip("torch", reason="torch (the 'train' extra) is needed to compare against")

@@ -11,9 +11,9 @@ from typer.testing import CliRunner
 
 from lookalike.io.robot_sequences import write_robot_sequence
 from lookalike.learn.data import IGNORE
-from lookalike.learn.encoding import EncodingSpec
 from lookalike.learn.recordings import RecordingSampler, split_recordings, validation_arrays
 from lookalike.sim import preset, simulate_robots
+from lookalike.trackers.lstm.encoding import EncodingSpec
 
 runner = CliRunner()
 
@@ -101,7 +101,7 @@ def test_train_recordings_refuses_bad_input_in_one_line(app, tmp_path, case):
     else:
         _recordings(folder, n=1, frames=30)
         expected = "at least 2 recordings"
-    from lookalike.learn.weights import shipped_weights_path
+    from lookalike.trackers.lstm.weights import shipped_weights_path
 
     r = runner.invoke(app, ["train", "--recordings", str(folder), "-o", str(tmp_path / "out"), "--steps", "1",
                             "--sequence-length", "150", "--init-from", str(shipped_weights_path(2, 3))])

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from lookalike.learn.encoding import EncodingSpec
 from lookalike.learn.sim_data import arrays_to_training
 from lookalike.sim import preset, simulate_robots
+from lookalike.trackers.lstm.encoding import EncodingSpec
 from tests.learn_oracle import frames_to_arrays
 
 

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from lookalike.learn import CheckpointError, EncodingSpec, NetworkWeights, save_weights
-from lookalike.learn.tracker import BeaconMemory, LstmIdentifier, decode
 from lookalike.trackers import make_tracker
+from lookalike.trackers.lstm import CheckpointError, EncodingSpec, NetworkWeights, save_weights
+from lookalike.trackers.lstm.tracker import BeaconMemory, LstmIdentifier, decode
 from lookalike.types import Beacons, Detections, Frame, TrackStatus
 
 

@@ -5,8 +5,8 @@ from lookalike.types import Beacons, Detections, Frame
 
 torch = pytest.importorskip("torch", reason="training needs torch (the 'train' extra)")
 
-from lookalike.learn.encoding import EncodingSpec  # noqa: E402
 from lookalike.learn.training import TrainConfig, plot_log, train  # noqa: E402
+from lookalike.trackers.lstm.encoding import EncodingSpec  # noqa: E402
 from tests.learn_oracle import frames_to_arrays  # noqa: E402
 
 
@@ -73,8 +73,8 @@ def test_batches_made_in_worker_processes_train_identically(tmp_path):
 
 
 def test_training_can_start_from_exported_weights(tmp_path):
-    from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.model import AssociationNet
+    from lookalike.trackers.lstm.checkpoint import load_weights
 
     torch.set_num_threads(1)
     first = train(_config(steps=10, validation_every=10), toy_sampler, tmp_path / "a")

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.learn.checkpoint import CheckpointError, NetworkWeights
-from lookalike.learn.encoding import EncodingSpec
-from lookalike.learn.numpy_net import NumpyAssociationNet
 from lookalike.learn.transfer import transfer_weights
+from lookalike.trackers.lstm.checkpoint import CheckpointError, NetworkWeights
+from lookalike.trackers.lstm.encoding import EncodingSpec
+from lookalike.trackers.lstm.network import NumpyAssociationNet
 
 
 def _weights(spec: EncodingSpec, hidden: int = 4, layers: int = 2, seed: int = 0) -> NetworkWeights:
@@ -70,7 +70,7 @@ def test_train_init_transfer_command(tmp_path) -> None:
     from typer.testing import CliRunner
 
     from lookalike.cli import app
-    from lookalike.learn.weights import WEIGHTS_DIR
+    from lookalike.trackers.lstm.weights import WEIGHTS_DIR
 
     source = WEIGHTS_DIR / "lstm_paper_m3_n2.npz"
     if not source.is_file():

@@ -6,7 +6,6 @@ from __future__ import annotations
 import shutil
 import subprocess
 import sys
-from importlib.metadata import entry_points
 from pathlib import Path
 
 import pytest
@@ -16,44 +15,40 @@ from lookalike.trackers import registry
 tomllib = pytest.importorskip("tomllib", reason="reading pyproject.toml needs Python 3.11's tomllib")
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
-PLUGINS: dict[str, str] = PYPROJECT["project"]["entry-points"]["lookalike.trackers"]
+PLUGINS: dict[str, str] = PYPROJECT["project"].get("entry-points", {}).get("lookalike.trackers", {})
 
 
-def _layer_index(module: str) -> int:
-    """Position of ``module`` in the layers contract (0: top), or -1 when no layer holds it."""
-    contract = next(c for c in PYPROJECT["tool"]["importlinter"]["contracts"] if c["type"] == "layers")
-    for i, layer in enumerate(contract["layers"]):
-        for part in layer.replace(":", "|").split("|"):
-            name = part.strip().strip("()")
-            if module == name or module.startswith(name + "."):
-                return i
-    return -1
+def test_every_shipped_tracker_is_built_in() -> None:
+    """The package declares no tracker plugins: every shipped tracker sits in the trackers layer (the
+    entry-point group stays open to other packages' trackers)."""
+    assert PLUGINS == {}
+    for name, module in registry.BUILTIN_TRACKERS.items():
+        assert module.startswith("lookalike.trackers."), f"{name}: {module}"
+        assert registry.tracker_class(name).__module__ == module
 
 
-def test_tracker_plugins_sit_above_the_trackers_layer() -> None:
-    trackers = _layer_index("lookalike.trackers")
-    assert PLUGINS, "no [project.entry-points.\"lookalike.trackers\"] in pyproject.toml"
-    for name, target in PLUGINS.items():
-        module = target.split(":")[0]
-        assert 0 <= _layer_index(module) < trackers, f"plugin {name}: {module} is not in a layer above the trackers"
+def test_a_third_party_plugin_registers_under_its_entry_point_name(monkeypatch: pytest.MonkeyPatch,
+                                                                    tmp_path: Path) -> None:
+    import sys
 
-
-def test_tracker_plugins_register_under_their_entry_point_name() -> None:
-    for name, target in PLUGINS.items():
-        module, _, attr = target.partition(":")
-        cls = getattr(__import__(module, fromlist=[attr]), attr)
-        assert registry.tracker_class(name) is cls
-
-
-def test_the_registry_loads_exactly_the_declared_plugins() -> None:
-    declared = {target.split(":")[0] for target in PLUGINS.values()}
-    listed = getattr(registry, "PLUGIN_MODULES", None)
-    if listed is not None:  # the string list the registry imports, until it reads the entry points
-        assert set(listed) == declared
-    installed = {ep.name: ep.value for ep in entry_points(group="lookalike.trackers")}
-    if not installed:
-        pytest.skip("the installed metadata predates the entry point (reinstall: make venv)")
-    assert installed == PLUGINS
+    (tmp_path / "lookalike_test_plugin.py").write_text(
+        "from dataclasses import dataclass\n\n"
+        "from lookalike.trackers.registry import register_tracker\n\n\n"
+        "@register_tracker('test-plugin')\n"
+        "class TestPlugin:\n"
+        "    @dataclass(frozen=True)\n"
+        "    class Config:\n"
+        "        pass\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))  # (undone after the test)
+    monkeypatch.setattr(registry, "_plugins", {"test-plugin": "lookalike_test_plugin"})
+    try:
+        assert "test-plugin" in registry.tracker_names()
+        cls = registry.tracker_class("test-plugin")
+        assert cls.__module__ == "lookalike_test_plugin" and cls.__name__ == "TestPlugin"
+    finally:
+        sys.modules.pop("lookalike_test_plugin", None)
 
 
 def test_ruff_is_clean() -> None:

@@ -170,7 +170,7 @@ def test_bench_pixels_tiny(models, tmp_path):
 
 
 def test_bench_pixels_weights_replace_the_lstms_on_both_sides(models, tmp_path):
-    from lookalike.learn.weights import shipped_weights_path
+    from lookalike.trackers.lstm.weights import shipped_weights_path
 
     _, _, det_path, head_path = models
     base = ["bench", "pixels", "--setups", "m3n2", "--identifiers", "lstm", "--sequences", "1", "--frames", "10",

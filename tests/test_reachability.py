@@ -4,7 +4,7 @@ imports the research code or the benchmark scripts.
 The import graph is read from the source with ``ast`` (nothing is imported): ``import`` and
 ``from ... import`` statements anywhere in a module (lazy imports inside functions included, relative
 ones resolved), plus string constants that name a lookalike module (``"lookalike.trackers.sort"``,
-``"lookalike.learn.tracker:LstmIdentifier"``), as the lazy ``_HOME`` tables and the tracker registry
+``"lookalike.trackers.lstm.tracker:LstmIdentifier"``), as the lazy ``_HOME`` tables and the tracker registry
 use. Importing ``a.b.c`` also imports the packages ``a`` and ``a.b``. The roots are the command line
 (every module of ``lookalike.cli``), ``python -m lookalike``, the package and every subpackage
 ``__init__`` (the public API), and the entry points in pyproject.toml.

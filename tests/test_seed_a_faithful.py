@@ -11,12 +11,12 @@ from typer.testing import CliRunner
 from lookalike.bench.ident_paper import margin_rows, resolve_identifier
 from lookalike.bench.table3 import draw_windows, table3_rows
 from lookalike.cli import app
-from lookalike.learn.encoding import EncodingSpec, encode_frame
 from lookalike.learn.paper_protocol import NoiseMixSampler, arrays_to_training_paper, noise_worlds
-from lookalike.learn.tracker import BeaconMemory, decode
 from lookalike.sim import NOISE_MODELS, noise_sensor, preset, simulate_arrays, simulate_robots
 from lookalike.sim.robots_sensors import position_noise_std
 from lookalike.trackers import make_tracker
+from lookalike.trackers.lstm.encoding import EncodingSpec, encode_frame
+from lookalike.trackers.lstm.tracker import BeaconMemory, decode
 from lookalike.trackers.parts.identity.localiser import KalmanLocaliser, LowPassLocaliser, make_localiser
 
 runner = CliRunner()

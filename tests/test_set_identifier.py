@@ -3,10 +3,10 @@ import json
 import numpy as np
 import pytest
 
-from lookalike.learn import CheckpointError
 from lookalike.learn.set_data import SetBatchMaker, agent_tokens, detection_tokens
 from lookalike.sim import simulate_robots
 from lookalike.trackers import make_tracker
+from lookalike.trackers.lstm import CheckpointError
 from lookalike.trackers.set.network import NumpySetAssociator, SetWeights, load_set_weights, save_set_weights
 
 

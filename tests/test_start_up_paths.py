@@ -65,17 +65,6 @@ def test_writer_buffers_and_writes_every_row_once(tmp_path):
     assert (tmp_path / "out.txt").read_text() == expected
 
 
-def test_plugin_fallback_names_match_pyproject():
-    import tomllib
-    from pathlib import Path
-
-    from lookalike.trackers import registry
-
-    project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
-    declared = project["project"]["entry-points"]["lookalike.trackers"]
-    assert {name: target.split(":")[0] for name, target in declared.items()} == registry.PLUGIN_TRACKERS
-
-
 @pytest.mark.parametrize(("given", "expected"), [(None, "1"), ("2", "2")])
 def test_the_program_runs_blas_on_one_thread_unless_told(given, expected):
     import os

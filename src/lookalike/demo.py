@@ -64,8 +64,8 @@ class DemoResult:
 
 def lstm_status(setup: str) -> str | None:
     """None when shipped LSTM weights exist for preset ``setup``, else why the LSTM is left out."""
-    from lookalike.learn.checkpoint import CheckpointError
-    from lookalike.learn.weights import shipped_weights_path
+    from lookalike.trackers.lstm.weights import shipped_weights_path
+    from lookalike.trackers.parts.weights_io import CheckpointError
 
     cfg = preset(setup)
     try:

@@ -23,12 +23,12 @@ from lookalike.bench.paired import Comparison, PairedDifference, add_comparisons
 from lookalike.bench.progress import ProgressFactory, Step, no_progress
 from lookalike.eval import identification_counts, identification_success_rate, localisation_error
 from lookalike.io.results import Results, percent_row_metrics
-from lookalike.learn.checkpoint import CheckpointError
-from lookalike.learn.weights import shipped_weights_path
 from lookalike.loop import RunStats, run
 from lookalike.sim import DEFAULT_NOISE, PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
 from lookalike.trackers import make_tracker, tracker_parameters
+from lookalike.trackers.lstm.weights import shipped_weights_path
 from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
+from lookalike.trackers.parts.weights_io import CheckpointError
 from lookalike.types import Frame
 
 # lstm: the paper's method, our inputs; lstm-paper: the paper's protocol; set: any team size

@@ -132,12 +132,12 @@ def train(
         return
     if learning_rate is None:
         learning_rate = 0.004
-    from lookalike.learn.encoding import EncodingSpec
     from lookalike.learn.paper_protocol import noise_worlds
     from lookalike.learn.training import TrainConfig, plot_log
     from lookalike.learn.training import train as run_training
-    from lookalike.learn.weights import WEIGHTS_DIR
     from lookalike.parallel import JobPool
+    from lookalike.trackers.lstm.encoding import EncodingSpec
+    from lookalike.trackers.lstm.weights import WEIGHTS_DIR
 
     if device == "auto":
         device = "cuda" if torch.cuda.is_available() else "cpu"
@@ -203,9 +203,9 @@ def _initial_weights(init_from: Path | None, transfer: bool, spec: Any, sample: 
                      seed: int) -> Any:
     """The weights ``--init-from`` names (None without it); with ``--init-transfer`` mapped onto ``spec``'s
     set-up and normalised on 8 sequences of ``sample`` (seeds just below the training seeds)."""
-    from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.training import TRAIN_SEED_BASE
     from lookalike.learn.transfer import transfer_from_file
+    from lookalike.trackers.lstm.checkpoint import load_weights
 
     if transfer and init_from is None:
         raise ValueError("--init-transfer needs --init-from")

@@ -55,12 +55,12 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     import torch
 
     from lookalike.cli.train import _with_progress
-    from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.recordings import RecordingSampler, check_recordings, split_recordings, validation_arrays
     from lookalike.learn.training import TrainConfig, plot_log
     from lookalike.learn.training import train as run_training
-    from lookalike.learn.weights import shipped_weights_path
     from lookalike.parallel import JobPool
+    from lookalike.trackers.lstm.checkpoint import load_weights
+    from lookalike.trackers.lstm.weights import shipped_weights_path
 
     recordings = read_recordings(folder, "--recordings")
     tests = read_recordings(opt.test, "--test") if opt.test is not None else []

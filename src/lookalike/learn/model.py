@@ -9,8 +9,8 @@ import numpy as np
 import torch
 from torch import nn
 
-from lookalike.learn.checkpoint import NetworkWeights
-from lookalike.learn.encoding import EncodingSpec
+from lookalike.trackers.lstm.checkpoint import NetworkWeights
+from lookalike.trackers.lstm.encoding import EncodingSpec
 
 
 class AssociationNet(nn.Module):
@@ -58,7 +58,7 @@ class AssociationNet(nn.Module):
         self.set_normalisation(weights.input_mean, weights.input_std)
 
     def export(self, info: dict | None = None) -> NetworkWeights:
-        """The weights as numpy arrays for :class:`~lookalike.learn.numpy_net.NumpyAssociationNet`."""
+        """The weights as numpy arrays for :class:`~lookalike.trackers.lstm.network.NumpyAssociationNet`."""
         layers = []
         for i in range(self.rnn.num_layers):
             layers.append(

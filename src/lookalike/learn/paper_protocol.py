@@ -1,5 +1,6 @@
-"""Training arrays in the robot-identification paper's input layout (``N + 4·M``, :mod:`lookalike.learn.encoding`; no
-augmentation beyond slot shuffling) and a sampler drawing each sequence's noise model from its seed."""
+"""Training arrays in the robot-identification paper's input layout (``N + 4·M``,
+:mod:`lookalike.trackers.lstm.encoding`; no augmentation beyond slot shuffling) and a sampler drawing each
+sequence's noise model from its seed."""
 
 from __future__ import annotations
 
@@ -8,9 +9,9 @@ import dataclasses
 import numpy as np
 
 from lookalike.learn.data import IGNORE
-from lookalike.learn.encoding import EncodingSpec, encode_agents_paper
 from lookalike.learn.sim_data import arrays_to_training, latest_reports, mix_pick, slot_order
 from lookalike.sim import RobotArrays, RobotWorldConfig, simulate_arrays
+from lookalike.trackers.lstm.encoding import EncodingSpec, encode_agents_paper
 
 NOISE_CHOICES = ("ours", "paper", "mix")
 

@@ -11,10 +11,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.learn.data import IGNORE
-from lookalike.learn.encoding import EncodingSpec
 from lookalike.learn.paper_protocol import NoiseMixSampler, arrays_to_training_paper
 from lookalike.learn.sim_data import arrays_to_training
 from lookalike.sim import RobotArrays, RobotSequence, RobotWorldConfig
+from lookalike.trackers.lstm.encoding import EncodingSpec
 
 
 def recording_arrays(spec: EncodingSpec, arrays: RobotArrays, rng: np.random.Generator | None = None

@@ -102,10 +102,10 @@ def run_trial(config: Any, world: RobotWorldConfig, out_dir: str, threads: int =
 def check_success(weights_path: Path, world: RobotWorldConfig, sequences: int, length: int) -> float:
     """Per-slot success rate of the network at ``weights_path`` on ``sequences`` sequences of ``length``
     frames from the held-out check seeds (slots most probable first, as at inference)."""
-    from lookalike.learn.checkpoint import load_weights
     from lookalike.learn.data import success_rate
-    from lookalike.learn.numpy_net import NumpyAssociationNet
     from lookalike.learn.sim_data import make_sim_sampler
+    from lookalike.trackers.lstm.checkpoint import load_weights
+    from lookalike.trackers.lstm.network import NumpyAssociationNet
 
     weights = load_weights(weights_path)
     net = NumpyAssociationNet(weights)

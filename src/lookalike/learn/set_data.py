@@ -1,6 +1,6 @@
 """Training arrays for the set associator (any team size), straight from the robot simulator.
 
-Unlike the LSTM's flat input vector (:mod:`lookalike.learn.encoding`), the set associator reads
+Unlike the LSTM's flat input vector (:mod:`lookalike.trackers.lstm.encoding`), the set associator reads
 tokens: per agent ``cos ψ, sin ψ, age / max_age, known`` (the latest reported absolute heading
 ``ψ``, the report's age in seconds clipped to ``max_age_s``, 1 if heard from else 0) and per
 detection ``x, y, cos φ, sin φ, γ`` (observer-frame position in metres, absolute visual heading,

@@ -10,8 +10,8 @@ import dataclasses
 import numpy as np
 
 from lookalike.learn.data import IGNORE
-from lookalike.learn.encoding import AGENT_WIDTH, EncodingSpec, encode_agents, relative_headings
 from lookalike.sim import RobotArrays, RobotWorldConfig, simulate_arrays
+from lookalike.trackers.lstm.encoding import AGENT_WIDTH, EncodingSpec, encode_agents, relative_headings
 
 
 def slot_order(arrays: RobotArrays, rng: np.random.Generator | None) -> np.ndarray:
@@ -26,7 +26,7 @@ def slot_order(arrays: RobotArrays, rng: np.random.Generator | None) -> np.ndarr
 def latest_reports(arrays: RobotArrays, n_agents: int) -> tuple[np.ndarray, np.ndarray]:
     """Per frame and agent, the newest report received so far (by send time): headings and send
     times ``(T, N)``, NaN where nothing was received yet. Late reports older than the kept one are
-    ignored, as :class:`~lookalike.trackers.set.agents.BeaconMemory` does at inference."""
+    ignored, as :class:`~lookalike.trackers.parts.agents.BeaconMemory` does at inference."""
     r = arrays.reports
     T = len(arrays)
     heading = np.full((T, n_agents), np.nan)

@@ -18,11 +18,11 @@ import numpy as np
 import torch
 from torch import nn
 
-from lookalike.learn.checkpoint import NetworkWeights, save_weights
 from lookalike.learn.data import IGNORE, success_rate
-from lookalike.learn.encoding import EncodingSpec
 from lookalike.learn.model import AssociationNet
 from lookalike.parallel import JobPool
+from lookalike.trackers.lstm.checkpoint import NetworkWeights, save_weights
+from lookalike.trackers.lstm.encoding import EncodingSpec
 
 TRAIN_SEED_BASE = 2_000_000_000  # training sequences use seeds from here on
 VALIDATION_SEED_BASE = 1_900_000_000  # fixed held-out validation seeds

@@ -12,8 +12,9 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.learn.checkpoint import CheckpointError, NetworkWeights
-from lookalike.learn.encoding import EncodingSpec
+from lookalike.trackers.lstm.checkpoint import NetworkWeights
+from lookalike.trackers.lstm.encoding import EncodingSpec
+from lookalike.trackers.parts.weights_io import CheckpointError
 
 
 def _input_map(source: EncodingSpec, target: EncodingSpec) -> np.ndarray:
@@ -97,7 +98,7 @@ def transfer_from_file(
 ) -> NetworkWeights:
     """Weights at ``path`` (any N, M of ``target``'s protocol) mapped onto ``target``, normalised by the
     mean and standard deviation of ``sample(seed, length, None)`` inputs over ``seeds`` (the new set-up's data)."""
-    from lookalike.learn.checkpoint import load_weights
+    from lookalike.trackers.lstm.checkpoint import load_weights
 
     source = load_weights(path)
     xs = np.concatenate([sample(int(s), length, None)[0] for s in seeds])

@@ -58,11 +58,7 @@ def register_tracker(name: str) -> Callable[[type], type]:
 def tracker_names() -> list[str]:
     """Names of all registered trackers, sorted: the built-in ones (:data:`BUILTIN_TRACKERS`), the
     plugins' entry-point names and any registered since, without importing a tracker module."""
-    plugins = _plugin_names()
-    if plugins is None:  # no package metadata: the plugin modules tell their names when imported
-        _load_builtin()
-        return sorted(_REGISTRY)
-    return sorted(set(BUILTIN_TRACKERS) | plugins | set(_REGISTRY))
+    return sorted(set(BUILTIN_TRACKERS) | set(_plugin_entry_points()) | set(_REGISTRY))
 
 
 def tracker_class(name: str) -> type:
@@ -164,45 +160,33 @@ BUILTIN_TRACKERS = {
     "jpda": "lookalike.trackers.jpda",
     "kalman_ha": "lookalike.trackers.kalman_ha",
     "kalman_ha2": "lookalike.trackers.kalman_ha",
+    "lstm": "lookalike.trackers.lstm.tracker",
     "set": "lookalike.trackers.set.tracker",
     "sort": "lookalike.trackers.sort",
 }
 """The trackers of this layer and the module that registers each (tests check the list is complete),
 so that :func:`tracker_names` needs no tracker module imported."""
 
-# Trackers defined above the trackers layer (they need the learned network); imported by name
-# so that this layer never imports upwards.
-PLUGIN_TRACKERS = {"lstm": "lookalike.learn.tracker"}
-"""The plugins pyproject.toml declares (entry points of group ``lookalike.trackers``), used where the
-installed metadata does not list them (an install older than the entry points)."""
-PLUGIN_MODULES = tuple(PLUGIN_TRACKERS.values())
-
 ENTRY_POINT_GROUP = "lookalike.trackers"
+"""Other packages add trackers through entry points of this group (name = "module:Class"); the package itself
+declares none: every shipped tracker is built in."""
 
 _PLUGINS_LOADED = False
 _plugins: dict[str, str] | None = None
 
 
 def _plugin_entry_points() -> dict[str, str]:
-    """Entry-point name -> module of group ``lookalike.trackers`` (read once), or
-    :data:`PLUGIN_TRACKERS` where the installed metadata lists none."""
+    """Entry-point name -> module of group ``lookalike.trackers`` (read once)."""
     global _plugins
     if _plugins is None:
         from importlib.metadata import entry_points
 
-        _plugins = {ep.name: ep.module for ep in entry_points(group=ENTRY_POINT_GROUP)} or dict(PLUGIN_TRACKERS)
+        _plugins = {ep.name: ep.module for ep in entry_points(group=ENTRY_POINT_GROUP)}
     return _plugins
 
 
-def _plugin_names() -> set[str] | None:
-    """The plugins' names (None: none known, the plugin modules must be imported to tell)."""
-    names = set(_plugin_entry_points())
-    return names or None
-
-
 def _load_builtin() -> None:
-    """Register the built-in trackers and the plugins: the entry points of group ``lookalike.trackers``
-    (read once), or :data:`PLUGIN_TRACKERS` where the installed metadata lists none."""
+    """Register the built-in trackers and the plugins (the entry points of group ``lookalike.trackers``)."""
     global _PLUGINS_LOADED
     if _PLUGINS_LOADED:
         return

@@ -15,6 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.trackers.parts.weights_io import CheckpointError, read_metadata
+
 FORMAT = "lookalike-set-associator"
 FORMAT_VERSION = 1
 POSITION_SCALE_M = 4.0
@@ -23,28 +25,6 @@ AGENT_FEATURES = 4
 DET_FEATURES = 5
 MAX_AGE_S = 5.0  # report age at which an agent token's age feature saturates, seconds
 SHIPPED_SET_WEIGHTS = Path(__file__).with_name("weights") / "set_any.npz"
-
-
-class CheckpointError(ValueError):
-    """A weights file that is corrupt, of another version, or does not fit the requested set-up."""
-
-
-def read_metadata(path: str | os.PathLike[str], fmt: str, what: str) -> tuple[Path, Path, dict[str, Any]]:
-    """``(weights .npz path, metadata .json path, parsed metadata)`` of weights stored as an ``.npz``
-    with a ``.json`` beside it; :class:`CheckpointError` naming the file when either is missing, the
-    JSON is invalid or its ``format`` is not ``fmt`` (``what`` names the expected kind in the message)."""
-    path = Path(path).with_suffix(".npz")
-    meta_path = path.with_suffix(".json")
-    if not path.is_file() or not meta_path.is_file():
-        raise CheckpointError(f"{path}: expected {path.name} and {meta_path.name} side by side")
-    try:
-        meta = json.loads(meta_path.read_text())
-    except json.JSONDecodeError as exc:
-        raise CheckpointError(f"{meta_path}: not valid JSON ({exc})") from None
-    if not isinstance(meta, dict) or meta.get("format") != fmt:
-        found = meta.get("format") if isinstance(meta, dict) else None
-        raise CheckpointError(f"{meta_path}: not a {what} (format {found!r})")
-    return path, meta_path, meta
 
 
 def shipped_set_weights_path() -> Path:

@@ -39,10 +39,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.trackers.base import check_params, param
+from lookalike.trackers.parts.agents import BeaconMemory, agent_detections, agent_snapshots, decode
 from lookalike.trackers.parts.identity.localiser import LOCALISERS, make_localiser
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.set import report_exchange
-from lookalike.trackers.set.agents import BeaconMemory, agent_detections, agent_snapshots, decode
 from lookalike.trackers.set.network import (
     NumpySetAssociator,
     agent_tokens,

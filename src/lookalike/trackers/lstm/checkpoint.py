@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.learn.encoding import ENCODING_VERSION, EncodingSpec
-from lookalike.trackers.set.network import CheckpointError, read_metadata
+from lookalike.trackers.lstm.encoding import ENCODING_VERSION, EncodingSpec
+from lookalike.trackers.parts.weights_io import CheckpointError, read_metadata
 
 FORMAT_VERSION = 1
 GATES = {"lstm": 4, "gru": 3}

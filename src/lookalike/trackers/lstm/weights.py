@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from lookalike.learn.checkpoint import CheckpointError
+from lookalike.trackers.parts.weights_io import CheckpointError
 
 WEIGHTS_DIR = Path(__file__).with_name("weights_data")
 

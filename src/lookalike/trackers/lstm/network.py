@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lookalike.learn.checkpoint import NetworkWeights
+from lookalike.trackers.lstm.checkpoint import NetworkWeights
 
 
 def _sigmoid(x: np.ndarray) -> np.ndarray:
@@ -69,4 +69,5 @@ class NumpyAssociationNet:
         logits = logits.reshape(*logits.shape[:-1], self.spec.n_slots, self.spec.n_classes)
         logits = logits - logits.max(axis=-1, keepdims=True)
         p = np.exp(logits)
-        return p / p.sum(axis=-1, keepdims=True)
+        probabilities: np.ndarray = p / p.sum(axis=-1, keepdims=True)
+        return probabilities

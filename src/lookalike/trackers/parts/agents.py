@@ -1,7 +1,7 @@
 """What the learned identifiers share: the agents' latest heading reports, decoding class probabilities into
 one detection per agent, and the agents as tracks (one snapshot per agent, positioned by a localiser).
 
-Used by ``set`` (:mod:`lookalike.trackers.set.tracker`) and the LSTM identifier (``lookalike.learn.tracker``).
+Used by ``set`` (:mod:`lookalike.trackers.set.tracker`) and the LSTM identifier (``lookalike.trackers.lstm.tracker``).
 """
 
 from __future__ import annotations

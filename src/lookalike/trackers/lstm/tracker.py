@@ -12,14 +12,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.learn.checkpoint import load_weights
-from lookalike.learn.encoding import PROTOCOLS, EncodingSpec, encode_frame
-from lookalike.learn.numpy_net import NumpyAssociationNet
-from lookalike.learn.weights import shipped_weights_path
 from lookalike.trackers.base import check_params, param
+from lookalike.trackers.lstm.checkpoint import load_weights
+from lookalike.trackers.lstm.encoding import PROTOCOLS, EncodingSpec, encode_frame
+from lookalike.trackers.lstm.network import NumpyAssociationNet
+from lookalike.trackers.lstm.weights import shipped_weights_path
+from lookalike.trackers.parts.agents import BeaconMemory, agent_snapshots, decode
 from lookalike.trackers.parts.identity.localiser import LOCALISERS, make_localiser
 from lookalike.trackers.registry import register_tracker
-from lookalike.trackers.set.agents import BeaconMemory, agent_snapshots, decode
 from lookalike.types import Frame, TrackSnapshot
 
 

@@ -1,0 +1,31 @@
+"""Network weights stored as an ``.npz`` with a ``.json`` of metadata beside it: reading the metadata, and the error
+a corrupt or mismatched file raises."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+
+class CheckpointError(ValueError):
+    """A weights file that is corrupt, of another version, or does not fit the requested set-up."""
+
+
+def read_metadata(path: str | os.PathLike[str], fmt: str, what: str) -> tuple[Path, Path, dict[str, Any]]:
+    """``(weights .npz path, metadata .json path, parsed metadata)`` of weights stored as an ``.npz``
+    with a ``.json`` beside it; :class:`CheckpointError` naming the file when either is missing, the
+    JSON is invalid or its ``format`` is not ``fmt`` (``what`` names the expected kind in the message)."""
+    path = Path(path).with_suffix(".npz")
+    meta_path = path.with_suffix(".json")
+    if not path.is_file() or not meta_path.is_file():
+        raise CheckpointError(f"{path}: expected {path.name} and {meta_path.name} side by side")
+    try:
+        meta = json.loads(meta_path.read_text())
+    except json.JSONDecodeError as exc:
+        raise CheckpointError(f"{meta_path}: not valid JSON ({exc})") from None
+    if not isinstance(meta, dict) or meta.get("format") != fmt:
+        found = meta.get("format") if isinstance(meta, dict) else None
+        raise CheckpointError(f"{meta_path}: not a {what} (format {found!r})")
+    return path, meta_path, meta
