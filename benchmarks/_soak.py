@@ -36,7 +36,8 @@ from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
 # Datagram outcomes that exclude each other: every datagram read falls under exactly one.
 EXCLUSIVE = ("rate_limited", "reports", "late", "duplicate", "unknown_robot", "time_backwards", "queue_full",
-             "frames", "frame_backwards", "status_requests", "tracker_errors", "handler_errors")
+             "frames", "frame_backwards", "time_ahead", "other_camera", "status_requests", "tracker_errors",
+             "handler_errors")
 
 
 class LatestHeadingMatcher:
@@ -191,7 +192,8 @@ def soak(seconds: float, seed: int = 0, n_robots: int = 3, n_ports: int = 40) ->
             elif roll < 0.85:
                 frame += 1 if rng.random() < 0.95 else -3  # sometimes backwards
                 n = int(rng.integers(0, 6))
-                port.send(DetectionsMessage(frame=max(frame, 0), time=max(frame, 0) * 0.033, heading=tuple(
+                camera = ports[0] if rng.random() < 0.95 else port  # the camera, and now and then another sender
+                camera.send(DetectionsMessage(frame=max(frame, 0), time=max(frame, 0) * 0.033, heading=tuple(
                     rng.uniform(-3, 3, n).tolist()), position=tuple((float(i), 0.0) for i in range(n)),
                     score=(1.0,) * n))
                 sim = max(sim, max(frame, 0) * 0.033)
@@ -240,6 +242,7 @@ def _final_frame(node: NodeServer, subscriber: Endpoint, n_robots: int, frame: i
     order = list(reversed(range(n_robots)))
     positions = tuple((10.0 + k, -1.0 * k) for k in range(n_robots))
     subscriber.drain()
+    time.sleep(1.5 * node.config.camera_timeout_s)  # the mix's camera falls silent: a new camera is accepted
     with Endpoint(node.address) as robots, Endpoint(node.address) as camera:
         # an empty frame first takes the reports still queued from the mix
         camera.send(DetectionsMessage(frame=frame - 1, time=t - 0.5, position=(), heading=(), score=()))

@@ -93,7 +93,8 @@ def serve(
     group: str | None = typer.Option(None, help="IPv4 multicast GROUP:PORT that gets each team state once "
                                      "(one send per frame) instead of one reply per robot; robots join it."),
     max_report_age: float = typer.Option(1.0, help="Drop reports sent this many seconds before the last frame."),
-    camera_timeout: float = typer.Option(2.0, help="Wall seconds without frames before the camera counts as lost."),
+    camera_timeout: float = typer.Option(2.0, help="Wall seconds without an accepted frame before the camera counts "
+                                         "as lost."),
     rate: float = typer.Option(2000.0, help="Packets/s one sender may send before being rate-limited."),
     burst: float = typer.Option(500.0, help="Packets one sender may send at once."),
     status_interval: float = typer.Option(5.0, help="Seconds between status log lines (0: none)."),

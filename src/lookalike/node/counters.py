@@ -23,6 +23,9 @@ EVENTS = (
     "queue_dropped",  # accepted reports pushed out of their robot's full queue before a frame came
     "queue_full",  # reports dropped because the queues of all robots together were full
     "frame_backwards",  # a detection frame older than the last one (dropped)
+    "time_ahead",  # a frame or report whose time is too far after the camera's last frame (dropped)
+    "other_camera",  # a detection frame from another sender while the camera is alive (dropped)
+    "robot_resets",  # robots whose sequence and clock were forgotten: their last report was ahead of a new frame
     "camera_lost",  # the camera went silent for longer than the timeout
     "camera_restarts",  # the camera came back with an earlier time: the tracker was reset
     "rate_limited",  # datagrams dropped because their sender exceeded its packet rate

@@ -1,7 +1,8 @@
 """Socket-free core of the node: checks reports and frames, runs the tracker, builds team states.
 
 Every time is simulated time carried by the messages (a report's ``t_sent``, a frame's ``time``); a report reaches the
-tracker with the next frame, stamped ``t_received`` = that frame's time."""
+tracker with the next frame, stamped ``t_received`` = that frame's time. A time is trusted only within bounds of the
+camera's clock (:class:`IdentifierConfig`): one message far ahead is dropped (``time_ahead``), never the new "now"."""
 
 from __future__ import annotations
 
@@ -38,18 +39,28 @@ class IdentifierConfig:
         max_queued_per_robot: reports of one robot kept for the next frame; beyond it the oldest
             is dropped (counted ``queue_dropped``).
         max_queued: reports of all robots kept for the next frame; beyond it a new report is
-            dropped (counted ``queue_full``)."""
+            dropped (counted ``queue_full``).
+        max_frame_jump_s: a frame more than this after the last frame (seconds) is dropped as
+            ``time_ahead`` while the camera is alive (a camera lost may come back at any time).
+        max_report_ahead_s: a report sent more than this after the last frame (seconds) is dropped as
+            ``time_ahead``; a robot whose last report (taken before any frame, or while the camera was lost) is
+            that far ahead of a new frame has its sequence and clock forgotten (counted ``robot_resets``)."""
 
     n_robots: int = 3
     max_report_age_s: float = 1.0
     max_queued_per_robot: int = 64
     max_queued: int = 4096
+    max_frame_jump_s: float = 10.0
+    max_report_ahead_s: float = 1.0
 
     def __post_init__(self) -> None:
         if not 1 <= self.n_robots <= MAX_ROBOTS:
             raise ValueError(f"n_robots must be in 1 .. {MAX_ROBOTS}, got {self.n_robots}")
         if not (self.max_report_age_s > 0 and math.isfinite(self.max_report_age_s)):
             raise ValueError(f"max_report_age_s must be a finite number > 0, got {self.max_report_age_s}")
+        for name in ("max_frame_jump_s", "max_report_ahead_s"):
+            if not (getattr(self, name) > 0 and math.isfinite(getattr(self, name))):
+                raise ValueError(f"{name} must be a finite number > 0, got {getattr(self, name)}")
         if self.max_queued_per_robot < 1 or self.max_queued < 1:
             raise ValueError(f"max_queued_per_robot and max_queued must be >= 1, got "
                              f"{self.max_queued_per_robot} and {self.max_queued}")
@@ -81,12 +92,16 @@ class TeamIdentifier:
         self.last_time = -math.inf
         self.camera_lost = False
         self.restarts = 0
+        self.robot_resets = 0  # robots whose sequence and clock were forgotten (ahead of a new frame)
 
     def add_report(self, report: HeadingReport) -> str:
         """Queue ``report`` for the next frame, or say why it is dropped."""
         j = report.robot
         if j >= self.config.n_robots:
             return "unknown_robot"
+        if (self.last_frame is not None and not self.camera_lost
+                and report.t_sent > self.last_time + self.config.max_report_ahead_s):
+            return "time_ahead"  # (judged against the camera's clock: never taken as the robot's "now")
         last_seq, last_sent = self._last_seq[j], self._last_sent[j]
         if report.seq == last_seq:
             return "duplicate"
@@ -145,11 +160,24 @@ class TeamIdentifier:
                 if not self.camera_lost:
                     return "frame_backwards", None
                 self.restart()
+            elif message.time - self.last_time > self.config.max_frame_jump_s and not self.camera_lost:
+                return "time_ahead", None
         self.camera_lost = False
+        self._forget_robots_ahead_of(message.time)
         frame = self._frame(message)
         snapshots = self.tracker.update(frame)
         self.last_frame, self.last_time = message.frame, message.time
         return "frames", self._team_state(frame, snapshots)
+
+    def _forget_robots_ahead_of(self, time: float) -> None:
+        """Forget the sequence number and send time of every robot whose last report is more than
+        ``max_report_ahead_s`` after the frame ``time``: a report taken before the camera's clock was known
+        cannot lock its robot out (counted in ``robot_resets``)."""
+        ahead = self._last_sent > time + self.config.max_report_ahead_s
+        if ahead.any():
+            self._last_sent[ahead] = -math.inf
+            self._last_seq[ahead] = -1
+            self.robot_resets += int(ahead.sum())
 
     def prepare(self) -> None:
         """Between frames: let the tracker prepare the next frame now (its ``prepare()``, when it has one:

@@ -3,7 +3,11 @@
 Each datagram is rate-limited by sender, decoded and handed to the ``TeamIdentifier``. A frame's team state goes to
 every ``publish`` address and either to the multicast ``group`` or (``reply_to_robots``) to each robot's last address;
 then the tracker prepares the next frame. Every failure is counted and logged, never stops the loop. Default addresses
-are loopback."""
+are loopback.
+
+The camera is the sender of the last accepted frame: while it is alive, frames from any other sender are dropped
+(``other_camera``), and only accepted frames keep it alive, so a hostile clock (a frame far ahead) costs at most
+``camera_timeout_s`` before the node follows the camera again."""
 
 from __future__ import annotations
 
@@ -99,7 +103,8 @@ class NodeConfig:
         sender_rate: packets per second one sender may send before being rate-limited.
         sender_burst: packets one sender may send at once.
         max_senders: rate-limit buckets kept (the oldest are forgotten beyond this).
-        camera_timeout_s: wall seconds without frames after which the camera counts as lost.
+        camera_timeout_s: wall seconds without an accepted frame after which the camera counts as lost
+            (then a frame from any sender, at any time, is accepted: the camera may have restarted).
         status_interval_s: wall seconds between status log lines (0: never).
         recv_buffer_bytes: socket receive buffer asked of the OS.
         batch: datagrams read per loop iteration before timers are checked."""
@@ -154,6 +159,7 @@ class NodeServer:
         self._buckets: dict[Address, list[float]] = {}
         self._robot_addr: dict[int, Address] = {}
         self._last_frame_wall: float | None = None
+        self._camera: Address | None = None  # the sender of the last accepted frame
         self._next_status = time.monotonic() + self.config.status_interval_s
         self._cpu_received: float | None = None  # thread CPU time when the datagram being handled was read
         _preload()  # (before the address is announced: the first frame does not wait for imports)
@@ -242,17 +248,27 @@ class NodeServer:
             self.counters.reject(UNEXPECTED)
 
     def _frame(self, message: DetectionsMessage, addr: Address, t_received: float) -> None:
-        restarts = self.identifier.restarts
-        self._last_frame_wall = time.monotonic()  # any valid frame shows the camera is alive
+        identifier = self.identifier
+        if self._camera is not None and addr != self._camera and not identifier.camera_lost:
+            self.counters.add("other_camera")
+            log_event(self.log, "other_camera", logging.DEBUG, sender=list(addr), frame=message.frame)
+            return
+        restarts, robot_resets = identifier.restarts, identifier.robot_resets
         try:
-            outcome, team = self.identifier.add_frame(message)
+            outcome, team = identifier.add_frame(message)
         except Exception as exc:  # noqa: BLE001 (a tracker bug must not take the node down)
+            self._camera, self._last_frame_wall = addr, time.monotonic()
             self.counters.add("tracker_errors")
             log_event(self.log, "tracker_error", logging.ERROR, frame=message.frame, error=repr(exc))
             return
-        if self.identifier.restarts > restarts:
+        if outcome == "frames":  # (only an accepted frame shows the camera is alive)
+            self._camera, self._last_frame_wall = addr, time.monotonic()
+        if identifier.restarts > restarts:
             self.counters.add("camera_restarts")
             log_event(self.log, "camera_restart", frame=message.frame, time=message.time)
+        if identifier.robot_resets > robot_resets:
+            self.counters.add("robot_resets", identifier.robot_resets - robot_resets)
+            log_event(self.log, "robot_reset", frame=message.frame, time=message.time)
         self.counters.add(outcome)
         if team is None:
             log_event(self.log, outcome, logging.DEBUG, sender=list(addr), frame=message.frame)
