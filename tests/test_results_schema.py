@@ -85,7 +85,7 @@ def test_eval_json(tmp_path):
     assert rows[1]["metrics"]["hota"] == pytest.approx(1.0, abs=1e-6)
 
 
-def test_eval_json_unwritable_is_one_line_after_the_table(tmp_path):
+def test_eval_json_unwritable_is_one_line_before_any_work(tmp_path):
     seq = tmp_path / "gt" / "SEQ-1"
     (seq / "gt").mkdir(parents=True)
     (seq / "gt" / "gt.txt").write_text("1,1,0,0,10,10,1,1,1\n")
@@ -96,8 +96,8 @@ def test_eval_json_unwritable_is_one_line_after_the_table(tmp_path):
     res = runner.invoke(app, ["eval", "--gt", str(tmp_path / "gt"), "--results", str(tmp_path / "res"),
                               "--metrics", "CLEAR,Identity", "--json", str(blocker / "e.json")])
     assert res.exit_code == 2
-    assert "MOTA" in res.output  # the table was printed
-    assert "--json: cannot write" in res.output and "Traceback" not in res.output
+    assert "MOTA" not in res.output  # outputs are checked before anything is scored
+    assert "is a file, not a folder" in res.output and "Traceback" not in res.output
 
 
 def test_bench_real_json(tmp_path):

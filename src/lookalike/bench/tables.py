@@ -8,17 +8,17 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from lookalike.io.outputs import atomic_path, write_atomic
+
 
 def write_rows(rows: list[dict[str, Any]], json_path: Path | None, csv_path: Path | None,
                columns: Sequence[str] | None = None) -> None:
     """Write table rows as JSON (a list of objects) and/or CSV (``columns``, default the first row's keys;
     missing cells empty)."""
     if json_path is not None:
-        json_path.parent.mkdir(parents=True, exist_ok=True)
-        json_path.write_text(json.dumps(rows, indent=2) + "\n")
+        write_atomic(json_path, json.dumps(rows, indent=2) + "\n")
     if csv_path is not None and rows:
-        csv_path.parent.mkdir(parents=True, exist_ok=True)
-        with csv_path.open("w", newline="") as fh:
+        with atomic_path(csv_path) as tmp, tmp.open("w", newline="") as fh:
             writer = csv.DictWriter(fh, fieldnames=list(columns or rows[0]), restval="")
             writer.writeheader()
             writer.writerows(rows)

@@ -57,8 +57,26 @@ def _load_commands() -> None:
 _load_commands()
 
 
+def _terminate_cleanly() -> None:
+    """SIGTERM raises ``SystemExit(143)`` in this process (not in worker processes it forks, which keep the default):
+    the ``finally`` blocks run, so temporary files are removed and no half-written output is left."""
+    import signal
+
+    pid = os.getpid()
+
+    def handler(signum: int, frame: object) -> None:
+        if os.getpid() != pid:  # a forked worker: die as before
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, handler)
+
+
 def main() -> None:
     """Entry point of the ``lookalike`` script."""
+    _terminate_cleanly()
     app()
 
 

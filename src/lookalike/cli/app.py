@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import shlex
 import sys
+from collections.abc import Collection, Iterable
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -71,6 +72,17 @@ def fail(message: str, code: int = 2) -> NoReturn:
     with ``code``."""
     err_console.print(f"[bold red]error:[/] {escape(message)}", highlight=False)
     raise typer.Exit(code)
+
+
+def check_outputs_or_fail(outputs: dict[str, Path | None], inputs: Iterable[Path | None] = (),
+                          folders: Collection[str] = ()) -> None:
+    """:func:`lookalike.io.outputs.check_outputs`, failing (exit 2) with its one line: run before any work."""
+    from lookalike.io.outputs import check_outputs
+
+    try:
+        check_outputs(outputs, inputs, folders=folders)
+    except ValueError as exc:
+        fail(str(exc))
 
 
 def split_list(values: list[str] | None) -> list[str]:

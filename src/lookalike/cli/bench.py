@@ -21,7 +21,7 @@ from lookalike.bench.ident import (
 from lookalike.bench.ident_paper import IDENT_VARIANTS, margin_rows
 from lookalike.bench.paired import Comparison, comparison_rows, difference_title
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import SortedGroup, app, command_line, console, fail, split_list
+from lookalike.cli.app import SortedGroup, app, check_outputs_or_fail, command_line, console, fail, split_list
 from lookalike.cli.progress import progress_bars
 from lookalike.io.results import Results
 from lookalike.sim import PRESET_NAMES, preset_label
@@ -104,6 +104,7 @@ def ident(
 ) -> None:
     """The robot-identification paper's Table I: identification success rate per set-up and identifier (+ error, speed).
     With --lengths or --recordings: the paper's Table III protocol."""
+    check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, [recordings, human, weights])
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
     check_names("--trackers", tracker_list, [*tracker_names(), *IDENT_VARIANTS], "tracker")

@@ -11,7 +11,7 @@ from rich.table import Column, Table
 
 from lookalike.bench.divers import COLUMNS, TRACKERS, bar_chart, diver_results, diver_table, pearson
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import command_line, console, fail
+from lookalike.cli.app import check_outputs_or_fail, command_line, console, fail
 from lookalike.cli.bench import bench_app, write_results
 from lookalike.sim.divers_paper import DETECTION_LEVELS
 
@@ -35,6 +35,7 @@ def divers(
     csv_path: Path | None = typer.Option(None, "--csv", help="Write the table(s) as CSV (a Detections column first)."),
 ) -> None:
     """SORT, deep SORT and diver SORT with hand-crafted or learned features on the rendered divers (Table 2)."""
+    check_outputs_or_fail({"--png": png, "--json": json_path, "--csv": csv_path})
     levels = list(DETECTION_LEVELS) if detections == "both" else [detections]
     if detections != "both" and detections not in DETECTION_LEVELS:
         fail(f"--detections: choose one of {', '.join(DETECTION_LEVELS)} or both, got {detections!r}")

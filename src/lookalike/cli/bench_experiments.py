@@ -15,7 +15,7 @@ from lookalike.bench.experiments import (
     shuffle_rows,
 )
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import command_line, fail, split_list
+from lookalike.cli.app import check_outputs_or_fail, command_line, fail, split_list
 from lookalike.cli.bench import bench_app, print_differences, print_rows, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
@@ -33,6 +33,7 @@ def shuffle(
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
 ) -> None:
     """Control experiment: success rate on frames in order and in random order."""
+    check_outputs_or_fail({"--json": json_path, "--csv": csv_path})
     try:
         with progress_bars() as progress:
             rows = shuffle_rows(split_list(setups), split_list(trackers), sequences, frames, seed, progress)
@@ -58,6 +59,7 @@ def recovery(
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
 ) -> None:
     """Recovery experiment: swap two robots' reports, restore them, time the return to normal."""
+    check_outputs_or_fail({"--json": json_path, "--csv": csv_path})
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     try:
         with progress_bars() as progress:

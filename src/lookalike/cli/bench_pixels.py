@@ -9,7 +9,7 @@ import typer
 
 from lookalike.bench.pixels import DEFAULT_SEED, PERCEPTION_COLUMNS, PIXEL_COLUMNS, pixels_results, pixels_table
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import command_line, fail, split_list
+from lookalike.cli.app import check_outputs_or_fail, command_line, fail, split_list
 from lookalike.cli.bench import bench_app, check_names, print_rows, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
@@ -38,6 +38,7 @@ def pixels(
                                         "of the shipped ones, e.g. `train --recordings`' model.npz (one set-up)."),
 ) -> None:
     """Identification success rate from rendered pixels next to the simulator's own detections, per identifier."""
+    check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, [detector_model, heading_model, weights])
     setup_list, ident_list = split_list(setups), split_list(identifiers)
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
     check_names("--trackers", ident_list, IDENTIFIERS, "identifier")

@@ -16,7 +16,7 @@ from lookalike.bench.leaderboard import COLUMNS, leaderboard, leaderboard_result
 from lookalike.bench.peers import PEERS, peer_status
 from lookalike.bench.runner import default_entries, params_entry
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import command_line, console, fail, split_list
+from lookalike.cli.app import check_outputs_or_fail, command_line, console, fail, split_list
 from lookalike.cli.bench import bench_app, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.parallel import BACKENDS
@@ -90,6 +90,8 @@ def real(
                                             "sequence)."),
 ) -> None:
     """Leaderboard on real data: HOTA, IDF1, MOTA, IDSW, frames/s and rank per dataset, and combined."""
+    check_outputs_or_fail({"--json": json_path, "--csv": csv_path, "--plots": plots}, [data, params_file],
+                          folders={"--plots"})
     tracker_list, peer_list = split_list(trackers), [p for p in split_list(peers) if p != "none"]
     _check(part, backend, tracker_list)
     try:

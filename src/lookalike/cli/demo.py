@@ -18,7 +18,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from lookalike.cli.app import app, command_line, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, command_line, console, fail
 from lookalike.cli.bench import rich_table
 from lookalike.demo import DIVER_COLS, IDENT_COLS, QUICK, DemoSize, lstm_status, run_demo
 from lookalike.sim import PRESET_NAMES, preset_label
@@ -71,6 +71,7 @@ def demo(
     rerun_save: Path | None = typer.Option(None, "--rerun-save", help="Also write a Rerun recording (.rrd) here."),
 ) -> None:
     """Simulate robots and divers, run every relevant tracker, write videos, plots and an HTML report."""
+    check_outputs_or_fail({"-o/--output": output, "--rerun-save": rerun_save}, folders={"-o/--output"})
     if robot_preset not in PRESET_NAMES:
         fail(f"--robot-preset: unknown preset {robot_preset!r}; known: {', '.join(PRESET_NAMES)}")
     logger = _open_rerun(rerun, rerun_save)

@@ -9,9 +9,10 @@ import typer
 from rich import box
 from rich.table import Table
 
-from lookalike.cli.app import app, command_line, console, fail, split_list
+from lookalike.cli.app import app, check_outputs_or_fail, command_line, console, fail, split_list
 from lookalike.eval import BENCHMARKS, METRICS
 from lookalike.eval.folders import COMBINED, evaluate_folders, folder_results
+from lookalike.io.outputs import atomic_path
 
 HEADLINE = {
     "HOTA": ("HOTA", "DetA", "AssA"),
@@ -49,6 +50,7 @@ def eval_command(
 ) -> None:
     """Score trackers with HOTA, CLEAR MOT and identity metrics (values shown in %)."""
     chosen = _chosen(metrics)
+    check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, _eval_inputs(gt, results))
     if points or radius is not None:
         if not points or radius is None or radius <= 0:
             fail("--points and --radius PX go together (point ground truth matched within PX pixels)")
@@ -90,6 +92,21 @@ def eval_command(
             fail(f"--csv: cannot write {csv_path}: {exc.strerror or exc}")
 
 
+def _eval_inputs(gt: Path, results: list[Path]) -> list[Path]:
+    """The files ``eval`` reads (ground truth, ``seqinfo.ini``, result files) and the folders holding them."""
+    from lookalike.io import find_sequences
+    from lookalike.io.outputs import sequence_inputs
+
+    inputs = [gt, *results]
+    try:
+        inputs += sequence_inputs(find_sequences(gt)) if gt.is_dir() else []
+    except (FileNotFoundError, ValueError):
+        pass  # (eval itself names the problem)
+    for folder in results:
+        inputs += sorted(folder.glob("*.txt")) if folder.is_dir() else []
+    return inputs
+
+
 def _chosen(metrics: list[str] | None) -> list[str]:
     chosen = [next((m for m in METRICS if m.lower() == x.lower()), x) for x in (split_list(metrics) or METRICS)]
     for m in chosen:
@@ -120,8 +137,7 @@ def _table(title: str, first: str, columns: list[str]) -> Table:
 
 def _write_csv(path: Path, scores: dict[str, dict[str, dict[str, float]]]) -> None:
     keys = list(next(iter(next(iter(scores.values())).values())).keys())
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with open(path, "w", newline="") as fh:
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(["tracker", "seq", *keys])
         for tracker, per_seq in scores.items():

@@ -12,8 +12,9 @@ from typing import Any
 
 import typer
 
-from lookalike.cli.app import app, fail
+from lookalike.cli.app import app, check_outputs_or_fail, fail
 from lookalike.cli.track import build_tracker
+from lookalike.io.outputs import write_atomic
 from lookalike.node import (
     Endpoint,
     IdentifierConfig,
@@ -106,6 +107,7 @@ def serve(
     robots with a tracker, publish their positions at the camera rate. Logs are JSON Lines on
     stderr; send a status_request message for the counters."""
     listen_address = _address(listen, "--listen")
+    check_outputs_or_fail({"--port-file": port_file})
     group_address = _group(group)
     publish_addresses = tuple(_address(p, "--publish") for p in publish or [])
     settings = list(set_ or [])
@@ -130,9 +132,7 @@ def serve(
     with server, _Stop(duration) as stop:
         host, port = server.address
         if port_file is not None:
-            tmp = port_file.with_name(port_file.name + ".tmp")
-            tmp.write_text(f"{host}:{port}\n")
-            tmp.replace(port_file)
+            write_atomic(port_file, f"{host}:{port}\n")
         server.serve(stop)
         if stop.signal is not None:
             log_event(log, "signal", signal=stop.signal)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 from lookalike.sim import PRESET_NAMES, preset
 
 
@@ -28,6 +28,7 @@ def record_pixels(
 ) -> None:
     """Render robot sequences, detect them from the pixels and write each as a labelled recording
     (pixel detections, renderer truth as labels, the simulated reports)."""
+    check_outputs_or_fail({"-o/--output": output}, [detector_model, heading_model], folders={"-o/--output"})
     from lookalike.bench.pixel_recordings import record_pixels as record
     from lookalike.bench.pixel_recordings import write_recording
     from lookalike.cli.progress import progress_bars

@@ -14,7 +14,7 @@ from rich.progress import (
     TimeElapsedColumn,
 )
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 from lookalike.io import read_mot
 from lookalike.viz.overlay import birdseye_video, overlay_tracks, source_frames
 
@@ -32,6 +32,7 @@ def render(
     fps: float | None = typer.Option(None, min=0.1, help="Output frame rate (default: the input's; 30 otherwise)."),
 ) -> None:
     """Draw tracks (identity colours, ids, tails) on every frame of a video, or from above (--birdseye)."""
+    check_outputs_or_fail({"-o/--output": output, "--gif": gif}, [tracks, video])
     if video is None and not birdseye:
         fail("--video: give the video to draw on (or --birdseye for world tracks seen from above)")
     try:

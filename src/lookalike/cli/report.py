@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 from lookalike.viz.report import HtmlReport
 from lookalike.viz.results import add_results, load_results
 
@@ -21,6 +21,7 @@ def report(
     title: str = typer.Option("lookalike results", help="Title of the report."),
 ) -> None:
     """Build an HTML report (tables and bar charts, images embedded) from result files."""
+    check_outputs_or_fail({"-o/--output": output}, results)
     doc = HtmlReport(title)
     try:
         loaded = [(p, *load_results(p)) for p in results]

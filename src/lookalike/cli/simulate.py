@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 from lookalike.io.robot_sequences import write_robot_sequence
 from lookalike.sim import DEFAULT_NOISE, NOISE_MODELS, PRESET_NAMES, preset, simulate_robots
 
@@ -26,6 +26,7 @@ def simulate(
 
     Format: see ``lookalike.io.robot_sequences`` (a header line, then one object per frame with detections, received
     reports and the truth)."""
+    check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})
     if preset_name not in PRESET_NAMES:
         fail(f"--preset: unknown preset {preset_name!r}; known: {', '.join(PRESET_NAMES)}")
     if noise not in NOISE_MODELS:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -16,7 +16,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextC
 from lookalike.cli.app import app, console, err_console, fail
 from lookalike.io import find_sequences
 from lookalike.io.needs import box_input_problem
-from lookalike.io.outputs import ensure_writable, refuse_inputs, result_paths
+from lookalike.io.outputs import atomic_path, check_outputs, ensure_writable, refuse_inputs, result_paths
 from lookalike.io.stream import sequence_stream, track_to_file
 from lookalike.loop import RunStats
 from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
@@ -130,11 +130,16 @@ def _speed(stats: RunStats) -> str:
     return f"{stats.frames} frames, {stats.fps:,.0f} frames/s (tracker only)"
 
 
-def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None]) -> None:
-    """Refuse (exit 2) when the result, or a file written beside it, is one of the input files."""
+def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None], annotate: Path | None = None) -> None:
+    """Refuse (exit 2) when the result, or a file written beside it, is one of the input files, or when
+    ``annotate`` is an input or one of those outputs (checked with :func:`~lookalike.io.outputs.check_outputs`)."""
     siblings = [output.with_name(output.stem + s) for s in (".health.csv", ".merges.csv", ".det.txt")]
+    files = [p for p in inputs if p is not None and p.is_file()]
     try:
-        refuse_inputs([output, *siblings], [p for p in inputs if p is not None and p.is_file()])
+        refuse_inputs([output, *siblings], files)
+        if annotate is not None:
+            check_outputs({"-o/--output": output, **{f"-o/--output's {s.name}": s for s in siblings},
+                           "--annotate": annotate}, files)
     except ValueError as exc:
         fail(str(exc))
 
@@ -236,63 +241,68 @@ def track(
     if offline and tracker != "boxtrack":
         fail(f"--offline: the closed set's online pass is boxtrack; use -t boxtrack, not {tracker!r}")
     _refuse_overwriting_inputs(output, [path, video, detections, points, reports, params_file, detector_model,
-                                        heading_model])
+                                        heading_model], annotate)
     settings = set_ or []
     team_size = team_size if team_size is not None else targets
     video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
                                          min_score=min_score, fps=fps, features=features)
     # the video, pixel, blob and closed-set paths are imported in their branch: keeps the CLI's start-up short
-    try:
-        if branch == "pipeline":
-            from lookalike.cli.track_pixels import run_track_pixels
+    with ExitStack() as stack:
+        if annotate is not None:  # (the video is written to a temporary file, renamed into place when complete)
+            annotate = video_options["annotate"] = stack.enter_context(atomic_path(annotate))
+        try:
+            if branch == "pipeline":
+                from lookalike.cli.track_pixels import run_track_pixels
 
-            if params_file is not None:
-                settings = [*(f"{k}={v}" for k, v in tracker_params(tracker, [], params_file).items()), *settings]
-            run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker, settings,
-                             annotate=annotate, fps=fps, min_score=min_score)
-            return
-        trk = _box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets,
-                           params_file=params_file)
-        online = tracker_params(tracker, settings, params_file) if offline else None
-        if branch == "points":
-            from lookalike.cli.track_closed import track_points
+                if params_file is not None:
+                    settings = [*(f"{k}={v}" for k, v in tracker_params(tracker, [], params_file).items()), *settings]
+                run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker,
+                                 settings, annotate=annotate, fps=fps, min_score=min_score)
+                return
+            trk = _box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets,
+                               params_file=params_file)
+            online = tracker_params(tracker, settings, params_file) if offline else None
+            if branch == "points":
+                from lookalike.cli.track_closed import track_points
 
-            assert points is not None
-            track_points(points, output, trk, tracker, n_targets=targets, offline=offline, params=online or {}, fps=fps)
-        elif branch in ("blobs", "video"):
-            assert video is not None
-            if branch == "blobs":
-                from lookalike.cli.track_blobs import run_track_blobs
+                assert points is not None
+                track_points(points, output, trk, tracker, n_targets=targets, offline=offline, params=online or {},
+                             fps=fps)
+            elif branch in ("blobs", "video"):
+                assert video is not None
+                if branch == "blobs":
+                    from lookalike.cli.track_blobs import run_track_blobs
 
-                run_track_blobs(video, output, trk, tracker, detector or "", blob or [],
-                                n_targets=0 if open_set else targets, offline=online,
-                                explicit=tracker_params(tracker, settings, params_file).keys(), **video_options)
-            else:
-                det_path = detections or path
-                assert det_path is not None
-                if online is not None and targets is not None:
-                    if output.is_dir():
-                        fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
-                    from lookalike.cli.track_closed import offline_video
-
-                    _, count, rate = _video_info(video)
-                    offline_video(det_path, output, targets, online, fps or rate, count or None, min_score)
+                    run_track_blobs(video, output, trk, tracker, detector or "", blob or [],
+                                    n_targets=0 if open_set else targets, offline=online,
+                                    explicit=tracker_params(tracker, settings, params_file).keys(), **video_options)
                 else:
-                    from lookalike.cli.track_video import run_track_video
+                    det_path = detections or path
+                    assert det_path is not None
+                    if online is not None and targets is not None:
+                        if output.is_dir():
+                            fail(f"-o/--output: {output} is a folder; with --video give a result file such as "
+                                 "tracks.txt")
+                        from lookalike.cli.track_closed import offline_video
 
-                    run_track_video(video, det_path, output, trk, tracker, **video_options)
-        elif online is not None and targets is not None:
-            from lookalike.cli.track_closed import offline_files
+                        _, count, rate = _video_info(video)
+                        offline_video(det_path, output, targets, online, fps or rate, count or None, min_score)
+                    else:
+                        from lookalike.cli.track_video import run_track_video
 
-            assert path is not None
-            count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length)
-            where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
-            console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
-        else:
-            assert path is not None
-            count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length)
-            where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
-            console.print(f"[green]{tracker}[/]: {count} sequence(s), {_speed(stats)} → {where}")
+                        run_track_video(video, det_path, output, trk, tracker, **video_options)
+            elif online is not None and targets is not None:
+                from lookalike.cli.track_closed import offline_files
 
-    except OSError as exc:  # an output that cannot be written, an input that cannot be read
-        fail(f"{exc.filename or output}: {exc.strerror or exc}")
+                assert path is not None
+                count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length)
+                where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
+                console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
+            else:
+                assert path is not None
+                count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length)
+                where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
+                console.print(f"[green]{tracker}[/]: {count} sequence(s), {_speed(stats)} → {where}")
+
+        except OSError as exc:  # an output that cannot be written, an input that cannot be read
+            fail(f"{exc.filename or output}: {exc.strerror or exc}")

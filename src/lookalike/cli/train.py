@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 
 if TYPE_CHECKING:
     from lookalike.parallel import JobPool
@@ -100,6 +100,7 @@ def train(
 ) -> None:
     """Train the association network on simulated sequences generated on the fly (or fine-tune it on labelled
     recordings with --recordings, or search its hyper-parameters with --search)."""
+    check_outputs_or_fail({"-o/--output": output}, [recordings, init_from, validation_folder], folders={"-o/--output"})
     try:
         import torch
     except ImportError:

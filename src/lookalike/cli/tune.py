@@ -19,7 +19,7 @@ from rich.progress import (
 )
 from rich.table import Table
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 from lookalike.parallel import BACKENDS
 
 
@@ -75,6 +75,7 @@ def tune(
         fail("-o/--output: give the parameter file to write")
         return
     _check_options(sampler, backend, resume, study)
+    check_outputs_or_fail({"-o/--output": output}, _data_inputs(data, space_path))
     seqs, fold_list = _load_data(data, data_root, folds)
     console.print(f"{tracker}: {len(seqs)} sequence(s), {trials} trials ({sampler}), criterion {metric}, "
                   f"{len(space)} parameters in the space")
@@ -110,6 +111,20 @@ def _check_options(sampler: str, backend: str, resume: bool, study: str | None) 
         fail(f"--backend: expected one of {', '.join(BACKENDS)}, got {backend!r}")
     if resume and study is None:
         fail("--resume: needs --study (the storage the study was saved in)")
+
+
+def _data_inputs(data: list[str], space_path: Path | None) -> list[Path]:
+    """The files and folders ``tune`` reads from (the given sequence folders and their files, the space)."""
+    from lookalike.io import find_sequences
+    from lookalike.io.outputs import sequence_inputs
+
+    inputs: list[Path] = [Path(d) for d in data if Path(d).exists()]
+    for path in list(inputs):
+        try:
+            inputs += sequence_inputs(find_sequences(path))
+        except (FileNotFoundError, ValueError):
+            pass  # (the data loading names the problem)
+    return [*inputs, *([space_path] if space_path is not None else [])]
 
 
 def _load_data(data: list[str], data_root: Path | None, folds: str) -> tuple[Any, Any]:

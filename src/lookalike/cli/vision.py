@@ -19,7 +19,7 @@ from rich.progress import (
     TimeElapsedColumn,
 )
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 from lookalike.learn.vision_train import train_robot_detector
 
 
@@ -43,6 +43,7 @@ def train_detector(
                                           "(without --data; 0: keep every stage)."),
 ) -> None:
     """Train the HOG cascade robot detector and save it."""
+    check_outputs_or_fail({"-o/--output": output}, [data])
     try:
         with _progress() as bar:
             def step(description: str, total: int) -> Callable[[int, str], None]:
@@ -73,6 +74,7 @@ def train_heading_command(
     seed: int = typer.Option(0, help="Seed of the training renders; held-out renders use seed + 1000003."),
 ) -> None:
     """Train the heading classifier on rendered robots, report its held-out error and save it."""
+    check_outputs_or_fail({"-o/--output": output})
     from lookalike.learn.vision_train import rendered_heading_samples
     from lookalike.vision.heading import HeadingConfig, mean_abs_error_deg, train_heading
 

@@ -1,12 +1,16 @@
-"""Where results go, decided before anything runs: one file per sequence, never onto an input, never two sequences onto
-one file, a writable folder. Refusals are one-line ``ValueError``s."""
+"""Where results go, decided before anything runs: one file per sequence, never onto an input, never two outputs onto
+one file, a writable folder (:func:`check_outputs`, used by every command that writes files); and every file written
+through a temporary file beside it, renamed into place (:func:`atomic_path`). Refusals are one-line ``ValueError``s."""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Sequence
+import tempfile
+from collections.abc import Collection, Iterable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
+from lookalike.io.rules import user_mode
 from lookalike.io.sequences import MotSequence
 
 
@@ -18,6 +22,93 @@ def _same_file(a: Path, b: Path) -> bool:
         return a.resolve() == b.resolve()
     except OSError:
         return False
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    """Whether ``path`` resolves to a place inside ``folder`` (resolved)."""
+    try:
+        return path.resolve().is_relative_to(folder.resolve())
+    except OSError:
+        return False
+
+
+def check_outputs(outputs: Mapping[str, Path | None], inputs: Iterable[Path | None] = (), *,
+                  folders: Collection[str] = ()) -> None:
+    """Check every output of a command before it runs; ``ValueError`` naming the option and the path when an output
+    is one of the ``inputs`` (compared resolved, symbolic and hard links followed) or an existing file inside an input
+    folder, when two outputs are one file, when an output is an existing folder (a name in ``folders``: an existing
+    file, the output being a folder), or when its folder cannot be created or written. ``outputs``: option name to
+    path (None: not given). Creates the outputs' parent folders."""
+    given = [(name, Path(p)) for name, p in outputs.items() if p is not None]
+    for i, (name, path) in enumerate(given):
+        for other, other_path in given[:i]:
+            if _same_file(path, other_path):
+                raise ValueError(f"{other} {other_path} and {name} {path} are one file; give each output its own "
+                                 "path (nothing was written)")
+    sources = [Path(p) for p in inputs if p is not None]
+    files = [p for p in sources if not p.is_dir()]
+    dirs = [p for p in sources if p.is_dir()]
+    for name, path in given:
+        for src in files:
+            if _same_file(path, src):
+                raise ValueError(f"{name} {path} is the input {src}; choose another output (nothing was written)")
+        if path.is_file():
+            for folder in dirs:
+                if _inside(path, folder):
+                    raise ValueError(f"{name} {path} would replace a file in the input folder {folder}; choose "
+                                     "another output (nothing was written)")
+        if name in folders:
+            if path.exists() and not path.is_dir():
+                raise ValueError(f"{name} {path}: is a file, not a folder (nothing was written)")
+            for src in files:
+                if _same_file(path, src):
+                    raise ValueError(f"{name} {path} is the input {src}")
+            _check_folder(path)
+        else:
+            if path.is_dir():
+                raise ValueError(f"{name} {path} is a folder; expected a file (nothing was written)")
+            _check_folder(path.parent)
+
+
+def _check_folder(folder: Path) -> None:
+    """Create ``folder`` (and its parents); ``ValueError`` naming it when it cannot be created or written."""
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"output folder {folder}: is a file, not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ValueError(f"output folder {folder}: cannot be created ({exc.strerror or exc})") from None
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ValueError(f"output folder {folder}: not writable (permission denied)")
+
+
+@contextmanager
+def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """A new temporary file beside ``path`` (same folder and suffix, unique name, the mode ``open()`` would give) to
+    write instead of ``path``: renamed onto ``path`` when the block ends, removed when it raises (any exception,
+    ``KeyboardInterrupt`` and the ``SystemExit`` of a SIGTERM included). A reader never sees a half-written file and
+    a failed run keeps the old one."""
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=f".tmp{target.suffix}", dir=target.parent)
+    tmp = Path(name)
+    try:
+        try:
+            os.fchmod(fd, user_mode())
+        except OSError:
+            pass  # a file system without modes
+        os.close(fd)
+        yield tmp
+        os.replace(tmp, target)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> Path:
+    """Write ``data`` (text as UTF-8) to ``path`` through :func:`atomic_path`; returns the path."""
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
+    return Path(path)
 
 
 def refuse_inputs(outputs: Iterable[Path], inputs: Iterable[Path | None]) -> None:
@@ -69,17 +160,11 @@ def ensure_writable(targets: Iterable[Path]) -> None:
     """Create the folders of ``targets`` and check that files can be created there (``ValueError``
     naming the folder otherwise), and that no target is an existing folder."""
     for folder in dict.fromkeys(Path(t).parent for t in targets):
-        if folder.exists() and not folder.is_dir():
-            raise ValueError(f"output folder {folder}: is a file, not a folder")
-        try:
-            folder.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise ValueError(f"output folder {folder}: cannot be created ({exc.strerror or exc})") from None
-        if not os.access(folder, os.W_OK | os.X_OK):
-            raise ValueError(f"output folder {folder}: not writable (permission denied)")
+        _check_folder(folder)
     for t in targets:
         if Path(t).is_dir():
             raise ValueError(f"output {t} is a folder; expected a result file")
 
 
-__all__ = ["ensure_writable", "refuse_inputs", "result_paths", "sequence_inputs"]
+__all__ = ["atomic_path", "check_outputs", "ensure_writable", "refuse_inputs", "result_paths", "sequence_inputs",
+           "write_atomic"]

@@ -183,10 +183,10 @@ class Results:
         return json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
 
     def write(self, path: Path) -> Path:
-        """Write the document to ``path`` (parent folders created)."""
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(self.dumps())
-        return path
+        """Write the document to ``path`` (parent folders created; through a temporary file renamed into place)."""
+        from lookalike.io.outputs import write_atomic
+
+        return write_atomic(path, self.dumps())
 
 
 def _plain(value: Any) -> Any:

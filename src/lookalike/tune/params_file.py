@@ -62,10 +62,9 @@ def save_params(path: str | Path, tracker: str, params: dict[str, Any], *, chose
     """Write a parameter file (checked by :func:`check_params` first); returns its path."""
     check_params(tracker, params, source=str(path))
     content = TunedParams(tracker, dict(params), list(chosen_on), criterion, int(trials), _version(), dict(extra))
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(content.to_json(), indent=2) + "\n")
-    return out
+    from lookalike.io.outputs import write_atomic
+
+    return write_atomic(path, json.dumps(content.to_json(), indent=2) + "\n")
 
 
 def check_params(tracker: str, params: dict[str, Any], source: str = "params") -> None:

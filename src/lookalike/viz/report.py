@@ -121,9 +121,6 @@ class HtmlReport:
 
     def write(self, path: Path | str) -> Path:
         """Write the document to ``path`` atomically (a temporary file renamed into place)."""
-        out = Path(path)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out.with_name(out.name + ".tmp")
-        tmp.write_text(self.render(), encoding="utf-8")
-        os.replace(tmp, out)
-        return out
+        from lookalike.io.outputs import write_atomic
+
+        return write_atomic(path, self.render())
