@@ -224,3 +224,202 @@ def test_markup_in_quoted_input_is_printed_literally(tmp_path, text):
     _one_error_line(r, "det.txt")
     assert "MarkupError" not in r.output
     assert not (tmp_path / "o.txt").exists()
+
+
+# One output rule for every command: outputs decided and checked before any work, never onto an input, never two
+# outputs on one file; every file written through a temporary file renamed into place.
+GT_ROW = "{f},{i},{x},10,20,40,1,1,1\n"
+
+
+def _gt_folder(root: Path) -> tuple[Path, Path]:
+    """A ground-truth root with one sequence and a results folder for it; returns (gt root, results folder)."""
+    seq = _seq(root / "gt" / "S1", length=21)
+    (seq / "gt").mkdir()
+    (seq / "gt" / "gt.txt").write_text("".join(GT_ROW.format(f=f, i=1, x=10 + f) for f in range(1, 22)))
+    res = root / "res"
+    res.mkdir()
+    (res / "S1.txt").write_text("".join(ROW.format(f=f, x=10 + f).replace(",-1,", ",1,", 1) for f in range(1, 22)))
+    return root / "gt", res
+
+
+def _eval(gt: Path, res: Path, *extra):
+    return runner.invoke(app, ["eval", "--gt", str(gt), "--results", str(res), "--metrics", "CLEAR", *map(str, extra)])
+
+
+def _snapshot(*paths: Path) -> dict[Path, bytes]:
+    return {p: p.read_bytes() for root in paths for p in ([root] if root.is_file() else sorted(root.rglob("*")))
+            if p.is_file()}
+
+
+def test_eval_outputs_onto_its_inputs_are_refused_before_scoring(tmp_path):
+    gt, res = _gt_folder(tmp_path)
+    before = _snapshot(tmp_path)
+    gt_txt, seqinfo, result = gt / "S1" / "gt" / "gt.txt", gt / "S1" / "seqinfo.ini", res / "S1.txt"
+    hard = tmp_path / "hard.txt"
+    os.link(gt_txt, hard)
+    soft = tmp_path / "soft.txt"
+    soft.symlink_to(result)
+    for option in ("--json", "--csv"):
+        for target in (gt_txt, seqinfo, result, hard, soft):
+            line = _one_error_line(_eval(gt, res, option, target), option)
+            assert "MOTA" not in line
+    _one_error_line(_eval(gt, res, "--json", tmp_path / "x", "--csv", tmp_path / "x"), "--json", "--csv", "one file")
+    _one_error_line(_eval(gt, res, "--json", tmp_path / "x", "--csv", tmp_path / "sub" / ".." / "x"), "one file")
+    assert _snapshot(gt, res) == {p: b for p, b in before.items() if p != hard}
+    assert not (tmp_path / "x").exists()
+    r = _eval(gt, res, "--json", tmp_path / "e.json", "--csv", tmp_path / "e.csv")
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["e.csv", "e.json", "gt", "hard.txt", "res", "soft.txt"]
+
+
+def test_report_tune_and_bench_ident_refuse_their_inputs(tmp_path):
+    gt, res = _gt_folder(tmp_path)
+    doc = tmp_path / "e.json"
+    assert _eval(gt, res, "--json", doc).exit_code == 0
+    before = doc.read_bytes()
+    _one_error_line(runner.invoke(app, ["report", str(doc), "-o", str(doc)]), "-o/--output", "is the input")
+    assert doc.read_bytes() == before
+    gt_txt = gt / "S1" / "gt" / "gt.txt"
+    text = gt_txt.read_text()
+    _one_error_line(runner.invoke(app, ["tune", str(gt / "S1"), "-o", str(gt_txt), "--trials", "1"]), "is the input")
+    assert gt_txt.read_text() == text
+    recordings = tmp_path / "rec"
+    recordings.mkdir()
+    (recordings / "a.jsonl").write_text("recording\n")
+    for option in ("--json", "--csv"):
+        r = runner.invoke(app, ["bench", "ident", "--recordings", str(recordings), option,
+                                str(recordings / "a.jsonl")])
+        _one_error_line(r, option, "input folder")
+    assert (recordings / "a.jsonl").read_text() == "recording\n"
+    r = runner.invoke(app, ["bench", "ident", "--json", str(tmp_path / "t"), "--csv", str(tmp_path / "t")])
+    _one_error_line(r, "one file")
+
+
+@pytest.mark.parametrize("command", [["simulate", "--frames", "2"], ["train", "--steps", "1"],
+                                     ["train-appearance"], ["record-pixels"]])
+def test_folder_outputs_onto_an_existing_file_are_refused(tmp_path, command):
+    existing = tmp_path / "model.npz"
+    existing.write_text("keep\n")
+    r = runner.invoke(app, [*command, "-o", str(existing)])
+    _one_error_line(r, str(existing), "is a file")
+    assert existing.read_text() == "keep\n"
+
+
+def test_serve_port_file_in_a_missing_folder_is_created(tmp_path):
+    port_file = tmp_path / "new" / "deeper" / "port.txt"
+    r = runner.invoke(app, ["serve", "--duration", "0.1", "--port-file", str(port_file)])
+    assert r.exit_code == 0, r.output
+    assert port_file.read_text().startswith("127.0.0.1:")
+    assert os.listdir(port_file.parent) == ["port.txt"]
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    _one_error_line(runner.invoke(app, ["serve", "--duration", "0.1", "--port-file", str(blocker / "p.txt")]),
+                    "is a file")
+
+
+@pytest.fixture(scope="module")
+def tiny_video(tmp_path_factory):
+    """A 12-frame MP4 of a moving square and its det.txt."""
+    import numpy as np
+
+    from lookalike.viz.video import VideoWriter
+
+    root = tmp_path_factory.mktemp("video")
+    rows = []
+    with VideoWriter(root / "in.mp4", fps=10) as writer:
+        for k in range(12):
+            image = np.zeros((64, 96, 3), np.uint8)
+            image[20:40, 10 + 4 * k:30 + 4 * k] = 255
+            writer.write(image)
+            rows.append(f"{k + 1},-1,{10 + 4 * k},20,20,20,0.9,-1,-1,-1\n")
+    (root / "det.txt").write_text("".join(rows))
+    return root / "in.mp4", root / "det.txt"
+
+
+def test_annotate_onto_an_input_or_another_output_is_refused_before_running(tiny_video, tmp_path):
+    video, det = tiny_video
+    before = _snapshot(video, det)
+    link = tmp_path / "link.mp4"
+    link.symlink_to(video)
+    hard = tmp_path / "hard.mp4"
+    os.link(video, hard)
+    out = tmp_path / "o.txt"
+    for target in (video, link, hard, det):
+        _one_error_line(_track("--video", video, "--detections", det, "-o", out, "--annotate", target),
+                        "--annotate", "is the input")
+    _one_error_line(_track("--video", video, "--detections", det, "-o", out, "--annotate", out), "one file")
+    _one_error_line(_track("--video", video, "--detections", det, "-o", out, "--annotate",
+                           tmp_path / "o.health.csv"), "one file")
+    assert _snapshot(video, det) == before and not out.exists()
+
+
+def test_annotate_is_written_through_a_temporary_file(tiny_video, tmp_path):
+    video, det = tiny_video
+    old = tmp_path / "a.mp4"
+    old.write_text("old video\n")
+    r = _track("--video", video, "--detections", det, "-o", tmp_path / "o.txt", "--annotate", old)
+    assert r.exit_code == 0, r.output
+    assert old.read_bytes() != b"old video\n" and old.stat().st_size > 100
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.mp4", "o.health.csv", "o.txt"]
+
+
+def test_sigterm_leaves_no_temporary_file(tmp_path):
+    import signal
+    import subprocess
+    import sys
+
+    det = tmp_path / "det.txt"
+    with det.open("w") as fh:  # long enough to be mid-way when the signal comes
+        for f in range(1, 60_001):
+            fh.write("".join(f"{f},-1,{10 + 30 * i + f % 7},{20 + f % 5},20,40,0.9,-1,-1,-1\n" for i in range(6)))
+    out = tmp_path / "res" / "o.txt"
+    out.parent.mkdir()
+    out.write_text("previous result\n")
+    proc = subprocess.Popen([sys.executable, "-m", "lookalike", "track", str(det), "-o", str(out)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env={**os.environ, "COLUMNS": "200"})
+    try:
+        deadline = time.monotonic() + 60
+        while len(os.listdir(out.parent)) < 2 and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert proc.poll() is None, "the run ended before the signal"
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert b"Traceback" not in err
+    assert os.listdir(out.parent) == ["o.txt"] and out.read_text() == "previous result\n"
+
+
+_TARGETS = st.sampled_from(["det", "gt", "seqinfo", "result", "json_in", "link_det", "hard_gt", "new_a", "new_b",
+                            "gt_folder", "res_folder"])
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(command=st.sampled_from(["track", "eval", "report"]), first=_TARGETS, second=_TARGETS)
+def test_no_combination_of_output_paths_modifies_an_input(tmp_path, command, first, second):
+    import tempfile
+
+    root = Path(tempfile.mkdtemp(dir=tmp_path))
+    gt, res = _gt_folder(root)
+    det = gt / "S1" / "det" / "det.txt"
+    json_in = root / "in.json"
+    assert _eval(gt, res, "--json", json_in).exit_code == 0
+    (root / "link_det").symlink_to(det)
+    os.link(gt / "S1" / "gt" / "gt.txt", root / "hard_gt")
+    paths = {"det": det, "gt": gt / "S1" / "gt" / "gt.txt", "seqinfo": gt / "S1" / "seqinfo.ini",
+             "result": res / "S1.txt", "json_in": json_in, "link_det": root / "link_det", "hard_gt": root / "hard_gt",
+             "new_a": root / "new_a", "new_b": root / "new_b", "gt_folder": gt, "res_folder": res}
+    read = {"track": [det, paths["seqinfo"]], "eval": [gt, res], "report": [json_in]}[command]
+    inputs = _snapshot(*read)  # (the files the command reads)
+    a, b = paths[first], paths[second]
+    if command == "track":
+        r = _track(det, "-o", a)
+    elif command == "eval":
+        r = _eval(gt, res, "--json", a, "--csv", b)
+    else:
+        r = runner.invoke(app, ["report", str(json_in), "-o", str(a)])
+    assert "Traceback" not in r.output
+    assert _snapshot(*read) == inputs, r.output
+    if r.exit_code != 0:
+        _one_error_line(r)
