@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from contextlib import ExitStack
 from pathlib import Path
 
 import typer
@@ -16,6 +17,7 @@ from rich.progress import (
 
 from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 from lookalike.io import read_mot
+from lookalike.io.outputs import atomic_path
 from lookalike.viz.overlay import birdseye_video, overlay_tracks, source_frames
 
 
@@ -40,22 +42,28 @@ def render(
         total = int(table.frame.max()) if birdseye and len(table) else source_frames(video)[1] if video else 0
     except (ValueError, FileNotFoundError, OSError) as exc:
         fail(str(exc))
-    try:
-        with Progress(TextColumn("rendering"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                      console=console) as progress:
-            task = progress.add_task("render", total=total or None)
+    interrupted = False
+    # (the files are written to temporary files beside them, renamed into place when closed)
+    with atomic_path(output) as out, ExitStack() as stack:
+        gif_out = stack.enter_context(atomic_path(gif)) if gif is not None else None
+        try:
+            with Progress(TextColumn("rendering"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                          console=console) as progress:
+                task = progress.add_task("render", total=total or None)
 
-            def advance() -> None:
-                progress.advance(task)
+                def advance() -> None:
+                    progress.advance(task)
 
-            if birdseye:
-                n = birdseye_video(table, output, fps=fps or 30.0, gif=gif, tail=tail, advance=advance)
-            else:
-                assert video is not None
-                n = overlay_tracks(video, table, output, gif=gif, tail=tail, fps=fps, advance=advance)
-    except ValueError as exc:
-        fail(str(exc))
-    except KeyboardInterrupt:
+                if birdseye:
+                    n = birdseye_video(table, out, fps=fps or 30.0, gif=gif_out, tail=tail, advance=advance)
+                else:
+                    assert video is not None
+                    n = overlay_tracks(video, table, out, gif=gif_out, tail=tail, fps=fps, advance=advance)
+        except ValueError as exc:
+            fail(str(exc))
+        except KeyboardInterrupt:
+            interrupted = True
+    if interrupted:
         console.print(f"\n[yellow]Interrupted.[/] {escape(str(output))} holds the frames written so far.")
-        raise typer.Exit(130) from None
+        raise typer.Exit(130)
     console.print(f"wrote {output} ({n} frames)" + (f" and {gif}" if gif else ""), markup=False)

@@ -20,6 +20,7 @@ from rich.progress import (
 )
 
 from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.io.outputs import atomic_path
 from lookalike.learn.vision_train import train_robot_detector
 
 
@@ -54,7 +55,8 @@ def train_detector(
                                                          validation_frames, step)
     except ValueError as exc:
         fail(str(exc))
-    model.save(output)
+    with atomic_path(output) as tmp:
+        model.save(tmp)
     if tried:
         best = next(t for t in tried if t.stages == len(model.stages)
                     and t.min_height_px == model.config.min_height_px)
@@ -99,7 +101,8 @@ def train_heading_command(
             bar.update(fit, completed=1)
     except ValueError as exc:
         fail(str(exc))
-    model.save(output)
+    with atomic_path(output) as tmp:
+        model.save(tmp)
     if len(ft):
         err = mean_abs_error_deg(model.estimate(ft).heading_rad, ht)
         console.print(f"held-out mean absolute heading error: {err:.1f} deg on {len(ft)} robots")

@@ -23,7 +23,6 @@ so reading gives back the simulated arrays exactly.
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 from typing import Any
 
@@ -40,13 +39,13 @@ MAX_DETECTIONS = 10_000
 
 def write_robot_sequence(path: str | Path, sequence: RobotSequence) -> Path:
     """Write ``sequence`` to ``path`` (atomically: a temporary file renamed); returns the path."""
+    from lookalike.io.outputs import atomic_path
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     a, r = sequence.arrays, sequence.arrays.reports
     header = {"format": FORMAT, "version": VERSION, "seed": sequence.seed, "n_frames": len(a),
               "reports_sent": r.n_sent, "config": sequence.config.to_dict()}
-    tmp = path.with_name(path.name + ".tmp")
-    with tmp.open("w") as fh:
+    with atomic_path(path) as tmp, tmp.open("w") as fh:
         fh.write(json.dumps(header) + "\n")
         for k in range(len(a)):
             n = int(a.det_valid[k].sum())
@@ -63,7 +62,6 @@ def write_robot_sequence(path: str | Path, sequence: RobotSequence) -> Path:
                           "n_false_positives": int(a.n_false_positives[k]), "n_misses": int(a.n_misses[k])},
             }
             fh.write(json.dumps(row) + "\n")
-    os.replace(tmp, path)
     return path
 
 
