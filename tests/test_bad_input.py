@@ -423,3 +423,38 @@ def test_no_combination_of_output_paths_modifies_an_input(tmp_path, command, fir
     assert _snapshot(*read) == inputs, r.output
     if r.exit_code != 0:
         _one_error_line(r)
+
+
+# Options that would make the output meaningless: one line, exit 2, before any work.
+@pytest.mark.parametrize("args, needles", [
+    (["bench", "shuffle", "--trackers", "nosuch"], ["--trackers", "'nosuch'"]),
+    (["bench", "shuffle", "--setups", "nosuch"], ["--setups", "'nosuch'"]),
+    (["bench", "recovery", "--trackers", "nosuch"], ["--trackers", "'nosuch'"]),
+    (["bench", "recovery", "--swap-at-s", "100"], ["--swap-at-s 100", "end before the sequences do"]),
+    (["bench", "recovery", "--swap-s", "-1"], ["--swap-s -1"]),
+    (["bench", "recovery", "--swap-at-s", "-2"], ["--swap-at-s -2"]),
+    (["serve", "--burst", "0.5", "--duration", "0.1"], ["--burst", "0.5"]),
+    (["train", "--steps", "-5", "-o", "{tmp}/run"], ["--steps", "-5"]),
+    (["train", "--minutes", "0", "-o", "{tmp}/run"], ["--minutes"]),
+])
+def test_meaningless_options_are_refused(tmp_path, args, needles):
+    r = runner.invoke(app, [a.format(tmp=tmp_path) for a in args])
+    _one_error_line(r, *needles)
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("setting, needle", [("threads=100000", "threads"), ("classes=-1", "classes")])
+def test_onnx_detector_settings_out_of_range_are_refused(tiny_video, tmp_path, setting, needle):
+    model = Path(__file__).resolve().parents[1] / "src" / "lookalike" / "vision" / "models_data" / "diver_reid.onnx"
+    video, _ = tiny_video
+    r = _track("--video", video, "--detector", model, "--blob", setting, "-o", tmp_path / "o.txt")
+    _one_error_line(r, needle)
+    assert not (tmp_path / "o.txt").exists()
+
+
+def test_eval_refuses_fractional_track_ids_naming_the_line(tmp_path):
+    gt, res = _gt_folder(tmp_path)
+    lines = (res / "S1.txt").read_text().splitlines(keepends=True)
+    lines[3] = lines[3].replace(",1,", ",1.5,", 1)
+    (res / "S1.txt").write_text("".join(lines))
+    _one_error_line(_eval(gt, res), "S1.txt:4", "not a whole number")

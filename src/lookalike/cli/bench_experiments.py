@@ -14,11 +14,14 @@ from lookalike.bench.experiments import (
     recovery_runs,
     shuffle_rows,
 )
+from lookalike.bench.ident_paper import IDENT_VARIANTS
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import check_outputs_or_fail, command_line, fail, split_list
-from lookalike.cli.bench import bench_app, print_differences, print_rows, write_results
+from lookalike.cli.bench import bench_app, check_names, print_differences, print_rows, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
+from lookalike.sim.presets import preset
+from lookalike.trackers import tracker_names
 
 
 @bench_app.command("shuffle")
@@ -34,6 +37,7 @@ def shuffle(
 ) -> None:
     """Control experiment: success rate on frames in order and in random order."""
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path})
+    _check_setups_and_trackers(split_list(setups), split_list(trackers))
     try:
         with progress_bars() as progress:
             rows = shuffle_rows(split_list(setups), split_list(trackers), sequences, frames, seed, progress)
@@ -61,6 +65,8 @@ def recovery(
     """Recovery experiment: swap two robots' reports, restore them, time the return to normal."""
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path})
     setup_list, tracker_list = split_list(setups), split_list(trackers)
+    _check_setups_and_trackers(setup_list, tracker_list)
+    _check_swap(swap_at_s, swap_s, frames, setup_list)
     try:
         with progress_bars() as progress:
             rows, seconds = recovery_runs(setup_list, tracker_list, sequences, frames, swap_at_s, swap_s, seed,
@@ -74,3 +80,19 @@ def recovery(
     write_results(experiment_results("recovery", rows, setup_list, sequences, frames, seed, command_line(),
                                      options, differences), json_path)
     write_rows(rows, None, csv_path)
+
+
+def _check_setups_and_trackers(setups: list[str], trackers: list[str]) -> None:
+    """Fail in one line naming a preset or identifier that does not exist."""
+    check_names("--setups", setups, PRESET_NAMES, "preset")
+    check_names("--trackers", trackers, [*tracker_names(), *IDENT_VARIANTS], "tracker")
+
+
+def _check_swap(swap_at_s: float, swap_s: float, frames: int, setups: list[str]) -> None:
+    """Fail in one line unless the swap starts at >= 0 s, lasts > 0 s and ends before the sequences do
+    (a swap past the end leaves nothing to measure: the table would be NaN)."""
+    rate = min(preset(s).frame_rate_hz for s in setups) if setups else 30.0
+    length_s = frames / rate
+    if not (swap_at_s >= 0 and swap_s > 0 and swap_at_s + swap_s < length_s):
+        fail(f"--swap-at-s {swap_at_s:g} / --swap-s {swap_s:g}: the swap must start at >= 0 s, last > 0 s and end "
+             f"before the sequences do ({frames} frames = {length_s:g} s at {rate:g} Hz)")

@@ -13,11 +13,20 @@ from typing import TYPE_CHECKING, Any
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+from lookalike._optional import needs
 from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 
 if TYPE_CHECKING:
     from lookalike.parallel import JobPool
 from lookalike.sim import PRESET_NAMES, preset
+
+
+def _check_limits(steps: int, minutes: float | None) -> None:
+    """Fail in one line on a run that could not take a step: ``steps`` < 1 or ``minutes`` <= 0."""
+    if steps < 1:
+        fail(f"--steps: at least 1 optimisation step, got {steps}")
+    if minutes is not None and not minutes > 0:
+        fail(f"--minutes: a time limit > 0, got {minutes:g}")
 
 
 @app.command()
@@ -100,11 +109,10 @@ def train(
 ) -> None:
     """Train the association network on simulated sequences generated on the fly (or fine-tune it on labelled
     recordings with --recordings, or search its hyper-parameters with --search)."""
+    _check_limits(steps, minutes)
     check_outputs_or_fail({"-o/--output": output}, [recordings, init_from, validation_folder], folders={"-o/--output"})
-    try:
+    with needs("torch"):
         import torch
-    except ImportError:
-        fail("training needs PyTorch: pip install 'lookalike[train]' (torch==2.13.0)")
     if model not in ("lstm", "set"):
         fail(f"--model: unknown model {model!r}; known: lstm, set")
     if recordings is not None and search is not None:
@@ -222,7 +230,8 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
                threads: int, device: str, workers: int, backend: str, address: str | None, resume: bool,
                ship: bool, learning_rate: float | None) -> None:
     """``lookalike train --model set``: the set associator over every team size."""
-    import torch
+    with needs("torch"):
+        import torch
 
     from lookalike.learn.set_training import SetTrainConfig, train_set
     from lookalike.learn.training import plot_log

@@ -25,9 +25,10 @@ def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | N
     """Read a MOTChallenge text file (UTF-8).
 
     Raises ``ValueError`` naming the file and 1-based line number of a malformed line: too few columns, a non-number,
-    NaN or infinity in the first 7 columns (frame, id, box, score), a negative size (with ``positive_size``, as
-    detections need: a zero one too), a frame number that is not an integer >= 1, past ``length`` (named
-    ``length_name``), or that jumps too far (:mod:`lookalike.io.rules`); or naming the file when it is not UTF-8 text.
+    NaN or infinity in the first 7 columns (frame, id, box, score), an id that is not a whole number, a negative size
+    (with ``positive_size``, as detections need: a zero one too), a frame number that is not an integer >= 1, past
+    ``length`` (named ``length_name``), or that jumps too far (:mod:`lookalike.io.rules`); or naming the file when it
+    is not UTF-8 text.
     """
     path = Path(path)
     if not path.is_file():
@@ -57,7 +58,10 @@ def row_problem(data: np.ndarray, previous_max: float = 0.0, length: int | None 
     size_reason = "invalid box: zero or negative width or height" if positive_size else \
         "invalid box: negative width or height"
     frame = frame_problems(data[:, 0], previous_max, length, length_name)
+    ids = np.where(box, 0.0, data[:, 1])
+    fraction = np.floor(ids) != ids  # (an id is a whole number: 1.2 and 1.7 are not one track, nor two)
     first = [(int(np.flatnonzero(box)[0]), "NaN or infinity in frame, id, box or score") if box.any() else None,
+             (int(np.flatnonzero(fraction)[0]), "invalid id: not a whole number") if fraction.any() else None,
              (int(np.flatnonzero(size)[0]), size_reason) if size.any() else None,
              (frame[0], f"invalid frame: {frame[1]}") if frame is not None else None]
     found = [p for p in first if p is not None]
@@ -73,6 +77,8 @@ def _rows_fine(data: np.ndarray, previous_max: float, length: int | None, positi
         return False
     sizes = data[:, 4:6].min()
     if not (sizes > 0 if positive_size else sizes >= 0):
+        return False
+    if not (np.floor(data[:, 1]) == data[:, 1]).all():
         return False
     frames = data[:, 0]
     first, last = float(frames.min()), float(frames.max())

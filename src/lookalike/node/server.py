@@ -101,7 +101,7 @@ class NodeConfig:
             of the per-robot replies (robots join it: ``Endpoint(..., group=...)``).
         group_interface: IPv4 address of the interface multicast leaves from (loopback by default).
         sender_rate: packets per second one sender may send before being rate-limited.
-        sender_burst: packets one sender may send at once.
+        sender_burst: packets one sender may send at once (>= 1).
         max_senders: rate-limit buckets kept (the oldest are forgotten beyond this).
         camera_timeout_s: wall seconds without an accepted frame after which the camera counts as lost
             (then a frame from any sender, at any time, is accepted: the camera may have restarted).
@@ -126,6 +126,8 @@ class NodeConfig:
         for name in ("sender_rate", "sender_burst", "camera_timeout_s"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"NodeConfig.{name} must be > 0, got {getattr(self, name)}")
+        if not self.sender_burst >= 1:  # (a sender needs one whole token a packet: below 1 nothing passes)
+            raise ValueError(f"NodeConfig.sender_burst (--burst) must be >= 1 packet, got {self.sender_burst:g}")
         if self.max_senders < 1 or self.batch < 1:
             raise ValueError("NodeConfig.max_senders and NodeConfig.batch must be >= 1")
         if self.group is not None:

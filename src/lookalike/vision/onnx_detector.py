@@ -22,6 +22,7 @@ Each box gets its best class among ``classes`` (all when None); boxes scoring be
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -29,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.types import Detections
 from lookalike.types.mot_table import detection_rows
 from lookalike.vision.nms import nms
@@ -61,8 +63,11 @@ class OnnxDetectorConfig:
             raise ValueError(f"box_order: choose xyxy or yxyx, got {self.box_order!r}")
         if self.input_size is not None and min(self.input_size) < 8:
             raise ValueError(f"input_size: expected (width, height) of at least 8 px, got {self.input_size}")
-        if self.threads < 1:
-            raise ValueError(f"threads must be at least 1, got {self.threads}")
+        cpus = os.cpu_count() or 1
+        if not 1 <= self.threads <= cpus:
+            raise ValueError(f"threads: from 1 to this machine's {cpus} CPU(s), got {self.threads}")
+        if self.classes is not None and min(self.classes) < 0:
+            raise ValueError(f"classes: class indices are >= 0, got {','.join(map(str, self.classes))}")
 
 
 def config_from_settings(settings: list[str]) -> OnnxDetectorConfig:
@@ -103,7 +108,8 @@ def letterbox(image: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray, flo
     Returns the padded image, the scale ``r`` (input px per frame px) and the padding ``(dx, dy)``:
     a frame point ``p`` lands at ``r · p + (dx, dy)``.
     """
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     h, w = image.shape[:2]
     tw, th = size
