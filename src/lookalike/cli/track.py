@@ -248,8 +248,10 @@ def track(
                                          min_score=min_score, fps=fps, features=features)
     # the video, pixel, blob and closed-set paths are imported in their branch: keeps the CLI's start-up short
     with ExitStack() as stack:
+        annotate_as = annotate
         if annotate is not None:  # (the video is written to a temporary file, renamed into place when complete)
             annotate = video_options["annotate"] = stack.enter_context(atomic_path(annotate))
+            video_options["annotate_as"] = annotate_as
         try:
             if branch == "pipeline":
                 from lookalike.cli.track_pixels import run_track_pixels
@@ -257,7 +259,7 @@ def track(
                 if params_file is not None:
                     settings = [*(f"{k}={v}" for k, v in tracker_params(tracker, [], params_file).items()), *settings]
                 run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker,
-                                 settings, annotate=annotate, fps=fps, min_score=min_score)
+                                 settings, annotate=annotate, fps=fps, min_score=min_score, annotate_as=annotate_as)
                 return
             trk = _box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets,
                                params_file=params_file)

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 import typer
+from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from lookalike.cli.app import app, console, fail
@@ -44,9 +45,11 @@ def _check(video: Path | None, pipeline: str, reports: Path | None, identifier: 
 
 def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: Path | None, detector_model: Path | None,
                      heading_model: Path | None, identifier: str, settings: list[str], *,
-                     annotate: Path | None = None, fps: float | None = None, min_score: float = 0.5) -> None:
+                     annotate: Path | None = None, fps: float | None = None, min_score: float = 0.5,
+                     annotate_as: Path | None = None) -> None:
     """Run pipeline ``pipeline`` over ``video`` with the reports of ``reports``; write MOTChallenge rows
-    to ``output`` and, with ``annotate``, an annotated MP4. ``min_score``: detector probability (-inf: 0.5)."""
+    to ``output`` and, with ``annotate``, an annotated MP4 (named ``annotate_as`` in the summary line: ``annotate``
+    may be its temporary file). ``min_score``: detector probability (-inf: 0.5)."""
     from lookalike.viz.overlay import source_frames
     from lookalike.viz.video import VideoWriter
 
@@ -85,8 +88,9 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
         if writer is not None:
             writer.close()
     speed = f"{stats.fps:,.1f}" if stats.seconds > 0 else "inf"
+    where = escape(f"{output}" + (f", {annotate_as or annotate}" if annotate else ""))
     console.print(f"[green]{identifier}[/] from pixels: {stats.frames} frames, {speed} frames/s (detector + heading + "
-                  f"identifier) → {output}" + (f", {annotate}" if annotate else ""))
+                  f"identifier) → {where}")
 
 
 @app.command("render-robots")

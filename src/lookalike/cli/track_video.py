@@ -18,6 +18,7 @@ from rich.progress import (
 from lookalike.cli.app import console, fail
 from lookalike.cli.track_closed import offline_video
 from lookalike.io import read_mot, write_mot
+from lookalike.io.outputs import atomic_path
 from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
 from lookalike.trackers.parts.health import HealthConfig
 from lookalike.viz.overlay import source_frames
@@ -34,11 +35,12 @@ FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
 
 def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, tracker_name: str, *,
                     annotate: Path | None, team_size: int | None, health_window: int,
-                    min_score: float, fps: float | None, features: str = "video") -> None:
+                    min_score: float, fps: float | None, features: str = "video",
+                    annotate_as: Path | None = None) -> None:
     """Track ``detections`` on ``video`` and write ``output``, its ``.health.csv`` (and ``.merges.csv`` for trackers
     that merge identities) and, with ``annotate``, the annotated MP4. ``features``: ``video`` (standardised on this
     video), ``divers``/``handcrafted`` (statistics of the rendered validation divers), ``learned`` (the shipped ONNX
-    embedding) or ``FILE.onnx``."""
+    embedding) or ``FILE.onnx``. ``annotate_as``: the name to print for ``annotate`` (its temporary file)."""
     if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
         fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
     if output.is_dir():
@@ -67,22 +69,26 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
     except ValueError as exc:
         fail(str(exc))
     except KeyboardInterrupt:
-        console.print("\n[yellow]Interrupted.[/]"
-                      + (f" {escape(str(annotate))} holds the frames written so far." if annotate else ""))
+        console.print("\n[yellow]Interrupted.[/] Nothing was written"
+                      + (f" ({escape(str(annotate_as or annotate))} is left as it was)." if annotate else "."))
         raise SystemExit(130) from None
     write_mot(output, result.rows)
-    written = [output, write_health_csv(side_file(output, "health"), result.health)]
+    written = [output, side_file(output, "health")]
+    with atomic_path(written[1]) as tmp:  # (the side files too appear whole, through temporary files)
+        write_health_csv(tmp, result.health)
     if hasattr(tracker, "merges"):
-        written.append(write_merges_csv(side_file(output, "merges"), result.merges))
+        written.append(side_file(output, "merges"))
+        with atomic_path(written[-1]) as tmp:
+            write_merges_csv(tmp, result.merges)
     if annotate is not None:
-        written.append(annotate)
+        written.append(annotate_as or annotate)
     unhealthy = sum(not s.healthy for s in result.health)
     seconds = result.tracker_s + result.feature_s
     fps_text = f"{result.frames / seconds:,.0f}" if seconds > 0 else "inf"
     console.print(
         f"[green]{tracker_name}[/]: {result.frames} frames, {len(result.merges)} merge(s), "
         f"{unhealthy} frame(s) flagged unhealthy, {fps_text} frames/s (features + tracker) → "
-        + ", ".join(str(p) for p in written)
+        + escape(", ".join(str(p) for p in written))
     )
     if result.ignored_rows:
         console.print(f"[yellow]note:[/] {result.ignored_rows} detection row(s) are past the video's "
