@@ -7,6 +7,8 @@ import os
 from collections.abc import Callable
 from typing import Any, Generic, TypeVar, cast
 
+from lookalike._optional import needs
+
 K = TypeVar("K")
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -16,7 +18,8 @@ def exact_jit() -> Callable[[F], F]:
     (``fastmath`` off: no fused multiply-adds or reordering; numpy's float error model: division by zero gives
     inf/NaN), compiled code cached on disk, the GIL released, no bounds checks. Imports numba (an
     ``ImportError`` without it): call it only from a kernel module."""
-    import numba  # type: ignore[import-untyped, import-not-found, unused-ignore]
+    with needs("numba"):
+        import numba  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     jit = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy", boundscheck=False)
     return cast("Callable[[F], F]", jit)

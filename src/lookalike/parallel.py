@@ -9,6 +9,8 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from typing import Any
 
+from lookalike._optional import needs
+
 BACKENDS = ("local", "ray")
 
 
@@ -76,10 +78,8 @@ class JobPool:
 
 def init_ray(address: str | None, workers: int) -> Any:
     """The ``ray`` module, initialised on ``address`` or as a local instance (``workers`` CPUs)."""
-    try:
+    with needs("ray"):
         import ray
-    except ImportError:
-        raise ValueError("backend 'ray' needs the ray package (pip install 'lookalike[ray]')") from None
     if not ray.is_initialized():
         if address:
             ray.init(address=address, ignore_reinit_error=True, log_to_driver=False)

@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.bench.datasets import RealSequence
 from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.bench.runner import Entry, job_pairs, run_jobs
@@ -155,10 +156,12 @@ def leaderboard_results(part: str, rows: list[dict[str, Any]], combined: list[di
 
 def plot_leaderboard(rows: list[dict[str, Any]], folder: Path) -> list[Path]:
     """One bar chart per dataset (HOTA, IDF1, MOTA per tracker) as PNG files in ``folder``."""
-    import matplotlib
+    with needs("matplotlib"):
+        import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    with needs("matplotlib"):
+        import matplotlib.pyplot as plt
 
     folder.mkdir(parents=True, exist_ok=True)
     paths = []

@@ -10,6 +10,8 @@ import os
 import sys
 from pathlib import Path
 
+from rich.markup import escape
+
 SCRIPT_NAMES = ("lookalike", "__main__.py")
 """``sys.argv[0]`` names of the ``lookalike`` script and of ``python -m lookalike``."""
 
@@ -75,9 +77,20 @@ def _terminate_cleanly() -> None:
 
 
 def main() -> None:
-    """Entry point of the ``lookalike`` script."""
+    """Entry point of the ``lookalike`` script; a missing optional package ends it with one line naming the extra
+    to install (exit 2)."""
+    from lookalike._optional import MissingExtra
+
     _terminate_cleanly()
-    app()
+    try:
+        app()
+    except MissingExtra as exc:
+        from lookalike.cli.app import err_console
+
+        command = _script_command()
+        where = f"lookalike {command}" if command else "lookalike"
+        err_console.print(f"[bold red]error:[/] {escape(where)}: {escape(str(exc))}", highlight=False)
+        raise SystemExit(2) from None
 
 
 __all__ = ["app", "main"]

@@ -26,11 +26,8 @@ def train_appearance(
     check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})
     if output.exists() and not output.is_dir():
         fail(f"-o/--output: {output} is a file; give a folder")
-    try:
-        from lookalike.learn.appearance_train import AppearanceTrainConfig
-        from lookalike.learn.appearance_train import train_appearance as run
-    except ImportError as exc:
-        fail(f"train-appearance needs torch (pip install 'lookalike[train]'): {exc}")
+    from lookalike.learn.appearance_train import AppearanceTrainConfig
+    from lookalike.learn.appearance_train import train_appearance as run
     try:
         config = AppearanceTrainConfig(scenarios=scenarios, frames=frames, epochs=epochs, minutes=minutes, seed=seed,
                                        threads=threads, device=device)

@@ -7,6 +7,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from lookalike._optional import needs
 from lookalike.cli.app import console, fail
 from lookalike.cli.train_options import RunOptions
 from lookalike.sim import RobotSequence
@@ -52,7 +53,8 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     """Fine-tune on the recordings of ``folder`` (split by recording, or all of them with ``opt.validation``,
     the folder of the validation recordings), write ``OUTPUT/model.npz``; with ``opt.test``, print the
     starting and fine-tuned success rates on the test recordings."""
-    import torch
+    with needs("torch"):
+        import torch
 
     from lookalike.cli.train import _with_progress
     from lookalike.learn.recordings import RecordingSampler, check_recordings, split_recordings, validation_arrays

@@ -26,6 +26,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from lookalike._optional import needs
+
 SCHEMA_ID = "lookalike-results/1"
 SCHEMA_PATH = Path(__file__).with_name("results.schema.json")
 KEY_PATTERN = re.compile(r"^[a-z][a-z0-9_]*$")
@@ -212,7 +214,8 @@ def schema() -> dict[str, Any]:
 def validate(document: Mapping[str, Any]) -> None:
     """Check ``document`` against the schema (needs the ``jsonschema`` package of the test extra);
     ``jsonschema.ValidationError`` when it does not conform."""
-    import jsonschema  # type: ignore[import-untyped]  # no stubs; test extra
+    with needs("jsonschema"):
+        import jsonschema  # type: ignore[import-untyped]  # no stubs; test extra
 
     jsonschema.validate(dict(document), schema())
 

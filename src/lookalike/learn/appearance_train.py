@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.learn.appearance_data import CROP_SIZE, CropSet, diver_crops
 
 MODEL_NAME = "diver_reid"
@@ -52,10 +53,8 @@ class AppearanceTrainConfig:
 
 
 def _torch() -> Any:
-    try:
+    with needs("torch"):
         import torch
-    except ImportError as exc:  # pragma: no cover - the train extra is installed in development
-        raise RuntimeError("training the appearance model needs torch: pip install 'lookalike[train]'") from exc
     return torch
 
 

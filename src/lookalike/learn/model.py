@@ -6,11 +6,14 @@ output heads: its ``M·(N+1)`` outputs are read as M softmax groups."""
 from __future__ import annotations
 
 import numpy as np
-import torch
-from torch import nn
 
+from lookalike._optional import needs
 from lookalike.trackers.lstm.checkpoint import NetworkWeights
 from lookalike.trackers.lstm.encoding import EncodingSpec
+
+with needs("torch"):
+    import torch
+    from torch import nn
 
 
 class AssociationNet(nn.Module):

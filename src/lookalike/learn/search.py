@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.parallel import JobPool
 from lookalike.sim import RobotWorldConfig
 
@@ -84,7 +85,8 @@ class SearchResult:
 def run_trial(config: Any, world: RobotWorldConfig, out_dir: str, threads: int = 1) -> dict[str, Any]:
     """One training run (a job: picklable, its result depends on its arguments only): ``{"value", "step",
     "steps", "seconds"}``, or ``{"error"}`` when the configuration fails."""
-    import torch
+    with needs("torch"):
+        import torch
 
     from lookalike.learn.sim_data import make_sim_sampler
     from lookalike.learn.training import train
@@ -119,10 +121,8 @@ def check_success(weights_path: Path, world: RobotWorldConfig, sequences: int, l
 
 
 def _open_study(storage: str, name: str, meta: dict[str, Any]) -> Any:
-    try:
+    with needs("optuna"):
         import optuna
-    except ImportError:
-        raise ValueError("lookalike train --search needs optuna (pip install 'lookalike[tune]')") from None
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     study = optuna.create_study(study_name=name, storage=storage, direction="maximize", load_if_exists=True)
     old = study.user_attrs
@@ -136,7 +136,8 @@ def _open_study(storage: str, name: str, meta: dict[str, Any]) -> Any:
 
 
 def _sampler(name: str, seed: int) -> Any:
-    import optuna
+    with needs("optuna"):
+        import optuna
 
     if name == "tpe":
         return optuna.samplers.TPESampler(seed=seed, n_startup_trials=5)
@@ -154,7 +155,8 @@ def run_search(base: Any, world: RobotWorldConfig, out_dir: str | Path, trials: 
     :class:`~lookalike.learn.training.TrainConfig` ``base`` on the robot world ``world``; write each trial
     into ``out_dir/trial-NNNN``, the chosen network to ``out_dir/model.npz`` and the choice to
     ``out_dir/search.json``. ``progress(done, trials, row)`` is called after each finished trial."""
-    from optuna.trial import TrialState
+    with needs("optuna"):
+        from optuna.trial import TrialState
 
     if trials < 1:
         raise ValueError(f"trials must be >= 1, got {trials}")

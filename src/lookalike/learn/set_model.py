@@ -15,10 +15,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import torch
-from torch import nn
 
+from lookalike._optional import needs
 from lookalike.trackers.set.network import AGENT_FEATURES, DET_FEATURES
+
+with needs("torch"):
+    import torch
+    from torch import nn
 
 PAIR_FEATURES = 6
 POSITION_SCALE_M = 4.0  # positions are divided by this before entering the network

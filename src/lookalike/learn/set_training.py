@@ -17,15 +17,18 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-import torch
-from torch import nn
 
+from lookalike._optional import needs
 from lookalike.learn.data import IGNORE
 from lookalike.learn.set_data import SetBatchMaker, TeamSizes
 from lookalike.learn.set_model import SetAssociator, SetSizes
 from lookalike.learn.training import TRAIN_SEED_BASE, VALIDATION_SEED_BASE, TrainResult, _write_log
 from lookalike.parallel import JobPool
 from lookalike.trackers.set.network import SetWeights, save_set_weights
+
+with needs("torch"):
+    import torch
+    from torch import nn
 
 SET_SEED_OFFSET = 70_000_000  # keeps the set associator's seeds apart from the LSTM's
 # (N, M, false positives per frame) of the validation sequences: the paper's three set-ups and others.

@@ -15,14 +15,17 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
-import torch
-from torch import nn
 
+from lookalike._optional import needs
 from lookalike.learn.data import IGNORE, success_rate
 from lookalike.learn.model import AssociationNet
 from lookalike.parallel import JobPool
 from lookalike.trackers.lstm.checkpoint import NetworkWeights, save_weights
 from lookalike.trackers.lstm.encoding import EncodingSpec
+
+with needs("torch"):
+    import torch
+    from torch import nn
 
 TRAIN_SEED_BASE = 2_000_000_000  # training sequences use seeds from here on
 VALIDATION_SEED_BASE = 1_900_000_000  # fixed held-out validation seeds
@@ -228,10 +231,12 @@ def _write_log(path: Path, history: list[dict]) -> None:
 
 def plot_log(log_path: str | Path, png_path: str | Path) -> Path:
     """Plot a training log (loss and validation success rate against step) to PNG."""
-    import matplotlib
+    with needs("matplotlib"):
+        import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    with needs("matplotlib"):
+        import matplotlib.pyplot as plt
 
     with Path(log_path).open() as fh:
         rows = list(csv.DictReader(fh))

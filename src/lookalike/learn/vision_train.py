@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.vision.heading import HeadingConfig, feature_length, heading_features
 
 if TYPE_CHECKING:
@@ -99,7 +100,8 @@ def negative_sampler(frames: list[np.ndarray], truths: list[np.ndarray], window_
 
 
 def _read_grey(path: Path) -> np.ndarray:
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     from lookalike.vision.hog_features import as_bgr_image, to_grey
 
@@ -112,7 +114,8 @@ def _read_grey(path: Path) -> np.ndarray:
 def folder_detector_data(folder: Path, window_px: tuple[int, int]) -> tuple[np.ndarray, list[np.ndarray]]:
     """Positive windows from ``folder/positives`` (each image resized to the window) and negative images from
     ``folder/negatives``."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     def images(sub: str) -> list[Path]:
         d = folder / sub

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lookalike._optional import needs
+
 BGR = tuple[int, int, int]
 
 
@@ -109,7 +111,8 @@ def attenuate(colour: BGR, water: np.ndarray, z: float, attenuation: float) -> t
 def draw_diver(image: np.ndarray, pose: Pose, look: DiverLook, focal_px: float, water: np.ndarray,
                attenuation: float, blur_per_m: float) -> None:
     """Draw one diver in place on ``image (h, w, 3)`` uint8 BGR."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     pts = project(pose, look.size, focal_px)
     s = focal_px / pose.z * look.size
@@ -146,7 +149,8 @@ def draw_diver(image: np.ndarray, pose: Pose, look: DiverLook, focal_px: float, 
 
 def draw_bubbles(image: np.ndarray, centres: np.ndarray, radii: np.ndarray, colour: BGR, alpha: float) -> None:
     """Blend bubbles (circles, ``centres (k, 2)``, ``radii (k,)`` in pixels) into ``image`` in place."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     if not len(centres):
         return

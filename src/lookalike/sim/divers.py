@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.sim.diver_render import (
     TEAM,
@@ -148,7 +149,8 @@ class DiverScene:
 
     def image(self, k: int) -> np.ndarray:
         """Render frame ``k`` (0-based) as a ``(h, w, 3)`` uint8 BGR image."""
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         sc = self.scenario
         w, h = sc.image_size

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.geometry.angles import wrap_angle
 from lookalike.geometry.camera import Camera, Pose2D
 
@@ -120,7 +121,8 @@ class RobotRenderer:
     ) -> RenderedFrame:
         """Draw robots at fixed-frame ``positions_m (N, 2)`` with fixed-frame ``headings_rad (N,)``, seen
         by an observer at ``observer`` (fixed frame; default the origin looking along +x)."""
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         pos = np.asarray(positions_m, dtype=float).reshape(-1, 2) if np.size(positions_m) else np.zeros((0, 2))
         head = np.asarray(headings_rad, dtype=float).reshape(-1)
@@ -222,7 +224,8 @@ class RobotRenderer:
         return np.clip(img, 0, 255).reshape(k.height, k.width, 3).astype(np.uint8)
 
     def _nuisances(self, img: np.ndarray) -> np.ndarray:
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         cfg, rng = self.config, self._rng
         target = np.exp(rng.normal(0.0, cfg.brightness_std)) * np.exp(rng.normal(0.0, cfg.cast_std, 3))

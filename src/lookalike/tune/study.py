@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from lookalike._optional import needs
 from lookalike.parallel import JobPool
 from lookalike.trackers.registry import tracker_parameters
 from lookalike.tune.data import score_params, sequence_key
@@ -47,7 +48,8 @@ class StudyResult:
 
 def make_sampler(name: str, seed: int) -> Any:
     """An Optuna sampler: ``"tpe"`` (Tree-structured Parzen Estimator) or ``"random"``."""
-    import optuna
+    with needs("optuna"):
+        import optuna
 
     if name == "tpe":
         return optuna.samplers.TPESampler(seed=seed)
@@ -57,10 +59,8 @@ def make_sampler(name: str, seed: int) -> Any:
 
 
 def _import_optuna() -> Any:
-    try:
+    with needs("optuna"):
         import optuna
-    except ImportError:
-        raise ValueError("lookalike tune needs optuna (pip install 'lookalike[tune]')") from None
     optuna.logging.set_verbosity(optuna.logging.WARNING)
     return optuna
 
@@ -148,7 +148,8 @@ def run_study(tracker: str, sequences: Sequence[Any], *, space: Space | None = N
     name = study_name or tracker
     meta = {"tracker": tracker, "metric": metric.lower(), "sequences": keys, "space": space_to_json(space)}
     study = _open_study(optuna, name, storage, resume, None, meta)
-    from optuna.trial import TrialState
+    with needs("optuna"):
+        from optuna.trial import TrialState
 
     for stale in study.get_trials(deepcopy=False, states=(TrialState.RUNNING, TrialState.WAITING)):
         if stale.state == TrialState.RUNNING:

@@ -32,6 +32,8 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from lookalike._optional import needs
+
 BLOCKS: tuple[tuple[str, int], ...] = (
     ("colour", 25),
     ("frequency", 6),
@@ -180,7 +182,8 @@ def crop_boxes(image: np.ndarray, xywh: np.ndarray, size: int | tuple[int, int])
 
     A box wholly outside the image gives a black crop.
     """
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     img = np.asarray(image)
     if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8:
@@ -201,7 +204,8 @@ def crop_boxes(image: np.ndarray, xywh: np.ndarray, size: int | tuple[int, int])
 
 def raw_features(crops: np.ndarray) -> np.ndarray:
     """``(n, RAW_DIM)`` raw features of square BGR uint8 crops ``(n, s, s, 3)``."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     crops = np.asarray(crops)
     if crops.ndim != 4 or crops.shape[1] != crops.shape[2] or crops.shape[3] != 3:
@@ -297,7 +301,8 @@ def _edges(grey: np.ndarray) -> np.ndarray:
 
 def _shape_stats(mask: np.ndarray, s: int) -> tuple[np.ndarray, np.ndarray]:
     """Contour statistics ``(n, 3)`` and convex-hull statistics ``(n, 5)`` of each foreground mask."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     n = len(mask)
     contour = np.zeros((n, 3))

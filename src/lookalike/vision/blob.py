@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.types import Detections
 from lookalike.vision.hog_features import as_bgr_image
 
@@ -117,7 +118,8 @@ class BlobDetector:
     def foreground(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(mask, difference)``: a ``(h, w)`` uint8 mask (255 = foreground, after morphology) and the
         ``(h, w)`` float32 difference from the background in grey levels; updates an online model."""
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         cfg = self.config
         img = self._prepare(image, "image")
@@ -154,7 +156,8 @@ class BlobDetector:
 
     def __call__(self, image: np.ndarray) -> Detections:
         """Detections of one frame: boxes ``xywh`` (px) of the blobs, each scoring 1."""
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         cfg = self.config
         mask, _ = self.foreground(image)
@@ -172,7 +175,8 @@ class BlobDetector:
     detect = __call__
 
     def _prepare(self, image: np.ndarray, name: str) -> np.ndarray:
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         img = as_bgr_image(image, name)
         if self.config.blur_px > 1:
@@ -184,7 +188,8 @@ class BlobDetector:
 
     def _stabilise(self, img: np.ndarray) -> np.ndarray:
         """Shift ``img`` (float32 BGR) by the translation that best aligns it with the first frame seen."""
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         grey = (img[..., 0] + img[..., 1] + img[..., 2]) / 3  # the channel mean, without a slow last-axis reduce
         if self._reference is None or self._reference.shape != grey.shape:
@@ -208,7 +213,8 @@ class BlobDetector:
 
 def read_video(path: str, max_frames: int | None = None) -> list[np.ndarray]:
     """All frames (or the first ``max_frames``) of a video file as ``(h, w, 3)`` uint8 BGR arrays."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     cap = cv2.VideoCapture(str(path))
     if not cap.isOpened():

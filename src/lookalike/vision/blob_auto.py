@@ -42,6 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.vision.blob import BlobConfig
 from lookalike.vision.hog_features import as_bgr_image
 
@@ -117,7 +118,8 @@ def _odd(value: float, lo: int, hi: int) -> int:
 
 def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
     """Up to ``count`` frames spread evenly over a video file, read in one pass (BGR uint8)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     cap = cv2.VideoCapture(str(video))
     if not cap.isOpened():
@@ -159,7 +161,8 @@ def _spread(stack: np.ndarray) -> float:
 def _shifts(grey: list[np.ndarray]) -> np.ndarray:
     """``(n, 2)`` translation (px) of each frame against the median of all (phase correlation; moving
     targets are absent from the median, so they pull no peak of their own)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     reference = np.median(np.stack(grey), axis=0).astype(np.float32)
     window = cv2.createHanningWindow(reference.shape[::-1], cv2.CV_32F)
@@ -169,7 +172,8 @@ def _shifts(grey: list[np.ndarray]) -> np.ndarray:
 
 def _components(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Areas (px²) and labels of the 8-connected components of a uint8 mask."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     _, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
     return stats[1:, cv2.CC_STAT_AREA].astype(float), labels
@@ -188,7 +192,8 @@ def _target_area(areas: list[np.ndarray]) -> float:
 
 def _radii(masks: list[np.ndarray], area: float) -> list[float]:
     """Largest inscribed radius (px) of every component of ``masks`` with a target's area."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     radii: list[float] = []
     for mask in masks:
@@ -211,7 +216,8 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     """Blob detector settings estimated from a video (a file path, or its ``(h, w, 3)`` BGR frames),
     optionally knowing the number of targets ``n_targets`` (module doc). ``base`` supplies the settings
     that are not estimated (method, blur, history)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     if n_targets is not None and int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")

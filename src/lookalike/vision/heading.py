@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.vision.hog_features import as_bgr_image, dense_hog, hue_channel, to_grey
 from lookalike.vision.model_file import load_model_file, save_model_file
 
@@ -76,7 +77,8 @@ def class_centres(classes: int = 10) -> np.ndarray:
 def heading_features(image: np.ndarray, xywh: np.ndarray, config: HeadingConfig = HeadingConfig()) -> np.ndarray:
     """Features ``(n, d)`` float32 of boxes ``xywh (n, 4)`` (px) in ``image`` (BGR or grey; see
     :func:`~lookalike.vision.hog_features.as_bgr_image`): grey HOG, hue HOG, box centre / image size."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     img = as_bgr_image(image)
     boxes = np.asarray(xywh, dtype=float)
@@ -256,9 +258,10 @@ def train_heading(
     C and γ come from a ``config.folds``-fold grid search scored by the mean angular error (rad) between
     predicted and true class centres; the best pair is refitted on everything with Platt probabilities.
     """
-    from sklearn.metrics import make_scorer
-    from sklearn.model_selection import GridSearchCV, KFold
-    from sklearn.svm import SVC
+    with needs("sklearn"):
+        from sklearn.metrics import make_scorer
+        from sklearn.model_selection import GridSearchCV, KFold
+        from sklearn.svm import SVC
 
     f = np.asarray(features, dtype=np.float64)
     h = np.asarray(heading_rad, dtype=float).reshape(-1)
@@ -307,9 +310,10 @@ def train_heading(
 def _platt_pairs(svc, x: np.ndarray, y: np.ndarray, folds: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """Platt sigmoid per class pair, ``P(i | i or j) = 1 / (1 + exp(A f + B))``, fitted (as libsvm does) on
     out-of-fold one-vs-one decision values ``f`` of the samples of classes i and j."""
-    from sklearn.base import clone
-    from sklearn.linear_model import LogisticRegression
-    from sklearn.model_selection import KFold, cross_val_predict
+    with needs("sklearn"):
+        from sklearn.base import clone
+        from sklearn.linear_model import LogisticRegression
+        from sklearn.model_selection import KFold, cross_val_predict
 
     cv = KFold(folds, shuffle=True, random_state=seed + 1)
     try:

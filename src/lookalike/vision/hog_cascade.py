@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.types import Detections
 from lookalike.vision.hog_blocks import (  # noqa: F401  (block_pool, window_features: part of this module's API)
@@ -135,7 +136,8 @@ class HogCascade:
     def windows(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Every pyramid window of a ``(h, w, 3)`` BGR or grey image that passes all stages, before non-maximum
         suppression: ``(xywh (n, 4) px, last-stage margin (n,))``."""
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         cfg = self.config
         img = np.asarray(image)
@@ -301,9 +303,10 @@ def train_cascade(
             than ``hard_negative_max_iou`` becomes a negative (windows beside robots, field lines, partly
             visible robots); random windows from ``negative_windows`` fill up the rest.
     """
-    from sklearn.ensemble import AdaBoostClassifier
-    from sklearn.linear_model import LogisticRegression
-    from sklearn.tree import DecisionTreeClassifier
+    with needs("sklearn"):
+        from sklearn.ensemble import AdaBoostClassifier
+        from sklearn.linear_model import LogisticRegression
+        from sklearn.tree import DecisionTreeClassifier
 
     rng = np.random.default_rng(seed)
     blocks = block_pool(config.window_px, config.cell_px)

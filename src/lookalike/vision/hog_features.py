@@ -15,6 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.vision.hog_kernels import compiled
 
 BINS = 9  # unsigned orientation bins over [0, π)
@@ -54,7 +55,8 @@ def as_bgr_image(image: np.ndarray, name: str = "image") -> np.ndarray:
 def to_grey(image_bgr: np.ndarray) -> np.ndarray:
     """``(h, w)`` float32 luminance in 0..255 of a ``(h, w, 3)`` uint8 BGR image:
     ``0.114 B + 0.587 G + 0.299 R`` in float32 (channel planes, in bands of rows that stay in cache)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     img = np.ascontiguousarray(image_bgr)
     h, w = img.shape[:2]
@@ -76,7 +78,8 @@ def to_grey(image_bgr: np.ndarray) -> np.ndarray:
 
 def hue_channel(image_bgr: np.ndarray) -> np.ndarray:
     """``(h, w)`` float32 hue of a BGR uint8 image, scaled to 0..255 (OpenCV's full-range HSV)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     return cv2.cvtColor(image_bgr, cv2.COLOR_BGR2HSV_FULL)[..., 0].astype(np.float32)
 
@@ -84,7 +87,8 @@ def hue_channel(image_bgr: np.ndarray) -> np.ndarray:
 def _polar_gradients(g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Magnitude and angle in [0, 2π) (accurate to about 0.3°), float32 ``(h, w)``, of the central-difference
     gradients of float32 ``g (h, w)``, zero at the border."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     gx = cv2.Sobel(g, cv2.CV_32F, 1, 0, ksize=1)  # kernel [-1, 0, 1]: the central difference
     gy = cv2.Sobel(g, cv2.CV_32F, 0, 1, ksize=1)
@@ -237,7 +241,8 @@ def dense_hog(channel: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndarray
 def crop_window(grey: np.ndarray, xywh: np.ndarray, window_px: tuple[int, int], pad: float = 0.1) -> np.ndarray:
     """A ``(h+2, w+2)`` float32 crop of ``grey (H, W)`` around box ``xywh`` (px), widened to the window's aspect
     ratio with ``pad`` (fraction of the box height) of context, resized, with a 1-px margin for gradients."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     w_px, h_px = window_px
     x, y, w, h = (float(v) for v in xywh)
@@ -256,7 +261,8 @@ def augment_windows(windows: np.ndarray, copies: int, rng: np.random.Generator, 
     """``copies`` random variants of each ``(h, w)`` window: rotation within ±``max_rot_deg`` (normal, clipped),
     scale jitter, horizontal flip, and with probability ``cutout`` a cut-out rectangle (up to a quarter of
     the window) filled with the window's mean (partial occlusion)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     out = []
     for win in np.asarray(windows, np.float32):

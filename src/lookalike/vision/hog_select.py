@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.association import assign
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.vision.hog_cascade import HogCascade
@@ -115,7 +116,8 @@ def select_stages(model: HogCascade, scenes: Sequence[HeldOutScene], *, iou: flo
             break
         chosen, margin, label = coarser, result[1], result[2]
     if 0 < label.sum() < len(label):
-        from sklearn.linear_model import LogisticRegression
+        with needs("sklearn"):
+            from sklearn.linear_model import LogisticRegression
 
         lr = LogisticRegression().fit(margin[:, None], label.astype(int))
         if lr.coef_[0, 0] > 0:  # a larger margin must mean a likelier target

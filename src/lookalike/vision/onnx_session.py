@@ -5,12 +5,15 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from lookalike._optional import needs
+
 
 def open_session(path: Path, threads: int, what: str) -> Any:
     """An onnxruntime ``InferenceSession`` of ``path`` on the CPU with ``threads`` threads (quiet logs);
     ``FileNotFoundError`` when the file is missing, ``ValueError`` naming it when onnxruntime cannot
     load it (``what`` names the kind of model in the message)."""
-    import onnxruntime as ort  # type: ignore[import-untyped]
+    with needs("onnxruntime"):
+        import onnxruntime as ort  # type: ignore[import-untyped]
 
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such {what}")

@@ -27,6 +27,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.geometry.camera import Camera
 from lookalike.trackers.parts.identity import labels_from_tracks
 from lookalike.trackers.registry import make_tracker, tracker_class
@@ -199,7 +200,8 @@ class RobotPipeline:
     def perceive(self, image: np.ndarray, observer_yaw_rad: float = 0.0) -> Detections:
         """Detections of one frame: boxes (px), scores, ground positions (m), absolute headings and
         their spreads (rad); at most ``max_detections``, the most probable, in decreasing score."""
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         cfg = self.config
         k = self.camera.intrinsics

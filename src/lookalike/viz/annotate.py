@@ -7,6 +7,7 @@ from collections import deque
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.viz.colors import BGR, OUTLINE, identity_colour
 
 Rect = tuple[int, int, int, int]  # x0, y0, x1, y1 (px)
@@ -25,7 +26,8 @@ class LabelSpace:
 
 
 def _segment(image: np.ndarray, a: tuple[int, int], b: tuple[int, int], colour: BGR, thickness: int) -> None:
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     cv2.line(image, a, b, OUTLINE, thickness + 2, cv2.LINE_AA)
     cv2.line(image, a, b, colour, thickness, cv2.LINE_AA)
@@ -35,7 +37,8 @@ def draw_box(image: np.ndarray, xywh: np.ndarray, colour: BGR, label: str | None
              thickness: int = 2, dashed: bool = False, labels: LabelSpace | None = None) -> None:
     """A box ``xywh (4,)`` (px) with a dark outline and an optional filled label above it (placed
     where it hides no earlier label of ``labels``)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     x, y, w, h = (float(v) for v in xywh)
     if not np.isfinite([x, y, w, h]).all():
@@ -60,7 +63,8 @@ def draw_label(image: np.ndarray, text: str, anchor: tuple[int, int], colour: BG
     """``text`` on a filled, outlined tag of ``colour`` whose bottom-left corner is ``anchor`` (px);
     with ``labels``, the first of: above, below ``box``, further up, further down, that hides no
     earlier tag. Returns the tag's rectangle."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     (tw, th), base = cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, scale, 1)
     h_tag, w_tag = th + base + 3, tw + 4
@@ -85,7 +89,8 @@ def draw_label(image: np.ndarray, text: str, anchor: tuple[int, int], colour: BG
 
 def draw_tail(image: np.ndarray, points: np.ndarray, colour: BGR, thickness: int = 2) -> None:
     """A fading, outlined polyline through ``points (n, 2)`` (px, oldest first); NaN points break the line."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     n = len(pts)
@@ -103,7 +108,8 @@ def draw_tail(image: np.ndarray, points: np.ndarray, colour: BGR, thickness: int
 
 def draw_caption(image: np.ndarray, lines: list[str]) -> None:
     """Caption ``lines`` in the top-left corner on a translucent dark band."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     if not lines:
         return
@@ -183,7 +189,8 @@ def draw_box_tracks(image: np.ndarray, frame: int, ids: np.ndarray, xywh: np.nda
 def draw_legend(image: np.ndarray, entries: list[tuple[str, BGR, bool]], scale: float = 0.45) -> None:
     """A legend in the bottom-left corner: per entry a short box sample (``colour``, dashed or solid)
     and its text, on a translucent dark band."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     if not entries:
         return

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.types.mot_table import detection_rows
 from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config
@@ -139,7 +140,8 @@ def _file_hash(path: Path) -> str:
 def detection_cache_key(video: Path | str, config: BlobConfig, extra: dict[str, Any] | None = None) -> str:
     """The cache key of ``video``'s blob detections: its content hash (every file of an image folder),
     every field of ``config``, the lookalike version, the detector's source code and OpenCV's version."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     from lookalike import __version__
     from lookalike.vision import blob

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.eval import evaluate_sequence
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.io import MotTable, tracks_to_rows, write_mot
@@ -43,7 +44,8 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
     ``divers.mp4``/``divers.gif``/``divers-still.png``/``divers-raw.mp4`` and
     ``divers-<tracker>.txt``; returns the rows and the files written. ``rerun`` (a
     :class:`~lookalike.viz.rerun_log.RerunLogger`) also receives the frames and the video tracker's boxes."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     if video_tracker is not None and (out_dir is None or video_tracker not in trackers):
         raise ValueError(f"video_tracker: {video_tracker!r} needs out_dir and must be one of {trackers}")

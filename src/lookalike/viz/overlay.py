@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.io import MotTable
 from lookalike.viz.annotate import (
     Tails,
@@ -25,7 +26,8 @@ IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")
 def source_frames(source: Path | str) -> tuple[Iterator[np.ndarray], int, float]:
     """Frames of a video file or of a folder of images (sorted by name; a MOTChallenge ``img1``),
     with the frame count and the frame rate (30 for image folders)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     p = Path(source)
     if p.is_dir():
@@ -93,7 +95,8 @@ def birdseye_video(tracks: MotTable, output: Path | str, *, size_px: int = 640, 
                    gif: Path | str | None = None, tail: int = 60, advance: Callable[[], None] | None = None) -> int:
     """World tracks seen from above as an MP4 (one frame per frame number 1..last): a metre grid,
     each id as a dot in its identity colour with a tail; returns the number of frames written."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     xy = world_positions(tracks)
     frame_no = np.asarray(tracks.frame).astype(int)

@@ -8,14 +8,17 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.viz.colors import identity_colour, rgb_hex
 
 
 def _pyplot() -> Any:
-    import matplotlib
+    with needs("matplotlib"):
+        import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    with needs("matplotlib"):
+        import matplotlib.pyplot as plt
 
     return plt
 

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.viz.colors import identity_colour
 
 
@@ -55,10 +56,8 @@ def _rgb(identity: int) -> tuple[int, int, int]:
 
 def open_rerun(app_id: str = "lookalike", save: Path | str | None = None, spawn: bool = False) -> RerunLogger:
     """A logger that streams to a spawned viewer (``spawn``) or else writes a ``.rrd`` recording to ``save``."""
-    try:
+    with needs("rerun"):
         import rerun as rr
-    except ImportError:
-        raise ValueError("the optional package rerun-sdk is not installed (pip install rerun-sdk)") from None
     if save is None and not spawn:
         raise ValueError("open_rerun: give a file to save to or spawn=True")
     rec = rr.RecordingStream(app_id)

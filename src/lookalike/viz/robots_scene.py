@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.eval import identification_success_rate, localisation_error
 from lookalike.geometry.camera import Camera, Extrinsics, Intrinsics, Pose2D
 from lookalike.sim import preset, preset_label, simulate_robots
@@ -56,7 +57,8 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
     """Simulate ``frames`` frames of ``preset_name``, run ``trackers`` and write ``robots.mp4``, ``robots.gif``,
     ``robots-still.png`` and ``robots-birdseye.png`` in ``out_dir`` (rendered ``render_width`` pixels wide,
     annotated at ``scale`` times; ``advance`` called every frame; ``rerun`` also receives the frames)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     if video_tracker not in trackers:
         raise ValueError(f"video_tracker: {video_tracker!r} is not among trackers {trackers}")

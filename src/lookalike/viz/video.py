@@ -12,6 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
+
 
 class VideoWriter:
     """An MP4 file (H.264) written frame by frame (``(h, w, 3)`` uint8 BGR, same size; odd sizes padded by one
@@ -34,7 +36,8 @@ class VideoWriter:
 
     def write(self, image: np.ndarray) -> None:
         """Append one frame."""
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         img = np.asarray(image)
         if img.ndim != 3 or img.shape[2] != 3 or img.dtype != np.uint8:
@@ -75,7 +78,8 @@ class _H264Writer:
     """H.264 MP4 through PyAV: yuv420p, even size (padded), ``+faststart`` for streaming."""
 
     def __init__(self, path: Path, fps: float, size: tuple[int, int]) -> None:
-        import av
+        with needs("av"):
+            import av
 
         self.width, self.height = size[0] + size[0] % 2, size[1] + size[1] % 2
         self.container: Any = av.open(str(path), mode="w", options={"movflags": "+faststart"})
@@ -102,9 +106,11 @@ class _H264Writer:
 def _open_writer(path: Path, fps: float, size: tuple[int, int]) -> Any:
     """An H.264 writer (PyAV), else OpenCV's mp4v (which browsers do not play)."""
     try:
-        import av  # noqa: F401
+        with needs("av"):
+            import av  # noqa: F401
     except ImportError:
-        import cv2
+        with needs("cv2"):
+            import cv2
 
         writer = cv2.VideoWriter(str(path), cv2.VideoWriter.fourcc(*"mp4v"), fps, size)
         if not writer.isOpened():
@@ -135,7 +141,8 @@ def write_gif(path: Path | str, images: list[np.ndarray], fps: float) -> Path:
 @contextmanager
 def _capture(path: Path | str) -> Iterator[Any]:
     """An open ``cv2.VideoCapture`` of ``path``, released on exit; a clear error when it cannot open."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     p = Path(path)
     if not p.is_file():
@@ -161,7 +168,8 @@ def read_frames(path: Path | str) -> Iterator[np.ndarray]:
 
 def video_info(path: Path | str) -> tuple[int, float, tuple[int, int]]:
     """Frame count (as the container says), frames per second and ``(width, height)`` of a video."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     with _capture(path) as cap:
         n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))

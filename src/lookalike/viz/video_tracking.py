@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._optional import needs
 from lookalike.association.solver import assign
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.io import MotTable, frames_from_table, read_seqinfo, tracks_to_rows
@@ -236,7 +237,8 @@ def _draw(img: np.ndarray, k: int, det_xywh: np.ndarray, shown: list[TrackSnapsh
 def draw_banner(image: np.ndarray, text: str, colour: tuple[int, int, int] = UNHEALTHY_BGR) -> None:
     """A filled band of ``colour`` across the bottom of ``image`` (BGR uint8, in place) with white ``text``
     (cut with an ellipsis to the image width)."""
-    import cv2
+    with needs("cv2"):
+        import cv2
 
     scale, h = 0.45, 22
     width = image.shape[1] - 12

@@ -1,0 +1,97 @@
+"""Optional packages: every import of one goes through :func:`needs`, which turns a missing package into
+:class:`MissingExtra`, one line naming the extra of ``pyproject.toml`` that installs it and how to install it
+here (from the wheel or the source folder lookalike was installed from)."""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+OPTIONAL: dict[str, tuple[str, str]] = {
+    "cv2": ("vision", "OpenCV"),
+    "sklearn": ("vision", "scikit-learn"),
+    "onnxruntime": ("vision", "ONNX Runtime"),
+    "matplotlib": ("viz", "matplotlib"),
+    "av": ("viz", "PyAV"),
+    "numba": ("fast", "numba"),
+    "torch": ("train", "PyTorch"),
+    "optuna": ("tune", "Optuna"),
+    "rerun": ("rerun", "the Rerun SDK"),
+    "ray": ("ray", "Ray"),
+    "jsonschema": ("test", "jsonschema"),
+}
+"""Top-level module name → (extra that installs it, what it is called)."""
+
+
+class MissingExtra(ModuleNotFoundError):
+    """An optional package is not installed (or does not import); ``str()`` is one line naming the extra."""
+
+    def __init__(self, module: str, detail: str = "") -> None:
+        self.module = module
+        self.extra, self.label = OPTIONAL[module]
+        self.detail = detail
+        broken = f" ({module} is installed but does not import: {detail})" if detail else ""
+        super().__init__(f"needs {self.label} ({module}){broken}; install the '{self.extra}' extra: "
+                         f"{install_command(self.extra)}", name=module)
+
+    def __reduce__(self) -> tuple[type[MissingExtra], tuple[str, str]]:  # crosses process pools intact
+        return MissingExtra, (self.module, self.detail)
+
+
+def _installed_from() -> tuple[str, bool] | None:
+    """Where lookalike was installed from (a wheel file or a folder) and whether editable; None when unknown."""
+    from importlib import metadata
+    from urllib.parse import unquote, urlparse
+
+    try:
+        text = metadata.distribution("lookalike").read_text("direct_url.json")
+        info = json.loads(text) if text else None
+    except (metadata.PackageNotFoundError, ValueError, OSError):
+        return None
+    if not isinstance(info, dict) or not str(info.get("url", "")).startswith("file://"):
+        return None
+    editable = bool((info.get("dir_info") or {}).get("editable"))
+    return unquote(urlparse(info["url"]).path), editable
+
+
+def install_command(extra: str) -> str:
+    """The pip command that installs ``extra`` into this Python: from the wheel or folder lookalike was
+    installed from (``-e`` when it was an editable install), else a placeholder for them (lookalike is not
+    on PyPI)."""
+    found = _installed_from()
+    where, editable = found if found is not None else ("<lookalike wheel or source folder>", False)
+    pip = "pip" if Path(sys.executable).parent == Path(sys.prefix) / "bin" and _pip_on_path() else \
+        f"{sys.executable} -m pip"
+    return f"{pip} install {'-e ' if editable else ''}'{where}[{extra}]'"
+
+
+def _pip_on_path() -> bool:
+    """True when the ``pip`` found first on ``PATH`` belongs to this Python's environment."""
+    import shutil
+
+    found = shutil.which("pip")
+    return found is not None and Path(found).resolve().parent == (Path(sys.prefix) / "bin").resolve()
+
+
+@contextmanager
+def needs(module: str) -> Iterator[None]:
+    """Wrap the import of the optional package ``module`` (a key of :data:`OPTIONAL`): when it (or the package
+    itself) is missing or fails to import, :class:`MissingExtra` is raised instead, an ``ImportError``, so code
+    that falls back without the package keeps doing so. ``with needs("cv2"): import cv2``."""
+    if module not in OPTIONAL:
+        raise KeyError(f"{module!r} is not an optional package of lookalike ({', '.join(OPTIONAL)})")
+    try:
+        yield
+    except MissingExtra:
+        raise
+    except ImportError as exc:
+        if isinstance(exc, ModuleNotFoundError) and (exc.name or "").split(".")[0] == module:
+            raise MissingExtra(module) from None
+        # installed but broken: a package or shared library it needs is missing
+        raise MissingExtra(module, " ".join(str(exc).split())[:160]) from None
+
+
+__all__ = ["OPTIONAL", "MissingExtra", "install_command", "needs"]
