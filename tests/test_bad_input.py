@@ -458,3 +458,26 @@ def test_eval_refuses_fractional_track_ids_naming_the_line(tmp_path):
     lines[3] = lines[3].replace(",1,", ",1.5,", 1)
     (res / "S1.txt").write_text("".join(lines))
     _one_error_line(_eval(gt, res), "S1.txt:4", "not a whole number")
+
+
+def test_tune_study_and_space_problems_are_one_line(tmp_path):
+    seq = _seq(tmp_path / "S1")
+    (seq / "gt").mkdir()
+    (seq / "gt" / "gt.txt").write_text("".join(GT_ROW.format(f=f, i=1, x=10 + f) for f in range(1, 22)))
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    tune = ["tune", str(seq), "-o", str(tmp_path / "p.json"), "--trials", "1"]
+    _one_error_line(runner.invoke(app, [*tune, "--study", f"sqlite:///{blocker}/x.db"]), "--study", "is a file")
+    _one_error_line(runner.invoke(app, [*tune, "--study", f"sqlite:///{seq / 'gt' / 'gt.txt'}"]), "is the input")
+    _one_error_line(runner.invoke(app, [*tune, "--study", "nosuchdb://host/x"]), "--study nosuchdb://host/x")
+    (tmp_path / "list.json").write_text("[1, 2]")
+    _one_error_line(runner.invoke(app, [*tune, "--space", str(tmp_path / "list.json")]), "--space", "got a list")
+    assert not (tmp_path / "p.json").exists()
+
+
+def test_report_on_a_deeply_nested_json_is_one_line(tmp_path):
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    _one_error_line(runner.invoke(app, ["report", str(deep), "-o", str(tmp_path / "r.html")]), "deep.json",
+                    "nested too deeply")
+    assert not (tmp_path / "r.html").exists()

@@ -60,14 +60,19 @@ def check_outputs(outputs: Mapping[str, Path | None], inputs: Iterable[Path | No
         if name in folders:
             if path.exists() and not path.is_dir():
                 raise ValueError(f"{name} {path}: is a file, not a folder (nothing was written)")
-            for src in files:
-                if _same_file(path, src):
-                    raise ValueError(f"{name} {path} is the input {src}")
-            _check_folder(path)
+            _check_named_folder(name, path, path)
         else:
             if path.is_dir():
                 raise ValueError(f"{name} {path} is a folder; expected a file (nothing was written)")
-            _check_folder(path.parent)
+            _check_named_folder(name, path, path.parent)
+
+
+def _check_named_folder(name: str, path: Path, folder: Path) -> None:
+    """:func:`_check_folder`, its refusal naming the option ``name`` and its ``path``."""
+    try:
+        _check_folder(folder)
+    except ValueError as exc:
+        raise ValueError(f"{name} {path}: {exc}") from None
 
 
 def _check_folder(folder: Path) -> None:

@@ -165,6 +165,8 @@ def space_from_json(spec: Mapping[str, Any], tracker: str) -> Space:
     """A space from its JSON form (module docstring), checked against ``tracker``'s parameters.
 
     Raises ``ValueError`` naming an unknown parameter or a malformed entry."""
+    if not isinstance(spec, Mapping):
+        raise ValueError(f"space: expected a JSON object {{parameter: range}}, got a {type(spec).__name__}")
     hints = config_hints(tracker)
     out: Space = {}
     for name, entry in spec.items():

@@ -62,6 +62,8 @@ def load_results(path: Path | str) -> tuple[str, list[dict[str, Any]]]:
         data = json.loads(p.read_text())
     except json.JSONDecodeError as exc:
         raise ValueError(f"results: {p} is not JSON ({exc})") from None
+    except RecursionError:
+        raise ValueError(f"results: {p} is nested too deeply to be an eval or bench JSON output") from None
     if isinstance(data, dict) and data.get("schema") == SCHEMA_ID:
         return _from_schema(p, data)
     if isinstance(data, list) and data and all(isinstance(r, dict) for r in data):
