@@ -12,11 +12,12 @@ from rich.markup import escape
 
 from lookalike.cli.app import console, fail
 from lookalike.io import find_sequences, read_mot, write_mot
+from lookalike.io.det_format import read_det, sniff_det
 from lookalike.io.outputs import ensure_writable, result_paths
 from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv, read_points_mot, typical_spacing
 from lookalike.io.stream import track_to_file
 from lookalike.trackers.boxtrack import BoxTrack
-from lookalike.trackers.offline.closed_set import track_closed_set
+from lookalike.trackers.offline.closed_set import online_rows, track_closed_set
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import detection_rows
 
@@ -24,10 +25,15 @@ POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given 
 
 
 def table_rows(path: Path, min_score: float = float("-inf"), length: int | None = None,
-               length_name: str = "the length") -> np.ndarray:
-    """Detection rows ``(k, 10)`` of a MOTChallenge file, those scoring below ``min_score`` dropped
-    (``length``: frames past it are an error, :func:`~lookalike.io.read_mot`)."""
-    table = read_mot(path, length=length, length_name=length_name)
+               length_name: str = "the length", det_format: str = "auto") -> np.ndarray:
+    """Detection rows ``(k, 10)`` of a detection file, those scoring below ``min_score`` dropped
+    (``length``: frames past it are an error, :func:`~lookalike.io.read_mot`; ``det_format``: its layout,
+    :func:`~lookalike.io.det_format.sniff_det`, what was assumed printed as a note)."""
+    fmt, notes = sniff_det(path, det_format)
+    for line in notes:
+        console.print(f"[cyan]note:[/] {escape(f'{path}: {line}')}", highlight=False)
+    table = read_mot(path, length=length, length_name=length_name) if fmt.standard() else \
+        read_det(path, fmt, length, length_name)
     rows = detection_rows(table.frame, table.xywh, table.conf)
     return rows[rows[:, 6] >= min_score]
 
@@ -36,9 +42,16 @@ def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_f
                     params: dict[str, Any], vel_noise: float | None = None) -> np.ndarray:
     """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online
     ``boxtrack`` pass's parameters (``max_targets`` is dropped: that pass is an open set); ``vel_noise``:
-    its velocity noise when not boxtrack's own (points: ``POINT_VEL_NOISE``)."""
+    its velocity noise when not boxtrack's own (points: ``POINT_VEL_NOISE``). Detections too few for the offline
+    assignment (e.g. 1 to 3 frames) get the online closed set's result instead, with a printed note."""
     online = {k: v for k, v in params.items() if k != "max_targets"}
-    return track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise)
+    rows = track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise)
+    if len(rows) or not len(det_rows):
+        return rows
+    frames = len(np.unique(det_rows[:, 0]))
+    console.print(f"note: {frames} frame(s) of detections are too few for the offline closed set; the online closed "
+                  f"set's result (boxtrack --targets {n_targets}) is written instead", markup=False)
+    return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, **{**online, "max_targets": n_targets})
 
 
 def point_tracker(tracker: Any) -> Any:
@@ -48,7 +61,7 @@ def point_tracker(tracker: Any) -> Any:
 
 
 def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float,
-                  use_length: bool = True) -> int:
+                  use_length: bool = True, det_format: str = "auto") -> int:
     """``--offline`` over every sequence at ``path`` (as ``track_files``: outputs decided and inputs
     checked first; ``use_length``: seqinfo.ini's seqLength bounds the frames): returns the sequences written."""
     try:
@@ -61,7 +74,7 @@ def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, An
             assert seq.det_path is not None
             length = seq.length if use_length else None
             det = table_rows(seq.det_path, min_score, length, f"seqLength in {seq.root / 'seqinfo.ini'}"
-                             if seq.root is not None else "the length")
+                             if seq.root is not None else "the length", det_format)
             n_frames = max((seq.length if use_length else None) or 0, int(det[:, 0].max(initial=0)))
             with console.status(f"closed set of {n_targets} on {seq.name}"):
                 rows = closed_set_rows(det, n_targets, seq.frame_rate, n_frames, params)
@@ -75,10 +88,10 @@ def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, An
 
 
 def offline_video(det_path: Path, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
-                  n_frames: int | None, min_score: float) -> None:
+                  n_frames: int | None, min_score: float, det_format: str = "auto") -> None:
     """``--video ... --offline``: the closed set over the detections at ``det_path``, written to ``output``."""
     try:
-        det = table_rows(det_path, min_score)
+        det = table_rows(det_path, min_score, det_format=det_format)
         with console.status(f"closed set of {n_targets}"):
             rows = closed_set_rows(det, n_targets, frame_rate, n_frames, params)
     except (FileNotFoundError, ValueError) as exc:
