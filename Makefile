@@ -1,12 +1,16 @@
-# make demo | make test | make bench — each sets up .venv first.
+# make demo | make test | make bench — each sets up its environment first.
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
-EXTRAS ?= test,vision,viz,train,docs,tune,fast
+# make demo installs only what the demo needs (pyproject.toml's user extras vision and viz); make test and the
+# other developer targets install the `dev` extra (every user extra, tests, lint, docs, browser, build).
+DEMO_EXTRAS := vision,viz
+EXTRAS ?= dev
 comma := ,
 STAMP := $(VENV)/.installed-$(subst $(comma),-,$(EXTRAS))
+DEMO_STAMP := $(VENV)/.installed-$(subst $(comma),-,$(DEMO_EXTRAS))
 
-.PHONY: venv demo test lint docs bench bench-test clean browser train train-base train-refine train-mix train-set
+.PHONY: venv demo test lint docs bench bench-env bench-test clean browser train train-base train-refine train-mix train-set
 
 venv: $(STAMP)
 
@@ -16,7 +20,14 @@ $(STAMP): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet -c constraints.txt -e ".[$(EXTRAS)]"
 	touch $@
 
-demo: venv
+# The demo's environment (a no-op install where `make test` already installed `dev`, which holds vision and viz).
+$(DEMO_STAMP): pyproject.toml constraints.txt
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[$(DEMO_EXTRAS)]"
+	touch $@
+
+demo: $(DEMO_STAMP)
 	$(VENV)/bin/lookalike demo
 	@echo ""
 	@echo "The lookalike command is installed in $(VENV)/bin. Run it as"
@@ -60,11 +71,14 @@ $(BENCH_VENV)/.peers: $(BENCH_VENV)/.installed constraints-bench.txt
 	$(BENCH_VENV)/bin/python -m pip install --quiet --no-deps -c constraints-bench.txt $(BENCH_PEERS_NODEPS)
 	touch $@
 
-# pytest -m bench (the peer adapters, the ranking checks on ../shared/data) in the bench environment.
-bench-test: $(BENCH_VENV)/.peers
+# The bench environment with every peer; pytest -m bench (the peer adapters, the ranking checks on
+# ../shared/data) runs in it.
+bench-env: $(BENCH_VENV)/.peers
+
+bench-test: bench-env
 	$(BENCH_VENV)/bin/python -m pytest -q -m bench tests/test_bench_real.py tests/test_bench_ranking.py
 
-bench: $(BENCH_VENV)/.peers
+bench: bench-env
 	@log=$$(mktemp); failed=""; \
 	for script in benchmarks/[a-z]*.py; do \
 		echo "== $$script" | tee -a $$log; \

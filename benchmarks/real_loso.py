@@ -17,8 +17,9 @@ protocol with a study (TPE or random) per fold.
 - leave one dataset out over ``--datasets`` (default mot15, pigs, mot17-synth; add hexbug with
   ``--datasets mot15,pigs,hexbug,mot17-synth``: its blob detection adds about a minute).
 
-Printed beside: boxtrack's defaults, lookalike's ``sort`` and the peers (once each with their
-own defaults: they choose nothing). Each row says what its parameters were chosen on.
+Printed beside: boxtrack's defaults, lookalike's ``sort`` and every installed peer of ``bench real``
+(once each with their own defaults: they choose nothing; BoxMOT's trackers with their default presets,
+:mod:`lookalike.bench.peers`). Each row says what its parameters were chosen on.
 
     .venv-bench/bin/python benchmarks/real_loso.py --workers 2            # ~10 min on 2 cores
     .venv-bench/bin/python benchmarks/real_loso.py --trials 12 --peers none --json loso.json
