@@ -493,3 +493,21 @@ def test_offline_closed_set_on_a_few_frames_falls_back_to_the_online_result(tmp_
     assert "too few for the offline closed set" in " ".join(r.output.split())
     table = read_mot(tmp_path / "o.txt")
     assert len(table) == 3 * frames and set(table.track_id.tolist()) == {1, 2, 3}
+
+
+def test_blob_detector_reads_a_folder_of_images(tmp_path):
+    import cv2
+    import numpy as np
+
+    folder = tmp_path / "img1"
+    folder.mkdir()
+    for k in range(40):
+        image = np.full((120, 160, 3), 90, np.uint8)
+        image[40:70, 5 + 3 * k:35 + 3 * k] = 250
+        cv2.imwrite(str(folder / f"{k + 1:06d}.png"), image)
+    r = _track("--video", folder, "--detector", "blob", "-o", tmp_path / "o.txt")
+    assert r.exit_code == 0, r.output
+    assert len(read_mot(tmp_path / "o.txt")) >= 30
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    _one_error_line(_track("--video", empty, "--detector", "blob", "-o", tmp_path / "e.txt"), "holds no")

@@ -10,7 +10,7 @@ from typing import Any, NoReturn
 
 import typer
 from rich.console import Console
-from rich.markup import escape
+from rich.text import Text
 from typer._click import Context, HelpFormatter  # typer 0.29 vendors click (constraints.txt pins it)
 from typer._click.globals import get_current_context
 from typer.core import TyperGroup
@@ -70,7 +70,7 @@ def _main(
 def fail(message: str, code: int = 2) -> NoReturn:
     """Print ``message`` as an error, as plain text (markup-like input such as ``[/]`` printed as given), and exit
     with ``code``."""
-    err_console.print(f"[bold red]error:[/] {escape(message)}", highlight=False)
+    err_console.print(Text.assemble(("error:", "bold red"), " ", message), highlight=False)
     raise typer.Exit(code)
 
 

@@ -111,16 +111,35 @@ class BlobEstimate:
         return "\n".join(lines)
 
 
+_IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")  # image files of a folder given as the video (as viz reads them)
+
+
 def _odd(value: float, lo: int, hi: int) -> int:
     v = int(min(max(round(value), lo), hi))
     return v if v % 2 else v + 1 if v + 1 <= hi else v - 1
 
 
 def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
-    """Up to ``count`` frames spread evenly over a video file, read in one pass (BGR uint8)."""
+    """Up to ``count`` frames spread evenly over a video file or a folder of images (sorted by name, as
+    ``track --video`` reads them), read in one pass (BGR uint8)."""
     with needs("cv2"):
         import cv2
 
+    folder = Path(video)
+    if folder.is_dir():
+        paths = sorted(q for q in folder.iterdir() if q.suffix.lower() in _IMAGE_SUFFIXES)
+        chosen: list[int] = []
+        if paths:
+            chosen = np.unique(np.linspace(0, len(paths) - 1, min(len(paths), count)).round().astype(int)).tolist()
+        images: list[np.ndarray] = []
+        for i in chosen:
+            image = cv2.imread(str(paths[i]), cv2.IMREAD_COLOR)
+            if image is None:
+                raise ValueError(f"video: {paths[i]} is not a readable image")
+            images.append(image)
+        if not images:
+            raise ValueError(f"video: folder {folder} holds no readable images ({', '.join(_IMAGE_SUFFIXES)})")
+        return images
     cap = cv2.VideoCapture(str(video))
     if not cap.isOpened():
         raise ValueError(f"video: cannot open {video}")
