@@ -511,3 +511,27 @@ def test_blob_detector_reads_a_folder_of_images(tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()
     _one_error_line(_track("--video", empty, "--detector", "blob", "-o", tmp_path / "e.txt"), "holds no")
+
+
+@pytest.mark.parametrize("channels, dtype", [(1, "FLOAT"), (3, "UINT8")])
+def test_onnx_model_with_an_input_lookalike_cannot_feed_is_one_line(tiny_video, tmp_path, channels, dtype):
+    onnx = pytest.importorskip("onnx")
+    pytest.importorskip("onnxruntime")
+    from onnx import TensorProto, helper
+
+    x = helper.make_tensor_value_info("images", getattr(TensorProto, dtype), [1, channels, 64, 64])
+    y = helper.make_tensor_value_info("out", TensorProto.FLOAT, [1, 5, 1])
+    nodes = [helper.make_node("Cast", ["images"], ["f"], to=TensorProto.FLOAT),
+             helper.make_node("ReduceMean", ["f"], ["m"], keepdims=1, axes=[1, 2]),
+             helper.make_node("Reshape", ["m", "shape"], ["r"]),
+             helper.make_node("Tile", ["r", "reps"], ["out"])]
+    inits = [helper.make_tensor("shape", TensorProto.INT64, [3], [1, 1, 64]),
+             helper.make_tensor("reps", TensorProto.INT64, [3], [1, 5, 1])]
+    graph = helper.make_graph(nodes, "odd_input", [x], [y], inits)
+    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", 13)])
+    model.ir_version = 8
+    path = tmp_path / "odd.onnx"
+    onnx.save(model, str(path))
+    video, _ = tiny_video
+    r = _track("--video", video, "--detector", path, "-o", tmp_path / "o.txt")
+    _one_error_line(r, "odd.onnx", "channel" if channels != 3 else "tensor(uint8)")

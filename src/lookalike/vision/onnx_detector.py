@@ -133,6 +133,13 @@ class OnnxDetector:
         if len(inp) != 1 or len(inp[0].shape) != 4:
             raise ValueError(f"{self.path}: expected one NCHW image input, got {[i.shape for i in inp]}")
         self.input_name = inp[0].name
+        channels = inp[0].shape[1]
+        if isinstance(channels, int) and channels != 3:
+            raise ValueError(f"{self.path}: the image input has {channels} channel(s) {inp[0].shape}; lookalike "
+                             "feeds 3 (RGB, or BGR with rgb=0)")
+        if inp[0].type != "tensor(float)":
+            raise ValueError(f"{self.path}: the image input is {inp[0].type}; lookalike feeds tensor(float) "
+                             "(pixels times scale=...)")
         h, w = inp[0].shape[2:]
         if isinstance(h, int) and isinstance(w, int):
             self.input_size = (w, h)
