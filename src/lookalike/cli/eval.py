@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import numbers
 from pathlib import Path
 
 import typer
@@ -142,4 +143,14 @@ def _write_csv(path: Path, scores: dict[str, dict[str, dict[str, float]]]) -> No
         writer.writerow(["tracker", "seq", *keys])
         for tracker, per_seq in scores.items():
             for seq, values in per_seq.items():
-                writer.writerow([tracker, seq, *[repr(values.get(k, "")) for k in keys]])
+                writer.writerow([tracker, seq, *[_csv_cell(values.get(k, "")) for k in keys]])
+
+
+def _csv_cell(value: object) -> str:
+    """A CSV cell: an integer as such, any other number as Python's shortest round-tripping float text (a numpy
+    scalar too, never its ``np.float64(...)`` repr); anything else as text."""
+    if isinstance(value, numbers.Integral):
+        return str(int(value))
+    if isinstance(value, numbers.Real):
+        return repr(float(value))
+    return str(value)

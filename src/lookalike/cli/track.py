@@ -83,25 +83,51 @@ def _input_error(exc: Exception) -> str:
     return message + _LENGTH_HINT if "(seqLength in" in message else message
 
 
+def warn(message: str) -> None:
+    """Print ``message`` as a warning line (plain text) on stderr."""
+    err_console.print(f"[yellow]warning:[/] {escape(message)}", highlight=False)
+
+
+def note(message: str) -> None:
+    """Print ``message`` as a note line (plain text) on stderr: what was assumed about an input."""
+    err_console.print(f"[cyan]note:[/] {escape(message)}", highlight=False)
+
+
+def dropped_all(tracker: str, det_path: Path | None, rows: int, scores: tuple[float, float] | None) -> str:
+    """The warning for a tracker that wrote no tracks from ``rows`` detections scoring ``scores``."""
+    span = f" (scores {scores[0]:g} to {scores[1]:g})" if scores is not None else ""
+    return (f"{tracker} wrote no tracks from the {rows} detections of {det_path}{span}: its score thresholds "
+            f"(`lookalike trackers`) or --min-score may drop them all, or the columns are not what they seem "
+            f"(--det-format)")
+
+
 def track_files(path: Path, output: Path, tracker: Any, min_score: float,
-                use_length: bool = True) -> tuple[int, RunStats]:
+                use_length: bool = True, det_format: str = "auto", name: str = "") -> tuple[int, RunStats]:
     """Track every sequence at ``path`` (a det.txt, a sequence folder or a folder of them) into
     ``output`` (a file for a single det.txt, else ``output/<sequence>.txt``), streaming. Every input
     file is checked and every output decided before the first frame is tracked; ``use_length``:
-    seqinfo.ini's seqLength bounds the frames (else every frame in the file is tracked)."""
+    seqinfo.ini's seqLength bounds the frames (else every frame in the file is tracked); ``det_format``: the
+    detection files' layout (:func:`~lookalike.io.det_format.sniff_det`); ``name``: the tracker's, for warnings."""
+    from lookalike.io.det_format import det_warnings
+
     try:
         sequences = [s for s in find_sequences(path) if s.det_path is not None]
         if not sequences:
             raise ValueError(f"{path}: no det/det.txt found")
         targets = result_paths(path, sequences, output)
-        streams = [(seq, sequence_stream(seq, min_score, use_length)) for seq in sequences]
+        streams = [(seq, sequence_stream(seq, min_score, use_length, det_format)) for seq in sequences]
         ensure_writable(targets)
     except (FileNotFoundError, ValueError) as exc:
         fail(_input_error(exc))
     for (seq, frames), target in zip(streams, targets):
+        for line in frames.notes:
+            note(line)
         if frames.rows == 0:
-            what = escape(f"{seq.det_path}: no detections; {target} will hold no tracks")
-            err_console.print(f"[yellow]warning:[/] {what}")
+            warn(f"{seq.det_path}: no detections; {target} will hold no tracks")
+        size_from = f"imWidth, imHeight in {seq.root / 'seqinfo.ini'}" if seq.root is not None else ""
+        for line in det_warnings(seq.det_path or "", frames.rows, frames.scores, frames.outside, seq.image_size,
+                                 size_from):
+            warn(line)
     stats = RunStats()
     with _progress_bars(len(streams)) as (progress, overall):
         for (seq, frames), target in zip(streams, targets):
@@ -120,6 +146,8 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float,
                 fail(f"output {target}: cannot write ({exc.strerror or exc})")
             progress.remove_task(task)
             progress.advance(overall)
+            if frames.rows and target.is_file() and target.stat().st_size == 0:
+                warn(dropped_all(name or type(tracker).__name__, seq.det_path, frames.rows, frames.scores))
     return len(streams), stats
 
 
@@ -229,6 +257,10 @@ def track(
                                        "MOTChallenge rows frame,id,x,y (tracked as small boxes; --fps, default 25)."),
     no_seqinfo_length: bool = typer.Option(False, "--no-seqinfo-length", help="Track every frame in det.txt even "
                                            "past seqinfo.ini's seqLength (by default a frame past it is an error)."),
+    det_format: str = typer.Option("auto", "--det-format", help="The detection file's columns: 'auto' (MOTChallenge, "
+                                   "a header line naming the columns, or frame,x1,y1,x2,y2,score[,class] told apart "
+                                   "by their values; a note says what was assumed), 'mot', or the column names, e.g. "
+                                   "frame,x1,y1,x2,y2,score,class ('frame0' for 0-based frames)."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
     branch = _check_branches(path, video, detections, annotate, detector, blob, pipeline, points)
@@ -288,21 +320,25 @@ def track(
                         from lookalike.cli.track_closed import offline_video
 
                         _, count, rate = _video_info(video)
-                        offline_video(det_path, output, targets, online, fps or rate, count or None, min_score)
+                        offline_video(det_path, output, targets, online, fps or rate, count or None, min_score,
+                                      det_format)
                     else:
                         from lookalike.cli.track_video import run_track_video
 
-                        run_track_video(video, det_path, output, trk, tracker, **video_options)
+                        run_track_video(video, det_path, output, trk, tracker, det_format=det_format,
+                                        **video_options)
             elif online is not None and targets is not None:
                 from lookalike.cli.track_closed import offline_files
 
                 assert path is not None
-                count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length)
+                count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length,
+                                      det_format=det_format)
                 where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
                 console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
             else:
                 assert path is not None
-                count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length)
+                count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length,
+                                           det_format=det_format, name=tracker)
                 where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
                 console.print(f"[green]{tracker}[/]: {count} sequence(s), {_speed(stats)} → {where}")
 

@@ -16,8 +16,10 @@ from rich.progress import (
 )
 
 from lookalike.cli.app import console, fail
+from lookalike.cli.track import dropped_all, note, warn
 from lookalike.cli.track_closed import offline_video
 from lookalike.io import read_mot, write_mot
+from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
 from lookalike.io.outputs import atomic_path
 from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
 from lookalike.trackers.parts.health import HealthConfig
@@ -36,25 +38,34 @@ FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
 def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, tracker_name: str, *,
                     annotate: Path | None, team_size: int | None, health_window: int,
                     min_score: float, fps: float | None, features: str = "video",
-                    annotate_as: Path | None = None) -> None:
+                    annotate_as: Path | None = None, det_format: str = "auto") -> None:
     """Track ``detections`` on ``video`` and write ``output``, its ``.health.csv`` (and ``.merges.csv`` for trackers
     that merge identities) and, with ``annotate``, the annotated MP4. ``features``: ``video`` (standardised on this
     video), ``divers``/``handcrafted`` (statistics of the rendered validation divers), ``learned`` (the shipped ONNX
-    embedding) or ``FILE.onnx``. ``annotate_as``: the name to print for ``annotate`` (its temporary file)."""
+    embedding) or ``FILE.onnx``. ``annotate_as``: the name to print for ``annotate`` (its temporary file);
+    ``det_format``: the detection file's layout (:func:`~lookalike.io.det_format.sniff_det`)."""
     if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
         fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
     if output.is_dir():
         fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
     try:
-        table = read_mot(detections)
+        fmt, notes = sniff_det(detections, det_format)
+        table = read_mot(detections) if fmt.standard() else read_det(detections, fmt)
         health = HealthConfig(team_size=team_size, window=health_window)
-        total = source_frames(video)[1]
+        images, total, _ = source_frames(video)
+        first = next(iter(images), None)
+        size = (first.shape[1], first.shape[0]) if first is not None else None
         with console.status("standardising appearance features"):
             extractor = (fit_diver_features() if features in ("divers", "handcrafted")
                          else fit_video_features(video, table, min_score=min_score) if features == "video"
                          else diver_extractor(features))
     except (ValueError, FileNotFoundError, OSError) as exc:
         fail(str(exc))
+    for line in notes:
+        note(f"{detections}: {line}")
+    scores, outside = box_stats(table.xywh, table.conf, size)
+    for line in det_warnings(detections, len(table), scores, outside, size, f"the frames of {video}"):
+        warn(line)
     hint = stored_thresholds(extractor).get(tracker_name)
     if hint:
         console.print(f"note: {tracker_name}'s thresholds were chosen for the hand-crafted features; matched to "
@@ -73,6 +84,8 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
                       + (f" ({escape(str(annotate_as or annotate))} is left as it was)." if annotate else "."))
         raise SystemExit(130) from None
     write_mot(output, result.rows)
+    if len(table) and not len(result.rows):
+        warn(dropped_all(tracker_name, detections, len(table), scores))
     written = [output, side_file(output, "health")]
     with atomic_path(written[1]) as tmp:  # (the side files too appear whole, through temporary files)
         write_health_csv(tmp, result.health)

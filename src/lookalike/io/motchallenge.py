@@ -18,6 +18,7 @@ from lookalike.types.mot_table import ROW_WIDTH, MotTable, stack_rows, table_fro
 
 _ROW_FORMAT = "%d,%d,%.3f,%.3f,%.3f,%.3f,%g,%g,%g,%g\n"
 _FORMAT_BLOCK = 4096
+_COLUMNS = "columns: frame,id,left,top,width,height,score[,x,y,z]"
 
 
 def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | None = None,
@@ -113,12 +114,12 @@ def _parse_slowly(path: Path, rows: list[tuple[int, str]], min_columns: int) -> 
         if len(fields) < min_columns:
             raise ValueError(
                 f"{path}:{line_no}: expected at least {min_columns} comma-separated columns, "
-                f"got {len(fields)}: {line.strip()!r}"
+                f"got {len(fields)}: {line.strip()!r} ({_COLUMNS})"
             )
         try:
             values = [float(f) for f in fields]
         except ValueError:
-            raise ValueError(f"{path}:{line_no}: not a number in {line.strip()!r}") from None
+            raise ValueError(f"{path}:{line_no}: not a number in {line.strip()!r} ({_COLUMNS})") from None
         width = len(values) if width is None else min(width, len(values))
         parsed.append(values)
     return np.array([v[:width] for v in parsed], dtype=float)

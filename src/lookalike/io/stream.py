@@ -17,12 +17,13 @@ from typing import Any, TextIO
 
 import numpy as np
 
+from lookalike.io.det_format import box_stats, read_det, sniff_det
 from lookalike.io.motchallenge import format_rows, frames_from_table, read_mot, row_problem
 from lookalike.io.rules import temp_beside
 from lookalike.io.sequences import MotSequence
 from lookalike.loop import RunStats, Sink, Sinks, Updating, run
 from lookalike.types import Detections, Frame
-from lookalike.types.mot_table import tracks_to_rows
+from lookalike.types.mot_table import MotTable, tracks_to_rows
 
 CHUNK_LINES = 8_192
 WRITE_ROWS = 4_096
@@ -54,10 +55,13 @@ class DetectionStream:
         frame_rate: frames per second (``time = index / frame_rate``).
         min_score: boxes with a lower score are dropped.
         chunk_lines: lines parsed at a time.
-        length_name: what ``length`` is, for error messages (e.g. ``seqLength in X/seqinfo.ini``)."""
+        length_name: what ``length`` is, for error messages (e.g. ``seqLength in X/seqinfo.ini``).
+        image_size: the frame's ``(width, height)`` in pixels, if known: :meth:`check` counts the boxes centred
+            outside it (``outside``) and notes the lowest and highest score (``scores``)."""
 
     def __init__(self, path: str | os.PathLike[str], length: int | None = None, frame_rate: float = 30.0,
-                 min_score: float = -np.inf, chunk_lines: int = CHUNK_LINES, length_name: str = "the length") -> None:
+                 min_score: float = -np.inf, chunk_lines: int = CHUNK_LINES, length_name: str = "the length",
+                 image_size: tuple[int, int] | None = None) -> None:
         if not (np.isfinite(frame_rate) and frame_rate > 0):
             raise ValueError(f"frame_rate must be a positive number, got {frame_rate}")
         if length is not None and length < 0:
@@ -67,6 +71,21 @@ class DetectionStream:
         self._streamable: bool | None = None
         self._single: np.ndarray | None = None  # the parsed file when it fits one chunk
         self.rows = 0  # rows in the file (known after check())
+        self.image_size = image_size
+        self.scores: tuple[float, float] | None = None  # lowest and highest score (known after check())
+        self.outside = 0  # boxes centred outside image_size (known after check())
+        self.notes: list[str] = []  # what was assumed about the file's layout (sequence_stream)
+        self._table: MotTable | None = None  # rows read already (from_table)
+
+    @classmethod
+    def from_table(cls, table: MotTable, length: int | None = None, frame_rate: float = 30.0,
+                   min_score: float = -np.inf, image_size: tuple[int, int] | None = None) -> DetectionStream:
+        """The frames of detections read already (checked: :func:`~lookalike.io.det_format.read_det`)."""
+        assert table.path is not None
+        stream = cls(table.path, length, frame_rate, min_score, image_size=image_size)
+        stream._table, stream._streamable, stream.rows = table, False, len(table)
+        stream.scores, stream.outside = box_stats(table.xywh, table.conf, image_size)
+        return stream
 
     def check(self) -> DetectionStream:
         """Read the file once (constant memory); raise ``ValueError`` / ``FileNotFoundError`` as
@@ -76,6 +95,7 @@ class DetectionStream:
         last, width, rows = 0.0, None, 0
         self._single = None
         chunks: list[np.ndarray] = []
+        low, high, outside = np.inf, -np.inf, 0
         try:
             for data in _chunks(self.path, self.chunk_lines):
                 if len(chunks) < 2:
@@ -87,13 +107,19 @@ class DetectionStream:
                 if bad:
                     raise ValueError
                 width, last, rows = data.shape[1], float(frames[-1]), rows + len(data)
+                scores, out = box_stats(data[:, 2:6], data[:, 6] if width > 6 else np.ones(len(data)),
+                                        self.image_size)
+                if scores is not None:
+                    low, high, outside = min(low, scores[0]), max(high, scores[1]), outside + out
             self._streamable, self.rows = True, rows
+            self.scores, self.outside = ((low, high) if rows else None), outside
             if len(chunks) == 1:  # the whole file was one chunk: kept, not parsed again
                 self._single = chunks[0]
         except ValueError:
             # raises the precise error, or the file is valid but irregular (read whole)
-            self.rows = len(read_mot(self.path, length=self.length, length_name=self.length_name,
-                                     positive_size=True))
+            table = read_mot(self.path, length=self.length, length_name=self.length_name, positive_size=True)
+            self.rows = len(table)
+            self.scores, self.outside = box_stats(table.xywh, table.conf, self.image_size)
             self._streamable = False
         return self
 
@@ -101,7 +127,7 @@ class DetectionStream:
         if self._streamable is None:
             self.check()
         if not self._streamable:
-            table = read_mot(self.path)
+            table = self._table if self._table is not None else read_mot(self.path)
             yield from frames_from_table(table, self.length, self.frame_rate, self.min_score)
             return
         yield from self._stream()
@@ -223,14 +249,25 @@ class MotWriter:
             self.abort()
 
 
-def sequence_stream(seq: MotSequence, min_score: float = -np.inf, use_length: bool = True) -> DetectionStream:
+def sequence_stream(seq: MotSequence, min_score: float = -np.inf, use_length: bool = True,
+                    det_format: str = "auto") -> DetectionStream:
     """The checked :class:`DetectionStream` of a sequence's detection file (its frame rate, and its
-    ``seqLength`` unless ``use_length`` is false: then every frame in the file is tracked)."""
+    ``seqLength`` unless ``use_length`` is false: then every frame in the file is tracked). ``det_format``: the
+    file's layout (:func:`~lookalike.io.det_format.sniff_det`; a MOTChallenge file is streamed, any other layout
+    read whole); what was assumed is in the stream's ``notes``."""
     if seq.det_path is None:
         raise ValueError(f"{seq.name}: no detection file")
     length = seq.length if use_length else None
     where = f"seqLength in {seq.root / 'seqinfo.ini'}" if seq.root is not None else "the length"
-    return DetectionStream(seq.det_path, length, seq.frame_rate, min_score, length_name=where).check()
+    fmt, notes = sniff_det(seq.det_path, det_format)
+    if fmt.standard():
+        stream = DetectionStream(seq.det_path, length, seq.frame_rate, min_score, length_name=where,
+                                 image_size=seq.image_size).check()
+    else:
+        table = read_det(seq.det_path, fmt, length, where)
+        stream = DetectionStream.from_table(table, length, seq.frame_rate, min_score, seq.image_size)
+    stream.notes = [f"{seq.det_path}: {note}" for note in notes]
+    return stream
 
 
 def track_to_file(tracker: Updating, frames: Iterable[Frame], output: str | os.PathLike[str],

@@ -1,0 +1,245 @@
+"""Detection files in other layouts than MOTChallenge's: a header line naming the columns, corner boxes
+(``x1, y1, x2, y2``), whitespace separators, 0-based frames. :func:`sniff_det` decides the layout (from the file's
+first lines, or from a ``--det-format`` text) and says what it assumed; :func:`read_det` reads any layout as
+MOTChallenge rows (``frame`` 1-based, ``left, top, width, height`` in pixels); :func:`det_warnings` flags values
+that look wrong (boxes centred outside the frame, every score the same)."""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from lookalike.io.motchallenge import row_problem
+from lookalike.io.rules import read_text
+from lookalike.types.mot_table import MotTable, table_from_array
+
+MOT_COLUMNS = "frame,id,left,top,width,height,score[,x,y,z]"
+EXPECTED = (f"expected MOTChallenge columns {MOT_COLUMNS} (comma- or whitespace-separated), or a header line "
+            "naming the columns, or --det-format COLUMNS such as frame,x1,y1,x2,y2,score,class")
+"""What a detection file should hold, for error messages."""
+
+_ALIASES: dict[str, tuple[str, ...]] = {
+    "frame": ("frame", "frame_id", "frameid", "frame_no", "f"),
+    "frame0": ("frame0",),
+    "id": ("id", "track_id", "trackid", "track", "object_id", "obj_id"),
+    "left": ("left", "bb_left", "x1", "xmin", "x_min", "x0"),
+    "top": ("top", "bb_top", "y1", "ymin", "y_min", "y0"),
+    "right": ("right", "x2", "xmax", "x_max"),
+    "bottom": ("bottom", "y2", "ymax", "y_max"),
+    "width": ("width", "bb_width", "w"),
+    "height": ("height", "bb_height", "h"),
+    "score": ("score", "conf", "confidence", "prob", "probability", "det_score"),
+    "class": ("class", "cls", "label", "category", "class_id"),
+}
+_ROLE = {alias: role for role, names in _ALIASES.items() for alias in names}
+_SNIFF_LINES = 200
+
+
+@dataclass(frozen=True)
+class DetFormat:
+    """A detection file's layout: ``roles`` (one per column: frame/frame0, id, left, top, width, height, right,
+    bottom, score, class, or ``-`` for a column ignored), ``separator`` (``,`` or ``None``: whitespace),
+    ``header`` (the first non-blank line names the columns)."""
+
+    roles: tuple[str, ...]
+    separator: str | None = ","
+    header: bool = False
+
+    @property
+    def zero_based(self) -> bool:
+        return "frame0" in self.roles
+
+    @property
+    def corners(self) -> bool:
+        return "right" in self.roles
+
+    def standard(self) -> bool:
+        """True for MOTChallenge's own layout (read by :func:`~lookalike.io.read_mot` as before)."""
+        return (self.separator == "," and not self.header and len(self.roles) >= 6
+                and self.roles[:6] == ("frame", "id", "left", "top", "width", "height")
+                and (len(self.roles) == 6 or self.roles[6] == "score"))
+
+    def describe(self) -> str:
+        """The columns as a text (corners named x1,y1,x2,y2)."""
+        names = {"frame0": "frame (0-based)"}
+        if self.corners:
+            names.update(left="x1", top="y1", right="x2", bottom="y2")
+        return ",".join(names.get(r, r) for r in self.roles)
+
+
+MOT = DetFormat(("frame", "id", "left", "top", "width", "height", "score", "-", "-", "-"))
+
+
+def parse_columns(text: str, where: str = "--det-format") -> tuple[str, ...]:
+    """Roles of a comma- or space-separated list of column names (the aliases of ``_ALIASES``; any other name is a
+    column ignored); ``ValueError`` naming ``where`` when the frame or the box cannot be found."""
+    names = [n.strip().lower() for n in re.split(r"[,\s;]+", text.strip()) if n.strip()]
+    roles = [_ROLE.get(n, "-") for n in names]
+    if "left" not in roles and "top" not in roles:  # x, y name the corner only where nothing else does
+        roles = ["left" if n == "x" else "top" if n == "y" else r for n, r in zip(names, roles)]
+    for role in set(roles) - {"-"}:
+        if roles.count(role) > 1:
+            raise ValueError(f"{where}: column {role!r} named twice in {text.strip()!r}; {EXPECTED}")
+    has_box = {"left", "top"} <= set(roles) and ({"width", "height"} <= set(roles) or {"right", "bottom"} <= set(roles))
+    if not ({"frame", "frame0"} & set(roles)) or not has_box:
+        raise ValueError(f"{where}: no frame and box columns in {text.strip()!r}; {EXPECTED}")
+    return tuple(roles)
+
+
+def _split(line: str, separator: str | None) -> list[str]:
+    return [f.strip() for f in line.split(separator)] if separator else line.split()
+
+
+def _numbers(fields: list[str]) -> list[float] | None:
+    try:
+        return [float(f) for f in fields]
+    except ValueError:
+        return None
+
+
+def _integral(values: np.ndarray) -> bool:
+    return bool(np.all(np.isfinite(values)) and np.all(values == np.round(values)))
+
+
+def _guess_roles(sample: np.ndarray) -> tuple[tuple[str, ...], str | None]:
+    """Roles of header-less rows ``sample`` ``(k, c)`` and why they were chosen (None: MOTChallenge's own)."""
+    width = sample.shape[1]
+    mot = MOT.roles[:width] + ("-",) * max(0, width - len(MOT.roles))
+    if width < 6 or np.all(sample[:, 1] == -1):
+        return mot, None
+    x1, y1, x2, y2 = sample[:, 1], sample[:, 2], sample[:, 3], sample[:, 4]
+    corners = bool(np.all(x2 > x1) and np.all(y2 > y1))
+    score_col = width >= 6 and bool(np.all((sample[:, 5] >= 0) & (sample[:, 5] <= 1)))
+    class_col = width < 7 or _integral(sample[:, 6])
+    mot_unlikely = not _integral(sample[:, 1]) or bool(np.all(sample[:, 5] <= 1))  # an id, a height in pixels
+    if corners and score_col and class_col and mot_unlikely:
+        roles = ("frame", "left", "top", "right", "bottom", "score") + (("class",) if width > 6 else ())
+        return roles + ("-",) * (width - len(roles)), ("no id column, boxes as corners x1,y1,x2,y2 (column 2 is "
+                                                       "not an id, column 6 is a score in [0, 1])")
+    return mot, None
+
+
+def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetFormat, list[str]]:
+    """The layout of the detection file ``path`` and the notes on what was assumed (empty for a MOTChallenge file
+    read as before). ``spec``: ``auto`` (decide from the first lines), ``mot`` (MOTChallenge's layout, separator
+    and header still detected) or a list of column names (``frame,x1,y1,x2,y2,score,class``; ``frame0`` for
+    0-based frames). ``ValueError`` (with the expected columns) when the lines cannot be read as detections."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    lines = []
+    with open(path, encoding="utf-8", errors="replace") as fh:
+        for line in fh:
+            if line.strip():
+                lines.append(line)
+                if len(lines) >= _SNIFF_LINES:
+                    break
+    if not lines:
+        return MOT, []
+    first = lines[0]
+    separator = "," if "," in first else None
+    notes = [] if separator == "," else ["whitespace-separated columns"]
+    header = all(_numbers([f]) is None for f in _split(first, separator) if f)  # names only, no number
+    rows = lines[1:] if header else lines
+    parsed = [_numbers(_split(ln, separator)) for ln in rows]
+    sample = [p for p in parsed if p is not None]
+    if spec not in ("auto", "mot"):
+        roles, note = parse_columns(spec), f"columns read as {DetFormat(parse_columns(spec)).describe()} (--det-format)"
+    elif header and spec == "auto":
+        roles = parse_columns(first, f"{path}:1 (header line)")
+        note = f"header line: columns read as {DetFormat(roles).describe()}"
+    else:
+        width = min((len(p) for p in sample), default=len(MOT.roles))
+        if width < 6:
+            if separator == ",":
+                return MOT, []  # read_mot says which line and what it expects
+            raise ValueError(f"{path}: {width} column(s) per line; {EXPECTED}")
+        roles, why = MOT.roles[:width] + ("-",) * max(0, width - len(MOT.roles)), None
+        if spec == "auto" and sample:
+            roles, why = _guess_roles(np.array([p[:width] for p in sample]))
+        note = f"columns read as {DetFormat(roles).describe()}: {why}" if why else ""
+    if note:
+        notes.append(note)
+    if header and spec != "auto":
+        notes.append("first line skipped (a header)")
+    if "frame" in roles and sample and len(sample[0]) > roles.index("frame") and sample[0][roles.index("frame")] == 0:
+        roles = tuple("frame0" if r == "frame" else r for r in roles)
+        notes.append("frames start at 0: read as 0-based (file frame 0 is the first frame)")
+    fmt = DetFormat(roles, separator, header)
+    return fmt, notes
+
+
+def read_det(path: str | os.PathLike[str], fmt: DetFormat, length: int | None = None,
+             length_name: str = "the length") -> MotTable:
+    """The detections of ``path`` in layout ``fmt`` as a MOTChallenge table (1-based frames, ``left, top, width,
+    height``; score 1 without a score column). ``ValueError`` naming the file and line: a line that is not numbers
+    or has too few columns (with the expected columns), or a row :func:`~lookalike.io.read_mot` would refuse (a
+    box of zero or negative size, a frame past ``length``...)."""
+    path = Path(path)
+    need = max(i for i, r in enumerate(fmt.roles) if r != "-") + 1
+    numbers: list[list[float]] = []
+    line_nos: list[int] = []
+    for line_no, line in enumerate(read_text(path).splitlines(), start=1):
+        if not line.strip():
+            continue
+        if fmt.header and not line_nos and not numbers and _numbers(_split(line, fmt.separator)) is None:
+            fmt = DetFormat(fmt.roles, fmt.separator, False)  # the header: skipped once
+            continue
+        fields = _split(line, fmt.separator)
+        values = _numbers(fields[:need]) if len(fields) >= need else None
+        if values is None:
+            what = f"{len(fields)} column(s)" if len(fields) < need else "not a number"
+            raise ValueError(f"{path}:{line_no}: {what} in {line.strip()[:80]!r}; columns read as "
+                             f"{fmt.describe()}; {EXPECTED}")
+        numbers.append(values)
+        line_nos.append(line_no)
+    data = np.array(numbers, dtype=float).reshape(len(numbers), need)
+    col = {r: data[:, i] for i, r in enumerate(fmt.roles[:need]) if r != "-"}
+    n = len(data)
+    frame = col["frame0"] + 1 if "frame0" in col else col["frame"]
+    left, top = col["left"], col["top"]
+    width = col["right"] - left if "right" in col else col["width"]
+    height = col["bottom"] - top if "bottom" in col else col["height"]
+    rows = np.column_stack([frame, col.get("id", np.full(n, -1.0)), left, top, width, height,
+                            col.get("score", np.ones(n)), np.full((n, 3), -1.0)]) if n else np.zeros((0, 10))
+    problem = row_problem(rows, length=length, length_name=length_name, positive_size=True)
+    if problem is not None:
+        line_no = line_nos[problem[0]]
+        raise ValueError(f"{path}:{line_no}: {problem[1]} (columns read as {fmt.describe()})")
+    return table_from_array(rows, path)
+
+
+def det_warnings(path: Path | str, count: int, scores: tuple[float, float] | None, outside: int,
+                 image_size: tuple[int, int] | None, size_from: str = "") -> list[str]:
+    """Warnings on a detection file's values: ``outside`` of ``count`` boxes centred outside the ``image_size``
+    ``(width, height)`` frame (from ``size_from``), every score equal (``scores``: the lowest and highest)."""
+    found = []
+    if outside and image_size is not None:
+        found.append(f"{path}: {outside} of {count} boxes are centred outside the {image_size[0]}x{image_size[1]} "
+                     f"frame{f' ({size_from})' if size_from else ''}; are the columns {MOT_COLUMNS}? "
+                     "(--det-format names them)")
+    if count > 1 and scores is not None and scores[0] == scores[1]:
+        what = "zero" if scores[0] == 0 else f"{scores[0]:g}"
+        found.append(f"{path}: every score is {what}: is the score column the right one? (--min-score and the "
+                     "trackers' score thresholds see no difference between boxes)")
+    return found
+
+
+def box_stats(xywh: np.ndarray, conf: np.ndarray, image_size: tuple[int, int] | None) -> tuple[
+        tuple[float, float] | None, int]:
+    """``(lowest, highest)`` score (None without boxes) and the number of boxes centred outside ``image_size``."""
+    if not len(conf):
+        return None, 0
+    outside = 0
+    if image_size is not None:
+        cx, cy = xywh[:, 0] + xywh[:, 2] / 2, xywh[:, 1] + xywh[:, 3] / 2
+        outside = int(np.count_nonzero((cx < 0) | (cy < 0) | (cx > image_size[0]) | (cy > image_size[1])))
+    return (float(conf.min()), float(conf.max())), outside
+
+
+__all__ = ["EXPECTED", "MOT", "MOT_COLUMNS", "DetFormat", "box_stats", "det_warnings", "parse_columns", "read_det",
+           "sniff_det"]
