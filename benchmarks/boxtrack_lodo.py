@@ -15,6 +15,7 @@ included) once per dataset with its own defaults, and the best peer per column (
 
     .venv/bin/python benchmarks/boxtrack_lodo.py                    # ~20 min on one core
     .venv/bin/python benchmarks/boxtrack_lodo.py --min-counts 10    # the current constant only
+    .venv-bench/bin/python benchmarks/boxtrack_lodo.py --min-counts 10 --grid small   # with the peers (16 min)
 """
 
 from __future__ import annotations
