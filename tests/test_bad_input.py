@@ -535,3 +535,22 @@ def test_onnx_model_with_an_input_lookalike_cannot_feed_is_one_line(tiny_video, 
     video, _ = tiny_video
     r = _track("--video", video, "--detector", path, "-o", tmp_path / "o.txt")
     _one_error_line(r, "odd.onnx", "channel" if channels != 3 else "tensor(uint8)")
+
+
+def test_tune_names_a_missing_folder_and_empty_ground_truth(tmp_path):
+    _one_error_line(runner.invoke(app, ["tune", str(tmp_path / "none"), "-o", str(tmp_path / "p.json")]),
+                    "none: no such folder")
+    seq = _seq(tmp_path / "S1")
+    (seq / "gt").mkdir()
+    (seq / "gt" / "gt.txt").write_text("")
+    _one_error_line(runner.invoke(app, ["tune", str(seq), "-o", str(tmp_path / "p.json"), "--trials", "1"]),
+                    "ground truth", "is empty")
+    assert not (tmp_path / "p.json").exists()
+
+
+def test_points_input_problems_name_the_file_and_line(tmp_path):
+    _one_error_line(_track("--points", tmp_path, "-o", tmp_path / "o.txt"), "is a folder")
+    points = tmp_path / "p.csv"
+    points.write_text("frame,x,y\n1,5,5\n2,1e300,5\n")
+    _one_error_line(_track("--points", points, "-o", tmp_path / "o.txt"), "p.csv:3", "beyond")
+    assert not (tmp_path / "o.txt").exists()

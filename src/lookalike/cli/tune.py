@@ -155,9 +155,9 @@ def _load_data(data: list[str], data_root: Path | None, folds: str) -> tuple[Any
 
     try:
         root = None
-        if any(not Path(d).exists() for d in data):
-            from lookalike.bench.datasets import resolve_data_root
+        from lookalike.bench.datasets import DATASETS, resolve_data_root
 
+        if any(not Path(d).exists() and d in DATASETS for d in data):  # (a missing folder: named as such below)
             root = resolve_data_root(data_root)
         seqs = load_tuning_data(data, root)
         keys = [f"{s.dataset}/{s.name}" for s in seqs]

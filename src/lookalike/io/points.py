@@ -49,8 +49,14 @@ class PointFrames:
         return int(sum(len(p) for p in self.points))
 
 
-def _parse(path: Path, columns: int) -> list[tuple[int, list[float]]]:
-    """``(line number, values)`` of the data lines (blank lines and one leading header skipped)."""
+MAX_COORDINATE = 1e9  # pixels: a point or box value beyond this (in absolute value) is an error naming its line
+
+
+def _parse(path: Path, columns: int, first_coordinate: int = 1) -> list[tuple[int, list[float]]]:
+    """``(line number, values)`` of the data lines (blank lines and one leading header skipped); the columns from
+    ``first_coordinate`` on are pixel values, at most :data:`MAX_COORDINATE` in absolute value."""
+    if path.is_dir():
+        raise ValueError(f"{path}: is a folder; expected a points file (frame,x,y CSV or MOTChallenge rows)")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
     out = []
@@ -75,6 +81,8 @@ def _parse(path: Path, columns: int) -> list[tuple[int, list[float]]]:
             raise ValueError(f"{path}:{no}: not a number in {text!r}") from None
         if not all(math.isfinite(v) for v in values):
             raise ValueError(f"{path}:{no}: NaN or infinity in {text!r}")
+        if any(abs(v) > MAX_COORDINATE for v in values[first_coordinate:]):
+            raise ValueError(f"{path}:{no}: a coordinate beyond {MAX_COORDINATE:g} px in {text[:80]!r}")
         frame = values[0]
         if frame < 1 or frame != int(frame):
             raise ValueError(f"{path}:{no}: frame must be an integer >= 1, got {fields[0]!r}")
@@ -111,7 +119,7 @@ def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *
     """Points from MOTChallenge-style rows ``frame, id, x, y, ...`` (columns 3-4 are the point), or with
     ``centre=True`` rows ``frame, id, left, top, width, height, ...`` whose box centres are the points."""
     path = Path(path)
-    parsed = _parse(path, 6 if centre else 4)
+    parsed = _parse(path, 6 if centre else 4, first_coordinate=2)
     data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 6 if centre else 4)
     if centre:
         bad = np.flatnonzero((data[:, 4:6] < 0).any(axis=1))

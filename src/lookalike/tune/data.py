@@ -37,13 +37,17 @@ def load_tuning_data(items: Sequence[str], data_root: Path | None = None) -> lis
                 raise ValueError(f"{item}: a bench dataset needs the data folder (--data)")
             out += load_datasets(data_root, [item])
         else:
-            raise ValueError(f"{item}: neither a folder nor a bench dataset ({', '.join(DATASETS)})")
+            raise ValueError(f"{item}: no such folder; neither a folder nor a bench dataset ({', '.join(DATASETS)})")
     keys = [sequence_key(s) for s in out]
     dupes = sorted({k for k in keys if keys.count(k) > 1})
     if dupes:
         raise ValueError(f"sequences given twice: {', '.join(dupes)}")
     if not out:
         raise ValueError("no sequence to tune on")
+    empty = [sequence_key(s) for s in out if s.gt is not None and len(s.gt) == 0
+             or s.gt_points is not None and len(s.gt_points[0]) == 0]
+    if len(empty) == len(out):
+        raise ValueError(f"no ground truth to tune on: the ground truth of {', '.join(empty)} is empty")
     return out
 
 
