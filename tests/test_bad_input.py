@@ -554,3 +554,35 @@ def test_points_input_problems_name_the_file_and_line(tmp_path):
     points.write_text("frame,x,y\n1,5,5\n2,1e300,5\n")
     _one_error_line(_track("--points", points, "-o", tmp_path / "o.txt"), "p.csv:3", "beyond")
     assert not (tmp_path / "o.txt").exists()
+
+
+def test_labelling_page_answers_a_deeply_nested_body_with_400_and_exports_concurrently(tmp_path):
+    import json
+    import threading
+
+    from lookalike.io.robot_sequences import write_robot_sequence
+    from lookalike.sim import preset, simulate_robots
+    from lookalike.viz.label import open_label_app
+    from tests.test_label_server import _request, _serve
+
+    path = write_robot_sequence(tmp_path / "s" / "m3n2-000003.jsonl", simulate_robots(preset("m3n2"), 20, 3))
+    server, thread = _serve(open_label_app(path))
+    try:
+        status, data = _request(server, "POST", "/api/label", "[" * 5_000 + "]" * 5_000)
+        assert status == 400 and "nested" in json.loads(data)["error"]
+        statuses = []
+
+        def export():
+            statuses.append(_request(server, "POST", "/api/export", "{}")[0])
+
+        threads = [threading.Thread(target=export) for _ in range(8)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(30)
+        assert statuses == [200] * 8
+        assert not [p.name for p in path.parent.iterdir() if ".tmp" in p.name]
+    finally:
+        server.shutdown()
+        server.server_close()
+        thread.join(5)

@@ -283,6 +283,8 @@ class _Handler(BaseHTTPRequestHandler):
             body = json.loads(raw)
         except (json.JSONDecodeError, UnicodeDecodeError):
             raise _BadRequest(HTTPStatus.BAD_REQUEST, "body is not JSON") from None
+        except RecursionError:
+            raise _BadRequest(HTTPStatus.BAD_REQUEST, "body is nested too deeply") from None
         if not isinstance(body, dict):
             raise _BadRequest(HTTPStatus.BAD_REQUEST, "body must be a JSON object")
         return body
