@@ -586,3 +586,47 @@ def test_labelling_page_answers_a_deeply_nested_body_with_400_and_exports_concur
         server.shutdown()
         server.server_close()
         thread.join(5)
+
+
+def _recordings(folder: Path, frames: int, label: float | None = None) -> Path:
+    """Three labelled robot recordings (m3n2) of ``frames`` frames; ``label``: the first detection's label."""
+    import json
+
+    from lookalike.io.robot_sequences import write_robot_sequence
+    from lookalike.sim import preset, simulate_robots
+
+    for seed in range(3):
+        path = write_robot_sequence(folder / f"m3n2-{seed:06d}.labelled.jsonl",
+                                    simulate_robots(preset("m3n2"), frames, seed))
+        if label is not None and seed == 0:
+            lines = path.read_text().splitlines()
+            for i, line in enumerate(lines[1:], start=1):
+                record = json.loads(line)
+                if record["detections"]["label"]:
+                    record["detections"]["label"][0] = label
+                    lines[i] = json.dumps(record)
+                    break
+            path.write_text("\n".join(lines) + "\n")
+    return folder
+
+
+@pytest.mark.parametrize("label", [7, -5, 0.5])
+def test_recording_labels_outside_the_team_are_one_line_naming_the_line(tmp_path, label):
+    from lookalike.io.robot_sequences import read_robot_sequence
+
+    folder = _recordings(tmp_path / "rec", 20, label)
+    with pytest.raises(ValueError, match=r"m3n2-000000\.labelled\.jsonl:\d+: .*labels must be whole numbers from -1"):
+        read_robot_sequence(folder / "m3n2-000000.labelled.jsonl")
+
+
+def test_train_on_recordings_shorter_than_the_sequence_length_has_a_finite_loss(tmp_path):
+    pytest.importorskip("torch")
+    import csv
+
+    folder = _recordings(tmp_path / "rec", 150)
+    r = runner.invoke(app, ["train", "--preset", "m3n2", "--recordings", str(folder), "-o", str(tmp_path / "run"),
+                            "--steps", "2", "--sequence-length", "450", "--batch-size", "2", "--validate-every", "1"])
+    assert r.exit_code == 0, r.output
+    with (tmp_path / "run" / "training_log.csv").open() as fh:
+        losses = [float(row["loss"]) for row in csv.DictReader(fh) if int(row["step"]) > 0]
+    assert losses and all(loss == loss and loss < 1e6 for loss in losses), losses  # no NaN (padding only skipped)

@@ -95,8 +95,19 @@ def read_robot_sequence(path: str | Path) -> RobotSequence:
         raise ValueError(f"{path}: header says {header.get('n_frames')} frames, file has {T}")
     try:
         return _assemble(config, header, rows, T, N, M)
+    except _RecordError as exc:
+        no = lines[exc.index + 1][0]
+        raise ValueError(f"{path}:{no}: malformed frame record ({str(exc.__cause__ or exc)[:120]})") from None
     except (KeyError, TypeError, IndexError, ValueError, AttributeError, OverflowError) as exc:
         raise ValueError(f"{path}: malformed frame record ({str(exc)[:120]})") from None
+
+
+class _RecordError(ValueError):
+    """A frame record that cannot be read; ``index``: its place among the records (0: the first frame)."""
+
+    def __init__(self, index: int) -> None:
+        super().__init__(f"frame record {index}")
+        self.index = index
 
 
 def _assemble(config: RobotWorldConfig, header: dict, rows: list[dict], T: int, N: int, M: int) -> RobotSequence:
@@ -109,24 +120,10 @@ def _assemble(config: RobotWorldConfig, header: dict, rows: list[dict], T: int, 
                                                    "observer", "n_false_positives", "n_misses")}
     time = np.zeros(T)
     for k, row in enumerate(rows):
-        if row["frame"] != k:
-            raise ValueError(f"frame records out of order: record {k} is frame {row['frame']}")
-        time[k] = row["time"]
-        d = row["detections"]
-        n = len(d["label"])
-        if n > M:
-            raise ValueError(f"frame {k}: {n} detections exceed max_detections {M}")
-        valid[k, :n] = True
-        if n:
-            pos[k, :n], head[k, :n], score[k, :n], label[k, :n] = d["position"], d["heading"], d["score"], d["label"]
-            if not all(np.isfinite(a[k, :n]).all() for a in (pos, head, score)):
-                raise ValueError(f"frame {k}: NaN or infinity in a detection")
-        b = row["beacons"]
-        for key, values in b_parts.items():
-            values.extend(b[key])
-        offsets[k + 1] = offsets[k] + len(b["agent_id"])
-        for key, values in truth.items():
-            values.append(row["truth"][key])
+        try:
+            _read_record(k, row, N, M, time, valid, pos, head, score, label, b_parts, offsets, truth)
+        except (KeyError, TypeError, IndexError, ValueError, AttributeError, OverflowError) as exc:
+            raise _RecordError(k) from exc
     reports = ReportArrays(
         agent_id=np.asarray(b_parts["agent_id"], dtype=int), t_sent=np.asarray(b_parts["t_sent"], dtype=float),
         t_received=np.asarray(b_parts["t_received"], dtype=float), heading=np.asarray(b_parts["heading"], dtype=float),
@@ -144,3 +141,32 @@ def _assemble(config: RobotWorldConfig, header: dict, rows: list[dict], T: int, 
         n_misses=np.asarray(truth["n_misses"], dtype=int),
     )
     return RobotSequence(config, int(header["seed"]), arrays)
+
+
+def _read_record(k: int, row: dict, N: int, M: int, time: np.ndarray, valid: np.ndarray, pos: np.ndarray,
+                 head: np.ndarray, score: np.ndarray, label: np.ndarray, b_parts: dict[str, list],
+                 offsets: np.ndarray, truth: dict[str, list[Any]]) -> None:
+    """Read frame record ``k`` into the arrays (detection labels: whole numbers from -1, a false positive,
+    to ``N - 1``)."""
+    if row["frame"] != k:
+        raise ValueError(f"frame records out of order: record {k} is frame {row['frame']}")
+    time[k] = row["time"]
+    d = row["detections"]
+    n = len(d["label"])
+    if n > M:
+        raise ValueError(f"frame {k}: {n} detections exceed max_detections {M}")
+    valid[k, :n] = True
+    if n:
+        labels = np.asarray(d["label"], dtype=float)
+        if labels.shape != (n,) or not ((labels == np.floor(labels)) & (labels >= -1) & (labels < N)).all():
+            raise ValueError(f"frame {k}: detection labels must be whole numbers from -1 (a false positive) to "
+                             f"{N - 1}, got {d['label']}"[:160])
+        pos[k, :n], head[k, :n], score[k, :n], label[k, :n] = d["position"], d["heading"], d["score"], labels
+        if not all(np.isfinite(a[k, :n]).all() for a in (pos, head, score)):
+            raise ValueError(f"frame {k}: NaN or infinity in a detection")
+    b = row["beacons"]
+    for key, values in b_parts.items():
+        values.extend(b[key])
+    offsets[k + 1] = offsets[k] + len(b["agent_id"])
+    for key, values in truth.items():
+        values.append(row["truth"][key])

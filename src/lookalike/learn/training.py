@@ -13,6 +13,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -104,6 +105,31 @@ def _train_seeds(config: TrainConfig, step: int) -> np.ndarray:
     return TRAIN_SEED_BASE + config.seed * 10_000_000 + step * config.batch_size + np.arange(config.batch_size)
 
 
+
+def _train_chunks(model: Any, xt: Any, yt: Any, config: TrainConfig, n_classes: int, loss_fn: Any, optimiser: Any,
+                  schedule: Any) -> list[float]:
+    """One optimisation step per ``bptt`` chunk of the batch (truncated backpropagation through time); the losses.
+    A chunk without a label (padding past a recording shorter than the sequence) only carries the state on: its loss
+    would be NaN."""
+    from torch import nn
+
+    state_h, losses = None, []
+    for lo in range(0, config.sequence_length, config.bptt):
+        target = yt[:, lo : lo + config.bptt]
+        logp, state_h = model(xt[:, lo : lo + config.bptt], state_h)
+        if not bool((target != IGNORE).any()):
+            state_h = tuple(s.detach() for s in state_h) if isinstance(state_h, tuple) else state_h.detach()
+            continue
+        loss = loss_fn(logp.reshape(-1, n_classes), target.reshape(-1))
+        optimiser.zero_grad()
+        loss.backward()
+        nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
+        optimiser.step()
+        schedule.step()
+        state_h = tuple(s.detach() for s in state_h) if isinstance(state_h, tuple) else state_h.detach()
+        losses.append(loss.item())
+    return losses
+
 def train(
     config: TrainConfig,
     sample: Sampler,
@@ -174,19 +200,10 @@ def train(
                 pending[k] = pool.submit(make_batch, sample, _train_seeds(config, k), config.sequence_length)
         x, y = pending.pop(step).result()
         xt, yt = torch.as_tensor(x, device=device), torch.as_tensor(y, device=device)
-        state_h, losses = None, []
-        for lo in range(0, config.sequence_length, config.bptt):
-            logp, state_h = model(xt[:, lo : lo + config.bptt], state_h)
-            loss = loss_fn(logp.reshape(-1, spec.n_classes), yt[:, lo : lo + config.bptt].reshape(-1))
-            optimiser.zero_grad()
-            loss.backward()
-            nn.utils.clip_grad_norm_(model.parameters(), config.grad_clip)
-            optimiser.step()
-            schedule.step()
-            state_h = tuple(s.detach() for s in state_h) if isinstance(state_h, tuple) else state_h.detach()
-            losses.append(loss.item())
+        losses = _train_chunks(model, xt, yt, config, spec.n_classes, loss_fn, optimiser, schedule)
         step += 1
-        row: dict[str, float] = {"step": step, "loss": float(np.mean(losses)), "lr": float(schedule.get_last_lr()[0]),
+        row: dict[str, float] = {"step": step, "loss": float(np.mean(losses)) if losses else math.nan,
+                                 "lr": float(schedule.get_last_lr()[0]),
                "val_success": math.nan, "seconds": time.monotonic() - started}
         if step % config.validation_every == 0 or step == config.steps:
             row["val_success"] = _validate(model, val_xt, val_y)
