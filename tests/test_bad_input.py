@@ -630,3 +630,33 @@ def test_train_on_recordings_shorter_than_the_sequence_length_has_a_finite_loss(
     with (tmp_path / "run" / "training_log.csv").open() as fh:
         losses = [float(row["loss"]) for row in csv.DictReader(fh) if int(row["step"]) > 0]
     assert losses and all(loss == loss and loss < 1e6 for loss in losses), losses  # no NaN (padding only skipped)
+
+
+def test_nms_memory_is_linear_in_the_boxes_and_keeps_the_same_boxes():
+    import tracemalloc
+
+    import numpy as np
+
+    from lookalike.vision import nms as nms_module
+
+    rng = np.random.default_rng(0)
+
+    def boxes(n):
+        return np.hstack([rng.uniform(0, 640, (n, 2)), rng.uniform(5, 60, (n, 2))]), rng.random(n)
+
+    xywh, score = boxes(2000)
+    by_rows = nms_module.nms(xywh, score, 0.45)
+    old = nms_module.MATRIX_BOXES
+    nms_module.MATRIX_BOXES = 10**9
+    try:
+        assert np.array_equal(nms_module.nms(xywh, score, 0.45), by_rows)
+    finally:
+        nms_module.MATRIX_BOXES = old
+    xywh, score = boxes(10_000)
+    tracemalloc.start()
+    try:
+        kept = nms_module.nms(xywh, score, 0.45)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert 0 < len(kept) < 10_000 and peak < 50e6, peak  # the 10,000 x 10,000 overlap matrix alone is 800 MB
