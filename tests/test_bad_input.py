@@ -660,3 +660,14 @@ def test_nms_memory_is_linear_in_the_boxes_and_keeps_the_same_boxes():
     finally:
         tracemalloc.stop()
     assert 0 < len(kept) < 10_000 and peak < 50e6, peak  # the 10,000 x 10,000 overlap matrix alone is 800 MB
+
+
+def test_points_above_the_per_frame_limit_are_one_line_naming_the_frame(tmp_path):
+    from lookalike.cli.track_closed import MAX_POINTS_PER_FRAME
+
+    points = tmp_path / "p.csv"
+    rows = [f"1,{i},{i}\n" for i in range(10)] + [f"2,{i},{2 * i}\n" for i in range(MAX_POINTS_PER_FRAME + 1)]
+    points.write_text("".join(rows))
+    _one_error_line(_track("--points", points, "-o", tmp_path / "o.txt"), "frame 2 has",
+                    f"at most {MAX_POINTS_PER_FRAME}")
+    assert not (tmp_path / "o.txt").exists()

@@ -22,6 +22,9 @@ from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import detection_rows
 
 POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given (frames/s)
+MAX_POINTS_PER_FRAME = 1000
+"""Points in one frame that ``track --points`` accepts: the association's memory grows with their square (about
+0.3 GB in all at 1,000 a frame with boxtrack, 0.6 GB at 2,000), so more is a one-line error naming the frame."""
 
 
 def table_rows(path: Path, min_score: float = float("-inf"), length: int | None = None,
@@ -126,6 +129,11 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
     frame_rate = fps or POINTS_FPS
     try:
         points = read_points(points_path)
+        counts = [len(p) for p in points.points]
+        if counts and max(counts) > MAX_POINTS_PER_FRAME:
+            frame = int(np.argmax(counts)) + 1
+            raise ValueError(f"{points_path}: frame {frame} has {max(counts)} points; at most {MAX_POINTS_PER_FRAME} "
+                             "a frame are tracked (the association's memory grows with their square)")
         spacing = typical_spacing(points)
         det = points_to_rows(points)
     except (FileNotFoundError, ValueError) as exc:
@@ -152,5 +160,5 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
     console.print(f"[green]{tracker_name}[/], {what}: {len(np.unique(rows[:, 1]))} identities → {escape(str(output))}")
 
 
-__all__ = ["POINTS_FPS", "closed_set_rows", "offline_files", "offline_video", "point_tracker", "read_points",
-           "table_rows", "track_points"]
+__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "closed_set_rows", "offline_files", "offline_video", "point_tracker",
+           "read_points", "table_rows", "track_points"]
