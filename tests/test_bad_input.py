@@ -671,3 +671,25 @@ def test_points_above_the_per_frame_limit_are_one_line_naming_the_frame(tmp_path
     _one_error_line(_track("--points", points, "-o", tmp_path / "o.txt"), "frame 2 has",
                     f"at most {MAX_POINTS_PER_FRAME}")
     assert not (tmp_path / "o.txt").exists()
+
+
+def test_a_truncated_video_is_named_as_such(tmp_path):
+    import numpy as np
+
+    from lookalike.viz.video import VideoWriter
+
+    rows = []
+    with VideoWriter(tmp_path / "full.mp4", fps=10) as writer:
+        for k in range(60):
+            image = np.full((120, 160, 3), 90, np.uint8)
+            image[40:70, 5 + 2 * k:35 + 2 * k] = 250
+            writer.write(image)
+            rows.append(f"{k + 1},-1,{5 + 2 * k},40,30,30,0.9,-1,-1,-1\n")
+    (tmp_path / "det.txt").write_text("".join(rows))
+    data = (tmp_path / "full.mp4").read_bytes()
+    (tmp_path / "cut.mp4").write_bytes(data[: len(data) // 2])
+    for args in (["--detections", tmp_path / "det.txt"], ["--detector", "blob"]):
+        r = _track("--video", tmp_path / "cut.mp4", *args, "-o", tmp_path / "o.txt")
+        assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+        assert "declares 60 frames but only" in r.output and "truncated" in r.output, r.output
+        assert not (tmp_path / "o.txt").exists()

@@ -156,6 +156,9 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
                 if k in wanted:
                     frames.append(frame)
                 k += 1
+            if k < total - max(2, total // 20):  # (as viz.overlay.source_frames says it)
+                raise ValueError(f"video: {video} declares {total} frames but only {k} could be read "
+                                 "(truncated or damaged?)")
         else:
             while True:
                 ok, frame = cap.read()

@@ -44,7 +44,19 @@ def source_frames(source: Path | str) -> tuple[Iterator[np.ndarray], int, float]
 
         return images(), len(paths), 30.0
     n, fps, _ = video_info(p)
-    return read_frames(p), n, fps
+    return _all_frames(p, n), n, fps
+
+
+def _all_frames(path: Path, declared: int) -> Iterator[np.ndarray]:
+    """:func:`read_frames`, ending in a ``ValueError`` naming ``path`` when it stops well short of the ``declared``
+    frame count (a truncated or damaged file: otherwise it would be tracked in part, without a word)."""
+    count = 0
+    for img in read_frames(path):
+        count += 1
+        yield img
+    if declared > 0 and count < declared - max(2, declared // 20):
+        raise ValueError(f"video: {path} declares {declared} frames but only {count} could be read "
+                         "(truncated or damaged?)")
 
 
 def overlay_tracks(source: Path | str, tracks: MotTable, output: Path | str, *, gif: Path | str | None = None,
