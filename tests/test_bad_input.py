@@ -693,3 +693,14 @@ def test_a_truncated_video_is_named_as_such(tmp_path):
         assert r.exit_code == 2 and "Traceback" not in r.output, r.output
         assert "declares 60 frames but only" in r.output and "truncated" in r.output, r.output
         assert not (tmp_path / "o.txt").exists()
+
+
+def test_onnx_ssd_outputs_that_do_not_match_name_the_model(tiny_video, tmp_path):
+    import numpy as np
+
+    from tests.test_onnx_detector import _constant_model
+
+    model = _constant_model(tmp_path / "ssd.onnx", {"boxes": np.zeros((1, 10, 4)), "scores": np.zeros((1, 7, 3))})
+    video, _ = tiny_video
+    r = _track("--video", video, "--detector", model, "-o", tmp_path / "o.txt")
+    _one_error_line(r, "ssd.onnx", "do not match")

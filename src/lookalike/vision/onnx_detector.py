@@ -170,6 +170,10 @@ class OnnxDetector:
         """Boxes ``(N, 4)`` x0, y0, x1, y1 in input pixels and class scores ``(N, C)``."""
         if self.layout == "ssd":
             boxes, scores = (outputs if outputs[0].shape[-1] == 4 else outputs[::-1])
+            n = boxes.size // 4 if boxes.shape[-1] == 4 else -1
+            if n < 0 or (scores.size % n if n else scores.size):
+                raise ValueError(f"{self.path}: SSD outputs {outputs[0].shape} and {outputs[1].shape} do not match: "
+                                 "expected boxes (..., N, 4) and scores with N rows")
             boxes = boxes.reshape(-1, 4)
             scores = scores.reshape(len(boxes), -1)
             if self.config.box_order == "yxyx":
