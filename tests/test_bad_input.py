@@ -704,3 +704,15 @@ def test_onnx_ssd_outputs_that_do_not_match_name_the_model(tiny_video, tmp_path)
     video, _ = tiny_video
     r = _track("--video", video, "--detector", model, "-o", tmp_path / "o.txt")
     _one_error_line(r, "ssd.onnx", "do not match")
+
+
+def test_a_one_pixel_video_with_the_blob_detector_is_one_line(tmp_path):
+    import cv2
+    import numpy as np
+
+    writer = cv2.VideoWriter(str(tmp_path / "one.avi"), cv2.VideoWriter_fourcc(*"MJPG"), 10, (1, 1))
+    for k in range(20):
+        writer.write(np.full((1, 1, 3), 10 * k, np.uint8))
+    writer.release()
+    _one_error_line(_track("--video", tmp_path / "one.avi", "--detector", "blob", "-o", tmp_path / "o.txt"),
+                    "one.avi", "1x1 px")

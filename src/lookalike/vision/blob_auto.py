@@ -111,6 +111,7 @@ class BlobEstimate:
         return "\n".join(lines)
 
 
+MIN_SIDE_PX = 16  # frames narrower or lower than this cannot hold a blob against a background (pixels)
 _IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")  # image files of a folder given as the video (as viz reads them)
 
 
@@ -232,6 +233,25 @@ def _radii(masks: list[np.ndarray], area: float) -> list[float]:
     return radii
 
 
+def _pick_frames(frames: str | Path | Iterable[np.ndarray], sample: int) -> list[np.ndarray]:
+    """Up to ``sample`` frames spread over ``frames`` (a video path or the frames); ``ValueError`` when there are none
+    or they are smaller than :data:`MIN_SIDE_PX` a side."""
+    if isinstance(frames, (str, Path)):
+        picked = sample_frames(frames, sample)
+    else:
+        every = list(frames)
+        if not every:
+            raise ValueError("frames: no frames to estimate blob settings on")
+        idx = np.unique(np.linspace(0, len(every) - 1, min(len(every), sample)).round().astype(int))
+        picked = [every[i] for i in idx]
+    height, width = as_bgr_image(picked[0], "frames[0]").shape[:2]
+    if min(height, width) < MIN_SIDE_PX:
+        what = f"video: {frames}" if isinstance(frames, (str, Path)) else "frames"
+        raise ValueError(f"{what}: {width}x{height} px; the blob detector needs frames of at least {MIN_SIDE_PX} px "
+                         "a side")
+    return picked
+
+
 def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: int | None = None, *,
                          sample: int = 25, shake_px: float = 0.5, polarity_ratio: float = 0.1,
                          base: BlobConfig | None = None) -> BlobEstimate:
@@ -244,14 +264,7 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     if n_targets is not None and int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
     base = base or BlobConfig()
-    if isinstance(frames, (str, Path)):
-        picked = sample_frames(frames, sample)
-    else:
-        every = list(frames)
-        if not every:
-            raise ValueError("frames: no frames to estimate blob settings on")
-        idx = np.unique(np.linspace(0, len(every) - 1, min(len(every), sample)).round().astype(int))
-        picked = [every[i] for i in idx]
+    picked = _pick_frames(frames, sample)
     blur = base.blur_px
     height, width = as_bgr_image(picked[0], "frames[0]").shape[:2]
     scale = min(1.0, _WORK_SIDE_PX / max(height, width))  # statistics on a reduced copy, for speed
