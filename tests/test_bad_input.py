@@ -716,3 +716,16 @@ def test_a_one_pixel_video_with_the_blob_detector_is_one_line(tmp_path):
     writer.release()
     _one_error_line(_track("--video", tmp_path / "one.avi", "--detector", "blob", "-o", tmp_path / "o.txt"),
                     "one.avi", "1x1 px")
+
+
+@pytest.mark.parametrize("body", ['{"schema": "SCHEMA", "header": 5, "tables": 5}',
+                                  '[{"Setup": "a", "Tracker": "b", "Success rate (%)": "x"}]',
+                                  '[{"Setup": [1], "Tracker": {"x": 1}, "Success rate (%)": null}]',
+                                  '{"T": {"S": {"HOTA": [1]}}}', '[{"Scenario": 1, "IDF1": "z", "Tracker": 3}]'])
+def test_report_on_wrong_typed_json_is_one_line_naming_the_file(tmp_path, body):
+    from lookalike.io.results import SCHEMA_ID
+
+    doc = tmp_path / "wt.json"
+    doc.write_text(body.replace("SCHEMA", SCHEMA_ID))
+    _one_error_line(runner.invoke(app, ["report", str(doc), "-o", str(tmp_path / "r.html")]), "wt.json")
+    assert not (tmp_path / "r.html").exists()

@@ -27,7 +27,13 @@ def report(
         loaded = [(p, *load_results(p)) for p in results]
         with tempfile.TemporaryDirectory() as tmp:
             for i, (path, kind, rows) in enumerate(loaded):
-                add_results(doc, kind, rows, Path(tmp), f"chart{i}", title=f"{path.name}")
+                try:
+                    add_results(doc, kind, rows, Path(tmp), f"chart{i}", title=f"{path.name}")
+                except (TypeError, KeyError, AttributeError, IndexError, ValueError) as exc:  # a value's wrong type
+                    if isinstance(exc, ValueError) and str(exc).startswith("results:"):
+                        raise
+                    raise ValueError(f"results: {path}: unexpected content ({type(exc).__name__}: "
+                                     f"{str(exc)[:80]})") from None
             out = doc.write(output)
     except ValueError as exc:
         fail(str(exc))

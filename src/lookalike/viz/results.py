@@ -64,6 +64,16 @@ def load_results(path: Path | str) -> tuple[str, list[dict[str, Any]]]:
         raise ValueError(f"results: {p} is not JSON ({exc})") from None
     except RecursionError:
         raise ValueError(f"results: {p} is nested too deeply to be an eval or bench JSON output") from None
+    try:
+        return _interpret(p, data)
+    except (TypeError, AttributeError, KeyError, IndexError, OverflowError, ValueError) as exc:  # a wrong type
+        if isinstance(exc, ValueError) and str(exc).startswith("results:"):
+            raise
+        raise ValueError(f"results: {p}: unexpected content ({type(exc).__name__}: {str(exc)[:80]})") from None
+
+
+def _interpret(p: Path, data: Any) -> tuple[str, list[dict[str, Any]]]:
+    """:func:`load_results` of the parsed JSON ``data`` of ``p``."""
     if isinstance(data, dict) and data.get("schema") == SCHEMA_ID:
         return _from_schema(p, data)
     if isinstance(data, list) and data and all(isinstance(r, dict) for r in data):
