@@ -175,7 +175,7 @@ def test_rerun_missing_is_a_clear_error(monkeypatch, tmp_path):
 
     monkeypatch.setattr(builtins, "__import__", no_rerun)
     r = runner.invoke(app, ["demo", "--quick", "-o", str(tmp_path), "--rerun-save", str(tmp_path / "x.rrd")])
-    assert r.exit_code != 0 and "rerun-sdk" in r.output
+    assert r.exit_code == 2 and "--rerun-save:" in r.output and "'rerun' extra" in r.output
 
 
 def test_demo_rerun_save_errors_name_the_option(tmp_path):

@@ -29,12 +29,13 @@ __all__ = ["QUICK", "demo", "lstm_status", "run_demo"]
 def _open_rerun(rerun: bool, rerun_save: Path | None) -> object | None:
     if not rerun and rerun_save is None:
         return None
+    from lookalike._optional import MissingExtra
     from lookalike.viz.rerun_log import open_rerun
 
     option = "--rerun" if rerun else "--rerun-save"
     try:
         return open_rerun("lookalike-demo", save=rerun_save, spawn=rerun)
-    except (ValueError, OSError) as exc:
+    except (ValueError, OSError, MissingExtra) as exc:
         fail(f"{option}: {exc}")
     return None
 

@@ -111,7 +111,8 @@ def _train_chunks(model: Any, xt: Any, yt: Any, config: TrainConfig, n_classes: 
     """One optimisation step per ``bptt`` chunk of the batch (truncated backpropagation through time); the losses.
     A chunk without a label (padding past a recording shorter than the sequence) only carries the state on: its loss
     would be NaN."""
-    from torch import nn
+    with needs("torch"):
+        from torch import nn
 
     state_h, losses = None, []
     for lo in range(0, config.sequence_length, config.bptt):
