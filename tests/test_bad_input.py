@@ -729,3 +729,11 @@ def test_report_on_wrong_typed_json_is_one_line_naming_the_file(tmp_path, body):
     doc.write_text(body.replace("SCHEMA", SCHEMA_ID))
     _one_error_line(runner.invoke(app, ["report", str(doc), "-o", str(tmp_path / "r.html")]), "wt.json")
     assert not (tmp_path / "r.html").exists()
+
+
+def test_an_output_beside_the_inputs_that_is_not_read_may_be_replaced(tmp_path):
+    gt, res = _gt_folder(tmp_path)
+    (res / "scores.json").write_text("an earlier run\n")  # in the results folder, but not a result eval reads
+    r = _eval(gt, res, "--json", res / "scores.json")
+    assert r.exit_code == 0, r.output
+    assert (res / "scores.json").read_text().startswith("{")

@@ -75,12 +75,12 @@ def fail(message: str, code: int = 2) -> NoReturn:
 
 
 def check_outputs_or_fail(outputs: dict[str, Path | None], inputs: Iterable[Path | None] = (),
-                          folders: Collection[str] = ()) -> None:
+                          folders: Collection[str] = (), input_folders: Iterable[Path | None] = ()) -> None:
     """:func:`lookalike.io.outputs.check_outputs`, failing (exit 2) with its one line: run before any work."""
     from lookalike.io.outputs import check_outputs
 
     try:
-        check_outputs(outputs, inputs, folders=folders)
+        check_outputs(outputs, inputs, folders=folders, input_folders=input_folders)
     except ValueError as exc:
         fail(str(exc))
 

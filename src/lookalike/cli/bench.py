@@ -104,7 +104,7 @@ def ident(
 ) -> None:
     """The robot-identification paper's Table I: identification success rate per set-up and identifier (+ error, speed).
     With --lengths or --recordings: the paper's Table III protocol."""
-    check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, [recordings, human, weights])
+    check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, [weights], input_folders=[recordings, human])
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     check_names("--setups", setup_list, PRESET_NAMES, "preset")
     check_names("--trackers", tracker_list, [*tracker_names(), *IDENT_VARIANTS], "tracker")

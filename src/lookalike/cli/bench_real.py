@@ -90,8 +90,8 @@ def real(
                                             "sequence)."),
 ) -> None:
     """Leaderboard on real data: HOTA, IDF1, MOTA, IDSW, frames/s and rank per dataset, and combined."""
-    check_outputs_or_fail({"--json": json_path, "--csv": csv_path, "--plots": plots}, [data, params_file],
-                          folders={"--plots"})
+    check_outputs_or_fail({"--json": json_path, "--csv": csv_path, "--plots": plots}, [params_file],
+                          folders={"--plots"}, input_folders=[data])
     tracker_list, peer_list = split_list(trackers), [p for p in split_list(peers) if p != "none"]
     _check(part, backend, tracker_list)
     try:

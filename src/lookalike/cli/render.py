@@ -34,7 +34,7 @@ def render(
     fps: float | None = typer.Option(None, min=0.1, help="Output frame rate (default: the input's; 30 otherwise)."),
 ) -> None:
     """Draw tracks (identity colours, ids, tails) on every frame of a video, or from above (--birdseye)."""
-    check_outputs_or_fail({"-o/--output": output, "--gif": gif}, [tracks, video])
+    check_outputs_or_fail({"-o/--output": output, "--gif": gif}, [tracks, video], input_folders=[video])
     if video is None and not birdseye:
         fail("--video: give the video to draw on (or --birdseye for world tracks seen from above)")
     try:

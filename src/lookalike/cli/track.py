@@ -158,7 +158,8 @@ def _speed(stats: RunStats) -> str:
     return f"{stats.frames} frames, {stats.fps:,.0f} frames/s (tracker only)"
 
 
-def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None], annotate: Path | None = None) -> None:
+def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None], annotate: Path | None = None,
+                               video: Path | None = None) -> None:
     """Refuse (exit 2) when the result, or a file written beside it, is one of the input files, or when
     ``annotate`` is an input or one of those outputs (checked with :func:`~lookalike.io.outputs.check_outputs`)."""
     siblings = [output.with_name(output.stem + s) for s in (".health.csv", ".merges.csv", ".det.txt")]
@@ -167,7 +168,7 @@ def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None], annotate
         refuse_inputs([output, *siblings], files)
         if annotate is not None:
             check_outputs({"-o/--output": output, **{f"-o/--output's {s.name}": s for s in siblings},
-                           "--annotate": annotate}, files)
+                           "--annotate": annotate}, files, input_folders=[video])  # (video: an image folder)
     except ValueError as exc:
         fail(str(exc))
 
@@ -273,7 +274,7 @@ def track(
     if offline and tracker != "boxtrack":
         fail(f"--offline: the closed set's online pass is boxtrack; use -t boxtrack, not {tracker!r}")
     _refuse_overwriting_inputs(output, [path, video, detections, points, reports, params_file, detector_model,
-                                        heading_model], annotate)
+                                        heading_model], annotate, video)
     settings = set_ or []
     team_size = team_size if team_size is not None else targets
     video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,

@@ -44,7 +44,7 @@ def train_detector(
                                           "(without --data; 0: keep every stage)."),
 ) -> None:
     """Train the HOG cascade robot detector and save it."""
-    check_outputs_or_fail({"-o/--output": output}, [data])
+    check_outputs_or_fail({"-o/--output": output}, input_folders=[data])
     try:
         with _progress() as bar:
             def step(description: str, total: int) -> Callable[[int, str], None]:

@@ -33,21 +33,21 @@ def _inside(path: Path, folder: Path) -> bool:
 
 
 def check_outputs(outputs: Mapping[str, Path | None], inputs: Iterable[Path | None] = (), *,
-                  folders: Collection[str] = ()) -> None:
+                  folders: Collection[str] = (), input_folders: Iterable[Path | None] = ()) -> None:
     """Check every output of a command before it runs; ``ValueError`` naming the option and the path when an output
-    is one of the ``inputs`` (compared resolved, symbolic and hard links followed) or an existing file inside an input
-    folder, when two outputs are one file, when an output is an existing folder (a name in ``folders``: an existing
-    file, the output being a folder), or when its folder cannot be created or written. ``outputs``: option name to
-    path (None: not given). Creates the outputs' parent folders."""
+    is one of the files in ``inputs`` (compared resolved, symbolic and hard links followed; folders among them are
+    skipped) or an existing file inside one of ``input_folders`` (folders the command reads every file of), when two
+    outputs are one file, when an output is an existing folder (a name in ``folders``: an existing file, the output
+    being a folder), or when its folder cannot be created or written. ``outputs``: option name to path (None: not
+    given). Creates the outputs' parent folders."""
     given = [(name, Path(p)) for name, p in outputs.items() if p is not None]
     for i, (name, path) in enumerate(given):
         for other, other_path in given[:i]:
             if _same_file(path, other_path):
                 raise ValueError(f"{other} {other_path} and {name} {path} are one file; give each output its own "
                                  "path (nothing was written)")
-    sources = [Path(p) for p in inputs if p is not None]
-    files = [p for p in sources if not p.is_dir()]
-    dirs = [p for p in sources if p.is_dir()]
+    files = [Path(p) for p in inputs if p is not None and not Path(p).is_dir()]
+    dirs = [Path(p) for p in input_folders if p is not None and Path(p).is_dir()]
     for name, path in given:
         for src in files:
             if _same_file(path, src):
