@@ -396,7 +396,7 @@ _TARGETS = st.sampled_from(["det", "gt", "seqinfo", "result", "json_in", "link_d
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(command=st.sampled_from(["track", "eval", "report"]), first=_TARGETS, second=_TARGETS)
+@given(command=st.sampled_from(["track", "eval", "report", "tune"]), first=_TARGETS, second=_TARGETS)
 def test_no_combination_of_output_paths_modifies_an_input(tmp_path, command, first, second):
     import tempfile
 
@@ -410,15 +410,18 @@ def test_no_combination_of_output_paths_modifies_an_input(tmp_path, command, fir
     paths = {"det": det, "gt": gt / "S1" / "gt" / "gt.txt", "seqinfo": gt / "S1" / "seqinfo.ini",
              "result": res / "S1.txt", "json_in": json_in, "link_det": root / "link_det", "hard_gt": root / "hard_gt",
              "new_a": root / "new_a", "new_b": root / "new_b", "gt_folder": gt, "res_folder": res}
-    read = {"track": [det, paths["seqinfo"]], "eval": [gt, res], "report": [json_in]}[command]
+    read = {"track": [det, paths["seqinfo"]], "eval": [gt, res], "report": [json_in], "tune": [gt]}[command]
     inputs = _snapshot(*read)  # (the files the command reads)
     a, b = paths[first], paths[second]
     if command == "track":
         r = _track(det, "-o", a)
     elif command == "eval":
         r = _eval(gt, res, "--json", a, "--csv", b)
-    else:
+    elif command == "report":
         r = runner.invoke(app, ["report", str(json_in), "-o", str(a)])
+    else:  # two outputs: the parameter file and the study's database
+        r = runner.invoke(app, ["tune", str(gt / "S1"), "-t", "sort", "--trials", "1", "-o", str(a),
+                                "--study", f"sqlite:///{b}"])
     assert "Traceback" not in r.output
     assert _snapshot(*read) == inputs, r.output
     if r.exit_code != 0:
