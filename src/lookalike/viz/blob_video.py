@@ -13,7 +13,6 @@ import io
 import json
 import math
 import os
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -21,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from lookalike._optional import needs
+from lookalike.io.outputs import write_atomic
 from lookalike.types.mot_table import detection_rows
 from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config
@@ -111,11 +111,7 @@ def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
 
 def _write_atomic(path: Path, data: bytes) -> None:
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
+        write_atomic(path, data)  # (a unique temporary file, removed on any failure)
     except OSError:
         pass  # a read-only cache folder: no cache, same result
 
