@@ -225,13 +225,3 @@ def test_bench_real_params_option(tmp_path):
     assert r.exit_code == 0, r.output
     names = {row["tracker"] for row in json.loads(out.read_text())["tables"]["datasets"]}
     assert names == {"sort", "campus (tuned on this data)"}
-
-
-def test_offline_with_nothing_worth_an_identity_writes_an_empty_result(tmp_path):
-    """One stray detection: no tracklet earns an identity, the result is empty (not a crash)."""
-    det = _write_det(tmp_path, np.array([[1, -1, 0, 0, 10, 10, 0.99, -1, -1, -1]]))
-    out = tmp_path / "o.txt"
-    r = runner.invoke(app, ["track", str(det), "-t", "boxtrack", "--targets", "2", "--offline", "--set", "n_init=1",
-                            "-o", str(out)])
-    assert r.exit_code == 0, r.output
-    assert out.is_file() and len(read_mot(out)) == 0
