@@ -39,6 +39,13 @@ def _saved(tmp_path):
     return save_weights(net.export(), tmp_path / "m")
 
 
+def test_saving_weights_leaves_the_two_files_and_no_temporary(tmp_path):
+    path = _saved(tmp_path)
+    _saved(tmp_path)  # over the old files
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.json", "m.npz"]
+    assert load_weights(path, n_agents=2).spec.n_slots == 3
+
+
 def test_mismatched_checkpoints_are_refused(tmp_path):
     path = _saved(tmp_path)
     with pytest.raises(CheckpointError, match="trained for n_agents=2, but 7 was requested"):

@@ -6,7 +6,6 @@ records the format version, cell type, sizes, the encoding version and free-form
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.trackers.lstm.encoding import ENCODING_VERSION, EncodingSpec
-from lookalike.trackers.parts.weights_io import CheckpointError, read_metadata
+from lookalike.trackers.parts.weights_io import CheckpointError, read_metadata, write_weights
 
 FORMAT_VERSION = 1
 GATES = {"lstm": 4, "gru": 3}
@@ -76,10 +75,7 @@ def save_weights(weights: NetworkWeights, path: str | os.PathLike[str]) -> Path:
     for i, layer in enumerate(weights.layers):
         for name, arr in layer.items():
             arrays[f"layer{i}.{name}"] = arr
-    tmp = path.with_name(path.name + ".tmp.npz")
     payload: dict[str, Any] = {k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()}
-    np.savez(tmp, **payload)
-    os.replace(tmp, path)
     meta = {
         "format": "lookalike-association-net",
         "format_version": FORMAT_VERSION,
@@ -95,7 +91,7 @@ def save_weights(weights: NetworkWeights, path: str | os.PathLike[str]) -> Path:
     }
     if weights.spec.protocol != "ours":  # files of the default layout stay as they were
         meta["protocol"] = weights.spec.protocol
-    path.with_suffix(".json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    write_weights(path, payload, meta)
     return path
 
 

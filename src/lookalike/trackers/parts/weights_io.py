@@ -5,8 +5,12 @@ from __future__ import annotations
 
 import json
 import os
+import tempfile
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
+
+import numpy as np
 
 
 class CheckpointError(ValueError):
@@ -29,3 +33,23 @@ def read_metadata(path: str | os.PathLike[str], fmt: str, what: str) -> tuple[Pa
         found = meta.get("format") if isinstance(meta, dict) else None
         raise CheckpointError(f"{meta_path}: not a {what} (format {found!r})")
     return path, meta_path, meta
+
+
+def write_weights(path: Path, arrays: dict[str, Any], meta: dict[str, Any], *, compressed: bool = False) -> None:
+    """Write ``path`` (``.npz``) and its ``.json`` metadata, each through a unique temporary file in the same folder
+    renamed into place (a killed run leaves the old files whole and no temporary behind)."""
+    save = np.savez_compressed if compressed else np.savez
+    _replace(path, lambda f: save(f, **arrays))
+    text = json.dumps(meta, indent=2, sort_keys=True) + "\n"
+    _replace(path.with_suffix(".json"), lambda f: f.write(text.encode()))
+
+
+def _replace(target: Path, write: Callable[[BinaryIO], object]) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -7,7 +7,6 @@ agents N and detections K per frame, no padding (absent detections simply are no
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.trackers.parts.weights_io import CheckpointError, read_metadata
+from lookalike.trackers.parts.weights_io import CheckpointError, read_metadata, write_weights
 
 FORMAT = "lookalike-set-associator"
 FORMAT_VERSION = 1
@@ -85,13 +84,10 @@ def save_set_weights(weights: SetWeights, path: str | os.PathLike[str]) -> Path:
     """Write ``path`` (``.npz``) and its ``.json`` configuration; returns the ``.npz`` path."""
     path = Path(path).with_suffix(".npz")
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".tmp.npz")
     payload: dict[str, Any] = {k: np.asarray(v, dtype=np.float32) for k, v in weights.arrays.items()}
-    np.savez_compressed(tmp, **payload)
-    os.replace(tmp, path)
     meta = {"format": FORMAT, "format_version": FORMAT_VERSION, "token": weights.token, "pair": weights.pair,
             "memory": weights.memory, "max_age_s": weights.max_age_s, "info": weights.info}
-    path.with_suffix(".json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    write_weights(path, payload, meta, compressed=True)
     return path
 
 
