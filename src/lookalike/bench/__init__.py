@@ -9,5 +9,4 @@ behind ``lookalike bench``; ``benchmarks/`` scripts and tests import it, the CLI
 - :mod:`lookalike.bench.presets`: parameter presets (JSON files saying what they were chosen on),
 - :mod:`lookalike.bench.ident`, :mod:`~lookalike.bench.divers`, :mod:`~lookalike.bench.pixels`,
   :mod:`~lookalike.bench.experiments`: the simulated benches (robots, divers, pixels, controls),
-- :mod:`lookalike.bench.tables`: writing table rows as JSON/CSV.
-"""
+- :mod:`lookalike.bench.tables`: writing table rows as JSON/CSV."""

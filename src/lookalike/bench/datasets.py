@@ -1,21 +1,12 @@
-"""The real datasets of ``lookalike bench real``: MOT15 and pig boxes, HexBug blobs and head points,
-and ``mot17-synth``: the real MOT17 ground truth seen through a *synthetic* detector (labelled so).
+"""The real datasets of ``lookalike bench real``: MOT15 and pig boxes, HexBug blobs and head points, and
+``mot17-synth``: the real MOT17 ground truth seen through a synthetic detector (labelled so).
 
-Every sequence becomes a :class:`RealSequence` holding the detections every tracker receives
-(identical for all of them) and the ground truth it is scored against. Box data (MOT15, pigs) is
-scored with CLEAR/identity/HOTA on boxes (IoU 0.5, MOT15 rules; MOT17 rules for ``mot17-synth``);
-HexBug clips are scored on points: the centre of each reported box against the annotated head
-position.
-
-``mot17-synth`` is a set that no parameter of lookalike was chosen on: the 7 MOT17 training
-sequences' real trajectories (``mot17/gt``) with detections from
-:func:`~lookalike.bench.synthetic.synthesize_detections` (fixed seeds). Its detections are not a
-real detector's; use it for rankings, not absolute figures. ``mot17-synth2`` and ``mot17-synth3``
-are the same truth with other noise draws (:data:`SYNTH_SEEDS`).
-
-The data folder is found by :func:`resolve_data_root`: the ``--data`` option, else the environment
-variable ``LOOKALIKE_DATA``, else ``../shared/data`` relative to the current directory.
-"""
+Each sequence becomes a :class:`RealSequence` (the detections every tracker receives, and the ground truth). Boxes are
+scored with CLEAR/identity/HOTA (IoU 0.5, MOT15 rules; MOT17 rules for ``mot17-synth``), HexBug clips on points (box
+centres against annotated heads). ``mot17-synth`` (and ``-synth2``/``-synth3``, other noise draws: :data:`SYNTH_SEEDS`)
+uses :func:`~lookalike.bench.synthetic.synthesize_detections`; no parameter was chosen on it, and its figures are for
+rankings, not absolutes. The data folder: :func:`resolve_data_root` (``--data``, ``LOOKALIKE_DATA``, else
+``../shared/data``)."""
 
 from __future__ import annotations
 
@@ -73,8 +64,7 @@ class RealSequence:
         gt_points: ``(frame (n,) 1-based, id (n,), xy (n, 2) px)`` for point data, else None.
         image_size: ``(width, height)`` in pixels, or None.
         n_targets: the documented number of targets when the set is closed, else None.
-        benchmark: the ground-truth rules of :func:`lookalike.eval.evaluate_sequence`.
-    """
+        benchmark: the ground-truth rules of :func:`lookalike.eval.evaluate_sequence`."""
 
     dataset: str
     name: str
@@ -122,11 +112,10 @@ def load_boxes(root: Path, dataset: str) -> list[RealSequence]:
 
 
 def cut_sequence(seq: RealSequence, part: str) -> RealSequence:
-    """``seq`` whole (``"full"``), cut to frames ``1..⌊N/2⌋`` (``"first"``, where parameters are
-    chosen) or to frames ``⌊N/2⌋+1..N`` (``"second"``, unseen by that choice, renumbered from 1).
+    """``seq`` whole (``"full"``), cut to frames ``1..⌊N/2⌋`` (``"first"``, where parameters are chosen) or to frames
+    ``⌊N/2⌋+1..N`` (``"second"``, unseen by that choice, renumbered from 1).
 
-    Detections and ground truth (boxes or points) are cut alike; a tracker starts afresh on a part.
-    """
+    Detections and ground truth (boxes or points) are cut alike; a tracker starts afresh on a part."""
     if part not in PARTS:
         raise ValueError(f"part: expected one of {PARTS}, got {part!r}")
     if part == "full":
@@ -182,9 +171,8 @@ def read_hexbug_points(path: Path, image_size: tuple[int, int] | None = None
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(frame 1-based (n,), id (n,), xy (n, 2) px)`` from a HexBug CSV (``,t,hexbug,x,y``).
 
-    Some CSVs store (y, x); with the clip's ``image_size`` (``(width, height)`` px) the order is
-    decided by :func:`points_swapped` (points outside the image as (x, y) but inside as (y, x)).
-    """
+    Some CSVs store (y, x); with the clip's ``image_size`` (``(width, height)`` px) the order is decided by
+    :func:`points_swapped` (points outside the image as (x, y) but inside as (y, x))."""
     rows = []
     with open(path, newline="") as fh:
         for rec in csv.DictReader(fh):
@@ -206,11 +194,10 @@ def hexbug_clips(root: Path) -> list[Path]:
 def detect_hexbug(video: Path, cache: Path | bool = True) -> RealSequence:
     """Run the blob detector over one HexBug clip (OpenCV needed) and attach its head points.
 
-    The detector settings are those ``lookalike track --video V --detector blob`` uses: estimated from
-    the clip itself (:func:`lookalike.viz.blob_video.auto_blob_config`, no target count), nothing
-    chosen for the bench. Detections are cached on disk (:func:`~lookalike.viz.blob_video.cached_blob_detection_rows`;
-    ``cache``: a folder, ``True`` for the default one, ``False`` for none).
-    """
+    The detector settings are those ``lookalike track --video V --detector blob`` uses: estimated from the clip itself
+    (:func:`lookalike.viz.blob_video.auto_blob_config`, no target count), nothing chosen for the bench. Detections are
+    cached on disk (:func:`~lookalike.viz.blob_video.cached_blob_detection_rows`; ``cache``: a folder, ``True`` for the
+    default one, ``False`` for none)."""
     from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows
     from lookalike.viz.overlay import source_frames
 
@@ -233,9 +220,8 @@ def load_datasets(root: Path, names: Sequence[str], *, sequences: Sequence[str] 
                   address: str | None = None) -> list[RealSequence]:
     """The sequences of datasets ``names`` under ``root`` (HexBug detection runs on the chosen backend).
 
-    ``sequences``: only these sequence/clip names (a dataset's name selects all of it);
-    ``max_clips``: at most this many HexBug clips.
-    """
+    ``sequences``: only these sequence/clip names (a dataset's name selects all of it); ``max_clips``: at most this many
+    HexBug clips."""
     out: list[RealSequence] = []
     for name in names:
         if name not in DATASETS:

@@ -1,18 +1,12 @@
-"""The diver bench (``lookalike bench divers``): the paper's Table 2 and Figure 5 on the rendered diver scenarios.
+"""The diver bench (``lookalike bench divers``): the diver-tracking paper's Table 2 and Figure 5 on the rendered diver
+scenarios.
 
-Every scenario is rendered, passed through the detector model (``detections``: ``sim``, the
-scenario's own, or ``paper``, :data:`~lookalike.sim.divers_paper.PAPER_DETECTORS` with de Langis and Sattar's
-detection precision and recall), and its detections' appearance features are extracted once per
-feature set (``handcrafted``, standardised on the validation scenarios; ``learned``, the shipped ONNX
-embedding trained on other divers). The entries (:data:`ENTRIES`) then run on identical detections:
-SORT, deep SORT with the learned model (the paper's baseline), deep SORT with the hand-crafted
-features, diver SORT with the hand-crafted features (the paper's method) and diver SORT with the
-learned model. With learned features the trackers' cosine thresholds are moved by
-:func:`~lookalike.sim.divers_run.matched_thresholds` (validation scenarios). The table gives the
-detector's DP/DR and each entry's IDF1, IDP, IDR, IDSW and Frag (percentages and counts), with an
-ALL row per entry (counts pooled over scenarios); :func:`pearson` gives each entry's correlation
-between DP and IDP over the scenarios (the paper: 0.727 diver SORT, 0.850 deep SORT).
-"""
+Each scenario is rendered, passed through a detector model (``sim``, or ``paper``:
+:data:`~lookalike.sim.divers_paper.PAPER_DETECTORS` with the paper's precision and recall), and its features extracted
+once per feature set (``handcrafted``, ``learned``). The entries (:data:`ENTRIES`: SORT, deep SORT and DiverSORT with
+either feature set) run on identical detections; with learned features the cosine thresholds come from
+:func:`~lookalike.sim.divers_run.matched_thresholds`. The table gives DP/DR and each entry's IDF1, IDP, IDR, IDSW and
+Frag with an ALL row; :func:`pearson` correlates DP and IDP over the scenarios."""
 
 from __future__ import annotations
 

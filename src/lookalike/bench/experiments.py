@@ -1,24 +1,14 @@
 """Farazi and Behnke's control and recovery experiments (``lookalike bench shuffle`` / ``bench recovery``).
 
-Shuffle: the identifiers on frames fed in random order. A method that really uses the sequence
-(motion, report history) must collapse; one that only matched single frames would not.
+Shuffle: the identifiers on frames in random order; a method that uses the sequence must collapse.
 
-Recovery: the heading reports of two robots are swapped for ``swap_s`` seconds, so the identifiers
-learn wrong identities, then restored. The two are, per sequence, the robots detected most often
-from the swap's start to 3 s after the restore (so that there is something to recover). Reported:
-the success rate on those two robots' detections while swapped and in the 3 s after the restore (each
-also without the swap, for comparison), and how long after the restore their success rate over a
-one-second window is back within 5 points of the same run without the swap. The recovery time compares
-each identifier with itself: one that confuses the pair without the swap too recovers at once; the
-success after the restore says how right it is. A sequence whose pair is not detected while swapped or
-not after the restore (:func:`measurable`, from the truth alone) has nothing to recover from and is left
-out; the table says how many sequences were measured. The mean recovery is also given over the sequences whose
-pair heads at least :data:`APART_RAD` apart just after the restore (:func:`restore_gap`): where the two head
-closer, the reports hardly tell them apart, and an identifier that kept them apart without the swap has the most
-to make up (docs/experiments/any-team-size.md). :func:`recovery_differences` compares each
-identifier's mean recovery time with the first one's on the same sequences (95% interval over sequences;
-:mod:`lookalike.bench.paired`).
-"""
+Recovery: the heading reports of the two robots detected most often around the swap are swapped for ``swap_s`` seconds,
+then restored. Reported: the success rate on those two while swapped and in the 3 s after the restore (each also without
+the swap), and the time after the restore until their one-second success rate is back within 5 points of the unswapped
+run. Sequences with nothing to recover (:func:`measurable`) are left out and counted; the mean recovery is also given
+over sequences whose pair heads at least :data:`APART_RAD` apart after the restore (:func:`restore_gap`).
+:func:`recovery_differences` compares each identifier with the first on the same sequences (95% intervals,
+:mod:`lookalike.bench.paired`)."""
 
 from __future__ import annotations
 
@@ -295,10 +285,9 @@ def restore_gap(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float =
 
 def recovery_differences(seconds: dict[tuple[str, str], list[float]], setups: Sequence[str],
                          trackers: Sequence[str]) -> list[Comparison]:
-    """Per set-up and identifier after the first: its mean recovery seconds minus the first identifier's
-    on the same sequences, with the 95% interval over sequences (:func:`~lookalike.bench.paired.mean_difference`;
-    no interval, note ``"never"``, when either never recovers in some sequence); none with fewer than two
-    identifiers or two sequences."""
+    """Per set-up and identifier after the first: its mean recovery seconds minus the first identifier's on the same
+    sequences, with the 95% interval over sequences (:func:`~lookalike.bench.paired.mean_difference`; no interval, note
+    ``"never"``, when either never recovers in some sequence); none with fewer than two identifiers or two sequences."""
     return compare_to_first(seconds, setups, trackers, mean_difference, preset_label)
 
 

@@ -1,15 +1,10 @@
 """Farazi and Behnke's Table I: robot identification on simulated sequences (``lookalike bench ident``).
 
-The same test sequences for every identifier (seeds ``seed + 1000·setup + sequence``; the default
-``seed`` 900000 is disjoint from the seeds below 100000 used for tuning and training); per set-up
-and identifier: the identification success rate (correct labels / all detections, a false positive
-labelled as such counting as correct), the localisation error (mean distance in metres between each
-agent's identified position and its true position while in view) and frames/s (tracking only).
-An LSTM identifier whose shipped weights do not exist for a set-up (the paper's protocol is not trained
-for every set-up) gets a row saying so (:data:`NOT_TRAINED` in its cells) instead of stopping the run.
-:func:`ident_differences` compares each identifier with the first on the same sequences (success rate
-difference in points, 95% interval over sequences; :mod:`lookalike.bench.paired`).
-"""
+The same test sequences for every identifier (seeds ``seed + 1000·setup + sequence``, default 900000, disjoint from the
+tuning and training seeds below 100000); per set-up and identifier: success rate (a false positive labelled as such
+counts as correct), localisation error (metres, while in view) and frames/s. An LSTM without shipped weights for a
+set-up gets :data:`NOT_TRAINED` cells. :func:`ident_differences` compares each identifier with the first on the same
+sequences (:mod:`lookalike.bench.paired`)."""
 
 from __future__ import annotations
 
@@ -60,10 +55,9 @@ def weights_missing(name: str, n_agents: int, n_slots: int, weights: str | None 
 
 def build_identifier(name: str, sequence: RobotSequence, weights: str | None = None,
                      options: Mapping[str, Any] | None = None) -> Any:
-    """Tracker ``name`` (or a variant of :data:`~lookalike.bench.ident_paper.IDENT_VARIANTS`)
-    configured for the sequence's N (and M for trackers with slots); ``weights``: exported network
-    weights (.npz) for our protocol's LSTM rows instead of the shipped ones; ``options``: more of the
-    tracker's parameters (they override the variant's)."""
+    """Tracker ``name`` (or a variant of :data:`~lookalike.bench.ident_paper.IDENT_VARIANTS`) configured for the
+    sequence's N (and M for trackers with slots); ``weights``: exported network weights (.npz) for our protocol's LSTM
+    rows instead of the shipped ones; ``options``: more of the tracker's parameters (they override the variant's)."""
     base, extra = resolve_identifier(name)
     extra.update(options or {})
     if weights and uses_weights(name):

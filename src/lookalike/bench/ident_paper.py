@@ -1,13 +1,6 @@
-"""The robot paper's own figures (Farazi and Behnke, IROS 2017) beside ours: identifier variants for
-``bench ident``, the paper's Tables I–III and the margins over Kalman-HA.
-
-Variants name an identifier with parameters: ``lstm-paper`` is the LSTM with the paper's input
-protocol (``N + 4·M`` inputs) decoded per slot, ``lstm-lowpass`` the shipped LSTM with the paper's
-Eq. 3 low-pass filter instead of our Kalman localiser.
-
-Only margins over the same-world Kalman-HA compare like for like: the paper's simulator and ours
-differ, so absolute rates do not.
-"""
+"""Farazi and Behnke's own figures (IROS 2017) beside ours: identifier variants for ``bench ident`` (``lstm-paper``: the
+paper's input protocol decoded per slot; ``lstm-lowpass``: the paper's low-pass localiser), the paper's Tables I–III and
+the margins over Kalman-HA (the only like-for-like comparison: the simulators differ)."""
 
 from __future__ import annotations
 

@@ -1,9 +1,8 @@
 """The leaderboard of ``lookalike bench real``: per-dataset rows, ranks, the combined ranking, plots.
 
-Per dataset, entries are ordered by the mean of their ranks on HOTA, IDF1 and MOTA (ties: IDF1);
-metrics are combined over the sequences as TrackEval does. The combined ranking orders entries by
-their mean rank over the datasets (entries on more datasets first).
-"""
+Per dataset, entries are ordered by the mean of their ranks on HOTA, IDF1 and MOTA (ties: IDF1); metrics are combined
+over the sequences as TrackEval does. The combined ranking orders entries by their mean rank over the datasets (entries
+on more datasets first)."""
 
 from __future__ import annotations
 

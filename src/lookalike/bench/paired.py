@@ -1,18 +1,10 @@
 """Paired comparison of two identifiers over the same sequences: is A really better than B?
 
-The unit of resampling is the sequence: both identifiers ran on the same sequences, so each sequence
-gives one pair of figures, and the 95% interval of the difference of the pooled figure comes from a
-percentile bootstrap that draws sequences with replacement, keeping each sequence's pair together
-(:func:`scipy.stats.bootstrap` with ``paired=True``, a fixed seed: the same figures print the same
-interval). The percentile method never fails on few or constant samples (BCa does); with few sequences
-its interval is too narrow rather than too wide, so read it as a lower bound on the uncertainty.
-
-- :func:`rate_difference`: success rate, ``sum(correct_A - correct_B) / sum(detections)``, in points;
-- :func:`mean_difference`: mean of a per-sequence figure (recovery seconds), A minus B, in its unit.
-
-One sequence gives the point difference and no interval (``low``/``high`` NaN, ``note`` says why), as
-does a figure that is infinite in some sequence (``note`` ``"never"``: an identifier never recovered).
-"""
+The 95% interval of the pooled difference comes from a percentile bootstrap over sequences, each sequence's pair kept
+together (:func:`scipy.stats.bootstrap`, ``paired=True``, fixed seed); with few sequences read it as a lower bound on
+the uncertainty. :func:`rate_difference`: success rate difference in points; :func:`mean_difference`: difference of a
+per-sequence mean (e.g. recovery seconds). One sequence, or an infinite figure (``note`` ``"never"``), gives no
+interval."""
 
 from __future__ import annotations
 

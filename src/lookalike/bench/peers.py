@@ -13,8 +13,7 @@ nothing else is changed from the library's defaults, except where a library has 
   a black image of the sequence's size (the detections' extent where it is unknown; only the size
   is read), one call per frame.
 
-A peer whose package is not installed is reported as skipped by :func:`peer_status`.
-"""
+A peer whose package is not installed is reported as skipped by :func:`peer_status`."""
 
 from __future__ import annotations
 

@@ -1,16 +1,9 @@
 """Recordings of the pixel pipeline: rendered robot sequences turned into labelled robot-sequence files.
 
-Each sequence is simulated with the observer's field of view set to the camera's, rendered, and passed
-through the perception of :class:`~lookalike.vision.pipeline.RobotPipeline` (HOG cascade → heading
-classifier → ground projection), exactly as ``lookalike bench pixels`` does
-(:func:`lookalike.bench.pixels.perceive_sequence`, same seeds ``seed + 1000·preset index + k``). The
-recording keeps the simulated sequence's reports, times and truth, but its detections are the pixel
-detections (ground position in metres, absolute heading in radians, detector probability), labelled
-with the renderer's truth: the robot whose rendered box they overlap best (IoU ≥ ``min_iou``), else -1
-(false positive). Written with :func:`lookalike.io.robot_sequences.write_robot_sequence`, this is the
-format the labelling page exports (``.labelled.jsonl``), so the files train and test the LSTM
-(``lookalike train --recordings``) like a team's own labelled recordings.
-"""
+Each sequence is simulated, rendered and perceived as ``lookalike bench pixels`` does
+(:func:`lookalike.bench.pixels.perceive_sequence`, same seeds); the recording keeps the simulation's reports, times and
+truth with the pixel detections, labelled with the robot whose rendered box they overlap best (IoU >= ``min_iou``, else
+-1). Written as ``.labelled.jsonl`` files, they train and test the LSTM like a team's recordings."""
 
 from __future__ import annotations
 

@@ -1,32 +1,17 @@
 """The pixels bench (``lookalike bench pixels``): identification from rendered pixels against the simulator's own
 detections.
 
-For each set-up, held-out robot sequences are simulated (seeds ``seed + 1000·setup + sequence``, the
-default ``seed`` 700000 being disjoint from the renders the detector and heading models train on:
-seeds below 400000) with the observer's field of view set to the camera's, and rendered through
-that camera (:func:`lookalike.viz.robot_pixels.render_robot_frames`). Every frame goes once through
-the perception of :class:`~lookalike.vision.pipeline.RobotPipeline` (HOG cascade → heading
-classifier → ground projection); then each identifier runs on those detections, and, for
-comparison, on the simulator's own detections of the same sequences. A pixel detection's true
-robot is the rendered robot whose visible box it overlaps best (Hungarian on IoU, at least
-``--min-iou``), otherwise it is a false positive. Success rate = correct labels / all detections,
-a false positive labelled as such counting as correct.
+Held-out sequences (seeds ``seed + 1000·setup + sequence``, default 700000, disjoint from the models' training renders
+below 400000) are simulated with the camera's field of view and rendered
+(:func:`lookalike.viz.robot_pixels.render_robot_frames`). Each frame goes once through
+:class:`~lookalike.vision.pipeline.RobotPipeline`'s perception; each identifier then runs on those detections and on the
+simulator's own. A pixel detection's true robot is the rendered robot it overlaps best (Hungarian on IoU, at least
+``--min-iou``), else it is a false positive.
 
-Identification table: ``Pixels (%)`` and ``Simulated (%)`` success rates, ``Gap (pp)`` = pixels − simulated;
-``Pixels robots (%)`` and ``Sim robots (%)``: the same on the detections of true robots only — the like-for-like
-comparison, since the two sides make false positives at very different rates (an identifier calls most false
-positives correctly, so a side with more of them scores higher on all detections);
-Farazi and Behnke's Table II localisation error on each side (``Pixels loc. (m)``, ``Simulated loc. (m)``: mean distance
-in metres between each robot's identified position and its true observer-frame position over the frames where
-it is in view and has a position), the detections scored on each side, and the identifier's own frames/s on
-the pixel detections.
-Perception table: recall of the rendered robots at least half visible, precision, mean absolute error
-of the absolute visual heading of matched detections (degrees), and perception frames/s (detector +
-heading + ground projection; rendering not counted).
-
-The detector and heading models are those shipped in ``lookalike/vision/models_data`` unless
-``--detector-model``/``--heading-model`` name others.
-"""
+Identification table: success rates on all detections and on true robots only (the like-for-like comparison: the two
+sides make false positives at different rates), their gap, the paper's Table II localisation error (metres) on each
+side, detections scored and frames/s. Perception table: recall of robots at least half visible, precision, heading error
+(degrees) and perception frames/s. Models: the shipped ones unless ``--detector-model`` / ``--heading-model``."""
 
 from __future__ import annotations
 

@@ -1,13 +1,6 @@
-"""Parameter presets of the benches, read from the JSON files in ``presets/``.
-
-Each file says what every set of parameters was chosen on (``chosen_on``) and how (``search``):
-parameters chosen on data that is then scored are "tuned on this data", never a headline figure.
-
-- ``boxtrack.json``: boxtrack's parameters per MOT15 sequence (``sequences``) and per dataset
-  (``tuned``), both for the separate "tuned on this data" row only. The headline rows of
-  ``bench real`` use boxtrack's defaults and :class:`~lookalike.trackers.offline.OfflineConfig`'s,
-  as ``lookalike track`` does.
-"""
+"""Parameter presets of the benches, read from ``presets/*.json``, each saying what it was chosen on (``chosen_on``) and
+how (``search``). Presets chosen on the scored data only feed the "tuned on this data" rows; headline rows use the
+defaults, as ``lookalike track`` does."""
 
 from __future__ import annotations
 

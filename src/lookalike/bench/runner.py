@@ -1,24 +1,12 @@
 """Jobs of ``lookalike bench real`` and the backends that run them: serial, processes, Ray.
 
-A job is one tracker entry on one sequence; it returns the sequence's scores (counts that combine)
-and the tracking time. Every backend maps the same pure function over the same jobs and returns
-the results in job order, so the tables do not depend on the backend (frames/s aside). The Ray
-backend uses Ray's task API (``ray.remote`` / ``ray.get``), connecting to ``address`` or starting
-a local instance (``ray.init()``); the sequences are put in Ray's object store once.
-
-Parameters of an entry: the tracker's defaults, overridden by the entry's own. Only a ``tuned``
-entry (the "tuned on this data" row) also gets the parameters chosen on the scored data: the
-dataset's :data:`~lookalike.bench.presets.TUNED_PARAMS`, then the sequence's
-:data:`~lookalike.bench.presets.SEQUENCE_PARAMS`.
-
-On blob detections (:data:`BLOB_DATASETS`: the HexBug clips) ``boxtrack`` gets what
-``lookalike track --video V --detector blob`` gives it (:func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config`):
-the blob parameters for every parameter the entry does not give, and a closed set of the number of
-targets inferred from the blob counts, so the bench and the tuning score what a user runs.
-
-``boxtrack-closed-offline`` runs the offline closed set (:func:`lookalike.trackers.offline.closed_set.track_closed_set`)
-on the detections with boxtrack's defaults, as ``lookalike track --targets N --offline`` does.
-"""
+A job is one tracker entry on one sequence and returns its combinable scores and tracking time; every backend returns
+results in job order, so tables do not depend on the backend (frames/s aside). An entry's parameters are the tracker's
+defaults overridden by the entry's; only a ``tuned`` entry also gets the presets chosen on the scored data
+(:data:`~lookalike.bench.presets.TUNED_PARAMS`, :data:`~lookalike.bench.presets.SEQUENCE_PARAMS`). On blob detections
+(:data:`BLOB_DATASETS`) ``boxtrack`` gets what ``lookalike track --detector blob`` gives it
+(:func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config`); ``boxtrack-closed-offline`` runs
+:func:`lookalike.trackers.offline.closed_set.track_closed_set` as ``lookalike track --targets N --offline`` does."""
 
 from __future__ import annotations
 
@@ -81,9 +69,8 @@ def default_entries(trackers: Sequence[str], peers: Sequence[str], closed_set: b
 
 def params_entry(path: str, tracker: str, params: dict[str, Any], chosen_on: Sequence[str],
                  sequences: Sequence[RealSequence]) -> Entry:
-    """The entry of a ``lookalike tune`` parameter file: labelled with the file's stem, and
-    ``(tuned on this data)`` when its ``chosen_on`` names any scored sequence (``dataset/name`` or a
-    dataset)."""
+    """The entry of a ``lookalike tune`` parameter file: labelled with the file's stem, and ``(tuned on this data)``
+    when its ``chosen_on`` names any scored sequence (``dataset/name`` or a dataset)."""
     from pathlib import Path
 
     scored = {f"{s.dataset}/{base_name(s)}" for s in sequences} | {s.dataset for s in sequences}

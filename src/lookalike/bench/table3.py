@@ -1,17 +1,9 @@
 """Farazi and Behnke's Table III protocol on recordings: success rate by sequence length.
 
-For each length (frames), ``draws`` windows of that length are drawn at random (seeded) from the
-recordings, each identifier runs on every window from a fresh state, and the success rate is
-correct labels / detections over the windows of that length; the ``Total`` column runs each
-identifier over every recording whole. Recordings are robot sequences (simulated, or rendered-pixel
-runs written in the robot-sequence format) with the truth in each detection's label.
-
-Human benchmark results (``lookalike label --benchmark`` writes one file per session,
-:mod:`lookalike.viz.label.human`) of the same set-up (N, M) add a ``human`` row: per length, the
-sessions in which the person worked through at least that many frames (the longest such length
-only), and in ``Total`` every session, each scored over the frames it worked through (correct
-labels / detections, unset labels wrong); people give no positions, so no localisation error.
-"""
+For each length, ``draws`` seeded random windows are drawn from the recordings and each identifier runs on every window
+from a fresh state; ``Total`` runs each over every whole recording. Human-benchmark result files
+(:mod:`lookalike.viz.label.human`) of the same set-up add a ``human`` row (per length, the sessions that worked through
+at least that many frames; no localisation error)."""
 
 from __future__ import annotations
 
