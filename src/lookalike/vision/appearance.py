@@ -1,29 +1,10 @@
-"""Hand-crafted appearance features for look-alike targets (de Langis and Sattar, DESIGN §6) and the extractor
-protocol.
+"""Hand-crafted appearance features for look-alike targets (the diver-tracking paper's) and the extractor protocol.
 
-Each detection box is cropped from the frame and resized to a ``crop_px`` square; all crops of a
-frame are then processed together as one ``(n, s, s, 3)`` array. The raw vector concatenates five
-blocks:
-
-- **colour** (25): LAB colour of the foreground: mean and spread of a and b, relative spread of L,
-  a 4×4 histogram of (a, b) and a 4-bin histogram of L relative to its mean (brightness-invariant);
-- **frequency** (6): mean amplitude of the 2-D spectrum of the brightness-normalised grey crop in 6
-  radial bands (log-scaled);
-- **edges / contour** (12): edge density, 8-bin gradient-orientation histogram, number of
-  foreground contours, circularity and elongation of the largest one;
-- **convex hull** (5): solidity, hull-to-crop area ratio, number of convexity defects, mean and
-  largest defect depth relative to the hull size;
-- **Hu moments** (7): of the foreground mask, log-scaled ``sign(h)·log10(1 + |h|/1e-9)``.
-
-The foreground is the set of pixels whose LAB colour differs from the crop's border (the water)
-by more than half the crop's 95th-percentile difference. Raw vectors are standardised per
-dimension (statistics from :func:`fit_stats`, or, without them, running statistics of the first
-``warmup`` crops, then frozen), weighted (equal block weights, or weights calibrated on labelled
-validation crops by :func:`fit_stats`), and rows are L2-normalised so that ``1 - f·g`` is the
-cosine distance.
-
-OpenCV is imported inside the functions that need it.
-"""
+Each box is cropped and resized to a ``crop_px`` square; a frame's crops are processed together. The raw vector
+concatenates colour (25: LAB statistics and histograms of the foreground), frequency (6 radial spectrum bands), edges
+and contour (12), convex hull (5) and Hu moments (7) blocks; the foreground is what differs from the crop's border (the
+water). Raw vectors are standardised (:func:`fit_stats`, or running statistics of the first ``warmup`` crops), weighted
+per block and L2-normalised, so ``1 - f·g`` is the cosine distance. OpenCV is imported lazily."""
 
 from __future__ import annotations
 
@@ -60,8 +41,7 @@ class FeatureExtractor(Protocol):
 class FeatureStats:
     """Per-dimension standardisation of raw features, ``weight · (raw - mean) / scale``, all ``(RAW_DIM,)``.
 
-    ``weight`` defaults to equal block weights (each block contributes the same expected share).
-    """
+    ``weight`` defaults to equal block weights (each block contributes the same expected share)."""
 
     mean: np.ndarray
     scale: np.ndarray
@@ -89,11 +69,10 @@ def fit_stats(raw: np.ndarray, labels: np.ndarray | None = None, floor: float = 
               max_weight: float = 3.0) -> FeatureStats:
     """Standardisation statistics from raw vectors ``(m, RAW_DIM)``.
 
-    Without labels: each dimension's mean and standard deviation, equal block weights. With
-    identity ``labels (m,)`` (calibration data): the scale is the pooled within-identity standard
-    deviation and each dimension is weighted by ``sqrt(between / within)`` variance (clipped to
-    ``max_weight``), a diagonal discriminant that lets stable, telling dimensions dominate.
-    """
+    Without labels: each dimension's mean and standard deviation, equal block weights. With identity ``labels (m,)``
+    (calibration data): the scale is the pooled within-identity standard deviation and each dimension is weighted by
+    ``sqrt(between / within)`` variance (clipped to ``max_weight``), a diagonal discriminant that lets stable, telling
+    dimensions dominate."""
     raw = np.asarray(raw, dtype=float)
     if raw.ndim != 2 or raw.shape[1] != RAW_DIM or len(raw) < 2:
         raise ValueError(f"raw: expected shape (m >= 2, {RAW_DIM}), got {raw.shape}")
@@ -177,11 +156,10 @@ class HandcraftedFeatures:
 
 
 def crop_boxes(image: np.ndarray, xywh: np.ndarray, size: int | tuple[int, int]) -> np.ndarray:
-    """``(n, size, size, 3)`` uint8 crops of boxes ``xywh (n, 4)`` (pixels), clipped to the image;
-    ``size`` may be ``(width, height)`` for ``(n, height, width, 3)`` crops.
+    """``(n, size, size, 3)`` uint8 crops of boxes ``xywh (n, 4)`` (pixels), clipped to the image; ``size`` may be
+    ``(width, height)`` for ``(n, height, width, 3)`` crops.
 
-    A box wholly outside the image gives a black crop.
-    """
+    A box wholly outside the image gives a black crop."""
     with needs("cv2"):
         import cv2
 

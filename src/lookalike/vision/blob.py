@@ -1,19 +1,9 @@
-"""Background-subtraction blob detector for static cameras over arenas (DESIGN §6).
+"""Background-subtraction blob detector for static cameras over arenas.
 
-Foreground is where a frame differs from the background model by more than ``threshold`` grey
-levels (largest difference over the three colour channels, after a Gaussian blur). Two models:
-
-- ``median``: the per-pixel median of frames sampled across the video (:meth:`BlobDetector.fit`),
-  the robust choice when the animals keep moving; without ``fit`` the detector keeps a rolling
-  buffer of sampled frames and uses their median;
-- ``mog2``: OpenCV's adaptive Gaussian-mixture model, learned online frame by frame.
-
-The mask is cleaned by a morphological opening then closing, split into external contours, and
-each contour with ``min_area_px <= area <= max_area_px`` becomes one detection: its bounding box
-and score 1: a blob carries no confidence of its own (its contrast says how dark a target is, not
-how likely it is one), so a box tracker's score thresholds pass every blob (docs/blobs.md).
-OpenCV is imported lazily.
-"""
+Foreground is where a blurred frame differs from the background model by more than ``threshold`` grey levels (``median``
+of sampled frames, :meth:`BlobDetector.fit` or a rolling buffer; or OpenCV's ``mog2``). The mask is opened and closed,
+and each external contour with ``min_area_px <= area <= max_area_px`` becomes a box with score 1 (docs/blobs.md). OpenCV
+is imported lazily."""
 
 from __future__ import annotations
 

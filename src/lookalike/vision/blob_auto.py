@@ -1,36 +1,12 @@
 """Blob detector settings estimated from the video itself (no per-video hand tuning).
 
-:func:`estimate_blob_config` looks at ``sample`` frames spread evenly over the video and derives every
-setting of :class:`~lookalike.vision.blob.BlobConfig` from statistics of that video:
-
-- **stabilise**: the translation of each sampled frame against the median of the samples (phase
-  correlation), relative to the first sample's; a camera that moves by more than ``shake_px`` pixels
-  (median over the samples) is stabilised if aligning the samples cuts the 90th percentile of their
-  absolute differences from their median by at least 20% (a test that the motion is real).
-- **background**: the per-pixel median of the samples (the detector's own ``median`` model).
-- **polarity**: the foreground mass (pixels differing from the background by more than the noise
-  threshold) that is darker, and that is brighter than the background; when one side holds less than
-  ``polarity_ratio`` of the other, only the dominant side is kept (``dark``/``bright``), else ``any``.
-- **noise**: σ = 1.4826 × the median absolute difference from the background (most pixels are
-  background), in grey levels.
-- **threshold**: candidates at 4, 6, 8, 10, 14 and 20 σ (within 8..100 grey levels). At each, the
-  foreground's connected components give a typical target area ``A`` (the area-weighted median of the
-  components, i.e. where most of the foreground lies) and the blobs counted per frame between ``A/5``
-  and ``6·A``. With ``n_targets`` the threshold that gives exactly ``n_targets`` blobs in most sampled
-  frames wins (if any does in at least 20% of them); otherwise the one whose median count is the most
-  common over the candidates (the count's plateau: a real set of targets is counted alike over a range
-  of thresholds, noise is not).
-- **persistence**: components lying mostly on pixels that are foreground in more than 30% of the
-  samples (a moved object, a lighting change) are left out of these statistics: targets move.
-- **areas**: ``min_area_px = A/5`` (smaller pieces are noise or fragments), ``max_area_px = 6·A`` (two or
-  three touching targets are still one detection; larger regions are lighting changes).
-- **morphology**: the targets' half thickness ``r`` (median largest inscribed radius, from a distance
-  transform) sets the opening to ``r`` (odd, 3..15 px: thinner structures than the targets go) and the
-  closing to ``2r`` (odd, 3..15 px: fragments of one target rejoin).
-
-The result is printed by :func:`BlobEstimate.summary` so that a user can see and override each value.
-OpenCV is imported lazily.
-"""
+:func:`estimate_blob_config` derives every setting of :class:`~lookalike.vision.blob.BlobConfig` from ``sample`` frames
+spread over the video: stabilisation (when the camera shakes by more than ``shake_px`` and aligning helps), the median
+background, polarity (``dark``/``bright``/``any`` by the foreground mass each side), the noise σ (robust, grey levels),
+the threshold (4-20 σ: with ``n_targets`` the one counting exactly N blobs most often, else the plateau of the per-frame
+count), the area bounds around the typical target area ``A`` (``A/5`` to ``6·A``, persistent regions left out) and the
+morphology from the targets' half thickness. The table of rules: docs/blobs.md. :func:`BlobEstimate.summary` prints each
+value so it can be overridden."""
 
 from __future__ import annotations
 
@@ -74,8 +50,7 @@ class BlobEstimate:
         shake_px: median camera translation of the samples against the first (px).
         dark_share: share of the foreground mass darker than the background.
         counts: per candidate threshold, the median blob count per sampled frame.
-        n_targets: the number of targets given, or None.
-    """
+        n_targets: the number of targets given, or None."""
 
     config: BlobConfig
     noise: float
@@ -360,8 +335,7 @@ class TargetCount:
     Attributes:
         n: the most common number of blobs per frame (0 when no frame has a blob).
         share: share of the frames with exactly ``n`` blobs.
-        frames: frames counted.
-    """
+        frames: frames counted."""
 
     n: int
     share: float

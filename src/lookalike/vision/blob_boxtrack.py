@@ -1,13 +1,7 @@
-"""What ``boxtrack`` gets on blob detections: the one rule ``lookalike track --detector blob`` and the
-benches (``bench real``, ``lookalike tune``, benchmarks/boxtrack_lodo.py) share (docs/blobs.md).
-
-- Each parameter of :data:`~lookalike.vision.blob_auto.BOX_TRACKER_PARAMS` replaces the tracker's value
-  unless the user gave that parameter (``--set KEY=VALUE`` or a ``--params`` file): decided by the keys
-  given, not by comparing values, so an explicit ``match_iou=0.3`` (the default) is kept.
-- Without a known number of targets (no ``--targets``, no ``max_targets``), a closed set of the number
-  read off the blob count per frame (:func:`~lookalike.vision.blob_auto.infer_target_count`) when one
-  count holds in a strict majority of the frames; ``n_targets=0`` keeps the open set.
-"""
+"""What ``boxtrack`` gets on blob detections, the one rule ``lookalike track --detector blob`` and the benches share
+(docs/blobs.md): each parameter of :data:`~lookalike.vision.blob_auto.BOX_TRACKER_PARAMS` unless the user gave it (by
+key, not by value), and without a known number of targets a closed set of the count inferred from the blobs
+(:func:`~lookalike.vision.blob_auto.infer_target_count`; ``n_targets=0`` keeps the open set)."""
 
 from __future__ import annotations
 
@@ -30,8 +24,7 @@ class BlobBoxTrack:
     Attributes:
         config: the configuration to run.
         count: the number of targets inferred from the blob counts (None when it was given or not asked).
-        n_targets: the closed set's size (``config.max_targets``), or None for an open set.
-    """
+        n_targets: the closed set's size (``config.max_targets``), or None for an open set."""
 
     config: BoxTrackConfig
     count: TargetCount | None
@@ -40,10 +33,9 @@ class BlobBoxTrack:
 
 def blob_boxtrack_config(config: BoxTrackConfig, counts: np.ndarray, explicit: Collection[str] = (),
                          n_targets: int | None = None) -> BlobBoxTrack:
-    """``config`` for blob detections (module doc). ``counts``: blobs per frame ``(n_frames,)`` (frames
-    without a blob as 0, :func:`~lookalike.vision.blob_auto.frame_counts`); ``explicit``: the parameter
-    names the user gave (their values are kept); ``n_targets``: the known number of targets (None: infer
-    it from ``counts``; 0: an open set)."""
+    """``config`` for blob detections (module doc). ``counts``: blobs per frame ``(n_frames,)`` (frames without a blob
+    as 0, :func:`~lookalike.vision.blob_auto.frame_counts`); ``explicit``: the parameter names the user gave (their
+    values are kept); ``n_targets``: the known number of targets (None: infer it from ``counts``; 0: an open set)."""
     given = set(explicit)
     changes: dict[str, Any] = {k: v for k, v in BOX_TRACKER_PARAMS.items() if k not in given}
     count = None

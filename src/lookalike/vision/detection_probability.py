@@ -1,13 +1,8 @@
 """A detector's last-stage margin → the detection probability the identifiers were trained on.
 
-The HOG cascade's own probability (a logistic fit of its last-stage margin) rounds to 1 for nearly
-every box it keeps, while the simulator's detector score, which the learned identifiers read as an
-input, spreads over (0, 1). :class:`DetectionProbability` is a monotone piecewise-linear map from
-margin to probability (knots ``margin`` → ``probability``, clipped at both ends), so the order of the
-detections is kept and only the value given to the identifier changes. It is fitted by quantile
-mapping (:func:`fit_quantile_map`): the margin at quantile q of the pixel detections is mapped to the
-simulator's score at quantile q.
-"""
+:class:`DetectionProbability` is a monotone piecewise-linear map from margin to probability, fitted by quantile mapping
+(:func:`fit_quantile_map`: the margin at quantile q of the pixel detections goes to the simulator's score at quantile
+q), so detections keep their order and the identifiers see the score spread they were trained on."""
 
 from __future__ import annotations
 
@@ -28,8 +23,7 @@ class DetectionProbability:
     Attributes:
         margin: ``(k,)`` increasing knot margins.
         probability: ``(k,)`` non-decreasing probabilities at the knots.
-        fitted_on: how the knots were fitted (seeds, counts, command), kept in the file.
-    """
+        fitted_on: how the knots were fitted (seeds, counts, command), kept in the file."""
 
     margin: tuple[float, ...]
     probability: tuple[float, ...]

@@ -1,19 +1,10 @@
-"""Visual heading classifier (Farazi and Behnke, DESIGN §6): dense HOG of a robot's torso into an RBF SVM over
-10 classes.
+"""Visual heading classifier (the robot-identification paper's): dense HOG of a robot's torso into an RBF SVM over
+``classes`` heading sectors.
 
-Per box, the upper half (the torso, invariant to the legs) is cut out of the image and resized to
-``patch_px``; dense HOG of its grey channel and of its HSV hue channel plus the box centre
-normalised by the image size form the feature vector. Heading (egocentric, radians) is split into
-``classes`` sectors of equal width centred on ``k * 2π / classes``. An RBF SVM (scikit-learn, with
-C and γ chosen by k-fold grid search, scored by the mean angular error between class centres) is
-fitted with Platt probabilities. Prediction runs in numpy from the saved support vectors: the
-one-vs-one decision values, their pairwise probabilities and the pairwise coupling of Wu, Lin and
-Weng (solved exactly), so a saved model needs no pickle and no scikit-learn to run.
-
-Output per box: the most probable class, a continuous heading (probability-weighted circular mean
-of the class centres) and a spread (circular standard deviation of that distribution combined
-with the sector's own width).
-"""
+Features: dense HOG of the box's upper half (grey and hue) and the box centre. The SVM (C and γ by k-fold grid search,
+Platt probabilities) is evaluated in numpy from the saved support vectors with Wu, Lin and Weng's pairwise coupling, so
+a saved model needs no pickle or scikit-learn. Output per box: the most probable class, a continuous heading (circular
+mean, egocentric radians) and its spread."""
 
 from __future__ import annotations
 
@@ -255,9 +246,8 @@ def train_heading(
 ) -> HeadingClassifier:
     """Fit the classifier on ``features (n, d)`` from :func:`heading_features` and true headings ``(n,)`` (rad).
 
-    C and γ come from a ``config.folds``-fold grid search scored by the mean angular error (rad) between
-    predicted and true class centres; the best pair is refitted on everything with Platt probabilities.
-    """
+    C and γ come from a ``config.folds``-fold grid search scored by the mean angular error (rad) between predicted and
+    true class centres; the best pair is refitted on everything with Platt probabilities."""
     with needs("sklearn"):
         from sklearn.metrics import make_scorer
         from sklearn.model_selection import GridSearchCV, KFold

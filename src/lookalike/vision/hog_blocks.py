@@ -1,8 +1,7 @@
-"""HOG block descriptors of the cascade detector: the block pool of a window and the L2-normalised 2×2-cell
-descriptors of many blocks for many windows, read from per-orientation integral histograms
-(:mod:`lookalike.vision.hog_features`). Two layouts compute the same values bit for bit: row gathers for
-windows anywhere (:func:`block_features_rows`) and strided slices for a regular grid of windows
-(:func:`block_features_grid`)."""
+"""HOG block descriptors of the cascade detector: the block pool of a window and the L2-normalised 2×2-cell descriptors
+of many blocks for many windows, read from per-orientation integral histograms (:mod:`lookalike.vision.hog_features`).
+Two layouts compute the same values bit for bit: row gathers for windows anywhere (:func:`block_features_rows`) and
+strided slices for a regular grid of windows (:func:`block_features_grid`)."""
 
 from __future__ import annotations
 
@@ -62,11 +61,10 @@ def block_pool(window_px: tuple[int, int], cell_px: int) -> np.ndarray:
 
 def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
                    unit_px: int = 1) -> np.ndarray:
-    """Descriptors of ``blocks (b, 4)`` (px) for windows at offsets ``ox, oy (k,)`` (px)
-    of ``integral (BINS, H+1, W+1)`` whose entries are ``unit_px`` pixels apart (1: a pixel integral;
-    ``cell_px``: an integral of :func:`~lookalike.vision.hog_features.cell_histograms`, all offsets
-    then multiples of it);
-    returns ``(k, b * 4 * BINS)`` float32."""
+    """Descriptors of ``blocks (b, 4)`` (px) for windows at offsets ``ox, oy (k,)`` (px) of ``integral (BINS, H+1,
+    W+1)`` whose entries are ``unit_px`` pixels apart (1: a pixel integral; ``cell_px``: an integral of
+    :func:`~lookalike.vision.hog_features.cell_histograms`, all offsets then multiples of it); returns ``(k, b * 4 *
+    BINS)`` float32."""
     rows = np.ascontiguousarray(np.asarray(integral).transpose(1, 2, 0)).reshape(-1, integral.shape[0])
     return block_features_rows(rows, integral.shape[2], blocks, ox, oy, unit_px)
 

@@ -1,20 +1,11 @@
-"""HOG cascade detector (Farazi and Behnke, DESIGN §6): variable-size HOG blocks, boosted stages, a cascade of
+"""HOG cascade detector (the robot-identification paper's): variable-size HOG blocks, boosted stages, a cascade of
 rejectors.
 
-A window of ``window_px`` (width, height) is described by a pool of rectangular blocks of several
-sizes and aspect ratios; each block is split into 2×2 cells and gives an L2-normalised 36-value
-descriptor read from per-orientation integral histograms (:mod:`lookalike.vision.hog_features`).
-Stage ``k`` of the cascade is a discrete AdaBoost (scikit-learn, decision stumps) over the pooled
-block descriptors, with a threshold set so that the stage keeps ``stage_hit_rate`` of the training
-positives; a window is a detection when every stage accepts it. Between stages the negatives are
-refilled with windows that the cascade so far still accepts (hard negatives): first windows mined by
-running it over whole training scenes away from the true boxes (beside robots, field lines, partly
-visible robots), then random background windows.
-
-Detection slides the window over an image pyramid (from the image itself, no upscaling), keeps the windows
-that pass every stage, shrinks them by the training context to target boxes, maps
-their last-stage margin to a probability with a logistic fit, and applies non-maximum suppression.
-"""
+A ``window_px`` window is described by a pool of blocks (2×2 cells, 36 values each, from integral histograms:
+:mod:`lookalike.vision.hog_features`). Each stage is a discrete AdaBoost over the block descriptors, its threshold
+keeping ``stage_hit_rate`` of the training positives; between stages the negatives are refilled with hard negatives
+mined from training scenes, then random windows. Detection slides the window over an image pyramid, keeps windows
+passing every stage, maps the last-stage margin to a probability and applies NMS."""
 
 from __future__ import annotations
 
@@ -301,8 +292,7 @@ def train_cascade(
         scenes: ``(grey (H, W) float32 frame, true boxes (m, 4) px)`` pairs. From the second stage on, the
             cascade so far is run over them and every window it accepts that overlaps no true box by more
             than ``hard_negative_max_iou`` becomes a negative (windows beside robots, field lines, partly
-            visible robots); random windows from ``negative_windows`` fill up the rest.
-    """
+            visible robots); random windows from ``negative_windows`` fill up the rest."""
     with needs("sklearn"):
         from sklearn.ensemble import AdaBoostClassifier
         from sklearn.linear_model import LogisticRegression

@@ -1,13 +1,8 @@
 """Image checks and HOG building blocks: per-orientation integral histograms and block descriptors.
 
-The orientation histogram of an image is a stack of ``bins`` gradient-magnitude maps, one per
-unsigned orientation bin (0..π), soft-assigned between the two nearest bins. Its integral image
-(summed-area table) lets the descriptor of any rectangle be read in four look-ups per bin, which
-is what makes variable-size HOG blocks cheap (Zhu et al., as used by Farazi and Behnke). For detection, where every
-rectangle corner lies on the cell grid, :func:`cell_histograms` gives the same sums per cell in one pass,
-so the integral image is built over cells instead of pixels. OpenCV (gradients, colour conversion,
-resizing) is imported lazily.
-"""
+The orientation histogram is a stack of ``bins`` gradient-magnitude maps (unsigned, soft-assigned); its integral image
+gives any rectangle's descriptor in four look-ups per bin, which makes variable-size blocks cheap. For detection,
+:func:`cell_histograms` sums per cell in one pass and the integral is built over cells. OpenCV is imported lazily."""
 
 from __future__ import annotations
 
@@ -24,10 +19,9 @@ BINS = 9  # unsigned orientation bins over [0, π)
 def as_bgr_image(image: np.ndarray, name: str = "image") -> np.ndarray:
     """Validate an image and return it as ``(h, w, 3)`` uint8 BGR.
 
-    Grey ``(h, w)`` or ``(h, w, 1)`` images are replicated to three channels, BGRA drops alpha,
-    float images in [0, 1] are scaled to 0..255, other integer types are clipped. Empty images,
-    other shapes and non-finite values raise ``ValueError`` naming ``name``.
-    """
+    Grey ``(h, w)`` or ``(h, w, 1)`` images are replicated to three channels, BGRA drops alpha, float images in [0, 1]
+    are scaled to 0..255, other integer types are clipped. Empty images, other shapes and non-finite values raise
+    ``ValueError`` naming ``name``."""
     arr = np.asarray(image)
     if arr.size == 0:
         raise ValueError(f"{name}: empty image (shape {arr.shape})")
@@ -119,8 +113,7 @@ def _gradient_bins(grey: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray,
 def orientation_maps(grey: np.ndarray, bins: int = BINS) -> np.ndarray:
     """``(bins, h, w)`` float32 gradient magnitude soft-assigned to unsigned orientation bins.
 
-    Gradients are central differences (zero at the border) of ``grey (h, w)``.
-    """
+    Gradients are central differences (zero at the border) of ``grey (h, w)``."""
     lo, w_lo, w_hi = _gradient_bins(grey, bins)
     out = np.empty((bins,) + lo.shape, dtype=np.float32)
     for b in range(bins):
@@ -216,9 +209,8 @@ def rect_sums(integral: np.ndarray, x0: np.ndarray, y0: np.ndarray, x1: np.ndarr
 def block_descriptor(cell_sums: np.ndarray, eps: float = 1e-3) -> np.ndarray:
     """L2-normalised HOG block descriptors from the orientation sums of its 2×2 cells.
 
-    ``cell_sums`` has shape ``(4, bins, ...)``; the result ``(4 * bins, ...)``. ``eps`` (in
-    gradient units per pixel-area of the cells) keeps flat regions near zero.
-    """
+    ``cell_sums`` has shape ``(4, bins, ...)``; the result ``(4 * bins, ...)``. ``eps`` (in gradient units per
+    pixel-area of the cells) keeps flat regions near zero."""
     flat = cell_sums.reshape((-1,) + cell_sums.shape[2:])
     norm = np.sqrt((flat * flat).sum(axis=0, keepdims=True)) + eps
     return flat / norm

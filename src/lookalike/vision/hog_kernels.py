@@ -1,14 +1,9 @@
-"""Optional compiled kernels (numba) for the HOG detector (:mod:`lookalike.vision.hog_numba`): grey conversion,
-cell histograms from OpenCV's gradient magnitude and angle, their float32 integral, and the block-descriptor columns
-a cascade stage reads.
+"""Optional numba kernels for the HOG detector (:mod:`lookalike.vision.hog_numba`): grey conversion, cell histograms,
+their integral, and the block-descriptor columns a cascade stage reads.
 
-Each kernel does the floating-point operations of the numpy path one pixel, cell or window at a time, in the same
-order and precision (float32 binning, float64 sums in each cell's raster order, the 36-term block norms in numpy's
-pairwise order, no fused multiply-adds), so detections are bit for bit the same; ``tests/test_hog_kernels.py``
-compares both paths. They are used when numba is installed (the ``fast`` extra) unless ``LOOKALIKE_HOG_NUMBA=0``.
-Start-up: numba is imported and the cached kernels loaded in the first detector call of a process; right after
-installation that call compiles them into numba's cache (figures: docs/experiments/speed.md, HOG).
-"""
+Each does the numpy path's operations one pixel, cell or window at a time in the same order and precision, so detections
+are bit for bit the same (``tests/test_hog_kernels.py``). Used when numba is installed unless ``LOOKALIKE_HOG_NUMBA=0``;
+loaded at a process's first detector call."""
 
 from __future__ import annotations
 

@@ -1,18 +1,10 @@
-"""Choosing how many stages of a trained HOG cascade to use and where its pyramid starts, and calibrating its
-detection probability, on held-out scenes.
+"""Choosing how many stages of a trained HOG cascade to use and where its pyramid starts, and calibrating its detection
+probability, on held-out scenes.
 
-Training adds stages until the hard negatives run out; the last stages then remove few false positives
-but reject true targets (each keeps ``stage_hit_rate`` of the *training* positives, fewer of unseen ones).
-:func:`select_stages` runs every cascade prefix from half its length to the whole over held-out scenes
-(images with their true boxes and boxes to ignore), matches detections to true boxes one-to-one at IoU >=
-``iou`` (Hungarian; a detection matching only an ignored box, say a mostly hidden robot, is neither a hit
-nor a false positive) and keeps the prefix with the best F1, the longer on ties. Then it starts the image
-pyramid one or two levels coarser (smallest window ``min_height_px`` times ``scale_step`` or its square)
-when that loses at most ``f1_tolerance`` of held-out F1: the finest level is the costliest and only
-finds the smallest targets. Last it refits the probability of the kept model: a logistic regression
-of "this detection is a hit" on the last-stage margin of the held-out detections, so that the score
-of a box estimates its chance of being a target.
-"""
+:func:`select_stages` scores every cascade prefix from half its length on held-out scenes (one-to-one matching at IoU >=
+``iou``; ignored boxes neither hit nor false positive) and keeps the best F1 (the longer on ties), starts the pyramid
+one or two levels coarser when that costs at most ``f1_tolerance`` of F1, and refits the probability as a logistic
+regression of "hit" on the last-stage margin."""
 
 from __future__ import annotations
 

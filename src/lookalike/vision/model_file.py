@@ -27,9 +27,8 @@ def load_model_file(
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """The header and arrays of a file written by :func:`save_model_file`.
 
-    Raises ``ValueError`` naming ``path`` when it is unreadable, of another format (``what`` names
-    the expected kind of model in the message) or of another version.
-    """
+    Raises ``ValueError`` naming ``path`` when it is unreadable, of another format (``what`` names the expected kind of
+    model in the message) or of another version."""
     try:
         with np.load(path, allow_pickle=False) as data:
             header = json.loads(str(data["header"]))

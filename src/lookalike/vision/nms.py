@@ -33,12 +33,11 @@ def nms(xywh: np.ndarray, score: np.ndarray, iou: float) -> np.ndarray:
 def merge_nms(xywh: np.ndarray, score: np.ndarray, overlap: float, merge_iou: float) -> tuple[np.ndarray, np.ndarray]:
     """Greedy suppression by intersection over the smaller box, with box averaging.
 
-    Boxes ``(n, 4)`` px are visited best ``score`` first; each one not yet suppressed is kept and suppresses
-    every box whose intersection with it exceeds ``overlap`` of the smaller area (windows on parts of
-    a target, or shifted copies). Its output box is the plain mean of the not yet suppressed boxes overlapping
-    it by IoU > ``merge_iou``, which localises better than the single best window of a coarse pyramid.
-    Returns ``(boxes (k, 4) px, index (k,) of each kept box)``.
-    """
+    Boxes ``(n, 4)`` px are visited best ``score`` first; each one not yet suppressed is kept and suppresses every box
+    whose intersection with it exceeds ``overlap`` of the smaller area (windows on parts of a target, or shifted
+    copies). Its output box is the plain mean of the not yet suppressed boxes overlapping it by IoU > ``merge_iou``,
+    which localises better than the single best window of a coarse pyramid. Returns ``(boxes (k, 4) px, index (k,) of
+    each kept box)``."""
     x = np.asarray(xywh, float).reshape(-1, 4)
     order = np.argsort(-np.asarray(score), kind="stable")
     xo = x[order]

@@ -1,24 +1,11 @@
 """Any ONNX detection model as a box detector (onnxruntime; ``lookalike track --video V --detector FILE.onnx``).
 
-Input: each BGR frame is letterboxed (resized keeping its aspect ratio, centred, padded with grey
-114) to the model's input size (its static ``(h, w)``, else ``input_size``, default 640×640),
-converted to RGB (``rgb=False`` keeps BGR), scaled by ``scale`` (default 1/255) and fed as one
-float32 NCHW tensor ``(1, 3, h, w)``.
-
-Output layouts (``layout``; ``auto`` picks ``yolo`` for one output, ``ssd`` for two):
-
-- ``yolo`` — one tensor ``(1, N, 4 + C)`` or ``(1, 4 + C, N)`` (YOLOv8/v11 exports; the shorter
-  axis is taken as the per-box axis): ``cx, cy, w, h`` in input pixels, then ``C`` class scores.
-- ``yolo-obj`` — as ``yolo`` with an objectness column after the box, ``(1, N, 5 + C)`` (YOLOv5/v7
-  exports); the score is objectness × class score.
-- ``ssd`` — two tensors: boxes ``(1, N, 4)`` as ``x0, y0, x1, y1`` (``box_order="yxyx"`` for
-  TensorFlow-style ``y0, x0, y1, x1``) in ``[0, 1]`` of the input (``normalised=False``: input
-  pixels), and scores ``(1, N, C)`` or ``(1, N)``. The boxes tensor is the one whose last axis is 4.
-
-Each box gets its best class among ``classes`` (all when None); boxes scoring below
-``score_threshold`` are dropped, the rest pass class-wise greedy non-maximum suppression at
-``nms_iou`` and are mapped back to frame pixels (``xywh``) through the letterbox.
-"""
+Frames are letterboxed to the model's input size (grey 114 padding), converted to RGB unless ``rgb=False``, scaled by
+``scale`` and fed as float32 NCHW. Output ``layout``: ``yolo`` (one ``(1, N, 4 + C)`` tensor, either axis order),
+``yolo-obj`` (with an objectness column), or ``ssd`` (boxes ``(1, N, 4)`` in ``[0, 1]`` or pixels, ``box_order`` xyxy or
+yxyx, and scores); ``auto`` picks by the number of outputs. Boxes keep their best class in ``classes``, those below
+``score_threshold`` are dropped, the rest pass class-wise NMS at ``nms_iou`` and are mapped back to frame pixels
+(``xywh``)."""
 
 from __future__ import annotations
 
@@ -105,9 +92,8 @@ def config_from_settings(settings: list[str]) -> OnnxDetectorConfig:
 def letterbox(image: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray, float, tuple[float, float]]:
     """``image (h, w, 3)`` resized into ``size = (width, height)`` keeping its aspect, centred on grey 114.
 
-    Returns the padded image, the scale ``r`` (input px per frame px) and the padding ``(dx, dy)``:
-    a frame point ``p`` lands at ``r · p + (dx, dy)``.
-    """
+    Returns the padded image, the scale ``r`` (input px per frame px) and the padding ``(dx, dy)``: a frame point ``p``
+    lands at ``r · p + (dx, dy)``."""
     with needs("cv2"):
         import cv2
 

@@ -1,21 +1,11 @@
-"""From pixels to robot identities (DESIGN §1.3, §6; Farazi and Behnke's full chain).
+"""From pixels to robot identities (the robot-identification paper's full chain).
 
-:class:`RobotPipeline` runs, per camera frame: the HOG-cascade detector → the visual heading
-classifier on each box → the ground position of each box through the calibrated camera → an
-identifier from :func:`lookalike.trackers.registry.make_tracker` (``kalman_ha``, ``kalman_ha2``,
-``jpda`` or ``lstm``) fed with the heading reports received since the previous frame.
-
-Conventions: boxes ``xywh`` in pixels; ground positions in metres in the observer's egocentric
-frame (x forward, y left); the classifier sees egocentric headings, which the pipeline turns into
-absolute headings by adding the observer's yaw (radians, from odometry; 0 for a fixed camera whose
-forward axis is the reports' reference direction), so that they compare with the robots' IMU
-reports. A box whose bottom edge touches the image border hides the robot's feet: its ground
-position then comes from the top edge at the robot's known height (when that edge is inside).
-
-The perception step (:meth:`RobotPipeline.perceive`) and the identification step
-(:meth:`RobotPipeline.identify`) are also public, so one frame's detections can feed several
-identifiers (as ``lookalike bench pixels`` does).
-"""
+:class:`RobotPipeline` runs per frame: the HOG-cascade detector, the visual heading classifier on each box, the ground
+position through the calibrated camera, and an identifier from :func:`lookalike.trackers.registry.make_tracker` fed with
+the heading reports. Boxes are ``xywh`` pixels; ground positions metres in the observer frame; headings become absolute
+by adding the observer's yaw (radians). A box cut by the image's bottom edge is placed from its top edge at the robot's
+known height. :meth:`RobotPipeline.perceive` and :meth:`RobotPipeline.identify` are public, so one frame's detections
+can feed several identifiers."""
 
 from __future__ import annotations
 
@@ -67,8 +57,7 @@ class PipelineConfig:
         target_height_m: height of the targets (m), used when a box's bottom is cut by the image border.
         border_px: a box edge this close to the image border (px) counts as cut.
         identifier_params: further ``make_tracker`` parameters as ``(name, value)`` pairs; those
-            the identifier does not know are refused.
-    """
+            the identifier does not know are refused."""
 
     identifier: str = "kalman_ha2"
     n_agents: int = 3
@@ -114,8 +103,7 @@ class PipelineResult:
         frame: the :class:`Frame` given to the identifier (its detections carry ``xywh`` px,
             ``score``, ``position (n, 2)`` m, absolute ``heading (n,)`` rad and ``heading_std (n,)`` rad).
         tracks: the identifier's snapshots.
-        labels: ``(n,)`` agent id (0-based) given to each detection, -1 for none (false positive).
-    """
+        labels: ``(n,)`` agent id (0-based) given to each detection, -1 for none (false positive)."""
 
     frame: Frame
     tracks: list[TrackSnapshot]
