@@ -1,7 +1,6 @@
 """A 2-D box world: pedestrian-like targets moving in an image, seen by a noisy detector.
 
-Used by the demo and by tests that need image-space tracking data with ground truth.
-"""
+Used by the demo and by tests that need image-space tracking data with ground truth."""
 
 from __future__ import annotations
 
@@ -36,8 +35,7 @@ class BoxScene:
     Attributes:
         frames: one :class:`Frame` per time step (detections with ``label`` = target id or -1).
         gt: ``(n, 10)`` MOTChallenge ground-truth rows (1-based frames and ids).
-        config: the configuration that made it.
-    """
+        config: the configuration that made it."""
 
     frames: list[Frame]
     gt: np.ndarray

@@ -1,12 +1,9 @@
-"""Look-alike divers drawn as camera images (DESIGN §8): body geometry, appearance and the renderer.
+"""Look-alike divers drawn as camera images: body geometry, appearance and the renderer.
 
-A diver is a jointed figure in body coordinates (metres, x towards the head, y towards the back):
-torso, head, tank, two legs with fins that kick with the stroke phase, and arms that are either
-stretched forward or held along the body. The figure is projected with ``scale = focal_px / z``
-(pixels per metre at distance ``z``), mirrored by its facing, rotated by its pitch. Colours fade
-towards the water colour with distance (``exp(-attenuation · z)``) and the figure is blurred more
-the farther it is; nearer divers and bubbles occlude farther ones. OpenCV is imported lazily.
-"""
+A diver is a jointed figure (metres, x towards the head, y towards the back: torso, head, tank, kicking legs with fins,
+arms) projected with ``scale = focal_px / z``, mirrored by its facing and rotated by its pitch; colours fade towards the
+water with distance, far divers are blurred more, and nearer divers and bubbles occlude farther ones. OpenCV is imported
+lazily."""
 
 from __future__ import annotations
 

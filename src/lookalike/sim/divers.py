@@ -1,17 +1,11 @@
-"""Look-alike divers seen by an underwater robot's camera (de Langis and Sattar, ICRA 2020; DESIGN §8):
-scenarios, motion, rendered frames, ground truth (MOTChallenge rows) and a detector model.
+"""Look-alike divers seen by an underwater robot's camera (the diver-tracking paper's setting): scenarios, motion,
+rendered frames, ground truth (MOTChallenge rows) and a detector model.
 
-Divers swim with strokes (kick phase, arm pose), drift in distance (2.5–9 m), leave the view for
-long periods and come back at an edge; the camera drifts. A :class:`DiverScenario` is a frozen,
-seeded description; :func:`simulate_divers` makes the motion (cheap) and :meth:`DiverScene.image`
-renders any frame on demand (so long sequences never sit in memory as images).
-
-The detector model (:class:`DetectorModel`) turns ground truth into detections: each visible diver
-is found with probability ``recall · visibility`` (visibility lowered by nearer divers and
-bubbles), its box jittered by ``box_noise`` of its size; false positives (Poisson,
-``false_positives`` per frame) fall on bubble clouds or anywhere, sized like divers. Every
-tracker is then run on the same detections, as in the paper.
-"""
+Divers swim with strokes, drift in distance (2.5–9 m), leave the view for long periods and come back; the camera drifts.
+A :class:`DiverScenario` is a frozen, seeded description; :func:`simulate_divers` makes the motion and
+:meth:`DiverScene.image` renders any frame on demand. :class:`DetectorModel` finds each visible diver with probability
+``recall · visibility``, jitters its box by ``box_noise`` and adds Poisson false positives (``false_positives`` per
+frame) on bubbles or anywhere."""
 
 from __future__ import annotations
 
@@ -137,8 +131,7 @@ class DiverScene:
         poses: ``poses[k][i]`` the :class:`Pose` of diver ``i`` in frame ``k``, or None when absent.
         camera: ``(frames, 2)`` camera offset in pixels.
         bubbles: per frame, ``(m, 3)`` bubbles ``(x, y, radius)`` in image pixels.
-        gt: ``(n, 9)`` MOTChallenge (MOT16+) ground truth: frame, id, xywh, 1, class 1, visibility.
-    """
+        gt: ``(n, 9)`` MOTChallenge (MOT16+) ground truth: frame, id, xywh, 1, class 1, visibility."""
 
     scenario: DiverScenario
     poses: list[list[Pose | None]]

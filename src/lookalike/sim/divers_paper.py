@@ -1,14 +1,9 @@
 """Paper-hard detections for the diver scenarios (``bench divers --detections paper``), and new draws.
 
-de Langis and Sattar's real diver detector found far fewer divers, and far more false boxes, than the default
-detector model of :data:`~lookalike.sim.divers.SCENARIOS` (DP 80.5 / DR 66.8 overall). Its per-video
-detection precision and recall (Table 2: DP 30.5–81.6, DR 25.0–60.3) are :data:`PAPER_DETECTION`,
-matched to our scenarios in order (six ocean, then two pool, as in the paper). :data:`PAPER_DETECTORS`
-are detector models whose recall and false-positive rate were found by bisection so that each
-scenario's DP/DR (IoU 0.5) lands on the paper's figure for detector draw 0, with box jitter 0.10 of
-the box size (the paper's detector localised worse than the truth-based default); on draws 1–3 they
-give DP 30.9–80.7 and DR 22.4–64.4.
-"""
+:data:`PAPER_DETECTION` holds the diver-tracking paper's per-video detection precision and recall (Table 2), matched to
+our scenarios in order; :data:`PAPER_DETECTORS` are detector models whose recall and false-positive rate were set by
+bisection so each scenario's DP/DR (IoU 0.5) lands on the paper's figure on detector draw 0 (box jitter 0.10 of the box
+size)."""
 
 from __future__ import annotations
 

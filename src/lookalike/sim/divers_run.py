@@ -1,12 +1,9 @@
 """Running appearance trackers on simulated diver scenarios: render, detect, extract features, track.
 
-Every tracker sees the same detections (as in the paper's comparison); the appearance features
-are chosen by name (:func:`diver_extractor`: ``handcrafted``, ``learned`` or a ``FILE.onnx``
-embedding network). Hand-crafted feature standardisation is fitted on the validation scenarios'
-ground-truth crops (:func:`fit_diver_features`), never on the scenario being scored. The trackers'
-cosine thresholds were chosen for the hand-crafted features; :func:`matched_thresholds` moves them
-to another extractor by matching quantiles of same-diver distances on the validation scenarios.
-"""
+Every tracker sees the same detections; features are chosen by name (:func:`diver_extractor`: ``handcrafted``,
+``learned`` or a ``FILE.onnx``). Hand-crafted standardisation is fitted on the validation scenarios
+(:func:`fit_diver_features`), never on the scored one; :func:`matched_thresholds` moves the trackers' cosine thresholds
+to another extractor by matching quantiles of same-diver distances."""
 
 from __future__ import annotations
 

@@ -1,13 +1,6 @@
-"""Training scenes for a learned diver appearance model: new divers in new conditions.
-
-The test and validation scenarios all show the same four-diver team (:data:`~lookalike.sim.diver_render.TEAM`).
-A re-identification network trained on that team would be a closed-set classifier of the very divers it
-is tested on, unlike de Langis and Sattar's deep SORT baseline (a network trained on other people, MARS). The
-training scenarios therefore draw *new* look-alike divers (:func:`random_looks`: dark suits, random
-tank, fin, stripe and hood colours, sizes 0.9–1.1) and random conditions (ocean or pool, turbidity,
-attenuation, blur, bubbles, absences, camera drift) from seeds 5000+, disjoint from the test seeds
-(101–108) and the validation seeds (901–904).
-"""
+"""Training scenes for a learned diver appearance model: new divers (:func:`random_looks`) in new conditions, from seeds
+5000+, disjoint from the test (101–108) and validation (901–904) seeds, so the network is not a classifier of the test
+team (:data:`~lookalike.sim.diver_render.TEAM`)."""
 
 from __future__ import annotations
 

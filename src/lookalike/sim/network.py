@@ -1,7 +1,6 @@
 """Heading reports over a lossy network: send times, delay with jitter, losses and loss bursts.
 
-Everything is generated for a whole sequence at once with array operations.
-"""
+Everything is generated for a whole sequence at once with array operations."""
 
 from __future__ import annotations
 
@@ -24,8 +23,7 @@ class ReportArrays:
         heading: ``(B,)`` reported absolute heading, radians.
         frame_offsets: ``(T + 1,)``; frame ``k`` carries rows ``frame_offsets[k]:frame_offsets[k+1]``
             (received after frame ``k - 1`` and not after frame ``k``).
-        n_sent: reports sent during the sequence, lost ones included.
-    """
+        n_sent: reports sent during the sequence, lost ones included."""
 
     agent_id: np.ndarray
     t_sent: np.ndarray
@@ -38,9 +36,8 @@ class ReportArrays:
 def _burst_mask(t_sent: np.ndarray, cfg: NetworkConfig, horizon_s: float, rng: np.random.Generator) -> np.ndarray:
     """Whether each send time ``(n_agents, K)`` falls into a loss burst of that agent's link.
 
-    The link alternates between good periods (exponential, mean ``1 / burst_rate_hz``) and
-    bursts (exponential, mean ``burst_s``), starting in the stationary state.
-    """
+    The link alternates between good periods (exponential, mean ``1 / burst_rate_hz``) and bursts (exponential, mean
+    ``burst_s``), starting in the stationary state."""
     n_agents = t_sent.shape[0]
     if cfg.burst_rate_hz == 0 or cfg.burst_s == 0:
         return np.zeros(t_sent.shape, dtype=bool)

@@ -1,15 +1,10 @@
-"""Named robot-world scenarios: the paper's set-ups (M detections at most, N robots) at 30 Hz, each
-with one of two position-noise models.
+"""Named robot-world scenarios: the paper's set-ups (M detections at most, N robots) at 30 Hz, with one of two
+position-noise models (observer frame: x forward = depth, y left = across the image, ``d`` the distance in metres):
 
-Noise models (observer frame: x forward = depth = image rows, y left = across the image = columns):
-
-* ``"paper"`` — Farazi and Behnke's: "more perception noise in the x direction than in the y", where the
-  paper's x runs across the image and its y (image rows) is the better estimated one. Here: the
-  lateral (observer y) std is ``0.05 + 0.04·d`` metres, the depth (observer x) std ``0.03 +
-  0.015·d`` at distance ``d`` metres.
-* ``"ours"`` — the same two laws on the other axes (depth noisier, as a flat-ground projection of a
-  box's foot row gives); the default, on which the shipped weights were trained.
-"""
+* ``"paper"`` — Farazi and Behnke's (noisier across the image): lateral std ``0.05 + 0.04·d``, depth std
+  ``0.03 + 0.015·d`` metres.
+* ``"ours"`` — the same laws on the other axes (depth noisier); the default, on which the shipped weights were
+  trained."""
 
 from __future__ import annotations
 

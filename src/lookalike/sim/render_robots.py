@@ -1,17 +1,10 @@
-"""Identical humanoid robots on a football field, drawn through the camera model (DESIGN §8).
+"""Identical humanoid robots on a football field, drawn through the camera model.
 
-Each robot is a set of coloured cuboids (legs, torso with a chest plate in front and a backpack
-behind, arms, head with a visor in front) posed by its ground position and heading and projected
-with :class:`lookalike.geometry.Camera`; only the faces that look towards the camera are filled,
-parts and robots are painted far to near, so robots hide one another and the image border cuts
-them. Every robot looks the same: only the view of its torso tells its heading.
-
-The ground is a green field (fixed frame: centre at the origin, ``field_m`` long in x and wide in
-y) with white lines, seen from the observer's :class:`~lookalike.geometry.Pose2D`. Per frame, a
-seeded random walk changes the global brightness and colour cast, and images get Gaussian blur
-and pixel noise. Ground truth per robot: box (clipped to the image), visible fraction, egocentric
-position and heading, id. OpenCV is imported lazily.
-"""
+Each robot is a set of coloured cuboids (legs, torso with chest plate and backpack, arms, head with a visor) posed by
+its ground position and heading and projected with :class:`lookalike.geometry.Camera`, painted far to near so robots
+hide one another; only the torso's view tells the heading. The field (centre at the origin, ``field_m``) is seen from
+the observer's :class:`~lookalike.geometry.Pose2D`, with seeded brightness and colour drift, blur and noise. Ground
+truth per robot: box, visible fraction, egocentric position and heading, id. OpenCV is imported lazily."""
 
 from __future__ import annotations
 
@@ -83,8 +76,7 @@ class RenderedFrame:
         xywh_full: ``(n, 4)`` box of the whole robot, not clipped (px).
         visible: ``(n,)`` fraction of the robot's silhouette that is visible (not hidden by others or the border).
         position_m: ``(n, 2)`` egocentric ground position (m).
-        heading_rad: ``(n,)`` egocentric heading (rad, 0 = facing the observer's forward direction).
-    """
+        heading_rad: ``(n,)`` egocentric heading (rad, 0 = facing the observer's forward direction)."""
 
     image: np.ndarray
     robot_id: np.ndarray

@@ -1,14 +1,9 @@
-"""The robot world of Farazi and Behnke (IROS 2017; DESIGN §8): identical robots seen by an observer, heading reports.
+"""The robot world of Farazi and Behnke (IROS 2017): identical robots seen by an observer, heading reports.
 
-:func:`simulate_arrays` makes a whole sequence with array operations over time (tens of
-thousands of frames per second) and returns :class:`RobotArrays`: detections padded to the
-set-up's M slots per frame, the reports received, and the truth. :class:`RobotSequence` wraps the
-arrays and builds :class:`~lookalike.types.Frame` objects lazily for trackers.
-
-Detections are in the observer frame (x forward, y left, metres) with absolute visual headings
-(radians); their ``label`` is the truth (agent id or -1 for a false positive) and must not be
-read by trackers. Within a frame the detections are in random order.
-"""
+:func:`simulate_arrays` makes a whole sequence with array operations over time and returns :class:`RobotArrays`;
+:class:`RobotSequence` wraps them and builds :class:`~lookalike.types.Frame` objects lazily. Detections are in the
+observer frame (metres) with absolute visual headings (radians), in random order within a frame; their ``label`` is the
+truth and must not be read by trackers."""
 
 from __future__ import annotations
 
@@ -54,8 +49,7 @@ class RobotArrays:
         observer: ``(T, 3)`` observer field pose ``(x, y, yaw)``.
         reports: the heading reports received (see :class:`ReportArrays`).
         n_false_positives: ``(T,)`` false positives made before keeping the M best.
-        n_misses: ``(T,)`` visible robots not detected (before keeping the M best).
-    """
+        n_misses: ``(T,)`` visible robots not detected (before keeping the M best)."""
 
     time: np.ndarray
     det_valid: np.ndarray

@@ -1,7 +1,6 @@
 """Robot and observer motion for whole sequences at once (array operations over time).
 
-Field coordinates: origin at the field centre, x along the length, metres; headings in radians.
-"""
+Field coordinates: origin at the field centre, x along the length, metres; headings in radians."""
 
 from __future__ import annotations
 
@@ -32,11 +31,10 @@ def simulate_motion(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Field positions ``(T, N, 2)`` metres and unwrapped absolute headings ``(T, N)`` radians.
 
-    Behaviour segments switch with probability ``dt / segment_s`` per frame; each segment draws a
-    mode (walk, stand, turn, walk + turn) and targets; velocities and turn rates follow the
-    targets with first-order lags sized so that accelerations stay within the configured bounds;
-    positions bounce off the field boundary (inset by the robot radius).
-    """
+    Behaviour segments switch with probability ``dt / segment_s`` per frame; each segment draws a mode (walk, stand,
+    turn, walk + turn) and targets; velocities and turn rates follow the targets with first-order lags sized so that
+    accelerations stay within the configured bounds; positions bounce off the field boundary (inset by the robot
+    radius)."""
     T, N = n_frames, n_agents
     switch = rng.random((T, N)) < dt_s / cfg.segment_s
     switch[0] = True
