@@ -1,7 +1,7 @@
 """Tests of the selection stages that chose set's weights and options (research code, not the package).
 
-Run against the commit that still has the options they name (research/set/README.md):
-``python -m pytest research/set/test_selection.py`` (pytest puts this folder on the path).
+They set options the current identifier no longer has: they ran in tests/ at commit c7fe8f3, where they still
+run (research/set/README.md); kept here as the record of each stage's rule.
 """
 
 import numpy as np
