@@ -32,8 +32,8 @@ def test_builtin_tracker_list_is_complete():
     import lookalike.trackers as package
     from lookalike.trackers import registry
 
-    for info in pkgutil.iter_modules(package.__path__):
-        importlib.import_module(f"lookalike.trackers.{info.name}")
+    for info in pkgutil.walk_packages(package.__path__, prefix="lookalike.trackers."):
+        importlib.import_module(info.name)
     ours = {name for name, cls in registry._REGISTRY.items() if cls.__module__.startswith("lookalike.trackers.")}
     assert ours == set(registry.BUILTIN_TRACKERS)
     assert all(registry._REGISTRY[n].__module__ == m for n, m in registry.BUILTIN_TRACKERS.items())
