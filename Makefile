@@ -113,7 +113,7 @@ train-refine: venv
 	    --batch-size 64 --steps 2100 --device auto --workers $$(nproc) --ship
 
 # The noise-mix fine-tunes that ship, each chosen on tuning seeds 50000 by the rule in
-# docs/experiments/robot-identification.md; --steps is the step of the shipped run's best validation
+# research/notes/robot-identification.md; --steps is the step of the shipped run's best validation
 # (those runs stopped on time), so a rerun replays up to it. The shipped JSONs also record the choice.
 MIX = OMP_NUM_THREADS=1 $(VENV)/bin/lookalike train --noise mix --patience 40 --threads 1
 train-mix: venv

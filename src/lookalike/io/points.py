@@ -25,7 +25,7 @@ __all__ = ["POINT_VEL_NOISE", "PointFrames", "points_to_rows", "read_points_csv"
 # its box side is half the points' typical spacing, so boxtrack's own VEL_NOISE (1/160 of an object's
 # extent) makes the motion model far too sure of the velocity for animals that turn and change speed.
 # Chosen among 1/160, 0.01, 0.02, 0.03, 0.05, 0.075, 0.1, 0.2 on the simulated arenas of
-# benchmarks/closed_points.py, seeds 0-29 only (docs/closed-set.md has the figures).
+# benchmarks/closed_points.py, seeds 0-29 only (research/notes/closed-set.md has the figures).
 POINT_VEL_NOISE = 0.02
 
 

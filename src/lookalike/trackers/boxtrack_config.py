@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from lookalike.trackers.base import COUNT, POSITIVE, UNIT, check_params, param
 
-# Fixed constants (docs/tuning.md, "Which parameters earn their place").
+# Fixed constants (how each was chosen: research/notes/tuning.md, "Which parameters earn their place").
 LOW_IOU = 0.5  # minimum IoU of a low-score detection with a track updated in the previous frame
 RECENT_FRAMES = 2  # confirmed tracks missed at most this many frames take confident detections first
 COAST_S = 0.5  # seconds a lost track keeps extrapolating its velocity (then waits where it was seen)

@@ -45,7 +45,8 @@ class LowPassLocaliser:
 
 @dataclass(frozen=True)
 class KalmanLocaliserConfig:
-    """Parameters of :class:`KalmanLocaliser` (metres, seconds); defaults: docs/experiments/robot-identification.md."""
+    """Parameters of :class:`KalmanLocaliser` (metres, seconds); defaults chosen on tuning seeds
+    (research/notes/robot-identification.md)."""
 
     accel_std: float = 1.4  # m/s², white acceleration of the velocity model
     velocity_decay_s: float = 0.6  # velocity relaxes to 0 with this time constant
