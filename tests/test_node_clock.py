@@ -2,7 +2,6 @@
 and counted, frames from another sender do not replace a live camera, lockouts expire, and the node follows a
 camera again within one camera timeout of a hostile clock."""
 
-import threading
 import time
 from contextlib import contextmanager
 
@@ -14,13 +13,12 @@ from lookalike.node import (
     Endpoint,
     HeadingReport,
     IdentifierConfig,
-    NodeConfig,
-    NodeServer,
     StatusRequest,
     TeamIdentifier,
     TeamState,
 )
 from tests.test_node_identifier import HeadingMatcher, _frame
+from tests.test_node_server import running_node
 
 BIG_SEQ = 2**63 - 1
 
@@ -56,18 +54,11 @@ def test_a_report_far_ahead_cannot_lock_a_robot_out():
 def _node(camera_timeout_s=2.0):
     """A node publishing every team state to ``node.listener``, served by a background thread."""
     listener = Endpoint(("127.0.0.1", 9))
-    server = NodeServer(HeadingMatcher(), NodeConfig(status_interval_s=0, camera_timeout_s=camera_timeout_s,
-                                                     publish=(listener.address,)), IdentifierConfig(n_robots=3))
-    server.listener = listener
-    stop = threading.Event()
-    thread = threading.Thread(target=server.serve, args=(stop.is_set, 0.005), daemon=True)
-    thread.start()
     try:
-        yield server
+        with running_node(camera_timeout_s=camera_timeout_s, publish=(listener.address,)) as server:
+            server.listener = listener
+            yield server
     finally:
-        stop.set()
-        thread.join(timeout=10)
-        server.close()
         listener.close()
 
 
