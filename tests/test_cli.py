@@ -54,7 +54,14 @@ def test_trackers_listing():
     r = runner.invoke(app, ["trackers", "--names"])
     assert r.exit_code == 0 and "sort" in r.output.split()
     r = runner.invoke(app, ["trackers"])
+    lines = r.output.splitlines()
+    assert r.exit_code == 0 and all(len(line) <= 80 for line in lines), r.output
+    assert sum(line.split()[0] in {"sort", "boxtrack", "set"} for line in lines if line.strip()) == 3
+    assert any(line.startswith("sort") and "boxes" in line for line in lines)
+    r = runner.invoke(app, ["trackers", "--details", "sort"], env={"COLUMNS": "200"})
     assert r.exit_code == 0 and "max_age" in r.output and "iou_threshold" in r.output
+    r = runner.invoke(app, ["trackers", "--details", "no_such"])
+    assert r.exit_code == 2 and "registered:" in r.output
 
 
 def test_demo_runs(tmp_path):

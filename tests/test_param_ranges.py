@@ -97,7 +97,7 @@ def test_track_set_out_of_range_exits_2_in_one_line(tmp_path, value):
 
 
 def test_trackers_lists_the_ranges():
-    r = runner.invoke(app, ["trackers"], env={"COLUMNS": "200"})
+    r = runner.invoke(app, ["trackers", "--details", "boxtrack"], env={"COLUMNS": "200"})
     assert r.exit_code == 0, r.output
     assert "allowed" in r.output and "[0, 1]" in r.output and "(0, inf)" in r.output
 

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import stats
 
 from lookalike.io.results import Results
 
@@ -47,6 +46,8 @@ class PairedDifference:
 
 
 def _interval(data: tuple[np.ndarray, ...], statistic: Any) -> tuple[float, float]:
+    from scipy import stats  # (imported here: scipy.stats takes most of a second to import)
+
     result = stats.bootstrap(data, statistic, paired=True, vectorized=True, method="percentile",
                              confidence_level=CONFIDENCE, n_resamples=RESAMPLES, random_state=SEED)
     ci = result.confidence_interval

@@ -29,4 +29,14 @@ def box_input_problem(name: str, *, video: bool = False) -> str | None:
     return f"tracker {name!r} cannot run on boxes alone; it needs {need}"
 
 
-__all__ = ["BUILTIN_NEEDS", "ROBOT_NEEDS", "box_input_problem"]
+def input_kind(name: str) -> str:
+    """What tracker ``name`` reads, in a few words: ``boxes``, ``boxes + video`` (appearance from the pixels) or
+    ``robot positions`` (ground positions with heading reports)."""
+    declared = getattr(tracker_class(name), "needs", None)
+    need = declared if isinstance(declared, str) else BUILTIN_NEEDS.get(name)
+    if need is None:
+        return "boxes"
+    return "boxes + video" if need == _APPEARANCE else "robot positions"
+
+
+__all__ = ["BUILTIN_NEEDS", "ROBOT_NEEDS", "box_input_problem", "input_kind"]
