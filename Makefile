@@ -25,6 +25,8 @@ $(DEMO_STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -c constraints.txt -e ".[$(DEMO_EXTRAS)]"
+	@# boxtrack's numba kernels (where numba is installed) compiled into numba's cache now, not in the first run
+	$(PY) -c "from lookalike.trackers.kernels.boxtrack import warm; warm()"
 	touch $@
 
 demo: $(DEMO_STAMP)

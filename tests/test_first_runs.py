@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
+
+import pytest
 
 
 def _imported(code: str, modules: tuple[str, ...]) -> list[str]:
@@ -37,3 +40,39 @@ def test_compact_listing_fits_80_columns_with_every_tracker():
     assert "robot positions" in kinds["kalman_ha"] and "robot positions" in kinds["set"]
     assert compact_lines(["sort"], width=30)[1].endswith("…") and len(compact_lines(["sort"], width=30)[1]) == 30
 
+
+
+def test_kernels_not_cached_compile_after_the_run_while_it_takes_the_numpy_path(monkeypatch, capsys):
+    import types
+
+    from lookalike import _compiled
+
+    module = types.ModuleType("fake_kernels")
+    started: list[object] = []
+    monkeypatch.setattr(_compiled, "compile_aside", True)
+    monkeypatch.setattr(_compiled, "kernels_cached", lambda m: False)
+    monkeypatch.setattr(_compiled.atexit, "register", started.append)
+    switch = _compiled.KernelSwitch("LOOKALIKE_TEST_FIRST_RUN", lambda: module, warm="fake_kernels:warm")
+    assert switch.compiled() is None and len(started) == 1  # this run: the numpy path; the compile: at exit
+    assert "not compiled yet" in capsys.readouterr().err
+    switch.use_compiled(True)
+    assert switch.compiled() is module  # forced on (as the tests of the kernels do): compiled here
+    monkeypatch.setattr(_compiled, "kernels_cached", lambda m: True)
+    switch.use_compiled(None)
+    assert switch.compiled() is module and len(started) == 1
+    monkeypatch.setattr(_compiled, "compile_aside", False)  # a library user: compiled in the process
+    monkeypatch.setattr(_compiled, "kernels_cached", lambda m: False)
+    assert switch.compiled() is module and len(started) == 1
+
+
+def test_boxtrack_kernels_compile_once_with_one_line_then_load_from_the_cache(tmp_path):
+    pytest.importorskip("numba")
+    code = ("from lookalike import _compiled\nfrom lookalike.trackers.kernels import boxtrack as k\n"
+            "before = _compiled.kernels_cached(k.module())\nk.warm()\n"
+            "print('cached:', before, _compiled.kernels_cached(k.module()))")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    runs = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env)
+            for _ in range(2)]
+    assert runs[0].stdout.split() == ["cached:", "False", "True"] and runs[1].stdout.split() == ["cached:", "True",
+                                                                                               "True"]
+    assert runs[0].stderr.count("compiling the fast kernels once") == 1 and "compiling" not in runs[1].stderr

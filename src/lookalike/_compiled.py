@@ -1,10 +1,21 @@
 """Optional compiled (numba) kernels: their switch (loaded on first use, never by ``import lookalike``; off when
-numba does not import, when an environment variable is ``0``, or when forced off) and the compiler's settings."""
+numba does not import, when an environment variable is ``0``, or when forced off) and the compiler's settings.
+
+Compiled code is cached on disk by numba (next to the kernel module, or in a user folder when that is read-only, or
+in ``NUMBA_CACHE_DIR``), so a machine compiles each kernel once; when a compile does happen one line on stderr says
+so. Run as the ``lookalike`` program (:data:`compile_aside` set), a switch with a ``warm`` function whose kernels are
+not cached yet leaves this run on the numpy path (the same results) and compiles them in a separate process started
+when the run ends."""
 
 from __future__ import annotations
 
+import atexit
 import os
+import subprocess
+import sys
+import time
 from collections.abc import Callable
+from types import ModuleType
 from typing import Any, Generic, TypeVar, cast
 
 from lookalike._optional import needs
@@ -21,8 +32,105 @@ def exact_jit() -> Callable[[F], F]:
     with needs("numba"):
         import numba  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
+    _announce_compiles(numba)
     jit = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy", boundscheck=False)
     return cast("Callable[[F], F]", jit)
+
+
+COMPILE_SECONDS = {"lookalike.trackers.kernels.boxtrack_numba": 6, "lookalike.trackers.kernels.world_numba": 10,
+                   "lookalike.vision.hog_numba": 5}
+"""About how long each kernel module takes to compile on a laptop core (s), for the message."""
+
+compile_aside = False
+"""Set by the ``lookalike`` program: kernels with a ``warm`` function that are not cached yet are compiled in a
+separate process when this run (which takes the numpy path) ends."""
+
+_announced = False
+
+
+def _say(message: str) -> None:
+    print(message, file=sys.stderr, flush=True)
+
+
+def _announce_compiles(numba: Any) -> None:
+    """Print one line on stderr at the first compile of a kernel in this process (not when numba loads one from its
+    cache: that fires no compile event)."""
+    global _announced
+    if _announced:
+        return
+    _announced = True
+    from numba.core import event  # type: ignore[import-untyped, import-not-found, unused-ignore]
+
+    class _Once(event.Listener):  # type: ignore[misc, name-defined, unused-ignore]
+        said = False
+
+        def on_start(self, ev: Any) -> None:
+            if self.said:
+                return
+            dispatcher = (ev.data or {}).get("dispatcher")
+            module = getattr(getattr(dispatcher, "py_func", None), "__module__", "")
+            if not str(module).startswith("lookalike."):
+                return
+            self.said = True
+            seconds = COMPILE_SECONDS.get(str(module), 10)
+            _say(f"compiling the fast kernels once (about {seconds} s); later runs load them from numba's cache…")
+
+        def on_end(self, ev: Any) -> None:
+            pass
+
+    event.register("numba:compile", _Once())
+
+
+def kernels_cached(module: ModuleType) -> bool:
+    """Whether every numba kernel defined in ``module`` has compiled code in numba's on-disk cache for the current
+    source (a stale or missing index: not cached)."""
+    found = False
+    for value in vars(module).values():
+        cache = getattr(value, "_cache", None)
+        if getattr(getattr(value, "py_func", None), "__module__", None) != module.__name__ or cache is None:
+            continue
+        found = True
+        index = getattr(getattr(cache, "_cache_file", None), "_load_index", None)
+        try:
+            if index is None or not index():
+                return False
+        except OSError:
+            return False
+    return found
+
+
+def _compile_elsewhere(warm: str, module: ModuleType) -> None:
+    """Start ``warm`` ("module:function", which compiles the kernels by running them) in a detached process when
+    this one exits, unless one was started less than two minutes ago (a stamp file beside the cache)."""
+    stamp = None
+    for value in vars(module).values():
+        cache = getattr(value, "_cache", None)
+        if cache is not None and getattr(cache, "_cache_path", None):
+            stamp = os.path.join(cache._cache_path, f".{module.__name__}.compiling")
+            break
+    try:
+        if stamp is not None and time.time() - os.path.getmtime(stamp) < 120:
+            return
+    except OSError:
+        pass
+    try:
+        if stamp is not None:
+            os.makedirs(os.path.dirname(stamp), exist_ok=True)
+            with open(stamp, "w") as f:
+                f.write(str(os.getpid()))
+    except OSError:
+        stamp = None
+    name, function = warm.split(":")
+    code = f"import os; os.nice(10); from {name} import {function}; {function}()"
+    seconds = COMPILE_SECONDS.get(module.__name__, 10)
+    _say(f"the fast kernels are not compiled yet: this run takes the numpy path (the same results) and they compile "
+         f"once, in the background when it ends (about {seconds} s)…")
+
+    def start() -> None:  # after the run, so that it does not share the CPU with the compiler
+        subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL, start_new_session=True)
+
+    atexit.register(start)
 
 
 class KernelSwitch(Generic[K]):
@@ -32,12 +140,15 @@ class KernelSwitch(Generic[K]):
     available); it runs once, at the first call that needs the kernels. ``env`` names the environment
     variable that switches them off when ``0``. ``decide_once``: :meth:`compiled` reads the forcing and the
     environment once, after which a call costs an attribute lookup (:meth:`use_compiled` makes it read them
-    again); otherwise at every call."""
+    again); otherwise at every call. ``warm``: "module:function" that compiles the kernels (a module ``K``) by
+    running them, for :data:`compile_aside`."""
 
-    def __init__(self, env: str, load: Callable[[], K | None], *, decide_once: bool = False) -> None:
+    def __init__(self, env: str, load: Callable[[], K | None], *, decide_once: bool = False,
+                 warm: str | None = None) -> None:
         self.env = env
         self._load = load
         self._decide_once = decide_once
+        self._warm = warm
         self._forced: bool | None = None
         self._loaded = False
         self._kernels: K | None = None
@@ -60,6 +171,10 @@ class KernelSwitch(Generic[K]):
             active = None
         else:
             active = self.kernels()
+            if (forced is None and compile_aside and self._warm is not None and isinstance(active, ModuleType)
+                    and not kernels_cached(active)):
+                _compile_elsewhere(self._warm, active)
+                active = None
         if self._decide_once:
             self._active, self._decided = active, True
         return active

@@ -79,8 +79,10 @@ def _terminate_cleanly() -> None:
 def main() -> None:
     """Entry point of the ``lookalike`` script; a missing optional package ends it with one line naming the extra
     to install (exit 2)."""
+    from lookalike import _compiled
     from lookalike._optional import MissingExtra
 
+    _compiled.compile_aside = True  # kernels not cached yet compile in another process, not in this run
     _terminate_cleanly()
     try:
         app()

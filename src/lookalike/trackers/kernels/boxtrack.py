@@ -4,7 +4,8 @@ update with bookkeeping, and the report with the lifecycle.
 
 They do the numpy path's operations one track or pair at a time in the same order, so rows are bit for bit the same
 (``tests/test_boxtrack_kernels.py``). Used when numba is installed unless ``LOOKALIKE_BOXTRACK_NUMBA=0``; numba loads
-when the first BoxTrack is built."""
+when the first BoxTrack is built. Run as the ``lookalike`` program with nothing in numba's cache, :func:`warm` compiles
+them in a separate process while that run takes the numpy path."""
 
 from __future__ import annotations
 
@@ -19,7 +20,31 @@ def _load() -> ModuleType:
     return boxtrack_numba
 
 
-_SWITCH: KernelSwitch[ModuleType] = KernelSwitch("LOOKALIKE_BOXTRACK_NUMBA", _load)
+def warm() -> None:
+    """Compile the kernels into numba's cache by tracking a short synthetic sequence (boxes of people walking,
+    scores high and low, frames without detections) with them switched on."""
+    import numpy as np
+
+    from lookalike.trackers.boxtrack import BoxTrack
+    from lookalike.types import Detections, Frame
+
+    use_compiled(True)
+    rng = np.random.default_rng(0)
+    tracker = BoxTrack()
+    start = rng.uniform(0, 600, (12, 2))
+    for k in range(60):
+        if k % 17 == 16:
+            tracker.update(Frame(index=k, time=k / 30))
+            continue
+        keep = rng.random(12) < 0.85
+        xy = start[keep] + k * 2.0 + rng.normal(0, 1, (int(keep.sum()), 2))
+        xywh = np.column_stack([xy, np.full((len(xy), 2), [40.0, 100.0])])
+        score = rng.uniform(0.05, 1.0, len(xy))
+        tracker.update(Frame(index=k, time=k / 30, detections=Detections(xywh=xywh, score=score)))
+
+
+_SWITCH: KernelSwitch[ModuleType] = KernelSwitch("LOOKALIKE_BOXTRACK_NUMBA", _load,
+                                                 warm="lookalike.trackers.kernels.boxtrack:warm")
 use_compiled = _SWITCH.use_compiled  # (trackers built from now on)
 compiled = _SWITCH.compiled  # the kernels' module, or None when they are off or numba is not installed
 module = _SWITCH.kernels  # the kernels' module whatever the switch says, None when numba is not installed
