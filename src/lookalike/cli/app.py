@@ -85,6 +85,20 @@ def check_outputs_or_fail(outputs: dict[str, Path | None], inputs: Iterable[Path
         fail(str(exc))
 
 
+def check_study_or_fail(study: str | None) -> None:
+    """Open an Optuna ``--study`` storage URL once before any work: fail (exit 2) in one line when optuna cannot."""
+    if study is None:
+        return
+    from lookalike._optional import needs
+
+    try:
+        with needs("optuna"):
+            import optuna
+        optuna.storages.get_storage(study)
+    except Exception as exc:  # noqa: BLE001 (optuna and sqlalchemy raise many kinds; each becomes one line)
+        fail(f"--study {study}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}")
+
+
 def split_list(values: list[str] | None) -> list[str]:
     """Option values given repeated and/or comma-separated, as one list (blanks dropped)."""
     return [v.strip() for item in values or [] for v in item.split(",") if v.strip()]

@@ -11,7 +11,7 @@ import typer
 from rich.markup import escape
 
 from lookalike.bench.ident import identify
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 from lookalike.sim import RobotSequence
 from lookalike.trackers import tracker_names
 
@@ -66,6 +66,8 @@ def label(
         fail(f"SEQUENCE: {sequence}: no such file")
     if benchmark and tracks:
         fail("--benchmark starts from no labels; leave out --tracks")
+    # the benchmark result's folder, checked before the session (or --export) writes anything
+    check_outputs_or_fail({"--results": results if benchmark else None}, [sequence], folders={"--results"})
     initial, source = None, "empty"
     if tracks and not Path(tracks).is_file() and tracks not in tracker_names():
         fail(f"--tracks: {tracks!r} is neither a file nor a tracker ({', '.join(tracker_names())})")

@@ -10,7 +10,7 @@ import typer
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail
 from lookalike.io.robot_sequences import read_robot_sequence
 from lookalike.trackers.registry import parse_parameter
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
@@ -103,6 +103,7 @@ def render_robots(
     `lookalike track --video FILE --pipeline robots --reports SEQUENCE`."""
     from lookalike.viz.video import VideoWriter
 
+    check_outputs_or_fail({"-o/--output": output}, [sequence])
     try:
         seq = read_robot_sequence(sequence)
     except (ValueError, FileNotFoundError, OSError) as exc:

@@ -14,7 +14,7 @@ import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
 from lookalike._optional import needs
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, check_study_or_fail, console, fail
 
 if TYPE_CHECKING:
     from lookalike.parallel import JobPool
@@ -110,13 +110,18 @@ def train(
     """Train the association network on simulated sequences generated on the fly (or fine-tune it on labelled
     recordings with --recordings, or search its hyper-parameters with --search)."""
     _check_limits(steps, minutes)
-    check_outputs_or_fail({"-o/--output": output}, [recordings, init_from, validation_folder], folders={"-o/--output"})
+    from lookalike.io.outputs import sqlite_file
+
+    check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)},
+                          [recordings, init_from, validation_folder], folders={"-o/--output"})
     with needs("torch"):
         import torch
     if model not in ("lstm", "set"):
         fail(f"--model: unknown model {model!r}; known: lstm, set")
     if recordings is not None and search is not None:
         fail("--recordings and --search: choose one")
+    if search is not None:
+        check_study_or_fail(study)
     run: dict[str, Any] = dict(  # the options every training run shares (cli.train_options.RunOptions)
         steps=steps, minutes=minutes, batch_size=batch_size, sequence_length=sequence_length, seed=seed,
         patience=patience, validate_every=validate_every, threads=threads, workers=workers, backend=backend,

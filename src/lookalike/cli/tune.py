@@ -19,7 +19,7 @@ from rich.progress import (
 )
 from rich.table import Table
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, check_study_or_fail, console, fail
 from lookalike.parallel import BACKENDS
 
 
@@ -75,8 +75,10 @@ def tune(
         fail("-o/--output: give the parameter file to write")
         return
     _check_options(sampler, backend, resume, study)
-    check_outputs_or_fail({"-o/--output": output, "--study": _study_file(study)}, _data_inputs(data, space_path))
-    _check_storage(study)
+    from lookalike.io.outputs import sqlite_file
+
+    check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)}, _data_inputs(data, space_path))
+    check_study_or_fail(study)
     seqs, fold_list = _load_data(data, data_root, folds)
     console.print(f"{tracker}: {len(seqs)} sequence(s), {trials} trials ({sampler}), criterion {metric}, "
                   f"{len(space)} parameters in the space")
@@ -112,27 +114,6 @@ def _check_options(sampler: str, backend: str, resume: bool, study: str | None) 
         fail(f"--backend: expected one of {', '.join(BACKENDS)}, got {backend!r}")
     if resume and study is None:
         fail("--resume: needs --study (the storage the study was saved in)")
-
-
-def _check_storage(study: str | None) -> None:
-    """Open the ``--study`` storage once before any work: fail in one line when optuna cannot."""
-    if study is None:
-        return
-    from lookalike._optional import needs
-
-    try:
-        with needs("optuna"):
-            import optuna
-        optuna.storages.get_storage(study)
-    except Exception as exc:  # noqa: BLE001 (optuna and sqlalchemy raise many kinds; each becomes one line)
-        fail(f"--study {study}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}")
-
-
-def _study_file(study: str | None) -> Path | None:
-    """The database file of an SQLite ``--study`` URL (``sqlite:///PATH``), else None."""
-    if study is None or not study.startswith("sqlite:///") or study.endswith(":memory:"):
-        return None
-    return Path(study[len("sqlite:///"):])
 
 
 def _data_inputs(data: list[str], space_path: Path | None) -> list[Path]:

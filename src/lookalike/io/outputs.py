@@ -171,5 +171,13 @@ def ensure_writable(targets: Iterable[Path]) -> None:
             raise ValueError(f"output {t} is a folder; expected a result file")
 
 
+def sqlite_file(url: str | None) -> Path | None:
+    """The database file of an SQLite storage URL (``sqlite:///PATH``, e.g. an Optuna ``--study``), else None: the
+    output to check with :func:`check_outputs`."""
+    if url is None or not url.startswith("sqlite:///") or url.endswith(":memory:"):
+        return None
+    return Path(url[len("sqlite:///"):])
+
+
 __all__ = ["atomic_path", "check_outputs", "ensure_writable", "refuse_inputs", "result_paths", "sequence_inputs",
-           "write_atomic"]
+           "sqlite_file", "write_atomic"]
