@@ -3,6 +3,8 @@
 nothing is written, and an existing output is kept; or the behaviour is correct."""
 
 import os
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -365,8 +367,6 @@ def test_annotate_is_written_through_a_temporary_file(tiny_video, tmp_path):
 
 def test_sigterm_leaves_no_temporary_file(tmp_path):
     import signal
-    import subprocess
-    import sys
 
     det = tmp_path / "det.txt"
     with det.open("w") as fh:  # long enough to be mid-way when the signal comes
@@ -696,6 +696,13 @@ def test_a_truncated_video_is_named_as_such(tmp_path):
         assert r.exit_code == 2 and "Traceback" not in r.output, r.output
         assert "declares 60 frames but only" in r.output and "truncated" in r.output, r.output
         assert not (tmp_path / "o.txt").exists()
+        # run as the program: FFmpeg's own lines ("[h264 @ ...] Invalid NAL unit size") are not printed before it
+        env = {k: v for k, v in os.environ.items() if k != "OPENCV_FFMPEG_LOGLEVEL"}
+        proc = subprocess.run([sys.executable, "-m", "lookalike", "track", "--video", str(tmp_path / "cut.mp4"),
+                               *map(str, args), "-o", str(tmp_path / "o.txt")], capture_output=True, text=True,
+                              env={**env, "COLUMNS": "200"}, timeout=120)
+        lines = [line for line in (proc.stdout + proc.stderr).splitlines() if line.strip()]
+        assert proc.returncode == 2 and len(lines) == 1 and lines[0].startswith("error: video:"), lines
 
 
 def test_onnx_ssd_outputs_that_do_not_match_name_the_model(tiny_video, tmp_path):

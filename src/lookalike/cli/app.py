@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shlex
 import sys
 from collections.abc import Collection, Iterable
@@ -18,6 +19,11 @@ from typer.core import TyperGroup
 from lookalike.cli.coercion import install
 
 install()  # plain option values converted without pydantic (same values and errors as typer's)
+
+if sys.argv and Path(sys.argv[0]).name in ("lookalike", "__main__.py"):
+    # Run as the program: FFmpeg's own lines on a truncated or damaged video (OpenCV's decoder prints them) would come
+    # before lookalike's one-line error naming the video. A level the user set (e.g. 16 to see them) is kept.
+    os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
 
 
 class SortedGroup(TyperGroup):
