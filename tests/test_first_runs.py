@@ -76,3 +76,39 @@ def test_boxtrack_kernels_compile_once_with_one_line_then_load_from_the_cache(tm
     assert runs[0].stdout.split() == ["cached:", "False", "True"] and runs[1].stdout.split() == ["cached:", "True",
                                                                                                "True"]
     assert runs[0].stderr.count("compiling the fast kernels once") == 1 and "compiling" not in runs[1].stderr
+
+
+def test_warm_up_runs_a_throw_away_tracker_over_the_first_frames():
+    from lookalike.loop import warm_up
+
+    made: list[list[int]] = []
+
+    class Counting:
+        def __init__(self) -> None:
+            self.seen: list[int] = []
+            made.append(self.seen)
+
+        def update(self, frame: int) -> list[int]:
+            self.seen.append(frame)
+            return []
+
+    warm_up(Counting, iter(range(100)), n=4)
+    assert made == [[0, 1, 2, 3]]
+    warm_up(Counting, [7])
+    assert made[1] == [7]
+
+
+def test_identification_figures_do_not_change_with_the_warm_up():
+    from lookalike.bench.ident import build_identifier, run_identifier
+    from lookalike.eval import identification_success_rate
+    from lookalike.loop import run
+    from lookalike.sim import preset, simulate_robots
+    from lookalike.trackers.parts.identity import labels_from_tracks
+
+    seq = simulate_robots(preset("m3n2"), 40, 5)
+    labels: list[object] = []
+    run(build_identifier("kalman_ha2", seq), seq.frames(),
+        lambda f, tracks: labels.append(labels_from_tracks(len(f.detections), tracks)))
+    figures = run_identifier("kalman_ha2", [seq])
+    assert figures["success"] == identification_success_rate(labels, seq.true_labels())
+    assert figures["detections"] == sum(len(x) for x in labels)  # type: ignore[arg-type]

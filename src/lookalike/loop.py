@@ -57,6 +57,21 @@ def run(tracker: Updating, frames: Iterable[Any], sink: Sink | None = None, *,
     return stats
 
 
+WARM_UP_FRAMES = 10
+"""Frames a throw-away tracker is run over by :func:`warm_up`."""
+
+
+def warm_up(make: Callable[[], Updating], frames: Iterable[Any], n: int = WARM_UP_FRAMES) -> None:
+    """Run a throw-away tracker from ``make()`` over the first ``n`` of ``frames``, untimed, so that what a tracker's
+    first frames cost once per process (imports, numba compiles or cache loads) stays out of a frames/s figure; the
+    tracker that is timed is another instance, so its tracks do not change."""
+    tracker = make()
+    for k, frame in enumerate(frames):
+        if k >= n:
+            break
+        tracker.update(frame)
+
+
 class RowCollector:
     """A sink that keeps the MOTChallenge rows of every frame in memory (small sequences: benches)."""
 

@@ -18,7 +18,7 @@ from lookalike.bench.paired import Comparison, PairedDifference, add_comparisons
 from lookalike.bench.progress import ProgressFactory, Step, no_progress
 from lookalike.eval import identification_counts, identification_success_rate, localisation_error
 from lookalike.io.results import Results, percent_row_metrics
-from lookalike.loop import RunStats, run
+from lookalike.loop import RunStats, run, warm_up
 from lookalike.sim import DEFAULT_NOISE, PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
 from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.lstm.weights import shipped_weights_path
@@ -95,6 +95,8 @@ def run_identifier_by_sequence(name: str, sequences: list[RobotSequence], step: 
     est, true_pos = [], []
     counts: list[tuple[int, int]] = []
     stats = RunStats()
+    if sequences:  # frames/s without the first frames' one-off costs (imports, compiles)
+        warm_up(lambda: build_identifier(name, sequences[0], weights), sequences[0].frames())
     for seq in sequences:
         frames = list(seq.frames())
         positions = np.full((len(frames), seq.config.n_agents, 2), np.nan)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,7 @@ from lookalike._optional import needs
 from lookalike.eval import evaluate_sequence
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.io import MotTable, tracks_to_rows, write_mot
+from lookalike.loop import warm_up
 from lookalike.sim.divers import DiverScenario, simulate_divers
 from lookalike.trackers import TrackStatus, make_tracker
 from lookalike.types import Frame
@@ -63,6 +65,7 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
         video = VideoWriter(files["video"], fps=sc.frame_rate, gif=files["gif"], gif_every=2, gif_frames=80)
         raw = VideoWriter(files["raw"], fps=sc.frame_rate)
     tails = Tails(length=25)
+    warmed = False
     best_still = -1  # the still is the frame with the most tracks shown, in the second quarter onwards
     try:
         for frame in frames:
@@ -72,6 +75,10 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
             assert det.xywh is not None  # simulated detections have boxes
             feats = extractor(image, det.xywh) if len(det) else np.zeros((0, extractor.dim))
             f = Frame(index=k, time=frame.time, detections=det.replace(feature=feats))
+            if not warmed:  # frames/s without the first frame's one-off costs (imports)
+                for name in trackers:
+                    warm_up(partial(make_tracker, name), [f])
+                warmed = True
             shown = _update_all(instances, f, results, elapsed, video_tracker)
             if rerun is not None and shown is not None:
                 rerun.set_time(k, frame.time)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -14,6 +15,7 @@ import numpy as np
 from lookalike._optional import needs
 from lookalike.eval import identification_success_rate, localisation_error
 from lookalike.geometry.camera import Camera, Extrinsics, Intrinsics, Pose2D
+from lookalike.loop import warm_up
 from lookalike.sim import preset, preset_label, simulate_robots
 from lookalike.sim.render_robots import (
     ROBOT_HEIGHT_M,
@@ -72,6 +74,8 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
     camera = Camera(Intrinsics.from_fov(render_width, render_width * 3 // 4, cfg.observer.fov_rad),
                     Extrinsics(0.9, np.radians(9.0)))
     renderer = RobotRenderer(camera=camera, config=RenderConfig(field_m=cfg.field_m), seed=seed)
+    for name in trackers:  # frames/s without the first frames' one-off costs (imports, compiles)
+        warm_up(partial(_make, name, n, cfg.max_detections), seq.frames())
     instances = {name: _make(name, n, cfg.max_detections) for name in trackers}
     elapsed = dict.fromkeys(trackers, 0.0)
     predicted: dict[str, list[np.ndarray]] = {name: [] for name in trackers}
