@@ -95,3 +95,17 @@ def test_frame_counts_include_frames_without_blobs() -> None:
                      [3, -1, 0, 0, 5, 5, 1, -1, -1, -1]], dtype=float)
     assert frame_counts(rows, 4).tolist() == [2, 0, 1, 0]
     assert frame_counts(np.zeros((0, 10)), 2).tolist() == [0, 0]
+
+
+def test_estimate_reports_its_steps_and_gives_the_same_settings() -> None:
+    frames = _arena(3, True, 7)
+    bars: list[tuple[str, int]] = []
+    steps: list[int] = []
+
+    def progress(description: str, total: int):
+        bars.append((description, total))
+        return lambda: steps.append(1)
+
+    with_bar = estimate_blob_config(frames, progress=progress)
+    assert len(bars) == 1 and len(steps) == bars[0][1]  # every step of the declared total, no more
+    assert with_bar == estimate_blob_config(frames)

@@ -112,3 +112,33 @@ def test_identification_figures_do_not_change_with_the_warm_up():
     figures = run_identifier("kalman_ha2", [seq])
     assert figures["success"] == identification_success_rate(labels, seq.true_labels())
     assert figures["detections"] == sum(len(x) for x in labels)  # type: ignore[arg-type]
+
+
+def test_blob_detection_shows_frames_done_of_the_declared_count(monkeypatch, tmp_path):
+    from contextlib import contextmanager
+
+    from lookalike.cli import track_blobs
+
+    bars: list[tuple[str, int]] = []
+    steps: list[int] = []
+
+    @contextmanager
+    def fake_bars():
+        def factory(description: str, total: int):
+            bars.append((description, total))
+            return lambda: steps.append(1)
+
+        yield factory
+
+    def fake_rows(video, config, advance=None):
+        for _ in range(5):
+            if advance is not None:
+                advance()
+        return "rows", 5
+
+    monkeypatch.setattr(track_blobs, "progress_bars", fake_bars)
+    monkeypatch.setattr(track_blobs, "cached_blob_detection_rows", fake_rows)
+    video = tmp_path / "v.mp4"
+    assert track_blobs._detect_with_progress(video, None, 5) == ("rows", 5)
+    assert bars == [("detecting blobs in v.mp4", 5)] and len(steps) == 5
+    assert track_blobs._detect_with_progress(video, None, 0) == ("rows", 5) and len(bars) == 1  # count unknown

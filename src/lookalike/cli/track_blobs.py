@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from lookalike.cli.app import console, fail
+from lookalike.cli.progress import progress_bars
 from lookalike.cli.track_closed import offline_video
 from lookalike.cli.track_video import run_track_onnx, run_track_video
 from lookalike.io import write_mot
@@ -21,6 +22,16 @@ from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_row
 from lookalike.viz.overlay import source_frames
 
 DETECTORS = ("blob",)
+
+
+def _detect_with_progress(video: Path, config: Any, declared: int) -> tuple[Any, int]:
+    """:func:`~lookalike.viz.blob_video.cached_blob_detection_rows` with a bar (frames done of ``declared``, time
+    left) on a terminal, or a spinner when the video does not declare its frame count."""
+    if declared <= 0:
+        with console.status(f"detecting blobs in {video.name}"):
+            return cached_blob_detection_rows(video, config)
+    with progress_bars() as progress:
+        return cached_blob_detection_rows(video, config, progress(f"detecting blobs in {video.name}", declared))
 
 
 def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, detector: str,
@@ -41,8 +52,8 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
     if not video.exists():
         fail(f"--video: {video} does not exist")
     try:
-        with console.status(f"estimating blob settings on {video.name}"):
-            config, estimate = auto_blob_config(video, settings, n_targets or None)
+        with progress_bars() as progress:  # (steps: reading the sampled frames, the background, each threshold)
+            config, estimate = auto_blob_config(video, settings, n_targets or None, progress=progress)
         if estimate is not None:
             given = {s.partition("=")[0].strip() for s in settings}
             console.print("blob settings estimated from the video (override with --blob KEY=VALUE):")
@@ -50,9 +61,9 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
                 console.print(f"  {line}", markup=False)
             if given:
                 console.print(f"  given with --blob: {', '.join(sorted(given))}", markup=False)
-        with console.status(f"detecting blobs in {video.name}"):
-            rows, frames = cached_blob_detection_rows(video, config)
-        frame_rate = options.get("fps") or source_frames(video)[2]
+        _, declared, source_rate = source_frames(video)
+        rows, frames = _detect_with_progress(video, config, declared)
+        frame_rate = options.get("fps") or source_rate
     except (ValueError, OSError) as exc:
         fail(str(exc))
     det_path = write_mot(output.with_name(output.stem + ".det.txt"), rows)

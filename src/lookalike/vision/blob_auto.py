@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -229,17 +229,22 @@ def _pick_frames(frames: str | Path | Iterable[np.ndarray], sample: int) -> list
 
 def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: int | None = None, *,
                          sample: int = 25, shake_px: float = 0.5, polarity_ratio: float = 0.1,
-                         base: BlobConfig | None = None) -> BlobEstimate:
+                         base: BlobConfig | None = None,
+                         progress: Callable[[str, int], Callable[[], None]] | None = None) -> BlobEstimate:
     """Blob detector settings estimated from a video (a file path, or its ``(h, w, 3)`` BGR frames),
     optionally knowing the number of targets ``n_targets`` (module doc). ``base`` supplies the settings
-    that are not estimated (method, blur, history)."""
+    that are not estimated (method, blur, history). ``progress(description, total)`` gives a function called
+    after each of ``total`` steps (reading the sampled frames, the background, each candidate threshold)."""
     with needs("cv2"):
         import cv2
 
     if n_targets is not None and int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
     base = base or BlobConfig()
+    total = 2 + len(_FACTORS)
+    step = progress("estimating blob settings", total) if progress is not None else (lambda: None)
     picked = _pick_frames(frames, sample)
+    step()
     blur = base.blur_px
     height, width = as_bgr_image(picked[0], "frames[0]").shape[:2]
     scale = min(1.0, _WORK_SIDE_PX / max(height, width))  # statistics on a reduced copy, for speed
@@ -279,6 +284,8 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3)) if scale > 0.67 else None
     lo, hi = _THRESHOLD_RANGE
     candidates = sorted({float(round(min(max(f * noise, lo), hi))) for f in _FACTORS})
+    for _ in range(1 + len(_FACTORS) - len(candidates)):  # the background; thresholds that coincide
+        step()
     results = {}
     for thr in candidates:
         per_frame, masks = [], []
@@ -295,6 +302,7 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
         lo_a, hi_a = area * _MIN_AREA_FRACTION, area * _MAX_AREA_FACTOR
         counts = np.array([int(((a >= lo_a) & (a <= hi_a)).sum()) for a in per_frame])
         results[thr] = (area, counts, masks)
+        step()
     medians = {thr: float(np.median(r[1])) for thr, r in results.items()}
     hit = {thr: float(np.mean(r[1] == n_targets)) for thr, r in results.items()} if n_targets else {}
     if hit and max(hit.values()) >= _MIN_HIT_SHARE:

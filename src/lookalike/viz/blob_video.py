@@ -26,6 +26,8 @@ from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config
 from lookalike.viz.overlay import source_frames
 
+Progress = Callable[[str, int], Callable[[], None]]  # (description, total steps) -> called after each step
+
 _BOOL_TRUE = ("1", "true", "yes", "on")
 _BOOL_FALSE = ("0", "false", "no", "off")
 
@@ -71,22 +73,24 @@ def blob_settings(settings: list[str]) -> dict[str, Any]:
 
 
 def auto_blob_config(video: Path | str, settings: list[str], n_targets: int | None = None,
-                     cache: Path | None | bool = True) -> tuple[BlobConfig, BlobEstimate | None]:
+                     cache: Path | None | bool = True, progress: Progress | None = None,
+                     ) -> tuple[BlobConfig, BlobEstimate | None]:
     """The blob settings for ``video``: estimated (with ``n_targets`` when known), then ``KEY=VALUE`` ``settings``
     on top. Skips the estimate when ``settings`` give threshold, polarity and both areas; returns the estimate
-    (or None) so it can be printed. Cached like the detections."""
+    (or None) so it can be printed. Cached like the detections. ``progress``: as for
+    :func:`~lookalike.vision.blob_auto.estimate_blob_config` (not called when the estimate is cached)."""
     given = blob_settings(settings)
     if {"threshold", "polarity", "min_area_px", "max_area_px"} <= set(given):
         return BlobConfig(**given), None
     base = BlobConfig(**{k: v for k, v in given.items() if k in ("method", "blur_px", "history", "sample_every")})
-    estimate = _cached_estimate(video, n_targets, base, cache)
+    estimate = _cached_estimate(video, n_targets, base, cache, progress)
     return dataclasses.replace(estimate.config, **given), estimate
 
 
 def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
-                     cache: Path | None | bool) -> BlobEstimate:
+                     cache: Path | None | bool, progress: Progress | None = None) -> BlobEstimate:
     if cache is False or cache is None:
-        return estimate_blob_config(video, n_targets, base=base)
+        return estimate_blob_config(video, n_targets, base=base, progress=progress)
     from lookalike.vision import blob_auto
 
     path = (cache_dir() if cache is True else Path(cache)) / "blobs" / (
@@ -100,7 +104,7 @@ def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
             return BlobEstimate(**data)
         except (OSError, ValueError, TypeError, KeyError):
             pass
-    estimate = estimate_blob_config(video, n_targets, base=base)
+    estimate = estimate_blob_config(video, n_targets, base=base, progress=progress)
     content = dataclasses.asdict(estimate)
     content["counts"] = {repr(k): v for k, v in estimate.counts.items()}
     _write_atomic(path, json.dumps(content, default=float).encode())
