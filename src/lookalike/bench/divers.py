@@ -163,7 +163,7 @@ def bar_chart(rows: list[dict[str, Any]], path: Path) -> Path:
     ax.legend(fontsize=7)
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=120, format="png")  # --png: a PNG whatever the name (matplotlib would add .png)
     plt.close(fig)
     return path
 

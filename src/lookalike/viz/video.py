@@ -82,7 +82,10 @@ class _H264Writer:
             import av
 
         self.width, self.height = size[0] + size[0] % 2, size[1] + size[1] % 2
-        self.container: Any = av.open(str(path), mode="w", options={"movflags": "+faststart"})
+        try:
+            self.container: Any = av.open(str(path), mode="w", options={"movflags": "+faststart"})
+        except ValueError:  # FFmpeg cannot tell a container from the name (no or an unknown suffix): an MP4
+            self.container = av.open(str(path), mode="w", format="mp4", options={"movflags": "+faststart"})
         self.stream: Any = self.container.add_stream("libx264", rate=Fraction(fps).limit_denominator(1001))
         self.stream.width, self.stream.height, self.stream.pix_fmt = self.width, self.height, "yuv420p"
         self.stream.options = {"crf": "23", "preset": "veryfast"}
@@ -133,7 +136,7 @@ def write_gif(path: Path | str, images: list[np.ndarray], fps: float) -> Path:
     frames = [Image.fromarray(np.ascontiguousarray(im[..., ::-1])).quantize(colors=128) for im in images]
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    frames[0].save(out, save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0,
+    frames[0].save(out, format="GIF", save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0,
                    optimize=False)
     return out
 
