@@ -142,3 +142,31 @@ def test_blob_detection_shows_frames_done_of_the_declared_count(monkeypatch, tmp
     assert track_blobs._detect_with_progress(video, None, 5) == ("rows", 5)
     assert bars == [("detecting blobs in v.mp4", 5)] and len(steps) == 5
     assert track_blobs._detect_with_progress(video, None, 0) == ("rows", 5) and len(bars) == 1  # count unknown
+
+
+@pytest.mark.parametrize("columns", ["80", "130"])
+def test_help_without_a_command_lists_the_same_commands_without_importing_them(columns):
+    env = {**os.environ, "COLUMNS": columns}
+    script = subprocess.run([sys.executable, "-m", "lookalike", "--help"], capture_output=True, text=True, env=env,
+                            check=True).stdout
+    library = ("import sys\nfrom lookalike.cli import app\nsys.argv = ['lookalike', '--help']\n"
+               "app(prog_name='lookalike')")
+    every = subprocess.run([sys.executable, "-c", library], capture_output=True, text=True, env=env).stdout
+    assert script.replace("python -m lookalike", "lookalike") == every and "trackers" in script and "bench" in script
+
+
+def test_the_summaries_of_help_are_the_commands_own():
+    from typer.main import get_command
+
+    from lookalike.cli import app
+    from lookalike.cli.summaries import SUMMARIES
+
+    group = get_command(app)
+    assert {n: (c.help or "").split("\n\n")[0].strip() for n, c in group.commands.items()  # type: ignore[attr-defined]
+            if not c.hidden} == SUMMARIES
+
+
+def test_a_command_after_options_still_runs():
+    out = subprocess.run([sys.executable, "-m", "lookalike", "trackers", "--names"], capture_output=True, text=True,
+                         check=True).stdout
+    assert "boxtrack" in out.split()

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import atexit
 import os
-import subprocess
 import sys
 import time
 from collections.abc import Callable
@@ -127,6 +126,8 @@ def _compile_elsewhere(warm: str, module: ModuleType) -> None:
          f"once, in the background when it ends (about {seconds} s)…")
 
     def start() -> None:  # after the run, so that it does not share the CPU with the compiler
+        import subprocess
+
         subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                          stderr=subprocess.DEVNULL, start_new_session=True)
 

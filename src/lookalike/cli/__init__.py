@@ -46,8 +46,23 @@ def _registered(command: str) -> bool:
     return command in names | {info.name for info in app.registered_groups}
 
 
+def _list_commands_only() -> None:
+    """Register each command by name and summary alone (:data:`~lookalike.cli.summaries.SUMMARIES`): the script was
+    given no command (``lookalike``, ``lookalike --help``), so none runs and no command module is imported."""
+    from lookalike.cli.summaries import SUMMARIES
+
+    def listed_only() -> None:  # never runs: a command given on the line loads its module instead
+        raise AssertionError("a listed-only command was run")
+
+    for name, summary in SUMMARIES.items():
+        app.command(name=name, help=summary)(listed_only)
+
+
 def _load_commands() -> None:
     command = _script_command()
+    if command is None and sys.argv and Path(sys.argv[0]).name in SCRIPT_NAMES:
+        _list_commands_only()
+        return
     only = COMMAND_MODULES.get(command or "")
     for name in (only,) if only is not None else MODULES:
         importlib.import_module(f"lookalike.cli.{name}")
