@@ -170,3 +170,25 @@ def test_a_command_after_options_still_runs():
     out = subprocess.run([sys.executable, "-m", "lookalike", "trackers", "--names"], capture_output=True, text=True,
                          check=True).stdout
     assert "boxtrack" in out.split()
+
+
+@pytest.mark.parametrize(("argv0", "expected"), [
+    ("/usr/local/bin/lookalike", True),
+    ("/x/src/lookalike/__main__.py", True),  # python -m lookalike
+    ("/x/site-packages/pytest/__main__.py", False),  # python -m pytest: another module's __main__
+    ("/x/bin/python", False),
+])
+def test_only_the_lookalike_program_counts_as_the_program(monkeypatch, argv0, expected):
+    from lookalike.cli.program import run_as_program
+
+    monkeypatch.setattr(sys, "argv", [argv0, "-q"])
+    assert run_as_program() is expected
+
+
+def test_commands_keep_their_options_under_python_m_pytest():
+    """``python -m pytest -q`` (argv[0] pytest's ``__main__.py``, no command) must load the real commands."""
+    code = ("import sys; sys.argv = ['/x/site-packages/pytest/__main__.py', '-q']\n"
+            "from typer.testing import CliRunner\nfrom lookalike.cli import app\n"
+            "r = CliRunner().invoke(app, ['eval', '--help'])\nprint('--gt' in r.output)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.stdout.strip() == "True", out.stdout + out.stderr

@@ -58,7 +58,8 @@ def _announce_compiles(numba: Any) -> None:
     if _announced:
         return
     _announced = True
-    from numba.core import event  # type: ignore[import-untyped, import-not-found, unused-ignore]
+    with needs("numba"):
+        from numba.core import event  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
     class _Once(event.Listener):  # type: ignore[misc, name-defined, unused-ignore]
         said = False

@@ -8,14 +8,12 @@ from __future__ import annotations
 import importlib
 import os
 import sys
-from pathlib import Path
 
 from rich.markup import escape
 
-SCRIPT_NAMES = ("lookalike", "__main__.py")
-"""``sys.argv[0]`` names of the ``lookalike`` script and of ``python -m lookalike``."""
+from lookalike.cli.program import run_as_program
 
-if sys.argv and Path(sys.argv[0]).name in SCRIPT_NAMES:
+if run_as_program():
     # Run as the program (before numpy is imported): lookalike's matrices are small, so OpenBLAS's
     # thread pool only costs its start-up in every process and waits in the node; a value the user
     # set is kept.
@@ -35,7 +33,7 @@ COMMAND_MODULES = {"track": "track", "trackers": "trackers", "eval": "eval", "si
 
 def _script_command() -> str | None:
     """The command the ``lookalike`` script is running, or None (imported as a library, or no command)."""
-    if not sys.argv or Path(sys.argv[0]).name not in SCRIPT_NAMES:
+    if not run_as_program():
         return None
     return next((a for a in sys.argv[1:] if not a.startswith("-")), None)
 
@@ -60,7 +58,7 @@ def _list_commands_only() -> None:
 
 def _load_commands() -> None:
     command = _script_command()
-    if command is None and sys.argv and Path(sys.argv[0]).name in SCRIPT_NAMES:
+    if command is None and run_as_program():
         _list_commands_only()
         return
     only = COMMAND_MODULES.get(command or "")

@@ -17,10 +17,11 @@ from typer._click.globals import get_current_context
 from typer.core import TyperGroup
 
 from lookalike.cli.coercion import install
+from lookalike.cli.program import run_as_program
 
 install()  # plain option values converted without pydantic (same values and errors as typer's)
 
-if sys.argv and Path(sys.argv[0]).name in ("lookalike", "__main__.py"):
+if run_as_program():
     # Run as the program: FFmpeg's own lines on a truncated or damaged video (OpenCV's decoder prints them) would come
     # before lookalike's one-line error naming the video. A level the user set (e.g. 16 to see them) is kept.
     os.environ.setdefault("OPENCV_FFMPEG_LOGLEVEL", "-8")
@@ -113,7 +114,7 @@ def split_list(values: list[str] | None) -> list[str]:
 def command_line() -> str:
     """The command line being run, for the header of a results file: ``sys.argv`` when run as the
     ``lookalike`` script, else (tests, ``python -m``) the command path and its non-default options."""
-    if sys.argv and Path(sys.argv[0]).name in ("lookalike", "__main__.py"):
+    if run_as_program():
         return shlex.join(["lookalike", *sys.argv[1:]])
     ctx = get_current_context(silent=True)
     if ctx is None:
