@@ -11,6 +11,7 @@ from typing import Any, NoReturn
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.text import Text
 from typer._click import Context, HelpFormatter  # typer 0.29 vendors click (constraints.txt pins it)
 from typer._click.globals import get_current_context
@@ -79,6 +80,16 @@ def fail(message: str, code: int = 2) -> NoReturn:
     with ``code``."""
     err_console.print(Text.assemble(("error:", "bold red"), " ", message), highlight=False)
     raise typer.Exit(code)
+
+
+def warn(message: str) -> None:
+    """Print ``message`` as a warning line (plain text) on stderr."""
+    err_console.print(f"[yellow]warning:[/] {escape(message)}", highlight=False)
+
+
+def note(message: str) -> None:
+    """Print ``message`` as a note line (plain text) on stderr: what was assumed about an input."""
+    err_console.print(f"[cyan]note:[/] {escape(message)}", highlight=False)
 
 
 def check_outputs_or_fail(outputs: dict[str, Path | None], inputs: Iterable[Path | None] = (),

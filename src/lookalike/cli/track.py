@@ -13,7 +13,7 @@ import typer
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 
-from lookalike.cli.app import app, console, err_console, fail
+from lookalike.cli.app import app, console, fail, note, warn
 from lookalike.io import find_sequences
 from lookalike.io.needs import box_input_problem
 from lookalike.io.outputs import atomic_path, check_outputs, ensure_writable, refuse_inputs, result_paths
@@ -81,16 +81,6 @@ def _input_error(exc: Exception) -> str:
     """One line for a bad input; the seqLength rule names the option that lifts it."""
     message = str(exc)
     return message + _LENGTH_HINT if "(seqLength in" in message else message
-
-
-def warn(message: str) -> None:
-    """Print ``message`` as a warning line (plain text) on stderr."""
-    err_console.print(f"[yellow]warning:[/] {escape(message)}", highlight=False)
-
-
-def note(message: str) -> None:
-    """Print ``message`` as a note line (plain text) on stderr: what was assumed about an input."""
-    err_console.print(f"[cyan]note:[/] {escape(message)}", highlight=False)
 
 
 def dropped_all(tracker: str, det_path: Path | None, rows: int, scores: tuple[float, float] | None) -> str:

@@ -15,8 +15,8 @@ from rich.progress import (
     TimeElapsedColumn,
 )
 
-from lookalike.cli.app import console, fail
-from lookalike.cli.track import dropped_all, note, warn
+from lookalike.cli.app import console, fail, note, warn
+from lookalike.cli.track import dropped_all
 from lookalike.cli.track_closed import offline_video
 from lookalike.io import read_mot, write_mot
 from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
