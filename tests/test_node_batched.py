@@ -69,7 +69,7 @@ def _plain_associate(tracker, det):
     t = tracker._tracks
     det_of_track = np.full(len(t), -1, dtype=int)
     if len(t) and len(det):
-        noise = tracker._noise(t.mean[:, :2])
+        noise = tracker._space.R(t.mean[:, :2])
         d2 = gating_distance(t.mean, t.cov, det.position, H, noise)
         matches, _, _ = assign(np.where(d2 <= tracker._gate, d2, np.inf))
         rows = matches[:, 0]

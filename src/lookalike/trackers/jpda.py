@@ -1,11 +1,7 @@
-"""JPDA tracker (a baseline of the robot-identification paper): joint probabilistic data association in world
-coordinates (metres).
-
-Each track is updated with all gated detections weighted by the exact JPDA marginals
-(:func:`lookalike.association.jpda.jpda_marginals`) by the mixture-reduced Kalman update. For identification and labels
-each track's one detection is found by the Hungarian method on ``1 - β`` (none below ``min_assignment_prob``);
-detections no track explains (``Σ_i β_ij < 0.5``) may start tracks. Lifecycle, births and identification are
-Kalman-HA2's."""
+"""JPDA tracker (a baseline of the robot-identification paper) in world coordinates (metres): each track takes the
+mixture-reduced Kalman update of all gated detections weighted by the exact JPDA marginals β; its one detection for
+labels is found by the Hungarian method on ``1 - β`` (none below ``min_assignment_prob``); detections no track explains
+(``Σ_i β_ij < 0.5``) may start tracks. Lifecycle, births and identification are Kalman-HA2's."""
 
 from __future__ import annotations
 
@@ -33,9 +29,6 @@ class JpdaConfig(HeuristicsConfig):
     min_assignment_prob: float = param(0.3, "smallest β of a track's labelled detection", range=UNIT)
     max_events: int = param(5000, "joint events enumerated per cluster before the exact subset DP", range=COUNT)
 
-    def __post_init__(self) -> None:
-        super().__post_init__()  # checks every field (check_params)
-
 
 @register_tracker("jpda")
 class JpdaTracker(WorldTracker):
@@ -55,7 +48,7 @@ class JpdaTracker(WorldTracker):
         self._explained = np.zeros(m)
         if not k or not m:
             return det_of_track
-        R = self._noise(t.mean[:, :2])
+        R = self._space.R(t.mean[:, :2])
         z_hat, S = kalman.project(t.mean, t.cov, H, R)
         d2 = kalman.gating_distance(t.mean, t.cov, positions(det), H, R)
         d2 = np.where(d2 <= self._gate, d2, np.inf)

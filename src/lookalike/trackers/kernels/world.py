@@ -1,13 +1,9 @@
-"""Small batched kernels of the world trackers' per-frame path (Kalman-HA and its beacon identifier).
+"""Small batched kernels of the world trackers' per-frame path (Kalman-HA and its beacon identifier), each bit for bit
+what the general function returns with fewer calls (numpy's LAPACK gufuncs, ``einsum``, :func:`pairs`).
 
-Each returns what the general function it stands in for returns, bit for bit, with fewer calls: numpy's LAPACK kernels
-without per-call checks (:func:`cholesky`, :func:`solve`), ``einsum``, and :func:`pairs`
-(:func:`lookalike.association.solver.assign_pairs`'s pairs).
-
-:func:`compiled` gives the optional numba kernels (:mod:`lookalike.trackers.kernels.world_numba`), used unless
-``LOOKALIKE_WORLD_NUMBA=0``; ``tests/test_world_numba.py`` compares both paths. The two whose rounding depends on the
-BLAS build (:func:`lower_solve_exact`, :func:`update_exact`) are checked against numpy when the kernels load and used
-only where they agree. numba loads at the first frame that needs it (or :func:`warm`)."""
+:func:`compiled` gives the optional numba kernels (:mod:`~lookalike.trackers.kernels.world_numba`) unless
+``LOOKALIKE_WORLD_NUMBA=0``; the two whose rounding depends on the BLAS build (:func:`lower_solve_exact`,
+:func:`update_exact`) are used only where they matched numpy when they loaded."""
 
 from __future__ import annotations
 
@@ -61,10 +57,9 @@ _NONE.flags.writeable = False
 
 def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf,
           unit: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Rows and columns of :func:`~lookalike.association.solver.assign_pairs` on the float matrix ``where(allowed, cost,
-    inf)`` (no NaN) with ``max_cost``, where ``allowed`` is ``cost <= max_cost`` (finite ``max_cost``) or the pairs to
-    consider (``max_cost = inf``). ``unit``: the allowed costs are >= 0 and ``max_cost <= 1``, so the solver's scale is
-    1 and nothing needs rescaling (those checks are skipped)."""
+    """Rows and columns of :func:`~lookalike.association.solver.assign_pairs` on ``where(allowed, cost, inf)`` (no NaN)
+    with ``max_cost`` (``allowed``: ``cost <= max_cost``, or the pairs to consider with ``max_cost = inf``). ``unit``:
+    allowed costs >= 0 and ``max_cost <= 1`` (the solver's scale is 1: no rescaling)."""
     if not cost.size or not allowed.any():
         return _NONE, _NONE
     most = np.maximum.reduce
@@ -78,8 +73,8 @@ def pairs(cost: np.ndarray, allowed: np.ndarray, max_cost: float = np.inf,
 
 
 def decided_pairs(decision: int, work: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`pairs` once its checks are made: ``decision`` 0 (nothing allowed), 1 (the ``allowed`` pairs are disjoint:
-    they are the pairs) or 2 (solve ``work``, the matrix :func:`pairs` hands the solver, and keep the allowed pairs)."""
+    """:func:`pairs` once its checks are made: ``decision`` 0 (nothing allowed), 1 (the disjoint ``allowed`` pairs) or
+    2 (solve ``work`` and keep the allowed pairs)."""
     if decision == 0:
         return _NONE, _NONE
     if decision == 1:
@@ -94,8 +89,7 @@ _solver: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None
 
 
 def _load_solver() -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
-    """scipy's ``linear_sum_assignment``, the function ``association.solver.linear_sum_assignment`` calls,
-    kept after its first use (a frame calls it without the wrapper's import statement)."""
+    """scipy's ``linear_sum_assignment`` (what ``association.solver``'s wrapper calls), kept after its first use."""
     global _solver
     linear_sum_assignment(np.zeros((1, 1)))  # (imports it, as the wrapper does)
     from scipy.optimize import linear_sum_assignment as solver
@@ -123,14 +117,12 @@ CHECKED_RHS = 16  # the most right-hand sides (detections) the 2×2 solve replic
 
 
 def update_exact() -> bool:
-    """Whether the compiled kernels are in use and their Kalman mean update (``world_numba.update_hits``) gave
-    ``einsum``'s sums bit for bit on the check updates when they loaded."""
+    """Whether the compiled kernels are in use and ``update_hits`` matched ``einsum`` bit for bit when they loaded."""
     return compiled() is not None and _update_exact
 
 
 def _same_updates(kernels: ModuleType) -> bool:
-    """Compare ``kernels.update_hits`` with the numpy lines it stands for on 2,000 random updates (zeros and
-    negative zeros among the gains and innovations)."""
+    """Compare ``kernels.update_hits`` with numpy on 2,000 random updates (with zeros and negative zeros)."""
     rng = np.random.default_rng(20261203)
     k = 2000
     gain = rng.normal(0.0, 1.0, (k, 2, 6)) * rng.choice([0.0, -0.0, 1e-3, 1.0, 1e3], (k, 2, 6))
@@ -144,15 +136,13 @@ def _same_updates(kernels: ModuleType) -> bool:
 
 
 def lower_solve_exact(n_rhs: int = 1) -> bool:
-    """Whether the compiled 2×2 lower-triangular solve is in use and matched numpy's ``solve`` bit for bit on the
-    check systems for ``n_rhs`` right-hand sides (checked up to :data:`CHECKED_RHS`); otherwise the Kalman gate
-    uses numpy's ``solve``."""
+    """Whether the compiled 2×2 lower-triangular solve is in use and matched numpy's ``solve`` bit for bit on the check
+    systems for ``n_rhs`` right-hand sides (checked up to :data:`CHECKED_RHS`)."""
     return n_rhs <= CHECKED_RHS and compiled() is not None and _lower_solve_exact
 
 
 def _same_lower_solves(kernels: ModuleType) -> bool:
-    """Compare ``kernels.solve_lower`` with numpy's ``solve`` on 4,800 random 2×2 Cholesky systems with 1 to 16
-    right-hand sides each."""
+    """Compare ``kernels.solve_lower`` with numpy's ``solve`` on 4,800 random 2×2 Cholesky systems."""
     rng = np.random.default_rng(20261202)
     for d in (1, 2, 5, 10, CHECKED_RHS):
         k = 960 // d
@@ -170,17 +160,13 @@ def _same_lower_solves(kernels: ModuleType) -> bool:
     return True
 
 
-# (decided at the first call of compiled(): a frame's calls cost an attribute lookup)
 _SWITCH: KernelSwitch[ModuleType] = KernelSwitch("LOOKALIKE_WORLD_NUMBA", _load, decide_once=True)
 use_compiled = _SWITCH.use_compiled  # (None: the environment is read again at the next call of compiled)
-# the world_numba module, or None when the kernels are off, numba is not installed or its cos rounds
-# differently from numpy's here
-compiled = _SWITCH.compiled
+compiled = _SWITCH.compiled  # the world_numba module; None when off, without numba, or its cos differs from numpy's
 
 
 def warm() -> bool:
-    """Import and load (compiling at the first use after installation) the compiled kernels now, so that
-    the first frame does not wait for them; whether they are in use."""
+    """Load (and compile at the first use) the kernels now, not at the first frame; whether they are in use."""
     kernels = compiled()
     if kernels is None:
         return False

@@ -1,7 +1,5 @@
-"""The numba kernels of :mod:`lookalike.trackers.kernels.world` (imported only when numba is installed).
-
-Each does the numpy path's floating-point operations value by value in the same order (``fastmath`` off), so results are
-bit for bit the same. Seconds, radians, metres (world frame)."""
+"""The numba kernels of :mod:`lookalike.trackers.kernels.world`: the numpy path's floating-point operations value by
+value in the same order (``fastmath`` off), so bit for bit the same results. Seconds, radians, metres (world frame)."""
 
 from __future__ import annotations
 
@@ -42,10 +40,8 @@ def _wrap(x: float) -> float:
 @_jit
 def _agent_headings(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, max_turn_rate: float,
                     max_extrapolation_s: float) -> np.ndarray:
-    """``BeaconIdentifier._headings``: the agents' headings ``(W, N)`` (radians) at the times ``q (W,)`` (seconds;
-    ``q_count``: ``q`` with NaN as +inf) from the report histories ``th (2, N, r)`` (send times in seconds,
-    headings in radians; NaN padded at the front), turning at most ``max_turn_rate`` radians/s, extrapolated at
-    most ``max_extrapolation_s`` seconds past the last report."""
+    """``BeaconIdentifier._headings``: the agents' headings ``(W, N)`` at the times ``q (W,)`` (``q_count``: NaN as
+    +inf) from the report histories ``th (2, N, r)`` (send times, headings; NaN padded at the front)."""
     n, r = th.shape[1], th.shape[2]
     n_times = q.shape[0]
     agent = np.full((n_times, n), np.nan)
@@ -83,11 +79,8 @@ def _agent_headings(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, max_turn
 @_jit
 def window_costs(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np.ndarray, max_turn_rate: float,
                  max_extrapolation_s: float, out: np.ndarray) -> None:
-    """The beacon identifier's window costs into ``out (k, N)``: the mean ``(1 - cos)/2`` of each sample row
-    ``samples (k, W)`` (track headings, radians; NaN: none) against each agent's heading at the window times
-    (:func:`_agent_headings`) over the finite terms (``inf`` with none). The operations of
-    ``BeaconIdentifier._headings`` and ``_costs``, value by value in the same order (each sum runs over the window
-    times in order, as numpy's reduction over that axis)."""
+    """``BeaconIdentifier._costs`` into ``out (k, N)``: the mean ``(1 - cos)/2`` of each sample row ``samples (k, W)``
+    (track headings; NaN: none) against each agent's heading at the window times, over the finite terms (else inf)."""
     agent = _agent_headings(th, q, q_count, max_turn_rate, max_extrapolation_s)
     n_times, n = agent.shape
     for row in range(samples.shape[0]):
@@ -109,10 +102,8 @@ def window_costs(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np
 def identity_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np.ndarray, current: np.ndarray,
                   max_turn_rate: float, max_extrapolation_s: float, hysteresis: float,
                   max_cost: float) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-    """``BeaconIdentifier.assign_arrays`` up to the solver: window costs ``(k, N)``, each held agent's (``current
-    (k,)``, -1: none) cost less ``hysteresis`` (floored at 0), the allowed pairs (``<= max_cost``) and the solver's
-    matrix. Returns ``(decision, cost, work, allowed)``; decision as in ``world_kernels.pairs`` (0 none allowed, 1
-    disjoint pairs, 2 solve)."""
+    """``BeaconIdentifier.assign_arrays`` up to the solver (``current (k,)``: each row's held agent, -1 none).
+    Returns ``(decision, cost, work, allowed)`` as ``world_kernels.pairs`` decides (0 none, 1 disjoint, 2 solve)."""
     k, n = samples.shape[0], th.shape[1]
     cost = np.empty((k, n))
     window_costs(th, q, q_count, samples, max_turn_rate, max_extrapolation_s, cost)
@@ -145,8 +136,7 @@ def identity_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: n
 def identity_rows_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, win: np.ndarray, current: np.ndarray,
                        rows: np.ndarray, max_turn_rate: float, max_extrapolation_s: float, hysteresis: float,
                        max_cost: float) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`identity_work` on the rows ``rows (k,)`` of the identifier's sample table ``win`` and of its
-    agents per row ``current`` (the gathers ``win[rows]``, ``current[rows]`` made here)."""
+    """:func:`identity_work` on ``win[rows]`` and ``current[rows]`` (gathered here)."""
     k, w = rows.shape[0], win.shape[1]
     samples = np.empty((k, w))
     held = np.empty(k, np.int64)
@@ -160,9 +150,8 @@ def identity_rows_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, win: 
 @_jit
 def identity_results(pair_rows: np.ndarray, pair_agents: np.ndarray, cost: np.ndarray, current: np.ndarray,
                      rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``BeaconIdentifier.assign_arrays``'s results from the assigned pairs (index into ``rows``, agent): the
-    agent per row (-1: none) and the probability ``1 - cost`` (NaN: none), each row's agent kept in
-    ``current[rows]`` (in order: a repeated row keeps the last)."""
+    """``BeaconIdentifier.assign_arrays``'s agent per row (-1: none) and probability ``1 - cost`` (NaN: none) from the
+    assigned pairs; each row's agent kept in ``current[rows]`` (a repeated row keeps the last)."""
     k = rows.shape[0]
     agent = np.full(k, -1, np.int64)
     prob = np.full(k, np.nan)
@@ -177,11 +166,9 @@ def identity_results(pair_rows: np.ndarray, pair_agents: np.ndarray, cost: np.nd
 
 @_jit
 def gate_work(y: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
-    """The Kalman trackers' association up to the solver, from the whitened innovations ``y (k, 2, d)``: the
-    squared Mahalanobis distances ``y0² + y1²``, the pairs inside the ``gate`` (NaN: outside), and the matrix
-    ``solver.solve_allowed`` hands the solver for them without a cost limit (allowed costs less their minimum,
-    forbidden ones at ``(top + 1)(min(k, d) + 1)`` above the largest; rescaled when huge), with the decision of
-    ``world_kernels.pairs`` (0 nothing allowed, 1 disjoint pairs, 2 solve). Returns ``(decision, work, allowed)``."""
+    """The world trackers' association up to the solver from the whitened innovations ``y (k, 2, d)``: squared
+    Mahalanobis distances, the pairs inside ``gate`` and ``solver.solve_allowed``'s matrix without a cost limit.
+    Returns ``(decision, work, allowed)`` as ``world_kernels.pairs`` decides (0 none, 1 disjoint, 2 solve)."""
     k, d = y.shape[0], y.shape[2]
     work = np.empty((k, d))
     for i in range(k):
@@ -199,9 +186,8 @@ def _times_inverse(x: float, pivot: float, divide: bool) -> float:
 
 @_jit
 def solve_lower(l00: float, l10: float, l11: float, b0: float, b1: float, divide: bool) -> tuple[float, float, bool]:
-    """``np.linalg.solve(L, b)`` for ``L = [[l00, 0], [l10, l11]]`` as OpenBLAS's ``dgesv`` rounds it (row pivoting,
-    reciprocal pivots multiplied in, divided instead when ``divide``), with whether the inputs were plain (finite,
-    non-zero pivots); otherwise the result must not be used. ``world_kernels`` checks it against numpy first."""
+    """``np.linalg.solve(L, b)`` for ``L = [[l00, 0], [l10, l11]]`` as OpenBLAS's ``dgesv`` rounds it, and whether the
+    inputs were plain (finite, non-zero pivots; else the result is unusable). Checked against numpy at load."""
     if not (math.isfinite(l00) and math.isfinite(l10) and math.isfinite(l11) and math.isfinite(b0)
             and math.isfinite(b1) and l00 != 0.0 and l11 != 0.0):
         return 0.0, 0.0, False
@@ -216,10 +202,8 @@ def solve_lower(l00: float, l10: float, l11: float, b0: float, b1: float, divide
 @_jit
 def gate_work_lower(factor: np.ndarray, z: np.ndarray, mean: np.ndarray,
                     gate: float) -> tuple[int, np.ndarray, np.ndarray]:
-    """:func:`gate_work` from the lower Cholesky factors ``factor (k, 2, 2)`` of the innovation covariances, the
-    detections ``z (d, 2)`` and the predicted means ``mean (k, >= 2)`` (metres): the innovations and their
-    whitening (:func:`solve_lower`) in the same call. Decision -1 when a factor or an innovation is not plain
-    (the caller then whitens with numpy's solve)."""
+    """:func:`gate_work` from the innovation covariances' lower Cholesky factors ``(k, 2, 2)``, detections ``z (d, 2)``
+    and means ``mean (k, >= 2)``, whitening here (:func:`solve_lower`); decision -1 when not plain."""
     k, d = factor.shape[0], z.shape[0]
     work = np.empty((k, d))
     for i in range(k):
@@ -234,7 +218,7 @@ def gate_work_lower(factor: np.ndarray, z: np.ndarray, mean: np.ndarray,
 
 @_jit
 def _gate_decision(work: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
-    """The rest of :func:`gate_work`, in place on ``work``, the squared distances ``(k, d)``."""
+    """The rest of :func:`gate_work`, in place on the squared distances ``work (k, d)``."""
     k, d = work.shape
     allowed = np.zeros((k, d), np.bool_)
     per_column = np.zeros(d, np.int64)
@@ -277,9 +261,8 @@ def _gate_decision(work: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.n
 @_jit
 def update_hits(mean: np.ndarray, cov: np.ndarray, rows: np.ndarray, cols: np.ndarray, gain: np.ndarray,
                 cov_hit: np.ndarray, z: np.ndarray) -> None:
-    """Kalman update of tracks ``rows`` by detections ``cols`` (``z (d, 2)``, metres), in place: ``mean[i] += Kᵀ
-    (z[j] - mean[i, :2])`` with transposed gains ``gain (k, 2, n)`` summed as ``einsum`` does, and ``cov[i] =
-    cov_hit[i]``. ``world_kernels`` checks it against the einsum first."""
+    """Kalman update of tracks ``rows`` by detections ``cols`` in place: ``mean[i] += Kᵀ (z[j] - mean[i, :2])`` summed
+    as ``einsum`` does (``gain (k, 2, n)``: K transposed), ``cov[i] = cov_hit[i]``. Checked against numpy at load."""
     n = mean.shape[1]
     for r in range(rows.shape[0]):
         i, j = rows[r], cols[r]
@@ -296,8 +279,7 @@ def update_hits(mean: np.ndarray, cov: np.ndarray, rows: np.ndarray, cols: np.nd
 
 @_jit
 def solve_lower_many(factor: np.ndarray, b: np.ndarray, divide: bool) -> np.ndarray:
-    """:func:`solve_lower` of each factor ``(k, 2, 2)`` and right-hand side ``b (k, 2)``, NaN where not plain
-    (for the check against numpy's ``solve``)."""
+    """:func:`solve_lower` of each factor ``(k, 2, 2)`` and ``b (k, 2)``, NaN where not plain (for the check)."""
     out = np.full((factor.shape[0], 2), np.nan)
     for i in range(factor.shape[0]):
         x0, x1, plain = solve_lower(factor[i, 0, 0], factor[i, 1, 0], factor[i, 1, 1], b[i, 0], b[i, 1], divide)
@@ -308,9 +290,8 @@ def solve_lower_many(factor: np.ndarray, b: np.ndarray, divide: bool) -> np.ndar
 
 @_jit
 def shift_reports(th: np.ndarray, agent_id: np.ndarray, t_sent: np.ndarray, heading: np.ndarray) -> bool:
-    """``BeaconIdentifier.begin_frame``'s common case: when the reports (``t_sent`` seconds, ``heading`` radians)
-    are of distinct agents ``0 .. N-1``, each sent after the latest kept of its agent (or its first), shift them
-    into the histories ``th (2, N, r)`` and return True; otherwise change nothing and return False."""
+    """``BeaconIdentifier._shift_common``: when the reports are of distinct agents ``0 .. N-1``, each newer than its
+    agent's latest, shift them into ``th (2, N, r)`` and return True; otherwise change nothing, return False."""
     n, r = th.shape[1], th.shape[2]
     seen = np.zeros(n, np.bool_)
     for i in range(agent_id.shape[0]):
@@ -331,10 +312,8 @@ def shift_reports(th: np.ndarray, agent_id: np.ndarray, t_sent: np.ndarray, head
 @_jit
 def birth_candidates(det_of_track: np.ndarray, score: np.ndarray, min_score: float, check_score: bool,
                      position: np.ndarray, mean: np.ndarray, exclusion_m: float, check_exclusion: bool) -> np.ndarray:
-    """``WorldTracker._birth_candidates``: indices of the detections no track took (``det_of_track``, -1: a
-    miss), scoring at least ``min_score`` (when ``check_score``) and, when ``check_exclusion``, farther than
-    ``exclusion_m`` from every track's predicted position (``mean (k, 6)``; distances as ``np.linalg.norm``:
-    the square root of the summed squares)."""
+    """``WorldTracker._birth_candidates``: the detections no track took, scoring at least ``min_score`` (when
+    ``check_score``), farther than ``exclusion_m`` from every track's position (when ``check_exclusion``)."""
     n = position.shape[0]
     free = np.ones(n + 1, np.bool_)  # (the extra last entry takes the misses' -1)
     for i in range(det_of_track.shape[0]):
@@ -362,11 +341,8 @@ def lifecycle_work(det_of_track: np.ndarray, hit_bits: np.ndarray, misses: np.nd
                    hits: np.ndarray, confirmed: np.ndarray, dt: float, confirm_window: int, n_init: int,
                    tentative_max_misses: int, max_misses: int, in_view: np.ndarray, limit_in_s: float,
                    limit_out_s: float) -> np.ndarray:
-    """``WorldTracker._lifecycle`` and ``Lifecycle.alive`` in place on the table's columns (``k`` tracks): hit history
-    ``hit_bits`` (bit 0 this frame, 30 kept), ``misses`` (frames) and ``unseen_s`` (seconds, ``dt`` a frame) reset by a
-    hit or grown; with ``confirm_window`` > 0, ``n_init`` hits in the window confirm a track, and a confirmed track
-    survives unseen at most ``limit_in_s`` (``in_view``) or ``limit_out_s``; with 0 every track is confirmed. Miss
-    limits ``tentative_max_misses`` and ``max_misses`` (-1: none). Returns the survivors' mask."""
+    """``WorldTracker._lifecycle`` with ``Lifecycle.alive``, in place on the table's columns; ``confirm_window`` 0: no
+    window (every track confirmed); miss limits -1: none. Returns the survivors' mask."""
     k = det_of_track.shape[0]
     keep = np.empty(k, np.bool_)
     window_mask = (1 << confirm_window) - 1 if confirm_window > 0 else 0

@@ -1,6 +1,5 @@
-"""The world trackers' shared base: a track table of ground positions (observer frame, metres) with one
-constant-acceleration Kalman filter per track, prediction, births, beacon identification and output.
-Kalman-HA, Kalman-HA2 and JPDA differ only in their rules (:class:`WorldRules`) and association."""
+"""The world trackers' shared base: ground positions (observer frame, metres), one constant-acceleration Kalman filter
+per track, beacon identification. Kalman-HA, Kalman-HA2 and JPDA differ in their rules and association."""
 
 from __future__ import annotations
 
@@ -30,10 +29,8 @@ from lookalike.types import Detections, Frame, Tracks
 H = WorldCA.H
 
 
-
 class WorldTracker:
-    """Track table, prediction, births, identification and output shared by the world trackers;
-    what differs between them is data (:class:`WorldRules`) and :meth:`_associate_and_update`
+    """The world trackers' frame loop; they differ in :class:`WorldRules` and :meth:`_associate_and_update`
     (returns the detection index per track, -1 for a miss)."""
 
     name: ClassVar[str] = "world"
@@ -51,8 +48,7 @@ class WorldTracker:
         cfg = self.config
         self._tracks = TrackTable(6, {"hit_bits": ((), np.int64)})  # hit history, bit 0 = this frame
         self._time: float | None = None
-        # per frame interval (s): WorldCA.predict's F, F.T (the view kalman.predict multiplies by), Q, and the
-        # velocity factor of a coasting track (None: no decay); kept for the latest intervals
+        # per frame interval (s): F, F.T, Q and the coasting velocity factor (None: no decay)
         self._models: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray, float | None]] = {}
         self._intervals: list[float] = []  # the last two distinct frame intervals (> 0 s), the latest first
         self._repeated: set[float] = set()  # those of them that came again while in that list
@@ -86,21 +82,23 @@ class WorldTracker:
             self._ready = {}
         if ready is not None:
             t.mean, t.cov = ready.mean, ready.cov
-        else:
-            self._predict(dt)
+        elif len(t) and dt != 0:
+            t.mean, t.cov = self._predicted(t.mean, t.cov, dt)
         self._frame_ready = ready
         det_of_track = self._associate_and_update(det)
         det_of_track = self._lifecycle(det_of_track, dt, None if ready is None else ready.in_view)
-        new = self._births(det, det_of_track)
+        new = self._birth_candidates(det, det_of_track)
+        if len(new):
+            mean, cov = self._space.initial(positions(det)[new])
+            self._tracks.add(mean, cov, hit_bits=1, confirmed=self.rules.born_confirmed)  # (_lifecycle may replace it)
         return self._report(det, np.concatenate([det_of_track, new]))
 
     # -- steps -------------------------------------------------------------------------------
 
     def prepare(self) -> None:
-        """Between frames (optional; the node calls it): predict the tracks for each of the last two distinct frame
-        intervals seen more than once, with the detection-independent parts of the next association (innovation
-        covariances, Cholesky factors, gains, updated covariances, in-view flags). :meth:`update` uses them when its
-        interval matches exactly (same operations, same bits). JPDA prepares nothing."""
+        """Between frames (optional; the node calls it): predict the tracks and the detection-independent parts of the
+        next association for each of the last two distinct intervals seen more than once; :meth:`update` uses them
+        when its interval matches exactly (same bits). JPDA prepares nothing."""
         t = self._tracks
         self._ready = {}
         if (self._time is None or not len(t)
@@ -110,15 +108,9 @@ class WorldTracker:
             if dt not in self._repeated:
                 continue
             mean, cov = self._predicted(t.mean.copy(), t.cov, dt)
-            S, L, gain, cov_hit = self._gains(mean, cov)
+            S = cov[:, :2, :2] + self._space.R(mean[:, :2])
             in_view = None if self.rules.confirm_window is None else self.rules.in_view(mean[:, :2])
-            self._ready[dt] = _Prepared(dt, mean, cov, S, L, gain, cov_hit, in_view)
-
-    def _predict(self, dt: float) -> None:
-        t = self._tracks
-        if not len(t) or dt == 0:
-            return
-        t.mean, t.cov = self._predicted(t.mean, t.cov, dt)
+            self._ready[dt] = _Prepared(mean, cov, S, cholesky(S), *self._gains(S, cov), in_view)
 
     def _predicted(self, mean: np.ndarray, cov: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """The predicted means and covariances over ``dt`` > 0 seconds (``mean``'s coasting rows are
@@ -139,17 +131,13 @@ class WorldTracker:
                 mean[coasting, 4:6] = 0.0
         return mean @ Ft, F @ cov @ Ft + Q
 
-    def _gains(self, mean: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Every track's innovation covariance ``S (k, 2, 2)``, its lower Cholesky factor, the solve of
-        ``S K = H P`` (``(k, 2, 6)``: the Kalman gains transposed) and the covariance after an update."""
-        S = cov[:, :2, :2] + self._noise(mean[:, :2])
+    @staticmethod
+    def _gains(S: np.ndarray, cov: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The solve of ``S K = H P`` (``(k, 2, 6)``: the Kalman gains transposed) for innovation covariances
+        ``S (k, 2, 2)`` and covariances ``cov (k, 6, 6)``, and the covariances after an update."""
         PHt_T = np.ascontiguousarray(cov[:, :, :2]).swapaxes(-1, -2)  # (``(P @ H.T).T``, (k, 2, 6))
         gain = solve(S, PHt_T)
-        return S, cholesky(S), gain, cov - gain.swapaxes(-1, -2) @ PHt_T
-
-    def _noise(self, position: np.ndarray) -> np.ndarray:
-        """Measurement covariances ``(k, 2, 2)`` for positions ``(k, 2)``."""
-        return self._space.R(position)
+        return gain, cov - gain.swapaxes(-1, -2) @ PHt_T
 
     def _associate_and_update(self, det: Detections) -> np.ndarray:
         """Hungarian on the gated squared Mahalanobis distance; Kalman update of matched tracks.
@@ -165,8 +153,7 @@ class WorldTracker:
         if ready is not None:
             S, L = ready.S, ready.L
         else:
-            noise = self._noise(mean[:, :2])  # (row by row: the matched rows' noise is noise[rows])
-            S = cov[:, :2, :2] + noise
+            S = cov[:, :2, :2] + self._space.R(mean[:, :2])
             L = cholesky(S)
         kernels = compiled()
         # (with LAPACK's 2×2 solve replicated bit for bit (world_kernels.lower_solve_exact), the innovations,
@@ -174,30 +161,22 @@ class WorldTracker:
         gated = kernels.gate_work_lower(L, z, mean, self._gate) if kernels and lower_solve_exact(len(z)) else None
         if gated is not None and gated[0] >= 0:
             rows, cols = decided_pairs(*gated)
-        elif kernels is not None:  # (the lines below and pairs' steps up to the solver, in one compiled call)
-            y = solve(L, (z[None, :, :] - mean[:, None, :2]).swapaxes(-1, -2))  # (k, 2, d)
-            rows, cols = decided_pairs(*kernels.gate_work(y, self._gate))
         else:
-            diff = z[None, :, :] - mean[:, None, :2]  # (k, d, 2)
-            y = solve(L, diff.swapaxes(-1, -2))  # (k, 2, d)
-            d2 = np.add.reduce(y * y, axis=1)
-            rows, cols = pairs(d2, d2 <= self._gate)
+            y = solve(L, (z[None, :, :] - mean[:, None, :2]).swapaxes(-1, -2))  # (k, 2, d)
+            if kernels is not None:  # (the lines below and pairs' steps up to the solver, in one compiled call)
+                rows, cols = decided_pairs(*kernels.gate_work(y, self._gate))
+            else:
+                d2 = np.add.reduce(y * y, axis=1)
+                rows, cols = pairs(d2, d2 <= self._gate)
         det_of_track[rows] = cols
         if len(rows) and ready is not None and kernels is not None and update_exact():  # (below, one call)
             kernels.update_hits(t.mean, t.cov, rows, cols, ready.gain, ready.cov_hit, z)
-        elif len(rows) and ready is not None:  # (the lines below, with the gains and covariances made ahead)
-            K = ready.gain[rows].swapaxes(-1, -2)
+        elif len(rows):  # (with the gains and covariances made ahead when prepared)
+            gain, cov_hit = (ready.gain[rows], ready.cov_hit[rows]) if ready is not None else self._gains(
+                S[rows], cov[rows])
             m = mean[rows]
-            t.mean[rows] = m + einsum("kij,kj->ki", K, z[cols] - m[:, :2])
-            t.cov[rows] = ready.cov_hit[rows]
-        elif len(rows):
-            m, P = mean[rows], cov[rows]
-            PHt = np.ascontiguousarray(P[:, :, :2])  # (k, 6, 2), laid out as ``P @ H.T``
-            PHt_T = PHt.swapaxes(-1, -2)
-            K = solve(S[rows], PHt_T).swapaxes(-1, -2)
-            innovation = z[cols] - m[:, :2]
-            t.mean[rows] = m + einsum("kij,kj->ki", K, innovation)
-            t.cov[rows] = P - K @ PHt_T
+            t.mean[rows] = m + einsum("kij,kj->ki", gain.swapaxes(-1, -2), z[cols] - m[:, :2])
+            t.cov[rows] = cov_hit
         return det_of_track
 
     def _lifecycle(self, det_of_track: np.ndarray, dt: float, in_view: np.ndarray | None = None) -> np.ndarray:
@@ -258,13 +237,6 @@ class WorldTracker:
             new = new[np.minimum.reduce(gap, axis=1) > rules.birth_exclusion_m]
         return new
 
-    def _births(self, det: Detections, det_of_track: np.ndarray) -> np.ndarray:
-        new = self._birth_candidates(det, det_of_track)
-        if len(new):
-            mean, cov = self._space.initial(positions(det)[new])
-            self._tracks.add(mean, cov, hit_bits=1, confirmed=self.rules.born_confirmed)
-        return new
-
     def _report(self, det: Detections, det_of_track: np.ndarray) -> Tracks:
         """Identify (the visual headings of this frame's hits and births go to the identifier
         first) and report every track."""
@@ -297,12 +269,9 @@ class WorldTracker:
 
 
 class _Prepared(NamedTuple):
-    """The next frame's prediction made between frames (:meth:`WorldTracker.prepare`) for interval ``dt``:
-    means ``(k, 6)``, covariances ``(k, 6, 6)``, innovation covariances ``S (k, 2, 2)`` and their lower
-    Cholesky factors ``L``, the gains transposed ``(k, 2, 6)``, the covariances after an update ``(k, 6, 6)``
-    and which tracks are predicted in the camera's view (None without view rules)."""
+    """:meth:`WorldTracker.prepare`'s prediction for one interval: means ``(k, 6)``, covariances, ``S (k, 2, 2)`` and
+    its Cholesky factors, gains transposed ``(k, 2, 6)``, covariances after an update, in view (None: no rules)."""
 
-    dt: float
     mean: np.ndarray
     cov: np.ndarray
     S: np.ndarray

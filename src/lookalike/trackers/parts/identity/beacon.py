@@ -53,8 +53,7 @@ class BeaconIdentifier:
         self._times = np.full(w, np.nan)  # frame times of the ring
         self._times_count = np.full(w, np.inf)  # the same, +inf for no time (counts every report)
         self._slot = -1
-        # Per-track heading samples as one table: row 0 stays all NaN (tracks never observed),
-        # ``_row`` maps a track id to its row, ``_current`` holds each row's agent (-1: none).
+        # per-track heading samples (row 0 all NaN: never observed), each row's agent (-1: none), track id -> row
         self._win = np.full((8, w), np.nan)
         self._current = np.full(8, -1, dtype=int)
         self._row: dict[int, int] = {}
@@ -83,8 +82,8 @@ class BeaconIdentifier:
         self._win[:, self._slot] = np.nan
 
     def _shift_common(self, agent_id: np.ndarray, new_t: np.ndarray, heading: np.ndarray) -> bool:
-        """:meth:`begin_frame`'s common case (one report per agent, each newer than those kept): shift all in at
-        once, as :meth:`_store` would. False, nothing changed, otherwise."""
+        """:meth:`begin_frame`'s common case (one report per agent, each newer than those kept) as :meth:`_store`
+        would do it; False, nothing changed, otherwise."""
         ids = agent_id.tolist()
         if len(set(ids)) < len(ids) or max(ids) >= self.config.n_agents or (new_t <= self._t[agent_id, -1]).any():
             return False
@@ -110,10 +109,7 @@ class BeaconIdentifier:
 
     def observe(self, track_id: int, heading_rad: float) -> None:
         """Record the visual heading of track ``track_id`` in the current frame."""
-        if self._slot < 0:
-            raise ValueError("observe() before begin_frame()")
-        row = self._rows([track_id])[0]  # (may grow the table: before indexing it)
-        self._win[row, self._slot] = heading_rad
+        self.observe_many([track_id], np.array([heading_rad], dtype=float))
 
     def observe_many(self, track_ids: list[int], headings_rad: np.ndarray) -> None:
         """Record the visual headings ``(k,)`` of tracks ``track_ids`` in the current frame."""
