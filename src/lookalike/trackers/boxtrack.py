@@ -28,6 +28,7 @@ from lookalike.motion.spaces import BoxCXCYWH
 from lookalike.trackers import boxtrack_config as const
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
 from lookalike.trackers.kernels import boxtrack as boxtrack_kernels
+from lookalike.trackers.parts.batches import batches, near_pairs, overlapping_pairs, pair_iou
 from lookalike.trackers.parts.closed_slots import ClosedSlots
 from lookalike.trackers.parts.clutter import ClutterShare
 from lookalike.trackers.parts.coasting import Coasting
@@ -42,6 +43,7 @@ from lookalike.types import Detections, Frame, Tracks
 _NO_BOXES = np.zeros((0, 4))
 _NO_INDEX = np.zeros(0, dtype=np.int64)
 _F64 = np.dtype(np.float64)
+LARGE_PAIRS = 1 << 20  # frames with more (track + previous box) × detection pairs are associated in batches
 
 
 def _xywh_columns(cxcywh: np.ndarray, out: np.ndarray) -> None:
@@ -100,7 +102,7 @@ class BoxTrack:
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
         dets = frame.detections
-        if self._compiled and dets.xywh.dtype is _F64 and dets.score.dtype is _F64:
+        if self._compiled and dets.xywh.dtype is _F64 and dets.score.dtype is _F64 and not self._large(len(dets)):
             # (float64 columns, as Detections makes them: the kernels' arithmetic is the numpy path's; the
             # module is looked up, not kept, so the tracker stays picklable)
             return self._update_compiled(frame, boxtrack_kernels.module())
@@ -115,9 +117,14 @@ class BoxTrack:
             if np.count_nonzero(still):
                 x[4:8, still] = 0.0  # a long-lost track waits where it was last seen
             self._predict_space().predict_columns(x, steps)
-        iou, low_gate = self._overlaps(x, det_xywh)
-        high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
-        matching = self._associate(iou, low_gate, z.T, score, high_score, was_tracked, dt)
+        if self._large(len(score)):
+            self._observe_clutter_pairs(det_xywh)
+            high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
+            matching = self._associate_batches(x, det_xywh, z.T, score, high_score, was_tracked, dt)
+        else:
+            iou, low_gate = self._overlaps(x, det_xywh)
+            high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
+            matching = self._associate(iou, low_gate, z.T, score, high_score, was_tracked, dt)
         det_of_track, free = matching.det_of_track, matching.free
         hit = det_of_track >= 0
         matched = hit.nonzero()[0]
@@ -291,6 +298,48 @@ class BoxTrack:
             return None, None
         return iou[:k], overlap[:k] if shared else None  # type: ignore[index]
 
+    def _large(self, n: int) -> bool:
+        """Whether a frame of ``n`` detections is associated in batches (:meth:`_associate_batches`): more than
+        :data:`LARGE_PAIRS` pairs with the tracks and the previous frame's boxes, and IoU gates that split it."""
+        previous = self._clutter.previous
+        pairs = (len(self._tracks) + (0 if previous is None else len(previous))) * n
+        return pairs > LARGE_PAIRS and self.config.match_iou > 0
+
+    def _observe_clutter_pairs(self, det_xywh: np.ndarray) -> None:
+        """The clutter share's count of a large frame from the overlapping pairs alone (:meth:`_overlaps`'s numbers)."""
+        clutter = self._clutter
+        previous = clutter.previous
+        if previous is None or not len(previous) or not len(det_xywh):
+            clutter.observe_overlaps(det_xywh, None)
+            return
+        i, j = overlapping_pairs(previous, det_xywh)
+        near = j[pair_iou(previous[i], det_xywh[j]) >= clutter.min_iou]
+        clutter.observe_count(det_xywh, len(det_xywh) - len(np.unique(near)))
+
+    def _associate_batches(self, x: np.ndarray, det_xywh: np.ndarray, det_box: np.ndarray, score: np.ndarray,
+                           high_score: float, was_tracked: np.ndarray, dt: float) -> Matching:
+        """:meth:`_associate` of a large frame, in memory linear in its boxes: the plan runs on batches of the
+        connected groups of tracks and detections that overlap or lie within re-identification reach
+        (:mod:`~lookalike.trackers.parts.batches`); no stage can match across groups, so the matches are the same."""
+        t, k, n = self._tracks, x.shape[1], len(score)
+        boxes = np.empty((4, k))
+        _xywh_columns(x, boxes)
+        i, j = overlapping_pairs(boxes.T, det_xywh)
+        centres, radius = self._reid_reach(dt)
+        radius[~t.confirmed] = np.nan  # only confirmed tracks are re-identified
+        ri, rj = near_pairs(centres, radius, det_box[:, :2])
+        matching = Matching.empty(k, n)
+        for rows, cols in batches(k, n, np.concatenate((i, ri)), np.concatenate((j, rj)), LARGE_PAIRS):
+            iou = iou_columns(boxes[:, rows], det_xywh[cols].T)
+            part = run_plan(self._plan(iou, None, det_box[cols], score[cols], high_score, was_tracked[rows], dt, rows),
+                            len(rows), len(cols))
+            hit = part.det_of_track >= 0
+            matching.det_of_track[rows[hit]] = cols[part.det_of_track[hit]]
+            matching.free[cols] = part.free
+            matching.stage_of_track[rows] = part.stage_of_track
+        self._observe_continued(score, matching)
+        return matching
+
     def _associate(self, iou: np.ndarray | None, low_gate: np.ndarray | None, det_box: np.ndarray,
                    score: np.ndarray, high_score: float, was_tracked: np.ndarray, dt: float) -> Matching:
         """The association plan: confident detections to confirmed tracks (recent ones first), low-score
@@ -301,10 +350,10 @@ class BoxTrack:
         return matching
 
     def _plan(self, iou: np.ndarray | None, low_gate: np.ndarray | None, det_box: np.ndarray, score: np.ndarray,
-              high_score: float, was_tracked: np.ndarray, dt: float) -> list[Stage]:
+              high_score: float, was_tracked: np.ndarray, dt: float, rows: np.ndarray | None = None) -> list[Stage]:
         """:meth:`_associate`'s stages: IoU ``iou (k, n)`` of the predicted boxes and the detections (None
         without either), ``low_gate`` its pairs reaching ``LOW_IOU`` (None: computed here), ``det_box (n, 4)``
-        the detections' cx, cy, w, h (pixels)."""
+        the detections' cx, cy, w, h (pixels); ``rows``: the tracks of a batch (None: all)."""
         cfg, t = self.config, self._tracks
         high = score >= high_score
         # each IoU stage takes its block of the frame's matrix; it allows the pairs reaching its IoU
@@ -319,9 +368,9 @@ class BoxTrack:
             return lambda r, c: cost_from_iou(iou[r[:, None], c], min_iou,  # type: ignore[index]
                                               score[c] if weigh else None)
 
-        confirmed = t.confirmed
-        recent = t.misses <= const.RECENT_FRAMES
-        reid = self._reid(det_box, dt)
+        confirmed, misses = (t.confirmed, t.misses) if rows is None else (t.confirmed[rows], t.misses[rows])
+        recent = misses <= const.RECENT_FRAMES
+        reid = self._reid(det_box, dt, rows)
         return [
             Stage(confirmed & recent, high, overlap(cfg.match_iou, True), name="confident, recent", gate=match_gate),
             Stage(confirmed > recent, high, overlap(cfg.match_iou, True), name="confident, lost longer",
@@ -331,13 +380,15 @@ class BoxTrack:
             Stage(confirmed, high, reid, name="re-identification"),
         ]
 
-    def _reid(self, det_box: np.ndarray, dt: float) -> CostFn:
+    def _reid(self, det_box: np.ndarray, dt: float, rows: np.ndarray | None = None) -> CostFn:
         """The re-identification stage's cost of lost tracks and detections ``det_box (n, 4)`` (cx, cy, w, h;
-        pixels), ``dt`` seconds after the tracks' last frame."""
+        pixels), ``dt`` seconds after the tracks' last frame; ``rows``: the tracks of a batch (None: all)."""
         cfg, t, slots = self.config, self._tracks, self._slots
 
         def reid(r: np.ndarray, c: np.ndarray) -> np.ndarray:
             # built only when some lost track and confident detection are left
+            if rows is not None:
+                r = rows[r]
             if slots is not None:  # closed set: sizes as sqrt(w·h), a turning target keeps its size; gates in heights
                 track_box, box = slots.squared(t.mean[:, :4]), slots.squared(det_box)
                 gate, scale = slots.gate(t.unseen_s + dt), max(cfg.reid_scale, const.CLOSED_SCALE)
@@ -347,6 +398,19 @@ class BoxTrack:
             return centre_distance_cost(t.mean[r, :4], det_box[c], gate_all, cfg.reid_scale)
 
         return reid
+
+    def _reid_reach(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Every track's centre ``(k, 2)`` and the distance (pixels) within which :meth:`_reid` allows a detection's
+        centre (its gate times the track's height)."""
+        t, slots = self._tracks, self._slots
+        gate: np.ndarray | float
+        if slots is not None:
+            box = slots.squared(t.mean[:, :4])
+            gate = slots.gate(t.unseen_s + dt)[:, 0]
+        else:
+            box, gate = t.mean[:, :4], const.REID_DISTANCE * math.sqrt(self._fit.scale)
+        radius: np.ndarray = gate * np.maximum(box[:, 3], 1.0) * (1 + 1e-9)  # (a hair wider: never a pair too few)
+        return np.array(box[:, :2]), radius
 
     def _correct(self, x: np.ndarray, matched: np.ndarray, z: np.ndarray) -> None:
         """Kalman update of the tracks ``matched`` (columns of ``x``) with their measurements ``z (4, m)``; the centre
