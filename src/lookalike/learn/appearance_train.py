@@ -1,9 +1,5 @@
-"""Training the learned diver appearance model (torch; training only) and exporting it to ONNX.
-
-:class:`EmbeddingNet` maps ``(n, 3, 32, 64)`` float32 BGR crops in ``[0, 1]`` to 32-dimensional L2-normalised embeddings
-(four conv blocks, global pooling, a linear layer), trained as an identity classifier with an additive cosine margin and
-heavy augmentation on :func:`~lookalike.sim.divers_train.training_scenarios`. The epoch with the best validation ROC AUC
-(same vs different diver) is exported (:func:`export_onnx`) with its configuration."""
+"""Training the diver appearance embedding (torch) as an identity classifier with an additive cosine margin, and its
+ONNX export: ``(n, 3, 32, 64)`` BGR crops in ``[0, 1]`` -> L2-normalised embeddings."""
 
 from __future__ import annotations
 

@@ -1,7 +1,5 @@
-"""The association network in PyTorch (training only; import needs torch).
-
-Stacked recurrent layers (LSTM by default, GRU as the paper's comparison) followed by one linear layer that holds the M
-output heads: its ``M·(N+1)`` outputs are read as M softmax groups."""
+"""The association network in PyTorch (training only; needs torch): stacked LSTM or GRU layers and one linear layer
+whose ``M·(N+1)`` outputs are read as M softmax groups."""
 
 from __future__ import annotations
 
@@ -14,6 +12,8 @@ from lookalike.trackers.lstm.encoding import EncodingSpec
 with needs("torch"):
     import torch
     from torch import nn
+
+_NAMES = (("weight_ih", "w_ih"), ("weight_hh", "w_hh"), ("bias_ih", "b_ih"), ("bias_hh", "b_hh"))  # torch, ours
 
 
 class AssociationNet(nn.Module):
@@ -53,33 +53,21 @@ class AssociationNet(nn.Module):
             raise ValueError(f"weights of (spec, cell, hidden, layers) {theirs} do not fit this network {mine}")
         with torch.no_grad():
             for i, layer in enumerate(weights.layers):
-                names = (("weight_ih", "w_ih"), ("weight_hh", "w_hh"), ("bias_ih", "b_ih"), ("bias_hh", "b_hh"))
-                for ours, key in names:
-                    getattr(self.rnn, f"{ours}_l{i}").copy_(torch.as_tensor(layer[key]))
+                for name, key in _NAMES:
+                    getattr(self.rnn, f"{name}_l{i}").copy_(torch.as_tensor(layer[key]))
             self.head.weight.copy_(torch.as_tensor(weights.head_weight))
             self.head.bias.copy_(torch.as_tensor(weights.head_bias))
         self.set_normalisation(weights.input_mean, weights.input_std)
 
     def export(self, info: dict | None = None) -> NetworkWeights:
         """The weights as numpy arrays for :class:`~lookalike.trackers.lstm.network.NumpyAssociationNet`."""
-        layers = []
-        for i in range(self.rnn.num_layers):
-            layers.append(
-                {name: getattr(self.rnn, f"{name}_l{i}").detach().cpu().double().numpy().copy()
-                 for name in ("weight_ih", "weight_hh", "bias_ih", "bias_hh")}
-            )
-        layers = [
-            {"w_ih": lay["weight_ih"], "w_hh": lay["weight_hh"], "b_ih": lay["bias_ih"], "b_hh": lay["bias_hh"]}
-            for lay in layers
-        ]
+        def array(t: torch.Tensor) -> np.ndarray:
+            return t.detach().cpu().double().numpy().copy()
+
+        layers = [{key: array(getattr(self.rnn, f"{name}_l{i}")) for name, key in _NAMES}
+                  for i in range(self.rnn.num_layers)]
         return NetworkWeights(
-            spec=self.spec,
-            cell=self.cell,
-            hidden=self.hidden,
-            layers=layers,
-            head_weight=self.head.weight.detach().cpu().double().numpy().copy(),
-            head_bias=self.head.bias.detach().cpu().double().numpy().copy(),
-            input_mean=self.input_mean.cpu().numpy().copy(),
-            input_std=self.input_std.cpu().numpy().copy(),
-            info=dict(info or {}),
+            spec=self.spec, cell=self.cell, hidden=self.hidden, layers=layers, head_weight=array(self.head.weight),
+            head_bias=array(self.head.bias), input_mean=self.input_mean.cpu().numpy().copy(),
+            input_std=self.input_std.cpu().numpy().copy(), info=dict(info or {}),
         )

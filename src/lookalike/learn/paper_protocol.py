@@ -1,5 +1,4 @@
-"""Training arrays in the robot-identification paper's input layout (``N + 4·M``,
-:mod:`lookalike.trackers.lstm.encoding`; no augmentation beyond slot shuffling) and a sampler drawing each
+"""Training arrays in the robot-identification paper's input layout (``N + 4·M``) and a sampler drawing each
 sequence's noise model from its seed."""
 
 from __future__ import annotations
@@ -19,21 +18,19 @@ NOISE_CHOICES = ("ours", "paper", "mix")
 def arrays_to_training_paper(
     spec: EncodingSpec, arrays: RobotArrays, rng: np.random.Generator | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Inputs ``(T, N + 4·M)`` and targets ``(T, M)`` in the paper's layout from a simulated sequence;
-    with ``rng`` the occupied slots are shuffled per frame, else ordered most probable first."""
+    """Inputs ``(T, N + 4·M)`` and targets ``(T, M)`` in the paper's layout; slots ordered by ``slot_order``."""
     if spec.protocol != "paper":
         raise ValueError(f"arrays_to_training_paper needs an encoding of protocol 'paper', got {spec.protocol!r}")
     T, M = arrays.det_valid.shape
     if M != spec.n_slots:
         raise ValueError(f"the sequence has {M} detection slots, the encoding {spec.n_slots}")
     heading, _ = latest_reports(arrays, spec.n_agents)
-    valid = arrays.det_valid
     order = slot_order(arrays, rng)
 
     def take(a: np.ndarray) -> np.ndarray:
         return np.take_along_axis(a, order, axis=1)
 
-    v = take(valid)
+    v = take(arrays.det_valid)
     columns = [take(arrays.det_position[..., 0]), take(arrays.det_position[..., 1]),
                encode_agents_paper(take(arrays.det_heading)), take(arrays.det_score)]
     slots = np.stack(columns, axis=-1) * v[..., None]
@@ -45,8 +42,8 @@ def arrays_to_training_paper(
 
 @dataclasses.dataclass(frozen=True)
 class NoiseMixSampler:
-    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler: each sequence simulates one of
-    ``worlds`` (chosen from its seed, uniformly) and is encoded by ``spec``'s protocol."""
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler: each sequence simulates one of ``worlds``
+    (:func:`mix_pick`), encoded by ``spec``'s protocol."""
 
     worlds: tuple[RobotWorldConfig, ...]
     spec: EncodingSpec

@@ -1,9 +1,5 @@
-"""The simulator's detector model measured on labelled recordings, so that simulated sequences look like them.
-
-:func:`fit_sensor` measures :class:`~lookalike.sim.robots_config.SensorConfig`'s false positives per frame, detection
-probabilities over range, position noise ``std0 + std_per_m · distance``, heading flips and noise, and score
-distributions (Beta, by moments) on recordings that carry the simulator's truth (``true_position``, ``true_heading``,
-``visible``, ``occlusion``)."""
+"""The simulator's detector model (:class:`~lookalike.sim.robots_config.SensorConfig`) measured on labelled recordings
+that carry the simulator's truth."""
 
 from __future__ import annotations
 
@@ -63,8 +59,8 @@ def _linear_std(d: np.ndarray, err: np.ndarray) -> tuple[float, float]:
 
 
 def fit_sensor(recordings: Sequence[RobotArrays], base: SensorConfig, observer: ObserverConfig) -> SensorConfig:
-    """``base`` with the detector parameters measured on ``recordings`` (see the module); ``observer`` gives the range
-    limits of the detection-probability profile. ``ValueError`` when the recordings hold no detection of a robot."""
+    """``base`` with false positives, detection probabilities, position and heading noise and score Betas measured
+    on ``recordings``; ``ValueError`` when they hold no detection of a robot."""
     fp_count, frames = 0, 0
     tp_scores, fp_scores, features, detected = [], [], [], []
     dist, err_xy, err_heading = [], [], []

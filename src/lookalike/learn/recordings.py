@@ -1,7 +1,5 @@
-"""Training arrays from labelled recordings (``.labelled.jsonl`` exports, the simulator's format), for fine-tuning.
-Validation splits by recording, never by frame. A training window: the seed picks a recording (by length) and a start;
-the whole recording is encoded, slots shuffled, then cut to the window (short recordings padded with ignored empty
-frames)."""
+"""Training arrays from labelled recordings (``.labelled.jsonl``, the simulator's format) for fine-tuning; validation
+splits by recording."""
 
 from __future__ import annotations
 
@@ -26,8 +24,7 @@ def recording_arrays(spec: EncodingSpec, arrays: RobotArrays, rng: np.random.Gen
 
 
 def check_recordings(spec: EncodingSpec, recordings: Sequence[RobotSequence], names: Sequence[str]) -> None:
-    """``ValueError`` naming the first recording whose N or M differs from the network's, or that has no
-    labelled detection."""
+    """``ValueError`` naming the first recording whose N or M differs from the network's, or without detections."""
     for rec, name in zip(recordings, names):
         n, m = rec.config.n_agents, rec.config.max_detections
         if (n, m) != (spec.n_agents, spec.n_slots):
@@ -38,8 +35,8 @@ def check_recordings(spec: EncodingSpec, recordings: Sequence[RobotSequence], na
 
 
 def split_recordings(n: int, validation_fraction: float, seed: int = 0) -> tuple[list[int], list[int]]:
-    """Indices ``(training, validation)`` of ``n`` recordings: a seeded draw of ``round(fraction·n)``
-    (at least one) recordings for validation. ``ValueError`` with fewer than two recordings."""
+    """Indices ``(training, validation)`` of ``n`` >= 2 recordings, ``round(fraction·n)`` (at least one) for
+    validation."""
     if n < 2:
         raise ValueError(f"need at least 2 recordings for a validation split by recording, got {n}")
     if not 0.0 < validation_fraction < 1.0:
@@ -60,10 +57,8 @@ def _pad(x: np.ndarray, y: np.ndarray, length: int) -> tuple[np.ndarray, np.ndar
 
 @dataclass(frozen=True)
 class RecordingSampler:
-    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler of windows of ``recordings`` (see the module).
-
-    ``sim_fraction``: share of the sequences simulated in ``world`` instead (drawn from the seed; rehearsal of the
-    simulator's sequences, which keeps a few recordings from being learnt by heart)."""
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler of windows of ``recordings`` (the seed picks one by
+    length and a start; short ones padded); ``sim_fraction``: share simulated in ``world`` instead."""
 
     spec: EncodingSpec
     recordings: tuple[RobotArrays, ...]

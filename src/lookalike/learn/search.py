@@ -1,9 +1,5 @@
-"""Hyper-parameter search for the LSTM associator with Optuna: ``hidden``, ``num_layers`` and ``learning_rate`` drawn in
-log space (TPE or random), each trial one training run scored on the validation seeds. The chosen network is scored
-again on other held-out seeds (:data:`CHECK_SEED_BASE`), the figure that estimates how the choice does on new sequences.
-
-Trials run on :class:`lookalike.parallel.JobPool`, each in its own ``trial-NNNN`` folder; with an Optuna storage URL a
-rerun continues the study up to the requested trials."""
+"""Hyper-parameter search for the LSTM associator with Optuna (``hidden``, ``num_layers``, ``learning_rate`` in log
+space): each trial a training run scored on the validation seeds; the choice scored again on :data:`CHECK_SEED_BASE`."""
 
 from __future__ import annotations
 
@@ -67,8 +63,7 @@ class SearchSpace:
 
 @dataclass(frozen=True)
 class SearchResult:
-    """The outcome of :func:`run_search`: the chosen hyper-parameters, their validation success rate (the
-    criterion they were chosen on), their success rate on the check seeds, and where things were written."""
+    """The outcome of :func:`run_search`: the choice, its validation and check-seed success rates, the files."""
 
     params: dict[str, Any]
     value: float
@@ -83,8 +78,7 @@ class SearchResult:
 
 
 def run_trial(config: Any, world: RobotWorldConfig, out_dir: str, threads: int = 1) -> dict[str, Any]:
-    """One training run (a job: picklable, its result depends on its arguments only): ``{"value", "step",
-    "steps", "seconds"}``, or ``{"error"}`` when the configuration fails."""
+    """One training run (a picklable job): ``{"value", "step", "steps", "seconds"}``, or ``{"error"}``."""
     with needs("torch"):
         import torch
 
@@ -102,8 +96,7 @@ def run_trial(config: Any, world: RobotWorldConfig, out_dir: str, threads: int =
 
 
 def check_success(weights_path: Path, world: RobotWorldConfig, sequences: int, length: int) -> float:
-    """Per-slot success rate of the network at ``weights_path`` on ``sequences`` sequences of ``length``
-    frames from the held-out check seeds (slots most probable first, as at inference)."""
+    """Per-slot success rate of the network at ``weights_path`` on ``sequences`` check-seed sequences."""
     from lookalike.learn.data import success_rate
     from lookalike.learn.sim_data import make_sim_sampler
     from lookalike.trackers.lstm.checkpoint import load_weights
@@ -151,10 +144,8 @@ def run_search(base: Any, world: RobotWorldConfig, out_dir: str | Path, trials: 
                study_name: str = "lstm", workers: int = 1, backend: str = "local", address: str | None = None,
                threads: int = 1, check_sequences: int = 8,
                progress: Callable[[int, int, dict[str, Any]], None] | None = None) -> SearchResult:
-    """Search ``trials`` trials in all (a continued study runs only the missing ones) around the base
-    :class:`~lookalike.learn.training.TrainConfig` ``base`` on the robot world ``world``; write each trial
-    into ``out_dir/trial-NNNN``, the chosen network to ``out_dir/model.npz`` and the choice to
-    ``out_dir/search.json``. ``progress(done, trials, row)`` is called after each finished trial."""
+    """Run ``trials`` trials in all (a continued study only the missing ones) around ``base`` (a ``TrainConfig``);
+    write ``out_dir/trial-NNNN``, ``model.npz`` and ``search.json``; ``progress(done, trials, row)`` after each."""
     with needs("optuna"):
         from optuna.trial import TrialState
 

@@ -1,12 +1,6 @@
-"""Training arrays for the set associator (any team size), straight from the robot simulator.
-
-Unlike the LSTM's flat input vector (:mod:`lookalike.trackers.lstm.encoding`), the set associator reads
-tokens: per agent ``cos ψ, sin ψ, age / max_age, known`` (the latest reported absolute heading
-``ψ``, the report's age in seconds clipped to ``max_age_s``, 1 if heard from else 0) and per
-detection ``x, y, cos φ, sin φ, γ`` (observer-frame position in metres, absolute visual heading,
-detector probability). A team size ``(N, M, false positives per frame)`` is drawn per batch
-from the batch's seed, so every batch is a pure function of its seed.
-"""
+"""Training arrays for the set associator (any team size) from the robot simulator: agent tokens
+``cos ψ, sin ψ, age / max_age, known`` and detection tokens ``x, y, cos φ, sin φ, γ`` (metres, observer frame).
+A team size ``(N, M, false positives per frame)`` is drawn per batch from its seed."""
 
 from __future__ import annotations
 
@@ -30,13 +24,12 @@ def arrays_to_tokens(
     T, M = arrays.det_valid.shape
     heading, sent = latest_reports(arrays, n_agents)
     agents = agent_tokens(heading, arrays.time[:, None] - sent)
-    valid = arrays.det_valid
     order = slot_order(arrays, rng)
 
     def take(a: np.ndarray) -> np.ndarray:
         return np.take_along_axis(a, order, axis=1)
 
-    v = take(valid)
+    v = take(arrays.det_valid)
     pos = np.stack([take(arrays.det_position[..., 0]), take(arrays.det_position[..., 1])], axis=-1)
     dets = detection_tokens(pos, take(arrays.det_heading), take(arrays.det_score)) * v[..., None]
     label = take(arrays.det_label)
@@ -95,26 +88,14 @@ def closest_headings(arrays: RobotArrays, at_s: float) -> tuple[int, int]:
 
 @dataclasses.dataclass(frozen=True)
 class SetBatchMaker:
-    """A picklable ``(seed, batch_size, n_frames) -> batch`` over team sizes ``sizes``.
+    """A picklable ``(seed, batch_size, n_frames) -> batch``: ``agents (B, T, N, 4)``, ``detections (B, T, M, 5)``,
+    ``valid (B, T, M)``, targets ``(B, T, M)`` and the frame interval (s).
 
-    A batch is ``agents (B, T, N, 4)``, ``detections (B, T, M, 5)``, ``valid (B, T, M)``, targets
-    ``(B, T, M)`` and the frame interval in seconds. With ``swap_prob`` two random robots exchange
-    identities for 1–10 s in that fraction of the sequences (:func:`~lookalike.learn.sim_data.swap_identities`).
-    ``swap_s``: the swap's duration range (seconds); with ``swap_ends`` the swap ends at least ``swap_ends``
-    seconds before the sequence does (the network sees the identities come back), else it starts in the
-    first 80% of the sequence and may outlast it. ``fixed``: one ``(N, M, fp)`` for every batch instead
-    of drawing from ``sizes``.
-
-    ``noises``: position-noise models (:data:`~lookalike.sim.NOISE_MODELS`, e.g. ``("ours", "paper")``),
-    one drawn per sequence from its seed (:func:`~lookalike.learn.sim_data.mix_pick`, as the LSTM's noise
-    mix); empty: the default world's noise. ``close_swap_prob``: the fraction of the swaps made between
-    the two robots whose true headings are closest when the swap starts (the pairs a heading report
-    hardly tells apart), instead of two random robots. ``silent_swap_prob``: the fraction of the swaps
-    (drawn after the pair) whose end falls inside a silence of one of the two agents: its reports sent from
-    0.2–1.5 s before the swap ends, for 1–3 s, are dropped (:func:`~lookalike.learn.sim_data.silence_agent`),
-    so that the network learns to move an agent's memory when it reports again. Their defaults draw the same
-    batches as before.
-    """
+    ``swap_prob``: fraction of sequences where two robots exchange identities for ``swap_s`` seconds (ending
+    ``swap_ends`` s before the sequence's end when given). ``fixed``: one ``(N, M, fp)`` instead of ``sizes``.
+    ``noises``: position-noise models, one drawn per sequence. ``close_swap_prob``: fraction of swaps between the
+    two robots with the closest true headings. ``silent_swap_prob``: fraction of swaps ending inside a 1–3 s
+    silence of one of the two agents."""
 
     sizes: TeamSizes = TeamSizes()
     swap_prob: float = 0.0
@@ -129,10 +110,9 @@ class SetBatchMaker:
         unknown = [x for x in self.noises if x not in NOISE_MODELS]
         if unknown:
             raise ValueError(f"SetBatchMaker: unknown noise models {unknown}; known: {', '.join(NOISE_MODELS)}")
-        if not 0.0 <= self.close_swap_prob <= 1.0:
-            raise ValueError(f"SetBatchMaker: close_swap_prob must lie in [0, 1], got {self.close_swap_prob}")
-        if not 0.0 <= self.silent_swap_prob <= 1.0:
-            raise ValueError(f"SetBatchMaker: silent_swap_prob must lie in [0, 1], got {self.silent_swap_prob}")
+        for name in ("close_swap_prob", "silent_swap_prob"):
+            if not 0.0 <= getattr(self, name) <= 1.0:
+                raise ValueError(f"SetBatchMaker: {name} must lie in [0, 1], got {getattr(self, name)}")
 
     def world_of(self, cfg: RobotWorldConfig, seed: int) -> RobotWorldConfig:
         """The world of the sequence of ``seed``: ``cfg`` with the noise model :attr:`noises` draws for it."""

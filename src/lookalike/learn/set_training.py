@@ -1,12 +1,5 @@
-"""Training the set associator once over a range of team sizes (needs torch).
-
-The LSTM's machinery (:mod:`lookalike.learn.training`): batches generated ahead by a
-:class:`~lookalike.parallel.JobPool` (processes or Ray), each a pure function of its seed; Adam
-with ``lr / (1 + decay·t)``; truncated back-propagation through time; validation on fixed
-held-out seeds every ``validation_every`` steps; early stopping; a resumable checkpoint and a CSV
-log. Every batch draws its own team size (N, M, false positives per frame) from ``TeamSizes``;
-validation averages the success rate over :data:`VALIDATION_TEAMS`.
-"""
+"""Training the set associator over a range of team sizes (needs torch), with the LSTM's machinery
+(:mod:`lookalike.learn.training`); validation averages the success rate over :data:`VALIDATION_TEAMS`."""
 
 from __future__ import annotations
 
@@ -118,8 +111,7 @@ def validate(model: SetAssociator, batches: list[tuple], device: str = "cpu") ->
 
 
 def _run_shape(config: dict) -> dict:
-    """The configuration without the stopping rules and the learning rate (a run may be resumed with
-    more steps or minutes, or cooled down at a lower learning rate)."""
+    """The configuration without the stopping rules and the learning rate (which a resumed run may change)."""
     return {k: v for k, v in config.items()
             if k not in ("steps", "minutes", "patience", "learning_rate", "keep_snapshots")}
 
@@ -140,8 +132,7 @@ def _new_model(config: SetTrainConfig, init: SetWeights | None) -> SetAssociator
 
 
 def _trained(model: nn.Module, prefixes: tuple[str, ...]) -> list[nn.Parameter]:
-    """The parameters of ``model`` whose names start with one of ``prefixes`` (all when empty); the others are
-    frozen (``requires_grad`` off)."""
+    """The parameters of ``model`` whose names start with one of ``prefixes`` (all when empty); the others frozen."""
     if not prefixes:
         return list(model.parameters())
     kept = []

@@ -1,7 +1,4 @@
-"""Training arrays straight from the robot simulator's arrays (vectorised over time).
-
-Optional augmentation (ours): in a share of the sequences two robots exchange reports for a while and the targets swap
-with them, so the network learns to re-identify when reports contradict its memory."""
+"""Training arrays from the robot simulator's arrays (vectorised over time), with optional identity swaps."""
 
 from __future__ import annotations
 
@@ -15,8 +12,7 @@ from lookalike.trackers.lstm.encoding import AGENT_WIDTH, EncodingSpec, encode_a
 
 
 def slot_order(arrays: RobotArrays, rng: np.random.Generator | None) -> np.ndarray:
-    """Per frame, the detection slots ``(T, M)`` with the occupied ones first: by score (highest
-    first), or shuffled with ``rng`` (a network must not rely on the slots' order)."""
+    """Per frame, the detection slots ``(T, M)`` with the occupied ones first: by score, or shuffled with ``rng``."""
     valid = arrays.det_valid
     key = -arrays.det_score if rng is None else rng.random(valid.shape)
     order: np.ndarray = np.argsort(np.where(valid, key, np.inf), axis=1, kind="stable")
@@ -24,9 +20,8 @@ def slot_order(arrays: RobotArrays, rng: np.random.Generator | None) -> np.ndarr
 
 
 def latest_reports(arrays: RobotArrays, n_agents: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per frame and agent, the newest report received so far (by send time): headings and send
-    times ``(T, N)``, NaN where nothing was received yet. Late reports older than the kept one are
-    ignored, as :class:`~lookalike.trackers.parts.agents.BeaconMemory` does at inference."""
+    """Per frame and agent, the newest report (by send time) received so far: headings and send times ``(T, N)``,
+    NaN where nothing was received yet."""
     r = arrays.reports
     T = len(arrays)
     heading = np.full((T, n_agents), np.nan)
@@ -50,10 +45,8 @@ def latest_reports(arrays: RobotArrays, n_agents: int) -> tuple[np.ndarray, np.n
 def arrays_to_training(
     spec: EncodingSpec, arrays: RobotArrays, rng: np.random.Generator | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Inputs ``(T, n_inputs)`` and targets ``(T, M)`` from a simulated sequence.
-
-    Equal to the frame-by-frame oracle (tests/learn_oracle.py) on the same sequence's frames; with ``rng`` the occupied
-    slots are shuffled per frame, else ordered most probable first."""
+    """Inputs ``(T, n_inputs)`` and targets ``(T, M)`` from a simulated sequence; slots ordered by
+    :func:`slot_order`."""
     T, M = arrays.det_valid.shape
     if M != spec.n_slots:
         raise ValueError(f"the sequence has {M} detection slots, the encoding {spec.n_slots}")
@@ -61,11 +54,9 @@ def arrays_to_training(
     x = np.zeros((T, spec.n_inputs))
     n_agent_inputs = AGENT_WIDTH * spec.n_agents
     x[:, :n_agent_inputs] = encode_agents(spec, heading, arrays.time[:, None] - sent)
-    valid = arrays.det_valid
-    key = -arrays.det_score if rng is None else rng.random((T, M))
-    order = np.argsort(np.where(valid, key, np.inf), axis=1, kind="stable")
+    order = slot_order(arrays, rng)
     take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
-    v = take(valid)
+    v = take(arrays.det_valid)
     phi = take(arrays.det_heading)
     columns = [take(arrays.det_position[..., 0])[..., None], take(arrays.det_position[..., 1])[..., None],
                np.cos(phi)[..., None], np.sin(phi)[..., None], take(arrays.det_score)[..., None]]
@@ -79,9 +70,8 @@ def arrays_to_training(
 
 
 def swap_identities(arrays: RobotArrays, a: int, b: int, start_s: float, stop_s: float) -> RobotArrays:
-    """``arrays`` with robots ``a`` and ``b`` sending each other's reports from ``start_s`` to
-    ``stop_s`` (send time, seconds); detection labels of ``a`` and ``b`` swap on the frames whose
-    newest received report of ``a`` or ``b`` was sent in that interval."""
+    """``arrays`` with robots ``a`` and ``b`` sending each other's reports from ``start_s`` to ``stop_s`` (send time,
+    s); their detection labels swap on the frames whose newest received report of either was sent then."""
     r = arrays.reports
     sent_in = (r.t_sent >= start_s) & (r.t_sent < stop_s)
     agent = r.agent_id.copy()
@@ -96,8 +86,7 @@ def swap_identities(arrays: RobotArrays, a: int, b: int, start_s: float, stop_s:
 
 
 def silence_agent(arrays: RobotArrays, agent: int, start_s: float, stop_s: float) -> RobotArrays:
-    """``arrays`` without the reports ``agent`` sent from ``start_s`` to ``stop_s`` (seconds): a lost burst
-    of one agent's reports. Detections and their labels are unchanged."""
+    """``arrays`` without the reports ``agent`` sent from ``start_s`` to ``stop_s`` (seconds)."""
     r = arrays.reports
     keep = ~((r.agent_id == agent) & (r.t_sent >= start_s) & (r.t_sent < stop_s))
     kept_before = np.concatenate([[0], np.cumsum(keep)])  # rows kept among the first k
@@ -109,10 +98,8 @@ def silence_agent(arrays: RobotArrays, agent: int, start_s: float, stop_s: float
 
 @dataclasses.dataclass(frozen=True)
 class SimSampler:
-    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler over the robot world ``config``.
-
-    ``swap_prob``: fraction of sequences in which two random robots swap identities for 1–10 s
-    (:func:`swap_identities`), drawn from the sequence's seed."""
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler over ``config``; ``swap_prob``: fraction of sequences
+    in which two random robots swap identities for 1–10 s."""
 
     config: RobotWorldConfig
     relative: bool = True
@@ -142,9 +129,8 @@ def mix_pick(seed: int, count: int) -> int:
 
 @dataclasses.dataclass(frozen=True)
 class WorldMixSampler:
-    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler: each sequence is made by one of
-    ``samplers`` (e.g. one world per noise model, each with its identity swaps), chosen from its
-    seed uniformly, with the same draw as :class:`~lookalike.learn.paper_protocol.NoiseMixSampler`."""
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler: each sequence from one of ``samplers``, chosen by
+    :func:`mix_pick`."""
 
     samplers: tuple[SimSampler, ...]
 

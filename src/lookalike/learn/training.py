@@ -1,9 +1,6 @@
-"""Training the association network on simulated sequences (needs torch).
-
-Adam with the paper's schedule (``lr_t = lr / (1 + 1e-4·t)``), L2 weight decay, truncated BPTT over 150 steps, slot
-shuffling, validation on fixed held-out seeds, early stopping, resumable checkpoints and a CSV log. Each sequence is a
-pure function of its seed, so batches can be made ahead in worker processes (:class:`~lookalike.parallel.JobPool`) with
-the same result."""
+"""Training the association network on simulated sequences (needs torch): Adam with ``lr / (1 + decay·t)``, truncated
+BPTT, validation on fixed held-out seeds, early stopping, resumable checkpoints, a CSV log; batches are pure functions
+of their seeds, made ahead by a :class:`~lookalike.parallel.JobPool`."""
 
 from __future__ import annotations
 
@@ -108,12 +105,8 @@ def _train_seeds(config: TrainConfig, step: int) -> np.ndarray:
 
 def _train_chunks(model: Any, xt: Any, yt: Any, config: TrainConfig, n_classes: int, loss_fn: Any, optimiser: Any,
                   schedule: Any) -> list[float]:
-    """One optimisation step per ``bptt`` chunk of the batch (truncated backpropagation through time); the losses.
-    A chunk without a label (padding past a recording shorter than the sequence) only carries the state on: its loss
-    would be NaN."""
-    with needs("torch"):
-        from torch import nn
-
+    """One optimisation step per ``bptt`` chunk of the batch; the losses. A chunk without a label only carries the
+    state on."""
     state_h, losses = None, []
     for lo in range(0, config.sequence_length, config.bptt):
         target = yt[:, lo : lo + config.bptt]
@@ -146,10 +139,8 @@ def train(
     info: dict | None = None,
 ) -> TrainResult:
     """Train on sequences from ``sample(seed, n_frames, rng)``; write weights, checkpoint and log to ``out_dir``.
-
-    ``pool`` generates batches ahead; ``init`` starts from exported weights of the same shape (validated first, so the
-    weights kept are never worse than them); ``validation_sample`` or ``validation`` (a batch ``(B, T, n_inputs), (B, T,
-    M)``) set the validation data; ``info`` is added to the exported metadata."""
+    ``init``: exported weights of the same shape to start from (validated first); ``validation_sample`` or
+    ``validation`` (``(B, T, n_inputs), (B, T, M)``) set the validation data; ``info`` goes into the metadata."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     torch.manual_seed(config.seed)
@@ -182,7 +173,7 @@ def train(
         step, best, best_step, history = state["step"], state["best"], state["best_step"], state["history"]
     started = time.monotonic()
     extra = dict(info or {})
-    notify = on_step or _ignore
+    notify = on_step or (lambda row: None)
     if init is not None and not history:  # the starting weights are the first candidate
         best = _validate(model, val_xt, val_y)
         history.append({"step": 0, "loss": math.nan, "lr": config.learning_rate, "val_success": best, "seconds": 0.0})
@@ -235,9 +226,6 @@ def train(
         _write_log(log_path, history)
     return TrainResult(best, best_step, step, weights_path, log_path, history)
 
-
-def _ignore(row: dict) -> None:
-    del row
 
 
 def _write_log(path: Path, history: list[dict]) -> None:

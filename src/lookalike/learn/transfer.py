@@ -1,9 +1,4 @@
-"""Warm start across set-ups: weights trained for (N, M) mapped onto a network for (N', M').
-
-Layers above the first are copied; the first layer's input columns and the output head are mapped block by block (new
-agent ``j`` from source agent ``j mod N``, slot ``k`` from ``k mod M``, the false-positive class from the source's),
-repeated blocks jittered by ``jitter`` times the block's spread. Input normalisation comes from the new set-up's
-``mean``/``std``."""
+"""Warm start across set-ups: weights trained for (N, M) mapped onto a network for (N', M')."""
 
 from __future__ import annotations
 
@@ -57,8 +52,9 @@ def transfer_weights(
     jitter: float = 0.1,
     info: dict | None = None,
 ) -> NetworkWeights:
-    """``weights`` mapped onto ``target``'s set-up (see the module docstring); ``mean``/``std``
-    ``(target.n_inputs,)`` are the new input normalisation (raw input units)."""
+    """``weights`` mapped onto ``target``'s set-up: upper layers copied; first-layer input columns and output head
+    mapped block by block (agent ``j`` from ``j mod N``, slot ``k`` from ``k mod M``), repeated blocks jittered by
+    ``jitter`` × the block's spread. ``mean``/``std`` ``(target.n_inputs,)``: the new input normalisation."""
     source = weights.spec
     if source.protocol != target.protocol:
         raise CheckpointError(f"cannot transfer weights of protocol {source.protocol!r} to {target.protocol!r}")

@@ -1,7 +1,5 @@
-"""Training data for the robot vision models: for the detector (``lookalike train-detector``), windows
-of rendered robots (:mod:`lookalike.sim.render_robots`) or of a folder of images, negative sampling and
-held-out scenes; for the heading classifier (``lookalike train-heading``), features and true headings of
-rendered robots (:func:`rendered_heading_samples`)."""
+"""Training data for the robot detector (rendered or folder windows, negatives, held-out scenes) and the heading
+classifier (features and true headings of rendered robots)."""
 
 from __future__ import annotations
 
@@ -47,8 +45,7 @@ def rendered_detector_data(
 
 
 def _rendered_frames(n_frames: int, seed: int, camera: Camera | None = None) -> Iterator[Any]:
-    """Rendered frames of 1-4 robots 1-5 m ahead (depth), across a little more than the field of view,
-    random headings. Deterministic by ``seed``."""
+    """Rendered frames of 1-4 robots 1-5 m ahead, a little beyond the field of view, random headings."""
     from lookalike.geometry.camera import Camera
     from lookalike.sim.render_robots import RobotRenderer
 
@@ -141,15 +138,12 @@ def _no_step(description: str, total: int) -> Callable[[int, str], None]:
 
 def train_robot_detector(data: Path | None, frames: int, stages: int, negatives: int, copies: int, seed: int,
                          validation_frames: int, step: Step = _no_step) -> tuple[Any, int, list[Any]]:
-    """Train the HOG cascade on ``data`` (``positives/`` and ``negatives/``) or ``frames`` rendered frames (``copies``
-    augmented copies per positive), then keep the cascade prefix with the best held-out F1 on ``validation_frames``
-    renders (0: keep all). ``step(description, total)`` gives each phase's ``progress(done, note)``. Returns ``(model,
-    stages trained, candidates tried)``."""
+    """Train the HOG cascade on ``data`` (``positives/``, ``negatives/``) or ``frames`` rendered frames, keep the
+    prefix with the best held-out F1 on ``validation_frames`` renders; ``(model, stages trained, candidates tried)``."""
     from lookalike.vision.hog_cascade import CascadeConfig, train_cascade
     from lookalike.vision.hog_features import augment_windows
     from lookalike.vision.hog_select import select_stages
 
-    # Folder positives fill their whole window; rendered ones carry the default context margin.
     config = CascadeConfig(stages=stages, negatives_per_stage=negatives)
     if data is not None:
         config = dataclasses.replace(config, context_pad=0.0)
@@ -173,7 +167,6 @@ def train_robot_detector(data: Path | None, frames: int, stages: int, negatives:
         pos = np.concatenate([pos, np.pad(extra, ((0, 0), (1, 1), (1, 1)), mode="edge")])
     sampler = negative_sampler(neg_images, truths, config.window_px, heights)
     training = step(f"training on {len(pos)} positives", stages)
-    # Hard negatives are also mined from whole frames (windows the cascade accepts away from robots).
     model = train_cascade(pos, sampler, config, seed=seed, progress=lambda k, message: training(k + 1, message),
                           scenes=list(zip(neg_images, truths)))
     trained, tried = len(model.stages), list[Any]()
@@ -194,10 +187,8 @@ def rendered_heading_samples(
     box_jitter: float = 0.05,
     camera: Camera | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Features ``(n, d)`` and true egocentric headings ``(n,)`` (rad) of robots rendered by
-    :class:`lookalike.sim.render_robots.RobotRenderer` at random places ``range_m`` (m) ahead inside the
-    field of view with random headings. Robots less than ``min_visible`` visible are skipped; boxes get a
-    Gaussian jitter of ``box_jitter`` × their size, as a detector's would. Deterministic by ``seed``."""
+    """Features ``(n, d)`` and true egocentric headings ``(n,)`` (rad) of robots rendered ``range_m`` (m) ahead in the
+    field of view (at least ``min_visible`` visible), boxes jittered by ``box_jitter`` × their size."""
     from lookalike.geometry.camera import Camera
     from lookalike.sim.render_robots import RobotRenderer
 

@@ -1,9 +1,5 @@
-"""Look-alike divers drawn as camera images: body geometry, appearance and the renderer.
-
-A diver is a jointed figure (metres, x towards the head, y towards the back: torso, head, tank, kicking legs with fins,
-arms) projected with ``scale = focal_px / z``, mirrored by its facing and rotated by its pitch; colours fade towards the
-water with distance, far divers are blurred more, and nearer divers and bubbles occlude farther ones. OpenCV is imported
-lazily."""
+"""Look-alike divers drawn as camera images: a jointed figure (metres, x towards the head) projected with
+``scale = focal_px / z``, mirrored by facing, rotated by pitch, faded and blurred with distance."""
 
 from __future__ import annotations
 

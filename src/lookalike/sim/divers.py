@@ -1,11 +1,5 @@
-"""Look-alike divers seen by an underwater robot's camera (the diver-tracking paper's setting): scenarios, motion,
-rendered frames, ground truth (MOTChallenge rows) and a detector model.
-
-Divers swim with strokes, drift in distance (2.5–9 m), leave the view for long periods and come back; the camera drifts.
-A :class:`DiverScenario` is a frozen, seeded description; :func:`simulate_divers` makes the motion and
-:meth:`DiverScene.image` renders any frame on demand. :class:`DetectorModel` finds each visible diver with probability
-``recall · visibility``, jitters its box by ``box_noise`` and adds Poisson false positives (``false_positives`` per
-frame) on bubbles or anywhere."""
+"""Look-alike divers seen by an underwater robot's camera: seeded scenarios, motion (divers leave and come back, the
+camera drifts), frames rendered on demand, MOTChallenge ground truth and a detector model."""
 
 from __future__ import annotations
 
@@ -29,7 +23,7 @@ from lookalike.types import Detections, Frame
 
 @dataclass(frozen=True)
 class DetectorModel:
-    """Detector noise: nominal recall, false positives per frame, box jitter (fraction of size)."""
+    """Detector noise: recall (times visibility), Poisson false positives per frame, box jitter (fraction of size)."""
 
     recall: float = 0.85
     false_positives: float = 0.3

@@ -1,9 +1,4 @@
-"""Paper-hard detections for the diver scenarios (``bench divers --detections paper``), and new draws.
-
-:data:`PAPER_DETECTION` holds the diver-tracking paper's per-video detection precision and recall (Table 2), matched to
-our scenarios in order; :data:`PAPER_DETECTORS` are detector models whose recall and false-positive rate were set by
-bisection so each scenario's DP/DR (IoU 0.5) lands on the paper's figure on detector draw 0 (box jitter 0.10 of the box
-size)."""
+"""Paper-hard detections for the diver scenarios (``bench divers --detections paper``), and new draws."""
 
 from __future__ import annotations
 
@@ -23,7 +18,8 @@ PAPER_DETECTION: dict[str, tuple[float, float]] = {
     "pool_four_crossing": (63.2, 25.8),
 }
 
-#: Detector models reproducing :data:`PAPER_DETECTION` (recall, false positives per frame, box noise, min visibility).
+#: Detector models reproducing :data:`PAPER_DETECTION` at IoU 0.5 on detector draw 0 (recall, false positives per
+#: frame, box noise, min visibility).
 PAPER_DETECTORS: dict[str, DetectorModel] = {
     "ocean_pair_clear": DetectorModel(0.405, 0.643, 0.10, 0.3),
     "ocean_trio": DetectorModel(0.424, 0.617, 0.10, 0.3),

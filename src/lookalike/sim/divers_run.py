@@ -1,9 +1,5 @@
-"""Running appearance trackers on simulated diver scenarios: render, detect, extract features, track.
-
-Every tracker sees the same detections; features are chosen by name (:func:`diver_extractor`: ``handcrafted``,
-``learned`` or a ``FILE.onnx``). Hand-crafted standardisation is fitted on the validation scenarios
-(:func:`fit_diver_features`), never on the scored one; :func:`matched_thresholds` moves the trackers' cosine thresholds
-to another extractor by matching quantiles of same-diver distances."""
+"""Running appearance trackers on simulated diver scenarios: render, detect, extract features, track. Hand-crafted
+features are standardised on the validation scenarios, never on the scored one."""
 
 from __future__ import annotations
 
@@ -108,10 +104,8 @@ def same_diver_distances(extractor: FeatureExtractor, scenarios: tuple[DiverScen
 
 
 def matched_thresholds(extractor: FeatureExtractor, tracker: str) -> dict[str, float]:
-    """The tracker's cosine thresholds for ``extractor``: each hand-crafted threshold ``t`` becomes the
-    distance that lets through the same share of same-diver pairs on the validation scenarios
-    (quantile matching; read from the model's JSON when ``train-appearance`` stored them). Empty for
-    trackers without appearance thresholds and for the hand-crafted features themselves."""
+    """The tracker's cosine thresholds for ``extractor``, matched to the hand-crafted ones by quantiles of same-diver
+    distances on the validation scenarios (or as stored by ``train-appearance``); empty when not applicable."""
     names = HANDCRAFTED_THRESHOLDS.get(tracker)
     if not names or isinstance(extractor, HandcraftedFeatures):
         return {}
@@ -124,8 +118,7 @@ def matched_thresholds(extractor: FeatureExtractor, tracker: str) -> dict[str, f
 
 
 def stored_thresholds(extractor: FeatureExtractor) -> dict[str, dict[str, float]]:
-    """The matched thresholds that ``train-appearance`` stored in the JSON beside an ONNX model
-    (``matched_thresholds``: tracker -> parameter -> value); empty when there are none."""
+    """``matched_thresholds`` (tracker -> parameter -> value) stored in the JSON beside an ONNX model, or empty."""
     path = getattr(extractor, "path", None)
     meta = Path(path).with_suffix(".json") if path is not None else None
     if meta is None or not meta.is_file():
@@ -158,23 +151,15 @@ def prepare(sc: DiverScenario, extractor: FeatureExtractor, detector: DetectorMo
             detector_seed: int | None = None) -> PreparedScenario:
     """Simulate, render, detect (``detector``: the scenario's own by default) and extract the features
     of every detection of ``sc``."""
-    scene = simulate_divers(sc)
-    frames = []
-    for frame in scene.frames(detector, detector_seed):
-        det = frame.detections
-        assert det.xywh is not None  # simulated detections have boxes
-        feats = extractor(scene.image(frame.index), det.xywh) if len(det) else np.zeros((0, extractor.dim))
-        frames.append(Frame(index=frame.index, time=frame.time, detections=det.replace(feature=feats)))
-    return PreparedScenario(sc, scene, frames, scene.gt)
+    return prepare_features(sc, {"": extractor}, detector, detector_seed)[""]
 
 
-def prepare_features(sc: DiverScenario, extractors: dict[str, FeatureExtractor],
-                     detector: DetectorModel | None = None) -> dict[str, PreparedScenario]:
-    """:func:`prepare` for several feature sets at once (each frame rendered once): name -> scenario,
-    the same detections everywhere, only their features differ."""
+def prepare_features(sc: DiverScenario, extractors: dict[str, FeatureExtractor], detector: DetectorModel | None = None,
+                     detector_seed: int | None = None) -> dict[str, PreparedScenario]:
+    """:func:`prepare` for several feature sets at once (each frame rendered once): name -> scenario."""
     scene = simulate_divers(sc)
     frames: dict[str, list[Frame]] = {name: [] for name in extractors}
-    for frame in scene.frames(detector):
+    for frame in scene.frames(detector, detector_seed):
         det = frame.detections
         assert det.xywh is not None  # simulated detections have boxes
         image = scene.image(frame.index) if len(det) else None

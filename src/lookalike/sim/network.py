@@ -1,6 +1,4 @@
-"""Heading reports over a lossy network: send times, delay with jitter, losses and loss bursts.
-
-Everything is generated for a whole sequence at once with array operations."""
+"""Heading reports over a lossy network (delay with jitter, losses, loss bursts), for a whole sequence at once."""
 
 from __future__ import annotations
 
@@ -34,10 +32,8 @@ class ReportArrays:
 
 
 def _burst_mask(t_sent: np.ndarray, cfg: NetworkConfig, horizon_s: float, rng: np.random.Generator) -> np.ndarray:
-    """Whether each send time ``(n_agents, K)`` falls into a loss burst of that agent's link.
-
-    The link alternates between good periods (exponential, mean ``1 / burst_rate_hz``) and bursts (exponential, mean
-    ``burst_s``), starting in the stationary state."""
+    """Whether each send time ``(n_agents, K)`` falls into a loss burst of that agent's link (alternating exponential
+    good periods and bursts, from the stationary state)."""
     n_agents = t_sent.shape[0]
     if cfg.burst_rate_hz == 0 or cfg.burst_s == 0:
         return np.zeros(t_sent.shape, dtype=bool)
@@ -46,8 +42,7 @@ def _burst_mask(t_sent: np.ndarray, cfg: NetworkConfig, horizon_s: float, rng: n
     n_cycles = int(np.ceil(horizon_s / cycle * 2.0 + 10.0 * np.sqrt(horizon_s / cycle + 1.0))) + 4
     good = rng.exponential(mean_good, (n_agents, n_cycles))
     bad = rng.exponential(cfg.burst_s, (n_agents, n_cycles))
-    # Stationary start: begin inside a burst with probability burst_s / cycle, at a random offset
-    # (exponential durations are memoryless, so the residual has the same law).
+    # Stationary start: inside a burst with probability burst_s / cycle (memoryless durations).
     start_bad = rng.random(n_agents) < cfg.burst_s / cycle
     first = np.where(start_bad, 0.0, good[:, 0])
     durations = np.empty((n_agents, 2 * n_cycles))

@@ -21,8 +21,7 @@ DEFAULT_NOISE = "ours"
 
 
 def noise_sensor(noise: str, base: SensorConfig | None = None) -> SensorConfig:
-    """``base`` (default :class:`SensorConfig`) with the position noise of model ``noise``
-    (``"paper"`` or ``"ours"``, see the module docstring); others raise ``ValueError``."""
+    """``base`` (default :class:`SensorConfig`) with the position noise of ``"paper"`` or ``"ours"``."""
     sensor = base or SensorConfig()
     ours = SensorConfig()
     if noise == "ours":
@@ -35,8 +34,7 @@ def noise_sensor(noise: str, base: SensorConfig | None = None) -> SensorConfig:
 
 
 def preset(name: str, noise: str = DEFAULT_NOISE) -> RobotWorldConfig:
-    """The scenario named ``name`` (``m3n2``, ``m5n3`` or ``m10n7``) with noise model ``noise``
-    (``"paper"`` or ``"ours"``); other names raise ``ValueError``."""
+    """The scenario ``m3n2``, ``m5n3`` or ``m10n7`` with noise model ``noise``."""
     try:
         m, n, fp = _SETUPS[name]
     except KeyError:

@@ -1,10 +1,5 @@
-"""Identical humanoid robots on a football field, drawn through the camera model.
-
-Each robot is a set of coloured cuboids (legs, torso with chest plate and backpack, arms, head with a visor) posed by
-its ground position and heading and projected with :class:`lookalike.geometry.Camera`, painted far to near so robots
-hide one another; only the torso's view tells the heading. The field (centre at the origin, ``field_m``) is seen from
-the observer's :class:`~lookalike.geometry.Pose2D`, with seeded brightness and colour drift, blur and noise. Ground
-truth per robot: box, visible fraction, egocentric position and heading, id. OpenCV is imported lazily."""
+"""Identical humanoid robots (coloured cuboids, painted far to near) on a football field, drawn through
+:class:`lookalike.geometry.Camera` with seeded lighting drift, blur and noise; with per-robot ground truth."""
 
 from __future__ import annotations
 
@@ -160,13 +155,9 @@ class RobotRenderer:
             rows.append((i, box, min(1.0, count / max(full_area[i], 1.0))))
         sel = np.array([r[0] for r in rows], dtype=int)
         return RenderedFrame(
-            image=img,
-            robot_id=sel,
-            xywh=np.array([r[1] for r in rows], dtype=float).reshape(-1, 4),
-            xywh_full=full_boxes[sel].reshape(-1, 4),
-            visible=np.array([r[2] for r in rows], dtype=float),
-            position_m=ego[sel].reshape(-1, 2),
-            heading_rad=ego_heading[sel],
+            image=img, robot_id=sel, xywh=np.array([r[1] for r in rows], dtype=float).reshape(-1, 4),
+            xywh_full=full_boxes[sel].reshape(-1, 4), visible=np.array([r[2] for r in rows], dtype=float),
+            position_m=ego[sel].reshape(-1, 2), heading_rad=ego_heading[sel],
         )
 
     def _robot_polygons(
@@ -234,8 +225,7 @@ class RobotRenderer:
 def random_walk_poses(
     n_frames: int, n_robots: int, seed: int, field_m: tuple[float, float] = (9.0, 6.0), dt_s: float = 0.1
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Bounded random omnidirectional motion on the field: positions ``(T, N, 2)`` (m) and headings ``(T, N)``
-    (rad) in the fixed frame, for rendering without the full world simulator."""
+    """Bounded random motion on the field: fixed-frame positions ``(T, N, 2)`` (m) and headings ``(T, N)`` (rad)."""
     if n_frames < 1 or n_robots < 0:
         raise ValueError(f"n_frames/n_robots: need n_frames >= 1 and n_robots >= 0, got {n_frames}, {n_robots}")
     rng = np.random.default_rng(seed)

@@ -1,9 +1,6 @@
 """The robot world of Farazi and Behnke (IROS 2017): identical robots seen by an observer, heading reports.
-
-:func:`simulate_arrays` makes a whole sequence with array operations over time and returns :class:`RobotArrays`;
-:class:`RobotSequence` wraps them and builds :class:`~lookalike.types.Frame` objects lazily. Detections are in the
-observer frame (metres) with absolute visual headings (radians), in random order within a frame; their ``label`` is the
-truth and must not be read by trackers."""
+Detections are in the observer frame (metres) with absolute visual headings (radians), in random order within a frame;
+their ``label`` is the truth, never read by trackers."""
 
 from __future__ import annotations
 
@@ -90,8 +87,7 @@ def simulate_arrays(config: RobotWorldConfig, n_frames: int, seed: int) -> Robot
     detected = rng.random((T, N)) < p_det
 
     # True positives: noisy positions, classifier-like headings, scores lowered by occlusion.
-    std = position_noise_std(dist, sensor)
-    tp_pos = rel + rng.normal(size=rel.shape) * std
+    tp_pos = rel + rng.normal(size=rel.shape) * position_noise_std(dist, sensor)
     tp_head = visual_heading(heading_unwrapped, bearing + pose[:, 2:3], sensor, rng)
     tp_score = rng.beta(*sensor.tp_score_beta, (T, N)) * (1.0 - 0.5 * occlusion)
 
@@ -141,9 +137,7 @@ class RobotSequence:
     """A simulated sequence: its scenario, seed and arrays, with frames built on demand."""
 
     def __init__(self, config: RobotWorldConfig, seed: int, arrays: RobotArrays) -> None:
-        self.config = config
-        self.seed = seed
-        self.arrays = arrays
+        self.config, self.seed, self.arrays = config, seed, arrays
 
     def __len__(self) -> int:
         return len(self.arrays)

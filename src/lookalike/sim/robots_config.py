@@ -1,7 +1,5 @@
-"""Frozen configuration of the robot world: field, observer, motion, sensors, network.
-
-Units: metres, seconds, radians; rates per second unless the name says ``per_frame``. The observer frame is x forward, y
-left (metres), headings are absolute (world) in (-π, π]."""
+"""Frozen configuration of the robot world. Units: metres, seconds, radians; rates per second unless the name says
+``per_frame``. Observer frame: x forward, y left; headings absolute in (-π, π]."""
 
 from __future__ import annotations
 
@@ -22,12 +20,8 @@ def _require(owner: str, name: str, value: float, low: float, high: float = math
 
 @dataclass(frozen=True)
 class MotionConfig:
-    """Random bounded omnidirectional motion, piecewise by behaviour segments.
-
-    Each robot switches behaviour after exponentially distributed times (mean ``segment_s``): walk (random velocity up
-    to ``max_speed_mps``), stand still, turn on the spot (random turn rate up to ``max_turn_rate``), or walk while
-    turning; probabilities in that order. Velocity follows its target with a first-order lag so that acceleration stays
-    below ``max_accel``."""
+    """Random bounded omnidirectional motion: behaviour segments (mean ``segment_s``) of walk, stand, turn or walk while
+    turning (probabilities in that order); velocity follows its target with acceleration below ``max_accel``."""
 
     max_speed_mps: float = 0.5
     max_accel_mps2: float = 0.8
@@ -54,11 +48,8 @@ class MotionConfig:
 
 @dataclass(frozen=True)
 class ObserverConfig:
-    """The observer's camera: fixed position on the field, a slowly panning yaw.
-
-    ``position_m`` is in field coordinates (origin at the centre, x along the length). The yaw is ``yaw_rad`` plus a sum
-    of two sinusoids of amplitude ``pan_amplitude_rad`` (random phases), so robots leave and re-enter the ``fov_rad``
-    wide view."""
+    """The observer's camera at field position ``position_m`` (origin at the centre, x along the length); its yaw is
+    ``yaw_rad`` plus two sinusoids of amplitude ``pan_amplitude_rad`` (random phases)."""
 
     position_m: tuple[float, float] = (-4.3, 0.0)
     yaw_rad: float = 0.0
@@ -81,16 +72,12 @@ class ObserverConfig:
 class SensorConfig:
     """The detector and heading-classifier model.
 
-    Position noise is Gaussian in the observer frame, ``std = std0 + std_per_m · distance``. The defaults make it larger
-    along x (depth) than along y (across the image): our noise model, the reverse of Farazi and Behnke's, which is
-    larger across the image (:func:`lookalike.sim.presets.noise_sensor` makes either; ``preset(name, noise="paper")`` is
-    Farazi and Behnke's). The visual heading behaves like a 10-class classifier: with probability ``heading_flip_prob``
-    the front and back are confused (+π); the relative heading gets Gaussian noise ``heading_noise_rad`` and is then
-    snapped to the centre of its ``heading_classes`` bin (mean error ≈ 17° by default). Detection probability is
-    ``p_detect`` within ``best_range_m``, falling linearly to ``p_detect_far`` at the maximum range and to
-    ``p_detect_near`` at the minimum range, times ``1 - occlusion / occlusion_hide`` (0 once ``occlusion_hide`` of the
-    width is hidden). False positives: Poisson with mean ``fp_per_frame``, uniform over the visible sector. Scores are
-    Beta distributed, true positives ``tp_score_beta``, false positives ``fp_score_beta``."""
+    Position noise: Gaussian in the observer frame, ``std = std0 + std_per_m · distance`` (by default larger in depth;
+    :func:`lookalike.sim.presets.noise_sensor` makes the paper's). Visual heading: flipped (+π) with
+    ``heading_flip_prob``, Gaussian noise ``heading_noise_rad``, snapped to its ``heading_classes`` bin. Detection
+    probability: ``p_detect`` within ``best_range_m``, linear to ``p_detect_far``/``p_detect_near`` at the range limits,
+    times ``1 - occlusion / occlusion_hide``. False positives: Poisson ``fp_per_frame`` over the visible sector. Scores:
+    Beta ``tp_score_beta`` / ``fp_score_beta``."""
 
     std_x0_m: float = 0.05
     std_x_per_m: float = 0.04
@@ -130,12 +117,8 @@ class SensorConfig:
 
 @dataclass(frozen=True)
 class NetworkConfig:
-    """Heading reports over an unreliable network.
-
-    Every robot sends its IMU heading (noise ``imu_noise_rad``) at ``rate_hz`` with a random phase; each report is
-    delayed by ``delay_s`` plus an exponential jitter of mean ``jitter_s`` (so reports can arrive out of order), lost
-    independently with ``loss_prob``, and lost for sure during loss bursts: bursts start at ``burst_rate_hz`` (per
-    second of good link) and last an exponential time of mean ``burst_s``."""
+    """Heading reports (IMU noise ``imu_noise_rad``) sent at ``rate_hz``, delayed by ``delay_s`` plus exponential jitter
+    of mean ``jitter_s``, lost with ``loss_prob``, in bursts (from ``burst_rate_hz``, mean ``burst_s``)."""
 
     rate_hz: float = 10.0
     delay_s: float = 0.03
@@ -161,10 +144,8 @@ class NetworkConfig:
 
 @dataclass(frozen=True)
 class RobotWorldConfig:
-    """A robot-world scenario: N identical robots, an observer, at most M detections per frame.
-
-    ``max_detections`` is the set-up's M: when more are made, the M with the highest scores are kept. ``field_m`` is
-    (length, width) of the field in metres."""
+    """A robot-world scenario: N identical robots, an observer, at most M (``max_detections``, the best scores)
+    detections per frame on a ``field_m`` (length, width) field."""
 
     n_agents: int = 3
     max_detections: int = 5
@@ -199,13 +180,7 @@ class RobotWorldConfig:
         """Inverse of :meth:`to_dict`; unknown keys raise ``ValueError``."""
         parts = {"observer": ObserverConfig, "motion": MotionConfig, "sensor": SensorConfig,
                  "network": NetworkConfig}
-        kwargs: dict[str, Any] = {}
-        for key, value in data.items():
-            if key in parts:
-                kwargs[key] = _build(parts[key], value)
-            else:
-                kwargs[key] = value
-        return _build(cls, kwargs)
+        return _build(cls, {k: _build(parts[k], v) if k in parts else v for k, v in data.items()})
 
 
 def _build(cls: type, data: Mapping[str, Any]) -> Any:

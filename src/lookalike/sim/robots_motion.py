@@ -29,12 +29,8 @@ def simulate_motion(
     cfg: MotionConfig, field_m: tuple[float, float], n_frames: int, n_agents: int, dt_s: float,
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Field positions ``(T, N, 2)`` metres and unwrapped absolute headings ``(T, N)`` radians.
-
-    Behaviour segments switch with probability ``dt / segment_s`` per frame; each segment draws a mode (walk, stand,
-    turn, walk + turn) and targets; velocities and turn rates follow the targets with first-order lags sized so that
-    accelerations stay within the configured bounds; positions bounce off the field boundary (inset by the robot
-    radius)."""
+    """Field positions ``(T, N, 2)`` metres and unwrapped absolute headings ``(T, N)`` radians; positions bounce off
+    the field boundary (inset by the robot radius)."""
     T, N = n_frames, n_agents
     switch = rng.random((T, N)) < dt_s / cfg.segment_s
     switch[0] = True
