@@ -1,8 +1,11 @@
+from itertools import islice
+
 import numpy as np
 import pytest
 
-from lookalike.vision.blob import BlobConfig, BlobDetector, read_video
+from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.hog_features import as_bgr_image
+from lookalike.viz.video import read_frames
 from tests.conftest import SHARED_DATA
 
 
@@ -83,7 +86,7 @@ def test_real_hexbug_clip_recall():
     video = SHARED_DATA / "hexbug" / "training035.mp4"
     if not video.exists():
         pytest.skip(f"HexBug data not found at {video.parent}")
-    frames = read_video(str(video), max_frames=101)[::10]
+    frames = list(islice(read_frames(video), 101))[::10]
     truth = np.loadtxt(video.with_suffix(".csv"), delimiter=",", skiprows=1)
     det = BlobDetector(BlobConfig(min_area_px=800, open_px=9, stabilise=True)).fit(frames)
     found = total = 0

@@ -11,9 +11,10 @@ import threading
 
 import pytest
 
+from lookalike.io.outputs import write_atomic
+from lookalike.io.rules import user_mode
 from lookalike.viz.label import make_server, open_label_app
 from lookalike.viz.label.server import LISTEN_BACKLOG
-from lookalike.viz.label.store import atomic_write_text, current_umask
 from tests.test_label_server import _json, _request, seq_path  # noqa: F401 (fixture)
 
 
@@ -101,8 +102,8 @@ def test_label_files_follow_the_umask(tmp_path, seq_path, mask):  # noqa: F811
     """Row: label files were created with mode 0600 instead of the user's umask."""
     old = os.umask(mask)
     try:
-        assert current_umask() == mask
-        atomic_write_text(tmp_path / "x.json", "{}")
+        assert user_mode() == 0o666 & ~mask
+        write_atomic(tmp_path / "x.json", "{}")
         assert stat.S_IMODE((tmp_path / "x.json").stat().st_mode) == 0o666 & ~mask
         app = open_label_app(seq_path, fresh=True)
         app.store.set_label(0, 0, 0)

@@ -28,6 +28,11 @@ _METHODS = ("median", "mog2")
 _POLARITIES = ("any", "dark", "bright")
 
 
+def spread(n: int, count: int) -> np.ndarray:
+    """Up to ``count`` indices spread evenly over ``range(n)``, increasing."""
+    return np.unique(np.linspace(0, n - 1, min(n, count)).round().astype(int))
+
+
 @dataclass(frozen=True)
 class BlobConfig:
     """Blob detector settings; sizes in pixels of the input image, differences in grey levels (0..255)."""
@@ -99,8 +104,7 @@ class BlobDetector:
         frames = list(frames)
         if not frames:
             raise ValueError("frames: no frames to fit a background on")
-        pick = np.unique(np.linspace(0, len(frames) - 1, min(len(frames), self.config.history)).round().astype(int))
-        stack = np.stack([self._prepare(frames[i], f"frames[{i}]") for i in pick])
+        stack = np.stack([self._prepare(frames[i], f"frames[{i}]") for i in spread(len(frames), self.config.history)])
         self.background_ = np.median(stack, axis=0).astype(np.float32)
         self._fitted = True
         return self
@@ -200,24 +204,3 @@ class BlobDetector:
             return np.maximum(np.maximum(np.maximum(b, g), r), 0)
         return np.maximum(np.maximum(np.abs(b), np.abs(g)), np.abs(r))
 
-
-def read_video(path: str, max_frames: int | None = None) -> list[np.ndarray]:
-    """All frames (or the first ``max_frames``) of a video file as ``(h, w, 3)`` uint8 BGR arrays."""
-    with needs("cv2"):
-        import cv2
-
-    cap = cv2.VideoCapture(str(path))
-    if not cap.isOpened():
-        raise ValueError(f"video: cannot open {path}")
-    frames: list[np.ndarray] = []
-    try:
-        while max_frames is None or len(frames) < max_frames:
-            ok, frame = cap.read()
-            if not ok:
-                break
-            frames.append(frame)
-    finally:
-        cap.release()
-    if not frames:
-        raise ValueError(f"video: {path} has no readable frames")
-    return frames

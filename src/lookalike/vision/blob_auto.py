@@ -1,12 +1,6 @@
-"""Blob detector settings estimated from the video itself (no per-video hand tuning).
-
-:func:`estimate_blob_config` derives every setting of :class:`~lookalike.vision.blob.BlobConfig` from ``sample`` frames
-spread over the video: stabilisation (when the camera shakes by more than ``shake_px`` and aligning helps), the median
-background, polarity (``dark``/``bright``/``any`` by the foreground mass each side), the noise σ (robust, grey levels),
-the threshold (4-20 σ: with ``n_targets`` the one counting exactly N blobs most often, else the plateau of the per-frame
-count), the area bounds around the typical target area ``A`` (``A/5`` to ``6·A``, persistent regions left out) and the
-morphology from the targets' half thickness. The table of rules: docs/blobs.md. :func:`BlobEstimate.summary` prints each
-value so it can be overridden."""
+"""Blob detector settings estimated from ``sample`` frames of the video itself: stabilisation, polarity, noise σ, the
+threshold (4-20 σ: counting N blobs most often, else the plateau of the count), area bounds ``A/5`` to ``6·A`` around
+the typical target area and morphology from the targets' thickness. The rules: docs/blobs.md."""
 
 from __future__ import annotations
 
@@ -19,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike._optional import needs
-from lookalike.vision.blob import BlobConfig
+from lookalike.vision.blob import BlobConfig, spread
 from lookalike.vision.hog_features import as_bgr_image
 
 __all__ = ["BOX_TRACKER_PARAMS", "BlobEstimate", "TargetCount", "estimate_blob_config", "frame_counts",
@@ -40,17 +34,9 @@ _PERSISTENT_SHARE = 0.3  # pixels in the foreground of more sampled frames than 
 
 @dataclass(frozen=True)
 class BlobEstimate:
-    """An estimated :class:`BlobConfig` and the statistics it came from.
-
-    Attributes:
-        config: the settings to detect with.
-        noise: background noise σ (grey levels).
-        target_area_px: typical target area (px²).
-        half_thickness_px: median largest inscribed radius of the targets (px).
-        shake_px: median camera translation of the samples against the first (px).
-        dark_share: share of the foreground mass darker than the background.
-        counts: per candidate threshold, the median blob count per sampled frame.
-        n_targets: the number of targets given, or None."""
+    """An estimated :class:`BlobConfig` and its statistics: background ``noise`` σ (grey levels), typical
+    ``target_area_px`` (px²), median inscribed radius ``half_thickness_px`` and camera ``shake_px`` (px), the
+    foreground's ``dark_share``, the median blobs per frame of each candidate threshold, and ``n_targets`` given."""
 
     config: BlobConfig
     noise: float
@@ -63,8 +49,7 @@ class BlobEstimate:
 
     @property
     def typical_count(self) -> int:
-        """Median number of blobs per sampled frame at the chosen threshold: an estimate of the number
-        of targets when none is given (an arena whose animals are all in view)."""
+        """Median blobs per sampled frame at the chosen threshold (the number of targets, when all are in view)."""
         return int(round(self.counts.get(self.config.threshold, 0.0)))
 
     @property
@@ -96,19 +81,15 @@ def _odd(value: float, lo: int, hi: int) -> int:
 
 
 def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
-    """Up to ``count`` frames spread evenly over a video file or a folder of images (sorted by name, as
-    ``track --video`` reads them), read in one pass (BGR uint8)."""
+    """Up to ``count`` BGR uint8 frames spread evenly over a video file or an image folder (by name), in one pass."""
     with needs("cv2"):
         import cv2
 
     folder = Path(video)
     if folder.is_dir():
         paths = sorted(q for q in folder.iterdir() if q.suffix.lower() in _IMAGE_SUFFIXES)
-        chosen: list[int] = []
-        if paths:
-            chosen = np.unique(np.linspace(0, len(paths) - 1, min(len(paths), count)).round().astype(int)).tolist()
         images: list[np.ndarray] = []
-        for i in chosen:
+        for i in spread(len(paths), count):
             image = cv2.imread(str(paths[i]), cv2.IMREAD_COLOR)
             if image is None:
                 raise ValueError(f"video: {paths[i]} is not a readable image")
@@ -123,7 +104,7 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
         total = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
         frames: list[np.ndarray] = []
         if total > 0:
-            wanted = set(np.linspace(0, total - 1, min(total, count)).round().astype(int).tolist())
+            wanted = set(spread(total, count).tolist())
             k = 0
             while True:
                 ok, frame = cap.read()
@@ -141,8 +122,7 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
                 if not ok:
                     break
                 frames.append(frame)
-            pick = np.unique(np.linspace(0, len(frames) - 1, min(len(frames), count)).round().astype(int))
-            frames = [frames[i] for i in pick] if frames else []
+            frames = [frames[i] for i in spread(len(frames), count)]
     finally:
         cap.release()
     if not frames:
@@ -151,14 +131,12 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
 
 
 def _spread(stack: np.ndarray) -> float:
-    """90th percentile of the absolute differences from the per-pixel median (grey levels): edges of a
-    moving camera's scene are a minority of the pixels, so the median would not see them."""
+    """90th percentile of the absolute differences from the per-pixel median (grey levels)."""
     return float(np.percentile(np.abs(stack - np.median(stack, axis=0)), 90))
 
 
 def _shifts(grey: list[np.ndarray]) -> np.ndarray:
-    """``(n, 2)`` translation (px) of each frame against the median of all (phase correlation; moving
-    targets are absent from the median, so they pull no peak of their own)."""
+    """``(n, 2)`` translation (px) of each frame against the median of all (phase correlation)."""
     with needs("cv2"):
         import cv2
 
@@ -178,8 +156,7 @@ def _components(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _target_area(areas: list[np.ndarray]) -> float:
-    """Area-weighted median of the components' areas (px²): the size of the blobs holding most of the
-    foreground, whatever the number of small noise specks."""
+    """Area-weighted median of the components' areas (px²), blind to small noise specks."""
     pooled = np.concatenate(areas) if areas else np.zeros(0)
     if not len(pooled):
         return 0.0
@@ -209,16 +186,14 @@ def _radii(masks: list[np.ndarray], area: float) -> list[float]:
 
 
 def _pick_frames(frames: str | Path | Iterable[np.ndarray], sample: int) -> list[np.ndarray]:
-    """Up to ``sample`` frames spread over ``frames`` (a video path or the frames); ``ValueError`` when there are none
-    or they are smaller than :data:`MIN_SIDE_PX` a side."""
+    """Up to ``sample`` frames spread over ``frames`` (a video path or frames); ``ValueError`` for none or tiny ones."""
     if isinstance(frames, (str, Path)):
         picked = sample_frames(frames, sample)
     else:
         every = list(frames)
         if not every:
             raise ValueError("frames: no frames to estimate blob settings on")
-        idx = np.unique(np.linspace(0, len(every) - 1, min(len(every), sample)).round().astype(int))
-        picked = [every[i] for i in idx]
+        picked = [every[i] for i in spread(len(every), sample)]
     height, width = as_bgr_image(picked[0], "frames[0]").shape[:2]
     if min(height, width) < MIN_SIDE_PX:
         what = f"video: {frames}" if isinstance(frames, (str, Path)) else "frames"
@@ -231,10 +206,9 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
                          sample: int = 25, shake_px: float = 0.5, polarity_ratio: float = 0.1,
                          base: BlobConfig | None = None,
                          progress: Callable[[str, int], Callable[[], None]] | None = None) -> BlobEstimate:
-    """Blob detector settings estimated from a video (a file path, or its ``(h, w, 3)`` BGR frames),
-    optionally knowing the number of targets ``n_targets`` (module doc). ``base`` supplies the settings
-    that are not estimated (method, blur, history). ``progress(description, total)`` gives a function called
-    after each of ``total`` steps (reading the sampled frames, the background, each candidate threshold)."""
+    """Blob detector settings estimated from a video (a path, or its ``(h, w, 3)`` BGR frames), knowing
+    ``n_targets`` or not; ``base`` gives the settings not estimated. ``progress(description, total)`` gives a
+    function called after each of ``total`` steps."""
     with needs("cv2"):
         import cv2
 
@@ -328,22 +302,15 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
 
 
 BOX_TRACKER_PARAMS: dict[str, float] = {"match_iou": 0.01}
-"""``boxtrack`` parameters for blob detections (docs/blobs.md): a track takes a blob its predicted box
-overlaps at all. Blobs are the separate foreground regions of one frame, so the IoU gate has no
-neighbours to keep apart; small targets seen at a low frame rate, turning and stopping, overlap
-their predicted box little (HexBug clips at 10 frames/s: many continuations below the default 0.3)."""
+"""``boxtrack`` parameters for blob detections: a track takes any blob its predicted box overlaps (docs/blobs.md)."""
 
 _MAJORITY = 0.5  # a count holding in more than this share of the frames is an arena's number of targets
 
 
 @dataclass(frozen=True)
 class TargetCount:
-    """The number of targets read off a video's blob counts.
-
-    Attributes:
-        n: the most common number of blobs per frame (0 when no frame has a blob).
-        share: share of the frames with exactly ``n`` blobs.
-        frames: frames counted."""
+    """The number of targets read off a video's blob counts: the most common count ``n`` (0 without blobs), the
+    ``share`` of the ``frames`` counted showing it."""
 
     n: int
     share: float
@@ -351,9 +318,7 @@ class TargetCount:
 
     @property
     def closed(self) -> bool:
-        """Whether the evidence is strong enough for a closed set of ``n``: the same count in a strict
-        majority of the frames (an arena whose targets are all in view, counted lower only while
-        some touch or hide). A scene where targets come and go has no such count."""
+        """Whether ``n`` makes a closed set: the same count in a strict majority of the frames."""
         return self.n >= 1 and self.share > _MAJORITY
 
     @property
@@ -368,8 +333,7 @@ class TargetCount:
 
 
 def infer_target_count(counts: np.ndarray) -> TargetCount:
-    """The number of targets from ``counts``, the blobs found in each frame (frames without a blob
-    included as 0): the most common count (the larger on a tie), with the share of frames showing it."""
+    """The most common of ``counts``, blobs per frame (the larger on a tie), with the share of frames showing it."""
     counts = np.asarray(counts, dtype=int).ravel()
     if not len(counts) or counts.max(initial=0) <= 0:
         return TargetCount(0, 0.0, len(counts))

@@ -1,7 +1,5 @@
-"""HOG block descriptors of the cascade detector: the block pool of a window and the L2-normalised 2×2-cell descriptors
-of many blocks for many windows, read from per-orientation integral histograms (:mod:`lookalike.vision.hog_features`).
-Two layouts compute the same values bit for bit: row gathers for windows anywhere (:func:`block_features_rows`) and
-strided slices for a regular grid of windows (:func:`block_features_grid`)."""
+"""HOG block descriptors of the cascade detector from integral histograms: row gathers for windows anywhere
+(:func:`block_features_rows`) and strided slices for a grid of windows (:func:`block_features_grid`), bit for bit."""
 
 from __future__ import annotations
 
@@ -12,9 +10,8 @@ from lookalike.vision.hog_kernels import compiled
 
 
 def _output(k: int, n_blocks: int, columns: np.ndarray | None) -> tuple[np.ndarray | None, np.ndarray]:
-    """The selected columns (int64, or None for all) and the float32 result to fill: ``(k, n_blocks * 36)``, or
-    ``(k, len(columns))`` in column-major order, as ``features[:, columns]`` gives them (the vote matrix then
-    keeps that layout and its product with the stage weights sums in the same order)."""
+    """The selected columns (int64, or None for all) and the float32 result: ``(k, n_blocks * 36)``, or
+    ``(k, len(columns))`` column-major, as ``features[:, columns]`` gives them."""
     if columns is None:
         return None, np.empty((k, n_blocks * 4 * BINS), np.float32)
     cols = np.asarray(columns, np.int64)
@@ -22,11 +19,8 @@ def _output(k: int, n_blocks: int, columns: np.ndarray | None) -> tuple[np.ndarr
 
 
 def _block_norms(cells: np.ndarray, area: np.ndarray) -> np.ndarray:
-    """``sqrt(sum of squares) + area`` of each block from its cells ``(2, 2, BINS, ...)`` (cell row, cell column,
-    bin, then any block shape), in the order and grouping in which numpy sums a contiguous row of the 36 values
-    (cell row, cell column, bin): eight running sums of every eighth value, combined pairwise, then the last
-    four. So the norms equal ``np.sqrt((flat * flat).sum(axis=-1)) + area`` of the (block, 36) layout bit for bit
-    (tests/test_hog_fast_paths.py keeps that as the oracle) without transposing to it."""
+    """``sqrt(sum of squares) + area`` of each block from its cells ``(2, 2, BINS, ...)``, summed as numpy's pairwise
+    summation sums a row of 36 values, so bit for bit ``np.sqrt((flat * flat).sum(axis=-1)) + area``."""
     sq = cells * cells
     n = 4 * BINS  # numpy's pairwise summation of 8 <= n <= 128 values
     v = [sq[j // (2 * BINS), (j // BINS) % 2, j % BINS] for j in range(n)]
@@ -44,8 +38,7 @@ def _block_norms(cells: np.ndarray, area: np.ndarray) -> np.ndarray:
 
 
 def block_pool(window_px: tuple[int, int], cell_px: int) -> np.ndarray:
-    """``(b, 4)`` blocks ``(x, y, w, h)`` in pixels inside the window: several sizes and aspect ratios, even
-    numbers of cells so that each block splits into 2×2 cells, stepped by half a block."""
+    """``(b, 4)`` blocks ``xywh`` (px) in the window: even cell counts, aspect up to 3, stepped by half a block."""
     w, h = window_px[0] // cell_px, window_px[1] // cell_px
     blocks = set()
     for bw in range(2, w + 1, 2):
@@ -61,10 +54,8 @@ def block_pool(window_px: tuple[int, int], cell_px: int) -> np.ndarray:
 
 def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
                    unit_px: int = 1) -> np.ndarray:
-    """Descriptors of ``blocks (b, 4)`` (px) for windows at offsets ``ox, oy (k,)`` (px) of ``integral (BINS, H+1,
-    W+1)`` whose entries are ``unit_px`` pixels apart (1: a pixel integral; ``cell_px``: an integral of
-    :func:`~lookalike.vision.hog_features.cell_histograms`, all offsets then multiples of it); returns ``(k, b * 4 *
-    BINS)`` float32."""
+    """``(k, b * 36)`` float32 descriptors of ``blocks (b, 4)`` (px) for windows at ``ox, oy (k,)`` (px) of
+    ``integral (BINS, H+1, W+1)`` whose entries are ``unit_px`` pixels apart."""
     rows = np.ascontiguousarray(np.asarray(integral).transpose(1, 2, 0)).reshape(-1, integral.shape[0])
     return block_features_rows(rows, integral.shape[2], blocks, ox, oy, unit_px)
 
@@ -72,14 +63,9 @@ def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy:
 def block_features_rows(rows: np.ndarray, width: int | np.ndarray, blocks: np.ndarray, ox: np.ndarray,
                          oy: np.ndarray, unit_px: int, columns: np.ndarray | None = None,
                          offset: np.ndarray | None = None) -> np.ndarray:
-    """:func:`block_features` on an integral laid out as ``rows ((H+1) * width, BINS)``, one row per corner: the
-    nine corners of a block's 2×2 cells are nine row gathers, done for several blocks at once. With ``columns``,
-    only those columns of the result ``(k, len(columns))`` (each still normalised by its whole block).
-
-    Several integrals stacked in ``rows`` (e.g. the levels of a pyramid) are read at once with a per-window
-    ``width (k,)`` (corners per integral row) and ``offset (k,)`` (the integral's first row in ``rows``).
-    Selected columns of a float32 integral are computed by a compiled kernel when numba is there
-    (:mod:`lookalike.vision.hog_kernels`), with the same operations in the same order."""
+    """:func:`block_features` on an integral as ``rows ((H+1) * width, BINS)``, one row per corner; with
+    ``columns``, only those ``(k, len(columns))``. Stacked integrals (pyramid levels) take a per-window ``width (k,)``
+    and ``offset (k,)`` (first row). Compiled when numba is there, the same operations in the same order."""
     k, d = len(ox), 4 * BINS
     cols, out = _output(k, len(blocks), columns)
     ox, oy = np.asarray(ox, np.int64), np.asarray(oy, np.int64)
@@ -129,9 +115,8 @@ def cumsum_rows(a: np.ndarray) -> np.ndarray:
 
 
 def cell_integral32(hist: np.ndarray) -> np.ndarray:
-    """``(ny + 1, nx + 1, bins)`` float32 integral of cell histograms ``hist (ny, nx, bins)`` float64, first row and
-    column zero: cumulative sums in float64 down the rows (:func:`cumsum_rows`), then along each row
-    (``np.cumsum``), rounded to float32 at the end; compiled when numba is there, the same sums in the same order."""
+    """``(ny + 1, nx + 1, bins)`` float32 integral (summed in float64, first row and column zero) of cell histograms
+    ``hist (ny, nx, bins)``; compiled when numba is there, the same sums in the same order."""
     h = np.ascontiguousarray(hist, dtype=np.float64)
     kernels = compiled()
     if kernels is not None:
@@ -145,9 +130,8 @@ def cell_integral32(hist: np.ndarray) -> np.ndarray:
 
 def block_features_grid(planes: np.ndarray, blocks: np.ndarray, grid: tuple[int, int], stride: int,
                          unit_px: int, columns: np.ndarray | None = None) -> np.ndarray:
-    """:func:`block_features_rows` for every window of a ``grid`` (rows, columns) of windows ``stride`` corners
-    apart, starting at corner (0, 0), of an integral ``planes (BINS, H+1, W+1)`` float32: each corner of a block is
-    a slice of one bin-plane phase (long inner loops, no gathers); values bit for bit those of the gathers."""
+    """:func:`block_features_rows` for a ``grid`` (rows, columns) of windows ``stride`` corners apart of a float32
+    integral ``planes (BINS, H+1, W+1)``, by strided slices; bit for bit the gathers' values."""
     ny, nx = grid
     k, d = ny * nx, 4 * BINS
     cols, out = _output(k, len(blocks), columns)
@@ -189,8 +173,7 @@ def window_features(windows: np.ndarray, blocks: np.ndarray) -> np.ndarray:
     if wins.ndim != 3 or len(wins) == 0:
         return np.zeros((0, len(blocks) * 4 * BINS), np.float32)
     n, hh, ww = wins.shape
-    # Tile the windows side by side: one gradient pass and one integral image serve them all; each
-    # window's 1-px margin keeps its gradients its own.
+    # Windows side by side: one gradient pass and one integral; each 1-px margin keeps its gradients its own.
     tiled = wins.transpose(1, 0, 2).reshape(hh, n * ww)
     integral = integral_maps(orientation_maps(tiled))
     ox = np.arange(n, dtype=np.int64) * ww + 1

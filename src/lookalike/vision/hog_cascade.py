@@ -1,11 +1,6 @@
-"""HOG cascade detector (the robot-identification paper's): variable-size HOG blocks, boosted stages, a cascade of
-rejectors.
-
-A ``window_px`` window is described by a pool of blocks (2×2 cells, 36 values each, from integral histograms:
-:mod:`lookalike.vision.hog_features`). Each stage is a discrete AdaBoost over the block descriptors, its threshold
-keeping ``stage_hit_rate`` of the training positives; between stages the negatives are refilled with hard negatives
-mined from training scenes, then random windows. Detection slides the window over an image pyramid, keeps windows
-passing every stage, maps the last-stage margin to a probability and applies NMS."""
+"""HOG cascade detector: a pool of variable-size HOG blocks, discrete AdaBoost stages (each keeping ``stage_hit_rate``
+of the positives, trained against mined hard negatives), slid over an image pyramid; the last-stage margin becomes a
+probability, then NMS."""
 
 from __future__ import annotations
 
@@ -135,8 +130,7 @@ class HogCascade:
         grey = img.astype(np.float32) if img.ndim == 2 and img.dtype == np.float32 else to_grey(as_bgr_image(img))
         win_w, win_h = cfg.window_px
         step = cfg.stride_cells * cfg.cell_px
-        # Per pyramid level: the first stage on its whole window grid; then every later stage once for the windows
-        # still alive on all levels together, their corners gathered from the levels' stacked integrals.
+        # Per level the first stage on the whole window grid; later stages on the survivors of all levels at once.
         levels: list[tuple[float, int, np.ndarray, np.ndarray, np.ndarray]] = []  # scale, width, ox, oy, alive
         stacked: list[np.ndarray] = []  # each level's integral, one row of BINS values per corner
         first: list[np.ndarray] = []  # the first stage's margins of each level's windows that passed it
@@ -147,15 +141,10 @@ class HogCascade:
                 break
             level = grey if size == (grey.shape[1], grey.shape[0]) else cv2.resize(
                 grey, size, interpolation=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
-            # Integral over cells (corners lie on the grid), summed in float64 in (y, x, bin) order: the
-            # histograms' own memory layout, and one row of BINS values per corner for the gathers.
-            # float32 corners (faster gathers): on 640x480 the corner sums stay below ~1e7, so rounding moves a
-            # block sum by a few gradient units at most, far below the block sums the stumps threshold.
+            # Integral over cells in (y, x, bin) order; float32 corners (rounding far below the stump thresholds).
             rows = cell_integral32(cell_histograms(level, cfg.cell_px).transpose(1, 2, 0))
             grid_y, grid_x = np.arange(0, size[1] - win_h + 1, step), np.arange(0, size[0] - win_w + 1, step)
             ox, oy = np.tile(grid_x, len(grid_y)), np.repeat(grid_y, len(grid_x))  # window origins (px), row by row
-            # The first stage sees every window of the grid: with numpy, strided slices of the integral instead of
-            # gathers (the same arithmetic); compiled, one pass over the windows.
             if self.stages:
                 stage, (used, columns) = self.stages[0], self._stage_blocks[0]
                 if compiled() is not None:
@@ -187,8 +176,7 @@ class HogCascade:
             if not len(level_of):
                 break
             cols = block_features_rows(corners, width, used, ox, oy, cfg.cell_px, columns, offsets[level_of])
-            # The votes of each level's windows are summed apart, as one matrix per level (the sum's rounding
-            # may depend on the matrix it is computed in).
+            # One vote matrix per level (the sum's rounding may depend on the matrix).
             bounds = np.searchsorted(level_of, np.arange(len(levels) + 1))
             margin = np.concatenate([_margin(np.asfortranarray(cols[a:b]), stage)
                                      for a, b in zip(bounds[:-1], bounds[1:]) if b > a])
@@ -201,20 +189,17 @@ class HogCascade:
         return boxes.astype(float), margin
 
     def target_boxes(self, windows_xywh: np.ndarray) -> np.ndarray:
-        """Target boxes ``(n, 4)`` px inside detection windows ``(n, 4)`` px: the window less its
-        ``context_pad`` margin, about the same centre."""
+        """Target boxes ``(n, 4)`` px of windows ``(n, 4)`` px: the window less its ``context_pad``, same centre."""
         w = np.asarray(windows_xywh, float).reshape(-1, 4)
         f = 1.0 / (1.0 + 2.0 * self.config.context_pad)
         cx, cy = w[:, 0] + w[:, 2] / 2, w[:, 1] + w[:, 3] / 2
         return np.column_stack([cx - w[:, 2] * f / 2, cy - w[:, 3] * f / 2, w[:, 2] * f, w[:, 3] * f])
 
     def boxes_and_margins(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Target boxes ``(n, 4)`` px after non-maximum suppression, clipped to the image, and the last-stage
-        margin ``(n,)`` of the window each one was kept for."""
+        """Target boxes ``(n, 4)`` px after NMS, clipped to the image, and their windows' last-stage margins."""
         xywh, margins = self.windows(image)
         if not len(xywh):
             return np.zeros((0, 4)), np.zeros(0)
-        # Best first by the calibrated logit (probabilities of strong windows all round to 1).
         a, b = self.calibration
         boxes, keep = merge_nms(self.target_boxes(xywh), a * margins + b, self.config.nms_overlap,
                                 self.config.merge_iou)
@@ -231,8 +216,7 @@ class HogCascade:
         return 1.0 / (1.0 + np.exp(-(a * np.asarray(margins, float) + b)))
 
     def __call__(self, image: np.ndarray) -> Detections:
-        """Detections (target boxes in pixels, clipped to the image; probability scores) in a ``(h, w, 3)`` BGR
-        or grey image."""
+        """Detections (target boxes px, probability scores) in a ``(h, w, 3)`` BGR or grey image."""
         boxes, margins = self.boxes_and_margins(image)
         if not len(boxes):
             return Detections.empty()
@@ -286,13 +270,11 @@ def train_cascade(
 
     Args:
         positives: ``(n, h+2, w+2)`` grey positive windows with a 1-px margin (augmented already).
-        negative_windows: ``(count, rng) -> (m, h+2, w+2)`` random background windows (called repeatedly;
-            those the cascade so far rejects are discarded, so only hard negatives are kept).
+        negative_windows: ``(count, rng) -> (m, h+2, w+2)`` random background windows; only those the cascade so
+            far accepts are kept.
         progress: called with ``(stage, message)`` after each stage.
-        scenes: ``(grey (H, W) float32 frame, true boxes (m, 4) px)`` pairs. From the second stage on, the
-            cascade so far is run over them and every window it accepts that overlaps no true box by more
-            than ``hard_negative_max_iou`` becomes a negative (windows beside robots, field lines, partly
-            visible robots); random windows from ``negative_windows`` fill up the rest."""
+        scenes: ``(grey (H, W) float32 frame, true boxes (m, 4) px)`` pairs: from the second stage on, windows the
+            cascade accepts away from true boxes become negatives first."""
     with needs("sklearn"):
         from sklearn.ensemble import AdaBoostClassifier
         from sklearn.linear_model import LogisticRegression
@@ -305,9 +287,7 @@ def train_cascade(
     neg = np.zeros((0, pos.shape[1]), np.float32)
     last_neg = neg
     for k in range(config.stages):
-        # Refill the negatives with windows that the cascade so far accepts.
-        # Stop rule: at most max_draws_per_stage batches; stop early once the measured false-positive rate
-        # of the cascade so far is below the target (the search would otherwise stall on a good cascade).
+        # Refill the negatives with windows the cascade accepts, until the false-positive rate is below target.
         mined = 0
         if model.stages and scenes:
             found = _mine_scenes(model, scenes, config, config.negatives_per_stage - len(neg), rng)
@@ -367,8 +347,8 @@ def train_cascade(
 
 def _mine_scenes(model: HogCascade, scenes: Sequence[tuple[np.ndarray, np.ndarray]], config: CascadeConfig,
                  count: int, rng: np.random.Generator) -> np.ndarray:
-    """Up to ``count`` windows ``(k, h+2, w+2)`` that ``model`` accepts in ``scenes`` away from their true boxes;
-    scenes in random order, at most a tenth of ``count`` from any one scene so that no frame dominates."""
+    """Up to ``count`` windows ``(k, h+2, w+2)`` that ``model`` accepts in ``scenes`` away from their true boxes,
+    at most a tenth from any one scene."""
     from lookalike.vision.hog_features import crop_window
 
     per_scene = max(1, count // 10)

@@ -1,8 +1,5 @@
-"""Image checks and HOG building blocks: per-orientation integral histograms and block descriptors.
-
-The orientation histogram is a stack of ``bins`` gradient-magnitude maps (unsigned, soft-assigned); its integral image
-gives any rectangle's descriptor in four look-ups per bin, which makes variable-size blocks cheap. For detection,
-:func:`cell_histograms` sums per cell in one pass and the integral is built over cells. OpenCV is imported lazily."""
+"""Image checks and HOG building blocks: soft-assigned orientation maps, their integral images (any rectangle in four
+look-ups per bin), cell histograms and block descriptors. OpenCV is imported lazily."""
 
 from __future__ import annotations
 
@@ -17,11 +14,8 @@ BINS = 9  # unsigned orientation bins over [0, π)
 
 
 def as_bgr_image(image: np.ndarray, name: str = "image") -> np.ndarray:
-    """Validate an image and return it as ``(h, w, 3)`` uint8 BGR.
-
-    Grey ``(h, w)`` or ``(h, w, 1)`` images are replicated to three channels, BGRA drops alpha, float images in [0, 1]
-    are scaled to 0..255, other integer types are clipped. Empty images, other shapes and non-finite values raise
-    ``ValueError`` naming ``name``."""
+    """``image`` as ``(h, w, 3)`` uint8 BGR: grey replicated, alpha dropped, floats in [0, 1] scaled to 0..255, other
+    integers clipped. Empty images, other shapes and non-finite values raise ``ValueError`` naming ``name``."""
     arr = np.asarray(image)
     if arr.size == 0:
         raise ValueError(f"{name}: empty image (shape {arr.shape})")
@@ -47,8 +41,7 @@ def as_bgr_image(image: np.ndarray, name: str = "image") -> np.ndarray:
 
 
 def to_grey(image_bgr: np.ndarray) -> np.ndarray:
-    """``(h, w)`` float32 luminance in 0..255 of a ``(h, w, 3)`` uint8 BGR image:
-    ``0.114 B + 0.587 G + 0.299 R`` in float32 (channel planes, in bands of rows that stay in cache)."""
+    """``(h, w)`` float32 luminance ``0.114 B + 0.587 G + 0.299 R`` (0..255) of a ``(h, w, 3)`` uint8 BGR image."""
     with needs("cv2"):
         import cv2
 
@@ -79,8 +72,7 @@ def hue_channel(image_bgr: np.ndarray) -> np.ndarray:
 
 
 def _polar_gradients(g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Magnitude and angle in [0, 2π) (accurate to about 0.3°), float32 ``(h, w)``, of the central-difference
-    gradients of float32 ``g (h, w)``, zero at the border."""
+    """Magnitude and angle in [0, 2π) (float32 ``(h, w)``) of the central-difference gradients of ``g``."""
     with needs("cv2"):
         import cv2
 
@@ -93,8 +85,7 @@ def _polar_gradients(g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _gradient_bins(grey: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Central-difference gradients of ``grey (h, w)`` (zero at the border) as ``(lower bin int32, weight to the
-    lower bin, weight to the next bin)``, all ``(h, w)``; bin centres sit at ``(k + 0.5) π / bins``."""
+    """Gradients of ``grey (h, w)`` as ``(lower bin int32, its weight, the next bin's weight)``, all ``(h, w)``."""
     g = np.asarray(grey, dtype=np.float32)
     if g.ndim != 2:
         raise ValueError(f"grey: expected shape (h, w), got {g.shape}")
@@ -111,9 +102,7 @@ def _gradient_bins(grey: np.ndarray, bins: int) -> tuple[np.ndarray, np.ndarray,
 
 
 def orientation_maps(grey: np.ndarray, bins: int = BINS) -> np.ndarray:
-    """``(bins, h, w)`` float32 gradient magnitude soft-assigned to unsigned orientation bins.
-
-    Gradients are central differences (zero at the border) of ``grey (h, w)``."""
+    """``(bins, h, w)`` float32 central-difference gradient magnitude of ``grey (h, w)``, soft-assigned to bins."""
     lo, w_lo, w_hi = _gradient_bins(grey, bins)
     out = np.empty((bins,) + lo.shape, dtype=np.float32)
     for b in range(bins):
@@ -122,12 +111,8 @@ def orientation_maps(grey: np.ndarray, bins: int = BINS) -> np.ndarray:
 
 
 def cell_histograms(grey: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndarray:
-    """``(bins, h // cell_px, w // cell_px)`` float64 orientation histograms of square cells: equal to summing
-    :func:`orientation_maps` over each cell, in one pass (two weighted ``bincount`` calls, no per-bin maps).
-
-    Worked in bands of cell rows (a row of context above and below for the vertical gradient), so that the
-    temporaries stay in cache; every cell's sum runs over the same pixels in the same order as over the whole
-    image, so the result is bit for bit the same."""
+    """``(bins, h // cell_px, w // cell_px)`` float64 orientation histograms of square cells (:func:`orientation_maps`
+    summed per cell), in bands of cell rows that stay in cache; bit for bit the whole image's sums."""
     g = np.asarray(grey, dtype=np.float32)
     if g.ndim != 2:
         raise ValueError(f"grey: expected shape (h, w), got {g.shape}")
@@ -159,8 +144,7 @@ def cell_histograms(grey: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndar
 
 def _compiled_cell_histograms(kernel: Callable[..., None], g: np.ndarray, cell_px: int, bins: int, band: int,
                               out: np.ndarray) -> None:
-    """:func:`cell_histograms` into ``out (ny, nx, bins)`` with the compiled binning and sums: the gradients of each
-    band from :func:`_polar_gradients` (OpenCV), the rest one pixel at a time."""
+    """:func:`cell_histograms` into ``out (ny, nx, bins)`` with the compiled binning and sums."""
     h = g.shape[0]
     ny, nx = out.shape[:2]
     scale = np.float32(bins / np.pi)
@@ -201,16 +185,13 @@ def integral_maps(maps: np.ndarray) -> np.ndarray:
 
 
 def rect_sums(integral: np.ndarray, x0: np.ndarray, y0: np.ndarray, x1: np.ndarray, y1: np.ndarray) -> np.ndarray:
-    """Sums of every channel over rectangles ``[y0, y1) × [x0, x1)`` (pixel indices, broadcastable
-    integer arrays) from ``integral (c, h+1, w+1)``; result shape ``(c,) + broadcast shape``."""
+    """Sums ``(c,) + broadcast shape`` over rectangles ``[y0, y1) × [x0, x1)`` (px) of ``integral (c, h+1, w+1)``."""
     return integral[:, y1, x1] - integral[:, y0, x1] - integral[:, y1, x0] + integral[:, y0, x0]
 
 
 def block_descriptor(cell_sums: np.ndarray, eps: float = 1e-3) -> np.ndarray:
-    """L2-normalised HOG block descriptors from the orientation sums of its 2×2 cells.
-
-    ``cell_sums`` has shape ``(4, bins, ...)``; the result ``(4 * bins, ...)``. ``eps`` (in gradient units per
-    pixel-area of the cells) keeps flat regions near zero."""
+    """L2-normalised block descriptors ``(4 * bins, ...)`` of 2×2 cell sums ``(4, bins, ...)``; ``eps`` keeps flat
+    regions near zero."""
     flat = cell_sums.reshape((-1,) + cell_sums.shape[2:])
     norm = np.sqrt((flat * flat).sum(axis=0, keepdims=True)) + eps
     return flat / norm
@@ -231,8 +212,8 @@ def dense_hog(channel: np.ndarray, cell_px: int, bins: int = BINS) -> np.ndarray
 
 
 def crop_window(grey: np.ndarray, xywh: np.ndarray, window_px: tuple[int, int], pad: float = 0.1) -> np.ndarray:
-    """A ``(h+2, w+2)`` float32 crop of ``grey (H, W)`` around box ``xywh`` (px), widened to the window's aspect
-    ratio with ``pad`` (fraction of the box height) of context, resized, with a 1-px margin for gradients."""
+    """A ``(h+2, w+2)`` float32 crop of ``grey (H, W)`` around box ``xywh`` (px) at the window's aspect, with ``pad``
+    (of the box height) of context and a 1-px margin."""
     with needs("cv2"):
         import cv2
 
@@ -250,9 +231,8 @@ def crop_window(grey: np.ndarray, xywh: np.ndarray, window_px: tuple[int, int], 
 
 def augment_windows(windows: np.ndarray, copies: int, rng: np.random.Generator, max_rot_deg: float = 15.0,
                     scale_std: float = 0.06, cutout: float = 0.5) -> np.ndarray:
-    """``copies`` random variants of each ``(h, w)`` window: rotation within ±``max_rot_deg`` (normal, clipped),
-    scale jitter, horizontal flip, and with probability ``cutout`` a cut-out rectangle (up to a quarter of
-    the window) filled with the window's mean (partial occlusion)."""
+    """``copies`` random variants of each ``(h, w)`` window: rotation within ±``max_rot_deg``, scale jitter, flip,
+    and with probability ``cutout`` a rectangle filled with the window's mean."""
     with needs("cv2"):
         import cv2
 

@@ -1,11 +1,6 @@
-"""From pixels to robot identities (the robot-identification paper's full chain).
-
-:class:`RobotPipeline` runs per frame: the HOG-cascade detector, the visual heading classifier on each box, the ground
-position through the calibrated camera, and an identifier from :func:`lookalike.trackers.registry.make_tracker` fed with
-the heading reports. Boxes are ``xywh`` pixels; ground positions metres in the observer frame; headings become absolute
-by adding the observer's yaw (radians). A box cut by the image's bottom edge is placed from its top edge at the robot's
-known height. :meth:`RobotPipeline.perceive` and :meth:`RobotPipeline.identify` are public, so one frame's detections
-can feed several identifiers."""
+"""From pixels to robot identities: HOG-cascade detector, heading classifier, ground projection through the camera,
+and an identifier fed with the heading reports. Boxes ``xywh`` px; ground positions m in the observer frame; headings
+absolute (observer yaw added), rad."""
 
 from __future__ import annotations
 
@@ -36,8 +31,7 @@ class Detector(Protocol):
 
 
 class HeadingModel(Protocol):
-    """Anything that estimates egocentric headings of boxes ``(n, 4)`` px: returns an object with
-    ``heading_rad (n,)`` and ``heading_std_rad (n,)`` (radians)."""
+    """Egocentric headings of boxes ``(n, 4)`` px: an object with ``heading_rad`` and ``heading_std_rad (n,)``."""
 
     def __call__(self, image: np.ndarray, xywh: np.ndarray) -> Any: ...
 
@@ -47,17 +41,15 @@ class PipelineConfig:
     """Settings of the chain.
 
     Attributes:
-        identifier: registered identifier name (one of :data:`IDENTIFIERS`, or any tracker that
-            reads ground positions and headings).
+        identifier: registered identifier name (one of :data:`IDENTIFIERS`, or any tracker reading positions and
+            headings).
         n_agents: number of reporting robots N.
         max_detections: M, the most probable detections kept per frame (also the LSTM's slots).
         min_score: detector probability below which a box is dropped.
-        detect_scale: the image is resized by this factor before detection (> 1 finds robots
-            smaller than the detector window, at a cost in speed); boxes are mapped back.
-        target_height_m: height of the targets (m), used when a box's bottom is cut by the image border.
+        detect_scale: resize factor before detection (> 1 finds robots smaller than the window); boxes mapped back.
+        target_height_m: target height (m), to place a box whose bottom is cut by the image border.
         border_px: a box edge this close to the image border (px) counts as cut.
-        identifier_params: further ``make_tracker`` parameters as ``(name, value)`` pairs; those
-            the identifier does not know are refused."""
+        identifier_params: further ``make_tracker`` parameters as ``(name, value)`` pairs."""
 
     identifier: str = "kalman_ha2"
     n_agents: int = 3
@@ -97,13 +89,9 @@ class PipelineConfig:
 
 @dataclass(frozen=True)
 class PipelineResult:
-    """One frame's output.
-
-    Attributes:
-        frame: the :class:`Frame` given to the identifier (its detections carry ``xywh`` px,
-            ``score``, ``position (n, 2)`` m, absolute ``heading (n,)`` rad and ``heading_std (n,)`` rad).
-        tracks: the identifier's snapshots.
-        labels: ``(n,)`` agent id (0-based) given to each detection, -1 for none (false positive)."""
+    """One frame's output: the :class:`Frame` given to the identifier (detections with ``xywh`` px, ``score``,
+    ``position (n, 2)`` m, absolute ``heading`` and ``heading_std (n,)`` rad), its ``tracks``, and ``labels (n,)``:
+    each detection's 0-based agent id, -1 for a false positive."""
 
     frame: Frame
     tracks: list[TrackSnapshot]
@@ -115,8 +103,7 @@ class PipelineResult:
 
 
 def check_image(image: np.ndarray, size: tuple[int, int] | None = None, name: str = "image") -> np.ndarray:
-    """``image`` as ``(h, w, 3)`` uint8 BGR. Accepts uint8 BGR ``(h, w, 3)`` or grey ``(h, w)`` / ``(h, w, 1)``;
-    ``size`` = (width, height) in pixels it must have. Anything else raises ``ValueError`` naming ``name``."""
+    """``image`` (uint8 BGR or grey) as ``(h, w, 3)`` uint8 BGR of ``size`` (width, height) px, else ValueError."""
     if not isinstance(image, np.ndarray):
         raise ValueError(f"{name}: expected a numpy array, got {type(image).__name__}")
     if image.size == 0:
@@ -138,11 +125,8 @@ def check_image(image: np.ndarray, size: tuple[int, int] | None = None, name: st
 class RobotPipeline:
     """Detector → heading classifier → ground projection → identifier, one frame at a time.
 
-    ``probability``: a map from the detector's last-stage margins to the probability given to the
-    identifier (:class:`~lookalike.vision.detection_probability.DetectionProbability`), used when the
-    detector has ``boxes_and_margins`` (the HOG cascade); ``None`` keeps the detector's own score. Which
-    boxes are kept (``min_score`` on the detector's own score, the ``max_detections`` with the largest
-    margins) does not depend on it."""
+    ``probability`` maps a detector's last-stage margins (one with ``boxes_and_margins``) to the score given to the
+    identifier; ``None`` keeps the detector's score. Which boxes are kept does not depend on it."""
 
     def __init__(self, detector: Detector, heading: HeadingModel, camera: Camera | None = None,
                  config: PipelineConfig | None = None,
@@ -164,10 +148,8 @@ class RobotPipeline:
     def from_files(cls, detector_path: str | Path | None = None, heading_path: str | Path | None = None,
                    camera: Camera | None = None, config: PipelineConfig | None = None,
                    probability_path: str | Path | None = None) -> RobotPipeline:
-        """A pipeline with models written by ``lookalike train-detector`` and ``lookalike train-heading``
-        (``None``: the models shipped with the package, see :func:`shipped_model_path`). The detection
-        probability map is read from ``probability_path``; without one, the shipped map is used with the
-        shipped detector (its margins are that detector's), none with another detector."""
+        """A pipeline with models written by ``lookalike train-detector``/``train-heading`` (``None``: the shipped
+        ones). Without ``probability_path`` the shipped probability map goes with the shipped detector only."""
         from lookalike.vision.detection_probability import DetectionProbability, shipped_detection_probability
         from lookalike.vision.heading import HeadingClassifier
         from lookalike.vision.hog_cascade import HogCascade
@@ -186,8 +168,8 @@ class RobotPipeline:
         self._index = 0
 
     def perceive(self, image: np.ndarray, observer_yaw_rad: float = 0.0) -> Detections:
-        """Detections of one frame: boxes (px), scores, ground positions (m), absolute headings and
-        their spreads (rad); at most ``max_detections``, the most probable, in decreasing score."""
+        """Detections of one frame (boxes px, scores, positions m, absolute headings and spreads rad): the
+        ``max_detections`` most probable, in decreasing score."""
         with needs("cv2"):
             import cv2
 
@@ -235,9 +217,8 @@ class RobotPipeline:
         return det.xywh, det.score, det.score
 
     def ground_positions(self, xywh: np.ndarray) -> np.ndarray:
-        """Egocentric ground positions ``(n, 2)`` (m) of boxes ``(n, 4)`` (px): the bottom-centre on the
-        ground, or, when the bottom is cut by the image border, the top-centre at the target's height.
-        NaN where neither works (above the horizon, or both edges cut)."""
+        """Egocentric ground positions ``(n, 2)`` (m) of boxes ``(n, 4)`` (px): the bottom-centre on the ground, or
+        the top-centre at the target's height when the bottom is cut; NaN where neither works."""
         b = np.asarray(xywh, float).reshape(-1, 4)
         pos = self.camera.box_to_ground(b)
         k, cfg = self.camera.intrinsics, self.config
@@ -251,8 +232,7 @@ class RobotPipeline:
 
     def identify(self, detections: Detections, beacons: Beacons | None = None, time_s: float | None = None,
                  index: int | None = None) -> PipelineResult:
-        """Feed one frame's detections and the reports received since the last frame to the identifier.
-        ``time_s`` defaults to the frame index / 30 Hz; ``index`` to the next frame."""
+        """Feed one frame's detections and reports to the identifier (``time_s`` default: index / 30 Hz)."""
         idx = self._index if index is None else int(index)
         t = idx / 30.0 if time_s is None else float(time_s)
         frame = Frame(index=idx, time=t, detections=detections,
@@ -268,8 +248,7 @@ class RobotPipeline:
 
 
 def shipped_model_path(kind: str) -> Path:
-    """The model shipped in ``lookalike/vision/models_data`` for ``kind`` ``"detector"`` or ``"heading"``
-    (trained on rendered robots by the commands in that folder's README.md)."""
+    """The shipped model (``lookalike/vision/models_data``) for ``kind`` ``"detector"`` or ``"heading"``."""
     if kind not in SHIPPED_MODELS:
         raise ValueError(f"kind: expected one of {sorted(SHIPPED_MODELS)}, got {kind!r}")
     path = MODELS_DIR / SHIPPED_MODELS[kind]
@@ -281,8 +260,7 @@ def shipped_model_path(kind: str) -> Path:
 
 def labelled_rows(index: int, detections: Detections, labels: Sequence[int] | np.ndarray,
                   tracks: Sequence[TrackSnapshot]) -> np.ndarray:
-    """MOTChallenge result rows ``(k, 10)`` for the identified detections of 0-based frame ``index``:
-    ``frame, agent id + 1, box (px), identity confidence, ground x, y (m), -1``."""
+    """MOTChallenge rows ``(k, 10)`` of 0-based frame ``index``: frame, agent id + 1, box px, confidence, x, y m, -1."""
     lab = np.asarray(labels, int).reshape(-1)
     assert detections.xywh is not None  # detections of the pixel pipeline have boxes
     prob = {t.detection_index: t.identity_prob for t in tracks if t.agent_id is not None and t.detection_index >= 0}

@@ -55,7 +55,14 @@ def draw_box(image: np.ndarray, xywh: np.ndarray, colour: BGR, label: str | None
         cv2.rectangle(image, p0, p1, OUTLINE, thickness + 2, cv2.LINE_AA)
         cv2.rectangle(image, p0, p1, colour, thickness, cv2.LINE_AA)
     if label:
-        draw_label(image, label, (p0[0], p0[1] - 2), colour, labels=labels, box=(p0[0], p0[1], p1[0], p1[1]))
+        draw_box_label(image, label, xywh, colour, labels)
+
+
+def draw_box_label(image: np.ndarray, text: str, xywh: np.ndarray, colour: BGR, labels: LabelSpace | None) -> Rect:
+    """:func:`draw_label` above box ``xywh (4,)`` (px), or where ``labels`` leave room around it."""
+    x, y, w, h = (float(v) for v in xywh)
+    x0, y0 = round(x), round(y)
+    return draw_label(image, text, (x0, y0 - 2), colour, labels=labels, box=(x0, y0, round(x + w), round(y + h)))
 
 
 def draw_label(image: np.ndarray, text: str, anchor: tuple[int, int], colour: BGR, scale: float = 0.45,
@@ -181,9 +188,7 @@ def draw_box_tracks(image: np.ndarray, frame: int, ids: np.ndarray, xywh: np.nda
         draw_box(image, b, identity_colour(int(i)), dashed=bool(d))
     for i, b in zip(ids, boxes):
         if np.isfinite(b).all():
-            x0, y0 = round(float(b[0])), round(float(b[1]))
-            draw_label(image, f"{prefix}{int(i)}", (x0, y0 - 2), identity_colour(int(i)), labels=space,
-                       box=(x0, y0, round(float(b[0] + b[2])), round(float(b[1] + b[3]))))
+            draw_box_label(image, f"{prefix}{int(i)}", b, identity_colour(int(i)), space)
 
 
 def draw_legend(image: np.ndarray, entries: list[tuple[str, BGR, bool]], scale: float = 0.45) -> None:

@@ -21,9 +21,9 @@ import numpy as np
 
 from lookalike._optional import needs
 from lookalike.io.outputs import write_atomic
-from lookalike.types.mot_table import detection_rows
-from lookalike.vision.blob import BlobConfig, BlobDetector
+from lookalike.vision.blob import BlobConfig, BlobDetector, spread
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config
+from lookalike.vision.onnx_detector import detect_frames
 from lookalike.viz.overlay import source_frames
 
 Progress = Callable[[str, int], Callable[[], None]]  # (description, total steps) -> called after each step
@@ -111,8 +111,6 @@ def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
     return estimate
 
 
-
-
 def _write_atomic(path: Path, data: bytes) -> None:
     try:
         write_atomic(path, data)  # (a unique temporary file, removed on any failure)
@@ -185,29 +183,19 @@ def blob_detection_rows(video: Path | str, config: BlobConfig,
         if not picked:
             raise ValueError(f"video: {video} has no frames")
         detector.fit(picked)
-    frames, _, _ = source_frames(video)
-    rows: list[np.ndarray] = []
-    count = 0
-    for k, image in enumerate(frames):
-        det = detector(image)
-        if len(det):
-            rows.append(detection_rows(k + 1, det.xywh, det.score))
-        count += 1
-        if advance is not None:
-            advance()
+    rows, count = detect_frames(source_frames(video)[0], detector, advance)
     if count == 0:
         raise ValueError(f"video: {video} has no frames")
-    return (np.vstack(rows) if rows else np.zeros((0, 10))), count
+    return rows, count
 
 
 def _background_sample(frames: Any, declared: int, count: int) -> list[np.ndarray]:
     """Up to ``count`` frames spread evenly over the video (all of them when its length is unknown and short)."""
     if declared > 0:
-        wanted = set(np.linspace(0, declared - 1, min(declared, count)).round().astype(int).tolist())
+        wanted = set(spread(declared, count).tolist())
         return [img for k, img in enumerate(frames) if k in wanted]
     every = list(frames)  # length unknown: keep the frames, then subsample
-    pick: Any = np.unique(np.linspace(0, len(every) - 1, min(len(every), count)).round().astype(int)) if every else []
-    return [every[k] for k in pick]
+    return [every[k] for k in spread(len(every), count)]
 
 
 __all__ = ["CACHE_ENV", "auto_blob_config", "blob_config", "blob_detection_rows", "blob_settings", "cache_dir",

@@ -24,9 +24,9 @@ from lookalike.viz.annotate import (
     LabelSpace,
     Tails,
     draw_box,
+    draw_box_label,
     draw_box_tracks,
     draw_caption,
-    draw_label,
     draw_legend,
 )
 from lookalike.viz.colors import BGR
@@ -174,9 +174,7 @@ def _annotated(image: np.ndarray, k: int, gt_rows: np.ndarray, shown: list[Any],
                     labels=space, dashed=~on_diver)
     for b, text, colour in [*((b, "missed", MISSED) for b in missed),
                             *((b + np.array([-3, -3, 6, 6]), "false", FALSE_TRACK) for b in boxes[~on_diver])]:
-        x0, y0 = round(float(b[0])), round(float(b[1]))
-        draw_label(img, text, (x0, y0 - 2), colour, labels=space,
-                   box=(x0, y0, round(float(b[0] + b[2])), round(float(b[1] + b[3]))))
+        draw_box_label(img, text, b, colour, space)
     draw_caption(img, caption)
     draw_legend(img, [("track on a diver (true)", (0, 140, 255), False),
                       ("track on no diver (false)", FALSE_TRACK, False),

@@ -25,7 +25,7 @@ from lookalike.sim.render_robots import (
 )
 from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
-from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_caption, draw_label, draw_legend, draw_tail
+from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_box_label, draw_caption, draw_legend, draw_tail
 from lookalike.viz.colors import identity_colour
 from lookalike.viz.plots import birdseye_plot
 from lookalike.viz.video import VideoWriter
@@ -175,8 +175,7 @@ def _draw_detections(img: np.ndarray, camera: Camera, scale: int, det: Any, labe
     for i in order:
         b, lab = boxes[i], int(labels[i])
         text = robot_label(lab) + (" (wrong)" if lab != int(truth[i]) else "")
-        draw_label(img, text, (round(b[0]), round(b[1]) - 2), identity_colour(lab), labels=space,
-                   box=(round(b[0]), round(b[1]), round(b[0] + b[2]), round(b[1] + b[3])))
+        draw_box_label(img, text, b, identity_colour(lab), space)
 
 
 def _log_robots(rerun: Any, k: int, time_s: float, img: np.ndarray, camera: Camera, scale: int, det: Any,

@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from lookalike.viz.label.store import atomic_write_text
+from lookalike.io.outputs import write_atomic
 
 FORMAT = "lookalike-human-benchmark"
 VERSION = 1
@@ -79,10 +79,7 @@ def human_result(sequence_name: str, labeller: str, n_agents: int, max_detection
 
 def write_human_result(path: str | Path, result: HumanResult) -> Path:
     """Write ``result`` to ``path`` atomically (folders created); returns the path."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(path, json.dumps({"format": FORMAT, "version": VERSION, **asdict(result)}, indent=1) + "\n")
-    return path
+    return write_atomic(path, json.dumps({"format": FORMAT, "version": VERSION, **asdict(result)}, indent=1) + "\n")
 
 
 def read_human_result(path: str | Path) -> HumanResult:

@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 import threading
 import time
 from collections.abc import Sequence
@@ -19,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.eval import identification_success_rate
+from lookalike.io.outputs import write_atomic
 
 FORMAT = "lookalike-labels"
 VERSION = 1
@@ -29,36 +28,6 @@ def label_path_for(sequence_path: str | Path) -> Path:
     """The label file beside ``sequence_path``: ``<folder>/<stem>.labels.json``."""
     p = Path(sequence_path)
     return p.with_name(f"{p.stem}.labels.json")
-
-
-def current_umask() -> int:
-    """The process's file-mode creation mask (read without changing it where /proc allows)."""
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    mask = os.umask(0o022)  # (elsewhere: set and restore at once)
-    os.umask(mask)
-    return mask
-
-
-def atomic_write_text(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same folder and ``os.replace``. The file gets the mode
-    a plain ``open(path, "w")`` would give: 0o666 less the user's umask (``mkstemp`` alone would make it 0o600)."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        os.fchmod(fd, 0o666 & ~current_umask())
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _check_labels(labels: Sequence[Sequence[int]], counts: Sequence[int], n_agents: int, what: str) -> list[list[int]]:
@@ -125,7 +94,7 @@ class LabelStore:
         doc = {"format": FORMAT, "version": VERSION, "sequence": self.sequence_name, "n_frames": len(self.counts),
                "n_agents": self.n_agents, "counts": self.counts, "labels": self.labels, "source": self.source,
                "benchmark": self.benchmark, "saved_at": time.time()}
-        atomic_write_text(self.path, json.dumps(doc, separators=(",", ":")))
+        write_atomic(self.path, json.dumps(doc, separators=(",", ":")))
 
     def set_label(self, frame: int, detection: int, label: int) -> None:
         """Set one detection's label (agent id, -1 false positive, -2 unset) and save."""
