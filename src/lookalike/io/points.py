@@ -136,13 +136,22 @@ def typical_spacing(points: PointFrames | list[np.ndarray]) -> float:
     """Median distance from each point to its nearest neighbour in the same frame (input unit); 0 when
     no frame has two points."""
     per_frame = points.points if isinstance(points, PointFrames) else points
-    near = []
-    for p in per_frame:
-        if len(p) > 1:
-            d = np.linalg.norm(p[:, None, :] - p[None, :, :], axis=2)
-            np.fill_diagonal(d, np.inf)
-            near.append(d.min(axis=1))
+    near = [_nearest(p, p, second=True) for p in per_frame if len(p) > 1]
     return float(np.median(np.concatenate(near))) if near else 0.0
+
+
+def _nearest(points: np.ndarray, among: np.ndarray, second: bool = False) -> np.ndarray:
+    """Distance from each of ``points (n, 2)`` to its nearest neighbour in ``among (m, 2)`` (the second nearest with
+    ``second``, when ``among`` is ``points``), found with a k-d tree: memory linear in the points."""
+    from scipy.spatial import cKDTree  # imported on first use
+
+    dist, idx = cKDTree(among).query(points, k=2 if second else 1)
+    if second:
+        dist, idx = dist[:, 1], idx[:, 1]
+    ok = np.isfinite(dist)  # the same arithmetic as a dense distance matrix, where a neighbour was found
+    out: np.ndarray = np.full(len(points), np.inf)
+    out[ok] = np.linalg.norm(points[ok] - among[idx[ok]], axis=1)
+    return out
 
 
 def typical_step(points: PointFrames | list[np.ndarray]) -> float:
@@ -153,7 +162,7 @@ def typical_step(points: PointFrames | list[np.ndarray]) -> float:
     for a, b in zip(per_frame[:-1], per_frame[1:]):
         a, b = np.asarray(a, dtype=float).reshape(-1, 2), np.asarray(b, dtype=float).reshape(-1, 2)
         if len(a) and len(b):
-            near.append(np.linalg.norm(b[:, None, :] - a[None, :, :], axis=2).min(axis=1))
+            near.append(_nearest(b, a))
     return float(np.median(np.concatenate(near))) if near else 0.0
 
 
