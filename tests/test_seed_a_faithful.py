@@ -16,7 +16,7 @@ from lookalike.sim import NOISE_MODELS, noise_sensor, preset, simulate_arrays, s
 from lookalike.sim.robots_sensors import position_noise_std
 from lookalike.trackers import make_tracker
 from lookalike.trackers.lstm.encoding import EncodingSpec, encode_frame
-from lookalike.trackers.lstm.tracker import BeaconMemory, decode
+from lookalike.trackers.parts.agents import BeaconMemory, decode
 from lookalike.trackers.parts.identity.localiser import KalmanLocaliser, LowPassLocaliser, make_localiser
 
 runner = CliRunner()
@@ -61,7 +61,7 @@ def test_paper_encoding_has_n_plus_4m_inputs_and_matches_the_training_arrays():
 
 def test_per_slot_decoding_is_the_argmax():
     prob = np.array([[0.6, 0.3, 0.1], [0.7, 0.2, 0.1], [0.1, 0.1, 0.8]])
-    label, conf = decode(prob, 3, one_to_one=False)
+    label, conf = decode(prob, np.arange(3), 3, one_to_one=False)
     assert label.tolist() == [0, 0, -1] and np.allclose(conf, [0.6, 0.7, 0.8])
 
 

@@ -17,14 +17,14 @@ from lookalike.trackers.lstm.checkpoint import load_weights
 from lookalike.trackers.lstm.encoding import PROTOCOLS, EncodingSpec, encode_frame
 from lookalike.trackers.lstm.network import NumpyAssociationNet
 from lookalike.trackers.lstm.weights import shipped_weights_path
-from lookalike.trackers.parts.agents import BeaconMemory, agent_snapshots, decode
-from lookalike.trackers.parts.identity.localiser import LOCALISERS, make_localiser
+from lookalike.trackers.parts.agents import AgentIdentifier, agent_snapshots, decode
+from lookalike.trackers.parts.identity.localiser import LOCALISERS
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot
 
 
 @register_tracker("lstm")
-class LstmIdentifier:
+class LstmIdentifier(AgentIdentifier):
     """The deep LSTM associator: per-detection identities and low-pass filtered agent positions."""
 
     @dataclass(frozen=True)
@@ -53,28 +53,17 @@ class LstmIdentifier:
     def reset(self) -> None:
         """Forget the recurrent state, the reports and the agents' positions."""
         self.net.reset()
-        self._beacons = BeaconMemory(self.config.n_agents)
-        self._localiser = make_localiser(self.config.localiser, self.config.n_agents)
-        self._last_seen = np.full(self.config.n_agents, -1)
-        self.last_labels = np.zeros(0, dtype=int)
-        self.last_probabilities = np.zeros(0)
-        self._last_time = -np.inf
+        self._reset_agents(self.config.n_agents, self.config.localiser)
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
-        if frame.time < self._last_time:
-            raise ValueError(f"frame time went backwards: {self._last_time} s then {frame.time} s")
-        self._last_time = frame.time
+        self._step_time(frame)
         self._beacons.add(frame)
         det = frame.detections
-        n = len(det)
         x, used = encode_frame(self.spec, det, self._beacons.heading, self._beacons.age(frame.time))
-        prob = self.net.step(x)
-        slot_label, slot_conf = decode(prob, len(used), self.config.one_to_one)
-        labels, conf = np.full(n, -1), np.zeros(n)
-        labels[used], conf[used] = slot_label, slot_conf
+        labels, conf = decode(self.net.step(x), used, len(det), self.config.one_to_one)
         self.last_labels, self.last_probabilities = labels, conf
-        if n and (det.position is None or det.heading is None):
+        if len(det) and (det.position is None or det.heading is None):
             raise ValueError("lstm: frame.detections need position (m) and heading (rad) columns")
         position = det.position if det.position is not None else np.zeros((0, 2))
         heading = det.heading if det.heading is not None else np.zeros(0)

@@ -1,14 +1,12 @@
-"""What the learned identifiers share: the agents' latest heading reports, decoding class probabilities into
-one detection per agent, and the agents as tracks (one snapshot per agent, positioned by a localiser).
-
-Used by ``set`` (:mod:`lookalike.trackers.set.tracker`) and the LSTM identifier (``lookalike.trackers.lstm.tracker``).
-"""
+"""What the learned identifiers (``set``, ``lstm``) share: the agents' latest heading reports, decoding class
+probabilities into one detection per agent, and the agents as tracks (one snapshot per agent, positioned by a
+localiser)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from lookalike.trackers.parts.identity.localiser import KalmanLocaliser, LowPassLocaliser
+from lookalike.trackers.parts.identity.localiser import KalmanLocaliser, LowPassLocaliser, make_localiser
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
 
@@ -32,8 +30,35 @@ class BeaconMemory:
         return np.where(np.isfinite(age), age, np.nan)
 
 
-def decode(prob: np.ndarray, n_used: int, one_to_one: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Labels ``(n_used,)`` (agent or -1) and their probabilities from slot probabilities ``(M, N+1)``."""
+class AgentIdentifier:
+    """The learned identifiers' state besides their network: reports, positions, the frame time, the latest labels."""
+
+    def _reset_agents(self, n_agents: int, localiser: str) -> None:
+        self._beacons = BeaconMemory(n_agents)
+        self._localiser = make_localiser(localiser, n_agents)
+        self._last_seen = np.full(n_agents, -1)
+        self.last_labels = np.zeros(0, dtype=int)
+        self.last_probabilities = np.zeros(0)
+        self._last_time = -np.inf
+
+    def _step_time(self, frame: Frame) -> float:
+        """Seconds since the previous frame (0 at the first); ``ValueError`` when time goes backwards."""
+        if frame.time < self._last_time:
+            raise ValueError(f"frame time went backwards: {self._last_time} s then {frame.time} s")
+        dt = 0.0 if not np.isfinite(self._last_time) else frame.time - self._last_time
+        self._last_time = frame.time
+        return dt
+
+
+def decode(prob: np.ndarray, used: np.ndarray, n: int, one_to_one: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Labels ``(n,)`` of a frame's ``n`` detections (agent or -1) and their probabilities (0 where unused) from the
+    probabilities ``(M, N+1)`` of the slots holding detections ``used``."""
+    labels, conf = np.full(n, -1), np.zeros(n)
+    labels[used], conf[used] = _decode(prob, len(used), one_to_one)
+    return labels, conf
+
+
+def _decode(prob: np.ndarray, n_used: int, one_to_one: bool) -> tuple[np.ndarray, np.ndarray]:
     p = prob[:n_used]
     n_agents = p.shape[1] - 1
     if not one_to_one:

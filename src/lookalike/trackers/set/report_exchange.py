@@ -1,21 +1,11 @@
-"""Which two agents' heading reports have exchanged robots (ids swapped, or a swap undone), even when the
-two headings differ by less than a robot can turn between two reports.
+"""Which two agents' heading reports have exchanged robots (ids swapped, or a swap undone), even when the two headings
+differ by less than a robot can turn between two reports.
 
-Each agent's reports (absolute heading, radians, at their send time) feed a constant-turn-rate Kalman
-filter that runs ``lag_s`` seconds behind the newest report of any agent, so that the reports just after an
-exchange are compared with heading tracks that have not absorbed them yet. For every new report of agent
-``a`` and every other agent ``b``, the log-likelihood ratio of "this report continues b's track" over "it
-continues a's own" is summed (a CUSUM: never below 0) and decays with time constant ``memory_s``, so that
-evidence one stream left long ago (two robots heading alike) does not complete an exchange later. When the sums
-of ``(a, b)`` and of ``(b, a)`` together pass twice ``threshold`` and each passes a quarter of it, each stream
-continues the other's track (a robot that starts to turn just then may fit neither, so one stream can carry most
-of the evidence): the two tracks are exchanged and the pair is returned. One stream alone (a robot turning fast)
-does not pass, as the other keeps fitting its own track.
-
-:func:`for_team` builds the detector ``set`` runs: teams of :data:`TIGHT_TEAM` agents or more expect smoother
-turning (:data:`TIGHT_ACCEL_PSD`, :data:`TIGHT_LAG_S`), which finds exchanges between robots heading alike, and
-teams of more than :data:`MAX_AGENTS` run none.
-"""
+Each agent's reports feed a constant-turn-rate Kalman filter running ``lag_s`` behind the newest report of any agent.
+Each new report of agent ``a`` adds, for every other agent ``b``, the log-likelihood ratio of "it continues b's track"
+over "it continues a's own" to a CUSUM decaying with time constant ``memory_s``. When the sums of ``(a, b)`` and
+``(b, a)`` pass twice ``threshold`` together and each a quarter of it, the two tracks are exchanged and the pair
+returned (one stream alone, a robot turning fast, does not pass). :func:`for_team` builds the detector ``set`` runs."""
 
 from __future__ import annotations
 
@@ -42,10 +32,8 @@ class ReportExchange:
 
     def __init__(self, n: int, threshold: float, accel_psd: float = ACCEL_PSD, lag_s: float = LAG_S,
                  noise_rad: float = NOISE_RAD, memory_s: float = MEMORY_S) -> None:
-        """``threshold``: half the log-likelihood ratio the two streams must pass together; ``accel_psd``: spectral
-        density of the heading's angular acceleration, rad²/s³; ``lag_s``: how far the tracks run behind the
-        newest report of any agent, seconds; ``noise_rad``: a report's heading noise (standard deviation), radians;
-        ``memory_s``: time constant of the evidence's decay, seconds."""
+        """Parameters as in the module; ``accel_psd``: the heading's angular acceleration, rad²/s³; ``noise_rad``: a
+        report's heading noise (standard deviation)."""
         self.n, self.threshold, self.q, self.lag_s, self.r = n, threshold, accel_psd, lag_s, noise_rad ** 2
         self.memory_s = memory_s
         self.clock = -np.inf  # newest send time seen, seconds
@@ -134,7 +122,8 @@ class ReportExchange:
 
 
 def for_team(n: int, threshold: float) -> ReportExchange | None:
-    """The detector ``set`` runs for a team of ``n`` agents (None: none, a team of more than :data:`MAX_AGENTS`)."""
+    """The detector ``set`` runs for ``n`` agents: smoother turning (``TIGHT_*``) from :data:`TIGHT_TEAM` agents, none
+    beyond :data:`MAX_AGENTS`."""
     if n > MAX_AGENTS:
         return None
     if n >= TIGHT_TEAM:

@@ -1,14 +1,9 @@
 """Which agents' heading reports jumped to another robot, and with which agent they exchanged robots.
 
-An agent whose reported heading jumps by more than a robot can turn between two of its reports (``jump`` +
-``turn_rate`` · the time between them, radians) now reports for another robot: ids swapped, or a swap undone.
-It has exchanged robots with the one other agent that reported the new heading just before. With none or several,
-it waits :data:`PAIR_WAIT_S` seconds for a jump that mirrors its own (another agent now reporting the heading it
-reported before, and the reverse) and exchanges with that agent, forgotten when none comes. An agent's first
-report after a silence too long to call a jump (more than ``jump`` off its previous one, within ``jump`` +
-``turn_rate`` · the silence) is paired with such a waiting jump when the two mirror each other; alone it changes
-nothing. :meth:`ReportJumps.find` returns what the identifier must do to the agents' memories, in order.
-"""
+A report jumping more than ``jump`` + ``turn_rate`` · the time since the agent's previous one means it now reports for
+another robot: exchanged with the one agent that reported the new heading just before, else with the agent whose jump
+mirrors it within :data:`PAIR_WAIT_S` seconds (forgotten when none comes). A report after a long silence that is off
+by more than ``jump`` is paired only with a mirroring waiting jump. :meth:`ReportJumps.find` returns the actions."""
 
 from __future__ import annotations
 

@@ -1,35 +1,23 @@
 """``set``: one network that labels detections with agent identities for any number of agents and detections.
 
-How it works, by mechanism (each public parameter switches one on or sets its strength; None: off):
+Each public parameter switches one mechanism on or sets its strength (None: off):
 
-- **Network** (``weights``, ``n_slots``): a set associator (:mod:`~lookalike.trackers.set.network`) reads each
-  frame's detections (ground position in metres, absolute visual heading in radians, detector score) and the
-  agents' latest heading reports, keeps a memory per agent and gives each detection a probability of being agent
-  ``j`` or a false positive; decoded one-to-one (Hungarian on ``-log p``, false positives allowed).
-- **Positions** (``localiser``): each agent's position comes from the detection labelled ``j`` and its
-  probability, through a per-agent Kalman filter or a low-pass filter
-  (:mod:`lookalike.trackers.parts.identity.localiser`).
-- **Stale reports** (``stale_s``): an agent whose report is older than ``stale_s`` while a detection within
-  :data:`STALE_RADIUS_M` of its remembered position has turned more than :data:`STALE_TURN_RAD` away from that
-  report is shown to the network as not heard from (its memory still places it).
-- **False-positive prior** (``fp_prior_ref``): the false-positive probability is scaled by the running mean of the
-  detections labelled false positive per frame (time constant :data:`FP_PRIOR_S`) over ``fp_prior_ref``, clipped to
-  :data:`FP_PRIOR_CLIP`: the network was trained over 0.3-2.5 false positives per frame and cannot tell the rate
-  from one frame.
-- **Report jumps** (``report_jump``): an agent whose reports jump further than a robot can turn (``report_jump`` +
-  :data:`TURN_RATE_RAD_S` · the time between them) now reports for another robot; its memory is exchanged with the
-  agent it swapped with, else forgotten (:mod:`~lookalike.trackers.set.report_jumps`).
-- **Report exchange** (``exchange_llr``): two agents whose heading reports each continue the other's report track
-  exchange memories: a swap too small for a report jump (:mod:`~lookalike.trackers.set.report_exchange`; teams of
-  up to seven agents).
-- **Visual exchange** (``visual_exchange``): two agents whose detections' visual headings, gathered over seconds,
-  fit each other's reports better than their own exchange memories (:mod:`~lookalike.trackers.set.visual_exchange`).
-- **Undo** (``undo_factor``): a pair exchanged within the last :data:`UNDO_S` seconds needs that fraction of the two
-  exchange detectors' evidence to be exchanged back (a swap of ids is often undone); an agent undoes only its
-  latest exchange.
+- **Network** (``weights``, ``n_slots``): a set associator (:mod:`~lookalike.trackers.set.network`) gives each detection
+  (position m, visual heading rad, score) a probability of being agent ``j`` or a false positive from the agents'
+  latest reports and its memory per agent; decoded one-to-one (Hungarian on ``-log p``).
+- **Positions** (``localiser``): Kalman or low-pass filters (:mod:`lookalike.trackers.parts.identity.localiser`).
+- **Stale reports** (``stale_s``): an older report is hidden from the network when a detection within
+  :data:`STALE_RADIUS_M` of the agent's remembered position has turned more than :data:`STALE_TURN_RAD` from it.
+- **False-positive prior** (``fp_prior_ref``): the false-positive probability is scaled by the running rate of
+  false positives per frame (time constant :data:`FP_PRIOR_S`) over ``fp_prior_ref``, clipped to :data:`FP_PRIOR_CLIP`.
+- **Report jumps** (``report_jump``), **report exchange** (``exchange_llr``, teams of up to seven) and **visual
+  exchange** (``visual_exchange``): detectors of swapped ids (:mod:`~lookalike.trackers.set.report_jumps`,
+  :mod:`~lookalike.trackers.set.report_exchange`, :mod:`~lookalike.trackers.set.visual_exchange`) that exchange or
+  forget the agents' memories.
+- **Undo** (``undo_factor``): a pair exchanged within :data:`UNDO_S` seconds is exchanged back on that fraction of the
+  evidence; an agent undoes only its latest exchange.
 
-Every value was chosen on tuning sequences and checked on fresh ones (docs/experiments/any-team-size.md).
-"""
+Values chosen on tuning sequences and checked on fresh ones (docs/experiments/any-team-size.md)."""
 
 from __future__ import annotations
 
@@ -39,8 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.trackers.base import check_params, param
-from lookalike.trackers.parts.agents import BeaconMemory, agent_detections, agent_snapshots, decode
-from lookalike.trackers.parts.identity.localiser import LOCALISERS, make_localiser
+from lookalike.trackers.parts.agents import AgentIdentifier, agent_detections, agent_snapshots, decode
+from lookalike.trackers.parts.identity.localiser import LOCALISERS
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.set import report_exchange
 from lookalike.trackers.set.network import (
@@ -63,7 +51,7 @@ UNDO_S = 30.0  # how long a pair's exchange can be undone on less evidence, seco
 
 
 @register_tracker("set")
-class SetIdentifier:
+class SetIdentifier(AgentIdentifier):
     """The set associator: per-detection identities for any number of agents and detections (see the module)."""
 
     needs = ("ground positions, headings and heading reports of robots (a `lookalike simulate` sequence, "
@@ -107,12 +95,7 @@ class SetIdentifier:
         cfg = self.config
         n = cfg.n_agents
         self.net.reset(n)
-        self._beacons = BeaconMemory(n)
-        self._localiser = make_localiser(cfg.localiser, n)
-        self._last_seen = np.full(n, -1)
-        self.last_labels = np.zeros(0, dtype=int)
-        self.last_probabilities = np.zeros(0)
-        self._last_time = -np.inf
+        self._reset_agents(n, cfg.localiser)
         self._jumps = None if cfg.report_jump is None else ReportJumps(cfg.report_jump, TURN_RATE_RAD_S)
         self.fp_rate = cfg.fp_prior_ref  # running mean of false positives per frame
         self._exchange = None if cfg.exchange_llr is None else report_exchange.for_team(n, cfg.exchange_llr)
@@ -123,10 +106,7 @@ class SetIdentifier:
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
-        if frame.time < self._last_time:
-            raise ValueError(f"frame time went backwards: {self._last_time} s then {frame.time} s")
-        dt = 0.0 if not np.isfinite(self._last_time) else frame.time - self._last_time
-        self._last_time = frame.time
+        dt = self._step_time(frame)
         before = (self._beacons.heading.copy(), self._beacons.t_sent.copy())
         self._beacons.add(frame)
         if self._jumps is not None:
@@ -149,21 +129,18 @@ class SetIdentifier:
         prob = self.net.step(agents, detection_tokens(position[used], heading[used], score[used]), dt)
         if self.fp_rate is not None:
             prob = self._fp_prior(prob)
-        slot_label, slot_conf = decode(prob, len(used), True)
+        labels, conf = decode(prob, used, n, True)
         if self.fp_rate is not None:
             weight = 1.0 - math.exp(-dt / FP_PRIOR_S)
-            self.fp_rate += weight * (int((slot_label < 0).sum()) - self.fp_rate)
-        labels, conf = np.full(n, -1), np.zeros(n)
-        labels[used], conf[used] = slot_label, slot_conf
+            self.fp_rate += weight * (int((labels[used] < 0).sum()) - self.fp_rate)
         if self._visual is not None:
             labels = self._visual_exchanges(labels, conf, heading, age, dt)
         self.last_labels, self.last_probabilities = labels, conf
         return agent_snapshots(labels, conf, position, heading, self._localiser, self._last_seen, frame)
 
     def _fp_prior(self, prob: np.ndarray) -> np.ndarray:
-        """``prob`` (slots x N+1, false positive last) with the false-positive column scaled by the world's
-        running false-positive rate over ``fp_prior_ref`` (the prior-shift correction of a posterior trained on
-        another mix of false positives) and the rows normalised again."""
+        """``prob (slots, N+1)`` with the false-positive column scaled by the running rate over ``fp_prior_ref`` (a
+        prior-shift correction), rows normalised again."""
         assert self.fp_rate is not None and self.config.fp_prior_ref is not None
         out = prob.copy()
         out[:, -1] *= min(max(self.fp_rate / self.config.fp_prior_ref, FP_PRIOR_CLIP[0]), FP_PRIOR_CLIP[1])
@@ -171,10 +148,7 @@ class SetIdentifier:
 
     def _hide_stale(self, reported: np.ndarray, age: np.ndarray, position: np.ndarray,
                     heading: np.ndarray) -> np.ndarray:
-        """The reported headings (radians) with NaN (never heard, for the network) for every agent whose
-        report is older than ``stale_s`` while a detection within :data:`STALE_RADIUS_M` of its remembered
-        position is more than :data:`STALE_TURN_RAD` away from that report: the robot has turned since it last
-        reported, and only its remembered position still says which detection it is."""
+        """The reported headings (radians) with NaN (never heard) for the stale reports to hide (see the module)."""
         assert self.config.stale_s is not None
         stale = np.isfinite(age) & (age > self.config.stale_s) & self.net.remembers()
         if not stale.any() or not len(position):
@@ -188,8 +162,8 @@ class SetIdentifier:
         return np.asarray(out)
 
     def _report_jumps(self, heading: np.ndarray, t_sent: np.ndarray) -> None:
-        """Exchange or forget the memories of the agents whose reports jumped to another robot since their previous
-        newest report (``heading``, radians, sent at ``t_sent`` seconds)."""
+        """Exchange or forget the memories of agents whose reports jumped since the previous newest ``heading``
+        (radians, sent at ``t_sent`` s)."""
         assert self._jumps is not None
         for action in self._jumps.find(heading, t_sent, self._beacons.heading, self._beacons.t_sent, self._last_time):
             if isinstance(action, tuple):
@@ -211,8 +185,7 @@ class SetIdentifier:
             self._exchange.swap(a, b)
 
     def _swap_network(self, a: int, b: int) -> None:
-        """Exchange agents ``a`` and ``b``'s memories in the network and note when (undo): an agent may undo only its
-        latest exchange, and an exchange that undoes one leaves the pair as any other."""
+        """Exchange agents ``a`` and ``b``'s memories in the network and note when (undo: only an agent's latest)."""
         self.net.swap(a, b)
         undone = self._last_time - self._exchanged_at[a, b] <= UNDO_S
         self._exchanged_at[[a, b], :] = -np.inf
@@ -221,8 +194,7 @@ class SetIdentifier:
             self._exchanged_at[a, b] = self._exchanged_at[b, a] = self._last_time
 
     def _threshold_scale(self, agent: int | None = None) -> np.ndarray | None:
-        """The factor on the exchange detectors' thresholds per pair of agents, or of ``agent`` with each other
-        agent (None: no undo)."""
+        """The factor on the exchange thresholds per pair, or of ``agent`` with each other agent (None: no undo)."""
         factor = self.config.undo_factor
         if factor is None:
             return None
@@ -230,8 +202,7 @@ class SetIdentifier:
         return np.where(since <= UNDO_S, factor, 1.0)
 
     def _report_exchanges(self, frame: Frame) -> None:
-        """Feed the frame's reports to the report-exchange detector and exchange the memories of each pair it
-        finds; a report jump of either agent within the next second is then the same exchange."""
+        """Feed the frame's reports to the report-exchange detector and exchange the memories of each pair it finds."""
         assert self._exchange is not None
         b = frame.beacons
         for agent, t_sent, heading in zip(b.agent_id.tolist(), b.t_sent.tolist(), b.heading.tolist()):
@@ -246,8 +217,7 @@ class SetIdentifier:
 
     def _visual_exchanges(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, age: np.ndarray,
                           dt: float) -> np.ndarray:
-        """Exchange the memories, and this frame's labels, of the pairs of agents whose detections' visual headings
-        ``heading`` (radians) fit each other's reports better. Returns the labels."""
+        """Exchange the memories and this frame's labels of the pairs the visual-exchange detector finds; the labels."""
         assert self._visual is not None
         held = agent_detections(labels, conf, self.config.n_agents)
         pairs = self._visual.update(held, heading, self._beacons.heading, age, dt, self._threshold_scale())

@@ -1,21 +1,11 @@
-"""Which two agents hold each other's robots, from the detections' visual headings gathered over seconds.
+"""Which two agents hold each other's robots, from the detections' visual headings gathered over seconds (after a
+swap of ids the reports barely show, the network's memory of positions keeps the two agents on the wrong robots).
 
-After an exchange of ids that the heading reports barely show (two robots heading within a few tenths of a
-radian of each other), the network's memory of positions keeps the two agents on the wrong robots. One frame's
-visual heading cannot tell them apart (a 10-class heading classifier is off by about 0.28 rad), but many can:
-for two agents ``a`` and ``b`` that each hold a detection and have a fresh report, a frame adds to the pair's
-evidence the log-likelihood ratio of "a's detection is b's robot and b's is a's" over the labels as they are,
-each detection's visual heading modelled as its robot's reported heading plus Gaussian noise ``noise_rad``,
-turned front to back with probability ``flip_prob`` and anything at all with probability ``outlier_prob``. A
-frame adds at most ``max_step`` either way (both detections seen front to back in one frame would otherwise
-add about 7 for two robots heading opposite ways), so an exchange needs consistent evidence over several frames. The
-evidence is summed over frames, decays with time constant ``memory_s`` and never drops below zero (a CUSUM), so
-that two robots whose headings stay apart keep it at zero; when a pair's passes ``threshold`` the two agents
-are said to be exchanged and their evidence starts again. An agent whose report is older than ``fresh_s`` (its robot
-silent for a while) takes part too, its robot's heading modelled as its last report with the noise widened by
-``stale_rad_s`` radians per second beyond ``fresh_s`` (how far a robot may have turned since): the pair's evidence
-then comes mostly from the agent that still reports.
-"""
+For agents ``a`` and ``b`` that each hold a detection, a frame adds the log-likelihood ratio of "a's detection is b's
+robot and b's is a's" over the labels as they are (a visual heading: its robot's reported heading plus Gaussian noise
+``noise_rad``, turned by π with probability ``flip_prob``, uniform with ``outlier_prob``), at most ``max_step`` either
+way, to a CUSUM decaying with time constant ``memory_s``; a pair passing ``threshold`` is exchanged and starts again.
+A report older than ``fresh_s`` counts with its noise widened by ``stale_rad_s`` per second beyond it."""
 
 from __future__ import annotations
 
@@ -45,12 +35,7 @@ class VisualExchange:
     def __init__(self, n: int, threshold: float, memory_s: float = MEMORY_S, noise_rad: float = NOISE_RAD,
                  flip_prob: float = 0.03, outlier_prob: float = 0.02, fresh_s: float = 0.5,
                  max_step: float = 1.5, stale_rad_s: float = STALE_RAD_S) -> None:
-        """``threshold``: log-likelihood ratio a pair must pass; ``memory_s``: time constant of the evidence's
-        decay, seconds; ``noise_rad``: a visual heading's noise around its robot's heading (standard deviation),
-        radians; ``flip_prob``: probability that a visual heading is turned by π; ``outlier_prob``: probability that
-        it says nothing of the robot (uniform); ``fresh_s``: only reports younger than this count, seconds;
-        ``max_step``: the most one frame adds or takes; ``stale_rad_s``: older reports count with their noise
-        widened by this many radians per second beyond ``fresh_s``."""
+        """Parameters as in the module (seconds, radians; ``noise_rad`` a standard deviation)."""
         if n < 0 or min(threshold, memory_s, noise_rad, max_step, stale_rad_s) <= 0:
             raise ValueError(f"VisualExchange needs n >= 0 and positive threshold, memory_s, noise_rad, max_step and "
                              f"stale_rad_s, "
@@ -67,8 +52,8 @@ class VisualExchange:
 
     def log_likelihood(self, visual: np.ndarray, reported: np.ndarray, sigma: np.ndarray | float | None = None
                        ) -> np.ndarray:
-        """Log-likelihood of visual headings ``visual`` (radians) given robot headings ``reported`` (radians) with
-        noise ``sigma`` (radians; None: ``noise_rad``); the three broadcast."""
+        """Log-likelihood of visual headings given robot headings ``reported``, noise ``sigma`` (None: ``noise_rad``);
+        radians, broadcast."""
         sigma = self.sigma if sigma is None else np.asarray(sigma)
         d = np.angle(np.exp(1j * (np.asarray(visual) - np.asarray(reported))))
         flipped = np.pi - np.abs(d)
@@ -80,11 +65,9 @@ class VisualExchange:
 
     def update(self, held: np.ndarray, visual: np.ndarray, reported: np.ndarray, age: np.ndarray,
                dt: float, scale: np.ndarray | None = None) -> list[tuple[int, int]]:
-        """One frame: ``held`` (n) each agent's detection index (-1: none), ``visual`` each detection's visual
-        heading (radians), ``reported`` and ``age`` each agent's newest reported heading (radians) and its age
-        (seconds; NaN: never heard), ``dt`` seconds since the last frame, ``scale`` (n x n, symmetric) a factor on
-        each pair's threshold (None: 1). Returns the pairs found exchanged (the strongest first, each agent at most
-        once)."""
+        """One frame: ``held (n,)`` each agent's detection index (-1: none), ``visual`` the detections' visual headings,
+        ``reported``/``age`` each agent's newest reported heading and its age (NaN: never heard), ``dt`` seconds since
+        the last frame, ``scale (n, n)`` a factor on each pair's threshold (None: 1). Returns :func:`take_pairs`'."""
         self.evidence *= np.exp(-max(dt, 0.0) / self.memory_s)
         usable = (held >= 0) & np.isfinite(reported) & np.isfinite(age)
         live = np.flatnonzero(usable)
