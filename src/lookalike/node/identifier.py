@@ -1,8 +1,5 @@
-"""Socket-free core of the node: checks reports and frames, runs the tracker, builds team states.
-
-Every time is simulated time carried by the messages (a report's ``t_sent``, a frame's ``time``); a report reaches the
-tracker with the next frame, stamped ``t_received`` = that frame's time. A time is trusted only within bounds of the
-camera's clock (:class:`IdentifierConfig`): one message far ahead is dropped (``time_ahead``), never the new "now"."""
+"""Socket-free core of the node: checks reports and frames, runs the tracker, builds team states. Times are the
+messages' simulated times; a report reaches the tracker with the next frame, stamped with that frame's time."""
 
 from __future__ import annotations
 
@@ -36,15 +33,12 @@ class IdentifierConfig:
     Attributes:
         n_robots: robots in the team; ids ``0 .. n_robots-1`` are accepted.
         max_report_age_s: a report sent more than this before the latest frame is late (seconds).
-        max_queued_per_robot: reports of one robot kept for the next frame; beyond it the oldest
-            is dropped (counted ``queue_dropped``).
-        max_queued: reports of all robots kept for the next frame; beyond it a new report is
-            dropped (counted ``queue_full``).
-        max_frame_jump_s: a frame more than this after the last frame (seconds) is dropped as
-            ``time_ahead`` while the camera is alive (a camera lost may come back at any time).
-        max_report_ahead_s: a report sent more than this after the last frame (seconds) is dropped as
-            ``time_ahead``; a robot whose last report (taken before any frame, or while the camera was lost) is
-            that far ahead of a new frame has its sequence and clock forgotten (counted ``robot_resets``)."""
+        max_queued_per_robot: reports of one robot kept for the next frame (beyond: oldest dropped).
+        max_queued: reports of all robots kept for the next frame (beyond: new ones dropped).
+        max_frame_jump_s: a frame more than this after the last one (seconds) is ``time_ahead`` while the camera is
+            alive.
+        max_report_ahead_s: a report sent more than this after the last frame (seconds) is ``time_ahead``; a robot
+            whose last report is that far ahead of a new frame is forgotten (``robot_resets``)."""
 
     n_robots: int = 3
     max_report_age_s: float = 1.0
@@ -56,9 +50,7 @@ class IdentifierConfig:
     def __post_init__(self) -> None:
         if not 1 <= self.n_robots <= MAX_ROBOTS:
             raise ValueError(f"n_robots must be in 1 .. {MAX_ROBOTS}, got {self.n_robots}")
-        if not (self.max_report_age_s > 0 and math.isfinite(self.max_report_age_s)):
-            raise ValueError(f"max_report_age_s must be a finite number > 0, got {self.max_report_age_s}")
-        for name in ("max_frame_jump_s", "max_report_ahead_s"):
+        for name in ("max_report_age_s", "max_frame_jump_s", "max_report_ahead_s"):
             if not (getattr(self, name) > 0 and math.isfinite(getattr(self, name))):
                 raise ValueError(f"{name} must be a finite number > 0, got {getattr(self, name)}")
         if self.max_queued_per_robot < 1 or self.max_queued < 1:
@@ -67,15 +59,11 @@ class IdentifierConfig:
 
 
 class TeamIdentifier:
-    """Accepts heading reports and detection frames in arrival order and identifies the team.
-
-    ``add_report`` and ``add_frame`` return the counter the message falls under (``"reports"``/``"frames"`` when
-    accepted); ``add_frame`` also returns the team state. Reports wait for the next frame in bounded queues
-    (:class:`IdentifierConfig`)."""
+    """Accepts heading reports and detection frames in arrival order and identifies the team; ``add_report`` and
+    ``add_frame`` return the counter the message falls under (``"reports"``/``"frames"`` when accepted)."""
 
     def __init__(self, tracker: Any, config: IdentifierConfig | None = None) -> None:
-        self.tracker = tracker
-        self.config = config or IdentifierConfig()
+        self.tracker, self.config = tracker, config or IdentifierConfig()
         n = self.config.n_robots
         self._last_seq = np.full(n, -1)
         self._last_sent = np.full(n, -math.inf)
@@ -171,8 +159,7 @@ class TeamIdentifier:
 
     def _forget_robots_ahead_of(self, time: float) -> None:
         """Forget the sequence number and send time of every robot whose last report is more than
-        ``max_report_ahead_s`` after the frame ``time``: a report taken before the camera's clock was known
-        cannot lock its robot out (counted in ``robot_resets``)."""
+        ``max_report_ahead_s`` after the frame ``time``."""
         ahead = self._last_sent > time + self.config.max_report_ahead_s
         if ahead.any():
             self._last_sent[ahead] = -math.inf
@@ -180,8 +167,7 @@ class TeamIdentifier:
             self.robot_resets += int(ahead.sum())
 
     def prepare(self) -> None:
-        """Between frames: let the tracker prepare the next frame now (its ``prepare()``, when it has one:
-        work that does not depend on the next frame's data, taken off that frame's path)."""
+        """Between frames: call the tracker's ``prepare()``, when it has one."""
         prepare = getattr(self.tracker, "prepare", None)
         if prepare is not None:
             prepare()
@@ -197,8 +183,7 @@ class TeamIdentifier:
         self.last_frame, self.last_time = None, -math.inf
 
     def _frame(self, message: DetectionsMessage) -> Frame:
-        """The tracker's frame: the message's detections and the queued reports. A ``decode``d message's arrays go
-        straight into the frame's types; others through the validating constructors."""
+        """The tracker's frame: the message's detections and the queued reports."""
         n = len(message.position)
         spread = message.heading_std
         decoded = numbers_of(message)
@@ -276,8 +261,7 @@ _Row = tuple[int, int, float | None, float, float, float | None]
 
 
 def _rows(snapshots: Sequence[TrackSnapshot], n_robots: int) -> list[_Row]:
-    """The identified tracks with a position and an agent id in ``0 .. n_robots-1``, in order
-    (read from the columns when the tracker returns :class:`Tracks`)."""
+    """The identified tracks with a position and an agent id in ``0 .. n_robots-1``, in order."""
     if isinstance(snapshots, Tracks):
         t = snapshots
         if t.agent_id is None or t.position is None or not len(t):
@@ -302,8 +286,7 @@ def _rows(snapshots: Sequence[TrackSnapshot], n_robots: int) -> list[_Row]:
 
 
 def _trusted(cls: type[_T], **fields: Any) -> _T:
-    """An instance of the frozen dataclass ``cls`` with ``fields`` set as given (read-only arrays),
-    without its validation: for data checked already."""
+    """An instance of the frozen dataclass ``cls`` with ``fields`` set as given (read-only arrays), unvalidated."""
     obj = object.__new__(cls)
     for value in fields.values():
         if isinstance(value, np.ndarray):

@@ -116,9 +116,8 @@ def encode(message: Message) -> bytes:
 
 
 def _team_bytes(message: TeamState) -> bytes | None:
-    """The datagram ``encode`` writes for a team state, written directly when every number is a plain finite ``float``
-    (ids and labels plain ``int``): the same bytes as ``json.dumps`` with compact separators (``repr`` of each number,
-    ``null`` for None); None for anything else, which then goes through ``json.dumps`` and its errors."""
+    """A team state's datagram written directly (the same bytes as ``json.dumps``) when every number is a plain finite
+    ``float`` and ids plain ``int``; None otherwise."""
     robots = []
     for r in message.robots:
         if len(r.position) != 2:
@@ -152,8 +151,6 @@ def decode(data: bytes) -> Message:
         raise MessageError(TOO_LARGE, f"{len(data)} bytes exceeds {MAX_DATAGRAM_BYTES}")
     try:
         text = data.decode("utf-8")
-        # (json.loads with parse_constant builds a decoder per call; one is kept. A leading BOM
-        # goes through json.loads for its own error message.)
         if text.startswith("\ufeff"):
             body = json.loads(text, parse_constant=_reject_constant)
         else:
@@ -181,8 +178,7 @@ _SCAN = _DECODER.scan_once  # type: ignore[attr-defined]  # (the C scanner decod
 
 
 def _scan_object(text: str) -> Any:
-    """``_DECODER.decode(text)``: a text that is one JSON object and nothing else (no whitespace around it) is
-    scanned directly; anything else goes through ``decode`` itself (its whitespace rules and errors)."""
+    """``_DECODER.decode(text)``, scanning a bare JSON object directly."""
     if text.startswith("{"):
         try:
             body, end = _SCAN(text, 0)
@@ -255,8 +251,7 @@ class _Fields:
 
 
 def _plain_numbers(values: list[Any], minimum: float) -> tuple[float, ...] | None:
-    """``values`` as floats when every one is a JSON float (or a small int) within the bounds; None
-    otherwise (then each value is checked on its own, naming the first bad one)."""
+    """``values`` as floats when every one is a JSON float (or a small int) within the bounds, else None."""
     kinds = set(map(type, values))
     if kinds <= _FLOAT:
         out = tuple(values)
@@ -294,15 +289,13 @@ _DETECTION_FIELDS = frozenset({"v", "type", "frame", "time", "position", "headin
 
 
 def numbers_of(message: DetectionsMessage) -> list[float] | None:
-    """A ``decode``d detections message's numbers as one flat list (positions ``x, y``, headings, scores,
-    heading spreads, time), or None for a message built otherwise."""
+    """A ``decode``d detections message's numbers as one flat list (positions, headings, scores, spreads, time)."""
     flat: list[float] | None = message.__dict__.get("_numbers")
     return flat
 
 
 def _plain_detections(body: dict[str, Any]) -> DetectionsMessage | None:
-    """The common detections message in few steps (known fields, equal lengths, JSON floats within bounds);
-    None for anything else, which the field-by-field checks then take."""
+    """The common detections message in few steps; None for anything else (checked field by field)."""
     if not body.keys() <= _DETECTION_FIELDS:
         return None
     frame, raw, heading, score = body.get("frame"), body.get("position"), body.get("heading"), body.get("score")

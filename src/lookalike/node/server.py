@@ -1,13 +1,6 @@
-"""The observer node's UDP server: one socket, a selector loop, per-sender rate limits.
-
-Each datagram is rate-limited by sender, decoded and handed to the ``TeamIdentifier``. A frame's team state goes to
-every ``publish`` address and either to the multicast ``group`` or (``reply_to_robots``) to each robot's last address;
-then the tracker prepares the next frame. Every failure is counted and logged, never stops the loop. Default addresses
-are loopback.
-
-The camera is the sender of the last accepted frame: while it is alive, frames from any other sender are dropped
-(``other_camera``), and only accepted frames keep it alive, so a hostile clock (a frame far ahead) costs at most
-``camera_timeout_s`` before the node follows the camera again."""
+"""The observer node's UDP server: one socket, a selector loop, per-sender rate limits. A frame's team state goes to
+every ``publish`` address and to the multicast ``group`` or each robot's last address. The camera is the sender of the
+last accepted frame: while it is alive, frames from others are dropped. Failures are counted and logged."""
 
 from __future__ import annotations
 
@@ -40,8 +33,7 @@ LOCALHOST = "127.0.0.1"
 
 
 def _preload() -> None:
-    """Import what the first frame would otherwise import (the solver's scipy module, the world trackers' numba
-    kernels: :func:`~lookalike.trackers.kernels.world.warm`)."""
+    """Import what the first frame would otherwise import (scipy's solver, the world trackers' numba kernels)."""
     import numpy as np
 
     from lookalike.association.solver import linear_sum_assignment
@@ -53,8 +45,7 @@ def _preload() -> None:
 
 @contextmanager
 def _one_blas_thread() -> Iterator[None]:
-    """BLAS and LAPACK on the calling thread only inside the block (threadpoolctl, when installed): a frame's
-    matrices are too small for BLAS threads to pay."""
+    """BLAS and LAPACK on the calling thread only inside the block (threadpoolctl, when installed)."""
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:  # pragma: no cover (scikit-learn, a core dependency, requires it)
@@ -95,16 +86,13 @@ class NodeConfig:
     Attributes:
         listen: address to bind (port 0: an ephemeral port).
         publish: addresses that receive every team state.
-        reply_to_robots: also send each team state to the address each robot reports from
-            (when there is no ``group``).
-        group: an IPv4 multicast ``(group, port)`` that receives each team state once, in place
-            of the per-robot replies (robots join it: ``Endpoint(..., group=...)``).
+        reply_to_robots: also send each team state to each robot's address (when there is no ``group``).
+        group: an IPv4 multicast ``(group, port)`` that receives each team state in place of the per-robot replies.
         group_interface: IPv4 address of the interface multicast leaves from (loopback by default).
         sender_rate: packets per second one sender may send before being rate-limited.
         sender_burst: packets one sender may send at once (>= 1).
         max_senders: rate-limit buckets kept (the oldest are forgotten beyond this).
-        camera_timeout_s: wall seconds without an accepted frame after which the camera counts as lost
-            (then a frame from any sender, at any time, is accepted: the camera may have restarted).
+        camera_timeout_s: wall seconds without an accepted frame after which the camera counts as lost.
         status_interval_s: wall seconds between status log lines (0: never).
         recv_buffer_bytes: socket receive buffer asked of the OS.
         batch: datagrams read per loop iteration before timers are checked."""
@@ -186,8 +174,8 @@ class NodeServer:
             self.sock.close()
 
     def serve(self, stop: Callable[[], bool], tick_s: float = 0.05) -> None:
-        """Serve until ``stop()`` returns true (checked every ``tick_s`` seconds at least), with objects alive at
-        the start frozen out of the garbage collector (``gc.freeze``) and BLAS on this thread only."""
+        """Serve until ``stop()`` returns true (checked every ``tick_s`` seconds at least), with ``gc.freeze`` and
+        BLAS on this thread only."""
         gc.collect()
         gc.freeze()
         try:

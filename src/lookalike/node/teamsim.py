@@ -1,8 +1,5 @@
-"""Simulated robot and camera processes that talk to the node, on top of the robot-world simulator.
-
-Every process builds the same sequence from ``(preset, seed, duration, network)`` (:func:`team_sequence`), so no truth
-travels: the camera sends detections, each robot its heading reports when the simulated network delivers them. A
-:class:`SimClock` maps simulated time ``t`` to wall time ``epoch + t / speed``."""
+"""Simulated robot and camera processes that talk to the node; each builds the same sequence (:func:`team_sequence`),
+so no truth travels."""
 
 from __future__ import annotations
 
@@ -47,8 +44,8 @@ class SimClock:
 
 def team_sequence(preset_name: str, seed: int, duration_s: float, loss: float | None = None,
                   delay_s: float | None = None, jitter_s: float | None = None) -> RobotSequence:
-    """The sequence every process of a simulated team shares: ``duration_s`` seconds of preset ``preset_name`` with seed
-    ``seed``, the network's loss probability, delay and mean jitter (seconds) replaced where given."""
+    """``duration_s`` seconds of preset ``preset_name`` with ``seed``, the network's loss probability, delay and mean
+    jitter (seconds) replaced where given."""
     if not duration_s > 0:
         raise ValueError(f"duration_s must be > 0, got {duration_s!r}")
     config = preset(preset_name)
@@ -75,8 +72,7 @@ def camera_messages(sequence: RobotSequence) -> list[DetectionsMessage]:
 
 
 def robot_reports(sequence: RobotSequence, robot: int) -> list[tuple[float, HeadingReport]]:
-    """Robot ``robot``'s reports that the simulated network delivers, as ``(t_received, report)``
-    in delivery order; ``seq`` numbers follow the send order (lost reports keep their number)."""
+    """Robot ``robot``'s delivered reports as ``(t_received, report)`` in delivery order; ``seq`` follows send order."""
     if not 0 <= robot < sequence.config.n_agents:
         raise ValueError(f"robot {robot} is not in a team of {sequence.config.n_agents}")
     r = sequence.arrays.reports
@@ -127,9 +123,8 @@ class RobotLog:
 def run_robot(endpoint: Endpoint, robot: int, sequence: RobotSequence, clock: SimClock,
               linger_s: float = 0.5, stop: Callable[[], bool] = lambda: False,
               on_position: Callable[[TeamState, float], None] | None = None) -> RobotLog:
-    """Send robot ``robot``'s reports on time, meanwhile receive team states and log the error of
-    the node's estimate of this robot against its true observer-frame position (also passed to
-    ``on_position(team_state, error_m)``); stop ``linger_s`` simulated seconds after the last frame."""
+    """Send robot ``robot``'s reports on time, receive team states and log the error (m) of the node's estimate of
+    this robot (also to ``on_position(team_state, error_m)``); stop ``linger_s`` after the last frame."""
     log = RobotLog(robot)
     truth = sequence.arrays.true_position[:, robot]
     schedule = robot_reports(sequence, robot)
