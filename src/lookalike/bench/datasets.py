@@ -1,12 +1,6 @@
-"""The real datasets of ``lookalike bench real``: MOT15 and pig boxes, HexBug blobs and head points, and
-``mot17-synth``: the real MOT17 ground truth seen through a synthetic detector (labelled so).
-
-Each sequence becomes a :class:`RealSequence` (the detections every tracker receives, and the ground truth). Boxes are
-scored with CLEAR/identity/HOTA (IoU 0.5, MOT15 rules; MOT17 rules for ``mot17-synth``), HexBug clips on points (box
-centres against annotated heads). ``mot17-synth`` (and ``-synth2``/``-synth3``, other noise draws: :data:`SYNTH_SEEDS`)
-uses :func:`~lookalike.bench.synthetic.synthesize_detections`; no parameter was chosen on it, and its figures are for
-rankings, not absolutes. The data folder: :func:`resolve_data_root` (``--data``, ``LOOKALIKE_DATA``, else
-``../shared/data``)."""
+"""The datasets of ``lookalike bench real`` as :class:`RealSequence`: MOT15 and pig boxes, HexBug blobs scored on head
+points, and ``mot17-synth`` (``-synth2``/``-synth3``: other draws), MOT17 ground truth seen through
+:func:`~lookalike.bench.synthetic.synthesize_detections`."""
 
 from __future__ import annotations
 
@@ -34,8 +28,7 @@ DATA_ENV = "LOOKALIKE_DATA"
 
 
 def resolve_data_root(option: Path | str | None = None) -> Path:
-    """The data folder: ``option`` when given, else ``$LOOKALIKE_DATA``, else ``../shared/data``
-    relative to the current directory. Raises ``FileNotFoundError`` naming what was tried."""
+    """The data folder: ``option``, else ``$LOOKALIKE_DATA``, else ``../shared/data`` (``FileNotFoundError``)."""
     if option is not None:
         tried = [(Path(option), "--data")]
     elif os.environ.get(DATA_ENV):
@@ -51,20 +44,9 @@ def resolve_data_root(option: Path | str | None = None) -> Path:
 
 @dataclass(frozen=True, eq=False)
 class RealSequence:
-    """One sequence: per-frame detections (0-based frames) and its ground truth.
-
-    Attributes:
-        dataset: ``"mot15"``, ``"pigs"``, ``"hexbug"`` or a ``mot17-synth`` set.
-        name: sequence or clip name.
-        frame_rate: frames per second.
-        length: number of frames.
-        det_xywh: per frame, ``(n, 4)`` boxes in pixels.
-        det_score: per frame, ``(n,)`` detector scores.
-        gt: ground-truth boxes (:class:`MotTable`) for box data, else None.
-        gt_points: ``(frame (n,) 1-based, id (n,), xy (n, 2) px)`` for point data, else None.
-        image_size: ``(width, height)`` in pixels, or None.
-        n_targets: the documented number of targets when the set is closed, else None.
-        benchmark: the ground-truth rules of :func:`lookalike.eval.evaluate_sequence`."""
+    """One sequence: per frame (0-based) ``(n, 4)`` px boxes and ``(n,)`` scores; ground truth as boxes (``gt``) or
+    points (``gt_points``: 1-based frame, id, ``(n, 2)`` px); ``image_size`` ``(width, height)`` px; ``n_targets``
+    the documented count of a closed set; ``benchmark`` the ground-truth rules of scoring."""
 
     dataset: str
     name: str
@@ -112,10 +94,8 @@ def load_boxes(root: Path, dataset: str) -> list[RealSequence]:
 
 
 def cut_sequence(seq: RealSequence, part: str) -> RealSequence:
-    """``seq`` whole (``"full"``), cut to frames ``1..⌊N/2⌋`` (``"first"``, where parameters are chosen) or to frames
-    ``⌊N/2⌋+1..N`` (``"second"``, unseen by that choice, renumbered from 1).
-
-    Detections and ground truth (boxes or points) are cut alike; a tracker starts afresh on a part."""
+    """``seq`` whole (``"full"``), cut to frames ``1..⌊N/2⌋`` (``"first"``) or ``⌊N/2⌋+1..N`` (``"second"``,
+    renumbered from 1), detections and ground truth alike."""
     if part not in PARTS:
         raise ValueError(f"part: expected one of {PARTS}, got {part!r}")
     if part == "full":
@@ -135,8 +115,8 @@ def cut_sequence(seq: RealSequence, part: str) -> RealSequence:
 
 
 def load_mot17_synth(root: Path, seed: int = 0, dataset: str = "mot17-synth") -> list[RealSequence]:
-    """The MOT17 ground-truth sequences under ``root`` (``mot17/gt``) with :func:`synthesize_detections`
-    (seeded by ``seed`` and the sequence's name, so every run sees the same detections), labelled ``dataset``."""
+    """The MOT17 ground-truth sequences under ``root`` with :func:`synthesize_detections` seeded by ``seed`` and the
+    sequence's name."""
     out = []
     for seq in find_sequences(root):
         if seq.gt_path is None:
@@ -154,9 +134,8 @@ def load_mot17_synth(root: Path, seed: int = 0, dataset: str = "mot17-synth") ->
 
 
 def points_swapped(xy: np.ndarray, image_size: tuple[int, int] | None) -> bool:
-    """Whether points ``(n, 2)`` px were stored as (y, x): more of them fall outside the image
-    (``(width, height)`` px) read as (x, y) than read as (y, x). A tie (e.g. all inside both ways,
-    or no image size) keeps the order as written."""
+    """Whether points ``(n, 2)`` px were stored as (y, x): more fall outside the image read as (x, y) than as
+    (y, x) (a tie, or no image size: no)."""
     if image_size is None or not len(xy):
         return False
     width, height = image_size
@@ -169,10 +148,8 @@ def points_swapped(xy: np.ndarray, image_size: tuple[int, int] | None) -> bool:
 
 def read_hexbug_points(path: Path, image_size: tuple[int, int] | None = None
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(frame 1-based (n,), id (n,), xy (n, 2) px)`` from a HexBug CSV (``,t,hexbug,x,y``).
-
-    Some CSVs store (y, x); with the clip's ``image_size`` (``(width, height)`` px) the order is decided by
-    :func:`points_swapped` (points outside the image as (x, y) but inside as (y, x))."""
+    """``(frame 1-based (n,), id (n,), xy (n, 2) px)`` from a HexBug CSV (``,t,hexbug,x,y``; (y, x) order
+    detected by :func:`points_swapped`)."""
     rows = []
     with open(path, newline="") as fh:
         for rec in csv.DictReader(fh):
@@ -192,12 +169,8 @@ def hexbug_clips(root: Path) -> list[Path]:
 
 
 def detect_hexbug(video: Path, cache: Path | bool = True) -> RealSequence:
-    """Run the blob detector over one HexBug clip (OpenCV needed) and attach its head points.
-
-    The detector settings are those ``lookalike track --video V --detector blob`` uses: estimated from the clip itself
-    (:func:`lookalike.viz.blob_video.auto_blob_config`, no target count), nothing chosen for the bench. Detections are
-    cached on disk (:func:`~lookalike.viz.blob_video.cached_blob_detection_rows`; ``cache``: a folder, ``True`` for the
-    default one, ``False`` for none)."""
+    """One HexBug clip through the blob detector with the settings ``lookalike track --detector blob`` estimates,
+    with its head points; ``cache``: a folder, ``True`` for the default one, ``False`` for none."""
     from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows
     from lookalike.viz.overlay import source_frames
 
@@ -218,10 +191,8 @@ def _selected(seqs: list[RealSequence], dataset: str, sequences: Sequence[str] |
 def load_datasets(root: Path, names: Sequence[str], *, sequences: Sequence[str] | None = None,
                   max_clips: int | None = None, workers: int = 1, backend: str = "local",
                   address: str | None = None) -> list[RealSequence]:
-    """The sequences of datasets ``names`` under ``root`` (HexBug detection runs on the chosen backend).
-
-    ``sequences``: only these sequence/clip names (a dataset's name selects all of it); ``max_clips``: at most this many
-    HexBug clips."""
+    """The sequences of datasets ``names`` under ``root``; ``sequences``: only these names (a dataset's name: all of
+    it); ``max_clips``: at most this many HexBug clips, detected on the chosen backend."""
     out: list[RealSequence] = []
     for name in names:
         if name not in DATASETS:

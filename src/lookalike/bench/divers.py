@@ -1,12 +1,6 @@
-"""The diver bench (``lookalike bench divers``): the diver-tracking paper's Table 2 and Figure 5 on the rendered diver
-scenarios.
-
-Each scenario is rendered, passed through a detector model (``sim``, or ``paper``:
-:data:`~lookalike.sim.divers_paper.PAPER_DETECTORS` with the paper's precision and recall), and its features extracted
-once per feature set (``handcrafted``, ``learned``). The entries (:data:`ENTRIES`: SORT, deep SORT and DiverSORT with
-either feature set) run on identical detections; with learned features the cosine thresholds come from
-:func:`~lookalike.sim.divers_run.matched_thresholds`. The table gives DP/DR and each entry's IDF1, IDP, IDR, IDSW and
-Frag with an ALL row; :func:`pearson` correlates DP and IDP over the scenarios."""
+"""The diver bench (``lookalike bench divers``): the diver-tracking paper's Table 2 and Figure 5. Each rendered scenario
+goes through a detector model (``sim`` or ``paper``) and its features are extracted once per feature set; every entry
+(:data:`ENTRIES`) runs on identical detections."""
 
 from __future__ import annotations
 
@@ -37,9 +31,8 @@ COLUMNS = ("Scenario", "Location", "DP", "DR", "Tracker", "IDF1", "IDP", "IDR", 
 
 
 def entries(features: tuple[str, ...] = ("handcrafted", "learned")) -> tuple[tuple[str, str, str], ...]:
-    """The bench entries ``(label, tracker, features)`` for feature sets ``features`` (``handcrafted``,
-    ``learned`` or ``FILE.onnx``, labelled by the file's stem): :data:`ENTRIES` for the default, else
-    SORT, then deep SORT and diver SORT with each feature set."""
+    """Entries ``(label, tracker, features)`` for feature sets ``handcrafted``, ``learned`` or ``FILE.onnx``
+    (labelled by its stem): :data:`ENTRIES` for the default, else SORT, then deep SORT and DiverSORT with each."""
     if tuple(features) == ("handcrafted", "learned"):
         return ENTRIES
     if not features:
@@ -53,9 +46,8 @@ def entries(features: tuple[str, ...] = ("handcrafted", "learned")) -> tuple[tup
 def diver_table(names: list[str] | None = None, trackers: tuple[str, ...] | None = None, frames: int | None = None,
                 detections: str = "sim", seed: int = 0,
                 features: tuple[str, ...] = ("handcrafted", "learned")) -> list[dict[str, Any]]:
-    """Rows of Table 2 (keys :data:`COLUMNS`) for scenarios ``names`` (default: all test scenarios),
-    entries ``trackers`` (labels of :func:`entries` for ``features``; default all), detector level
-    ``detections`` and draw ``seed``."""
+    """Rows of Table 2 (:data:`COLUMNS`) for scenarios ``names`` (default all), entry labels ``trackers`` (default
+    all), detector level ``detections`` and draw ``seed``, with an ALL row per entry."""
     known = entries(features)
     entry = {label: (tracker, feats) for label, tracker, feats in known}
     trackers = tuple(trackers) if trackers else tuple(label for label, _, _ in known)
@@ -102,8 +94,7 @@ def _row(name: str, where: str, dp: float, dr: float, tracker: str, s: dict[str,
 
 
 def pearson(rows: list[dict[str, Any]]) -> dict[str, tuple[float, float]]:
-    """Per entry, Pearson's r between DP and IDP over the scenario rows (ALL left out) and its
-    two-sided p-value; ``(nan, nan)`` with fewer than three scenarios or a constant column."""
+    """Per entry, Pearson's r between DP and IDP over the scenarios and its p-value (NaN: < 3 or constant)."""
     from scipy.stats import pearsonr
 
     out: dict[str, tuple[float, float]] = {}
@@ -118,9 +109,8 @@ def pearson(rows: list[dict[str, Any]]) -> dict[str, tuple[float, float]]:
 
 
 def diver_results(tables: dict[str, list[dict[str, Any]]], frames: int, seed: int, command: str = "") -> Results:
-    """The tables of :func:`diver_table` (one per detection level) as a results document: table
-    ``divers``, dataset ``divers-<level>``, one row per scenario and entry, the ALL rows ``combined``
-    (sequence None); Pearson r and p per entry and level in the header's notes."""
+    """:func:`diver_table`'s tables (one per detection level) as a results document: table ``divers``, dataset
+    ``divers-<level>``, ALL rows ``combined``; Pearson r and p in the notes."""
     sequences = sorted({r["Scenario"] for rows in tables.values() for r in rows if r["Scenario"] != "ALL"})
     seeds = [redraw(scenario(n), seed).seed for n in sequences]
     doc = Results("bench divers", command=command, seeds=seeds, sequences=len(sequences) * len(tables),

@@ -1,28 +1,21 @@
-"""Farazi and Behnke's control and recovery experiments (``lookalike bench shuffle`` / ``bench recovery``).
-
-Shuffle: the identifiers on frames in random order; a method that uses the sequence must collapse.
-
-Recovery: the heading reports of the two robots detected most often around the swap are swapped for ``swap_s`` seconds,
-then restored. Reported: the success rate on those two while swapped and in the 3 s after the restore (each also without
-the swap), and the time after the restore until their one-second success rate is back within 5 points of the unswapped
-run. Sequences with nothing to recover (:func:`measurable`) are left out and counted; the mean recovery is also given
-over sequences whose pair heads at least :data:`APART_RAD` apart after the restore (:func:`restore_gap`).
-:func:`recovery_differences` compares each identifier with the first on the same sequences (95% intervals,
-:mod:`lookalike.bench.paired`)."""
+"""Farazi and Behnke's control experiments: ``bench shuffle`` (frames in random order) and ``bench recovery`` (the
+reports of the two robots seen most swapped for ``swap_s`` seconds, then restored: success while swapped and after,
+and seconds until the one-second success rate is back within 5 points of the unswapped run)."""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from functools import partial
 from typing import Any, NamedTuple
 
 import numpy as np
 
-from lookalike.bench.ident import identify
+from lookalike.bench.ident import identify, sequence_seeds
 from lookalike.bench.paired import Comparison, add_comparisons, compare_to_first, mean_difference
 from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.eval import identification_success_rate
 from lookalike.io.results import Results, add_printed_rows
-from lookalike.sim import PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
+from lookalike.sim import RobotSequence, preset, preset_label, simulate_robots
 from lookalike.types import Beacons, Frame
 
 DEFAULT_SEED = 950_000  # disjoint from training (>= 1.9e9), tuning (< 100000) and bench ident (900000+)
@@ -43,7 +36,7 @@ def _retime(beacons: Beacons, t: float) -> Beacons:
 
 
 def swap_reports(frames: list[Frame], start_s: float, stop_s: float, pair: tuple[int, int] = (0, 1)) -> list[Frame]:
-    """Frames whose reports from the robots ``pair`` sent in ``[start_s, stop_s)`` carry each other's id."""
+    """Frames whose reports from ``pair`` sent in ``[start_s, stop_s)`` carry each other's id."""
     out = []
     for f in frames:
         b = f.beacons
@@ -79,8 +72,8 @@ def hit_rate(hits: Hits) -> float:
 
 
 def recovery_s(clean: Hits, swapped: Hits, restore: int, window: int, rate: float, tolerance: float = 0.05) -> float:
-    """Seconds from ``restore`` until the swapped run's success on the swapped pair over ``window``
-    frames is within ``tolerance`` of the clean run's over the same frames (inf: never)."""
+    """Seconds from ``restore`` until the swapped run's success over ``window`` frames is within ``tolerance`` of
+    the clean run's (inf: never)."""
     for t in range(restore, len(clean) - window + 1):
         a, b = hit_rate(swapped[t : t + window]), hit_rate(clean[t : t + window])
         if np.isfinite(a) and np.isfinite(b) and a >= b - tolerance:
@@ -89,14 +82,12 @@ def recovery_s(clean: Hits, swapped: Hits, restore: int, window: int, rate: floa
 
 
 def _sequences(setup: str, sequences: int, frames: int, seed: int) -> list[RobotSequence]:
-    cfg = preset(setup)
-    return [simulate_robots(cfg, frames, seed + 1000 * PRESET_NAMES.index(setup) + k) for k in range(sequences)]
+    return [simulate_robots(preset(setup), frames, s) for s in sequence_seeds([setup], sequences, seed)]
 
 
 def shuffle_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int,
                  seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
-    """Per set-up and identifier: success rate on frames in order and in random order (%)
-    (``progress`` advanced once per set-up and identifier)."""
+    """Per set-up and identifier: success rate (%) on frames in order and in random order."""
     rows = []
     for setup in setups:
         preset(setup)  # an unknown set-up fails before any work
@@ -122,9 +113,8 @@ def shuffle_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int,
 
 
 class SwapRun(NamedTuple):
-    """One sequence of :func:`swap_recovery`: success on the swapped pair (fractions; NaN: the pair unseen)
-    while swapped and in the :data:`AFTER_S` seconds after the restore, each also without the swap, and the
-    recovery seconds (inf: never)."""
+    """One sequence of :func:`swap_recovery`: success on the swapped pair (fractions; NaN: unseen) while swapped and
+    :data:`AFTER_S` seconds after the restore, each also without the swap, and the recovery seconds (inf: never)."""
 
     while_swapped: float
     clean_while_swapped: float
@@ -144,22 +134,20 @@ def swap_frames(rate_hz: float, swap_at_s: float, swap_s: float) -> tuple[int, i
 
 
 def longest_recovery_s(frames: int, rate_hz: float, swap_at_s: float, swap_s: float) -> float:
-    """The longest finite recovery (seconds) :func:`swap_recovery` can measure in a sequence of ``frames``
-    frames: from the restore to the start of its last one-second window."""
+    """The longest recovery (s) measurable in ``frames`` frames: from the restore to the last one-second window."""
     return (frames - int(rate_hz) - swap_frames(rate_hz, swap_at_s, swap_s)[1]) / rate_hz
 
 
 def swapped_pair(sequence: RobotSequence, swap_at_s: float, swap_s: float) -> tuple[int, int]:
-    """The two robots whose reports :func:`swap_recovery` swaps: those seen most from ``swap_at_s`` to
-    :data:`AFTER_S` seconds after the restore (from the truth alone)."""
+    """The two robots seen most from ``swap_at_s`` to :data:`AFTER_S` s after the restore: those swapped."""
     start, _, after = swap_frames(sequence.config.frame_rate_hz, swap_at_s, swap_s)
     return most_seen_pair(sequence.true_labels()[start:after], sequence.config.n_agents)
 
 
 def swap_recovery(labels: Callable[[RobotSequence, list[Frame]], list[np.ndarray]], seq: RobotSequence,
                   swap_at_s: float, swap_s: float) -> SwapRun:
-    """:class:`SwapRun` of one sequence whose two robots seen most swap reports from ``swap_at_s`` for
-    ``swap_s`` seconds, ``labels`` giving an identifier's per-frame labels of a sequence's frames."""
+    """:class:`SwapRun` of ``seq`` with :func:`swapped_pair`'s reports swapped from ``swap_at_s`` for ``swap_s``
+    seconds; ``labels(seq, frames)``: an identifier's per-frame labels."""
     rate = seq.config.frame_rate_hz
     fs = list(seq.frames())
     truth = seq.true_labels()
@@ -173,9 +161,7 @@ def swap_recovery(labels: Callable[[RobotSequence, list[Frame]], list[np.ndarray
 
 
 def measurable(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 10.0) -> bool:
-    """Whether the swap of :func:`swap_recovery` in ``sequence`` can be recovered from at all: its swapped
-    pair (the two robots seen most) has a detection while swapped and one after the restore. From the
-    truth alone: the same for every identifier."""
+    """Whether :func:`swapped_pair` has a detection while swapped and one after the restore (from the truth)."""
     rate = sequence.config.frame_rate_hz
     truth = sequence.true_labels()
     start, restore, _ = swap_frames(rate, swap_at_s, swap_s)
@@ -193,12 +179,6 @@ def measured_sequences(setup: str, sequences: int, frames: int, seed: int, swap_
     return [q for q in _sequences(setup, sequences, frames, seed) if measurable(q, swap_at_s, swap_s)]
 
 
-def _recovery_run(name: str, seq: RobotSequence, swap_at_s: float, swap_s: float,
-                  options: Mapping[str, Any] | None = None) -> SwapRun:
-    """:func:`swap_recovery` of the registered identifier ``name`` (with ``options``, its parameters)."""
-    return swap_recovery(lambda s, fs: identify(name, s, fs, options=options), seq, swap_at_s, swap_s)
-
-
 def _seen_mean(rates: np.ndarray) -> float:
     """Mean of the sequences' success rates where the pair was seen (NaN: nowhere)."""
     seen = rates[np.isfinite(rates)]
@@ -208,9 +188,8 @@ def _seen_mean(rates: np.ndarray) -> float:
 def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,
                   swap_s: float, seed: int = DEFAULT_SEED,
                   progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
-    """Per set-up and identifier: success on the swapped pair while swapped (and without the swap),
-    the mean and worst recovery time (s) over the :func:`measurable` sequences and how many there were
-    (``progress`` advanced once per set-up and identifier)."""
+    """Per set-up and identifier: success on the swapped pair while swapped (and without the swap), the mean and
+    worst recovery time (s) over the :func:`measurable` sequences, and their count."""
     return recovery_runs(setups, trackers, sequences, frames, swap_at_s, swap_s, seed, progress)[0]
 
 
@@ -218,8 +197,8 @@ def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int
                   swap_s: float, seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress,
                   options: Mapping[str, Mapping[str, Any]] | None = None
                   ) -> tuple[list[dict[str, Any]], dict[tuple[str, str], list[float]]]:
-    """:func:`recovery_rows`'s rows and, per (set-up, identifier), the recovery seconds of each sequence
-    (inf: never), for :func:`recovery_differences`; ``options``: identifier -> its parameters (default: none)."""
+    """:func:`recovery_rows`'s rows and per (set-up, identifier) each sequence's recovery seconds (inf: never);
+    ``options``: identifier -> its parameters."""
     rows, runs = swap_runs(setups, trackers, sequences, frames, swap_at_s, swap_s, seed, progress, options)
     recovery = SwapRun._fields.index("recovery_s")
     return rows, {key: [float(v) for v in run[:, recovery]] for key, run in runs.items()}
@@ -229,8 +208,7 @@ def swap_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, fr
               swap_s: float, seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress,
               options: Mapping[str, Mapping[str, Any]] | None = None
               ) -> tuple[list[dict[str, Any]], dict[tuple[str, str], np.ndarray]]:
-    """:func:`recovery_rows`'s rows and, per (set-up, identifier), one :class:`SwapRun` per measured sequence
-    (an array, sequences x its fields; ``options`` as for :func:`recovery_runs`)."""
+    """:func:`recovery_rows`'s rows and per (set-up, identifier) an array of :class:`SwapRun` (sequences x fields)."""
     rows = []
     runs_of: dict[tuple[str, str], np.ndarray] = {}
     for setup in setups:
@@ -241,8 +219,8 @@ def swap_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, fr
         apart = np.array([restore_gap(q, swap_at_s, swap_s) >= APART_RAD for q in measured], dtype=bool)
         width = len(SwapRun._fields)
         for name in trackers:
-            runs = np.array([_recovery_run(name, seq, swap_at_s, swap_s, (options or {}).get(name))
-                             for seq in measured]).reshape(-1, width)
+            labels = partial(identify, name, options=(options or {}).get(name))
+            runs = np.array([swap_recovery(labels, seq, swap_at_s, swap_s) for seq in measured]).reshape(-1, width)
             runs_of[(setup, name)] = runs
             if not len(runs):  # nothing measurable: NaN figures, said by the count
                 runs = np.full((1, width), np.nan)
@@ -265,9 +243,8 @@ def swap_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, fr
 
 
 def restore_gap(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float = 10.0, window_s: float = 1.0) -> float:
-    """How far apart (radians, 0 to π) the headings of :func:`swap_recovery`'s pair are just after the restore:
-    the difference of the circular means of each one's own reports sent in the ``window_s`` seconds from the
-    restore (NaN: either sent none). From the data alone: how much the reports can tell the two apart there."""
+    """How far apart (rad, 0 to π) the circular means of :func:`swapped_pair`'s own reports sent in the ``window_s``
+    seconds from the restore are (NaN: either sent none)."""
     pair = swapped_pair(sequence, swap_at_s, swap_s)
     restore_s = swap_at_s + swap_s
     sums, counts = np.zeros(2, dtype=complex), np.zeros(2, dtype=int)
@@ -285,9 +262,8 @@ def restore_gap(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float =
 
 def recovery_differences(seconds: dict[tuple[str, str], list[float]], setups: Sequence[str],
                          trackers: Sequence[str]) -> list[Comparison]:
-    """Per set-up and identifier after the first: its mean recovery seconds minus the first identifier's on the same
-    sequences, with the 95% interval over sequences (:func:`~lookalike.bench.paired.mean_difference`; no interval, note
-    ``"never"``, when either never recovers in some sequence); none with fewer than two identifiers or two sequences."""
+    """Each identifier's mean recovery seconds minus the first's on the same sequences
+    (:func:`~lookalike.bench.paired.mean_difference`)."""
     return compare_to_first(seconds, setups, trackers, mean_difference, preset_label)
 
 
@@ -304,12 +280,11 @@ EXPERIMENT_KEYS = {"In order (%)": "success_rate_in_order", "Random order (%)": 
 def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[str], sequences: int, frames: int,
                        seed: int = DEFAULT_SEED, command: str = "", options: dict[str, Any] | None = None,
                        differences: Sequence[Comparison] = ()) -> Results:
-    """Rows of :func:`shuffle_rows` or :func:`recovery_rows` as a results document (table ``kind``,
-    e.g. ``"shuffle"``; success rates as fractions, recovery times in seconds, ``null`` when never);
-    ``differences`` (:func:`recovery_differences`, if any) go in table ``<kind>_difference`` (seconds)."""
+    """Rows of :func:`shuffle_rows` or :func:`recovery_rows` as a results document (table ``kind``; success rates as
+    fractions, seconds, ``null`` when never); ``differences`` go in table ``<kind>_difference`` (seconds)."""
     names = {preset_label(s): s for s in setups}
-    seeds = [seed + 1000 * PRESET_NAMES.index(s) + k for s in setups for k in range(sequences)]
-    doc = Results(f"bench {kind}", command=command, seeds=seeds, sequences=len(setups) * sequences,
+    doc = Results(f"bench {kind}", command=command, seeds=sequence_seeds(list(setups), sequences, seed),
+                  sequences=len(setups) * sequences,
                   frames=len(setups) * sequences * frames,
                   options={"setups": list(setups), "sequences_per_setup": sequences, "frames_per_sequence": frames,
                            "seed": seed, **(options or {})})

@@ -1,10 +1,6 @@
-"""Farazi and Behnke's Table I: robot identification on simulated sequences (``lookalike bench ident``).
-
-The same test sequences for every identifier (seeds ``seed + 1000·setup + sequence``, default 900000, disjoint from the
-tuning and training seeds below 100000); per set-up and identifier: success rate (a false positive labelled as such
-counts as correct), localisation error (metres, while in view) and frames/s. An LSTM without shipped weights for a
-set-up gets :data:`NOT_TRAINED` cells. :func:`ident_differences` compares each identifier with the first on the same
-sequences (:mod:`lookalike.bench.paired`)."""
+"""Farazi and Behnke's Table I (``lookalike bench ident``): per set-up and identifier, on the same simulated sequences
+(seeds ``seed + 1000·setup + sequence``), success rate (a false positive labelled as such is correct), localisation
+error (m, while in view) and frames/s."""
 
 from __future__ import annotations
 
@@ -41,8 +37,7 @@ def uses_weights(name: str) -> bool:
 
 
 def weights_missing(name: str, n_agents: int, n_slots: int, weights: str | None = None) -> bool:
-    """Whether identifier ``name`` is an LSTM using shipped weights and none ship for N, M
-    (never when ``weights`` names the weights of our protocol's rows)."""
+    """Whether identifier ``name`` needs shipped LSTM weights for N, M and none ship (``weights`` given: never)."""
     base, extra = resolve_identifier(name)
     if base != "lstm" or extra.get("weights") or (weights and uses_weights(name)):
         return False
@@ -55,9 +50,8 @@ def weights_missing(name: str, n_agents: int, n_slots: int, weights: str | None 
 
 def build_identifier(name: str, sequence: RobotSequence, weights: str | None = None,
                      options: Mapping[str, Any] | None = None) -> Any:
-    """Tracker ``name`` (or a variant of :data:`~lookalike.bench.ident_paper.IDENT_VARIANTS`) configured for the
-    sequence's N (and M for trackers with slots); ``weights``: exported network weights (.npz) for our protocol's LSTM
-    rows instead of the shipped ones; ``options``: more of the tracker's parameters (they override the variant's)."""
+    """Tracker or variant ``name`` for the sequence's N (and M); ``weights``: exported .npz for our protocol's LSTM
+    rows; ``options``: more parameters (overriding the variant's)."""
     base, extra = resolve_identifier(name)
     extra.update(options or {})
     if weights and uses_weights(name):
@@ -70,8 +64,8 @@ def build_identifier(name: str, sequence: RobotSequence, weights: str | None = N
 
 def identify(name: str, sequence: RobotSequence, frames: Sequence[Frame] | None = None,
              stats: RunStats | None = None, options: Mapping[str, Any] | None = None) -> list[np.ndarray]:
-    """Per frame, the agent label of each detection (-1: false positive) given by identifier ``name``
-    (with ``options`` as in :func:`build_identifier`) run over ``frames`` (default: the sequence's own)."""
+    """Per frame, each detection's agent label (-1: false positive) from identifier ``name`` run over ``frames``
+    (default: the sequence's own)."""
     labels: list[np.ndarray] = []
     tracker = build_identifier(name, sequence, options=options)
     run(tracker, sequence.frames() if frames is None else frames,
@@ -81,15 +75,13 @@ def identify(name: str, sequence: RobotSequence, frames: Sequence[Frame] | None 
 
 def run_identifier(name: str, sequences: list[RobotSequence], step: Step | None = None,
                    weights: str | None = None) -> dict[str, float]:
-    """Success rate, localisation error, frames/s and detection count of tracker ``name``
-    (``step()`` called after each sequence; ``weights`` as in :func:`build_identifier`)."""
+    """Success rate, localisation error, frames/s and detection count of tracker ``name`` (``step()`` per sequence)."""
     return run_identifier_by_sequence(name, sequences, step, weights)[0]
 
 
 def run_identifier_by_sequence(name: str, sequences: list[RobotSequence], step: Step | None = None,
                                weights: str | None = None) -> tuple[dict[str, float], list[tuple[int, int]]]:
-    """:func:`run_identifier`'s figures and, per sequence, (correct labels, detections): the counts
-    that the success rate pools (for paired comparisons, :mod:`lookalike.bench.paired`)."""
+    """:func:`run_identifier`'s figures and per sequence (correct labels, detections)."""
     predicted: list[np.ndarray] = []
     truth: list[np.ndarray] = []
     est, true_pos = [], []
@@ -129,18 +121,15 @@ def sequence_seeds(setups: list[str], sequences: int, seed: int = DEFAULT_SEED) 
 def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: int,
                 seed: int = DEFAULT_SEED, noise: str = DEFAULT_NOISE,
                 progress: ProgressFactory = no_progress, weights: str | None = None) -> list[dict[str, Any]]:
-    """Rows (keys :data:`IDENT_COLUMNS`) for every set-up and tracker, on identical sequences of the
-    simulator with position-noise model ``noise`` (``"paper"`` or ``"ours"``); ``progress`` advances
-    once per sequence and tracker; ``weights``: exported weights (.npz) for our protocol's LSTM rows
-    instead of the shipped ones (one set-up: they are for one N, M)."""
+    """Rows (:data:`IDENT_COLUMNS`) per set-up and tracker on the same sequences, position noise ``noise``
+    (``"paper"`` or ``"ours"``); ``weights``: exported .npz for our protocol's LSTM rows (one set-up only)."""
     return ident_runs(setups, trackers, sequences, frames, seed, noise, progress, weights)[0]
 
 
 def ident_runs(setups: list[str], trackers: list[str], sequences: int, frames: int,
                seed: int = DEFAULT_SEED, noise: str = DEFAULT_NOISE, progress: ProgressFactory = no_progress,
                weights: str | None = None) -> tuple[list[dict[str, Any]], SequenceCounts]:
-    """:func:`ident_table`'s rows and, per (set-up, identifier) that ran (not :data:`NOT_TRAINED`), the
-    per-sequence (correct labels, detections) behind its success rate, for :func:`ident_differences`."""
+    """:func:`ident_table`'s rows and per (set-up, identifier) that ran, per-sequence (correct labels, detections)."""
     if weights and len(setups) != 1:
         raise ValueError(f"weights: {weights} are for one set-up; got {len(setups)} set-ups")
     rows = []
@@ -166,10 +155,8 @@ def ident_runs(setups: list[str], trackers: list[str], sequences: int, frames: i
 
 
 def ident_differences(counts: SequenceCounts, setups: list[str], trackers: list[str]) -> list[Comparison]:
-    """Per set-up and identifier after the first: its success rate minus the first identifier's on the
-    same sequences, in points, with the 95% interval over sequences (:func:`~lookalike.bench.paired.rate_difference`);
-    none with fewer than two identifiers or two sequences, nor for identifiers (or a first one) that did
-    not run (:data:`NOT_TRAINED`)."""
+    """Each identifier's success rate minus the first's on the same sequences, in points
+    (:func:`~lookalike.bench.paired.rate_difference`)."""
     def difference(other: Sequence[tuple[int, int]], base: Sequence[tuple[int, int]]) -> PairedDifference:
         return rate_difference([c for c, _ in other], [c for c, _ in base], [n for _, n in base])
 
@@ -179,10 +166,8 @@ def ident_differences(counts: SequenceCounts, setups: list[str], trackers: list[
 def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int, frames: int,
                   seed: int = DEFAULT_SEED, command: str = "", noise: str = DEFAULT_NOISE,
                   weights: str | None = None, differences: Sequence[Comparison] = ()) -> Results:
-    """The rows of :func:`ident_table` as a results document (:mod:`lookalike.io.results`):
-    table ``ident``, one row per set-up (dataset: the preset name) and identifier, over all its sequences;
-    ``weights`` (the LSTM rows' weights when not the shipped ones) is recorded in its options;
-    ``differences`` (:func:`ident_differences`, if any) go in table ``ident_difference`` (fractions)."""
+    """:func:`ident_table`'s rows as a results document: table ``ident`` (dataset: the preset name) and
+    ``differences`` in table ``ident_difference`` (fractions)."""
     names = {preset_label(s): s for s in setups}
     doc = Results("bench ident", command=command, seeds=sequence_seeds(setups, sequences, seed),
                   sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,

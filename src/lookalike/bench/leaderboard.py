@@ -1,8 +1,5 @@
-"""The leaderboard of ``lookalike bench real``: per-dataset rows, ranks, the combined ranking, plots.
-
-Per dataset, entries are ordered by the mean of their ranks on HOTA, IDF1 and MOTA (ties: IDF1); metrics are combined
-over the sequences as TrackEval does. The combined ranking orders entries by their mean rank over the datasets (entries
-on more datasets first)."""
+"""The leaderboard of ``lookalike bench real``: per dataset, entries by mean rank on HOTA, IDF1 and MOTA combined over
+sequences (ties: IDF1); the combined ranking by mean rank over datasets (more datasets first); plots."""
 
 from __future__ import annotations
 
@@ -86,8 +83,7 @@ def combined_ranking(table: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 def leaderboard(entries: Sequence[Entry], sequences: Sequence[RealSequence], results: Sequence[dict[str, Any]]
                 ) -> tuple[list[dict[str, Any]], list[dict[str, Any]], list[dict[str, Any]]]:
-    """``(dataset rows, combined ranking rows, per-sequence rows)`` from :func:`~lookalike.bench.runner.run_jobs`
-    results."""
+    """``(dataset rows, combined ranking, per-sequence rows)`` from :func:`~lookalike.bench.runner.run_jobs`."""
     pairs = job_pairs(entries, sequences)
     if len(pairs) != len(results):
         raise ValueError(f"results: expected {len(pairs)} job results, got {len(results)}")
@@ -105,8 +101,7 @@ def leaderboard(entries: Sequence[Entry], sequences: Sequence[RealSequence], res
 def run_with_progress(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, workers: int = 1,
                       backend: str = "local", address: str | None = None,
                       progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
-    """:func:`~lookalike.bench.runner.run_jobs`, sequence after sequence on the local backend so that
-    ``progress`` advances once per sequence (same results, same order); one step on Ray."""
+    """:func:`~lookalike.bench.runner.run_jobs`, one sequence at a time locally (``progress`` per sequence)."""
     if backend != "local" or len(sequences) < 2:
         step = progress("bench real", 1)
         results = run_jobs(entries, sequences, workers=workers, backend=backend, address=address)
@@ -135,9 +130,8 @@ def leaderboard_results(part: str, rows: list[dict[str, Any]], combined: list[di
                         per_seq: list[dict[str, Any]], skipped: dict[str, str | None],
                         sequences: Sequence[RealSequence], command: str = "",
                         options: dict[str, Any] | None = None) -> Results:
-    """The leaderboard as a results document (:mod:`lookalike.io.results`): tables ``datasets``
-    (one combined row per dataset and entry, with its ``rank``), ``sequences`` (one row per sequence
-    and entry) and ``ranking`` (``dataset`` None: ``mean_rank`` over the ``datasets`` it ran on)."""
+    """The leaderboard as a results document: tables ``datasets`` (combined, with ``rank``), ``sequences`` and
+    ``ranking`` (``mean_rank`` over ``datasets``)."""
     doc = Results("bench real", command=command, sequences=len(sequences),
                   frames=sum(s.length for s in sequences), options={"part": part, **(options or {})},
                   notes={"skipped_peers": {k: v for k, v in skipped.items() if v}})

@@ -1,10 +1,5 @@
-"""Paired comparison of two identifiers over the same sequences: is A really better than B?
-
-The 95% interval of the pooled difference comes from a percentile bootstrap over sequences, each sequence's pair kept
-together (:func:`scipy.stats.bootstrap`, ``paired=True``, fixed seed); with few sequences read it as a lower bound on
-the uncertainty. :func:`rate_difference`: success rate difference in points; :func:`mean_difference`: difference of a
-per-sequence mean (e.g. recovery seconds). One sequence, or an infinite figure (``note`` ``"never"``), gives no
-interval."""
+"""Paired comparison of two identifiers on the same sequences: the pooled difference with a 95% percentile bootstrap
+interval over sequences (:func:`scipy.stats.bootstrap`, ``paired=True``, fixed seed)."""
 
 from __future__ import annotations
 
@@ -28,9 +23,8 @@ NO_SEQUENCES = "no sequences"
 
 @dataclass(frozen=True)
 class PairedDifference:
-    """A minus B: ``difference`` of the pooled figure and its 95% interval ``[low, high]`` over
-    sequences (the figure's unit: points for success rates, seconds for recovery times);
-    ``low``/``high`` NaN when there is no interval, ``note`` then says why."""
+    """A minus B: ``difference`` and its 95% interval ``[low, high]`` (points or seconds; NaN: none, ``note`` says
+    why)."""
 
     difference: float
     low: float
@@ -40,8 +34,7 @@ class PairedDifference:
 
     @property
     def excludes_zero(self) -> bool:
-        """Whether the interval lies wholly above or below 0 (A and B differ beyond the spread over
-        sequences); False without an interval."""
+        """Whether the interval lies wholly above or below 0 (False without one)."""
         return bool(self.low > 0 or self.high < 0)
 
 
@@ -60,9 +53,8 @@ def _pooled_points(gain: np.ndarray, detections: np.ndarray, axis: int = -1) -> 
 
 def rate_difference(correct_a: Sequence[float], correct_b: Sequence[float],
                     detections: Sequence[float]) -> PairedDifference:
-    """Success rate of A minus B in points (``100 · sum(correct_A - correct_B) / sum(detections)``)
-    from per-sequence counts of correct labels and detections (the same sequences, in the same order);
-    sequences without detections weigh nothing and are left out."""
+    """Success rate of A minus B in points, ``100 · sum(correct_A - correct_B) / sum(detections)``, from
+    per-sequence counts (sequences without detections left out)."""
     a, b, n = (np.asarray(v, dtype=float) for v in (correct_a, correct_b, detections))
     if not a.shape == b.shape == n.shape or a.ndim != 1:
         raise ValueError(f"per-sequence counts differ in length: {a.shape}, {b.shape}, {n.shape}")
@@ -78,9 +70,8 @@ def rate_difference(correct_a: Sequence[float], correct_b: Sequence[float],
 
 
 def mean_difference(values_a: Sequence[float], values_b: Sequence[float]) -> PairedDifference:
-    """Mean per-sequence figure of A minus B (e.g. recovery seconds), on the same sequences in the same
-    order; an infinite figure (never recovered) in any sequence gives ``mean(A) - mean(B)`` (inf, -inf or
-    NaN) and no interval, ``note`` :data:`NEVER`."""
+    """Mean per-sequence figure of A minus B (e.g. recovery seconds); with an infinite figure, ``mean(A) -
+    mean(B)`` and no interval (``note`` :data:`NEVER`)."""
     a, b = np.asarray(values_a, dtype=float), np.asarray(values_b, dtype=float)
     if a.shape != b.shape or a.ndim != 1:
         raise ValueError(f"per-sequence figures differ in length: {a.shape}, {b.shape}")
@@ -101,8 +92,7 @@ def mean_difference(values_a: Sequence[float], values_b: Sequence[float]) -> Pai
 
 @dataclass(frozen=True)
 class Comparison:
-    """One identifier against the baseline on the sequences of one data set: ``result`` is
-    ``tracker`` minus ``baseline``; ``dataset``: machine name (``m3n2``), ``label``: as printed."""
+    """``result``: ``tracker`` minus ``baseline`` on data set ``dataset`` (``label``: as printed)."""
 
     dataset: str
     label: str
@@ -114,10 +104,8 @@ class Comparison:
 def compare_to_first(runs: Mapping[tuple[str, str], Sequence[Any]], datasets: Sequence[str],
                      trackers: Sequence[str], difference: Callable[[Sequence[Any], Sequence[Any]], PairedDifference],
                      label: Callable[[str], str] = str) -> list[Comparison]:
-    """Per data set and identifier after the first: ``difference(its per-sequence figures, the first's)``
-    on the same sequences (``runs``: (data set, identifier) -> per-sequence figures; ``label``: the data
-    set as printed). None with fewer than two identifiers, for a data set whose first identifier has fewer
-    than two sequences or did not run, nor for identifiers that did not run."""
+    """Per data set and identifier after the first, ``difference(its per-sequence figures, the first's)`` (``runs``:
+    (data set, identifier) -> figures); none where either did not run or the first has < 2 sequences."""
     if len(trackers) < 2:
         return []
     baseline, out = trackers[0], []
@@ -140,8 +128,7 @@ def interval_text(result: PairedDifference, digits: int = 2) -> str:
 
 
 def difference_cells(result: PairedDifference, unit: str, digits: int = 2) -> dict[str, Any]:
-    """Printed cells of one comparison: ``Difference (<unit>)``, ``95% CI (<unit>)``, ``Excludes 0``
-    (yes/no) and ``Sequences``."""
+    """Printed cells of one comparison: difference, interval, ``Excludes 0`` and ``Sequences``."""
     diff = result.difference
     return {f"Difference ({unit})": "nan" if math.isnan(diff) else f"{diff:+.{digits}f}",
             f"95% CI ({unit})": interval_text(result, digits), "Excludes 0": "yes" if result.excludes_zero else "no",
@@ -149,17 +136,15 @@ def difference_cells(result: PairedDifference, unit: str, digits: int = 2) -> di
 
 
 def difference_metrics(result: PairedDifference, scale: float = 1.0, suffix: str = "") -> dict[str, float | int]:
-    """Results-document metrics of one comparison: ``difference``, ``ci_low``, ``ci_high`` (each times
-    ``scale``, key + ``suffix``: e.g. ``scale=0.01`` for points as fractions, ``suffix="_s"`` for seconds;
-    6 decimals; NaN/inf written as null by the document) and ``sequences``."""
+    """Metrics of one comparison: ``difference``, ``ci_low``, ``ci_high`` (times ``scale``, keys + ``suffix``,
+    6 decimals) and ``sequences``."""
     values = {"difference": result.difference, "ci_low": result.low, "ci_high": result.high}
     scaled = {f"{k}{suffix}": v * scale for k, v in values.items()}
     return {**{k: round(v, 6) if math.isfinite(v) else v for k, v in scaled.items()}, "sequences": result.n_sequences}
 
 
 def difference_title(baseline: str, unit: str, figure: str = "") -> str:
-    """The printed title of a table of comparisons with ``baseline`` (``figure``: what is compared, when
-    the title should say)."""
+    """The printed title of a table of comparisons with ``baseline`` (``figure``: what is compared)."""
     lead = f"{figure}: difference" if figure else "Difference"
     return f"{lead} from {baseline} ({unit}; {CONFIDENCE:.0%} CI over sequences)"
 
@@ -171,9 +156,8 @@ def comparison_rows(comparisons: Sequence[Comparison], unit: str, digits: int = 
 
 def add_comparisons(doc: Results, table: str, comparisons: Sequence[Comparison], figure: str,
                     scale: float = 1.0, suffix: str = "") -> None:
-    """Add ``comparisons`` to ``doc`` as table ``table`` (none: nothing added), one row per data set and
-    identifier with :func:`difference_metrics` and info ``baseline``, ``figure`` (the compared metric's
-    key) and ``note`` (why there is no interval), and a note on the method under ``notes[table]``."""
+    """Add ``comparisons`` to ``doc`` as table ``table`` (:func:`difference_metrics`, info ``baseline``, ``figure``,
+    ``note``) with a note on the method."""
     if not comparisons:
         return
     for c in comparisons:

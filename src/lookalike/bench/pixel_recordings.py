@@ -1,9 +1,5 @@
-"""Recordings of the pixel pipeline: rendered robot sequences turned into labelled robot-sequence files.
-
-Each sequence is simulated, rendered and perceived as ``lookalike bench pixels`` does
-(:func:`lookalike.bench.pixels.perceive_sequence`, same seeds); the recording keeps the simulation's reports, times and
-truth with the pixel detections, labelled with the robot whose rendered box they overlap best (IoU >= ``min_iou``, else
--1). Written as ``.labelled.jsonl`` files, they train and test the LSTM like a team's recordings."""
+"""Pixel recordings: sequences perceived as ``bench pixels`` does, with the pixel detections and their renderer-truth
+labels in place of the simulator's, written as ``.labelled.jsonl`` robot sequences."""
 
 from __future__ import annotations
 
@@ -13,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike.bench.ident import sequence_seeds
 from lookalike.bench.pixels import PerceivedSequence, perceive_sequence
 from lookalike.bench.progress import ProgressFactory
 from lookalike.eval import identification_success_rate
@@ -31,12 +28,11 @@ def recording_seeds(setup: str, sequences: int, seed: int) -> list[int]:
     """Seeds of the ``sequences`` recordings of preset ``setup`` from base ``seed`` (as ``bench pixels``)."""
     if setup not in PRESET_NAMES:
         raise ValueError(f"unknown preset {setup!r}; known: {', '.join(PRESET_NAMES)}")
-    return [seed + 1000 * PRESET_NAMES.index(setup) + k for k in range(sequences)]
+    return sequence_seeds([setup], sequences, seed)
 
 
 def to_recording(perceived: PerceivedSequence) -> RobotSequence:
-    """The simulated sequence of ``perceived`` with its detections replaced by the pixel detections
-    (most probable first, at most the world's M) and their renderer-truth labels."""
+    """``perceived``'s sequence with the pixel detections (at most M) and their labels as its detections."""
     seq = perceived.sequence
     a = seq.arrays
     T, M = a.det_valid.shape
@@ -61,8 +57,7 @@ def to_recording(perceived: PerceivedSequence) -> RobotSequence:
 
 def record_pixels(setup: str, sequences: int, frames: int, seed: int, pipe: RobotPipeline, camera: Camera,
                   min_iou: float = 0.3, progress: ProgressFactory | None = None) -> Iterator[RobotSequence]:
-    """Pixel recordings of ``sequences`` sequences of ``frames`` frames of preset ``setup`` (see the module),
-    one at a time as each is done."""
+    """Pixel recordings of ``sequences`` sequences of ``frames`` frames of preset ``setup``, as each is done."""
     cfg = world_for_camera(preset(setup), camera)
     advance = progress(f"{setup}: rendering + perception", sequences * frames) if progress else None
     for s in recording_seeds(setup, sequences, seed):
@@ -77,8 +72,8 @@ def write_recording(recording: RobotSequence, folder: str | Path, setup: str) ->
 
 def identifier_labels(recordings: list[RobotSequence], name: str = "lstm", **params: object
                       ) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Per frame, the labels identifier ``name`` gives and the true labels, the identifier run over every
-    recording from its first frame with its N and M from the recording; ``params`` go to ``make_tracker``."""
+    """Per frame, identifier ``name``'s labels and the true ones over every recording (``params``: to
+    ``make_tracker``)."""
     predicted: list[np.ndarray] = []
     truth: list[np.ndarray] = []
     for rec in recordings:
@@ -93,9 +88,7 @@ def identifier_labels(recordings: list[RobotSequence], name: str = "lstm", **par
 
 
 def score_identifier(recordings: list[RobotSequence], name: str = "lstm", **params: object) -> tuple[float, int]:
-    """Identification success rate (a false positive labelled as such counts as correct, as in ``bench
-    pixels``) and the number of detections of identifier ``name`` run over every recording from its
-    first frame, with its N and M from the recording; ``params`` go to ``make_tracker`` (e.g. ``weights``)."""
+    """Success rate and detection count of :func:`identifier_labels`."""
     predicted, truth = identifier_labels(recordings, name, **params)
     return identification_success_rate(predicted, truth), sum(len(t) for t in truth)
 

@@ -1,17 +1,7 @@
-"""The pixels bench (``lookalike bench pixels``): identification from rendered pixels against the simulator's own
-detections.
-
-Held-out sequences (seeds ``seed + 1000·setup + sequence``, default 700000, disjoint from the models' training renders
-below 400000) are simulated with the camera's field of view and rendered
-(:func:`lookalike.viz.robot_pixels.render_robot_frames`). Each frame goes once through
-:class:`~lookalike.vision.pipeline.RobotPipeline`'s perception; each identifier then runs on those detections and on the
-simulator's own. A pixel detection's true robot is the rendered robot it overlaps best (Hungarian on IoU, at least
-``--min-iou``), else it is a false positive.
-
-Identification table: success rates on all detections and on true robots only (the like-for-like comparison: the two
-sides make false positives at different rates), their gap, the paper's Table II localisation error (metres) on each
-side, detections scored and frames/s. Perception table: recall of robots at least half visible, precision, heading error
-(degrees) and perception frames/s. Models: the shipped ones unless ``--detector-model`` / ``--heading-model``."""
+"""The pixels bench (``lookalike bench pixels``): identifiers on detections perceived from rendered frames
+(:class:`~lookalike.vision.pipeline.RobotPipeline`) against the simulator's own detections, on held-out sequences
+(seeds ``seed + 1000·setup + sequence``). A pixel detection's true robot is the rendered one it overlaps best
+(Hungarian on IoU >= ``min_iou``), else it is a false positive."""
 
 from __future__ import annotations
 
@@ -29,13 +19,7 @@ from lookalike.geometry.boxes import iou_matrix
 from lookalike.geometry.camera import Camera
 from lookalike.io.results import Results, add_printed_rows
 from lookalike.loop import RunStats, run
-from lookalike.sim import (
-    PRESET_NAMES,
-    RobotSequence,
-    preset,
-    preset_label,
-    simulate_robots,
-)
+from lookalike.sim import RobotSequence, preset, preset_label, simulate_robots
 from lookalike.trackers import make_tracker
 from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
 from lookalike.types import Beacons, Detections
@@ -51,8 +35,8 @@ PERCEPTION_COLUMNS = ("Setup", "Frames", "Recall", "Precision", "Heading error (
 
 @dataclass
 class PerceivedSequence:
-    """One sequence after perception: per frame the pixel detections, their true robots (-1: false
-    positive), the received reports and the time; plus detection and heading statistics."""
+    """One sequence after perception: per frame the pixel detections, their true robots (-1: false positive),
+    the reports and the time; plus detection and heading statistics."""
 
     sequence: RobotSequence
     detections: list[Detections] = field(default_factory=list)
@@ -109,8 +93,7 @@ def perceive_sequence(pipe: RobotPipeline, seq: RobotSequence, camera: Camera, m
 
 
 def _identifier(name: str, seq: RobotSequence, camera: Camera, weights: str | None = None) -> PipelineConfig:
-    """The identification settings of ``name`` for the sequence's N and M and the camera's field of view;
-    ``weights`` (exported .npz) replace the shipped ones of the ``lstm`` identifier."""
+    """Identification settings of ``name`` for the sequence and camera (``weights``: .npz for ``lstm``)."""
     params = identifier_settings(name, camera) + ((("weights", weights),) if weights and uses_weights(name) else ())
     return PipelineConfig(identifier=name, n_agents=seq.config.n_agents, max_detections=seq.config.max_detections,
                           identifier_params=params)
@@ -128,9 +111,8 @@ class _Identify:
 
 @dataclass
 class IdentScore:
-    """One identifier on one side (pixels or simulated): success rate (fraction), localisation error (metres,
-    NaN when no robot ever had a position while in view), detections scored, frames/s (tracking only) and the
-    success rate on the detections of true robots only (fraction; NaN when there are none)."""
+    """One identifier on one side (pixels or simulated): success rate (fraction), localisation error (m; NaN: no
+    position while in view), detections scored, tracking frames/s and success on true robots only (NaN: none)."""
 
     success: float
     loc_error: float
@@ -139,17 +121,18 @@ class IdentScore:
     robot_success: float = float("nan")
 
 
-def _localisation(positions: list[np.ndarray], perceived: list[PerceivedSequence]) -> float:
-    """Table II's error (m) of per-frame ``(N, 2)`` agent positions, sequence after sequence, against the truth."""
-    truth = [p.sequence.true_positions_visible() for p in perceived]
-    if not positions:
-        return float("nan")
-    return localisation_error(np.stack(positions), np.concatenate(truth))
+def _score(predicted: list[np.ndarray], positions: list[np.ndarray], truth: list[np.ndarray],
+           perceived: list[PerceivedSequence], stats: RunStats) -> IdentScore:
+    """:class:`IdentScore` of per-frame labels and ``(N, 2)`` agent positions, sequence after sequence."""
+    true_positions = [p.sequence.true_positions_visible() for p in perceived]
+    loc = localisation_error(np.stack(positions), np.concatenate(true_positions)) if positions else float("nan")
+    return IdentScore(identification_success_rate(predicted, truth), loc, sum(len(t) for t in truth), stats.fps,
+                      robot_success_rate(predicted, truth))
 
 
 def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipeline, camera: Camera,
                  weights: str | None = None) -> IdentScore:
-    """Identifier ``name`` on the pixel detections (``weights``: as in :func:`pixels_table`)."""
+    """Identifier ``name`` on the pixel detections."""
     predicted: list[np.ndarray] = []
     positions: list[np.ndarray] = []
     truth: list[np.ndarray] = []
@@ -165,14 +148,12 @@ def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipel
         step = _Identify(RobotPipeline(pipe.detector, pipe.heading, camera, config, pipe.probability), p)
         run(step, range(len(p.detections)), sink, stats=stats)
         truth.extend(p.truth)
-    return IdentScore(identification_success_rate(predicted, truth), _localisation(positions, perceived),
-                      sum(len(t) for t in truth), stats.fps, robot_success_rate(predicted, truth))
+    return _score(predicted, positions, truth, perceived, stats)
 
 
 def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camera,
                     weights: str | None = None) -> IdentScore:
-    """Identifier ``name`` on the simulator's own detections of the same sequences (``weights``: as in
-    :func:`pixels_table`)."""
+    """Identifier ``name`` on the simulator's own detections of the same sequences."""
     predicted: list[np.ndarray] = []
     positions: list[np.ndarray] = []
     truth: list[np.ndarray] = []
@@ -187,13 +168,11 @@ def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camer
 
         run(make_tracker(name, **cfg.identifier_kwargs()), p.sequence.frames(), sink, stats=stats)
         truth.extend(p.sequence.true_labels())
-    return IdentScore(identification_success_rate(predicted, truth), _localisation(positions, perceived),
-                      sum(len(t) for t in truth), stats.fps, robot_success_rate(predicted, truth))
+    return _score(predicted, positions, truth, perceived, stats)
 
 
 def perception_pipeline(pipe: RobotPipeline, n_agents: int, max_detections: int) -> RobotPipeline:
-    """``pipe``'s detector, heading model, camera and detection probability, keeping up to the set-up's M
-    (``max_detections``) detections per frame for its N robots."""
+    """``pipe`` keeping up to ``max_detections`` detections per frame for ``n_agents`` robots."""
     config = dataclasses.replace(pipe.config, n_agents=n_agents, max_detections=max_detections)
     return RobotPipeline(pipe.detector, pipe.heading, pipe.camera, config, pipe.probability)
 
@@ -202,10 +181,8 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
                  pipe: RobotPipeline, camera: Camera, min_iou: float,
                  progress: ProgressFactory | None = None, weights: str | None = None
                  ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """Rows of the identification table (:data:`PIXEL_COLUMNS`) and of the perception table
-    (:data:`PERCEPTION_COLUMNS`). ``progress(description, total)`` returns a callable advanced once per frame.
-    ``weights``: exported LSTM weights (.npz, e.g. a fine-tuning run's ``model.npz``) for the ``lstm`` rows,
-    on both sides, instead of the shipped ones (one set-up: they are for one N, M)."""
+    """Rows of the identification (:data:`PIXEL_COLUMNS`) and perception (:data:`PERCEPTION_COLUMNS`) tables;
+    ``weights``: exported LSTM .npz for the ``lstm`` rows on both sides (one set-up only)."""
     if weights and len(setups) != 1:
         raise ValueError(f"weights: {weights} are for one set-up; got {len(setups)} set-ups")
     rows, perception = [], []
@@ -213,11 +190,8 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
         cfg = world_for_camera(preset(setup), camera)
         advance = progress(f"{setup}: rendering + perception", sequences * frames) if progress else None
         seeing = perception_pipeline(pipe, cfg.n_agents, cfg.max_detections)
-        perceived = [
-            perceive_sequence(seeing, simulate_robots(cfg, frames, seed + 1000 * PRESET_NAMES.index(setup) + k),
-                              camera, min_iou, min_visible=0.5, advance=advance)
-            for k in range(sequences)
-        ]
+        perceived = [perceive_sequence(seeing, simulate_robots(cfg, frames, s), camera, min_iou, min_visible=0.5,
+                                       advance=advance) for s in sequence_seeds([setup], sequences, seed)]
         seconds = sum(p.seconds for p in perceived)
         n_det = sum(len(d) for p in perceived for d in p.detections)
         matched = sum(p.matched for p in perceived)
@@ -252,11 +226,8 @@ PIXEL_KEYS = {"Pixels (%)": "success_rate_pixels", "Simulated (%)": "success_rat
 def pixels_results(rows: list[dict[str, Any]], perception: list[dict[str, Any]], setups: list[str],
                    sequences: int, frames: int, seed: int = DEFAULT_SEED, command: str = "",
                    options: dict[str, Any] | None = None) -> Results:
-    """The tables of :func:`pixels_table` as a results document: ``identification`` (per set-up and
-    identifier: ``success_rate_pixels``, ``success_rate_simulated``, ``gap``, and the same on true robots only
-    (``success_rate_robots_pixels``/``_simulated``) as fractions,
-    ``localisation_error_pixels``/``_simulated`` in metres, detection counts, frames/s) and ``perception``
-    (tracker ``perception``: recall, precision, heading error)."""
+    """The tables of :func:`pixels_table` as a results document: ``identification`` (:data:`PIXEL_KEYS`; fractions,
+    metres) and ``perception`` (tracker ``perception``)."""
     names = {preset_label(s): s for s in setups}
     doc = Results("bench pixels", command=command, seeds=sequence_seeds(setups, sequences, seed),
                   sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
@@ -269,5 +240,4 @@ def pixels_results(rows: list[dict[str, Any]], perception: list[dict[str, Any]],
 
 __all__ = ["DEFAULT_SEED", "PERCEPTION_COLUMNS", "PIXEL_COLUMNS", "PIXEL_KEYS", "IdentScore", "PerceivedSequence",
            "match_truth", "perceive_sequence", "perception_pipeline", "pixels_results", "pixels_table",
-           "robot_success_rate", "score_pixels",
-           "score_simulated"]
+           "robot_success_rate", "score_pixels", "score_simulated"]

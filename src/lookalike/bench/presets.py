@@ -1,6 +1,5 @@
-"""Parameter presets of the benches, read from ``presets/*.json``, each saying what it was chosen on (``chosen_on``) and
-how (``search``). Presets chosen on the scored data only feed the "tuned on this data" rows; headline rows use the
-defaults, as ``lookalike track`` does."""
+"""Parameter presets of the benches (``presets/*.json``, each with ``chosen_on`` and ``search``); they feed only the
+"tuned on this data" rows."""
 
 from __future__ import annotations
 

@@ -1,9 +1,4 @@
-"""Progress reporting for long benches, without a dependency on any display.
-
-A bench function takes ``progress: ProgressFactory`` and calls ``step = progress("m3n2 jpda", total)`` once per stage,
-then ``step()`` once per unit done (a sequence, a frame, a job). The command line passes
-:func:`lookalike.cli.progress.progress_bars` (rich bars with time left); the default :func:`no_progress` does nothing.
-"""
+"""Progress of long benches: ``step = progress("m3n2 jpda", total)`` once per stage, then ``step()`` per unit done."""
 
 from __future__ import annotations
 

@@ -1,12 +1,6 @@
-"""Jobs of ``lookalike bench real`` and the backends that run them: serial, processes, Ray.
-
-A job is one tracker entry on one sequence and returns its combinable scores and tracking time; every backend returns
-results in job order, so tables do not depend on the backend (frames/s aside). An entry's parameters are the tracker's
-defaults overridden by the entry's; only a ``tuned`` entry also gets the presets chosen on the scored data
-(:data:`~lookalike.bench.presets.TUNED_PARAMS`, :data:`~lookalike.bench.presets.SEQUENCE_PARAMS`). On blob detections
-(:data:`BLOB_DATASETS`) ``boxtrack`` gets what ``lookalike track --detector blob`` gives it
-(:func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config`); ``boxtrack-closed-offline`` runs
-:func:`lookalike.trackers.offline.closed_set.track_closed_set` as ``lookalike track --targets N --offline`` does."""
+"""Jobs of ``lookalike bench real``: one tracker entry on one sequence, giving combinable scores and tracking time,
+run serially, in processes or on Ray, results in job order. Only a ``tuned`` entry gets the presets chosen on the
+scored data; on blob detections ``boxtrack`` runs as ``lookalike track --detector blob`` does."""
 
 from __future__ import annotations
 
@@ -53,10 +47,8 @@ TUNED_LABEL = "tuned on this data"
 
 
 def default_entries(trackers: Sequence[str], peers: Sequence[str], closed_set: bool = True) -> list[Entry]:
-    """lookalike trackers and peers, all with their defaults; with ``boxtrack`` also ``boxtrack-offline``
-    (its result post-processed offline, :mod:`lookalike.trackers.offline.gap_fill`), ``boxtrack (tuned on this
-    data)`` (where parameters were chosen on the scored data), and, where the count is known,
-    ``boxtrack-closed`` (online) and ``boxtrack-closed-offline`` (the offline closed set)."""
+    """lookalike trackers and peers with their defaults; with ``boxtrack`` also ``boxtrack-offline``, ``boxtrack
+    (tuned on this data)`` and (``closed_set``) ``boxtrack-closed`` and ``boxtrack-closed-offline``."""
     entries = [Entry(t, t) for t in trackers]
     if "boxtrack" in trackers:
         entries += [Entry("boxtrack-offline", "boxtrack", offline=True),
@@ -69,8 +61,8 @@ def default_entries(trackers: Sequence[str], peers: Sequence[str], closed_set: b
 
 def params_entry(path: str, tracker: str, params: dict[str, Any], chosen_on: Sequence[str],
                  sequences: Sequence[RealSequence]) -> Entry:
-    """The entry of a ``lookalike tune`` parameter file: labelled with the file's stem, and ``(tuned on this data)``
-    when its ``chosen_on`` names any scored sequence (``dataset/name`` or a dataset)."""
+    """The entry of a ``lookalike tune`` parameter file, labelled with its stem (and ``(tuned on this data)`` when
+    ``chosen_on`` names a scored ``dataset/name`` or dataset)."""
     from pathlib import Path
 
     scored = {f"{s.dataset}/{base_name(s)}" for s in sequences} | {s.dataset for s in sequences}
@@ -92,8 +84,8 @@ def sequence_params(entry: Entry, seq: RealSequence) -> dict[str, Any]:
 
 
 def entry_params(entry: Entry, seq: RealSequence) -> dict[str, Any]:
-    """The parameters ``entry``'s tracker gets on ``seq`` (a tuned entry's dataset < sequence < the
-    entry's own; the target count as ``max_targets`` for a closed-set entry where it is known)."""
+    """``entry``'s parameters on ``seq``: a tuned entry's dataset < sequence < its own; a closed-set entry's
+    ``max_targets``."""
     preset = TUNED_PARAMS.get(seq.dataset, {}) if entry.tuned else {}
     params = {**preset.get(entry.name, {}), **sequence_params(entry, seq), **entry.params}
     if entry.closed_set and seq.n_targets is not None:
@@ -102,8 +94,7 @@ def entry_params(entry: Entry, seq: RealSequence) -> dict[str, Any]:
 
 
 def track_rows(entry: Entry, seq: RealSequence) -> np.ndarray:
-    """MOTChallenge rows ``(k, 10)`` of ``entry`` on ``seq`` (parameters: :func:`entry_params`).
-    An ``offline`` entry's rows are post-processed with :class:`OfflineConfig`'s defaults."""
+    """MOTChallenge rows ``(k, 10)`` of ``entry`` on ``seq`` (``offline``: post-processed with the defaults)."""
     if entry.kind == "peer":
         return run_peer(entry.name, seq)
     params = entry_params(entry, seq)
@@ -126,9 +117,7 @@ def track_rows(entry: Entry, seq: RealSequence) -> np.ndarray:
 
 
 def blob_tracker_config(config: Any, seq: RealSequence, params: dict[str, Any]) -> Any:
-    """The ``boxtrack`` configuration ``lookalike track --detector blob`` runs on ``seq``'s blob
-    detections when the user gives ``params`` (:func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config`;
-    a sequence's documented count is the known number of targets)."""
+    """The ``boxtrack`` configuration ``lookalike track --detector blob`` runs on ``seq`` given ``params``."""
     counts = np.array([len(x) for x in seq.det_xywh], dtype=int)
     return blob_boxtrack_config(config, counts, params.keys(), seq.n_targets).config
 
@@ -178,8 +167,8 @@ def map_jobs(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int = 1
 
 
 def job_pairs(entries: Sequence[Entry], sequences: Sequence[RealSequence]) -> list[tuple[Entry, RealSequence]]:
-    """``(entry, sequence)`` for every sequence and entry; closed-set entries only where the count is
-    known, tuned entries only on datasets with parameters chosen on them."""
+    """``(entry, sequence)`` per sequence and entry; closed-set entries where the count is known, tuned entries
+    where parameters were chosen."""
     return [(e, s) for s in sequences for e in entries
             if not (e.closed_set and s.n_targets is None)
             and not (e.tuned and e.name not in TUNED_PARAMS.get(s.dataset, {})

@@ -10,14 +10,10 @@ from lookalike.types.mot_table import MotTable
 def synthesize_detections(gt: MotTable, length: int, image_size: tuple[int, int], rng: np.random.Generator, *,
                           noise: float = 0.05, miss_rate: float = 0.1, min_visibility: float = 0.25,
                           false_positives_per_frame: float = 0.5) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Per-frame detections ``(n, 4)`` px and scores ``(n,)`` of a synthetic detector looking at MOT17 ground truth
-    ``gt`` (columns: consider flag, class, visibility).
-
-    The noise model of :func:`lookalike.sim.boxes.simulate_boxes`, with its noise proportional to the box: a considered
-    pedestrian (class 1) at least ``min_visibility`` visible is missed with probability ``miss_rate``, else seen with
-    Gaussian noise of std ``noise``·[w, h, w/2, h/2] on ``[x, y, w, h]`` and a score uniform in [0.6, 1]; each frame
-    adds Poisson(``false_positives_per_frame``) false boxes, uniform over the image (``(width, height)`` px) with the
-    size of a random true box, scored uniform in [0.3, 0.8]."""
+    """Per-frame boxes ``(n, 4)`` px and scores ``(n,)`` of a synthetic detector on MOT17 ground truth ``gt``: a
+    considered pedestrian at least ``min_visibility`` visible is missed with probability ``miss_rate``, else seen with
+    noise of std ``noise``·[w, h, w/2, h/2], scored U[0.6, 1]; plus Poisson(``false_positives_per_frame``) boxes
+    uniform over the image (``(width, height)`` px), sized as a random true box, scored U[0.3, 0.8]."""
     if gt.extra.shape[1] < 2:
         raise ValueError("gt: expected MOT17 ground truth with class and visibility columns")
     person = (gt.conf != 0) & (gt.extra[:, 0] == 1)

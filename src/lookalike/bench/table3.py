@@ -1,9 +1,6 @@
-"""Farazi and Behnke's Table III protocol on recordings: success rate by sequence length.
-
-For each length, ``draws`` seeded random windows are drawn from the recordings and each identifier runs on every window
-from a fresh state; ``Total`` runs each over every whole recording. Human-benchmark result files
-(:mod:`lookalike.viz.label.human`) of the same set-up add a ``human`` row (per length, the sessions that worked through
-at least that many frames; no localisation error)."""
+"""Farazi and Behnke's Table III: success rate by sequence length, each identifier run from a fresh state on ``draws``
+seeded random windows per length and over every whole recording (``Total``); human-benchmark sessions
+(:mod:`lookalike.viz.label.human`) of the same set-up add a ``human`` row."""
 
 from __future__ import annotations
 
@@ -31,8 +28,8 @@ HUMAN = "human"
 
 def draw_windows(lengths: Sequence[int], recording_lengths: Sequence[int], draws: int,
                  seed: int) -> list[tuple[int, int, int]]:
-    """``(length, recording, first frame)`` of ``draws`` random windows per length; recordings shorter
-    than a length are never drawn for it; a length no recording holds raises ``ValueError``."""
+    """``(length, recording, first frame)`` of ``draws`` random windows per length, in recordings that hold it
+    (``ValueError`` when none does)."""
     rng = np.random.default_rng(seed)
     out = []
     for length in lengths:
@@ -62,8 +59,8 @@ def _run_window(name: str, seq: RobotSequence, first: int, length: int) -> tuple
 def table3_rows(recordings: Sequence[RobotSequence], trackers: Sequence[str], lengths: Sequence[int] = DEFAULT_LENGTHS,
                 draws: int = DEFAULT_DRAWS, seed: int = 0,
                 progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
-    """One row per identifier: success rate (%) per length, the total over whole recordings, and the
-    localisation error (m) over whole recordings. All recordings must share N and M."""
+    """Per identifier: success rate (%) per length and over whole recordings, and localisation error (m);
+    recordings share N and M."""
     if not recordings:
         raise ValueError("no recordings")
     if draws < 1 or any(n < 1 for n in lengths):
@@ -102,8 +99,8 @@ def table3_rows(recordings: Sequence[RobotSequence], trackers: Sequence[str], le
 
 
 def recording_files(folder: Path) -> list[Path]:
-    """The robot-sequence ``.jsonl`` files of ``folder``, by name; a labelling page export
-    ``<stem>.labelled.jsonl`` is left out when ``<stem>.jsonl`` (its sequence, with its own truth) is there."""
+    """The ``.jsonl`` robot sequences of ``folder`` by name, without a ``<stem>.labelled.jsonl`` whose
+    ``<stem>.jsonl`` is there."""
     files = sorted(folder.glob("*.jsonl")) if folder.is_dir() else []
     names = {f.name for f in files}
     return [f for f in files if not (f.name.endswith(".labelled.jsonl")
@@ -111,8 +108,8 @@ def recording_files(folder: Path) -> list[Path]:
 
 
 def human_row(results: Sequence[HumanResult], lengths: Sequence[int], total_key: str) -> dict[str, Any]:
-    """The ``human`` row of :func:`table3_rows`'s columns from benchmark sessions (see the module docstring):
-    success rate (%) per length and in total (``total_key``), :data:`NO_VALUE` where no session counts."""
+    """The ``human`` row: per length, the sessions that worked through at least that many frames; in total
+    (``total_key``) all of them; :data:`NO_VALUE` where none counts."""
     def rate(chosen: Sequence[HumanResult]) -> float | str:
         detections = sum(r.detections_scored for r in chosen)
         return round(100 * sum(r.correct for r in chosen) / detections, 2) if detections else NO_VALUE
@@ -128,8 +125,7 @@ def human_row(results: Sequence[HumanResult], lengths: Sequence[int], total_key:
 
 
 def human_sessions(results: Sequence[HumanResult], label: str) -> list[dict[str, Any]]:
-    """One printable row per benchmark session: labeller, sequence, frames worked through, success rate,
-    labelling time."""
+    """One printed row per benchmark session."""
     return [{"Setup": label, "Labeller": r.labeller, "Sequence": r.sequence, "Frames": r.frames_scored,
              "Detections": r.detections_scored,
              "Success rate (%)": NO_VALUE if r.success_rate is None else round(100 * r.success_rate, 2),
@@ -142,11 +138,9 @@ def table3_table(setups: Sequence[str], trackers: Sequence[str], sequences: int,
                  noise: str, lengths: Sequence[int], draws: int, recordings: Path | None = None,
                  progress: ProgressFactory = no_progress, human: Path | None = None,
                  sessions: list[dict[str, Any]] | None = None) -> list[dict[str, Any]]:
-    """Rows of :func:`table3_rows` with a ``Setup`` column: on the robot-sequence ``.jsonl`` files of
-    folder ``recordings`` when given, else per set-up on the simulated test sequences of ``bench ident``
-    (``sequences`` × ``frames``, noise model ``noise``, seeds from ``seed``). Human-benchmark result files
-    in folder ``human`` (default: ``recordings``, if given) of a group's N and M add its ``human`` row
-    (:func:`human_row`); their sessions are appended to ``sessions`` (:func:`human_sessions`) when given."""
+    """Rows of :func:`table3_rows` with a ``Setup`` column, on the recordings in folder ``recordings`` or else on
+    ``bench ident``'s sequences per set-up; human results in ``human`` (default ``recordings``) of a group's N and M
+    add its :func:`human_row`, and their sessions go to ``sessions`` when given."""
     if any(n < 1 for n in lengths):
         raise ValueError(f"--lengths: frame counts must be positive, got {list(lengths)}")
     people = read_human_results(human) if human is not None else []

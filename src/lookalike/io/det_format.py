@@ -1,8 +1,6 @@
-"""Detection files in other layouts than MOTChallenge's: a header line naming the columns, corner boxes
-(``x1, y1, x2, y2``), whitespace separators, 0-based frames. :func:`sniff_det` decides the layout (from the file's
-first lines, or from a ``--det-format`` text) and says what it assumed; :func:`read_det` reads any layout as
-MOTChallenge rows (``frame`` 1-based, ``left, top, width, height`` in pixels); :func:`det_warnings` flags values
-that look wrong (boxes centred outside the frame, every score the same)."""
+"""Detection files in other layouts than MOTChallenge's (a header naming the columns, corner boxes, whitespace, 0-based
+frames): :func:`sniff_det` decides the layout and says what it assumed, :func:`read_det` reads it as MOTChallenge rows,
+:func:`det_warnings` flags values that look wrong."""
 
 from __future__ import annotations
 
@@ -41,17 +39,12 @@ _SNIFF_LINES = 200
 
 @dataclass(frozen=True)
 class DetFormat:
-    """A detection file's layout: ``roles`` (one per column: frame/frame0, id, left, top, width, height, right,
-    bottom, score, class, or ``-`` for a column ignored), ``separator`` (``,`` or ``None``: whitespace),
-    ``header`` (the first non-blank line names the columns)."""
+    """A detection file's layout: a role per column (``-``: ignored), ``separator`` (None: whitespace), and whether
+    the first line is a ``header``."""
 
     roles: tuple[str, ...]
     separator: str | None = ","
     header: bool = False
-
-    @property
-    def zero_based(self) -> bool:
-        return "frame0" in self.roles
 
     @property
     def corners(self) -> bool:
@@ -75,8 +68,8 @@ MOT = DetFormat(("frame", "id", "left", "top", "width", "height", "score", "-", 
 
 
 def parse_columns(text: str, where: str = "--det-format") -> tuple[str, ...]:
-    """Roles of a comma- or space-separated list of column names (the aliases of ``_ALIASES``; any other name is a
-    column ignored); ``ValueError`` naming ``where`` when the frame or the box cannot be found."""
+    """Roles of a list of column names (``_ALIASES``; others ignored); ``ValueError`` naming ``where`` without a frame
+    and a box."""
     names = [n.strip().lower() for n in re.split(r"[,\s;]+", text.strip()) if n.strip()]
     roles = [_ROLE.get(n, "-") for n in names]
     if "left" not in roles and "top" not in roles:  # x, y name the corner only where nothing else does
@@ -124,10 +117,9 @@ def _guess_roles(sample: np.ndarray) -> tuple[tuple[str, ...], str | None]:
 
 
 def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetFormat, list[str]]:
-    """The layout of the detection file ``path`` and the notes on what was assumed (empty for a MOTChallenge file
-    read as before). ``spec``: ``auto`` (decide from the first lines), ``mot`` (MOTChallenge's layout, separator
-    and header still detected) or a list of column names (``frame,x1,y1,x2,y2,score,class``; ``frame0`` for
-    0-based frames). ``ValueError`` (with the expected columns) when the lines cannot be read as detections."""
+    """The layout of detection file ``path`` and notes on what was assumed; ``spec``: ``auto`` (from the first lines),
+    ``mot`` (separator and header still detected) or column names (``frame,x1,y1,x2,y2,score,class``; ``frame0``:
+    0-based). ``ValueError`` when the lines cannot be read as detections."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
@@ -175,10 +167,8 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
 
 def read_det(path: str | os.PathLike[str], fmt: DetFormat, length: int | None = None,
              length_name: str = "the length") -> MotTable:
-    """The detections of ``path`` in layout ``fmt`` as a MOTChallenge table (1-based frames, ``left, top, width,
-    height``; score 1 without a score column). ``ValueError`` naming the file and line: a line that is not numbers
-    or has too few columns (with the expected columns), or a row :func:`~lookalike.io.read_mot` would refuse (a
-    box of zero or negative size, a frame past ``length``...)."""
+    """The detections of ``path`` in layout ``fmt`` as a MOTChallenge table (score 1 without a score column);
+    ``ValueError`` naming file and line for what :func:`~lookalike.io.read_mot` would refuse."""
     path = Path(path)
     need = max(i for i, r in enumerate(fmt.roles) if r != "-") + 1
     numbers: list[list[float]] = []
@@ -215,8 +205,8 @@ def read_det(path: str | os.PathLike[str], fmt: DetFormat, length: int | None = 
 
 def det_warnings(path: Path | str, count: int, scores: tuple[float, float] | None, outside: int,
                  image_size: tuple[int, int] | None, size_from: str = "") -> list[str]:
-    """Warnings on a detection file's values: ``outside`` of ``count`` boxes centred outside the ``image_size``
-    ``(width, height)`` frame (from ``size_from``), every score equal (``scores``: the lowest and highest)."""
+    """Warnings: ``outside`` of ``count`` boxes centred outside ``image_size`` (from ``size_from``), or every score
+    equal (``scores``: lowest and highest)."""
     found = []
     if outside and image_size is not None:
         found.append(f"{path}: {outside} of {count} boxes are centred outside the {image_size[0]}x{image_size[1]} "

@@ -1,7 +1,5 @@
-"""MOTChallenge text files: ``frame, id, left, top, width, height, conf, x, y, z[, ...]``.
-
-Frames and ids are 1-based in files; in memory ``MotTable.frame`` keeps the file's 1-based numbers and
-:func:`frames_from_table` yields 0-based :class:`Frame` objects."""
+"""MOTChallenge text files: ``frame, id, left, top, width, height, conf, x, y, z[, ...]``, frames 1-based (kept so in
+``MotTable.frame``; :func:`frames_from_table` yields 0-based :class:`Frame` objects)."""
 
 from __future__ import annotations
 
@@ -12,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.io.rules import GAP_FACTOR, MIN_GAP, frame_problems, read_text, temp_beside
+from lookalike.io.rules import GAP_FACTOR, MIN_GAP, frame_problems, read_text
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import ROW_WIDTH, MotTable, stack_rows, table_from_array, tracks_to_rows
 
@@ -23,14 +21,9 @@ _COLUMNS = "columns: frame,id,left,top,width,height,score[,x,y,z]"
 
 def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | None = None,
              length_name: str = "the length", positive_size: bool = False) -> MotTable:
-    """Read a MOTChallenge text file (UTF-8).
-
-    Raises ``ValueError`` naming the file and 1-based line number of a malformed line: too few columns, a non-number,
-    NaN or infinity in the first 7 columns (frame, id, box, score), an id that is not a whole number, a negative size
-    (with ``positive_size``, as detections need: a zero one too), a frame number that is not an integer >= 1, past
-    ``length`` (named ``length_name``), or that jumps too far (:mod:`lookalike.io.rules`); or naming the file when it
-    is not UTF-8 text.
-    """
+    """Read a MOTChallenge text file (UTF-8); ``ValueError`` naming the file and line of a malformed one: too few
+    columns, a non-number, NaN or infinity in frame, id, box or score, an id not whole, a negative size (zero too with
+    ``positive_size``), or a frame number breaking :mod:`lookalike.io.rules` or past ``length``."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
@@ -50,8 +43,7 @@ def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | N
 
 def row_problem(data: np.ndarray, previous_max: float = 0.0, length: int | None = None,
                 length_name: str = "the length", positive_size: bool = False) -> tuple[int, str] | None:
-    """``(row, reason)`` of the first row of ``data`` ``(k, c)`` that breaks the rules of
-    :func:`read_mot` (``previous_max``: the largest frame of the rows before), else None."""
+    """``(row, reason)`` of the first row of ``data`` ``(k, c)`` that :func:`read_mot` refuses, else None."""
     if not len(data) or _rows_fine(data, previous_max, length, positive_size):
         return None
     box = ~np.isfinite(data[:, 1:7]).all(axis=1)
@@ -70,8 +62,7 @@ def row_problem(data: np.ndarray, previous_max: float = 0.0, length: int | None 
 
 
 def _rows_fine(data: np.ndarray, previous_max: float, length: int | None, positive_size: bool) -> bool:
-    """True when no row of ``data`` breaks a rule of :func:`row_problem`, from a few whole-table reductions
-    (a sufficient condition; False sends the table to the row-by-row checks)."""
+    """True when no row breaks a rule of :func:`row_problem`, from whole-table reductions (False: look closer)."""
     with np.errstate(over="ignore", invalid="ignore"):
         total = data[:, 1:7].sum()
     if not np.isfinite(total):  # a NaN or infinity makes the sum one (a huge sum only looks like one)
@@ -128,10 +119,8 @@ def _parse_slowly(path: Path, rows: list[tuple[int, str]], min_columns: int) -> 
 def frames_from_table(
     table: MotTable, length: int | None = None, frame_rate: float = 30.0, min_score: float = -np.inf
 ) -> Iterator[Frame]:
-    """Yield one :class:`Frame` per frame ``0 .. length-1`` (file frame ``k`` is index ``k-1``).
-
-    Frames without boxes are yielded empty; ``time = index / frame_rate``. Boxes whose score is below ``min_score`` are
-    dropped."""
+    """One :class:`Frame` per frame ``0 .. length-1`` (file frame ``k`` is index ``k-1``; ``time = index /
+    frame_rate``), boxes scored below ``min_score`` dropped."""
     if frame_rate <= 0:
         raise ValueError(f"frame_rate must be positive, got {frame_rate}")
     if length is None:
@@ -144,32 +133,19 @@ def frames_from_table(
     bounds = np.searchsorted(frames, np.arange(1, length + 2))
     for index in range(length):
         lo, hi = bounds[index], bounds[index + 1]
-        yield Frame(
-            index=index,
-            time=index / frame_rate,
-            detections=Detections(xywh=xywh[lo:hi], score=conf[lo:hi]),
-        )
+        yield Frame(index=index, time=index / frame_rate, detections=Detections(xywh=xywh[lo:hi], score=conf[lo:hi]))
 
 
 def write_mot(path: str | os.PathLike[str], rows: Iterable[np.ndarray] | np.ndarray) -> Path:
     """Write result rows ``(n, 10)`` atomically: a failure never leaves a half-written file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    from lookalike.io.outputs import write_atomic
+
     data = np.asarray(rows, dtype=float) if isinstance(rows, np.ndarray) else stack_rows(rows)
-    fd, tmp = temp_beside(path)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(format_rows(data))
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return write_atomic(path, format_rows(data))
 
 
 def format_rows(rows: np.ndarray) -> str:
-    """Result rows ``(k, >= 10)`` as MOTChallenge lines, newlines included
-    (:func:`~lookalike.types.mot_table.format_row`'s text), formatted a block at a time."""
+    """Result rows ``(k, >= 10)`` as MOTChallenge lines (:func:`~lookalike.types.mot_table.format_row`'s text)."""
     data = np.asarray(rows, dtype=float)
     if data.ndim != 2 or data.shape[1] < ROW_WIDTH:
         raise ValueError(f"result rows need shape (k, {ROW_WIDTH}) or wider, got {data.shape}")

@@ -16,27 +16,27 @@ BUILTIN_NEEDS = {
     "jpda": _ROBOTS,
     "lstm": _ROBOTS,
 }
-ROBOT_NEEDS = frozenset(n for n, why in BUILTIN_NEEDS.items() if why == _ROBOTS)
+
+
+def _need(name: str) -> str | None:
+    declared = getattr(tracker_class(name), "needs", None)
+    return declared if isinstance(declared, str) else BUILTIN_NEEDS.get(name)
 
 
 def box_input_problem(name: str, *, video: bool = False) -> str | None:
-    """None when tracker ``name`` can run on MOTChallenge boxes (with a video when ``video``), else one
-    line naming what it needs."""
-    declared = getattr(tracker_class(name), "needs", None)
-    need = declared if isinstance(declared, str) else BUILTIN_NEEDS.get(name)
+    """None when tracker ``name`` can run on boxes (with a video when ``video``), else a line naming what it needs."""
+    need = _need(name)
     if need is None or (video and need == _APPEARANCE):
         return None
     return f"tracker {name!r} cannot run on boxes alone; it needs {need}"
 
 
 def input_kind(name: str) -> str:
-    """What tracker ``name`` reads, in a few words: ``boxes``, ``boxes + video`` (appearance from the pixels) or
-    ``robot positions`` (ground positions with heading reports)."""
-    declared = getattr(tracker_class(name), "needs", None)
-    need = declared if isinstance(declared, str) else BUILTIN_NEEDS.get(name)
+    """What tracker ``name`` reads: ``boxes``, ``boxes + video`` or ``robot positions``."""
+    need = _need(name)
     if need is None:
         return "boxes"
     return "boxes + video" if need == _APPEARANCE else "robot positions"
 
 
-__all__ = ["BUILTIN_NEEDS", "ROBOT_NEEDS", "box_input_problem", "input_kind"]
+__all__ = ["BUILTIN_NEEDS", "box_input_problem", "input_kind"]

@@ -1,16 +1,14 @@
-"""Where results go, decided before anything runs: one file per sequence, never onto an input, never two outputs onto
-one file, a writable folder (:func:`check_outputs`, used by every command that writes files); and every file written
-through a temporary file beside it, renamed into place (:func:`atomic_path`). Refusals are one-line ``ValueError``s."""
+"""Where results go, checked before anything runs (:func:`check_outputs`: never onto an input, never two outputs onto
+one file, a writable folder), and files written through a temporary file renamed into place (:func:`atomic_path`)."""
 
 from __future__ import annotations
 
 import os
-import tempfile
 from collections.abc import Collection, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
-from lookalike.io.rules import user_mode
+from lookalike.io.rules import temp_beside
 from lookalike.io.sequences import MotSequence
 
 
@@ -34,12 +32,9 @@ def _inside(path: Path, folder: Path) -> bool:
 
 def check_outputs(outputs: Mapping[str, Path | None], inputs: Iterable[Path | None] = (), *,
                   folders: Collection[str] = (), input_folders: Iterable[Path | None] = ()) -> None:
-    """Check every output of a command before it runs; ``ValueError`` naming the option and the path when an output
-    is one of the files in ``inputs`` (compared resolved, symbolic and hard links followed; folders among them are
-    skipped) or an existing file inside one of ``input_folders`` (folders the command reads every file of), when two
-    outputs are one file, when an output is an existing folder (a name in ``folders``: an existing file, the output
-    being a folder), or when its folder cannot be created or written. ``outputs``: option name to path (None: not
-    given). Creates the outputs' parent folders."""
+    """Check a command's ``outputs`` (option name -> path or None) and create their folders; ``ValueError`` naming
+    the option and path when an output is one of ``inputs`` (links followed) or an existing file in ``input_folders``,
+    two outputs are one file, an output is a folder (one named in ``folders``: a file), or cannot be written."""
     given = [(name, Path(p)) for name, p in outputs.items() if p is not None]
     for i, (name, path) in enumerate(given):
         for other, other_path in given[:i]:
@@ -89,19 +84,12 @@ def _check_folder(folder: Path) -> None:
 
 @contextmanager
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
-    """A new temporary file beside ``path`` (same folder and suffix, unique name, the mode ``open()`` would give) to
-    write instead of ``path``: renamed onto ``path`` when the block ends, removed when it raises (any exception,
-    ``KeyboardInterrupt`` and the ``SystemExit`` of a SIGTERM included). A reader never sees a half-written file and
-    a failed run keeps the old one."""
+    """A temporary file (:func:`~lookalike.io.rules.temp_beside`) to write instead of ``path``: renamed onto ``path``
+    when the block ends, removed when it raises (``KeyboardInterrupt`` and SIGTERM's ``SystemExit`` included)."""
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, name = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=f".tmp{target.suffix}", dir=target.parent)
-    tmp = Path(name)
+    fd, tmp = temp_beside(target)
     try:
-        try:
-            os.fchmod(fd, user_mode())
-        except OSError:
-            pass  # a file system without modes
         os.close(fd)
         yield tmp
         os.replace(tmp, target)
@@ -117,8 +105,7 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> Path:
 
 
 def refuse_inputs(outputs: Iterable[Path], inputs: Iterable[Path | None]) -> None:
-    """``ValueError`` when an output is (or resolves to) one of the ``inputs``: the run would
-    overwrite its own input."""
+    """``ValueError`` when an output is (or resolves to) one of the ``inputs``."""
     files = [Path(p) for p in inputs if p is not None]
     for out in outputs:
         for src in files:
@@ -137,10 +124,9 @@ def sequence_inputs(sequences: Iterable[MotSequence]) -> list[Path]:
 
 
 def result_paths(path: Path, sequences: Sequence[MotSequence], output: Path) -> list[Path]:
-    """The result file of each of ``sequences`` read from ``path``: ``output`` itself for a single
-    detection file, else ``output/<sequence name>.txt``. Refused (``ValueError``): ``output`` a folder
-    for a single file or an existing file for a folder of sequences; two sequences with one name
-    (compared ignoring case, for case-insensitive file systems); an output that is an input file."""
+    """The result file of each of ``sequences`` read from ``path``: ``output`` for a single detection file, else
+    ``output/<sequence name>.txt``; ``ValueError`` for a folder/file mismatch, two sequences with one name (ignoring
+    case) or an output that is an input."""
     if path.is_file():
         if output.is_dir():
             raise ValueError(f"output {output} is a folder; a single detection file is tracked into one result "
@@ -162,8 +148,7 @@ def result_paths(path: Path, sequences: Sequence[MotSequence], output: Path) -> 
 
 
 def ensure_writable(targets: Iterable[Path]) -> None:
-    """Create the folders of ``targets`` and check that files can be created there (``ValueError``
-    naming the folder otherwise), and that no target is an existing folder."""
+    """Create the folders of ``targets``; ``ValueError`` when one cannot be written or a target is a folder."""
     for folder in dict.fromkeys(Path(t).parent for t in targets):
         _check_folder(folder)
     for t in targets:
@@ -172,8 +157,7 @@ def ensure_writable(targets: Iterable[Path]) -> None:
 
 
 def sqlite_file(url: str | None) -> Path | None:
-    """The database file of an SQLite storage URL (``sqlite:///PATH``, e.g. an Optuna ``--study``), else None: the
-    output to check with :func:`check_outputs`."""
+    """The database file of an SQLite storage URL (``sqlite:///PATH``), else None."""
     if url is None or not url.startswith("sqlite:///") or url.endswith(":memory:"):
         return None
     return Path(url[len("sqlite:///"):])

@@ -1,10 +1,5 @@
-"""Anonymous points per frame as tracker input: readers, and points as small boxes for the box trackers.
-
-Formats (comma-separated, 1-based frames): point CSV ``frame,x,y[,...]`` with an optional header
-(:func:`read_points_csv`), and MOTChallenge rows with the point in columns 3-4, or a box whose centre is the point with
-``centre=True`` (:func:`read_points_mot`). Both give :class:`PointFrames`; bad input raises ``ValueError`` naming file
-and line. :func:`points_to_rows` makes square boxes for the trackers; :func:`rows_to_points` takes result rows back to
-centres."""
+"""Anonymous points per frame as tracker input (point CSV or MOTChallenge rows, 1-based frames; ``ValueError`` naming
+file and line), and points as small square boxes for the box trackers and back."""
 
 from __future__ import annotations
 
@@ -21,21 +16,14 @@ from lookalike.types.mot_table import detection_rows
 __all__ = ["POINT_VEL_NOISE", "PointFrames", "points_to_rows", "read_points_csv", "read_points_mot", "rows_to_points",
            "typical_spacing", "typical_step"]
 
-# boxtrack's velocity noise (fraction of the box side per frame) for points as boxes. A point has no size:
-# its box side is half the points' typical spacing, so boxtrack's own VEL_NOISE (1/160 of an object's
-# extent) makes the motion model far too sure of the velocity for animals that turn and change speed.
-# Chosen among 1/160, 0.01, 0.02, 0.03, 0.05, 0.075, 0.1, 0.2 on the simulated arenas of
-# benchmarks/closed_points.py, seeds 0-29 only (research/notes/closed-set.md has the figures).
+# boxtrack's velocity noise (box sides per frame) for points as boxes, chosen on the simulated arenas of
+# benchmarks/closed_points.py, seeds 0-29 (docs/closed-set.md).
 POINT_VEL_NOISE = 0.02
 
 
 @dataclass(frozen=True, eq=False)
 class PointFrames:
-    """Anonymous points of a sequence.
-
-    Attributes:
-        points: per frame (index = frame − 1), an ``(n, 2)`` float array of positions.
-        path: the file it came from, if any."""
+    """Anonymous points of a sequence: per frame (index = frame − 1) ``(n, 2)`` positions; ``path``: the file."""
 
     points: list[np.ndarray]
     path: Path | None = None
@@ -53,8 +41,8 @@ MAX_COORDINATE = 1e9  # pixels: a point or box value beyond this (in absolute va
 
 
 def _parse(path: Path, columns: int, first_coordinate: int = 1) -> list[tuple[int, list[float]]]:
-    """``(line number, values)`` of the data lines (blank lines and one leading header skipped); the columns from
-    ``first_coordinate`` on are pixel values, at most :data:`MAX_COORDINATE` in absolute value."""
+    """``(line number, values)`` of the data lines (blank lines and one leading header skipped); columns from
+    ``first_coordinate`` on are pixels, at most :data:`MAX_COORDINATE` in absolute value."""
     if path.is_dir():
         raise ValueError(f"{path}: is a folder; expected a points file (frame,x,y CSV or MOTChallenge rows)")
     if not path.is_file():
@@ -106,8 +94,7 @@ def _group(path: Path, frames: np.ndarray, xy: np.ndarray, n_frames: int | None)
 
 
 def read_points_csv(path: str | os.PathLike[str], n_frames: int | None = None) -> PointFrames:
-    """Points from a ``frame,x,y`` CSV (1-based frames, optional header line, extra columns ignored);
-    ``n_frames`` pads the sequence with empty frames up to that length."""
+    """Points from a ``frame,x,y`` CSV (optional header, extra columns ignored), padded to ``n_frames``."""
     path = Path(path)
     parsed = _parse(path, 3)
     data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 3)
@@ -116,8 +103,7 @@ def read_points_csv(path: str | os.PathLike[str], n_frames: int | None = None) -
 
 def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *,
                     centre: bool = False) -> PointFrames:
-    """Points from MOTChallenge-style rows ``frame, id, x, y, ...`` (columns 3-4 are the point), or with
-    ``centre=True`` rows ``frame, id, left, top, width, height, ...`` whose box centres are the points."""
+    """Points from rows ``frame, id, x, y, ...``, or with ``centre=True`` the centres of MOTChallenge boxes."""
     path = Path(path)
     parsed = _parse(path, 6 if centre else 4, first_coordinate=2)
     data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 6 if centre else 4)
@@ -168,9 +154,8 @@ def typical_step(points: PointFrames | list[np.ndarray]) -> float:
 
 def points_to_rows(points: PointFrames | list[np.ndarray], box_px: float | None = None,
                    score: float = 1.0) -> np.ndarray:
-    """MOTChallenge detection rows ``(k, 10)`` (1-based frames, id -1) of square boxes of side ``box_px`` centred
-    on the points. Default side: half the :func:`typical_spacing`; with never two points in a frame, twice the
-    :func:`typical_step`; else 1."""
+    """Detection rows ``(k, 10)`` of square boxes of side ``box_px`` centred on the points (default: half the
+    :func:`typical_spacing`, else twice the :func:`typical_step`, else 1)."""
     per_frame = points.points if isinstance(points, PointFrames) else points
     if box_px is None:
         spacing = typical_spacing(per_frame)

@@ -1,19 +1,8 @@
-"""One results schema for every ``--json`` (``eval``, ``bench ...``, the demo's data files).
-
-A document is ``{"schema": "lookalike-results/1", "header": {...}, "tables": {name: [row, ...]}}``,
-described by ``results.schema.json`` (:data:`SCHEMA_PATH`). The header holds ``lookalike_version``,
-``command``, ``kind``, ``seeds``, ``sequences``, ``frames``, ``created_utc``, ``options`` and ``notes``;
-a row holds ``dataset``, ``sequence`` (None across sequences), ``tracker``, ``combined``, ``metrics``
-(machine keys, :func:`metric_key`; fractions in [0, 1]) and optional ``info`` and ``error``.
-
-Usage::
-
-    doc = Results("bench divers", command=command_line, seeds=seeds, sequences=3, frames=900)
-    doc.add("divers", dataset="divers", sequence="pool-1", tracker="sort", metrics={"idf1": 0.81})
-    doc.write(path)   # or doc.to_dict() / doc.dumps()
-
-:meth:`Results.add` refuses non-machine keys and fractions outside [0, 1] (NaN written as ``null``).
-"""
+"""One results schema for every ``--json``: ``{"schema": "lookalike-results/1", "header": {...}, "tables": {name:
+[row, ...]}}`` (``results.schema.json``); a row holds ``dataset``, ``sequence`` (None across sequences), ``tracker``,
+``combined``, ``metrics`` (machine keys, :func:`metric_key`; fractions in [0, 1]; NaN as ``null``), and optional
+``info`` and ``error``. Usage: ``doc = Results("bench divers", ...)``; ``doc.add("divers", dataset=..., tracker=...,
+metrics={"idf1": 0.81})``; ``doc.write(path)``."""
 
 from __future__ import annotations
 
@@ -31,8 +20,7 @@ from lookalike._optional import needs
 SCHEMA_ID = "lookalike-results/1"
 SCHEMA_PATH = Path(__file__).with_name("results.schema.json")
 KEY_PATTERN = re.compile(r"^[a-z][a-z0-9_]*$")
-#: Metrics that are fractions in [0, 1], as are ``success_rate_*`` and HOTA's per-alpha values
-#: (``gap`` in [-1, 1], MOTA/MODA at most 1).
+#: Metrics that are fractions in [0, 1], as are ``success_rate_*`` and HOTA's per-alpha values.
 FRACTIONS = frozenset({
     "success_rate", "hota", "deta", "assa", "loca", "idf1", "idp", "idr", "motp", "dp", "dr",
     "recall", "precision",
@@ -53,9 +41,9 @@ def lookalike_version() -> str:
 
 
 def metric_key(name: str) -> str:
-    """A machine key for a printed or TrackEval metric name: ``"HOTA(0)"`` -> ``"hota_0"``,
-    ``"HOTA___AUC"`` -> ``"hota_auc"``, ``"Localisation error (m)"`` -> ``"localisation_error_m"``,
-    ``"Frames/s"`` -> ``"frames_per_s"``, ``"Success rate (%)"`` -> ``"success_rate"``."""
+    """A machine key for a printed or TrackEval metric name: ``"HOTA___AUC"`` -> ``"hota_auc"``, ``"Localisation
+    error (m)"`` -> ``"localisation_error_m"``, ``"Frames/s"`` -> ``"frames_per_s"``, ``"Success rate (%)"`` ->
+    ``"success_rate"``."""
     text = name.strip()
     for unit, suffix in _UNITS.items():
         if text.endswith(unit):
@@ -112,8 +100,8 @@ def clean_metrics(metrics: Mapping[str, Any]) -> dict[str, float | int | None]:
 
 def percent_row_metrics(row: Mapping[str, Any], skip: Iterable[str] = (),
                         rename: Mapping[str, str] | None = None) -> dict[str, float | int | None]:
-    """Metrics of a printed table row: numeric cells under machine keys (:func:`metric_key`, or ``rename[column]``),
-    cells marked ``(%)`` or ``(pp)`` divided by 100; text cells and the columns in ``skip`` left out."""
+    """Numeric cells of a printed row under machine keys (``rename[column]`` or :func:`metric_key`), ``(%)`` and
+    ``(pp)`` cells divided by 100; text cells and ``skip`` left out."""
     skipped, names = set(skip), dict(rename or {})
     out: dict[str, Any] = {}
     for name, value in row.items():
@@ -128,9 +116,8 @@ def add_printed_rows(doc: Results, table: str, printed: Iterable[Mapping[str, An
                      dataset_key: str = "Setup", tracker_key: str = "Tracker",
                      datasets: Mapping[str, str] | None = None, tracker: str = "",
                      rename: Mapping[str, str] | None = None) -> None:
-    """Add printed table rows (one per data set and tracker, over all its sequences) to ``doc``:
-    ``dataset`` from column ``dataset_key`` (through ``datasets``, e.g. ``{"M=3, N=2": "m3n2"}``),
-    ``tracker`` from ``tracker_key`` (else ``tracker``), metrics by :func:`percent_row_metrics`."""
+    """Add printed rows to ``doc``: ``dataset`` from column ``dataset_key`` (through ``datasets``), ``tracker`` from
+    ``tracker_key`` (else ``tracker``), metrics by :func:`percent_row_metrics`."""
     names = dict(datasets or {})
     for r in printed:
         label = r.get(dataset_key)
@@ -185,7 +172,7 @@ class Results:
         return json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
 
     def write(self, path: Path) -> Path:
-        """Write the document to ``path`` (parent folders created; through a temporary file renamed into place)."""
+        """Write the document to ``path`` atomically."""
         from lookalike.io.outputs import write_atomic
 
         return write_atomic(path, self.dumps())
@@ -212,8 +199,7 @@ def schema() -> dict[str, Any]:
 
 
 def validate(document: Mapping[str, Any]) -> None:
-    """Check ``document`` against the schema (needs the ``jsonschema`` package of the test extra);
-    ``jsonschema.ValidationError`` when it does not conform."""
+    """Check ``document`` against the schema (``jsonschema.ValidationError``; needs ``jsonschema``)."""
     with needs("jsonschema"):
         import jsonschema  # type: ignore[import-untyped]  # no stubs; test extra
 

@@ -1,11 +1,9 @@
-"""Simulated robot sequences on disk as JSON Lines (one file per sequence).
-
-Line 1 is a header object::
+"""Simulated robot sequences as JSON Lines: a header line::
 
     {"format": "lookalike-robots", "version": 1, "seed": 900000, "n_frames": 1000,
      "reports_sent": 29870, "config": {...RobotWorldConfig as nested objects...}}
 
-then one object per frame, in order::
+then one line per frame, in order::
 
     {"frame": 0, "time": 0.0,
      "detections": {"position": [[x, y], ...], "heading": [...], "score": [...], "label": [...]},
@@ -14,11 +12,8 @@ then one object per frame, in order::
                "field_position": [[x, y] x N], "observer": [x, y, yaw],
                "n_false_positives": 1, "n_misses": 0}}
 
-Positions in metres (detections and ``truth.position`` in the observer frame: x forward, y left;
-``field_position`` and ``observer`` in field coordinates), angles in radians, times in seconds;
-``label`` is the agent id or -1 for a false positive. Floats are written with full precision,
-so reading gives back the simulated arrays exactly.
-"""
+Metres (detections and ``truth.position`` in the observer frame: x forward, y left; the rest in field coordinates),
+radians, seconds; ``label``: agent id or -1 (a false positive). Floats at full precision: reading is exact."""
 
 from __future__ import annotations
 
@@ -66,9 +61,8 @@ def write_robot_sequence(path: str | Path, sequence: RobotSequence) -> Path:
 
 
 def read_robot_sequence(path: str | Path) -> RobotSequence:
-    """Read a sequence written by :func:`write_robot_sequence`. Anything else (not UTF-8, not JSON
-    Lines, another format, a malformed record, NaN or infinity in a detection) raises ``ValueError``
-    naming the file (and the line where it is known)."""
+    """Read a sequence written by :func:`write_robot_sequence`; anything else raises ``ValueError`` naming the
+    file (and line)."""
     path = Path(path)
     lines = [(no, line) for no, line in enumerate(read_text(path).splitlines(), start=1) if line.strip()]
     if not lines:
@@ -146,8 +140,7 @@ def _assemble(config: RobotWorldConfig, header: dict, rows: list[dict], T: int, 
 def _read_record(k: int, row: dict, N: int, M: int, time: np.ndarray, valid: np.ndarray, pos: np.ndarray,
                  head: np.ndarray, score: np.ndarray, label: np.ndarray, b_parts: dict[str, list],
                  offsets: np.ndarray, truth: dict[str, list[Any]]) -> None:
-    """Read frame record ``k`` into the arrays (detection labels: whole numbers from -1, a false positive,
-    to ``N - 1``)."""
+    """Read frame record ``k`` into the arrays."""
     if row["frame"] != k:
         raise ValueError(f"frame records out of order: record {k} is frame {row['frame']}")
     time[k] = row["time"]

@@ -1,7 +1,6 @@
-"""The input rules every reader in :mod:`lookalike.io` applies, and file creation with the user's umask.
-
-Frame numbers are integers >= 1 and may not jump past the largest so far by more than ``max(MIN_GAP, GAP_FACTOR × that
-frame)``, unless a declared length bounds them (docs/concepts/data-formats.md)."""
+"""The input rules every reader in :mod:`lookalike.io` applies (frame numbers are integers >= 1 that jump past the
+largest so far by at most ``max(MIN_GAP, GAP_FACTOR × that frame)`` unless a length bounds them), and temporary files
+with the user's umask."""
 
 from __future__ import annotations
 
@@ -35,9 +34,8 @@ def read_text(path: str | os.PathLike[str]) -> str:
 
 def frame_problems(frames: np.ndarray, previous_max: float = 0.0, length: int | None = None,
                    length_name: str = "the length") -> tuple[int, str] | None:
-    """``(index, reason)`` of the first frame number in ``frames`` (file order, 1-based) that breaks
-    the rules (not finite, not an integer >= 1, past ``length``, or a jump past the bound), else None.
-    ``previous_max``: the largest frame before these (streaming); ``length_name`` names the length."""
+    """``(index, reason)`` of the first frame number in ``frames`` (file order, 1-based) that breaks the rules, else
+    None; ``previous_max``: the largest frame before these (streaming)."""
     frames = np.asarray(frames, dtype=float)
     if not len(frames):
         return None
@@ -78,9 +76,9 @@ def user_mode() -> int:
 
 
 def temp_beside(path: Path) -> tuple[int, Path]:
-    """A new temporary file beside ``path`` (same folder, so that ``os.replace`` is atomic), with
-    the mode of a file created by ``open()`` (:func:`user_mode`), not ``mkstemp``'s 0600."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    """A new temporary file beside ``path`` (same folder and suffix, so that ``os.replace`` is atomic), with the mode
+    a file created by ``open()`` gets (:func:`user_mode`), not ``mkstemp``'s 0600."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=path.parent)
     try:
         os.fchmod(fd, user_mode())
     except OSError:

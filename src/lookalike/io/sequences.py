@@ -5,7 +5,7 @@ from __future__ import annotations
 import configparser
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from lookalike.io.rules import read_text
@@ -13,16 +13,8 @@ from lookalike.io.rules import read_text
 
 @dataclass(frozen=True)
 class MotSequence:
-    """One sequence on disk.
-
-    Attributes:
-        name: sequence name (folder name, or the ``name`` in ``seqinfo.ini``).
-        root: the sequence folder (None for a bare detection file).
-        det_path: the detection file, or None.
-        gt_path: the ground-truth file, or None.
-        frame_rate: frames per second (30 when unknown).
-        length: number of frames, or None when unknown (then the last detected frame).
-        image_size: ``(width, height)`` in pixels, or None."""
+    """One sequence on disk: ``name`` (folder's, or ``seqinfo.ini``'s), ``root`` folder (None: a bare file), the
+    detection and ground-truth files, frames per second, ``length`` in frames and ``(width, height)`` px if known."""
 
     name: str
     root: Path | None
@@ -34,8 +26,7 @@ class MotSequence:
 
 
 def read_seqinfo(path: str | os.PathLike[str]) -> dict[str, str]:
-    """The ``[Sequence]`` section of a ``seqinfo.ini`` as a dict (keys as written); ``ValueError``
-    naming the file when it is not UTF-8 text, malformed, or has no such section."""
+    """The ``[Sequence]`` section of a ``seqinfo.ini`` (keys as written); ``ValueError`` naming the file."""
     path = Path(path)
     parser = configparser.ConfigParser(interpolation=None)
     parser.optionxform = str  # type: ignore[assignment,method-assign]  # keep key case
@@ -82,8 +73,7 @@ def _plain_name(name: str, path: Path) -> str:
 
 
 def _sequence_from_folder(folder: Path) -> MotSequence:
-    """The sequence in ``folder``; its ``seqinfo.ini`` (if any) is checked: ``seqLength``, ``imWidth``,
-    ``imHeight`` integers >= 1, ``frameRate`` a positive number, ``name`` a plain file name."""
+    """The sequence in ``folder``, with its ``seqinfo.ini`` (if any) checked."""
     det = folder / "det" / "det.txt"
     gt = folder / "gt" / "gt.txt"
     info_path = folder / "seqinfo.ini"
@@ -95,15 +85,7 @@ def _sequence_from_folder(folder: Path) -> MotSequence:
         length = _positive_int(info, "seqLength", info_path) if "seqLength" in info else None
         if "imWidth" in info and "imHeight" in info:
             size = (_positive_int(info, "imWidth", info_path), _positive_int(info, "imHeight", info_path))
-    return MotSequence(
-        name=name,
-        root=folder,
-        det_path=det if det.is_file() else None,
-        gt_path=gt if gt.is_file() else None,
-        frame_rate=rate,
-        length=length,
-        image_size=size,
-    )
+    return MotSequence(name, folder, det if det.is_file() else None, gt if gt.is_file() else None, rate, length, size)
 
 
 def _is_sequence(folder: Path) -> bool:
@@ -111,15 +93,13 @@ def _is_sequence(folder: Path) -> bool:
 
 
 def find_sequences(path: str | os.PathLike[str]) -> list[MotSequence]:
-    """Sequences at ``path``: a detection file, one sequence folder, or a folder of them.
-
-    A bare ``det.txt`` inside ``<seq>/det/`` picks up that sequence's ``seqinfo.ini``."""
+    """Sequences at ``path``: a detection file (in ``<seq>/det/``: with that sequence's ``seqinfo.ini``), one sequence
+    folder, or a folder of them."""
     path = Path(path)
     if path.is_file():
         parent = path.parent.parent if path.parent.name == "det" else None
         if parent is not None and _is_sequence(parent):
-            seq = _sequence_from_folder(parent)
-            return [MotSequence(seq.name, seq.root, path, seq.gt_path, seq.frame_rate, seq.length, seq.image_size)]
+            return [replace(_sequence_from_folder(parent), det_path=path)]
         return [MotSequence(path.stem, None, path, None)]
     if not path.is_dir():
         raise FileNotFoundError(f"{path}: no such file or folder")
@@ -127,7 +107,5 @@ def find_sequences(path: str | os.PathLike[str]) -> list[MotSequence]:
         return [_sequence_from_folder(path)]
     found = [_sequence_from_folder(p) for p in sorted(path.iterdir()) if p.is_dir() and _is_sequence(p)]
     if not found:
-        raise ValueError(
-            f"{path}: neither a sequence folder (seqinfo.ini, det/ or gt/) nor a folder of sequences"
-        )
+        raise ValueError(f"{path}: neither a sequence folder (seqinfo.ini, det/ or gt/) nor a folder of sequences")
     return found

@@ -1,9 +1,5 @@
-"""Streaming MOTChallenge input and output for :func:`lookalike.loop.run`.
-
-:class:`DetectionStream` checks the whole file first in chunks (the errors of :func:`~lookalike.io.read_mot`), then
-yields frames parsing a chunk at a time (files with decreasing frames or uneven columns are read whole); frames equal
-:func:`~lookalike.io.frames_from_table`'s. :class:`MotWriter` writes rows as they come to a file that appears atomically
-at the end."""
+"""Streaming MOTChallenge input (:class:`DetectionStream`) and output (:class:`MotWriter`) for
+:func:`lookalike.loop.run`."""
 
 from __future__ import annotations
 
@@ -31,8 +27,7 @@ WRITE_ROWS = 4_096
 
 
 def _chunks(path: Path, lines: int) -> Iterator[np.ndarray]:
-    """The file's rows, ``lines`` text lines at a time, parsed by numpy's C parser (``(k, c)``);
-    ``ValueError`` for anything it cannot parse (then :func:`read_mot` says where)."""
+    """The file's rows ``(k, c)``, ``lines`` lines at a time (``ValueError`` for anything numpy cannot parse)."""
     with open(path, encoding="utf-8") as fh:
         while True:
             block = list(itertools.islice(fh, lines))
@@ -46,18 +41,10 @@ def _chunks(path: Path, lines: int) -> Iterator[np.ndarray]:
 
 
 class DetectionStream:
-    """The frames of a MOTChallenge detection file, produced lazily.
-
-    Args:
-        path: the detection file (``det.txt``).
-        length: number of frames (frames ``0 .. length-1``; a row past it is an error), or None for
-            the last frame in the file.
-        frame_rate: frames per second (``time = index / frame_rate``).
-        min_score: boxes with a lower score are dropped.
-        chunk_lines: lines parsed at a time.
-        length_name: what ``length`` is, for error messages (e.g. ``seqLength in X/seqinfo.ini``).
-        image_size: the frame's ``(width, height)`` in pixels, if known: :meth:`check` counts the boxes centred
-            outside it (``outside``) and notes the lowest and highest score (``scores``)."""
+    """The frames of a MOTChallenge detection file, checked whole in chunks first (:func:`~lookalike.io.read_mot`'s
+    errors), then parsed a chunk at a time (irregular files read whole); frames equal
+    :func:`~lookalike.io.frames_from_table`'s. ``length``: frames (None: the file's last); ``length_name`` names it
+    in errors; ``image_size`` ``(width, height)`` px: :meth:`check` counts boxes centred outside it."""
 
     def __init__(self, path: str | os.PathLike[str], length: int | None = None, frame_rate: float = 30.0,
                  min_score: float = -np.inf, chunk_lines: int = CHUNK_LINES, length_name: str = "the length",
@@ -173,10 +160,8 @@ class DetectionStream:
 
 
 class MotWriter:
-    """A sink for :func:`lookalike.loop.run` that writes MOTChallenge result rows as they come.
-
-    Rows go to a temporary file beside ``path``; :meth:`close` renames it to ``path`` (atomic), and leaving a ``with``
-    block on an exception deletes it, so a failed run never leaves a half file."""
+    """A sink for :func:`lookalike.loop.run` writing result rows to a temporary file that :meth:`close` renames to
+    ``path`` (leaving a ``with`` block on an exception deletes it)."""
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
@@ -191,9 +176,8 @@ class MotWriter:
         self.write_rows(tracks_to_rows(frame.index, tracks))
 
     def write_rows(self, rows: np.ndarray) -> None:
-        """Append result rows ``(k, 10)``; ``ValueError`` naming the frame for a NaN or infinite frame,
-        id, box or score (a file :func:`~lookalike.io.read_mot` would refuse is never written; checked
-        a block at a time, when the block is written)."""
+        """Append result rows ``(k, 10)``; ``ValueError`` naming the frame of a NaN or infinite value (checked a block
+        at a time)."""
         if self._fh is None:
             raise ValueError(f"{self.path}: writer already closed")
         if len(rows):
@@ -251,10 +235,8 @@ class MotWriter:
 
 def sequence_stream(seq: MotSequence, min_score: float = -np.inf, use_length: bool = True,
                     det_format: str = "auto") -> DetectionStream:
-    """The checked :class:`DetectionStream` of a sequence's detection file (its frame rate, and its
-    ``seqLength`` unless ``use_length`` is false: then every frame in the file is tracked). ``det_format``: the
-    file's layout (:func:`~lookalike.io.det_format.sniff_det`; a MOTChallenge file is streamed, any other layout
-    read whole); what was assumed is in the stream's ``notes``."""
+    """The checked :class:`DetectionStream` of a sequence (its ``seqLength`` unless not ``use_length``); ``det_format``:
+    the layout (:func:`~lookalike.io.det_format.sniff_det`; other layouts read whole; assumptions in ``notes``)."""
     if seq.det_path is None:
         raise ValueError(f"{seq.name}: no detection file")
     length = seq.length if use_length else None
@@ -272,8 +254,7 @@ def sequence_stream(seq: MotSequence, min_score: float = -np.inf, use_length: bo
 
 def track_to_file(tracker: Updating, frames: Iterable[Frame], output: str | os.PathLike[str],
                   sink: Sink | None = None, stats: RunStats | None = None) -> RunStats:
-    """Run ``tracker`` over ``frames`` with :func:`lookalike.loop.run`, streaming its MOTChallenge
-    rows to ``output`` (atomically; nothing is written when it fails); ``sink`` also sees every frame."""
+    """Run ``tracker`` over ``frames``, streaming its rows to ``output`` atomically; ``sink`` also sees every frame."""
     with MotWriter(output) as writer:
         return run(tracker, frames, Sinks(writer, sink), stats=stats)
 
