@@ -3,7 +3,8 @@ import pytest
 
 from lookalike.trackers import make_tracker
 from lookalike.trackers.lstm import CheckpointError, EncodingSpec, NetworkWeights, save_weights
-from lookalike.trackers.lstm.tracker import BeaconMemory, LstmIdentifier, decode
+from lookalike.trackers.lstm.tracker import LstmIdentifier
+from lookalike.trackers.parts.agents import BeaconMemory, decode
 from lookalike.types import Beacons, Detections, Frame, TrackStatus
 
 
@@ -59,8 +60,8 @@ def test_beacon_memory_keeps_newest_and_ignores_late_reports():
 
 def test_decode_argmax_and_one_to_one():
     p = np.array([[0.6, 0.3, 0.1], [0.7, 0.2, 0.1], [0.1, 0.1, 0.8]])
-    labels, _ = decode(p, 3, one_to_one=False)
+    labels, _ = decode(p, np.arange(3), 3, one_to_one=False)
     assert labels.tolist() == [0, 0, -1]
-    labels, conf = decode(p, 3, one_to_one=True)
+    labels, conf = decode(p, np.arange(3), 3, one_to_one=True)
     assert labels.tolist() == [1, 0, -1]  # 0.3*0.7 > 0.6*0.2
     assert conf.tolist() == [0.3, 0.7, 0.8]

@@ -35,35 +35,28 @@ class NetworkWeights:
     info: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        _check_shapes(self, "weights")
-
-
-def _check_shapes(w: NetworkWeights, source: str) -> None:
-    if w.cell not in GATES:
-        raise CheckpointError(f"{source}: unknown cell type {w.cell!r} (expected 'lstm' or 'gru')")
-    g, h, n_in = GATES[w.cell], w.hidden, w.spec.n_inputs
-    expected_out = w.spec.n_slots * w.spec.n_classes
-    for i, layer in enumerate(w.layers):
-        width = n_in if i == 0 else h
-        shapes = {"w_ih": (g * h, width), "w_hh": (g * h, h), "b_ih": (g * h,), "b_hh": (g * h,)}
-        for name, shape in shapes.items():
-            arr = layer.get(name)
-            got = () if arr is None else np.shape(arr)
-            if got != shape:
-                raise CheckpointError(f"{source}: layer{i}.{name} has shape {got}, expected {shape}")
-    checks = {
-        "head.weight": (w.head_weight, (expected_out, h)),
-        "head.bias": (w.head_bias, (expected_out,)),
-        "input_mean": (w.input_mean, (n_in,)),
-        "input_std": (w.input_std, (n_in,)),
-    }
-    for name, (arr, shape) in checks.items():
-        if np.shape(arr) != shape:
-            raise CheckpointError(f"{source}: {name} has shape {np.shape(arr)}, expected {shape}")
-        if not np.isfinite(arr).all():
-            raise CheckpointError(f"{source}: {name} holds NaN or infinity")
-    if (w.input_std <= 0).any():
-        raise CheckpointError(f"{source}: input_std must be positive")
+        w = self
+        if w.cell not in GATES:
+            raise CheckpointError(f"weights: unknown cell type {w.cell!r} (expected 'lstm' or 'gru')")
+        g, h, n_in = GATES[w.cell], w.hidden, w.spec.n_inputs
+        expected_out = w.spec.n_slots * w.spec.n_classes
+        for i, layer in enumerate(w.layers):
+            width = n_in if i == 0 else h
+            shapes = {"w_ih": (g * h, width), "w_hh": (g * h, h), "b_ih": (g * h,), "b_hh": (g * h,)}
+            for name, shape in shapes.items():
+                arr = layer.get(name)
+                got = () if arr is None else np.shape(arr)
+                if got != shape:
+                    raise CheckpointError(f"weights: layer{i}.{name} has shape {got}, expected {shape}")
+        checks = {"head.weight": (w.head_weight, (expected_out, h)), "head.bias": (w.head_bias, (expected_out,)),
+                  "input_mean": (w.input_mean, (n_in,)), "input_std": (w.input_std, (n_in,))}
+        for name, (arr, shape) in checks.items():
+            if np.shape(arr) != shape:
+                raise CheckpointError(f"weights: {name} has shape {np.shape(arr)}, expected {shape}")
+            if not np.isfinite(arr).all():
+                raise CheckpointError(f"weights: {name} holds NaN or infinity")
+        if (w.input_std <= 0).any():
+            raise CheckpointError("weights: input_std must be positive")
 
 
 def save_weights(weights: NetworkWeights, path: str | os.PathLike[str]) -> Path:
@@ -76,28 +69,19 @@ def save_weights(weights: NetworkWeights, path: str | os.PathLike[str]) -> Path:
         for name, arr in layer.items():
             arrays[f"layer{i}.{name}"] = arr
     payload: dict[str, Any] = {k: np.asarray(v, dtype=np.float64) for k, v in arrays.items()}
-    meta = {
-        "format": "lookalike-association-net",
-        "format_version": FORMAT_VERSION,
-        "encoding_version": ENCODING_VERSION,
-        "cell": weights.cell,
-        "hidden": weights.hidden,
-        "num_layers": len(weights.layers),
-        "n_agents": weights.spec.n_agents,
-        "n_slots": weights.spec.n_slots,
-        "max_age_s": weights.spec.max_age_s,
-        "relative_headings": weights.spec.relative_headings,
-        "info": weights.info,
-    }
-    if weights.spec.protocol != "ours":  # files of the default layout stay as they were
-        meta["protocol"] = weights.spec.protocol
+    spec = weights.spec
+    meta = {"format": "lookalike-association-net", "format_version": FORMAT_VERSION,
+            "encoding_version": ENCODING_VERSION, "cell": weights.cell, "hidden": weights.hidden,
+            "num_layers": len(weights.layers), "n_agents": spec.n_agents, "n_slots": spec.n_slots,
+            "max_age_s": spec.max_age_s, "relative_headings": spec.relative_headings, "info": weights.info}
+    if spec.protocol != "ours":  # files of the default layout stay as they were
+        meta["protocol"] = spec.protocol
     write_weights(path, payload, meta)
     return path
 
 
-def load_weights(
-    path: str | os.PathLike[str], n_agents: int | None = None, n_slots: int | None = None
-) -> NetworkWeights:
+def load_weights(path: str | os.PathLike[str], n_agents: int | None = None,
+                 n_slots: int | None = None) -> NetworkWeights:
     """Load weights saved by :func:`save_weights`, refusing files that do not fit.
 
     Raises :class:`CheckpointError` naming the file when the metadata is missing or of another version, when N or M
@@ -105,9 +89,8 @@ def load_weights(
     path, meta_path, meta = read_metadata(path, "lookalike-association-net", "lookalike association network")
     for key, current in (("format_version", FORMAT_VERSION), ("encoding_version", ENCODING_VERSION)):
         if meta.get(key) != current:
-            raise CheckpointError(
-                f"{meta_path}: {key} {meta.get(key)} is not supported (this lookalike reads {current})"
-            )
+            raise CheckpointError(f"{meta_path}: {key} {meta.get(key)} is not supported "
+                                  f"(this lookalike reads {current})")
     for key, wanted in (("n_agents", n_agents), ("n_slots", n_slots)):
         if wanted is not None and meta.get(key) != wanted:
             raise CheckpointError(f"{meta_path}: trained for {key}={meta.get(key)}, but {wanted} was requested")
@@ -116,28 +99,14 @@ def load_weights(
             arrays = {k: data[k] for k in data.files}
     except (OSError, ValueError) as exc:
         raise CheckpointError(f"{path}: cannot read the weights ({exc})") from None
-
-    def get(key: str) -> Any:  # None where missing: the shape check rejects it
-        return arrays.get(key)
-
+    get = arrays.get  # (None where missing: the shape check rejects it)
     try:
         spec = EncodingSpec(int(meta["n_agents"]), int(meta["n_slots"]), float(meta["max_age_s"]),
                             bool(meta.get("relative_headings", False)), str(meta.get("protocol", "ours")))
-        layers = [
-            {name: get(f"layer{i}.{name}") for name in ("w_ih", "w_hh", "b_ih", "b_hh")}
-            for i in range(int(meta["num_layers"]))
-        ]
-        return NetworkWeights(
-            spec=spec,
-            cell=str(meta["cell"]),
-            hidden=int(meta["hidden"]),
-            layers=layers,
-            head_weight=get("head.weight"),
-            head_bias=get("head.bias"),
-            input_mean=get("input_mean"),
-            input_std=get("input_std"),
-            info=dict(meta.get("info", {})),
-        )
+        layers = [{name: get(f"layer{i}.{name}") for name in ("w_ih", "w_hh", "b_ih", "b_hh")}
+                  for i in range(int(meta["num_layers"]))]
+        return NetworkWeights(spec, str(meta["cell"]), int(meta["hidden"]), layers, get("head.weight"),
+                              get("head.bias"), get("input_mean"), get("input_std"), dict(meta.get("info", {})))
     except KeyError as exc:
         raise CheckpointError(f"{meta_path}: missing field {exc}") from None
     except CheckpointError as exc:

@@ -72,41 +72,31 @@ def encode_agents(spec: EncodingSpec, heading_rad: np.ndarray, age_s: np.ndarray
     age = np.asarray(age_s, dtype=float)
     known = np.isfinite(heading) & np.isfinite(age)
     h = np.where(known, heading, 0.0)
-    out = np.stack(
-        [
-            np.where(known, np.cos(h), 0.0),
-            np.where(known, np.sin(h), 0.0),
-            np.where(known, np.clip(age, 0.0, spec.max_age_s), spec.max_age_s),
-        ],
-        axis=-1,
-    )
+    out = np.stack([np.where(known, np.cos(h), 0.0), np.where(known, np.sin(h), 0.0),
+                    np.where(known, np.clip(age, 0.0, spec.max_age_s), spec.max_age_s)], axis=-1)
     return out.reshape(*heading.shape[:-1], AGENT_WIDTH * spec.n_agents)
 
 
-def encode_slots(
-    spec: EncodingSpec,
-    position_m: np.ndarray,
-    heading_rad: np.ndarray,
-    probability: np.ndarray,
-    agent_heading_rad: np.ndarray | None = None,
-) -> np.ndarray:
-    """Slot blocks ``(slot_width·M,)`` for up to M detections given in slot order.
-
-    ``agent_heading_rad (N,)`` (NaN = never heard) is needed with ``spec.relative_headings``."""
+def encode_slots(spec: EncodingSpec, position_m: np.ndarray, heading_rad: np.ndarray, probability: np.ndarray,
+                 agent_heading_rad: np.ndarray | None = None) -> np.ndarray:
+    """Slot blocks ``(slot_width·M,)`` in ``spec.protocol``'s layout for up to M detections given in slot order (empty
+    slots are zeros). ``agent_heading_rad (N,)`` (NaN = never heard) is needed with ``spec.relative_headings``."""
     n = len(probability)
     if n > spec.n_slots:
         raise ValueError(f"{n} detections for {spec.n_slots} slots; select the most probable first")
     slots = np.zeros((spec.n_slots, spec.slot_width))
     slots[:n, 0:2] = position_m
+    if spec.protocol == "paper":  # x, y, φ / π, γ
+        slots[:n, 2] = encode_agents_paper(np.asarray(heading_rad, dtype=float))
+        slots[:n, 3] = probability
+        return slots.reshape(-1)
     slots[:n, 2] = np.cos(heading_rad)
     slots[:n, 3] = np.sin(heading_rad)
     slots[:n, 4] = probability
     if spec.relative_headings:
         if agent_heading_rad is None:
             raise ValueError("relative_headings needs the agents' latest headings")
-        slots[:n, SLOT_WIDTH:] = relative_headings(
-            np.asarray(heading_rad)[None], np.asarray(agent_heading_rad)[None]
-        )[0]
+        slots[:n, SLOT_WIDTH:] = relative_headings(np.asarray(heading_rad), np.asarray(agent_heading_rad))
     return slots.reshape(-1)
 
 
@@ -130,46 +120,16 @@ def encode_agents_paper(heading_rad: np.ndarray) -> np.ndarray:
     return np.where(known, wrapped / np.pi, 0.0)
 
 
-def encode_slots_paper(
-    spec: EncodingSpec, position_m: np.ndarray, heading_rad: np.ndarray, probability: np.ndarray
-) -> np.ndarray:
-    """The paper's slot inputs ``(4·M,)`` — ``x, y`` (m), ``φ / π``, ``γ`` — for up to M detections
-    given in slot order; empty slots are zeros."""
-    n = len(probability)
-    if n > spec.n_slots:
-        raise ValueError(f"{n} detections for {spec.n_slots} slots; select the most probable first")
-    slots = np.zeros((spec.n_slots, PAPER_SLOT_WIDTH))
-    slots[:n, 0:2] = position_m
-    slots[:n, 2] = encode_agents_paper(np.asarray(heading_rad, dtype=float))
-    slots[:n, 3] = probability
-    return slots.reshape(-1)
-
-
-def select_slots(score: np.ndarray, n_slots: int) -> np.ndarray:
-    """Indices of the (at most) ``n_slots`` most probable detections, most probable first."""
-    order = np.argsort(-np.asarray(score), kind="stable")
-    return order[:n_slots]
-
-
-def encode_frame(
-    spec: EncodingSpec,
-    detections: Detections,
-    latest_heading_rad: np.ndarray,
-    report_age_s: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:
-    """One frame's input ``(n_inputs,)`` and the detection index of each used slot ``(k,)``, in the layout of
-    ``spec.protocol`` (the paper's ignores ``report_age_s``).
-
-    ``detections`` must carry ``position`` (metres) and ``heading`` (radians)."""
+def encode_frame(spec: EncodingSpec, detections: Detections, latest_heading_rad: np.ndarray,
+                 report_age_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One frame's input ``(n_inputs,)`` in the layout of ``spec.protocol`` (the paper's ignores ``report_age_s``) and
+    the detection index of each used slot ``(k,)``: the M most probable detections, most probable first."""
     if detections.position is None or detections.heading is None or detections.score is None:
         raise ValueError("the LSTM encoding needs Detections.position, Detections.heading and Detections.score")
-    used = select_slots(detections.score, spec.n_slots)
+    used = np.argsort(-np.asarray(detections.score), kind="stable")[: spec.n_slots]
+    slots = encode_slots(spec, detections.position[used], detections.heading[used], detections.score[used],
+                         latest_heading_rad)
     if spec.protocol == "paper":
-        paper_slots = encode_slots_paper(spec, detections.position[used], detections.heading[used],
-                                         detections.score[used])
-        return np.concatenate([encode_agents_paper(latest_heading_rad), paper_slots]), used
-    slots = encode_slots(
-        spec, detections.position[used], detections.heading[used], detections.score[used], latest_heading_rad
-    )
+        return np.concatenate([encode_agents_paper(latest_heading_rad), slots]), used
     agents = encode_agents(spec, np.asarray(latest_heading_rad)[None], np.asarray(report_age_s)[None])[0]
     return np.concatenate([agents, slots]), used
