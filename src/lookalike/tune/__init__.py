@@ -1,8 +1,5 @@
-"""Choosing a tracker's parameters on labelled data, and the left-out score of that choice: search spaces
-(:mod:`~lookalike.tune.space`), Optuna studies (:mod:`~lookalike.tune.study`), folds and left-out selection
-(:mod:`~lookalike.tune.folds`, :mod:`~lookalike.tune.selection`), ablation (:mod:`~lookalike.tune.ablation`), parameter
-files (:mod:`~lookalike.tune.params_file`) and data (:mod:`~lookalike.tune.data`). Optuna (the ``tune`` extra) is needed
-for studies only."""
+"""Choosing a tracker's parameters on labelled data, and the left-out score of that choice (Optuna, the ``tune``
+extra, for studies only)."""
 
 from __future__ import annotations
 

@@ -1,9 +1,5 @@
-"""Which parameters earn their place: the left-out gain of tuning one parameter against fixing it.
-
-Candidates are the defaults and the defaults with one parameter moved over its range
-(:func:`lookalike.tune.space.grid`), each scored once per sequence; per fold, a parameter's best candidate on the
-training sequences is compared with the defaults on the left-out ones. Worth tuning when the mean gain exceeds twice its
-standard error over the folds."""
+"""Which parameters earn their place: per fold, the best of the defaults and the defaults with one parameter moved over
+its range, chosen on the training sequences, against the defaults on the left-out ones."""
 
 from __future__ import annotations
 
@@ -28,8 +24,8 @@ def _same(a: Any, b: Any) -> bool:
 
 
 def one_at_a_time(tracker: str, space: Space, points: int = 5) -> tuple[list[dict[str, Any]], dict[str, list[int]]]:
-    """``(candidates, by_parameter)``: candidate 0 is the defaults; ``by_parameter[name]`` lists the
-    indices of the candidates that move only ``name`` (``points`` values over its range)."""
+    """``(candidates, by_parameter)``: candidate 0 is the defaults, ``by_parameter[name]`` the indices of those
+    moving only ``name``."""
     defaults = {p.name: p.default for p in tracker_parameters(tracker)}
     candidates: list[dict[str, Any]] = [{}]
     by_parameter: dict[str, list[int]] = {}
@@ -45,17 +41,9 @@ def one_at_a_time(tracker: str, space: Space, points: int = 5) -> tuple[list[dic
 
 @dataclass(frozen=True)
 class ParameterGain:
-    """Left-out gain of tuning one parameter (points of the criterion x 100, per fold paired).
-
-    Attributes:
-        name: the parameter.
-        gains: per fold, left-out criterion of the tuned choice minus that of the defaults.
-        mean: mean gain over the folds.
-        sd: standard deviation of the per-fold gains (the fold-to-fold noise).
-        se: its standard error (``sd / sqrt(folds)``).
-        spread: the largest change the parameter's range makes to any fold's training objective.
-        chosen: per fold, the chosen value (``"default"`` when the defaults won).
-        verdict: ``"keep"`` (gain > 2 se), ``"drop"`` (inert: spread < :data:`INERT_POINTS`) or ``"fix"``."""
+    """Left-out ``gains`` per fold of tuning parameter ``name`` over the defaults (criterion points), their ``mean``,
+    ``sd`` and ``se``; ``spread``: the largest change its range makes to a training objective; ``chosen`` per fold;
+    ``verdict``: ``"keep"`` (mean > 2 se), ``"drop"`` (spread < :data:`INERT_POINTS`) or ``"fix"``."""
 
     name: str
     gains: list[float]

@@ -19,11 +19,8 @@ def sequence_key(seq: RealSequence) -> str:
 
 
 def load_tuning_data(items: Sequence[str], data_root: Path | None = None) -> list[RealSequence]:
-    """Sequences from ``items``: bench dataset names (``mot15``, ``pigs``, ``mot17-synth``...; read under ``data_root``)
-    or folders holding MOTChallenge sequences (``gt/gt.txt`` and ``det/det.txt``; a sequence folder or a folder of them,
-    the dataset named after the folder).
-
-    Raises ``ValueError``/``FileNotFoundError`` with a message saying what is missing."""
+    """Sequences from ``items``: bench dataset names (under ``data_root``) or MOTChallenge sequence folders (the
+    dataset named after the folder); ``ValueError``/``FileNotFoundError`` saying what is missing."""
     out: list[RealSequence] = []
     for item in items:
         path = Path(item)

@@ -16,10 +16,7 @@ class Fold:
 
 
 def leave_one_group_out(groups: Sequence[str]) -> list[Fold]:
-    """One fold per distinct group (in first-seen order): that group's sequences left out.
-
-    ``groups[i]`` is sequence ``i``'s group: its own name for leave-one-sequence-out, its dataset for
-    leave-one-dataset-out. Needs at least two groups."""
+    """One fold per group ``groups[i]`` of sequence ``i`` (first-seen order; at least two), its sequences left out."""
     names = list(dict.fromkeys(groups))
     if len(names) < 2:
         raise ValueError(f"folds: leaving one out needs at least two sequences/groups, got {len(names)}")
@@ -39,8 +36,7 @@ def k_folds(names: Sequence[str], k: int) -> list[Fold]:
 
 
 def make_folds(names: Sequence[str], spec: str | int, groups: Sequence[str] | None = None) -> list[Fold]:
-    """Folds from a CLI spec: ``"loso"`` (one per sequence), ``"lodo"`` (one per group, e.g.
-    dataset; ``groups`` needed) or an integer K (:func:`k_folds`)."""
+    """Folds from ``"loso"`` (one per sequence), ``"lodo"`` (one per group) or K (:func:`k_folds`)."""
     text = str(spec).strip().lower()
     if text == "loso":
         return leave_one_group_out(list(names))

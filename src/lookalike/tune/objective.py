@@ -1,10 +1,10 @@
-"""What a choice maximises (``hota+idf1+mota``, ``hota`` or ``idf1``), and evaluating parameter sets on sequences.
-Scores combine as TrackEval's over sequences; over groups (datasets) the objective is the mean of each group's
-criterion."""
+"""What a choice maximises (:data:`CRITERIA`: combined over sequences, averaged over groups), and evaluating parameter
+sets on sequences."""
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from operator import itemgetter
 from typing import Any
 
 from lookalike.eval import combine, headline
@@ -14,15 +14,8 @@ Scores = dict[str, float]
 Evaluator = Callable[[str, dict[str, Any], Any], Scores]
 
 
-def _hota(s: Scores) -> float:
-    return s["HOTA"]
-
-
-def _idf1(s: Scores) -> float:
-    return s["IDF1"]
-
-
-CRITERIA: dict[str, Callable[[Scores], float]] = {"hota+idf1+mota": headline, "hota": _hota, "idf1": _idf1}
+CRITERIA: dict[str, Callable[[Scores], float]] = {"hota+idf1+mota": headline, "hota": itemgetter("HOTA"),
+                                                  "idf1": itemgetter("IDF1")}
 
 
 def criterion(name: str) -> Callable[[Scores], float]:
@@ -44,8 +37,7 @@ def objective(per_sequence: Sequence[Scores], groups: Sequence[str], crit: Calla
 
 
 def evaluate_job(evaluator: Evaluator, tracker: str, params: dict[str, Any], seq: Any) -> dict[str, Any]:
-    """``{"scores": ...}`` of ``evaluator(tracker, params, seq)``, or ``{"error": ...}`` when the
-    tracker refuses the parameters or fails (a failed trial, never a crash of the study)."""
+    """``{"scores": ...}`` of ``evaluator(tracker, params, seq)``, or ``{"error": ...}`` when it fails."""
     try:
         return {"scores": evaluator(tracker, params, seq)}
     except Exception as exc:  # noqa: BLE001 - reported per trial
@@ -55,8 +47,7 @@ def evaluate_job(evaluator: Evaluator, tracker: str, params: dict[str, Any], seq
 def evaluate_table(tracker: str, candidates: Sequence[dict[str, Any]], sequences: Sequence[Any], evaluator: Evaluator,
                    *, workers: int = 1, backend: str = "local", address: str | None = None,
                    progress: Callable[[int, int], None] | None = None) -> list[list[Scores | None]]:
-    """``table[k][i]``: scores of candidate ``k`` on sequence ``i`` (None where it failed), every
-    (candidate, sequence) a job on the pool; ``progress(done, total)`` after each job."""
+    """``table[k][i]``: scores of candidate ``k`` on sequence ``i`` (None: failed), each a job on the pool."""
     total = len(candidates) * len(sequences)
     with JobPool(max(1, min(workers, total)), backend, address) as pool:
         shared = [pool.share(s) for s in sequences]

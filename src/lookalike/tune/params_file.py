@@ -1,14 +1,10 @@
-"""Parameter files: a tracker's chosen parameters and what they were chosen on.
-
-The JSON written by ``lookalike tune -o params.json`` and read by ``lookalike track --params`` and
-``lookalike bench real --params``::
+"""Parameter files, written by ``lookalike tune -o`` and read by ``--params``::
 
     {"tracker": "boxtrack", "params": {"high_score": 0.85, ...},
      "chosen_on": ["mot15/ADL-Rundle-6", ...], "criterion": "hota+idf1+mota",
      "trials": 60, "lookalike_version": "0.1.0"}
 
-Extra keys (``score``, ``sampler``, ``folds``...) are kept but not needed.
-"""
+(extra keys kept)."""
 
 from __future__ import annotations
 
@@ -25,16 +21,7 @@ REQUIRED = ("tracker", "params")
 
 @dataclass(frozen=True)
 class TunedParams:
-    """A parameter file's content.
-
-    Attributes:
-        tracker: registered tracker name.
-        params: parameter name -> value (JSON types; ``None`` switches a mechanism off).
-        chosen_on: the sequences (``dataset/name``) the parameters were chosen on.
-        criterion: what was maximised (e.g. ``"hota+idf1+mota"``).
-        trials: number of trials of the study.
-        lookalike_version: the version that chose them.
-        extra: any other keys of the file."""
+    """A parameter file's content (``params``: JSON values, ``None``: a mechanism off; ``extra``: other keys)."""
 
     tracker: str
     params: dict[str, Any]
@@ -68,8 +55,7 @@ def save_params(path: str | Path, tracker: str, params: dict[str, Any], *, chose
 
 
 def check_params(tracker: str, params: dict[str, Any], source: str = "params") -> None:
-    """Raise ``ValueError`` naming ``source`` when ``tracker`` is not registered, a parameter is
-    unknown, or the tracker refuses the values."""
+    """``ValueError`` naming ``source`` for an unknown tracker or parameter, or values the tracker refuses."""
     if tracker not in tracker_names():
         raise ValueError(f"{source}: unknown tracker {tracker!r}; registered: {', '.join(tracker_names())}")
     known = config_hints(tracker)
@@ -101,11 +87,8 @@ def read_params(path: str | Path) -> TunedParams:
 
 
 def load_params(path: str | Path, tracker: str | None = None) -> dict[str, Any]:
-    """The parameters in the file at ``path``, checked against the tracker they are for.
-
-    ``tracker``: the tracker the caller will build; a file written for another tracker is refused. Raises ``ValueError``
-    with a message naming the file and what is wrong (not found, not a parameter file, another tracker, unknown tracker
-    or parameter, values the tracker refuses)."""
+    """The checked parameters in the file at ``path`` (``ValueError`` naming it; a file for another ``tracker``
+    refused)."""
     content = read_params(path)
     if tracker is not None and content.tracker != tracker:
         raise ValueError(f"{path}: these parameters are for tracker {content.tracker!r}, not {tracker!r} "

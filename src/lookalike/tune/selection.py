@@ -1,8 +1,5 @@
-"""The left-out score of the whole selection procedure.
-
-:func:`leave_one_out_selection` runs a study per fold on the other sequences and scores the choice on the left-out ones;
-:func:`select_from_table` does the same from stored per-sequence scores of every candidate (an argmax per fold: with
-random candidates, random search's left-out figure in one pass)."""
+"""The left-out score of the whole selection procedure: a study per fold (:func:`leave_one_out_selection`) or an argmax
+per fold over stored scores of every candidate (:func:`select_from_table`), scored on the left-out sequences."""
 
 from __future__ import annotations
 
@@ -20,18 +17,9 @@ from lookalike.tune.study import run_study
 
 @dataclass(frozen=True)
 class FoldChoice:
-    """One fold: what was chosen on which sequences, and how it scored on the left-out ones.
-
-    Attributes:
-        fold: the fold's name (the left-out sequence or group).
-        chosen_on: names of the sequences the choice was made on.
-        left_out: names of the sequences it was scored on.
-        params: the chosen parameters (or, for a table, the candidate's).
-        candidate: the chosen candidate's index in the table (-1 for a study).
-        train_value: the objective on ``chosen_on``.
-        test_scores: left-out scores, combined over ``left_out``.
-        test_value: the criterion of ``test_scores``.
-        per_sequence: left-out scores per left-out sequence (same order as ``left_out``)."""
+    """One fold: ``params`` (``candidate``'s index in a table, -1 for a study) chosen on ``chosen_on`` with objective
+    ``train_value``, scored on ``left_out``: combined ``test_scores``, their criterion ``test_value``, and
+    ``per_sequence``."""
 
     fold: str
     chosen_on: list[str]
@@ -52,12 +40,8 @@ def select_from_table(table: Sequence[Sequence[Scores | None]], folds: Sequence[
                       groups: Sequence[str] | None = None, metric: str = "hota+idf1+mota",
                       candidates: Sequence[dict[str, Any]] | None = None,
                       allowed: Sequence[int] | None = None) -> list[FoldChoice]:
-    """Per fold, the candidate with the best objective on the fold's training sequences (first on ties; candidates
-    failing on any of them excluded) and its scores on the left-out ones.
-
-    ``table[k][i]``: candidate ``k``'s scores on sequence ``i`` (None: failed); ``allowed``: only these candidate
-    indices may be chosen (default all). Only ``table[k][j]`` for ``j`` in a fold's training sequences enter that fold's
-    choice."""
+    """Per fold, the ``allowed`` candidate (default all; first on ties; none that failed) with the best objective on
+    the training sequences, scored on the left-out ones; ``table[k][i]``: candidate ``k`` on sequence ``i``."""
     crit = criterion(metric)
     groups = list(keys) if groups is None else list(groups)
     pool = list(range(len(table))) if allowed is None else list(allowed)
@@ -86,12 +70,9 @@ def leave_one_out_selection(tracker: str, sequences: Sequence[Any], *, folds: st
                             backend: str = "local", address: str | None = None, evaluator: Evaluator = score_params,
                             progress: Callable[[str, int, int, float | None], None] | None = None
                             ) -> list[FoldChoice]:
-    """For each fold, :func:`lookalike.tune.study.run_study` on the other sequences, then the chosen parameters scored
-    on the left-out ones (the only time they are run).
-
-    ``folds``: ``"loso"`` (one per sequence), ``"lodo"`` (one per dataset), K, or explicit
-    :class:`~lookalike.tune.folds.Fold` objects. The study of a fold is named ``<study_name or tracker>/<fold>`` in
-    ``storage``. Other arguments as for ``run_study``; ``progress(fold, done, trials, best)``."""
+    """Per fold (``"loso"``, ``"lodo"``, K or :class:`~lookalike.tune.folds.Fold` objects), a
+    :func:`~lookalike.tune.study.run_study` (``<study_name or tracker>/<fold>``) on the other sequences, its choice
+    scored on the left-out ones."""
     keys = [sequence_key(s) for s in sequences] if keys is None else list(keys)
     groups = [str(getattr(s, "dataset", "")) for s in sequences] if groups is None else list(groups)
     fold_list = make_folds(keys, folds, groups) if isinstance(folds, (str, int)) else list(folds)

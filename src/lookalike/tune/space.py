@@ -1,11 +1,6 @@
-"""Search spaces: which parameters of a tracker are searched, over which ranges.
-
-A space maps parameter names to :class:`Dim` (a range or a list of choices) or to a fixed value.
-Scale-like numbers (ages in seconds, distances in box heights, noise fractions, counts) are
-searched in log space; fractions (scores, IoUs, quantiles) linearly. An ``optional`` dimension
-may also be ``None`` (the mechanism switched off). The default space of ``sort`` and ``boxtrack``
-is declared here; other trackers get one built from their defaults (:func:`generic_space`).
-A JSON file overrides it (:func:`space_from_json`)::
+"""Search spaces: parameter name -> :class:`Dim` (a range, log for scale-like numbers, or choices; ``optional``: also
+``None``) or a fixed value. ``sort`` and ``boxtrack`` have declared spaces, other trackers :func:`generic_space`; the
+JSON form (:func:`space_from_json`)::
 
     {"high_score": {"low": 0.5, "high": 0.99},
      "max_age_s": {"low": 0.25, "high": 4, "log": true},
@@ -13,8 +8,7 @@ A JSON file overrides it (:func:`space_from_json`)::
      "clutter_factor": {"low": 0.5, "high": 8, "log": true, "optional": true},
      "low_score": 0.1}
 
-(a bare value fixes the parameter: it is passed to every trial and written to the result).
-"""
+(a bare value fixes the parameter)."""
 
 from __future__ import annotations
 
@@ -35,8 +29,7 @@ NOT_SEARCHED = ("frame_interval_s", "max_targets")  # set by the data (frame rat
 
 @dataclass(frozen=True)
 class Dim:
-    """One searched parameter: ``kind`` ``"float"``/``"int"`` in ``[low, high]`` (log-uniform when
-    ``log``), or ``"choice"`` among ``choices``; ``optional`` adds ``None`` (switched off)."""
+    """One searched parameter: ``"float"``/``"int"`` in ``[low, high]`` or ``"choice"``; ``optional`` adds ``None``."""
 
     kind: str
     low: float | None = None
@@ -118,9 +111,8 @@ def _base_type(hint: Any) -> tuple[Any, bool]:
 
 
 def generic_space(tracker: str) -> Space:
-    """A space from ``tracker``'s defaults: booleans both ways; a positive number ``d`` log-uniform
-    in ``[d/3, 3d]`` (fractions capped at 1; integers at least 1), clipped to the parameter's declared
-    range; zero, ``None`` and text defaults are not searched (nor :data:`NOT_SEARCHED`)."""
+    """A space from ``tracker``'s defaults: booleans both ways, a positive default ``d`` log-uniform in ``[d/3, 3d]``
+    (fractions at most 1, integers at least 1) within its declared range; others not searched."""
     hints = config_hints(tracker)
     out: Space = {}
     for p in tracker_parameters(tracker):
@@ -153,8 +145,7 @@ def _inside(bounds: Range | None, low: float, high: float, default: float) -> tu
 
 
 def default_space(tracker: str) -> Space:
-    """The declared space of ``tracker`` (:data:`DEFAULT_SPACES`), else :func:`generic_space`;
-    names the tracker does not have are left out."""
+    """The declared space of ``tracker`` (its parameters only), else :func:`generic_space`."""
     if tracker not in DEFAULT_SPACES:
         return generic_space(tracker)
     known = {p.name for p in tracker_parameters(tracker)}
@@ -162,9 +153,7 @@ def default_space(tracker: str) -> Space:
 
 
 def space_from_json(spec: Mapping[str, Any], tracker: str) -> Space:
-    """A space from its JSON form (module docstring), checked against ``tracker``'s parameters.
-
-    Raises ``ValueError`` naming an unknown parameter or a malformed entry."""
+    """A space from its JSON form (module docstring); ``ValueError`` naming an unknown parameter or bad entry."""
     if not isinstance(spec, Mapping):
         raise ValueError(f"space: expected a JSON object {{parameter: range}}, got a {type(spec).__name__}")
     hints = config_hints(tracker)
@@ -211,9 +200,7 @@ def _cast(dim: Dim, value: float) -> Any:
 
 
 def suggest(trial: Any, space: Space) -> dict[str, Any]:
-    """Tracker parameters drawn by an Optuna ``trial`` from ``space`` (fixed values included).
-
-    An optional dimension is drawn as ``<name>:on`` (bool) and, when on, ``<name>``."""
+    """Tracker parameters drawn by an Optuna ``trial`` from ``space`` (optional ones as ``<name>:on`` first)."""
     params = dict(fixed(space))
     for name, dim in searched(space).items():
         if dim.optional and not trial.suggest_categorical(f"{name}:on", [True, False]):
@@ -228,8 +215,7 @@ def suggest(trial: Any, space: Space) -> dict[str, Any]:
 
 
 def trial_values(params: Mapping[str, Any], space: Space) -> dict[str, Any]:
-    """The Optuna trial parameters (:func:`suggest`'s names) that give tracker ``params``
-    (for ``enqueue_trial``); values outside a range are left to Optuna to reject."""
+    """The Optuna trial parameters (:func:`suggest`'s names) that give tracker ``params``."""
     out: dict[str, Any] = {}
     for name, dim in searched(space).items():
         if name not in params:
@@ -243,8 +229,7 @@ def trial_values(params: Mapping[str, Any], space: Space) -> dict[str, Any]:
 
 
 def sample(space: Space, rng: np.random.Generator) -> dict[str, Any]:
-    """Tracker parameters drawn uniformly (log-uniformly where ``log``) from ``space`` with ``rng``;
-    an optional dimension is off with probability 1/2 (random search without Optuna)."""
+    """Tracker parameters drawn (log-)uniformly from ``space`` with ``rng``, optional ones off with p = 1/2."""
     params = dict(fixed(space))
     for name, dim in searched(space).items():
         if dim.optional and rng.random() < 0.5:
@@ -265,8 +250,7 @@ def sample(space: Space, rng: np.random.Generator) -> dict[str, Any]:
 
 
 def grid(dim: Dim, points: int = 5) -> list[Any]:
-    """``points`` values spread over ``dim`` (log-spaced where ``log``; integers deduplicated), its
-    choices, and ``None`` for an optional dimension."""
+    """``points`` values spread over ``dim`` (or its choices), and ``None`` when optional."""
     if dim.kind == "choice":
         values = list(dim.choices)
     else:

@@ -1,9 +1,5 @@
-"""An Optuna study that chooses a tracker's parameters on labelled sequences.
-
-Each trial (TPE or random) runs the tracker on every sequence; its value is the combined criterion
-(:func:`lookalike.tune.objective.objective`). The first trial is the defaults. Trials run in batches on
-:class:`lookalike.parallel.JobPool`; with ``storage`` (an Optuna RDB URL) trials are saved and ``resume=True`` continues
-up to ``trials`` in all."""
+"""An Optuna study choosing a tracker's parameters on labelled sequences: each trial (the first: the defaults) runs the
+tracker on every sequence and is valued by :func:`lookalike.tune.objective.objective`."""
 
 from __future__ import annotations
 
@@ -23,17 +19,8 @@ SAMPLERS = ("tpe", "random")
 
 @dataclass(frozen=True)
 class StudyResult:
-    """The outcome of :func:`run_study`.
-
-    Attributes:
-        params: the best trial's tracker parameters (fixed values of the space included).
-        value: its objective on the sequences it was chosen on.
-        trials: finished trials in the study (complete or failed).
-        study_name: the study's name in its storage.
-        chosen_on: the sequences (``dataset/name``) the choice was made on.
-        criterion: the criterion's name.
-        default_value: the objective of the tracker's defaults (the first trial), if it completed.
-        failed: finished trials that failed (parameters the tracker refused, or an error)."""
+    """The outcome of :func:`run_study`: the best trial's ``params`` and ``value`` on the sequences ``chosen_on``,
+    finished ``trials`` (``failed`` of them), and ``default_value``, the defaults' objective if it completed."""
 
     params: dict[str, Any]
     value: float
@@ -65,8 +52,7 @@ def _import_optuna() -> Any:
     return optuna
 
 
-def _open_study(optuna: Any, name: str, storage: str | None, resume: bool, sampler: Any,
-                meta: dict[str, Any]) -> Any:
+def _open_study(optuna: Any, name: str, storage: str | None, resume: bool, meta: dict[str, Any]) -> Any:
     if storage is not None and not resume:
         try:
             optuna.load_study(study_name=name, storage=storage)
@@ -75,8 +61,7 @@ def _open_study(optuna: Any, name: str, storage: str | None, resume: bool, sampl
         else:
             raise ValueError(f"study {name!r} already exists in {storage}; pass --resume to continue it "
                              "or --study-name for a new one")
-    study = optuna.create_study(study_name=name, storage=storage, direction="maximize", sampler=sampler,
-                                load_if_exists=resume)
+    study = optuna.create_study(study_name=name, storage=storage, direction="maximize", load_if_exists=resume)
     old = study.user_attrs
     if old:
         for key, value in meta.items():
@@ -119,23 +104,10 @@ def run_study(tracker: str, sequences: Sequence[Any], *, space: Space | None = N
               workers: int = 1, backend: str = "local", address: str | None = None,
               evaluator: Evaluator = score_params,
               progress: Callable[[int, int, float | None], None] | None = None) -> StudyResult:
-    """Choose ``tracker``'s parameters on ``sequences`` with Optuna (module docstring).
-
-    Args:
-        tracker: registered tracker name.
-        sequences: labelled sequences (:class:`lookalike.bench.datasets.RealSequence`).
-        space: the search space (default :func:`lookalike.tune.space.default_space`).
-        trials: trials in the study in all (a resumed study runs only the missing ones).
-        sampler: ``"tpe"`` or ``"random"``; ``seed`` seeds it.
-        metric: the criterion (:data:`lookalike.tune.objective.CRITERIA`).
-        groups: each sequence's group (default: its dataset); the objective is the mean over groups.
-        keys: each sequence's name in the study and results (default ``dataset/name``).
-        storage: Optuna storage URL (``sqlite:///study.db``); None keeps the study in memory.
-        study_name: the study's name (default ``<tracker>``).
-        resume: continue an existing study (it must have been run with the same settings).
-        workers, backend, address: where trials run (:class:`lookalike.parallel.JobPool`).
-        evaluator: ``(tracker, params, sequence) -> scores`` (tests replace it).
-        progress: called after each finished trial with ``(done, trials, best value so far)``."""
+    """Choose ``tracker``'s parameters on labelled ``sequences`` in ``trials`` trials in all (``sampler`` ``"tpe"`` or
+    ``"random"``, seeded by ``seed``; criterion ``metric``), the objective averaged over ``groups`` (default: datasets).
+    ``storage``: an Optuna URL (None: in memory) where ``resume`` continues the study of the same settings;
+    ``evaluator(tracker, params, sequence)`` gives scores; ``progress(done, trials, best so far)`` after each trial."""
     optuna = _import_optuna()
     crit = criterion(metric)
     if trials < 1:
@@ -147,7 +119,7 @@ def run_study(tracker: str, sequences: Sequence[Any], *, space: Space | None = N
     groups = [str(getattr(s, "dataset", "")) for s in sequences] if groups is None else list(groups)
     name = study_name or tracker
     meta = {"tracker": tracker, "metric": metric.lower(), "sequences": keys, "space": space_to_json(space)}
-    study = _open_study(optuna, name, storage, resume, None, meta)
+    study = _open_study(optuna, name, storage, resume, meta)
     with needs("optuna"):
         from optuna.trial import TrialState
 
