@@ -1,9 +1,5 @@
-"""Joint probabilistic data association: exact marginal association probabilities.
-
-A joint event gives each track "missed" (weight ``miss[i]``) or one detection (``likelihood[i, j]``), no detection
-shared; ``β_ij`` is the weight of the events with ``i→j`` over the total. Tracks and detections split into independent
-clusters; a cluster of at most ``max_events`` events is enumerated, a larger one solved exactly by a dynamic programme
-over detection subsets (up to ``MAX_DP_DETECTIONS`` detections)."""
+"""Joint probabilistic data association: exact marginal association probabilities, per independent cluster by
+enumeration (at most ``max_events`` events) or by a dynamic programme over detection subsets."""
 
 from __future__ import annotations
 
@@ -29,10 +25,8 @@ def _check(likelihood: np.ndarray, miss: np.ndarray) -> tuple[np.ndarray, np.nda
 def jpda_marginals(
     likelihood: np.ndarray, miss: np.ndarray, max_events: int = 5000
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Marginals ``beta (k, m)`` (track i took detection j) and ``beta_miss (k,)``; rows sum to 1.
-
-    ``likelihood (k, m)`` and ``miss (k,)`` are non-negative hypothesis weights. A track whose every hypothesis has
-    weight 0 gets ``beta_miss = 1``."""
+    """Marginals ``beta (k, m)`` (track i took detection j) and ``beta_miss (k,)`` of the non-negative hypothesis
+    weights ``likelihood (k, m)`` and ``miss (k,)``; rows sum to 1 (all-zero tracks: ``beta_miss = 1``)."""
     L, q = _check(likelihood, miss)
     k, m = L.shape
     beta = np.zeros((k, m))

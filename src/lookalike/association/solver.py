@@ -1,8 +1,5 @@
-"""The assignment solver contract, with scipy's ``linear_sum_assignment`` behind it.
-
-``assign(cost, max_cost)`` matches rows (e.g. tracks) to columns (e.g. detections) so that no pair costs more than
-``max_cost``: ``inf`` (or anything above ``max_cost``) forbids a pair. Rectangular, empty and all-forbidden matrices are
-legal."""
+"""The assignment solver contract (scipy's ``linear_sum_assignment`` behind it): rows matched to columns, pairs costing
+``inf`` or more than ``max_cost`` forbidden; rectangular, empty and all-forbidden matrices are legal."""
 
 from __future__ import annotations
 
@@ -65,11 +62,9 @@ def _check(cost: np.ndarray) -> np.ndarray:
 
 
 def assign(cost: np.ndarray, max_cost: float = np.inf) -> Assignment:
-    """Minimum-cost assignment where pairs costing more than ``max_cost`` (or ``inf``) are forbidden.
-
-    With a finite ``max_cost``, leaving a row unmatched costs as much as a pair at ``max_cost`` (deep SORT's
-    convention). With ``max_cost = inf`` the solver first maximises the number of allowed pairs, then minimises their
-    total cost."""
+    """Minimum-cost assignment where pairs costing more than ``max_cost`` (or ``inf``) are forbidden. With a finite
+    ``max_cost`` an unmatched row costs as much as a pair at ``max_cost`` (deep SORT's convention); with ``inf`` the
+    number of allowed pairs is maximised first."""
     c = _check(cost)
     rows, cols = _solve(c, max_cost)
     return _result(rows, cols, c.shape)
@@ -98,14 +93,12 @@ def _solve(c: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray]:
     if not len(rows):
         return none, none
     if len(set(rows.tolist())) == len(rows) and len(set(cols.tolist())) == len(cols):
-        # The allowed pairs are disjoint: every optimum holds all of them, nothing else is kept.
-        return rows, cols
+        return rows, cols  # disjoint allowed pairs: every optimum holds all of them
     return solve_allowed(c, allowed, max_cost)
 
 
 def solve_allowed(c: np.ndarray, allowed: np.ndarray, max_cost: float) -> tuple[np.ndarray, np.ndarray]:
-    """The minimum-cost matching of ``c`` over the ``allowed`` pairs (at least one), forbidden pairs
-    dropped: ``allowed`` is ``c <= max_cost`` (finite ``max_cost``) or the pairs to consider."""
+    """The minimum-cost matching of ``c`` over the ``allowed`` pairs (at least one), forbidden pairs dropped."""
     if math.isfinite(max_cost):
         # Clip forbidden pairs to just above the limit; they are dropped after solving.
         scale = max(abs(max_cost - float(c[allowed].min())), 1.0)
@@ -129,9 +122,7 @@ def solve_allowed(c: np.ndarray, allowed: np.ndarray, max_cost: float) -> tuple[
 
 
 def max_weight_complete(weight: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rows and columns of a maximum-weight complete matching (no gating), as SORT solves it.
-
-    The caller filters the pairs afterwards; this is the reference SORT's "solve then gate" order."""
+    """Rows and columns of a maximum-weight complete matching (no gating; SORT's "solve then gate")."""
     w = _check(weight)
     if w.size == 0:
         return np.zeros(0, int), np.zeros(0, int)

@@ -1,6 +1,5 @@
-"""Association as data: an ordered plan of stages (track set, detection set, cost, gate) run by one function. Each stage
-sees only the tracks still unmatched and detections still free, in the order it gives them (an index array's order
-decides the solver's tie-breaking), and solves its own assignment."""
+"""Association as data: an ordered plan of stages (track set, detection set, cost, gate), each solving its own
+assignment over the tracks still unmatched and detections still free, in the order it gives them."""
 
 from __future__ import annotations
 
@@ -29,9 +28,8 @@ class Stage(NamedTuple):
         max_cost: pairs costing more are forbidden (the solver's gate, see :func:`assign`).
         solve: a replacement solver taking the cost matrix (default: :func:`assign` with ``max_cost``).
         name: a label for diagnostics.
-        gate: optional boolean ``(k, n)``, True exactly where the cost is allowed, known before any cost is
-            computed (e.g. an IoU threshold); costs are then computed only when allowed pairs compete.
-            Ignored with ``solve``."""
+        gate: optional boolean ``(k, n)``, True exactly where the cost is allowed (e.g. an IoU threshold); costs are
+            then computed only when allowed pairs compete. Ignored with ``solve``."""
 
     tracks: np.ndarray | None
     detections: np.ndarray | None
@@ -85,8 +83,7 @@ def _eligible(selector: np.ndarray | None, allowed: np.ndarray) -> np.ndarray:
 
 
 class _PlanLists:
-    """What a plan's gated stages share as Python lists: each gate's allowed pairs, each boolean selector (by
-    array id) and the matching's columns (None once an array-path stage changed them)."""
+    """What a plan's gated stages share as Python lists: gates' allowed pairs, boolean selectors, matching columns."""
 
     def __init__(self) -> None:
         self.pairs: dict[int, list[tuple[int, int]]] = {}
@@ -95,9 +92,8 @@ class _PlanLists:
         self.left: list[bool] | None = None
 
     def run(self, stage: Stage, gate: np.ndarray, matching: Matching, index: int) -> bool:
-        """Run a stage with a gate (boolean selectors) from the gate's allowed pairs when those still
-        eligible (eligible track still unmatched, eligible detection still free) are disjoint: each is
-        then a match of every optimum. Returns False, having changed nothing, when they compete."""
+        """Run a gated stage from the gate's allowed pairs when those still eligible are disjoint; False, having
+        changed nothing, when they compete."""
         masks = self.masks
         pairs = self.pairs.get(id(gate))
         if pairs is None:

@@ -1,8 +1,5 @@
-"""Box format conversions and the vectorised IoU matrix.
-
-Formats are named by their columns: ``xywh`` (left, top, width, height), ``xyxy`` (left, top, right, bottom), ``cxcywh``
-(centre x, centre y, width, height) and ``xysr`` (centre x, centre y, area, aspect ratio width/height, as in SORT). All
-in pixels; arrays are ``(n, 4)``."""
+"""Box format conversions and the vectorised IoU matrix, in pixels, ``(n, 4)``: ``xywh`` (left, top, width, height),
+``xyxy`` (left, top, right, bottom), ``cxcywh`` (centre, size), ``xysr`` (centre, area, aspect w/h, as in SORT)."""
 
 from __future__ import annotations
 
@@ -14,8 +11,7 @@ def xywh_to_xyxy(xywh: np.ndarray) -> np.ndarray:
     b = np.asarray(xywh, dtype=float)
     out = b.copy()
     out[..., 2:] += b[..., :2]
-    result: np.ndarray = out
-    return result
+    return out
 
 
 def xyxy_to_xywh(xyxy: np.ndarray) -> np.ndarray:
@@ -23,8 +19,7 @@ def xyxy_to_xywh(xyxy: np.ndarray) -> np.ndarray:
     b = np.asarray(xyxy, dtype=float)
     out = b.copy()
     out[..., 2:] -= b[..., :2]
-    result: np.ndarray = out
-    return result
+    return out
 
 
 def xywh_to_cxcywh(xywh: np.ndarray) -> np.ndarray:
@@ -32,8 +27,7 @@ def xywh_to_cxcywh(xywh: np.ndarray) -> np.ndarray:
     b = np.asarray(xywh, dtype=float)
     out = b.copy()
     out[..., :2] += b[..., 2:] / 2.0
-    result: np.ndarray = out
-    return result
+    return out
 
 
 def xywh_to_xysr(xywh: np.ndarray) -> np.ndarray:
@@ -49,18 +43,12 @@ def xysr_to_xywh(xysr: np.ndarray) -> np.ndarray:
     area = z[..., 2] * z[..., 3]
     w = np.sqrt(area, out=np.full_like(area, np.nan), where=area >= 0)
     h = np.divide(z[..., 2], w, out=np.full_like(area, np.nan), where=w > 0)
-    out = np.empty(z.shape)
-    out[..., 0] = z[..., 0] - w / 2.0
-    out[..., 1] = z[..., 1] - h / 2.0
-    out[..., 2] = w
-    out[..., 3] = h
-    return out
+    return np.stack([z[..., 0] - w / 2.0, z[..., 1] - h / 2.0, w, h], axis=-1)
 
 
 def iou_matrix(xywh_a: np.ndarray, xywh_b: np.ndarray) -> np.ndarray:
-    """Intersection over union of every box in ``a`` with every box in ``b``: ``(n, m)``.
-
-    Boxes of zero area that do not overlap anything give 0, never NaN."""
+    """Intersection over union ``(n, m)`` of every box in ``a`` with every box in ``b`` (0, never NaN, for empty
+    unions)."""
     a = np.asarray(xywh_a, dtype=float).reshape(-1, 4)
     b = np.asarray(xywh_b, dtype=float).reshape(-1, 4)
     ax1, ay1 = a[:, 0:1], a[:, 1:2]

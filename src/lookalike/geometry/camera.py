@@ -1,9 +1,6 @@
-"""Pinhole camera over a flat ground plane, and observer odometry.
-
-Frames: egocentric (observer; metres, origin on the ground below the camera, x forward, y left, z up), camera (x right,
-y down, z along the optical axis) and image (pixels, u right, v down, origin at the top-left pixel's corner).
-Extrinsics: height, ``yaw`` (left about z), ``pitch`` (positive looks down) and ``roll`` (image clockwise). No lens
-distortion."""
+"""Pinhole camera over a flat ground plane (no lens distortion), and observer odometry. Frames: egocentric (metres,
+origin on the ground below the camera, x forward, y left, z up), camera (x right, y down, z along the optical axis),
+image (pixels, u right, v down, origin at the top-left corner)."""
 
 from __future__ import annotations
 
@@ -163,9 +160,7 @@ class Camera:
         return result
 
     def box_to_ground(self, xywh: np.ndarray) -> np.ndarray:
-        """Ground positions ``(n, 2)`` (m) of the bottom-centres of boxes ``xywh (n, 4)`` (px).
-
-        NaN above the horizon."""
+        """Ground positions ``(n, 2)`` (m) of the bottom centres of boxes ``xywh (n, 4)``; NaN above the horizon."""
         b = _rows("xywh", xywh, 4)
         return self.pixels_to_ground(np.column_stack([b[:, 0] + 0.5 * b[:, 2], b[:, 1] + b[:, 3]]))
 
@@ -189,11 +184,6 @@ class Camera:
         h = foot[:, 1] - head[:, 1]
         return np.column_stack([foot[:, 0] - 0.5 * w, foot[:, 1] - h, w, h])
 
-    def bearing_rad(self, position_m: np.ndarray) -> np.ndarray:
-        """Egocentric bearing ``atan2(y, x)`` (rad) of ground positions ``(n, 2)``."""
-        xy = _rows("position_m", position_m, 2)
-        result: np.ndarray = np.arctan2(xy[:, 1], xy[:, 0])
-        return result
 
 
 @dataclass(frozen=True)
@@ -238,11 +228,7 @@ class Pose2D:
         """The pose after an odometry step ``(dx, dy, dθ)`` measured in this pose's own frame."""
         c, s = math.cos(self.heading_rad), math.sin(self.heading_rad)
         h = self.heading_rad + float(dheading_rad)
-        return Pose2D(
-            self.x_m + c * dx_m - s * dy_m,
-            self.y_m + s * dx_m + c * dy_m,
-            _wrap(h),
-        )
+        return Pose2D(self.x_m + c * dx_m - s * dy_m, self.y_m + s * dx_m + c * dy_m, _wrap(h))
 
     def relative_to(self, other: Pose2D) -> tuple[float, float, float]:
         """The odometry step ``(dx, dy, dθ)`` that takes ``other`` to this pose (in ``other``'s frame)."""
@@ -251,9 +237,8 @@ class Pose2D:
 
 
 def integrate_odometry(steps: np.ndarray, start: Pose2D | None = None) -> list[Pose2D]:
-    """Poses after each odometry step ``(n, 3)`` of ``(dx_m, dy_m, dheading_rad)`` in the robot frame.
-
-    Returns ``n + 1`` poses, the first being ``start`` (origin by default)."""
+    """The ``n + 1`` poses from ``start`` (origin by default) through each odometry step ``(n, 3)`` of
+    ``(dx_m, dy_m, dheading_rad)`` in the robot frame."""
     d = _rows("steps", steps, 3)
     poses = [start if start is not None else Pose2D()]
     for dx, dy, dh in d:

@@ -1,8 +1,5 @@
-"""A stateless linear Kalman filter, vectorised over tracks.
-
-Shapes: ``mean (k, n)``, ``cov (k, n, n)``, measurement ``z (k, m)``, ``H (m, n)``; the model matrices ``F``, ``Q``,
-``R`` are either shared ``(n, n)`` / ``(m, m)`` or per track ``(k, n, n)`` / ``(k, m, m)``. State lives with the caller;
-these functions never mutate input."""
+"""A stateless linear Kalman filter, vectorised over tracks: ``mean (k, n)``, ``cov (k, n, n)``, ``z (k, m)``,
+``H (m, n)``; ``F``, ``Q``, ``R`` shared or per track. Inputs are never mutated."""
 
 from __future__ import annotations
 
@@ -28,9 +25,7 @@ def project(
 def update(
     mean: np.ndarray, cov: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Measurement update with ``z (k, m)``; returns the posterior ``(mean, cov)``.
-
-    Uses the Joseph-free form ``P' = (I - K H) P`` with ``K = P Hᵀ S⁻¹`` computed by a solve."""
+    """Measurement update with ``z (k, m)``: the posterior ``(mean, cov)``, ``P' = (I - K H) P``."""
     z_hat, S = project(mean, cov, H, R)
     PHt = cov @ H.T  # (k, n, m)
     # K = PHt S^-1  <=>  S K^T = PHt^T (S symmetric)

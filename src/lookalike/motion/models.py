@@ -1,8 +1,5 @@
-"""Motion models: transition ``F(dt)`` and process noise ``Q(dt)`` for any dimension.
-
-The state is ordered by derivative: positions of all dimensions first, then velocities, then (for constant acceleration)
-accelerations, e.g. ``[x, y, vx, vy]``. ``dt`` is in seconds and the noise intensity ``q`` is the spectral density of
-the white-noise highest derivative (units²/s^k)."""
+"""Motion models: transition ``F(dt)`` and process noise ``Q(dt)`` for any dimension, state ordered by derivative
+(e.g. ``[x, y, vx, vy]``); ``q`` is the spectral density of the white-noise highest derivative."""
 
 from __future__ import annotations
 

@@ -50,9 +50,8 @@ _P, _V = np.arange(4), np.arange(4, 8)  # the value and velocity rows of an 8-nu
 
 
 def _blocks(cov: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``(k, 4)`` views of ``cov (k, 8, 8)``'s value/value, value/velocity, velocity/value and
-    velocity/velocity diagonals (``cov[:, _P, _P]`` …) by strides, without fancy-indexing copies
-    (views of ``cov`` itself when it is C-contiguous, so writing them writes ``cov``)."""
+    """``(k, 4)`` strided views of ``cov (k, 8, 8)``'s value/value, value/velocity, velocity/value and
+    velocity/velocity diagonals (writing them writes ``cov`` when it is C-contiguous)."""
     flat = cov.reshape(len(cov), 64)
     return flat[:, 0:28:9], flat[:, 4:32:9], flat[:, 32:60:9], flat[:, 36:64:9]
 
@@ -88,8 +87,7 @@ class BoxCXCYWH:
         return np.hstack([z, np.zeros((n, 4))]), np.einsum("ki,ij->kij", std**2, np.eye(8))
 
     def predict(self, mean: np.ndarray, cov: np.ndarray, steps: float) -> tuple[np.ndarray, np.ndarray]:
-        """``F x`` and ``F P Fᵀ + Q`` on the 2×2 blocks (value, velocity) of each box number: the
-        covariance of this space stays block-diagonal (diagonal ``P0``, ``Q``, ``R``)."""
+        """``F x`` and ``F P Fᵀ + Q`` on the 2×2 (value, velocity) blocks of each box number."""
         size = np.maximum(mean[:, 2:4], 1.0)
         sq = size * size
         var = np.concatenate((sq, sq), axis=1)  # (k, 4) for [cx, cy, w, h]
@@ -118,8 +116,7 @@ class BoxCXCYWH:
         return mean_p, cov_p
 
     def update(self, mean: np.ndarray, cov: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Kalman update with measurements ``z (k, 4)`` (noise :meth:`R` of their sizes) on the 2×2
-        blocks; the same posterior as :func:`lookalike.motion.kalman.update`, to rounding."""
+        """Kalman update with measurements ``z (k, 4)`` (noise :meth:`R` of their sizes) on the 2×2 blocks."""
         std = self.pos_noise * np.concatenate((z[:, 2:4], z[:, 2:4]), axis=1)
         p11, p12, p21, p22 = _blocks(cov)
         s = p11 + std * std
@@ -136,14 +133,9 @@ class BoxCXCYWH:
         u22[...] = p22 - k2 * p21
         return mean_u, cov_u
 
-
-    # Column form: every track's state in one quantity-major table ``(24, k)``, a column per track:
-    # rows 0-7 the mean ``[cx, cy, w, h, vx, vy, vw, vh]``, then the covariance as its four 2×2-block
-    # diagonals over ``[cx, cy, w, h]``: rows 8-11 value/value (p11), 12-15 value/velocity (p12), 16-19
-    # velocity/value (p21), 20-23 velocity/velocity (p22); the rest of the covariance stays 0 in this
-    # space. p12 and p21 are kept apart as the full form computes them (an update rounds them
-    # differently). Each operation then works on contiguous rows of all tracks at once; the numbers
-    # are those of the full-covariance methods above, bit for bit (tests/test_motion_columns.py).
+    # Column form: a table ``(24, k)``, a column per track: rows 0-7 the mean, then the four 2×2-block
+    # diagonals of the covariance, p11 (8-11), p12 (12-15), p21 (16-19), p22 (20-23); the numbers are
+    # those of the full-covariance methods above, bit for bit.
 
     @staticmethod
     def to_columns(mean: np.ndarray, cov: np.ndarray) -> np.ndarray:

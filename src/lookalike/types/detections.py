@@ -21,11 +21,9 @@ class Detections:
     """A frame's detections; every array has one row per detection.
 
     Attributes:
-        xywh: ``(n, 4)`` boxes, left/top/width/height in pixels; always an array. May be omitted
-            for world-only detections (then all zeros).
-        score: ``(n,)`` detector confidence; always an array, default 1.
-        position: ``(n, 2)`` ground-plane position in metres (observer frame: x forward,
-            y left), or None.
+        xywh: ``(n, 4)`` boxes, left/top/width/height in pixels (zeros when omitted).
+        score: ``(n,)`` detector confidence, default 1.
+        position: ``(n, 2)`` ground-plane position in metres (observer frame: x forward, y left), or None.
         heading: ``(n,)`` absolute visual heading in radians, or None.
         heading_std: ``(n,)`` spread of the visual heading in radians, or None.
         feature: ``(n, d)`` appearance features, or None.
@@ -56,14 +54,10 @@ class Detections:
         require_finite(own, "score", score)
         object.__setattr__(self, "xywh", xywh)
         object.__setattr__(self, "score", score)
-        if self.position is not None:
-            pos = as_column(own, "position", self.position, n, 2)
-            require_finite(own, "position", pos)
-            object.__setattr__(self, "position", pos)
-        for name in ("heading", "heading_std"):
+        for name, width in (("position", 2), ("heading", None), ("heading_std", None)):
             value = getattr(self, name)
             if value is not None:
-                arr = as_column(own, name, value, n, None)
+                arr = as_column(own, name, value, n, width)
                 require_finite(own, name, arr)
                 object.__setattr__(self, name, arr)
         if self.feature is not None:
@@ -80,8 +74,7 @@ class Detections:
             object.__setattr__(self, "label", as_column(own, "label", self.label, n, None, int))
 
     def _fast_init(self) -> bool:
-        """The common case, boxes and scores as float arrays and nothing else, checked with a few
-        whole-array operations; False (nothing set) when anything needs the full checks."""
+        """The common case (float boxes and scores only) checked whole-array; False (nothing set) otherwise."""
         xywh, score = self.xywh, self.score
         if (type(xywh) is not np.ndarray or xywh.dtype != np.float64 or xywh.ndim != 2 or xywh.shape[1] != 4
                 or self.position is not None or self.heading is not None or self.heading_std is not None

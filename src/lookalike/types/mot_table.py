@@ -49,14 +49,8 @@ def table_from_array(data: np.ndarray, path: Path | None = None) -> MotTable:
     n = data.shape[0]
     conf = data[:, 6] if data.shape[1] > 6 else np.ones(n)
     extra = data[:, 7:] if data.shape[1] > 7 else np.zeros((n, 0))
-    return MotTable(
-        frame=data[:, 0].astype(int),
-        track_id=data[:, 1].astype(int),
-        xywh=data[:, 2:6].copy(),
-        conf=conf.copy(),
-        extra=extra.copy(),
-        path=path,
-    )
+    return MotTable(frame=data[:, 0].astype(int), track_id=data[:, 1].astype(int), xywh=data[:, 2:6].copy(),
+                    conf=conf.copy(), extra=extra.copy(), path=path)
 
 
 def tracks_to_rows(frame_index: int, tracks: Iterable[TrackSnapshot]) -> np.ndarray:

@@ -50,8 +50,7 @@ _STATUS_CODE = {s: i for i, s in enumerate(_STATUS)}
 
 
 class Tracks(Sequence[TrackSnapshot]):
-    """The tracks a tracker reports for one frame, as columns; iterating or indexing gives
-    :class:`TrackSnapshot` views, so code written for a list of snapshots keeps working.
+    """The tracks a tracker reports for one frame, as columns; iterating or indexing gives :class:`TrackSnapshot`s.
 
     Attributes:
         id: ``(k,)`` track ids.
@@ -77,12 +76,8 @@ class Tracks(Sequence[TrackSnapshot]):
             self.status = np.full(k, _STATUS_CODE[status], dtype=np.int8)
         else:
             self.status = np.asarray(status, dtype=np.int8).reshape(k)
-        self.xywh = xywh
-        self.position = position
-        self.velocity = velocity
-        self.heading = heading
-        self.agent_id = agent_id
-        self.identity_prob = identity_prob
+        self.xywh, self.position, self.velocity, self.heading = xywh, position, velocity, heading
+        self.agent_id, self.identity_prob = agent_id, identity_prob
         self.detection_index = (np.full(k, -1, dtype=int) if detection_index is None
                                 else np.asarray(detection_index, dtype=int).reshape(k))
         for name in ("xywh", "position", "velocity", "heading", "agent_id", "identity_prob"):
