@@ -101,17 +101,15 @@ def make_tracker(name: str, **params: Any) -> Any:
     (``TypeError`` for a wrong type) in one line naming the tracker and the parameter."""
     from lookalike.trackers.base import check_value
 
-    cls = tracker_class(name)
-    known = {f.name for f in dataclasses.fields(_config_class(name))}
-    unknown = sorted(set(params) - known)
+    config_cls = _config_class(name)
+    known = {f.name: f.metadata for f in dataclasses.fields(config_cls)}
+    unknown = sorted(set(params) - set(known))
     if unknown:
         raise ValueError(f"tracker {name!r} has no parameter(s) {unknown}; known: {sorted(known)}")
-    hints = typing.get_type_hints(_config_class(name))
-    fields = {f.name: f for f in dataclasses.fields(_config_class(name))}
+    hints = typing.get_type_hints(config_cls)
     for key, value in params.items():
-        meta = fields[key].metadata
-        check_value(name, key, value, hints[key], meta.get("range"), meta.get("choices"))
-    return cls(_config_class(name)(**params))
+        check_value(name, key, value, hints[key], known[key].get("range"), known[key].get("choices"))
+    return tracker_class(name)(config_cls(**params))
 
 
 def parse_parameter(name: str, assignment: str) -> tuple[str, Any]:

@@ -1,10 +1,9 @@
-"""Tracking-health monitor: is the detector failing, so that identities should not be relied on?
+"""Tracking-health monitor beside any tracker, from each frame's detections and time: is the detector failing?
 
-It sees only each frame's detections and time, so it runs beside any tracker. Per frame it flags ``dropped`` (frames
-missing before this one), ``empty``, ``too_many`` (more detections than the team size plus ``extra_allowed``),
-``score_collapse`` (mean score below ``collapse_ratio`` × the baseline median) and ``too_few`` (informational). Over the
-last ``window`` frames it flags ``unhealthy_frames``, ``undercount``, ``score_collapse`` and ``dropped``. Scores are
-confidences (>= 0); with a baseline <= 0 score checks are skipped."""
+Per frame it flags ``dropped`` (frames missing before it), ``empty``, ``too_many`` (over the team size plus
+``extra_allowed``), ``score_collapse`` (mean score below ``collapse_ratio`` × the baseline median; none with a
+baseline <= 0) and ``too_few`` (informational); over the last ``window`` frames ``unhealthy_frames``, ``undercount``,
+``score_collapse`` and ``dropped``."""
 
 from __future__ import annotations
 
@@ -37,14 +36,11 @@ class HealthConfig:
     min_baseline: int = 5  # non-empty frames needed before the score checks start
 
     def __post_init__(self) -> None:
-        if self.team_size is not None and self.team_size < 0:
-            raise ValueError(f"HealthConfig.team_size must be >= 0, got {self.team_size}")
-        for name in ("window", "baseline_frames", "min_baseline"):
-            if getattr(self, name) < 1:
-                raise ValueError(f"HealthConfig.{name} must be >= 1, got {getattr(self, name)}")
-        for name in ("extra_allowed", "max_dropped"):
-            if getattr(self, name) < 0:
-                raise ValueError(f"HealthConfig.{name} must be >= 0, got {getattr(self, name)}")
+        least = {"team_size": 0, "window": 1, "baseline_frames": 1, "min_baseline": 1, "extra_allowed": 0,
+                 "max_dropped": 0}
+        for name, low in least.items():
+            if getattr(self, name) is not None and getattr(self, name) < low:
+                raise ValueError(f"HealthConfig.{name} must be >= {low}, got {getattr(self, name)}")
         for name in ("min_count_fraction", "collapse_ratio", "max_bad_fraction"):
             if not 0 <= getattr(self, name) <= 1:
                 raise ValueError(f"HealthConfig.{name} must be in [0, 1], got {getattr(self, name)}")

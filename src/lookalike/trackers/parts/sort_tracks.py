@@ -256,29 +256,22 @@ class SortTracks:
         det = xywh.copy()
         det[:, 2:] += xywh[:, :2]
         z = measure(det)
-        k = len(self.ids)
-        det_of_track = np.full(k, -1)
-        if k and n:
+        d = np.zeros(0, dtype=np.intp)
+        if len(self.ids):
             pred, pred_area = self._predict(steps)
-            d, t = match(det, z[:, 2], pred, pred_area, self.iou_threshold)
-            det_of_track = det_of_track[: len(self.ids)]
-            if len(t):
+            det_of_track = np.full(len(self.ids), -1)
+            if n:
+                d, t = match(det, z[:, 2], pred, pred_area, self.iou_threshold)
                 det_of_track[t] = d
                 self.state[t] = kalman_update(self.state[t], z[d])
                 self.misses[t] = 0
                 self.hits[t] += 1
         else:
-            if k:
-                self._predict(steps)
-                det_of_track = det_of_track[: len(self.ids)]
-            d = np.zeros(0, dtype=np.intp)
+            det_of_track = np.full(0, -1)
         if len(d) < n:
-            if len(d):
-                free = np.ones(n, dtype=bool)
-                free[d] = False
-                new = free.nonzero()[0]
-            else:
-                new = np.arange(n)
+            free = np.ones(n, dtype=bool)
+            free[d] = False
+            new = free.nonzero()[0]
             m = len(new)
             self.state = np.concatenate([self.state, initial_state(z[new])])
             self.ids = np.concatenate([self.ids, np.arange(self.next_id, self.next_id + m)])
