@@ -1,10 +1,6 @@
-"""Hand-crafted appearance features for look-alike targets (the diver-tracking paper's) and the extractor protocol.
-
-Each box is cropped and resized to a ``crop_px`` square; a frame's crops are processed together. The raw vector
-concatenates colour (25: LAB statistics and histograms of the foreground), frequency (6 radial spectrum bands), edges
-and contour (12), convex hull (5) and Hu moments (7) blocks; the foreground is what differs from the crop's border (the
-water). Raw vectors are standardised (:func:`fit_stats`, or running statistics of the first ``warmup`` crops), weighted
-per block and L2-normalised, so ``1 - f·g`` is the cosine distance. OpenCV is imported lazily."""
+"""Hand-crafted appearance features of ``crop_px`` square crops: colour (25), frequency (6), edges and contour (12),
+convex hull (5) and Hu moment (7) blocks of the foreground (what differs from the crop's border), standardised,
+weighted per block and L2-normalised (``1 - f·g`` is the cosine distance)."""
 
 from __future__ import annotations
 
@@ -39,9 +35,7 @@ class FeatureExtractor(Protocol):
 
 @dataclass(frozen=True)
 class FeatureStats:
-    """Per-dimension standardisation of raw features, ``weight · (raw - mean) / scale``, all ``(RAW_DIM,)``.
-
-    ``weight`` defaults to equal block weights (each block contributes the same expected share)."""
+    """Standardisation ``weight · (raw - mean) / scale``, all ``(RAW_DIM,)``; ``weight`` defaults to equal blocks."""
 
     mean: np.ndarray
     scale: np.ndarray
@@ -67,12 +61,8 @@ def _block_weights() -> np.ndarray:
 
 def fit_stats(raw: np.ndarray, labels: np.ndarray | None = None, floor: float = 1e-3,
               max_weight: float = 3.0) -> FeatureStats:
-    """Standardisation statistics from raw vectors ``(m, RAW_DIM)``.
-
-    Without labels: each dimension's mean and standard deviation, equal block weights. With identity ``labels (m,)``
-    (calibration data): the scale is the pooled within-identity standard deviation and each dimension is weighted by
-    ``sqrt(between / within)`` variance (clipped to ``max_weight``), a diagonal discriminant that lets stable, telling
-    dimensions dominate."""
+    """Standardisation statistics of raw vectors ``(m, RAW_DIM)``: mean and spread, or with identity ``labels (m,)``
+    the within-identity spread and weights ``sqrt(between / within)`` (at most ``max_weight``)."""
     raw = np.asarray(raw, dtype=float)
     if raw.ndim != 2 or raw.shape[1] != RAW_DIM or len(raw) < 2:
         raise ValueError(f"raw: expected shape (m >= 2, {RAW_DIM}), got {raw.shape}")
@@ -156,10 +146,8 @@ class HandcraftedFeatures:
 
 
 def crop_boxes(image: np.ndarray, xywh: np.ndarray, size: int | tuple[int, int]) -> np.ndarray:
-    """``(n, size, size, 3)`` uint8 crops of boxes ``xywh (n, 4)`` (pixels), clipped to the image; ``size`` may be
-    ``(width, height)`` for ``(n, height, width, 3)`` crops.
-
-    A box wholly outside the image gives a black crop."""
+    """``(n, size, size, 3)`` uint8 crops (``size`` may be ``(width, height)``) of boxes ``xywh (n, 4)`` (px), clipped
+    to the image; a box wholly outside gives a black crop."""
     with needs("cv2"):
         import cv2
 

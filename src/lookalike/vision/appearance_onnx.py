@@ -1,9 +1,5 @@
-"""Learned appearance features: an ONNX embedding network run with onnxruntime (no torch at inference).
-
-The network takes crops as float32 NCHW BGR in ``[0, 1]`` (``(n, 3, h, w)``; ``h, w`` from the model's static input
-shape) and returns ``(n, d)`` embeddings, L2-normalised here so that ``1 - f·g`` is the cosine distance, as for the
-hand-crafted features. The shipped model (:data:`LEARNED_MODEL`, trained by ``lookalike train-appearance``; its training
-configuration is the JSON beside it) embeds rendered divers in 32 dimensions from 64×32 px crops."""
+"""Learned appearance features: an ONNX embedding network (onnxruntime) of float32 NCHW BGR crops in [0, 1], returning
+L2-normalised ``(n, d)`` embeddings. The shipped :data:`LEARNED_MODEL` embeds divers in 32 dimensions from 64×32 px."""
 
 from __future__ import annotations
 

@@ -1,9 +1,6 @@
-"""Background-subtraction blob detector for static cameras over arenas.
-
-Foreground is where a blurred frame differs from the background model by more than ``threshold`` grey levels (``median``
-of sampled frames, :meth:`BlobDetector.fit` or a rolling buffer; or OpenCV's ``mog2``). The mask is opened and closed,
-and each external contour with ``min_area_px <= area <= max_area_px`` becomes a box with score 1 (docs/blobs.md). OpenCV
-is imported lazily."""
+"""Background-subtraction blob detector for static cameras: foreground differs from a ``median`` (or ``mog2``)
+background by more than ``threshold`` grey levels; after opening and closing, each component of ``min_area_px`` to
+``max_area_px`` becomes a box scoring 1 (docs/blobs.md)."""
 
 from __future__ import annotations
 
@@ -97,8 +94,7 @@ class BlobDetector:
         self._window = None
 
     def fit(self, frames: Iterable[np.ndarray] | np.ndarray) -> BlobDetector:
-        """Median background from ``frames`` (an iterable or ``(n, h, w, 3)`` array), sampling at most
-        ``history`` of them evenly. Only for the ``median`` method."""
+        """Median background of at most ``history`` of ``frames``, spread evenly (``median`` method only)."""
         if self.config.method != "median":
             raise ValueError("BlobDetector.fit: only the 'median' method has a fitted background")
         frames = list(frames)
@@ -110,8 +106,7 @@ class BlobDetector:
         return self
 
     def foreground(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``(mask, difference)``: a ``(h, w)`` uint8 mask (255 = foreground, after morphology) and the
-        ``(h, w)`` float32 difference from the background in grey levels; updates an online model."""
+        """``(mask, difference)``: ``(h, w)`` uint8 foreground (255) and float32 difference from the background."""
         with needs("cv2"):
             import cv2
 
@@ -195,7 +190,6 @@ class BlobDetector:
         return cv2.warpAffine(img, shift, grey.shape[::-1], borderMode=cv2.BORDER_REPLICATE)
 
     def _difference(self, img: np.ndarray, background: np.ndarray) -> np.ndarray:
-        # Channel by channel: numpy reduces a last axis of length 3 far slower than two element-wise maxima.
         d = img - background
         b, g, r = d[..., 0], d[..., 1], d[..., 2]
         if self.config.polarity == "dark":

@@ -102,27 +102,21 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
         raise ValueError(f"video: cannot open {video}")
     try:
         total = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
+        wanted = set(spread(total, count).tolist()) if total > 0 else None  # None: keep all, pick after
         frames: list[np.ndarray] = []
-        if total > 0:
-            wanted = set(spread(total, count).tolist())
-            k = 0
-            while True:
-                ok, frame = cap.read()
-                if not ok:
-                    break
-                if k in wanted:
-                    frames.append(frame)
-                k += 1
-            if k < total - max(2, total // 20):  # (as viz.overlay.source_frames says it)
-                raise ValueError(f"video: {video} declares {total} frames but only {k} could be read "
-                                 "(truncated or damaged?)")
-        else:
-            while True:
-                ok, frame = cap.read()
-                if not ok:
-                    break
+        k = 0
+        while True:
+            ok, frame = cap.read()
+            if not ok:
+                break
+            if wanted is None or k in wanted:
                 frames.append(frame)
+            k += 1
+        if wanted is None:
             frames = [frames[i] for i in spread(len(frames), count)]
+        elif k < total - max(2, total // 20):  # (as viz.overlay.source_frames says it)
+            raise ValueError(f"video: {video} declares {total} frames but only {k} could be read "
+                             "(truncated or damaged?)")
     finally:
         cap.release()
     if not frames:

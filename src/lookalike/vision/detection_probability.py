@@ -1,8 +1,5 @@
-"""A detector's last-stage margin → the detection probability the identifiers were trained on.
-
-:class:`DetectionProbability` is a monotone piecewise-linear map from margin to probability, fitted by quantile mapping
-(:func:`fit_quantile_map`: the margin at quantile q of the pixel detections goes to the simulator's score at quantile
-q), so detections keep their order and the identifiers see the score spread they were trained on."""
+"""A detector's last-stage margin → the detection probability the identifiers were trained on: a monotone
+piecewise-linear map fitted by quantile mapping onto the simulator's scores."""
 
 from __future__ import annotations
 
@@ -18,12 +15,8 @@ SHIPPED_PROBABILITY = Path(__file__).resolve().parent / "models_data" / "robot_d
 
 @dataclass(frozen=True)
 class DetectionProbability:
-    """Monotone map from last-stage margin (the cascade's unit) to a probability in [0, 1].
-
-    Attributes:
-        margin: ``(k,)`` increasing knot margins.
-        probability: ``(k,)`` non-decreasing probabilities at the knots.
-        fitted_on: how the knots were fitted (seeds, counts, command), kept in the file."""
+    """Monotone map from last-stage margin to probability: knots ``margin`` (increasing) and ``probability``
+    (non-decreasing, in [0, 1]), and ``fitted_on``, how they were fitted."""
 
     margin: tuple[float, ...]
     probability: tuple[float, ...]
@@ -61,9 +54,8 @@ class DetectionProbability:
 
 def fit_quantile_map(margins: np.ndarray, target_scores: np.ndarray, knots: int = 101,
                      fitted_on: dict[str, Any] | None = None) -> DetectionProbability:
-    """Quantile mapping: the margin at quantile q of ``margins`` → the value at quantile q of
-    ``target_scores`` (e.g. the simulator's detector scores), at ``knots`` evenly spaced quantiles.
-    Tied margin knots are merged (the highest probability kept) so the map stays a function."""
+    """The margin at quantile q of ``margins`` → the value at quantile q of ``target_scores``, at ``knots`` quantiles
+    (tied margins merged, the highest probability kept)."""
     m, s = np.asarray(margins, float).ravel(), np.asarray(target_scores, float).ravel()
     if len(m) < 2 or len(s) < 2:
         raise ValueError(f"fit_quantile_map: need at least 2 margins and 2 target scores, got {len(m)}, {len(s)}")

@@ -1,10 +1,6 @@
-"""Visual heading classifier (the robot-identification paper's): dense HOG of a robot's torso into an RBF SVM over
-``classes`` heading sectors.
-
-Features: dense HOG of the box's upper half (grey and hue) and the box centre. The SVM (C and γ by k-fold grid search,
-Platt probabilities) is evaluated in numpy from the saved support vectors with Wu, Lin and Weng's pairwise coupling, so
-a saved model needs no pickle or scikit-learn. Output per box: the most probable class, a continuous heading (circular
-mean, egocentric radians) and its spread."""
+"""Visual heading classifier: dense HOG (grey and hue) of a box's upper half and its centre into an RBF SVM over
+``classes`` heading sectors, evaluated in numpy (pairwise coupling of Platt probabilities): a class, a continuous
+egocentric heading (rad) and its spread per box."""
 
 from __future__ import annotations
 
@@ -24,8 +20,8 @@ VERSION = 1
 
 @dataclass(frozen=True)
 class HeadingConfig:
-    """Feature and training settings. ``patch_px`` is (width, height) of the resized torso crop in pixels;
-    ``gamma_grid`` holds multiples of ``1 / n_features`` (scikit-learn's ``"scale"`` on standardised data)."""
+    """Feature and training settings: ``patch_px`` (width, height) of the torso crop; ``gamma_grid`` in units of
+    ``1 / n_features``."""
 
     classes: int = 10
     patch_px: tuple[int, int] = (32, 32)
@@ -66,8 +62,7 @@ def class_centres(classes: int = 10) -> np.ndarray:
 
 
 def heading_features(image: np.ndarray, xywh: np.ndarray, config: HeadingConfig = HeadingConfig()) -> np.ndarray:
-    """Features ``(n, d)`` float32 of boxes ``xywh (n, 4)`` (px) in ``image`` (BGR or grey; see
-    :func:`~lookalike.vision.hog_features.as_bgr_image`): grey HOG, hue HOG, box centre / image size."""
+    """Features ``(n, d)`` float32 of boxes ``xywh (n, 4)`` (px) in ``image``: grey HOG, hue HOG, relative centre."""
     with needs("cv2"):
         import cv2
 
@@ -244,10 +239,8 @@ def train_heading(
     seed: int = 0,
     progress: Callable[[str], None] | None = None,
 ) -> HeadingClassifier:
-    """Fit the classifier on ``features (n, d)`` from :func:`heading_features` and true headings ``(n,)`` (rad).
-
-    C and γ come from a ``config.folds``-fold grid search scored by the mean angular error (rad) between predicted and
-    true class centres; the best pair is refitted on everything with Platt probabilities."""
+    """Fit on ``features (n, d)`` of :func:`heading_features` and true headings ``(n,)`` (rad); C and γ by a
+    ``config.folds``-fold grid search on the mean angular error."""
     with needs("sklearn"):
         from sklearn.metrics import make_scorer
         from sklearn.model_selection import GridSearchCV, KFold
@@ -298,8 +291,7 @@ def train_heading(
 
 
 def _platt_pairs(svc, x: np.ndarray, y: np.ndarray, folds: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """Platt sigmoid per class pair, ``P(i | i or j) = 1 / (1 + exp(A f + B))``, fitted (as libsvm does) on
-    out-of-fold one-vs-one decision values ``f`` of the samples of classes i and j."""
+    """Platt sigmoid ``P(i | i or j) = 1 / (1 + exp(A f + B))`` per class pair, on out-of-fold decision values."""
     with needs("sklearn"):
         from sklearn.base import clone
         from sklearn.linear_model import LogisticRegression

@@ -86,8 +86,7 @@ class Stage:
     bias: float
 
     def margin(self, features: np.ndarray) -> np.ndarray:
-        votes = np.where((features[:, self.index] > self.threshold) == (self.sign > 0), 1.0, -1.0)
-        return votes @ self.weight
+        return _margin(features[:, self.index], self)
 
 
 @dataclass

@@ -1,9 +1,5 @@
-"""Optional numba kernels for the HOG detector (:mod:`lookalike.vision.hog_numba`): grey conversion, cell histograms,
-their integral, and the block-descriptor columns a cascade stage reads.
-
-Each does the numpy path's operations one pixel, cell or window at a time in the same order and precision, so detections
-are bit for bit the same (``tests/test_hog_kernels.py``). Used when numba is installed unless ``LOOKALIKE_HOG_NUMBA=0``;
-loaded at a process's first detector call."""
+"""Optional numba kernels of the HOG detector (:mod:`lookalike.vision.hog_numba`), bit for bit the numpy path's
+results; used when numba is installed unless ``LOOKALIKE_HOG_NUMBA=0``."""
 
 from __future__ import annotations
 

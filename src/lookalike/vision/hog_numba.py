@@ -12,9 +12,8 @@ _jit = exact_jit()
 @_jit  # type: ignore[misc]
 def cell_hist(mag: np.ndarray, ang: np.ndarray, row0: int, cell_px: int, bins: int, scale: np.float32,
               out: np.ndarray) -> None:
-    """Cell histograms of one band: ``mag, ang`` float32 from ``cv2.cartToPolar``, rows ``row0`` onwards, into
-    ``out (cell rows, cell columns, bins)`` float64. Each cell's pixels are summed in raster order, the weights
-    to the lower and to the upper bin apart, then the two sums added (as two ``np.bincount`` calls do)."""
+    """Cell histograms of one band (``mag, ang`` float32 from row ``row0``) into ``out (cell rows, cell columns,
+    bins)`` float64, summed as the two ``np.bincount`` calls of the numpy path do."""
     ny, nx = out.shape[0], out.shape[1]
     rows, cols = ny * cell_px, nx * cell_px
     pi = np.float32(np.pi)
@@ -36,8 +35,7 @@ def cell_hist(mag: np.ndarray, ang: np.ndarray, row0: int, cell_px: int, bins: i
             w_hi[y, x] = w
             w_lo[y, x] = m - w
             lo[y, x] = int(f)
-    # 2. sums: for each cell row, pixel by pixel of the cells, the cells of the row side by side (consecutive
-    # additions go to different cells, so they do not wait for each other; each cell's order is unchanged)
+    # 2. sums: per cell row, the row's cells side by side (each cell's order unchanged)
     lo_sum = np.empty((nx, bins))
     hi_sum = np.empty((nx, bins))
     for cy in range(ny):
@@ -83,11 +81,8 @@ def integral32(hist: np.ndarray, out: np.ndarray) -> None:
 def block_columns(rows: np.ndarray, width: np.ndarray, offset: np.ndarray, ox: np.ndarray, oy: np.ndarray,
                   unit_px: int, blocks: np.ndarray, col_block: np.ndarray, col_local: np.ndarray,
                   out: np.ndarray) -> None:
-    """Selected block-descriptor columns ``out (k, columns)`` float32 of windows at ``ox, oy (k,)`` px, read from an
-    integral laid out as ``rows (corners, bins)`` float32 (``width (k,)`` corners per integral row, ``offset
-    (k,)`` its first row) for ``blocks (b, 4)`` px; column ``j`` is value ``col_local[j]`` (cell row, cell column,
-    bin) of block ``col_block[j]`` over the block's norm: the cell sums, squares, the pairwise sum of the 36
-    squares (numpy's order, as ``hog_blocks._block_norms``), square root, area and division of the numpy path."""
+    """``hog_blocks.block_features_rows`` with ``columns``: column ``j`` of ``out (k, columns)`` is value
+    ``col_local[j]`` of block ``col_block[j]``, with the numpy path's operations in its order."""
     bins = rows.shape[1]
     n = 4 * bins
     cells = np.empty(n, np.float32)
@@ -124,8 +119,7 @@ def block_columns(rows: np.ndarray, width: np.ndarray, offset: np.ndarray, ox: n
 
 @_jit  # type: ignore[misc]
 def grey(image: np.ndarray, out: np.ndarray) -> None:
-    """``out (h, w)`` float32 = ``(0.114 B + 0.587 G) + 0.299 R`` of ``image (h, w, 3)`` uint8 BGR, each product and
-    sum rounded to float32 (as the numpy path computes it)."""
+    """``out (h, w)`` float32 = ``(0.114 B + 0.587 G) + 0.299 R`` of ``image (h, w, 3)`` uint8 BGR, as numpy does."""
     cb, cg, cr = np.float32(0.114), np.float32(0.587), np.float32(0.299)
     for y in range(image.shape[0]):
         for x in range(image.shape[1]):

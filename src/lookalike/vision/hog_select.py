@@ -1,10 +1,5 @@
-"""Choosing how many stages of a trained HOG cascade to use and where its pyramid starts, and calibrating its detection
-probability, on held-out scenes.
-
-:func:`select_stages` scores every cascade prefix from half its length on held-out scenes (one-to-one matching at IoU >=
-``iou``; ignored boxes neither hit nor false positive) and keeps the best F1 (the longer on ties), starts the pyramid
-one or two levels coarser when that costs at most ``f1_tolerance`` of F1, and refits the probability as a logistic
-regression of "hit" on the last-stage margin."""
+"""Choosing a trained HOG cascade's number of stages and first pyramid level, and calibrating its probability, on
+held-out scenes."""
 
 from __future__ import annotations
 

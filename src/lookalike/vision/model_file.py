@@ -25,10 +25,8 @@ def save_model_file(path: str | Path, fmt: str, version: int, header: dict[str, 
 def load_model_file(
     path: str | Path, fmt: str, version: int, what: str
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
-    """The header and arrays of a file written by :func:`save_model_file`.
-
-    Raises ``ValueError`` naming ``path`` when it is unreadable, of another format (``what`` names the expected kind of
-    model in the message) or of another version."""
+    """The header and arrays of a :func:`save_model_file` file; ``ValueError`` when unreadable, of another format
+    (``what`` names the expected kind) or version."""
     try:
         with np.load(path, allow_pickle=False) as data:
             header = json.loads(str(data["header"]))

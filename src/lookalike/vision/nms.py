@@ -7,8 +7,7 @@ import numpy as np
 from lookalike.geometry.boxes import iou_matrix
 
 MATRIX_BOXES = 1024
-"""Up to this many boxes, :func:`nms` computes all overlaps at once; above it, one kept box's row at a time (memory
-linear in the boxes: 33,600 candidates need a few MB, not the 9 GB of their matrix). Both keep the same boxes."""
+"""Up to this many boxes :func:`nms` computes all overlaps at once, above it a row at a time (the same boxes kept)."""
 
 
 def nms(xywh: np.ndarray, score: np.ndarray, iou: float) -> np.ndarray:
@@ -31,13 +30,9 @@ def nms(xywh: np.ndarray, score: np.ndarray, iou: float) -> np.ndarray:
 
 
 def merge_nms(xywh: np.ndarray, score: np.ndarray, overlap: float, merge_iou: float) -> tuple[np.ndarray, np.ndarray]:
-    """Greedy suppression by intersection over the smaller box, with box averaging.
-
-    Boxes ``(n, 4)`` px are visited best ``score`` first; each one not yet suppressed is kept and suppresses every box
-    whose intersection with it exceeds ``overlap`` of the smaller area (windows on parts of a target, or shifted
-    copies). Its output box is the plain mean of the not yet suppressed boxes overlapping it by IoU > ``merge_iou``,
-    which localises better than the single best window of a coarse pyramid. Returns ``(boxes (k, 4) px, index (k,) of
-    each kept box)``."""
+    """Greedy suppression of boxes ``(n, 4)`` px, best ``score`` first, by intersection over the smaller box >
+    ``overlap``; each kept box becomes the mean of the unsuppressed boxes it overlaps by IoU > ``merge_iou``.
+    Returns ``(boxes (k, 4) px, index (k,) of each kept box)``."""
     x = np.asarray(xywh, float).reshape(-1, 4)
     order = np.argsort(-np.asarray(score), kind="stable")
     xo = x[order]

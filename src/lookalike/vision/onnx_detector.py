@@ -1,11 +1,7 @@
-"""Any ONNX detection model as a box detector (onnxruntime; ``lookalike track --video V --detector FILE.onnx``).
-
-Frames are letterboxed to the model's input size (grey 114 padding), converted to RGB unless ``rgb=False``, scaled by
-``scale`` and fed as float32 NCHW. Output ``layout``: ``yolo`` (one ``(1, N, 4 + C)`` tensor, either axis order),
-``yolo-obj`` (with an objectness column), or ``ssd`` (boxes ``(1, N, 4)`` in ``[0, 1]`` or pixels, ``box_order`` xyxy or
-yxyx, and scores); ``auto`` picks by the number of outputs. Boxes keep their best class in ``classes``, those below
-``score_threshold`` are dropped, the rest pass class-wise NMS at ``nms_iou`` and are mapped back to frame pixels
-(``xywh``)."""
+"""Any ONNX detection model as a box detector (``lookalike track --video V --detector FILE.onnx``): letterboxed float32
+NCHW input (RGB unless ``rgb=False``, times ``scale``); output ``layout`` ``yolo`` (``(1, N, 4 + C)``, either axis
+order), ``yolo-obj`` (with objectness) or ``ssd`` (boxes and scores), ``auto`` by the number of outputs; best class in
+``classes``, ``score_threshold``, class-wise NMS at ``nms_iou``, boxes ``xywh`` in frame pixels."""
 
 from __future__ import annotations
 
@@ -58,8 +54,8 @@ class OnnxDetectorConfig:
 
 
 def config_from_settings(settings: list[str]) -> OnnxDetectorConfig:
-    """An :class:`OnnxDetectorConfig` from ``KEY=VALUE`` strings (``score=``/``iou=`` short forms,
-    ``classes=0,2``, ``input_size=640x480``); an unknown key or bad value raises ``ValueError`` naming it."""
+    """An :class:`OnnxDetectorConfig` from ``KEY=VALUE`` strings (``score=``, ``iou=``, ``classes=0,2``,
+    ``input_size=640x480``); an unknown key or bad value raises ``ValueError`` naming it."""
     alias = {"score": "score_threshold", "iou": "nms_iou", "size": "input_size"}
     known = {f.name for f in fields(OnnxDetectorConfig)}
     values: dict[str, Any] = {}
@@ -90,10 +86,8 @@ def config_from_settings(settings: list[str]) -> OnnxDetectorConfig:
 
 
 def letterbox(image: np.ndarray, size: tuple[int, int]) -> tuple[np.ndarray, float, tuple[float, float]]:
-    """``image (h, w, 3)`` resized into ``size = (width, height)`` keeping its aspect, centred on grey 114.
-
-    Returns the padded image, the scale ``r`` (input px per frame px) and the padding ``(dx, dy)``: a frame point ``p``
-    lands at ``r · p + (dx, dy)``."""
+    """``image (h, w, 3)`` resized into ``size = (width, height)`` keeping its aspect, centred on grey 114, with the
+    scale ``r`` and padding ``(dx, dy)``: a frame point ``p`` lands at ``r · p + (dx, dy)``."""
     with needs("cv2"):
         import cv2
 
@@ -209,8 +203,7 @@ class OnnxDetector:
 
 def detect_frames(frames: Iterable[np.ndarray], detector: Callable[[np.ndarray], Detections],
                   advance: Callable[[], None] | None = None) -> tuple[np.ndarray, int]:
-    """MOTChallenge detection rows ``(n, 10)`` (1-based frames, id -1, box px, score) of every frame,
-    and the number of frames read."""
+    """MOTChallenge detection rows ``(n, 10)`` (1-based frames, id -1, box px, score) and the number of frames."""
     chunks = []
     count = 0
     for k, image in enumerate(frames):

@@ -9,9 +9,8 @@ from lookalike._optional import needs
 
 
 def open_session(path: Path, threads: int, what: str) -> Any:
-    """An onnxruntime ``InferenceSession`` of ``path`` on the CPU with ``threads`` threads (quiet logs);
-    ``FileNotFoundError`` when the file is missing, ``ValueError`` naming it when onnxruntime cannot
-    load it (``what`` names the kind of model in the message)."""
+    """An onnxruntime CPU ``InferenceSession`` of ``path`` with ``threads`` threads; ``FileNotFoundError`` when
+    missing, ``ValueError`` when it cannot load (``what``: the kind of model, for the message)."""
     with needs("onnxruntime"):
         import onnxruntime as ort  # type: ignore[import-untyped]
 

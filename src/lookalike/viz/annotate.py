@@ -35,8 +35,7 @@ def _segment(image: np.ndarray, a: tuple[int, int], b: tuple[int, int], colour: 
 
 def draw_box(image: np.ndarray, xywh: np.ndarray, colour: BGR, label: str | None = None,
              thickness: int = 2, dashed: bool = False, labels: LabelSpace | None = None) -> None:
-    """A box ``xywh (4,)`` (px) with a dark outline and an optional filled label above it (placed
-    where it hides no earlier label of ``labels``)."""
+    """A box ``xywh (4,)`` (px) with a dark outline and an optional label above it (hiding none of ``labels``)."""
     with needs("cv2"):
         import cv2
 
@@ -67,9 +66,8 @@ def draw_box_label(image: np.ndarray, text: str, xywh: np.ndarray, colour: BGR, 
 
 def draw_label(image: np.ndarray, text: str, anchor: tuple[int, int], colour: BGR, scale: float = 0.45,
                labels: LabelSpace | None = None, box: Rect | None = None) -> Rect:
-    """``text`` on a filled, outlined tag of ``colour`` whose bottom-left corner is ``anchor`` (px);
-    with ``labels``, the first of: above, below ``box``, further up, further down, that hides no
-    earlier tag. Returns the tag's rectangle."""
+    """``text`` on a filled tag of ``colour`` with its bottom-left at ``anchor`` (px), or with ``labels`` the first
+    place above, below ``box``, further up or down that hides no earlier tag. Returns the tag's rectangle."""
     with needs("cv2"):
         import cv2
 
@@ -129,9 +127,8 @@ def draw_caption(image: np.ndarray, lines: list[str]) -> None:
 
 
 class Tails:
-    """The last ``length`` points of each id, for drawing track tails (any coordinate frame); a tail
-    breaks (NaN) where frames are missing or where a point jumps more than ``max_jump`` (same units)
-    from the previous one, so that an identity switch draws no streak across the picture."""
+    """The last ``length`` points of each id, for track tails; a tail breaks (NaN) at missing frames or a jump of
+    more than ``max_jump`` (same units)."""
 
     def __init__(self, length: int = 30, max_jump: float | None = None) -> None:
         if length < 1:
@@ -143,8 +140,7 @@ class Tails:
         self._last: dict[int, int] = {}
 
     def add(self, frame: int, identity: int, point: np.ndarray, max_jump: float | None = None) -> None:
-        """Record ``point (2,)`` of ``identity`` at ``frame``; a gap in frames or a jump of more than
-        ``max_jump`` (default: the tails' own) breaks the tail (NaN)."""
+        """Record ``point (2,)`` of ``identity`` at ``frame`` (``max_jump`` default: the tails' own)."""
         q = self._points.setdefault(identity, deque(maxlen=self.length))
         p = np.asarray(point, dtype=float).reshape(2)
         limit = max_jump if max_jump is not None else self.max_jump
@@ -169,9 +165,8 @@ class Tails:
 def draw_box_tracks(image: np.ndarray, frame: int, ids: np.ndarray, xywh: np.ndarray, tails: Tails,
                     prefix: str = "id ", max_gap: int = 5, labels: LabelSpace | None = None,
                     dashed: np.ndarray | None = None) -> None:
-    """Boxes ``xywh (n, 4)`` (px) of tracks ``ids (n,)`` in their identity colours, with tails of their
-    bottom-centres (``tails`` updated; dropped after ``max_gap`` frames unseen; broken by a jump over the box's
-    height); labels avoid each other and ``labels``; ``dashed (n,)`` marks boxes drawn dashed."""
+    """Boxes ``xywh (n, 4)`` (px) of tracks ``ids (n,)`` in their identity colours with tails of their bottom-centres
+    (kept ``max_gap`` frames unseen), labels avoiding each other and ``labels``; ``dashed (n,)`` boxes dashed."""
     boxes = np.asarray(xywh, dtype=float).reshape(-1, 4)
     ids = np.asarray(ids).reshape(-1).astype(int)
     if len(ids) != len(boxes):
@@ -192,8 +187,7 @@ def draw_box_tracks(image: np.ndarray, frame: int, ids: np.ndarray, xywh: np.nda
 
 
 def draw_legend(image: np.ndarray, entries: list[tuple[str, BGR, bool]], scale: float = 0.45) -> None:
-    """A legend in the bottom-left corner: per entry a short box sample (``colour``, dashed or solid)
-    and its text, on a translucent dark band."""
+    """A legend in the bottom-left corner: per entry a box sample (``colour``, dashed or not) and its text."""
     with needs("cv2"):
         import cv2
 

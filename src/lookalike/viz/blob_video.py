@@ -1,9 +1,5 @@
-"""Blob detections of a whole video as MOTChallenge rows (``lookalike track --video V --detector blob``).
-
-The ``median`` method reads the video twice (background from ``history`` frames, then detection).
-:func:`auto_blob_config` gives the estimated settings with the user's overrides; :func:`cached_blob_detection_rows`
-caches detections on disk (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``), keyed by the video's content, every setting,
-the version and the detector's code."""
+"""Blob detections of a whole video as MOTChallenge rows (``lookalike track --video V --detector blob``), with the
+estimated settings and the user's overrides, cached on disk keyed by the video's content, settings and code."""
 
 from __future__ import annotations
 
@@ -37,8 +33,8 @@ _SOURCE_HASH = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()  # this m
 
 
 def blob_config(settings: list[str]) -> BlobConfig:
-    """A :class:`BlobConfig` from ``KEY=VALUE`` strings (keys are its field names, e.g. ``threshold=40``,
-    ``polarity=dark``, ``min_area_px=50``); an unknown key or a bad value raises ``ValueError`` naming it."""
+    """A :class:`BlobConfig` from ``KEY=VALUE`` strings of its fields (``threshold=40``); ``ValueError`` naming a bad
+    key or value."""
     return BlobConfig(**blob_settings(settings))
 
 
@@ -75,10 +71,9 @@ def blob_settings(settings: list[str]) -> dict[str, Any]:
 def auto_blob_config(video: Path | str, settings: list[str], n_targets: int | None = None,
                      cache: Path | None | bool = True, progress: Progress | None = None,
                      ) -> tuple[BlobConfig, BlobEstimate | None]:
-    """The blob settings for ``video``: estimated (with ``n_targets`` when known), then ``KEY=VALUE`` ``settings``
-    on top. Skips the estimate when ``settings`` give threshold, polarity and both areas; returns the estimate
-    (or None) so it can be printed. Cached like the detections. ``progress``: as for
-    :func:`~lookalike.vision.blob_auto.estimate_blob_config` (not called when the estimate is cached)."""
+    """The blob settings for ``video``: estimated (cached; skipped when ``settings`` give threshold, polarity and both
+    areas), then ``KEY=VALUE`` ``settings`` on top; and the estimate or None. ``progress``: as for
+    :func:`~lookalike.vision.blob_auto.estimate_blob_config`."""
     given = blob_settings(settings)
     if {"threshold", "polarity", "min_area_px", "max_area_px"} <= set(given):
         return BlobConfig(**given), None
@@ -136,8 +131,7 @@ def _file_hash(path: Path) -> str:
 
 
 def detection_cache_key(video: Path | str, config: BlobConfig, extra: dict[str, Any] | None = None) -> str:
-    """The cache key of ``video``'s blob detections: its content hash (every file of an image folder),
-    every field of ``config``, the lookalike version, the detector's source code and OpenCV's version."""
+    """The cache key of ``video``'s blob detections: its content, ``config``, lookalike, detector code and OpenCV."""
     with needs("cv2"):
         import cv2
 
@@ -153,8 +147,8 @@ def detection_cache_key(video: Path | str, config: BlobConfig, extra: dict[str, 
 
 def cached_blob_detection_rows(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
                                cache: Path | None | bool = True) -> tuple[np.ndarray, int]:
-    """:func:`blob_detection_rows`, read from / written to the cache (``cache``: a folder, ``True`` for
-    :func:`cache_dir`, ``False`` or None for no cache). A damaged cache file is recomputed."""
+    """:func:`blob_detection_rows` through the cache (``cache``: a folder, ``True`` for :func:`cache_dir`, ``False``
+    or None for none)."""
     if cache is False or cache is None:
         return blob_detection_rows(video, config, advance)
     folder = (cache_dir() if cache is True else Path(cache)) / "blobs"
@@ -174,8 +168,7 @@ def cached_blob_detection_rows(video: Path | str, config: BlobConfig, advance: C
 
 def blob_detection_rows(video: Path | str, config: BlobConfig,
                         advance: Callable[[], None] | None = None) -> tuple[np.ndarray, int]:
-    """Blob detections of every frame of ``video`` (a file or an image folder) as MOTChallenge rows
-    ``(n, 10)`` (1-based frames, id -1, box in pixels, score), and the number of frames read."""
+    """Blob detections of ``video`` (a file or image folder) as MOTChallenge rows ``(n, 10)``, and the frame count."""
     detector = BlobDetector(config)
     if config.method == "median":
         frames, declared, _ = source_frames(video)

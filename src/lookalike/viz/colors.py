@@ -1,12 +1,10 @@
-"""Identity colours: a fixed, distinguishable BGR colour per id (the same id keeps its colour), and
-the dark outline drawn around every coloured mark so that it contrasts with any scene."""
+"""Identity colours: a fixed BGR colour per id, and the dark outline drawn around every coloured mark."""
 
 from __future__ import annotations
 
 BGR = tuple[int, int, int]
 
-# Saturated, light-to-mid colours in BGR, chosen to stand out on grass, water, sand and white
-# (no pure greens, which vanish on grass); everything drawn with them also gets a dark outline (OUTLINE).
+# Saturated BGR colours that stand out on grass, water, sand and white (no pure greens).
 PALETTE: tuple[BGR, ...] = (
     (0, 140, 255), (255, 160, 30), (230, 60, 230), (0, 230, 255), (255, 255, 90),
     (190, 150, 255), (180, 105, 255), (255, 255, 255), (90, 190, 255), (160, 80, 255),

@@ -1,6 +1,5 @@
-"""The demo's diver scenes: render, extract features, run every box tracker, score them (IDF1, HOTA, MOTA, ID switches,
-frames/s) and optionally write videos, a still and MOTChallenge files. The annotated video marks tracks on a diver
-(solid), false tracks (dashed red) and missed divers (dashed white)."""
+"""The demo's diver scenes: render, run and score every box tracker, optionally writing videos (tracks on a diver
+solid, false tracks dashed red, missed divers dashed white), a still and MOTChallenge files."""
 
 from __future__ import annotations
 
@@ -41,11 +40,9 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
                        out_dir: Path | None = None, video_tracker: str | None = None,
                        advance: Callable[[], None] | None = None,
                        rerun: Any = None) -> tuple[list[dict[str, Any]], dict[str, Path]]:
-    """Score ``trackers`` on scenario ``sc`` (rows keyed Scenario, Tracker, IDF1, HOTA, MOTA, IDSW,
-    Frames/s; metrics in %). With ``out_dir`` and ``video_tracker`` also write
-    ``divers.mp4``/``divers.gif``/``divers-still.png``/``divers-raw.mp4`` and
-    ``divers-<tracker>.txt``; returns the rows and the files written. ``rerun`` (a
-    :class:`~lookalike.viz.rerun_log.RerunLogger`) also receives the frames and the video tracker's boxes."""
+    """Score ``trackers`` on ``sc`` (rows: Scenario, Tracker, IDF1, HOTA, MOTA in %, IDSW, Frames/s); with ``out_dir``
+    and ``video_tracker`` also write ``divers.mp4``, ``.gif``, ``-still.png``, ``-raw.mp4`` and ``divers-<tracker>.txt``
+    (``rerun`` gets the frames and boxes). Returns the rows and the files."""
     with needs("cv2"):
         import cv2
 
@@ -124,8 +121,8 @@ def _score_row(scenario: str, tracker: str, gt: MotTable, table: np.ndarray, n_f
 
 def _update_all(instances: dict[str, Any], f: Frame, results: dict[str, list[list[float]]],
                 elapsed: dict[str, float], video_tracker: str | None) -> list[Any] | None:
-    """Update every tracker with frame ``f``, appending MOTChallenge rows to ``results`` and seconds to
-    ``elapsed``; returns the video tracker's confirmed tracks with a box (None without a video tracker)."""
+    """Update every tracker with ``f`` (rows to ``results``, seconds to ``elapsed``); returns the video tracker's
+    confirmed tracks with a box, or None."""
     shown = None
     for name, tracker in instances.items():
         t0 = time.perf_counter()
@@ -139,9 +136,8 @@ def _update_all(instances: dict[str, Any], f: Frame, results: dict[str, list[lis
 
 def true_false_missed(track_xywh: np.ndarray, gt_rows: np.ndarray, min_iou: float = MATCH_IOU,
                       min_visibility: float = 0.3) -> tuple[np.ndarray, np.ndarray]:
-    """``(on_diver (n,) bool, missed (m, 4) xywh)``: which track boxes lie on a diver (greedy IoU
-    matching at ``min_iou`` against the frame's ground-truth rows) and the boxes of the visible
-    divers (visibility >= ``min_visibility``) that no track covers. Pixels."""
+    """``(on_diver (n,) bool, missed (m, 4) xywh px)``: track boxes on a diver (greedy IoU >= ``min_iou`` against
+    the frame's truth rows) and the visible divers (>= ``min_visibility``) no track covers."""
     boxes = np.asarray(track_xywh, dtype=float).reshape(-1, 4)
     gt = np.asarray(gt_rows, dtype=float).reshape(-1, 9)
     gt = gt[gt[:, 8] >= min_visibility]
@@ -160,8 +156,7 @@ def true_false_missed(track_xywh: np.ndarray, gt_rows: np.ndarray, min_iou: floa
 
 def _annotated(image: np.ndarray, k: int, gt_rows: np.ndarray, shown: list[Any], tails: Tails,
                caption: list[str]) -> np.ndarray:
-    """A copy of ``image`` with the shown tracks (identity colours and tails; tracks on no diver
-    dashed, with a red frame), the visible divers no track covers ("missed"), ``caption`` and a legend."""
+    """A copy of ``image`` with the tracks (on no diver: dashed, red frame), missed divers, ``caption`` and legend."""
     img = image.copy()
     boxes = np.array([t.xywh for t in shown], dtype=float).reshape(-1, 4)
     on_diver, missed = true_false_missed(boxes, gt_rows)

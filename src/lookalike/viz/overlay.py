@@ -1,5 +1,4 @@
-"""Overlaying MOTChallenge tracking results on a video or an image folder, or drawing world tracks
-from above (MP4 out, optional GIF)."""
+"""MOTChallenge tracks drawn on a video or image folder, or world tracks from above (MP4, optional GIF)."""
 
 from __future__ import annotations
 
@@ -24,8 +23,7 @@ IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")
 
 
 def source_frames(source: Path | str) -> tuple[Iterator[np.ndarray], int, float]:
-    """Frames of a video file or of a folder of images (sorted by name; a MOTChallenge ``img1``),
-    with the frame count and the frame rate (30 for image folders)."""
+    """Frames of a video file or image folder (by name), the frame count and rate (30 for folders)."""
     with needs("cv2"):
         import cv2
 
@@ -48,8 +46,7 @@ def source_frames(source: Path | str) -> tuple[Iterator[np.ndarray], int, float]
 
 
 def _all_frames(path: Path, declared: int) -> Iterator[np.ndarray]:
-    """:func:`read_frames`, ending in a ``ValueError`` naming ``path`` when it stops well short of the ``declared``
-    frame count (a truncated or damaged file: otherwise it would be tracked in part, without a word)."""
+    """:func:`read_frames`, then ``ValueError`` when it stopped well short of the ``declared`` count."""
     count = 0
     for img in read_frames(path):
         count += 1
@@ -62,27 +59,20 @@ def _all_frames(path: Path, declared: int) -> Iterator[np.ndarray]:
 def overlay_tracks(source: Path | str, tracks: MotTable, output: Path | str, *, gif: Path | str | None = None,
                    tail: int = 25, fps: float | None = None,
                    advance: Callable[[], None] | None = None) -> int:
-    """Draw ``tracks`` (1-based frames) on every frame of ``source`` and write ``output`` (MP4);
-    returns the number of frames written (the input's). Rows with an id < 0 are ignored."""
+    """Draw ``tracks`` (1-based frames, ids >= 0) on every frame of ``source`` into ``output``; returns the count."""
     frames, _, source_fps = source_frames(source)
-    rows_by_frame: dict[int, np.ndarray] = {}
     keep = np.asarray(tracks.track_id) >= 0
     frame_no = np.asarray(tracks.frame)[keep].astype(int)
-    order = np.argsort(frame_no, kind="stable")
-    ids = np.asarray(tracks.track_id)[keep].astype(int)[order]
-    boxes = np.asarray(tracks.xywh, dtype=float)[keep][order]
-    frame_no = frame_no[order]
-    starts = np.searchsorted(frame_no, np.unique(frame_no))
-    for s, e in zip(starts, list(starts[1:]) + [len(frame_no)]):
-        rows_by_frame[int(frame_no[s])] = np.arange(s, e)
+    ids = np.asarray(tracks.track_id)[keep].astype(int)
+    boxes = np.asarray(tracks.xywh, dtype=float)[keep]
     tails = Tails(length=max(tail, 1))
     count = 0
     with VideoWriter(output, fps=fps or source_fps, gif=gif) as writer:
         for k, image in enumerate(frames):
             img = image.copy()
-            sel = rows_by_frame.get(k + 1, np.zeros(0, dtype=int))
+            sel = frame_no == k + 1
             draw_box_tracks(img, k, ids[sel], boxes[sel], tails)
-            draw_caption(img, [f"frame {k + 1}  tracks: {len(sel)}"])
+            draw_caption(img, [f"frame {k + 1}  tracks: {int(sel.sum())}"])
             writer.write(img)
             count += 1
             if advance is not None:
@@ -105,8 +95,7 @@ def world_positions(tracks: MotTable) -> np.ndarray:
 
 def birdseye_video(tracks: MotTable, output: Path | str, *, size_px: int = 640, fps: float = 30.0,
                    gif: Path | str | None = None, tail: int = 60, advance: Callable[[], None] | None = None) -> int:
-    """World tracks seen from above as an MP4 (one frame per frame number 1..last): a metre grid,
-    each id as a dot in its identity colour with a tail; returns the number of frames written."""
+    """World tracks from above, one MP4 frame per frame 1..last (a metre grid, dots with tails); returns the count."""
     with needs("cv2"):
         import cv2
 

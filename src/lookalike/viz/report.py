@@ -35,6 +35,12 @@ def _cell(value: Any) -> tuple[str, bool]:
     return html.escape(str(value)), False
 
 
+def _href(target: Path | str, relative_to: Path | str | None) -> str:
+    """``target``'s path relative to the folder ``relative_to`` (if given), escaped for an attribute."""
+    href = os.path.relpath(target, relative_to) if relative_to is not None else str(target)
+    return html.escape(Path(href).as_posix(), quote=True)
+
+
 class HtmlReport:
     """Collects report blocks in order; :meth:`write` saves one HTML file."""
 
@@ -89,18 +95,13 @@ class HtmlReport:
 
     def link(self, target: Path | str, text: str, relative_to: Path | str | None = None) -> None:
         """A link to ``target`` (e.g. a video), written relative to the folder ``relative_to``."""
-        t = Path(target)
-        href = os.path.relpath(t, relative_to) if relative_to is not None else str(t)
-        link = html.escape(Path(href).as_posix(), quote=True)
-        self._blocks.append(f'<p><a href="{link}">{html.escape(text)}</a></p>')
+        self._blocks.append(f'<p><a href="{_href(target, relative_to)}">{html.escape(text)}</a></p>')
 
     def video(self, target: Path | str, caption: str, relative_to: Path | str | None = None,
               width: int | None = None) -> None:
         """An inline video player for the MP4 at ``target`` (path relative to the folder ``relative_to``),
         with a caption that also links to the file."""
-        t = Path(target)
-        href = os.path.relpath(t, relative_to) if relative_to is not None else str(t)
-        src = html.escape(Path(href).as_posix(), quote=True)
+        src = _href(target, relative_to)
         style = f' style="width:{int(width)}px"' if width else ""
         self._blocks.append(
             f'<figure><video controls muted playsinline preload="metadata" src="{src}"{style}></video>'

@@ -1,5 +1,4 @@
-"""Optional live view: frames, boxes and world positions logged to the Rerun viewer (the optional ``rerun-sdk``,
-imported lazily; :func:`open_rerun` raises ``ValueError`` when it is missing)."""
+"""Optional live view: frames, boxes and world positions logged to the Rerun viewer (``rerun-sdk``, imported lazily)."""
 
 from __future__ import annotations
 
@@ -13,8 +12,7 @@ from lookalike.viz.colors import identity_colour
 
 
 class RerunLogger:
-    """Logs to one Rerun recording; entity paths are ``<scene>/camera``, ``<scene>/camera/boxes``,
-    ``<scene>/world/...``. Times: a ``frame`` sequence and a ``time`` in seconds per scene."""
+    """Logs to one Rerun recording: entities ``<scene>/camera...``, ``<scene>/world/...``; times ``frame``, ``time``."""
 
     def __init__(self, stream: Any, rr: Any) -> None:
         self._rec, self._rr = stream, rr

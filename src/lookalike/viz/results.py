@@ -1,9 +1,5 @@
-"""Reading ``eval``/``bench`` JSON outputs and adding them to an :class:`HtmlReport` as tables and charts.
-
-Recognised files: results documents (``"schema": "lookalike-results/1"``, see :mod:`lookalike.io.results`) with a table
-``ident`` (``bench ident --json``, the demo's ``robots-ident.json``), ``divers`` (``bench divers --json``, the demo's
-``divers.json``) or ``scores`` (``eval --json``); and the older files: rows with ``Setup`` and ``Success rate (%)``,
-rows with ``Scenario`` and ``IDF1``, ``{tracker: {sequence: {metric: fraction}}}``. Values are shown in %."""
+"""``eval``/``bench`` JSON outputs (results documents with a table ``ident``, ``divers`` or ``scores``, or the older
+row lists and ``{tracker: {sequence: {metric: fraction}}}``) as tables and charts (in %) of an :class:`HtmlReport`."""
 
 from __future__ import annotations
 

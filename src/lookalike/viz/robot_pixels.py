@@ -1,9 +1,5 @@
-"""Robots identified from a video's pixels (``lookalike track --video V --pipeline robots``) and robot sequences drawn
-through the robot camera (``lookalike render-robots``).
-
-The pipeline (:class:`lookalike.vision.pipeline.RobotPipeline`) detects robots, estimates their headings, projects boxes
-to the ground through :meth:`lookalike.geometry.Camera.default` and identifies them with the heading reports of a
-``lookalike simulate`` file (frame k of the file is frame k of the video)."""
+"""Robots identified from a video's pixels with the heading reports of a ``lookalike simulate`` file (``lookalike track
+--video V --pipeline robots``), and robot sequences rendered through the robot camera (``lookalike render-robots``)."""
 
 from __future__ import annotations
 
@@ -38,8 +34,7 @@ def hfov_rad(camera: Camera) -> float:
 
 
 def world_for_camera(config: RobotWorldConfig, camera: Camera) -> RobotWorldConfig:
-    """``config`` with the observer's field of view set to the camera's, so that the simulator's own
-    detections and the pixels see the same robots."""
+    """``config`` with the observer's field of view set to the camera's."""
     return dataclasses.replace(config, observer=dataclasses.replace(config.observer, fov_rad=hfov_rad(camera)))
 
 
@@ -51,8 +46,7 @@ def identifier_settings(name: str, camera: Camera) -> tuple[tuple[str, Any], ...
 
 @contextmanager
 def one_blas_thread() -> Iterator[None]:
-    """Limit BLAS to one thread inside the block (threadpoolctl, when installed): the heading SVM's small matrix
-    products run several times faster so than spread over the threads of a busy machine."""
+    """Limit BLAS to one thread inside the block (threadpoolctl, when installed): faster for the heading SVM."""
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:
@@ -63,8 +57,7 @@ def one_blas_thread() -> Iterator[None]:
 
 
 def render_robot_frames(sequence: RobotSequence, camera: Camera, seed: int) -> Iterator[Any]:
-    """The :class:`~lookalike.sim.render_robots.RenderedFrame` of every frame of ``sequence``, seen from
-    its observer pose (robots at their field positions with their absolute headings)."""
+    """The rendered frame of every frame of ``sequence``, seen from its observer pose."""
     from lookalike.sim.render_robots import RenderConfig, RobotRenderer
 
     a = sequence.arrays
@@ -121,8 +114,8 @@ class PipelineStep:
 def identify_video(pipe: RobotPipeline, frames: Iterable[PixelFrame], output: Path, *,
                    annotate: Callable[[PixelFrame, PipelineResult], None] | None = None,
                    advance: Callable[[], None] | None = None) -> RunStats:
-    """Run the pipeline over ``frames``, streaming ``frame, robot id + 1, box, identity confidence,
-    ground x, y (m), -1`` rows to ``output``; ``annotate(frame, result)`` sees every frame."""
+    """Run the pipeline over ``frames``, streaming its rows (:func:`labelled_rows`) to ``output``; ``annotate(frame,
+    result)`` sees every frame."""
     with MotWriter(output) as writer:
         def sink(frame: PixelFrame, result: PipelineResult) -> None:
             writer.write_rows(labelled_rows(frame.index, result.detections, result.labels, result.tracks))

@@ -17,17 +17,13 @@ from lookalike.eval import identification_success_rate, localisation_error
 from lookalike.geometry.camera import Camera, Extrinsics, Intrinsics, Pose2D
 from lookalike.loop import warm_up
 from lookalike.sim import preset, preset_label, simulate_robots
-from lookalike.sim.render_robots import (
-    ROBOT_HEIGHT_M,
-    ROBOT_WIDTH_M,
-    RenderConfig,
-    RobotRenderer,
-)
+from lookalike.sim.render_robots import ROBOT_HEIGHT_M, ROBOT_WIDTH_M
 from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
 from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_box_label, draw_caption, draw_legend, draw_tail
 from lookalike.viz.colors import identity_colour
 from lookalike.viz.plots import birdseye_plot
+from lookalike.viz.robot_pixels import render_robot_frames
 from lookalike.viz.video import VideoWriter
 
 WRONG = (0, 0, 230)  # BGR red outline of a wrongly identified detection
@@ -73,7 +69,7 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
     # A level-ish wide camera like the simulated observer's (80° field of view), so the robots fill the view.
     camera = Camera(Intrinsics.from_fov(render_width, render_width * 3 // 4, cfg.observer.fov_rad),
                     Extrinsics(0.9, np.radians(9.0)))
-    renderer = RobotRenderer(camera=camera, config=RenderConfig(field_m=cfg.field_m), seed=seed)
+    rendered = render_robot_frames(seq, camera, seed)
     for name in trackers:  # frames/s without the first frames' one-off costs (imports, compiles)
         warm_up(partial(_make, name, n, cfg.max_detections), seq.frames())
     instances = {name: _make(name, n, cfg.max_detections) for name in trackers}
@@ -98,7 +94,7 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
                 estimated[name][k] = agent_positions(tracks, n)
             pose = a.observer[k]
             observer = Pose2D(float(pose[0]), float(pose[1]), float(pose[2]))
-            img = renderer.render(a.field_position[k], a.true_heading[k], observer).image
+            img = next(rendered).image
             img = cv2.resize(img, (img.shape[1] * scale, img.shape[0] * scale), interpolation=cv2.INTER_LINEAR)
             labels = predicted[video_tracker][-1]
             truth = truth_labels[k]

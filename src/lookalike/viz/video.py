@@ -16,9 +16,8 @@ from lookalike._optional import needs
 
 
 class VideoWriter:
-    """An MP4 file (H.264) written frame by frame (``(h, w, 3)`` uint8 BGR, same size; odd sizes padded by one
-    pixel). A context manager. ``gif`` also writes every ``gif_every``-th of the first ``gif_frames`` frames,
-    ``gif_width`` pixels wide, as an animated GIF."""
+    """An H.264 MP4 written frame by frame (``(h, w, 3)`` uint8 BGR, odd sizes padded); a context manager. ``gif``
+    also gets every ``gif_every``-th of the first ``gif_frames`` frames, ``gif_width`` px wide."""
 
     def __init__(self, path: Path | str, fps: float, gif: Path | str | None = None, gif_every: int = 2,
                  gif_frames: int = 120, gif_width: int = 640) -> None:

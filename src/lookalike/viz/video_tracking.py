@@ -1,9 +1,7 @@
-"""Tracking on real video: detections from a MOTChallenge file, appearance features from the pixels, any registered
-tracker, the detector-health monitor, and an optional annotated video.
-
-In the annotated video, unsettled identities (tentative, the tracker's ``uncertain``, or reported fewer than
-``new_frames`` frames) are dashed with a ``?``; a recovery is labelled ``id T<-S``; untaken detections are thin grey
-dashed boxes; an unhealthy frame gets a red banner with the reasons."""
+"""Tracking on real video: MOTChallenge detections, appearance features from the pixels, any tracker, the
+detector-health monitor and an optional annotated video: unsettled identities (tentative, the tracker's ``uncertain``,
+or younger than ``new_frames``) dashed with ``?``, recoveries ``id T<-S``, untaken detections thin grey dashed, an
+unhealthy frame a red banner."""
 
 from __future__ import annotations
 
@@ -46,16 +44,9 @@ UNHEALTHY_BGR = (40, 40, 200)
 
 @dataclass(frozen=True, eq=False)
 class VideoTrackingResult:
-    """What :func:`track_video` produced.
-
-    Attributes:
-        frames: number of video frames read (and written to the annotated video, if any).
-        rows: ``(n, 10)`` MOTChallenge result rows (1-based frames).
-        merges: ``(frame, source id, target id)`` identity recoveries, frames 1-based.
-        health: one :class:`HealthStatus` per frame.
-        uncertain: ``(frame, track id)`` pairs drawn as uncertain (frames 1-based).
-        ignored_rows: detection rows whose frame is past the video's end.
-        tracker_s, feature_s: seconds spent in the tracker and in the feature extractor."""
+    """What :func:`track_video` produced (frames 1-based): ``frames`` read, MOTChallenge ``rows (n, 10)``,
+    ``merges`` ``(frame, source id, target id)``, one ``health`` status per frame, ``uncertain`` ``(frame, track id)``,
+    ``ignored_rows`` past the video's end, and seconds in the tracker and the feature extractor."""
 
     frames: int
     rows: np.ndarray
@@ -82,9 +73,8 @@ def source_frame_rate(source: Path | str) -> float | None:
 
 def fit_video_features(source: Path | str, detections: MotTable, *, min_score: float = -np.inf,
                        max_crops: int = 3000, crop_px: int = 32, link_iou: float = 0.6) -> HandcraftedFeatures:
-    """Hand-crafted features standardised on this video's own detections, without ground truth: boxes of up to
-    ``max_crops`` crops are chained frame to frame by IoU >= ``link_iou`` and the chains serve as identity
-    labels for :func:`~lookalike.vision.appearance.fit_stats` (plain mean and spread with fewer than two)."""
+    """Hand-crafted features standardised on this video's detections: up to ``max_crops`` boxes chained frame to
+    frame by IoU >= ``link_iou`` serve as identity labels for :func:`~lookalike.vision.appearance.fit_stats`."""
     if max_crops < 2:
         raise ValueError(f"max_crops: must be >= 2, got {max_crops}")
     keep = detections.conf >= min_score
@@ -128,9 +118,8 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
                 annotate: Path | str | None = None, health: HealthConfig | None = None,
                 fps: float | None = None, min_score: float = -np.inf, new_frames: int = 10,
                 tail: int = 25, advance: Callable[[], None] | None = None) -> VideoTrackingResult:
-    """Run ``tracker`` (reset first) over the frames of ``source`` (a video file or an image folder)
-    with ``detections`` (1-based frames, pixels); each frame's boxes get ``extractor(image, xywh)``
-    as ``feature``. With ``annotate`` also write that MP4, one frame per input frame."""
+    """Run ``tracker`` (reset first) over ``source`` (a video file or image folder) with ``detections`` (1-based
+    frames, px), features from ``extractor(image, xywh)``; with ``annotate`` also write that MP4."""
     if new_frames < 1:
         raise ValueError(f"new_frames: must be >= 1, got {new_frames}")
     images, n_declared, source_fps = source_frames(source)
@@ -235,8 +224,7 @@ def _draw(img: np.ndarray, k: int, det_xywh: np.ndarray, shown: list[TrackSnapsh
 
 
 def draw_banner(image: np.ndarray, text: str, colour: tuple[int, int, int] = UNHEALTHY_BGR) -> None:
-    """A filled band of ``colour`` across the bottom of ``image`` (BGR uint8, in place) with white ``text``
-    (cut with an ellipsis to the image width)."""
+    """A band of ``colour`` across the bottom of ``image`` (in place) with white ``text``, cut to fit."""
     with needs("cv2"):
         import cv2
 
@@ -251,28 +239,26 @@ def draw_banner(image: np.ndarray, text: str, colour: tuple[int, int, int] = UNH
 
 
 def side_file(output: Path | str, kind: str) -> Path:
-    """The side file ``<output stem>.<kind>.csv`` next to a result file (``tracks.txt`` → ``tracks.merges.csv``)."""
+    """The side file ``<output stem>.<kind>.csv`` next to a result file."""
     p = Path(output)
     return p.with_name(f"{p.stem}.{kind}.csv")
 
 
 def write_merges_csv(path: Path | str, merges: list[tuple[int, int, int]]) -> Path:
     """``frame,source_id,target_id`` (frame 1-based; from that frame on the source is reported as the target)."""
-    p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    with p.open("w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["frame", "source_id", "target_id"])
-        w.writerows(merges)
-    return p
+    return _write_csv(path, ["frame", "source_id", "target_id"], merges)
 
 
 def write_health_csv(path: Path | str, statuses: list[HealthStatus]) -> Path:
     """One row per frame, columns :data:`~lookalike.trackers.parts.health.HEALTH_CSV_HEADER`."""
+    return _write_csv(path, HEALTH_CSV_HEADER, [health_row(s) for s in statuses])
+
+
+def _write_csv(path: Path | str, header: Any, rows: Any) -> Path:
     p = Path(path)
     p.parent.mkdir(parents=True, exist_ok=True)
     with p.open("w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(HEALTH_CSV_HEADER)
-        w.writerows(health_row(s) for s in statuses)
+        w.writerow(header)
+        w.writerows(rows)
     return p

@@ -34,9 +34,8 @@ def _label_array(sequence: RobotSequence, labels: Sequence[Sequence[int]]) -> np
 
 
 def export_truth(sequence: RobotSequence, labels: Sequence[Sequence[int]], path: str | Path) -> tuple[Path, int]:
-    """Write ``sequence`` with its detection labels replaced by ``labels`` (the simulator's JSON
-    Lines format, readable by ``read_robot_sequence``); unset labels are written as -1 (false
-    positive). Returns the path and the number of unset labels."""
+    """Write ``sequence`` with ``labels`` as its detection labels (unset ones as -1); returns the path and the
+    number of unset labels."""
     lab = _label_array(sequence, labels)
     n_unset = int((lab == UNSET).sum())
     lab[lab == UNSET] = -1
@@ -60,9 +59,8 @@ def export_mot(sequence: RobotSequence, labels: Sequence[Sequence[int]], path: s
 
 
 def load_labels(path: str | Path, sequence: RobotSequence) -> list[list[int]]:
-    """Starting labels for ``sequence`` from ``path``: a label file (``.json``), a robot sequence
-    with the same detections (``.jsonl``, e.g. an :func:`export_truth` file) or a MOTChallenge file
-    written by :func:`export_mot` (``.txt``; rows matched to detections by frame and position)."""
+    """Starting labels for ``sequence`` from a label file (``.json``), a robot sequence with the same detections
+    (``.jsonl``) or a MOTChallenge file of :func:`export_mot` (``.txt``, matched by frame and position)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"{path}: no such file")

@@ -1,9 +1,6 @@
-"""Human-benchmark result files: what a finished ``lookalike label --benchmark`` session writes, read back by
-``lookalike bench ident --lengths`` to put people beside the identifiers.
-
-One JSON file per session, ``<sequence stem>.human-<labeller>.json`` (format ``lookalike-human-benchmark``, version 1),
-holding the sequence, labeller, times (Unix seconds), counts and ``success_rate`` (frames worked through, unset labels
-wrong) and ``success_rate_all`` (the whole sequence; see :func:`~lookalike.viz.label.store.score_labels`)."""
+"""Human-benchmark result files, ``<sequence stem>.human-<labeller>.json``, written by a finished ``lookalike label
+--benchmark`` session and read by ``lookalike bench ident --lengths``: sequence, labeller, Unix times, counts and
+success rates (:func:`~lookalike.viz.label.store.score_labels`)."""
 
 from __future__ import annotations
 
@@ -23,8 +20,7 @@ _LABELLER = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}")
 
 
 def check_labeller(labeller: str) -> str:
-    """``labeller`` if it is a usable id (1-64 letters, digits, ``.``, ``_``, ``-``, starting with a
-    letter or digit: it becomes part of a file name), else ``ValueError``."""
+    """``labeller`` if it is a usable id (1-64 letters, digits, ``.``, ``_``, ``-``), else ``ValueError``."""
     if not isinstance(labeller, str) or not _LABELLER.fullmatch(labeller):
         raise ValueError(f"--labeller: {labeller!r} is not a labeller id (1-64 letters, digits, '.', '_', '-')")
     return labeller
@@ -64,8 +60,7 @@ class HumanResult:
 
 def human_result(sequence_name: str, labeller: str, n_agents: int, max_detections: int, n_frames: int,
                  benchmark: Mapping[str, Any]) -> HumanResult:
-    """The result of a finished session from the label file's ``benchmark`` entry
-    (:meth:`~lookalike.viz.label.store.LabelStore.finish_benchmark`)."""
+    """The result of a finished session from the label file's ``benchmark`` entry."""
     if benchmark.get("finished_at") is None:
         raise ValueError("the benchmark session has not finished")
     return HumanResult(

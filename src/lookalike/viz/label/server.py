@@ -12,9 +12,8 @@ Routes (JSON unless stated)::
     POST /api/export             write <stem>.labelled.jsonl and <stem>.labels.mot.txt beside the sequence
     GET  /files/<path>           a file inside the sequence's folder (benchmark mode: frame images only)
 
-Foreign ``Host`` headers and non-JSON POSTs are refused; malformed requests get 400. Each connection has a
-thread, idle ones close after ``IDLE_TIMEOUT_S``, slow bodies get 408 after ``BODY_TIMEOUT_S``.
-"""
+Foreign ``Host`` headers and non-JSON POSTs are refused; idle connections close after ``IDLE_TIMEOUT_S``, slow bodies
+get 408 after ``BODY_TIMEOUT_S``."""
 
 from __future__ import annotations
 
@@ -46,15 +45,9 @@ LISTEN_BACKLOG = 128
 
 
 class LabelApp:
-    """What the server serves: one sequence, its label store and the mode.
-
-    Args:
-        sequence_path: the robot sequence file (JSON Lines); its folder is the only one served.
-        sequence: the sequence read from it.
-        store: its labels.
-        benchmark: human-benchmark mode (truth never sent to the page; timed; scored at the end).
-        labeller: who labels (an id for the benchmark's result file, :mod:`lookalike.viz.label.human`).
-        results_dir: folder of the benchmark's result file (default: the sequence's)."""
+    """What the server serves: the sequence read from ``sequence_path`` (only its folder is served), its label
+    ``store``, and whether it is a ``benchmark`` (truth never sent; timed; scored at the end, the result file in
+    ``results_dir``, default the sequence's folder, named after ``labeller``)."""
 
     def __init__(self, sequence_path: str | Path, sequence: RobotSequence, store: LabelStore,
                  benchmark: bool = False, labeller: str = "anonymous", results_dir: str | Path | None = None) -> None:
@@ -97,8 +90,7 @@ class LabelApp:
         return score_labels(self.store.snapshot(), self.truth, self.sequence.config.n_agents)
 
     def finish_benchmark(self) -> dict[str, Any]:
-        """Stop and score the benchmark session (idempotent) and write its result file
-        (:attr:`result_path`: time, success rate, labeller id); returns the session's entry."""
+        """Stop and score the benchmark session (idempotent), write its result file and return its entry."""
         bench = self.store.finish_benchmark(self.truth)
         self.write_result()
         return bench
@@ -358,6 +350,5 @@ class LabelServer(ThreadingHTTPServer):
 
 def make_server(app: LabelApp, host: str = "127.0.0.1", port: int = 8765,
                 log: Callable[[str], None] | None = None, body_timeout_s: float = BODY_TIMEOUT_S) -> LabelServer:
-    """A server for ``app`` bound to ``host:port`` (port 0: any free port); call ``serve_forever``.
-    ``body_timeout_s``: seconds a request body may take to arrive (then 408)."""
+    """A server for ``app`` on ``host:port`` (0: any free port); bodies slower than ``body_timeout_s`` get 408."""
     return LabelServer((host, port), make_handler(app, log, body_timeout_s))

@@ -15,11 +15,8 @@ from lookalike.viz.label.store import LabelStore, label_path_for
 def open_label_app(sequence_path: str | Path, initial: Sequence[Sequence[int]] | None = None,
                    source: str = "empty", benchmark: bool = False, fresh: bool = False,
                    labeller: str = "anonymous", results_dir: str | Path | None = None) -> LabelApp:
-    """A :class:`LabelApp` for the robot sequence at ``sequence_path``.
-
-    Saved labels (``<stem>.labels.json``) win over ``initial``; ``fresh=True`` first moves them to ``.bak``. Benchmark
-    mode starts from no labels and refuses ``initial``, and writes ``<stem>.human-<labeller>.json`` to ``results_dir``
-    (default: beside the sequence). Raises ``ValueError`` for unreadable or mismatched files or a bad labeller id."""
+    """A :class:`LabelApp` for the robot sequence at ``sequence_path``: saved labels win over ``initial`` (``fresh``
+    moves them to ``.bak`` first); a benchmark starts from none. ``ValueError`` for bad files or labeller ids."""
     sequence_path = Path(sequence_path)
     check_labeller(labeller)
     if not sequence_path.is_file():

@@ -1,8 +1,5 @@
-"""The labels a person gives a robot sequence's detections, saved atomically after every change.
-
-Per detection: an agent id ``0 .. N-1``, ``-1`` for a false positive, or :data:`UNSET` (-2). The file ``<sequence
-stem>.labels.json`` holds ``format``, ``version``, ``sequence``, ``n_frames``, ``n_agents``, ``counts``, ``labels``,
-``source`` and ``benchmark``."""
+"""A person's labels of a robot sequence's detections (agent id ``0 .. N-1``, ``-1`` false positive, :data:`UNSET`
+-2), saved atomically to ``<sequence stem>.labels.json`` after every change."""
 
 from __future__ import annotations
 
@@ -45,15 +42,8 @@ def _check_labels(labels: Sequence[Sequence[int]], counts: Sequence[int], n_agen
 
 
 class LabelStore:
-    """Per-detection labels of one sequence, thread-safe, saved to ``path`` after every change.
-
-    Args:
-        path: the label file.
-        sequence_name: file name of the sequence (recorded, and checked when loading).
-        counts: detections per frame, ``(T,)``.
-        n_agents: N, the number of robots.
-        initial: labels to start from when ``path`` does not exist yet (default: all unset).
-        source: where ``initial`` came from (recorded in the file)."""
+    """Per-detection labels of one sequence (``counts (T,)`` detections per frame, ``n_agents`` robots), thread-safe,
+    saved to ``path`` after every change; ``initial`` labels (default unset) and their ``source`` when it is new."""
 
     def __init__(self, path: str | Path, sequence_name: str, counts: Sequence[int], n_agents: int,
                  initial: Sequence[Sequence[int]] | None = None, source: str = "empty") -> None:
@@ -141,10 +131,8 @@ class LabelStore:
 
 
 def score_labels(labels: Sequence[Sequence[int]], truth: Sequence[np.ndarray], n_agents: int) -> dict[str, Any]:
-    """Identification success rate of ``labels`` against ``truth``.
-
-    ``success_rate`` covers frames up to the last with any label set (unset labels count as wrong), ``success_rate_all``
-    the whole sequence; also the counts scored, correct and unset. Rates are None without detections."""
+    """Success rate of ``labels`` against ``truth`` up to the last labelled frame (unset is wrong) and over the whole
+    sequence (None without detections), with the counts scored, correct and unset."""
     if len(labels) != len(truth):
         raise ValueError(f"labels has {len(labels)} frames, truth {len(truth)}")
     touched = [k for k, row in enumerate(labels) if any(v != UNSET for v in row)]
