@@ -1,11 +1,9 @@
-"""Deep SORT (Wojke et al., 2017) with any appearance feature.
+"""Deep SORT (Wojke et al., 2017) with any appearance feature (L2-normalised ``feature`` rows; pixels, aspect ``w/h``).
 
-A track table of :class:`~lookalike.motion.spaces.BoxXYAH` states (pixels, aspect ``w/h``), per-track feature galleries
-and an association plan (:mod:`lookalike.association.stages`). Each frame: predict; matching cascade over confirmed
-tracks (most recently seen first) on the minimum cosine distance to the track's gallery, gated by
-``max_cosine_distance`` and the chi-square Mahalanobis gate; ``1 - IoU`` fallback for tentative tracks and those missed
-one frame; confirm after ``n_init`` hits, delete tentative tracks at their first miss and confirmed ones after
-``max_age`` frames. Detections must carry L2-normalised ``feature`` rows. Defaults: docs/trackers/deepsort.md."""
+Each frame: predict; matching cascade over confirmed tracks (most recently seen first) on the minimum cosine distance
+to the track's gallery, gated by ``max_cosine_distance`` and the chi-square gate; ``1 - IoU`` fallback for tentative
+tracks and those missed one frame; confirm after ``n_init`` hits, delete tentative tracks at their first miss and
+confirmed ones after ``max_age`` frames. Defaults: docs/trackers/deepsort.md."""
 
 from __future__ import annotations
 

@@ -1,20 +1,15 @@
-"""DiverSORT: appearance-first tracking of look-alike divers with long-term re-identification.
-
-The diver-tracking paper's seven mechanisms, each a step of :meth:`DiverSort.update`:
+"""DiverSORT: appearance-first tracking of look-alike divers with long-term re-identification; the diver-tracking
+paper's seven mechanisms (defaults and their sources: docs/trackers/diversort.md):
 
 1. IoU shortcut: a detection overlapping a track's previous detection by ``iou_shortcut`` joins it first.
 2. Centre-only Kalman filter on ``(x, y, vx, vy)`` (pixels); box size from the latest detection.
-3. Cost: minimum cosine distance to the track's gallery of ``gallery_size`` features, plus a location
-   term ``location_weight · d²/location_gate`` where tracks tie within ``tie_margin``; pairs beyond
-   ``location_gate`` (squared Mahalanobis) or ``appearance_threshold`` are not allowed.
+3. Cost: minimum cosine distance to the track's gallery, plus ``location_weight · d²/location_gate`` where tracks tie
+   within ``tie_margin``; pairs beyond ``location_gate`` (squared Mahalanobis) or ``appearance_threshold`` excluded.
 4. Tentative tracks: confirmed after ``n_init`` consecutive matches, deleted at their first miss.
-5. Long-term re-identification: tracks unseen over ``long_term_after`` frames match on appearance alone
-   (``long_term_threshold``).
-6. Identity recovery: a young confirmed track merges into an older lost one when enough gallery
-   distances are below ``recovery_threshold`` (:attr:`DiverSort.merges` records each merge).
-7. Persistent identities: at most ``max_lost`` unseen confirmed tracks are kept.
-
-Defaults and their sources: docs/trackers/diversort.md."""
+5. Long-term re-identification: tracks unseen over ``long_term_after`` frames match on appearance alone.
+6. Identity recovery: a young confirmed track merges into an older lost one with enough gallery distances below
+   ``recovery_threshold`` (:attr:`DiverSort.merges`).
+7. Persistent identities: at most ``max_lost`` unseen confirmed tracks are kept."""
 
 from __future__ import annotations
 

@@ -1,8 +1,5 @@
-"""SORT (Bewley et al., 2016): Kalman filter on ``[u, v, s, r]``, IoU cost, Hungarian matching.
-
-Follows the reference implementation (its ``R``, ``P0`` and per-frame ``Q``; maximum-IoU association with pairs below
-``iou_threshold`` rejected; reported after ``min_hits`` hits or in the first ``min_hits`` frames; deleted after
-``max_age`` frames unseen). Tracks are updated together as arrays (:mod:`lookalike.trackers.parts.sort_tracks`)."""
+"""SORT (Bewley et al., 2016) as its reference implementation: Kalman filter on ``[u, v, s, r]``, maximum-IoU matching,
+reported after ``min_hits`` hits or in the first ``min_hits`` frames (:mod:`lookalike.trackers.parts.sort_tracks`)."""
 
 from __future__ import annotations
 

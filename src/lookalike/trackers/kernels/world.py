@@ -173,7 +173,6 @@ def warm() -> bool:
     # (each kernel called with the argument types of the trackers' calls: float64 and int arrays, C order)
     th, times, samples = np.full((2, 2, 2), np.nan), np.zeros(1), np.zeros((1, 1))
     kernels.window_costs(th, times, times, samples, 1.0, 1.0, np.empty((1, 2)))
-    kernels.identity_work(th, times, times, samples, np.zeros(1, dtype=int), 1.0, 1.0, 0.1, 0.3)
     _, cost, _, _ = kernels.identity_rows_work(th, times, times, np.full((2, 1), np.nan), np.full(2, -1),
                                                np.zeros(1, dtype=int), 1.0, 1.0, 0.1, 0.3)
     kernels.identity_results(np.zeros(0, dtype=int), np.zeros(0, dtype=int), cost, np.full(2, -1),

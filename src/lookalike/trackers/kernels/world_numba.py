@@ -99,52 +99,30 @@ def window_costs(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np
 
 
 @_jit
-def identity_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, samples: np.ndarray, current: np.ndarray,
-                  max_turn_rate: float, max_extrapolation_s: float, hysteresis: float,
-                  max_cost: float) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-    """``BeaconIdentifier.assign_arrays`` up to the solver (``current (k,)``: each row's held agent, -1 none).
-    Returns ``(decision, cost, work, allowed)`` as ``world_kernels.pairs`` decides (0 none, 1 disjoint, 2 solve)."""
-    k, n = samples.shape[0], th.shape[1]
-    cost = np.empty((k, n))
-    window_costs(th, q, q_count, samples, max_turn_rate, max_extrapolation_s, cost)
-    work = np.empty((k, n))
-    allowed = np.zeros((k, n), np.bool_)
-    forbidden = max_cost + 1e-6
-    per_column = np.zeros(n, np.int64)
-    found, disjoint = False, True
-    for i in range(k):
-        per_row = 0
-        for j in range(n):
-            c = cost[i, j]
-            if j == current[i]:
-                c = _maximum(c - hysteresis, 0.0)
-            if c <= max_cost:
-                allowed[i, j] = True
-                work[i, j] = c
-                per_row += 1
-                per_column[j] += 1
-                found = True
-            else:
-                work[i, j] = forbidden
-        disjoint = disjoint and per_row <= 1
-    for j in range(n):
-        disjoint = disjoint and per_column[j] <= 1
-    return (0 if not found else 1 if disjoint else 2), cost, work, allowed
-
-
-@_jit
 def identity_rows_work(th: np.ndarray, q: np.ndarray, q_count: np.ndarray, win: np.ndarray, current: np.ndarray,
                        rows: np.ndarray, max_turn_rate: float, max_extrapolation_s: float, hysteresis: float,
                        max_cost: float) -> tuple[int, np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`identity_work` on ``win[rows]`` and ``current[rows]`` (gathered here)."""
-    k, w = rows.shape[0], win.shape[1]
+    """``BeaconIdentifier.assign_arrays`` up to the solver for the sample rows ``win[rows]`` held by agents
+    ``current[rows]`` (-1: none). Returns ``(decision, cost, work, allowed)`` as ``world_kernels.pairs`` decides (0
+    none, 1 disjoint, 2 solve)."""
+    k, w, n = rows.shape[0], win.shape[1], th.shape[1]
     samples = np.empty((k, w))
-    held = np.empty(k, np.int64)
     for i in range(k):
-        held[i] = current[rows[i]]
         for j in range(w):
             samples[i, j] = win[rows[i], j]
-    return identity_work(th, q, q_count, samples, held, max_turn_rate, max_extrapolation_s, hysteresis, max_cost)
+    cost = np.empty((k, n))
+    window_costs(th, q, q_count, samples, max_turn_rate, max_extrapolation_s, cost)
+    work = cost.copy()
+    for i in range(k):
+        a = current[rows[i]]
+        if a >= 0:
+            work[i, a] = _maximum(work[i, a] - hysteresis, 0.0)
+    allowed, found, disjoint = _allowed(work, max_cost)
+    for i in range(k):
+        for j in range(n):
+            if not allowed[i, j]:
+                work[i, j] = max_cost + 1e-6
+    return (0 if not found else 1 if disjoint else 2), cost, work, allowed
 
 
 @_jit
@@ -217,28 +195,34 @@ def gate_work_lower(factor: np.ndarray, z: np.ndarray, mean: np.ndarray,
 
 
 @_jit
+def _allowed(work: np.ndarray, limit: float) -> tuple[np.ndarray, bool, bool]:
+    """Which entries of ``work (k, d)`` are at most ``limit``, whether any is, and whether they are disjoint."""
+    k, d = work.shape
+    allowed = np.zeros((k, d), np.bool_)
+    per_row = np.zeros(k, np.int64)
+    per_column = np.zeros(d, np.int64)
+    for i in range(k):
+        for j in range(d):
+            if work[i, j] <= limit:
+                allowed[i, j] = True
+                per_row[i] += 1
+                per_column[j] += 1
+    found = per_row.sum() > 0
+    return allowed, found, found and per_row.max() <= 1 and per_column.max() <= 1
+
+
+@_jit
 def _gate_decision(work: np.ndarray, gate: float) -> tuple[int, np.ndarray, np.ndarray]:
     """The rest of :func:`gate_work`, in place on the squared distances ``work (k, d)``."""
     k, d = work.shape
-    allowed = np.zeros((k, d), np.bool_)
-    per_column = np.zeros(d, np.int64)
-    found, disjoint = False, True
-    low = np.inf
-    for i in range(k):
-        per_row = 0
-        for j in range(d):
-            c = work[i, j]
-            if c <= gate:
-                allowed[i, j] = True
-                per_row += 1
-                per_column[j] += 1
-                found = True
-                low = _minimum(low, c)
-        disjoint = disjoint and per_row <= 1
-    for j in range(d):
-        disjoint = disjoint and per_column[j] <= 1
+    allowed, found, disjoint = _allowed(work, gate)
     if not found or disjoint:
         return (1 if found else 0), work, allowed
+    low = np.inf
+    for i in range(k):
+        for j in range(d):
+            if allowed[i, j]:
+                low = _minimum(low, work[i, j])
     top = 0.0  # (the forbidden pairs' 0.0 takes part in the maximum)
     for i in range(k):
         for j in range(d):

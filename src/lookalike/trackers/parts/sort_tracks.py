@@ -1,12 +1,7 @@
-"""SORT's tracks as one array, updated with a few array operations per frame.
-
-SORT's Kalman filter (state ``[u, v, s, r, u', v', s']``, constant velocity, diagonal noises) keeps a block-diagonal
-covariance, so a track is 20 numbers ``[x1 (4) | x2 (4) | p11 (4) | p12 (4) | p22 (4)]`` and the update is element-wise:
-the full 7×7 filter to rounding (tests/test_sort.py compares it with a one-track-at-a-time oracle).
-
-Association is the reference's: IoU on ``xyxy``, direct matches when pairs above the threshold are disjoint, else a
-maximum-IoU matching. From :data:`SPARSE_FROM` pairs only boxes whose x-ranges overlap are compared, solved per
-connected component (the same matches wherever the matching is unique)."""
+"""SORT's tracks as one array: its Kalman filter (``[u, v, s, r, u', v', s']``, constant velocity, diagonal noise) keeps
+a block-diagonal covariance, so a track is 20 numbers ``[x1 (4) | x2 (4) | p11 (4) | p12 (4) | p22 (4)]`` updated
+element-wise (the full 7×7 filter to rounding). Association is the reference's IoU matching; from :data:`SPARSE_FROM`
+pairs only boxes whose x-ranges overlap are compared, solved per connected component."""
 
 from __future__ import annotations
 

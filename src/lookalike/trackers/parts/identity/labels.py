@@ -17,7 +17,7 @@ def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np
     if n_detections < 0:
         raise ValueError(f"n_detections must be >= 0, got {n_detections}")
     if isinstance(tracks, Tracks):
-        return _labels_from_columns(n_detections, tracks)
+        return np.array(_label_list(n_detections, tracks), dtype=int)  # (columns read as lists: a frame is small)
     label = np.full(n_detections, -1, dtype=int)
     best = np.full(n_detections, -np.inf)
     claimed: dict[int, float] = {}
@@ -40,18 +40,11 @@ def labels_from_tracks(n_detections: int, tracks: Sequence[TrackSnapshot]) -> np
 
 
 def label_list(n_detections: int, tracks: Sequence[TrackSnapshot]) -> list[int]:
-    """:func:`labels_from_tracks` as a list of ints (the columns of :class:`Tracks` are read without
-    building the array)."""
+    """:func:`labels_from_tracks` as a list of ints."""
     if isinstance(tracks, Tracks) and n_detections >= 0:
         return _label_list(n_detections, tracks)
     out: list[int] = labels_from_tracks(n_detections, tracks).tolist()
     return out
-
-
-def _labels_from_columns(n_detections: int, tracks: Tracks) -> np.ndarray:
-    """:func:`labels_from_tracks` on columns (same rule and result, without per-track snapshots;
-    a frame holds a few tracks, so the columns are read as lists)."""
-    return np.array(_label_list(n_detections, tracks), dtype=int)
 
 
 def _label_list(n_detections: int, tracks: Tracks) -> list[int]:

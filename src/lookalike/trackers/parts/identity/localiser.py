@@ -1,13 +1,5 @@
-"""Agent positions from the detections an identifier assigns to each agent (observer frame, metres).
-
-Both localisers have ``update(time_s, measured (N, 2), weight (N,)) -> (N, 2)`` (NaN rows: not detected;
-NaN output until an agent's first detection):
-
-- :class:`LowPassLocaliser`: the robot-identification paper's low-pass filter ``T_j ← α·L_k + (1 − α)·T_j``
-  (``α`` the assignment's class probability).
-- :class:`KalmanLocaliser`: a constant-velocity Kalman filter per agent with decaying velocity, noise growing
-  with distance and shrinking with ``α``, a chi-square gate with restarts, and no position after
-  ``max_coast_s`` without detections."""
+"""Agent positions (observer frame, metres) from the detections an identifier assigns to each agent: both localisers
+have ``update(time_s, measured (N, 2), weight (N,)) -> (N, 2)`` (NaN rows: not detected, or no position yet)."""
 
 from __future__ import annotations
 
@@ -21,7 +13,7 @@ LOCALISERS = ("lowpass", "kalman")
 
 
 class LowPassLocaliser:
-    """The robot-identification paper's first-order low-pass filter (class probability as smoothing factor)."""
+    """The robot-identification paper's low-pass filter ``T_j ← α·L_k + (1 − α)·T_j`` (``α``: class probability)."""
 
     def __init__(self, n_agents: int) -> None:
         self.n_agents = n_agents
@@ -72,7 +64,8 @@ _H = np.hstack([np.eye(2), np.zeros((2, 2))])
 
 
 class KalmanLocaliser:
-    """Per-agent Kalman filters on ``[x, y, vx, vy]`` fed by the assigned detections."""
+    """Per-agent constant-velocity Kalman filters on ``[x, y, vx, vy]`` with decaying velocity, noise growing with
+    distance and shrinking with ``α``, a chi-square gate with restarts, no position after ``max_coast_s`` unseen."""
 
     def __init__(self, n_agents: int, config: KalmanLocaliserConfig | None = None) -> None:
         self.n_agents = n_agents
@@ -118,10 +111,7 @@ class KalmanLocaliser:
             weight, cfg.min_weight, 1.0) ** (cfg.weight_power / 2)
         R = (std**2)[:, None, None] * np.eye(2)
         start = seen & ~self._started
-        for j in np.flatnonzero(start):
-            self._mean[j] = (z[j, 0], z[j, 1], 0.0, 0.0)
-            self._cov[j] = np.diag([std[j] ** 2, std[j] ** 2, 0.5, 0.5])
-            self._started[j] = True
+        self._started |= start
         live = np.flatnonzero(seen & ~start)
         if len(live):
             m, P, zj, Rj = self._mean[live], self._cov[live], z[live], R[live]
@@ -133,11 +123,11 @@ class KalmanLocaliser:
             if accept.any():
                 mu, Pu = kalman.update(m[accept], P[accept], zj[accept], _H, Rj[accept])
                 self._mean[live[accept]], self._cov[live[accept]] = mu, Pu
-            for k in np.flatnonzero(restart):
-                j = live[k]
-                self._mean[j] = (z[j, 0], z[j, 1], 0.0, 0.0)
-                self._cov[j] = np.diag([std[j] ** 2, std[j] ** 2, 0.5, 0.5])
+            start[live[restart]] = True
             self._rejects[live] = np.where(accept | restart, 0, self._rejects[live] + 1)
+        for j in np.flatnonzero(start):  # (new filters, and those restarted)
+            self._mean[j] = (z[j, 0], z[j, 1], 0.0, 0.0)
+            self._cov[j] = np.diag([std[j] ** 2, std[j] ** 2, 0.5, 0.5])
         self._last_seen = np.where(seen, time_s, self._last_seen)
         fresh = self._started & (time_s - self._last_seen <= cfg.max_coast_s)
         return np.where(fresh[:, None], self._mean[:, :2], np.nan)
