@@ -1,9 +1,5 @@
-"""The set associator evaluated with numpy only, its input tokens and its weight files (``.npz`` + ``.json``).
-
-Same maths as the training model (``lookalike.learn.set_model.SetAssociator``) for one sequence: any number of
-agents N and detections K per frame, no padding (absent detections simply are not passed). The shipped weights
-(:data:`SHIPPED_SET_WEIGHTS`, one file for every N and M) sit beside this module.
-"""
+"""The set associator in numpy (``lookalike.learn.set_model.SetAssociator``'s maths for one sequence, any N agents and
+K detections per frame, no padding), its input tokens and weight files (``.npz`` + ``.json``)."""
 
 from __future__ import annotations
 
@@ -126,11 +122,7 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 
 
 class NumpySetAssociator:
-    """Frame-by-frame evaluation: :meth:`reset` for N agents, then :meth:`step` per frame.
-
-    ``step(agents (N,4), dets (K,5), dt_s)`` returns class probabilities ``(K, N+1)`` (agents, then
-    false positive) and advances each agent's memory, remembered position and staleness.
-    """
+    """Frame-by-frame evaluation: :meth:`reset` for N agents, then :meth:`step` per frame."""
 
     def __init__(self, weights: SetWeights) -> None:
         self.weights = weights
@@ -169,7 +161,8 @@ class NumpySetAssociator:
         return self.m[:, 0] > threshold
 
     def step(self, agents: np.ndarray, dets: np.ndarray, dt_s: float) -> np.ndarray:
-        """Advance one frame; return ``(K, N+1)`` probabilities."""
+        """Advance each agent's memory, remembered position and staleness by one frame (agent tokens ``(N, 4)``,
+        detection tokens ``(K, 5)``); return class probabilities ``(K, N+1)`` (agents, then false positive)."""
         t, b = self._t, self._b
         agents = np.asarray(agents, dtype=float)
         dets = np.asarray(dets, dtype=float).reshape(-1, 5)

@@ -66,10 +66,9 @@ class ReportExchange:
         self.p[a], self.t[a] = p - np.outer(gain, p[0]), t
 
     def add(self, agent: int, t_sent: float, heading: float, scale: np.ndarray | None = None) -> tuple[int, int] | None:
-        """Take one report (send time in seconds, absolute heading in radians); a report not newer than the
-        agent's newest is ignored; ``scale`` (n) a factor on the threshold of the agent's pair with each other agent
-        (None: 1). Returns the exchanged pair ``(agent, other)`` when this report completes an exchange (the two
-        tracks are exchanged already), else None."""
+        """Take one report (send time s, heading rad; ignored unless newer than the agent's newest); ``scale (n,)``: a
+        factor on the threshold of each pair with ``agent`` (None: 1). Returns the pair ``(agent, other)`` when this
+        report completes an exchange (the tracks exchanged already), else None."""
         a = agent
         if not (t_sent > self.newest[a] and np.isfinite(heading)):
             return None
@@ -102,9 +101,7 @@ class ReportExchange:
         return a, b
 
     def swap(self, a: int, b: int) -> None:
-        """Exchange the tracks of agents ``a`` and ``b`` and clear their evidence: their report streams now
-        continue each other's. Their queued reports straddle the exchange and are dropped (the tracks predict
-        over the gap)."""
+        """Exchange the tracks of agents ``a`` and ``b``, clear their evidence and drop their queued reports."""
         for arr in (self.x, self.p, self.t):
             arr[[a, b]] = arr[[b, a]]
         self.queue[a].clear()
@@ -113,8 +110,7 @@ class ReportExchange:
         self.evidence[:, [a, b]] = 0.0
 
     def forget(self, a: int) -> None:
-        """Start agent ``a``'s track afresh from its next report (its reports now come from a robot no other
-        agent reported for) and clear its evidence."""
+        """Start agent ``a``'s track afresh from its next report and clear its evidence."""
         self.t[a] = np.nan
         self.queue[a].clear()
         self.evidence[a, :] = 0.0

@@ -22,8 +22,6 @@ class ReportJumps:
     """Report jumps over the agents' newest reports (see the module)."""
 
     def __init__(self, jump: float, turn_rate: float) -> None:
-        """``jump``: radians a report may turn beyond ``turn_rate`` (rad/s) times the time since the agent's previous
-        one."""
         self.jump, self.turn_rate = jump, turn_rate
         self.expected: dict[int, float] = {}  # agent -> send time of the exchange whose second half it awaits
         self.pending: Waiting = {}  # jumps waiting for their mirror
@@ -31,9 +29,8 @@ class ReportJumps:
 
     def find(self, old: np.ndarray, t_old: np.ndarray, new: np.ndarray, t_new: np.ndarray,
              now: float) -> list[Action]:
-        """The actions on the agents' memories, in order, given each agent's previous newest report (``old``
-        heading, radians, sent at ``t_old`` seconds) and its newest now (``new``, ``t_new``), at frame time ``now``
-        (seconds)."""
+        """The actions on the agents' memories, in order, from each agent's previous newest report (``old`` heading,
+        sent at ``t_old`` s) and its newest now (``new``, ``t_new``), at frame time ``now``."""
         actions: list[Action] = []
         fresh = np.isfinite(old) & np.isfinite(new) & (t_new > t_old)
         if fresh.any():
@@ -54,8 +51,8 @@ class ReportJumps:
         return actions
 
     def exchanged(self, pair: tuple[int, int], t_sent: float) -> None:
-        """Another rule exchanged ``pair`` on a report sent at ``t_sent`` seconds: a jump of either agent within the
-        next second is the same exchange, and neither waits any more."""
+        """Another rule exchanged ``pair`` on a report sent at ``t_sent`` s: a jump of either agent within
+        :data:`SAME_EXCHANGE_S` is the same exchange, and neither waits any more."""
         for j in pair:
             self.expected[j] = t_sent
             self.pending.pop(j, None)
@@ -63,10 +60,8 @@ class ReportJumps:
 
     def _swap(self, jumped: np.ndarray, old: np.ndarray, t_old: np.ndarray, new: np.ndarray, t_new: np.ndarray,
               actions: list[Action]) -> None:
-        """An agent ``a`` whose reports jumped now reports for the robot that exactly one other
-        agent ``b`` reported for just before (within ``jump`` + ``turn_rate`` · the time between the two reports):
-        the two exchange memories, and ``b``'s own jump, expected within a second, changes nothing more. An agent
-        with no such partner, or several, waits for its mirror (looked for before the partner)."""
+        """Each agent ``a`` of ``jumped`` exchanges memories with its mirror among the waiting jumps, else with the one
+        agent ``b`` that reported its new heading just before (whose own jump then changes nothing), else waits."""
         done: set[int] = set()
         for a in jumped.tolist():
             if a in done:
@@ -97,9 +92,8 @@ class ReportJumps:
 
     def _after_silence(self, agents: np.ndarray, old: np.ndarray, new: np.ndarray, t_new: np.ndarray,
                        actions: list[Action]) -> None:
-        """Each of ``agents`` reports, after a silence, a heading more than ``jump`` off its
-        previous report, too long after it to call a jump. When a waiting jump mirrors it, the two exchange
-        memories; otherwise it waits as well, and is dropped without forgetting anything."""
+        """Each of ``agents`` reports after a silence a heading over ``jump`` off its previous one: exchanged with a
+        mirroring waiting jump, else it waits too (dropped later without forgetting anything)."""
         for c in agents.tolist():
             if c in self.pending:
                 continue
@@ -111,9 +105,8 @@ class ReportJumps:
                 self.silent[c] = (float(old[c]), heading, float(t_new[c]))
 
     def _mirror(self, a: int, old: float, new: float, t: float, waiting: Waiting) -> int | None:
-        """The agent in ``waiting`` (its match removed) whose jump mirrors agent ``a``'s jump from heading ``old`` to
-        ``new`` at ``t`` seconds: it now reports ``old`` and reported ``new`` before, each within ``jump`` +
-        ``turn_rate`` · the time between the two jumps (the closest of several; None: none)."""
+        """The closest agent in ``waiting`` (removed from it) mirroring ``a``'s jump from ``old`` to ``new`` at ``t``
+        seconds within ``jump`` + ``turn_rate`` · the time between them (None: none)."""
         best, best_error = None, np.inf
         for c, (old_c, new_c, t_c) in waiting.items():
             if c == a:

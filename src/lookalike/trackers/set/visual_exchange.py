@@ -17,9 +17,8 @@ STALE_RAD_S = 0.5  # widening of an older report's noise, radians per second of 
 
 
 def take_pairs(evidence: np.ndarray, threshold: float | np.ndarray) -> list[tuple[int, int]]:
-    """The pairs ``(a, b)``, ``a < b``, whose symmetric ``evidence`` passes ``threshold`` (one for all, or one per
-    pair), the strongest first and each agent at most once; their rows and columns are cleared in place (their
-    evidence starts again)."""
+    """The pairs ``(a, b)``, ``a < b``, whose symmetric ``evidence`` passes ``threshold`` (scalar or per pair), the
+    strongest first, each agent at most once; their rows and columns cleared in place."""
     pairs = []
     while (passing := evidence > threshold).any():
         a, b = np.unravel_index(int(np.argmax(np.where(passing, evidence, -np.inf))), evidence.shape)
