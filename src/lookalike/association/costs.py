@@ -9,14 +9,12 @@ from lookalike.geometry.boxes import iou_matrix
 
 def iou_cost(track_xywh: np.ndarray, det_xywh: np.ndarray, min_iou: float = 0.0,
              det_weight: np.ndarray | None = None) -> np.ndarray:
-    """``1 - IoU`` (``1 - IoU·weight`` with a per-detection ``det_weight``, e.g. its score) for every
-    track/detection pair, ``inf`` where IoU < ``min_iou``: ``(k, d)``."""
+    """``(k, d)`` costs ``1 - IoU`` (times ``det_weight`` per detection, if given), ``inf`` below ``min_iou``."""
     return cost_from_iou(iou_matrix(track_xywh, det_xywh), min_iou, det_weight)
 
 
 def iou_columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """:func:`~lookalike.geometry.boxes.iou_matrix` of boxes given as columns, ``a (4, m)`` and ``b (4, n)`` (rows left,
-    top, width, height; pixels): ``(m, n)``, the same numbers bit for bit, with x and y handled together."""
+    """:func:`~lookalike.geometry.boxes.iou_matrix` bit for bit, of column boxes ``a (4, m)``, ``b (4, n)``."""
     lo_a, lo_b = a[0:2, :, None], b[0:2, None, :]
     side = np.minimum(lo_a + a[2:4, :, None], lo_b + b[2:4, None, :])
     side -= np.maximum(lo_a, lo_b)
@@ -32,8 +30,7 @@ def iou_columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def cost_from_iou(iou: np.ndarray, min_iou: float = 0.0, det_weight: np.ndarray | None = None) -> np.ndarray:
-    """:func:`iou_cost` from an IoU matrix ``(k, d)`` already computed (e.g. a block of a frame's
-    whole track × detection matrix)."""
+    """:func:`iou_cost` from an IoU matrix ``(k, d)`` already computed."""
     cost = 1.0 - (iou if det_weight is None else iou * det_weight[None, :])
     if min_iou > 0:
         cost[iou < min_iou] = np.inf

@@ -92,8 +92,7 @@ class _PlanLists:
         self.left: list[bool] | None = None
 
     def run(self, stage: Stage, gate: np.ndarray, matching: Matching, index: int) -> bool:
-        """Run a gated stage from the gate's allowed pairs when those still eligible are disjoint; False, having
-        changed nothing, when they compete."""
+        """Run a gated stage from its disjoint allowed pairs; False, changing nothing, when they compete."""
         masks = self.masks
         pairs = self.pairs.get(id(gate))
         if pairs is None:
@@ -167,8 +166,7 @@ def run_stage(stage: Stage, matching: Matching, index: int = 0, _lists: _PlanLis
 
 def run_plan(stages: list[Stage], n_tracks: int, n_detections: int,
              start: Matching | None = None) -> Matching:
-    """Run ``stages`` in order on ``n_tracks`` tracks and ``n_detections`` detections (or on what
-    ``start`` left over); return the matches and the left-overs."""
+    """Run ``stages`` in order on the tracks and detections (or on what ``start`` left over)."""
     matching = start if start is not None else Matching.empty(n_tracks, n_detections)
     lists = _PlanLists()  # what the gated stages share, found once per plan
     for i, stage in enumerate(stages):

@@ -47,8 +47,7 @@ def xysr_to_xywh(xysr: np.ndarray) -> np.ndarray:
 
 
 def iou_matrix(xywh_a: np.ndarray, xywh_b: np.ndarray) -> np.ndarray:
-    """Intersection over union ``(n, m)`` of every box in ``a`` with every box in ``b`` (0, never NaN, for empty
-    unions)."""
+    """Intersection over union ``(n, m)`` of every box in ``a`` with every box in ``b`` (0 for empty unions)."""
     a = np.asarray(xywh_a, dtype=float).reshape(-1, 4)
     b = np.asarray(xywh_b, dtype=float).reshape(-1, 4)
     ax1, ay1 = a[:, 0:1], a[:, 1:2]

@@ -145,8 +145,7 @@ class Camera:
         return self.points_to_pixels(np.column_stack([xy, z]))
 
     def pixels_to_ground(self, uv_px: np.ndarray, z_m: float = 0.0) -> np.ndarray:
-        """Egocentric positions ``(n, 2)`` where the rays through pixels ``(n, 2)`` meet the plane
-        ``z = z_m``; NaN for rays that never reach it (at or above the horizon)."""
+        """Where the rays through pixels ``(n, 2)`` meet the plane ``z = z_m``, egocentric ``(n, 2)``; NaN if never."""
         uv = _rows("uv_px", uv_px, 2)
         k = self.intrinsics
         rays_cam = np.column_stack([(uv[:, 0] - k.cx) / k.fx, (uv[:, 1] - k.cy) / k.fy, np.ones(len(uv))])

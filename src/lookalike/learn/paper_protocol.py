@@ -1,5 +1,4 @@
-"""Training arrays in the robot-identification paper's input layout (``N + 4·M``) and a sampler drawing each
-sequence's noise model from its seed."""
+"""Training arrays in the robot-identification paper's layout ``N + 4·M``, and a noise-mix sampler."""
 
 from __future__ import annotations
 
@@ -42,8 +41,7 @@ def arrays_to_training_paper(
 
 @dataclasses.dataclass(frozen=True)
 class NoiseMixSampler:
-    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler: each sequence simulates one of ``worlds``
-    (:func:`mix_pick`), encoded by ``spec``'s protocol."""
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler over ``worlds`` (:func:`mix_pick`)."""
 
     worlds: tuple[RobotWorldConfig, ...]
     spec: EncodingSpec

@@ -1,5 +1,4 @@
-"""The simulator's detector model (:class:`~lookalike.sim.robots_config.SensorConfig`) measured on labelled recordings
-that carry the simulator's truth."""
+"""The simulator's detector model (``SensorConfig``) measured on labelled recordings with truth."""
 
 from __future__ import annotations
 

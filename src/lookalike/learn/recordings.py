@@ -1,5 +1,4 @@
-"""Training arrays from labelled recordings (``.labelled.jsonl``, the simulator's format) for fine-tuning; validation
-splits by recording."""
+"""Training arrays from labelled recordings for fine-tuning; validation splits by recording."""
 
 from __future__ import annotations
 
@@ -35,8 +34,7 @@ def check_recordings(spec: EncodingSpec, recordings: Sequence[RobotSequence], na
 
 
 def split_recordings(n: int, validation_fraction: float, seed: int = 0) -> tuple[list[int], list[int]]:
-    """Indices ``(training, validation)`` of ``n`` >= 2 recordings, ``round(fraction·n)`` (at least one) for
-    validation."""
+    """Indices ``(training, validation)`` of ``n`` >= 2 recordings, ``round(fraction·n)`` >= 1 for validation."""
     if n < 2:
         raise ValueError(f"need at least 2 recordings for a validation split by recording, got {n}")
     if not 0.0 < validation_fraction < 1.0:
@@ -86,8 +84,7 @@ class RecordingSampler:
 
 def validation_arrays(spec: EncodingSpec, recordings: Sequence[RobotArrays], bptt: int
                       ) -> tuple[np.ndarray, np.ndarray]:
-    """Whole recordings as one batch ``(B, T, n_inputs)``, ``(B, T, M)``, slots most probable first, padded
-    to the longest (rounded up to a multiple of ``bptt`` frames)."""
+    """Whole recordings as one batch ``(B, T, n_inputs)``, ``(B, T, M)``, padded to a multiple of ``bptt``."""
     pairs = [recording_arrays(spec, a) for a in recordings]
     longest = max(len(x) for x, _ in pairs)
     length = -(-longest // bptt) * bptt

@@ -39,8 +39,7 @@ class SearchSpace:
 
     @classmethod
     def parse(cls, text: str) -> SearchSpace:
-        """From ``"hidden=16:256,layers=1:6,learning_rate=3e-4:3e-2"`` (names left out keep their defaults);
-        ``ValueError`` naming the bad part."""
+        """From ``"hidden=16:256,layers=1:6,learning_rate=3e-4:3e-2"`` (omitted names keep their defaults)."""
         ranges: dict[str, Any] = {}
         for part in (p.strip() for p in text.split(",") if p.strip()):
             name, _, span = part.partition("=")

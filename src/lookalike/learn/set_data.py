@@ -56,8 +56,7 @@ class TeamSizes:
             raise ValueError(f"TeamSizes: need 0 <= focus_prob <= 1 and focus teams when > 0, got {self.focus_prob}")
 
     def draw(self, rng: np.random.Generator) -> tuple[int, int, float]:
-        """``(N, M, false positives per frame)``; with ``focus_prob`` > 0 one of the ``focus`` teams
-        ``(N, M, fp)`` that often (e.g. more weight on the small set-ups)."""
+        """``(N, M, false positives per frame)``; one of the ``focus`` teams with ``focus_prob``."""
         if self.focus_prob > 0 and rng.random() < self.focus_prob:
             n, m, fp = self.focus[int(rng.integers(len(self.focus)))]
             return int(n), int(m), float(fp)
@@ -76,8 +75,7 @@ Batch = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]
 
 
 def closest_headings(arrays: RobotArrays, at_s: float) -> tuple[int, int]:
-    """The two robots (lower id first) whose true headings are closest at the first frame at or after
-    ``at_s`` seconds (the last frame if none)."""
+    """The two robots (lower id first) whose true headings are closest at ``at_s`` seconds."""
     t = min(int(np.searchsorted(arrays.time, at_s)), len(arrays) - 1)
     h = arrays.true_heading[t]
     gap = np.abs(np.angle(np.exp(1j * (h[:, None] - h[None, :]))))

@@ -77,8 +77,7 @@ class SetAssociator(nn.Module):
     def step(self, agents: torch.Tensor, dets: torch.Tensor, valid: torch.Tensor, dt_s: float,
              state: tuple[torch.Tensor, ...], pre: tuple[torch.Tensor, torch.Tensor] | None = None,
              ) -> tuple[torch.Tensor, tuple[torch.Tensor, ...]]:
-        """One frame: ``agents (B,N,4)``, ``dets (B,M,5)``, ``valid (B,M)`` -> log-probs ``(B,M,N+1)``;
-        ``pre``: this frame's :meth:`precompute` output, if already computed."""
+        """One frame: ``agents (B,N,4)``, ``dets (B,M,5)``, ``valid (B,M)`` -> log-probs ``(B,M,N+1)``."""
         h, p, m, s = state
         B, N, _ = agents.shape
         u, pair_pre = pre if pre is not None else self.precompute(agents, dets)

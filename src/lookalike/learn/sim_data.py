@@ -20,8 +20,7 @@ def slot_order(arrays: RobotArrays, rng: np.random.Generator | None) -> np.ndarr
 
 
 def latest_reports(arrays: RobotArrays, n_agents: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per frame and agent, the newest report (by send time) received so far: headings and send times ``(T, N)``,
-    NaN where nothing was received yet."""
+    """Per frame and agent, the newest report received: headings and send times ``(T, N)``, NaN before any."""
     r = arrays.reports
     T = len(arrays)
     heading = np.full((T, n_agents), np.nan)
@@ -45,8 +44,7 @@ def latest_reports(arrays: RobotArrays, n_agents: int) -> tuple[np.ndarray, np.n
 def arrays_to_training(
     spec: EncodingSpec, arrays: RobotArrays, rng: np.random.Generator | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Inputs ``(T, n_inputs)`` and targets ``(T, M)`` from a simulated sequence; slots ordered by
-    :func:`slot_order`."""
+    """Inputs ``(T, n_inputs)`` and targets ``(T, M)``; slots ordered by :func:`slot_order`."""
     T, M = arrays.det_valid.shape
     if M != spec.n_slots:
         raise ValueError(f"the sequence has {M} detection slots, the encoding {spec.n_slots}")
@@ -98,8 +96,7 @@ def silence_agent(arrays: RobotArrays, agent: int, start_s: float, stop_s: float
 
 @dataclasses.dataclass(frozen=True)
 class SimSampler:
-    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler over ``config``; ``swap_prob``: fraction of sequences
-    in which two random robots swap identities for 1–10 s."""
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler; ``swap_prob``: share of 1–10 s identity swaps."""
 
     config: RobotWorldConfig
     relative: bool = True
@@ -129,8 +126,7 @@ def mix_pick(seed: int, count: int) -> int:
 
 @dataclasses.dataclass(frozen=True)
 class WorldMixSampler:
-    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler: each sequence from one of ``samplers``, chosen by
-    :func:`mix_pick`."""
+    """A picklable ``(seed, n_frames, rng) -> (x, y)`` sampler over ``samplers`` (:func:`mix_pick`)."""
 
     samplers: tuple[SimSampler, ...]
 

@@ -75,8 +75,7 @@ Sampler = Callable[[int, int, "np.random.Generator | None"], tuple[np.ndarray, n
 
 
 def make_batch(sample: Sampler, seeds: Sequence[int], length: int) -> tuple[np.ndarray, np.ndarray]:
-    """Inputs ``(B, T, n_inputs)`` and targets ``(B, T, M)``; slots shuffled by a generator seeded
-    from each sequence's seed, so a batch depends on ``seeds`` alone."""
+    """Inputs ``(B, T, n_inputs)`` and targets ``(B, T, M)``, a function of ``seeds`` alone."""
     xs, ys = zip(*(sample(int(s), length, np.random.default_rng([int(s), 1])) for s in seeds))
     return np.stack(xs), np.stack(ys)
 
@@ -90,23 +89,9 @@ def _validate(model: AssociationNet, x: torch.Tensor, y: np.ndarray) -> float:
     return correct / max(total, 1)
 
 
-def _validation_batch(config: TrainConfig, sample: Sampler, given: tuple[np.ndarray, np.ndarray] | None
-                      ) -> tuple[np.ndarray, np.ndarray]:
-    if given is not None:
-        return given
-    seeds = [VALIDATION_SEED_BASE + i for i in range(config.validation_sequences)]
-    return make_batch(sample, seeds, config.sequence_length)
-
-
-def _train_seeds(config: TrainConfig, step: int) -> np.ndarray:
-    return TRAIN_SEED_BASE + config.seed * 10_000_000 + step * config.batch_size + np.arange(config.batch_size)
-
-
-
 def _train_chunks(model: Any, xt: Any, yt: Any, config: TrainConfig, n_classes: int, loss_fn: Any, optimiser: Any,
                   schedule: Any) -> list[float]:
-    """One optimisation step per ``bptt`` chunk of the batch; the losses. A chunk without a label only carries the
-    state on."""
+    """One optimisation step per ``bptt`` chunk with a label; the losses."""
     state_h, losses = None, []
     for lo in range(0, config.sequence_length, config.bptt):
         target = yt[:, lo : lo + config.bptt]
@@ -148,7 +133,9 @@ def train(
                         protocol=config.protocol)
     if config.sequence_length % config.bptt:
         raise ValueError(f"sequence_length {config.sequence_length} must be a multiple of bptt {config.bptt}")
-    val_x, val_y = _validation_batch(config, validation_sample or sample, validation)
+    val_x, val_y = validation if validation is not None else make_batch(
+        validation_sample or sample, [VALIDATION_SEED_BASE + i for i in range(config.validation_sequences)],
+        config.sequence_length)
     model = AssociationNet(spec, config.hidden, config.num_layers, config.cell)
     if init is not None:
         model.load_exported(init)
@@ -189,7 +176,9 @@ def train(
             break
         for k in range(step, min(step + ahead, config.steps)):
             if k not in pending:
-                pending[k] = pool.submit(make_batch, sample, _train_seeds(config, k), config.sequence_length)
+                first = TRAIN_SEED_BASE + config.seed * 10_000_000 + k * config.batch_size
+                seeds = first + np.arange(config.batch_size)
+                pending[k] = pool.submit(make_batch, sample, seeds, config.sequence_length)
         x, y = pending.pop(step).result()
         xt, yt = torch.as_tensor(x, device=device), torch.as_tensor(y, device=device)
         losses = _train_chunks(model, xt, yt, config, spec.n_classes, loss_fn, optimiser, schedule)

@@ -1,5 +1,4 @@
-"""Training data for the robot detector (rendered or folder windows, negatives, held-out scenes) and the heading
-classifier (features and true headings of rendered robots)."""
+"""Training data for the robot detector and the heading classifier, from renders or image folders."""
 
 from __future__ import annotations
 
@@ -61,8 +60,7 @@ def _rendered_frames(n_frames: int, seed: int, camera: Camera | None = None) -> 
 
 
 def rendered_held_out_scenes(n_frames: int, seed: int, camera: Camera | None = None) -> list[Any]:
-    """Rendered frames as :class:`~lookalike.vision.hog_select.HeldOutScene`: robots at least half visible are
-    targets, the others in view are ignored."""
+    """Rendered frames as ``HeldOutScene``: robots at least half visible are targets, others ignored."""
     from lookalike.vision.hog_select import HeldOutScene
 
     return [HeldOutScene(f.image, f.xywh[f.visible >= 0.5], f.xywh[(f.visible < 0.5) & (f.visible > 0)])
@@ -109,8 +107,7 @@ def _read_grey(path: Path) -> np.ndarray:
 
 
 def folder_detector_data(folder: Path, window_px: tuple[int, int]) -> tuple[np.ndarray, list[np.ndarray]]:
-    """Positive windows from ``folder/positives`` (each image resized to the window) and negative images from
-    ``folder/negatives``."""
+    """Positive windows from ``folder/positives`` (resized) and negative images from ``folder/negatives``."""
     with needs("cv2"):
         import cv2
 

@@ -29,8 +29,7 @@ def chi2_cdf(x: float, dof: int) -> float:
 
 @lru_cache(maxsize=64)
 def chi2_gate(dof: int, probability: float = 0.95) -> float:
-    """The ``probability`` quantile of the chi-square distribution with ``dof`` degrees of freedom (``chi2_gate(4)
-    == 9.4877…``)."""
+    """The ``probability`` quantile of chi-square with ``dof`` degrees of freedom (``chi2_gate(4) == 9.4877…``)."""
     if dof < 1:
         raise ValueError(f"dof must be at least 1, got {dof}")
     if not 0.0 < probability < 1.0:

@@ -26,8 +26,7 @@ def _f1(order: int, dt: float) -> np.ndarray:
 
 
 def kinematic_transition(dim: int, order: int, dt: float) -> np.ndarray:
-    """The transition ``F(dt)`` alone of a kinematic model of ``order`` (1: constant velocity,
-    2: constant acceleration) in ``dim`` dimensions; ``dt`` in seconds or frames. Read-only (cached)."""
+    """The cached, read-only ``F(dt)`` of a kinematic model of ``order`` (1: velocity, 2: acceleration)."""
     _check(dim, dt)
     return _transition(dim, order, float(dt))
 

@@ -64,8 +64,7 @@ class Endpoint:
         self.sock.sendto(data, self.peer)
 
     def receive(self, timeout_s: float) -> Message | None:
-        """The next valid message within ``timeout_s`` seconds, or None; invalid datagrams are
-        counted in ``rejected`` and skipped."""
+        """The next valid message within ``timeout_s`` seconds, or None; invalid ones counted in ``rejected``."""
         deadline = time.monotonic() + timeout_s
         while True:
             remaining = deadline - time.monotonic()

@@ -63,15 +63,12 @@ class NodeCounters:
         out: dict[str, Any] = dict(self.events)
         out["rejected"] = dict(sorted(self.rejected.items()))
         out["rejected_total"] = sum(self.rejected.values())
-        if self.latency_s:
-            lat = np.asarray(self.latency_s) * 1e3
-            out["latency_ms"] = {"median": round(float(np.median(lat)), 4),
-                                 "p99": round(float(np.percentile(lat, 99)), 4), "frames": len(lat)}
-        for name, values in (("cpu_ms", self.cpu_s), ("cpu_with_prepare_ms", self.cpu_with_prepare_s)):
+        for name, values in (("latency_ms", self.latency_s), ("cpu_ms", self.cpu_s),
+                             ("cpu_with_prepare_ms", self.cpu_with_prepare_s)):
             if values:
-                cpu = np.asarray(values) * 1e3
-                out[name] = {"median": round(float(np.median(cpu)), 4),
-                             "p99": round(float(np.percentile(cpu, 99)), 4), "frames": len(cpu)}
+                ms = np.asarray(values) * 1e3
+                out[name] = {"median": round(float(np.median(ms)), 4),
+                             "p99": round(float(np.percentile(ms, 99)), 4), "frames": len(ms)}
         return out
 
     def status_line(self) -> str:

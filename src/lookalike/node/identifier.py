@@ -158,8 +158,7 @@ class TeamIdentifier:
         return "frames", self._team_state(frame, snapshots)
 
     def _forget_robots_ahead_of(self, time: float) -> None:
-        """Forget the sequence number and send time of every robot whose last report is more than
-        ``max_report_ahead_s`` after the frame ``time``."""
+        """Forget robots whose last report is more than ``max_report_ahead_s`` after the frame ``time``."""
         ahead = self._last_sent > time + self.config.max_report_ahead_s
         if ahead.any():
             self._last_sent[ahead] = -math.inf

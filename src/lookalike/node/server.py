@@ -174,8 +174,7 @@ class NodeServer:
             self.sock.close()
 
     def serve(self, stop: Callable[[], bool], tick_s: float = 0.05) -> None:
-        """Serve until ``stop()`` returns true (checked every ``tick_s`` seconds at least), with ``gc.freeze`` and
-        BLAS on this thread only."""
+        """Serve until ``stop()`` is true (checked every ``tick_s`` s), with ``gc.freeze`` and one BLAS thread."""
         gc.collect()
         gc.freeze()
         try:

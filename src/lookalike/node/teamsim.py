@@ -1,5 +1,4 @@
-"""Simulated robot and camera processes that talk to the node; each builds the same sequence (:func:`team_sequence`),
-so no truth travels."""
+"""Simulated robot and camera processes that talk to the node, from a shared :func:`team_sequence`."""
 
 from __future__ import annotations
 

@@ -1,5 +1,4 @@
-"""Running appearance trackers on simulated diver scenarios: render, detect, extract features, track. Hand-crafted
-features are standardised on the validation scenarios, never on the scored one."""
+"""Running appearance trackers on simulated diver scenarios: render, detect, extract features, track."""
 
 from __future__ import annotations
 
@@ -62,8 +61,7 @@ HANDCRAFTED_THRESHOLDS: dict[str, dict[str, float]] = {
 
 
 def diver_extractor(name: str) -> FeatureExtractor:
-    """Appearance features by name: ``handcrafted`` (calibrated on the validation divers), ``learned``
-    (the shipped ONNX embedding) or the path of an ONNX embedding network ``FILE.onnx``."""
+    """Appearance features: ``handcrafted``, ``learned`` (the shipped ONNX embedding) or ``FILE.onnx``."""
     if name == "handcrafted":
         return _handcrafted()
     from lookalike.vision.appearance_onnx import LEARNED_MODEL, OnnxAppearance
@@ -82,8 +80,7 @@ def _handcrafted() -> HandcraftedFeatures:
 
 def same_diver_distances(extractor: FeatureExtractor, scenarios: tuple[DiverScenario, ...] = VALIDATION_SCENARIOS,
                          every: int = 10) -> np.ndarray:
-    """Cosine distances between crops of the same diver (ground-truth boxes of every ``every``-th frame,
-    visibility >= 0.5) of each scenario, all pairs pooled."""
+    """Cosine distances between ground-truth crops (visibility >= 0.5) of the same diver, pooled."""
     out = []
     for sc in scenarios:
         scene = simulate_divers(sc)
@@ -149,8 +146,7 @@ def _distances_of(extractor: FeatureExtractor) -> np.ndarray:
 
 def prepare(sc: DiverScenario, extractor: FeatureExtractor, detector: DetectorModel | None = None,
             detector_seed: int | None = None) -> PreparedScenario:
-    """Simulate, render, detect (``detector``: the scenario's own by default) and extract the features
-    of every detection of ``sc``."""
+    """Simulate, render, detect (``detector``: the scenario's own) and extract the detections' features."""
     return prepare_features(sc, {"": extractor}, detector, detector_seed)[""]
 
 

@@ -60,8 +60,7 @@ def _burst_mask(t_sent: np.ndarray, cfg: NetworkConfig, horizon_s: float, rng: n
 def simulate_reports(
     heading_rad: np.ndarray, dt_s: float, cfg: NetworkConfig, rng: np.random.Generator
 ) -> ReportArrays:
-    """Reports of ``heading_rad (T, N)`` (true absolute headings, may be unwrapped) sampled at frame
-    times ``k · dt_s``; the heading at a send time is interpolated linearly in time."""
+    """Reports of ``heading_rad (T, N)`` (unwrapped), interpolated linearly at the send times."""
     T, n_agents = heading_rad.shape
     horizon = (T - 1) * dt_s
     period = 1.0 / cfg.rate_hz

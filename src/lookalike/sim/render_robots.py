@@ -106,8 +106,7 @@ class RobotRenderer:
     def render(
         self, positions_m: np.ndarray, headings_rad: np.ndarray, observer: Pose2D | None = None
     ) -> RenderedFrame:
-        """Draw robots at fixed-frame ``positions_m (N, 2)`` with fixed-frame ``headings_rad (N,)``, seen
-        by an observer at ``observer`` (fixed frame; default the origin looking along +x)."""
+        """Draw robots at fixed-frame ``positions_m (N, 2)``, ``headings_rad (N,)`` seen from ``observer``."""
         with needs("cv2"):
             import cv2
 

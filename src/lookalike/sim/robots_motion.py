@@ -60,8 +60,7 @@ def simulate_motion(
 
 
 def observer_pose(cfg: ObserverConfig, n_frames: int, dt_s: float, rng: np.random.Generator) -> np.ndarray:
-    """Observer pose per frame ``(T, 3)``: field x, y (metres) and yaw (radians), the yaw panning
-    as two sinusoids (periods ``pan_period_s`` and 0.37 of it) with random phases."""
+    """Observer pose per frame ``(T, 3)``: field x, y (m) and a panning yaw (rad)."""
     t = np.arange(n_frames) * dt_s
     phase = rng.uniform(0, 2 * np.pi, 2)
     w = 2 * np.pi / cfg.pan_period_s

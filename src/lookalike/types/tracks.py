@@ -88,8 +88,7 @@ class Tracks(Sequence[TrackSnapshot]):
     @classmethod
     def trusted(cls, id: np.ndarray, status: np.ndarray, xywh: np.ndarray, velocity: np.ndarray,
                 detection_index: np.ndarray) -> Tracks:
-        """Box tracks from columns a tracker built itself, without the checks of ``__init__``: ``id`` and
-        ``detection_index`` int ``(k,)``, ``status`` int8 ``(k,)``, ``xywh (k, 4)``, ``velocity (k, d)``."""
+        """Box tracks from columns a tracker built itself, without the checks of ``__init__``."""
         out = cls.__new__(cls)
         out.id, out.status, out.xywh, out.velocity, out.detection_index = id, status, xywh, velocity, detection_index
         out.position = out.heading = out.agent_id = out.identity_prob = None
