@@ -5,7 +5,8 @@ from __future__ import annotations
 import os
 import shlex
 import sys
-from collections.abc import Collection, Iterable
+from collections.abc import Collection, Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -82,6 +83,28 @@ def fail(message: str, code: int = 2) -> NoReturn:
     raise typer.Exit(code)
 
 
+@contextmanager
+def failing(*errors: type[Exception], prefix: str = "") -> Iterator[None]:
+    """Turn ``errors`` raised in the block into :func:`fail` with ``prefix`` and the error's text."""
+    try:
+        yield
+    except errors as exc:
+        fail(f"{prefix}{exc}")
+
+
+def check_names(option: str, names: list[str], known: Sequence[str], what: str) -> None:
+    """Fail naming the first of ``names`` not in ``known``."""
+    for n in names:
+        if n not in known:
+            fail(f"{option}: unknown {what} {n!r}; known: {', '.join(known)}")
+
+
+def check_choice(option: str, value: str, choices: Sequence[str]) -> None:
+    """Fail unless ``value`` is one of ``choices``."""
+    if value not in choices:
+        fail(f"{option}: expected one of {', '.join(choices)}, got {value!r}")
+
+
 def warn(message: str) -> None:
     """Print ``message`` as a warning line (plain text) on stderr."""
     err_console.print(f"[yellow]warning:[/] {escape(message)}", highlight=False)
@@ -97,10 +120,8 @@ def check_outputs_or_fail(outputs: dict[str, Path | None], inputs: Iterable[Path
     """:func:`lookalike.io.outputs.check_outputs`, failing (exit 2) with its one line: run before any work."""
     from lookalike.io.outputs import check_outputs
 
-    try:
+    with failing(ValueError):
         check_outputs(outputs, inputs, folders=folders, input_folders=input_folders)
-    except ValueError as exc:
-        fail(str(exc))
 
 
 def check_study_or_fail(study: str | None) -> None:

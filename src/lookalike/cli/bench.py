@@ -21,7 +21,17 @@ from lookalike.bench.ident import (
 from lookalike.bench.ident_paper import IDENT_VARIANTS, margin_rows
 from lookalike.bench.paired import Comparison, comparison_rows, difference_title
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import SortedGroup, app, check_outputs_or_fail, command_line, console, fail, split_list
+from lookalike.cli.app import (
+    SortedGroup,
+    app,
+    check_names,
+    check_outputs_or_fail,
+    command_line,
+    console,
+    fail,
+    failing,
+    split_list,
+)
 from lookalike.cli.progress import progress_bars
 from lookalike.io.results import Results
 from lookalike.sim import PRESET_NAMES, preset_label
@@ -69,13 +79,6 @@ def write_results(doc: Results, path: Path | None) -> None:
         fail(f"--json: cannot write {path}: {exc.strerror or exc}")
 
 
-def check_names(option: str, names: list[str], known: Sequence[str], what: str) -> None:
-    """Fail naming the first of ``names`` not in ``known``."""
-    for n in names:
-        if n not in known:
-            fail(f"{option}: unknown {what} {n!r}; known: {', '.join(known)}")
-
-
 @bench_app.command("ident")
 def ident(
     setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help="Presets (comma-separated or repeated)."),
@@ -115,12 +118,9 @@ def ident(
         table3_command(setup_list, tracker_list, sequences, frames, seed, noise, lengths, draws, recordings,
                        json_path, csv_path, human)
         return
-    try:
-        with progress_bars() as progress:
-            rows, counts = ident_runs(setup_list, tracker_list, sequences, frames, seed, noise, progress,
-                                      str(weights) if weights else None)
-    except (ValueError, FileNotFoundError) as exc:
-        fail(str(exc))
+    with failing(ValueError, FileNotFoundError), progress_bars() as progress:
+        rows, counts = ident_runs(setup_list, tracker_list, sequences, frames, seed, noise, progress,
+                                  str(weights) if weights else None)
     labels = [preset_label(s) for s in setup_list]
     rate = {(r["Setup"], r["Tracker"]): f"{v:.1f}%" if isinstance(v := r["Success rate (%)"], float) else str(v)
             for r in rows}
@@ -149,12 +149,9 @@ def table3_command(setups: list[str], trackers: list[str], sequences: int, frame
     except ValueError:
         fail(f"--lengths: expected comma-separated frame counts, got {lengths!r}")
     sessions: list[dict[str, Any]] = []
-    try:
-        with progress_bars() as progress:
-            rows = table3_table(setups, trackers, sequences, frames, seed, noise, length_list, draws, recordings,
-                                progress, human, sessions)
-    except (ValueError, FileNotFoundError) as exc:
-        fail(str(exc))
+    with failing(ValueError, FileNotFoundError), progress_bars() as progress:
+        rows = table3_table(setups, trackers, sequences, frames, seed, noise, length_list, draws, recordings,
+                            progress, human, sessions)
     print_rows(f"Success rate by sequence length (the paper's Table III protocol: {draws} random windows per "
                "length, then whole recordings)", rows)
     if sessions:
@@ -162,4 +159,4 @@ def table3_command(setups: list[str], trackers: list[str], sequences: int, frame
     write_rows(rows, json_path, csv_path)
 
 
-__all__ = ["bench_app", "check_names", "print_rows", "rich_table", "write_results"]
+__all__ = ["bench_app", "print_rows", "rich_table", "write_results"]

@@ -11,7 +11,7 @@ from rich.table import Column, Table
 
 from lookalike.bench.divers import COLUMNS, TRACKERS, bar_chart, diver_results, diver_table, pearson
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import check_outputs_or_fail, command_line, console, fail
+from lookalike.cli.app import check_outputs_or_fail, command_line, console, fail, failing
 from lookalike.cli.bench import bench_app, write_results
 from lookalike.sim.divers_paper import DETECTION_LEVELS
 
@@ -39,14 +39,11 @@ def divers(
     levels = list(DETECTION_LEVELS) if detections == "both" else [detections]
     if detections != "both" and detections not in DETECTION_LEVELS:
         fail(f"--detections: choose one of {', '.join(DETECTION_LEVELS)} or both, got {detections!r}")
-    tables = {}
-    try:
-        for level in levels:
-            tables[level] = diver_table(scenario_names, tuple(trackers) if trackers else None, frames=frames,
-                                        detections=level, seed=seed,
-                                        features=tuple(features) if features else ("handcrafted", "learned"))
-    except (ValueError, FileNotFoundError) as exc:
-        fail(str(exc))
+    with failing(ValueError, FileNotFoundError):
+        tables = {level: diver_table(scenario_names, tuple(trackers) if trackers else None, frames=frames,
+                                     detections=level, seed=seed,
+                                     features=tuple(features) if features else ("handcrafted", "learned"))
+                  for level in levels}
     wide = Console(width=max(console.width, 120))  # the table is wider than a default terminal
     for level, rows in tables.items():
         table = Table(*(Column(c, no_wrap=True) for c in COLUMNS), title=f"detections: {level}, seed {seed}")

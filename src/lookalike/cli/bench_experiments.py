@@ -16,8 +16,8 @@ from lookalike.bench.experiments import (
 )
 from lookalike.bench.ident_paper import IDENT_VARIANTS
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import check_outputs_or_fail, command_line, fail, split_list
-from lookalike.cli.bench import bench_app, check_names, print_differences, print_rows, write_results
+from lookalike.cli.app import check_names, check_outputs_or_fail, command_line, fail, failing, split_list
+from lookalike.cli.bench import bench_app, print_differences, print_rows, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
 from lookalike.sim.presets import preset
@@ -38,11 +38,8 @@ def shuffle(
     """Control experiment: success rate on frames in order and in random order."""
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path})
     _check_setups_and_trackers(split_list(setups), split_list(trackers))
-    try:
-        with progress_bars() as progress:
-            rows = shuffle_rows(split_list(setups), split_list(trackers), sequences, frames, seed, progress)
-    except ValueError as exc:
-        fail(str(exc))
+    with failing(ValueError), progress_bars() as progress:
+        rows = shuffle_rows(split_list(setups), split_list(trackers), sequences, frames, seed, progress)
     print_rows("Control: frames in random order", rows)
     write_results(experiment_results("shuffle", rows, split_list(setups), sequences, frames, seed, command_line()),
                   json_path)
@@ -67,12 +64,8 @@ def recovery(
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     _check_setups_and_trackers(setup_list, tracker_list)
     _check_swap(swap_at_s, swap_s, frames, setup_list)
-    try:
-        with progress_bars() as progress:
-            rows, seconds = recovery_runs(setup_list, tracker_list, sequences, frames, swap_at_s, swap_s, seed,
-                                          progress)
-    except ValueError as exc:
-        fail(str(exc))
+    with failing(ValueError), progress_bars() as progress:
+        rows, seconds = recovery_runs(setup_list, tracker_list, sequences, frames, swap_at_s, swap_s, seed, progress)
     print_rows(f"Recovery after {swap_s:g} s of swapped reports", rows)
     differences = recovery_differences(seconds, setup_list, tracker_list)
     print_differences(differences, tracker_list[0], "s", "Mean recovery time")
@@ -89,8 +82,7 @@ def _check_setups_and_trackers(setups: list[str], trackers: list[str]) -> None:
 
 
 def _check_swap(swap_at_s: float, swap_s: float, frames: int, setups: list[str]) -> None:
-    """Fail in one line unless the swap starts at >= 0 s, lasts > 0 s and ends before the sequences do
-    (a swap past the end leaves nothing to measure: the table would be NaN)."""
+    """Fail in one line unless the swap starts at >= 0 s, lasts > 0 s and ends before the sequences do."""
     rate = min(preset(s).frame_rate_hz for s in setups) if setups else 30.0
     length_s = frames / rate
     if not (swap_at_s >= 0 and swap_s > 0 and swap_at_s + swap_s < length_s):

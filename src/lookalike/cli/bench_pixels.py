@@ -9,8 +9,8 @@ import typer
 
 from lookalike.bench.pixels import DEFAULT_SEED, PERCEPTION_COLUMNS, PIXEL_COLUMNS, pixels_results, pixels_table
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import check_outputs_or_fail, command_line, fail, split_list
-from lookalike.cli.bench import bench_app, check_names, print_rows, write_results
+from lookalike.cli.app import check_names, check_outputs_or_fail, command_line, fail, failing, split_list
+from lookalike.cli.bench import bench_app, print_rows, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
@@ -45,14 +45,12 @@ def pixels(
     if not setup_list or not ident_list:
         fail("--setups/--trackers: need at least one of each")
     camera = pixel_camera()
-    try:
+    with failing(ValueError, FileNotFoundError):
         pipe = RobotPipeline.from_files(detector_model, heading_model, camera,
                                         PipelineConfig(detect_scale=detect_scale))
         with progress_bars() as progress, one_blas_thread():
             rows, perception = pixels_table(setup_list, ident_list, sequences, frames, seed, pipe, camera, min_iou,
                                             progress, str(weights) if weights else None)
-    except (ValueError, FileNotFoundError) as exc:
-        fail(str(exc))
     print_rows(f"Perception on rendered robots, {sequences} × {frames} frames per set-up", perception,
                PERCEPTION_COLUMNS)
     print_rows("Identification success rate: from pixels vs the simulator's detections", rows, PIXEL_COLUMNS)

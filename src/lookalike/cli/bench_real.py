@@ -1,5 +1,5 @@
-"""``lookalike bench real``: a leaderboard on real data, lookalike's box trackers against the peers. Datasets, runners
-and ranking live in :mod:`lookalike.bench`; this module parses options and prints."""
+"""``lookalike bench real``: a leaderboard on real data, lookalike's box trackers against the peers
+(:mod:`lookalike.bench.leaderboard`)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from lookalike.bench.leaderboard import COLUMNS, leaderboard, leaderboard_result
 from lookalike.bench.peers import PEERS, peer_status
 from lookalike.bench.runner import default_entries, params_entry
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import check_outputs_or_fail, command_line, console, fail, split_list
+from lookalike.cli.app import check_choice, check_outputs_or_fail, command_line, console, fail, failing, split_list
 from lookalike.cli.bench import bench_app, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.parallel import BACKENDS
@@ -30,16 +30,6 @@ def _cell(value: Any) -> str:
     if isinstance(value, float):
         return "–" if not np.isfinite(value) else f"{value:.2f}" if abs(value) < 1e4 else f"{value:,.0f}"
     return str(value)
-
-
-def _check(part: str, backend: str, trackers: list[str]) -> None:
-    if part not in PARTS:
-        fail(f"--part: expected one of {', '.join(PARTS)}, got {part!r}")
-    if backend not in BACKENDS:
-        fail(f"--backend: expected one of {', '.join(BACKENDS)}, got {backend!r}")
-    for t in trackers:
-        if t not in BOX_TRACKERS:
-            fail(f"--trackers: {t!r} is not a box tracker; choose from {', '.join(BOX_TRACKERS)}")
 
 
 def print_leaderboard(rows: list[dict[str, Any]], combined: list[dict[str, Any]], counts: dict[str, int],
@@ -93,27 +83,27 @@ def real(
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path, "--plots": plots}, [params_file],
                           folders={"--plots"}, input_folders=[data])
     tracker_list, peer_list = split_list(trackers), [p for p in split_list(peers) if p != "none"]
-    _check(part, backend, tracker_list)
-    try:
+    check_choice("--part", part, PARTS)
+    check_choice("--backend", backend, BACKENDS)
+    for t in tracker_list:
+        if t not in BOX_TRACKERS:
+            fail(f"--trackers: {t!r} is not a box tracker; choose from {', '.join(BOX_TRACKERS)}")
+    with failing(ValueError, FileNotFoundError):
         status = peer_status(peer_list)
         seqs = load_datasets(resolve_data_root(data), split_list(datasets), sequences=split_list(sequence) or None,
                              max_clips=max_clips, workers=workers, backend=backend, address=address)
-    except (ValueError, FileNotFoundError) as exc:
-        fail(str(exc))
     seqs = [cut_sequence(s, part) for s in seqs]
     for name, why in status.items():
         if why is not None:
             console.print(f"[yellow]skipped peer {escape(name)}: {escape(str(why))}[/yellow]")
     entries = default_entries(tracker_list, [p for p, why in status.items() if why is None])
     if params_file is not None:
-        try:
+        with failing(ValueError):
             content = read_params(params_file)
             if content.tracker not in BOX_TRACKERS:
                 raise ValueError(f"{params_file}: parameters for {content.tracker!r}; bench real runs "
                                  f"{', '.join(BOX_TRACKERS)}")
             entry = params_entry(str(params_file), content.tracker, load_params(params_file), content.chosen_on, seqs)
-        except ValueError as exc:
-            fail(str(exc))
         console.print(f"{entry.label}: {content.tracker} with {params_file} (chosen on "
                       f"{', '.join(content.chosen_on) or 'unknown data'})")
         entries.append(entry)

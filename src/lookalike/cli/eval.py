@@ -10,7 +10,7 @@ import typer
 from rich import box
 from rich.table import Table
 
-from lookalike.cli.app import app, check_outputs_or_fail, command_line, console, fail, split_list
+from lookalike.cli.app import app, check_names, check_outputs_or_fail, command_line, console, fail, failing, split_list
 from lookalike.eval import BENCHMARKS, METRICS
 from lookalike.eval.folders import COMBINED, evaluate_folders, folder_results
 from lookalike.io.outputs import atomic_path
@@ -60,17 +60,15 @@ def eval_command(
         names = [str(p) for p in results]
     scores: dict[str, dict[str, dict[str, float]]] = {}
     for name, folder in zip(names, results):
-        try:
+        with failing(FileNotFoundError, ValueError):
             if points:
                 from lookalike.cli.eval_points import score_points  # imported when used: a short start-up
 
                 assert radius is not None
                 scores[name] = {COMBINED: score_points(gt, folder, radius)}
-                continue
-            scores[name] = evaluate_folders(gt, folder, benchmark=benchmark, metrics=chosen,
-                                            iou_threshold=iou_threshold, workers=workers)
-        except (FileNotFoundError, ValueError) as exc:
-            fail(str(exc))
+            else:
+                scores[name] = evaluate_folders(gt, folder, benchmark=benchmark, metrics=chosen,
+                                                iou_threshold=iou_threshold, workers=workers)
     columns = _columns(chosen)
     if len(scores) == 1:
         name, per_seq = next(iter(scores.items()))
@@ -110,18 +108,14 @@ def _eval_inputs(gt: Path, results: list[Path]) -> list[Path]:
 
 def _chosen(metrics: list[str] | None) -> list[str]:
     chosen = [next((m for m in METRICS if m.lower() == x.lower()), x) for x in (split_list(metrics) or METRICS)]
-    for m in chosen:
-        if m not in METRICS:
-            fail(f"--metrics: unknown metric {m!r}; known: {', '.join(METRICS)}")
+    check_names("--metrics", chosen, METRICS, "metric")
     return chosen
 
 
 def _write_json(path: Path, scores: dict[str, dict[str, dict[str, float]]], gt: Path,
                 options: dict[str, object]) -> None:
-    try:
+    with failing(ValueError, prefix="--json: "):
         doc = folder_results(scores, gt, command_line(), options)
-    except ValueError as exc:
-        fail(f"--json: {exc}")
     from lookalike.cli.bench import write_results  # imported when used: a short start-up
 
     write_results(doc, path)

@@ -11,7 +11,7 @@ import typer
 from rich.markup import escape
 
 from lookalike.bench.ident import identify
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing
 from lookalike.sim import RobotSequence
 from lookalike.trackers import tracker_names
 
@@ -71,7 +71,7 @@ def label(
     initial, source = None, "empty"
     if tracks and not Path(tracks).is_file() and tracks not in tracker_names():
         fail(f"--tracks: {tracks!r} is neither a file nor a tracker ({', '.join(tracker_names())})")
-    try:
+    with failing(ValueError):
         if tracks and not fresh and (sequence.with_name(f"{sequence.stem}.labels.json")).exists():
             console.print("saved labels exist: --tracks ignored (use --fresh to start over from them)")
         elif tracks:
@@ -83,22 +83,16 @@ def label(
                 initial, source = tracker_labels(tracks, seq), f"tracker {tracks}"
         label_app = open_label_app(sequence, initial, source, benchmark, fresh,
                                    labeller if labeller is not None else login_name(), results)
-    except ValueError as exc:
-        fail(str(exc))
     if export:
         r = label_app.export()
         console.print(f"wrote {r['truth']} and {r['mot']} ({r['mot_rows']} rows, {r['unset']} not labelled) "
                       f"in {label_app.folder}", markup=False)
         if benchmark:
-            try:
+            with failing(ValueError, OSError, prefix="--benchmark: "):
                 console.print(f"wrote {label_app.write_result()}", markup=False)
-            except (ValueError, OSError) as exc:
-                fail(f"--benchmark: {exc}")
         return
-    try:
+    with failing(OSError, prefix=f"cannot listen on {host}:{port}: "):
         server = make_server(label_app, host, port)
-    except OSError as exc:
-        fail(f"cannot listen on {host}:{port}: {exc}")
     try:
         if not ipaddress.ip_address(str(server.server_address[0])).is_loopback:
             console.print(f"[yellow]warning:[/] {escape(host)} is reachable from other machines")

@@ -12,26 +12,12 @@ from typing import Any
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, fail
+from lookalike.cli.app import app, check_outputs_or_fail, fail, failing
 from lookalike.cli.track import build_tracker
 from lookalike.io.outputs import write_atomic
-from lookalike.node import (
-    Endpoint,
-    IdentifierConfig,
-    NodeConfig,
-    NodeServer,
-    TeamState,
-    log_event,
-    parse_address,
-)
+from lookalike.node import Endpoint, IdentifierConfig, NodeConfig, NodeServer, TeamState, log_event, parse_address
 from lookalike.node.server import check_group
-from lookalike.node.teamsim import (
-    SimClock,
-    camera_messages,
-    run_camera,
-    run_robot,
-    team_sequence,
-)
+from lookalike.node.teamsim import SimClock, camera_messages, run_camera, run_robot, team_sequence
 from lookalike.sim.presets import PRESET_NAMES
 from lookalike.trackers import tracker_parameters
 
@@ -76,11 +62,8 @@ def _logger(level: str) -> logging.Logger:
 
 
 def _address(text: str, option: str) -> tuple[str, int]:
-    try:
+    with failing(ValueError, prefix=f"{option}: "):
         return parse_address(text)
-    except ValueError as exc:
-        fail(f"{option}: {exc}")
-    raise AssertionError  # unreachable: fail() exits
 
 
 @app.command()
@@ -142,10 +125,8 @@ def _group(text: str | None) -> tuple[str, int] | None:
     if text is None:
         return None
     group = _address(text, "--group")
-    try:
+    with failing(ValueError, prefix="--group: "):
         check_group(group)
-    except ValueError as exc:
-        fail(f"--group: {exc}")
     return group
 
 
@@ -154,12 +135,8 @@ def _clock(start_at: str, speed: float) -> SimClock:
     if start_at == "stdin":
         print("ready", flush=True)
         start_at = sys.stdin.readline().strip()
-    try:
-        epoch = time.time() if start_at == "now" else float(start_at)
-        return SimClock(epoch=epoch, speed=speed)
-    except ValueError as exc:
-        fail(f"--start-at / --speed: {exc}")
-    raise AssertionError  # unreachable
+    with failing(ValueError, prefix="--start-at / --speed: "):
+        return SimClock(epoch=time.time() if start_at == "now" else float(start_at), speed=speed)
 
 
 _PRESET_HELP = f"Robot-world preset: {', '.join(PRESET_NAMES)}."
@@ -168,10 +145,8 @@ _START_HELP = "Wall time of simulated t=0: now, a UNIX time, or stdin (print 're
 
 def _sequence(preset_name: str, seed: int, duration: float, loss: float | None, delay: float | None,
               jitter: float | None) -> Any:
-    try:
+    with failing(ValueError):
         return team_sequence(preset_name, seed, duration, loss, delay, jitter)
-    except ValueError as exc:
-        fail(str(exc))
 
 
 @app.command("robot-sim")
@@ -199,10 +174,8 @@ def robot_sim(
         fail(f"--robot {robot}: preset {preset_name} has robots 1..{sequence.config.n_agents}")
     robot -= 1  # the wire protocol's 0-based id
     node_address, bind_address, group_address = _address(node, "--node"), _address(bind, "--bind"), _group(group)
-    try:
+    with failing(OSError, prefix=f"--bind {bind} / --group {group}: "):
         endpoint = Endpoint(node_address, bind_address, group=group_address)
-    except OSError as exc:
-        fail(f"--bind {bind} / --group {group}: {exc}")
     with endpoint:
         clock = _clock(start_at, speed)
         with _Stop() as stop:

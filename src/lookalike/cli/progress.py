@@ -1,38 +1,48 @@
-"""Progress bars with time left for the long commands (``bench ...``, ``tune``), drawn on stderr and only when it is a
-terminal: ``with progress_bars() as progress: ...``."""
+"""Progress bars: :func:`bars` on standard output, and :func:`progress_bars` for the long commands (``bench ...``,
+``tune``), drawn on stderr with time left and only when it is a terminal."""
 
 from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 from rich.console import Console
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
     Progress,
+    ProgressColumn,
     TextColumn,
     TimeElapsedColumn,
     TimeRemainingColumn,
 )
 
-from lookalike.bench.progress import ProgressFactory, Step
+from lookalike.cli.app import console
 
-_console = Console(stderr=True)
+if TYPE_CHECKING:
+    from lookalike.bench.progress import ProgressFactory, Step
+
+_stderr = Console(stderr=True)
+
+
+def bars(label: str = "{task.description}", *more: ProgressColumn, transient: bool = True) -> Progress:
+    """Rich progress on standard output: ``label``, the bar, done/total and time elapsed, then ``more`` columns."""
+    return Progress(TextColumn(label), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(), *more,
+                    console=console, transient=transient)
 
 
 @contextmanager
-def progress_bars(console: Console | None = None) -> Iterator[ProgressFactory]:
-    """A progress factory drawing rich bars (done/total, elapsed, time left) while the block runs."""
-    out = console or _console
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-               TextColumn("left"), TimeRemainingColumn())
-    with Progress(*columns, console=out, transient=True, disable=not out.is_terminal) as bars:
+def progress_bars() -> Iterator[ProgressFactory]:
+    """A progress factory drawing rich bars (done/total, elapsed, time left) on stderr while the block runs."""
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                  TextColumn("left"), TimeRemainingColumn(), console=_stderr, transient=True,
+                  disable=not _stderr.is_terminal) as progress:
         def factory(description: str, total: int) -> Step:
-            task = bars.add_task(description, total=max(int(total), 1))
-            return lambda: bars.advance(task)
+            task = progress.add_task(description, total=max(int(total), 1))
+            return lambda: progress.advance(task)
 
         yield factory
 
 
-__all__ = ["progress_bars"]
+__all__ = ["bars", "progress_bars"]

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_names, check_outputs_or_fail, console, failing
 from lookalike.sim import PRESET_NAMES, preset
 
 
@@ -35,11 +35,10 @@ def record_pixels(
     from lookalike.vision.pipeline import PipelineConfig, RobotPipeline
     from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera
 
-    if preset_name not in PRESET_NAMES:
-        fail(f"--preset: unknown preset {preset_name!r}; known: {', '.join(PRESET_NAMES)}")
+    check_names("--preset", [preset_name], PRESET_NAMES, "preset")
     world = preset(preset_name)
     camera = pixel_camera()
-    try:
+    with failing(ValueError, OSError):
         config = PipelineConfig(n_agents=world.n_agents, max_detections=max_detections or world.max_detections)
         pipe = RobotPipeline.from_files(detector_model, heading_model, camera, config)
         recordings = []
@@ -47,8 +46,6 @@ def record_pixels(
             for rec in record(preset_name, sequences, frames, seed, pipe, camera, min_iou, progress):
                 recordings.append(rec)
                 console.print(f"wrote {write_recording(rec, output, preset_name)}", markup=False)
-    except (ValueError, FileNotFoundError, OSError) as exc:
-        fail(str(exc))
     n_det = sum(int(r.arrays.det_valid.sum()) for r in recordings)
     n_fp = sum(int(((r.arrays.det_label < 0) & r.arrays.det_valid).sum()) for r in recordings)
     console.print(f"wrote {len(recordings)} recordings to {output} ({sequences} × {frames} frames, {n_det} pixel "

@@ -7,15 +7,9 @@ from pathlib import Path
 
 import typer
 from rich.markup import escape
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-)
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing
+from lookalike.cli.progress import bars
 from lookalike.io import read_mot
 from lookalike.io.outputs import atomic_path
 from lookalike.viz.overlay import birdseye_video, overlay_tracks, source_frames
@@ -37,18 +31,15 @@ def render(
     check_outputs_or_fail({"-o/--output": output, "--gif": gif}, [tracks, video], input_folders=[video])
     if video is None and not birdseye:
         fail("--video: give the video to draw on (or --birdseye for world tracks seen from above)")
-    try:
+    with failing(ValueError, OSError):
         table = read_mot(tracks, min_columns=6)
         total = int(table.frame.max()) if birdseye and len(table) else source_frames(video)[1] if video else 0
-    except (ValueError, FileNotFoundError, OSError) as exc:
-        fail(str(exc))
     interrupted = False
     # (the files are written to temporary files beside them, renamed into place when closed)
     with atomic_path(output) as out, ExitStack() as stack:
         gif_out = stack.enter_context(atomic_path(gif)) if gif is not None else None
         try:
-            with Progress(TextColumn("rendering"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                          console=console) as progress:
+            with bars("rendering", transient=False) as progress:
                 task = progress.add_task("render", total=total or None)
 
                 def advance() -> None:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, failing
 from lookalike.viz.report import HtmlReport
 from lookalike.viz.results import add_results, load_results
 
@@ -23,7 +23,7 @@ def report(
     """Build an HTML report (tables and bar charts, images embedded) from result files."""
     check_outputs_or_fail({"-o/--output": output}, results)
     doc = HtmlReport(title)
-    try:
+    with failing(ValueError):
         loaded = [(p, *load_results(p)) for p in results]
         with tempfile.TemporaryDirectory() as tmp:
             for i, (path, kind, rows) in enumerate(loaded):
@@ -35,6 +35,4 @@ def report(
                     raise ValueError(f"results: {path}: unexpected content ({type(exc).__name__}: "
                                      f"{str(exc)[:80]})") from None
             out = doc.write(output)
-    except ValueError as exc:
-        fail(str(exc))
     console.print(f"wrote {out} ({len(loaded)} result file(s))", markup=False)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_names, check_outputs_or_fail, console
 from lookalike.io.robot_sequences import write_robot_sequence
 from lookalike.sim import DEFAULT_NOISE, NOISE_MODELS, PRESET_NAMES, preset, simulate_robots
 
@@ -27,10 +27,8 @@ def simulate(
     Format: see ``lookalike.io.robot_sequences`` (a header line, then one object per frame with detections, received
     reports and the truth)."""
     check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})
-    if preset_name not in PRESET_NAMES:
-        fail(f"--preset: unknown preset {preset_name!r}; known: {', '.join(PRESET_NAMES)}")
-    if noise not in NOISE_MODELS:
-        fail(f"--noise: unknown noise model {noise!r}; known: {', '.join(NOISE_MODELS)}")
+    check_names("--preset", [preset_name], PRESET_NAMES, "preset")
+    check_names("--noise", [noise], NOISE_MODELS, "noise model")
     cfg = preset(preset_name, noise)
     for k in range(sequences):
         seq = simulate_robots(cfg, frames, seed + k)

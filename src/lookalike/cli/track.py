@@ -1,5 +1,5 @@
-"""``lookalike track``: argument parsing and printing; the frame loop is
-:func:`lookalike.loop.run`, the input and output streams are :mod:`lookalike.io.stream`."""
+"""``lookalike track``: argument parsing and printing; the frame loop is :func:`lookalike.loop.run`, the input and
+output streams are :mod:`lookalike.io.stream`."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import typer
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 
-from lookalike.cli.app import app, console, fail, note, warn
+from lookalike.cli.app import app, console, fail, failing, note, warn
 from lookalike.io import find_sequences
 from lookalike.io.needs import box_input_problem
 from lookalike.io.outputs import atomic_path, check_outputs, ensure_writable, refuse_inputs, result_paths
@@ -28,31 +28,26 @@ def tracker_params(name: str, settings: list[str], params_file: Path | None = No
     ``KEY=VALUE`` ``settings`` on top; fails with a readable message."""
     if name not in tracker_names():
         fail(f"unknown tracker {name!r}; choose one of: {', '.join(tracker_names())}")
-    try:
+    with failing(ValueError, TypeError):
         base: dict[str, Any] = {}
         if params_file is not None:
             from lookalike.tune.params_file import load_params  # imported when used: keeps the CLI's start-up short
 
             base = load_params(params_file, name)
         return {**base, **dict(parse_parameter(name, s) for s in settings)}
-    except (ValueError, TypeError) as exc:
-        fail(str(exc))
 
 
 def build_tracker(name: str, settings: list[str], params_file: Path | None = None) -> Any:
     """A tracker from its name, an optional parameter file and ``KEY=VALUE`` settings (which win),
     failing with a readable message."""
     params = tracker_params(name, settings, params_file)
-    try:
+    with failing(ValueError, TypeError):
         return make_tracker(name, **params)
-    except (ValueError, TypeError) as exc:
-        fail(str(exc))
 
 
 def _box_tracker(name: str, settings: list[str], *, video: bool = False, targets: int | None = None,
                  params_file: Path | None = None) -> Any:
-    """:func:`build_tracker`, refusing in one line a tracker that cannot run on boxes; ``targets``: the
-    known number of targets, the tracker's ``max_targets`` (a closed set)."""
+    """:func:`build_tracker`, refusing a tracker that cannot run on boxes; ``targets``: its ``max_targets``."""
     if targets is not None:
         if "max_targets" not in {p.name for p in tracker_parameters(name)}:
             fail(f"--targets: tracker {name!r} has no closed-set mode (max_targets); use -t boxtrack")
@@ -77,10 +72,18 @@ _BAR_STEP = 25
 _LENGTH_HINT = " (--no-seqinfo-length tracks every frame in the file)"
 
 
-def _input_error(exc: Exception) -> str:
+def input_error(exc: Exception) -> str:
     """One line for a bad input; the seqLength rule names the option that lifts it."""
     message = str(exc)
     return message + _LENGTH_HINT if "(seqLength in" in message else message
+
+
+def sequences_and_targets(path: Path, output: Path) -> tuple[list[Any], list[Path]]:
+    """The sequences with detections at ``path`` and their result files under ``output``."""
+    sequences = [s for s in find_sequences(path) if s.det_path is not None]
+    if not sequences:
+        raise ValueError(f"{path}: no det/det.txt found")
+    return sequences, result_paths(path, sequences, output)
 
 
 def dropped_all(tracker: str, det_path: Path | None, rows: int, scores: tuple[float, float] | None) -> str:
@@ -93,22 +96,17 @@ def dropped_all(tracker: str, det_path: Path | None, rows: int, scores: tuple[fl
 
 def track_files(path: Path, output: Path, tracker: Any, min_score: float,
                 use_length: bool = True, det_format: str = "auto", name: str = "") -> tuple[int, RunStats]:
-    """Track every sequence at ``path`` (a det.txt, a sequence folder or a folder of them) into
-    ``output`` (a file for a single det.txt, else ``output/<sequence>.txt``), streaming. Every input
-    file is checked and every output decided before the first frame is tracked; ``use_length``:
-    seqinfo.ini's seqLength bounds the frames (else every frame in the file is tracked); ``det_format``: the
-    detection files' layout (:func:`~lookalike.io.det_format.sniff_det`); ``name``: the tracker's, for warnings."""
+    """Track every sequence at ``path`` (a det.txt, a sequence folder or a folder of them) into ``output`` (a file
+    for a single det.txt, else ``output/<sequence>.txt``), streaming, inputs checked and outputs decided first;
+    ``use_length``: seqinfo.ini's seqLength bounds the frames; ``name``: the tracker's, for warnings."""
     from lookalike.io.det_format import det_warnings
 
     try:
-        sequences = [s for s in find_sequences(path) if s.det_path is not None]
-        if not sequences:
-            raise ValueError(f"{path}: no det/det.txt found")
-        targets = result_paths(path, sequences, output)
+        sequences, targets = sequences_and_targets(path, output)
         streams = [(seq, sequence_stream(seq, min_score, use_length, det_format)) for seq in sequences]
         ensure_writable(targets)
     except (FileNotFoundError, ValueError) as exc:
-        fail(_input_error(exc))
+        fail(input_error(exc))
     for (seq, frames), target in zip(streams, targets):
         for line in frames.notes:
             note(line)
@@ -131,7 +129,7 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float,
             try:
                 track_to_file(tracker, frames, target, advance, stats)
             except ValueError as exc:
-                fail(f"{seq.name}: {_input_error(exc)}")
+                fail(f"{seq.name}: {input_error(exc)}")
             except OSError as exc:
                 fail(f"output {target}: cannot write ({exc.strerror or exc})")
             progress.remove_task(task)
@@ -150,17 +148,14 @@ def _speed(stats: RunStats) -> str:
 
 def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None], annotate: Path | None = None,
                                video: Path | None = None) -> None:
-    """Refuse (exit 2) when the result, or a file written beside it, is one of the input files, or when
-    ``annotate`` is an input or one of those outputs (checked with :func:`~lookalike.io.outputs.check_outputs`)."""
+    """Refuse (exit 2) when the result, a file written beside it, or ``annotate`` is an input or another output."""
     siblings = [output.with_name(output.stem + s) for s in (".health.csv", ".merges.csv", ".det.txt")]
     files = [p for p in inputs if p is not None and p.is_file()]
-    try:
+    with failing(ValueError):
         refuse_inputs([output, *siblings], files)
         if annotate is not None:
             check_outputs({"-o/--output": output, **{f"-o/--output's {s.name}": s for s in siblings},
                            "--annotate": annotate}, files, input_folders=[video])  # (video: an image folder)
-    except ValueError as exc:
-        fail(str(exc))
 
 
 def _check_branches(path: Path | None, video: Path | None, detections: Path | None, annotate: Path | None,
@@ -188,15 +183,6 @@ def _check_branches(path: Path | None, video: Path | None, detections: Path | No
     if path is None:
         fail("PATH: give det.txt, a sequence folder or a folder of sequences (or --video with --detections)")
     return "files"
-
-
-def _video_info(video: Path) -> tuple[Any, int, float]:
-    from lookalike.viz.overlay import source_frames
-
-    try:
-        return source_frames(video)
-    except (ValueError, OSError) as exc:
-        fail(str(exc))
 
 
 @app.command()
@@ -305,12 +291,12 @@ def track(
                     det_path = detections or path
                     assert det_path is not None
                     if online is not None and targets is not None:
-                        if output.is_dir():
-                            fail(f"-o/--output: {output} is a folder; with --video give a result file such as "
-                                 "tracks.txt")
-                        from lookalike.cli.track_closed import offline_video
+                        from lookalike.cli.track_closed import check_result_file, offline_video
+                        from lookalike.viz.overlay import source_frames
 
-                        _, count, rate = _video_info(video)
+                        check_result_file(output)
+                        with failing(ValueError, OSError):
+                            _, count, rate = source_frames(video)
                         offline_video(det_path, output, targets, online, fps or rate, count or None, min_score,
                                       det_format)
                     else:

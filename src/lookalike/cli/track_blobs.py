@@ -1,9 +1,5 @@
-"""The ``--video FILE --detector blob`` branch of ``lookalike track`` (not a command of its own).
-
-Blob settings are estimated from the video (:func:`~lookalike.viz.blob_video.auto_blob_config`) and printed; ``--blob
-KEY=VALUE`` overrides them. Detections are cached (``$LOOKALIKE_CACHE`` or ``~/.cache/lookalike``), written to ``<output
-stem>.det.txt`` and tracked as the ``--video`` branch does, or by the offline closed set. ``boxtrack`` gets
-:func:`~lookalike.vision.blob_boxtrack.blob_boxtrack_config` (docs/blobs.md)."""
+"""The ``--video FILE --detector blob`` branch of ``lookalike track``: blob settings estimated from the video (``--blob
+KEY=VALUE`` overrides them), detections cached, written to ``<output stem>.det.txt`` and tracked (docs/blobs.md)."""
 
 from __future__ import annotations
 
@@ -11,9 +7,9 @@ from collections.abc import Collection
 from pathlib import Path
 from typing import Any
 
-from lookalike.cli.app import console, fail
+from lookalike.cli.app import console, fail, failing
 from lookalike.cli.progress import progress_bars
-from lookalike.cli.track_closed import offline_video
+from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.cli.track_video import run_track_onnx, run_track_video
 from lookalike.io import write_mot
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, frame_counts
@@ -25,8 +21,8 @@ DETECTORS = ("blob",)
 
 
 def _detect_with_progress(video: Path, config: Any, declared: int) -> tuple[Any, int]:
-    """:func:`~lookalike.viz.blob_video.cached_blob_detection_rows` with a bar (frames done of ``declared``, time
-    left) on a terminal, or a spinner when the video does not declare its frame count."""
+    """:func:`~lookalike.viz.blob_video.cached_blob_detection_rows` with a bar of ``declared`` frames on a terminal,
+    or a spinner when the video does not declare its frame count."""
     if declared <= 0:
         with console.status(f"detecting blobs in {video.name}"):
             return cached_blob_detection_rows(video, config)
@@ -37,21 +33,17 @@ def _detect_with_progress(video: Path, config: Any, declared: int) -> tuple[Any,
 def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, detector: str,
                     settings: list[str], *, n_targets: int | None = None, offline: dict[str, Any] | None = None,
                     explicit: Collection[str] = (), **options: Any) -> None:
-    """Detect blobs on ``video``, write them to ``<output stem>.det.txt``, then track them as
-    :func:`~lookalike.cli.track_video.run_track_video` does (``options`` are passed on to it) or, with
-    ``offline`` (the online pass's parameters), by the offline closed set of ``n_targets``.
-    ``n_targets`` None: inferred from the blob counts for ``boxtrack`` (module doc); 0: an open set.
-    ``explicit``: the tracker parameters the user gave (``--set``, ``--params``), kept as given."""
+    """Detect blobs on ``video`` into ``<output stem>.det.txt``, then track them as
+    :func:`~lookalike.cli.track_video.run_track_video` (given ``options``) or, with ``offline`` (the online pass's
+    parameters), by the offline closed set of ``n_targets`` (None: inferred from the blob counts for ``boxtrack``;
+    0: an open set). ``explicit``: the tracker parameters the user gave, kept as given."""
     if detector.lower().endswith(".onnx"):
         return run_track_onnx(video, output, tracker, tracker_name, Path(detector), settings, n_targets=n_targets,
                               offline=offline, **options)
     if detector not in DETECTORS:
         fail(f"--detector: choose one of {', '.join(DETECTORS)} or FILE.onnx, got {detector!r}")
-    if output.is_dir():
-        fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
-    if not video.exists():
-        fail(f"--video: {video} does not exist")
-    try:
+    check_result_file(output, video)
+    with failing(ValueError, OSError):
         with progress_bars() as progress:  # (steps: reading the sampled frames, the background, each threshold)
             config, estimate = auto_blob_config(video, settings, n_targets or None, progress=progress)
         if estimate is not None:
@@ -64,8 +56,6 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
         _, declared, source_rate = source_frames(video)
         rows, frames = _detect_with_progress(video, config, declared)
         frame_rate = options.get("fps") or source_rate
-    except (ValueError, OSError) as exc:
-        fail(str(exc))
     det_path = write_mot(output.with_name(output.stem + ".det.txt"), rows)
     console.print(f"blob detector: {len(rows)} boxes in {frames} frames → {det_path}", markup=False)
     if len(rows) < 2:

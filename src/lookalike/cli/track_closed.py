@@ -1,6 +1,5 @@
-"""The ``--targets N --offline`` and ``--points FILE`` branches of ``lookalike track`` (not commands of their own): the
-offline closed set (:func:`lookalike.trackers.offline.closed_set.track_closed_set`) and anonymous points tracked as
-small boxes (:mod:`lookalike.io.points`)."""
+"""The ``--targets N --offline`` and ``--points FILE`` branches of ``lookalike track``: the offline closed set
+(:func:`lookalike.trackers.offline.closed_set.track_closed_set`) and anonymous points tracked as small boxes."""
 
 from __future__ import annotations
 
@@ -10,10 +9,11 @@ from typing import Any
 import numpy as np
 from rich.markup import escape
 
-from lookalike.cli.app import console, fail
-from lookalike.io import find_sequences, read_mot, write_mot
+from lookalike.cli.app import console, fail, failing
+from lookalike.cli.track import input_error, sequences_and_targets
+from lookalike.io import read_mot, write_mot
 from lookalike.io.det_format import read_det, sniff_det
-from lookalike.io.outputs import ensure_writable, result_paths
+from lookalike.io.outputs import ensure_writable
 from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv, read_points_mot, typical_spacing
 from lookalike.io.stream import track_to_file
 from lookalike.trackers.boxtrack import BoxTrack
@@ -23,15 +23,22 @@ from lookalike.types.mot_table import detection_rows
 
 POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given (frames/s)
 MAX_POINTS_PER_FRAME = 1000
-"""Points in one frame that ``track --points`` accepts: the association's memory grows with their square (about
-0.3 GB in all at 1,000 a frame with boxtrack, 0.6 GB at 2,000), so more is a one-line error naming the frame."""
+"""Points in one frame that ``track --points`` accepts (the association's memory grows with their square: about
+0.3 GB at 1,000 a frame with boxtrack)."""
+
+
+def check_result_file(output: Path, video: Path | None = None) -> None:
+    """Fail unless ``output`` can be the ``--video`` branch's result file and ``video`` (if given) exists."""
+    if output.is_dir():
+        fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
+    if video is not None and not video.exists():
+        fail(f"--video: {video} does not exist")
 
 
 def table_rows(path: Path, min_score: float = float("-inf"), length: int | None = None,
                length_name: str = "the length", det_format: str = "auto") -> np.ndarray:
-    """Detection rows ``(k, 10)`` of a detection file, those scoring below ``min_score`` dropped
-    (``length``: frames past it are an error, :func:`~lookalike.io.read_mot`; ``det_format``: its layout,
-    :func:`~lookalike.io.det_format.sniff_det`, what was assumed printed as a note)."""
+    """Detection rows ``(k, 10)`` of a detection file, those scoring below ``min_score`` dropped (``length``: frames
+    past it are an error; ``det_format``: its layout, what was assumed printed as a note)."""
     fmt, notes = sniff_det(path, det_format)
     for line in notes:
         console.print(f"[cyan]note:[/] {escape(f'{path}: {line}')}", highlight=False)
@@ -43,10 +50,9 @@ def table_rows(path: Path, min_score: float = float("-inf"), length: int | None 
 
 def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
                     params: dict[str, Any], vel_noise: float | None = None) -> np.ndarray:
-    """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online
-    ``boxtrack`` pass's parameters (``max_targets`` is dropped: that pass is an open set); ``vel_noise``:
-    its velocity noise when not boxtrack's own (points: ``POINT_VEL_NOISE``). Detections too few for the offline
-    assignment (e.g. 1 to 3 frames) get the online closed set's result instead, with a printed note."""
+    """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online ``boxtrack``
+    pass's parameters (``max_targets`` dropped); ``vel_noise``: its velocity noise when not boxtrack's own. Too few
+    detections for the offline assignment get the online closed set's result instead, with a printed note."""
     online = {k: v for k, v in params.items() if k != "max_targets"}
     rows = track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise)
     if len(rows) or not len(det_rows):
@@ -58,20 +64,16 @@ def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_f
 
 
 def point_tracker(tracker: Any) -> Any:
-    """``tracker`` for points as boxes: a ``boxtrack`` rebuilt with the same config and the points'
-    velocity noise (:data:`~lookalike.io.points.POINT_VEL_NOISE`); any other tracker unchanged."""
+    """``tracker`` for points as boxes: a ``boxtrack`` rebuilt with the points' velocity noise; others unchanged."""
     return BoxTrack(tracker.config, vel_noise=POINT_VEL_NOISE) if isinstance(tracker, BoxTrack) else tracker
 
 
 def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float,
                   use_length: bool = True, det_format: str = "auto") -> int:
-    """``--offline`` over every sequence at ``path`` (as ``track_files``: outputs decided and inputs
-    checked first; ``use_length``: seqinfo.ini's seqLength bounds the frames): returns the sequences written."""
+    """``--offline`` over every sequence at ``path`` (outputs decided first; ``use_length``: seqinfo.ini's seqLength
+    bounds the frames): returns the sequences written."""
     try:
-        sequences = [s for s in find_sequences(path) if s.det_path is not None]
-        if not sequences:
-            raise ValueError(f"{path}: no det/det.txt found")
-        targets = result_paths(path, sequences, output)
+        sequences, targets = sequences_and_targets(path, output)
         ensure_writable(targets)
         for seq, target in zip(sequences, targets):
             assert seq.det_path is not None
@@ -83,8 +85,7 @@ def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, An
                 rows = closed_set_rows(det, n_targets, seq.frame_rate, n_frames, params)
             write_mot(target, rows)
     except (FileNotFoundError, ValueError) as exc:
-        message = str(exc)
-        fail(message + (" (--no-seqinfo-length tracks every frame in the file)" if "(seqLength in" in message else ""))
+        fail(input_error(exc))
     except OSError as exc:
         fail(f"output {output}: cannot write ({exc.strerror or exc})")
     return len(sequences)
@@ -93,12 +94,10 @@ def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, An
 def offline_video(det_path: Path, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
                   n_frames: int | None, min_score: float, det_format: str = "auto") -> None:
     """``--video ... --offline``: the closed set over the detections at ``det_path``, written to ``output``."""
-    try:
+    with failing(FileNotFoundError, ValueError):
         det = table_rows(det_path, min_score, det_format=det_format)
         with console.status(f"closed set of {n_targets}"):
             rows = closed_set_rows(det, n_targets, frame_rate, n_frames, params)
-    except (FileNotFoundError, ValueError) as exc:
-        fail(str(exc))
     write_mot(output, rows)
     console.print(f"[green]boxtrack[/], offline closed set of {n_targets}: {len(np.unique(rows[:, 1]))} "
                   f"identities, {len(rows)} rows at {frame_rate:g} frames/s → {output}")
@@ -121,13 +120,12 @@ def _frames(det_rows: np.ndarray, n_frames: int, frame_rate: float) -> Any:
 
 def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: str, *, n_targets: int | None,
                  offline: bool, params: dict[str, Any], fps: float | None) -> None:
-    """``--points FILE``: points as boxes of half their typical spacing, tracked online by ``tracker`` or,
-    with ``offline``, by the closed set of ``n_targets`` (boxtrack with the points' velocity noise,
-    :func:`point_tracker`); result rows (boxes centred on the points) to ``output``."""
+    """``--points FILE``: points as boxes of half their typical spacing, tracked online by ``tracker`` or, with
+    ``offline``, by the closed set of ``n_targets``; result rows (boxes centred on the points) to ``output``."""
     if output.is_dir():
         fail(f"-o/--output: {output} is a folder; with --points give a result file such as tracks.txt")
     frame_rate = fps or POINTS_FPS
-    try:
+    with failing(FileNotFoundError, ValueError):
         points = read_points(points_path)
         counts = [len(p) for p in points.points]
         if counts and max(counts) > MAX_POINTS_PER_FRAME:
@@ -136,24 +134,18 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
                              "a frame are tracked (the association's memory grows with their square)")
         spacing = typical_spacing(points)
         det = points_to_rows(points)
-    except (FileNotFoundError, ValueError) as exc:
-        fail(str(exc))
     side = float(det[0, 4]) if len(det) else 1.0
     why = f"half the typical spacing {spacing:.3g}" if spacing > 0 else "one point a frame: twice the typical step"
     console.print(f"points: {points.count} in {len(points)} frames, boxes of {side:.3g} ({why}), "
                   f"{frame_rate:g} frames/s" + ("" if fps else " (--fps to change)"))
     if offline:
         assert n_targets is not None
-        try:
+        with failing(ValueError):
             rows = closed_set_rows(det, n_targets, frame_rate, len(points), params, vel_noise=POINT_VEL_NOISE)
-        except ValueError as exc:
-            fail(str(exc))
         write_mot(output, rows)
     else:
-        try:
+        with failing(ValueError):
             track_to_file(point_tracker(tracker), _frames(det, len(points), frame_rate), output)
-        except ValueError as exc:
-            fail(str(exc))
         table = read_mot(output)
         rows = np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
     what = f"offline closed set of {n_targets}" if offline else "online"

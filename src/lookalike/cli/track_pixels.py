@@ -8,9 +8,9 @@ from typing import Any
 
 import typer
 from rich.markup import escape
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing
+from lookalike.cli.progress import bars
 from lookalike.io.robot_sequences import read_robot_sequence
 from lookalike.trackers.registry import parse_parameter
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
@@ -24,10 +24,6 @@ from lookalike.viz.robot_pixels import (
 )
 
 PIPELINES = ("robots",)
-
-
-def _columns() -> tuple[Any, ...]:
-    return BarColumn(), MofNCompleteColumn(), TimeElapsedColumn()
 
 
 def _check(video: Path | None, pipeline: str, reports: Path | None, identifier: str, output: Path) -> None:
@@ -47,16 +43,16 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
                      heading_model: Path | None, identifier: str, settings: list[str], *,
                      annotate: Path | None = None, fps: float | None = None, min_score: float = 0.5,
                      annotate_as: Path | None = None) -> None:
-    """Run pipeline ``pipeline`` over ``video`` with the reports of ``reports``; write MOTChallenge rows
-    to ``output`` and, with ``annotate``, an annotated MP4 (named ``annotate_as`` in the summary line: ``annotate``
-    may be its temporary file). ``min_score``: detector probability (-inf: 0.5)."""
+    """Run pipeline ``pipeline`` over ``video`` with the reports of ``reports``; write MOTChallenge rows to ``output``
+    and, with ``annotate``, an annotated MP4 (printed as ``annotate_as``). ``min_score``: detector probability
+    (-inf: 0.5)."""
     from lookalike.viz.overlay import source_frames
     from lookalike.viz.video import VideoWriter
 
     _check(video, pipeline, reports, identifier, output)
     assert video is not None and reports is not None
     camera = pixel_camera()
-    try:
+    with failing(ValueError, OSError, TypeError):
         seq = read_robot_sequence(reports)
         params = identifier_settings(identifier, camera) + tuple(parse_parameter(identifier, s) for s in settings)
         config = PipelineConfig(identifier=identifier, n_agents=seq.config.n_agents,
@@ -65,8 +61,6 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
                                 identifier_params=tuple(dict(params).items()))
         pipe = RobotPipeline.from_files(detector_model, heading_model, camera, config)
         images, total, video_fps = source_frames(video)
-    except (ValueError, FileNotFoundError, OSError, TypeError) as exc:
-        fail(str(exc))
     if total and total > len(seq):
         fail(f"--reports: {reports} has {len(seq)} frames but the video has {total}")
     writer = VideoWriter(annotate, fps=fps or video_fps) if annotate is not None else None
@@ -78,7 +72,7 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
                 f"frame {f.index + 1}  t = {f.frame.time:.2f} s  {len(result.detections)} detection(s)"]))
 
     try:
-        with Progress(TextColumn("identifying robots"), *_columns(), console=console, transient=True) as progress:
+        with bars("identifying robots") as progress:
             task = progress.add_task(video.name, total=total or None)
             stats = identify_video(pipe, pixel_frames(images, seq, f"--reports: {reports}"), output, annotate=draw,
                                    advance=lambda: progress.advance(task))
@@ -104,12 +98,9 @@ def render_robots(
     from lookalike.viz.video import VideoWriter
 
     check_outputs_or_fail({"-o/--output": output}, [sequence])
-    try:
+    with failing(ValueError, OSError):
         seq = read_robot_sequence(sequence)
-    except (ValueError, FileNotFoundError, OSError) as exc:
-        fail(str(exc))
-    with Progress(TextColumn("rendering"), *_columns(), console=console, transient=True) as progress, \
-            VideoWriter(output, fps=seq.config.frame_rate_hz) as writer:
+    with bars("rendering") as progress, VideoWriter(output, fps=seq.config.frame_rate_hz) as writer:
         task = progress.add_task("render", total=len(seq))
         for frame in render_robot_frames(seq, pixel_camera(), seed):
             writer.write(frame.image)

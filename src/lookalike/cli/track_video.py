@@ -1,5 +1,5 @@
-"""``lookalike track --video``: the video branch of ``lookalike track`` (features from the frames'
-pixels, tracks, merges, detector health, optional annotated video). Not a command of its own."""
+"""The ``--video`` branch of ``lookalike track``: features from the frames' pixels, tracks, merges, detector
+health, optional annotated video."""
 
 from __future__ import annotations
 
@@ -7,30 +7,18 @@ from pathlib import Path
 from typing import Any
 
 from rich.markup import escape
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-)
 
-from lookalike.cli.app import console, fail, note, warn
+from lookalike.cli.app import console, fail, failing, note, warn
+from lookalike.cli.progress import bars
 from lookalike.cli.track import dropped_all
-from lookalike.cli.track_closed import offline_video
+from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.io import read_mot, write_mot
 from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
 from lookalike.io.outputs import atomic_path
 from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
 from lookalike.trackers.parts.health import HealthConfig
 from lookalike.viz.overlay import source_frames
-from lookalike.viz.video_tracking import (
-    fit_video_features,
-    side_file,
-    track_video,
-    write_health_csv,
-    write_merges_csv,
-)
+from lookalike.viz.video_tracking import fit_video_features, side_file, track_video, write_health_csv, write_merges_csv
 
 FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
 
@@ -39,16 +27,13 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
                     annotate: Path | None, team_size: int | None, health_window: int,
                     min_score: float, fps: float | None, features: str = "video",
                     annotate_as: Path | None = None, det_format: str = "auto") -> None:
-    """Track ``detections`` on ``video`` and write ``output``, its ``.health.csv`` (and ``.merges.csv`` for trackers
-    that merge identities) and, with ``annotate``, the annotated MP4. ``features``: ``video`` (standardised on this
-    video), ``divers``/``handcrafted`` (statistics of the rendered validation divers), ``learned`` (the shipped ONNX
-    embedding) or ``FILE.onnx``. ``annotate_as``: the name to print for ``annotate`` (its temporary file);
-    ``det_format``: the detection file's layout (:func:`~lookalike.io.det_format.sniff_det`)."""
+    """Track ``detections`` on ``video``; write ``output``, its ``.health.csv`` (``.merges.csv`` for merging
+    trackers) and, with ``annotate``, the annotated MP4 (printed as ``annotate_as``). ``features``: ``video``,
+    ``divers``/``handcrafted``, ``learned`` or ``FILE.onnx`` (the ``--features`` option)."""
     if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
         fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
-    if output.is_dir():
-        fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
-    try:
+    check_result_file(output)
+    with failing(ValueError, OSError):
         fmt, notes = sniff_det(detections, det_format)
         table = read_mot(detections) if fmt.standard() else read_det(detections, fmt)
         health = HealthConfig(team_size=team_size, window=health_window)
@@ -59,8 +44,6 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
             extractor = (fit_diver_features() if features in ("divers", "handcrafted")
                          else fit_video_features(video, table, min_score=min_score) if features == "video"
                          else diver_extractor(features))
-    except (ValueError, FileNotFoundError, OSError) as exc:
-        fail(str(exc))
     for line in notes:
         note(f"{detections}: {line}")
     scores, outside = box_stats(table.xywh, table.conf, size)
@@ -71,9 +54,8 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
         console.print(f"note: {tracker_name}'s thresholds were chosen for the hand-crafted features; matched to "
                       f"{features} on the validation divers they are "
                       + " ".join(f"--set {k}={v:g}" for k, v in hint.items()), markup=False)
-    columns = (TextColumn("tracking {task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
     try:
-        with Progress(*columns, console=console, transient=True) as progress:
+        with bars("tracking {task.description}") as progress:
             task = progress.add_task(video.name, total=total or None)
             result = track_video(video, table, tracker, extractor, annotate=annotate, health=health,
                                  fps=fps, min_score=min_score, advance=lambda: progress.advance(task))
@@ -110,31 +92,24 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
 
 def run_track_onnx(video: Path, output: Path, tracker: Any, tracker_name: str, model: Path, settings: list[str], *,
                    n_targets: int | None = None, offline: dict[str, Any] | None = None, **options: Any) -> None:
-    """``track --video V --detector FILE.onnx``: run the ONNX detection model on every frame (settings
-    ``KEY=VALUE`` of :func:`~lookalike.vision.onnx_detector.config_from_settings`), write the boxes to
-    ``<output stem>.det.txt``, then track them as :func:`run_track_video` does (``options`` are passed
-    on) or, with ``offline``, by the offline closed set of ``n_targets``."""
+    """``track --video V --detector FILE.onnx``: detect with the ONNX model (``settings``: ``KEY=VALUE``), write
+    ``<output stem>.det.txt``, then track as :func:`run_track_video` (given ``options``) or, with ``offline``, by
+    the offline closed set of ``n_targets``."""
     import time
 
     from lookalike.vision.onnx_detector import OnnxDetector, config_from_settings, detect_frames
 
-    if output.is_dir():
-        fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
-    if not video.exists():
-        fail(f"--video: {video} does not exist")
+    check_result_file(output, video)
     if not model.is_file():
         fail(f"--detector: {model} does not exist")
-    try:
+    with failing(ValueError, OSError):
         detector = OnnxDetector(model, config_from_settings(settings))
         images, total, rate = source_frames(video)
-        columns = (TextColumn("detecting {task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
-        with Progress(*columns, console=console, transient=True) as progress:
+        with bars("detecting {task.description}") as progress:
             task = progress.add_task(video.name, total=total or None)
             t0 = time.perf_counter()
             rows, frames = detect_frames(images, detector, advance=lambda: progress.advance(task))
             seconds = time.perf_counter() - t0
-    except (ValueError, FileNotFoundError, OSError) as exc:
-        fail(str(exc))
     det_path = write_mot(output.with_name(output.stem + ".det.txt"), rows)
     speed = f"{frames / seconds:,.1f} frames/s" if seconds > 0 else "inf frames/s"
     console.print(f"{model.name} ({detector.layout}, input {detector.input_size[0]}x{detector.input_size[1]}): "

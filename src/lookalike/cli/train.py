@@ -11,10 +11,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import TextColumn
 
 from lookalike._optional import needs
-from lookalike.cli.app import app, check_outputs_or_fail, check_study_or_fail, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, check_study_or_fail, console, fail, failing
+from lookalike.cli.progress import bars
 
 if TYPE_CHECKING:
     from lookalike.parallel import JobPool
@@ -153,15 +154,12 @@ def train(
     from lookalike.trackers.lstm.encoding import EncodingSpec
     from lookalike.trackers.lstm.weights import WEIGHTS_DIR
 
-    if device == "auto":
-        device = "cuda" if torch.cuda.is_available() else "cpu"
-    if device.startswith("cuda") and not torch.cuda.is_available():
-        fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
+    device = torch_device(device)
     if protocol not in ("ours", "paper"):
         fail(f"--protocol: unknown protocol {protocol!r}; known: ours, paper")
     if protocol == "paper" and (relative or swap_prob > 0):
         relative, swap_prob = False, 0.0  # the paper's inputs; no augmentation beyond slot shuffling
-    try:
+    with failing(ValueError):
         world = preset(preset_name)
         worlds = noise_worlds(preset_name, noise)
         config = TrainConfig(
@@ -177,8 +175,6 @@ def train(
         if init_transfer and init is not None:
             config = dataclasses.replace(config, hidden=init.hidden, num_layers=len(init.layers))
         pool = JobPool(workers, backend, address)
-    except ValueError as exc:
-        fail(str(exc))
     torch.set_num_threads(threads)
     result = _with_progress(f"training {preset_name}", steps, pool, lambda on_step: run_training(
         config, sample, output, resume=resume, on_step=on_step, device=device, pool=pool, init=init,
@@ -243,17 +239,12 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
     from lookalike.parallel import JobPool
     from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS
 
-    if device == "auto":
-        device = "cuda" if torch.cuda.is_available() else "cpu"
-    if device.startswith("cuda") and not torch.cuda.is_available():
-        fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
-    try:
+    device = torch_device(device)
+    with failing(ValueError):
         config = SetTrainConfig(steps=steps, minutes=minutes, batch_size=batch_size, seed=seed, patience=patience)
         if learning_rate is not None:
             config = dataclasses.replace(config, learning_rate=learning_rate)
         pool = JobPool(workers, backend, address)
-    except ValueError as exc:
-        fail(str(exc))
     torch.set_num_threads(threads)
     result = _with_progress("training set (N 1-12)", steps, pool, lambda on_step: train_set(
         config, output, resume=resume, on_step=on_step, device=device, pool=pool))
@@ -270,13 +261,23 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
         console.print(f"shipped as {SHIPPED_SET_WEIGHTS}", markup=False)
 
 
+def torch_device(device: str) -> str:
+    """``--device`` resolved (``auto``: cuda where PyTorch sees one), failing on a CUDA device PyTorch does not see."""
+    import torch
+
+    if device == "auto":
+        device = "cuda" if torch.cuda.is_available() else "cpu"
+    if device.startswith("cuda") and not torch.cuda.is_available():
+        fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
+    return device
+
+
 def _with_progress(description: str, steps: int, pool: JobPool,
                    train: Callable[[Callable[[dict], None]], Any]) -> Any:
     """Run ``train(on_step)`` inside ``pool`` under a progress bar of ``steps`` showing the loss and the
     validation success rate; a ``ValueError`` (bad configuration or checkpoint) becomes a one-line error."""
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-               TextColumn("loss {task.fields[loss]:.3f}  validation {task.fields[val]}"))
-    with Progress(*columns, console=console) as progress:
+    with bars("{task.description}", TextColumn("loss {task.fields[loss]:.3f}  validation {task.fields[val]}"),
+              transient=False) as progress:
         task = progress.add_task(description, total=steps, loss=math.nan, val="–")
 
         def on_step(row: dict) -> None:
@@ -285,8 +286,5 @@ def _with_progress(description: str, steps: int, pool: JobPool,
                 fields["val"] = f"{100 * row['val_success']:.1f}%"
             progress.update(task, completed=row["step"], **fields)
 
-        try:
-            with pool:
-                return train(on_step)
-        except ValueError as exc:
-            fail(str(exc))
+        with failing(ValueError), pool:
+            return train(on_step)

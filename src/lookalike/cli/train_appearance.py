@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing
 
 
 @app.command("train-appearance")
@@ -28,11 +28,9 @@ def train_appearance(
         fail(f"-o/--output: {output} is a file; give a folder")
     from lookalike.learn.appearance_train import AppearanceTrainConfig
     from lookalike.learn.appearance_train import train_appearance as run
-    try:
+    with failing(ValueError, RuntimeError):
         config = AppearanceTrainConfig(scenarios=scenarios, frames=frames, epochs=epochs, minutes=minutes, seed=seed,
                                        threads=threads, device=device)
         info = run(config, output, log=lambda line: console.print(line, markup=False))
-    except (ValueError, RuntimeError) as exc:
-        fail(str(exc))
     console.print(f"[green]trained[/] in {info['minutes']:.1f} min: validation AUC {info['validation']['best_auc']:.4f}"
                   f" → {output / info['model']}")

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from lookalike._optional import needs
-from lookalike.cli.app import console, fail
+from lookalike.cli.app import console, fail, failing
 from lookalike.cli.train_options import RunOptions
 from lookalike.sim import RobotSequence
 
@@ -56,7 +56,7 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     with needs("torch"):
         import torch
 
-    from lookalike.cli.train import _with_progress
+    from lookalike.cli.train import _with_progress, torch_device
     from lookalike.learn.recordings import RecordingSampler, check_recordings, split_recordings, validation_arrays
     from lookalike.learn.training import TrainConfig, plot_log
     from lookalike.learn.training import train as run_training
@@ -72,12 +72,8 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
         paths += sorted(opt.validation.glob(PATTERN))
     names = [str(p) for p in paths]
     n, m = recordings[0].config.n_agents, recordings[0].config.max_detections
-    device = opt.device
-    if device == "auto":
-        device = "cuda" if torch.cuda.is_available() else "cpu"
-    if device.startswith("cuda") and not torch.cuda.is_available():
-        fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
-    try:
+    device = torch_device(opt.device)
+    with failing(ValueError):
         init_path = opt.init_from if opt.init_from is not None else shipped_weights_path(n, m)
         init = load_weights(init_path)
         spec = init.spec
@@ -106,8 +102,6 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
         sampler = RecordingSampler(spec, tuple(recordings[i].arrays for i in train_idx), world, opt.sim_fraction)
         validation = validation_arrays(spec, [recordings[i].arrays for i in val_idx], config.bptt)
         pool = JobPool(opt.workers, opt.backend, opt.address)
-    except ValueError as exc:
-        fail(str(exc))
     held_out = [paths[i].name for i in val_idx]
     info = {"recordings": {"folder": str(folder), "training": [paths[i].name for i in train_idx],
                            "validation": held_out, "sim_fraction": opt.sim_fraction}}

@@ -7,9 +7,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.progress import TextColumn
 
-from lookalike.cli.app import console, fail
+from lookalike.cli.app import check_choice, console, failing
+from lookalike.cli.progress import bars
 from lookalike.cli.train_options import RunOptions
 
 
@@ -31,20 +32,15 @@ def train_search(trials: int, output: Path, preset_name: str, opt: SearchOptions
     from lookalike.learn.training import TrainConfig
     from lookalike.sim import preset
 
-    if opt.sampler not in SAMPLERS:
-        fail(f"--sampler: expected one of {', '.join(SAMPLERS)}, got {opt.sampler!r}")
-    try:
+    check_choice("--sampler", opt.sampler, SAMPLERS)
+    with failing(ValueError):
         space = SearchSpace.parse(opt.space)
         world = preset(preset_name)
         base = TrainConfig(n_agents=world.n_agents, n_slots=world.max_detections, relative_headings=opt.relative,
                            cell=opt.cell, batch_size=opt.batch_size, sequence_length=opt.sequence_length,
                            steps=opt.steps, minutes=opt.minutes, seed=opt.seed, patience=opt.patience,
                            validation_every=opt.validate_every)
-    except ValueError as exc:
-        fail(str(exc))
-    columns = (TextColumn("search {task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-               TextColumn("best {task.fields[best]}"))
-    with Progress(*columns, console=console) as progress:
+    with bars("search {task.description}", TextColumn("best {task.fields[best]}"), transient=False) as progress:
         task = progress.add_task(preset_name, total=trials, best="–")
 
         def on_trial(done: int, total: int, row: dict[str, Any]) -> None:
@@ -55,12 +51,10 @@ def train_search(trials: int, output: Path, preset_name: str, opt: SearchOptions
             best = row["best"]
             progress.update(task, completed=done, best="–" if math.isnan(best) else f"{100 * best:.1f}%")
 
-        try:
+        with failing(ValueError):
             result = run_search(base, world, output, trials, space=space, sampler=opt.sampler, storage=opt.study,
                                 study_name=f"lstm-{preset_name}", workers=opt.workers, backend=opt.backend,
                                 address=opt.address, threads=opt.threads, progress=on_trial)
-        except ValueError as exc:
-            fail(str(exc))
     p = result.params
     console.print(
         f"chosen: hidden {p['hidden']}, layers {p['num_layers']}, learning rate {p['learning_rate']:.3g} (trial "

@@ -8,24 +8,12 @@ from typing import Any
 
 import typer
 from rich.markup import escape
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TaskID,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
+from rich.progress import TaskID, TimeRemainingColumn
 from rich.table import Table
 
-from lookalike.cli.app import app, check_outputs_or_fail, check_study_or_fail, console, fail
+from lookalike.cli.app import app, check_choice, check_outputs_or_fail, check_study_or_fail, console, fail, failing
+from lookalike.cli.progress import bars
 from lookalike.parallel import BACKENDS
-
-
-def _progress() -> Progress:
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                    TimeRemainingColumn(), console=console, transient=True)
 
 
 def _pct(scores: dict[str, float]) -> str:
@@ -70,11 +58,14 @@ def tune(
         return
     if not data:
         fail("DATA: give at least one sequence folder or bench dataset")
-        return
     if output is None:
         fail("-o/--output: give the parameter file to write")
-        return
-    _check_options(sampler, backend, resume, study)
+    from lookalike.tune import SAMPLERS
+
+    check_choice("--sampler", sampler, SAMPLERS)
+    check_choice("--backend", backend, BACKENDS)
+    if resume and study is None:
+        fail("--resume: needs --study (the storage the study was saved in)")
     from lookalike.io.outputs import sqlite_file
 
     check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)}, _data_inputs(data, space_path))
@@ -96,24 +87,11 @@ def _load_space(tracker: str, space_path: Path | None) -> Any:
 
     if tracker not in tracker_names():
         fail(f"unknown tracker {tracker!r}; choose one of: {', '.join(tracker_names())}")
-    try:
+    with failing(OSError, ValueError, prefix="--space: "):
         space = default_space(tracker)
         if space_path is not None:
             space = space_from_json(json.loads(space_path.read_text()), tracker)
-    except (OSError, ValueError) as exc:
-        fail(f"--space: {exc}")
     return space
-
-
-def _check_options(sampler: str, backend: str, resume: bool, study: str | None) -> None:
-    from lookalike.tune import SAMPLERS
-
-    if sampler not in SAMPLERS:
-        fail(f"--sampler: expected one of {', '.join(SAMPLERS)}, got {sampler!r}")
-    if backend not in BACKENDS:
-        fail(f"--backend: expected one of {', '.join(BACKENDS)}, got {backend!r}")
-    if resume and study is None:
-        fail("--resume: needs --study (the storage the study was saved in)")
 
 
 def _data_inputs(data: list[str], space_path: Path | None) -> list[Path]:
@@ -132,19 +110,16 @@ def _data_inputs(data: list[str], space_path: Path | None) -> list[Path]:
 
 def _load_data(data: list[str], data_root: Path | None, folds: str) -> tuple[Any, Any]:
     """The labelled sequences and the folds (None for ``--folds none``)."""
+    from lookalike.bench.datasets import DATASETS, resolve_data_root
     from lookalike.tune import load_tuning_data, make_folds
 
-    try:
+    with failing(ValueError, FileNotFoundError):
         root = None
-        from lookalike.bench.datasets import DATASETS, resolve_data_root
-
         if any(not Path(d).exists() and d in DATASETS for d in data):  # (a missing folder: named as such below)
             root = resolve_data_root(data_root)
         seqs = load_tuning_data(data, root)
         keys = [f"{s.dataset}/{s.name}" for s in seqs]
         fold_list = None if folds.lower() == "none" else make_folds(keys, folds, [s.dataset for s in seqs])
-    except (ValueError, FileNotFoundError) as exc:
-        fail(str(exc))
     return seqs, fold_list
 
 
@@ -153,8 +128,8 @@ def _run(tracker: str, seqs: Any, fold_list: Any, study_name: str | None, metric
     """The study on all sequences, and the per-fold choices (None without folds)."""
     from lookalike.tune import leave_one_out_selection, run_study
 
-    try:
-        with _progress() as bar:
+    with failing(ValueError):
+        with bars("{task.description}", TimeRemainingColumn()) as bar:
             task = bar.add_task("trials", total=trials)
 
             def step(done: int, total: int, best: float | None) -> None:
@@ -164,7 +139,7 @@ def _run(tracker: str, seqs: Any, fold_list: Any, study_name: str | None, metric
             result = run_study(tracker, seqs, study_name=study_name, progress=step, **common)
         choices = None
         if fold_list is not None:
-            with _progress() as bar:
+            with bars("{task.description}", TimeRemainingColumn()) as bar:
                 tasks: dict[str, TaskID] = {}
 
                 def fold_step(fold: str, done: int, total: int, best: float | None) -> None:
@@ -174,8 +149,6 @@ def _run(tracker: str, seqs: Any, fold_list: Any, study_name: str | None, metric
 
                 choices = leave_one_out_selection(tracker, seqs, folds=fold_list, study_name=study_name,
                                                   progress=fold_step, **common)
-    except ValueError as exc:
-        fail(str(exc))
     return result, choices
 
 
@@ -192,11 +165,9 @@ def _save(output: Path, tracker: str, result: Any, choices: Any, space: Any, sam
         extra["left_out"] = {"folds": folds, "combined": {m: held[m] for m in ("HOTA", "IDF1", "MOTA")},
                              "per_fold": [{"left_out": c.left_out, "chosen_on": c.chosen_on, "score": c.test_value,
                                            "params": c.params} for c in choices]}
-    try:
+    with failing(ValueError):
         path = save_params(output, tracker, result.params, chosen_on=result.chosen_on, criterion=result.criterion,
                            trials=result.trials, **extra)
-    except ValueError as exc:
-        fail(str(exc))
     return path, held
 
 

@@ -1,8 +1,5 @@
-"""``lookalike train-detector`` and ``lookalike train-heading``: train the vision models.
-
-Both train from rendered robots by default; the detector also from a folder of ``positives/`` (one target filling each
-image) and ``negatives/``. A detector trained on renders is cut to the cascade prefix with the best F1 on held-out
-renders (:mod:`lookalike.vision.hog_select`)."""
+"""``lookalike train-detector`` and ``lookalike train-heading``: train the vision models from rendered robots (the
+detector also from a folder of ``positives/`` and ``negatives/`` images)."""
 
 from __future__ import annotations
 
@@ -11,22 +8,16 @@ from pathlib import Path
 
 import numpy as np
 import typer
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-)
+from rich.progress import Progress, TextColumn
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail
+from lookalike.cli.app import app, check_outputs_or_fail, console, failing
+from lookalike.cli.progress import bars
 from lookalike.io.outputs import atomic_path
 from lookalike.learn.vision_train import train_robot_detector
 
 
 def _progress() -> Progress:
-    return Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                    TextColumn("{task.fields[note]}"), console=console)
+    return bars("{task.description}", TextColumn("{task.fields[note]}"), transient=False)
 
 
 @app.command("train-detector")
@@ -45,7 +36,7 @@ def train_detector(
 ) -> None:
     """Train the HOG cascade robot detector and save it."""
     check_outputs_or_fail({"-o/--output": output}, input_folders=[data])
-    try:
+    with failing(ValueError):
         with _progress() as bar:
             def step(description: str, total: int) -> Callable[[int, str], None]:
                 task = bar.add_task(description, total=total, note="")
@@ -53,8 +44,6 @@ def train_detector(
 
             model, trained, tried = train_robot_detector(data, frames, stages, negatives, copies, seed,
                                                          validation_frames, step)
-    except ValueError as exc:
-        fail(str(exc))
     with atomic_path(output) as tmp:
         model.save(tmp)
     if tried:
@@ -80,7 +69,7 @@ def train_heading_command(
     from lookalike.learn.vision_train import rendered_heading_samples
     from lookalike.vision.heading import HeadingConfig, mean_abs_error_deg, train_heading
 
-    try:
+    with failing(ValueError):
         config = HeadingConfig(folds=folds)
         if frames < 1 or test_frames < 0:
             raise ValueError(f"--frames/--test-frames: need frames >= 1, test_frames >= 0, got {frames}, {test_frames}")
@@ -99,8 +88,6 @@ def train_heading_command(
             fit = bar.add_task(f"grid search on {len(f)} robots", total=1, note="")
             model = train_heading(f, h, config, seed=seed, progress=lambda m: bar.update(fit, note=m))
             bar.update(fit, completed=1)
-    except ValueError as exc:
-        fail(str(exc))
     with atomic_path(output) as tmp:
         model.save(tmp)
     if len(ft):
