@@ -1,14 +1,7 @@
-"""The set associator in PyTorch (training only; import needs torch).
-
-One network for every team size: detections and agents are tokens, so permuting the detections
-(or the agents) permutes the outputs the same way. Per frame, every detection-agent pair is scored
-by a small MLP on the two tokens and pair features (heading agreement ``cos, sin (φ_k − ψ_j)`` and
-the offset from the agent's remembered position), every detection gets a learned false-positive
-logit from its token and its best pair, and a softmax over "agent 1..N or false positive" gives the
-output. Each agent token then attends to the detections with those probabilities: its remembered
-position moves towards the attended positions and a GRU cell per agent (shared weights) takes the
-attended pair features. :mod:`lookalike.trackers.set.network` evaluates the same maths with numpy.
-"""
+"""The set associator in PyTorch (training only; needs torch): one permutation-equivariant network for every team
+size; per frame an MLP scores detection-agent pairs, a softmax over "agent 1..N or false positive" gives the output,
+and each agent's memory (position, GRU state) attends to the detections. :mod:`lookalike.trackers.set.network`
+evaluates the same maths with numpy."""
 
 from __future__ import annotations
 

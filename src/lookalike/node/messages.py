@@ -1,8 +1,5 @@
-"""The node's wire format: versioned, validated messages as compact UTF-8 JSON, one per UDP datagram.
-
-Each holds ``"v"`` (schema version) and ``"type"``: inbound ``report``, ``detections``, ``status_request``; outbound
-``team`` and ``status``. ``decode`` raises only ``MessageError``, whose ``reason`` is a stable code the node counts.
-Messages, units and bounds: :mod:`lookalike.node.schema` (listed in docs/howto/robot-team.md)."""
+"""The node's wire format: versioned messages (:mod:`lookalike.node.schema`) as compact UTF-8 JSON, one per UDP
+datagram, each with ``"v"`` and ``"type"``; ``decode`` raises only ``MessageError`` (a stable ``reason`` code)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,4 @@
-"""A 2-D box world: pedestrian-like targets moving in an image, seen by a noisy detector.
-
-Used by the demo and by tests that need image-space tracking data with ground truth."""
+"""A 2-D box world: pedestrian-like targets moving in an image, seen by a noisy detector, with ground truth."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
-"""Training scenes for a learned diver appearance model: new divers (:func:`random_looks`) in new conditions, from seeds
-5000+, disjoint from the test (101–108) and validation (901–904) seeds, so the network is not a classifier of the test
-team (:data:`~lookalike.sim.diver_render.TEAM`)."""
+"""Training scenes for a learned diver appearance model: new divers in new conditions, from seeds 5000+ (disjoint from
+the test and validation seeds)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
-"""Named robot-world scenarios: the paper's set-ups (M detections at most, N robots) at 30 Hz, with one of two
-position-noise models (observer frame: x forward = depth, y left = across the image, ``d`` the distance in metres):
-
-* ``"paper"`` — Farazi and Behnke's (noisier across the image): lateral std ``0.05 + 0.04·d``, depth std
-  ``0.03 + 0.015·d`` metres.
-* ``"ours"`` — the same laws on the other axes (depth noisier); the default, on which the shipped weights were
-  trained."""
+"""Named robot-world scenarios: the paper's set-ups (M detections at most, N robots) at 30 Hz, with position noise
+``"paper"`` (Farazi and Behnke's: lateral std ``0.05 + 0.04·d``, depth ``0.03 + 0.015·d`` metres at distance ``d``) or
+``"ours"`` (the same laws on the other axes; the default, on which the shipped weights were trained)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
-"""Robot and observer motion for whole sequences at once (array operations over time).
-
-Field coordinates: origin at the field centre, x along the length, metres; headings in radians."""
+"""Robot and observer motion for whole sequences at once; field coordinates (origin at the centre, x along the length,
+metres), headings in radians."""
 
 from __future__ import annotations
 

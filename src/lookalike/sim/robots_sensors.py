@@ -1,7 +1,5 @@
-"""The observer's perception model: visibility, occlusion, misses, noise, visual heading, scores.
-
-All functions are vectorised over any leading axes (usually ``(T, N)``); positions are in the observer frame (x forward,
-y left, metres)."""
+"""The observer's perception model (visibility, occlusion, misses, noise, visual heading), vectorised over leading
+axes; positions in the observer frame (x forward, y left, metres)."""
 
 from __future__ import annotations
 
