@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from lookalike._optional import needs
+from lookalike.bench.tables import pyplot
 from lookalike.eval.api import combine, evaluate_sequence
 from lookalike.io.results import Results
 from lookalike.sim.divers import SCENARIOS, detection_quality, scenario
@@ -132,13 +132,7 @@ def diver_results(tables: dict[str, list[dict[str, Any]]], frames: int, seed: in
 
 def bar_chart(rows: list[dict[str, Any]], path: Path) -> Path:
     """IDF1 per scenario and tracker as a grouped bar chart PNG (the paper's Figure 5)."""
-    with needs("matplotlib"):
-        import matplotlib
-
-    matplotlib.use("Agg")
-    with needs("matplotlib"):
-        import matplotlib.pyplot as plt
-
+    plt = pyplot()
     scenarios = list(dict.fromkeys(r["Scenario"] for r in rows))
     trackers = list(dict.fromkeys(r["Tracker"] for r in rows))
     value = {(r["Scenario"], r["Tracker"]): r["IDF1"] for r in rows}

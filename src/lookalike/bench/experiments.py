@@ -10,7 +10,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from lookalike.bench.ident import identify, sequence_seeds
+from lookalike.bench.ident import identify, sequence_seeds, setup_results
 from lookalike.bench.paired import Comparison, add_comparisons, compare_to_first, mean_difference
 from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.eval import identification_success_rate
@@ -282,12 +282,7 @@ def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[s
                        differences: Sequence[Comparison] = ()) -> Results:
     """Rows of :func:`shuffle_rows` or :func:`recovery_rows` as a results document (table ``kind``; success rates as
     fractions, seconds, ``null`` when never); ``differences`` go in table ``<kind>_difference`` (seconds)."""
-    names = {preset_label(s): s for s in setups}
-    doc = Results(f"bench {kind}", command=command, seeds=sequence_seeds(list(setups), sequences, seed),
-                  sequences=len(setups) * sequences,
-                  frames=len(setups) * sequences * frames,
-                  options={"setups": list(setups), "sequences_per_setup": sequences, "frames_per_sequence": frames,
-                           "seed": seed, **(options or {})})
+    doc, names = setup_results(f"bench {kind}", setups, sequences, frames, seed, command, options)
     add_printed_rows(doc, kind, rows, datasets=names, rename=EXPERIMENT_KEYS)
     add_comparisons(doc, f"{kind}_difference", differences, "recovery_mean_s", suffix="_s")
     return doc

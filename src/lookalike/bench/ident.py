@@ -73,6 +73,32 @@ def identify(name: str, sequence: RobotSequence, frames: Sequence[Frame] | None 
     return labels
 
 
+def run_labels(tracker: Any, frames: Sequence[Frame], n_agents: int, stats: RunStats | None = None
+               ) -> tuple[list[np.ndarray], np.ndarray]:
+    """Per frame, each detection's label, and the ``(frames, n_agents, 2)`` agent positions (m; NaN: none) of
+    ``tracker`` run over ``frames``."""
+    labels: list[np.ndarray] = []
+    positions = np.full((len(frames), n_agents, 2), np.nan)
+
+    def sink(frame: Frame, tracks: Any) -> None:
+        positions[len(labels)] = agent_positions(tracks, n_agents)
+        labels.append(labels_from_tracks(len(frame.detections), tracks))
+
+    run(tracker, frames, sink, stats=stats)
+    return labels, positions
+
+
+def setup_results(kind: str, setups: Sequence[str], sequences: int, frames: int, seed: int, command: str,
+                  options: Mapping[str, Any] | None = None) -> tuple[Results, dict[str, str]]:
+    """An empty results document of a bench over ``sequences`` sequences of ``frames`` frames per set-up, and the
+    set-ups by printed label."""
+    doc = Results(kind, command=command, seeds=sequence_seeds(list(setups), sequences, seed),
+                  sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
+                  options={"setups": list(setups), "sequences_per_setup": sequences, "frames_per_sequence": frames,
+                           "seed": seed, **(options or {})})
+    return doc, {preset_label(s): s for s in setups}
+
+
 def run_identifier(name: str, sequences: list[RobotSequence], step: Step | None = None,
                    weights: str | None = None) -> dict[str, float]:
     """Success rate, localisation error, frames/s and detection count of tracker ``name`` (``step()`` per sequence)."""
@@ -90,17 +116,11 @@ def run_identifier_by_sequence(name: str, sequences: list[RobotSequence], step: 
     if sequences:  # frames/s without the first frames' one-off costs (imports, compiles)
         warm_up(lambda: build_identifier(name, sequences[0], weights), sequences[0].frames())
     for seq in sequences:
-        frames = list(seq.frames())
-        positions = np.full((len(frames), seq.config.n_agents, 2), np.nan)
-        k_seq = len(predicted)
-
-        def sink(frame: Frame, tracks: Any, positions: np.ndarray = positions, k0: int = len(predicted)) -> None:
-            positions[len(predicted) - k0] = agent_positions(tracks, positions.shape[1])
-            predicted.append(labels_from_tracks(len(frame.detections), tracks))
-
-        run(build_identifier(name, seq, weights), frames, sink, stats=stats)
-        truth.extend(seq.true_labels())
-        counts.append(identification_counts(predicted[k_seq:], truth[k_seq:]))
+        labels, positions = run_labels(build_identifier(name, seq, weights), list(seq.frames()), seq.config.n_agents,
+                                       stats)
+        counts.append(identification_counts(labels, seq.true_labels()))
+        predicted += labels
+        truth += seq.true_labels()
         est.append(positions)
         true_pos.append(seq.true_positions_visible())
         if step is not None:
@@ -168,11 +188,8 @@ def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int,
                   weights: str | None = None, differences: Sequence[Comparison] = ()) -> Results:
     """:func:`ident_table`'s rows as a results document: table ``ident`` (dataset: the preset name) and
     ``differences`` in table ``ident_difference`` (fractions)."""
-    names = {preset_label(s): s for s in setups}
-    doc = Results("bench ident", command=command, seeds=sequence_seeds(setups, sequences, seed),
-                  sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
-                  options={"setups": setups, "sequences_per_setup": sequences, "frames_per_sequence": frames,
-                           "seed": seed, "noise": noise, **({"weights": weights} if weights else {})})
+    doc, names = setup_results("bench ident", setups, sequences, frames, seed, command,
+                               {"noise": noise, **({"weights": weights} if weights else {})})
     for r in rows:
         doc.add("ident", dataset=names.get(r["Setup"], r["Setup"]), tracker=r["Tracker"],
                 metrics=percent_row_metrics(r, skip=("Setup", "Tracker")))
@@ -182,4 +199,5 @@ def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int,
 
 __all__ = ["DEFAULT_SEED", "IDENT_COLUMNS", "IDENT_TRACKERS", "NOT_TRAINED", "SequenceCounts", "build_identifier",
            "ident_differences", "ident_results", "ident_runs", "ident_table", "identify", "run_identifier",
-           "run_identifier_by_sequence", "sequence_seeds", "uses_weights", "weights_missing"]
+           "run_identifier_by_sequence", "run_labels", "sequence_seeds", "setup_results", "uses_weights",
+           "weights_missing"]

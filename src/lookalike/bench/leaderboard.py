@@ -9,10 +9,10 @@ from typing import Any
 
 import numpy as np
 
-from lookalike._optional import needs
 from lookalike.bench.datasets import RealSequence
 from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.bench.runner import Entry, job_pairs, run_jobs
+from lookalike.bench.tables import pyplot
 from lookalike.eval import combine
 from lookalike.io.results import Results
 
@@ -149,13 +149,7 @@ def leaderboard_results(part: str, rows: list[dict[str, Any]], combined: list[di
 
 def plot_leaderboard(rows: list[dict[str, Any]], folder: Path) -> list[Path]:
     """One bar chart per dataset (HOTA, IDF1, MOTA per tracker) as PNG files in ``folder``."""
-    with needs("matplotlib"):
-        import matplotlib
-
-    matplotlib.use("Agg")
-    with needs("matplotlib"):
-        import matplotlib.pyplot as plt
-
+    plt = pyplot()
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
     for dataset in dict.fromkeys(r["Dataset"] for r in rows):

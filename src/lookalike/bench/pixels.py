@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.bench.ident import sequence_seeds, uses_weights
+from lookalike.bench.ident import run_labels, sequence_seeds, setup_results, uses_weights
 from lookalike.bench.progress import ProgressFactory
 from lookalike.eval import identification_success_rate, localisation_error, robot_success_rate
 from lookalike.geometry.boxes import iou_matrix
@@ -21,7 +21,7 @@ from lookalike.io.results import Results, add_printed_rows
 from lookalike.loop import RunStats, run
 from lookalike.sim import RobotSequence, preset, preset_label, simulate_robots
 from lookalike.trackers import make_tracker
-from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
+from lookalike.trackers.parts.identity import agent_positions
 from lookalike.types import Beacons, Detections
 from lookalike.vision.pipeline import PipelineConfig, PipelineResult, RobotPipeline
 from lookalike.viz.robot_pixels import identifier_settings, render_robot_frames, world_for_camera
@@ -159,14 +159,10 @@ def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camer
     truth: list[np.ndarray] = []
     stats = RunStats()
     for p in perceived:
-        cfg = _identifier(name, p.sequence, camera, weights)
-        n_agents = p.sequence.config.n_agents
-
-        def sink(frame: Any, tracks: Any, n_agents: int = n_agents) -> None:
-            predicted.append(labels_from_tracks(len(frame.detections), tracks))
-            positions.append(agent_positions(tracks, n_agents))
-
-        run(make_tracker(name, **cfg.identifier_kwargs()), p.sequence.frames(), sink, stats=stats)
+        tracker = make_tracker(name, **_identifier(name, p.sequence, camera, weights).identifier_kwargs())
+        labels, at = run_labels(tracker, list(p.sequence.frames()), p.sequence.config.n_agents, stats)
+        predicted += labels
+        positions += list(at)
         truth.extend(p.sequence.true_labels())
     return _score(predicted, positions, truth, perceived, stats)
 
@@ -228,11 +224,7 @@ def pixels_results(rows: list[dict[str, Any]], perception: list[dict[str, Any]],
                    options: dict[str, Any] | None = None) -> Results:
     """The tables of :func:`pixels_table` as a results document: ``identification`` (:data:`PIXEL_KEYS`; fractions,
     metres) and ``perception`` (tracker ``perception``)."""
-    names = {preset_label(s): s for s in setups}
-    doc = Results("bench pixels", command=command, seeds=sequence_seeds(setups, sequences, seed),
-                  sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
-                  options={"setups": setups, "sequences_per_setup": sequences, "frames_per_sequence": frames,
-                           "seed": seed, **(options or {})})
+    doc, names = setup_results("bench pixels", setups, sequences, frames, seed, command, options)
     add_printed_rows(doc, "identification", rows, tracker_key="Identifier", datasets=names, rename=PIXEL_KEYS)
     add_printed_rows(doc, "perception", perception, tracker="perception", datasets=names)
     return doc

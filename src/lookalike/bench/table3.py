@@ -10,14 +10,11 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.bench.ident import build_identifier, sequence_seeds
+from lookalike.bench.ident import build_identifier, run_labels, sequence_seeds
 from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.eval import identification_success_rate, localisation_error
 from lookalike.io.robot_sequences import read_robot_sequence
-from lookalike.loop import run
 from lookalike.sim import RobotSequence, preset, preset_label, simulate_robots
-from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
-from lookalike.types import Frame
 from lookalike.viz.label.human import HumanResult, read_human_results
 
 DEFAULT_LENGTHS = (200, 400, 800)
@@ -43,15 +40,8 @@ def draw_windows(lengths: Sequence[int], recording_lengths: Sequence[int], draws
 
 
 def _run_window(name: str, seq: RobotSequence, first: int, length: int) -> tuple[list, list, np.ndarray, np.ndarray]:
-    frames: list[Frame] = [seq.frame(k) for k in range(first, first + length)]
-    predicted: list[np.ndarray] = []
-    positions = np.full((length, seq.config.n_agents, 2), np.nan)
-
-    def sink(frame: Frame, tracks: Any) -> None:
-        positions[len(predicted)] = agent_positions(tracks, seq.config.n_agents)
-        predicted.append(labels_from_tracks(len(frame.detections), tracks))
-
-    run(build_identifier(name, seq), frames, sink)
+    frames = [seq.frame(k) for k in range(first, first + length)]
+    predicted, positions = run_labels(build_identifier(name, seq), frames, seq.config.n_agents)
     truth = seq.true_labels()[first:first + length]
     return predicted, truth, positions, seq.true_positions_visible()[first:first + length]
 

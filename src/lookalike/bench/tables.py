@@ -1,4 +1,4 @@
-"""Bench tables as files: rows (dicts) written as JSON and/or CSV."""
+"""Bench tables as files: rows (dicts) written as JSON and/or CSV, and matplotlib for their charts."""
 
 from __future__ import annotations
 
@@ -8,7 +8,18 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from lookalike._optional import needs
 from lookalike.io.outputs import atomic_path, write_atomic
+
+
+def pyplot() -> Any:
+    """``matplotlib.pyplot`` on the file-only Agg backend (``matplotlib`` needed)."""
+    with needs("matplotlib"):
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    return plt
 
 
 def write_rows(rows: list[dict[str, Any]], json_path: Path | None, csv_path: Path | None,
@@ -24,4 +35,4 @@ def write_rows(rows: list[dict[str, Any]], json_path: Path | None, csv_path: Pat
             writer.writerows(rows)
 
 
-__all__ = ["write_rows"]
+__all__ = ["pyplot", "write_rows"]
