@@ -108,13 +108,11 @@ class HandcraftedFeatures:
 
     def __call__(self, image: np.ndarray, xywh: np.ndarray) -> np.ndarray:
         """``(n, RAW_DIM)`` standardised, block-weighted, L2-normalised features of the boxes."""
-        raw = self.raw(image, xywh)
-        return self.normalise(raw)
+        return self.normalise(self.raw(image, xywh))
 
     def raw(self, image: np.ndarray, xywh: np.ndarray) -> np.ndarray:
         """``(n, RAW_DIM)`` raw features of boxes ``xywh (n, 4)`` in ``image (h, w, 3)`` BGR uint8."""
-        crops = crop_boxes(image, xywh, self.crop_px)
-        return raw_features(crops)
+        return raw_features(crop_boxes(image, xywh, self.crop_px))
 
     def normalise(self, raw: np.ndarray) -> np.ndarray:
         """Standardise (fitted or running statistics), weight blocks, L2-normalise rows."""

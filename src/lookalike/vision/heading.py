@@ -89,14 +89,10 @@ def heading_features(image: np.ndarray, xywh: np.ndarray, config: HeadingConfig 
     return np.array(out, dtype=np.float32).reshape(-1, d)
 
 
-def _hog_len(config: HeadingConfig) -> int:
-    nx, ny = config.patch_px[0] // config.cell_px, config.patch_px[1] // config.cell_px
-    return (nx - 1) * (ny - 1) * 4 * 9
-
-
 def feature_length(config: HeadingConfig) -> int:
     """Length of a row of :func:`heading_features`: two dense HOG blocks (grey, hue) and the box centre."""
-    return 2 * _hog_len(config) + 2
+    nx, ny = config.patch_px[0] // config.cell_px, config.patch_px[1] // config.cell_px
+    return 2 * (nx - 1) * (ny - 1) * 4 * 9 + 2
 
 
 @dataclass(frozen=True)

@@ -52,20 +52,13 @@ def block_pool(window_px: tuple[int, int], cell_px: int) -> np.ndarray:
     return np.array(sorted(blocks), dtype=np.int64)
 
 
-def block_features(integral: np.ndarray, blocks: np.ndarray, ox: np.ndarray, oy: np.ndarray,
-                   unit_px: int = 1) -> np.ndarray:
-    """``(k, b * 36)`` float32 descriptors of ``blocks (b, 4)`` (px) for windows at ``ox, oy (k,)`` (px) of
-    ``integral (BINS, H+1, W+1)`` whose entries are ``unit_px`` pixels apart."""
-    rows = np.ascontiguousarray(np.asarray(integral).transpose(1, 2, 0)).reshape(-1, integral.shape[0])
-    return block_features_rows(rows, integral.shape[2], blocks, ox, oy, unit_px)
-
-
 def block_features_rows(rows: np.ndarray, width: int | np.ndarray, blocks: np.ndarray, ox: np.ndarray,
                          oy: np.ndarray, unit_px: int, columns: np.ndarray | None = None,
                          offset: np.ndarray | None = None) -> np.ndarray:
-    """:func:`block_features` on an integral as ``rows ((H+1) * width, BINS)``, one row per corner; with
-    ``columns``, only those ``(k, len(columns))``. Stacked integrals (pyramid levels) take a per-window ``width (k,)``
-    and ``offset (k,)`` (first row). Compiled when numba is there, the same operations in the same order."""
+    """``(k, b * 36)`` float32 descriptors of ``blocks (b, 4)`` (px) for windows at ``ox, oy (k,)`` (px) of an integral
+    as ``rows ((H+1) * width, BINS)`` (one row per corner, ``unit_px`` pixels apart); with ``columns``, only those.
+    Stacked integrals (pyramid levels) take a per-window ``width (k,)`` and ``offset (k,)`` (first row). Compiled
+    when numba is there, the same operations in the same order."""
     k, d = len(ox), 4 * BINS
     cols, out = _output(k, len(blocks), columns)
     ox, oy = np.asarray(ox, np.int64), np.asarray(oy, np.int64)
@@ -176,10 +169,10 @@ def window_features(windows: np.ndarray, blocks: np.ndarray) -> np.ndarray:
     # Windows side by side: one gradient pass and one integral; each 1-px margin keeps its gradients its own.
     tiled = wins.transpose(1, 0, 2).reshape(hh, n * ww)
     integral = integral_maps(orientation_maps(tiled))
-    ox = np.arange(n, dtype=np.int64) * ww + 1
-    oy = np.ones(n, dtype=np.int64)
-    return block_features(integral, blocks, ox, oy)
+    rows = np.ascontiguousarray(integral.transpose(1, 2, 0)).reshape(-1, BINS)
+    return block_features_rows(rows, integral.shape[2], blocks, np.arange(n, dtype=np.int64) * ww + 1,
+                               np.ones(n, dtype=np.int64), 1)
 
 
-__all__ = ["block_features", "block_features_grid", "block_features_rows", "block_pool", "cell_integral32",
+__all__ = ["block_features_grid", "block_features_rows", "block_pool", "cell_integral32",
            "cumsum_rows", "window_features"]
