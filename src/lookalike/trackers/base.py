@@ -97,7 +97,7 @@ _Spec = tuple[str, Any, "Range | None", "tuple[Any, ...] | None"]
 _SPECS: dict[type, tuple[_Spec, ...]] = {}
 
 
-def _field_specs(config_cls: type) -> tuple[_Spec, ...]:
+def field_specs(config_cls: type) -> tuple[_Spec, ...]:
     """Each field's name, type hint, range and choices (computed once per class)."""
     if config_cls not in _SPECS:
         hints = typing.get_type_hints(config_cls)
@@ -145,7 +145,7 @@ def check_params(config: Any) -> None:
     """Check every field of the config dataclass against its :func:`param` declaration; the first bad one
     raises ``TypeError``/``ValueError`` in one line. Tracker configs call this in ``__post_init__``."""
     owner = _owner(type(config))
-    for name, hint, bounds, choices in _field_specs(type(config)):
+    for name, hint, bounds, choices in field_specs(type(config)):
         check_value(owner, name, getattr(config, name), hint, bounds, choices)
 
 

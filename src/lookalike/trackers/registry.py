@@ -99,34 +99,33 @@ def make_tracker(name: str, **params: Any) -> Any:
     """Build tracker ``name`` with config overrides; an unknown parameter, or a value outside its
     declared type, range or choices (:func:`~lookalike.trackers.base.param`), raises ``ValueError``
     (``TypeError`` for a wrong type) in one line naming the tracker and the parameter."""
-    from lookalike.trackers.base import check_value
+    from lookalike.trackers.base import check_value, field_specs
 
     config_cls = _config_class(name)
-    known = {f.name: f.metadata for f in dataclasses.fields(config_cls)}
+    known = {spec[0]: spec[1:] for spec in field_specs(config_cls)}
     unknown = sorted(set(params) - set(known))
     if unknown:
         raise ValueError(f"tracker {name!r} has no parameter(s) {unknown}; known: {sorted(known)}")
-    hints = typing.get_type_hints(config_cls)
     for key, value in params.items():
-        check_value(name, key, value, hints[key], known[key].get("range"), known[key].get("choices"))
+        check_value(name, key, value, *known[key])
     return tracker_class(name)(config_cls(**params))
 
 
 def parse_parameter(name: str, assignment: str) -> tuple[str, Any]:
     """Parse ``KEY=VALUE`` for tracker ``name``, converting VALUE to the parameter's type and checking
     it against the declared range or choices (``ValueError`` in one line otherwise)."""
-    from lookalike.trackers.base import check_value
+    from lookalike.trackers.base import check_value, field_specs
 
     if "=" not in assignment:
         raise ValueError(f"expected KEY=VALUE, got {assignment!r}")
     key, text = (part.strip() for part in assignment.split("=", 1))
-    params = {p.name: p for p in tracker_parameters(name)}
-    if key not in params:
-        raise ValueError(f"tracker {name!r} has no parameter {key!r}; known: {sorted(params)}")
-    hint = typing.get_type_hints(_config_class(name))[key]
+    known = {spec[0]: spec[1:] for spec in field_specs(_config_class(name))}
+    if key not in known:
+        raise ValueError(f"tracker {name!r} has no parameter {key!r}; known: {sorted(known)}")
+    hint = known[key][0]
     value = _convert(name, key, text, hint)
     try:
-        check_value(name, key, value, hint, params[key].range, params[key].choices)
+        check_value(name, key, value, *known[key])
     except TypeError as exc:
         raise ValueError(str(exc)) from None
     return key, value
