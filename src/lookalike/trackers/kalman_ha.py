@@ -1,13 +1,10 @@
-"""Kalman-HA and Kalman-HA2, the robot-identification paper's baselines: world-frame trackers identified by beacons.
-
-Both track ground positions (observer frame, metres) with a constant-acceleration Kalman filter per track,
-distance-dependent measurement noise and Hungarian association inside a chi-square gate, and identify
-tracks with the N reporting agents by the beacon identifier (:mod:`lookalike.trackers.parts.identity`).
+"""Kalman-HA and Kalman-HA2, the robot-identification paper's baselines: ground positions (observer frame, metres), a
+constant-acceleration Kalman filter per track, Hungarian association inside a chi-square gate, identities from the
+beacon identifier (:mod:`lookalike.trackers.parts.identity`).
 
 - Kalman-HA: a track starts at every unmatched detection and ends at its first miss.
-- Kalman-HA2 (heuristics the paper cites without listing; ours): births gated by score and distance to
-  existing tracks, confirmation by hits in a window, coasting limits inside and outside the camera's view,
-  and only confirmed tracks identified (:class:`~lookalike.trackers.parts.world_rules.WorldRules`)."""
+- Kalman-HA2 (heuristics the paper cites without listing; ours): births gated by score and distance to tracks,
+  confirmation by hits in a window, coasting limits in and out of view, only confirmed tracks identified."""
 
 from __future__ import annotations
 

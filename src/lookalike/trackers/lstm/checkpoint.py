@@ -99,7 +99,7 @@ def load_weights(path: str | os.PathLike[str], n_agents: int | None = None,
             arrays = {k: data[k] for k in data.files}
     except (OSError, ValueError) as exc:
         raise CheckpointError(f"{path}: cannot read the weights ({exc})") from None
-    get = arrays.get  # (None where missing: the shape check rejects it)
+    get: Any = arrays.get  # (None where missing: the shape check rejects it)
     try:
         spec = EncodingSpec(int(meta["n_agents"]), int(meta["n_slots"]), float(meta["max_age_s"]),
                             bool(meta.get("relative_headings", False)), str(meta.get("protocol", "ours")))

@@ -1,10 +1,8 @@
-"""The beacon identifier: which of the N reporting agents each track is.
-
-Each frame, tracks are assigned to agents by the Hungarian method on the cost ``(1 - cos(φ_i(t) - ψ_j(t))) / 2`` in [0,
-1] averaged over the last ``window_frames`` frames with a visual heading ``φ_i``; ``ψ_j(t)`` is agent ``j``'s reported
-heading at that frame's time, interpolated between its reports or extrapolated at its turn rate (clipped to
-``max_turn_rate``) for at most ``max_extrapolation_s``. Agents never heard from cannot be assigned; a track's current
-agent costs ``hysteresis`` less; pairs above ``max_cost`` are not assigned. The identity probability is ``1 - cost``."""
+"""The beacon identifier: which of the N reporting agents each track is, by the Hungarian method on the cost
+``(1 - cos(φ_i(t) - ψ_j(t))) / 2`` averaged over the last ``window_frames`` frames with a visual heading ``φ_i``;
+``ψ_j(t)``: agent ``j``'s reports interpolated, or extrapolated at their turn rate (at most ``max_turn_rate``) for at
+most ``max_extrapolation_s``. A track's current agent costs ``hysteresis`` less; pairs above ``max_cost`` are not
+assigned; the identity probability is ``1 - cost``."""
 
 from __future__ import annotations
 
