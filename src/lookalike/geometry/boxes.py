@@ -9,7 +9,7 @@ import numpy as np
 def xywh_to_xyxy(xywh: np.ndarray) -> np.ndarray:
     """``(n, 4)`` left/top/width/height to left/top/right/bottom."""
     b = np.asarray(xywh, dtype=float)
-    out = b.copy()
+    out: np.ndarray = b.copy()
     out[..., 2:] += b[..., :2]
     return out
 
@@ -17,7 +17,7 @@ def xywh_to_xyxy(xywh: np.ndarray) -> np.ndarray:
 def xyxy_to_xywh(xyxy: np.ndarray) -> np.ndarray:
     """``(n, 4)`` left/top/right/bottom to left/top/width/height."""
     b = np.asarray(xyxy, dtype=float)
-    out = b.copy()
+    out: np.ndarray = b.copy()
     out[..., 2:] -= b[..., :2]
     return out
 
@@ -25,7 +25,7 @@ def xyxy_to_xywh(xyxy: np.ndarray) -> np.ndarray:
 def xywh_to_cxcywh(xywh: np.ndarray) -> np.ndarray:
     """``(n, 4)`` left/top/width/height to centre x/centre y/width/height."""
     b = np.asarray(xywh, dtype=float)
-    out = b.copy()
+    out: np.ndarray = b.copy()
     out[..., :2] += b[..., 2:] / 2.0
     return out
 

@@ -218,11 +218,9 @@ def embed(net: Any, crops: np.ndarray, device: Any = "cpu", batch: int = 512) ->
     """Embeddings ``(n, d)`` of BGR uint8 crops with the torch network (evaluation mode)."""
     torch = _torch()
     net.eval()
-    out = []
     with torch.no_grad():
-        for i in range(0, len(crops), batch):
-            out.append(net(torch.from_numpy(to_tensor_input(crops[i : i + batch])).to(device)).cpu().numpy())
-    return np.concatenate(out)
+        return np.concatenate([net(torch.from_numpy(to_tensor_input(crops[i : i + batch])).to(device)).cpu().numpy()
+                               for i in range(0, len(crops), batch)])
 
 
 def export_onnx(net: Any, path: Path) -> Path:

@@ -88,12 +88,8 @@ def _to_torch(batch: tuple, device: str) -> tuple[torch.Tensor, torch.Tensor, to
 
 def validation_batches(config: SetTrainConfig) -> list[tuple]:
     """One batch per team of :data:`VALIDATION_TEAMS`, fixed seeds apart from training and the benches."""
-    out = []
-    for i, team in enumerate(VALIDATION_TEAMS):
-        maker = SetBatchMaker(fixed=team)
-        out.append(maker(VALIDATION_SEED_BASE + SET_SEED_OFFSET + i, config.validation_sequences,
-                         config.validation_length))
-    return out
+    return [SetBatchMaker(fixed=team)(VALIDATION_SEED_BASE + SET_SEED_OFFSET + i, config.validation_sequences,
+                                      config.validation_length) for i, team in enumerate(VALIDATION_TEAMS)]
 
 
 def validate(model: SetAssociator, batches: list[tuple], device: str = "cpu") -> float:

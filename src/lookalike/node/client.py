@@ -82,7 +82,4 @@ class Endpoint:
 
     def drain(self) -> list[Message]:
         """Every message already waiting, without blocking."""
-        out = []
-        while (msg := self.receive(1e-4)) is not None:
-            out.append(msg)
-        return out
+        return list(iter(lambda: self.receive(1e-4), None))

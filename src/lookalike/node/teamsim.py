@@ -58,16 +58,11 @@ def camera_messages(sequence: RobotSequence) -> list[DetectionsMessage]:
     """One detections message per frame (positions, headings, scores; never the labels)."""
     a = sequence.arrays
     std = float(sequence.config.sensor.heading_std_rad)
-    out = []
-    for k in range(len(a)):
-        n = int(a.det_valid[k].sum())
-        out.append(DetectionsMessage(
-            frame=k, time=float(a.time[k]),
-            position=tuple((float(x), float(y)) for x, y in a.det_position[k, :n]),
-            heading=tuple(float(h) for h in a.det_heading[k, :n]),
-            score=tuple(float(s) for s in a.det_score[k, :n]), heading_std=(std,) * n,
-        ))
-    return out
+    return [DetectionsMessage(
+        frame=k, time=float(a.time[k]), position=tuple((float(x), float(y)) for x, y in a.det_position[k, :n]),
+        heading=tuple(float(h) for h in a.det_heading[k, :n]), score=tuple(float(s) for s in a.det_score[k, :n]),
+        heading_std=(std,) * n,
+    ) for k, n in enumerate(a.det_valid.sum(axis=1).tolist())]
 
 
 def robot_reports(sequence: RobotSequence, robot: int) -> list[tuple[float, HeadingReport]]:
@@ -78,13 +73,10 @@ def robot_reports(sequence: RobotSequence, robot: int) -> list[tuple[float, Head
     mine = np.flatnonzero(r.agent_id == robot)
     period = 1.0 / sequence.config.network.rate_hz
     first = float(r.t_sent[mine].min()) if mine.size else 0.0
-    out = []
-    for i in mine:
-        seq = round(float(r.t_sent[i] - first) / period)
-        out.append((float(r.t_received[i]), HeadingReport(robot=robot, seq=seq, t_sent=float(r.t_sent[i]),
-                                                          heading=float(r.heading[i]))))
-    out.sort(key=lambda item: item[0])
-    return out
+    reports = [(float(r.t_received[i]), HeadingReport(robot=robot, seq=round(float(r.t_sent[i] - first) / period),
+                                                      t_sent=float(r.t_sent[i]), heading=float(r.heading[i])))
+               for i in mine]
+    return sorted(reports, key=lambda item: item[0])
 
 
 def run_camera(endpoint: Endpoint, messages: Sequence[DetectionsMessage], clock: SimClock,

@@ -165,10 +165,8 @@ class DiverScene:
         """Frames with the detector model's detections (``label`` = diver id, -1 false positive)."""
         det = detector or self.scenario.detector
         rng = np.random.default_rng(self.scenario.seed + 7919 if seed is None else seed)
-        out = []
-        for k in range(len(self.poses)):
-            out.append(Frame(index=k, time=k / self.scenario.frame_rate, detections=self._detect(k, det, rng)))
-        return out
+        return [Frame(index=k, time=k / self.scenario.frame_rate, detections=self._detect(k, det, rng))
+                for k in range(len(self.poses))]
 
     def _detect(self, k: int, det: DetectorModel, rng: np.random.Generator) -> Detections:
         sc = self.scenario
