@@ -108,33 +108,27 @@ class HealthMonitor:
         n = len(det)
         mean_score = float(np.mean(det.score)) if n else float("nan")
         dropped = self._dropped(frame)
-        flags: set[str] = set()
-        reasons: list[str] = []
+        found: dict[str, str] = {}  # flag -> reason, in order
         if dropped:
-            flags.add(DROPPED)
-            reasons.append(f"{dropped} frame(s) dropped before this one")
+            found[DROPPED] = f"{dropped} frame(s) dropped before this one"
         if n == 0 and cfg.team_size != 0:
-            flags.add(EMPTY)
-            reasons.append("no detections")
+            found[EMPTY] = "no detections"
         if cfg.team_size is not None:
             if n > cfg.team_size + cfg.extra_allowed:
-                flags.add(TOO_MANY)
-                reasons.append(f"{n} detections for a team of {cfg.team_size}")
+                found[TOO_MANY] = f"{n} detections for a team of {cfg.team_size}"
             elif 0 < n < cfg.team_size:
-                flags.add(TOO_FEW)
-                reasons.append(f"{n} of a team of {cfg.team_size} detected")
+                found[TOO_FEW] = f"{n} of a team of {cfg.team_size} detected"
         baseline = self.baseline_score
         checks_scores = np.isfinite(baseline) and baseline > 0
         if n and checks_scores and mean_score < cfg.collapse_ratio * baseline:
-            flags.add(SCORE_COLLAPSE)
-            reasons.append(f"mean score {mean_score:.2f} < {cfg.collapse_ratio:.0%} of usual {baseline:.2f}")
-        if n and SCORE_COLLAPSE not in flags:
+            found[SCORE_COLLAPSE] = f"mean score {mean_score:.2f} < {cfg.collapse_ratio:.0%} of usual {baseline:.2f}"
+        if n and SCORE_COLLAPSE not in found:
             self._baseline_scores.append(mean_score)
-        ok = not (flags - _INFORMATIONAL)
+        ok = not (found.keys() - _INFORMATIONAL)
         self._window.append((n, mean_score, dropped, ok))
-        window_flags, window_reasons = self._window_flags(baseline if checks_scores else float("nan"))
-        return HealthStatus(frame.index, n, mean_score, dropped, frozenset(flags), tuple(reasons),
-                            frozenset(window_flags), tuple(window_reasons))
+        window = self._window_flags(baseline if checks_scores else float("nan"))
+        return HealthStatus(frame.index, n, mean_score, dropped, frozenset(found), tuple(found.values()),
+                            frozenset(window), tuple(window.values()))
 
     def _dropped(self, frame: Frame) -> int:
         """Frames missing between the previous frame and this one (from indices, else from times)."""
@@ -157,30 +151,26 @@ class HealthMonitor:
             self._intervals.append(step / (missing + 1))
         return missing
 
-    def _window_flags(self, baseline: float) -> tuple[set[str], list[str]]:
+    def _window_flags(self, baseline: float) -> dict[str, str]:
         cfg = self.config
         counts = np.array([w[0] for w in self._window], dtype=float)
         scores = np.array([w[1] for w in self._window], dtype=float)
         dropped = sum(w[2] for w in self._window)
         bad = sum(not w[3] for w in self._window)
-        flags: set[str] = set()
-        reasons: list[str] = []
+        found: dict[str, str] = {}  # flag -> reason, in order
         m = len(self._window)
         if bad > cfg.max_bad_fraction * m:
-            flags.add(UNHEALTHY_FRAMES)
-            reasons.append(f"{bad}/{m} recent frames unhealthy")
+            found[UNHEALTHY_FRAMES] = f"{bad}/{m} recent frames unhealthy"
         if cfg.team_size and counts.mean() < cfg.min_count_fraction * cfg.team_size:
-            flags.add(UNDERCOUNT)
-            reasons.append(f"{counts.mean():.1f} detections/frame for a team of {cfg.team_size}")
+            found[UNDERCOUNT] = f"{counts.mean():.1f} detections/frame for a team of {cfg.team_size}"
         if np.isfinite(baseline) and np.isfinite(scores).any():
             mean = float(np.nanmean(scores))
             if mean < cfg.collapse_ratio * baseline:
-                flags.add(SCORE_COLLAPSE)
-                reasons.append(f"recent mean score {mean:.2f} < {cfg.collapse_ratio:.0%} of usual {baseline:.2f}")
+                found[SCORE_COLLAPSE] = (f"recent mean score {mean:.2f} < {cfg.collapse_ratio:.0%} of usual "
+                                         f"{baseline:.2f}")
         if dropped > cfg.max_dropped:
-            flags.add(DROPPED)
-            reasons.append(f"{dropped} frame(s) dropped in the last {m}")
-        return flags, reasons
+            found[DROPPED] = f"{dropped} frame(s) dropped in the last {m}"
+        return found
 
 
 def assess(frames: list[Frame], config: HealthConfig | None = None) -> list[HealthStatus]:
