@@ -30,9 +30,7 @@ def _check_threshold(threshold: float) -> None:
         raise ValueError(f"iou_threshold must be in (0, 1], got {threshold}")
 
 
-def evaluate_data(
-    data: SequenceData, *, threshold: float = 0.5, metrics: Sequence[str] = METRICS
-) -> dict[str, float]:
+def evaluate_data(data: SequenceData, *, threshold: float = 0.5, metrics: Sequence[str] = METRICS) -> dict[str, float]:
     """Score prepared data: ``threshold`` is the similarity a CLEAR/identity match needs."""
     _check_threshold(threshold)
     chosen = _metric_names(metrics)
@@ -54,39 +52,20 @@ def evaluate_data(
     return out
 
 
-def evaluate_sequence(
-    gt: MotTable,
-    result: MotTable,
-    *,
-    iou_threshold: float = 0.5,
-    benchmark: str = "MOT15",
-    metrics: Sequence[str] = METRICS,
-    num_frames: int | None = None,
-) -> dict[str, float]:
-    """CLEAR, identity and HOTA of tracker boxes ``result`` against ground truth ``gt`` (:class:`lookalike.io.MotTable`,
-    or anything with its columns).
-
-    ``benchmark`` picks the ground-truth rules (see :mod:`lookalike.eval.prepare`): ``"MOT17"`` (also MOT16/MOT20) for
-    MOTChallenge preprocessing, ``"MOT15"`` or ``"custom"`` for plain. ``num_frames`` is the sequence length
-    (``seqLength``); by default the last frame present. Returns TrackEval-named values as fractions (MOTA, MOTP = mean
-    IoU of matches, IDF1, HOTA, ``HOTA___50``, ...) and the counts (CLR_TP, IDSW, IDTP, HOTA_TP___50, ...)."""
+def evaluate_sequence(gt: MotTable, result: MotTable, *, iou_threshold: float = 0.5, benchmark: str = "MOT15",
+                      metrics: Sequence[str] = METRICS, num_frames: int | None = None) -> dict[str, float]:
+    """CLEAR, identity and HOTA of tracker boxes ``result`` against ground truth ``gt`` (anything with
+    :class:`lookalike.io.MotTable`'s columns) under ``benchmark``'s rules (:mod:`lookalike.eval.prepare`), over
+    ``num_frames`` frames (default: the last present): TrackEval-named fractions (MOTA, MOTP = mean IoU of matches,
+    IDF1, HOTA, ``HOTA___50``, ...) and counts (CLR_TP, IDSW, IDTP, HOTA_TP___50, ...)."""
     _check_threshold(iou_threshold)
     data = prepare_boxes(gt, result, num_frames=num_frames, benchmark=benchmark)
     return evaluate_data(data, threshold=iou_threshold, metrics=metrics)
 
 
-def evaluate_points(
-    gt_frame: np.ndarray,
-    gt_id: np.ndarray,
-    gt_xy: np.ndarray,
-    result_frame: np.ndarray,
-    result_id: np.ndarray,
-    result_xy: np.ndarray,
-    *,
-    radius: float,
-    metrics: Sequence[str] = METRICS,
-    num_frames: int | None = None,
-) -> dict[str, float]:
+def evaluate_points(gt_frame: np.ndarray, gt_id: np.ndarray, gt_xy: np.ndarray, result_frame: np.ndarray,
+                    result_id: np.ndarray, result_xy: np.ndarray, *, radius: float, metrics: Sequence[str] = METRICS,
+                    num_frames: int | None = None) -> dict[str, float]:
     """The same metrics for point data: ``(n,)`` 1-based frames and ids, ``(n, 2)`` positions (pixels or metres).
     Objects match within ``radius`` (same unit); the similarity is ``max(0, 1 - d / (2 * radius))`` so MOTP and LocA are
     mean scores, and HOTA's alphas sweep distances from 1.9 to 0.1 times ``radius``."""
@@ -96,9 +75,8 @@ def evaluate_points(
 
 
 def combine(per_sequence: list[dict[str, float]]) -> dict[str, float]:
-    """Combine per-sequence results as TrackEval does: counts summed (CLEAR, identity, HOTA
-    TP/FN/FP), HOTA's AssA/AssRe/AssPr and LocA averaged weighted by HOTA_TP per alpha, and every
-    ratio recomputed from the combined numbers."""
+    """Combine per-sequence results as TrackEval does: counts summed, HOTA's association scores and LocA weighted by
+    HOTA_TP per alpha, ratios recomputed."""
     if not per_sequence:
         raise ValueError("per_sequence: nothing to combine")
     first = per_sequence[0]

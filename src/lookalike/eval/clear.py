@@ -14,10 +14,8 @@ COUNTS = ("CLR_TP", "CLR_FN", "CLR_FP", "IDSW", "MT", "PT", "ML", "Frag", "MOTP_
 
 
 def clear_counts(data: SequenceData, threshold: float = 0.5) -> dict[str, float]:
-    """The summable CLEAR counts of one sequence (see :data:`COUNTS`).
-
-    Frames whose pairs at ``threshold`` are one-to-one are matched without the Hungarian algorithm (every such pair is a
-    match whatever the previous frame did); the rest are solved in frame order."""
+    """The summable CLEAR counts (:data:`COUNTS`) of one sequence; frames whose pairs at ``threshold`` are one-to-one
+    are matched without the Hungarian algorithm."""
     n_gt, n_frames = data.num_gt_ids, data.num_frames
     p = data.pairs()
     cand = np.flatnonzero(p.similarity >= threshold - _EPS)

@@ -10,9 +10,8 @@ import numpy as np
 
 @dataclass(frozen=True, eq=False)
 class Pairs:
-    """Flattened positive-similarity pairs, sorted by ground-truth detection then tracker detection:
-    ``gt_det``/``tracker_det`` index all detections of the sequence in frame order; ``gt_id``/``tracker_id``
-    are the relabelled ids."""
+    """Positive-similarity pairs sorted by ground-truth then tracker detection (``gt_det``/``tracker_det``: indices in
+    frame order; ``gt_id``/``tracker_id``: relabelled ids)."""
 
     frame: np.ndarray
     gt_det: np.ndarray
@@ -26,17 +25,8 @@ class Pairs:
 
 @dataclass(frozen=True, eq=False)
 class SequenceData:
-    """Detections and positive similarities of one sequence.
-
-    Attributes:
-        gt_bounds: ``(F + 1,)`` frame ``t``'s ground-truth detections are ``gt_id[gt_bounds[t]:gt_bounds[t+1]]``.
-        gt_id: ``(n_gt,)`` relabelled ground-truth id of each detection, in frame order.
-        tracker_bounds: ``(F + 1,)`` the same for tracker detections.
-        tracker_id: ``(n_tr,)`` relabelled tracker id of each detection.
-        pairs: every same-frame (ground truth, tracker) pair with similarity > 0 (in ``[0, 1]``:
-            IoU or distance score).
-        num_gt_ids: number of distinct ground-truth ids.
-        num_tracker_ids: number of distinct tracker ids."""
+    """One sequence: frame ``t``'s ground-truth detections have ids ``gt_id[gt_bounds[t]:gt_bounds[t+1]]`` (relabelled,
+    ``(F + 1,)`` bounds), the same for tracker detections, and ``pair``: every same-frame pair with similarity > 0."""
 
     gt_bounds: np.ndarray
     gt_id: np.ndarray

@@ -30,19 +30,11 @@ def _score(job: tuple[MotSequence, Path, str, tuple[str, ...], float]) -> dict[s
                              benchmark=benchmark, metrics=metrics, num_frames=seq.length)
 
 
-def evaluate_folders(
-    gt_root: str | os.PathLike[str],
-    results: str | os.PathLike[str],
-    *,
-    benchmark: str = "MOT15",
-    metrics: Sequence[str] = METRICS,
-    iou_threshold: float = 0.5,
-    workers: int = 1,
-) -> dict[str, dict[str, float]]:
-    """Per-sequence results (sequence name -> metrics) and their combination under ``"COMBINED"``.
-
-    Every ground-truth sequence needs a result file; sequence lengths come from ``seqinfo.ini`` (else the last frame
-    present). ``workers > 1`` scores sequences in that many processes."""
+def evaluate_folders(gt_root: str | os.PathLike[str], results: str | os.PathLike[str], *, benchmark: str = "MOT15",
+                     metrics: Sequence[str] = METRICS, iou_threshold: float = 0.5,
+                     workers: int = 1) -> dict[str, dict[str, float]]:
+    """Per-sequence results (name -> metrics) and their combination under ``"COMBINED"``; every ground-truth sequence
+    needs a result file; ``workers`` processes."""
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
     sequences = [s for s in find_sequences(gt_root) if s.gt_path is not None]
@@ -66,10 +58,8 @@ def evaluate_folders(
 
 def folder_results(scores: dict[str, dict[str, dict[str, float]]], gt_root: str | os.PathLike[str],
                    command: str = "", options: dict[str, object] | None = None) -> Results:
-    """Scores of :func:`evaluate_folders` per results folder (``{tracker: {sequence: metrics}}``) as a
-    results document: table ``scores``, one row per tracker and sequence (dataset: the ground-truth
-    folder's name) and the combined row (``sequence`` None, ``combined`` True); TrackEval's metric
-    names as machine keys (``HOTA`` -> ``hota``, ``CLR_FP`` -> ``clr_fp``, ``HOTA___AUC`` -> ``hota_auc``)."""
+    """``{tracker: {sequence: metrics}}`` of :func:`evaluate_folders` as a results document: table ``scores``, one
+    row per tracker and sequence and a combined one, metrics under :func:`~lookalike.io.results.metric_key`."""
     from lookalike.io.results import Results, metric_key  # imported when used: a short start-up
 
     dataset = Path(gt_root).name or str(gt_root)

@@ -1,8 +1,5 @@
-"""The robot-identification paper's metrics: how often a detection carries the right agent label, and how far estimated
-agent positions are from the true ones.
-
-Labels are agent ids (``>= 0``) or ``-1`` (false positive). Positions are ``(n_frames, n_agents, 2)`` arrays in metres,
-NaN where the agent is absent (truth) or not estimated."""
+"""The robot-identification paper's metrics over per-frame labels (agent ids, or -1: a false positive) and
+``(n_frames, n_agents, 2)`` positions in metres (NaN: absent or not estimated)."""
 
 from __future__ import annotations
 
@@ -30,37 +27,28 @@ def _flatten_labels(predicted: Sequence[np.ndarray], true: Sequence[np.ndarray])
     return cat(p_parts), cat(t_parts)
 
 
-def identification_counts(
-    predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]
-) -> tuple[int, int]:
+def identification_counts(predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]) -> tuple[int, int]:
     """(correct labels, detections) over all frames: the counts :func:`identification_success_rate` divides."""
     p, t = _flatten_labels(predicted_labels, true_labels)
     return int(np.sum(p == t)), int(p.size)
 
 
-def identification_success_rate(
-    predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]
-) -> float:
-    """Correct labels / all detections, over all frames (lists of ``(n_t,)`` int arrays).
-
-    A false positive (true label -1) labelled -1 is correct. NaN when there are no detections."""
+def identification_success_rate(predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]) -> float:
+    """Correct labels / detections over all frames (a false positive labelled -1 is correct; NaN: none)."""
     correct, detections = identification_counts(predicted_labels, true_labels)
     return correct / detections if detections else float("nan")
 
 
 def robot_success_rate(predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]) -> float:
-    """Correct labels / detections of true robots (true label >= 0), over all frames: the success rate without the false
-    positives, which sides with different false-positive rates score unequally. NaN when there are none."""
+    """Correct labels / detections of true robots (true label >= 0) over all frames (NaN: none)."""
     p, t = _flatten_labels(predicted_labels, true_labels)
     robots = t >= 0
     return float(np.mean(p[robots] == t[robots])) if robots.any() else float("nan")
 
 
-def identification_by_agent(
-    predicted_labels: Sequence[np.ndarray], true_labels: Sequence[np.ndarray]
-) -> dict[int, float]:
-    """Success rate per true label (agent id, and -1 for the false positives): the fraction of
-    that agent's detections that carry its label."""
+def identification_by_agent(predicted_labels: Sequence[np.ndarray],
+                            true_labels: Sequence[np.ndarray]) -> dict[int, float]:
+    """Success rate per true label (-1: the false positives)."""
     p, t = _flatten_labels(predicted_labels, true_labels)
     return {int(a): float(np.mean(p[t == a] == a)) for a in np.unique(t)}
 
@@ -76,8 +64,7 @@ def _positions(estimated: np.ndarray, truth: np.ndarray) -> tuple[np.ndarray, np
 
 
 def localisation_error_by_agent(estimated: np.ndarray, truth: np.ndarray) -> np.ndarray:
-    """Mean distance (metres) per agent ``(n_agents,)`` over the frames where the agent is present
-    and estimated; NaN for an agent never both."""
+    """Mean distance (m) per agent ``(n_agents,)`` where present and estimated (NaN: never)."""
     e, g = _positions(estimated, truth)
     d = np.linalg.norm(e - g, axis=2)
     ok = np.isfinite(d)
@@ -88,9 +75,8 @@ def localisation_error_by_agent(estimated: np.ndarray, truth: np.ndarray) -> np.
 
 
 def localisation_error(estimated: np.ndarray, truth: np.ndarray) -> float:
-    """Mean distance (metres) between estimated and true positions over every (frame, agent) where
-    the agent is present and estimated; NaN when there is none. Frames where a present agent has
-    no estimate are excluded here; see :func:`localisation_coverage`."""
+    """Mean distance (m) over every (frame, agent) present and estimated (NaN: none; see
+    :func:`localisation_coverage`)."""
     e, g = _positions(estimated, truth)
     d = np.linalg.norm(e - g, axis=2)
     d = d[np.isfinite(d)]

@@ -1,6 +1,5 @@
-"""Identity metrics (Ristani et al. 2016): IDF1, IDP, IDR from the global one-to-one matching of
-ground-truth ids to tracker ids that maximises the number of frames both are matched
-(similarity >= threshold) — equal to TrackEval's min-cost formulation with dummy ids."""
+"""Identity metrics (Ristani et al. 2016): IDF1, IDP, IDR from the one-to-one id matching maximising the frames both
+are matched (similarity >= threshold)."""
 
 from __future__ import annotations
 

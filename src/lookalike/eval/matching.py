@@ -1,6 +1,5 @@
-"""Per-frame Hungarian matching over sparse pairs, skipping frames whose pairs are already one-to-one (every
-maximum-score assignment contains them); the other frames' dense matrices are built in one reused buffer
-(:func:`negated_matrices`) and solved in turn (:func:`solve_matrices`)."""
+"""Per-frame Hungarian matching over sparse pairs, for the frames whose pairs are not one-to-one: dense matrices built
+in one reused buffer (:func:`negated_matrices`) and solved in turn (:func:`solve_matrices`)."""
 
 from __future__ import annotations
 
@@ -11,8 +10,7 @@ import numpy as np
 
 
 def hungarian() -> Callable[..., Any]:
-    """SciPy's ``linear_sum_assignment``, loaded on first use without ``scipy.optimize`` (which takes a
-    good part of a second to import; :mod:`lookalike._lsap`)."""
+    """SciPy's ``linear_sum_assignment`` without importing ``scipy.optimize`` (:mod:`lookalike._lsap`)."""
     from lookalike._lsap import linear_sum_assignment
 
     solve: Callable[..., Any] = linear_sum_assignment
@@ -40,8 +38,8 @@ _CHUNK = 1 << 15  # float64 entries (256 KiB) of the buffer that consecutive mat
 
 def negated_matrices(shapes: np.ndarray, block: np.ndarray, rows: np.ndarray, cols: np.ndarray,
                      values: np.ndarray) -> Iterator[np.ndarray]:
-    """``k`` dense negated matrices of ``shapes (k, 2)``: ``-0.0`` except ``-values`` at ``(rows, cols)`` of
-    matrix ``block``. Built a run at a time in one reused buffer; each is a view valid until the next is asked for."""
+    """``k`` dense negated matrices of ``shapes (k, 2)``: ``-0.0`` except ``-values`` at ``(rows, cols)`` of matrix
+    ``block``; each a view of one reused buffer, valid until the next is asked for."""
     k = len(shapes)
     if not k:
         return
@@ -67,8 +65,7 @@ def negated_matrices(shapes: np.ndarray, block: np.ndarray, rows: np.ndarray, co
 
 
 def solve_matrices(matrices: Iterable[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The minimum-cost assignment of each matrix (of :func:`negated_matrices`: the maximum one of the
-    un-negated matrix): its rows and columns (local indices) concatenated, and the number per matrix."""
+    """Each matrix's minimum-cost assignment: rows and columns (local) concatenated, and the number per matrix."""
     linear_sum_assignment = hungarian()
     rows, cols = [], []
     for cost in matrices:

@@ -1,9 +1,6 @@
-"""Turn ground-truth and result tables into :class:`SequenceData`, applying benchmark rules (``benchmark``):
-
-- ``"MOT16"``, ``"MOT17"``, ``"MOT20"``: tracker boxes matched (IoU >= 0.5) to distractor classes are
-  removed, then only ground truth with a non-zero consider flag and class pedestrian is kept;
-- ``"MOT15"``: ground truth with a zero consider flag is dropped;
-- ``"custom"``: everything is kept."""
+"""Ground-truth and result tables as :class:`SequenceData` under a benchmark's rules: ``"MOT16"``, ``"MOT17"`` and
+``"MOT20"`` drop tracker boxes matched (IoU >= 0.5) to distractor classes, then keep considered pedestrians; ``"MOT15"``
+drops ground truth with a zero consider flag; ``"custom"`` keeps everything."""
 
 from __future__ import annotations
 
@@ -20,10 +17,8 @@ from lookalike.types.mot_table import MotTable as MotTableData
 
 
 class MotTable(Protocol):
-    """What scoring needs of a table of boxes; :class:`lookalike.io.MotTable` has it.
-
-    ``frame`` ``(n,)`` 1-based, ``track_id`` ``(n,)``, ``xywh`` ``(n, 4)`` pixels, ``conf`` ``(n,)`` (the ground truth's
-    consider flag), ``extra`` ``(n, k)`` (class in column 0 for MOT16+ gt), ``path`` the source file or None."""
+    """What scoring needs of a table of boxes (:class:`lookalike.io.MotTable`): ``frame`` ``(n,)`` 1-based, ``xywh``
+    ``(n, 4)`` px, ``conf`` (gt: the consider flag), ``extra`` ``(n, k)`` (MOT16+ gt: class first), ``path``."""
 
     @property
     def frame(self) -> np.ndarray: ...
@@ -60,25 +55,20 @@ def where(table: MotTable, row: int, name: str) -> str:
 
 
 def check_table(table: MotTable, num_frames: int, name: str, keep: np.ndarray | None = None) -> None:
-    """Raise ``ValueError`` for frames beyond ``num_frames`` or an id twice in one frame (among
-    the rows in ``keep``, all by default)."""
+    """``ValueError`` for a frame beyond ``num_frames`` or an id twice in one frame (among rows ``keep``)."""
     beyond = np.flatnonzero(table.frame > num_frames)
     if len(beyond):
         row = int(beyond[0])
-        raise ValueError(
-            f"{where(table, row, name)}: frame {int(table.frame[row])} is beyond the sequence "
-            f"length {num_frames}"
-        )
+        raise ValueError(f"{where(table, row, name)}: frame {int(table.frame[row])} is beyond the sequence "
+                         f"length {num_frames}")
     kept = np.arange(len(table)) if keep is None else np.flatnonzero(keep)
     if len(kept) > 1:
         order = kept[np.lexsort((table.track_id[kept], table.frame[kept]))]
         same = (np.diff(table.frame[order]) == 0) & (np.diff(table.track_id[order]) == 0)
         if same.any():
             row = int(order[np.flatnonzero(same)[0] + 1])
-            raise ValueError(
-                f"{where(table, row, name)}: id {int(table.track_id[row])} appears twice in frame "
-                f"{int(table.frame[row])}"
-            )
+            raise ValueError(f"{where(table, row, name)}: id {int(table.track_id[row])} appears twice in frame "
+                             f"{int(table.frame[row])}")
 
 
 def _bounds(frames: np.ndarray, num_frames: int) -> tuple[np.ndarray, np.ndarray]:
@@ -95,12 +85,9 @@ def _relabel(ids: list[np.ndarray]) -> tuple[list[np.ndarray], int]:
     return list(np.split(inverse.astype(int).ravel(), splits)), len(unique)
 
 
-def prepare_boxes(
-    gt: MotTable, result: MotTable, *, num_frames: int | None = None, benchmark: str = "MOT15"
-) -> SequenceData:
-    """Box sequences (IoU similarity) with ``benchmark`` rules; frames ``1 .. num_frames``.
-
-    ``num_frames`` defaults to the last frame of either table."""
+def prepare_boxes(gt: MotTable, result: MotTable, *, num_frames: int | None = None,
+                  benchmark: str = "MOT15") -> SequenceData:
+    """Box sequences (IoU similarity) with ``benchmark`` rules over frames ``1 .. num_frames`` (default: the last)."""
     if benchmark not in BENCHMARKS:
         raise ValueError(f"benchmark must be one of {BENCHMARKS}, got {benchmark!r}")
     n = _num_frames(gt, result, num_frames)
@@ -151,9 +138,8 @@ def _relabel_flat(ids: np.ndarray) -> tuple[np.ndarray, int]:
 
 def _overlapping_pairs(a: np.ndarray, a_frame: np.ndarray, b: np.ndarray,
                        b_frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every same-frame pair ``(i, j)`` of boxes ``a[i]``, ``b[j]`` (``(n, 4)`` xywh px, 0-based frames sorted)
-    with a positive IoU, sorted by ``i`` then ``j``, and that IoU (bit for bit :func:`box_iou`'s), found by
-    sorted-range look-ups of left edges."""
+    """Every same-frame pair ``(i, j)`` of boxes ``a[i]``, ``b[j]`` (``(n, 4)`` xywh px, sorted 0-based frames) with a
+    positive IoU (bit for bit :func:`box_iou`'s), sorted by ``i`` then ``j``, found by sorted left-edge look-ups."""
     empty = np.zeros(0, np.int64)
     if not len(a) or not len(b):
         return empty, empty, np.zeros(0)
@@ -184,8 +170,8 @@ _CHUNK = 1 << 15  # candidate pairs per batch: keeps the IoU temporaries in cach
 
 def _ranges(keys: np.ndarray, start: np.ndarray, stop: np.ndarray,
             side: Literal["left", "right"]) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-    """Batches of ``(index into start, index into keys)`` of every key in ``[start, stop]`` (``(start, stop]``
-    with ``side="right"``), about :data:`_CHUNK` pairs each."""
+    """Batches of about :data:`_CHUNK` ``(index into start, index into keys)`` of every key in ``[start, stop]``
+    (``(start, stop]`` with ``side="right"``)."""
     order = np.argsort(keys, kind="stable")
     sorted_keys = keys[order]
     first = np.searchsorted(sorted_keys, start, side)
@@ -203,8 +189,7 @@ def _ranges(keys: np.ndarray, start: np.ndarray, stop: np.ndarray,
 def _drop_distractor_matches(keep_r: np.ndarray, gi: np.ndarray, ri: np.ndarray, sim: np.ndarray,
                              g_frame: np.ndarray, gb: np.ndarray, rb: np.ndarray, classes: np.ndarray,
                              distractors: tuple[int, ...]) -> None:
-    """Clear ``keep_r`` for tracker boxes that the per-frame Hungarian matching at IoU >= 0.5 pairs with a
-    distractor-class ground-truth box (TrackEval's MOT16+ preprocessing)."""
+    """Clear ``keep_r`` for tracker boxes matched (per-frame Hungarian, IoU >= 0.5) to a distractor ground-truth box."""
     strong = sim >= 0.5 - _EPS
     gi, ri, sim = gi[strong], ri[strong], sim[strong]
     frame = g_frame[gi]
@@ -231,19 +216,10 @@ def _drop_distractor_matches(keep_r: np.ndarray, gi: np.ndarray, ri: np.ndarray,
     keep_r[cols_at[listed & distractor[rows_at]]] = False
 
 
-def prepare_points(
-    gt_frame: np.ndarray,
-    gt_id: np.ndarray,
-    gt_xy: np.ndarray,
-    result_frame: np.ndarray,
-    result_id: np.ndarray,
-    result_xy: np.ndarray,
-    *,
-    radius: float,
-    num_frames: int | None = None,
-) -> SequenceData:
-    """Point sequences (``(n, 2)`` positions in pixels or metres; 1-based frames) scored with
-    :func:`point_similarity` at match distance ``radius`` (same unit as the positions)."""
+def prepare_points(gt_frame: np.ndarray, gt_id: np.ndarray, gt_xy: np.ndarray, result_frame: np.ndarray,
+                   result_id: np.ndarray, result_xy: np.ndarray, *, radius: float,
+                   num_frames: int | None = None) -> SequenceData:
+    """Point sequences (``(n, 2)`` positions, 1-based frames) scored by :func:`point_similarity` at ``radius``."""
     gt = _point_table(gt_frame, gt_id, gt_xy, "gt")
     res = _point_table(result_frame, result_id, result_xy, "result")
     n = _num_frames(gt, res, num_frames)

@@ -14,11 +14,8 @@ def headline(scores: dict[str, float]) -> float:
 
 def leave_one_out(scores: Sequence[Sequence[dict[str, float]]],
                   criterion: Callable[[dict[str, float]], float] = headline) -> tuple[dict[str, float], list[int]]:
-    """Left-out scores combined over the sequences, and the candidate chosen for each sequence.
-
-    ``scores[k][i]`` holds candidate ``k``'s per-sequence result (:func:`combine`-able counts) on sequence ``i``. For
-    each sequence the candidate with the best ``criterion`` combined over the *other* sequences is chosen (the first on
-    ties), and its result on the left-out sequence is kept."""
+    """Left-out scores combined, and per sequence ``i`` the candidate ``k`` chosen by ``criterion`` over the *other*
+    sequences (first on ties); ``scores[k][i]``: candidate ``k``'s :func:`combine`-able result on sequence ``i``."""
     if not scores or not scores[0]:
         raise ValueError("scores: need at least one candidate and one sequence")
     n = len(scores[0])

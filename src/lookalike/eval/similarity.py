@@ -9,15 +9,12 @@ _EPS = np.finfo(float).eps
 
 
 def box_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
-    """IoU ``(n, m)`` of ``(n, 4)`` and ``(m, 4)`` boxes (left, top, width, height; pixels).
-
-    Boxes of zero area, and pairs with no union, get 0."""
+    """IoU ``(n, m)`` of ``(n, 4)`` and ``(m, 4)`` xywh boxes (px); 0 for zero area or no union."""
     return _corner_iou(gt_xywh, tr_xywh, outer=True)
 
 
 def pair_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
-    """IoU ``(k,)`` of ``k`` box pairs, ``(k, 4)`` each (left, top, width, height; pixels): bit for bit
-    the entries :func:`box_iou` gives for the same pairs."""
+    """IoU ``(k,)`` of ``k`` pairs of xywh boxes (px), bit for bit :func:`box_iou`'s."""
     return _corner_iou(gt_xywh, tr_xywh, outer=False)
 
 
@@ -45,9 +42,7 @@ def _corner_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray, outer: bool) -> np.nda
 
 
 def point_similarity(gt_xy: np.ndarray, tr_xy: np.ndarray, radius: float) -> np.ndarray:
-    """Distance score ``(n, m)`` of ``(n, 2)`` and ``(m, 2)`` points (pixels or metres).
-
-    ``max(0, 1 - d / (2 * radius))``: 1 at the same place, 0.5 at ``radius``, 0 from ``2 * radius``."""
+    """Distance score ``(n, m)`` of ``(n, 2)`` and ``(m, 2)`` points: ``max(0, 1 - d / (2 * radius))``."""
     if not radius > 0:
         raise ValueError(f"radius must be positive, got {radius}")
     a = np.asarray(gt_xy, dtype=float).reshape(-1, 2)
