@@ -166,23 +166,15 @@ class SetIdentifier(AgentIdentifier):
         (radians, sent at ``t_sent`` s)."""
         assert self._jumps is not None
         for action in self._jumps.find(heading, t_sent, self._beacons.heading, self._beacons.t_sent, self._last_time):
-            if isinstance(action, tuple):
-                self._exchange_memories(*action)
-            else:
-                self._forget(action)
-
-    def _forget(self, agents: np.ndarray) -> None:
-        """Forget the network's memory of ``agents`` (indices) and restart their report tracks."""
-        self.net.forget(np.isin(np.arange(self.config.n_agents), agents))
-        if self._exchange is not None:
-            for a in agents.tolist():
-                self._exchange.forget(a)
-
-    def _exchange_memories(self, a: int, b: int) -> None:
-        """Exchange agents ``a`` and ``b``'s memories (the network's and the report-exchange detector's tracks)."""
-        self._swap_network(a, b)
-        if self._exchange is not None:
-            self._exchange.swap(a, b)
+            if isinstance(action, tuple):  # (the network's and the report-exchange detector's memories)
+                self._swap_network(*action)
+                if self._exchange is not None:
+                    self._exchange.swap(*action)
+            else:  # (forgotten, their report tracks restarted)
+                self.net.forget(np.isin(np.arange(self.config.n_agents), action))
+                if self._exchange is not None:
+                    for agent in action.tolist():
+                        self._exchange.forget(agent)
 
     def _swap_network(self, a: int, b: int) -> None:
         """Exchange agents ``a`` and ``b``'s memories in the network and note when (undo: only an agent's latest)."""
