@@ -51,8 +51,6 @@ def fit_diver_features(scenarios: tuple[DiverScenario, ...] = VALIDATION_SCENARI
     return HandcraftedFeatures(stats=fit_stats(np.vstack(raws), np.concatenate(labels)), crop_px=crop_px)
 
 
-FEATURE_NAMES = ("handcrafted", "learned")
-
 #: Cosine thresholds of the trackers' defaults, chosen with the hand-crafted features.
 HANDCRAFTED_THRESHOLDS: dict[str, dict[str, float]] = {
     "deepsort": {"max_cosine_distance": 0.2},

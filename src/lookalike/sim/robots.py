@@ -161,8 +161,7 @@ class RobotSequence:
 
     def frames(self) -> Iterator[Frame]:
         """All frames in order."""
-        for k in range(len(self)):
-            yield self.frame(k)
+        return (self.frame(k) for k in range(len(self)))
 
     def true_labels(self) -> list[np.ndarray]:
         """Per-frame truth labels of the detections (agent id or -1)."""

@@ -10,9 +10,7 @@ import numpy as np
 def as_column(
     owner: str, name: str, value: Any, n: int | None, width: int | None, dtype: type = float
 ) -> np.ndarray:
-    """Convert ``value`` to a read-only array of shape ``(n,)`` or ``(n, width)``.
-
-    Raises ``ValueError`` naming ``owner.name`` when the shape does not fit."""
+    """``value`` as a read-only array ``(n,)`` or ``(n, width)``; ``ValueError`` naming ``owner.name`` otherwise."""
     try:
         arr: np.ndarray = np.array(value, dtype=dtype, copy=True)
     except (TypeError, ValueError) as exc:

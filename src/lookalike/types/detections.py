@@ -115,11 +115,8 @@ class Detections:
 
     def select(self, index: np.ndarray | slice | list[int]) -> Detections:
         """Rows ``index`` as a new batch (boolean mask or integer indices)."""
-        values: dict[str, Any] = {}
-        for f in dataclasses.fields(self):
-            col = getattr(self, f.name)
-            values[f.name] = None if col is None else col[index]
-        return Detections(**values)
+        columns = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        return Detections(**{name: None if col is None else col[index] for name, col in columns.items()})
 
     def replace(self, **changes: Any) -> Detections:
         """A copy with some columns replaced (validated again)."""
