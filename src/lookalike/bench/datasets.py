@@ -30,16 +30,14 @@ DATA_ENV = "LOOKALIKE_DATA"
 def resolve_data_root(option: Path | str | None = None) -> Path:
     """The data folder: ``option``, else ``$LOOKALIKE_DATA``, else ``../shared/data`` (``FileNotFoundError``)."""
     if option is not None:
-        tried = [(Path(option), "--data")]
+        path, why = Path(option), "--data"
     elif os.environ.get(DATA_ENV):
-        tried = [(Path(os.environ[DATA_ENV]), f"${DATA_ENV}")]
+        path, why = Path(os.environ[DATA_ENV]), f"${DATA_ENV}"
     else:
-        tried = [(Path.cwd().parent / "shared" / "data", "../shared/data from the current directory")]
-    for path, _ in tried:
-        if path.is_dir():
-            return path
-    what = "; ".join(f"{p} ({why})" for p, why in tried)
-    raise FileNotFoundError(f"data folder not found: tried {what}; give --data FOLDER or set ${DATA_ENV}")
+        path, why = Path.cwd().parent / "shared" / "data", "../shared/data from the current directory"
+    if path.is_dir():
+        return path
+    raise FileNotFoundError(f"data folder not found: tried {path} ({why}); give --data FOLDER or set ${DATA_ENV}")
 
 
 @dataclass(frozen=True, eq=False)

@@ -7,8 +7,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from lookalike.bench.datasets import DATASETS, RealSequence, load_boxes, load_datasets
 from lookalike.bench.runner import Entry, score_rows, track_rows
 
@@ -48,14 +46,9 @@ def load_tuning_data(items: Sequence[str], data_root: Path | None = None) -> lis
     return out
 
 
-def run_params(tracker: str, params: dict[str, Any], seq: RealSequence) -> np.ndarray:
-    """MOTChallenge rows of ``tracker`` with exactly ``params`` on ``seq`` (no preset of the benches)."""
-    return track_rows(Entry(tracker, tracker, params=dict(params)), seq)
-
-
 def score_params(tracker: str, params: dict[str, Any], seq: RealSequence) -> dict[str, float]:
-    """Scores (combinable counts and metrics) of ``tracker`` with ``params`` on ``seq``."""
-    return score_rows(seq, run_params(tracker, params, seq))
+    """Scores (combinable counts and metrics) of ``tracker`` with exactly ``params`` (no bench preset) on ``seq``."""
+    return score_rows(seq, track_rows(Entry(tracker, tracker, params=dict(params)), seq))
 
 
-__all__ = ["RealSequence", "load_tuning_data", "run_params", "score_params", "sequence_key"]
+__all__ = ["RealSequence", "load_tuning_data", "score_params", "sequence_key"]

@@ -195,10 +195,6 @@ def fixed(space: Space) -> dict[str, Any]:
     return {k: v for k, v in space.items() if not isinstance(v, Dim)}
 
 
-def _cast(dim: Dim, value: float) -> Any:
-    return int(round(value)) if dim.kind == "int" else float(value)
-
-
 def suggest(trial: Any, space: Space) -> dict[str, Any]:
     """Tracker parameters drawn by an Optuna ``trial`` from ``space`` (optional ones as ``<name>:on`` first)."""
     params = dict(fixed(space))
@@ -256,7 +252,7 @@ def grid(dim: Dim, points: int = 5) -> list[Any]:
     else:
         lo, hi = float(dim.low), float(dim.high)  # type: ignore[arg-type]
         raw = np.geomspace(lo, hi, points) if dim.log else np.linspace(lo, hi, points)
-        values = list(dict.fromkeys(_cast(dim, v) for v in raw))
+        values = list(dict.fromkeys(int(round(v)) if dim.kind == "int" else float(v) for v in raw))
     return values + [None] if dim.optional else values
 
 

@@ -11,7 +11,7 @@ from lookalike._optional import needs
 from lookalike.parallel import JobPool
 from lookalike.trackers.registry import tracker_parameters
 from lookalike.tune.data import score_params, sequence_key
-from lookalike.tune.objective import Evaluator, Scores, criterion, evaluate_job, objective
+from lookalike.tune.objective import Evaluator, criterion, evaluate_job, objective
 from lookalike.tune.space import Space, default_space, searched, space_to_json, suggest, trial_values
 
 SAMPLERS = ("tpe", "random")
@@ -72,11 +72,6 @@ def _open_study(optuna: Any, name: str, storage: str | None, resume: bool, meta:
         for key, value in meta.items():
             study.set_user_attr(key, value)
     return study
-
-
-def _compact(scores: Scores) -> Scores:
-    """The scores as plain floats (JSON for the storage; everything :func:`combine` needs)."""
-    return {k: float(v) for k, v in scores.items()}
 
 
 def _defaults_in_space(tracker: str, space: Space) -> dict[str, Any]:
@@ -149,7 +144,8 @@ def run_study(tracker: str, sequences: Sequence[Any], *, space: Space | None = N
                     study.tell(trial, state=TrialState.FAIL)
                 else:
                     per_seq = [r["scores"] for r in results]
-                    trial.set_user_attr("scores", {k: _compact(s) for k, s in zip(keys, per_seq)})
+                    plain = [{m: float(v) for m, v in s.items()} for s in per_seq]  # JSON for the storage
+                    trial.set_user_attr("scores", dict(zip(keys, plain)))
                     study.tell(trial, objective(per_seq, groups, crit))
                 done += 1
                 if progress is not None:
