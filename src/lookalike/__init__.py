@@ -17,22 +17,11 @@ if TYPE_CHECKING:
 
 __version__ = "0.1.0"
 
-_HOME = {
-    "find_sequences": "lookalike.io",
-    "frames_from_table": "lookalike.io",
-    "read_mot": "lookalike.io",
-    "tracks_to_rows": "lookalike.io",
-    "write_mot": "lookalike.io",
-    "Sort": "lookalike.trackers",
-    "make_tracker": "lookalike.trackers",
-    "tracker_names": "lookalike.trackers",
-    "tracker_parameters": "lookalike.trackers",
-    "Beacons": "lookalike.types",
-    "Detections": "lookalike.types",
-    "Frame": "lookalike.types",
-    "TrackSnapshot": "lookalike.types",
-    "TrackStatus": "lookalike.types",
-}
+_HOME = {name: home for home, names in {
+    "lookalike.io": ("find_sequences", "frames_from_table", "read_mot", "tracks_to_rows", "write_mot"),
+    "lookalike.trackers": ("Sort", "make_tracker", "tracker_names", "tracker_parameters"),
+    "lookalike.types": ("Beacons", "Detections", "Frame", "TrackSnapshot", "TrackStatus"),
+}.items() for name in names}
 
 
 __getattr__, __dir__ = lazy_attributes("lookalike", _HOME, globals())

@@ -1,15 +1,11 @@
-"""Optional compiled (numba) kernels: their switch (loaded on first use, never by ``import lookalike``; off when
-numba does not import, when an environment variable is ``0``, or when forced off) and the compiler's settings.
-
-Compiled code is cached on disk by numba (next to the kernel module, or in a user folder when that is read-only, or
-in ``NUMBA_CACHE_DIR``), so a machine compiles each kernel once; when a compile does happen one line on stderr says
-so. Run as the ``lookalike`` program (:data:`compile_aside` set), a switch with a ``warm`` function whose kernels are
-not cached yet leaves this run on the numpy path (the same results) and compiles them in a separate process started
-when the run ends."""
+"""Optional compiled (numba) kernels: their switch (off when numba does not import, when an environment variable is
+``0``, or when forced off) and the compiler's settings. numba caches compiled code on disk, so a machine compiles each
+kernel once (one line on stderr says so)."""
 
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
 import sys
 import time
@@ -24,10 +20,8 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 
 def exact_jit() -> Callable[[F], F]:
-    """numba's ``njit`` decorator with the settings every kernel module uses: the numpy path's arithmetic kept
-    (``fastmath`` off: no fused multiply-adds or reordering; numpy's float error model: division by zero gives
-    inf/NaN), compiled code cached on disk, the GIL released, no bounds checks. Imports numba (an
-    ``ImportError`` without it): call it only from a kernel module."""
+    """numba's ``njit`` with the numpy path's arithmetic (no ``fastmath``, numpy's float error model), an on-disk
+    cache, the GIL released and no bounds checks. Imports numba (an ``ImportError`` without it)."""
     with needs("numba"):
         import numba  # type: ignore[import-untyped, import-not-found, unused-ignore]
 
@@ -52,8 +46,7 @@ def _say(message: str) -> None:
 
 
 def _announce_compiles(numba: Any) -> None:
-    """Print one line on stderr at the first compile of a kernel in this process (not when numba loads one from its
-    cache: that fires no compile event)."""
+    """Print one line on stderr at the first compile of a lookalike kernel in this process."""
     global _announced
     if _announced:
         return
@@ -82,8 +75,7 @@ def _announce_compiles(numba: Any) -> None:
 
 
 def kernels_cached(module: ModuleType) -> bool:
-    """Whether every numba kernel defined in ``module`` has compiled code in numba's on-disk cache for the current
-    source (a stale or missing index: not cached)."""
+    """Whether every numba kernel defined in ``module`` has compiled code in numba's cache for the current source."""
     found = False
     for value in vars(module).values():
         cache = getattr(value, "_cache", None)
@@ -102,24 +94,16 @@ def kernels_cached(module: ModuleType) -> bool:
 def _compile_elsewhere(warm: str, module: ModuleType) -> None:
     """Start ``warm`` ("module:function", which compiles the kernels by running them) in a detached process when
     this one exits, unless one was started less than two minutes ago (a stamp file beside the cache)."""
-    stamp = None
-    for value in vars(module).values():
-        cache = getattr(value, "_cache", None)
-        if cache is not None and getattr(cache, "_cache_path", None):
-            stamp = os.path.join(cache._cache_path, f".{module.__name__}.compiling")
-            break
-    try:
-        if stamp is not None and time.time() - os.path.getmtime(stamp) < 120:
-            return
-    except OSError:
-        pass
-    try:
-        if stamp is not None:
+    stamp = next((os.path.join(v._cache._cache_path, f".{module.__name__}.compiling") for v in vars(module).values()
+                  if getattr(getattr(v, "_cache", None), "_cache_path", None)), None)
+    if stamp is not None:
+        with contextlib.suppress(OSError):
+            if time.time() - os.path.getmtime(stamp) < 120:
+                return
+        with contextlib.suppress(OSError):
             os.makedirs(os.path.dirname(stamp), exist_ok=True)
             with open(stamp, "w") as f:
                 f.write(str(os.getpid()))
-    except OSError:
-        stamp = None
     name, function = warm.split(":")
     code = f"import os; os.nice(10); from {name} import {function}; {function}()"
     seconds = COMPILE_SECONDS.get(module.__name__, 10)
@@ -138,12 +122,10 @@ def _compile_elsewhere(warm: str, module: ModuleType) -> None:
 class KernelSwitch(Generic[K]):
     """Whether a set of compiled kernels ``K`` is in use, and the kernels.
 
-    ``load`` imports the kernels (an ``ImportError``, e.g. numba not installed, or ``None`` returned: not
-    available); it runs once, at the first call that needs the kernels. ``env`` names the environment
-    variable that switches them off when ``0``. ``decide_once``: :meth:`compiled` reads the forcing and the
-    environment once, after which a call costs an attribute lookup (:meth:`use_compiled` makes it read them
-    again); otherwise at every call. ``warm``: "module:function" that compiles the kernels (a module ``K``) by
-    running them, for :data:`compile_aside`."""
+    ``load`` imports them once, when first needed (an ``ImportError`` or ``None``: not available); ``env``: the
+    environment variable that switches them off when ``0``; ``decide_once``: :meth:`compiled` reads the forcing and
+    the environment once (until :meth:`use_compiled`); ``warm``: "module:function" compiling them, for
+    :data:`compile_aside`."""
 
     def __init__(self, env: str, load: Callable[[], K | None], *, decide_once: bool = False,
                  warm: str | None = None) -> None:

@@ -42,7 +42,7 @@ class MissingExtra(ModuleNotFoundError):
 
 
 def _installed_from() -> tuple[str, bool] | None:
-    """Where lookalike was installed from (a wheel file or a folder) and whether editable; None when unknown."""
+    """Where lookalike was installed from (a wheel or a folder) and whether editable; None when unknown."""
     from importlib import metadata
     from urllib.parse import unquote, urlparse
 
@@ -58,9 +58,8 @@ def _installed_from() -> tuple[str, bool] | None:
 
 
 def install_command(extra: str) -> str:
-    """The pip command that installs ``extra`` into this Python: from the wheel or folder lookalike was
-    installed from (``-e`` when it was an editable install), else a placeholder for them (lookalike is not
-    on PyPI)."""
+    """The pip command that installs ``extra`` into this Python from the wheel or folder lookalike was installed from
+    (``-e`` if editable), else a placeholder for them (lookalike is not on PyPI)."""
     found = _installed_from()
     where, editable = found if found is not None else ("<lookalike wheel or source folder>", False)
     pip = "pip" if Path(sys.executable).parent == Path(sys.prefix) / "bin" and _pip_on_path() else \
@@ -78,9 +77,8 @@ def _pip_on_path() -> bool:
 
 @contextmanager
 def needs(module: str) -> Iterator[None]:
-    """Wrap the import of the optional package ``module`` (a key of :data:`OPTIONAL`): when it (or the package
-    itself) is missing or fails to import, :class:`MissingExtra` is raised instead, an ``ImportError``, so code
-    that falls back without the package keeps doing so. ``with needs("cv2"): import cv2``."""
+    """``with needs("cv2"): import cv2``: a missing or broken optional package (a key of :data:`OPTIONAL`) raises
+    :class:`MissingExtra` (an ``ImportError``)."""
     if module not in OPTIONAL:
         raise KeyError(f"{module!r} is not an optional package of lookalike ({', '.join(OPTIONAL)})")
     try:

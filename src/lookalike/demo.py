@@ -1,17 +1,11 @@
-"""``lookalike demo``: the whole system on built-in simulated data, with videos, plots and a report.
-
-A robot scene (identical robots identified from their heading reports) and a diver scene (look-alike
-divers re-identified after long absences) are simulated, rendered and tracked by every relevant
-tracker; the robot identification table covers the three paper set-ups and the diver table every
-test scenario (shortened). Everything lands in the output folder with a self-contained ``report.html``.
-:data:`QUICK` is a reduced version (seconds) used by the test suite.
-"""
+"""``lookalike demo``: robots identified from their heading reports and look-alike divers re-identified after long
+absences, simulated, rendered and tracked by every relevant tracker, with videos, plots and a ``report.html``.
+:data:`QUICK` is a reduced version (seconds)."""
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -79,27 +73,21 @@ def _silent(description: str, total: int) -> Callable[[], None]:
     return lambda: None
 
 
-@contextmanager
-def _phase(step: Step, description: str, total: int) -> Iterator[Callable[[], None]]:
-    advance = step(description, total)
-    yield advance
-
-
 def _divers(output: Path, size: DemoSize, step: Step, rerun: Any) -> tuple[list[dict[str, Any]], dict[str, Path]]:
-    with _phase(step, "Divers: appearance features (validation)", 1) as adv:
-        val = tuple(dataclasses.replace(sc, frames=min(sc.frames, size.fit_frames)) for sc in VALIDATION_SCENARIOS)
-        extractor = fit_diver_features(val)
-        adv()
+    adv = step("Divers: appearance features (validation)", 1)
+    val = tuple(dataclasses.replace(sc, frames=min(sc.frames, size.fit_frames)) for sc in VALIDATION_SCENARIOS)
+    extractor = fit_diver_features(val)
+    adv()
     video_sc = dataclasses.replace(scenario("ocean_four_long_absences"), frames=size.diver_video_frames)
-    with _phase(step, f"Divers {video_sc.name}: render + track", video_sc.frames) as adv:
-        rows, files = run_diver_scenario(video_sc, extractor, DIVER_TRACKERS, out_dir=output,
-                                         video_tracker="diversort", advance=adv, rerun=rerun)
+    rows, files = run_diver_scenario(video_sc, extractor, DIVER_TRACKERS, out_dir=output, video_tracker="diversort",
+                                     advance=step(f"Divers {video_sc.name}: render + track", video_sc.frames),
+                                     rerun=rerun)
     others = [sc for sc in SCENARIOS if sc.name != video_sc.name][: max(size.diver_scenarios - 1, 0)]
-    with _phase(step, "Divers: other scenarios", len(others) * size.diver_frames) as adv:
-        for sc in others:
-            more, _ = run_diver_scenario(dataclasses.replace(sc, frames=size.diver_frames), extractor,
-                                         DIVER_TRACKERS, advance=adv)
-            rows += more
+    adv = step("Divers: other scenarios", len(others) * size.diver_frames)
+    for sc in others:
+        more, _ = run_diver_scenario(dataclasses.replace(sc, frames=size.diver_frames), extractor, DIVER_TRACKERS,
+                                     advance=adv)
+        rows += more
     return rows, {f"divers-{k}": v for k, v in files.items()}
 
 
@@ -119,23 +107,22 @@ def diver_results(rows: list[dict[str, Any]], size: DemoSize, command: str = "")
 
 def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str, rerun: Any = None,
              step: Step = _silent, command: str = "") -> DemoResult:
-    """Run the whole demo into ``output``. ``rerun``: an optional
-    :class:`~lookalike.viz.rerun_log.RerunLogger` that also receives the video scenes; ``command``:
-    the command line recorded in the JSON files' header."""
+    """Run the whole demo into ``output``. ``rerun``: an optional :class:`~lookalike.viz.rerun_log.RerunLogger` for
+    the video scenes; ``command``: the command line recorded in the JSON files' header."""
     output.mkdir(parents=True, exist_ok=True)
     notes = {s: lstm_status(s) for s in PRESET_NAMES}
     video_tracker = "lstm" if notes[robot_preset] is None else "kalman_ha2"
     robot_trackers = list(ROBOT_TRACKERS) + (["lstm"] if notes[robot_preset] is None else [])
-    with _phase(step, f"Robots {preset_label(robot_preset)}: render + identify", size.robot_frames) as adv:
-        robots = run_robot_scene(output, preset_name=robot_preset, frames=size.robot_frames, seed=seed,
-                                 trackers=robot_trackers, video_tracker=video_tracker, advance=adv, rerun=rerun)
+    adv = step(f"Robots {preset_label(robot_preset)}: render + identify", size.robot_frames)
+    robots = run_robot_scene(output, preset_name=robot_preset, frames=size.robot_frames, seed=seed,
+                             trackers=robot_trackers, video_tracker=video_tracker, advance=adv, rerun=rerun)
     files = {f"robots-{k}": v for k, v in robots.files.items()}
     ident_rows: list[dict[str, Any]] = []
-    with _phase(step, "Robot identification, all set-ups", len(PRESET_NAMES)) as adv:
-        for s in PRESET_NAMES:
-            names = list(ROBOT_TRACKERS) + (["lstm"] if notes[s] is None else [])
-            ident_rows += ident_table([s], names, size.ident_sequences, size.ident_frames, seed=900_000 + seed)
-            adv()
+    adv = step("Robot identification, all set-ups", len(PRESET_NAMES))
+    for s in PRESET_NAMES:
+        names = list(ROBOT_TRACKERS) + (["lstm"] if notes[s] is None else [])
+        ident_rows += ident_table([s], names, size.ident_sequences, size.ident_frames, seed=900_000 + seed)
+        adv()
     diver_rows, diver_files = _divers(output, size, step, rerun)
     files.update(diver_files)
     files["idf1"] = grouped_bar_chart(output / "divers-idf1.png", diver_rows, "Scenario", "Tracker", "IDF1",

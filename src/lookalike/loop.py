@@ -1,6 +1,5 @@
-"""The one frame loop: ``run(tracker, frames, sink)`` feeds frames from any iterable to a tracker in order and hands
-each ``(frame, tracks)`` to ``sink`` at once, keeping nothing per frame (constant memory with lazy frames and a
-streaming sink such as :class:`lookalike.io.stream.MotWriter`). It times ``update`` alone."""
+"""The one frame loop: ``run(tracker, frames, sink)`` feeds frames to a tracker in order and hands each
+``(frame, tracks)`` to ``sink`` at once, keeping nothing per frame; it times ``update`` alone."""
 
 from __future__ import annotations
 
@@ -16,8 +15,7 @@ from lookalike.types.mot_table import stack_rows, tracks_to_rows
 
 
 class Updating(Protocol):
-    """What the loop needs of a tracker (every registered tracker has it; ``frame`` is usually a
-    :class:`~lookalike.types.Frame`, but any per-frame input the tracker takes will do)."""
+    """What the loop needs of a tracker (``frame``: usually a :class:`~lookalike.types.Frame`)."""
 
     def update(self, frame: Any) -> Any:
         """Process one frame; return the tracks reported for it (iterable of ``TrackSnapshot``)."""
@@ -42,10 +40,8 @@ class RunStats:
 
 def run(tracker: Updating, frames: Iterable[Any], sink: Sink | None = None, *,
         stats: RunStats | None = None) -> RunStats:
-    """Run ``tracker`` over ``frames`` in order, calling ``sink(frame, tracks)`` after every frame.
-
-    ``stats``: accumulate into an existing :class:`RunStats` (several sequences, one total). Returns the stats (frames,
-    tracker seconds)."""
+    """Run ``tracker`` over ``frames`` in order, calling ``sink(frame, tracks)`` after every frame; returns the
+    stats, accumulated into ``stats`` if given."""
     stats = RunStats() if stats is None else stats
     for frame in frames:
         t0 = time.perf_counter()
@@ -62,9 +58,8 @@ WARM_UP_FRAMES = 10
 
 
 def warm_up(make: Callable[[], Updating], frames: Iterable[Any], n: int = WARM_UP_FRAMES) -> None:
-    """Run a throw-away tracker from ``make()`` over the first ``n`` of ``frames``, untimed, so that what a tracker's
-    first frames cost once per process (imports, numba compiles or cache loads) stays out of a frames/s figure; the
-    tracker that is timed is another instance, so its tracks do not change."""
+    """Run a throw-away tracker from ``make()`` over the first ``n`` of ``frames``, so that one-off costs (imports,
+    numba compiles) stay out of a frames/s figure."""
     tracker = make()
     for k, frame in enumerate(frames):
         if k >= n:

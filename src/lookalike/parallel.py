@@ -1,6 +1,5 @@
-"""Independent jobs run serially, in local processes, or as Ray tasks (``backend="ray"``, on the cluster at ``address``
-or a local ``ray.init()``), with identical results. Jobs must be picklable top-level callables whose result depends only
-on their arguments."""
+"""Independent jobs (picklable top-level callables) run serially, in local processes, or as Ray tasks, with identical
+results."""
 
 from __future__ import annotations
 
@@ -25,10 +24,8 @@ class Pending:
 
 
 class JobPool:
-    """``submit(fn, *args)`` and ``map(fn, items)`` over ``workers`` processes or a Ray cluster.
-
-    With ``workers=1`` and the local backend, jobs run in this process when their result is asked for. Use as a context
-    manager (or call :meth:`close`) to release the processes."""
+    """``submit(fn, *args)`` and ``map(fn, items)`` over ``workers`` processes (1: in this process, when the result is
+    asked for) or a Ray cluster (at ``address``, or a local ``ray.init()``); a context manager."""
 
     def __init__(self, workers: int = 1, backend: str = "local", address: str | None = None) -> None:
         if backend not in BACKENDS:
@@ -56,8 +53,7 @@ class JobPool:
         return Pending(lambda: fn(*args))
 
     def share(self, obj: Any) -> Any:
-        """``obj`` as an argument for many jobs: put once in Ray's object store (the tasks receive
-        the object itself), or ``obj`` unchanged locally."""
+        """``obj`` as an argument for many jobs: put once in Ray's object store, or ``obj`` unchanged locally."""
         return self._ray.put(obj) if self._ray is not None else obj
 
     def map(self, fn: Callable[[Any], Any], items: Sequence[Any]) -> list[Any]:

@@ -1,7 +1,5 @@
-"""The ``lookalike`` command line (typer); each command lives in its own module of this package.
-
-Run as the ``lookalike`` script, only the module of the command given (:data:`COMMAND_MODULES`) is imported; imported by
-anything else, this package imports them all."""
+"""The ``lookalike`` command line (typer), a module per command; run as the program, only the module of the command
+given is imported (:data:`COMMAND_MODULES`)."""
 
 from __future__ import annotations
 
@@ -14,9 +12,7 @@ from rich.markup import escape
 from lookalike.cli.program import run_as_program
 
 if run_as_program():
-    # Run as the program (before numpy is imported): lookalike's matrices are small, so OpenBLAS's
-    # thread pool only costs its start-up in every process and waits in the node; a value the user
-    # set is kept.
+    # before numpy loads: lookalike's matrices are small, so OpenBLAS's threads only cost (a value set is kept)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from lookalike.cli.app import app  # noqa: E402
@@ -45,14 +41,13 @@ def _registered(command: str) -> bool:
 
 
 def _list_commands_only() -> None:
-    """Register each command by name and summary alone (:data:`~lookalike.cli.summaries.SUMMARIES`): the script was
-    given no command (``lookalike``, ``lookalike --help``), so none runs and no command module is imported."""
-    from lookalike.cli.summaries import SUMMARIES
+    """Register each command by name and summary alone: the script was given no command (``lookalike --help``)."""
+    from lookalike.cli.summaries import summaries
 
     def listed_only() -> None:  # never runs: a command given on the line loads its module instead
         raise AssertionError("a listed-only command was run")
 
-    for name, summary in SUMMARIES.items():
+    for name, summary in summaries(MODULES).items():
         app.command(name=name, help=summary)(listed_only)
 
 
@@ -73,8 +68,8 @@ _load_commands()
 
 
 def _terminate_cleanly() -> None:
-    """SIGTERM raises ``SystemExit(143)`` in this process (not in worker processes it forks, which keep the default):
-    the ``finally`` blocks run, so temporary files are removed and no half-written output is left."""
+    """SIGTERM raises ``SystemExit(143)`` in this process (forked workers keep the default): the ``finally`` blocks
+    run, so no half-written output is left."""
     import signal
 
     pid = os.getpid()
@@ -90,8 +85,7 @@ def _terminate_cleanly() -> None:
 
 
 def main() -> None:
-    """Entry point of the ``lookalike`` script; a missing optional package ends it with one line naming the extra
-    to install (exit 2)."""
+    """Entry point of the ``lookalike`` script; a missing optional package ends it with one line (exit 2)."""
     from lookalike import _compiled
     from lookalike._optional import MissingExtra
 

@@ -9,17 +9,11 @@ from pathlib import Path
 
 import typer
 from rich.markup import escape
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
+from rich.progress import TimeRemainingColumn
 
-from lookalike.cli.app import app, check_outputs_or_fail, command_line, console, fail
+from lookalike.cli.app import app, check_names, check_outputs_or_fail, command_line, console, failing
 from lookalike.cli.bench import rich_table
+from lookalike.cli.progress import bars
 from lookalike.demo import DIVER_COLS, IDENT_COLS, QUICK, DemoSize, lstm_status, run_demo
 from lookalike.sim import PRESET_NAMES, preset_label
 
@@ -32,12 +26,8 @@ def _open_rerun(rerun: bool, rerun_save: Path | None) -> object | None:
     from lookalike._optional import MissingExtra
     from lookalike.viz.rerun_log import open_rerun
 
-    option = "--rerun" if rerun else "--rerun-save"
-    try:
+    with failing(ValueError, OSError, MissingExtra, prefix="--rerun: " if rerun else "--rerun-save: "):
         return open_rerun("lookalike-demo", save=rerun_save, spawn=rerun)
-    except (ValueError, OSError, MissingExtra) as exc:
-        fail(f"{option}: {exc}")
-    return None
 
 
 def _run(output: Path, seed: int, size: DemoSize, robot_preset: str, logger: object | None) -> dict[str, Path]:
@@ -45,8 +35,7 @@ def _run(output: Path, seed: int, size: DemoSize, robot_preset: str, logger: obj
         why = lstm_status(s)
         if why:
             console.print(f"[yellow]LSTM left out for {preset_label(s)}:[/] {escape(str(why))}")
-    with Progress(TextColumn("{task.description:<42}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-                  TimeRemainingColumn(), console=console, transient=False) as progress:
+    with bars("{task.description:<42}", TimeRemainingColumn(), transient=False) as progress:
         def step(description: str, total: int) -> Callable[[], None]:
             task = progress.add_task(description, total=total)
             return lambda: progress.advance(task)
@@ -73,8 +62,7 @@ def demo(
 ) -> None:
     """Simulate robots and divers, run every relevant tracker, write videos, plots and an HTML report."""
     check_outputs_or_fail({"-o/--output": output, "--rerun-save": rerun_save}, folders={"-o/--output"})
-    if robot_preset not in PRESET_NAMES:
-        fail(f"--robot-preset: unknown preset {robot_preset!r}; known: {', '.join(PRESET_NAMES)}")
+    check_names("--robot-preset", [robot_preset], PRESET_NAMES, "preset")
     logger = _open_rerun(rerun, rerun_save)
     t0 = time.perf_counter()
     try:

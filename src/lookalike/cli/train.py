@@ -263,7 +263,8 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
 
 def torch_device(device: str) -> str:
     """``--device`` resolved (``auto``: cuda where PyTorch sees one), failing on a CUDA device PyTorch does not see."""
-    import torch
+    with needs("torch"):
+        import torch
 
     if device == "auto":
         device = "cuda" if torch.cuda.is_available() else "cpu"
