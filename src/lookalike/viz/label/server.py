@@ -141,7 +141,7 @@ def _find_images(folder: Path, stem: str) -> str | None:
 
 
 class _BadRequest(Exception):
-    def __init__(self, status: HTTPStatus, message: str) -> None:
+    def __init__(self, message: str, status: HTTPStatus = HTTPStatus.BAD_REQUEST) -> None:
         super().__init__(message)
         self.status = status
 
@@ -150,7 +150,7 @@ def _int(query: dict[str, list[str]], name: str, default: int) -> int:
     try:
         return int(query.get(name, [str(default)])[0])
     except ValueError:
-        raise _BadRequest(HTTPStatus.BAD_REQUEST, f"query parameter {name} must be an integer") from None
+        raise _BadRequest(f"query parameter {name} must be an integer") from None
 
 
 class _Handler(BaseHTTPRequestHandler):
@@ -183,7 +183,7 @@ class _Handler(BaseHTTPRequestHandler):
         host = (self.headers.get("Host") or "").rsplit(":", 1)[0].strip("[]").lower()
         bound = cast(tuple[str, int], self.server.server_address)[0]
         if bound in ("127.0.0.1", "::1", "localhost") and host not in ("127.0.0.1", "localhost", "::1"):
-            raise _BadRequest(HTTPStatus.FORBIDDEN, f"unexpected Host header {host!r}")
+            raise _BadRequest(f"unexpected Host header {host!r}", HTTPStatus.FORBIDDEN)
 
     def _dispatch(self, route: Callable[[], None]) -> None:
         try:
@@ -226,59 +226,57 @@ class _Handler(BaseHTTPRequestHandler):
         elif path == "/api/frames":
             start, count = _int(query, "start", 0), _int(query, "count", 100)
             if start < 0 or not 0 < count <= MAX_FRAMES_PER_REQUEST:
-                raise _BadRequest(
-                    HTTPStatus.BAD_REQUEST, f"need start >= 0 and 0 < count <= {MAX_FRAMES_PER_REQUEST}"
-                )
+                raise _BadRequest(f"need start >= 0 and 0 < count <= {MAX_FRAMES_PER_REQUEST}")
             self._json({"frames": self.app.frames(start, count)})
         elif path == "/api/labels":
             self._json({"labels": self.app.store.snapshot(), "benchmark": self.app.store.benchmark})
         elif path == "/api/score":
             bench = self.app.store.benchmark
             if self.app.benchmark and not (bench and bench.get("finished_at") is not None):
-                raise _BadRequest(HTTPStatus.FORBIDDEN, "the score is shown when the benchmark session ends")
+                raise _BadRequest("the score is shown when the benchmark session ends", HTTPStatus.FORBIDDEN)
             self._json(self.app.score())
         else:
-            raise _BadRequest(HTTPStatus.NOT_FOUND, f"no such page {path!r}")
+            raise _BadRequest(f"no such page {path!r}", HTTPStatus.NOT_FOUND)
 
     def _static(self, name: str) -> None:
         if name not in {p.name for p in STATIC_DIR.iterdir() if p.is_file()}:
-            raise _BadRequest(HTTPStatus.NOT_FOUND, f"no static file {name!r}")
+            raise _BadRequest(f"no static file {name!r}", HTTPStatus.NOT_FOUND)
         p = STATIC_DIR / name
         self._send(HTTPStatus.OK, p.read_bytes(), mimetypes.guess_type(p.name)[0] or "application/octet-stream")
 
     def _file(self, rel: str) -> None:
         rel = unquote(rel)
         if "\x00" in rel:
-            raise _BadRequest(HTTPStatus.BAD_REQUEST, "NUL in path")
+            raise _BadRequest("NUL in path")
         target = (self.app.folder / rel).resolve()
         if not target.is_relative_to(self.app.folder) or target == self.app.folder:
-            raise _BadRequest(HTTPStatus.FORBIDDEN, "outside the sequence folder")
+            raise _BadRequest("outside the sequence folder", HTTPStatus.FORBIDDEN)
         if not target.is_file():
-            raise _BadRequest(HTTPStatus.NOT_FOUND, f"no file {rel!r}")
+            raise _BadRequest(f"no file {rel!r}", HTTPStatus.NOT_FOUND)
         if self.app.benchmark and not _is_frame_image(target, self.app.folder, self.app.image_pattern):
-            raise _BadRequest(HTTPStatus.FORBIDDEN, "benchmark mode serves the frame images only")
+            raise _BadRequest("benchmark mode serves the frame images only", HTTPStatus.FORBIDDEN)
         ctype = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
         self._send(HTTPStatus.OK, target.read_bytes(), ctype)
 
     def _body(self) -> dict[str, Any]:
         ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
         if ctype != "application/json":
-            raise _BadRequest(HTTPStatus.UNSUPPORTED_MEDIA_TYPE, "POST bodies must be application/json")
+            raise _BadRequest("POST bodies must be application/json", HTTPStatus.UNSUPPORTED_MEDIA_TYPE)
         try:
             length = int(self.headers.get("Content-Length", ""))
         except ValueError:
-            raise _BadRequest(HTTPStatus.LENGTH_REQUIRED, "Content-Length required") from None
+            raise _BadRequest("Content-Length required", HTTPStatus.LENGTH_REQUIRED) from None
         if not 0 <= length <= MAX_BODY_BYTES:
-            raise _BadRequest(HTTPStatus.REQUEST_ENTITY_TOO_LARGE, f"body over {MAX_BODY_BYTES} bytes")
+            raise _BadRequest(f"body over {MAX_BODY_BYTES} bytes", HTTPStatus.REQUEST_ENTITY_TOO_LARGE)
         raw = self._read_body(length) if length else b"{}"
         try:
             body = json.loads(raw)
         except (json.JSONDecodeError, UnicodeDecodeError):
-            raise _BadRequest(HTTPStatus.BAD_REQUEST, "body is not JSON") from None
+            raise _BadRequest("body is not JSON") from None
         except RecursionError:
-            raise _BadRequest(HTTPStatus.BAD_REQUEST, "body is nested too deeply") from None
+            raise _BadRequest("body is nested too deeply") from None
         if not isinstance(body, dict):
-            raise _BadRequest(HTTPStatus.BAD_REQUEST, "body must be a JSON object")
+            raise _BadRequest("body must be a JSON object")
         return body
 
     def _read_body(self, length: int) -> bytes:
@@ -293,7 +291,7 @@ class _Handler(BaseHTTPRequestHandler):
                 self.connection.settimeout(remaining)
                 chunk = self.rfile.read1(length - got)
                 if not chunk:
-                    raise _BadRequest(HTTPStatus.BAD_REQUEST, f"body ended after {got} of {length} bytes")
+                    raise _BadRequest(f"body ended after {got} of {length} bytes")
                 chunks.append(chunk)
                 got += len(chunk)
         finally:
@@ -306,21 +304,21 @@ class _Handler(BaseHTTPRequestHandler):
         if path == "/api/label":
             missing = [k for k in ("frame", "detection", "label") if k not in body]
             if missing:
-                raise _BadRequest(HTTPStatus.BAD_REQUEST, f"missing {', '.join(missing)}")
+                raise _BadRequest(f"missing {', '.join(missing)}")
             self.app.store.set_label(body["frame"], body["detection"], body["label"])
             self._json({"ok": True})
         elif path == "/api/benchmark/start":
             if not self.app.benchmark:
-                raise _BadRequest(HTTPStatus.CONFLICT, "not in benchmark mode")
+                raise _BadRequest("not in benchmark mode", HTTPStatus.CONFLICT)
             self._json({"benchmark": self.app.store.start_benchmark()})
         elif path == "/api/benchmark/finish":
             if not self.app.benchmark:
-                raise _BadRequest(HTTPStatus.CONFLICT, "not in benchmark mode")
+                raise _BadRequest("not in benchmark mode", HTTPStatus.CONFLICT)
             self._json({"benchmark": self.app.finish_benchmark()})
         elif path == "/api/export":
             self._json(self.app.export())
         else:
-            raise _BadRequest(HTTPStatus.NOT_FOUND, f"no such action {path!r}")
+            raise _BadRequest(f"no such action {path!r}", HTTPStatus.NOT_FOUND)
 
 
 def _is_frame_image(target: Path, folder: Path, pattern: str | None) -> bool:
