@@ -54,26 +54,22 @@ def decode(prob: np.ndarray, used: np.ndarray, n: int, one_to_one: bool) -> tupl
     """Labels ``(n,)`` of a frame's ``n`` detections (agent or -1) and their probabilities (0 where unused) from the
     probabilities ``(M, N+1)`` of the slots holding detections ``used``."""
     labels, conf = np.full(n, -1), np.zeros(n)
-    labels[used], conf[used] = _decode(prob, len(used), one_to_one)
-    return labels, conf
-
-
-def _decode(prob: np.ndarray, n_used: int, one_to_one: bool) -> tuple[np.ndarray, np.ndarray]:
-    p = prob[:n_used]
+    k = len(used)
+    p = prob[:k]
     n_agents = p.shape[1] - 1
     if not one_to_one:
         label = p.argmax(axis=1)
-        conf = p[np.arange(n_used), label]
-        return np.where(label == n_agents, -1, label), conf
+        labels[used], conf[used] = np.where(label == n_agents, -1, label), p[np.arange(k), label]
+        return labels, conf
     # Each detection may be a false positive; each agent takes at most one detection.
-    cost = -np.log(np.clip(np.hstack([p[:, :n_agents], np.repeat(p[:, n_agents:], n_used, axis=1)]), 1e-12, 1))
+    cost = -np.log(np.clip(np.hstack([p[:, :n_agents], np.repeat(p[:, n_agents:], k, axis=1)]), 1e-12, 1))
     from scipy.optimize import linear_sum_assignment  # imported on first use (slow to import)
 
     rows, cols = linear_sum_assignment(cost)
-    label = np.full(n_used, -1)
+    label = np.full(k, -1)
     label[rows] = np.where(cols < n_agents, cols, -1)
-    conf = np.where(label >= 0, p[np.arange(n_used), np.maximum(label, 0)], p[:, n_agents])
-    return label, conf
+    labels[used], conf[used] = label, np.where(label >= 0, p[np.arange(k), np.maximum(label, 0)], p[:, n_agents])
+    return labels, conf
 
 
 def agent_detections(labels: np.ndarray, conf: np.ndarray, n_agents: int) -> np.ndarray:
