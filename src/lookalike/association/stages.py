@@ -176,8 +176,7 @@ def run_plan(stages: list[Stage], n_tracks: int, n_detections: int,
 
 def cascade(track_age: np.ndarray, max_age: int, tracks: np.ndarray, detections: np.ndarray,
             cost: CostFn, max_cost: float = np.inf) -> list[Stage]:
-    """Deep SORT's matching cascade as stages: the ``tracks`` (a mask) updated 1, 2, …, ``max_age``
-    frames ago (``track_age``), most recent first, each level on the detections the earlier left."""
+    """Deep SORT's matching cascade: one stage per age 1 .. ``max_age`` of ``tracks`` (a mask), newest first."""
     age = np.asarray(track_age)
     levels = np.unique(age[tracks & (age >= 1) & (age <= max_age)])
     return [Stage(tracks & (age == level), detections, cost, max_cost, name=f"cascade level {level}")

@@ -236,8 +236,7 @@ class Pose2D:
 
 
 def integrate_odometry(steps: np.ndarray, start: Pose2D | None = None) -> list[Pose2D]:
-    """The ``n + 1`` poses from ``start`` (origin by default) through each odometry step ``(n, 3)`` of
-    ``(dx_m, dy_m, dheading_rad)`` in the robot frame."""
+    """The ``n + 1`` poses from ``start`` (default origin) through odometry steps ``(n, 3)`` (m, m, rad)."""
     d = _rows("steps", steps, 3)
     poses = [start if start is not None else Pose2D()]
     for dx, dy, dh in d:

@@ -39,8 +39,7 @@ def arrays_to_tokens(
 
 @dataclasses.dataclass(frozen=True)
 class TeamSizes:
-    """The range of team sizes trained on: N in ``[n_min, n_max]``, M in ``[N, 2N + m_extra]``
-    (at least 1), false positives per frame uniform in ``fp_range`` — all drawn per batch."""
+    """Team sizes drawn per batch: N in ``[n_min, n_max]``, M in ``[N, 2N + m_extra]``, fp uniform in ``fp_range``."""
 
     n_min: int = 1
     n_max: int = 12

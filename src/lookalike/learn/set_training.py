@@ -153,8 +153,7 @@ def train_set(
     pool: JobPool | None = None,
     init: SetWeights | None = None,
 ) -> TrainResult:
-    """Train; write ``set.npz``/``.json`` (best validation), ``checkpoint.pt`` and ``training_log.csv``
-    to ``out_dir``. ``init``: start from these weights (fine-tuning; same widths as ``config``)."""
+    """Train; write ``set.npz`` (best), ``checkpoint.pt`` and ``training_log.csv``; ``init``: weights to start from."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     if config.sequence_length % config.bptt:

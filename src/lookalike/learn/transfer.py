@@ -92,8 +92,7 @@ def transfer_from_file(
     path: str, target: EncodingSpec, sample: Callable[[int, int, Any], tuple[np.ndarray, np.ndarray]],
     seeds: list[int], length: int, seed: int = 0,
 ) -> NetworkWeights:
-    """Weights at ``path`` (any N, M of ``target``'s protocol) mapped onto ``target``, normalised by the
-    mean and standard deviation of ``sample(seed, length, None)`` inputs over ``seeds`` (the new set-up's data)."""
+    """Weights at ``path`` onto ``target``, normalised by ``sample`` inputs over ``seeds``."""
     from lookalike.trackers.lstm.checkpoint import load_weights
 
     source = load_weights(path)

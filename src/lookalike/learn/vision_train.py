@@ -70,8 +70,7 @@ def rendered_held_out_scenes(n_frames: int, seed: int, camera: Camera | None = N
 def negative_sampler(frames: list[np.ndarray], truths: list[np.ndarray], window_px: tuple[int, int],
                      height_px: tuple[float, float], max_iou: float = 0.2
                      ) -> Callable[[int, np.random.Generator], np.ndarray]:
-    """``(count, rng) -> (count, h+2, w+2)`` random windows of ``frames`` (heights log-uniform in ``height_px``)
-    that overlap no box of ``truths`` by more than ``max_iou``."""
+    """``(count, rng) -> (count, h+2, w+2)`` random windows overlapping no truth by more than ``max_iou``."""
     from lookalike.geometry.boxes import iou_matrix
     from lookalike.vision.hog_features import crop_window
 

@@ -191,8 +191,7 @@ class BoxCXCYWH:
         x[22:24] += q
 
     def innovation_columns(self, columns: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Innovations ``z - H x`` ``(4, m)`` of measurement columns ``z (4, m)`` (cx, cy, w, h) for the
-        tracks of ``columns (24, m)``, and their variances ``(4, m)`` (``H P Hᵀ + R`` is diagonal here)."""
+        """Innovations ``(4, m)`` of measurement columns ``z (4, m)`` and their (diagonal) variances ``(4, m)``."""
         std = self.pos_noise * z[2:4]
         r = std * std
         s = np.empty(z.shape)

@@ -36,8 +36,7 @@ EVENTS = (
 
 
 class NodeCounters:
-    """Counts of every event, rejections by reason, and the publish latencies (seconds from reading a
-    detections datagram to sending its team state) of the last ``window`` frames."""
+    """Counts of every event and rejection reason, and latencies and CPU times of the last ``window`` frames."""
 
     def __init__(self, window: int = 1000) -> None:
         self.events: Counter[str] = Counter({name: 0 for name in EVENTS})

@@ -113,8 +113,7 @@ def encode(message: Message) -> bytes:
 
 
 def _team_bytes(message: TeamState) -> bytes | None:
-    """A team state's datagram written directly (the same bytes as ``json.dumps``) when every number is a plain finite
-    ``float`` and ids plain ``int``; None otherwise."""
+    """A team state's datagram written directly (as ``json.dumps`` would), or None when not plain numbers."""
     robots = []
     for r in message.robots:
         if len(r.position) != 2:

@@ -43,8 +43,7 @@ class SimClock:
 
 def team_sequence(preset_name: str, seed: int, duration_s: float, loss: float | None = None,
                   delay_s: float | None = None, jitter_s: float | None = None) -> RobotSequence:
-    """``duration_s`` seconds of preset ``preset_name`` with ``seed``, the network's loss probability, delay and mean
-    jitter (seconds) replaced where given."""
+    """``duration_s`` seconds of a preset, with the network's loss, delay and jitter (s) replaced where given."""
     if not duration_s > 0:
         raise ValueError(f"duration_s must be > 0, got {duration_s!r}")
     config = preset(preset_name)

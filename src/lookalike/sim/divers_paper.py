@@ -47,8 +47,7 @@ def with_detections(sc: DiverScenario, level: str) -> DiverScenario:
 
 
 def redraw(sc: DiverScenario, seed: int) -> DiverScenario:
-    """``sc`` as a new draw: ``seed`` 0 keeps the published scenario, any other seed gives new motion,
-    absences, bubbles and detections with the same conditions (scenario seed ``sc.seed + 10000 · seed``)."""
+    """``sc`` as a new draw (scenario seed ``sc.seed + 10000 · seed``); ``seed`` 0 keeps it."""
     if seed < 0:
         raise ValueError(f"seed must be >= 0, got {seed}")
     return sc if seed == 0 else dataclasses.replace(sc, seed=sc.seed + 10000 * seed)

@@ -32,8 +32,7 @@ class ReportArrays:
 
 
 def _burst_mask(t_sent: np.ndarray, cfg: NetworkConfig, horizon_s: float, rng: np.random.Generator) -> np.ndarray:
-    """Whether each send time ``(n_agents, K)`` falls into a loss burst of that agent's link (alternating exponential
-    good periods and bursts, from the stationary state)."""
+    """Whether each send time ``(n_agents, K)`` falls into a loss burst of that agent's link."""
     n_agents = t_sent.shape[0]
     if cfg.burst_rate_hz == 0 or cfg.burst_s == 0:
         return np.zeros(t_sent.shape, dtype=bool)

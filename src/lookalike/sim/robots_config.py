@@ -144,8 +144,7 @@ class NetworkConfig:
 
 @dataclass(frozen=True)
 class RobotWorldConfig:
-    """A robot-world scenario: N identical robots, an observer, at most M (``max_detections``, the best scores)
-    detections per frame on a ``field_m`` (length, width) field."""
+    """A robot-world scenario: N robots, an observer, at most M detections per frame, a ``field_m`` field."""
 
     n_agents: int = 3
     max_detections: int = 5

@@ -28,8 +28,7 @@ def simulate_motion(
     cfg: MotionConfig, field_m: tuple[float, float], n_frames: int, n_agents: int, dt_s: float,
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Field positions ``(T, N, 2)`` metres and unwrapped absolute headings ``(T, N)`` radians; positions bounce off
-    the field boundary (inset by the robot radius)."""
+    """Field positions ``(T, N, 2)`` (m, bouncing off the field's edges) and unwrapped headings ``(T, N)`` (rad)."""
     T, N = n_frames, n_agents
     switch = rng.random((T, N)) < dt_s / cfg.segment_s
     switch[0] = True

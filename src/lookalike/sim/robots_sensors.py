@@ -17,8 +17,7 @@ def in_view(position_obs: np.ndarray, cfg: ObserverConfig) -> np.ndarray:
 
 
 def occlusion_fraction(position_obs: np.ndarray, radius_m: float) -> np.ndarray:
-    """Fraction ``(..., N)`` of each robot's angular width hidden by the nearer robots ``(..., N, 2)`` in front of the
-    camera (discs of ``radius_m``; the largest overlap counts)."""
+    """Fraction ``(..., N)`` of each robot's angular width hidden by nearer robots ``(..., N, 2)``."""
     d = np.hypot(position_obs[..., 0], position_obs[..., 1])
     bearing = np.arctan2(position_obs[..., 1], position_obs[..., 0])
     half = np.arcsin(np.clip(radius_m / np.maximum(d, 1e-9), 0.0, 1.0))
@@ -43,8 +42,7 @@ def detection_probability(distance_m: np.ndarray, occlusion: np.ndarray, sensor:
 
 def visual_heading(true_heading: np.ndarray, bearing_abs: np.ndarray, sensor: SensorConfig,
                    rng: np.random.Generator) -> np.ndarray:
-    """A classifier-like estimate of absolute headings: the heading relative to the viewing ray, flipped, noisy and
-    snapped to its class as :class:`SensorConfig` says."""
+    """Classifier-like absolute headings: flipped, noisy and snapped to classes as :class:`SensorConfig` says."""
     rel = true_heading - bearing_abs
     flip = rng.random(rel.shape) < sensor.heading_flip_prob
     rel = rel + np.where(flip, np.pi, 0.0) + rng.normal(0.0, sensor.heading_noise_rad, rel.shape)

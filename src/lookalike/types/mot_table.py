@@ -68,8 +68,7 @@ def tracks_to_rows(frame_index: int, tracks: Iterable[TrackSnapshot]) -> np.ndar
 
 
 def detection_rows(frame: int | np.ndarray, xywh: np.ndarray, score: np.ndarray | float) -> np.ndarray:
-    """MOTChallenge detection rows ``(k, 10)``: 1-based ``frame`` (one or per row), id -1, boxes
-    ``xywh (k, 4)`` in pixels, ``score``, -1, -1, -1."""
+    """MOTChallenge detection rows ``(k, 10)``: 1-based ``frame``, -1, ``xywh (k, 4)`` (px), ``score``, -1, -1, -1."""
     xywh = np.asarray(xywh, dtype=float).reshape(-1, 4)
     rows = np.full((len(xywh), ROW_WIDTH), -1.0)
     rows[:, 0], rows[:, 2:6], rows[:, 6] = frame, xywh, score
