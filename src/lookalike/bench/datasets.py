@@ -113,8 +113,7 @@ def cut_sequence(seq: RealSequence, part: str) -> RealSequence:
 
 
 def load_mot17_synth(root: Path, seed: int = 0, dataset: str = "mot17-synth") -> list[RealSequence]:
-    """The MOT17 ground-truth sequences under ``root`` with :func:`synthesize_detections` seeded by ``seed`` and the
-    sequence's name."""
+    """MOT17 ground truth under ``root`` with :func:`synthesize_detections` seeded by ``seed`` and name."""
     out = []
     for seq in find_sequences(root):
         if seq.gt_path is None:
@@ -146,8 +145,7 @@ def points_swapped(xy: np.ndarray, image_size: tuple[int, int] | None) -> bool:
 
 def read_hexbug_points(path: Path, image_size: tuple[int, int] | None = None
                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(frame 1-based (n,), id (n,), xy (n, 2) px)`` from a HexBug CSV (``,t,hexbug,x,y``; (y, x) order
-    detected by :func:`points_swapped`)."""
+    """``(frame 1-based (n,), id (n,), xy (n, 2) px)`` from a HexBug CSV (``,t,hexbug,x,y``; (y, x) detected)."""
     rows = []
     with open(path, newline="") as fh:
         for rec in csv.DictReader(fh):

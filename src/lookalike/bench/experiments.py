@@ -72,8 +72,7 @@ def hit_rate(hits: Hits) -> float:
 
 
 def recovery_s(clean: Hits, swapped: Hits, restore: int, window: int, rate: float, tolerance: float = 0.05) -> float:
-    """Seconds from ``restore`` until the swapped run's success over ``window`` frames is within ``tolerance`` of
-    the clean run's (inf: never)."""
+    """Seconds from ``restore`` until the swapped run's ``window``-frame success nears the clean one (inf: never)."""
     for t in range(restore, len(clean) - window + 1):
         a, b = hit_rate(swapped[t : t + window]), hit_rate(clean[t : t + window])
         if np.isfinite(a) and np.isfinite(b) and a >= b - tolerance:
@@ -262,8 +261,7 @@ def restore_gap(sequence: RobotSequence, swap_at_s: float = 5.0, swap_s: float =
 
 def recovery_differences(seconds: dict[tuple[str, str], list[float]], setups: Sequence[str],
                          trackers: Sequence[str]) -> list[Comparison]:
-    """Each identifier's mean recovery seconds minus the first's on the same sequences
-    (:func:`~lookalike.bench.paired.mean_difference`)."""
+    """Each identifier's mean recovery seconds minus the first's (:func:`~lookalike.bench.paired.mean_difference`)."""
     return compare_to_first(seconds, setups, trackers, mean_difference, preset_label)
 
 

@@ -64,8 +64,7 @@ def build_identifier(name: str, sequence: RobotSequence, weights: str | None = N
 
 def identify(name: str, sequence: RobotSequence, frames: Sequence[Frame] | None = None,
              stats: RunStats | None = None, options: Mapping[str, Any] | None = None) -> list[np.ndarray]:
-    """Per frame, each detection's agent label (-1: false positive) from identifier ``name`` run over ``frames``
-    (default: the sequence's own)."""
+    """Per frame, each detection's agent label (-1: false positive) from identifier ``name``."""
     labels: list[np.ndarray] = []
     tracker = build_identifier(name, sequence, options=options)
     run(tracker, sequence.frames() if frames is None else frames,
@@ -75,8 +74,7 @@ def identify(name: str, sequence: RobotSequence, frames: Sequence[Frame] | None 
 
 def run_labels(tracker: Any, frames: Sequence[Frame], n_agents: int, stats: RunStats | None = None
                ) -> tuple[list[np.ndarray], np.ndarray]:
-    """Per frame, each detection's label, and the ``(frames, n_agents, 2)`` agent positions (m; NaN: none) of
-    ``tracker`` run over ``frames``."""
+    """Per frame, each detection's label, and ``(frames, n_agents, 2)`` agent positions (m) of ``tracker``."""
     labels: list[np.ndarray] = []
     positions = np.full((len(frames), n_agents, 2), np.nan)
 
@@ -90,8 +88,7 @@ def run_labels(tracker: Any, frames: Sequence[Frame], n_agents: int, stats: RunS
 
 def setup_results(kind: str, setups: Sequence[str], sequences: int, frames: int, seed: int, command: str,
                   options: Mapping[str, Any] | None = None) -> tuple[Results, dict[str, str]]:
-    """An empty results document of a bench over ``sequences`` sequences of ``frames`` frames per set-up, and the
-    set-ups by printed label."""
+    """An empty results document of a bench over set-ups, and the set-ups by printed label."""
     doc = Results(kind, command=command, seeds=sequence_seeds(list(setups), sequences, seed),
                   sequences=len(setups) * sequences, frames=len(setups) * sequences * frames,
                   options={"setups": list(setups), "sequences_per_setup": sequences, "frames_per_sequence": frames,
@@ -175,8 +172,7 @@ def ident_runs(setups: list[str], trackers: list[str], sequences: int, frames: i
 
 
 def ident_differences(counts: SequenceCounts, setups: list[str], trackers: list[str]) -> list[Comparison]:
-    """Each identifier's success rate minus the first's on the same sequences, in points
-    (:func:`~lookalike.bench.paired.rate_difference`)."""
+    """Each identifier's success rate minus the first's (:func:`~lookalike.bench.paired.rate_difference`)."""
     def difference(other: Sequence[tuple[int, int]], base: Sequence[tuple[int, int]]) -> PairedDifference:
         return rate_difference([c for c, _ in other], [c for c, _ in base], [n for _, n in base])
 

@@ -29,8 +29,7 @@ def resolve_identifier(name: str) -> tuple[str, dict[str, Any]]:
 
 def margin_rows(rows: Sequence[dict[str, Any]], setups: Sequence[str], labels: Sequence[str],
                 baseline: str = "kalman_ha") -> list[dict[str, Any]]:
-    """Per set-up and LSTM row of ``bench ident`` ``rows``, its margin (points) over ``baseline`` beside the
-    paper's."""
+    """Per set-up and LSTM row of ``bench ident``, its margin (points) over ``baseline`` beside the paper's."""
     out = []
     for setup, label in zip(setups, labels):
         mine = {r["Tracker"]: r["Success rate (%)"] for r in rows if r["Setup"] == label}

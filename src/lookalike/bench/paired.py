@@ -23,8 +23,7 @@ NO_SEQUENCES = "no sequences"
 
 @dataclass(frozen=True)
 class PairedDifference:
-    """A minus B: ``difference`` and its 95% interval ``[low, high]`` (points or seconds; NaN: none, ``note`` says
-    why)."""
+    """A minus B: ``difference`` and its 95% interval ``[low, high]`` (NaN: none, ``note`` says why)."""
 
     difference: float
     low: float
@@ -136,8 +135,7 @@ def difference_cells(result: PairedDifference, unit: str, digits: int = 2) -> di
 
 
 def difference_metrics(result: PairedDifference, scale: float = 1.0, suffix: str = "") -> dict[str, float | int]:
-    """Metrics of one comparison: ``difference``, ``ci_low``, ``ci_high`` (times ``scale``, keys + ``suffix``,
-    6 decimals) and ``sequences``."""
+    """``difference``, ``ci_low``, ``ci_high`` (times ``scale``, keys + ``suffix``) and ``sequences``."""
     values = {"difference": result.difference, "ci_low": result.low, "ci_high": result.high}
     scaled = {f"{k}{suffix}": v * scale for k, v in values.items()}
     return {**{k: round(v, 6) if math.isfinite(v) else v for k, v in scaled.items()}, "sequences": result.n_sequences}
@@ -156,8 +154,7 @@ def comparison_rows(comparisons: Sequence[Comparison], unit: str, digits: int = 
 
 def add_comparisons(doc: Results, table: str, comparisons: Sequence[Comparison], figure: str,
                     scale: float = 1.0, suffix: str = "") -> None:
-    """Add ``comparisons`` to ``doc`` as table ``table`` (:func:`difference_metrics`, info ``baseline``, ``figure``,
-    ``note``) with a note on the method."""
+    """Add ``comparisons`` to ``doc`` as table ``table`` (:func:`difference_metrics`), with a note on the method."""
     if not comparisons:
         return
     for c in comparisons:

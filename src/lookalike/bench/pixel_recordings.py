@@ -72,8 +72,7 @@ def write_recording(recording: RobotSequence, folder: str | Path, setup: str) ->
 
 def identifier_labels(recordings: list[RobotSequence], name: str = "lstm", **params: object
                       ) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """Per frame, identifier ``name``'s labels and the true ones over every recording (``params``: to
-    ``make_tracker``)."""
+    """Per frame, identifier ``name``'s labels and the true ones over every recording."""
     predicted: list[np.ndarray] = []
     truth: list[np.ndarray] = []
     for rec in recordings:

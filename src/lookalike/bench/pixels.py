@@ -50,8 +50,7 @@ class PerceivedSequence:
 
 
 def match_truth(det_xywh: np.ndarray, true_xywh: np.ndarray, true_id: np.ndarray, min_iou: float) -> np.ndarray:
-    """``(n,)`` robot id of each detection box (px) from a one-to-one IoU matching with the rendered boxes, -1
-    where none overlaps by ``min_iou``."""
+    """``(n,)`` robot id of each detection box from one-to-one IoU matching (-1: none >= ``min_iou``)."""
     from scipy.optimize import linear_sum_assignment
 
     out = np.full(len(det_xywh), -1, dtype=int)

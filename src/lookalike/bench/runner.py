@@ -84,8 +84,7 @@ def sequence_params(entry: Entry, seq: RealSequence) -> dict[str, Any]:
 
 
 def entry_params(entry: Entry, seq: RealSequence) -> dict[str, Any]:
-    """``entry``'s parameters on ``seq``: a tuned entry's dataset < sequence < its own; a closed-set entry's
-    ``max_targets``."""
+    """``entry``'s parameters on ``seq`` (tuned: dataset < sequence < its own; closed set: ``max_targets``)."""
     preset = TUNED_PARAMS.get(seq.dataset, {}) if entry.tuned else {}
     params = {**preset.get(entry.name, {}), **sequence_params(entry, seq), **entry.params}
     if entry.closed_set and seq.n_targets is not None:
@@ -167,8 +166,7 @@ def map_jobs(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int = 1
 
 
 def job_pairs(entries: Sequence[Entry], sequences: Sequence[RealSequence]) -> list[tuple[Entry, RealSequence]]:
-    """``(entry, sequence)`` per sequence and entry; closed-set entries where the count is known, tuned entries
-    where parameters were chosen."""
+    """``(entry, sequence)`` per sequence and entry that can run there (a known count, chosen parameters)."""
     return [(e, s) for s in sequences for e in entries
             if not (e.closed_set and s.n_targets is None)
             and not (e.tuned and e.name not in TUNED_PARAMS.get(s.dataset, {})

@@ -25,8 +25,7 @@ HUMAN = "human"
 
 def draw_windows(lengths: Sequence[int], recording_lengths: Sequence[int], draws: int,
                  seed: int) -> list[tuple[int, int, int]]:
-    """``(length, recording, first frame)`` of ``draws`` random windows per length, in recordings that hold it
-    (``ValueError`` when none does)."""
+    """``(length, recording, first frame)`` of ``draws`` random windows per length in recordings that hold it."""
     rng = np.random.default_rng(seed)
     out = []
     for length in lengths:
@@ -49,8 +48,7 @@ def _run_window(name: str, seq: RobotSequence, first: int, length: int) -> tuple
 def table3_rows(recordings: Sequence[RobotSequence], trackers: Sequence[str], lengths: Sequence[int] = DEFAULT_LENGTHS,
                 draws: int = DEFAULT_DRAWS, seed: int = 0,
                 progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
-    """Per identifier: success rate (%) per length and over whole recordings, and localisation error (m);
-    recordings share N and M."""
+    """Per identifier: success rate (%) per length and in total, and localisation error (m)."""
     if not recordings:
         raise ValueError("no recordings")
     if draws < 1 or any(n < 1 for n in lengths):
@@ -89,8 +87,7 @@ def table3_rows(recordings: Sequence[RobotSequence], trackers: Sequence[str], le
 
 
 def recording_files(folder: Path) -> list[Path]:
-    """The ``.jsonl`` robot sequences of ``folder`` by name, without a ``<stem>.labelled.jsonl`` whose
-    ``<stem>.jsonl`` is there."""
+    """``folder``'s ``.jsonl`` robot sequences but a ``X.labelled.jsonl`` beside ``X.jsonl``."""
     files = sorted(folder.glob("*.jsonl")) if folder.is_dir() else []
     names = {f.name for f in files}
     return [f for f in files if not (f.name.endswith(".labelled.jsonl")

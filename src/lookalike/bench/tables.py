@@ -24,8 +24,7 @@ def pyplot() -> Any:
 
 def write_rows(rows: list[dict[str, Any]], json_path: Path | None, csv_path: Path | None,
                columns: Sequence[str] | None = None) -> None:
-    """Write table rows as JSON (a list of objects) and/or CSV (``columns``, default the first row's keys;
-    missing cells empty)."""
+    """Write rows as JSON and/or CSV (``columns``: default the first row's keys; missing cells empty)."""
     if json_path is not None:
         write_atomic(json_path, json.dumps(rows, indent=2) + "\n")
     if csv_path is not None and rows:

@@ -75,8 +75,7 @@ def localisation_error_by_agent(estimated: np.ndarray, truth: np.ndarray) -> np.
 
 
 def localisation_error(estimated: np.ndarray, truth: np.ndarray) -> float:
-    """Mean distance (m) over every (frame, agent) present and estimated (NaN: none; see
-    :func:`localisation_coverage`)."""
+    """Mean distance (m) over every (frame, agent) present and estimated (NaN: none)."""
     e, g = _positions(estimated, truth)
     d = np.linalg.norm(e - g, axis=2)
     d = d[np.isfinite(d)]

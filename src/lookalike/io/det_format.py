@@ -39,8 +39,7 @@ _SNIFF_LINES = 200
 
 @dataclass(frozen=True)
 class DetFormat:
-    """A detection file's layout: a role per column (``-``: ignored), ``separator`` (None: whitespace), and whether
-    the first line is a ``header``."""
+    """A detection file's layout: a role per column (``-``: ignored), ``separator`` (None: whitespace), ``header``."""
 
     roles: tuple[str, ...]
     separator: str | None = ","
@@ -68,8 +67,7 @@ MOT = DetFormat(("frame", "id", "left", "top", "width", "height", "score", "-", 
 
 
 def parse_columns(text: str, where: str = "--det-format") -> tuple[str, ...]:
-    """Roles of a list of column names (``_ALIASES``; others ignored); ``ValueError`` naming ``where`` without a frame
-    and a box."""
+    """Roles of a list of column names (``_ALIASES``); ``ValueError`` naming ``where`` without frame and box."""
     names = [n.strip().lower() for n in re.split(r"[,\s;]+", text.strip()) if n.strip()]
     roles = [_ROLE.get(n, "-") for n in names]
     if "left" not in roles and "top" not in roles:  # x, y name the corner only where nothing else does

@@ -119,8 +119,7 @@ def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *
 
 
 def typical_spacing(points: PointFrames | list[np.ndarray]) -> float:
-    """Median distance from each point to its nearest neighbour in the same frame (input unit); 0 when
-    no frame has two points."""
+    """Median distance from each point to its nearest neighbour in the same frame (0: never two)."""
     per_frame = points.points if isinstance(points, PointFrames) else points
     near = [_nearest(p, p, second=True) for p in per_frame if len(p) > 1]
     return float(np.median(np.concatenate(near))) if near else 0.0
@@ -141,8 +140,7 @@ def _nearest(points: np.ndarray, among: np.ndarray, second: bool = False) -> np.
 
 
 def typical_step(points: PointFrames | list[np.ndarray]) -> float:
-    """Median distance from each point to the nearest point of the previous frame (input unit per
-    frame); 0 when no two consecutive frames hold points."""
+    """Median distance from each point to the nearest point of the previous frame (0: none)."""
     per_frame = points.points if isinstance(points, PointFrames) else points
     near = []
     for a, b in zip(per_frame[:-1], per_frame[1:]):

@@ -61,8 +61,7 @@ def write_robot_sequence(path: str | Path, sequence: RobotSequence) -> Path:
 
 
 def read_robot_sequence(path: str | Path) -> RobotSequence:
-    """Read a sequence written by :func:`write_robot_sequence`; anything else raises ``ValueError`` naming the
-    file (and line)."""
+    """Read a :func:`write_robot_sequence` file; ``ValueError`` naming file (and line) for anything else."""
     path = Path(path)
     lines = [(no, line) for no, line in enumerate(read_text(path).splitlines(), start=1) if line.strip()]
     if not lines:

@@ -15,8 +15,7 @@ GAP_FACTOR = 10  # ... and up to this times the largest frame number seen before
 
 
 def read_text(path: str | os.PathLike[str]) -> str:
-    """The text of ``path`` (UTF-8); ``FileNotFoundError``/``ValueError`` naming the file otherwise
-    (not a file, not readable, not UTF-8 text)."""
+    """The UTF-8 text of ``path``; ``FileNotFoundError``/``ValueError`` naming the file otherwise."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")

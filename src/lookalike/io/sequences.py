@@ -93,8 +93,7 @@ def _is_sequence(folder: Path) -> bool:
 
 
 def find_sequences(path: str | os.PathLike[str]) -> list[MotSequence]:
-    """Sequences at ``path``: a detection file (in ``<seq>/det/``: with that sequence's ``seqinfo.ini``), one sequence
-    folder, or a folder of them."""
+    """Sequences at ``path``: a detection file, one sequence folder, or a folder of them."""
     path = Path(path)
     if path.is_file():
         parent = path.parent.parent if path.parent.name == "det" else None

@@ -176,8 +176,7 @@ class MotWriter:
         self.write_rows(tracks_to_rows(frame.index, tracks))
 
     def write_rows(self, rows: np.ndarray) -> None:
-        """Append result rows ``(k, 10)``; ``ValueError`` naming the frame of a NaN or infinite value (checked a block
-        at a time)."""
+        """Append result rows ``(k, 10)``; ``ValueError`` naming the frame of a NaN or infinite value."""
         if self._fh is None:
             raise ValueError(f"{self.path}: writer already closed")
         if len(rows):

@@ -24,8 +24,7 @@ def _same(a: Any, b: Any) -> bool:
 
 
 def one_at_a_time(tracker: str, space: Space, points: int = 5) -> tuple[list[dict[str, Any]], dict[str, list[int]]]:
-    """``(candidates, by_parameter)``: candidate 0 is the defaults, ``by_parameter[name]`` the indices of those
-    moving only ``name``."""
+    """``(candidates, by_parameter)``: 0 is the defaults; ``by_parameter[name]``: those moving only ``name``."""
     defaults = {p.name: p.default for p in tracker_parameters(tracker)}
     candidates: list[dict[str, Any]] = [{}]
     by_parameter: dict[str, list[int]] = {}

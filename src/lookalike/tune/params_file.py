@@ -87,8 +87,7 @@ def read_params(path: str | Path) -> TunedParams:
 
 
 def load_params(path: str | Path, tracker: str | None = None) -> dict[str, Any]:
-    """The checked parameters in the file at ``path`` (``ValueError`` naming it; a file for another ``tracker``
-    refused)."""
+    """The checked parameters in the file at ``path`` (``ValueError``: not for ``tracker``, or bad)."""
     content = read_params(path)
     if tracker is not None and content.tracker != tracker:
         raise ValueError(f"{path}: these parameters are for tracker {content.tracker!r}, not {tracker!r} "
