@@ -1,5 +1,5 @@
-"""The world-frame trackers' configuration (:class:`WorldConfig`, :class:`HeuristicsConfig`) and
-their lifecycle rules as data (:class:`WorldRules`): Kalman-HA's, or Kalman-HA2's heuristics."""
+"""The world-frame trackers' configuration (:class:`WorldConfig`, :class:`HeuristicsConfig`) and their lifecycle rules
+as data (:class:`WorldRules`)."""
 
 from __future__ import annotations
 
@@ -53,7 +53,7 @@ class HeuristicsConfig(WorldConfig):
     max_range_m: float = param(7.0, "farthest visible distance (m)", range=POSITIVE)
 
     def __post_init__(self) -> None:
-        super().__post_init__()  # checks every field (check_params)
+        super().__post_init__()
         if self.confirm_hits > self.confirm_window:
             raise ValueError(f"{type(self).__name__}.confirm_hits ({self.confirm_hits}) exceeds confirm_window "
                              f"({self.confirm_window})")
@@ -61,28 +61,18 @@ class HeuristicsConfig(WorldConfig):
 
 @dataclass(frozen=True)
 class WorldRules:
-    """A world tracker's lifecycle rules: Kalman-HA's (:meth:`none`) or Kalman-HA2's heuristics
-    (:meth:`from_config`).
+    """A world tracker's lifecycle rules: Kalman-HA's (:meth:`none`) or Kalman-HA2's heuristics (:meth:`from_config`);
+    None: the rule is off. Seconds, metres."""
 
-    Attributes:
-        lifecycle: confirmation (``n_init`` hits within ``confirm_window`` frames) and deletion.
-        born_confirmed: whether a new track is confirmed (and identified) at once.
-        confirm_window: latest frames whose hits count towards confirmation (None: every track confirmed).
-        coast_decay_s: time constant of the velocity decay of a missed track (s), None: no decay.
-        birth_min_score: lowest score that starts a track (None: any).
-        birth_exclusion_m: no birth this close to a track's prediction (m), None: anywhere.
-        view: ``(fov_deg, min_range_m, max_range_m)`` of the camera, None: no coasting limits by view.
-        max_coast_s: longest coasting while predicted in view, and ``max_out_of_view_s`` out of it (s)."""
-
-    lifecycle: Lifecycle
-    born_confirmed: bool = True
-    confirm_window: int | None = None
-    coast_decay_s: float | None = None
-    birth_min_score: float | None = None
-    birth_exclusion_m: float | None = None
-    view: tuple[float, float, float] | None = None
-    max_coast_s: float = 0.0
-    max_out_of_view_s: float = 0.0
+    lifecycle: Lifecycle  # confirmation (``n_init`` hits within ``confirm_window`` frames) and deletion
+    born_confirmed: bool = True  # a new track is confirmed (and identified) at once
+    confirm_window: int | None = None  # latest frames whose hits confirm (None: every track confirmed)
+    coast_decay_s: float | None = None  # time constant of a missed track's velocity decay
+    birth_min_score: float | None = None  # lowest score that starts a track
+    birth_exclusion_m: float | None = None  # no birth this close to a track's prediction
+    view: tuple[float, float, float] | None = None  # the camera's (fov_deg, min_range_m, max_range_m)
+    max_coast_s: float = 0.0  # longest coasting while predicted in view ...
+    max_out_of_view_s: float = 0.0  # ... and out of it
 
     @classmethod
     def none(cls) -> WorldRules:

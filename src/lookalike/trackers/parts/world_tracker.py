@@ -76,10 +76,7 @@ class WorldTracker:
                 self._intervals = [dt, *self._intervals[:1]]
                 self._repeated.intersection_update(self._intervals)
         self._identifier.begin_frame(frame.time, frame.beacons)
-        ready = None
-        if self._ready:
-            ready = self._ready.get(dt)  # (made for this interval from this table: prepare)
-            self._ready = {}
+        ready, self._ready = self._ready.get(dt), {}  # (made for this interval from this table: prepare)
         if ready is not None:
             t.mean, t.cov = ready.mean, ready.cov
         elif len(t) and dt != 0:
