@@ -1,12 +1,8 @@
-"""Input encoding of one frame for the association network.
-
-Our layout (length ``3·N + 5·M``): per agent ``cos ψ_j, sin ψ_j, age_j`` (latest reported heading and its age in
-seconds, clipped to ``max_age_s``; ``(0, 0, max_age_s)`` if never heard), then per detection slot ``x, y, cos φ, sin φ,
-γ`` (ground position in metres, visual heading, detector probability), with ``relative_headings`` followed by ``cos(φ −
-ψ_j), sin(φ − ψ_j)`` per agent. Empty slots are zeros; with more than M detections the M most probable are kept.
-
-The robot-identification paper's layout (``protocol="paper"``, length ``N + 4·M``): per agent ``ψ_j / π``, per slot ``x,
-y, φ / π, γ``; no ages or relative headings."""
+"""Input encoding of one frame for the association network. Ours (``3·N + 5·M``): per agent ``cos ψ_j, sin ψ_j, age_j``
+(latest report, its age in seconds clipped to ``max_age_s``; ``(0, 0, max_age_s)`` if never heard), then per slot ``x,
+y, cos φ, sin φ, γ`` (metres, visual heading, detector probability), with ``relative_headings`` followed by ``cos(φ −
+ψ_j), sin(φ − ψ_j)`` per agent. The paper's (``protocol="paper"``, ``N + 4·M``): ``ψ_j / π``; per slot ``x, y, φ / π,
+γ``."""
 
 from __future__ import annotations
 

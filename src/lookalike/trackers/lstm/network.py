@@ -12,11 +12,7 @@ def _sigmoid(x: np.ndarray) -> np.ndarray:
 
 
 class NumpyAssociationNet:
-    """Step-by-step evaluation of the stacked recurrent network.
-
-    ``step(x)`` takes one frame's raw input ``(n_inputs,)`` (or a batch ``(b, n_inputs)``), standardises it with the
-    saved statistics and returns class probabilities ``(M, N+1)`` (or ``(b, M, N+1)``); the recurrent state is kept
-    inside until :meth:`reset`."""
+    """Step-by-step evaluation of the stacked recurrent network (its state kept until :meth:`reset`)."""
 
     def __init__(self, weights: NetworkWeights) -> None:
         self.weights = weights
@@ -42,7 +38,8 @@ class NumpyAssociationNet:
         self._c = [np.zeros(shape) for _ in range(n)]
 
     def step(self, x: np.ndarray) -> np.ndarray:
-        """Advance one frame; return per-slot class probabilities."""
+        """Advance one frame of raw input ``(n_inputs,)`` (or a batch ``(b, n_inputs)``), standardised here; return
+        class probabilities ``(M, N+1)`` (or ``(b, M, N+1)``)."""
         h_in = (np.asarray(x, dtype=float) - self.weights.input_mean) * self._inv_std
         hidden = self.weights.hidden
         for i, (w_ih, w_hh, b, b_hh) in enumerate(self._layers):

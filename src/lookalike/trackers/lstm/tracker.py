@@ -1,10 +1,7 @@
-"""The LSTM identifier of the robot-identification paper as a registered tracker: labels every detection "agent j" or
-"false positive" from the detections and the agents' heading reports (numpy network).
-
-Tracks are the agents, positioned by a localiser (:mod:`lookalike.trackers.parts.identity.localiser`): the paper's
-low-pass filter (``localiser="lowpass"``) or a per-agent Kalman filter (``"kalman"``). With ``protocol="paper"`` the
-shipped weights use the paper's ``N + 4·M`` inputs (``lstm_paper_m{M}_n{N}``); decode them per slot
-(``one_to_one=False``) as the paper does."""
+"""The robot-identification paper's LSTM identifier: labels every detection "agent j" or "false positive" from the
+detections and the agents' heading reports (numpy network); tracks are the agents, positioned by a localiser. With
+``protocol="paper"`` the shipped weights take the paper's ``N + 4·M`` inputs (decode per slot, ``one_to_one=False``,
+as the paper does)."""
 
 from __future__ import annotations
 
