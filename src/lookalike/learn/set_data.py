@@ -15,9 +15,8 @@ from lookalike.sim.robots_config import SensorConfig
 from lookalike.trackers.set.network import agent_tokens, detection_tokens
 
 
-def arrays_to_tokens(
-    arrays: RobotArrays, n_agents: int, rng: np.random.Generator | None = None
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def arrays_to_tokens(arrays: RobotArrays, n_agents: int, rng: np.random.Generator | None = None
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``agents (T, N, 4)``, ``detections (T, M, 5)``, ``valid (T, M)`` and targets ``(T, M)``
     (agent id, N for a false positive, ``IGNORE`` for an empty slot). With ``rng`` the occupied
     slots are shuffled per frame (the network must not rely on their order)."""

@@ -143,16 +143,9 @@ def _trained(model: nn.Module, prefixes: tuple[str, ...]) -> list[nn.Parameter]:
     return kept
 
 
-def train_set(
-    config: SetTrainConfig,
-    out_dir: str | Path,
-    resume: bool = False,
-    on_step: Callable[[dict], None] | None = None,
-    *,
-    device: str = "cpu",
-    pool: JobPool | None = None,
-    init: SetWeights | None = None,
-) -> TrainResult:
+def train_set(config: SetTrainConfig, out_dir: str | Path, resume: bool = False,
+              on_step: Callable[[dict], None] | None = None, *, device: str = "cpu", pool: JobPool | None = None,
+              init: SetWeights | None = None) -> TrainResult:
     """Train; write ``set.npz`` (best), ``checkpoint.pt`` and ``training_log.csv``; ``init``: weights to start from."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

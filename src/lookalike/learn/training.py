@@ -109,20 +109,10 @@ def _train_chunks(model: Any, xt: Any, yt: Any, config: TrainConfig, n_classes: 
         losses.append(loss.item())
     return losses
 
-def train(
-    config: TrainConfig,
-    sample: Sampler,
-    out_dir: str | Path,
-    resume: bool = False,
-    on_step: Callable[[dict], None] | None = None,
-    *,
-    device: str = "cpu",
-    pool: JobPool | None = None,
-    init: NetworkWeights | None = None,
-    validation_sample: Sampler | None = None,
-    validation: tuple[np.ndarray, np.ndarray] | None = None,
-    info: dict | None = None,
-) -> TrainResult:
+def train(config: TrainConfig, sample: Sampler, out_dir: str | Path, resume: bool = False,
+          on_step: Callable[[dict], None] | None = None, *, device: str = "cpu", pool: JobPool | None = None,
+          init: NetworkWeights | None = None, validation_sample: Sampler | None = None,
+          validation: tuple[np.ndarray, np.ndarray] | None = None, info: dict | None = None) -> TrainResult:
     """Train on sequences from ``sample(seed, n_frames, rng)``; write weights, checkpoint and log to ``out_dir``.
     ``init``: exported weights of the same shape to start from (validated first); ``validation_sample`` or
     ``validation`` (``(B, T, n_inputs), (B, T, M)``) set the validation data; ``info`` goes into the metadata."""

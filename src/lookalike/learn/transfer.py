@@ -43,15 +43,8 @@ def _head_map(source: EncodingSpec, target: EncodingSpec) -> tuple[np.ndarray, n
     return np.asarray(rows, dtype=np.int64), np.asarray(repeat, dtype=bool)
 
 
-def transfer_weights(
-    weights: NetworkWeights,
-    target: EncodingSpec,
-    mean: np.ndarray,
-    std: np.ndarray,
-    rng: np.random.Generator,
-    jitter: float = 0.1,
-    info: dict | None = None,
-) -> NetworkWeights:
+def transfer_weights(weights: NetworkWeights, target: EncodingSpec, mean: np.ndarray, std: np.ndarray,
+                     rng: np.random.Generator, jitter: float = 0.1, info: dict | None = None) -> NetworkWeights:
     """``weights`` mapped onto ``target``'s set-up: upper layers copied; first-layer input columns and output head
     mapped block by block (agent ``j`` from ``j mod N``, slot ``k`` from ``k mod M``), repeated blocks jittered by
     ``jitter`` × the block's spread. ``mean``/``std`` ``(target.n_inputs,)``: the new input normalisation."""
@@ -88,10 +81,9 @@ def transfer_weights(
     )
 
 
-def transfer_from_file(
-    path: str, target: EncodingSpec, sample: Callable[[int, int, Any], tuple[np.ndarray, np.ndarray]],
-    seeds: list[int], length: int, seed: int = 0,
-) -> NetworkWeights:
+def transfer_from_file(path: str, target: EncodingSpec,
+                       sample: Callable[[int, int, Any], tuple[np.ndarray, np.ndarray]], seeds: list[int], length: int,
+                       seed: int = 0) -> NetworkWeights:
     """Weights at ``path`` onto ``target``, normalised by ``sample`` inputs over ``seeds``."""
     from lookalike.trackers.lstm.checkpoint import load_weights
 

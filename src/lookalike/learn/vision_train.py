@@ -173,16 +173,10 @@ def train_robot_detector(data: Path | None, frames: int, stages: int, negatives:
     return model, trained, tried
 
 
-def rendered_heading_samples(
-    n_frames: int,
-    seed: int,
-    config: HeadingConfig = HEADING_CONFIG,
-    robots_per_frame: int = 4,
-    range_m: tuple[float, float] = (1.0, 5.0),
-    min_visible: float = 0.8,
-    box_jitter: float = 0.05,
-    camera: Camera | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
+def rendered_heading_samples(n_frames: int, seed: int, config: HeadingConfig = HEADING_CONFIG,
+                             robots_per_frame: int = 4, range_m: tuple[float, float] = (1.0, 5.0),
+                             min_visible: float = 0.8, box_jitter: float = 0.05,
+                             camera: Camera | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Features ``(n, d)`` and true egocentric headings ``(n,)`` (rad) of robots rendered ``range_m`` (m) ahead in the
     field of view (at least ``min_visible`` visible), boxes jittered by ``box_jitter`` × their size."""
     from lookalike.geometry.camera import Camera

@@ -56,9 +56,8 @@ def _burst_mask(t_sent: np.ndarray, cfg: NetworkConfig, horizon_s: float, rng: n
     return out
 
 
-def simulate_reports(
-    heading_rad: np.ndarray, dt_s: float, cfg: NetworkConfig, rng: np.random.Generator
-) -> ReportArrays:
+def simulate_reports(heading_rad: np.ndarray, dt_s: float, cfg: NetworkConfig,
+                     rng: np.random.Generator) -> ReportArrays:
     """Reports of ``heading_rad (T, N)`` (unwrapped), interpolated linearly at the send times."""
     T, n_agents = heading_rad.shape
     horizon = (T - 1) * dt_s

@@ -116,7 +116,8 @@ class Detections:
     def select(self, index: np.ndarray | slice | list[int]) -> Detections:
         """Rows ``index`` as a new batch (boolean mask or integer indices)."""
         columns = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        return Detections(**{name: None if col is None else col[index] for name, col in columns.items()})
+        values: dict[str, Any] = {name: None if col is None else col[index] for name, col in columns.items()}
+        return Detections(**values)
 
     def replace(self, **changes: Any) -> Detections:
         """A copy with some columns replaced (validated again)."""
