@@ -53,11 +53,7 @@ def run(tracker: Updating, frames: Iterable[Any], sink: Sink | None = None, *,
     return stats
 
 
-WARM_UP_FRAMES = 10
-"""Frames a throw-away tracker is run over by :func:`warm_up`."""
-
-
-def warm_up(make: Callable[[], Updating], frames: Iterable[Any], n: int = WARM_UP_FRAMES) -> None:
+def warm_up(make: Callable[[], Updating], frames: Iterable[Any], n: int = 10) -> None:
     """Run a throw-away tracker from ``make()`` over the first ``n`` of ``frames``, so that one-off costs (imports,
     numba compiles) stay out of a frames/s figure."""
     tracker = make()

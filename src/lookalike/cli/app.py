@@ -77,8 +77,7 @@ def _main(
 
 
 def fail(message: str, code: int = 2) -> NoReturn:
-    """Print ``message`` as an error, as plain text (markup-like input such as ``[/]`` printed as given), and exit
-    with ``code``."""
+    """Print ``message`` as an error, as plain text (markup-like input printed as given), and exit with ``code``."""
     err_console.print(Text.assemble(("error:", "bold red"), " ", message), highlight=False)
     raise typer.Exit(code)
 
@@ -144,8 +143,8 @@ def split_list(values: list[str] | None) -> list[str]:
 
 
 def command_line() -> str:
-    """The command line being run, for the header of a results file: ``sys.argv`` when run as the
-    ``lookalike`` script, else (tests, ``python -m``) the command path and its non-default options."""
+    """The command line being run, for a results file's header: ``sys.argv`` when run as the program, else the
+    command path and its non-default options."""
     if run_as_program():
         return shlex.join(["lookalike", *sys.argv[1:]])
     ctx = get_current_context(silent=True)

@@ -304,20 +304,20 @@ def track(
 
                         run_track_video(video, det_path, output, trk, tracker, det_format=det_format,
                                         **video_options)
-            elif online is not None and targets is not None:
-                from lookalike.cli.track_closed import offline_files
-
-                assert path is not None
-                count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length,
-                                      det_format=det_format)
-                where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
-                console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
             else:
                 assert path is not None
-                count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length,
-                                           det_format=det_format, name=tracker)
                 where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
-                console.print(f"[green]{tracker}[/]: {count} sequence(s), {_speed(stats)} → {where}")
+                if online is not None and targets is not None:
+                    from lookalike.cli.track_closed import offline_files
+
+                    count = offline_files(path, output, targets, online, min_score,
+                                          use_length=not no_seqinfo_length, det_format=det_format)
+                    console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → "
+                                  f"{where}")
+                else:
+                    count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length,
+                                               det_format=det_format, name=tracker)
+                    console.print(f"[green]{tracker}[/]: {count} sequence(s), {_speed(stats)} → {where}")
 
         except OSError as exc:  # an output that cannot be written, an input that cannot be read
             fail(f"{exc.filename or output}: {exc.strerror or exc}")

@@ -116,7 +116,7 @@ def train(
     check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)},
                           [recordings, init_from, validation_folder], folders={"-o/--output"})
     with needs("torch"):
-        import torch
+        import torch  # noqa: F401 (fails early without the 'train' extra)
     if model not in ("lstm", "set"):
         fail(f"--model: unknown model {model!r}; known: lstm, set")
     if recordings is not None and search is not None:
@@ -148,7 +148,7 @@ def train(
     if learning_rate is None:
         learning_rate = 0.004
     from lookalike.learn.paper_protocol import noise_worlds
-    from lookalike.learn.training import TrainConfig, plot_log
+    from lookalike.learn.training import TrainConfig
     from lookalike.learn.training import train as run_training
     from lookalike.parallel import JobPool
     from lookalike.trackers.lstm.encoding import EncodingSpec
@@ -175,23 +175,12 @@ def train(
         if init_transfer and init is not None:
             config = dataclasses.replace(config, hidden=init.hidden, num_layers=len(init.layers))
         pool = JobPool(workers, backend, address)
-    torch.set_num_threads(threads)
-    result = _with_progress(f"training {preset_name}", steps, pool, lambda on_step: run_training(
+    result = _with_progress(f"training {preset_name}", steps, pool, threads, lambda on_step: run_training(
         config, sample, output, resume=resume, on_step=on_step, device=device, pool=pool, init=init,
         validation_sample=validation,
         info={"transferred_from": init.info["transferred_from"]} if init is not None and init_transfer else None))
-    png = plot_log(result.log_path, output / "training_log.png")
-    console.print(
-        f"best validation success rate [bold]{100 * result.best_success:.1f}%[/] at step {result.best_step} "
-        f"of {result.steps}; weights {result.weights_path}, log {result.log_path}, plot {png}"
-    )
-    if ship:
-        WEIGHTS_DIR.mkdir(exist_ok=True)
-        stem = "lstm_paper" if protocol == "paper" else "lstm"
-        target = WEIGHTS_DIR / f"{stem}_m{world.max_detections}_n{world.n_agents}"
-        shutil.copy(result.weights_path, target.with_suffix(".npz"))
-        shutil.copy(result.weights_path.with_suffix(".json"), target.with_suffix(".json"))
-        console.print(f"shipped as {target.with_suffix('.npz')}", markup=False)
+    stem = "lstm_paper" if protocol == "paper" else "lstm"
+    _finish(result, output, WEIGHTS_DIR / f"{stem}_m{world.max_detections}_n{world.n_agents}.npz" if ship else None)
 
 
 def _sim_samplers(world: Any, worlds: Any, spec: Any, noise: str, swap_prob: float) -> tuple[Any, Any]:
@@ -231,11 +220,7 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
                threads: int, device: str, workers: int, backend: str, address: str | None, resume: bool,
                ship: bool, learning_rate: float | None) -> None:
     """``lookalike train --model set``: the set associator over every team size."""
-    with needs("torch"):
-        import torch
-
     from lookalike.learn.set_training import SetTrainConfig, train_set
-    from lookalike.learn.training import plot_log
     from lookalike.parallel import JobPool
     from lookalike.trackers.set.network import SHIPPED_SET_WEIGHTS
 
@@ -245,20 +230,24 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
         if learning_rate is not None:
             config = dataclasses.replace(config, learning_rate=learning_rate)
         pool = JobPool(workers, backend, address)
-    torch.set_num_threads(threads)
-    result = _with_progress("training set (N 1-12)", steps, pool, lambda on_step: train_set(
+    result = _with_progress("training set (N 1-12)", steps, pool, threads, lambda on_step: train_set(
         config, output, resume=resume, on_step=on_step, device=device, pool=pool))
+    _finish(result, output, SHIPPED_SET_WEIGHTS if ship else None, " (mean over the validation teams)")
+
+
+def _finish(result: Any, output: Path, ship_to: Path | None, detail: str = "") -> None:
+    """Plot the training log, print the best validation and, with ``ship_to`` (an ``.npz``), ship the weights."""
+    from lookalike.learn.training import plot_log
+
     png = plot_log(result.log_path, output / "training_log.png")
-    console.print(
-        f"best validation success rate [bold]{100 * result.best_success:.1f}%[/] (mean over the validation teams) "
-        f"at step {result.best_step} of {result.steps}; weights {result.weights_path}, log {result.log_path}, "
-        f"plot {png}"
-    )
-    if ship:
-        SHIPPED_SET_WEIGHTS.parent.mkdir(exist_ok=True)
-        shutil.copy(result.weights_path, SHIPPED_SET_WEIGHTS)
-        shutil.copy(result.weights_path.with_suffix(".json"), SHIPPED_SET_WEIGHTS.with_suffix(".json"))
-        console.print(f"shipped as {SHIPPED_SET_WEIGHTS}", markup=False)
+    console.print(f"best validation success rate [bold]{100 * result.best_success:.1f}%[/]{detail} at step "
+                  f"{result.best_step} of {result.steps}; weights {result.weights_path}, log {result.log_path}, "
+                  f"plot {png}")
+    if ship_to is not None:
+        ship_to.parent.mkdir(exist_ok=True)
+        shutil.copy(result.weights_path, ship_to)
+        shutil.copy(result.weights_path.with_suffix(".json"), ship_to.with_suffix(".json"))
+        console.print(f"shipped as {ship_to}", markup=False)
 
 
 def torch_device(device: str) -> str:
@@ -273,10 +262,14 @@ def torch_device(device: str) -> str:
     return device
 
 
-def _with_progress(description: str, steps: int, pool: JobPool,
+def _with_progress(description: str, steps: int, pool: JobPool, threads: int,
                    train: Callable[[Callable[[dict], None]], Any]) -> Any:
-    """Run ``train(on_step)`` inside ``pool`` under a progress bar of ``steps`` showing the loss and the
-    validation success rate; a ``ValueError`` (bad configuration or checkpoint) becomes a one-line error."""
+    """Run ``train(on_step)`` with ``threads`` torch threads inside ``pool`` under a progress bar of ``steps`` showing
+    the loss and the validation success rate; a ``ValueError`` becomes a one-line error."""
+    with needs("torch"):
+        import torch
+
+    torch.set_num_threads(threads)
     with bars("{task.description}", TextColumn("loss {task.fields[loss]:.3f}  validation {task.fields[val]}"),
               transient=False) as progress:
         task = progress.add_task(description, total=steps, loss=math.nan, val="–")

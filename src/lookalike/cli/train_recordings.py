@@ -7,7 +7,6 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from lookalike._optional import needs
 from lookalike.cli.app import console, fail, failing
 from lookalike.cli.train_options import RunOptions
 from lookalike.sim import RobotSequence
@@ -53,9 +52,6 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     """Fine-tune on the recordings of ``folder`` (split by recording, or all of them with ``opt.validation``,
     the folder of the validation recordings), write ``OUTPUT/model.npz``; with ``opt.test``, print the
     starting and fine-tuned success rates on the test recordings."""
-    with needs("torch"):
-        import torch
-
     from lookalike.cli.train import _with_progress, torch_device
     from lookalike.learn.recordings import RecordingSampler, check_recordings, split_recordings, validation_arrays
     from lookalike.learn.training import TrainConfig, plot_log
@@ -113,8 +109,7 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
                       f"recordings: {_sensor_line(world.sensor)}")
     console.print(f"fine-tuning {init_path} on {len(train_idx)} recordings, validating on {len(val_idx)}: "
                   f"{', '.join(held_out)}")
-    torch.set_num_threads(opt.threads)
-    result = _with_progress(f"fine-tuning M={m}, N={n}", opt.steps, pool, lambda on_step: run_training(
+    result = _with_progress(f"fine-tuning M={m}, N={n}", opt.steps, pool, opt.threads, lambda on_step: run_training(
         config, sampler, output, resume=opt.resume, on_step=on_step, device=device, pool=pool, init=init,
         validation=validation, info=info))
     png = plot_log(result.log_path, output / "training_log.png")
