@@ -84,8 +84,7 @@ def load_boxes(root: Path, dataset: str) -> list[RealSequence]:
         length = seq.length or int(max(det.frame.max(initial=0), gt.frame.max(initial=0)))
         xywh, score = _split_frames(det, length)
         out.append(RealSequence(dataset, seq.name, seq.frame_rate, length, xywh, score, gt=gt,
-                                image_size=seq.image_size,
-                                n_targets=PIGS_COUNT if dataset == "pigs" else None))
+                                image_size=seq.image_size, n_targets=PIGS_COUNT if dataset == "pigs" else None))
     if not out:
         raise ValueError(f"{root}: no sequence with det/det.txt and gt/gt.txt")
     return out

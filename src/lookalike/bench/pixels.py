@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -120,9 +121,21 @@ class IdentScore:
     robot_success: float = float("nan")
 
 
-def _score(predicted: list[np.ndarray], positions: list[np.ndarray], truth: list[np.ndarray],
-           perceived: list[PerceivedSequence], stats: RunStats) -> IdentScore:
-    """:class:`IdentScore` of per-frame labels and ``(N, 2)`` agent positions, sequence after sequence."""
+Labelled = tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]  # per frame: labels, positions (N, 2), truth
+
+
+def _score(perceived: list[PerceivedSequence], labelled: Callable[[PerceivedSequence, RunStats], Labelled]
+           ) -> IdentScore:
+    """:class:`IdentScore` of ``labelled(sequence, stats)`` over the sequences."""
+    predicted: list[np.ndarray] = []
+    positions: list[np.ndarray] = []
+    truth: list[np.ndarray] = []
+    stats = RunStats()
+    for p in perceived:
+        labels, at, true = labelled(p, stats)
+        predicted += labels
+        positions += at
+        truth += true
     true_positions = [p.sequence.true_positions_visible() for p in perceived]
     loc = localisation_error(np.stack(positions), np.concatenate(true_positions)) if positions else float("nan")
     return IdentScore(identification_success_rate(predicted, truth), loc, sum(len(t) for t in truth), stats.fps,
@@ -132,38 +145,31 @@ def _score(predicted: list[np.ndarray], positions: list[np.ndarray], truth: list
 def score_pixels(name: str, perceived: list[PerceivedSequence], pipe: RobotPipeline, camera: Camera,
                  weights: str | None = None) -> IdentScore:
     """Identifier ``name`` on the pixel detections."""
-    predicted: list[np.ndarray] = []
-    positions: list[np.ndarray] = []
-    truth: list[np.ndarray] = []
-    stats = RunStats()
-    for p in perceived:
-        n_agents = p.sequence.config.n_agents
+    def labelled(p: PerceivedSequence, stats: RunStats) -> Labelled:
+        labels: list[np.ndarray] = []
+        positions: list[np.ndarray] = []
 
-        def sink(k: int, result: PipelineResult, n_agents: int = n_agents) -> None:
-            predicted.append(result.labels)
-            positions.append(agent_positions(result.tracks, n_agents))
+        def sink(k: int, result: PipelineResult) -> None:
+            labels.append(result.labels)
+            positions.append(agent_positions(result.tracks, p.sequence.config.n_agents))
 
         config = _identifier(name, p.sequence, camera, weights)
         step = _Identify(RobotPipeline(pipe.detector, pipe.heading, camera, config, pipe.probability), p)
         run(step, range(len(p.detections)), sink, stats=stats)
-        truth.extend(p.truth)
-    return _score(predicted, positions, truth, perceived, stats)
+        return labels, positions, p.truth
+
+    return _score(perceived, labelled)
 
 
 def score_simulated(name: str, perceived: list[PerceivedSequence], camera: Camera,
                     weights: str | None = None) -> IdentScore:
     """Identifier ``name`` on the simulator's own detections of the same sequences."""
-    predicted: list[np.ndarray] = []
-    positions: list[np.ndarray] = []
-    truth: list[np.ndarray] = []
-    stats = RunStats()
-    for p in perceived:
+    def labelled(p: PerceivedSequence, stats: RunStats) -> Labelled:
         tracker = make_tracker(name, **_identifier(name, p.sequence, camera, weights).identifier_kwargs())
         labels, at = run_labels(tracker, list(p.sequence.frames()), p.sequence.config.n_agents, stats)
-        predicted += labels
-        positions += list(at)
-        truth.extend(p.sequence.true_labels())
-    return _score(predicted, positions, truth, perceived, stats)
+        return labels, list(at), p.sequence.true_labels()
+
+    return _score(perceived, labelled)
 
 
 def perception_pipeline(pipe: RobotPipeline, n_agents: int, max_detections: int) -> RobotPipeline:

@@ -53,7 +53,7 @@ def default_entries(trackers: Sequence[str], peers: Sequence[str], closed_set: b
     if "boxtrack" in trackers:
         entries += [Entry("boxtrack-offline", "boxtrack", offline=True),
                     Entry(f"boxtrack ({TUNED_LABEL})", "boxtrack", tuned=True)]
-    if closed_set and "boxtrack" in trackers:
+    if "boxtrack" in trackers and closed_set:
         entries += [Entry("boxtrack-closed", "boxtrack", closed_set=True),
                     Entry("boxtrack-closed-offline", "boxtrack", closed_set=True, closed_offline=True)]
     return entries + [Entry(p, p, kind="peer") for p in peers]

@@ -64,11 +64,8 @@ def folder_results(scores: dict[str, dict[str, dict[str, float]]], gt_root: str 
 
     dataset = Path(gt_root).name or str(gt_root)
     seqs = {s for per in scores.values() for s in per if s != COMBINED}
-    frames = 0
     first = next(iter(scores.values()), {})
-    for seq, values in first.items():
-        if seq != COMBINED:
-            frames += int(values.get("CLR_Frames", 0))
+    frames = sum(int(values.get("CLR_Frames", 0)) for seq, values in first.items() if seq != COMBINED)
     if not seqs and first:
         frames = int(first.get(COMBINED, {}).get("CLR_Frames", 0))
     doc = Results("eval", command=command, sequences=max(len(seqs), 1 if first else 0), frames=frames,
