@@ -8,14 +8,10 @@ Step = Callable[[], None]
 ProgressFactory = Callable[[str, int], Step]
 
 
-def _nothing() -> None:
-    return None
-
-
 def no_progress(description: str, total: int) -> Step:
     """A progress factory that reports nothing."""
     del description, total
-    return _nothing
+    return lambda: None
 
 
 __all__ = ["ProgressFactory", "Step", "no_progress"]

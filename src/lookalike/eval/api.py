@@ -38,15 +38,14 @@ def evaluate_data(data: SequenceData, *, threshold: float = 0.5, metrics: Sequen
         "Dets": data.num_tracker_dets, "GT_Dets": data.num_gt_dets,
         "IDs": data.num_tracker_ids, "GT_IDs": data.num_gt_ids,
     }
-    pairs = data.pairs() if ("HOTA" in chosen or "Identity" in chosen) else None
-    if "HOTA" in chosen and pairs is not None:
-        out.update(hota.flatten(hota.hota_final(hota.hota_arrays(data, pairs))))
+    if "HOTA" in chosen:
+        out.update(hota.flatten(hota.hota_final(hota.hota_arrays(data, data.pair))))
     if "CLEAR" in chosen:
         counts = clear.clear_counts(data, threshold)
         out.update(counts)
         out.update(clear.clear_final(counts))
-    if "Identity" in chosen and pairs is not None:
-        id_counts = identity.identity_counts(data, pairs, threshold)
+    if "Identity" in chosen:
+        id_counts = identity.identity_counts(data, data.pair, threshold)
         out.update(id_counts)
         out.update(identity.identity_final(id_counts))
     return out
