@@ -22,9 +22,8 @@ MODULES = ("bench", "bench_divers", "bench_experiments", "bench_pixels", "bench_
            "train_appearance", "tune", "vision")
 """Every command module, in the order they are imported."""
 
-COMMAND_MODULES = {"track": "track", "trackers": "trackers", "eval": "eval", "simulate": "simulate",
-                   "render": "render", "report": "report", "demo": "demo", "label": "label"}
-"""Commands whose module alone is imported when the script runs them."""
+COMMAND_MODULES = ("track", "trackers", "eval", "simulate", "render", "report", "demo", "label")
+"""Commands whose module (of the same name) alone is imported when the script runs them."""
 
 
 def _script_command() -> str | None:
@@ -56,7 +55,7 @@ def _load_commands() -> None:
     if command is None and run_as_program():
         _list_commands_only()
         return
-    only = COMMAND_MODULES.get(command or "")
+    only = command if command in COMMAND_MODULES else None
     for name in (only,) if only is not None else MODULES:
         importlib.import_module(f"lookalike.cli.{name}")
     if only is not None and not _registered(command or ""):

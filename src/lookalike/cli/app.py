@@ -137,6 +137,17 @@ def check_study_or_fail(study: str | None) -> None:
         fail(f"--study {study}: {str(exc).splitlines()[0] if str(exc) else type(exc).__name__}")
 
 
+def sequence_files(path: Path) -> list[Path]:
+    """The files of the sequences at ``path``; none where it holds none (the command names that problem itself)."""
+    from lookalike.io import find_sequences
+    from lookalike.io.outputs import sequence_inputs
+
+    try:
+        return sequence_inputs(find_sequences(path))
+    except (FileNotFoundError, ValueError):
+        return []
+
+
 def split_list(values: list[str] | None) -> list[str]:
     """Option values given repeated and/or comma-separated, as one list (blanks dropped)."""
     return [v.strip() for item in values or [] for v in item.split(",") if v.strip()]

@@ -59,8 +59,7 @@ def print_leaderboard(rows: list[dict[str, Any]], combined: list[dict[str, Any]]
 def real(
     data: Path | None = typer.Option(None, "--data", help="Folder with mot15/, pigs/, hexbug/, mot17/ "
                                      "(default: $LOOKALIKE_DATA, else ../shared/data from the current directory)."),
-    datasets: list[str] = typer.Option(list(DATASETS[:3]), "--datasets",
-                                       help=_DATASETS_HELP),
+    datasets: list[str] = typer.Option(list(DATASETS[:3]), "--datasets", help=_DATASETS_HELP),
     trackers: list[str] = typer.Option(list(BOX_TRACKERS), "--trackers", help="lookalike box trackers."),
     peers: list[str] = typer.Option(list(PEERS), "--peers",
                                     help="Peers to try ('none' for none); absent ones are skipped."),

@@ -15,11 +15,8 @@ from lookalike.eval import BENCHMARKS, METRICS
 from lookalike.eval.folders import COMBINED, evaluate_folders, folder_results
 from lookalike.io.outputs import atomic_path
 
-HEADLINE = {
-    "HOTA": ("HOTA", "DetA", "AssA"),
-    "CLEAR": ("MOTA", "MOTP", "IDSW", "Frag", "CLR_FP", "CLR_FN"),
-    "Identity": ("IDF1",),
-}
+HEADLINE = {"HOTA": ("HOTA", "DetA", "AssA"), "CLEAR": ("MOTA", "MOTP", "IDSW", "Frag", "CLR_FP", "CLR_FN"),
+            "Identity": ("IDF1",)}
 SHORT = {"CLR_FP": "FP", "CLR_FN": "FN"}
 _METRICS_HELP = f"Any of {', '.join(METRICS)} (comma-separated or repeated; default all)."
 PERCENT = {"HOTA", "DetA", "AssA", "LocA", "MOTA", "MOTP", "IDF1", "IDP", "IDR"}
@@ -93,14 +90,9 @@ def eval_command(
 
 def _eval_inputs(gt: Path, results: list[Path]) -> list[Path]:
     """The files ``eval`` reads (ground truth, ``seqinfo.ini``, result files) and the folders holding them."""
-    from lookalike.io import find_sequences
-    from lookalike.io.outputs import sequence_inputs
+    from lookalike.cli.app import sequence_files
 
-    inputs = [gt, *results]
-    try:
-        inputs += sequence_inputs(find_sequences(gt)) if gt.is_dir() else []
-    except (FileNotFoundError, ValueError):
-        pass  # (eval itself names the problem)
+    inputs = [gt, *results, *(sequence_files(gt) if gt.is_dir() else [])]
     for folder in results:
         inputs += sorted(folder.glob("*.txt")) if folder.is_dir() else []
     return inputs
@@ -141,8 +133,7 @@ def _write_csv(path: Path, scores: dict[str, dict[str, dict[str, float]]]) -> No
 
 
 def _csv_cell(value: object) -> str:
-    """A CSV cell: an integer as such, any other number as Python's shortest round-tripping float text (a numpy
-    scalar too, never its ``np.float64(...)`` repr); anything else as text."""
+    """A CSV cell: an integer as such, any other number (numpy scalars too) as its shortest round-tripping float."""
     if isinstance(value, numbers.Integral):
         return str(int(value))
     if isinstance(value, numbers.Real):

@@ -36,11 +36,8 @@ def _details(name: str) -> None:
     from rich.table import Table
 
     table = Table(title=f"[bold]{name}[/]: {summary(name)}", title_justify="left", show_lines=False)
-    table.add_column("parameter")
-    table.add_column("type")
-    table.add_column("default")
-    table.add_column("allowed")
-    table.add_column("meaning")
+    for column in ("parameter", "type", "default", "allowed", "meaning"):
+        table.add_column(column)
     for p in tracker_parameters(name):
         table.add_row(p.name, p.type, repr(p.default), p.allowed(), p.doc)
     console.print(table)

@@ -96,16 +96,10 @@ def _load_space(tracker: str, space_path: Path | None) -> Any:
 
 def _data_inputs(data: list[str], space_path: Path | None) -> list[Path]:
     """The files and folders ``tune`` reads from (the given sequence folders and their files, the space)."""
-    from lookalike.io import find_sequences
-    from lookalike.io.outputs import sequence_inputs
+    from lookalike.cli.app import sequence_files
 
-    inputs: list[Path] = [Path(d) for d in data if Path(d).exists()]
-    for path in list(inputs):
-        try:
-            inputs += sequence_inputs(find_sequences(path))
-        except (FileNotFoundError, ValueError):
-            pass  # (the data loading names the problem)
-    return [*inputs, *([space_path] if space_path is not None else [])]
+    folders = [Path(d) for d in data if Path(d).exists()]
+    return [*folders, *(f for path in folders for f in sequence_files(path)), *([space_path] if space_path else [])]
 
 
 def _load_data(data: list[str], data_root: Path | None, folds: str) -> tuple[Any, Any]:
