@@ -135,8 +135,7 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
     notes = [] if separator == "," else ["whitespace-separated columns"]
     header = all(_numbers([f]) is None for f in _split(first, separator) if f)  # names only, no number
     rows = lines[1:] if header else lines
-    parsed = [_numbers(_split(ln, separator)) for ln in rows]
-    sample = [p for p in parsed if p is not None]
+    sample = [p for p in (_numbers(_split(ln, separator)) for ln in rows) if p is not None]
     if spec not in ("auto", "mot"):
         roles, note = parse_columns(spec), f"columns read as {DetFormat(parse_columns(spec)).describe()} (--det-format)"
     elif header and spec == "auto":
@@ -159,8 +158,7 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
     if "frame" in roles and sample and len(sample[0]) > roles.index("frame") and sample[0][roles.index("frame")] == 0:
         roles = tuple("frame0" if r == "frame" else r for r in roles)
         notes.append("frames start at 0: read as 0-based (file frame 0 is the first frame)")
-    fmt = DetFormat(roles, separator, header)
-    return fmt, notes
+    return DetFormat(roles, separator, header), notes
 
 
 def read_det(path: str | os.PathLike[str], fmt: DetFormat, length: int | None = None,
