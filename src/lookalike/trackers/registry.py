@@ -84,15 +84,13 @@ def _config_class(name: str) -> Any:
 
 def tracker_parameters(name: str) -> list[ParameterInfo]:
     """The parameters of tracker ``name`` with their defaults and descriptions."""
+    from lookalike.trackers.base import field_specs
+
     config_cls = _config_class(name)
-    hints = typing.get_type_hints(config_cls)
-    out = []
-    for f in dataclasses.fields(config_cls):
-        default = f.default if f.default_factory is dataclasses.MISSING else f.default_factory()
-        type_name = getattr(hints[f.name], "__name__", str(hints[f.name]))
-        out.append(ParameterInfo(f.name, type_name, default, f.metadata.get("doc", ""), f.metadata.get("range"),
-                                 f.metadata.get("choices")))
-    return out
+    return [ParameterInfo(f.name, getattr(hint, "__name__", str(hint)),
+                          f.default if f.default_factory is dataclasses.MISSING else f.default_factory(),
+                          f.metadata.get("doc", ""), bounds, choices)
+            for f, (_, hint, bounds, choices) in zip(dataclasses.fields(config_cls), field_specs(config_cls))]
 
 
 def make_tracker(name: str, **params: Any) -> Any:

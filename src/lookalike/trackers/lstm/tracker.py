@@ -7,8 +7,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from lookalike.trackers.base import check_params, param
 from lookalike.trackers.lstm.checkpoint import load_weights
 from lookalike.trackers.lstm.encoding import PROTOCOLS, EncodingSpec, encode_frame
@@ -60,8 +58,5 @@ class LstmIdentifier(AgentIdentifier):
         x, used = encode_frame(self.spec, det, self._beacons.heading, self._beacons.age(frame.time))
         labels, conf = decode(self.net.step(x), used, len(det), self.config.one_to_one)
         self.last_labels, self.last_probabilities = labels, conf
-        if len(det) and (det.position is None or det.heading is None):
-            raise ValueError("lstm: frame.detections need position (m) and heading (rad) columns")
-        position = det.position if det.position is not None else np.zeros((0, 2))
-        heading = det.heading if det.heading is not None else np.zeros(0)
-        return agent_snapshots(labels, conf, position, heading, self._localiser, self._last_seen, frame)
+        assert det.position is not None and det.heading is not None  # (encode_frame checked them)
+        return agent_snapshots(labels, conf, det.position, det.heading, self._localiser, self._last_seen, frame)
