@@ -79,10 +79,8 @@ def _bounds(frames: np.ndarray, num_frames: int) -> tuple[np.ndarray, np.ndarray
 def _relabel(ids: list[np.ndarray]) -> tuple[list[np.ndarray], int]:
     if not ids:
         return [], 0
-    flat = np.concatenate(ids) if ids else np.zeros(0, int)
-    unique, inverse = np.unique(flat, return_inverse=True)
-    splits = np.cumsum([len(i) for i in ids])[:-1]
-    return list(np.split(inverse.astype(int).ravel(), splits)), len(unique)
+    flat, n = _relabel_flat(np.concatenate(ids))
+    return list(np.split(flat, np.cumsum([len(i) for i in ids])[:-1])), n
 
 
 def prepare_boxes(gt: MotTable, result: MotTable, *, num_frames: int | None = None,
