@@ -52,22 +52,14 @@ def check_outputs(outputs: Mapping[str, Path | None], inputs: Iterable[Path | No
                 if _inside(path, folder):
                     raise ValueError(f"{name} {path} would replace a file in the input folder {folder}; choose "
                                      "another output (nothing was written)")
-        if name in folders:
-            if path.exists() and not path.is_dir():
-                raise ValueError(f"{name} {path}: is a file, not a folder (nothing was written)")
-            _check_named_folder(name, path, path)
-        else:
-            if path.is_dir():
-                raise ValueError(f"{name} {path} is a folder; expected a file (nothing was written)")
-            _check_named_folder(name, path, path.parent)
-
-
-def _check_named_folder(name: str, path: Path, folder: Path) -> None:
-    """:func:`_check_folder`, its refusal naming the option ``name`` and its ``path``."""
-    try:
-        _check_folder(folder)
-    except ValueError as exc:
-        raise ValueError(f"{name} {path}: {exc}") from None
+        if name in folders and path.exists() and not path.is_dir():
+            raise ValueError(f"{name} {path}: is a file, not a folder (nothing was written)")
+        if name not in folders and path.is_dir():
+            raise ValueError(f"{name} {path} is a folder; expected a file (nothing was written)")
+        try:
+            _check_folder(path if name in folders else path.parent)
+        except ValueError as exc:
+            raise ValueError(f"{name} {path}: {exc}") from None
 
 
 def _check_folder(folder: Path) -> None:
