@@ -176,22 +176,18 @@ def robot_sim(
     node_address, bind_address, group_address = _address(node, "--node"), _address(bind, "--bind"), _group(group)
     with failing(OSError, prefix=f"--bind {bind} / --group {group}: "):
         endpoint = Endpoint(node_address, bind_address, group=group_address)
-    with endpoint:
-        clock = _clock(start_at, speed)
-        with _Stop() as stop:
-            log = run_robot(endpoint, robot, sequence, clock, stop=stop,
-                            on_position=_print_position(robot) if verbose else None)
-    print(json.dumps(log.summary()), flush=True)
 
-
-def _print_position(robot: int) -> Any:
     def show(team: TeamState, error_m: float) -> None:
         mine = next(r for r in team.robots if r.id == robot)
         print(json.dumps({"frame": team.frame, "time": team.time, "position": mine.position, "heading": mine.heading,
                           "confidence": mine.confidence, "age": mine.age, "error_m": round(error_m, 4)}),
               file=sys.stderr, flush=True)
 
-    return show
+    with endpoint:
+        clock = _clock(start_at, speed)
+        with _Stop() as stop:
+            log = run_robot(endpoint, robot, sequence, clock, stop=stop, on_position=show if verbose else None)
+    print(json.dumps(log.summary()), flush=True)
 
 
 @app.command("camera-sim")

@@ -4,8 +4,7 @@ output streams are :mod:`lookalike.io.stream`."""
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from contextlib import ExitStack, contextmanager
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
@@ -59,13 +58,6 @@ def _box_tracker(name: str, settings: list[str], *, video: bool = False, targets
     return tracker
 
 
-@contextmanager
-def _progress_bars(count: int) -> Iterator[tuple[Progress, Any]]:
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn())
-    with Progress(*columns, console=console, transient=True) as progress:
-        yield progress, progress.add_task("sequences", total=count)
-
-
 _BAR_STEP = 25
 """Frames between two moves of a sequence's progress bar."""
 
@@ -117,7 +109,9 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float,
                                  size_from):
             warn(line)
     stats = RunStats()
-    with _progress_bars(len(streams)) as (progress, overall):
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                  console=console, transient=True) as progress:
+        overall = progress.add_task("sequences", total=len(streams))
         for (seq, frames), target in zip(streams, targets):
             tracker.reset()
             task = progress.add_task(seq.name, total=frames.length)

@@ -22,14 +22,6 @@ if TYPE_CHECKING:
 from lookalike.sim import PRESET_NAMES, preset
 
 
-def _check_limits(steps: int, minutes: float | None) -> None:
-    """Fail in one line on a run that could not take a step: ``steps`` < 1 or ``minutes`` <= 0."""
-    if steps < 1:
-        fail(f"--steps: at least 1 optimisation step, got {steps}")
-    if minutes is not None and not minutes > 0:
-        fail(f"--minutes: a time limit > 0, got {minutes:g}")
-
-
 @app.command()
 def train(
     preset_name: str = typer.Option("m3n2", "--preset", help=f"Robot world set-up: {', '.join(PRESET_NAMES)}."),
@@ -110,7 +102,10 @@ def train(
 ) -> None:
     """Train the association network on simulated sequences generated on the fly (or fine-tune it on labelled
     recordings with --recordings, or search its hyper-parameters with --search)."""
-    _check_limits(steps, minutes)
+    if steps < 1:
+        fail(f"--steps: at least 1 optimisation step, got {steps}")
+    if minutes is not None and not minutes > 0:
+        fail(f"--minutes: a time limit > 0, got {minutes:g}")
     from lookalike.io.outputs import sqlite_file
 
     check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)},
