@@ -26,9 +26,9 @@ class ClosedSetConfig:
     max_z: float = param(6.0, "largest miss of a link candidate, in spreads σ")
     candidates: int = param(6, "cheapest successors per end and predecessors per start kept as links")
     max_gap_s: float = param(math.inf, "longest gap (seconds) a link may bridge")
-    tracklet_cost: float = param(3.0, "cost of putting a tracklet on an identity (rows' worth); shorter "
+    tracklet_cost: float = param(1.0, "cost of putting a tracklet on an identity (rows' worth); shorter "
                                       "tracklets with costly links are left out as clutter")
-    edge_cost: float = param(3.0, "cost (rows' worth) of an identity that starts after the sequence's first "
+    edge_cost: float = param(10.0, "cost (rows' worth) of an identity that starts after the sequence's first "
                                    "frames or ends before its last (a closed set's targets are always there)")
     min_rows: int = param(5, "tracklets with fewer rows are not chained but placed into the chains' gaps")
     fill_gap_s: float = param(math.inf, "longest gap (seconds) inside an identity filled by interpolation "
