@@ -12,7 +12,7 @@ from lookalike.trackers.lstm.checkpoint import load_weights
 from lookalike.trackers.lstm.encoding import PROTOCOLS, EncodingSpec, encode_frame
 from lookalike.trackers.lstm.network import NumpyAssociationNet
 from lookalike.trackers.lstm.weights import shipped_weights_path
-from lookalike.trackers.parts.agents import AgentIdentifier, agent_snapshots, decode
+from lookalike.trackers.parts.agents import AgentIdentifier, decode
 from lookalike.trackers.parts.identity.localiser import LOCALISERS
 from lookalike.trackers.registry import register_tracker
 from lookalike.types import Frame, TrackSnapshot
@@ -59,4 +59,4 @@ class LstmIdentifier(AgentIdentifier):
         labels, conf = decode(self.net.step(x), used, len(det), self.config.one_to_one)
         self.last_labels, self.last_probabilities = labels, conf
         assert det.position is not None and det.heading is not None  # (encode_frame checked them)
-        return agent_snapshots(labels, conf, det.position, det.heading, self._localiser, self._last_seen, frame)
+        return self._snapshots(labels, conf, det.position, det.heading, frame)

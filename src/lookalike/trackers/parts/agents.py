@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lookalike.trackers.parts.identity.localiser import KalmanLocaliser, LowPassLocaliser, make_localiser
+from lookalike.trackers.parts.identity.localiser import make_localiser
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
 
@@ -49,6 +49,40 @@ class AgentIdentifier:
         self._last_time = frame.time
         return dt
 
+    def _snapshots(self, labels: np.ndarray, conf: np.ndarray, position: np.ndarray, heading: np.ndarray,
+                   frame: Frame) -> list[TrackSnapshot]:
+        """One snapshot per agent seen so far from the frame's detection labels (-1: false positive), their
+        probabilities ``conf``, positions ``(n, 2)`` m and headings ``(n,)`` rad; each agent's most confident
+        detection updates the localiser and the frame each agent last took a detection (-1: never)."""
+        last_seen = self._last_seen
+        n_agents = len(last_seen)
+        det_of_agent = agent_detections(labels, conf, n_agents)
+        assigned = det_of_agent >= 0
+        measured = np.full((n_agents, 2), np.nan)
+        weight = np.zeros(n_agents)
+        measured[assigned] = position[det_of_agent[assigned]]
+        weight[assigned] = conf[det_of_agent[assigned]]
+        located = self._localiser.update(frame.time, measured, weight)
+        fallback = assigned & ~np.isfinite(located).all(axis=1)  # labels never depend on the localiser
+        located[fallback] = measured[fallback]
+        snapshots = []
+        for j in range(n_agents):
+            k = det_of_agent[j]
+            if k >= 0:
+                last_seen[j] = frame.index
+            if last_seen[j] < 0 or not np.isfinite(located[j]).all():
+                continue  # never seen, or lost for longer than the localiser keeps a position
+            snapshots.append(TrackSnapshot(
+                track_id=j + 1,
+                status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
+                position=located[j].copy(),
+                heading=float(heading[k]) if k >= 0 else None,
+                agent_id=j,
+                identity_prob=float(conf[k]) if k >= 0 else None,
+                detection_index=int(k),
+            ))
+        return snapshots
+
 
 def decode(prob: np.ndarray, used: np.ndarray, n: int, one_to_one: bool) -> tuple[np.ndarray, np.ndarray]:
     """Labels ``(n,)`` of a frame's ``n`` detections (agent or -1) and their probabilities (0 where unused) from the
@@ -80,39 +114,3 @@ def agent_detections(labels: np.ndarray, conf: np.ndarray, n_agents: int) -> np.
         if j >= 0 and det_of_agent[j] < 0:
             det_of_agent[j] = k
     return det_of_agent
-
-
-def agent_snapshots(labels: np.ndarray, conf: np.ndarray, position: np.ndarray, heading: np.ndarray,
-                    localiser: LowPassLocaliser | KalmanLocaliser, last_seen: np.ndarray,
-                    frame: Frame) -> list[TrackSnapshot]:
-    """One snapshot per agent seen so far, from the frame's detection labels (-1: false positive) and
-    their probabilities ``conf``; ``position`` ``(n, 2)`` m and ``heading`` ``(n,)`` rad of the detections.
-    Each agent's most confident detection updates ``localiser``; ``last_seen`` (the frame index each
-    agent last took a detection, -1 never) is updated in place."""
-    n_agents = len(last_seen)
-    det_of_agent = agent_detections(labels, conf, n_agents)
-    assigned = det_of_agent >= 0
-    measured = np.full((n_agents, 2), np.nan)
-    weight = np.zeros(n_agents)
-    measured[assigned] = position[det_of_agent[assigned]]
-    weight[assigned] = conf[det_of_agent[assigned]]
-    located = localiser.update(frame.time, measured, weight)
-    fallback = assigned & ~np.isfinite(located).all(axis=1)  # labels never depend on the localiser
-    located[fallback] = measured[fallback]
-    snapshots = []
-    for j in range(n_agents):
-        k = det_of_agent[j]
-        if k >= 0:
-            last_seen[j] = frame.index
-        if last_seen[j] < 0 or not np.isfinite(located[j]).all():
-            continue  # never seen, or lost for longer than the localiser keeps a position
-        snapshots.append(TrackSnapshot(
-            track_id=j + 1,
-            status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
-            position=located[j].copy(),
-            heading=float(heading[k]) if k >= 0 else None,
-            agent_id=j,
-            identity_prob=float(conf[k]) if k >= 0 else None,
-            detection_index=int(k),
-        ))
-    return snapshots

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.trackers.base import check_params, param
-from lookalike.trackers.parts.agents import AgentIdentifier, agent_detections, agent_snapshots, decode
+from lookalike.trackers.parts.agents import AgentIdentifier, agent_detections, decode
 from lookalike.trackers.parts.identity.localiser import LOCALISERS
 from lookalike.trackers.registry import register_tracker
 from lookalike.trackers.set import report_exchange
@@ -136,7 +136,7 @@ class SetIdentifier(AgentIdentifier):
         if self._visual is not None:
             labels = self._visual_exchanges(labels, conf, heading, age, dt)
         self.last_labels, self.last_probabilities = labels, conf
-        return agent_snapshots(labels, conf, position, heading, self._localiser, self._last_seen, frame)
+        return self._snapshots(labels, conf, position, heading, frame)
 
     def _fp_prior(self, prob: np.ndarray) -> np.ndarray:
         """``prob (slots, N+1)`` with the false-positive column scaled by the running rate over ``fp_prior_ref`` (a
