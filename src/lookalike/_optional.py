@@ -60,19 +60,14 @@ def _installed_from() -> tuple[str, bool] | None:
 def install_command(extra: str) -> str:
     """The pip command that installs ``extra`` into this Python from the wheel or folder lookalike was installed from
     (``-e`` if editable), else a placeholder for them (lookalike is not on PyPI)."""
-    found = _installed_from()
-    where, editable = found if found is not None else ("<lookalike wheel or source folder>", False)
-    pip = "pip" if Path(sys.executable).parent == Path(sys.prefix) / "bin" and _pip_on_path() else \
-        f"{sys.executable} -m pip"
-    return f"{pip} install {'-e ' if editable else ''}'{where}[{extra}]'"
-
-
-def _pip_on_path() -> bool:
-    """True when the ``pip`` found first on ``PATH`` belongs to this Python's environment."""
     import shutil
 
-    found = shutil.which("pip")
-    return found is not None and Path(found).resolve().parent == (Path(sys.prefix) / "bin").resolve()
+    found = _installed_from()
+    where, editable = found if found is not None else ("<lookalike wheel or source folder>", False)
+    bin_dir = Path(sys.prefix) / "bin"
+    pip = "pip" if Path(sys.executable).parent == bin_dir and Path(shutil.which("pip") or "/").resolve().parent == \
+        bin_dir.resolve() else f"{sys.executable} -m pip"  # (the pip first on PATH is this environment's)
+    return f"{pip} install {'-e ' if editable else ''}'{where}[{extra}]'"
 
 
 @contextmanager

@@ -33,12 +33,6 @@ def _script_command() -> str | None:
     return next((a for a in sys.argv[1:] if not a.startswith("-")), None)
 
 
-def _registered(command: str) -> bool:
-    names = {info.name or info.callback.__name__.replace("_", "-")  # type: ignore[union-attr]
-             for info in app.registered_commands}
-    return command in names | {info.name for info in app.registered_groups}
-
-
 def _list_commands_only() -> None:
     """Register each command by name and summary alone: the script was given no command (``lookalike --help``)."""
     from lookalike.cli.summaries import summaries
@@ -55,12 +49,8 @@ def _load_commands() -> None:
     if command is None and run_as_program():
         _list_commands_only()
         return
-    only = command if command in COMMAND_MODULES else None
-    for name in (only,) if only is not None else MODULES:
+    for name in (command,) if command in COMMAND_MODULES else MODULES:
         importlib.import_module(f"lookalike.cli.{name}")
-    if only is not None and not _registered(command or ""):
-        for name in MODULES:
-            importlib.import_module(f"lookalike.cli.{name}")
 
 
 _load_commands()
