@@ -8,7 +8,7 @@ import sys
 from collections.abc import Collection, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import NoReturn
 
 import typer
 from rich.console import Console
@@ -166,11 +166,9 @@ def command_line() -> str:
         value = ctx.params.get(param.name or "")
         if value is None or value == param.default or param.param_type_name != "option":
             continue
-        values: list[Any] = list(value) if isinstance(value, (list, tuple)) else [value]
         flag = param.opts[0]
         if isinstance(value, bool):
-            words += [flag if value else (param.secondary_opts or [flag])[0]]
-            continue
-        for v in values:
-            words += [flag, str(v)]
+            words.append(flag if value else (param.secondary_opts or [flag])[0])
+        else:
+            words += [w for v in (value if isinstance(value, (list, tuple)) else [value]) for w in (flag, str(v))]
     return shlex.join(words)

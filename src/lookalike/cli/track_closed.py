@@ -22,9 +22,9 @@ from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import detection_rows
 
 POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given (frames/s)
-MAX_POINTS_PER_FRAME = 1000
-"""Points in one frame that ``track --points`` accepts (the association's memory grows with their square: about
-0.3 GB at 1,000 a frame with boxtrack)."""
+MAX_POINTS_PER_FRAME = 100_000
+"""Points in one frame that ``track --points`` accepts (memory grows linearly with them: about 260 MB at 10,000 a
+frame; benchmarks/points_memory.py)."""
 
 
 def check_result_file(output: Path, video: Path | None = None) -> None:
@@ -131,7 +131,7 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
         if counts and max(counts) > MAX_POINTS_PER_FRAME:
             frame = int(np.argmax(counts)) + 1
             raise ValueError(f"{points_path}: frame {frame} has {max(counts)} points; at most {MAX_POINTS_PER_FRAME} "
-                             "a frame are tracked (the association's memory grows with their square)")
+                             "a frame are tracked")
         spacing = typical_spacing(points)
         det = points_to_rows(points)
     side = float(det[0, 4]) if len(det) else 1.0

@@ -80,8 +80,7 @@ def train_heading_command(
                 n = min(20, frames - start)
                 parts.append(rendered_heading_samples(n, seed * 7919 + start, config))
                 bar.advance(task, n)
-            f = np.concatenate([p[0] for p in parts])
-            h = np.concatenate([p[1] for p in parts])
+            f, h = (np.concatenate(columns) for columns in zip(*parts))
             ft, ht = (rendered_heading_samples(test_frames, seed + 1000003, config) if test_frames
                       else (np.zeros((0, f.shape[1])), np.zeros(0)))
             bar.advance(task, test_frames)
