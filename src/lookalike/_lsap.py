@@ -20,18 +20,15 @@ def _load() -> Callable[..., Any]:
         import scipy
 
         folder = Path(scipy.__file__).parent / "optimize"
-        for suffix in importlib.machinery.EXTENSION_SUFFIXES:
-            spec = importlib.util.spec_from_file_location(_NAME, folder / f"_lsap{suffix}")
-            if spec is None or spec.loader is None or not (folder / f"_lsap{suffix}").is_file():
-                continue
+        path = next((p for s in importlib.machinery.EXTENSION_SUFFIXES if (p := folder / f"_lsap{s}").is_file()), None)
+        spec = importlib.util.spec_from_file_location(_NAME, path) if path is not None else None
+        if spec is not None and spec.loader is not None:
             try:
-                module = importlib.util.module_from_spec(spec)
-                spec.loader.exec_module(module)
+                loaded = importlib.util.module_from_spec(spec)
+                spec.loader.exec_module(loaded)
+                sys.modules[_NAME] = module = loaded
             except ImportError:
-                module = None
-                break
-            sys.modules[_NAME] = module
-            break
+                pass
     found: Callable[..., Any] | None = getattr(module, "linear_sum_assignment", None)
     if found is None:  # another SciPy layout: the ordinary (slower) import
         from scipy.optimize import linear_sum_assignment
