@@ -49,9 +49,8 @@ def eval_command(
     """Score trackers with HOTA, CLEAR MOT and identity metrics (values shown in %)."""
     chosen = _chosen(metrics)
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, _eval_inputs(gt, results))
-    if points or radius is not None:
-        if not points or radius is None or radius <= 0:
-            fail("--points and --radius PX go together (point ground truth matched within PX pixels)")
+    if (points or radius is not None) and (not points or radius is None or radius <= 0):
+        fail("--points and --radius PX go together (point ground truth matched within PX pixels)")
     names = [p.name or str(p) for p in results]
     if len(set(names)) != len(names):
         names = [str(p) for p in results]
@@ -71,8 +70,7 @@ def eval_command(
         name, per_seq = next(iter(scores.items()))
         table = _table(f"{name} ({benchmark})", "sequence", columns)
         for seq, values in per_seq.items():
-            style = "bold" if seq == COMBINED else None
-            table.add_row(seq, *[_cell(c, values[c]) for c in columns], style=style)
+            table.add_row(seq, *[_cell(c, values[c]) for c in columns], style="bold" if seq == COMBINED else None)
     else:
         table = _table(f"trackers, combined over sequences ({benchmark})", "tracker", columns)
         for name, per_seq in scores.items():

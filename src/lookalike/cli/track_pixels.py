@@ -24,6 +24,7 @@ from lookalike.viz.robot_pixels import (
 )
 
 PIPELINES = ("robots",)
+SIZE_TOLERANCE = 2.0  # box height vs a robot's at its ground position; true boxes 0.79-1.48 on m5n3 seeds 11-12
 
 
 def _check(video: Path | None, pipeline: str, reports: Path | None, identifier: str, output: Path) -> None:
@@ -58,7 +59,8 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
         config = PipelineConfig(identifier=identifier, n_agents=seq.config.n_agents,
                                 max_detections=seq.config.max_detections,
                                 min_score=0.5 if min_score == float("-inf") else min_score,
-                                identifier_params=tuple(dict(params).items()))
+                                identifier_params=tuple(dict(params).items()), field_m=seq.config.field_m,
+                                max_range_m=seq.config.observer.max_range_m, size_tolerance=SIZE_TOLERANCE)
         pipe = RobotPipeline.from_files(detector_model, heading_model, camera, config)
         images, total, video_fps = source_frames(video)
     if total and total > len(seq):
@@ -85,6 +87,9 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
     where = escape(f"{output}" + (f", {annotate_as or annotate}" if annotate else ""))
     console.print(f"[green]{identifier}[/] from pixels: {stats.frames} frames, {speed} frames/s (detector + heading + "
                   f"identifier) → {where}")
+    dropped = ", ".join(f"{n} {why}" for why, n in pipe.dropped.items() if n)
+    if dropped:
+        console.print(f"dropped as implausible: {dropped}", markup=False)
 
 
 @app.command("render-robots")

@@ -80,11 +80,9 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
     unhealthy = sum(not s.healthy for s in result.health)
     seconds = result.tracker_s + result.feature_s
     fps_text = f"{result.frames / seconds:,.0f}" if seconds > 0 else "inf"
-    console.print(
-        f"[green]{tracker_name}[/]: {result.frames} frames, {len(result.merges)} merge(s), "
-        f"{unhealthy} frame(s) flagged unhealthy, {fps_text} frames/s (features + tracker) → "
-        + escape(", ".join(str(p) for p in written))
-    )
+    console.print(f"[green]{tracker_name}[/]: {result.frames} frames, {len(result.merges)} merge(s), {unhealthy} "
+                  f"frame(s) flagged unhealthy, {fps_text} frames/s (features + tracker) → "
+                  + escape(", ".join(str(p) for p in written)))
     if result.ignored_rows:
         console.print(f"[yellow]note:[/] {result.ignored_rows} detection row(s) are past the video's "
                       f"{result.frames} frames and were ignored")
