@@ -99,6 +99,33 @@ def test_bad_configuration_is_refused(models):
         shipped_model_path("tracker")
     with pytest.raises(ValueError, match="no parameter"):
         RobotPipeline(det, head, config=PipelineConfig(identifier="lstm", identifier_params=(("fov_deg", 70.0),)))
+    for bad, name in [({"field_m": (9.0, 0.0)}, "field_m"), ({"max_range_m": -1.0}, "max_range_m"),
+                      ({"field_margin_m": -0.1}, "field_margin_m"), ({"size_tolerance": 0.5}, "size_tolerance")]:
+        with pytest.raises(ValueError, match=name):
+            PipelineConfig(**bad)
+
+
+def test_implausible_detections_are_dropped_and_counted(models):
+    """Outside the field (given the observer's field pose), beyond the range, or a box of the wrong size for its
+    ground position: dropped, each counted once under its first reason; the rest kept."""
+    det, head, _, _ = models
+    camera = Camera.default()
+    config = PipelineConfig(field_m=(9.0, 6.0), field_margin_m=0.5, max_range_m=7.0, size_tolerance=2.0)
+    pipe = RobotPipeline(det, head, camera, config)
+    # Observer at field (-4.3, 0) looking along +x turned 0.3 rad left: ego (2, 0) is in the field; ego (5, 2.5)
+    # is at field y ≈ 3.9 (outside 3 + 0.5); ego (7.5, 0) is beyond 7 m but inside the field.
+    ego = np.array([[2.0, 0.0], [5.0, 2.5], [7.5, 0.0], [3.0, -0.5], [1.2, 0.3]])
+    boxes = camera.ground_to_box(ego, ROBOT_HEIGHT_M, ROBOT_WIDTH_M)
+    boxes[3, 1] += 0.75 * boxes[3, 3]
+    boxes[3, 3] *= 0.25  # a quarter of the height a robot 3 m away has, same foot point
+    ok = pipe.plausible(boxes, ego, 0.3, (-4.3, 0.0))
+    assert ok.tolist() == [True, False, False, False, True]
+    assert pipe.dropped == {"outside field": 1, "beyond range": 1, "size": 1}
+    # Without the observer's field position the field is not checked; without settings nothing is.
+    assert pipe.plausible(boxes, ego, 0.3).tolist() == [True, True, False, False, True]
+    assert RobotPipeline(det, head, camera).plausible(boxes, ego, 0.3, (-4.3, 0.0)).all()
+    pipe.reset()
+    assert sum(pipe.dropped.values()) == 0
 
 
 def test_ground_position_of_a_box_cut_by_the_image_bottom(models):

@@ -22,6 +22,7 @@ IDENTIFIERS = ("kalman_ha", "kalman_ha2", "jpda", "lstm", "set")
 MODELS_DIR = Path(__file__).resolve().parent / "models_data"
 SHIPPED_MODELS = {"detector": "robot_detector.npz", "heading": "robot_heading.npz"}
 ROBOT_HEIGHT_M = 0.62  # height of the rendered robots (lookalike.sim.render_robots), metres
+DROP_REASONS = ("outside field", "beyond range", "size")  # why RobotPipeline.perceive drops a detection
 
 
 class Detector(Protocol):
@@ -49,7 +50,16 @@ class PipelineConfig:
         detect_scale: resize factor before detection (> 1 finds robots smaller than the window); boxes mapped back.
         target_height_m: target height (m), to place a box whose bottom is cut by the image border.
         border_px: a box edge this close to the image border (px) counts as cut.
-        identifier_params: further ``make_tracker`` parameters as ``(name, value)`` pairs."""
+        identifier_params: further ``make_tracker`` parameters as ``(name, value)`` pairs.
+        field_m: ``(length, width)`` of the field (m, centred on the field origin, length along x), or ``None``
+            (unknown). With it, a detection whose field position lies more than ``field_margin_m`` outside is dropped
+            (only in frames given the observer's field position).
+        field_margin_m: tolerance of the field check (m): the ground-position error of a box near the edge.
+        max_range_m: the camera's range (m): a detection whose ground position is farther is dropped; ``None``: no
+            limit.
+        size_tolerance: a detection whose box height differs from that of a ``target_height_m`` target standing at
+            its ground position by more than this factor (either way) is dropped; ``None``: no check. Boxes touching
+            the top or bottom image border are not checked."""
 
     identifier: str = "kalman_ha2"
     n_agents: int = 3
@@ -59,6 +69,10 @@ class PipelineConfig:
     target_height_m: float = ROBOT_HEIGHT_M
     border_px: float = 2.0
     identifier_params: tuple[tuple[str, Any], ...] = field(default_factory=tuple)
+    field_m: tuple[float, float] | None = None
+    field_margin_m: float = 0.5
+    max_range_m: float | None = None
+    size_tolerance: float | None = None
 
     def __post_init__(self) -> None:
         own = "PipelineConfig"
@@ -73,6 +87,14 @@ class PipelineConfig:
         if not self.target_height_m > 0 or self.border_px < 0:
             raise ValueError(f"{own}.target_height_m/border_px: need > 0 and >= 0, got "
                              f"{self.target_height_m!r}, {self.border_px!r}")
+        if self.field_m is not None and (len(self.field_m) != 2 or not min(self.field_m) > 0):
+            raise ValueError(f"{own}.field_m: need (length, width) > 0 m or None, got {self.field_m!r}")
+        if not self.field_margin_m >= 0:
+            raise ValueError(f"{own}.field_margin_m: need >= 0 m, got {self.field_margin_m!r}")
+        if self.max_range_m is not None and not self.max_range_m > 0:
+            raise ValueError(f"{own}.max_range_m: need > 0 m or None, got {self.max_range_m!r}")
+        if self.size_tolerance is not None and not self.size_tolerance >= 1:
+            raise ValueError(f"{own}.size_tolerance: need a factor >= 1 or None, got {self.size_tolerance!r}")
 
     def identifier_kwargs(self) -> dict[str, Any]:
         """``make_tracker`` keyword arguments: N (and M for slot-based identifiers) plus ``identifier_params``."""
@@ -126,7 +148,9 @@ class RobotPipeline:
     """Detector → heading classifier → ground projection → identifier, one frame at a time.
 
     ``probability`` maps a detector's last-stage margins (one with ``boxes_and_margins``) to the score given to the
-    identifier; ``None`` keeps the detector's score. Which boxes are kept does not depend on it."""
+    identifier; ``None`` keeps the detector's score. Which boxes are kept does not depend on it. ``dropped`` counts
+    the detections dropped since the last :meth:`reset` as implausible, by reason: ``"outside field"``, ``"beyond
+    range"`` and ``"size"`` (see :class:`PipelineConfig`)."""
 
     def __init__(self, detector: Detector, heading: HeadingModel, camera: Camera | None = None,
                  config: PipelineConfig | None = None,
@@ -143,6 +167,7 @@ class RobotPipeline:
         except (KeyError, TypeError) as exc:
             raise ValueError(f"PipelineConfig.identifier: {exc}") from None
         self._index = 0
+        self.dropped: dict[str, int] = dict.fromkeys(DROP_REASONS, 0)
 
     @classmethod
     def from_files(cls, detector_path: str | Path | None = None, heading_path: str | Path | None = None,
@@ -166,10 +191,13 @@ class RobotPipeline:
         """Start a new video: the identifier forgets its tracks and the frame counter restarts."""
         self.identifier.reset()
         self._index = 0
+        self.dropped = dict.fromkeys(DROP_REASONS, 0)
 
-    def perceive(self, image: np.ndarray, observer_yaw_rad: float = 0.0) -> Detections:
+    def perceive(self, image: np.ndarray, observer_yaw_rad: float = 0.0,
+                 observer_xy_m: tuple[float, float] | None = None) -> Detections:
         """Detections of one frame (boxes px, scores, positions m, absolute headings and spreads rad): the
-        ``max_detections`` most probable, in decreasing score."""
+        ``max_detections`` most probable plausible ones, in decreasing score. ``observer_xy_m``: the camera's field
+        position (m), which the field check needs (``None``: not checked)."""
         with needs("cv2"):
             import cv2
 
@@ -189,6 +217,8 @@ class RobotPipeline:
         xywh, score, rank = xywh[keep], score[keep], rank[keep]
         position = self.ground_positions(xywh)
         ok = np.isfinite(position).all(axis=1)
+        xywh, score, rank, position = xywh[ok], score[ok], rank[ok], position[ok]
+        ok = self.plausible(xywh, position, observer_yaw_rad, observer_xy_m)
         xywh, score, rank, position = xywh[ok], score[ok], rank[ok], position[ok]
         order = np.lexsort((-rank, -score))[: cfg.max_detections]
         xywh, score, rank, position = xywh[order], score[order], rank[order], position[order]
@@ -230,6 +260,37 @@ class RobotPipeline:
             pos[cut] = head
         return pos
 
+    def plausible(self, xywh: np.ndarray, position: np.ndarray, observer_yaw_rad: float = 0.0,
+                  observer_xy_m: tuple[float, float] | None = None) -> np.ndarray:
+        """Which boxes ``(n, 4)`` px with egocentric ground positions ``(n, 2)`` m pass the configured field, range
+        and size checks, ``(n,)`` bool; each failure is counted in ``dropped`` under its first reason."""
+        cfg = self.config
+        pos = np.asarray(position, float).reshape(-1, 2)
+        ok = np.ones(len(pos), bool)
+
+        def drop(reason: str, bad: np.ndarray) -> None:
+            self.dropped[reason] += int((ok & bad).sum())
+            ok[bad] = False
+
+        if cfg.field_m is not None and observer_xy_m is not None:
+            c, s = np.cos(observer_yaw_rad), np.sin(observer_yaw_rad)
+            fx = observer_xy_m[0] + c * pos[:, 0] - s * pos[:, 1]
+            fy = observer_xy_m[1] + s * pos[:, 0] + c * pos[:, 1]
+            half_x, half_y = 0.5 * cfg.field_m[0] + cfg.field_margin_m, 0.5 * cfg.field_m[1] + cfg.field_margin_m
+            drop("outside field", (np.abs(fx) > half_x) | (np.abs(fy) > half_y))
+        if cfg.max_range_m is not None:
+            drop("beyond range", np.hypot(pos[:, 0], pos[:, 1]) > cfg.max_range_m)
+        if cfg.size_tolerance is not None and len(pos):
+            b = np.asarray(xywh, float).reshape(-1, 4)
+            h = self.camera.intrinsics.height
+            inside = (b[:, 1] > cfg.border_px) & (b[:, 1] + b[:, 3] < h - cfg.border_px)
+            expected = self.camera.ground_to_box(pos, cfg.target_height_m, cfg.target_height_m)[:, 3]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ratio = b[:, 3] / expected
+            wrong = ~((ratio <= cfg.size_tolerance) & (ratio >= 1.0 / cfg.size_tolerance))
+            drop("size", inside & wrong)
+        return ok
+
     def identify(self, detections: Detections, beacons: Beacons | None = None, time_s: float | None = None,
                  index: int | None = None) -> PipelineResult:
         """Feed one frame's detections and reports to the identifier (``time_s`` default: index / 30 Hz)."""
@@ -242,9 +303,9 @@ class RobotPipeline:
         return PipelineResult(frame, tracks, labels_from_tracks(len(detections), tracks))
 
     def update(self, image: np.ndarray, beacons: Beacons | None = None, time_s: float | None = None,
-               observer_yaw_rad: float = 0.0) -> PipelineResult:
+               observer_yaw_rad: float = 0.0, observer_xy_m: tuple[float, float] | None = None) -> PipelineResult:
         """Run the whole chain on one image (uint8 BGR or grey) with the reports received since the last frame."""
-        return self.identify(self.perceive(image, observer_yaw_rad), beacons, time_s)
+        return self.identify(self.perceive(image, observer_yaw_rad, observer_xy_m), beacons, time_s)
 
 
 def shipped_model_path(kind: str) -> Path:

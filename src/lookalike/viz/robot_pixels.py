@@ -84,12 +84,14 @@ def annotate_frame(image: np.ndarray, result: PipelineResult, caption: list[str]
 
 @dataclass(frozen=True)
 class PixelFrame:
-    """One video frame with the sequence's frame of the same index (reports, time) and observer yaw (rad)."""
+    """One video frame with the sequence's frame of the same index (reports, time), observer yaw (rad) and the
+    observer's field position ``(x, y)`` (m; ``None``: unknown)."""
 
     index: int
     image: np.ndarray
     frame: Frame
     yaw_rad: float
+    xy_m: tuple[float, float] | None = None
 
 
 def pixel_frames(images: Iterable[np.ndarray], reports: RobotSequence, source: str = "video") -> Iterator[PixelFrame]:
@@ -97,7 +99,8 @@ def pixel_frames(images: Iterable[np.ndarray], reports: RobotSequence, source: s
     for k, image in enumerate(images):
         if k >= len(reports):
             raise ValueError(f"{source}: the reports have {len(reports)} frames, the video more")
-        yield PixelFrame(k, image, reports.frame(k), float(reports.arrays.observer[k, 2]))
+        x, y, yaw = (float(v) for v in reports.arrays.observer[k])
+        yield PixelFrame(k, image, reports.frame(k), yaw, (x, y))
 
 
 class PipelineStep:
@@ -108,7 +111,7 @@ class PipelineStep:
 
     def update(self, frame: PixelFrame) -> PipelineResult:
         """Perceive and identify one frame."""
-        return self.pipe.update(frame.image, frame.frame.beacons, frame.frame.time, frame.yaw_rad)
+        return self.pipe.update(frame.image, frame.frame.beacons, frame.frame.time, frame.yaw_rad, frame.xy_m)
 
 
 def identify_video(pipe: RobotPipeline, frames: Iterable[PixelFrame], output: Path, *,
