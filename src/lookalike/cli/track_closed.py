@@ -11,15 +11,14 @@ from rich.markup import escape
 
 from lookalike.cli.app import console, fail, failing
 from lookalike.cli.track import input_error, sequences_and_targets
-from lookalike.io import read_mot, write_mot
+from lookalike.io import frames_from_table, read_mot, write_mot
 from lookalike.io.det_format import read_det, sniff_det
 from lookalike.io.outputs import ensure_writable
 from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv, read_points_mot, typical_spacing
 from lookalike.io.stream import track_to_file
 from lookalike.trackers.boxtrack import BoxTrack
 from lookalike.trackers.offline.closed_set import online_rows, track_closed_set
-from lookalike.types import Detections, Frame
-from lookalike.types.mot_table import detection_rows
+from lookalike.types.mot_table import MotTable, detection_rows
 
 POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given (frames/s)
 MAX_POINTS_PER_FRAME = 100_000
@@ -108,16 +107,6 @@ def read_points(path: Path) -> Any:
     return read_points_csv(path) if path.suffix.lower() == ".csv" else read_points_mot(path)
 
 
-def _frames(det_rows: np.ndarray, n_frames: int, frame_rate: float) -> Any:
-    order = np.argsort(det_rows[:, 0], kind="stable")
-    det_rows = det_rows[order]
-    bounds = np.searchsorted(det_rows[:, 0], np.arange(1, n_frames + 2))
-    for k in range(n_frames):
-        block = det_rows[bounds[k]:bounds[k + 1]]
-        dets = Detections(xywh=block[:, 2:6], score=block[:, 6]) if len(block) else Detections.empty()
-        yield Frame(index=k, time=k / frame_rate, detections=dets)
-
-
 def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: str, *, n_targets: int | None,
                  offline: bool, params: dict[str, Any], fps: float | None) -> None:
     """``--points FILE``: points as boxes of half their typical spacing, tracked online by ``tracker`` or, with
@@ -145,7 +134,8 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
         write_mot(output, rows)
     else:
         with failing(ValueError):
-            track_to_file(point_tracker(tracker), _frames(det, len(points), frame_rate), output)
+            track_to_file(point_tracker(tracker), frames_from_table(MotTable.from_rows(det), len(points), frame_rate),
+                          output)
         table = read_mot(output)
         rows = np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
     what = f"offline closed set of {n_targets}" if offline else "online"
