@@ -151,6 +151,7 @@ def test_labelled_rows_keep_identified_detections_only():
 def test_track_pipeline_robots_end_to_end(tmp_path):
     res = runner.invoke(app, ["simulate", "--preset", "m3n2", "--frames", "12", "--seed", "3", "-o", str(tmp_path)])
     assert res.exit_code == 0, res.output
+    assert "frames with each robot in view (of 12): robot 1: " in res.output
     seq = tmp_path / "m3n2-000003.jsonl"
     clip = tmp_path / "clip.mp4"
     res = runner.invoke(app, ["render-robots", str(seq), "-o", str(clip)])

@@ -121,6 +121,24 @@ def test_robots_leave_and_reenter_the_view():
     assert speed.max() <= preset("m5n3").motion.max_speed_mps * 1.01
 
 
+def test_frames_in_view_and_a_warning_for_a_robot_never_in_view():
+    """Counted from ``visible``; a robot pushed out of the field of view by a narrow one gets a warning line."""
+    cfg = preset("m3n2")
+    seq = simulate_robots(cfg, 60, seed=1)
+    counts = seq.frames_in_view()
+    assert counts.tolist() == seq.arrays.visible.sum(axis=0).tolist()
+    lines = seq.view_summary()
+    assert lines[0] == f"frames with each robot in view (of 60): robot 1: {counts[0]}, robot 2: {counts[1]}"
+    warned = [int(line.split()[2]) - 1 for line in lines[1:]]
+    assert warned == [i for i in range(2) if counts[i] == 0]
+    assert all(line.startswith("warning: robot ") and "never in view" in line for line in lines[1:])
+    narrow = dataclasses.replace(cfg, observer=dataclasses.replace(cfg.observer, max_range_m=0.31))
+    blind = simulate_robots(narrow, 30, seed=1)
+    assert blind.frames_in_view().tolist() == [0, 0]
+    assert [line.split(" (")[0] for line in blind.view_summary()[1:]] == [
+        "warning: robot 1 is never in view", "warning: robot 2 is never in view"]
+
+
 def test_identical_seeds_identical_sequences():
     cfg = preset("m3n2")
     a, b, c = simulate_arrays(cfg, 500, 7), simulate_arrays(cfg, 500, 7), simulate_arrays(cfg, 500, 8)

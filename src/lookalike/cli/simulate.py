@@ -36,3 +36,5 @@ def simulate(
         a = seq.arrays
         console.print(f"wrote {path}: {frames} frames, {int(a.det_valid.sum())} detections, "
                       f"{len(a.reports.agent_id)} reports", markup=False)
+        for line in seq.view_summary():
+            console.print(line, markup=False, style="yellow" if line.startswith("warning") else None)

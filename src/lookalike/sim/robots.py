@@ -168,6 +168,21 @@ class RobotSequence:
         a = self.arrays
         return [a.det_label[k, : int(a.det_valid[k].sum())] for k in range(len(a))]
 
+    def frames_in_view(self) -> np.ndarray:
+        """``(N,)`` number of frames in which each robot is inside the observer's field of view and range."""
+        return np.asarray(self.arrays.visible, bool).sum(axis=0)
+
+    def view_summary(self) -> list[str]:
+        """Lines telling how many frames have each robot in view, then a warning line for each robot never in view
+        (whose identity no tracker can say)."""
+        counts = self.frames_in_view()
+        obs = self.config.observer
+        where = f"{np.degrees(obs.fov_rad):.0f}° field of view, {obs.max_range_m:g} m range"
+        lines = [f"frames with each robot in view (of {len(self)}): "
+                 + ", ".join(f"robot {i + 1}: {int(c)}" for i, c in enumerate(counts))]
+        lines += [f"warning: robot {i + 1} is never in view ({where})" for i in np.flatnonzero(counts == 0)]
+        return lines
+
     def true_positions_visible(self) -> np.ndarray:
         """``(T, N, 2)`` true observer-frame positions, NaN where a robot is out of view."""
         a = self.arrays
