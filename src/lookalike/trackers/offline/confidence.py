@@ -1,0 +1,155 @@
+"""A probability per result row that its identity is right, from the rows alone (any tracker, online or offline,
+open or closed set), and the frame ranges where an identity is doubtful. Rows are MOTChallenge ``(k, 10)``: 1-based
+frame, id, ``x, y, w, h`` px, ...; ``frame_rate`` in frames/s sets the one-second window ``W`` of the features.
+
+The features (:data:`FEATURES`, per row; size ``s = sqrt(w h)`` px): ``crowd_now``, the distance to the nearest other
+identity's box centre in the frame over the mean of the two sizes, clipped to [0, 2]; ``crowd_window``, its minimum
+over the identity's rows within ±W frames; ``since`` and ``until``, log(1 + seconds) from the identity's start or last
+gap and to its end or next gap (clipped at 30 s); ``length``, log(1 + the identity's rows in seconds, clipped at
+300 s); ``jump``, the largest |log| size ratio of consecutive rows within ±W frames (clipped at 1). A logistic model
+maps them to a probability; :data:`COEFFICIENTS` were fitted by ``research/confidence/fit.py`` as
+``research/confidence/rule.md`` fixes it."""
+
+from __future__ import annotations
+
+import numpy as np
+
+FEATURES = ("crowd_now", "crowd_window", "since", "until", "length", "jump")
+# Intercept, then one weight per feature of FEATURES: L2-penalised logistic regression on the rows of boxtrack's
+# default (online) results on mot15, pigs, mot17-synth and HexBug and of the offline closed set on pigs and HexBug,
+# each dataset weighted equally (research/confidence/rule.md, fit-result.txt).
+COEFFICIENTS = (0.4865, -0.2975, 0.4194, 0.7158, 0.7521, -0.2170, -3.3267)
+DOUBTFUL_BELOW = 0.5  # a row is doubtful below this probability (research/confidence/rule.md)
+_CROWD_CLIP, _EDGE_CLIP_S, _LENGTH_CLIP_S, _JUMP_CLIP = 2.0, 30.0, 300.0, 1.0
+_PAIR_BUDGET = 1 << 22  # distances computed at once in crowd_now
+
+
+def _check(rows: np.ndarray, frame_rate: float) -> np.ndarray:
+    rows = np.asarray(rows, dtype=float)
+    if rows.ndim != 2 or (len(rows) and rows.shape[1] < 6):
+        raise ValueError(f"rows: expected (k, >= 6) MOTChallenge rows, got shape {rows.shape}")
+    if not np.isfinite(frame_rate) or frame_rate <= 0:
+        raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
+    return rows
+
+
+def window_frames(frame_rate: float) -> int:
+    """The features' and ranges' window ``W``: one second in frames (at least 1)."""
+    return max(1, int(round(frame_rate)))
+
+
+def _crowding(frame: np.ndarray, centre: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """Per row the nearest other row's centre distance in its frame over the mean size (clipped)."""
+    out = np.full(len(frame), _CROWD_CLIP)
+    order = np.argsort(frame, kind="stable")
+    f = frame[order]
+    starts = np.flatnonzero(np.r_[True, f[1:] != f[:-1]])
+    counts = np.diff(np.r_[starts, len(f)])
+    rank = np.arange(len(f)) - np.repeat(starts, counts)
+    width = int(counts.max())
+    if width < 2:
+        return out
+    block = np.repeat(np.arange(len(starts)), counts)
+    c = np.full((len(starts), width, 2), np.nan)
+    s = np.full((len(starts), width), np.nan)
+    c[block, rank], s[block, rank] = centre[order], size[order]
+    near = np.full((len(starts), width), np.inf)
+    step = max(1, _PAIR_BUDGET // (width * width))
+    for a in range(0, len(starts), step):
+        d = np.linalg.norm(c[a:a + step, :, None] - c[a:a + step, None], axis=3)
+        d /= (s[a:a + step, :, None] + s[a:a + step, None]) / 2
+        d[:, np.arange(width), np.arange(width)] = np.inf
+        near[a:a + step] = np.fmin.reduce(np.where(np.isnan(d), np.inf, d), axis=2)
+    out[order] = np.minimum(near[block, rank], _CROWD_CLIP)
+    return out
+
+
+def _windowed(values: np.ndarray, frames: np.ndarray, half: int, fill: float, reduce: str) -> np.ndarray:
+    """``reduce`` (min or max) of one identity's ``values`` over its rows within ±``half`` frames (sorted frames)."""
+    span = int(frames[-1] - frames[0]) + 1
+    dense = np.full(span + 2 * half, fill)
+    dense[(frames - frames[0]).astype(int) + half] = values
+    view = np.lib.stride_tricks.sliding_window_view(dense, 2 * half + 1)
+    picked = view.min(axis=1) if reduce == "min" else view.max(axis=1)
+    result: np.ndarray = picked[(frames - frames[0]).astype(int)]
+    return result
+
+
+def row_features(rows: np.ndarray, frame_rate: float) -> np.ndarray:
+    """``(k, 6)`` features of :data:`FEATURES` per row, in the rows' order."""
+    rows = _check(rows, frame_rate)
+    out = np.zeros((len(rows), len(FEATURES)))
+    if not len(rows):
+        return out
+    frame, ids = rows[:, 0].astype(np.int64), rows[:, 1].astype(np.int64)
+    wh = np.nan_to_num(np.maximum(rows[:, 4:6], 1.0), nan=1.0)
+    size = np.sqrt(wh[:, 0] * wh[:, 1])
+    centre = np.nan_to_num(rows[:, 2:4] + wh / 2)
+    crowd = _crowding(frame, centre, size)
+    out[:, 0] = crowd
+    half = window_frames(frame_rate)
+    order = np.lexsort((frame, ids))
+    bounds = np.flatnonzero(np.r_[True, ids[order][1:] != ids[order][:-1], True])
+    for a, b in zip(bounds[:-1].tolist(), bounds[1:].tolist()):
+        sel = order[a:b]
+        f = frame[sel]
+        out[sel, 1] = _windowed(crowd[sel], f, half, np.inf, "min")
+        new_run = np.r_[True, np.diff(f) > 1]
+        run = np.cumsum(new_run) - 1
+        run_first = f[new_run][run]
+        run_last = f[np.r_[new_run[1:], True]][run]
+        out[sel, 2] = np.log1p(np.minimum((f - run_first) / frame_rate, _EDGE_CLIP_S))
+        out[sel, 3] = np.log1p(np.minimum((run_last - f) / frame_rate, _EDGE_CLIP_S))
+        out[sel, 4] = np.log1p(min(len(sel) / frame_rate, _LENGTH_CLIP_S))
+        jumps = np.r_[0.0, np.abs(np.diff(np.log(size[sel])))]
+        out[sel, 5] = np.minimum(_windowed(jumps, f, half, 0.0, "max"), _JUMP_CLIP)
+    return out
+
+
+def logistic(features: np.ndarray, coefficients: tuple[float, ...] | np.ndarray = COEFFICIENTS) -> np.ndarray:
+    """``(k,)`` probabilities of ``(k, m)`` features under ``coefficients`` (intercept, then ``m`` weights)."""
+    coef = np.asarray(coefficients, dtype=float)
+    z = coef[0] + np.asarray(features, dtype=float) @ coef[1:]
+    result: np.ndarray = 1.0 / (1.0 + np.exp(-np.clip(z, -50.0, 50.0)))
+    return result
+
+
+def assignment_confidence(rows: np.ndarray, frame_rate: float,
+                          coefficients: tuple[float, ...] | np.ndarray = COEFFICIENTS) -> np.ndarray:
+    """``(k,)`` probability in [0, 1] that each row's identity is right, in the rows' order."""
+    return logistic(row_features(rows, frame_rate), coefficients)
+
+
+def doubtful_ranges(rows: np.ndarray, confidence: np.ndarray, frame_rate: float,
+                    threshold: float = DOUBTFUL_BELOW) -> dict[int, list[tuple[int, int]]]:
+    """Per id, inclusive ``(first, last)`` frame ranges of its rows with ``confidence`` below ``threshold``, frames
+    at most one second (:func:`window_frames`) apart merged; ids without one are left out."""
+    rows = _check(rows, frame_rate)
+    confidence = np.asarray(confidence, dtype=float)
+    if confidence.shape != (len(rows),):
+        raise ValueError(f"confidence: expected ({len(rows)},), got shape {confidence.shape}")
+    low = rows[confidence < threshold]
+    half = window_frames(frame_rate)
+    out: dict[int, list[tuple[int, int]]] = {}
+    for i in np.unique(low[:, 1]).astype(np.int64).tolist():
+        f = np.unique(low[low[:, 1] == i, 0].astype(np.int64))
+        cut = np.flatnonzero(np.diff(f) > half)
+        firsts, lasts = f[np.r_[0, cut + 1]], f[np.r_[cut, len(f) - 1]]
+        out[i] = list(zip(firsts.tolist(), lasts.tolist()))
+    return out
+
+
+def describe_ranges(ranges: dict[int, list[tuple[int, int]]], max_ids: int = 8, max_ranges: int = 4) -> str:
+    """One line: ``doubtful: id 3 frames 120-160, 410-433; id 7 ...``, the ids with the most doubtful frames first
+    (at most ``max_ids``, each with its first ``max_ranges`` ranges); ``doubtful: none`` when empty."""
+    if not ranges:
+        return "doubtful: none"
+    frames = {i: sum(b - a + 1 for a, b in r) for i, r in ranges.items()}
+    shown = sorted(sorted(ranges, key=lambda i: -frames[i])[:max_ids])
+    parts = []
+    for i in shown:
+        spans = [f"{a}-{b}" if b > a else f"{a}" for a, b in ranges[i][:max_ranges]]
+        more = len(ranges[i]) - max_ranges
+        parts.append(f"id {i} frames {', '.join(spans)}" + (f" (+{more} more)" if more > 0 else ""))
+    rest = len(ranges) - len(shown)
+    return "doubtful: " + "; ".join(parts) + (f"; {rest} more ids" if rest > 0 else "")
