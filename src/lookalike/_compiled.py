@@ -58,15 +58,11 @@ def _announce_compiles(numba: Any) -> None:
         said = False
 
         def on_start(self, ev: Any) -> None:
-            if self.said:
-                return
-            dispatcher = (ev.data or {}).get("dispatcher")
-            module = getattr(getattr(dispatcher, "py_func", None), "__module__", "")
-            if not str(module).startswith("lookalike."):
-                return
-            self.said = True
-            seconds = COMPILE_SECONDS.get(str(module), 10)
-            _say(f"compiling the fast kernels once (about {seconds} s); later runs load them from numba's cache…")
+            module = str(getattr(getattr((ev.data or {}).get("dispatcher"), "py_func", None), "__module__", ""))
+            if not self.said and module.startswith("lookalike."):
+                self.said = True
+                _say(f"compiling the fast kernels once (about {COMPILE_SECONDS.get(module, 10)} s); later runs load "
+                     "them from numba's cache…")
 
         def on_end(self, ev: Any) -> None:
             pass
