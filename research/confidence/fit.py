@@ -56,8 +56,10 @@ def ground_truth(seq: object) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nd
     return frame.astype(int), ids.astype(int), xy, np.ones(len(frame), bool), True
 
 
-def label_rows(seq: object, rows: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int, int, int]]]:
-    """Per-row labels under the global IDF1 mapping and CLEAR's identity switches (rule.md)."""
+def label_rows(seq: object, rows: np.ndarray,
+               radius: float = HEXBUG_RADIUS_PX) -> tuple[np.ndarray, list[tuple[int, int, int, int]]]:
+    """Per-row labels under the global IDF1 mapping and CLEAR's identity switches (rule.md); ``radius`` px for
+    ground-truth points."""
     g_frame, g_id, g_pos, g_keep, points = ground_truth(seq)
     length = seq.length  # type: ignore[attr-defined]
     inside = g_frame <= length
@@ -70,7 +72,7 @@ def label_rows(seq: object, rows: np.ndarray) -> tuple[np.ndarray, list[tuple[in
     g_rel_all[g_keep] = g_rel
 
     def sim(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        return point_similarity(a, b, HEXBUG_RADIUS_PX) if points else box_iou(a, b)
+        return point_similarity(a, b, radius) if points else box_iou(a, b)
 
     g_order, r_order = np.argsort(g_frame, kind="stable"), np.argsort(r_frame, kind="stable")
     g_b = np.searchsorted(g_frame[g_order], np.arange(1, length + 2))
