@@ -38,11 +38,17 @@ def test_demo_writes_every_file(demo_out):
     assert "report.html" in text and "Try next" in text
 
 
-def test_demo_videos_decode_with_the_scene_frame_counts(demo_out):
+def test_demo_videos_start_after_the_warm_up_on_their_still(demo_out):
+    import cv2
+
     out, _ = demo_out
-    assert len(list(read_frames(out / "robots.mp4"))) == QUICK.robot_frames
-    assert len(list(read_frames(out / "divers.mp4"))) == QUICK.diver_video_frames
-    assert video_info(out / "divers-raw.mp4")[0] == QUICK.diver_video_frames
+    for name, frames in (("robots", QUICK.robot_frames), ("divers", QUICK.diver_video_frames)):
+        clip = list(read_frames(out / f"{name}.mp4"))
+        assert 0 < len(clip) <= frames, name  # the warm-up's frames are left out
+        still = cv2.imread(str(out / f"{name}-still.png"))
+        assert clip[0].shape == still.shape  # the caption and legend band above the picture included
+        assert np.abs(clip[0].astype(int) - still.astype(int)).mean() < 4, name  # the first frame is the still
+    assert video_info(out / "divers-raw.mp4")[0] == QUICK.diver_video_frames  # the raw video has every frame
 
 
 def test_demo_tables_cover_trackers_and_lstm_presence(demo_out):
@@ -64,8 +70,10 @@ def test_demo_tables_cover_trackers_and_lstm_presence(demo_out):
     for r in ident:
         assert 0 <= r["metrics"]["success_rate"] <= 1
     html = (out / "report.html").read_text()
-    assert len(re.findall(r'<img src="data:image/(png|gif);base64,', html)) >= 5
-    assert '<video controls' in html and 'src="robots.mp4"' in html and 'src="divers.mp4"' in html
+    assert len(re.findall(r'<img src="data:image/(png|gif);base64,', html)) >= 3
+    assert html.count('<video controls') == 2 and html.count('src="data:video/mp4;base64,') == 2
+    assert html.count('poster="data:image/png;base64,') == 2 and html.count('<div class="legend">') == 2
+    assert 'href="robots.mp4"' in html and 'href="divers.mp4"' in html
 
 
 def test_render_overlays_demo_tracks(demo_out, tmp_path):

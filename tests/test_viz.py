@@ -172,3 +172,54 @@ def test_robot_labels_are_one_based_and_diver_boxes_are_true_false_or_missed():
     gt = np.array([[1, 1, 0, 0, 10, 10, 1, 1, 1.0], [1, 2, 50, 50, 10, 10, 1, 1, 1.0]])
     on, missed = true_false_missed(np.array([[1, 1, 10, 10], [100, 100, 10, 10]], float), gt)
     assert on.tolist() == [True, False] and missed.tolist() == [[50, 50, 10, 10]]
+
+
+def test_robot_video_starts_where_every_label_has_been_right_for_a_while():
+    from lookalike.viz.robots_scene import warm_up_end
+
+    truth = [np.array([0, -1])] * 3 + [np.array([], int)] + [np.array([1])] * 8
+    right = [np.array([0, -1])] * 3 + [np.array([], int)] + [np.array([1])] * 8
+    wrong_first = [np.array([1, -1])] + right[1:]
+    assert warm_up_end(right, truth, hold=4) == 0
+    assert warm_up_end(wrong_first, truth, hold=4) == 1
+    slip = right[:2] + [np.array([0, 2])] + right[3:]  # wrong at frame 2; frame 3 has no robot in view
+    assert warm_up_end(slip, truth, hold=4) == 4
+    assert warm_up_end([np.array([], int)] * 3, [np.array([], int)] * 3, hold=2) == 0  # no robot seen: from 0
+    never = [np.array([2])] * 12
+    assert warm_up_end(never, truth[4:] * 2, hold=4) == 0
+
+
+def test_header_band_keeps_the_picture_whole_and_its_height_fixed():
+    from lookalike.viz.annotate import with_header
+
+    img = _frames(1, w=320, h=120)[0]
+    legend = [("a colour per track", (0, 140, 255), False), ("missed", (255, 255, 255), True),
+              ("a long legend entry that needs its own row", (0, 0, 230), False)]
+    a = with_header(img, ["caption", "frame 1"], legend)
+    b = with_header(img, ["another caption, longer", "frame 200"], legend)
+    assert a.shape == b.shape and a.shape[1] == 320 and a.shape[0] > 120 + 2 * 18
+    assert np.array_equal(a[-120:], img)  # the picture is below the band, untouched
+    assert with_header(img, ["x"], legend[:2]).shape[0] < with_header(img, ["x"], legend).shape[0]  # rows wrap
+
+
+def test_report_embeds_small_videos_and_links_large_ones(tmp_path, monkeypatch):
+    import lookalike.viz.report as report_module
+    from lookalike.viz import HtmlReport
+
+    with VideoWriter(tmp_path / "v.mp4", fps=10) as w:
+        for f in _frames(5):
+            w.write(f)
+    cv2.imwrite(str(tmp_path / "p.png"), _frames(1)[0])
+    doc = HtmlReport("r")
+    assert doc.video(tmp_path / "v.mp4", "clip", relative_to=tmp_path, poster=tmp_path / "p.png",
+                     legend=[("missed", (255, 255, 255), True)])
+    html = doc.render()
+    assert 'src="data:video/mp4;base64,' in html and 'poster="data:image/png;base64,' in html
+    assert 'href="v.mp4"' in html and "embedded here" in html and "border-style:dashed" in html
+    monkeypatch.setattr(report_module, "EMBED_MAX_BYTES", 10)
+    doc = HtmlReport("r")
+    assert not doc.video(tmp_path / "v.mp4", "clip", relative_to=tmp_path)
+    html = doc.render()
+    assert 'src="v.mp4"' in html and "data:video" not in html and "played from" in html
+    with pytest.raises(ValueError, match="video"):
+        doc.video(tmp_path / "none.mp4", "clip")

@@ -14,10 +14,12 @@ from lookalike.io.results import Results
 from lookalike.sim import PRESET_NAMES, preset, preset_label
 from lookalike.sim.divers import SCENARIOS, VALIDATION_SCENARIOS, scenario
 from lookalike.sim.divers_run import fit_diver_features
+from lookalike.viz.divers_scene import LEGEND as DIVER_LEGEND
 from lookalike.viz.divers_scene import run_diver_scenario
 from lookalike.viz.plots import grouped_bar_chart
-from lookalike.viz.report import HtmlReport
-from lookalike.viz.robots_scene import run_robot_scene
+from lookalike.viz.report import EMBED_MAX_BYTES, HtmlReport
+from lookalike.viz.robots_scene import HOLD_FRAMES, run_robot_scene
+from lookalike.viz.robots_scene import LEGEND as ROBOT_LEGEND
 
 ROBOT_TRACKERS = ("kalman_ha", "kalman_ha2", "jpda")
 DIVER_TRACKERS = ["sort", "deepsort", "diversort"]
@@ -54,6 +56,7 @@ class DemoResult:
     ident_rows: list[dict[str, Any]]
     diver_rows: list[dict[str, Any]]
     notes: dict[str, str | None]
+    starts: dict[str, float] = dataclasses.field(default_factory=dict)  # where each video starts (s): its warm-up
 
 
 def lstm_status(setup: str) -> str | None:
@@ -73,22 +76,23 @@ def _silent(description: str, total: int) -> Callable[[], None]:
     return lambda: None
 
 
-def _divers(output: Path, size: DemoSize, step: Step, rerun: Any) -> tuple[list[dict[str, Any]], dict[str, Path]]:
+def _divers(output: Path, size: DemoSize, step: Step,
+            rerun: Any) -> tuple[list[dict[str, Any]], dict[str, Path], float | None]:
     adv = step("Divers: appearance features (validation)", 1)
     val = tuple(dataclasses.replace(sc, frames=min(sc.frames, size.fit_frames)) for sc in VALIDATION_SCENARIOS)
     extractor = fit_diver_features(val)
     adv()
     video_sc = dataclasses.replace(scenario("ocean_four_long_absences"), frames=size.diver_video_frames)
-    rows, files = run_diver_scenario(video_sc, extractor, DIVER_TRACKERS, out_dir=output, video_tracker="diversort",
-                                     advance=step(f"Divers {video_sc.name}: render + track", video_sc.frames),
-                                     rerun=rerun)
+    rows, files, start_s = run_diver_scenario(
+        video_sc, extractor, DIVER_TRACKERS, out_dir=output, video_tracker="diversort",
+        advance=step(f"Divers {video_sc.name}: render + track", video_sc.frames), rerun=rerun)
     others = [sc for sc in SCENARIOS if sc.name != video_sc.name][: max(size.diver_scenarios - 1, 0)]
     adv = step("Divers: other scenarios", len(others) * size.diver_frames)
     for sc in others:
-        more, _ = run_diver_scenario(dataclasses.replace(sc, frames=size.diver_frames), extractor, DIVER_TRACKERS,
+        more, _, _ = run_diver_scenario(dataclasses.replace(sc, frames=size.diver_frames), extractor, DIVER_TRACKERS,
                                      advance=adv)
         rows += more
-    return rows, {f"divers-{k}": v for k, v in files.items()}
+    return rows, {f"divers-{k}": v for k, v in files.items()}, start_s
 
 
 def diver_results(rows: list[dict[str, Any]], size: DemoSize, command: str = "") -> Results:
@@ -123,7 +127,7 @@ def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str, rerun: 
         names = list(ROBOT_TRACKERS) + (["lstm"] if notes[s] is None else [])
         ident_rows += ident_table([s], names, size.ident_sequences, size.ident_frames, seed=900_000 + seed)
         adv()
-    diver_rows, diver_files = _divers(output, size, step, rerun)
+    diver_rows, diver_files, diver_start = _divers(output, size, step, rerun)
     files.update(diver_files)
     files["idf1"] = grouped_bar_chart(output / "divers-idf1.png", diver_rows, "Scenario", "Tracker", "IDF1",
                                       ylabel="IDF1 (%)", title="Diver tracking: IDF1 per scenario")
@@ -132,24 +136,32 @@ def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str, rerun: 
     ident_results(ident_rows, list(PRESET_NAMES), size.ident_sequences, size.ident_frames, 900_000 + seed,
                   command).write(output / "robots-ident.json")
     diver_results(diver_rows, size, command).write(output / "divers.json")
-    result = DemoResult(files, robots.rows, ident_rows, diver_rows, notes)
+    starts = {"robots": robots.start_s, "divers": diver_start or 0.0}
+    result = DemoResult(files, robots.rows, ident_rows, diver_rows, notes, starts)
     files["report"] = write_report(output, result, video_tracker, size)
     return result
 
 
 def write_report(output: Path, result: DemoResult, video_tracker: str, size: DemoSize) -> Path:
-    """The demo's ``report.html``: tables, pictures and links to the videos."""
-    files = result.files
+    """The demo's ``report.html``: tables, pictures, and the videos (embedded when small, else linked) with their
+    first frame as poster and their legend above them."""
+    files, starts = result.files, result.starts
     report = HtmlReport("lookalike demo: identical robots and look-alike divers")
+    small = all(files[v].stat().st_size <= EMBED_MAX_BYTES for v in ("robots-video", "divers-video"))
     report.text("Everything here was simulated and rendered by lookalike itself; no data was downloaded. "
-                "Re-run with `lookalike demo`.", note=True)
+                "Re-run with `lookalike demo`. " + ("This page holds every picture and video; " if small else
+                "This page holds every picture; its videos are the MP4 files beside it (keep them together); ")
+                + f"the files it was made from are in its folder ({output.name}/).", note=True)
     report.heading("Identical robots identified from their heading reports")
     report.text(f"Each detection is labelled with the robot it belongs to (colours) or as a false positive, by "
-                f"the {video_tracker} identifier, from the robots' own heading reports. Red frames mark wrong labels.")
-    report.image(files["robots-still"], "A frame of the annotated robot video", width=640)
-    report.video(files["robots-video"], "Full annotated robot video (MP4, H.264)", relative_to=output, width=640)
+                f"the {video_tracker} identifier, from the robots' own heading reports. Red frames mark wrong labels. "
+                f"The video starts where the identifier's warm-up ends, at {starts.get('robots', 0.0):.1f} s: the "
+                f"first frame with a robot in view from which every label is right for {HOLD_FRAMES} frames; its "
+                f"percentage counts the labels from there. The table scores every frame.")
+    report.video(files["robots-video"], "Annotated robot video (MP4, H.264)", relative_to=output, width=640,
+                 poster=files["robots-still"], legend=ROBOT_LEGEND)
     report.image(files["robots-birdseye"], "True vs estimated robot paths, seen from above", width=560)
-    report.table(result.robot_rows, IDENT_COLS, caption="The video scene")
+    report.table(result.robot_rows, IDENT_COLS, caption="The video scene, every frame")
     report.heading("Robot identification, the paper's three set-ups")
     for why in (w for w in result.notes.values() if w):
         report.text(f"LSTM left out: {why}.", note=True)
@@ -157,8 +169,12 @@ def write_report(output: Path, result: DemoResult, video_tracker: str, size: Dem
                  caption=f"{size.ident_sequences} × {size.ident_frames} simulated frames per set-up")
     report.image(files["ident-chart"], "Identification success rate (%)", width=560)
     report.heading("Look-alike divers re-identified after long absences")
-    report.image(files["divers-still"], "A frame of the annotated diver video (diver SORT)", width=640)
-    report.video(files["divers-video"], "Full annotated diver video (MP4, H.264)", relative_to=output, width=640)
+    report.text(f"Diver SORT's tracks on the rendered video. The video starts where the trackers' warm-up ends, at "
+                f"{starts.get('divers', 0.0):.1f} s: the first frame where every diver in view has a track and no "
+                f"track is false (or, if none comes by half-way, the one with the fewest misses); its percentage "
+                f"counts the divers in view that have a track from there. The table scores every frame.")
+    report.video(files["divers-video"], "Annotated diver video (MP4, H.264)", relative_to=output, width=640,
+                 poster=files["divers-still"], legend=DIVER_LEGEND)
     report.image(files["idf1"], "IDF1 per scenario and tracker", width=640)
     report.table(result.diver_rows, DIVER_COLS, caption="Diver tracking (IDF1, HOTA, MOTA in %; scenarios shortened)")
     report.heading("Try next")

@@ -202,3 +202,34 @@ def draw_legend(image: np.ndarray, entries: list[tuple[str, BGR, bool]], scale: 
         y = top + 6 + step * k
         draw_box(image, np.array([8, y + 2, 28, step - 8], float), colour, thickness=2, dashed=dashed)
         cv2.putText(image, text, (44, y + step - 7), cv2.FONT_HERSHEY_SIMPLEX, scale, (255, 255, 255), 1, cv2.LINE_AA)
+
+
+def with_header(image: np.ndarray, lines: list[str], entries: list[tuple[str, BGR, bool]],
+                scale: float = 0.45) -> np.ndarray:
+    """A new image: ``image`` below a dark band with caption ``lines`` and, flowed left to right, the legend
+    ``entries`` (a box sample of ``colour``, dashed or not, and its text), so that neither hides the picture nor sits
+    under a video player's controls. The band's height depends only on the line count and the entries' texts."""
+    with needs("cv2"):
+        import cv2
+
+    width, step = image.shape[1], 20
+    rows: list[list[tuple[int, tuple[str, BGR, bool]]]] = [[]]
+    x = 8
+    for entry in entries:
+        w = cv2.getTextSize(entry[0], cv2.FONT_HERSHEY_SIMPLEX, scale, 1)[0][0] + 48
+        if rows[-1] and x + w > width:
+            rows.append([])
+            x = 8
+        rows[-1].append((x, entry))
+        x += w
+    rows = [r for r in rows if r]
+    band = np.full((8 + step * (len(lines) + len(rows)), width, 3), 32, np.uint8)
+    for i, text in enumerate(lines):
+        cv2.putText(band, text, (6, 17 + step * i), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
+    for r, row in enumerate(rows):
+        y = 4 + step * (len(lines) + r)
+        for x0, (text, colour, dashed) in row:
+            draw_box(band, np.array([x0, y + 4, 26, step - 9], float), colour, thickness=2, dashed=dashed)
+            cv2.putText(band, text, (x0 + 34, y + step - 6), cv2.FONT_HERSHEY_SIMPLEX, scale, (235, 235, 235), 1,
+                        cv2.LINE_AA)
+    return np.vstack([band, image])

@@ -1,5 +1,5 @@
-"""A single self-contained HTML report: headings, text, tables, images embedded as ``data:`` URIs, and videos linked by
-relative path."""
+"""A single HTML report: headings, text, tables, images embedded as ``data:`` URIs, and videos embedded the same way up
+to :data:`EMBED_MAX_BYTES` (larger ones linked by relative path, to be kept beside the report)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,10 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from lookalike.viz.colors import BGR, rgb_hex
+
 _MIME = {".png": "image/png", ".gif": "image/gif", ".jpg": "image/jpeg", ".jpeg": "image/jpeg"}
+EMBED_MAX_BYTES = 8_000_000  # a larger video is linked, not embedded (base64 adds a third)
 
 _STYLE = """
 body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; padding: 0 1em; color: #222; }
@@ -22,6 +25,9 @@ th { background: #f4f4f4; text-align: left; } td.num { text-align: right; font-v
 figure { display: inline-block; margin: 0.6em 1em 0.6em 0; vertical-align: top; }
 figure img, figure video { max-width: 100%; border: 1px solid #ccc; } figcaption { font-size: 0.85em; color: #555; }
 .note { color: #555; font-size: 0.9em; }
+.legend { font-size: 0.85em; margin: 0 0 4px; display: flex; flex-wrap: wrap; gap: 4px 16px; }
+.legend span { display: inline-flex; align-items: center; gap: 6px; }
+.legend i { display: inline-block; width: 22px; height: 11px; border: 3px solid; background: #202020; }
 """
 
 
@@ -33,6 +39,17 @@ def _cell(value: Any) -> tuple[str, bool]:
     if isinstance(value, float):
         return ("—" if math.isnan(value) else f"{value:,.3f}".rstrip("0").rstrip(".")), True
     return html.escape(str(value)), False
+
+
+def _data_uri(path: Path | str, mimes: Mapping[str, str], what: str) -> str:
+    """The file at ``path`` as a ``data:`` URI; ValueError for a missing file or a suffix not in ``mimes``."""
+    p = Path(path)
+    mime = mimes.get(p.suffix.lower())
+    if mime is None:
+        raise ValueError(f"{what}: unsupported type {p.suffix!r} of {p} (use {', '.join(mimes)})")
+    if not p.is_file():
+        raise ValueError(f"{what}: no such file {p}")
+    return f"data:{mime};base64,{base64.b64encode(p.read_bytes()).decode('ascii')}"
 
 
 def _href(target: Path | str, relative_to: Path | str | None) -> str:
@@ -79,17 +96,11 @@ class HtmlReport:
 
     def image(self, path: Path | str, caption: str = "", width: int | None = None) -> None:
         """Embed the image file at ``path`` (PNG, GIF or JPEG) with a caption."""
-        p = Path(path)
-        mime = _MIME.get(p.suffix.lower())
-        if mime is None:
-            raise ValueError(f"image: unsupported type {p.suffix!r} of {p} (use {', '.join(_MIME)})")
-        if not p.is_file():
-            raise ValueError(f"image: no such file {p}")
-        data = base64.b64encode(p.read_bytes()).decode("ascii")
+        src = _data_uri(path, _MIME, "image")
         style = f' style="width:{int(width)}px"' if width else ""
-        alt = html.escape(caption or p.name, quote=True)
+        alt = html.escape(caption or Path(path).name, quote=True)
         self._blocks.append(
-            f'<figure><img src="data:{mime};base64,{data}" alt="{alt}"{style}>'
+            f'<figure><img src="{src}" alt="{alt}"{style}>'
             f"<figcaption>{html.escape(caption)}</figcaption></figure>"
         )
 
@@ -98,15 +109,30 @@ class HtmlReport:
         self._blocks.append(f'<p><a href="{_href(target, relative_to)}">{html.escape(text)}</a></p>')
 
     def video(self, target: Path | str, caption: str, relative_to: Path | str | None = None,
-              width: int | None = None) -> None:
-        """An inline video player for the MP4 at ``target`` (path relative to the folder ``relative_to``),
-        with a caption that also links to the file."""
-        src = _href(target, relative_to)
+              width: int | None = None, poster: Path | str | None = None,
+              legend: Sequence[tuple[str, BGR, bool]] = ()) -> bool:
+        """An inline player for the MP4 at ``target``: embedded when it is at most :data:`EMBED_MAX_BYTES`, else
+        linked (path relative to the folder ``relative_to``); the caption links the file and says which. ``poster``:
+        an image embedded as the picture shown before playing; ``legend``: ``(text, BGR colour, dashed)`` keys shown
+        above the player, clear of its controls. Returns whether the video was embedded."""
+        if not Path(target).is_file():
+            raise ValueError(f"video: no such file {target}")
+        href = _href(target, relative_to)
+        embedded = Path(target).stat().st_size <= EMBED_MAX_BYTES
+        src = _data_uri(target, {".mp4": "video/mp4"}, "video") if embedded else href
         style = f' style="width:{int(width)}px"' if width else ""
+        cover = f' poster="{_data_uri(poster, _MIME, "poster")}"' if poster is not None else ""
+        keys = "".join(f'<span><i style="border-color:{rgb_hex(c)};border-style:{"dashed" if d else "solid"}"></i>'
+                       f"{html.escape(t)}</span>" for t, c, d in legend)
+        where = "embedded here; also" if embedded else "played from"
+        name = html.escape(Path(target).name)
         self._blocks.append(
-            f'<figure><video controls muted playsinline preload="metadata" src="{src}"{style}></video>'
-            f'<figcaption><a href="{src}">{html.escape(caption)}</a></figcaption></figure>'
+            "<figure>" + (f'<div class="legend">{keys}</div>' if keys else "")
+            + f'<video controls muted playsinline preload="auto" src="{src}"{cover}{style}></video>'
+            f'<figcaption>{html.escape(caption)} ({where} <a href="{href}">{name}</a>, a file beside this report)'
+            "</figcaption></figure>"
         )
+        return embedded
 
     def code(self, text: str) -> None:
         """A preformatted block (commands to try)."""

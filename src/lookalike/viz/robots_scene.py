@@ -4,7 +4,7 @@ annotated video, a still and a bird's-eye plot of true vs estimated paths."""
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
@@ -20,22 +20,27 @@ from lookalike.sim import preset, preset_label, simulate_robots
 from lookalike.sim.render_robots import ROBOT_HEIGHT_M, ROBOT_WIDTH_M
 from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
-from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_box_label, draw_caption, draw_legend, draw_tail
+from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_box_label, draw_tail, with_header
 from lookalike.viz.colors import identity_colour
 from lookalike.viz.plots import birdseye_plot
 from lookalike.viz.robot_pixels import render_robot_frames
 from lookalike.viz.video import VideoWriter
 
 WRONG = (0, 0, 230)  # BGR red outline of a wrongly identified detection
+LEGEND = [("robot N (a colour per identity)", identity_colour(0), False),
+          ("false positive (no robot)", identity_colour(-1), True), ("red frame: wrong label", WRONG, False)]
+HOLD_FRAMES = 10  # the warm-up ends when the labels are right this many frames running (1/3 s at 30 Hz)
 
 
 @dataclass
 class RobotSceneResult:
-    """Scores per tracker (rows), the files written, and the paths for plotting (fixed frame, m)."""
+    """Scores per tracker (rows, every frame), the files written, and where the video starts."""
 
     rows: list[dict[str, Any]]
     files: dict[str, Path] = field(default_factory=dict)
     video_tracker: str = ""
+    start: int = 0  # the video's first frame (0-based): the end of the identifier's warm-up
+    start_s: float = 0.0  # its time (s)
 
 
 def _make(name: str, n_agents: int, n_slots: int) -> Any:
@@ -52,9 +57,10 @@ def _to_fixed(ego: np.ndarray, pose: np.ndarray) -> np.ndarray:
 def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 300, seed: int = 0,
                     trackers: list[str], video_tracker: str, render_width: int = 320, scale: int = 2,
                     advance: Callable[[], None] | None = None, rerun: Any = None) -> RobotSceneResult:
-    """Simulate ``frames`` frames of ``preset_name``, run ``trackers`` and write ``robots.mp4``, ``robots.gif``,
-    ``robots-still.png`` and ``robots-birdseye.png`` in ``out_dir`` (rendered ``render_width`` pixels wide,
-    annotated at ``scale`` times; ``advance`` called every frame; ``rerun`` also receives the frames)."""
+    """Simulate ``frames`` frames of ``preset_name``, run ``trackers`` and write ``robots.mp4`` and ``robots.gif``
+    (from the end of ``video_tracker``'s warm-up, :func:`warm_up_end`), ``robots-still.png`` (their first frame) and
+    ``robots-birdseye.png`` in ``out_dir`` (rendered ``render_width`` pixels wide, annotated at ``scale`` times, below a
+    caption and legend band; ``advance`` called every frame; ``rerun`` also receives every frame)."""
     with needs("cv2"):
         import cv2
 
@@ -69,65 +75,56 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
     # A level-ish wide camera like the simulated observer's (80° field of view), so the robots fill the view.
     camera = Camera(Intrinsics.from_fov(render_width, render_width * 3 // 4, cfg.observer.fov_rad),
                     Extrinsics(0.9, np.radians(9.0)))
-    rendered = render_robot_frames(seq, camera, seed)
     for name in trackers:  # frames/s without the first frames' one-off costs (imports, compiles)
         warm_up(partial(_make, name, n, cfg.max_detections), seq.frames())
     instances = {name: _make(name, n, cfg.max_detections) for name in trackers}
     elapsed = dict.fromkeys(trackers, 0.0)
     predicted: dict[str, list[np.ndarray]] = {name: [] for name in trackers}
     estimated = {name: np.full((frames, n, 2), np.nan) for name in trackers}
+    for k, frame in enumerate(seq.frames()):  # every identifier over every frame first (no pixels needed)
+        for name, tracker in instances.items():
+            t0 = time.perf_counter()
+            tracks = tracker.update(frame)
+            elapsed[name] += time.perf_counter() - t0
+            predicted[name].append(labels_from_tracks(len(frame.detections), tracks))
+            estimated[name][k] = agent_positions(tracks, n)
     truth_labels = seq.true_labels()
+    start = warm_up_end(predicted[video_tracker], truth_labels)
     tails = Tails(length=30, max_jump=0.5)  # 1 s at 30 Hz; an identity switch (a jump > 0.5 m) breaks it
     out_dir.mkdir(parents=True, exist_ok=True)
     files = {"video": out_dir / "robots.mp4", "gif": out_dir / "robots.gif", "still": out_dir / "robots-still.png"}
-    best_still = -2  # the still: the frame after the first third with the most detections, all labelled right
+    warm = (f"frames 1-{start} ({a.time[start]:.1f} s): warm-up, not shown (identities learnt from heading reports)"
+            if start else "no warm-up end found: every frame shown")
     correct = total = 0
     with VideoWriter(files["video"], fps=cfg.frame_rate_hz, gif=files["gif"], gif_every=4, gif_frames=120) as video:
-        for k in range(frames):
-            frame = seq.frame(k)
-            det = frame.detections
-            for name, tracker in instances.items():
-                t0 = time.perf_counter()
-                tracks = tracker.update(frame)
-                elapsed[name] += time.perf_counter() - t0
-                predicted[name].append(labels_from_tracks(len(det), tracks))
-                estimated[name][k] = agent_positions(tracks, n)
+        for k, rendered in enumerate(render_robot_frames(seq, camera, seed)):
+            det = seq.frame(k).detections
             pose = a.observer[k]
             observer = Pose2D(float(pose[0]), float(pose[1]), float(pose[2]))
-            img = next(rendered).image
-            img = cv2.resize(img, (img.shape[1] * scale, img.shape[0] * scale), interpolation=cv2.INTER_LINEAR)
-            labels = predicted[video_tracker][-1]
-            truth = truth_labels[k]
+            img = cv2.resize(rendered.image, (rendered.image.shape[1] * scale, rendered.image.shape[0] * scale),
+                             interpolation=cv2.INTER_LINEAR)
+            labels, truth = predicted[video_tracker][k], truth_labels[k]
             if rerun is not None:
                 _log_robots(rerun, k, float(a.time[k]), img, camera, scale, det, labels,
                             _to_fixed(estimated[video_tracker][k], pose), a.field_position[k])
-            correct += int((labels == truth).sum())
-            total += len(labels)
             for j in range(n):
                 p = estimated[video_tracker][k, j]
                 if np.isfinite(p).all():
                     tails.add(k, j, _to_fixed(p[None], pose)[0])
             tails.expire(k, 60)
-            for j, pts in tails.items():
-                ego = observer.fixed_to_ego(pts)
-                ego[~(ego[:, 0] > 0.2)] = np.nan  # behind the camera: no streak across the picture
-                uv = camera.ground_to_pixels(np.nan_to_num(ego, nan=1e6)) * scale
-                uv[~np.isfinite(ego).all(axis=1)] = np.nan
-                draw_tail(img, uv, identity_colour(j), thickness=3)
-            _draw_detections(img, camera, scale, det, labels, truth)
-            rate = 100.0 * correct / total if total else float("nan")
-            draw_caption(img, [
-                f"{preset_label(preset_name)} identical robots, identifier: {video_tracker}",
-                f"frame {k + 1}/{frames}  t = {a.time[k]:.1f} s  correct so far: {rate:.1f}%",
-            ])
-            draw_legend(img, [("robot N: identity from heading reports (ids 1..N)", identity_colour(0), False),
-                              ("false positive (no robot)", identity_colour(-1), True),
-                              ("red frame: wrong label", WRONG, False)])
-            video.write(img)
-            score = (len(labels) if bool((labels == truth).all()) else -1) if k >= frames // 3 else -2
-            if score > best_still or (k == 0):
-                best_still = max(score, best_still)
-                cv2.imwrite(str(files["still"]), img)
+            if k >= start:
+                correct += int((labels == truth).sum())
+                total += len(labels)
+                _draw_tails(img, tails, observer, camera, scale)
+                _draw_detections(img, camera, scale, det, labels, truth)
+                rate = f"{100.0 * correct / total:.1f}%" if total else "-"
+                img = with_header(img, [
+                    f"{preset_label(preset_name)} identical robots, identifier: {video_tracker}",
+                    f"frame {k + 1}/{frames}  t = {a.time[k]:.1f} s  labels right since frame {start + 1}: {rate}",
+                    warm], LEGEND)
+                video.write(img)
+                if k == start:  # the poster: the clip's first frame
+                    cv2.imwrite(str(files["still"]), img)
             if advance is not None:
                 advance()
     truth_pos = seq.true_positions_visible()
@@ -145,7 +142,28 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
         observer=cfg.observer.position_m,
         title=f"{preset_label(preset_name)}: true paths (lines) vs {video_tracker} estimates (dots), field frame",
     )
-    return RobotSceneResult(rows=rows, files=files, video_tracker=video_tracker)
+    return RobotSceneResult(rows=rows, files=files, video_tracker=video_tracker, start=start,
+                            start_s=float(a.time[start]))
+
+
+def warm_up_end(predicted: Sequence[np.ndarray], truth: Sequence[np.ndarray], hold: int = HOLD_FRAMES) -> int:
+    """The first frame (0-based) with a robot in view from which every detection of ``hold`` frames is labelled
+    right (``predicted[k]`` against ``truth[k]``, agent index or -1); 0 when there is none."""
+    right = [bool(np.array_equal(p, t)) for p, t in zip(predicted, truth)]
+    for k in range(len(right)):
+        if bool((np.asarray(truth[k]) >= 0).any()) and all(right[k: k + hold]):
+            return k
+    return 0
+
+
+def _draw_tails(img: np.ndarray, tails: Tails, observer: Pose2D, camera: Camera, scale: int) -> None:
+    """Each identity's recent ground path (fixed frame, m) drawn through the camera."""
+    for j, pts in tails.items():
+        ego = observer.fixed_to_ego(pts)
+        ego[~(ego[:, 0] > 0.2)] = np.nan  # behind the camera: no streak across the picture
+        uv = camera.ground_to_pixels(np.nan_to_num(ego, nan=1e6)) * scale
+        uv[~np.isfinite(ego).all(axis=1)] = np.nan
+        draw_tail(img, uv, identity_colour(j), thickness=3)
 
 
 def robot_label(label: int) -> str:
