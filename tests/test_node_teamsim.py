@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lookalike.node import TeamState, decode, encode
-from lookalike.node.teamsim import SimClock, camera_messages, robot_reports, team_sequence
+from lookalike.node.teamsim import SimClock, camera_messages, robot_reports, run_camera, run_robot, team_sequence
 from tests.node_scoring import online_identification
 
 
@@ -71,3 +71,40 @@ def test_sim_clock():
     assert not SimClock(epoch=time.time() + 100.0).wait_until(1.0, stop=lambda: True)
     with pytest.raises(ValueError, match="speed"):
         SimClock(epoch=0.0, speed=0.0)
+
+
+class _Recorder:
+    """An endpoint that keeps what is sent and never receives anything."""
+
+    def __init__(self):
+        self.sent = []
+
+    def send(self, message):
+        self.sent.append(message)
+
+    def receive(self, timeout_s):
+        time.sleep(min(timeout_s, 0.001))
+        return None
+
+
+def test_a_late_start_is_warned_and_skips_what_was_due(sequence):
+    """A process started after --start-at says so and begins at the present instead of sending the past at once;
+    a robot that never heard its position says so too."""
+    assert SimClock(epoch=time.time() + 5.0).late_start("robot 1") == (0.0, None)
+    assert SimClock(epoch=time.time()).late_start("robot 1") == (0.0, None)  # --start-at now
+    start, line = SimClock(epoch=time.time() - 3.0, speed=1000.0).late_start("the camera")
+    assert 3000.0 <= start < 4000.0
+    assert line.startswith("warning: the camera started 3.") and "skipping the first 3" in line
+    # 5 simulated seconds at speed 1000 from a clock started 4.998 s (simulated) ago: only the last frames go out.
+    clock = SimClock(epoch=time.time() - 4.998 / 1000.0, speed=1000.0)
+    camera = _Recorder()
+    messages = camera_messages(sequence)
+    assert run_camera(camera, messages, clock, start_s=4.9) == sum(m.time >= 4.9 for m in messages)
+    assert min(m.time for m in camera.sent) >= 4.9
+    robot = _Recorder()
+    log = run_robot(robot, 0, sequence, clock, linger_s=0.0, start_s=4.0)
+    assert log.reports_sent == len(robot.sent) == sum(t >= 4.0 for t, _ in robot_reports(sequence, 0))
+    assert log.summary()["median_error_m"] is None
+    assert log.warning().startswith("warning: robot 1 received no team state")
+    log.errors_m.append(0.1)
+    assert log.warning() is None

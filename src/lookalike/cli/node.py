@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import signal
 import sys
 import time
@@ -139,6 +140,11 @@ def _clock(start_at: str, speed: float) -> SimClock:
         return SimClock(epoch=time.time() if start_at == "now" else float(start_at), speed=speed)
 
 
+def _warn(line: str | None) -> None:
+    if line is not None:
+        print(line, file=sys.stderr, flush=True)
+
+
 _PRESET_HELP = f"Robot-world preset: {', '.join(PRESET_NAMES)}."
 _START_HELP = "Wall time of simulated t=0: now, a UNIX time, or stdin (print 'ready', read it from stdin)."
 
@@ -185,9 +191,13 @@ def robot_sim(
 
     with endpoint:
         clock = _clock(start_at, speed)
+        start_s, late = clock.late_start(f"robot {robot + 1}")
+        _warn(late)
         with _Stop() as stop:
-            log = run_robot(endpoint, robot, sequence, clock, stop=stop, on_position=show if verbose else None)
+            log = run_robot(endpoint, robot, sequence, clock, stop=stop, on_position=show if verbose else None,
+                            start_s=start_s)
     print(json.dumps(log.summary()), flush=True)
+    _warn(log.warning())
 
 
 @app.command("camera-sim")
@@ -208,6 +218,8 @@ def camera_sim(
     messages = camera_messages(sequence)[max(first_frame, 0):]
     with Endpoint(_address(node, "--node")) as endpoint:
         clock = _clock(start_at, speed)
+        start_s, late = clock.late_start("the camera") if first_frame <= 0 else (-math.inf, None)
+        _warn(late)
         with _Stop() as stop:
-            sent = run_camera(endpoint, messages, clock, stop)
+            sent = run_camera(endpoint, messages, clock, stop, start_s)
     print(json.dumps({"camera_frames_sent": sent}), flush=True)

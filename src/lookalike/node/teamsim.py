@@ -31,6 +31,17 @@ class SimClock:
         """The simulated time now, seconds."""
         return (time.time() - self.epoch) * self.speed
 
+    def late_start(self, who: str, tolerance_s: float = 0.5) -> tuple[float, str | None]:
+        """Where a process started now begins, simulated seconds, and a warning line: ``(0, None)`` on time, else,
+        when t=0 passed more than ``tolerance_s`` wall seconds ago, the present and a line saying that ``who``
+        (e.g. ``"robot 2"``) skips what was due before (sent at once, it would reach the node too late)."""
+        late_s = time.time() - self.epoch
+        if late_s <= tolerance_s:
+            return 0.0, None
+        start = self.now()
+        return start, (f"warning: {who} started {late_s:.1f} s after --start-at; skipping the first {start:.1f} "
+                       f"simulated s (give every process a later --start-at)")
+
     def wait_until(self, t_sim: float, stop: Callable[[], bool] = lambda: False) -> bool:
         """Sleep until simulated time ``t_sim``; False when ``stop()`` became true first."""
         while not stop():
@@ -79,10 +90,12 @@ def robot_reports(sequence: RobotSequence, robot: int) -> list[tuple[float, Head
 
 
 def run_camera(endpoint: Endpoint, messages: Sequence[DetectionsMessage], clock: SimClock,
-               stop: Callable[[], bool] = lambda: False) -> int:
-    """Send each frame at its simulated time; return how many were sent."""
+               stop: Callable[[], bool] = lambda: False, start_s: float = -math.inf) -> int:
+    """Send each frame at its simulated time, from simulated time ``start_s`` on; return how many were sent."""
     sent = 0
     for message in messages:
+        if message.time < start_s:
+            continue
         if not clock.wait_until(message.time, stop):
             break
         endpoint.send(message)
@@ -99,6 +112,14 @@ class RobotLog:
     team_states: int = 0
     errors_m: list[float] = dataclasses.field(default_factory=list)
 
+    def warning(self) -> str | None:
+        """A warning line when no team state gave this robot's position (its errors are then ``null``)."""
+        if self.errors_m:
+            return None
+        heard = "no team state" if self.team_states == 0 else f"{self.team_states} team states but none with it"
+        return (f"warning: robot {self.robot + 1} received {heard}: is the node running, and did the camera start "
+                f"at the same --start-at?")
+
     def summary(self) -> dict[str, float | int | None]:
         """JSON-ready figures: counts, median and 95th-percentile position error in metres."""
         err = np.asarray(self.errors_m)
@@ -112,12 +133,14 @@ class RobotLog:
 
 def run_robot(endpoint: Endpoint, robot: int, sequence: RobotSequence, clock: SimClock,
               linger_s: float = 0.5, stop: Callable[[], bool] = lambda: False,
-              on_position: Callable[[TeamState, float], None] | None = None) -> RobotLog:
-    """Send robot ``robot``'s reports on time, receive team states and log the error (m) of the node's estimate of
-    this robot (also to ``on_position(team_state, error_m)``); stop ``linger_s`` after the last frame."""
+              on_position: Callable[[TeamState, float], None] | None = None,
+              start_s: float = -math.inf) -> RobotLog:
+    """Send robot ``robot``'s reports on time (those due from simulated time ``start_s`` on), receive team states and
+    log the error (m) of the node's estimate of this robot (also to ``on_position(team_state, error_m)``); stop
+    ``linger_s`` after the last frame."""
     log = RobotLog(robot)
     truth = sequence.arrays.true_position[:, robot]
-    schedule = robot_reports(sequence, robot)
+    schedule = [item for item in robot_reports(sequence, robot) if item[0] >= start_s]
     end = float(sequence.arrays.time[-1]) + linger_s
     i = 0
     while not stop():
