@@ -128,14 +128,17 @@ def doubtful_ranges(rows: np.ndarray, confidence: np.ndarray, frame_rate: float,
     confidence = np.asarray(confidence, dtype=float)
     if confidence.shape != (len(rows),):
         raise ValueError(f"confidence: expected ({len(rows)},), got shape {confidence.shape}")
-    low = rows[confidence < threshold]
+    low = rows[confidence < threshold][:, :2].astype(np.int64)
+    low = low[np.lexsort((low[:, 0], low[:, 1]))]
+    if not len(low):
+        return {}
     half = window_frames(frame_rate)
+    # a range starts at an id's first low row or after more than `half` frames without one
+    firsts = np.flatnonzero(np.r_[True, (low[1:, 1] != low[:-1, 1]) | (low[1:, 0] - low[:-1, 0] > half)])
+    lasts = np.r_[firsts[1:] - 1, len(low) - 1]
     out: dict[int, list[tuple[int, int]]] = {}
-    for i in np.unique(low[:, 1]).astype(np.int64).tolist():
-        f = np.unique(low[low[:, 1] == i, 0].astype(np.int64))
-        cut = np.flatnonzero(np.diff(f) > half)
-        firsts, lasts = f[np.r_[0, cut + 1]], f[np.r_[cut, len(f) - 1]]
-        out[i] = list(zip(firsts.tolist(), lasts.tolist()))
+    for i, a, b in zip(low[firsts, 1].tolist(), low[firsts, 0].tolist(), low[lasts, 0].tolist()):
+        out.setdefault(i, []).append((a, b))
     return out
 
 
