@@ -184,9 +184,9 @@ def test_robot_video_starts_where_every_label_has_been_right_for_a_while():
     assert warm_up_end(wrong_first, truth, hold=4) == 1
     slip = right[:2] + [np.array([0, 2])] + right[3:]  # wrong at frame 2; frame 3 has no robot in view
     assert warm_up_end(slip, truth, hold=4) == 4
-    assert warm_up_end([np.array([], int)] * 3, [np.array([], int)] * 3, hold=2) == 0  # no robot seen: from 0
+    assert warm_up_end([np.array([], int)] * 3, [np.array([], int)] * 3, hold=2) is None  # no robot ever seen
     never = [np.array([2])] * 12
-    assert warm_up_end(never, truth[4:] * 2, hold=4) == 0
+    assert warm_up_end(never, truth[4:] * 2, hold=4) is None
 
 
 def test_header_band_keeps_the_picture_whole_and_its_height_fixed():
