@@ -187,6 +187,9 @@ def test_robot_video_starts_where_every_label_has_been_right_for_a_while():
     assert warm_up_end([np.array([], int)] * 3, [np.array([], int)] * 3, hold=2) is None  # no robot ever seen
     never = [np.array([2])] * 12
     assert warm_up_end(never, truth[4:] * 2, hold=4) is None
+    assert warm_up_end(wrong_first, truth, hold=4, latest=1) is None  # not by frame 1
+    late = [np.array([1, -1])] * 3 + [np.array([], int)] + [np.array([2])] * 6 + right[10:]
+    assert warm_up_end(late, truth, hold=4) == 10  # right from frame 10 to the end (2 frames) counts
 
 
 def test_header_band_keeps_the_picture_whole_and_its_height_fixed():

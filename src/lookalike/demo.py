@@ -156,8 +156,9 @@ def write_report(output: Path, result: DemoResult, video_tracker: str, size: Dem
     report.text(f"Each detection is labelled with the robot it belongs to (colours) or as a false positive, by "
                 f"the {video_tracker} identifier, from the robots' own heading reports. Red frames mark wrong labels. "
                 f"The video starts where the identifier's warm-up ends, at {starts.get('robots', 0.0):.1f} s: the "
-                f"first frame with a robot in view from which every label is right for {HOLD_FRAMES} frames; its "
-                f"percentage counts the labels from there. The table scores every frame.")
+                f"first frame with a robot in view from which every label is right for {HOLD_FRAMES} frames (if "
+                f"that comes by half-way, else the first frame by then with every label right); its percentage "
+                f"counts the labels from there. The table scores every frame.")
     report.video(files["robots-video"], "Annotated robot video (MP4, H.264)", relative_to=output, width=640,
                  poster=files["robots-still"], legend=ROBOT_LEGEND)
     report.image(files["robots-birdseye"], "True vs estimated robot paths, seen from above", width=560)

@@ -89,13 +89,20 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
             predicted[name].append(labels_from_tracks(len(frame.detections), tracks))
             estimated[name][k] = agent_positions(tracks, n)
     truth_labels = seq.true_labels()
-    end = warm_up_end(predicted[video_tracker], truth_labels)
+    # The video starts where the warm-up ends, by half the scene at the latest (else at the first frame by then with
+    # every label right, else at the first frame).
+    end = warm_up_end(predicted[video_tracker], truth_labels, latest=max(frames // 2, 1))
+    settled = end is not None
+    if end is None:
+        end = warm_up_end(predicted[video_tracker], truth_labels, hold=1, latest=max(frames // 2, 1))
     start = end or 0
     tails = Tails(length=30, max_jump=0.5)  # 1 s at 30 Hz; an identity switch (a jump > 0.5 m) breaks it
     out_dir.mkdir(parents=True, exist_ok=True)
     files = {"video": out_dir / "robots.mp4", "gif": out_dir / "robots.gif", "still": out_dir / "robots-still.png"}
-    warm = (f"frames 1-{start} ({a.time[start]:.1f} s): warm-up, not shown (identities learnt from heading reports)"
-            if start else "every frame shown" + (": no warm-up end found" if end is None else ""))
+    why = "warm-up, not shown (identities learnt from heading reports)" if settled else \
+        "not shown, up to the first frame with every label right"
+    warm = (f"frames 1-{start} ({a.time[start]:.1f} s): {why}" if start
+            else "every frame shown" + ("" if settled else ": labels not settled by half-way"))
     correct = total = 0
     with VideoWriter(files["video"], fps=cfg.frame_rate_hz, gif=files["gif"], gif_every=4, gif_frames=120) as video:
         for k, rendered in enumerate(render_robot_frames(seq, camera, seed)):
@@ -147,11 +154,12 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
                             start_s=float(a.time[start]))
 
 
-def warm_up_end(predicted: Sequence[np.ndarray], truth: Sequence[np.ndarray], hold: int = HOLD_FRAMES) -> int | None:
-    """The first frame (0-based) with a robot in view from which every detection of ``hold`` frames is labelled
-    right (``predicted[k]`` against ``truth[k]``, agent index or -1); None when there is none."""
+def warm_up_end(predicted: Sequence[np.ndarray], truth: Sequence[np.ndarray], hold: int = HOLD_FRAMES,
+                latest: int | None = None) -> int | None:
+    """The first frame (0-based, before ``latest``) with a robot in view from which every detection of ``hold`` frames
+    is labelled right (``predicted[k]`` against ``truth[k]``, agent index or -1); None when there is none."""
     right = [bool(np.array_equal(p, t)) for p, t in zip(predicted, truth)]
-    for k in range(len(right)):
+    for k in range(min(len(right), latest if latest is not None else len(right))):
         if bool((np.asarray(truth[k]) >= 0).any()) and all(right[k: k + hold]):
             return k
     return None
