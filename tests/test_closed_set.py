@@ -10,6 +10,7 @@ from lookalike.io import MotTable
 from lookalike.trackers.offline.closed_set import (
     ClosedSetConfig,
     assign_identities,
+    link_costs,
     online_rows,
     split_tracklets,
     track_closed_set,
@@ -161,3 +162,23 @@ def test_boxes_are_smoothed_along_an_identity() -> None:
     rows[30, 2:4] += 8.0
     out = assign_identities(rows, 1, FPS)
     assert np.abs(out[:, 2:4] - 100.0).max() < 1e-9
+
+
+def test_link_costs_scored_in_blocks_are_those_of_one_block(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Many tracklets: ends scored a block at a time (memory linear in the tracklets) give the same links."""
+    import lookalike.trackers.offline.tracklets as tracklets_module
+
+    rng = np.random.default_rng(4)
+    rows = []
+    for tid in range(1, 121):
+        start = int(rng.integers(1, 150))
+        pos, vel = rng.uniform(0, 400, 2), rng.normal(0, 2, 2)
+        for f in range(start, start + int(rng.integers(5, 40))):
+            pos = pos + vel
+            rows.append([f, tid, *(pos - 5), 10, 10, 1, -1, -1, -1])
+    pieces = split_tracklets(np.array(rows, dtype=float), ClosedSetConfig())
+    whole = link_costs(pieces, 25.0)
+    monkeypatch.setattr(tracklets_module, "LINK_BLOCK", 300)  # a few ends per block
+    blocked = link_costs(pieces, 25.0)
+    assert len(whole[0]) > 100
+    assert all(np.array_equal(a, b) for a, b in zip(whole, blocked))

@@ -137,6 +137,9 @@ def motion_scale(tracklets: list[Tracklet]) -> tuple[float, float, float]:
     return size, speed, jitter
 
 
+LINK_BLOCK = 1 << 22  # tracklet end x start pairs scored at once by link_costs
+
+
 def link_costs(tracklets: list[Tracklet], frame_rate: float,
                config: ClosedSetConfig | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Candidate links ``(i, j, cost)``: tracklet ``j`` continues tracklet ``i`` (module doc, step 2)."""
@@ -158,11 +161,30 @@ def link_costs(tracklets: list[Tracklet], frame_rate: float,
     v_end = np.array([e[1] for e in ends])
     c_start = np.array([s[0] for s in starts])
     v_start = np.array([s[1] for s in starts])
-    gap = first[None, :] - last[:, None]  # [i, j]: frames from the end of i to the start of j
-    ii, jj = np.nonzero((gap >= 1) & (gap <= max_gap))
+    source = np.array([t.source_id for t in tracklets])
+    found = []
+    step = max(1, LINK_BLOCK // n)  # ends scored a block at a time: memory linear in the tracklets
+    for lo in range(0, n, step):
+        rows = slice(lo, min(lo + step, n))
+        gap = first[None, :] - last[rows, None]  # [i, j]: frames from the end of i to the start of j
+        ii, jj = np.nonzero((gap >= 1) & (gap <= max_gap))
+        g = gap[ii, jj]
+        ii += lo
+        found.append(_block_links(ii, jj, g, c_end, v_end, c_start, v_start, source, (size, speed, jitter), cfg))
+    ii, jj, cost = (np.concatenate(x) for x in zip(*found))
     if not len(ii):
         return empty
-    g = gap[ii, jj].astype(float)
+    keep = _cheapest(ii, cost, cfg.candidates) | _cheapest(jj, cost, cfg.candidates)
+    return ii[keep], jj[keep], cost[keep]
+
+
+def _block_links(ii: np.ndarray, jj: np.ndarray, gap: np.ndarray, c_end: np.ndarray, v_end: np.ndarray,
+                 c_start: np.ndarray, v_start: np.ndarray, source: np.ndarray, scale: tuple[float, float, float],
+                 cfg: ClosedSetConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`link_costs` of the pairs ``(ii, jj)`` ``gap`` frames apart: those within ``max_z``, and of them the
+    ``candidates`` cheapest per end and per start (a superset of the whole problem's cheapest)."""
+    size, speed, jitter = scale
+    g = gap.astype(float)
     # two motion hypotheses: constant velocity over the whole gap (spread grows with the jitter), or
     # holding still (spread grows with the speed); each scored as a 2-D Gaussian negative log-likelihood
     base = cfg.pos_sigma * size
@@ -175,9 +197,8 @@ def link_costs(tracklets: list[Tracklet], frame_rate: float,
     nll = np.minimum(0.5 * z_v**2 + 2 * np.log(spread_v / base), 0.5 * z_h**2 + 2 * np.log(spread_h / base))
     z = np.minimum(z_v, z_h)
     ok = z <= cfg.max_z
-    ii, jj, nll = ii[ok], jj[ok], nll[ok]
-    source = np.array([t.source_id for t in tracklets])
-    cut = (source[ii] == source[jj]) & (gap[ii, jj] == 1)  # a cut inside one input track (a contact)
+    ii, jj, nll, gap = ii[ok], jj[ok], nll[ok], gap[ok]
+    cut = (source[ii] == source[jj]) & (gap == 1)  # a cut inside one input track (a contact)
     cost = np.where(cut, cfg.continue_cost, cfg.link_cost) + nll
     keep = _cheapest(ii, cost, cfg.candidates) | _cheapest(jj, cost, cfg.candidates)
     return ii[keep], jj[keep], cost[keep]
