@@ -21,6 +21,8 @@ OPTIONAL: dict[str, tuple[str, str]] = {
     "optuna": ("tune", "Optuna"),
     "rerun": ("rerun", "the Rerun SDK"),
     "ray": ("ray", "Ray"),
+    "cyclonedds": ("ros", "Cyclone DDS"),
+    "rosbags": ("ros", "rosbags"),
     "jsonschema": ("test", "jsonschema"),
 }
 """Top-level module name → (extra that installs it, what it is called)."""
