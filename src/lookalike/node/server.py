@@ -10,7 +10,7 @@ import logging
 import selectors
 import socket
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Hashable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -122,8 +122,10 @@ class NodeConfig:
             check_group(self.group)
 
 
-class NodeServer:
-    """The running node. Use as a context manager; ``serve(stop)`` loops until ``stop()`` is true."""
+class NodeCore:
+    """What every transport of the node shares: the identifier, counters, rate limits, camera timer and status log.
+    A transport reads messages, calls :meth:`accept` and :meth:`handle_message`, and implements ``poll`` and
+    ``_publish``; ``serve(stop)`` loops until ``stop()`` is true."""
 
     def __init__(self, tracker: object, config: NodeConfig | None = None,
                  identifier_config: IdentifierConfig | None = None,
@@ -132,46 +134,12 @@ class NodeServer:
         self.identifier = TeamIdentifier(tracker, identifier_config)
         self.counters = NodeCounters()
         self.log = logger or logging.getLogger("lookalike.node")
-        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        try:
-            self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, self.config.recv_buffer_bytes)
-            self.sock.bind(self.config.listen)
-            if self.config.group is not None:
-                self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF,
-                                     socket.inet_aton(self.config.group_interface))
-                self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
-        except OSError:
-            self.sock.close()
-            raise
-        self.sock.setblocking(False)
-        self.selector = selectors.DefaultSelector()
-        self.selector.register(self.sock, selectors.EVENT_READ)
-        self._buckets: dict[Address, list[float]] = {}
+        self._buckets: dict[Hashable, list[float]] = {}
         self._robot_addr: dict[int, Address] = {}
         self._last_frame_wall: float | None = None
-        self._camera: Address | None = None  # the sender of the last accepted frame
+        self._camera: Hashable | None = None  # the sender of the last accepted frame
         self._next_status = time.monotonic() + self.config.status_interval_s
-        self._cpu_received: float | None = None  # thread CPU time when the datagram being handled was read
-        _preload()  # (before the address is announced: the first frame does not wait for imports)
-        log_event(self.log, "listening", address=list(self.address))
-
-    @property
-    def address(self) -> Address:
-        """The bound ``(host, port)``."""
-        return self.sock.getsockname()
-
-    def __enter__(self) -> NodeServer:  # noqa: PYI034
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def close(self) -> None:
-        """Log the final counters and close the socket."""
-        if self.sock.fileno() >= 0:
-            log_event(self.log, "stopped", counters=self.counters.snapshot())
-            self.selector.close()
-            self.sock.close()
+        self._cpu_received: float | None = None  # thread CPU time when the message being handled was read
 
     def serve(self, stop: Callable[[], bool], tick_s: float = 0.05) -> None:
         """Serve until ``stop()`` is true (checked every ``tick_s`` s), with ``gc.freeze`` and one BLAS thread."""
@@ -185,39 +153,23 @@ class NodeServer:
             gc.unfreeze()
 
     def poll(self, timeout_s: float) -> int:
-        """Wait up to ``timeout_s`` for datagrams, handle up to ``batch`` of them; return how many."""
-        handled = 0
-        if self.selector.select(timeout_s):
-            while handled < self.config.batch:
-                try:
-                    data, addr = self.sock.recvfrom(65_535)
-                except (BlockingIOError, InterruptedError):
-                    break
-                except OSError as exc:  # e.g. an ICMP error reported on the socket
-                    log_event(self.log, "socket_error", logging.WARNING, error=str(exc))
-                    break
-                handled += 1
-                self._cpu_received = time.thread_time()
-                try:
-                    self.handle(data, addr, time.perf_counter())
-                except Exception as exc:  # noqa: BLE001 (a bug of the node must not stop the loop)
-                    self.counters.add("handler_errors")
-                    log_event(self.log, "handler_error", logging.ERROR, sender=list(addr), error=repr(exc))
-        self._timers()
-        return handled
+        """Wait up to ``timeout_s`` for messages, handle them; return how many."""
+        raise NotImplementedError
 
-    def handle(self, data: bytes, addr: Address, t_received: float) -> None:
-        """Process one datagram read at ``t_received`` (``time.perf_counter`` seconds)."""
+    def _publish(self, team: TeamState) -> None:
+        raise NotImplementedError
+
+    def accept(self, sender: Hashable, t_received: float) -> bool:
+        """Count one received message of ``sender``; False when the sender is rate-limited (counted)."""
         self.counters.add("received")
-        if not self._allow(addr, t_received):
+        if not self._allow(sender, t_received):
             self.counters.add("rate_limited")
-            return
-        try:
-            message = decode(data)
-        except MessageError as exc:
-            self.counters.reject(exc.reason)
-            log_event(self.log, "rejected", logging.DEBUG, sender=list(addr), reason=exc.reason, detail=exc.detail)
-            return
+            return False
+        return True
+
+    def handle_message(self, message: HeadingReport | DetectionsMessage, sender: Hashable,
+                       t_received: float) -> None:
+        """Process one decoded report or frame of ``sender`` read at ``t_received`` (``time.perf_counter`` s)."""
         if isinstance(message, HeadingReport):
             dropped = self.identifier.queue_dropped
             outcome = self.identifier.add_report(message)
@@ -225,22 +177,19 @@ class NodeServer:
             if self.identifier.queue_dropped > dropped:
                 self.counters.add("queue_dropped", self.identifier.queue_dropped - dropped)
             if outcome == "reports":
-                self._robot_addr[message.robot] = addr
+                if isinstance(sender, tuple):
+                    self._robot_addr[message.robot] = sender
             else:
-                log_event(self.log, outcome, logging.DEBUG, sender=list(addr), robot=message.robot, seq=message.seq)
-        elif isinstance(message, DetectionsMessage):
-            self._frame(message, addr, t_received)
-        elif isinstance(message, StatusRequest):
-            self.counters.add("status_requests")
-            self._send(encode(Status(counters=self.counters.snapshot())), [addr], counted=False)
-        else:  # a team or status message sent to the node
-            self.counters.reject(UNEXPECTED)
+                log_event(self.log, outcome, logging.DEBUG, sender=_show(sender), robot=message.robot,
+                          seq=message.seq)
+        else:
+            self._frame(message, sender, t_received)
 
-    def _frame(self, message: DetectionsMessage, addr: Address, t_received: float) -> None:
+    def _frame(self, message: DetectionsMessage, addr: Hashable, t_received: float) -> None:
         identifier = self.identifier
         if self._camera is not None and addr != self._camera and not identifier.camera_lost:
             self.counters.add("other_camera")
-            log_event(self.log, "other_camera", logging.DEBUG, sender=list(addr), frame=message.frame)
+            log_event(self.log, "other_camera", logging.DEBUG, sender=_show(addr), frame=message.frame)
             return
         restarts, robot_resets = identifier.restarts, identifier.robot_resets
         try:
@@ -260,7 +209,7 @@ class NodeServer:
             log_event(self.log, "robot_reset", frame=message.frame, time=message.time)
         self.counters.add(outcome)
         if team is None:
-            log_event(self.log, outcome, logging.DEBUG, sender=list(addr), frame=message.frame)
+            log_event(self.log, outcome, logging.DEBUG, sender=_show(addr), frame=message.frame)
             return
         self._publish(team)
         self.counters.latency_s.append(time.perf_counter() - t_received)
@@ -274,31 +223,7 @@ class NodeServer:
             self.counters.cpu_s.append(cpu_sent - self._cpu_received)
             self.counters.cpu_with_prepare_s.append(time.thread_time() - self._cpu_received)
 
-    def _publish(self, team: TeamState) -> None:
-        try:
-            data = encode(team)
-        except ValueError as exc:
-            log_event(self.log, "encode_error", logging.ERROR, frame=team.frame, error=str(exc))
-            return
-        targets = list(self.config.publish)
-        if self.config.group is not None:
-            targets.append(self.config.group)
-        elif self.config.reply_to_robots:
-            targets += [a for a in self._robot_addr.values() if a not in targets]
-        self._send(data, targets)
-
-    def _send(self, data: bytes, targets: list[Address], counted: bool = True) -> None:
-        """Send ``data`` to each target; team states count as ``published``."""
-        for target in targets:
-            try:
-                self.sock.sendto(data, target)
-                if counted:
-                    self.counters.add("published")
-            except OSError as exc:
-                self.counters.add("send_errors")
-                log_event(self.log, "send_error", logging.WARNING, target=list(target), error=str(exc))
-
-    def _allow(self, addr: Address, now: float) -> bool:
+    def _allow(self, addr: Hashable, now: float) -> bool:
         """Token bucket per sender address."""
         bucket = self._buckets.get(addr)
         if bucket is None:
@@ -324,3 +249,115 @@ class NodeServer:
         if self.config.status_interval_s > 0 and now >= self._next_status:
             self._next_status = now + self.config.status_interval_s
             log_event(self.log, "status", line=self.counters.status_line(), counters=self.counters.snapshot())
+
+
+class NodeServer(NodeCore):
+    """The running UDP node. Use as a context manager; ``serve(stop)`` loops until ``stop()`` is true."""
+
+    def __init__(self, tracker: object, config: NodeConfig | None = None,
+                 identifier_config: IdentifierConfig | None = None,
+                 logger: logging.Logger | None = None) -> None:
+        super().__init__(tracker, config, identifier_config, logger)
+        self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, self.config.recv_buffer_bytes)
+            self.sock.bind(self.config.listen)
+            if self.config.group is not None:
+                self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF,
+                                     socket.inet_aton(self.config.group_interface))
+                self.sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+        except OSError:
+            self.sock.close()
+            raise
+        self.sock.setblocking(False)
+        self.selector = selectors.DefaultSelector()
+        self.selector.register(self.sock, selectors.EVENT_READ)
+        _preload()  # (before the address is announced: the first frame does not wait for imports)
+        log_event(self.log, "listening", address=list(self.address))
+
+    @property
+    def address(self) -> Address:
+        """The bound ``(host, port)``."""
+        return self.sock.getsockname()
+
+    def __enter__(self) -> NodeServer:  # noqa: PYI034
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Log the final counters and close the socket."""
+        if self.sock.fileno() >= 0:
+            log_event(self.log, "stopped", counters=self.counters.snapshot())
+            self.selector.close()
+            self.sock.close()
+
+    def poll(self, timeout_s: float) -> int:
+        """Wait up to ``timeout_s`` for datagrams, handle up to ``batch`` of them; return how many."""
+        handled = 0
+        if self.selector.select(timeout_s):
+            while handled < self.config.batch:
+                try:
+                    data, addr = self.sock.recvfrom(65_535)
+                except (BlockingIOError, InterruptedError):
+                    break
+                except OSError as exc:  # e.g. an ICMP error reported on the socket
+                    log_event(self.log, "socket_error", logging.WARNING, error=str(exc))
+                    break
+                handled += 1
+                self._cpu_received = time.thread_time()
+                try:
+                    self.handle(data, addr, time.perf_counter())
+                except Exception as exc:  # noqa: BLE001 (a bug of the node must not stop the loop)
+                    self.counters.add("handler_errors")
+                    log_event(self.log, "handler_error", logging.ERROR, sender=list(addr), error=repr(exc))
+        self._timers()
+        return handled
+
+    def handle(self, data: bytes, addr: Address, t_received: float) -> None:
+        """Process one datagram read at ``t_received`` (``time.perf_counter`` seconds)."""
+        if not self.accept(addr, t_received):
+            return
+        try:
+            message = decode(data)
+        except MessageError as exc:
+            self.counters.reject(exc.reason)
+            log_event(self.log, "rejected", logging.DEBUG, sender=list(addr), reason=exc.reason, detail=exc.detail)
+            return
+        if isinstance(message, (HeadingReport, DetectionsMessage)):
+            self.handle_message(message, addr, t_received)
+        elif isinstance(message, StatusRequest):
+            self.counters.add("status_requests")
+            self._send(encode(Status(counters=self.counters.snapshot())), [addr], counted=False)
+        else:  # a team or status message sent to the node
+            self.counters.reject(UNEXPECTED)
+
+    def _publish(self, team: TeamState) -> None:
+        try:
+            data = encode(team)
+        except ValueError as exc:
+            log_event(self.log, "encode_error", logging.ERROR, frame=team.frame, error=str(exc))
+            return
+        targets = list(self.config.publish)
+        if self.config.group is not None:
+            targets.append(self.config.group)
+        elif self.config.reply_to_robots:
+            targets += [a for a in self._robot_addr.values() if a not in targets]
+        self._send(data, targets)
+
+    def _send(self, data: bytes, targets: list[Address], counted: bool = True) -> None:
+        """Send ``data`` to each target; team states count as ``published``."""
+        for target in targets:
+            try:
+                self.sock.sendto(data, target)
+                if counted:
+                    self.counters.add("published")
+            except OSError as exc:
+                self.counters.add("send_errors")
+                log_event(self.log, "send_error", logging.WARNING, target=list(target), error=str(exc))
+
+
+def _show(sender: Hashable) -> object:
+    """A sender as logged: an address as ``[host, port]``, anything else as its text."""
+    return list(sender) if isinstance(sender, tuple) else str(sender)
