@@ -60,7 +60,7 @@ def _overlap(a: list[float], b: list[float]) -> bool:
     return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
 
 
-def test_demo_report_opens_without_errors_and_shows_every_image(tmp_path):
+def test_demo_report_plays_every_video_from_its_poster_with_the_legend_clear(tmp_path):
     sync_playwright, executable = _browser_or_skip()
     pytest.importorskip("cv2")
     from typer.testing import CliRunner
