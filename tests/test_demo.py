@@ -47,7 +47,8 @@ def test_demo_videos_start_after_the_warm_up_on_their_still(demo_out):
         assert 0 < len(clip) <= frames, name  # the warm-up's frames are left out
         still = cv2.imread(str(out / f"{name}-still.png"))
         assert clip[0].shape == still.shape  # the caption and legend band above the picture included
-        assert np.abs(clip[0].astype(int) - still.astype(int)).mean() < 4, name  # the first frame is the still
+        off = (np.abs(clip[0].astype(int) - still.astype(int)).max(axis=2) > 60).mean()
+        assert off < 0.0075, name  # the first frame is the still (the next frame differs in 1-8 % of its pixels)
     assert video_info(out / "divers-raw.mp4")[0] == QUICK.diver_video_frames  # the raw video has every frame
 
 
