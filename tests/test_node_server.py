@@ -29,10 +29,8 @@ HEADINGS = [0.0, 2.0, -2.0]
 
 
 @contextmanager
-def running_node(**config):
-    """A node on an ephemeral loopback port, served by a background thread until the block ends."""
-    tracker = HeadingMatcher()
-    server = NodeServer(tracker, NodeConfig(status_interval_s=0, **config), IdentifierConfig(n_robots=3))
+def serving(server):
+    """Serve ``server`` (a node) on a background thread until the block ends, then close it."""
     stop = threading.Event()
     thread = threading.Thread(target=server.serve, args=(stop.is_set, 0.01), daemon=True)
     thread.start()
@@ -43,6 +41,14 @@ def running_node(**config):
         thread.join(timeout=10)
         server.close()
     assert not thread.is_alive(), "the node did not stop"
+
+
+@contextmanager
+def running_node(**config):
+    """A node on an ephemeral loopback port, served by a background thread until the block ends."""
+    tracker = HeadingMatcher()
+    with serving(NodeServer(tracker, NodeConfig(status_interval_s=0, **config), IdentifierConfig(n_robots=3))) as s:
+        yield s
 
 
 def _detections(k, t=None):
