@@ -142,6 +142,7 @@ def _cases() -> list[tuple[str, list[str], str]]:
          "ray"),
         ("torch", ["train", "-o", "runs"], "train"),
         ("torch", ["train-appearance", "-o", "runs"], "train"),
+        ("cyclonedds", ["serve", "-t", "set", "--transport", "dds", "--duration", "1"], "ros"),
     ]
 
 

@@ -17,7 +17,7 @@ from lookalike.cli.app import app, check_outputs_or_fail, fail, failing
 from lookalike.cli.track import build_tracker
 from lookalike.io.outputs import write_atomic
 from lookalike.node import Endpoint, IdentifierConfig, NodeConfig, NodeServer, TeamState, log_event, parse_address
-from lookalike.node.server import check_group
+from lookalike.node.server import check_group, dds_node
 from lookalike.node.teamsim import SimClock, camera_messages, run_camera, run_robot, team_sequence
 from lookalike.sim.presets import PRESET_NAMES
 from lookalike.trackers import tracker_parameters
@@ -86,8 +86,11 @@ def serve(
     duration: float = typer.Option(0.0, help="Stop after this many wall seconds (0: run until SIGINT/SIGTERM)."),
     port_file: Path | None = typer.Option(None, help="Write the bound HOST:PORT to this file once listening."),
     log_level: str = typer.Option("info", help="debug, info, warning or error."),
+    transport: str = typer.Option("udp", help="udp (JSON datagrams, no extra) or dds: ROS 2 topics over DDS "
+                                  "(sensor_msgs/Imu in, geometry_msgs/PoseArray out; the 'ros' extra)."),
+    domain_id: int = typer.Option(0, help="With --transport dds: the DDS domain (ROS_DOMAIN_ID)."),
 ) -> None:
-    """Run the observer node: receive heading reports and detections over UDP, identify the
+    """Run the observer node: receive heading reports and detections over UDP (or DDS), identify the
     robots with a tracker, publish their positions at the camera rate. Logs are JSON Lines on
     stderr; send a status_request message for the counters."""
     listen_address = _address(listen, "--listen")
@@ -108,14 +111,17 @@ def serve(
                             reply_to_robots=reply, group=group_address, sender_rate=rate, sender_burst=burst,
                             camera_timeout_s=camera_timeout, status_interval_s=status_interval)
         id_config = IdentifierConfig(n_robots=robots, max_report_age_s=max_report_age)
-        server = NodeServer(trk, config, id_config, log)
+        if transport not in ("udp", "dds"):
+            raise ValueError(f"--transport: expected udp or dds, got {transport!r}")
+        server = NodeServer(trk, config, id_config, log) if transport == "udp" else dds_node(
+            trk, domain_id, config, id_config, log)
     except OSError as exc:
         fail(f"--listen {listen}: {exc}")
     except ValueError as exc:
         fail(str(exc))
     with server, _Stop(duration) as stop:
-        host, port = server.address
-        if port_file is not None:
+        if port_file is not None and isinstance(server, NodeServer):
+            host, port = server.address
             write_atomic(port_file, f"{host}:{port}\n")
         server.serve(stop)
         if stop.signal is not None:

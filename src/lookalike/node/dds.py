@@ -153,16 +153,6 @@ class DdsNode(NodeCore):
                   headings=heading_topic(topics.heading, 0), detections=topics.detections, poses=topics.poses,
                   identity=topics.identity)
 
-    def __enter__(self) -> DdsNode:  # noqa: PYI034
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def close(self) -> None:
-        """Log the final counters (the participant goes with the node)."""
-        log_event(self.log, "stopped", counters=self.counters.snapshot())
-
     def poll(self, timeout_s: float) -> int:
         """Wait up to ``timeout_s`` for samples, handle them in source-time order; return how many."""
         handled = 0

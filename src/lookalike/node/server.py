@@ -156,6 +156,16 @@ class NodeCore:
         """Wait up to ``timeout_s`` for messages, handle them; return how many."""
         raise NotImplementedError
 
+    def __enter__(self) -> NodeCore:  # noqa: PYI034
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Log the final counters."""
+        log_event(self.log, "stopped", counters=self.counters.snapshot())
+
     def _publish(self, team: TeamState) -> None:
         raise NotImplementedError
 
@@ -361,3 +371,12 @@ class NodeServer(NodeCore):
 def _show(sender: Hashable) -> object:
     """A sender as logged: an address as ``[host, port]``, anything else as its text."""
     return list(sender) if isinstance(sender, tuple) else str(sender)
+
+
+def dds_node(tracker: object, domain_id: int, config: NodeConfig | None = None,
+             identifier_config: IdentifierConfig | None = None, logger: logging.Logger | None = None) -> NodeCore:
+    """The node on DDS with ROS 2's names (:class:`lookalike.node.dds.DdsNode`) in domain ``domain_id``; raises
+    :class:`lookalike._optional.MissingExtra` without the ``ros`` extra."""
+    from lookalike.node.dds import DdsConfig, DdsNode
+
+    return DdsNode(tracker, DdsConfig(domain_id=domain_id), config, identifier_config, logger)
