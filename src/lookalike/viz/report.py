@@ -25,9 +25,10 @@ th { background: #f4f4f4; text-align: left; } td.num { text-align: right; font-v
 figure { display: inline-block; margin: 0.6em 1em 0.6em 0; vertical-align: top; }
 figure img, figure video { max-width: 100%; border: 1px solid #ccc; } figcaption { font-size: 0.85em; color: #555; }
 .note { color: #555; font-size: 0.9em; }
-.legend { font-size: 0.85em; margin: 0 0 4px; display: flex; flex-wrap: wrap; gap: 4px 16px; }
+.legend { font-size: 0.85em; margin: 0 0 4px; padding: 5px 8px; box-sizing: border-box; display: flex;
+          flex-wrap: wrap; gap: 4px 16px; background: #202020; color: #eee; max-width: 100%; }
 .legend span { display: inline-flex; align-items: center; gap: 6px; }
-.legend i { display: inline-block; width: 22px; height: 11px; border: 3px solid; background: #202020; }
+.legend i { display: inline-block; width: 22px; height: 11px; border: 3px solid; }
 """
 
 
@@ -127,7 +128,7 @@ class HtmlReport:
         where = "embedded here; also" if embedded else "played from"
         name = html.escape(Path(target).name)
         self._blocks.append(
-            "<figure>" + (f'<div class="legend">{keys}</div>' if keys else "")
+            "<figure>" + (f'<div class="legend"{style}>{keys}</div>' if keys else "")
             + f'<video controls muted playsinline preload="auto" src="{src}"{cover}{style}></video>'
             f'<figcaption>{html.escape(caption)} ({where} <a href="{href}">{name}</a>, a file beside this report)'
             "</figcaption></figure>"
