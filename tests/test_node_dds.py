@@ -15,10 +15,10 @@ import pytest
 
 pytest.importorskip("cyclonedds", reason="the DDS transport needs the 'ros' extra (cyclonedds)")
 
+from lookalike.io.rosmap import dds_topic, dds_type, quaternion, stamp, yaw  # noqa: E402
 from lookalike.node import IdentifierConfig, NodeConfig, TeamIdentifier  # noqa: E402
 from lookalike.node.dds import DdsConfig, DdsNode, DdsPeer, detections_message, team_state  # noqa: E402
 from lookalike.node.messages import DetectionsMessage, HeadingReport  # noqa: E402
-from lookalike.node.rosmap import dds_topic, dds_type, quaternion, stamp, yaw  # noqa: E402
 from lookalike.node.teamsim import camera_messages, robot_reports, team_sequence  # noqa: E402
 from lookalike.trackers import make_tracker  # noqa: E402
 from tests.test_node_server import serving  # noqa: E402

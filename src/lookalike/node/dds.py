@@ -1,7 +1,7 @@
 """The observer node over DDS with ROS 2's topic and type names (the ``ros`` extra; no ROS installation): headings
 in as ``sensor_msgs/Imu`` per robot, the camera's detections as ``vision_msgs/Detection2DArray``, identified
 positions out as ``geometry_msgs/PoseArray`` and ``lookalike_msgs/TeamIdentity``. :class:`DdsPeer` is the other
-side (robots and camera) in Python. The mapping is :mod:`lookalike.node.rosmap`.
+side (robots and camera) in Python. The mapping is :mod:`lookalike.io.rosmap`.
 
 Quality of service: the node reads best-effort (it matches both reliable and best-effort publishers, as ROS 2's
 sensor-data profile is) and writes reliable, both volatile, keep-last ``depth``; samples are plain CDR (XCDR1), as
@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from lookalike._optional import needs
+from lookalike.io.rosmap import Topics, dds_topic, heading_topic, quaternion, seconds, stamp, stamp_ns, yaw
 from lookalike.node.counters import log_event
 from lookalike.node.identifier import IdentifierConfig
 from lookalike.node.messages import (
@@ -26,7 +27,6 @@ from lookalike.node.messages import (
     RobotEstimate,
     TeamState,
 )
-from lookalike.node.rosmap import Topics, dds_topic, heading_topic, quaternion, seconds, stamp, stamp_ns, yaw
 from lookalike.node.server import NodeConfig, NodeCore, _preload
 
 MAX_DOMAIN_ID = 232  # DDS domain ids 0 .. 232 (ROS_DOMAIN_ID)

@@ -15,7 +15,7 @@ with needs("cyclonedds"):
     from cyclonedds.idl import IdlStruct
     from cyclonedds.idl.types import array, float64, int32, sequence, uint32, uint64
 
-from lookalike.node.rosmap import TEAM_IDENTITY, dds_type
+from lookalike.io.rosmap import TEAM_IDENTITY, dds_type
 
 
 def _zeros(n: int) -> "list[float]":
@@ -162,7 +162,7 @@ class Detection2DArray(IdlStruct, typename=dds_type("vision_msgs/msg/Detection2D
 @dataclass
 @annotate.final
 class TeamIdentity(IdlStruct, typename=dds_type(TEAM_IDENTITY)):
-    """``lookalike_msgs/TeamIdentity`` (:data:`lookalike.node.rosmap.TEAM_IDENTITY_MSG`)."""
+    """``lookalike_msgs/TeamIdentity`` (:data:`lookalike.io.rosmap.TEAM_IDENTITY_MSG`)."""
 
     header: Header = field(default_factory=Header)
     frame: uint64 = 0

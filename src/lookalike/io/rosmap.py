@@ -33,6 +33,19 @@ int32[] labels                # per detection of the frame, the robot id it was 
 """
 """The ROS 2 interface definition (``lookalike_msgs/msg/TeamIdentity.msg``) of the identity message."""
 
+VISION_MSGS = {
+    "vision_msgs/msg/Point2D": "float64 x\nfloat64 y\n",
+    "vision_msgs/msg/Pose2D": "vision_msgs/Point2D position\nfloat64 theta\n",
+    "vision_msgs/msg/BoundingBox2D": "vision_msgs/Pose2D center\nfloat64 size_x\nfloat64 size_y\n",
+    "vision_msgs/msg/ObjectHypothesis": "string class_id\nfloat64 score\n",
+    "vision_msgs/msg/ObjectHypothesisWithPose": "vision_msgs/ObjectHypothesis hypothesis\n"
+                                                "geometry_msgs/PoseWithCovariance pose\n",
+    "vision_msgs/msg/Detection2D": "std_msgs/Header header\nvision_msgs/ObjectHypothesisWithPose[] results\n"
+                                   "vision_msgs/BoundingBox2D bbox\nstring id\n",
+    "vision_msgs/msg/Detection2DArray": "std_msgs/Header header\nvision_msgs/Detection2D[] detections\n",
+}
+"""The vision_msgs 4 (ROS 2 Humble and later) definitions lookalike uses, dependencies first."""
+
 
 def dds_topic(ros_topic: str) -> str:
     """The DDS topic of a ROS 2 topic as ROS 2's DDS middlewares name it (``/a/b`` → ``rt/a/b``)."""
