@@ -143,6 +143,7 @@ def _cases() -> list[tuple[str, list[str], str]]:
         ("torch", ["train", "-o", "runs"], "train"),
         ("torch", ["train-appearance", "-o", "runs"], "train"),
         ("cyclonedds", ["serve", "-t", "set", "--transport", "dds", "--duration", "1"], "ros"),
+        ("rosbags", ["simulate", "--frames", "3", "--bag", "-o", "sims"], "ros"),
     ]
 
 

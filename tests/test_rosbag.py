@@ -99,3 +99,19 @@ def test_bag_with_images_replays_through_the_pixel_pipeline(tmp_path):
 
     direct = identify(pixel_frames(images, sequence), tmp_path / "direct.txt")
     assert identify(pixel_frames(back, replay.sequence), tmp_path / "bag.txt") == direct
+
+
+def test_simulate_bag_writes_a_bag_beside_the_jsonl(tmp_path):
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    args = ["simulate", "--preset", "m3n2", "--frames", "20", "--seed", "4", "--bag", "-o", str(tmp_path)]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    bag, jsonl = tmp_path / "m3n2-000004", tmp_path / "m3n2-000004.jsonl"
+    assert "(rosbag2)" in result.output and bag_topics(bag)["/robot_1/imu"] == "sensor_msgs/msg/Imu"
+    assert np.array_equal(read_bag(bag).sequence.arrays.det_label, read_robot_sequence(jsonl).arrays.det_label)
+    again = CliRunner().invoke(app, args)
+    assert again.exit_code != 0 and "exists" in again.output  # never overwritten
+    assert CliRunner().invoke(app, [*args[:-3], "--images", "-o", str(tmp_path / "x")]).exit_code != 0  # needs --bag

@@ -6,9 +6,11 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_names, check_outputs_or_fail, console
+from lookalike.cli.app import app, check_names, check_outputs_or_fail, console, fail, failing
 from lookalike.io.robot_sequences import write_robot_sequence
+from lookalike.io.rosbag import write_bag
 from lookalike.sim import DEFAULT_NOISE, NOISE_MODELS, PRESET_NAMES, preset, simulate_robots
+from lookalike.viz.robot_pixels import pixel_camera, render_robot_frames
 
 
 @app.command()
@@ -21,6 +23,10 @@ def simulate(
     noise: str = typer.Option(DEFAULT_NOISE, "--noise",
                               help="Position-noise model: paper (the robot-identification paper's, larger across the "
                               "image) or ours (larger in depth)."),
+    bag: bool = typer.Option(False, "--bag", help="Also write each sequence as a rosbag2 folder (ROS 2 messages: "
+                             "headings, detections, truth; the 'ros' extra)."),
+    images: bool = typer.Option(False, "--images", help="With --bag: render the camera frames into the bag "
+                                "(sensor_msgs/Image; the 'vision' extra)."),
 ) -> None:
     """Simulate identical robots seen by an observer, with heading reports; write JSON Lines files.
 
@@ -29,6 +35,8 @@ def simulate(
     check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})
     check_names("--preset", [preset_name], PRESET_NAMES, "preset")
     check_names("--noise", [noise], NOISE_MODELS, "noise model")
+    if images and not bag:
+        fail("--images: goes with --bag (the images are written into the bag)")
     cfg = preset(preset_name, noise)
     for k in range(sequences):
         seq = simulate_robots(cfg, frames, seed + k)
@@ -36,5 +44,9 @@ def simulate(
         a = seq.arrays
         console.print(f"wrote {path}: {frames} frames, {int(a.det_valid.sum())} detections, "
                       f"{len(a.reports.agent_id)} reports", markup=False)
+        if bag:
+            frames_bgr = (r.image for r in render_robot_frames(seq, pixel_camera(), seed + k)) if images else None
+            with failing(ValueError, OSError, prefix="--bag: "):
+                console.print(f"wrote {write_bag(path.with_suffix(''), seq, frames_bgr)} (rosbag2)", markup=False)
         for line in seq.view_summary():
             console.print(line, markup=False, style="yellow" if line.startswith("warning") else None)

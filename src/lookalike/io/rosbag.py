@@ -74,6 +74,8 @@ def write_bag(path: str | Path, sequence: RobotSequence, images: Iterable[np.nda
         from rosbags.rosbag2 import Writer
     topics = topics or Topics()
     store, path = _typestore(), Path(path)
+    if path.exists():
+        raise ValueError(f"{path} exists: a bag is written into a new folder")
     t = store.types
     a, r = sequence.arrays, sequence.arrays.reports
     n = sequence.config.n_agents
