@@ -1,14 +1,29 @@
-"""The README's and the docs' shell commands work as written.
+r"""The README's and the docs' shell commands work as written, with the outcome they promise.
 
 Every ``lookalike ...`` command in a shell code block of README.md or docs/**/*.md is parsed by the
 CLI itself: the (sub)command must exist and its options and arguments must parse (names, types,
 required options), as ``lookalike`` would parse them before doing any work. Shell variables (``$J``)
-stand for a value that parses. Blocks preceded by the line ``<!-- doc-test: run -->`` are also run,
-in document order, in one temporary folder beside a link to ``../shared/data`` and to the
-repository's ``demo-out/`` (commands needing either skip when it is absent); blocks marked
-``<!-- doc-test: run slow -->`` run only with ``LOOKALIKE_DOC_TEST_SLOW=1``. Commands run in-process
-through typer's test runner. Python blocks preceded by the same marker run too, in the same folder
-(``exec``, after the shell blocks of the same documents).
+stand for a value that parses.
+
+A comment on the line(s) before a block says what the tests do with it::
+
+    <!-- doc-test: run            (or: run slow, or: skip WHY)
+    file sims/m3n2-000000.jsonl rows 61
+    output 'frames with each robot in view \(of 60\)'
+    figure 'lstm\s*│\s*([\d.]+)%' 98.8 0.5
+    -->
+
+or on one line, the clauses separated by ``;``: ``<!-- doc-test: run; file robots.txt rows 1+ -->``.
+
+``run`` blocks run in document order, each page in its own temporary folder beside a link to
+``../shared/data`` and to the repository's ``demo-out/`` (blocks needing either skip when it is absent);
+``run slow`` blocks only with ``LOOKALIKE_DOC_TEST_SLOW=1``. Commands run in-process through typer's test
+runner; Python blocks with the same marker run too (``exec``) in their page's folder. After a block ran,
+each expectation line is checked: ``file PATH`` (exists, not empty), optionally with ``rows N``,
+``rows A-B`` or ``rows N+`` (non-empty lines); ``output REGEX`` (found in the block's output, whitespace
+runs read as one space; quote it with '...'); ``figure REGEX VALUE TOL`` (the number REGEX's group
+captures is within TOL of VALUE). Every block of the README and the how-to guides that holds a command
+runs with at least one expectation, or says why not (``skip WHY``).
 """
 
 from __future__ import annotations
@@ -25,12 +40,34 @@ REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared"
 DOC_FILES = [REPO / "README.md", *sorted((REPO / "docs").rglob("*.md"))]
 SHELL_LANGS = {"sh", "bash", "shell", "console"}
-MARKER = re.compile(r"<!--\s*doc-test:\s*run(\s+slow)?\s*-->")
+MARKER = re.compile(r"<!--\s*doc-test:\s*(.*?)-->", re.S)
+MUST_RUN = [REPO / "README.md", *sorted((REPO / "docs" / "howto").glob("*.md"))]  # every command run or skipped
 RUN_SLOW = os.environ.get("LOOKALIKE_DOC_TEST_SLOW") == "1"
 # How the docs call the CLI: the entry point, its path in the venv, or the module.
 PREFIXES = (("lookalike",), (".venv/bin/lookalike",), ("python", "-m", "lookalike"),
             (".venv/bin/python", "-m", "lookalike"))
 SEPARATORS = {";", "&", "&&", "|", "||", "(", ")", "do", "done", "then", "fi"}
+
+
+@dataclass(frozen=True)
+class Block:
+    """A fenced code block of a document, with what its ``doc-test`` comment asks (see the module docstring)."""
+
+    doc: Path
+    line: int  # 1-based line of the block's first line
+    lang: str
+    text: str
+    mode: str  # "check" (no comment: commands parsed only), "run", "slow" or "skip"
+    expect: tuple[tuple[str, ...], ...] = ()  # expectation lines, split like a shell line
+    reason: str = ""  # why a "skip" block is not run
+
+    @property
+    def where(self) -> str:
+        return f"{self.doc.relative_to(REPO)}:{self.line}"
+
+    @property
+    def is_shell(self) -> bool:
+        return self.lang in SHELL_LANGS
 
 
 @dataclass(frozen=True)
@@ -40,7 +77,7 @@ class Command:
     doc: Path
     line: int  # 1-based line of the block's first line
     args: tuple[str, ...]
-    mode: str  # "check", "run" or "slow"
+    mode: str  # "check", "run", "slow" or "skip"
 
     @property
     def where(self) -> str:
@@ -50,13 +87,42 @@ class Command:
         return f"{self.where}: lookalike {' '.join(self.args)}"
 
 
-def shell_blocks(doc: Path) -> list[tuple[int, str, str]]:
-    """``(first line, text, mode)`` of every shell code block in ``doc``."""
-    return code_blocks(doc, SHELL_LANGS)
+def _marker(lines: list[str], fence: int) -> tuple[str, tuple[tuple[str, ...], ...], str]:
+    """``(mode, expectations, reason)`` from the ``doc-test`` comment ending on the last non-blank line before
+    line ``fence`` (0-based), or ``("check", (), "")`` when there is none. Clauses are separated by line breaks
+    or by ``;`` outside quotes."""
+    k = fence - 1
+    while k >= 0 and not lines[k].strip():
+        k -= 1
+    if k < 0 or not lines[k].rstrip().endswith("-->"):
+        return "check", (), ""
+    start = k
+    while start > 0 and "<!--" not in lines[start]:
+        start -= 1
+    found = MARKER.search("\n".join(lines[start:k + 1]))
+    if found is None:
+        return "check", (), ""
+    body = found.group(1).strip()
+    if body.split()[:1] == ["skip"]:
+        return "skip", (), " ".join(body.split()[1:])
+    clauses: list[tuple[str, ...]] = []
+    for line in body.splitlines():
+        lexer = shlex.shlex(line, posix=True, punctuation_chars=";")
+        lexer.whitespace_split = True
+        clause: list[str] = []
+        for token in [*lexer, ";"]:
+            if token == ";":
+                clauses += [tuple(clause)] if clause else []
+                clause = []
+            else:
+                clause.append(token)
+    first = list(clauses[0]) if clauses else []
+    assert first in (["run"], ["run", "slow"]), f"line {start + 1}: unknown doc-test marker {body!r}"
+    return ("slow" if len(first) == 2 else "run"), tuple(clauses[1:]), ""
 
 
-def code_blocks(doc: Path, langs: set[str]) -> list[tuple[int, str, str]]:
-    """``(first line, text, mode)`` of every code block of a language in ``langs`` in ``doc``."""
+def code_blocks(doc: Path, langs: set[str] | None = None) -> list[Block]:
+    """Every fenced code block of ``doc`` (of a language in ``langs``; ``None``: any), in document order."""
     lines = doc.read_text(encoding="utf-8").splitlines()
     blocks, i = [], 0
     while i < len(lines):
@@ -69,15 +135,16 @@ def code_blocks(doc: Path, langs: set[str]) -> list[tuple[int, str, str]]:
         while j < len(lines) and not lines[j].strip().startswith(ticks):
             body.append(lines[j][len(indent):] if lines[j].startswith(indent) else lines[j])
             j += 1
-        if lang in langs:
-            k = i - 1
-            while k >= 0 and not lines[k].strip():
-                k -= 1
-            marker = MARKER.search(lines[k]) if k >= 0 else None
-            mode = "check" if marker is None else ("slow" if marker.group(1) else "run")
-            blocks.append((i + 2, "\n".join(body), mode))
+        if langs is None or lang in langs:
+            mode, expect, reason = _marker(lines, i)
+            blocks.append(Block(doc, i + 2, lang, "\n".join(body), mode, expect, reason))
         i = j + 1
     return blocks
+
+
+def shell_blocks(doc: Path) -> list[Block]:
+    """Every shell code block of ``doc``."""
+    return code_blocks(doc, SHELL_LANGS)
 
 
 def split_commands(text: str) -> list[tuple[str, ...]]:
@@ -111,12 +178,8 @@ def split_commands(text: str) -> list[tuple[str, ...]]:
     return found
 
 
-def all_commands() -> list[Command]:
-    return [Command(doc, line, args, mode)
-            for doc in DOC_FILES for line, text, mode in shell_blocks(doc) for args in split_commands(text)]
-
-
-COMMANDS = all_commands()
+BLOCKS = [b for doc in DOC_FILES for b in code_blocks(doc, SHELL_LANGS | {"python"})]
+COMMANDS = [Command(b.doc, b.line, args, b.mode) for b in BLOCKS if b.is_shell for args in split_commands(b.text)]
 
 
 def _cli():
@@ -187,7 +250,7 @@ def test_make_targets_and_extras_exist():
     section = pyproject.split("[project.optional-dependencies]", 1)[1].split("\n[", 1)[0]
     extras = set(re.findall(r"^([\w-]+)\s*=", section, flags=re.M))
     for doc in DOC_FILES:
-        for _, text, _ in shell_blocks(doc):
+        for text in (b.text for b in shell_blocks(doc)):
             for target in re.findall(r"(?:^|[;&]\s*)make\s+([\w.-]+)", text, flags=re.M):
                 assert target in targets, f"{doc.relative_to(REPO)}: no Makefile target {target!r}"
         for names in re.findall(r"(?:\.|lookalike)\[([\w,-]+)\]", doc.read_text(encoding="utf-8")):
@@ -204,69 +267,178 @@ def test_benchmark_scripts_exist():
 
 # --- running the marked blocks -------------------------------------------------------------------
 
-RUNNABLE = [c for c in COMMANDS if c.mode in ("run", "slow")]
-_WORK: list[Path] = []  # the one working folder, made on first use
-_DONE: set[tuple[str, ...]] = set()  # commands already run there (the README repeats the guides' commands)
+RUNNABLE = [b for b in BLOCKS if b.mode in ("run", "slow")]
+_FOLDERS: dict[Path, Path] = {}  # each document's working folder, made on first use
 
 
-def _workdir(factory: pytest.TempPathFactory) -> Path:
-    """The working folder every marked block runs in, in document order; ``../shared`` and
-    ``demo-out`` link to the real ones where they exist."""
-    if not _WORK:
-        root = factory.mktemp("doc-commands")
+def _workdir(doc: Path, factory: pytest.TempPathFactory) -> Path:
+    """The folder the marked blocks of ``doc`` run in, in document order (one per document, so no page reads or
+    rewrites another's files); ``../shared`` and ``demo-out`` link to the real ones where they exist."""
+    if doc not in _FOLDERS:
+        root = factory.mktemp("doc-" + re.sub(r"\W+", "-", str(doc.relative_to(REPO))))
         work = root / "work"
         work.mkdir()
         if SHARED.is_dir():
             (root / "shared").symlink_to(SHARED, target_is_directory=True)
         if (REPO / "demo-out").is_dir():
             (work / "demo-out").symlink_to(REPO / "demo-out", target_is_directory=True)
-        _WORK.append(work)
-    return _WORK[0]
+        _FOLDERS[doc] = work
+    return _FOLDERS[doc]
 
 
-@pytest.mark.parametrize("cmd", RUNNABLE, ids=[f"{c.where}:{' '.join(c.args[:2])}" for c in RUNNABLE])
-def test_command_runs(cmd: Command, tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch):
-    if cmd.mode == "slow" and not RUN_SLOW:
-        pytest.skip("a slow documented command: set LOOKALIKE_DOC_TEST_SLOW=1 to run it")
-    joined = " ".join(cmd.args)
-    if "../shared/" in joined and not (SHARED / "data").is_dir():
-        pytest.skip(f"needs {SHARED / 'data'}, which is absent")
-    if "demo-out/" in joined and not (REPO / "demo-out").is_dir():
-        pytest.skip("needs demo-out/ from `make demo`")
+def _rows(path: Path) -> int:
+    with path.open("rb") as f:
+        return sum(1 for line in f if line.strip())
+
+
+def _in_range(n: int, spec: str) -> bool:
+    """``n`` against ``N``, ``A-B`` or ``N+``."""
+    if spec.endswith("+"):
+        return n >= int(spec[:-1])
+    low, _, high = spec.partition("-")
+    return int(low) <= n <= int(high or low)
+
+
+def check_expectations(block: Block, folder: Path, output: str) -> None:
+    """Every expectation of ``block`` holds for the files in ``folder`` and the block's ``output``."""
+    text = " ".join(output.split())
+    for exp in block.expect:
+        kind, *args = exp
+        what = f"{block.where}: expected {' '.join(exp)}"
+        if kind == "file":
+            path = folder / args[0]
+            assert path.is_file() and path.stat().st_size > 0, f"{what}, but {path} is missing or empty"
+            if args[1:2] == ["rows"]:
+                n = _rows(path)
+                assert _in_range(n, args[2]), f"{what}, but it has {n} rows"
+        elif kind == "output":
+            assert re.search(args[0], text), f"{what}; the output was:\n{output[-3000:]}"
+        elif kind == "figure":
+            found = re.search(args[0], text)
+            assert found, f"{what}; the output was:\n{output[-3000:]}"
+            value, expected, tol = float(found.group(1).replace(",", "")), float(args[1]), float(args[2])
+            assert abs(value - expected) <= tol, f"{what}, got {value}"
+        else:
+            raise AssertionError(f"{block.where}: unknown expectation {kind!r} (file, output or figure)")
+
+
+def _run_shell(block: Block) -> str:
     from typer.testing import CliRunner
 
     app, _ = _cli()
-    if cmd.args in _DONE:
-        return  # the same command, already run with the same inputs in the same folder
-    monkeypatch.chdir(_workdir(tmp_path_factory))
-    result = CliRunner().invoke(app, list(cmd.args))
-    if result.exit_code != 0:
-        detail = result.output[-3000:]
-        if result.exception is not None and not isinstance(result.exception, SystemExit):
-            import traceback
+    out = []
+    for args in split_commands(block.text):
+        result = CliRunner().invoke(app, list(args))
+        out.append(result.output)
+        if result.exit_code != 0:
+            detail = result.output[-3000:]
+            if result.exception is not None and not isinstance(result.exception, SystemExit):
+                import traceback
 
-            detail += "".join(traceback.format_exception(result.exception))[-3000:]
-        pytest.fail(f"{cmd} exited with {result.exit_code} in {Path.cwd()}:\n{detail}")
-    _DONE.add(cmd.args)
-
-
-PYTHON_BLOCKS = [(doc, line, text, mode) for doc in DOC_FILES for line, text, mode in code_blocks(doc, {"python"})
-                 if mode in ("run", "slow")]
+                detail += "".join(traceback.format_exception(result.exception))[-3000:]
+            pytest.fail(f"{block.where}: lookalike {' '.join(args)} exited with {result.exit_code} in "
+                        f"{Path.cwd()}:\n{detail}")
+    return "\n".join(out)
 
 
-@pytest.mark.parametrize("doc, line, text, mode", PYTHON_BLOCKS,
-                         ids=[f"{d.relative_to(REPO)}:{n}" for d, n, _, _ in PYTHON_BLOCKS])
-def test_python_block_runs(doc: Path, line: int, text: str, mode: str, tmp_path_factory: pytest.TempPathFactory,
-                           monkeypatch: pytest.MonkeyPatch):
-    """A marked Python block runs as written, in the folder where the marked shell blocks run."""
-    if mode == "slow" and not RUN_SLOW:
+def _run_python(block: Block) -> str:
+    import contextlib
+    import io
+
+    buffer = io.StringIO()
+    with contextlib.redirect_stdout(buffer):
+        exec(compile(block.text, block.where, "exec"), {"__name__": "__doc_test__"})
+    return buffer.getvalue()
+
+
+@pytest.mark.parametrize("block", RUNNABLE, ids=[f"{b.where}:{b.lang}" for b in RUNNABLE])
+def test_block_runs(block: Block, tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch):
+    """A marked block runs as written in its page's folder and gives the outcome its comment expects."""
+    if block.mode == "slow" and not RUN_SLOW:
         pytest.skip("a slow documented block: set LOOKALIKE_DOC_TEST_SLOW=1 to run it")
-    if "../shared/" in text and not (SHARED / "data").is_dir():
+    if "../shared/" in block.text and not (SHARED / "data").is_dir():
         pytest.skip(f"needs {SHARED / 'data'}, which is absent")
-    monkeypatch.chdir(_workdir(tmp_path_factory))
-    exec(compile(text, f"{doc.relative_to(REPO)}:{line}", "exec"), {"__name__": "__doc_test__"})
+    if "demo-out/" in block.text and not (REPO / "demo-out").is_dir():
+        pytest.skip("needs demo-out/ from `make demo`")
+    folder = _workdir(block.doc, tmp_path_factory)
+    monkeypatch.chdir(folder)
+    output = _run_shell(block) if block.is_shell else _run_python(block)
+    check_expectations(block, folder, output)
 
 
 def test_readme_python_example_is_run():
     """The README's Python example is marked to run (so it cannot rot unnoticed)."""
-    assert any(doc.name == "README.md" for doc, _, _, _ in PYTHON_BLOCKS)
+    assert any(b.doc.name == "README.md" and b.lang == "python" for b in RUNNABLE)
+
+
+def test_every_guide_command_runs_with_an_expected_outcome():
+    """Each block of the README and the how-to guides that holds a command (or Python) runs with at least one
+    expectation, or says why it cannot (a server, your own files, hours of training); every marked block anywhere
+    has an expectation."""
+    for block in BLOCKS:
+        has_command = block.lang == "python" or bool(split_commands(block.text))
+        if block.doc in MUST_RUN and has_command:
+            assert block.mode != "check", f"{block.where}: mark the block `doc-test: run` or `doc-test: skip WHY`"
+        if block.mode == "skip":
+            assert block.reason, f"{block.where}: say why the block is skipped"
+        if block.mode in ("run", "slow"):
+            assert block.expect, f"{block.where}: a run block needs an expected outcome (file, output or figure)"
+
+
+def test_expectations_are_checked():
+    """The checker refuses a missing file, a wrong row count, an absent output line and a figure out of tolerance."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        (folder / "a.txt").write_text("1\n2\n\n3\n")
+
+        def block(*lines: str) -> Block:
+            return Block(REPO / "README.md", 1, "sh", "", "run", tuple(shlex.split(x) for x in lines))
+
+        check_expectations(block("file a.txt rows 3", "file a.txt rows 2-4", "file a.txt rows 1+",
+                                 "output 'robot 1: [1-9]'", "figure 'lstm +([\\d.]+)%' 98.8 0.5"),
+                           folder, "robot 1:\n 12\nlstm   98.6%")
+        for bad in ("file b.txt", "file a.txt rows 4", "file a.txt rows 4+", "output 'robot 2'",
+                    "figure 'lstm +([\\d.]+)%' 97.0 0.5"):
+            with pytest.raises(AssertionError):
+                check_expectations(block(bad), folder, "robot 1: 12 lstm 98.6%")
+
+
+def test_robot_team_recipe(tmp_path: Path):
+    """robot-team.md's node and team blocks as written (another free port for 7700; the node stops after 90 s):
+    every robot hears its position, with the median errors the page gives, and nothing warns."""
+    if not RUN_SLOW:
+        pytest.skip("a slow documented recipe (about 35 s): set LOOKALIKE_DOC_TEST_SLOW=1 to run it")
+    import json
+    import socket
+    import subprocess
+    import sys
+
+    serve, team = [b for b in shell_blocks(REPO / "docs" / "howto" / "robot-team.md")
+                   if "lookalike serve" in b.text or "robot-sim" in b.text][:2]
+    assert "robot-sim" in team.text and "camera-sim" in team.text
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    bin_dir = Path(sys.executable).parent
+    env = {**os.environ, "PATH": f"{bin_dir}{os.pathsep}{os.environ.get('PATH', '')}"}
+    args = [a.replace("127.0.0.1:7700", f"127.0.0.1:{port}") for a in split_commands(serve.text)[0]]
+    node = subprocess.Popen([str(bin_dir / "lookalike"), *args, "--duration", "90"], cwd=tmp_path, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        script = team.text.replace("127.0.0.1:7700", f"127.0.0.1:{port}") + "\nwait\n"
+        done = subprocess.run(["bash", "-c", script], cwd=tmp_path, env=env, capture_output=True, text=True,
+                              timeout=120)
+    finally:
+        node.terminate()
+        node.wait(timeout=30)
+    assert done.returncode == 0, done.stderr[-2000:]
+    summaries = [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
+    robots = sorted((s for s in summaries if "robot" in s), key=lambda s: s["robot"])
+    assert [r["robot"] for r in robots] == [0, 1, 2], done.stdout
+    assert {"camera_frames_sent": 601} in summaries, done.stdout
+    assert all(r["positions"] > 0 for r in robots), robots
+    for r, median in zip(robots, (0.07, 1.6, 0.14)):  # the page's figures (loopback timing: a little slack)
+        assert abs(r["median_error_m"] - median) <= 0.05 + 0.1 * median, (r, median)
+    assert "warning" not in done.stderr, done.stderr[-2000:]
