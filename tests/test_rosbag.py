@@ -115,3 +115,33 @@ def test_simulate_bag_writes_a_bag_beside_the_jsonl(tmp_path):
     again = CliRunner().invoke(app, args)
     assert again.exit_code != 0 and "exists" in again.output  # never overwritten
     assert CliRunner().invoke(app, [*args[:-3], "--images", "-o", str(tmp_path / "x")]).exit_code != 0  # needs --bag
+
+
+def test_track_bag_matches_track_video_on_the_same_frames(tmp_path):
+    """``simulate --bag --images`` then ``track --bag``: the same rows as ``track --video`` on the same frames (as
+    lossless PNGs) with the run's ``.jsonl`` as ``--reports``."""
+    cv2 = pytest.importorskip("cv2", reason="the pixel pipeline needs the 'vision' extra")
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+    from lookalike.viz.robot_pixels import pixel_camera, render_robot_frames
+
+    runner = CliRunner()
+    made = runner.invoke(app, ["simulate", "--preset", "m3n2", "--frames", "12", "--seed", "3", "--bag", "--images",
+                               "-o", str(tmp_path)])
+    assert made.exit_code == 0, made.output
+    jsonl, bag, pngs = tmp_path / "m3n2-000003.jsonl", tmp_path / "m3n2-000003", tmp_path / "frames"
+    pngs.mkdir()
+    for k, rendered in enumerate(render_robot_frames(read_robot_sequence(jsonl), pixel_camera(), 3)):
+        cv2.imwrite(str(pngs / f"{k + 1:06d}.png"), rendered.image)
+    from_bag = runner.invoke(app, ["track", "--bag", str(bag), "--camera-topic", "/camera/image_raw",
+                                   "--heading-topics", "/robot_0/imu,/robot_1/imu", "-t", "set",
+                                   "-o", str(tmp_path / "bag.txt")])
+    assert from_bag.exit_code == 0, from_bag.output
+    from_video = runner.invoke(app, ["track", "--video", str(pngs), "--pipeline", "robots", "--reports", str(jsonl),
+                                     "-t", "set", "-o", str(tmp_path / "video.txt")])
+    assert from_video.exit_code == 0, from_video.output
+    rows = (tmp_path / "bag.txt").read_text()
+    assert rows.strip() and rows == (tmp_path / "video.txt").read_text()
+    refused = runner.invoke(app, ["track", "--bag", str(bag), "-t", "set", "-o", str(tmp_path / "x.txt")])
+    assert refused.exit_code != 0 and "--camera-topic" in refused.output

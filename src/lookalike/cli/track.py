@@ -232,9 +232,18 @@ def track(
                                    "a header line naming the columns, or frame,x1,y1,x2,y2,score[,class] told apart "
                                    "by their values; a note says what was assumed), 'mot', or the column names, e.g. "
                                    "frame,x1,y1,x2,y2,score,class ('frame0' for 0-based frames)."),
+    bag: Path | None = typer.Option(None, "--bag", help="A rosbag2 folder as input, through the robots pipeline "
+                                    "(sensor_msgs/Image and sensor_msgs/Imu; the 'ros' extra)."),
+    camera_topic: str | None = typer.Option(None, "--camera-topic", help="With --bag: the camera's image topic."),
+    heading_topics: str | None = typer.Option(None, "--heading-topics", help="With --bag: the robots' Imu topics, "
+                                              "comma-separated, robot 0 first (default /robot_0/imu, /robot_1/imu, "
+                                              "...)."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
-    branch = _check_branches(path, video, detections, annotate, detector, blob, pipeline, points)
+    if bag is not None and (any(x is not None for x in (path, video, detections, points, reports, detector)) or blob):
+        fail("--bag: the bag is the input; drop PATH/--video/--detections/--points/--reports/--detector/--blob")
+    branch = "pipeline" if bag is not None else _check_branches(path, video, detections, annotate, detector, blob,
+                                                                pipeline, points)
     open_set = targets == 0  # --targets 0: an open set, no number of targets inferred (blob videos)
     targets = targets or None
     if offline and targets is None:
@@ -261,8 +270,9 @@ def track(
 
                 if params_file is not None:
                     settings = [*(f"{k}={v}" for k, v in tracker_params(tracker, [], params_file).items()), *settings]
-                run_track_pixels(video, output, pipeline or "", reports, detector_model, heading_model, tracker,
-                                 settings, annotate=annotate, fps=fps, min_score=min_score, annotate_as=annotate_as)
+                run_track_pixels(video, output, pipeline or "robots", reports, detector_model, heading_model, tracker,
+                                 settings, annotate=annotate, fps=fps, min_score=min_score, annotate_as=annotate_as,
+                                 bag=bag, camera_topic=camera_topic, heading_topics=heading_topics)
                 return
             trk = _box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets,
                                params_file=params_file)

@@ -27,12 +27,13 @@ PIPELINES = ("robots",)
 SIZE_TOLERANCE = 2.0  # box height vs a robot's at its ground position; true boxes 0.79-1.48 on m5n3 seeds 11-12
 
 
-def _check(video: Path | None, pipeline: str, reports: Path | None, identifier: str, output: Path) -> None:
-    if video is None:
+def _check(video: Path | None, pipeline: str, reports: Path | None, identifier: str, output: Path,
+           bag: bool = False) -> None:
+    if video is None and not bag:
         fail("--pipeline: give the video with --video FILE")
     if pipeline not in PIPELINES:
         fail(f"--pipeline: choose one of {', '.join(PIPELINES)}, got {pipeline!r}")
-    if reports is None:
+    if reports is None and not bag:
         fail("--pipeline robots: needs --reports (the heading reports: a `lookalike simulate` .jsonl)")
     if identifier not in IDENTIFIERS:
         fail(f"--tracker: with --pipeline robots choose an identifier: {', '.join(IDENTIFIERS)} (got {identifier!r})")
@@ -43,18 +44,30 @@ def _check(video: Path | None, pipeline: str, reports: Path | None, identifier: 
 def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: Path | None, detector_model: Path | None,
                      heading_model: Path | None, identifier: str, settings: list[str], *,
                      annotate: Path | None = None, fps: float | None = None, min_score: float = 0.5,
-                     annotate_as: Path | None = None) -> None:
-    """Run pipeline ``pipeline`` over ``video`` with the reports of ``reports``; write MOTChallenge rows to ``output``
-    and, with ``annotate``, an annotated MP4 (printed as ``annotate_as``). ``min_score``: detector probability
-    (-inf: 0.5)."""
+                     annotate_as: Path | None = None, bag: Path | None = None, camera_topic: str | None = None,
+                     heading_topics: str | None = None) -> None:
+    """Run pipeline ``pipeline`` over ``video`` with the reports of ``reports`` (or over the rosbag2 folder ``bag``:
+    images of ``camera_topic``, headings of the comma-separated ``heading_topics``); write MOTChallenge rows to
+    ``output`` and, with ``annotate``, an annotated MP4 (printed as ``annotate_as``). ``min_score``: detector
+    probability (-inf: 0.5)."""
     from lookalike.viz.overlay import source_frames
     from lookalike.viz.video import VideoWriter
 
-    _check(video, pipeline, reports, identifier, output)
-    assert video is not None and reports is not None
+    _check(video, pipeline, reports, identifier, output, bag is not None)
+    if bag is not None and camera_topic is None:
+        fail("--bag: give --camera-topic (the sensor_msgs/Image topic the pipeline reads)")
+    source = video or bag
+    assert source is not None
     camera = pixel_camera()
-    with failing(ValueError, OSError, TypeError):
-        seq = read_robot_sequence(reports)
+    with failing(ValueError, OSError, TypeError, prefix="" if bag is None else "--bag: "):
+        if bag is not None:
+            from lookalike.io.rosbag import bag_images, read_bag
+
+            topics = [t.strip() for t in heading_topics.split(",") if t.strip()] if heading_topics else None
+            seq = read_bag(bag, camera_topic, topics).sequence
+        else:
+            assert reports is not None
+            seq = read_robot_sequence(reports)
         params = identifier_settings(identifier, camera) + tuple(parse_parameter(identifier, s) for s in settings)
         config = PipelineConfig(identifier=identifier, n_agents=seq.config.n_agents,
                                 max_detections=seq.config.max_detections,
@@ -62,7 +75,10 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
                                 identifier_params=tuple(dict(params).items()), field_m=seq.config.field_m,
                                 max_range_m=seq.config.observer.max_range_m, size_tolerance=SIZE_TOLERANCE)
         pipe = RobotPipeline.from_files(detector_model, heading_model, camera, config)
-        images, total, video_fps = source_frames(video)
+        if bag is not None:
+            images, total, video_fps = bag_images(bag, camera_topic or ""), len(seq), seq.config.frame_rate_hz
+        else:
+            images, total, video_fps = source_frames(source)
     if total and total > len(seq):
         fail(f"--reports: {reports} has {len(seq)} frames but the video has {total}")
     writer = VideoWriter(annotate, fps=fps or video_fps) if annotate is not None else None
@@ -75,11 +91,11 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
 
     try:
         with bars("identifying robots") as progress:
-            task = progress.add_task(video.name, total=total or None)
-            stats = identify_video(pipe, pixel_frames(images, seq, f"--reports: {reports}"), output, annotate=draw,
-                                   advance=lambda: progress.advance(task))
+            task = progress.add_task(source.name, total=total or None)
+            stats = identify_video(pipe, pixel_frames(images, seq, f"--reports: {reports or bag}"), output,
+                                   annotate=draw, advance=lambda: progress.advance(task))
     except ValueError as exc:
-        fail(f"{video}: {exc}")
+        fail(f"{source}: {exc}")
     finally:
         if writer is not None:
             writer.close()
