@@ -144,7 +144,7 @@ def _cases() -> list[tuple[str, list[str], str]]:
         ("torch", ["train-appearance", "-o", "runs"], "train"),
         ("cyclonedds", ["serve", "-t", "set", "--transport", "dds", "--duration", "1"], "ros"),
         ("rosbags", ["simulate", "--frames", "3", "--bag", "-o", "sims"], "ros"),
-        ("rosbags", ["track", "--bag", "run", "--camera-topic", "/camera/image_raw", "-t", "set", "-o", "t.txt"], "ros"),
+        ("rosbags", ["track", "--bag", "run", "--camera-topic", "/c", "-t", "set", "-o", "t.txt"], "ros"),
     ]
 
 
