@@ -220,3 +220,28 @@ def test_fit_video_features_links_boxes_into_chains(diver_scene):
     r = runner.invoke(app, ["track", "--video", str(root / "divers.mp4"), "--detections", str(det),
                             "-o", str(root / "x.txt"), "--features", "nope"])
     assert r.exit_code == 2 and "--features" in r.output
+
+
+def test_trackers_reading_no_appearance_get_no_features(diver_scene, tmp_path, monkeypatch):
+    """boxtrack and sort read boxes only: `track --video` fits and computes no appearance features for them (the
+    feature code is made to fail), and their rows are those of the same detections tracked as a file."""
+    import lookalike.cli.track_video as track_video_cli
+    import lookalike.viz.video_tracking as video_tracking
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("appearance features computed for a tracker that reads none")
+
+    monkeypatch.setattr(track_video_cli, "fit_video_features", refuse)
+    monkeypatch.setattr(video_tracking, "fit_video_features", refuse)
+    root, det = diver_scene
+    for tracker in ("boxtrack", "sort"):
+        out, plain = tmp_path / f"{tracker}.txt", tmp_path / f"{tracker}-plain.txt"
+        r = runner.invoke(app, ["track", "-t", tracker, "--video", str(root / "divers.mp4"), "--detections", str(det),
+                                "-o", str(out)])
+        assert r.exit_code == 0, r.output
+        r = runner.invoke(app, ["track", "-t", tracker, str(det), "-o", str(plain)])
+        assert r.exit_code == 0, r.output
+        video_rows, file_rows = read_mot(out), read_mot(plain)
+        assert len(video_rows) and np.array_equal(video_rows.frame, file_rows.frame)
+        assert np.array_equal(video_rows.track_id, file_rows.track_id)
+        assert np.allclose(video_rows.xywh, file_rows.xywh, atol=1e-3)

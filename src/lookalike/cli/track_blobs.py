@@ -74,4 +74,4 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
             options["team_size"] = plan.n_targets
         if plan.config != tracker.config:
             tracker = type(tracker)(plan.config)
-    run_track_video(video, det_path, output, tracker, tracker_name, **options)
+    run_track_video(video, det_path, output, tracker, tracker_name, length=frames, score_warnings=False, **options)

@@ -14,6 +14,7 @@ from lookalike.cli.track import dropped_all
 from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.io import read_mot, write_mot
 from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
+from lookalike.io.needs import input_kind
 from lookalike.io.outputs import atomic_path
 from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
 from lookalike.trackers.parts.health import HealthConfig
@@ -26,10 +27,12 @@ FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
 def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, tracker_name: str, *,
                     annotate: Path | None, team_size: int | None, health_window: int,
                     min_score: float, fps: float | None, features: str = "video",
-                    annotate_as: Path | None = None, det_format: str = "auto") -> None:
+                    annotate_as: Path | None = None, det_format: str = "auto", length: int | None = None,
+                    score_warnings: bool = True) -> None:
     """Track ``detections`` on ``video``; write ``output``, its ``.health.csv`` (``.merges.csv`` for merging
     trackers) and, with ``annotate``, the annotated MP4 (printed as ``annotate_as``). ``features``: ``video``,
-    ``divers``/``handcrafted``, ``learned`` or ``FILE.onnx`` (the ``--features`` option)."""
+    ``divers``/``handcrafted``, ``learned`` or ``FILE.onnx`` (the ``--features`` option). ``length``: the video's
+    decoded frames when known; ``score_warnings``: False for a detector whose scores are all 1 by design (blobs)."""
     if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
         fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
     check_result_file(output)
@@ -40,16 +43,20 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
         images, total, _ = source_frames(video)
         first = next(iter(images), None)
         size = (first.shape[1], first.shape[0]) if first is not None else None
-        with console.status("standardising appearance features"):
-            extractor = (fit_diver_features() if features in ("divers", "handcrafted")
-                         else fit_video_features(video, table, min_score=min_score) if features == "video"
-                         else diver_extractor(features))
+        if input_kind(tracker_name) == "boxes":  # reads no appearance: no features computed
+            extractor: Any = None
+        else:
+            with console.status("standardising appearance features"):
+                extractor = (fit_diver_features() if features in ("divers", "handcrafted")
+                             else fit_video_features(video, table, min_score=min_score) if features == "video"
+                             else diver_extractor(features))
     for line in notes:
         note(f"{detections}: {line}")
     scores, outside = box_stats(table.xywh, table.conf, size)
-    for line in det_warnings(detections, len(table), scores, outside, size, f"the frames of {video}"):
+    for line in det_warnings(detections, len(table), scores if score_warnings else None, outside, size,
+                             f"the frames of {video}"):
         warn(line)
-    hint = stored_thresholds(extractor).get(tracker_name)
+    hint = stored_thresholds(extractor).get(tracker_name) if extractor is not None else None
     if hint:
         console.print(f"note: {tracker_name}'s thresholds were chosen for the hand-crafted features; matched to "
                       f"{features} on the validation divers they are "
@@ -58,7 +65,7 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
         with bars("tracking {task.description}") as progress:
             task = progress.add_task(video.name, total=total or None)
             result = track_video(video, table, tracker, extractor, annotate=annotate, health=health,
-                                 fps=fps, min_score=min_score, advance=lambda: progress.advance(task))
+                                 fps=fps, min_score=min_score, advance=lambda: progress.advance(task), length=length)
     except ValueError as exc:
         fail(str(exc))
     except KeyboardInterrupt:

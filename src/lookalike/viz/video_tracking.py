@@ -6,8 +6,9 @@ unhealthy frame a red banner."""
 from __future__ import annotations
 
 import csv
+import itertools
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -117,12 +118,18 @@ def fit_video_features(source: Path | str, detections: MotTable, *, min_score: f
 def track_video(source: Path | str, detections: MotTable, tracker: Any, extractor: Any, *,
                 annotate: Path | str | None = None, health: HealthConfig | None = None,
                 fps: float | None = None, min_score: float = -np.inf, new_frames: int = 10,
-                tail: int = 25, advance: Callable[[], None] | None = None) -> VideoTrackingResult:
+                tail: int = 25, advance: Callable[[], None] | None = None,
+                length: int | None = None) -> VideoTrackingResult:
     """Run ``tracker`` (reset first) over ``source`` (a video file or image folder) with ``detections`` (1-based
-    frames, px), features from ``extractor(image, xywh)``; with ``annotate`` also write that MP4."""
+    frames, px), features from ``extractor(image, xywh)`` (None: none, for trackers that read no appearance); with
+    ``annotate`` also write that MP4. ``length``: the video's frames, when known (then, with neither features nor
+    ``annotate``, no frame is decoded)."""
     if new_frames < 1:
         raise ValueError(f"new_frames: must be >= 1, got {new_frames}")
+    images: Iterable[np.ndarray | None]
     images, n_declared, source_fps = source_frames(source)
+    if extractor is None and annotate is None and length is not None:
+        images = itertools.repeat(None, length)  # the tracker reads only the boxes
     rate = fps or source_frame_rate(source) or source_fps
     if not rate > 0:
         raise ValueError(f"fps: must be positive, got {rate!r}")
@@ -145,7 +152,8 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
             det = found.detections if found is not None else Detections.empty()
             t0 = time.perf_counter()
             assert det.xywh is not None  # box detections
-            feats = extractor(image, det.xywh) if len(det) else np.zeros((0, int(extractor.dim)))
+            feats = None if extractor is None else extractor(image, det.xywh) if len(det) else np.zeros(
+                (0, int(extractor.dim)))
             current["feature_s"] += time.perf_counter() - t0
             current["image"] = image
             yield Frame(index=k, time=k / rate, detections=det.replace(feature=feats))
