@@ -16,6 +16,7 @@ from lookalike.cli import app
 from lookalike.io import read_mot, write_mot
 from lookalike.tune.params_file import save_params
 from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows, detection_cache_key
+from lookalike.viz.video import read_frames
 
 runner = CliRunner()
 
@@ -162,9 +163,12 @@ def test_blob_settings_estimated_printed_and_overridden(tmp_path):
                             "boxtrack", "--targets", "3", "--offline", *confident, "-o", str(again)])
     assert r.exit_code == 0, r.output
     np.testing.assert_array_equal(np.loadtxt(again, delimiter=","), np.loadtxt(out, delimiter=","))
+    annotated = tmp_path / "a.mp4"  # the closed set's identities drawn on the video
     r = runner.invoke(app, ["track", "--video", str(video), "--detector", "blob", "-t", "boxtrack", "--targets", "3",
-                            "--offline", "--annotate", str(tmp_path / "a.mp4"), "-o", str(out)])
-    assert r.exit_code != 0 and "--offline: not with --annotate" in _one_line_error(r)
+                            "--offline", *confident, "--annotate", str(annotated), "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    np.testing.assert_array_equal(np.loadtxt(again, delimiter=","), np.loadtxt(out, delimiter=","))
+    assert sum(1 for _ in read_frames(annotated)) == sum(1 for _ in read_frames(video))
     config, estimate = auto_blob_config(video, ["threshold=50", "open_px=5"], 3)
     assert estimate is not None and (config.threshold, config.open_px) == (50.0, 5)
     assert config.polarity == estimate.config.polarity == "dark"

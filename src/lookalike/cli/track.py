@@ -248,8 +248,8 @@ def track(
     targets = targets or None
     if offline and targets is None:
         fail("--offline: needs --targets N (the known number of targets)")
-    if offline and (annotate is not None or branch == "pipeline"):
-        fail("--offline: not with --annotate or --pipeline (the closed set is decided after the whole video)")
+    if offline and branch == "pipeline":
+        fail("--offline: not with --pipeline (the robots' identities come from their reports, frame by frame)")
     if offline and tracker != "boxtrack":
         fail(f"--offline: the closed set's online pass is boxtrack; use -t boxtrack, not {tracker!r}")
     _refuse_overwriting_inputs(output, [path, video, detections, points, reports, params_file, detector_model,
@@ -302,7 +302,7 @@ def track(
                         with failing(ValueError, OSError):
                             _, count, rate = source_frames(video)
                         offline_video(det_path, output, targets, online, fps or rate, count or None, min_score,
-                                      det_format)
+                                      det_format, video=video, annotate=annotate, annotate_as=annotate_as)
                     else:
                         from lookalike.cli.track_video import run_track_video
 

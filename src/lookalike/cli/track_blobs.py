@@ -64,7 +64,8 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
     if offline is not None:
         assert n_targets
         offline = {**{k: v for k, v in BOX_TRACKER_PARAMS.items() if tracker_name == "boxtrack"}, **offline}
-        offline_video(det_path, output, n_targets, offline, float(frame_rate), frames, options["min_score"])
+        offline_video(det_path, output, n_targets, offline, float(frame_rate), frames, options["min_score"],
+                      video=video, annotate=options.get("annotate"), annotate_as=options.get("annotate_as"))
         return
     if tracker_name == "boxtrack":
         plan = blob_boxtrack_config(tracker.config, frame_counts(rows, frames), explicit, n_targets)

@@ -91,8 +91,10 @@ def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, An
 
 
 def offline_video(det_path: Path, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
-                  n_frames: int | None, min_score: float, det_format: str = "auto") -> None:
-    """``--video ... --offline``: the closed set over the detections at ``det_path``, written to ``output``."""
+                  n_frames: int | None, min_score: float, det_format: str = "auto", *, video: Path | None = None,
+                  annotate: Path | None = None, annotate_as: Path | None = None) -> None:
+    """``--video ... --offline``: the closed set over the detections at ``det_path``, written to ``output``; with
+    ``annotate``, its identities drawn on ``video`` into that MP4 (printed as ``annotate_as``)."""
     with failing(FileNotFoundError, ValueError):
         det = table_rows(det_path, min_score, det_format=det_format)
         with console.status(f"closed set of {n_targets}"):
@@ -100,6 +102,13 @@ def offline_video(det_path: Path, output: Path, n_targets: int, params: dict[str
     write_mot(output, rows)
     console.print(f"[green]boxtrack[/], offline closed set of {n_targets}: {len(np.unique(rows[:, 1]))} "
                   f"identities, {len(rows)} rows at {frame_rate:g} frames/s → {output}")
+    if annotate is not None and video is not None:
+        from lookalike.io import MotTable
+        from lookalike.viz.overlay import overlay_tracks
+
+        with failing(ValueError, OSError), console.status("drawing the identities"):
+            overlay_tracks(video, MotTable.from_rows(rows), annotate, fps=frame_rate)
+        console.print(f"annotated video → {escape(str(annotate_as or annotate))}")
 
 
 def read_points(path: Path) -> Any:
