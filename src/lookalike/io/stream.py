@@ -196,6 +196,12 @@ class MotWriter:
             self._fh.write(format_rows(block))
         self._pending, self._pending_rows = [], 0
 
+    def flush(self) -> None:
+        """Write the rows held so far to the temporary file now (a live run: rows on disk as they come)."""
+        self._flush()
+        if self._fh is not None:
+            self._fh.flush()
+
     def close(self) -> Path:
         """Finish the file: rename the temporary file to ``path``. Returns ``path``."""
         if self._fh is not None:
