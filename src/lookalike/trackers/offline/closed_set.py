@@ -11,12 +11,17 @@
 4. places the short pieces on the chains with a second MILP (:func:`place_short`);
 5. writes ids 1..N, fills gaps up to ``fill_gap_s`` seconds and smooths boxes by a running median.
 
+:class:`ChainConstraints` (a proofreader's corrections) cut tracks, fix a tracklet's identity, keep two tracklets on
+different identities or leave a tracklet out; the MILP then solves with them.
+
 :func:`track_closed_set` first runs the online pass (open-set ``boxtrack``, ``n_init=1``). Positions are
 pixels. The method and its parameters: docs/closed-set.md."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Collection, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -36,19 +41,47 @@ from lookalike.trackers.offline.tracklets import (
 from lookalike.trackers.registry import make_tracker, tracker_class
 from lookalike.types import Detections, Frame
 
-__all__ = ["ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale", "place_short",
-           "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
+__all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale",
+           "place_short", "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
+
+
+Row = tuple[int, int]  # (1-based frame, input id): one input row
+
+
+@dataclass(frozen=True)
+class ChainConstraints:
+    """Constraints on :func:`assign_identities`, each naming input rows by ``(frame, input id)`` (1-based frame, the
+    id the row has in the input).
+
+    ``cut``: the row's input track is cut just before it (so a constraint can hold from that frame on);
+    ``identity``: ``(row, j)``, the tracklet holding the row is identity ``j`` (1..N);
+    ``apart``: pairs of rows whose tracklets are never on one identity;
+    ``clutter``: rows whose tracklets are on no identity."""
+
+    cut: tuple[Row, ...] = ()
+    identity: tuple[tuple[Row, int], ...] = ()
+    apart: tuple[tuple[Row, Row], ...] = ()
+    clutter: tuple[Row, ...] = ()
+
+    def rows(self) -> list[Row]:
+        """Every row a constraint names."""
+        return [r for r, _ in self.identity] + [r for pair in self.apart for r in pair] + list(self.clutter)
 
 
 def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
                  tracklet_cost: float, time_limit_s: float = 60.0, start_cost: np.ndarray | None = None,
-                 end_cost: np.ndarray | None = None) -> list[list[int]]:
+                 end_cost: np.ndarray | None = None, marks: Sequence[tuple[Collection[int], Collection[int]]] = (),
+                 excluded: Collection[int] = ()) -> list[list[int]]:
     """At most ``n_chains`` disjoint chains of tracklets (lists of indices in time order) maximising the rows covered
     minus ``tracklet_cost`` per tracklet used minus the link costs and the costs of starting (``start_cost[i]``) or
     ending (``end_cost[i]``) a chain at tracklet ``i``, by HiGHS MILP.
 
     Variables: ``x`` (tracklet used), ``y`` (link used), ``a`` (chain starts here), ``b`` (chain ends here); flow
-    conservation ``a_i + Σ_j y_ji = x_i = b_i + Σ_j y_ij`` and ``Σ a_i ≤ n_chains``."""
+    conservation ``a_i + Σ_j y_ji = x_i = b_i + Σ_j y_ij`` and ``Σ a_i ≤ n_chains``.
+
+    Each of ``marks`` is ``(on, off)``: one chain carries the mark, it holds every tracklet of ``on`` and none of
+    ``off`` (per mark, ``z_i`` marks tracklet ``i``: equal across a used link, ``z_i ≤ x_i``, and at most one chain
+    head marked). Tracklets in ``excluded`` are on no chain. Raises ValueError when the constraints cannot all hold."""
     n = len(lengths)
     src, dst, cost = links
     m = len(src)
@@ -72,8 +105,15 @@ def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.nd
     A = sparse.vstack([conserve_in, conserve_out, chains]).tocsr()
     lo = np.concatenate([np.zeros(2 * n), [0.0]])
     hi = np.concatenate([np.zeros(2 * n), [float(n_chains)]])
-    res = milp(c, constraints=LinearConstraint(A, lo, hi), integrality=np.ones(len(c)), bounds=Bounds(0, 1),
+    upper = np.ones(len(c))
+    upper[list(excluded)] = 0.0
+    lower = np.zeros(len(c))
+    if marks:
+        A, lo, hi, c, lower, upper = _with_marks(A, lo, hi, c, lower, upper, n, (src, dst), marks)
+    res = milp(c, constraints=LinearConstraint(A, lo, hi), integrality=np.ones(len(c)), bounds=Bounds(lower, upper),
                options={"time_limit": time_limit_s})
+    if res.x is None and (marks or len(excluded)):
+        raise ValueError(f"closed-set assignment: the constraints cannot all hold ({res.message})")
     if res.x is None:
         raise RuntimeError(f"closed-set assignment: the MILP solver found no solution ({res.message})")
     x = np.round(res.x).astype(int)
@@ -88,6 +128,44 @@ def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.nd
             chain.append(k)
         result.append(chain)
     return result
+
+
+def _with_marks(A: Any, lo: np.ndarray, hi: np.ndarray, c: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                n: int, links: tuple[np.ndarray, np.ndarray],
+                marks: Sequence[tuple[Collection[int], Collection[int]]]) -> tuple[Any, ...]:
+    """:func:`solve_chains`' problem with, per mark, variables ``z`` (tracklet marked) and ``h`` (chain head marked)
+    after the ``4n + m`` of the chains, and their constraints."""
+    from scipy import sparse
+
+    src, dst = links
+    m = len(src)
+    base = A.shape[1]
+    blocks, los, his = [], [], []
+    for k in range(len(marks)):
+        z0 = base + 2 * n * k  # z [z0, z0+n), h [z0+n, z0+2n)
+        e = np.arange(m)
+        # a used link joins two equally marked tracklets: z_s - z_d + y ≤ 1 and z_d - z_s + y ≤ 1
+        r = np.r_[e, e, e, m + e, m + e, m + e]
+        col = np.r_[z0 + src, z0 + dst, n + e, z0 + dst, z0 + src, n + e]
+        val = np.r_[np.ones(m), -np.ones(m), np.ones(m), np.ones(m), -np.ones(m), np.ones(m)]
+        i = np.arange(n)
+        # z_i - x_i ≤ 0; a_i + z_i - h_i ≤ 1; Σ h ≤ 1
+        r = np.r_[r, 2 * m + i, 2 * m + i, 2 * m + n + i, 2 * m + n + i, 2 * m + n + i, np.full(n, 2 * m + 2 * n)]
+        col = np.r_[col, z0 + i, i, n + m + i, z0 + i, z0 + n + i, z0 + n + i]
+        val = np.r_[val, np.ones(n), -np.ones(n), np.ones(n), np.ones(n), -np.ones(n), np.ones(n)]
+        width = base + 2 * n * len(marks)
+        blocks.append(sparse.csr_matrix((val, (r, col)), shape=(2 * m + 2 * n + 1, width)))
+        los.append(np.full(2 * m + 2 * n + 1, -np.inf))
+        his.append(np.r_[np.ones(2 * m), np.zeros(n), np.ones(n), 1.0])
+    extra = 2 * n * len(marks)
+    A = sparse.vstack([sparse.hstack([A, sparse.csr_matrix((A.shape[0], extra))]), *blocks]).tocsr()
+    lower = np.r_[lower, np.zeros(extra)]
+    upper = np.r_[upper, np.ones(extra)]
+    for k, (on, off) in enumerate(marks):
+        z0 = base + 2 * n * k
+        lower[[z0 + t for t in on]] = 1.0
+        upper[[z0 + t for t in off]] = 0.0
+    return A, np.concatenate([lo, *los]), np.concatenate([hi, *his]), np.r_[c, np.zeros(extra)], lower, upper
 
 
 def _chain_position(block: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -160,34 +238,46 @@ def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[fl
 
 
 def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
-                      config: ClosedSetConfig | None = None) -> np.ndarray:
+                      config: ClosedSetConfig | None = None, constraints: ChainConstraints | None = None) -> np.ndarray:
     """Result rows ``(k, 10)`` (any ids; 1-based frames, boxes in pixels) re-labelled with ids ``1..n_targets``
     by one global assignment of their tracklets (module doc); rows on no identity (clutter) are dropped
-    and gaps of at most ``fill_gap_s`` inside an identity are interpolated. ``frame_rate`` in frames/s."""
+    and gaps of at most ``fill_gap_s`` inside an identity are interpolated. ``frame_rate`` in frames/s.
+    ``constraints`` hold in the assignment (a tracklet fixed to identity ``j`` gets id ``j``; the other identities
+    take the free ids in order of their start); ValueError when they name no input row or cannot all hold."""
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
     rows = checked_rows(rows)
     pieces = split_tracklets(rows, cfg)
+    if constraints is not None:
+        pieces = _cut_tracklets(pieces, constraints.cut)
     if not pieces:
         unchanged: np.ndarray = rows.copy()
         return unchanged
-    tracklets = [t for t in pieces if len(t) >= cfg.min_rows] or pieces
-    short = [t for t in pieces if len(t) < cfg.min_rows and tracklets is not pieces]
+    named = {_tracklet_of(pieces, r) for r in constraints.rows()} if constraints is not None else set()
+    tracklets = [t for i, t in enumerate(pieces) if len(t) >= cfg.min_rows or i in named] or pieces
+    chained = {id(t) for t in tracklets}
+    short = [t for t in pieces if len(t) < cfg.min_rows and tracklets is not pieces and id(t) not in chained]
     links = link_costs(tracklets, frame_rate, cfg)
     lo, hi = rows[:, 0].min() + cfg.velocity_frames, rows[:, 0].max() - cfg.velocity_frames
     start_cost = np.array([cfg.edge_cost if t.first > lo else 0.0 for t in tracklets])
     end_cost = np.array([cfg.edge_cost if t.last < hi else 0.0 for t in tracklets])
+    fixed: dict[int, int] = {}
+    marks: list[tuple[Collection[int], Collection[int]]] = []
+    excluded: list[int] = []
+    if constraints is not None:
+        fixed, marks, excluded, links = _marks(tracklets, constraints, int(n_targets), links, cfg)
     chains = solve_chains(np.array([len(t) for t in tracklets]), links, int(n_targets), cfg.tracklet_cost,
-                          cfg.time_limit_s, start_cost, end_cost)
+                          cfg.time_limit_s, start_cost, end_cost, marks, excluded)
     chains.sort(key=lambda ch: (tracklets[ch[0]].first, tracklets[ch[0]].rows[0, 2]))
     blocks = [np.vstack([tracklets[i].rows for i in chain]) for chain in chains]
     placed = place_short(short, blocks, motion_scale(tracklets), cfg)
+    ids = _chain_ids(chains, fixed, int(n_targets))
     out = []
-    for new_id, block in enumerate(blocks, start=1):
-        extra = [short[p].rows for p in np.flatnonzero(placed == new_id - 1)]
+    for c, block in enumerate(blocks):
+        extra = [short[p].rows for p in np.flatnonzero(placed == c)]
         block = np.vstack([block, *extra]).copy()
-        block[:, 1] = new_id
+        block[:, 1] = ids[c]
         out.append(block)
     merged = np.vstack(out) if out else np.zeros((0, 10))
     merged = merged[np.lexsort((merged[:, 1], merged[:, 0]))]
@@ -196,6 +286,80 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     if not len(merged):
         return merged
     return smooth_boxes(fill_gaps(merged, max_fill), smoothing_window(merged, frame_rate, cfg))
+
+
+def _cut_tracklets(pieces: list[Tracklet], cuts: Sequence[Row]) -> list[Tracklet]:
+    """``pieces`` with each cut just before the rows named by ``cuts`` (1-based frame, input id)."""
+    at: dict[int, set[int]] = {}
+    for frame, source in cuts:
+        at.setdefault(int(source), set()).add(int(frame))
+    out: list[Tracklet] = []
+    for t in pieces:
+        frames = sorted(f for f in at.get(t.source_id, ()) if t.first < f <= t.last)
+        if not frames:
+            out.append(t)
+            continue
+        bounds = np.searchsorted(t.rows[:, 0], frames)
+        out += [Tracklet(r, t.source_id, t.contact) for r in np.split(t.rows, bounds) if len(r)]
+    out.sort(key=lambda t: (t.first, t.last))
+    return out
+
+
+def _tracklet_of(tracklets: list[Tracklet], row: Row) -> int:
+    """Index of the tracklet holding the input row ``(frame, input id)``; ValueError when none does."""
+    frame, source = int(row[0]), int(row[1])
+    for i, t in enumerate(tracklets):
+        if t.source_id == source and t.first <= frame <= t.last and np.any(t.rows[:, 0] == frame):
+            return i
+    raise ValueError(f"constraint: no input row of id {source} at frame {frame}")
+
+
+def _marks(tracklets: list[Tracklet], cons: ChainConstraints, n_targets: int,
+           links: tuple[np.ndarray, np.ndarray, np.ndarray], cfg: ClosedSetConfig) -> tuple[Any, ...]:
+    """The fixed identity per tracklet, the marks and exclusions of :func:`solve_chains` and the links with a direct
+    link added between consecutive tracklets fixed to one identity (at the dearest candidate's cost), so the
+    constraints can always be met by some chain."""
+    fixed: dict[int, int] = {}
+    for row, j in cons.identity:
+        if not 1 <= int(j) <= n_targets:
+            raise ValueError(f"constraint: identity {j} is not in 1..{n_targets}")
+        t = _tracklet_of(tracklets, row)
+        if fixed.get(t, j) != j:
+            raise ValueError(f"constraint: the tracklet of row {row} is fixed to identities {fixed[t]} and {j}")
+        fixed[t] = int(j)
+    excluded = sorted({_tracklet_of(tracklets, r) for r in cons.clutter})
+    if set(excluded) & set(fixed):
+        raise ValueError("constraint: a tracklet is both on an identity and clutter")
+    src, dst, cost = links
+    known = set(zip(src.tolist(), dst.tolist()))
+    dear = float(cost.max()) if len(cost) else cfg.link_cost
+    add: list[tuple[int, int]] = []
+    marks: list[tuple[Collection[int], Collection[int]]] = []
+    for j in sorted(set(fixed.values())):
+        on = sorted((t for t in fixed if fixed[t] == j), key=lambda t: tracklets[t].first)
+        for p, q in zip(on[:-1], on[1:]):
+            if tracklets[p].last >= tracklets[q].first:
+                raise ValueError(f"constraint: identity {j} is fixed to two tracklets that overlap in frames "
+                                 f"{tracklets[q].first}-{min(tracklets[p].last, tracklets[q].last)}")
+            if (p, q) not in known:
+                add.append((p, q))
+        marks.append((on, [t for t in fixed if fixed[t] != j]))
+    for a_row, b_row in cons.apart:
+        a, b = _tracklet_of(tracklets, a_row), _tracklet_of(tracklets, b_row)
+        if a == b or (a in fixed and fixed.get(b) == fixed[a]):
+            raise ValueError(f"constraint: rows {a_row} and {b_row} cannot be apart (same tracklet or identity)")
+        marks.append(([a], [b]))
+    if add:
+        p, q = np.array(add).T
+        links = (np.r_[src, p], np.r_[dst, q], np.r_[cost, np.full(len(add), dear)])
+    return fixed, marks, excluded, links
+
+
+def _chain_ids(chains: list[list[int]], fixed: dict[int, int], n_targets: int) -> list[int]:
+    """Id of each chain (in order): the identity fixed to one of its tracklets, else the free ids in order."""
+    ids = [next((fixed[t] for t in ch if t in fixed), 0) for ch in chains]
+    free = iter(sorted(set(range(1, max(n_targets, len(chains)) + 1)) - set(ids)))
+    return [i or next(free) for i in ids]
 
 
 def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfig | None = None) -> int:
