@@ -1,0 +1,255 @@
+"""A proofreading session over one tracking result: doubtful ranges, corrections, undo, export and replay.
+
+With a known number of identities ``n_targets`` each correction becomes a constraint on the offline closed set
+(:func:`lookalike.trackers.offline.closed_set.assign_identities`) and the whole assignment is solved again, so later
+frames that depended on the corrected link change too; without it corrections are plain edits
+(:func:`lookalike.proofread.edits.apply_edit`). Rows are MOTChallenge ``(k, 10)``, frames 1-based."""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from lookalike.io.motchallenge import read_mot, write_mot
+from lookalike.io.outputs import write_atomic
+from lookalike.proofread.edits import Change, Correction, apply_edit, changes, check, colocated
+from lookalike.trackers.offline.closed_set import (
+    ChainConstraints,
+    ClosedSetConfig,
+    Row,
+    assign_identities,
+    online_rows,
+)
+from lookalike.trackers.offline.confidence import DOUBTFUL_BELOW, assignment_confidence, doubtful_ranges
+
+__all__ = ["Doubt", "Session"]
+
+
+@dataclass(frozen=True)
+class Doubt:
+    """A doubtful range: id ``track`` in frames ``first``-``last`` (inclusive); ``doubt`` is the sum over its rows of
+    how far their confidence falls below the threshold (larger: more doubtful)."""
+
+    track: int
+    first: int
+    last: int
+    doubt: float
+
+
+def _rows_of(table_or_rows: np.ndarray | str | os.PathLike[str]) -> np.ndarray:
+    if isinstance(table_or_rows, (str, os.PathLike)):
+        t = read_mot(table_or_rows)
+        rows = np.column_stack([t.frame, t.track_id, t.xywh, t.conf, np.full((len(t), 3), -1.0)])
+    else:
+        rows = np.asarray(table_or_rows, dtype=float)
+        if rows.ndim != 2 or (len(rows) and rows.shape[1] < 6):
+            raise ValueError(f"rows: expected MOTChallenge rows (k, >= 6), got shape {rows.shape}")
+        if rows.shape[1] < 10:
+            rows = np.hstack([rows, np.full((len(rows), 10 - rows.shape[1]), -1.0)])
+    rows = rows[:, :10].reshape(-1, 10)
+    out: np.ndarray = rows[np.lexsort((rows[:, 1], rows[:, 0]))]
+    return out
+
+
+class Session:
+    """Proofreading of ``tracks`` (rows or a MOTChallenge file). With ``n_targets`` corrections re-solve the closed set
+    over the tracklets of ``solver_input`` (the rows the closed set was solved from), else of ``detections`` (their
+    online pass, as ``--offline`` makes it), else of the tracks themselves. ``frame_rate`` in frames/s (confidence
+    windows and the solver's motion)."""
+
+    def __init__(self, tracks: np.ndarray | str | os.PathLike[str], *, frame_rate: float = 30.0,
+                 n_targets: int | None = None, detections: np.ndarray | str | os.PathLike[str] | None = None,
+                 solver_input: np.ndarray | None = None, config: ClosedSetConfig | None = None) -> None:
+        if not frame_rate > 0:
+            raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
+        if n_targets is not None and int(n_targets) < 1:
+            raise ValueError(f"n_targets must be >= 1, got {n_targets}")
+        self.frame_rate = float(frame_rate)
+        self.n_targets = None if n_targets is None else int(n_targets)
+        self.config = config or ClosedSetConfig()
+        self.initial = _rows_of(tracks)
+        if not len(self.initial):
+            raise ValueError("tracks: no rows")
+        self._solver_rows: np.ndarray | None = None
+        if self.n_targets is not None:
+            if solver_input is not None:
+                self._solver_rows = _rows_of(solver_input)
+            elif detections is not None:
+                det = _rows_of(detections)
+                self._solver_rows = online_rows(det, self.frame_rate, int(det[:, 0].max()), n_init=1)
+            else:
+                self._solver_rows = self.initial.copy()
+        self.rows = self.initial.copy()
+        self.corrections: list[Correction] = []
+        self._history: list[tuple[np.ndarray, ChainConstraints]] = []
+        self._constraints = ChainConstraints()
+        self.last_change = Change((), (), 0)
+
+    @property
+    def propagates(self) -> bool:
+        """Whether corrections re-solve the closed set (a known ``n_targets``)."""
+        return self._solver_rows is not None
+
+    def confidence(self) -> np.ndarray:
+        """``(k,)`` probability that each current row's identity is right, in the order of :attr:`rows`."""
+        return assignment_confidence(self.rows, self.frame_rate)
+
+    def doubtful(self, threshold: float = DOUBTFUL_BELOW) -> list[Doubt]:
+        """The doubtful ranges of the current rows (rows with confidence below ``threshold``, merged within one
+        second), most doubtful first."""
+        conf = self.confidence()
+        out = []
+        for track, spans in doubtful_ranges(self.rows, conf, self.frame_rate, threshold).items():
+            sel = self.rows[:, 1] == track
+            for a, b in spans:
+                inside = sel & (self.rows[:, 0] >= a) & (self.rows[:, 0] <= b)
+                out.append(Doubt(track, a, b, float(np.clip(threshold - conf[inside], 0, None).sum())))
+        out.sort(key=lambda d: (-d.doubt, d.first, d.track))
+        return out
+
+    def apply(self, correction: Correction) -> Change:
+        """Apply ``correction`` (ValueError, and nothing changed, when it names an unknown id or frame or cannot
+        hold); returns what changed, also kept as :attr:`last_change`."""
+        check(self.rows, correction)
+        if self._solver_rows is None:
+            new, cons = apply_edit(self.rows, correction), self._constraints
+        else:
+            cons = self._constrain(correction)
+            new = self._solve(cons)
+        self._history.append((self.rows, self._constraints))
+        self.corrections.append(correction)
+        self.last_change = changes(self.rows, new)
+        self.rows, self._constraints = new, cons
+        return self.last_change
+
+    def undo(self) -> Change:
+        """Take back the last correction; ValueError when there is none."""
+        if not self.corrections:
+            raise ValueError("undo: no correction to take back")
+        rows, self._constraints = self._history.pop()
+        self.corrections.pop()
+        self.last_change = changes(self.rows, rows)
+        self.rows = rows
+        return self.last_change
+
+    # -- the closed set -------------------------------------------------------------------------------------------
+
+    def _anchor(self, track: int, frame: int, after: bool) -> Row | None:
+        """The solver's input row under ``track``'s first row at or after ``frame`` (``after``) or its last row
+        before it, as ``(frame, input id)``; None when there is none."""
+        assert self._solver_rows is not None
+        mine = self.rows[self.rows[:, 1] == track]
+        mine = mine[mine[:, 0] >= frame] if after else mine[mine[:, 0] < frame][::-1]
+        if not len(mine):
+            return None
+        near = self._solver_rows[np.isin(self._solver_rows[:, 0], mine[:, 0])]
+        ia, ib = colocated(mine, near)
+        if not len(ia):
+            return None
+        best = int(np.argmin(ia))  # mine is ordered outwards from the frame
+        return int(near[ib[best], 0]), int(near[ib[best], 1])
+
+    def _runs(self, track: int) -> list[Row]:
+        """One solver input row per run of one input id under ``track`` (its first)."""
+        assert self._solver_rows is not None
+        mine = self.rows[self.rows[:, 1] == track]
+        ia, ib = colocated(mine, self._solver_rows)
+        order = np.argsort(mine[ia, 0])
+        src = self._solver_rows[ib[order]]
+        first = np.r_[True, src[1:, 1] != src[:-1, 1]] if len(src) else np.zeros(0, bool)
+        return [(int(f), int(s)) for f, s in src[first, :2]]
+
+    def _constrain(self, c: Correction) -> ChainConstraints:
+        """The constraints after ``c``: its rows cut and fixed (module doc of :mod:`lookalike.proofread`)."""
+        cut: list[Row] = []
+        ident: list[tuple[Row, int]] = []
+        apart: list[tuple[Row, Row]] = []
+        clutter: list[Row] = []
+        if c.kind in ("swap", "assign", "split"):
+            assert c.frame is not None
+            a_after, a_before = self._anchor(c.track, c.frame, True), self._anchor(c.track, c.frame, False)
+            if a_after is None:
+                raise ValueError(f"correction {c.kind}: no row of track {c.track} from frame {c.frame} on to correct")
+            cut.append(a_after)
+            if c.kind == "split":
+                if a_before is None:
+                    raise ValueError(f"correction split: track {c.track} has no rows before frame {c.frame}")
+                apart.append((a_before, a_after))
+            else:
+                assert c.other is not None
+                ident.append((a_after, c.other))
+                if a_before is not None:
+                    ident.append((a_before, c.track))
+                if c.other in self.rows[:, 1]:
+                    b_before = self._anchor(c.other, c.frame, False)
+                    if b_before is not None:
+                        ident.append((b_before, c.other))
+                    b_after = self._anchor(c.other, c.frame, True)
+                    if c.kind == "swap" and b_after is not None:
+                        cut.append(b_after)
+                        ident.append((b_after, c.track))
+        elif c.kind == "merge":
+            assert c.other is not None
+            ident += [(r, c.track) for r in self._runs(c.track) + self._runs(c.other)]
+        else:
+            clutter += self._runs(c.track)
+        old = self._constraints
+        return ChainConstraints(old.cut + tuple(cut), old.identity + tuple(ident), old.apart + tuple(apart),
+                                old.clutter + tuple(clutter))
+
+    def _solve(self, cons: ChainConstraints) -> np.ndarray:
+        """The closed set under ``cons``, its free identities renamed to the current ids they overlap most."""
+        assert self._solver_rows is not None and self.n_targets is not None
+        new = assign_identities(self._solver_rows, self.n_targets, self.frame_rate, self.config, cons)
+        fixed = {j for _, j in cons.identity}
+        free_new = sorted(set(np.unique(new[:, 1]).astype(int).tolist()) - fixed)
+        free_old = sorted(set(np.unique(self.rows[:, 1]).astype(int).tolist()) - fixed)
+        if free_new and free_old:
+            from scipy.optimize import linear_sum_assignment
+
+            ia, ib = colocated(self.rows, new)
+            overlap = np.zeros((len(free_old), len(free_new)))
+            io, inew = {t: k for k, t in enumerate(free_old)}, {t: k for k, t in enumerate(free_new)}
+            for a, b in zip(self.rows[ia, 1].astype(int).tolist(), new[ib, 1].astype(int).tolist()):
+                if a in io and b in inew:
+                    overlap[io[a], inew[b]] += 1
+            r, col = linear_sum_assignment(-overlap)
+            rename = {free_new[k]: free_old[q] for q, k in zip(r, col)}
+            spare = iter(sorted(set(range(1, self.n_targets + 1)) - fixed - set(rename.values())))
+            rename.update({t: next(spare) for t in free_new if t not in rename})
+            new[:, 1] = [rename.get(int(i), int(i)) for i in new[:, 1]]
+        out: np.ndarray = new[np.lexsort((new[:, 1], new[:, 0]))]
+        return out
+
+    # -- export and replay ----------------------------------------------------------------------------------------
+
+    def save(self, tracks: str | os.PathLike[str], log: str | os.PathLike[str] | None = None) -> None:
+        """Write the current rows as a MOTChallenge file and (``log``) the corrections as JSON lines."""
+        write_mot(tracks, self.rows)
+        if log is not None:
+            write_atomic(log, self.log_text())
+
+    def log_text(self) -> str:
+        """The corrections log: a header line (mode) and one JSON line per correction, in order."""
+        head = json.dumps({"lookalike_proofread": 1, "n_targets": self.n_targets, "frame_rate": self.frame_rate})
+        return "".join(line + "\n" for line in [head, *(c.to_json() for c in self.corrections)])
+
+    def replay(self, log: str | os.PathLike[str] | list[Correction]) -> Change:
+        """Apply the corrections of a log (a path, or corrections) in order; the session must hold the same input the
+        log was made on (ValueError on a correction that does not apply)."""
+        if isinstance(log, list):
+            todo = log
+        else:
+            lines = [ln for ln in Path(log).read_text(encoding="utf-8").splitlines() if ln.strip()]
+            todo = [Correction.from_json(ln) for ln in lines if "lookalike_proofread" not in ln]
+        before = self.rows
+        for k, c in enumerate(todo):
+            try:
+                self.apply(c)
+            except ValueError as exc:
+                raise ValueError(f"replay: correction {k + 1} ({c.to_json()}): {exc}") from exc
+        return replace(changes(before, self.rows))
