@@ -179,6 +179,19 @@ def _check_branches(path: Path | None, video: Path | None, detections: Path | No
     return "files"
 
 
+def _live_source(video: str | None, detector: str | None, stops: bool) -> str | None:
+    """``--video``'s text when it names a live source (a camera index, a stream URL), else None; ``stops``: whether
+    --max-frames/--seconds were given (live only)."""
+    from lookalike.io.sources import is_live
+
+    live = video if is_live(video) else None
+    if live is None and stops:
+        fail("--max-frames/--seconds: only with a live --video (a camera index or a stream URL)")
+    if live is not None and detector is None:
+        fail(f"--video {live}: a live source needs --detector blob or --detector FILE.onnx")
+    return live
+
+
 @app.command()
 def track(
     path: Path | None = typer.Argument(
@@ -190,9 +203,10 @@ def track(
         None, "--set", "-s", help="Tracker parameter KEY=VALUE (repeatable); see `lookalike trackers`."
     ),
     min_score: float = typer.Option(float("-inf"), help="Drop detections with a lower score."),
-    video: Path | None = typer.Option(
+    video_arg: str | None = typer.Option(
         None, "--video", help="Video file or image folder (img1): appearance features from its pixels; also "
-        "writes <output stem>.health.csv and, for merging trackers, <output stem>.merges.csv."
+        "writes <output stem>.health.csv and, for merging trackers, <output stem>.merges.csv. Or a live source: a "
+        "camera index (0) or a stream URL (rtsp://, http://) with --detector (docs: live camera how-to)."
     ),
     detections: Path | None = typer.Option(None, "--detections", help="det.txt for --video (or give it as PATH)."),
     annotate: Path | None = typer.Option(
@@ -238,8 +252,12 @@ def track(
     heading_topics: str | None = typer.Option(None, "--heading-topics", help="With --bag: the robots' Imu topics, "
                                               "comma-separated, robot 0 first (default /robot_0/imu, /robot_1/imu, "
                                               "...)."),
+    max_frames: int | None = typer.Option(None, "--max-frames", min=1, help="Live --video: stop after N frames."),
+    seconds: float | None = typer.Option(None, "--seconds", min=0.0, help="Live --video: stop after S seconds."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
+    live = _live_source(video_arg, detector, max_frames is not None or seconds is not None)
+    video = Path(video_arg) if video_arg is not None else None
     if bag is not None and (any(x is not None for x in (path, video, detections, points, reports, detector)) or blob):
         fail("--bag: the bag is the input; drop PATH/--video/--detections/--points/--reports/--detector/--blob")
     branch = "pipeline" if bag is not None else _check_branches(path, video, detections, annotate, detector, blob,
@@ -285,7 +303,16 @@ def track(
                              fps=fps)
             elif branch in ("blobs", "video"):
                 assert video is not None
-                if branch == "blobs":
+                if live is not None:
+                    from lookalike.cli.track_live import run_track_live
+
+                    run_track_live(live, output, trk, tracker, detector or "", blob or [],
+                                   n_targets=0 if open_set else targets,
+                                   explicit=tracker_params(tracker, settings, params_file).keys(),
+                                   min_score=min_score, max_frames=max_frames, seconds=seconds,
+                                   refused={"--annotate": annotate is not None, "--offline": offline,
+                                            "--features": features != "video", "--fps": fps is not None})
+                elif branch == "blobs":
                     from lookalike.cli.track_blobs import run_track_blobs
 
                     run_track_blobs(video, output, trk, tracker, detector or "", blob or [],
