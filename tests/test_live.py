@@ -260,3 +260,18 @@ def test_live_source_refuses_what_needs_a_file(tmp_path):
     result = runner.invoke(app, ["track", "--video", "clip.mp4", "--detector", "blob", "--seconds", "3",
                                  "-o", str(tmp_path / "t.txt")])
     assert result.exit_code == 2 and "only with a live --video" in result.output
+
+
+def test_served_stream_with_an_onnx_detector_stops_after_max_frames(stream, tmp_path):
+    pytest.importorskip("onnx")
+    pytest.importorskip("onnxruntime")
+    from tests.test_onnx_detector import _darkness_grid_model  # a tiny model finding dark cells
+
+    model = _darkness_grid_model(tmp_path / "dark.onnx")
+    out = tmp_path / "live.txt"
+    result = runner.invoke(app, ["track", "--video", stream.url, "--detector", str(model), "--blob", "score=0.05",
+                                 "-t", "sort", "--max-frames", "40", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "stopped: 40 frames" in result.output
+    table = np.loadtxt(out, delimiter=",", ndmin=2)
+    assert len(table) > 0 and len(np.unique(table[:, 0])) <= 40
