@@ -1,0 +1,160 @@
+"""lookalike.proofread: corrections as plain edits and as constraints on a re-solved closed set, undo, replay."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lookalike.proofread import Correction, Session, apply_edit
+from lookalike.trackers.offline.closed_set import ChainConstraints, assign_identities
+
+
+def _row(frame: int, tid: int, x: float, y: float) -> list[float]:
+    return [frame, tid, x - 5, y - 5, 10, 10, 1, -1, -1, -1]
+
+
+def _lanes() -> np.ndarray:
+    """Three ids on parallel lanes, frames 1-30 (id 3 only in frames 11-20)."""
+    rows = [_row(f, 1, 10 * f, 0) for f in range(1, 31)] + [_row(f, 2, 10 * f, 100) for f in range(1, 31)]
+    rows += [_row(f, 3, 10 * f, 200) for f in range(11, 21)]
+    return np.array(rows, dtype=float)
+
+
+def _at(rows: np.ndarray, frame: int, y: float) -> int:
+    """Id of the row nearest the lane ``y`` (centre) in ``frame``."""
+    r = rows[rows[:, 0] == frame]
+    return int(r[np.argmin(np.abs(r[:, 3] + r[:, 5] / 2 - y)), 1])
+
+
+def test_each_plain_correction_and_undo():
+    s = Session(_lanes(), frame_rate=10)
+    start = s.rows.copy()
+    s.apply(Correction("swap", 1, 2, 16))
+    assert _at(s.rows, 15, 0) == 1 and _at(s.rows, 16, 0) == 2 and _at(s.rows, 16, 100) == 1
+    s.apply(Correction("split", 1, frame=25))
+    new = int(s.rows[:, 1].max())
+    assert _at(s.rows, 24, 100) == 1 and _at(s.rows, 25, 100) == new
+    s.apply(Correction("merge", 1, new))
+    assert _at(s.rows, 25, 100) == 1
+    s.apply(Correction("assign", 3, 7, frame=15))
+    assert _at(s.rows, 14, 200) == 3 and _at(s.rows, 15, 200) == 7
+    s.apply(Correction("delete", 7))
+    assert 7 not in s.rows[:, 1] and len(s.corrections) == 5
+    for _ in range(5):
+        s.undo()
+    np.testing.assert_array_equal(s.rows, start)
+    with pytest.raises(ValueError, match="no correction"):
+        s.undo()
+
+
+def test_swap_from_k_changes_only_frames_from_k():
+    rows = _lanes()
+    out = apply_edit(rows, Correction("swap", 1, 2, 12))
+    before = rows[rows[:, 0] < 12]
+    np.testing.assert_array_equal(out[out[:, 0] < 12], before[np.lexsort((before[:, 1], before[:, 0]))])
+    s = Session(rows, frame_rate=10)
+    change = s.apply(Correction("swap", 1, 2, 12))
+    assert min(change.frames) == 12 and change.ids == (1, 2) and change.rows == 2 * 2 * 19
+
+
+@pytest.mark.parametrize("bad, match", [
+    (Correction("swap", 1, 9, 5), "unknown other id 9"),
+    (Correction("delete", 8), "unknown track id 8"),
+    (Correction("split", 1, frame=99), "frame 99 is out of range"),
+    (Correction("assign", 3, 5, frame=25), "no rows at or after frame 25"),
+    (Correction("assign", 3, 1, frame=12), "identity 1 already has a row"),
+    (Correction("merge", 1, 2), "both have rows"),
+])
+def test_bad_corrections_raise_and_change_nothing(bad: Correction, match: str):
+    s = Session(_lanes(), frame_rate=10)
+    with pytest.raises(ValueError, match=match):
+        s.apply(bad)
+    np.testing.assert_array_equal(s.rows, Session(_lanes(), frame_rate=10).rows)
+    assert not s.corrections
+
+
+def test_malformed_corrections_raise():
+    with pytest.raises(ValueError, match="unknown kind"):
+        Correction("rename", 1, 2)
+    with pytest.raises(ValueError, match="needs track, other, frame"):
+        Correction("swap", 1, 2)
+    with pytest.raises(ValueError, match="both 3"):
+        Correction("merge", 3, 3)
+
+
+def _crossing() -> np.ndarray:
+    """Solver input: two targets converge (frames 1-20), are lost (21-25), go on straight (26-40, ids 3 and 4), are
+    lost again (41-43) and go on (44-60, ids 5 and 6 continuing 3 and 4)."""
+    rows = []
+    for f in range(1, 61):
+        if 21 <= f <= 25 or 41 <= f <= 43:
+            continue
+        up, down = (1, 2) if f <= 20 else (3, 4) if f <= 40 else (5, 6)
+        rows += [_row(f, up, 5 * f, 2.5 * f), _row(f, down, 5 * f, 110 - 2.5 * f)]
+    return np.array(rows, dtype=float)
+
+
+def test_identity_constraint_is_held_and_moves_a_later_link():
+    on = _crossing()
+    base = assign_identities(on, 2, 10)
+    a = _at(base, 10, 25)  # the target on the rising line before the crossing
+    rising = _at(base, 30, 75) == a  # where the solver sent it after the gap
+    assert _at(base, 50, 125 if rising else -15) == a
+    other_piece = (26, 4) if rising else (26, 3)
+    pinned = ChainConstraints(identity=(((1, 1), a), (other_piece, a)))
+    out = assign_identities(on, 2, 10, constraints=pinned)
+    assert _at(out, 10, 25) == a and _at(out, 30, 35 if rising else 75) == a  # the other piece after the gap is a
+    assert _at(out, 50, -15 if rising else 125) == a  # and the later link (to 5 or 6), not constrained, went with it
+    np.testing.assert_array_equal(assign_identities(on, 2, 10, constraints=ChainConstraints()), base)
+
+
+def test_session_swap_re_solves_and_undo_restores():
+    on = _crossing()
+    base = assign_identities(on, 2, 10)
+    a, b = _at(base, 10, 25), _at(base, 10, 85)
+    s = Session(base, frame_rate=10, n_targets=2, solver_input=on)
+    assert s.propagates
+    lines = {30: (75, 35), 50: (125, -15)}  # rising and falling line
+    after = {f: (_at(base, f, up), _at(base, f, down)) for f, (up, down) in lines.items()}
+    change = s.apply(Correction("swap", a, b, 26))
+    assert _at(s.rows, 10, 25) == a and _at(s.rows, 10, 85) == b
+    for f, (up, down) in after.items():  # both lines changed hands, the later pieces too
+        assert (_at(s.rows, f, lines[f][0]), _at(s.rows, f, lines[f][1])) == (down, up)
+    assert set(change.ids) == {a, b} and max(change.frames) == 60
+    s.undo()
+    np.testing.assert_array_equal(s.rows, base[np.lexsort((base[:, 1], base[:, 0]))])
+
+
+def test_conflicting_constraints_raise():
+    on = _crossing()
+    with pytest.raises(ValueError, match="overlap"):
+        assign_identities(on, 2, 10, constraints=ChainConstraints(identity=(((5, 1), 1), ((5, 2), 1))))
+    with pytest.raises(ValueError, match="no input row"):
+        assign_identities(on, 2, 10, constraints=ChainConstraints(identity=(((22, 1), 1),)))
+    with pytest.raises(ValueError, match="not in 1..2"):
+        assign_identities(on, 2, 10, constraints=ChainConstraints(identity=(((5, 1), 3),)))
+
+
+@pytest.mark.parametrize("propagate", [False, True])
+def test_replayed_log_gives_the_same_rows(tmp_path, propagate: bool):
+    on = _crossing()
+    base = assign_identities(on, 2, 10)
+    a, b = _at(base, 10, 25), _at(base, 10, 85)
+    kw = {"n_targets": 2, "solver_input": on} if propagate else {}
+    s = Session(base, frame_rate=10, **kw)
+    s.apply(Correction("swap", a, b, 26))
+    s.apply(Correction("split", b, frame=50))
+    s.save(tmp_path / "out.txt", tmp_path / "log.jsonl")
+    again = Session(base, frame_rate=10, **kw)
+    again.replay(tmp_path / "log.jsonl")
+    np.testing.assert_array_equal(again.rows, s.rows)
+    assert again.corrections == s.corrections
+    exported = np.loadtxt(tmp_path / "out.txt", delimiter=",")
+    np.testing.assert_allclose(exported[:, :6], s.rows[:, :6], atol=1e-3)
+
+
+def test_doubtful_ranges_are_sorted_most_doubtful_first():
+    s = Session(_crossing(), frame_rate=10)
+    d = s.doubtful()
+    assert [x.doubt for x in d] == sorted((x.doubt for x in d), reverse=True)
+    assert all(x.first <= x.last for x in d)
