@@ -4,6 +4,7 @@ leaves a complete result file."""
 
 from __future__ import annotations
 
+import dataclasses
 import http.server
 import os
 import signal
@@ -164,7 +165,7 @@ def test_slow_tracker_on_a_simulated_camera_writes_gaps_not_lag(tmp_path):
             time.sleep(0.1)  # three frame periods
             return plan.detector(image)
 
-        run = track_live(camera, slow, plan.tracker, out, sample=plan.sample, sampled=plan.sampled)
+        run = track_live(camera, dataclasses.replace(plan, detector=slow), out)
     assert run.dropped > 0 and run.frames + run.dropped == run.delivered == 90
     assert run.clock == "stream" and run.stopped == "end of stream"
     frames = np.unique(np.loadtxt(out, delimiter=",", ndmin=2)[:, 0])
@@ -212,9 +213,8 @@ def test_a_stop_mid_run_leaves_a_complete_result_file(tmp_path, how):
             if run.frames == 70 and how == "SIGTERM":
                 os.kill(os.getpid(), signal.SIGTERM)
 
-        run = track_live(source, plan.detector, plan.tracker, out, sample=plan.sample, sampled=plan.sampled,
-                         stop=stop, on_frame=on_frame, max_frames=90 if how == "max_frames" else None,
-                         seconds=3.0 if how == "seconds" else None)
+        run = track_live(source, plan, out, stop=stop, on_frame=on_frame,
+                         max_frames=90 if how == "max_frames" else None, seconds=3.0 if how == "seconds" else None)
     table = np.loadtxt(out, delimiter=",", ndmin=2)
     expected = {"KeyboardInterrupt": 70, "SIGTERM": 70, "max_frames": 90, "seconds": 91}[how]
     assert run.frames == expected, run.stopped

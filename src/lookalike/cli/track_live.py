@@ -57,8 +57,7 @@ def run_track_live(spec: str, output: Path, tracker: Any, tracker_name: str, det
                         status.update(f"tracking {escape(spec)}: {run.frames} frames, {run.fps:.1f} frames/s, "
                                       f"{source.dropped} dropped (Ctrl-C stops and keeps the result)")
 
-                run = track_live(source, plan.detector, plan.tracker, output, sample=plan.sample,
-                                 sampled=plan.sampled, max_frames=max_frames, seconds=seconds, stop=stop,
+                run = track_live(source, plan, output, max_frames=max_frames, seconds=seconds, stop=stop,
                                  on_frame=show)
     console.print(f"[green]{tracker_name}[/]: {run.frames} frames in {run.wall_s:.1f} s ({run.fps:.1f} frames/s; "
                   f"detector + tracker {run.busy_fps:,.0f} frames/s), {run.dropped} of {run.delivered} dropped "

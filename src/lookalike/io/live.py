@@ -96,6 +96,21 @@ class LiveRun:
         return self.frames / self.busy_s if self.busy_s > 0 else float("inf")
 
 
+@dataclass
+class LivePlan:
+    """A live run set up by :func:`prepare_live`: the ``detector`` and ``tracker`` to run, the ``sample`` frames
+    read already with their ``sampled`` detections, and for blobs the settings' ``estimate`` and the ``count`` of
+    targets inferred from the sample (each None when not made)."""
+
+    detector: Callable[[Any], Detections]
+    tracker: Any
+    sample: list[LiveFrame] = field(default_factory=list)
+    sampled: list[Detections] = field(default_factory=list)
+    estimate: BlobEstimate | None = None
+    count: TargetCount | None = None
+    n_targets: int | None = None
+
+
 def sample_frames(source: LiveSource, seconds: float = SAMPLE_S, count: int = SAMPLE_FRAMES,
                   stop: LiveStop | None = None) -> list[LiveFrame]:
     """The source's first frames: those of its first ``seconds`` (stream time), at most ``count``; fewer when the
@@ -142,26 +157,26 @@ def _frames(source: LiveSource, detector: Callable[[Any], Detections], sample: l
         yield Frame(index=live.number, time=live.time, detections=det), time.perf_counter() - t0
 
 
-def track_live(source: LiveSource, detector: Callable[[Any], Detections], tracker: Any, output: str | Path, *,
-               sample: list[LiveFrame] | None = None, sampled: list[Detections] | None = None,
-               max_frames: int | None = None, seconds: float | None = None, stop: LiveStop | None = None,
+def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_frames: int | None = None,
+               seconds: float | None = None, stop: LiveStop | None = None,
                on_frame: Callable[[LiveRun], None] | None = None) -> LiveRun:
-    """Detect and track ``source`` frame by frame into the MOTChallenge file ``output`` (frame numbers: the source's,
-    1-based, so a dropped frame leaves a gap), until the source ends, ``max_frames`` are tracked, ``seconds`` of
+    """Detect and track ``source`` frame by frame with ``plan``'s detector and tracker (:func:`prepare_live`, or a
+    :class:`LivePlan` of your own) into the MOTChallenge file ``output`` (frame numbers: the source's, 1-based, so a
+    dropped frame leaves a gap), until the source ends, ``max_frames`` are tracked, ``seconds`` of
     stream time have passed, or ``stop`` is set (or ``KeyboardInterrupt``). Rows reach a temporary file beside
     ``output`` as each frame ends; whatever stops the run, the file is completed up to the last whole frame and
     renamed onto ``output`` (a ``KeyboardInterrupt`` ends the run like ``stop``; a ``SystemExit`` is raised again
-    once the file is complete). ``sample``/``sampled``: frames read and detected already (:func:`sample_frames`),
-    tracked first. ``on_frame``: called with the running totals after each frame."""
+    once the file is complete). The plan's sample frames, read and detected already, are tracked first.
+    ``on_frame``: called with the running totals after each frame."""
     stop = stop if stop is not None else LiveStop()
     run = LiveRun(output=Path(output))
     start = time.monotonic()
     exiting: SystemExit | None = None
     with MotWriter(output) as writer:
         try:
-            for frame, detect_s in _frames(source, detector, sample or [], sampled or []):
+            for frame, detect_s in _frames(source, plan.detector, plan.sample, plan.sampled):
                 t0 = time.perf_counter()
-                tracks = tracker.update(frame)
+                tracks = plan.tracker.update(frame)
                 rows = tracks_to_rows(frame.index, tracks)
                 run.busy_s += detect_s + time.perf_counter() - t0
                 writer.write_rows(rows)
@@ -193,20 +208,6 @@ def track_live(source: LiveSource, detector: Callable[[Any], Detections], tracke
         raise exiting
     return run
 
-
-@dataclass
-class LivePlan:
-    """A live run set up by :func:`prepare_live`: the ``detector`` and ``tracker`` to run, the ``sample`` frames
-    read already with their ``sampled`` detections, and for blobs the settings' ``estimate`` and the ``count`` of
-    targets inferred from the sample (each None when not made)."""
-
-    detector: Callable[[Any], Detections]
-    tracker: Any
-    sample: list[LiveFrame] = field(default_factory=list)
-    sampled: list[Detections] = field(default_factory=list)
-    estimate: BlobEstimate | None = None
-    count: TargetCount | None = None
-    n_targets: int | None = None
 
 
 def prepare_live(source: LiveSource, detector: str, tracker: Any, tracker_name: str, *,
