@@ -140,26 +140,30 @@ class Session:
 
     def _anchor(self, track: int, frame: int, after: bool) -> Row | None:
         """The solver's input row under ``track``'s first row at or after ``frame`` (``after``) or its last row
-        before it, as ``(frame, input id)``; None when there is none."""
+        before it, as ``(frame, input id)``; None when there is none. Rows pair one-to-one per frame, so two ids that
+        pass close by never share one input row."""
         assert self._solver_rows is not None
-        mine = self.rows[self.rows[:, 1] == track]
-        mine = mine[mine[:, 0] >= frame] if after else mine[mine[:, 0] < frame][::-1]
-        if not len(mine):
-            return None
-        near = self._solver_rows[np.isin(self._solver_rows[:, 0], mine[:, 0])]
-        ia, ib = colocated(mine, near)
-        if not len(ia):
-            return None
-        best = int(np.argmin(ia))  # mine is ordered outwards from the frame
-        return int(near[ib[best], 0]), int(near[ib[best], 1])
+        mine = self.rows[self.rows[:, 1] == track, 0]
+        mine = mine[mine >= frame] if after else mine[mine < frame][::-1]
+        for lo in range(0, len(mine), 32):  # outwards from the frame, 32 frames at a time
+            frames = mine[lo:lo + 32]
+            here = self.rows[np.isin(self.rows[:, 0], frames)]
+            near = self._solver_rows[np.isin(self._solver_rows[:, 0], frames)]
+            ia, ib = colocated(here, near)
+            ours = here[ia, 1] == track
+            if ours.any():
+                f = here[ia[ours], 0]
+                best = int(np.argmin(f) if after else np.argmax(f))
+                return int(near[ib[ours][best], 0]), int(near[ib[ours][best], 1])
+        return None
 
     def _runs(self, track: int) -> list[Row]:
         """One solver input row per run of one input id under ``track`` (its first)."""
         assert self._solver_rows is not None
-        mine = self.rows[self.rows[:, 1] == track]
-        ia, ib = colocated(mine, self._solver_rows)
-        order = np.argsort(mine[ia, 0])
-        src = self._solver_rows[ib[order]]
+        ia, ib = colocated(self.rows, self._solver_rows)
+        ours = self.rows[ia, 1] == track
+        src = self._solver_rows[ib[ours]]
+        src = src[np.argsort(src[:, 0], kind="stable")]
         first = np.r_[True, src[1:, 1] != src[:-1, 1]] if len(src) else np.zeros(0, bool)
         return [(int(f), int(s)) for f, s in src[first, :2]]
 
