@@ -73,7 +73,7 @@ def test_demo_tables_cover_trackers_and_lstm_presence(demo_out):
     html = (out / "report.html").read_text()
     assert len(re.findall(r'<img src="data:image/(png|gif);base64,', html)) >= 3
     assert html.count('<video controls') == 2 and html.count('src="data:video/mp4;base64,') == 2
-    assert html.count('poster="data:image/png;base64,') == 2 and html.count('<div class="legend">') == 2
+    assert html.count('poster="data:image/png;base64,') == 2 and html.count('<div class="legend"') == 2
     assert 'href="robots.mp4"' in html and 'href="divers.mp4"' in html
 
 
