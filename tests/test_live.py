@@ -275,3 +275,18 @@ def test_served_stream_with_an_onnx_detector_stops_after_max_frames(stream, tmp_
     assert "stopped: 40 frames" in result.output
     table = np.loadtxt(out, delimiter=",", ndmin=2)
     assert len(table) > 0 and len(np.unique(table[:, 0])) <= 40
+
+
+def test_a_source_without_stamps_is_timed_by_the_wall_clock_on_its_frame_period():
+    images = iter([scene_frame(k) for k in range(12)])
+
+    def read():
+        time.sleep(0.02)
+        image = next(images, None)
+        return None if image is None else (image, None)
+
+    with LiveSource(read, "unstamped", frame_rate=50.0) as source:
+        times = [f.time for f in source]
+    assert source.clock == "wall clock" and len(times) + source.dropped == 12
+    assert times == sorted(times) and times[-1] > 0
+    assert np.allclose(np.asarray(times) * 50, np.round(np.asarray(times) * 50))  # whole frame periods
