@@ -204,9 +204,10 @@ def track(
     ),
     min_score: float = typer.Option(float("-inf"), help="Drop detections with a lower score."),
     video_arg: str | None = typer.Option(
-        None, "--video", help="Video file or image folder (img1): appearance features from its pixels; also "
-        "writes <output stem>.health.csv and, for merging trackers, <output stem>.merges.csv. Or a live source: a "
-        "camera index (0) or a stream URL (rtsp://, http://) with --detector (docs: live camera how-to)."
+        None, "--video", metavar="<path|0|url>", help="Video file or image folder (img1): appearance features from "
+        "its pixels; also writes <output stem>.health.csv and, for merging trackers, <output stem>.merges.csv. Or a "
+        "live source: a camera index (0) or a stream URL (rtsp://, http://) with --detector (docs: live camera "
+        "how-to)."
     ),
     detections: Path | None = typer.Option(None, "--detections", help="det.txt for --video (or give it as PATH)."),
     annotate: Path | None = typer.Option(
