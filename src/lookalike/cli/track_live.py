@@ -59,6 +59,8 @@ def run_track_live(spec: str, output: Path, tracker: Any, tracker_name: str, det
 
                 run = track_live(source, plan, output, max_frames=max_frames, seconds=seconds, stop=stop,
                                  on_frame=show)
+    setup = f" ({run.dropped_before} while setting up)" if run.dropped_before else ""
     console.print(f"[green]{tracker_name}[/]: {run.frames} frames in {run.wall_s:.1f} s ({run.fps:.1f} frames/s; "
                   f"detector + tracker {run.busy_fps:,.0f} frames/s), {run.dropped} of {run.delivered} dropped "
-                  f"while busy, times from the {run.clock}; stopped: {escape(run.stopped)} → {escape(str(output))}")
+                  f"while busy{setup}, times from the {run.clock}; stopped: {escape(run.stopped)} → "
+                  f"{escape(str(output))}")

@@ -70,13 +70,15 @@ class LiveStop:
 @dataclass
 class LiveRun:
     """What one :func:`track_live` did. ``frames``: tracked; ``delivered``/``dropped``: frames the source gave and
-    those skipped because the tracker was busy; ``rows``: result rows written; ``wall_s``: seconds from the first
+    those skipped because the tracker was busy (``dropped_before`` of them before tracking began, while the
+    detector was set up); ``rows``: result rows written; ``wall_s``: seconds from the first
     frame to the stop; ``busy_s``: seconds in the detector and the tracker; ``clock``: where frame times came from
     (``stream`` or ``wall clock``); ``stopped``: why the run ended."""
 
     frames: int = 0
     delivered: int = 0
     dropped: int = 0
+    dropped_before: int = 0
     rows: int = 0
     wall_s: float = 0.0
     busy_s: float = 0.0
@@ -171,6 +173,7 @@ def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_fr
     stop = stop if stop is not None else LiveStop()
     run = LiveRun(output=Path(output))
     start = time.monotonic()
+    run.dropped_before = source.dropped
     exiting: SystemExit | None = None
     with MotWriter(output) as writer:
         try:
