@@ -47,8 +47,8 @@ Read = Callable[[], "tuple[np.ndarray, float | None] | None"]
 
 
 class LiveSource:
-    """The newest frame of a source read on its own thread. Iterating yields :class:`LiveFrame`\\ s as they come,
-    waiting for the next one; a frame replaced before it was taken counts in :attr:`dropped`. Stamps: the stream's
+    """The newest frame of a source read on its own thread. Iterating yields :class:`LiveFrame` objects as they
+    come, waiting for the next one; a frame replaced before it was taken counts in :attr:`dropped`. Stamps: the stream's
     own (``clock == "stream"``) when ``read`` gives them, else the wall clock (rounded to the period of
     ``frame_rate`` when given); never decreasing."""
 
