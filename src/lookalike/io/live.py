@@ -149,10 +149,12 @@ def live_blob_detector(sample: list[LiveFrame], given: dict[str, Any], n_targets
 
 def _frames(source: LiveSource, detector: Callable[[Any], Detections], sample: list[LiveFrame],
             sampled: list[Detections]) -> Iterator[tuple[Frame, float]]:
-    """The tracker's frames: the sample's (detected already), then the source's as they come; with the seconds
-    spent detecting each."""
+    """The tracker's frames: the sample's (detected already; the lists are emptied once tracked, freeing the
+    images), then the source's as they come; with the seconds spent detecting each."""
     for live, det in zip(sample, sampled):
         yield Frame(index=live.number, time=live.time, detections=det), 0.0
+    sample.clear()
+    sampled.clear()
     for live in source:
         t0 = time.perf_counter()
         det = detector(live.image)
@@ -168,7 +170,8 @@ def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_fr
     stream time have passed, or ``stop`` is set (or ``KeyboardInterrupt``). Rows reach a temporary file beside
     ``output`` as each frame ends; whatever stops the run, the file is completed up to the last whole frame and
     renamed onto ``output`` (a ``KeyboardInterrupt`` ends the run like ``stop``; a ``SystemExit`` is raised again
-    once the file is complete). The plan's sample frames, read and detected already, are tracked first.
+    once the file is complete). The plan's sample frames, read and detected already, are tracked first, then
+    emptied from the plan.
     ``on_frame``: called with the running totals after each frame."""
     stop = stop if stop is not None else LiveStop()
     run = LiveRun(output=Path(output))
@@ -210,7 +213,6 @@ def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_fr
     if exiting is not None:
         raise exiting
     return run
-
 
 
 def prepare_live(source: LiveSource, detector: str, tracker: Any, tracker_name: str, *,
