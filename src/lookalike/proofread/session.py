@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -256,4 +256,4 @@ class Session:
                 self.apply(c)
             except ValueError as exc:
                 raise ValueError(f"replay: correction {k + 1} ({c.to_json()}): {exc}") from exc
-        return replace(changes(before, self.rows))
+        return changes(before, self.rows)
