@@ -44,7 +44,10 @@ class Correction:
         data = json.loads(line)
         if not isinstance(data, dict) or set(data) - {"kind", "track", "other", "frame"}:
             raise ValueError(f"correction: expected an object with kind, track[, other, frame], got {line[:80]!r}")
-        return cls(**{k: (v if k == "kind" else int(v)) for k, v in data.items()})
+        if not isinstance(data.get("kind"), str) or "track" not in data:
+            raise ValueError(f"correction: kind (text) and track are required, got {line[:80]!r}")
+        whole = {k: int(data[k]) for k in ("other", "frame") if data.get(k) is not None}
+        return cls(data["kind"], int(data["track"]), whole.get("other"), whole.get("frame"))
 
 
 @dataclass(frozen=True)
