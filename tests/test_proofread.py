@@ -158,3 +158,39 @@ def test_doubtful_ranges_are_sorted_most_doubtful_first():
     d = s.doubtful()
     assert [x.doubt for x in d] == sorted((x.doubt for x in d), reverse=True)
     assert all(x.first <= x.last for x in d)
+
+
+@pytest.mark.parametrize("kind, refused", [("swap", None), ("split", None), ("delete", None),
+                                            ("assign", "overlap"), ("merge", "overlap")])
+def test_each_correction_kind_re_solves_and_undoes(kind: str, refused: str | None):
+    on = _crossing()
+    base = assign_identities(on, 2, 10)
+    start = base[np.lexsort((base[:, 1], base[:, 0]))]
+    a, b = _at(base, 10, 25), _at(base, 10, 85)
+    c = {"swap": Correction("swap", a, b, 30), "assign": Correction("assign", a, b, 30),
+         "split": Correction("split", a, frame=30), "merge": Correction("merge", a, b),
+         "delete": Correction("delete", a)}[kind]
+    s = Session(base, frame_rate=10, n_targets=2, solver_input=on)
+    if refused:  # b holds those frames: the closed set refuses, says why and changes nothing
+        with pytest.raises(ValueError, match=refused):
+            s.apply(c)
+        np.testing.assert_array_equal(s.rows, start)
+        assert not s.corrections
+        return
+    change = s.apply(c)
+    assert s.corrections == [c]
+    if kind == "swap":
+        was = _at(base, 35, 87.5)
+        assert min(change.frames) >= 30 and _at(s.rows, 35, 87.5) == (b if was == a else a)
+    if kind == "delete":
+        assert change.rows > 0 and a in change.ids
+    s.undo()
+    np.testing.assert_array_equal(s.rows, start)
+
+
+def test_log_lines_round_trip_and_bad_lines_raise():
+    c = Correction("swap", 1, 2, 5)
+    assert Correction.from_json(c.to_json()) == c
+    for bad in ('{"kind": "swap"}', '[1, 2]', '{"kind": "swap", "track": 1, "other": 2, "frame": 5, "x": 1}'):
+        with pytest.raises(ValueError):
+            Correction.from_json(bad)
