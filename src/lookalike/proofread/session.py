@@ -17,14 +17,9 @@ import numpy as np
 from lookalike.io.motchallenge import read_mot, write_mot
 from lookalike.io.outputs import write_atomic
 from lookalike.proofread.edits import Change, Correction, apply_edit, changes, check, colocated
-from lookalike.trackers.offline.closed_set import (
-    ChainConstraints,
-    ClosedSetConfig,
-    Row,
-    assign_identities,
-    online_rows,
-)
+from lookalike.trackers.offline.closed_set import ClosedSetConfig, assign_identities, online_rows
 from lookalike.trackers.offline.confidence import DOUBTFUL_BELOW, assignment_confidence, doubtful_ranges
+from lookalike.trackers.offline.constraints import ChainConstraints, Row
 
 __all__ = ["Doubt", "Session"]
 

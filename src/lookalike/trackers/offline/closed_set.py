@@ -21,12 +21,19 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from lookalike.trackers.offline.closed_set_config import ClosedSetConfig
+from lookalike.trackers.offline.constraints import (
+    ChainConstraints,
+    chain_ids,
+    constraint_marks,
+    cut_tracklets,
+    tracklet_of,
+    with_marks,
+)
 from lookalike.trackers.offline.gap_fill import fill_gaps, smooth_boxes
 from lookalike.trackers.offline.tracklets import (
     Tracklet,
@@ -43,29 +50,6 @@ from lookalike.types import Detections, Frame
 
 __all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale",
            "place_short", "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
-
-
-Row = tuple[int, int]  # (1-based frame, input id): one input row
-
-
-@dataclass(frozen=True)
-class ChainConstraints:
-    """Constraints on :func:`assign_identities`, each naming input rows by ``(frame, input id)`` (1-based frame, the
-    id the row has in the input).
-
-    ``cut``: the row's input track is cut just before it (so a constraint can hold from that frame on);
-    ``identity``: ``(row, j)``, the tracklet holding the row is identity ``j`` (1..N);
-    ``apart``: pairs of rows whose tracklets are never on one identity;
-    ``clutter``: rows whose tracklets are on no identity."""
-
-    cut: tuple[Row, ...] = ()
-    identity: tuple[tuple[Row, int], ...] = ()
-    apart: tuple[tuple[Row, Row], ...] = ()
-    clutter: tuple[Row, ...] = ()
-
-    def rows(self) -> list[Row]:
-        """Every row a constraint names."""
-        return [r for r, _ in self.identity] + [r for pair in self.apart for r in pair] + list(self.clutter)
 
 
 def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
@@ -109,7 +93,7 @@ def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.nd
     upper[list(excluded)] = 0.0
     lower = np.zeros(len(c))
     if marks:
-        A, lo, hi, c, lower, upper = _with_marks(A, lo, hi, c, lower, upper, n, (src, dst), marks)
+        A, lo, hi, c, lower, upper = with_marks(A, lo, hi, c, lower, upper, n, (src, dst), marks)
     res = milp(c, constraints=LinearConstraint(A, lo, hi), integrality=np.ones(len(c)), bounds=Bounds(lower, upper),
                options={"time_limit": time_limit_s})
     if res.x is None and (marks or len(excluded)):
@@ -128,44 +112,6 @@ def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.nd
             chain.append(k)
         result.append(chain)
     return result
-
-
-def _with_marks(A: Any, lo: np.ndarray, hi: np.ndarray, c: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-                n: int, links: tuple[np.ndarray, np.ndarray],
-                marks: Sequence[tuple[Collection[int], Collection[int]]]) -> tuple[Any, ...]:
-    """:func:`solve_chains`' problem with, per mark, variables ``z`` (tracklet marked) and ``h`` (chain head marked)
-    after the ``4n + m`` of the chains, and their constraints."""
-    from scipy import sparse
-
-    src, dst = links
-    m = len(src)
-    base = A.shape[1]
-    blocks, los, his = [], [], []
-    for k in range(len(marks)):
-        z0 = base + 2 * n * k  # z [z0, z0+n), h [z0+n, z0+2n)
-        e = np.arange(m)
-        # a used link joins two equally marked tracklets: z_s - z_d + y ≤ 1 and z_d - z_s + y ≤ 1
-        r = np.r_[e, e, e, m + e, m + e, m + e]
-        col = np.r_[z0 + src, z0 + dst, n + e, z0 + dst, z0 + src, n + e]
-        val = np.r_[np.ones(m), -np.ones(m), np.ones(m), np.ones(m), -np.ones(m), np.ones(m)]
-        i = np.arange(n)
-        # z_i - x_i ≤ 0; a_i + z_i - h_i ≤ 1; Σ h ≤ 1
-        r = np.r_[r, 2 * m + i, 2 * m + i, 2 * m + n + i, 2 * m + n + i, 2 * m + n + i, np.full(n, 2 * m + 2 * n)]
-        col = np.r_[col, z0 + i, i, n + m + i, z0 + i, z0 + n + i, z0 + n + i]
-        val = np.r_[val, np.ones(n), -np.ones(n), np.ones(n), np.ones(n), -np.ones(n), np.ones(n)]
-        width = base + 2 * n * len(marks)
-        blocks.append(sparse.csr_matrix((val, (r, col)), shape=(2 * m + 2 * n + 1, width)))
-        los.append(np.full(2 * m + 2 * n + 1, -np.inf))
-        his.append(np.r_[np.ones(2 * m), np.zeros(n), np.ones(n), 1.0])
-    extra = 2 * n * len(marks)
-    A = sparse.vstack([sparse.hstack([A, sparse.csr_matrix((A.shape[0], extra))]), *blocks]).tocsr()
-    lower = np.r_[lower, np.zeros(extra)]
-    upper = np.r_[upper, np.ones(extra)]
-    for k, (on, off) in enumerate(marks):
-        z0 = base + 2 * n * k
-        lower[[z0 + t for t in on]] = 1.0
-        upper[[z0 + t for t in off]] = 0.0
-    return A, np.concatenate([lo, *los]), np.concatenate([hi, *his]), np.r_[c, np.zeros(extra)], lower, upper
 
 
 def _chain_position(block: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -250,11 +196,11 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     rows = checked_rows(rows)
     pieces = split_tracklets(rows, cfg)
     if constraints is not None:
-        pieces = _cut_tracklets(pieces, constraints.cut)
+        pieces = cut_tracklets(pieces, constraints.cut)
     if not pieces:
         unchanged: np.ndarray = rows.copy()
         return unchanged
-    named = {_tracklet_of(pieces, r) for r in constraints.rows()} if constraints is not None else set()
+    named = {tracklet_of(pieces, r) for r in constraints.rows()} if constraints is not None else set()
     tracklets = [t for i, t in enumerate(pieces) if len(t) >= cfg.min_rows or i in named] or pieces
     chained = {id(t) for t in tracklets}
     short = [t for t in pieces if len(t) < cfg.min_rows and tracklets is not pieces and id(t) not in chained]
@@ -266,13 +212,13 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     marks: list[tuple[Collection[int], Collection[int]]] = []
     excluded: list[int] = []
     if constraints is not None:
-        fixed, marks, excluded, links = _marks(tracklets, constraints, int(n_targets), links, cfg)
+        fixed, marks, excluded, links = constraint_marks(tracklets, constraints, int(n_targets), links, cfg)
     chains = solve_chains(np.array([len(t) for t in tracklets]), links, int(n_targets), cfg.tracklet_cost,
                           cfg.time_limit_s, start_cost, end_cost, marks, excluded)
     chains.sort(key=lambda ch: (tracklets[ch[0]].first, tracklets[ch[0]].rows[0, 2]))
     blocks = [np.vstack([tracklets[i].rows for i in chain]) for chain in chains]
     placed = place_short(short, blocks, motion_scale(tracklets), cfg)
-    ids = _chain_ids(chains, fixed, int(n_targets))
+    ids = chain_ids(chains, fixed, int(n_targets))
     out = []
     for c, block in enumerate(blocks):
         extra = [short[p].rows for p in np.flatnonzero(placed == c)]
@@ -286,80 +232,6 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     if not len(merged):
         return merged
     return smooth_boxes(fill_gaps(merged, max_fill), smoothing_window(merged, frame_rate, cfg))
-
-
-def _cut_tracklets(pieces: list[Tracklet], cuts: Sequence[Row]) -> list[Tracklet]:
-    """``pieces`` with each cut just before the rows named by ``cuts`` (1-based frame, input id)."""
-    at: dict[int, set[int]] = {}
-    for frame, source in cuts:
-        at.setdefault(int(source), set()).add(int(frame))
-    out: list[Tracklet] = []
-    for t in pieces:
-        frames = sorted(f for f in at.get(t.source_id, ()) if t.first < f <= t.last)
-        if not frames:
-            out.append(t)
-            continue
-        bounds = np.searchsorted(t.rows[:, 0], frames)
-        out += [Tracklet(r, t.source_id, t.contact) for r in np.split(t.rows, bounds) if len(r)]
-    out.sort(key=lambda t: (t.first, t.last))
-    return out
-
-
-def _tracklet_of(tracklets: list[Tracklet], row: Row) -> int:
-    """Index of the tracklet holding the input row ``(frame, input id)``; ValueError when none does."""
-    frame, source = int(row[0]), int(row[1])
-    for i, t in enumerate(tracklets):
-        if t.source_id == source and t.first <= frame <= t.last and np.any(t.rows[:, 0] == frame):
-            return i
-    raise ValueError(f"constraint: no input row of id {source} at frame {frame}")
-
-
-def _marks(tracklets: list[Tracklet], cons: ChainConstraints, n_targets: int,
-           links: tuple[np.ndarray, np.ndarray, np.ndarray], cfg: ClosedSetConfig) -> tuple[Any, ...]:
-    """The fixed identity per tracklet, the marks and exclusions of :func:`solve_chains` and the links with a direct
-    link added between consecutive tracklets fixed to one identity (at the dearest candidate's cost), so the
-    constraints can always be met by some chain."""
-    fixed: dict[int, int] = {}
-    for row, j in cons.identity:
-        if not 1 <= int(j) <= n_targets:
-            raise ValueError(f"constraint: identity {j} is not in 1..{n_targets}")
-        t = _tracklet_of(tracklets, row)
-        if fixed.get(t, j) != j:
-            raise ValueError(f"constraint: the tracklet of row {row} is fixed to identities {fixed[t]} and {j}")
-        fixed[t] = int(j)
-    excluded = sorted({_tracklet_of(tracklets, r) for r in cons.clutter})
-    if set(excluded) & set(fixed):
-        raise ValueError("constraint: a tracklet is both on an identity and clutter")
-    src, dst, cost = links
-    known = set(zip(src.tolist(), dst.tolist()))
-    dear = float(cost.max()) if len(cost) else cfg.link_cost
-    add: list[tuple[int, int]] = []
-    marks: list[tuple[Collection[int], Collection[int]]] = []
-    for j in sorted(set(fixed.values())):
-        on = sorted((t for t in fixed if fixed[t] == j), key=lambda t: tracklets[t].first)
-        for p, q in zip(on[:-1], on[1:]):
-            if tracklets[p].last >= tracklets[q].first:
-                raise ValueError(f"constraint: identity {j} is fixed to two tracklets that overlap in frames "
-                                 f"{tracklets[q].first}-{min(tracklets[p].last, tracklets[q].last)}")
-            if (p, q) not in known:
-                add.append((p, q))
-        marks.append((on, [t for t in fixed if fixed[t] != j]))
-    for a_row, b_row in cons.apart:
-        a, b = _tracklet_of(tracklets, a_row), _tracklet_of(tracklets, b_row)
-        if a == b or (a in fixed and fixed.get(b) == fixed[a]):
-            raise ValueError(f"constraint: rows {a_row} and {b_row} cannot be apart (same tracklet or identity)")
-        marks.append(([a], [b]))
-    if add:
-        p, q = np.array(add).T
-        links = (np.r_[src, p], np.r_[dst, q], np.r_[cost, np.full(len(add), dear)])
-    return fixed, marks, excluded, links
-
-
-def _chain_ids(chains: list[list[int]], fixed: dict[int, int], n_targets: int) -> list[int]:
-    """Id of each chain (in order): the identity fixed to one of its tracklets, else the free ids in order."""
-    ids = [next((fixed[t] for t in ch if t in fixed), 0) for ch in chains]
-    free = iter(sorted(set(range(1, max(n_targets, len(chains)) + 1)) - set(ids)))
-    return [i or next(free) for i in ids]
 
 
 def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfig | None = None) -> int:
