@@ -136,6 +136,8 @@ def test_writer_leaves_nothing_when_the_run_fails(tmp_path):
 
 
 def test_track_cli_streams_the_same_file_as_the_old_loop(tmp_path):
+    from lookalike.cli.track_confidence import add_confidence
+
     path = _det_file(tmp_path / "det.txt", frames=120)
     result = runner.invoke(app, ["track", "-t", "sort", str(path), "-o", str(tmp_path / "out.txt")])
     assert result.exit_code == 0, result.output
@@ -143,6 +145,7 @@ def test_track_cli_streams_the_same_file_as_the_old_loop(tmp_path):
     rows = [RowCollector()]
     run(tracker, frames_from_table(read_mot(path)), rows[0])
     write_mot(tmp_path / "ref.txt", rows[0].rows())
+    add_confidence([(tmp_path / "ref.txt", 30.0)])  # track's last step: column 7 is the identity confidence
     assert (tmp_path / "out.txt").read_bytes() == (tmp_path / "ref.txt").read_bytes()
 
 

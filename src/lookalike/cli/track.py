@@ -350,6 +350,9 @@ def track(
                     count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length,
                                                det_format=det_format, name=tracker)
                     console.print(f"[green]{tracker}[/]: {count} sequence(s), {_speed(stats)} → {where}")
+            from lookalike.cli.track_confidence import add_confidence, written_results
+
+            add_confidence(written_results(branch, path, output, video, fps, live=live is not None))
 
         except OSError as exc:  # an output that cannot be written, an input that cannot be read
             fail(f"{exc.filename or output}: {exc.strerror or exc}")
