@@ -77,6 +77,7 @@ def test_offline_needs_targets_in_one_line(tmp_path):
 def test_offline_writes_the_closed_set_of_the_whole_sequence(tmp_path):
     """``--targets N --offline`` writes exactly :func:`track_closed_set` of the file's detections (ids 1..N)."""
     from lookalike.trackers.offline.closed_set import track_closed_set
+    from lookalike.trackers.offline.confidence import assignment_confidence
 
     det_rows = _crossing_rows()
     det = _write_det(tmp_path, det_rows)
@@ -88,6 +89,7 @@ def test_offline_writes_the_closed_set_of_the_whole_sequence(tmp_path):
     assert set(np.unique(rows[:, 1]).tolist()) == {1, 2}
     assert np.bincount(rows[:, 0].astype(int)).max() == 2
     expected = track_closed_set(det_rows, 2, 30.0, n_frames=60, online={"n_init": 2})  # no seqinfo: 30 frames/s
+    expected[:, 6] = assignment_confidence(expected, 30.0)  # column 7: the rows' identity confidence
     np.testing.assert_allclose(rows, expected, atol=1e-3)
 
 
