@@ -1,9 +1,5 @@
-"""BoxTrack: a motion-only box tracker for look-alike targets (no appearance).
-
-A composition of shared parts: a track table of :class:`~lookalike.motion.spaces.BoxCXCYWH` states (pixels,
-pixels/frame), a score-split association plan (:mod:`lookalike.association.stages`), a lifecycle, self-calibrating score
-thresholds, coasting, a clutter-following birth threshold and, with ``max_targets``, closed-set slots (all in
-:mod:`lookalike.trackers.parts`).
+"""BoxTrack: a motion-only box tracker for look-alike targets (no appearance), composed of the parts in
+:mod:`lookalike.trackers.parts` (states :class:`~lookalike.motion.spaces.BoxCXCYWH` in pixels and pixels/frame).
 
 Each frame: detections below ``low_score`` are dropped; confirmed tracks take confident detections on ``1 - IoU·score``
 (recently seen first), tracks seen last frame take low-score ones on IoU, tentative tracks take the rest on IoU, and
@@ -28,7 +24,7 @@ from lookalike.motion.spaces import BoxCXCYWH
 from lookalike.trackers import boxtrack_config as const
 from lookalike.trackers.boxtrack_config import BoxTrackConfig
 from lookalike.trackers.kernels import boxtrack as boxtrack_kernels
-from lookalike.trackers.parts.batches import batches, near_pairs, overlapping_pairs, pair_iou
+from lookalike.trackers.parts.batches import near_pairs, overlapping_pairs, run_in_batches
 from lookalike.trackers.parts.closed_slots import ClosedSlots
 from lookalike.trackers.parts.clutter import ClutterShare
 from lookalike.trackers.parts.coasting import Coasting
@@ -118,7 +114,7 @@ class BoxTrack:
                 x[4:8, still] = 0.0  # a long-lost track waits where it was last seen
             self._predict_space().predict_columns(x, steps)
         if self._large(len(score)):
-            self._observe_clutter_pairs(det_xywh)
+            self._clutter.observe_pairs(det_xywh)
             high_score, birth_score, _ = self._calibration.decide(self._clutter.share)
             matching = self._associate_batches(x, det_xywh, z.T, score, high_score, was_tracked, dt)
         else:
@@ -305,38 +301,25 @@ class BoxTrack:
         pairs = (len(self._tracks) + (0 if previous is None else len(previous))) * n
         return pairs > LARGE_PAIRS and self.config.match_iou > 0
 
-    def _observe_clutter_pairs(self, det_xywh: np.ndarray) -> None:
-        """The clutter share's count of a large frame from the overlapping pairs alone (:meth:`_overlaps`'s numbers)."""
-        clutter = self._clutter
-        previous = clutter.previous
-        if previous is None or not len(previous) or not len(det_xywh):
-            clutter.observe_overlaps(det_xywh, None)
-            return
-        i, j = overlapping_pairs(previous, det_xywh)
-        near = j[pair_iou(previous[i], det_xywh[j]) >= clutter.min_iou]
-        clutter.observe_count(det_xywh, len(det_xywh) - len(np.unique(near)))
-
     def _associate_batches(self, x: np.ndarray, det_xywh: np.ndarray, det_box: np.ndarray, score: np.ndarray,
                            high_score: float, was_tracked: np.ndarray, dt: float) -> Matching:
         """:meth:`_associate` of a large frame, in memory linear in its boxes: the plan runs on batches of the
         connected groups of tracks and detections that overlap or lie within re-identification reach
         (:mod:`~lookalike.trackers.parts.batches`); no stage can match across groups, so the matches are the same."""
-        t, k, n = self._tracks, x.shape[1], len(score)
+        k = x.shape[1]
         boxes = np.empty((4, k))
         _xywh_columns(x, boxes)
         i, j = overlapping_pairs(boxes.T, det_xywh)
-        centres, radius = self._reid_reach(dt)
-        radius[~t.confirmed] = np.nan  # only confirmed tracks are re-identified
-        ri, rj = near_pairs(centres, radius, det_box[:, :2])
-        matching = Matching.empty(k, n)
-        for rows, cols in batches(k, n, np.concatenate((i, ri)), np.concatenate((j, rj)), LARGE_PAIRS):
+        track_box, gate, _ = self._reid_gate(dt)
+        radius = np.ravel(gate * np.maximum(track_box[:, 3:4], 1.0)) * (1 + 1e-9)  # (a hair wide: no pair too few)
+        radius[~self._tracks.confirmed] = np.nan  # only confirmed tracks are re-identified
+        ri, rj = near_pairs(track_box[:, :2], radius, det_box[:, :2])
+
+        def plan(rows: np.ndarray, cols: np.ndarray) -> list[Stage]:
             iou = iou_columns(boxes[:, rows], det_xywh[cols].T)
-            part = run_plan(self._plan(iou, None, det_box[cols], score[cols], high_score, was_tracked[rows], dt, rows),
-                            len(rows), len(cols))
-            hit = part.det_of_track >= 0
-            matching.det_of_track[rows[hit]] = cols[part.det_of_track[hit]]
-            matching.free[cols] = part.free
-            matching.stage_of_track[rows] = part.stage_of_track
+            return self._plan(iou, None, det_box[cols], score[cols], high_score, was_tracked[rows], dt, rows)
+
+        matching = run_in_batches(k, len(score), np.concatenate((i, ri)), np.concatenate((j, rj)), LARGE_PAIRS, plan)
         self._observe_continued(score, matching)
         return matching
 
@@ -383,34 +366,25 @@ class BoxTrack:
     def _reid(self, det_box: np.ndarray, dt: float, rows: np.ndarray | None = None) -> CostFn:
         """The re-identification stage's cost of lost tracks and detections ``det_box (n, 4)`` (cx, cy, w, h;
         pixels), ``dt`` seconds after the tracks' last frame; ``rows``: the tracks of a batch (None: all)."""
-        cfg, t, slots = self.config, self._tracks, self._slots
+        slots = self._slots
 
         def reid(r: np.ndarray, c: np.ndarray) -> np.ndarray:
             # built only when some lost track and confident detection are left
-            if rows is not None:
-                r = rows[r]
-            if slots is not None:  # closed set: sizes as sqrt(w·h), a turning target keeps its size; gates in heights
-                track_box, box = slots.squared(t.mean[:, :4]), slots.squared(det_box)
-                gate, scale = slots.gate(t.unseen_s + dt), max(cfg.reid_scale, const.CLOSED_SCALE)
-                return centre_distance_cost(track_box[r], box[c], gate[r], scale)
-            # in fitted standard deviations: a model that fits badly (MotionFit) widens the gate
-            gate_all = const.REID_DISTANCE * math.sqrt(self._fit.scale)
-            return centre_distance_cost(t.mean[r, :4], det_box[c], gate_all, cfg.reid_scale)
+            track_box, gate, scale = self._reid_gate(dt)
+            r = r if rows is None else rows[r]
+            box = det_box if slots is None else slots.squared(det_box)
+            return centre_distance_cost(track_box[r], box[c], gate[r] if isinstance(gate, np.ndarray) else gate, scale)
 
         return reid
 
-    def _reid_reach(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        """Every track's centre ``(k, 2)`` and the distance (pixels) within which :meth:`_reid` allows a detection's
-        centre (its gate times the track's height)."""
-        t, slots = self._tracks, self._slots
-        gate: np.ndarray | float
+    def _reid_gate(self, dt: float) -> tuple[np.ndarray, np.ndarray | float, float]:
+        """Re-identification's terms for every track: its box (cx, cy, w, h; closed set: a square of the same area, so
+        a turning target keeps its size), its gate in box heights (``(k, 1)``, or one for all) and the largest size
+        ratio. Open set: in fitted standard deviations, so a model that fits badly (MotionFit) widens the gate."""
+        cfg, t, slots = self.config, self._tracks, self._slots
         if slots is not None:
-            box = slots.squared(t.mean[:, :4])
-            gate = slots.gate(t.unseen_s + dt)[:, 0]
-        else:
-            box, gate = t.mean[:, :4], const.REID_DISTANCE * math.sqrt(self._fit.scale)
-        radius: np.ndarray = gate * np.maximum(box[:, 3], 1.0) * (1 + 1e-9)  # (a hair wider: never a pair too few)
-        return np.array(box[:, :2]), radius
+            return slots.squared(t.mean[:, :4]), slots.gate(t.unseen_s + dt), max(cfg.reid_scale, const.CLOSED_SCALE)
+        return t.mean[:, :4], const.REID_DISTANCE * math.sqrt(self._fit.scale), cfg.reid_scale
 
     def _correct(self, x: np.ndarray, matched: np.ndarray, z: np.ndarray) -> None:
         """Kalman update of the tracks ``matched`` (columns of ``x``) with their measurements ``z (4, m)``; the centre

@@ -7,11 +7,13 @@ whole frame's matches with memory linear in the number of boxes."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
-__all__ = ["batches", "near_pairs", "overlapping_pairs", "pair_iou"]
+from lookalike.association.stages import Matching, Stage, run_plan
+
+__all__ = ["batches", "near_pairs", "overlapping_pairs", "pair_iou", "run_in_batches"]
 
 
 def _pairs(lists: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -92,3 +94,17 @@ def pair_iou(a_xywh: np.ndarray, b_xywh: np.ndarray) -> np.ndarray:
     union = a_xywh[:, 2] * a_xywh[:, 3] + b_xywh[:, 2] * b_xywh[:, 3] - inter
     out: np.ndarray = np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
     return out
+
+
+def run_in_batches(n_rows: int, n_cols: int, i: np.ndarray, j: np.ndarray, budget: int,
+                   plan: Callable[[np.ndarray, np.ndarray], list[Stage]]) -> Matching:
+    """The matching of ``n_rows`` tracks and ``n_cols`` detections when only the pairs ``(i, j)`` can match:
+    ``plan(rows, cols)``'s stages (indices local to the batch) run on each of :func:`batches`' batches in turn."""
+    matching = Matching.empty(n_rows, n_cols)
+    for rows, cols in batches(n_rows, n_cols, i, j, budget):
+        part = run_plan(plan(rows, cols), len(rows), len(cols))
+        hit = part.det_of_track >= 0
+        matching.det_of_track[rows[hit]] = cols[part.det_of_track[hit]]
+        matching.free[cols] = part.free
+        matching.stage_of_track[rows] = part.stage_of_track
+    return matching

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from lookalike.geometry.boxes import iou_matrix
+from lookalike.trackers.parts.batches import overlapping_pairs, pair_iou
 
 
 class ClutterShare:
@@ -46,6 +47,17 @@ class ClutterShare:
             self.seen += n
             self.flicker += n if overlap is None else n - len(set(overlap.nonzero()[1].tolist()))
         self._previous = xywh
+
+    def observe_pairs(self, xywh: np.ndarray) -> None:
+        """:meth:`observe_overlaps` for a large frame, from the overlapping pairs alone (memory linear in the boxes):
+        ``xywh`` a float ``(k, 4)`` array (pixels)."""
+        previous = self._previous
+        if previous is None or not len(previous) or not len(xywh):
+            self.observe_overlaps(xywh, None)
+            return
+        i, j = overlapping_pairs(previous, xywh)
+        near = j[pair_iou(previous[i], xywh[j]) >= self.min_iou]
+        self.observe_count(xywh, len(xywh) - len(np.unique(near)))
 
     def observe_count(self, xywh: np.ndarray, flicker: int) -> None:
         """:meth:`observe` given the number ``flicker`` of this frame's boxes ``xywh (k, 4)`` overlapping none of
