@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import logging
 import math
-import signal
 import sys
 import time
 from pathlib import Path
@@ -16,35 +15,12 @@ import typer
 from lookalike.cli.app import app, check_outputs_or_fail, fail, failing
 from lookalike.cli.track import build_tracker
 from lookalike.io.outputs import write_atomic
+from lookalike.io.sources import SignalStop
 from lookalike.node import Endpoint, IdentifierConfig, NodeConfig, NodeServer, TeamState, log_event, parse_address
 from lookalike.node.server import check_group, dds_node
 from lookalike.node.teamsim import SimClock, camera_messages, run_camera, run_robot, team_sequence
 from lookalike.sim.presets import PRESET_NAMES
 from lookalike.trackers import tracker_parameters
-
-
-class _Stop:
-    """Set by SIGINT/SIGTERM (or a deadline); the serving loops poll it."""
-
-    def __init__(self, duration_s: float = 0.0) -> None:
-        self.deadline = time.monotonic() + duration_s if duration_s > 0 else None
-        self.signal: int | None = None
-        self._old: dict[int, Any] = {}
-
-    def __enter__(self) -> _Stop:  # noqa: PYI034
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            self._old[sig] = signal.signal(sig, self._handle)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        for sig, handler in self._old.items():
-            signal.signal(sig, handler)
-
-    def _handle(self, signum: int, _frame: object) -> None:
-        self.signal = signum
-
-    def __call__(self) -> bool:
-        return self.signal is not None or (self.deadline is not None and time.monotonic() >= self.deadline)
 
 
 def _logger(level: str) -> logging.Logger:
@@ -119,7 +95,7 @@ def serve(
         fail(f"--listen {listen}: {exc}")
     except ValueError as exc:
         fail(str(exc))
-    with server, _Stop(duration) as stop:
+    with server, SignalStop(duration) as stop:
         if port_file is not None and isinstance(server, NodeServer):
             host, port = server.address
             write_atomic(port_file, f"{host}:{port}\n")
@@ -199,7 +175,7 @@ def robot_sim(
         clock = _clock(start_at, speed)
         start_s, late = clock.late_start(f"robot {robot + 1}")
         _warn(late)
-        with _Stop() as stop:
+        with SignalStop() as stop:
             log = run_robot(endpoint, robot, sequence, clock, stop=stop, on_position=show if verbose else None,
                             start_s=start_s)
     print(json.dumps(log.summary()), flush=True)
@@ -226,6 +202,6 @@ def camera_sim(
         clock = _clock(start_at, speed)
         start_s, late = clock.late_start("the camera") if first_frame <= 0 else (-math.inf, None)
         _warn(late)
-        with _Stop() as stop:
+        with SignalStop() as stop:
             sent = run_camera(endpoint, messages, clock, stop, start_s)
     print(json.dumps({"camera_frames_sent": sent}), flush=True)

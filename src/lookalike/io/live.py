@@ -5,18 +5,15 @@ and a stop on a signal, a frame count or a duration that still leaves a whole re
 from __future__ import annotations
 
 import dataclasses
-import signal
-import threading
 import time
 from collections.abc import Callable, Collection, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import FrameType
 from typing import Any
 
 import numpy as np
 
-from lookalike.io.sources import LiveFrame, LiveSource
+from lookalike.io.sources import LiveFrame, LiveSource, SignalStop
 from lookalike.io.stream import MotWriter
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import tracks_to_rows
@@ -33,38 +30,11 @@ SAMPLE_FRAMES = 50
 """At most this many frames in that sample (memory: 50 frames of 1080p are 300 MB)."""
 
 
-class LiveStop:
-    """A stop flag set by SIGINT (Ctrl-C) or SIGTERM while in a ``with`` block (main thread only; a second Ctrl-C
-    interrupts at once), or by :meth:`set`. ``reason`` names what set it."""
+class LiveStop(SignalStop):
+    """:class:`~lookalike.io.sources.SignalStop` for a live run: a second Ctrl-C interrupts at once."""
 
     def __init__(self) -> None:
-        self._event = threading.Event()
-        self.reason = ""
-        self._old: dict[int, Any] = {}
-
-    def set(self, reason: str = "stopped") -> None:
-        """Ask the run to stop after the frame in hand."""
-        self.reason = self.reason or reason
-        self._event.set()
-
-    def __bool__(self) -> bool:
-        return self._event.is_set()
-
-    def _handle(self, signum: int, _frame: FrameType | None) -> None:
-        if signum == signal.SIGINT and self._event.is_set():
-            raise KeyboardInterrupt
-        self.set(signal.Signals(signum).name)
-
-    def __enter__(self) -> LiveStop:
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                self._old[sig] = signal.signal(sig, self._handle)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        for sig, handler in self._old.items():
-            signal.signal(sig, handler)
-        self._old.clear()
+        super().__init__(interrupt_twice=True)
 
 
 @dataclass

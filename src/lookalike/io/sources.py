@@ -5,6 +5,7 @@ slow consumer skips frames instead of falling behind; the skipped frames are cou
 from __future__ import annotations
 
 import re
+import signal
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -16,7 +17,7 @@ import numpy as np
 
 from lookalike._optional import needs
 
-__all__ = ["LiveFrame", "LiveSource", "is_live", "open_live", "replay_camera"]
+__all__ = ["LiveFrame", "LiveSource", "SignalStop", "is_live", "open_live", "replay_camera"]
 
 _URL = re.compile(r"^(rtsp|rtsps|rtmp|http|https|udp|tcp|srt)://", re.IGNORECASE)
 _OPEN_TIMEOUT_S = 10.0  # OpenCV's own open timeout is longer; a stream that sends nothing in this time is refused
@@ -195,3 +196,45 @@ def replay_camera(path: str | Path, speed: float = 1.0, frame_rate: float | None
         return image, k / rate
 
     return LiveSource(read, Path(path).name, rate, cap.release)
+
+
+class SignalStop:
+    """A stop flag set by SIGINT (Ctrl-C) or SIGTERM while in a ``with`` block (handlers installed on the main thread
+    only), by :meth:`set`, or ``duration_s`` seconds after it was made (0: never). ``stop()`` and ``bool(stop)`` say
+    whether to stop; ``signal`` is the signal that set it, ``reason`` what did. With ``interrupt_twice`` a second
+    Ctrl-C raises ``KeyboardInterrupt`` at once."""
+
+    def __init__(self, duration_s: float = 0.0, *, interrupt_twice: bool = False) -> None:
+        self.deadline = time.monotonic() + duration_s if duration_s > 0 else None
+        self.interrupt_twice = interrupt_twice
+        self.signal: int | None = None
+        self.reason = ""
+        self._event = threading.Event()
+        self._old: dict[int, Any] = {}
+
+    def set(self, reason: str = "stopped") -> None:
+        """Ask the run to stop after the frame in hand."""
+        self.reason = self.reason or reason
+        self._event.set()
+
+    def __bool__(self) -> bool:
+        return self._event.is_set() or (self.deadline is not None and time.monotonic() >= self.deadline)
+
+    __call__ = __bool__
+
+    def _handle(self, signum: int, _frame: object) -> None:
+        if self.interrupt_twice and signum == signal.SIGINT and self._event.is_set():
+            raise KeyboardInterrupt
+        self.signal = signum
+        self.set(signal.Signals(signum).name)
+
+    def __enter__(self) -> SignalStop:  # noqa: PYI034
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                self._old[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for sig, handler in self._old.items():
+            signal.signal(sig, handler)
+        self._old.clear()

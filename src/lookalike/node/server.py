@@ -4,6 +4,7 @@ last accepted frame: while it is alive, frames from others are dropped. Failures
 
 from __future__ import annotations
 
+import abc
 import gc
 import ipaddress
 import logging
@@ -122,7 +123,7 @@ class NodeConfig:
             check_group(self.group)
 
 
-class NodeCore:
+class NodeCore(abc.ABC):
     """What every transport of the node shares: the identifier, counters, rate limits, camera timer and status log.
     A transport reads messages, calls :meth:`accept` and :meth:`handle_message`, and implements ``poll`` and
     ``_publish``; ``serve(stop)`` loops until ``stop()`` is true."""
@@ -152,9 +153,9 @@ class NodeCore:
         finally:
             gc.unfreeze()
 
+    @abc.abstractmethod
     def poll(self, timeout_s: float) -> int:
         """Wait up to ``timeout_s`` for messages, handle them; return how many."""
-        raise NotImplementedError
 
     def __enter__(self) -> NodeCore:  # noqa: PYI034
         return self
@@ -166,8 +167,9 @@ class NodeCore:
         """Log the final counters."""
         log_event(self.log, "stopped", counters=self.counters.snapshot())
 
+    @abc.abstractmethod
     def _publish(self, team: TeamState) -> None:
-        raise NotImplementedError
+        """Send ``team`` to the robots (the transport's job)."""
 
     def accept(self, sender: Hashable, t_received: float) -> bool:
         """Count one received message of ``sender``; False when the sender is rate-limited (counted)."""
