@@ -84,7 +84,7 @@ class LivePlan:
 
 
 def sample_frames(source: LiveSource, seconds: float = SAMPLE_S, count: int = SAMPLE_FRAMES,
-                  stop: LiveStop | None = None) -> list[LiveFrame]:
+                  stop: SignalStop | None = None) -> list[LiveFrame]:
     """The source's first frames: those of its first ``seconds`` (stream time), at most ``count``; fewer when the
     source ends or ``stop`` is set."""
     frames: list[LiveFrame] = []
@@ -132,7 +132,7 @@ def _frames(source: LiveSource, detector: Callable[[Any], Detections], sample: l
 
 
 def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_frames: int | None = None,
-               seconds: float | None = None, stop: LiveStop | None = None,
+               seconds: float | None = None, stop: SignalStop | None = None,
                on_frame: Callable[[LiveRun], None] | None = None) -> LiveRun:
     """Detect and track ``source`` frame by frame with ``plan``'s detector and tracker (:func:`prepare_live`, or a
     :class:`LivePlan` of your own) into the MOTChallenge file ``output`` (frame numbers: the source's, 1-based, so a
@@ -187,7 +187,7 @@ def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_fr
 
 def prepare_live(source: LiveSource, detector: str, tracker: Any, tracker_name: str, *,
                  blob: dict[str, Any] | None = None, onnx: list[str] | None = None, n_targets: int | None = None,
-                 explicit: Collection[str] = (), min_score: float = -np.inf, stop: LiveStop | None = None,
+                 explicit: Collection[str] = (), min_score: float = -np.inf, stop: SignalStop | None = None,
                  sample_s: float = SAMPLE_S) -> LivePlan:
     """Set a live run up. ``detector``: ``blob`` (settings from the first ``sample_s`` seconds of ``source`` and
     ``blob``, typed :class:`BlobConfig` fields, on top; ``boxtrack`` gets the blob rules of
