@@ -194,3 +194,28 @@ def test_log_lines_round_trip_and_bad_lines_raise():
     for bad in ('{"kind": "swap"}', '[1, 2]', '{"kind": "swap", "track": 1, "other": 2, "frame": 5, "x": 1}'):
         with pytest.raises(ValueError):
             Correction.from_json(bad)
+
+
+def test_the_latest_correction_wins_and_drops_the_earlier_conflicting_one(tmp_path):
+    on = _crossing()
+    base = assign_identities(on, 2, 10)
+    start = base[np.lexsort((base[:, 1], base[:, 0]))]
+    a, b = _at(base, 10, 25), _at(base, 10, 85)
+    s = Session(base, frame_rate=10, n_targets=2, solver_input=on)
+    first = Correction("swap", a, b, 30)
+    s.apply(first)
+    s.apply(Correction("split", a, frame=50))  # pins other rows: kept
+    # swapped back from 30: contradicts `first`, which is dropped (the new one is not refused)
+    change = s.apply(Correction("swap", b, a, 30))
+    assert change.dropped == (first,) and s.dropped == [True, False, False]
+    assert f"dropped the earlier conflicting correction {first.to_json()}" in change.describe()
+    for f in (10, 35):
+        assert [_at(s.rows, f, y) for y in (5 * f / 2, 110 - 5 * f / 2)] == [_at(start, f, y) for y in
+                                                                            (5 * f / 2, 110 - 5 * f / 2)]
+    s.save(tmp_path / "out.txt", tmp_path / "log.jsonl")
+    again = Session(base, frame_rate=10, n_targets=2, solver_input=on)
+    again.replay(tmp_path / "log.jsonl")  # the log holds every correction; replay drops the same one
+    np.testing.assert_array_equal(again.rows, s.rows)
+    assert again.dropped == s.dropped
+    s.undo()  # the dropped correction comes back with the undo
+    assert s.dropped == [False, False] and s.last_change.rows > 0

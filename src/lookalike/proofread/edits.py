@@ -53,23 +53,25 @@ class Correction:
 @dataclass(frozen=True)
 class Change:
     """What a correction changed: the frames (sorted, 1-based) and ids (sorted) whose rows moved, appeared or went,
-    and how many rows."""
+    how many rows, and the earlier corrections it ``dropped`` because they conflicted with it."""
 
     frames: tuple[int, ...]
     ids: tuple[int, ...]
     rows: int
+    dropped: tuple[Correction, ...] = ()
 
     def describe(self, max_spans: int = 6) -> str:
-        """One line: ``changed 120 rows, ids 3, 7, frames 200-260, 400-410``."""
+        """One line: ``changed 120 rows, ids 3, 7, frames 200-260, 400-410``, then the dropped corrections."""
+        drop = "".join(f"; dropped the earlier conflicting correction {c.to_json()}" for c in self.dropped)
         if not self.rows:
-            return "changed nothing"
+            return "changed nothing" + drop
         f = np.asarray(self.frames)
         starts = np.flatnonzero(np.r_[True, np.diff(f) > 1])
         ends = np.r_[starts[1:] - 1, len(f) - 1]
         spans = [f"{f[a]}-{f[b]}" if f[b] > f[a] else f"{f[a]}" for a, b in zip(starts, ends)]
         more = f" (+{len(spans) - max_spans} more)" if len(spans) > max_spans else ""
         return (f"changed {self.rows} rows, ids {', '.join(map(str, self.ids))}, frames "
-                f"{', '.join(spans[:max_spans])}{more}")
+                f"{', '.join(spans[:max_spans])}{more}{drop}")
 
 
 def _check_track(rows: np.ndarray, track: int, name: str = "track") -> np.ndarray:

@@ -3,13 +3,14 @@
 With a known number of identities ``n_targets`` each correction becomes a constraint on the offline closed set
 (:func:`lookalike.trackers.offline.closed_set.assign_identities`) and the whole assignment is solved again, so later
 frames that depended on the corrected link change too; without it corrections are plain edits
-(:func:`lookalike.proofread.edits.apply_edit`). Rows are MOTChallenge ``(k, 10)``, frames 1-based."""
+(:func:`lookalike.proofread.edits.apply_edit`). The latest correction wins: earlier ones that conflict with it are
+dropped (newest kept first). Rows are MOTChallenge ``(k, 10)``, frames 1-based."""
 
 from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -80,8 +81,8 @@ class Session:
                 self._solver_rows = self.initial.copy()
         self.rows = self.initial.copy()
         self.corrections: list[Correction] = []
-        self._history: list[tuple[np.ndarray, ChainConstraints]] = []
-        self._constraints = ChainConstraints()
+        self._parts: list[ChainConstraints | None] = []  # per correction its constraints; None: dropped
+        self._history: list[tuple[np.ndarray, list[ChainConstraints | None]]] = []
         self.last_change = Change((), (), 0)
 
     @property
@@ -106,26 +107,55 @@ class Session:
         out.sort(key=lambda d: (-d.doubt, d.first, d.track))
         return out
 
+    @property
+    def dropped(self) -> list[bool]:
+        """Per correction in :attr:`corrections`, whether a later one that conflicted with it dropped it."""
+        return [p is None for p in self._parts]
+
     def apply(self, correction: Correction) -> Change:
-        """Apply ``correction`` (ValueError, and nothing changed, when it names an unknown id or frame or cannot
-        hold); returns what changed, also kept as :attr:`last_change`."""
+        """Apply ``correction``; returns what changed, also kept as :attr:`last_change`. With ``n_targets``, earlier
+        corrections that conflict with it are dropped (listed in the change's ``dropped``; newest kept first).
+        ValueError, and nothing changed, when it names an unknown id or frame or cannot hold even alone."""
         check(self.rows, correction)
+        parts, dropped = list(self._parts), ()
         if self._solver_rows is None:
-            new, cons = apply_edit(self.rows, correction), self._constraints
+            new, part = apply_edit(self.rows, correction), ChainConstraints()
         else:
-            cons = self._constrain(correction)
-            new = self._solve(cons)
-        self._history.append((self.rows, self._constraints))
+            part = self._constrain(correction)
+            new, parts = self._solve_latest_wins(parts, part)
+            dropped = tuple(c for c, was, now in zip(self.corrections, self._parts, parts)
+                            if was is not None and now is None)
+        self._history.append((self.rows, self._parts))
         self.corrections.append(correction)
-        self.last_change = changes(self.rows, new)
-        self.rows, self._constraints = new, cons
+        self.last_change = replace(changes(self.rows, new), dropped=dropped)
+        self.rows, self._parts = new, [*parts, part]
         return self.last_change
 
+    def _solve_latest_wins(self, parts: list[ChainConstraints | None],
+                           part: ChainConstraints) -> tuple[np.ndarray, list[ChainConstraints | None]]:
+        """The closed set under ``part`` and the earlier ``parts``; when they conflict, ``part`` with as many earlier
+        ones as hold, tried newest first (the others become None)."""
+        try:
+            return self._solve(_joined([*parts, part])), parts
+        except ValueError:
+            pass
+        new = self._solve(part)  # ValueError: the correction cannot hold even alone
+        kept: list[ChainConstraints | None] = [None] * len(parts)
+        for i in reversed(range(len(parts))):
+            if parts[i] is None:
+                continue
+            trial = [*kept[:i], parts[i], *kept[i + 1:]]
+            try:
+                new, kept = self._solve(_joined([*trial, part])), trial
+            except ValueError:
+                pass
+        return new, kept
+
     def undo(self) -> Change:
-        """Take back the last correction; ValueError when there is none."""
+        """Take back the last correction (and bring back the ones it dropped); ValueError when there is none."""
         if not self.corrections:
             raise ValueError("undo: no correction to take back")
-        rows, self._constraints = self._history.pop()
+        rows, self._parts = self._history.pop()
         self.corrections.pop()
         self.last_change = changes(self.rows, rows)
         self.rows = rows
@@ -163,7 +193,8 @@ class Session:
         return [(int(f), int(s)) for f, s in src[first, :2]]
 
     def _constrain(self, c: Correction) -> ChainConstraints:
-        """The constraints after ``c``: its rows cut and fixed (module doc of :mod:`lookalike.proofread`)."""
+        """The constraints of ``c`` on the current rows: its rows cut and fixed (module doc of
+        :mod:`lookalike.proofread`)."""
         cut: list[Row] = []
         ident: list[tuple[Row, int]] = []
         apart: list[tuple[Row, Row]] = []
@@ -196,9 +227,7 @@ class Session:
             ident += [(r, c.track) for r in self._runs(c.track) + self._runs(c.other)]
         else:
             clutter += self._runs(c.track)
-        old = self._constraints
-        return ChainConstraints(old.cut + tuple(cut), old.identity + tuple(ident), old.apart + tuple(apart),
-                                old.clutter + tuple(clutter))
+        return ChainConstraints(tuple(cut), tuple(ident), tuple(apart), tuple(clutter))
 
     def _solve(self, cons: ChainConstraints) -> np.ndarray:
         """The closed set under ``cons``, its free identities renamed to the current ids they overlap most."""
@@ -252,3 +281,9 @@ class Session:
             except ValueError as exc:
                 raise ValueError(f"replay: correction {k + 1} ({c.to_json()}): {exc}") from exc
         return changes(before, self.rows)
+
+
+def _joined(parts: list[ChainConstraints | None]) -> ChainConstraints:
+    """The constraints of every part that is not None, in order."""
+    kept = [p for p in parts if p is not None]
+    return ChainConstraints(*(sum((getattr(p, f) for p in kept), ()) for f in ("cut", "identity", "apart", "clutter")))
