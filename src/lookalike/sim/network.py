@@ -31,34 +31,35 @@ class ReportArrays:
     n_sent: int
 
 
-def _burst_mask(t_sent: np.ndarray, cfg: NetworkConfig, horizon_s: float, rng: np.random.Generator) -> np.ndarray:
-    """Whether each send time ``(n_agents, K)`` falls into a loss burst of that agent's link."""
+def _burst_mask(t_sent: np.ndarray, cfg: NetworkConfig, horizon_s: float,
+                seeds: np.random.SeedSequence) -> np.ndarray:
+    """Whether each send time ``(n_agents, K)`` falls into a loss burst of that agent's link (one stream per agent)."""
     n_agents = t_sent.shape[0]
     if cfg.burst_rate_hz == 0 or cfg.burst_s == 0:
         return np.zeros(t_sent.shape, dtype=bool)
     mean_good = 1.0 / cfg.burst_rate_hz
-    cycle = mean_good + cfg.burst_s
-    n_cycles = int(np.ceil(horizon_s / cycle * 2.0 + 10.0 * np.sqrt(horizon_s / cycle + 1.0))) + 4
-    good = rng.exponential(mean_good, (n_agents, n_cycles))
-    bad = rng.exponential(cfg.burst_s, (n_agents, n_cycles))
-    # Stationary start: inside a burst with probability burst_s / cycle (memoryless durations).
-    start_bad = rng.random(n_agents) < cfg.burst_s / cycle
-    first = np.where(start_bad, 0.0, good[:, 0])
-    durations = np.empty((n_agents, 2 * n_cycles))
-    durations[:, 0::2] = good
-    durations[:, 1::2] = bad
-    durations[:, 0] = first
-    ends = np.cumsum(durations, axis=1)  # ends of good, bad, good, bad ... periods
+    scale = np.resize(np.array([mean_good, cfg.burst_s]), 64)  # good, bad, good, bad ... mean durations
     out = np.empty(t_sent.shape, dtype=bool)
-    for a in range(n_agents):
-        period = np.searchsorted(ends[a], t_sent[a], side="right")
-        out[a] = (period % 2) == 1
+    for a, seed in enumerate(seeds.spawn(n_agents)):
+        rng = np.random.default_rng(seed)
+        # Stationary start: inside a burst with probability burst_s / cycle (memoryless durations).
+        start_bad = rng.random() < cfg.burst_s / (mean_good + cfg.burst_s)
+        durations = np.zeros(0)
+        ends = np.zeros(0)  # ends of good, bad, good, bad ... periods
+        while not ends.size or ends[-1] <= horizon_s:
+            more = rng.standard_exponential(scale.size) * scale
+            more[0] = 0.0 if start_bad and not durations.size else more[0]
+            durations = np.concatenate([durations, more])
+            ends = np.cumsum(durations)
+        out[a] = np.searchsorted(ends, t_sent[a], side="right") % 2 == 1
     return out
 
 
 def simulate_reports(heading_rad: np.ndarray, dt_s: float, cfg: NetworkConfig,
-                     rng: np.random.Generator) -> ReportArrays:
-    """Reports of ``heading_rad (T, N)`` (unwrapped), interpolated linearly at the send times."""
+                     seeds: np.random.SeedSequence) -> ReportArrays:
+    """Reports of ``heading_rad (T, N)`` (unwrapped), interpolated linearly at the send times. Phases, losses, bursts,
+    delays and IMU noise come from their own streams of ``seeds``, drawn report by report in time order, so the
+    reports of a shorter sequence are the start of those of a longer one."""
     T, n_agents = heading_rad.shape
     horizon = (T - 1) * dt_s
     period = 1.0 / cfg.rate_hz
@@ -67,11 +68,15 @@ def simulate_reports(heading_rad: np.ndarray, dt_s: float, cfg: NetworkConfig,
     if T == 0 or n_agents == 0 or k_max <= 0:
         z = np.zeros(0)
         return ReportArrays(np.zeros(0, int), z, z, z, frame_offsets_empty, 0)
-    phase = np.asarray(rng.uniform(0.0, period, n_agents))
+    r_phase, r_loss, r_burst, r_delay, r_imu = seeds.spawn(5)
+    phase = np.asarray(np.random.default_rng(r_phase).uniform(0.0, period, n_agents))
     t_sent = phase[:, None] + period * np.arange(k_max)[None, :]  # (N, K)
+    shape_km = (k_max, n_agents)  # draws are made (K, N): report k of every agent, then k + 1
     inside = t_sent <= horizon
-    lost = (rng.random(t_sent.shape) < cfg.loss_prob) | _burst_mask(t_sent, cfg, horizon, rng)
-    delay = cfg.delay_s + (rng.exponential(cfg.jitter_s, t_sent.shape) if cfg.jitter_s > 0 else 0.0)
+    lost = (np.random.default_rng(r_loss).random(shape_km).T < cfg.loss_prob) | _burst_mask(t_sent, cfg, horizon,
+                                                                                             r_burst)
+    jitter = np.random.default_rng(r_delay).exponential(cfg.jitter_s, shape_km).T if cfg.jitter_s > 0 else 0.0
+    delay = cfg.delay_s + jitter
     t_received = t_sent + delay
     # Heading at the send time: linear interpolation between frames (headings are unwrapped).
     pos = t_sent / dt_s
@@ -80,7 +85,7 @@ def simulate_reports(heading_rad: np.ndarray, dt_s: float, cfg: NetworkConfig,
     w = np.clip(pos - i0, 0.0, 1.0)
     agents = np.arange(n_agents)[:, None]
     h = (1 - w) * heading_rad[i0, agents] + w * heading_rad[i1, agents]
-    h = h + rng.normal(0.0, cfg.imu_noise_rad, h.shape) if cfg.imu_noise_rad > 0 else h
+    h = h + np.random.default_rng(r_imu).normal(0.0, cfg.imu_noise_rad, shape_km).T if cfg.imu_noise_rad > 0 else h
     n_sent = int(inside.sum())
     keep = inside & ~lost & (t_received <= horizon + 1e-9)
     agent_id = np.broadcast_to(agents, t_sent.shape)[keep]

@@ -69,38 +69,49 @@ class RobotArrays:
 
 
 def simulate_arrays(config: RobotWorldConfig, n_frames: int, seed: int) -> RobotArrays:
-    """Simulate ``n_frames`` frames of scenario ``config`` with random seed ``seed``."""
+    """Simulate ``n_frames`` frames of scenario ``config`` with random seed ``seed``. Each random quantity has its own
+    stream, drawn frame by frame, so the first F frames of a longer run with the same seed are the run of F frames."""
     if int(n_frames) != n_frames or n_frames < 1:
         raise ValueError(f"n_frames must be a positive integer, got {n_frames!r}")
-    rng = np.random.default_rng(seed)
+    s_motion, s_observer, s_heading, s_network, *s_draws = np.random.SeedSequence(seed).spawn(13)
+    r_detect, r_noise, r_score, r_nfp, r_fp_r, r_fp_b, r_fp_head, r_fp_score, r_shuffle = (
+        np.random.default_rng(s) for s in s_draws)
     T, N, M = int(n_frames), config.n_agents, config.max_detections
     dt = config.dt_s
     sensor, obs_cfg = config.sensor, config.observer
-    field_pos, heading_unwrapped = simulate_motion(config.motion, config.field_m, T, N, dt, rng)
-    pose = observer_pose(obs_cfg, T, dt, rng)
+    field_pos, heading_unwrapped = simulate_motion(config.motion, config.field_m, T, N, dt, s_motion)
+    pose = observer_pose(obs_cfg, T, dt, s_observer)
     rel = to_observer_frame(field_pos, pose)
     dist = np.hypot(rel[..., 0], rel[..., 1])
     bearing = np.arctan2(rel[..., 1], rel[..., 0])
     visible = in_view(rel, obs_cfg)
     occlusion = occlusion_fraction(rel, config.motion.robot_radius_m)
     p_det = np.where(visible, detection_probability(dist, occlusion, sensor, obs_cfg), 0.0)
-    detected = rng.random((T, N)) < p_det
+    detected = r_detect.random((T, N)) < p_det
 
     # True positives: noisy positions, classifier-like headings, scores lowered by occlusion.
-    tp_pos = rel + rng.normal(size=rel.shape) * position_noise_std(dist, sensor)
-    tp_head = visual_heading(heading_unwrapped, bearing + pose[:, 2:3], sensor, rng)
-    tp_score = rng.beta(*sensor.tp_score_beta, (T, N)) * (1.0 - 0.5 * occlusion)
+    tp_pos = rel + r_noise.normal(size=rel.shape) * position_noise_std(dist, sensor)
+    tp_head = visual_heading(heading_unwrapped, bearing + pose[:, 2:3], sensor, s_heading)
+    tp_score = r_score.beta(*sensor.tp_score_beta, (T, N)) * (1.0 - 0.5 * occlusion)
 
-    # False positives: Poisson per frame, uniform over the visible sector (area-uniform in range).
-    n_fp = rng.poisson(sensor.fp_per_frame, T)
+    # False positives: Poisson per frame, uniform over the visible sector (area-uniform in range), drawn one after
+    # another in frame order and placed in (T, cap) slots.
+    n_fp = r_nfp.poisson(sensor.fp_per_frame, T)
     cap = int(n_fp.max()) if T else 0
     fp_valid = np.arange(cap)[None, :] < n_fp[:, None]
+    n_all = int(n_fp.sum())
+
+    def per_frame(flat: np.ndarray) -> np.ndarray:
+        out = np.zeros((T, cap))
+        out[fp_valid] = flat
+        return out
+
     r0, r1 = obs_cfg.min_range_m, obs_cfg.max_range_m
-    fp_r = np.sqrt(rng.uniform(r0 * r0, r1 * r1, (T, cap)))
-    fp_b = rng.uniform(-obs_cfg.fov_rad / 2, obs_cfg.fov_rad / 2, (T, cap))
+    fp_r = per_frame(np.sqrt(r_fp_r.uniform(r0 * r0, r1 * r1, n_all)))
+    fp_b = per_frame(r_fp_b.uniform(-obs_cfg.fov_rad / 2, obs_cfg.fov_rad / 2, n_all))
     fp_pos = np.stack([fp_r * np.cos(fp_b), fp_r * np.sin(fp_b)], -1)
-    fp_head = rng.uniform(-np.pi, np.pi, (T, cap))
-    fp_score = rng.beta(*sensor.fp_score_beta, (T, cap))
+    fp_head = per_frame(r_fp_head.uniform(-np.pi, np.pi, n_all))
+    fp_score = per_frame(r_fp_score.beta(*sensor.fp_score_beta, n_all))
 
     # All candidates of a frame; keep the M best scores, then shuffle slots.
     pos = np.concatenate([tp_pos, fp_pos], axis=1)
@@ -112,7 +123,7 @@ def simulate_arrays(config: RobotWorldConfig, n_frames: int, seed: int) -> Robot
     best = np.argsort(-rank_key, axis=1, kind="stable")[:, :M]
     rows = np.arange(T)[:, None]
     kept = valid[rows, best]
-    shuffle_key = np.where(kept, rng.random(kept.shape), 2.0)
+    shuffle_key = np.where(kept, r_shuffle.random((T, M))[:, : kept.shape[1]], 2.0)
     order = best[rows, np.argsort(shuffle_key, axis=1)]
     pad = M - order.shape[1]
     if pad > 0:  # fewer candidates than slots in every frame
@@ -123,7 +134,7 @@ def simulate_arrays(config: RobotWorldConfig, n_frames: int, seed: int) -> Robot
     det_score = np.where(slot_valid, score[rows, order], 0.0)
     det_label = np.where(slot_valid, label[rows, order], -1)
 
-    reports = simulate_reports(heading_unwrapped, dt, config.network, rng)
+    reports = simulate_reports(heading_unwrapped, dt, config.network, s_network)
     return RobotArrays(
         time=np.arange(T) * dt, det_valid=slot_valid, det_position=det_position, det_heading=det_heading,
         det_score=det_score, det_label=det_label.astype(int), true_position=rel,

@@ -1,5 +1,6 @@
 """Robot and observer motion for whole sequences at once; field coordinates (origin at the centre, x along the length,
-metres), headings in radians."""
+metres), headings in radians. Every random quantity has its own stream, drawn time-major, so a shorter sequence is the
+start of a longer one with the same seeds."""
 
 from __future__ import annotations
 
@@ -26,21 +27,22 @@ def _reflect(x: np.ndarray, low: float, high: float) -> np.ndarray:
 
 def simulate_motion(
     cfg: MotionConfig, field_m: tuple[float, float], n_frames: int, n_agents: int, dt_s: float,
-    rng: np.random.Generator,
+    seeds: np.random.SeedSequence,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Field positions ``(T, N, 2)`` (m, bouncing off the field's edges) and unwrapped headings ``(T, N)`` (rad)."""
     T, N = n_frames, n_agents
-    switch = rng.random((T, N)) < dt_s / cfg.segment_s
+    r_switch, r_mode, r_speed, r_dir, r_turn, r_start, r_head = (np.random.default_rng(s) for s in seeds.spawn(7))
+    switch = r_switch.random((T, N)) < dt_s / cfg.segment_s
     switch[0] = True
     segment = np.cumsum(switch, axis=0) - 1  # (T, N) segment index per robot
     n_seg = int(segment.max()) + 1 if T else 0
-    mode = rng.choice(4, size=(n_seg, N), p=[cfg.p_walk, cfg.p_stand, cfg.p_turn, cfg.p_walk_turn])
+    mode = r_mode.choice(4, size=(n_seg, N), p=[cfg.p_walk, cfg.p_stand, cfg.p_turn, cfg.p_walk_turn])
     walking = (mode == 0) | (mode == 3)
     turning = (mode == 2) | (mode == 3)
-    speed = cfg.max_speed_mps * np.sqrt(rng.random((n_seg, N)))
-    direction = rng.uniform(-np.pi, np.pi, (n_seg, N))
+    speed = cfg.max_speed_mps * np.sqrt(r_speed.random((n_seg, N)))
+    direction = r_dir.uniform(-np.pi, np.pi, (n_seg, N))
     v_target = np.where(walking, speed, 0.0)[..., None] * np.stack([np.cos(direction), np.sin(direction)], -1)
-    w_target = np.where(turning, rng.uniform(-cfg.max_turn_rate, cfg.max_turn_rate, (n_seg, N)), 0.0)
+    w_target = np.where(turning, r_turn.uniform(-cfg.max_turn_rate, cfg.max_turn_rate, (n_seg, N)), 0.0)
     cols = np.arange(N)[None, :]
     v_t = v_target[segment, cols]  # (T, N, 2)
     w_t = w_target[segment, cols]  # (T, N)
@@ -50,17 +52,17 @@ def simulate_motion(
     v = _lag(v_t.reshape(T, 2 * N), alpha_v, v_t[0].reshape(-1)).reshape(T, N, 2)
     w = _lag(w_t, alpha_w, w_t[0])
     half = np.array(field_m, dtype=float) / 2.0 - cfg.robot_radius_m
-    start = rng.uniform(-half, half, (N, 2))
+    start = r_start.uniform(-half, half, (N, 2))
     path = start[None] + np.cumsum(v, axis=0) * dt_s - v[:1] * dt_s
     position = np.stack([_reflect(path[..., 0], -half[0], half[0]), _reflect(path[..., 1], -half[1], half[1])], -1)
-    heading = rng.uniform(-np.pi, np.pi, N)[None] + np.cumsum(w, axis=0) * dt_s - w[:1] * dt_s
+    heading = r_head.uniform(-np.pi, np.pi, N)[None] + np.cumsum(w, axis=0) * dt_s - w[:1] * dt_s
     return position, heading
 
 
-def observer_pose(cfg: ObserverConfig, n_frames: int, dt_s: float, rng: np.random.Generator) -> np.ndarray:
+def observer_pose(cfg: ObserverConfig, n_frames: int, dt_s: float, seeds: np.random.SeedSequence) -> np.ndarray:
     """Observer pose per frame ``(T, 3)``: field x, y (m) and a panning yaw (rad)."""
     t = np.arange(n_frames) * dt_s
-    phase = rng.uniform(0, 2 * np.pi, 2)
+    phase = np.random.default_rng(seeds).uniform(0, 2 * np.pi, 2)
     w = 2 * np.pi / cfg.pan_period_s
     pan = 0.5 * cfg.pan_amplitude_rad * (np.sin(w * t + phase[0]) + np.sin(w / 0.37 * t + phase[1]))
     pose = np.empty((n_frames, 3))

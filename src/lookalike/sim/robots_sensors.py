@@ -41,11 +41,13 @@ def detection_probability(distance_m: np.ndarray, occlusion: np.ndarray, sensor:
 
 
 def visual_heading(true_heading: np.ndarray, bearing_abs: np.ndarray, sensor: SensorConfig,
-                   rng: np.random.Generator) -> np.ndarray:
-    """Classifier-like absolute headings: flipped, noisy and snapped to classes as :class:`SensorConfig` says."""
+                   seeds: np.random.SeedSequence) -> np.ndarray:
+    """Classifier-like absolute headings: flipped, noisy and snapped to classes as :class:`SensorConfig` says (the
+    flips and the noise drawn from two streams of ``seeds``, in the order of the leading axes)."""
     rel = true_heading - bearing_abs
-    flip = rng.random(rel.shape) < sensor.heading_flip_prob
-    rel = rel + np.where(flip, np.pi, 0.0) + rng.normal(0.0, sensor.heading_noise_rad, rel.shape)
+    r_flip, r_noise = (np.random.default_rng(s) for s in seeds.spawn(2))
+    flip = r_flip.random(rel.shape) < sensor.heading_flip_prob
+    rel = rel + np.where(flip, np.pi, 0.0) + r_noise.normal(0.0, sensor.heading_noise_rad, rel.shape)
     if sensor.heading_classes > 0:
         width = 2 * np.pi / sensor.heading_classes
         rel = np.round(rel / width) * width
