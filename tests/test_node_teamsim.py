@@ -22,8 +22,8 @@ def test_team_sequence_is_shared_and_configured(sequence):
     assert np.array_equal(sequence.arrays.reports.t_received, again.arrays.reports.t_received)
     with pytest.raises(ValueError, match="duration_s"):
         team_sequence("m5n3", 0, 0.0)
-    with pytest.raises(ValueError, match="preset"):
-        team_sequence("m9n9", 0, 1.0)
+    with pytest.raises(ValueError, match="unknown team"):
+        team_sequence("m9x9", 0, 1.0)
 
 
 def test_camera_messages_carry_detections_but_not_labels(sequence):

@@ -193,8 +193,8 @@ def test_bench_pixels_tiny(models, tmp_path):
         assert 0 <= r["success_rate_pixels"] <= 1 and 0 <= r["success_rate_simulated"] <= 1
         assert r["gap"] == pytest.approx(r["success_rate_pixels"] - r["success_rate_simulated"], abs=2e-4)
     assert "Perception" in res.output
-    res = runner.invoke(app, ["bench", "pixels", "--setups", "m9n9"])
-    assert res.exit_code != 0 and "m9n9" in res.output
+    res = runner.invoke(app, ["bench", "pixels", "--setups", "m9x9"])
+    assert res.exit_code != 0 and "m9x9" in res.output
 
 
 def test_bench_pixels_weights_replace_the_lstms_on_both_sides(models, tmp_path):

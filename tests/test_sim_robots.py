@@ -164,8 +164,11 @@ def test_frames_and_truth():
 def test_bad_input_raises():
     with pytest.raises(ValueError, match="n_frames"):
         simulate_arrays(preset("m3n2"), 0, 1)
-    with pytest.raises(ValueError, match="preset"):
-        preset("m4n4")
+    with pytest.raises(ValueError, match="unknown team"):
+        preset("m4x4")
+    with pytest.raises(ValueError, match="1..1000"):
+        preset("m0n4")
+    assert (preset("m7n4").max_detections, preset("n4m7").n_agents) == (7, 4)
     with pytest.raises(ValueError, match="loss_prob"):
         NetworkConfig(loss_prob=1.5)
     with pytest.raises(ValueError, match="p_walk"):

@@ -15,7 +15,8 @@ from lookalike.bench.progress import ProgressFactory, Step, no_progress
 from lookalike.eval import identification_counts, identification_success_rate, localisation_error
 from lookalike.io.results import Results, percent_row_metrics
 from lookalike.loop import RunStats, run, warm_up
-from lookalike.sim import DEFAULT_NOISE, PRESET_NAMES, RobotSequence, preset, preset_label, simulate_robots
+from lookalike.sim import DEFAULT_NOISE, RobotSequence, preset, preset_label, simulate_robots
+from lookalike.sim.presets import team_index
 from lookalike.trackers import make_tracker, tracker_parameters
 from lookalike.trackers.lstm.weights import shipped_weights_path
 from lookalike.trackers.parts.identity import agent_positions, labels_from_tracks
@@ -131,8 +132,8 @@ def run_identifier_by_sequence(name: str, sequences: list[RobotSequence], step: 
 
 
 def sequence_seeds(setups: list[str], sequences: int, seed: int = DEFAULT_SEED) -> list[int]:
-    """Seeds of the test sequences, set-up after set-up (``seed + 1000·setup index + sequence``)."""
-    return [seed + 1000 * PRESET_NAMES.index(s) + k for s in setups for k in range(sequences)]
+    """Seeds of the test sequences, set-up after set-up (``seed + 1000·team_index + sequence``)."""
+    return [seed + 1000 * team_index(s) + k for s in setups for k in range(sequences)]
 
 
 def ident_table(setups: list[str], trackers: list[str], sequences: int, frames: int,

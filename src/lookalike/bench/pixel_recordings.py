@@ -15,7 +15,7 @@ from lookalike.bench.progress import ProgressFactory
 from lookalike.eval import identification_success_rate
 from lookalike.geometry.camera import Camera
 from lookalike.io.robot_sequences import write_robot_sequence
-from lookalike.sim import PRESET_NAMES, RobotSequence, preset, simulate_robots
+from lookalike.sim import RobotSequence, preset, simulate_robots
 from lookalike.trackers import make_tracker
 from lookalike.trackers.parts.identity import labels_from_tracks
 from lookalike.vision.pipeline import RobotPipeline
@@ -25,9 +25,7 @@ SUFFIX = ".labelled.jsonl"
 
 
 def recording_seeds(setup: str, sequences: int, seed: int) -> list[int]:
-    """Seeds of the ``sequences`` recordings of preset ``setup`` from base ``seed`` (as ``bench pixels``)."""
-    if setup not in PRESET_NAMES:
-        raise ValueError(f"unknown preset {setup!r}; known: {', '.join(PRESET_NAMES)}")
+    """Seeds of the ``sequences`` recordings of team ``setup`` from base ``seed`` (as ``bench pixels``)."""
     return sequence_seeds([setup], sequences, seed)
 
 

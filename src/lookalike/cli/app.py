@@ -95,6 +95,15 @@ def check_names(option: str, names: list[str], known: Sequence[str], what: str) 
             fail(f"{option}: unknown {what} {n!r}; known: {', '.join(known)}")
 
 
+def check_teams(option: str, names: list[str]) -> None:
+    """Fail naming the first of ``names`` that is no team (:func:`lookalike.sim.presets.team_size`)."""
+    from lookalike.sim.presets import team_size
+
+    with failing(ValueError, prefix=f"{option}: "):
+        for n in names:
+            team_size(n)
+
+
 def check_choice(option: str, value: str, choices: Sequence[str]) -> None:
     """Fail unless ``value`` is one of ``choices``."""
     if value not in choices:

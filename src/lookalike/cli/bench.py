@@ -26,6 +26,7 @@ from lookalike.cli.app import (
     app,
     check_names,
     check_outputs_or_fail,
+    check_teams,
     command_line,
     console,
     fail,
@@ -35,11 +36,13 @@ from lookalike.cli.app import (
 from lookalike.cli.progress import progress_bars
 from lookalike.io.results import Results
 from lookalike.sim import PRESET_NAMES, preset_label
+from lookalike.sim.presets import TEAM_HELP
 from lookalike.trackers import tracker_names
 
 bench_app = typer.Typer(help="Benchmarks that print tables (also written with --json/--csv).", no_args_is_help=True,
                         cls=SortedGroup, rich_markup_mode=None)
 app.add_typer(bench_app, name="bench")
+SETUPS_HELP = f"Teams (comma-separated or repeated): {TEAM_HELP}."
 TEXT_COLUMNS = ("Setup", "Tracker", "Identifier", "Scenario", "Labeller", "Sequence")
 
 
@@ -81,7 +84,7 @@ def write_results(doc: Results, path: Path | None) -> None:
 
 @bench_app.command("ident")
 def ident(
-    setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help="Presets (comma-separated or repeated)."),
+    setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help=SETUPS_HELP),
     trackers: list[str] = typer.Option(list(IDENT_TRACKERS), "--trackers",
                                        help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(10, "--sequences", min=1, help="Test sequences per set-up."),
@@ -109,7 +112,7 @@ def ident(
     With --lengths or --recordings: the paper's Table III protocol."""
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, [weights], input_folders=[recordings, human])
     setup_list, tracker_list = split_list(setups), split_list(trackers)
-    check_names("--setups", setup_list, PRESET_NAMES, "preset")
+    check_teams("--setups", setup_list)
     check_names("--trackers", tracker_list, [*tracker_names(), *IDENT_VARIANTS], "tracker")
     check_names("--noise", [noise], ("paper", "ours"), "noise model")
     if weights is not None and (lengths is not None or recordings is not None or human is not None):

@@ -16,8 +16,8 @@ from lookalike.bench.experiments import (
 )
 from lookalike.bench.ident_paper import IDENT_VARIANTS
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import check_names, check_outputs_or_fail, command_line, fail, failing, split_list
-from lookalike.cli.bench import bench_app, print_differences, print_rows, write_results
+from lookalike.cli.app import check_names, check_outputs_or_fail, check_teams, command_line, fail, failing, split_list
+from lookalike.cli.bench import SETUPS_HELP, bench_app, print_differences, print_rows, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
 from lookalike.sim.presets import preset
@@ -26,7 +26,7 @@ from lookalike.trackers import tracker_names
 
 @bench_app.command("shuffle")
 def shuffle(
-    setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help="Presets (comma-separated or repeated)."),
+    setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help=SETUPS_HELP),
     trackers: list[str] = typer.Option(["jpda", "lstm"], "--trackers",
                                        help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(3, "--sequences", min=1, help="Test sequences per set-up."),
@@ -48,7 +48,7 @@ def shuffle(
 
 @bench_app.command("recovery")
 def recovery(
-    setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help="Presets (comma-separated or repeated)."),
+    setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help=SETUPS_HELP),
     trackers: list[str] = typer.Option(["kalman_ha2", "jpda", "lstm"], "--trackers",
                                        help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(3, "--sequences", min=1, help="Test sequences per set-up."),
@@ -76,8 +76,8 @@ def recovery(
 
 
 def _check_setups_and_trackers(setups: list[str], trackers: list[str]) -> None:
-    """Fail in one line naming a preset or identifier that does not exist."""
-    check_names("--setups", setups, PRESET_NAMES, "preset")
+    """Fail in one line naming a team or identifier that does not exist."""
+    check_teams("--setups", setups)
     check_names("--trackers", trackers, [*tracker_names(), *IDENT_VARIANTS], "tracker")
 
 

@@ -9,17 +9,16 @@ import typer
 
 from lookalike.bench.pixels import DEFAULT_SEED, PERCEPTION_COLUMNS, PIXEL_COLUMNS, pixels_results, pixels_table
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import check_names, check_outputs_or_fail, command_line, fail, failing, split_list
-from lookalike.cli.bench import bench_app, print_rows, write_results
+from lookalike.cli.app import check_names, check_outputs_or_fail, check_teams, command_line, fail, failing, split_list
+from lookalike.cli.bench import SETUPS_HELP, bench_app, print_rows, write_results
 from lookalike.cli.progress import progress_bars
-from lookalike.sim import PRESET_NAMES
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
 from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera
 
 
 @bench_app.command("pixels")
 def pixels(
-    setups: list[str] = typer.Option(["m3n2", "m5n3"], "--setups", help="Presets (comma-separated or repeated)."),
+    setups: list[str] = typer.Option(["m3n2", "m5n3"], "--setups", help=SETUPS_HELP),
     identifiers: list[str] = typer.Option(list(IDENTIFIERS), "--trackers", "--identifiers",
                                           help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(2, "--sequences", min=1, help="Held-out sequences per set-up."),
@@ -40,7 +39,7 @@ def pixels(
     """Identification success rate from rendered pixels next to the simulator's own detections, per identifier."""
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, [detector_model, heading_model, weights])
     setup_list, ident_list = split_list(setups), split_list(identifiers)
-    check_names("--setups", setup_list, PRESET_NAMES, "preset")
+    check_teams("--setups", setup_list)
     check_names("--trackers", ident_list, IDENTIFIERS, "identifier")
     if not setup_list or not ident_list:
         fail("--setups/--trackers: need at least one of each")

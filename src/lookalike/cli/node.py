@@ -19,7 +19,7 @@ from lookalike.io.sources import SignalStop
 from lookalike.node import Endpoint, IdentifierConfig, NodeConfig, NodeServer, TeamState, log_event, parse_address
 from lookalike.node.server import check_group, dds_node
 from lookalike.node.teamsim import SimClock, camera_messages, run_camera, run_robot, team_sequence
-from lookalike.sim.presets import PRESET_NAMES
+from lookalike.sim.presets import TEAM_HELP
 from lookalike.trackers import tracker_parameters
 
 
@@ -45,7 +45,8 @@ def _address(text: str, option: str) -> tuple[str, int]:
 
 @app.command()
 def serve(
-    tracker: str = typer.Option("lstm", "--tracker", "-t", help="Registered tracker/identifier name."),
+    tracker: str = typer.Option("set", "--tracker", "-t", help="Registered tracker/identifier name (set: any team "
+                                "size; lstm: the shipped sizes, with --set n_slots=M)."),
     set_: list[str] | None = typer.Option(None, "--set", "-s", help="Tracker parameter KEY=VALUE (repeatable)."),
     robots: int = typer.Option(3, help="Robots in the team (ids 0..N-1); also the tracker's n_agents unless set."),
     listen: str = typer.Option("127.0.0.1:7700", help="HOST:PORT to receive reports and detections on (port 0: any)."),
@@ -127,13 +128,13 @@ def _warn(line: str | None) -> None:
         print(line, file=sys.stderr, flush=True)
 
 
-_PRESET_HELP = f"Robot-world preset: {', '.join(PRESET_NAMES)}."
+_PRESET_HELP = f"The simulated team: {TEAM_HELP}."
 _START_HELP = "Wall time of simulated t=0: now, a UNIX time, or stdin (print 'ready', read it from stdin)."
 
 
 def _sequence(preset_name: str, seed: int, duration: float, loss: float | None, delay: float | None,
               jitter: float | None) -> Any:
-    with failing(ValueError):
+    with failing(ValueError, prefix="--preset: "):
         return team_sequence(preset_name, seed, duration, loss, delay, jitter)
 
 

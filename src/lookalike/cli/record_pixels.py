@@ -7,14 +7,15 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_names, check_outputs_or_fail, console, failing
-from lookalike.sim import PRESET_NAMES, preset
+from lookalike.cli.app import app, check_outputs_or_fail, check_teams, console, failing
+from lookalike.sim import preset
+from lookalike.sim.presets import TEAM_HELP
 
 
 @app.command("record-pixels")
 def record_pixels(
     output: Path = typer.Option(..., "-o", "--output", help="Folder for the .labelled.jsonl recordings."),
-    preset_name: str = typer.Option("m10n7", "--preset", help=f"Robot world set-up: {', '.join(PRESET_NAMES)}."),
+    preset_name: str = typer.Option("m10n7", "--preset", help=f"The team: {TEAM_HELP}."),
     sequences: int = typer.Option(3, "--sequences", min=1, help="Recordings to make."),
     frames: int = typer.Option(300, "--frames", min=1, help="Frames per recording (30 Hz)."),
     seed: int = typer.Option(700_000, "--seed", help="Base seed (recording k: seed + 1000·preset index + k, as "
@@ -35,7 +36,7 @@ def record_pixels(
     from lookalike.vision.pipeline import PipelineConfig, RobotPipeline
     from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera
 
-    check_names("--preset", [preset_name], PRESET_NAMES, "preset")
+    check_teams("--preset", [preset_name])
     world = preset(preset_name)
     camera = pixel_camera()
     with failing(ValueError, OSError):

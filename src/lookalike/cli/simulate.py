@@ -6,16 +6,17 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_names, check_outputs_or_fail, console, fail, failing
+from lookalike.cli.app import app, check_names, check_outputs_or_fail, check_teams, console, fail, failing
 from lookalike.io.robot_sequences import write_robot_sequence
 from lookalike.io.rosbag import write_bag
-from lookalike.sim import DEFAULT_NOISE, NOISE_MODELS, PRESET_NAMES, preset, simulate_robots
+from lookalike.sim import DEFAULT_NOISE, NOISE_MODELS, preset, simulate_robots
+from lookalike.sim.presets import TEAM_HELP
 from lookalike.viz.robot_pixels import pixel_camera, render_robot_frames
 
 
 @app.command()
 def simulate(
-    preset_name: str = typer.Option("m5n3", "--preset", help=f"Scenario: one of {', '.join(PRESET_NAMES)}."),
+    preset_name: str = typer.Option("m5n3", "--preset", help=f"The team: {TEAM_HELP}."),
     frames: int = typer.Option(1000, "--frames", min=1, help="Frames per sequence (30 Hz)."),
     sequences: int = typer.Option(1, "--sequences", min=1, help="Number of sequences (seeds seed, seed+1, ...)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the first sequence."),
@@ -33,7 +34,7 @@ def simulate(
     Format: see ``lookalike.io.robot_sequences`` (a header line, then one object per frame with detections, received
     reports and the truth)."""
     check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})
-    check_names("--preset", [preset_name], PRESET_NAMES, "preset")
+    check_teams("--preset", [preset_name])
     check_names("--noise", [noise], NOISE_MODELS, "noise model")
     if images and not bag:
         fail("--images: goes with --bag (the images are written into the bag)")

@@ -53,6 +53,7 @@ def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: P
     from lookalike.viz.overlay import source_frames
     from lookalike.viz.video import VideoWriter
 
+    identifier = "set" if identifier == "sort" else identifier  # track's default tracks boxes; robots get set
     _check(video, pipeline, reports, identifier, output, bag is not None)
     if bag is not None and camera_topic is None:
         fail("--bag: give --camera-topic (the sensor_msgs/Image topic the pipeline reads)")

@@ -19,12 +19,13 @@ from lookalike.cli.progress import bars
 
 if TYPE_CHECKING:
     from lookalike.parallel import JobPool
-from lookalike.sim import PRESET_NAMES, preset
+from lookalike.sim import preset
+from lookalike.sim.presets import TEAM_HELP
 
 
 @app.command()
 def train(
-    preset_name: str = typer.Option("m3n2", "--preset", help=f"Robot world set-up: {', '.join(PRESET_NAMES)}."),
+    preset_name: str = typer.Option("m3n2", "--preset", help=f"The team an LSTM is trained for: {TEAM_HELP}."),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for model.npz/.json, log and checkpoint."),
     steps: int = typer.Option(3000, help="Maximum optimisation steps (batches of sequences)."),
     minutes: float | None = typer.Option(None, help="Stop after this many minutes."),

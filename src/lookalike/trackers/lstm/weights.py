@@ -17,6 +17,7 @@ def shipped_weights_path(n_agents: int, n_slots: int, stem: str = "lstm") -> Pat
         available = sorted(p.stem for p in WEIGHTS_DIR.glob("*.npz"))
         raise CheckpointError(
             f"no shipped weights for M={n_slots}, N={n_agents} ({path.name}); shipped: "
-            f"{available or 'none'}. Train some with `lookalike train` and pass weights=PATH."
+            f"{available or 'none'}. Use the set identifier (any team size), or train an LSTM with "
+            f"`lookalike train --preset m{n_slots}n{n_agents}` and pass weights=PATH."
         )
     return path
