@@ -198,7 +198,8 @@ def track(
         None, help="det.txt, a sequence folder, or a folder of sequences (with --video: the det.txt)."
     ),
     output: Path = typer.Option(..., "-o", "--output", help="Result file (single det.txt or --video) or folder."),
-    tracker: str = typer.Option("sort", "--tracker", "-t", help="Registered tracker name."),
+    tracker: str = typer.Option("sort", "--tracker", "-t", help="Registered tracker name (with --pipeline or --bag: "
+                                "an identifier, default set)."),
     set_: list[str] | None = typer.Option(
         None, "--set", "-s", help="Tracker parameter KEY=VALUE (repeatable); see `lookalike trackers`."
     ),
