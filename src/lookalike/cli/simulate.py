@@ -1,4 +1,5 @@
-"""``lookalike simulate``: write simulated robot-world sequences (JSON Lines, one file each)."""
+"""``lookalike simulate``: write simulated robot-world sequences (JSON Lines, one file each), or with ``--arena``
+rendered arenas of look-alike animals (a video and its truth)."""
 
 from __future__ import annotations
 
@@ -17,7 +18,8 @@ from lookalike.viz.robot_pixels import pixel_camera, render_robot_frames
 @app.command()
 def simulate(
     preset_name: str = typer.Option("m5n3", "--preset", help=f"The team: {TEAM_HELP}."),
-    frames: int = typer.Option(1000, "--frames", min=1, help="Frames per sequence (30 Hz)."),
+    frames: int | None = typer.Option(None, "--frames", min=1, show_default=False,
+                                      help="Frames per sequence (robots: 1000 at 30 Hz; --arena: 500 at 28 Hz)."),
     sequences: int = typer.Option(1, "--sequences", min=1, help="Number of sequences (seeds seed, seed+1, ...)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the first sequence."),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for the .jsonl files."),
@@ -28,12 +30,21 @@ def simulate(
                              "headings, detections, truth; the 'ros' extra)."),
     images: bool = typer.Option(False, "--images", help="With --bag: render the camera frames into the bag "
                                 "(sensor_msgs/Image; the 'vision' extra)."),
+    arena: int | None = typer.Option(None, "--arena", min=1, show_default=False,
+                                     help="Instead of robots: render an arena of this many look-alike animals "
+                                     "(fish-like, touching and crossing) into -o: arena.avi, gt.txt, points.csv (a "
+                                     "folder per seed with --sequences)."),
 ) -> None:
     """Simulate identical robots seen by an observer, with heading reports; write JSON Lines files.
 
     Format: see ``lookalike.io.robot_sequences`` (a header line, then one object per frame with detections, received
     reports and the truth)."""
     check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})
+    if arena is not None:
+        if bag:
+            fail("--bag: goes with the robots, not --arena")
+        return _arenas(arena, frames, sequences, seed, output)
+    frames = frames or 1000
     check_teams("--preset", [preset_name])
     check_names("--noise", [noise], NOISE_MODELS, "noise model")
     if images and not bag:
@@ -51,3 +62,19 @@ def simulate(
                 console.print(f"wrote {write_bag(path.with_suffix(''), seq, frames_bgr)} (rosbag2)", markup=False)
         for line in seq.view_summary():
             console.print(line, markup=False, style="yellow" if line.startswith("warning") else None)
+
+
+def _arenas(animals: int, frames: int | None, sequences: int, seed: int, output: Path) -> None:
+    """``--arena``: write each seed's arena into ``output`` (or ``output/arena-SEED`` for several)."""
+    import dataclasses
+
+    from lookalike.io.arena_files import write_arena
+    from lookalike.sim.arena import ArenaConfig
+
+    cfg = dataclasses.replace(ArenaConfig(), n_animals=animals, frames=frames or ArenaConfig().frames)
+    for s in range(seed, seed + sequences):
+        with failing(ValueError, OSError, prefix="--arena: "):
+            files = write_arena(output if sequences == 1 else output / f"arena-{s:06d}", cfg, s)
+        console.print(f"wrote {files.video}, {files.gt.name}, {files.points.name}: {animals} animals, {cfg.frames} "
+                      f"frames, {files.arena.contacts} contacts (two animals' centres within a body length)",
+                      markup=False)
