@@ -1,4 +1,5 @@
-"""``lookalike train --recordings DIR``: fine-tune the LSTM associator on labelled recordings."""
+"""``lookalike train --recordings DIR``: fine-tune the LSTM associator on labelled recordings (``*.labelled.jsonl``
+or rosbag2 folders with labels)."""
 
 from __future__ import annotations
 
@@ -29,19 +30,29 @@ class RecordingOptions(RunOptions):
     validation: Path | None = None
 
 
+def recording_paths(folder: Path) -> list[Path]:
+    """The recordings of ``folder`` sorted by name: ``*.labelled.jsonl`` files and rosbag2 folders."""
+    return sorted([*folder.glob(PATTERN), *(p.parent for p in folder.glob("*/metadata.yaml"))])
+
+
 def read_recordings(folder: Path, option: str) -> list[RobotSequence]:
-    """The recordings (``*.labelled.jsonl``, sorted by name) of ``folder``; a one-line error naming the folder
-    when it holds none, or the file that cannot be read."""
+    """The recordings (:func:`recording_paths`) of ``folder``; a one-line error naming the folder when it holds
+    none, or the recording that cannot be read."""
     from lookalike.io.robot_sequences import read_robot_sequence
 
     if not folder.is_dir():
         fail(f"{option}: {folder} is not a folder")
-    paths = sorted(folder.glob(PATTERN))
+    paths = recording_paths(folder)
     if not paths:
-        fail(f"{option}: {folder} holds no {PATTERN} (the labelling page's export)")
+        fail(f"{option}: {folder} holds no {PATTERN} (the labelling page's export) and no rosbag2 folder")
     recordings = []
     for path in paths:
         try:
+            if path.is_dir():
+                from lookalike.io.rosbag import read_labelled_bag
+
+                recordings.append(read_labelled_bag(path))
+                continue
             recordings.append(read_robot_sequence(path))
         except (ValueError, OSError) as exc:
             fail(str(exc) if str(path) in str(exc) else f"{path}: {exc}")
@@ -62,10 +73,10 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
 
     recordings = read_recordings(folder, "--recordings")
     tests = read_recordings(opt.test, "--test") if opt.test is not None else []
-    paths = sorted(folder.glob(PATTERN))
+    paths = recording_paths(folder)
     if opt.validation is not None:  # every recording of the folder trains; these validate
         recordings += read_recordings(opt.validation, "--validation")
-        paths += sorted(opt.validation.glob(PATTERN))
+        paths += recording_paths(opt.validation)
     names = [str(p) for p in paths]
     n, m = recordings[0].config.n_agents, recordings[0].config.max_detections
     device = torch_device(opt.device)
@@ -74,9 +85,9 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
         init = load_weights(init_path)
         spec = init.spec
         check_recordings(spec, recordings, names)
-        check_recordings(spec, tests, [str(p) for p in sorted(opt.test.glob(PATTERN))] if opt.test else [])
+        check_recordings(spec, tests, [str(p) for p in recording_paths(opt.test)] if opt.test else [])
         if opt.validation is not None:
-            n_train = len(sorted(folder.glob(PATTERN)))
+            n_train = len(recording_paths(folder))
             train_idx, val_idx = list(range(n_train)), list(range(n_train, len(recordings)))
         else:
             train_idx, val_idx = split_recordings(len(recordings), opt.validation_fraction, opt.seed)

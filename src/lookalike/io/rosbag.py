@@ -269,6 +269,20 @@ def _no_truth(n: int, detections: int, observer: tuple[float, float, float]) -> 
             "n_false_positives": 0, "n_misses": 0}
 
 
+def read_labelled_bag(path: str | Path) -> RobotSequence:
+    """A bag with per-detection labels (its ``/lookalike/truth_record`` topic, as ``simulate --bag`` writes) as a
+    sequence, for training; ``ValueError`` naming the bag when it has no labels or cannot be read."""
+    with needs("rosbags"):
+        from rosbags.rosbag2 import ReaderError
+    try:
+        if TRUTH_RECORD_TOPIC not in bag_topics(path):
+            raise ValueError(f"{path}: no labels (topic {TRUTH_RECORD_TOPIC} of std_msgs/String, the frames' truth "
+                             "records as `lookalike simulate --bag` writes them)")
+        return read_bag(path).sequence
+    except ReaderError as exc:
+        raise ValueError(f"{path}: not a readable rosbag2 folder ({exc})") from None
+
+
 def bag_images(path: str | Path, camera_topic: str = CAMERA_TOPIC) -> Iterator[np.ndarray]:
     """The ``sensor_msgs/Image`` frames of ``camera_topic`` in log-time order, as BGR ``uint8`` arrays
     (``bgr8``, ``rgb8`` and ``mono8`` images)."""
@@ -293,4 +307,4 @@ def bag_images(path: str | Path, camera_topic: str = CAMERA_TOPIC) -> Iterator[n
 
 
 __all__ = ["BagRun", "CAMERA_TOPIC", "OBSERVER_TOPIC", "TRUTH_RECORD_TOPIC", "TRUTH_TOPIC", "bag_images",
-           "bag_topics", "read_bag", "write_bag"]
+           "bag_topics", "read_bag", "read_labelled_bag", "write_bag"]
