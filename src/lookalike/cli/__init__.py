@@ -18,11 +18,11 @@ if run_as_program():
 from lookalike.cli.app import app  # noqa: E402
 
 MODULES = ("bench", "bench_divers", "bench_experiments", "bench_pixels", "bench_real", "demo", "eval", "label",
-           "node", "record_pixels", "render", "report", "simulate", "track", "track_pixels", "trackers", "train",
-           "train_appearance", "tune", "vision")
+           "node", "proofread", "record_pixels", "render", "report", "simulate", "track", "track_pixels", "trackers",
+           "train", "train_appearance", "tune", "vision")
 """Every command module, in the order they are imported."""
 
-COMMAND_MODULES = ("track", "trackers", "eval", "simulate", "render", "report", "demo", "label")
+COMMAND_MODULES = ("track", "trackers", "eval", "simulate", "render", "report", "demo", "label", "proofread")
 """Commands whose module (of the same name) alone is imported when the script runs them."""
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import getpass
 import ipaddress
 import re
+from http.server import HTTPServer
 from pathlib import Path
 
 import typer
@@ -93,18 +94,23 @@ def label(
         return
     with failing(OSError, prefix=f"cannot listen on {host}:{port}: "):
         server = make_server(label_app, host, port)
+    serve_until_stopped(server, host, f"labelling {sequence.name} ({len(label_app.sequence)} frames)",
+                        f"labels saved to {label_app.store.path.name}", "labels")
+
+
+def serve_until_stopped(server: HTTPServer, host: str, what: str, saved: str, kept: str) -> None:
+    """Print ``what`` with the page's address and ``saved``, serve until Ctrl-C, then say ``kept`` are saved."""
     try:
         if not ipaddress.ip_address(str(server.server_address[0])).is_loopback:
             console.print(f"[yellow]warning:[/] {escape(host)} is reachable from other machines")
     except ValueError:
         pass
     url = f"http://{host if ':' not in host else f'[{host}]'}:{server.server_address[1]}/"
-    console.print(f"labelling {sequence.name} ({len(label_app.sequence)} frames) at [bold]{url}[/] — "
-                  f"labels saved to {label_app.store.path.name}; Ctrl-C to stop", highlight=False)
+    console.print(f"{escape(what)} at [bold]{url}[/] — {escape(saved)}; Ctrl-C to stop", highlight=False)
     try:
         server.serve_forever()
     except KeyboardInterrupt:
         pass
     finally:
         server.server_close()
-    console.print("stopped; labels are saved")
+    console.print(f"stopped; {kept} are saved", highlight=False)

@@ -153,12 +153,12 @@ def _int(query: dict[str, list[str]], name: str, default: int) -> int:
         raise _BadRequest(f"query parameter {name} must be an integer") from None
 
 
-class _Handler(BaseHTTPRequestHandler):
-    """Routes of the labelling app; :func:`make_handler` binds ``app`` and ``log_sink``."""
+class JsonHandler(BaseHTTPRequestHandler):
+    """What the labelling and proofreading pages share: Host check, JSON answers, static files, bounded and timed
+    JSON bodies, errors answered without taking the server down; subclasses route in ``_get`` and ``_post``."""
 
-    app: LabelApp
     log_sink: Callable[[str], None] | None = None
-    server_version = "lookalike-label"
+    server_version = "lookalike"
     timeout = IDLE_TIMEOUT_S  # seconds a connection may stay silent
     body_timeout_s = BODY_TIMEOUT_S
 
@@ -212,51 +212,16 @@ class _Handler(BaseHTTPRequestHandler):
         self._dispatch(self._post)
 
     def _get(self) -> None:
-        url = urlsplit(self.path)
-        query = parse_qs(url.query)
-        path = url.path
-        if path in ("/", "/index.html"):
-            self._static("index.html")
-        elif path.startswith("/static/"):
-            self._static(path[len("/static/"):])
-        elif path.startswith("/files/"):
-            self._file(path[len("/files/"):])
-        elif path == "/api/meta":
-            self._json(self.app.meta())
-        elif path == "/api/frames":
-            start, count = _int(query, "start", 0), _int(query, "count", 100)
-            if start < 0 or not 0 < count <= MAX_FRAMES_PER_REQUEST:
-                raise _BadRequest(f"need start >= 0 and 0 < count <= {MAX_FRAMES_PER_REQUEST}")
-            self._json({"frames": self.app.frames(start, count)})
-        elif path == "/api/labels":
-            self._json({"labels": self.app.store.snapshot(), "benchmark": self.app.store.benchmark})
-        elif path == "/api/score":
-            bench = self.app.store.benchmark
-            if self.app.benchmark and not (bench and bench.get("finished_at") is not None):
-                raise _BadRequest("the score is shown when the benchmark session ends", HTTPStatus.FORBIDDEN)
-            self._json(self.app.score())
-        else:
-            raise _BadRequest(f"no such page {path!r}", HTTPStatus.NOT_FOUND)
+        raise _BadRequest(f"no such page {self.path!r}", HTTPStatus.NOT_FOUND)
+
+    def _post(self) -> None:
+        raise _BadRequest(f"no such action {self.path!r}", HTTPStatus.NOT_FOUND)
 
     def _static(self, name: str) -> None:
         if name not in {p.name for p in STATIC_DIR.iterdir() if p.is_file()}:
             raise _BadRequest(f"no static file {name!r}", HTTPStatus.NOT_FOUND)
         p = STATIC_DIR / name
         self._send(HTTPStatus.OK, p.read_bytes(), mimetypes.guess_type(p.name)[0] or "application/octet-stream")
-
-    def _file(self, rel: str) -> None:
-        rel = unquote(rel)
-        if "\x00" in rel:
-            raise _BadRequest("NUL in path")
-        target = (self.app.folder / rel).resolve()
-        if not target.is_relative_to(self.app.folder) or target == self.app.folder:
-            raise _BadRequest("outside the sequence folder", HTTPStatus.FORBIDDEN)
-        if not target.is_file():
-            raise _BadRequest(f"no file {rel!r}", HTTPStatus.NOT_FOUND)
-        if self.app.benchmark and not _is_frame_image(target, self.app.folder, self.app.image_pattern):
-            raise _BadRequest("benchmark mode serves the frame images only", HTTPStatus.FORBIDDEN)
-        ctype = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
-        self._send(HTTPStatus.OK, target.read_bytes(), ctype)
 
     def _body(self) -> dict[str, Any]:
         ctype = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
@@ -297,6 +262,54 @@ class _Handler(BaseHTTPRequestHandler):
         finally:
             self.connection.settimeout(self.timeout)
         return b"".join(chunks)
+
+
+class _Handler(JsonHandler):
+    """Routes of the labelling app; :func:`make_handler` binds ``app`` and ``log_sink``."""
+
+    app: LabelApp
+    server_version = "lookalike-label"
+
+    def _get(self) -> None:
+        url = urlsplit(self.path)
+        query = parse_qs(url.query)
+        path = url.path
+        if path in ("/", "/index.html"):
+            self._static("index.html")
+        elif path.startswith("/static/"):
+            self._static(path[len("/static/"):])
+        elif path.startswith("/files/"):
+            self._file(path[len("/files/"):])
+        elif path == "/api/meta":
+            self._json(self.app.meta())
+        elif path == "/api/frames":
+            start, count = _int(query, "start", 0), _int(query, "count", 100)
+            if start < 0 or not 0 < count <= MAX_FRAMES_PER_REQUEST:
+                raise _BadRequest(f"need start >= 0 and 0 < count <= {MAX_FRAMES_PER_REQUEST}")
+            self._json({"frames": self.app.frames(start, count)})
+        elif path == "/api/labels":
+            self._json({"labels": self.app.store.snapshot(), "benchmark": self.app.store.benchmark})
+        elif path == "/api/score":
+            bench = self.app.store.benchmark
+            if self.app.benchmark and not (bench and bench.get("finished_at") is not None):
+                raise _BadRequest("the score is shown when the benchmark session ends", HTTPStatus.FORBIDDEN)
+            self._json(self.app.score())
+        else:
+            raise _BadRequest(f"no such page {path!r}", HTTPStatus.NOT_FOUND)
+
+    def _file(self, rel: str) -> None:
+        rel = unquote(rel)
+        if "\x00" in rel:
+            raise _BadRequest("NUL in path")
+        target = (self.app.folder / rel).resolve()
+        if not target.is_relative_to(self.app.folder) or target == self.app.folder:
+            raise _BadRequest("outside the sequence folder", HTTPStatus.FORBIDDEN)
+        if not target.is_file():
+            raise _BadRequest(f"no file {rel!r}", HTTPStatus.NOT_FOUND)
+        if self.app.benchmark and not _is_frame_image(target, self.app.folder, self.app.image_pattern):
+            raise _BadRequest("benchmark mode serves the frame images only", HTTPStatus.FORBIDDEN)
+        ctype = mimetypes.guess_type(target.name)[0] or "application/octet-stream"
+        self._send(HTTPStatus.OK, target.read_bytes(), ctype)
 
     def _post(self) -> None:
         path = urlsplit(self.path).path

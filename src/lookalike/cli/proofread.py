@@ -1,0 +1,75 @@
+"""``lookalike proofread``: correct a tracking result's identities on its video, in the browser."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import typer
+
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing
+
+
+@app.command()
+def proofread(
+    video: Path = typer.Option(..., "--video", help="The video the tracks were made on."),
+    tracks: Path = typer.Option(..., "--tracks", help="The tracks to correct (MOTChallenge .txt)."),
+    targets: int | None = typer.Option(
+        None, "--targets", min=1,
+        help="Known number of identities: each correction re-solves the offline closed set of N (as `track "
+             "--targets N --offline`), so later frames that depended on it change too. Without: plain edits."),
+    detections: Path | None = typer.Option(
+        None, "--detections", help="With --targets: the detections the tracks came from (the closed set is built "
+                                   "from their online pass, as --offline does; default: from the tracks)."),
+    frame_rate: float | None = typer.Option(None, "--frame-rate", min=0.001,
+                                            help="Frames per second (default: the video's)."),
+    output: Path | None = typer.Option(None, "-o", "--output",
+                                       help="Corrected tracks, MOTChallenge (default: TRACKS_STEM.proofread.txt)."),
+    log: Path | None = typer.Option(None, "--log",
+                                    help="Corrections log, saved after every action and replayed when the page "
+                                         "opens again (default: TRACKS_STEM.corrections.jsonl)."),
+    port: int = typer.Option(8766, "--port", min=0, max=65535, help="Port (0: any free one)."),
+    host: str = typer.Option("127.0.0.1", "--host",
+                             help="Address to bind (others on the network can reach non-loopback ones)."),
+    fresh: bool = typer.Option(False, "--fresh", help="Start over: move the saved log to LOG.bak."),
+    export: bool = typer.Option(False, "--export",
+                                help="Replay the saved log, write the corrected tracks and exit (no server)."),
+) -> None:
+    """Serve the proofreading page: the video with its tracks; click a box and say who it is from that frame on.
+
+    Corrections: assign an identity, swap two ids, merge, split, delete, undo. With --targets N each correction
+    re-solves the closed set and the latest correction wins over earlier ones that contradict it. The log is saved
+    after every action; export (the button or --export) writes the corrected tracks."""
+    from lookalike.proofread import Correction, Session
+    from lookalike.viz.label.proofread import ProofreadApp, make_proofread_server
+    from lookalike.viz.video import video_info
+
+    for option, path in (("--video", video), ("--tracks", tracks), ("--detections", detections)):
+        if path is not None and not path.is_file():
+            fail(f"{option}: {path}: no such file")
+    if detections is not None and targets is None:
+        fail("--detections needs --targets N (plain edits use the tracks alone)")
+    log = log or tracks.with_name(f"{tracks.stem}.corrections.jsonl")
+    output = output or tracks.with_name(f"{tracks.stem}.proofread.txt")
+    check_outputs_or_fail({"--output": output, "--log": log}, [video, tracks, detections])
+    with failing(ValueError, prefix="--video: "):
+        fps = video_info(video)[1]
+    with failing(ValueError):
+        session = Session(tracks, frame_rate=frame_rate or fps, n_targets=targets, detections=detections)
+    if fresh and log.exists():
+        os.replace(log, log.with_name(log.name + ".bak"))
+    elif log.exists():
+        with failing(ValueError, prefix=f"{log}: "):
+            session.replay(log)
+        console.print(f"replayed {len(session.corrections)} corrections from {log.name}", markup=False)
+    page = ProofreadApp(session, video, log, output, Correction.from_json)
+    if export:
+        r = page.export()
+        console.print(f"wrote {r['tracks']} ({r['rows']} rows) and {r['log']}", markup=False)
+        return
+    with failing(OSError, prefix=f"cannot listen on {host}:{port}: "):
+        server = make_proofread_server(page, host, port)
+    from lookalike.cli.label import serve_until_stopped
+
+    serve_until_stopped(server, host, f"proofreading {tracks.name} on {video.name}", f"corrections saved to {log.name}",
+                        "corrections")
