@@ -4,8 +4,8 @@ The end-to-end test is issue 8's acceptance test: the node, 3 robot processes an
 process run 20 s of simulated time (at 2x real time) with 20% report loss and 100 ms mean jitter;
 every robot must receive its position and the identification success rate must be within
 2 points of the same sequence run offline (Kalman-HA2 on M=5, N=3; the LSTM on each set-up with
-shipped weights). Every process is started with a deadline and killed
-if it overstays it.
+shipped weights; the set identifier on M=6, N=4, a team size no LSTM ships for). Every process is
+started with a deadline and killed if it overstays it.
 """
 
 from __future__ import annotations
@@ -116,7 +116,8 @@ def _lstm(preset: str, n_agents: int, n_slots: int):
 
 @pytest.mark.parametrize(
     "tracker, preset_name, settings",
-    [pytest.param("kalman_ha2", PRESET, {}, id="kalman_ha2-m5n3"), _lstm("m3n2", 2, 3), _lstm(PRESET, 3, 5)],
+    [pytest.param("kalman_ha2", PRESET, {}, id="kalman_ha2-m5n3"), _lstm("m3n2", 2, 3), _lstm(PRESET, 3, 5),
+     pytest.param("set", "m6n4", {}, id="set-m6n4")],  # a team size without an LSTM
 )
 def test_team_on_loopback_matches_offline_identification(tmp_path, tracker, preset_name, settings):
     sets = [a for k, v in settings.items() for a in ("--set", f"{k}={v}")]
