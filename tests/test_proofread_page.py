@@ -22,17 +22,18 @@ FRAMES, SWAP = 20, 10
 LANES = {1: 30, 2: 90}  # id -> lane (centre y, px)
 
 
-def two_discs(folder: Path) -> tuple[Path, Path]:
-    """A 160x120 video of two discs on lanes y = 30 and 90 px, frames 1-20, and tracks whose ids swap at frame 10."""
+def two_discs(folder: Path, scale: int = 1) -> tuple[Path, Path]:
+    """A 160x120 video (times ``scale``) of two discs on lanes y = 30 and 90 px (times ``scale``), frames 1-20, and
+    tracks whose ids swap at frame 10."""
     video, tracks = folder / "two.avi", folder / "two.txt"
-    writer = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 10, (160, 120))
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 10, (160 * scale, 120 * scale))
     rows = []
     for k in range(1, FRAMES + 1):
-        img = np.full((120, 160, 3), 215, np.uint8)
+        img = np.full((120 * scale, 160 * scale, 3), 215, np.uint8)
         for tid, y in LANES.items():
-            x = 10 + 6 * k
-            cv2.circle(img, (x, y), 8, (40, 40, 40), -1)
-            rows.append([k, tid if k < SWAP else 3 - tid, x - 9, y - 9, 18, 18, 1, -1, -1, -1])
+            x, y, r = (10 + 6 * k) * scale, y * scale, 8 * scale
+            cv2.circle(img, (x, y), r, (40, 40, 40), -1)
+            rows.append([k, tid if k < SWAP else 3 - tid, x - r - 1, y - r - 1, 2 * r + 2, 2 * r + 2, 1, -1, -1, -1])
         writer.write(img)
     writer.release()
     np.savetxt(tracks, np.array(rows), fmt="%g", delimiter=",")
@@ -73,8 +74,8 @@ class Served:
         return r.status, (json.loads(data) if r.getheader("Content-Type") == "application/json" else data)
 
 
-def open_page(folder: Path, **kw) -> ProofreadApp:
-    video, tracks = two_discs(folder)
+def open_page(folder: Path, scale: int = 1, **kw) -> ProofreadApp:
+    video, tracks = two_discs(folder, scale)
     return ProofreadApp(Session(tracks, frame_rate=10, **kw), video, folder / "two.corrections.jsonl",
                         folder / "two.proofread.txt", Correction.from_json)
 

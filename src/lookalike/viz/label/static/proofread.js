@@ -19,7 +19,7 @@ async function api(path, body) {
   return data;
 }
 
-function showMessage(text) { $("message").textContent = text || ""; }
+function showMessage(text, ok) { $("message").textContent = text || ""; $("message").className = ok ? "ok" : ""; }
 function colour(id) { const c = state.meta.colours; return c[((id % c.length) + c.length) % c.length]; }
 
 async function rowsOf(k) {
@@ -99,6 +99,8 @@ async function refresh() {
     if (c.dropped) li.className = "dropped";
     return li;
   }));
+  if (state.picked !== null && !s.ids.includes(state.picked)) pick(null);
+  $("no-doubt").hidden = s.doubtful.length > 0;
   $("doubtful").replaceChildren(...s.doubtful.slice(0, 30).map((d) => {
     const li = document.createElement("li");
     li.textContent = `id ${d.track}: frames ${d.first}-${d.last}`;
@@ -113,7 +115,7 @@ async function post(path, body) {
   $("save-status").textContent = "saving"; $("save-status").className = "busy";
   try {
     const r = await api(path, body);
-    showMessage(r.message || `wrote ${r.tracks} (${r.rows} rows) and ${r.log}`);
+    showMessage(r.message || `wrote ${r.tracks} (${r.rows} rows) and ${r.log}`, true);
     $("save-status").textContent = "saved"; $("save-status").className = "ok";
     await refresh();
   } catch (e) {
@@ -124,6 +126,7 @@ async function post(path, body) {
 
 function correct() {
   const kind = $("kind").value, other = parseInt($("other").value, 10);
+  document.activeElement.blur();  // the keys go back to the page
   if (state.picked === null) { showMessage("click a box first"); return; }
   const c = { kind, track: state.picked };
   if (["swap", "merge", "assign"].includes(kind)) {
