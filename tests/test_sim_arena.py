@@ -17,7 +17,7 @@ cv2 = pytest.importorskip("cv2")
 
 SMALL = ArenaConfig(n_animals=4, frames=40, image_px=300, body_length_px=40.0, body_width_px=7.0)
 PLAIN = dataclasses.replace(SMALL, size_spread=0.0, head_darkness=0.0, pattern_darkness=0.0, light_drift=0.0,
-                            vignetting=0.0, blur_px=0.0, noise_level=0.0)
+                            vignetting=0.0, floor_texture=0.0, blur_px=0.0, noise_level=0.0)
 
 
 def test_same_seed_same_arena_other_seed_other_arena() -> None:
@@ -88,7 +88,7 @@ def test_individual_differences_exist_when_on_and_vanish_when_off() -> None:
     off = simulate_arena(PLAIN, 6)
     assert np.all(off.traits.scale == 1) and np.all(off.traits.head == 0)
     assert np.all(off.truth[:, 5] == 40)
-    no_noise = dataclasses.replace(SMALL, light_drift=0.0, vignetting=0.0, blur_px=0.0, noise_level=0.0)
+    no_noise = dataclasses.replace(PLAIN, size_spread=0.07, head_darkness=0.12, pattern_darkness=0.06)
     assert np.all(_darkness_at(no_noise) < -5)  # darker heads
     assert np.all(np.abs(_darkness_at(PLAIN)) <= 1)  # one grey level over the body
     banded = simulate_arena(dataclasses.replace(PLAIN, pattern_darkness=0.2), 6)

@@ -44,10 +44,11 @@ class ArenaConfig:
     rest_frames: float = 60.0  # mean length of a rest
     # image
     background_level: float = 185.0  # grey level of the lit floor at the centre
-    light_drift: float = 0.08  # amplitude of the slow brightness change, share of the level
-    vignetting: float = 0.12  # darkening at the image corners, share of the level
-    blur_px: float = 1.0  # std of the Gaussian blur (0: none)
-    noise_level: float = 3.0  # std of the pixel noise, grey levels (0: none)
+    light_drift: float = 0.03  # amplitude of the slow brightness change (period 20 s), share of the level
+    vignetting: float = 0.08  # darkening at the image corners, share of the level
+    floor_texture: float = 1.5  # std of the floor's static blotches, grey levels (0: a flat floor)
+    blur_px: float = 1.0  # std of the Gaussian blur of the animals (0: none)
+    noise_level: float = 1.5  # std of the pixel noise, grey levels (0: none)
 
     def __post_init__(self) -> None:
         if self.n_animals < 1 or self.frames < 1 or self.image_px < 64:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property
 
 import numpy as np
 
@@ -16,6 +16,8 @@ _LIGHT_PERIOD_S = 20.0  # period of the lighting drift, seconds
 _HEAD_FROM = 0.8  # the head: from this place along the body (0 = tail tip, 1 = head tip)
 _BAND_HALF = 0.04  # half the band's width along the body, share of the length
 _SUBPIXEL = 4  # fractional bits of the drawn polygons' vertices
+_NOISE_SHIFTS = 64  # offsets of the noise bank per axis: frames draw their noise from 64² crops of one bank
+_BLOTCH_PX = 8.0  # size (Gaussian std) of the floor texture's blotches
 
 
 def _outline(width_share: float, samples: int = 20) -> tuple[np.ndarray, np.ndarray]:
@@ -109,28 +111,38 @@ class Arena:
                 cv2.fillPoly(absorb, [pts], round(255 * dark), cv2.LINE_AA, _SUBPIXEL)
         if cfg.blur_px > 0:
             absorb = cv2.GaussianBlur(absorb, (0, 0), cfg.blur_px)
-        phase = np.random.default_rng([self.seed, 0]).uniform(0, 2 * np.pi)
-        rng = np.random.default_rng([self.seed, k])
+        floor, noise, phase = self._floor
         level = cfg.background_level * (1 + cfg.light_drift * np.sin(
             2 * np.pi * (k - 1) / (_LIGHT_PERIOD_S * cfg.frame_rate_hz) + phase))
-        image = _light_field(side, cfg.vignetting) * np.float32(level) * (1 - absorb.astype(np.float32) / 255)
-        if cfg.noise_level > 0:
-            image += rng.standard_normal((side, side), dtype=np.float32) * np.float32(cfg.noise_level)
-        grey = np.clip(image + 0.5, 0, 255).astype(np.uint8)
-        return np.repeat(grey[:, :, None], 3, axis=2)
+        transmit = cv2.LUT(absorb, (1 - np.arange(256, dtype=np.float32) / 255) * np.float32(level))
+        image = cv2.multiply(floor, transmit)
+        dx, dy = np.random.default_rng([self.seed, k]).integers(0, _NOISE_SHIFTS, 2)
+        image += noise[dy:dy + side, dx:dx + side]
+        grey = np.clip(image, 0, 255, out=image).astype(np.uint8)
+        return cv2.cvtColor(grey, cv2.COLOR_GRAY2BGR)
+
+    @cached_property
+    def _floor(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """The static floor (relative lighting with vignetting and texture, ``(side, side)`` float32), a bank of
+        pixel noise that each frame crops at its own offset (+0.5 to round), and the phase of the lighting drift."""
+        with needs("cv2"):
+            import cv2
+
+        cfg, side = self.config, self.config.image_px
+        rng = np.random.default_rng([self.seed, 0])
+        phase = float(rng.uniform(0, 2 * np.pi))
+        r = np.linspace(-1, 1, side, dtype=np.float32)
+        floor = 1 - np.float32(cfg.vignetting) * (r[None, :] ** 2 + r[:, None] ** 2) / 2
+        if cfg.floor_texture > 0:
+            blotches = cv2.GaussianBlur(rng.standard_normal((side, side), dtype=np.float32), (0, 0), _BLOTCH_PX)
+            floor += blotches * np.float32(cfg.floor_texture / cfg.background_level / blotches.std())
+        noise = rng.standard_normal((side + _NOISE_SHIFTS,) * 2, dtype=np.float32) * np.float32(cfg.noise_level)
+        return floor.astype(np.float32), noise + np.float32(0.5), phase
 
     def frames(self) -> Iterator[np.ndarray]:
         """Every frame in order (:meth:`frame`)."""
         for k in range(1, self.config.frames + 1):
             yield self.frame(k)
-
-
-@lru_cache(maxsize=4)
-def _light_field(side: int, vignetting: float) -> np.ndarray:
-    """Relative floor lighting ``(side, side)`` float32: 1 at the centre, ``1 − vignetting`` at the corners."""
-    r = np.linspace(-1, 1, side, dtype=np.float32)
-    r2 = (r[None, :] ** 2 + r[:, None] ** 2) / 2
-    return (1 - np.float32(vignetting) * r2).astype(np.float32)
 
 
 def simulate_arena(config: ArenaConfig | None = None, seed: int = 0) -> Arena:
