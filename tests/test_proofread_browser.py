@@ -4,10 +4,11 @@ what the server serves."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from tests.test_label_browser import ARGS, _browser_or_skip
 from tests.test_proofread_page import FRAMES, Served, lane_ids, open_page
@@ -39,56 +40,62 @@ def _served_rows(served) -> list[list[float]]:
     return served.request("GET", f"/api/tracks?start=1&count={FRAMES}")[1]["rows"]
 
 
-def test_proofread_page_end_to_end(tmp_path):
+@contextmanager
+def _chromium(errors: list[str]) -> Iterator:
+    """A page of headless Chromium (960 x 600) whose console errors and uncaught exceptions go to ``errors``."""
     sync_playwright, executable = _browser_or_skip()
-    pytest.importorskip("cv2")
-    page_app = open_page(tmp_path, scale=SCALE)
-    errors: list[str] = []
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=executable, headless=True, args=ARGS)
         try:
             page = browser.new_page(viewport={"width": 960, "height": 600})
             page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
             page.on("pageerror", lambda e: errors.append(str(e)))
-            with Served(page_app) as served:
-                page.goto(served.url)
-                _wait_version(page, 0, 1)
-                for _ in range(11):
-                    page.keyboard.press("ArrowRight")
-                _wait_version(page, 0, 12)
-                before = _served_rows(served)
-                assert lane_ids(before, 12) == {UP: 2, DOWN: 1}
-                # swap by keyboard: the upper box (2 since frame 10) swaps with 1 from frame 12 on
-                assert _click_lane(page, UP) == 2
-                page.keyboard.press("s")
-                page.keyboard.type("1")
-                page.keyboard.press("Enter")
-                _wait_version(page, 1, 12)
-                after = _served_rows(served)
-                assert all(lane_ids(after, f) == lane_ids(before, f) for f in range(1, 12))  # before 12: unchanged
-                assert all(lane_ids(after, f) == {UP: 1, DOWN: 2} for f in range(12, FRAMES + 1))
-                assert sorted(b[0] for b in _boxes(page)) == [1, 2]
-                assert "changed 36 rows, ids 1, 2, frames 12-20" in page.text_content("#message")
-                # undo by keyboard
-                page.keyboard.press("u")
-                _wait_version(page, 2, 12)
-                assert _served_rows(served) == before
-                # assign by mouse: the lower box (1) is identity 4 from frame 12 on
-                assert _click_lane(page, DOWN) == 1
-                page.select_option("#kind", "assign")
-                page.fill("#other", "4")
-                page.click("#apply-btn")
-                _wait_version(page, 3, 12)
-                assert lane_ids(_served_rows(served), 12) == {UP: 2, DOWN: 4}
-                assert lane_ids(_served_rows(served), 11) == {UP: 2, DOWN: 1}
-                assert page.eval_on_selector_all("#corrections li", "ls => ls.map(l => l.textContent)") == \
-                    ["assign 1 4 from 12"]
-                page.click("#export-btn")
-                page.wait_for_function("document.getElementById('message').textContent.startsWith('wrote')")
-                out = np.loadtxt(tmp_path / "two.proofread.txt", delimiter=",")
-                assert set(out[out[:, 0] >= 12, 1].astype(int)) == {2, 4}
-                if SCREENSHOT.parent.is_dir() and not SCREENSHOT.exists():
-                    page.screenshot(path=str(SCREENSHOT))
-            assert errors == []
+            yield page
         finally:
             browser.close()
+
+
+def test_proofread_page_end_to_end(tmp_path):
+    page_app = open_page(tmp_path, scale=SCALE)
+    errors: list[str] = []
+    with _chromium(errors) as page:
+        with Served(page_app) as served:
+            page.goto(served.url)
+            _wait_version(page, 0, 1)
+            for _ in range(11):
+                page.keyboard.press("ArrowRight")
+            _wait_version(page, 0, 12)
+            before = _served_rows(served)
+            assert lane_ids(before, 12) == {UP: 2, DOWN: 1}
+            # swap by keyboard: the upper box (2 since frame 10) swaps with 1 from frame 12 on
+            assert _click_lane(page, UP) == 2
+            page.keyboard.press("s")
+            page.keyboard.type("1")
+            page.keyboard.press("Enter")
+            _wait_version(page, 1, 12)
+            after = _served_rows(served)
+            assert all(lane_ids(after, f) == lane_ids(before, f) for f in range(1, 12))  # before 12: unchanged
+            assert all(lane_ids(after, f) == {UP: 1, DOWN: 2} for f in range(12, FRAMES + 1))
+            assert sorted(b[0] for b in _boxes(page)) == [1, 2]
+            assert "changed 36 rows, ids 1, 2, frames 12-20" in page.text_content("#message")
+            # undo by keyboard
+            page.keyboard.press("u")
+            _wait_version(page, 2, 12)
+            assert _served_rows(served) == before
+            # assign by mouse: the lower box (1) is identity 4 from frame 12 on
+            assert _click_lane(page, DOWN) == 1
+            page.select_option("#kind", "assign")
+            page.fill("#other", "4")
+            page.click("#apply-btn")
+            _wait_version(page, 3, 12)
+            assert lane_ids(_served_rows(served), 12) == {UP: 2, DOWN: 4}
+            assert lane_ids(_served_rows(served), 11) == {UP: 2, DOWN: 1}
+            assert page.eval_on_selector_all("#corrections li", "ls => ls.map(l => l.textContent)") == \
+                ["assign 1 4 from 12"]
+            page.click("#export-btn")
+            page.wait_for_function("document.getElementById('message').textContent.startsWith('wrote')")
+            out = np.loadtxt(tmp_path / "two.proofread.txt", delimiter=",")
+            assert set(out[out[:, 0] >= 12, 1].astype(int)) == {2, 4}
+            if SCREENSHOT.parent.is_dir() and not SCREENSHOT.exists():
+                page.screenshot(path=str(SCREENSHOT))
+    assert errors == []

@@ -117,7 +117,8 @@ class Session:
         corrections that conflict with it are dropped (listed in the change's ``dropped``; newest kept first).
         ValueError, and nothing changed, when it names an unknown id or frame or cannot hold even alone."""
         check(self.rows, correction)
-        parts, dropped = list(self._parts), ()
+        parts = list(self._parts)
+        dropped: tuple[Correction, ...] = ()
         if self._solver_rows is None:
             new, part = apply_edit(self.rows, correction), ChainConstraints()
         else:

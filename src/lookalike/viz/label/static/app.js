@@ -7,17 +7,6 @@ const state = {
   meta: null, labels: [], frames: new Map(), pending: new Map(), frame: 0,
   showTruth: false, bench: null, saving: Promise.resolve(), unsaved: 0, screen: [], timer: null,
 };
-const $ = (id) => document.getElementById(id);
-
-async function api(path, body) {
-  const opts = body === undefined ? {} : {
-    method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body),
-  };
-  const r = await fetch(path, opts);
-  const data = await r.json().catch(() => ({}));
-  if (!r.ok) throw new Error(data.error || `${path}: HTTP ${r.status}`);
-  return data;
-}
 
 function showMessage(text) { $("message").textContent = text || ""; }
 

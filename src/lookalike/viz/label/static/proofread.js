@@ -7,17 +7,6 @@ const state = {
   meta: null, frame: 1, version: -1, picked: null, rows: new Map(), lo: 0, hi: -1, rowsVersion: -2,
   image: null, imageFrame: 0, doubtful: [], scale: 1,
 };
-const $ = (id) => document.getElementById(id);
-
-async function api(path, body) {
-  const opts = body === undefined ? {} : {
-    method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body),
-  };
-  const r = await fetch(path, opts);
-  const data = await r.json().catch(() => ({}));
-  if (!r.ok) throw new Error(data.error || `${path}: HTTP ${r.status}`);
-  return data;
-}
 
 function showMessage(text, ok) { $("message").textContent = text || ""; $("message").className = ok ? "ok" : ""; }
 function colour(id) { const c = state.meta.colours; return c[((id % c.length) + c.length) % c.length]; }
