@@ -405,17 +405,15 @@ def test_expectations_are_checked():
                 check_expectations(block(bad), folder, "robot 1: 12 lstm 98.6%")
 
 
-def test_robot_team_recipe(tmp_path: Path):
-    """robot-team.md's node and team blocks as written (another free port for 7700; the node stops after 90 s):
-    every robot hears its position, with the median errors the page gives, and nothing warns."""
-    if not RUN_SLOW:
-        pytest.skip("a slow documented recipe (about 35 s): set LOOKALIKE_DOC_TEST_SLOW=1 to run it")
+def _run_team_recipe(page: str, tmp_path: Path, node_s: float) -> tuple[list[dict], list[dict], str]:
+    """A how-to's first node block and first robot-sim block as written (another free port for 7700; the node stops
+    after ``node_s`` s): the robots' JSON summaries by robot, the other summaries and the team's stderr."""
     import json
     import socket
     import subprocess
     import sys
 
-    serve, team = [b for b in shell_blocks(REPO / "docs" / "howto" / "robot-team.md")
+    serve, team = [b for b in shell_blocks(REPO / "docs" / "howto" / page)
                    if "lookalike serve" in b.text or "robot-sim" in b.text][:2]
     assert "robot-sim" in team.text and "camera-sim" in team.text
     with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
@@ -424,21 +422,40 @@ def test_robot_team_recipe(tmp_path: Path):
     bin_dir = Path(sys.executable).parent
     env = {**os.environ, "PATH": f"{bin_dir}{os.pathsep}{os.environ.get('PATH', '')}"}
     args = [a.replace("127.0.0.1:7700", f"127.0.0.1:{port}") for a in split_commands(serve.text)[0]]
-    node = subprocess.Popen([str(bin_dir / "lookalike"), *args, "--duration", "90"], cwd=tmp_path, env=env,
+    node = subprocess.Popen([str(bin_dir / "lookalike"), *args, "--duration", str(node_s)], cwd=tmp_path, env=env,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         script = team.text.replace("127.0.0.1:7700", f"127.0.0.1:{port}") + "\nwait\n"
         done = subprocess.run(["bash", "-c", script], cwd=tmp_path, env=env, capture_output=True, text=True,
-                              timeout=120)
+                              timeout=node_s + 30)
     finally:
         node.terminate()
         node.wait(timeout=30)
     assert done.returncode == 0, done.stderr[-2000:]
-    summaries = [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
+    summaries = [json.loads(found) for found in re.findall(r"\{[^{}]*\}", done.stdout)]  # lines may interleave
     robots = sorted((s for s in summaries if "robot" in s), key=lambda s: s["robot"])
-    assert [r["robot"] for r in robots] == [0, 1, 2], done.stdout
-    assert {"camera_frames_sent": 601} in summaries, done.stdout
+    return robots, [s for s in summaries if "robot" not in s], done.stderr
+
+
+def test_robot_team_recipe(tmp_path: Path):
+    """robot-team.md's node and team blocks as written (the node stops after 90 s): every robot hears its position,
+    with the median errors the page gives, and nothing warns."""
+    if not RUN_SLOW:
+        pytest.skip("a slow documented recipe (about 35 s): set LOOKALIKE_DOC_TEST_SLOW=1 to run it")
+    robots, others, stderr = _run_team_recipe("robot-team.md", tmp_path, 90)
+    assert [r["robot"] for r in robots] == [0, 1, 2], robots
+    assert {"camera_frames_sent": 601} in others, others
     assert all(r["positions"] > 0 for r in robots), robots
     for r, median in zip(robots, (0.07, 1.6, 0.14)):  # the page's figures (loopback timing: a little slack)
         assert abs(r["median_error_m"] - median) <= 0.05 + 0.1 * median, (r, median)
-    assert "warning" not in done.stderr, done.stderr[-2000:]
+    assert "warning" not in stderr, stderr[-2000:]
+
+
+def test_team_size_recipe(tmp_path: Path):
+    """team-size.md's node (set, 4 robots) and m7n4 team blocks as written (the node stops after 60 s): every frame
+    is sent, every robot hears the team state and the robots in view hear their position."""
+    robots, others, _ = _run_team_recipe("team-size.md", tmp_path, 60)
+    assert [r["robot"] for r in robots] == [0, 1, 2, 3], robots
+    assert {"camera_frames_sent": 301} in others, others
+    assert all(r["team_states"] >= 250 for r in robots), robots
+    assert sum(r["positions"] > 0 for r in robots) >= 3, robots  # robot 3 of seed 0 is never in view
