@@ -17,7 +17,7 @@ cv2 = pytest.importorskip("cv2")
 
 SMALL = ArenaConfig(n_animals=4, frames=40, image_px=300, body_length_px=40.0, body_width_px=7.0)
 PLAIN = dataclasses.replace(SMALL, size_spread=0.0, head_darkness=0.0, pattern_darkness=0.0, light_drift=0.0,
-                            vignetting=0.0, floor_texture=0.0, blur_px=0.0, noise_level=0.0)
+                            vignetting=0.0, floor_texture=0.0, blur_px=0.0, noise_level=0.0, body_bend=0.0)
 
 
 def test_same_seed_same_arena_other_seed_other_arena() -> None:
@@ -41,7 +41,7 @@ def test_truth_rows_and_animals_inside_the_arena(shape: str) -> None:
     assert np.all(reach <= cfg.wall_px - t[:, 5] / 2 + 1e-6)
     boxes = arena.boxes()
     assert np.all(boxes[:, :2] >= 0) and np.all(boxes[:, :2] + boxes[:, 2:] <= cfg.image_px)
-    assert np.all(boxes[:, 2:] <= 1.02 * t[:, 5:6]) and np.all(boxes[:, 2:].max(axis=1) >= 0.7 * t[:, 5])
+    assert np.all(boxes[:, 2:] <= 1.02 * t[:, 5:6]) and np.all(boxes[:, 2:].max(axis=1) >= 0.6 * t[:, 5])
 
 
 def test_animals_move_and_touch() -> None:
@@ -87,12 +87,23 @@ def test_individual_differences_exist_when_on_and_vanish_when_off() -> None:
     assert np.ptp(on.traits.scale) > 0.01 and np.ptp(on.traits.head) > 0
     off = simulate_arena(PLAIN, 6)
     assert np.all(off.traits.scale == 1) and np.all(off.traits.head == 0)
-    assert np.all(off.truth[:, 5] == 40)
+    assert np.all(off.truth[:, 5] == 40) and np.all(off.bend == 0) and np.ptp(on.bend) > 0.1
     no_noise = dataclasses.replace(PLAIN, size_spread=0.07, head_darkness=0.12, pattern_darkness=0.06)
     assert np.all(_darkness_at(no_noise) < -5)  # darker heads
     assert np.all(np.abs(_darkness_at(PLAIN)) <= 1)  # one grey level over the body
     banded = simulate_arena(dataclasses.replace(PLAIN, pattern_darkness=0.2), 6)
     assert banded.frame(1).min() < simulate_arena(PLAIN, 6).frame(1).min() - 20
+
+
+def test_truth_centre_is_the_silhouette_centroid_also_when_bent() -> None:
+    cfg = dataclasses.replace(PLAIN, n_animals=1, body_bend=1.0, image_px=300, body_length_px=60.0, frames=60)
+    arena = simulate_arena(cfg, 8)
+    k = int(np.argmax(np.abs(arena.bend))) + 1
+    assert abs(arena.bend[k - 1]) > 0.2
+    dark = cfg.background_level - arena.frame(k)[:, :, 0].astype(float)
+    ys, xs = np.mgrid[:300, :300]
+    centre = np.array([(dark * xs).sum(), (dark * ys).sum()]) / dark.sum()
+    assert np.linalg.norm(centre - arena.truth[k - 1, 2:4]) < 0.6  # was 1 px before the anti-aliasing inset
 
 
 def test_image_conditions_off_give_a_flat_floor() -> None:

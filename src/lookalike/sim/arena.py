@@ -33,15 +33,16 @@ class ArenaConfig:
     body_darkness: float = 0.45  # share of the light the body absorbs (0: invisible, 1: black)
     head_darkness: float = 0.12  # mean extra absorption of the head; each animal's is uniform in 0.5-1.5 × this
     pattern_darkness: float = 0.06  # extra absorption of each animal's faint band (0: no band)
+    body_bend: float = 1.0  # the body curves by this × the heading's change over the last 3 frames (0: rigid)
     # motion
     speed_px: float = 5.5  # mean speed while swimming, px per frame
     burst_rate: float = 0.15  # chance per frame of a tail-beat burst (speed then glides down)
     glide_decay: float = 0.9  # speed kept from one frame to the next between bursts
     turn_rad: float = 0.5  # std of the turn at a burst
     wiggle_rad: float = 0.05  # std of the heading's change per frame
-    attraction: float = 0.5  # share of the turn towards the nearest animal at a burst (0: none)
+    attraction: float = 0.2  # share of the turn towards the nearest animal at a burst (0: none)
     rest_rate: float = 0.0015  # chance per frame that a swimming animal starts a rest
-    rest_frames: float = 60.0  # mean length of a rest
+    rest_frames: float = 60.0  # mean length of a rest; each lasts 0.5-1.5 × this
     # image
     background_level: float = 185.0  # grey level of the lit floor at the centre
     light_drift: float = 0.03  # amplitude of the slow brightness change (period 20 s), share of the level
@@ -141,7 +142,7 @@ def simulate_motion(config: ArenaConfig, traits: Traits, rng: np.random.Generato
         resting = rest > 0
         rest = np.where(resting, rest - 1, 0)
         start = ~resting & (rng.random(n) < config.rest_rate)
-        rest[start] = rng.exponential(config.rest_frames, int(start.sum()))
+        rest[start] = config.rest_frames * rng.uniform(0.5, 1.5, int(start.sum()))
         kick = (rest <= 0) & (rng.random(n) < config.burst_rate)
         toward = config.attraction * _nearest_bearing(xy, heading, length)
         heading = heading + np.where(kick, rng.normal(0, config.turn_rad, n) + toward, 0.0)
