@@ -1,6 +1,6 @@
 """End to end in headless Chromium: on a two-disc video whose ids swap at frame 10, pick a box with the mouse, swap
-it back from frame 12 by keyboard (only frames >= 12 change), undo, assign with the mouse, export; the page shows
-what the server serves."""
+it back from frame 12 by keyboard (only frames >= 12 change), undo, assign with the mouse, export, go to a frame and
+id on the timeline, delete by keyboard and undo with the mouse; the page shows what the server serves."""
 
 from __future__ import annotations
 
@@ -30,6 +30,12 @@ def _click_lane(page, y: float) -> int:
     page.mouse.click(box["x"] + sx, box["y"] + sy)
     page.wait_for_function(f"document.getElementById('picked').textContent === '{tid}'")
     return int(tid)
+
+
+def _click_timeline(page, lane: int, frame: int) -> None:
+    box = page.locator("#timeline").bounding_box()
+    x = 1 + (frame - 1) / (FRAMES - 1) * (box["width"] - 2)
+    page.mouse.click(box["x"] + x + 0.5, box["y"] + 12 * lane + 6)
 
 
 def _wait_version(page, version: int, frame: int) -> None:
@@ -98,4 +104,15 @@ def test_proofread_page_end_to_end(tmp_path):
             assert set(out[out[:, 0] >= 12, 1].astype(int)) == {2, 4}
             if SCREENSHOT.parent.is_dir() and not SCREENSHOT.exists():
                 page.screenshot(path=str(SCREENSHOT))
+            # the timeline: a click on id 4's lane (lanes 1, 2, 4) at frame 15 goes there and picks 4
+            _click_timeline(page, lane=2, frame=15)
+            page.wait_for_function("document.body.dataset.frame === '15'")
+            assert page.text_content("#picked") == "4"
+            page.keyboard.press("Delete")  # delete by keyboard, then undo it
+            page.keyboard.press("Enter")
+            _wait_version(page, 4, 15)
+            assert 4 not in {r[1] for r in _served_rows(served)}
+            page.click("#undo-btn")
+            _wait_version(page, 5, 15)
+            assert lane_ids(_served_rows(served), 15) == {UP: 2, DOWN: 4}
     assert errors == []

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import http.client
 import json
+import socket
 import threading
 from pathlib import Path
 
@@ -48,8 +49,8 @@ def lane_ids(rows: list[list[float]], frame: int) -> dict[int, int]:
 class Served:
     """A page server on a free loopback port, in a thread."""
 
-    def __init__(self, page: ProofreadApp) -> None:
-        self.server = make_proofread_server(page, port=0)
+    def __init__(self, page: ProofreadApp, body_timeout_s: float = 5.0) -> None:
+        self.server = make_proofread_server(page, port=0, body_timeout_s=body_timeout_s)
         self.thread = threading.Thread(target=self.server.serve_forever, daemon=True)
         self.port = self.server.server_address[1]
         self.url = f"http://127.0.0.1:{self.port}/"
@@ -105,7 +106,8 @@ def test_correct_undo_and_export_through_the_api(tmp_path):
         assert lane_ids(rows, 12) == {30: 2, 90: 1}
         s.request("POST", "/api/correct", {"kind": "assign", "track": 1, "other": 5, "frame": 15})
         status, state = s.request("GET", "/api/state")
-        assert state["ids"] == [1, 2, 5] and [c["kind"] for c in state["corrections"]] == ["assign"]
+        assert state["spans"] == {"1": [[1, 14]], "2": [[1, 20]], "5": [[15, 20]]}
+        assert [c["kind"] for c in state["corrections"]] == ["assign"]
         status, r = s.request("POST", "/api/export", {})
         assert status == 200 and r["tracks"] == "two.proofread.txt"
     out = np.loadtxt(tmp_path / "two.proofread.txt", delimiter=",")
@@ -165,3 +167,14 @@ def test_proofread_command_replays_the_log_and_exports(tmp_path):
     assert r.exit_code == 0 and log.with_name(log.name + ".bak").exists()
     out = np.loadtxt(tmp_path / "two.proofread.txt", delimiter=",")
     assert set(out[(out[:, 3] < 60), 1].astype(int)) == {1, 2}
+
+
+def test_a_body_that_never_comes_gets_408_and_the_server_goes_on(tmp_path):
+    page = open_page(tmp_path)
+    with Served(page, body_timeout_s=0.5) as s:
+        with socket.create_connection(("127.0.0.1", s.port), timeout=10) as slow:
+            slow.sendall(b"POST /api/undo HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+                         b"Content-Length: 10\r\n\r\n{")
+            reply = slow.recv(4096)
+        assert b" 408 " in reply.split(b"\r\n")[0]
+        assert s.request("GET", "/api/state")[0] == 200

@@ -8,7 +8,8 @@ cross-origin POSTs::
     GET  /api/meta               video facts, colours, whether corrections re-solve a closed set
     GET  /api/frame?k=           frame k (1-based) of the video as JPEG
     GET  /api/tracks?start=&count=   rows of frames start.. (1-based): [frame, id, x, y, w, h] (px)
-    GET  /api/state              corrections (and which were dropped), doubtful ranges, last change
+    GET  /api/state              corrections (and which were dropped), doubtful ranges, each id's runs of
+                                 frames, last change
     POST /api/correct            {"kind", "track"[, "other", "frame"]}: apply one correction (log saved at once)
     POST /api/undo               take back the last correction
     POST /api/export             write the corrected tracks (MOTChallenge) and the log"""
@@ -130,9 +131,8 @@ class ProofreadApp:
             s = self.session
             corrections = [{**json.loads(c.to_json()), "dropped": d} for c, d in zip(s.corrections, s.dropped)]
             doubtful = [{"track": d.track, "first": d.first, "last": d.last} for d in s.doubtful()[:MAX_DOUBTFUL]]
-            ids = np.unique(s.rows[:, 1]).astype(int).tolist()
-            return {"version": self.version, "corrections": corrections, "doubtful": doubtful, "ids": ids,
-                    "message": self.message}
+            return {"version": self.version, "corrections": corrections, "doubtful": doubtful,
+                    "spans": _spans(s.rows), "message": self.message}
 
     def _after(self, change: Any) -> dict[str, Any]:
         self.version += 1
@@ -154,6 +154,16 @@ class ProofreadApp:
         with self.lock:
             self.session.save(self.export_path, self.log_path)
             return {"tracks": self.export_path.name, "log": self.log_path.name, "rows": len(self.session.rows)}
+
+
+def _spans(rows: np.ndarray) -> dict[int, list[list[int]]]:
+    """Per id, the runs of consecutive frames it has rows in: ``[[first, last], ...]`` (1-based, inclusive)."""
+    out = {}
+    for tid in np.unique(rows[:, 1]).astype(int).tolist():
+        f = np.unique(rows[rows[:, 1] == tid, 0]).astype(int)
+        cut = np.flatnonzero(np.diff(f) > 1)
+        out[tid] = np.column_stack([f[np.r_[0, cut + 1]], f[np.r_[cut, len(f) - 1]]]).tolist()
+    return out
 
 
 class _ProofreadHandler(JsonHandler):

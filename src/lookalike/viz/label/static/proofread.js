@@ -2,10 +2,10 @@
 // Frames are 1-based; rows are [frame, id, x, y, w, h] in video pixels.
 "use strict";
 
-const WINDOW = 400, MAX_WIDTH = 960;
+const WINDOW = 400, MAX_WIDTH = 960, LANE_PX = 12, MAX_LANES = 60;
 const state = {
   meta: null, frame: 1, version: -1, picked: null, rows: new Map(), lo: 0, hi: -1, rowsVersion: -2,
-  image: null, imageFrame: 0, doubtful: [], scale: 1,
+  image: null, imageFrame: 0, doubtful: [], spans: {}, scale: 1,
 };
 
 function showMessage(text, ok) { $("message").textContent = text || ""; $("message").className = ok ? "ok" : ""; }
@@ -67,9 +67,40 @@ async function show(k) {
   if (state.frame !== k) return;  // a later frame was asked for meanwhile
   state.image = img; state.imageFrame = k;
   draw(rows);
+  drawTimeline();
   history.replaceState(null, "", `#frame=${k}`);
   document.body.dataset.frame = k;
   document.body.dataset.shown = `${k}:${state.rowsVersion}`;
+}
+
+// One lane per id (the first MAX_LANES): its runs of frames in its colour, doubtful ranges in red below them, and
+// the frame shown as a line. A click goes to that frame and picks that id.
+function lanes() { return Object.keys(state.spans).map(Number).slice(0, MAX_LANES); }
+
+function drawTimeline() {
+  const cv = $("timeline"), ctx = cv.getContext("2d"), ids = lanes(), n = state.meta.n_frames;
+  cv.height = Math.max(1, ids.length) * LANE_PX;
+  const x = (f) => ((f - 1) / Math.max(1, n - 1)) * (cv.width - 2) + 1;
+  ctx.fillStyle = "#333"; ctx.fillRect(0, 0, cv.width, cv.height);
+  ids.forEach((id, lane) => {
+    const y = lane * LANE_PX;
+    ctx.fillStyle = colour(id);
+    for (const [a, b] of state.spans[id]) ctx.fillRect(x(a), y + 1, Math.max(1, x(b) - x(a)), LANE_PX - 5);
+    ctx.fillStyle = "#f33";
+    for (const d of state.doubtful) {
+      if (d.track === id) ctx.fillRect(x(d.first), y + LANE_PX - 4, Math.max(2, x(d.last) - x(d.first)), 3);
+    }
+  });
+  ctx.fillStyle = "#fff"; ctx.fillRect(x(state.frame) - 1, 0, 2, cv.height);
+}
+
+function onTimeline(ev) {
+  const cv = $("timeline"), r = cv.getBoundingClientRect(), ids = lanes();
+  const f = Math.round(((ev.clientX - r.left - 1) / (cv.width - 2)) * (state.meta.n_frames - 1)) + 1;
+  const id = ids[Math.floor((ev.clientY - r.top) / LANE_PX)];
+  if (id !== undefined) state.picked = id;
+  $("picked").textContent = state.picked === null ? "none (click a box)" : String(state.picked);
+  show(f);
 }
 
 function pick(id) {
@@ -88,7 +119,8 @@ async function refresh() {
     if (c.dropped) li.className = "dropped";
     return li;
   }));
-  if (state.picked !== null && !s.ids.includes(state.picked)) pick(null);
+  state.spans = s.spans;
+  if (state.picked !== null && !(String(state.picked) in s.spans)) pick(null);
   $("no-doubt").hidden = s.doubtful.length > 0;
   $("doubtful").replaceChildren(...s.doubtful.slice(0, 30).map((d) => {
     const li = document.createElement("li");
@@ -165,6 +197,8 @@ async function main() {
   state.scale = Math.min(1, MAX_WIDTH / m.width) || 1;
   $("view").width = Math.round(m.width * state.scale); $("view").height = Math.round(m.height * state.scale);
   $("view").addEventListener("click", onClick);
+  $("timeline").width = $("view").width;
+  $("timeline").addEventListener("click", onTimeline);
   $("prev").onclick = () => show(state.frame - 1);
   $("next").onclick = () => show(state.frame + 1);
   $("undo-btn").onclick = () => post("api/undo", {});
