@@ -158,11 +158,13 @@ class ProofreadApp:
 
 def _spans(rows: np.ndarray) -> dict[int, list[list[int]]]:
     """Per id, the runs of consecutive frames it has rows in: ``[[first, last], ...]`` (1-based, inclusive)."""
-    out = {}
-    for tid in np.unique(rows[:, 1]).astype(int).tolist():
-        f = np.unique(rows[rows[:, 1] == tid, 0]).astype(int)
-        cut = np.flatnonzero(np.diff(f) > 1)
-        out[tid] = np.column_stack([f[np.r_[0, cut + 1]], f[np.r_[cut, len(f) - 1]]]).tolist()
+    order = np.lexsort((rows[:, 0], rows[:, 1]))
+    ids, f = rows[order, 1].astype(int), rows[order, 0].astype(int)
+    starts = np.flatnonzero(np.r_[True, (ids[1:] != ids[:-1]) | (np.diff(f) > 1)])
+    ends = np.r_[starts[1:] - 1, len(f) - 1]
+    out: dict[int, list[list[int]]] = {}
+    for tid, a, b in zip(ids[starts].tolist(), f[starts].tolist(), f[ends].tolist()):
+        out.setdefault(tid, []).append([a, b])
     return out
 
 

@@ -2,7 +2,7 @@
 // Frames are 1-based; rows are [frame, id, x, y, w, h] in video pixels.
 "use strict";
 
-const WINDOW = 400, MAX_WIDTH = 960, LANE_PX = 12, MAX_LANES = 60;
+const WINDOW = 400, MAX_WIDTH = 960, MAX_HEIGHT = 600, LANE_PX = 12, MAX_LANES = 60;
 const state = {
   meta: null, frame: 1, version: -1, picked: null, rows: new Map(), lo: 0, hi: -1, rowsVersion: -2,
   image: null, imageFrame: 0, doubtful: [], spans: {}, scale: 1,
@@ -124,7 +124,7 @@ async function refresh() {
   $("no-doubt").hidden = s.doubtful.length > 0;
   $("doubtful").replaceChildren(...s.doubtful.slice(0, 30).map((d) => {
     const li = document.createElement("li");
-    li.textContent = `id ${d.track}: frames ${d.first}-${d.last}`;
+    li.textContent = `id ${d.track}: ` + (d.first === d.last ? `frame ${d.first}` : `frames ${d.first}-${d.last}`);
     li.onclick = () => { pick(d.track); show(d.first); };
     return li;
   }));
@@ -194,7 +194,7 @@ async function main() {
   $("video-name").textContent = m.video;
   $("frame-count").textContent = m.n_frames;
   $("mode").textContent = m.propagates ? `closed set of ${m.n_targets}: corrections re-solve it` : "plain edits";
-  state.scale = Math.min(1, MAX_WIDTH / m.width) || 1;
+  state.scale = Math.min(1, MAX_WIDTH / m.width, MAX_HEIGHT / m.height) || 1;
   $("view").width = Math.round(m.width * state.scale); $("view").height = Math.round(m.height * state.scale);
   $("view").addEventListener("click", onClick);
   $("timeline").width = $("view").width;
