@@ -138,6 +138,8 @@ def test_simulate_arena_writes_a_video_and_truth_that_read_back(tmp_path) -> Non
                                        str(tmp_path / "b")])
     assert several.exit_code == 0, several.output
     assert (tmp_path / "b" / "arena-000001" / "gt.txt").is_file()
+    with_bag = CliRunner().invoke(app, ["simulate", "--arena", "2", "--bag", "-o", str(tmp_path / "c")])
+    assert with_bag.exit_code == 2 and "--bag" in with_bag.output
 
 
 def test_config_refuses_nonsense() -> None:
