@@ -62,7 +62,7 @@ def test_success_after_the_restore_says_how_right_an_identifier_is_not_how_it_co
     from lookalike.bench.experiments import swap_recovery
     from lookalike.sim import preset, simulate_robots
 
-    seq = simulate_robots(preset("m3n2"), 300, 55_001)
+    seq = simulate_robots(preset("m3n2"), 300, 55_005)  # both robots detected in 2-5 s and after 5 s
     original = [f.beacons.agent_id for f in seq.frames()]
 
     def keeps_the_swap(s, frames):  # right without the swap; with it, the pair's labels exchanged from then on
@@ -97,7 +97,7 @@ def test_unmeasurable_recoveries_are_those_whose_pair_is_not_seen_both_times():
     from lookalike.bench.experiments import measurable
     from lookalike.sim import preset, simulate_robots
 
-    seq = simulate_robots(preset("m3n2"), 300, 55_001)
+    seq = simulate_robots(preset("m3n2"), 300, 55_005)  # both robots detected in 2-5 s and after 5 s
     assert measurable(seq, 2.0, 3.0)
     truth = seq.true_labels()
     gone_after = [t if k < 150 else np.full_like(t, -1) for k, t in enumerate(truth)]  # restore at frame 150

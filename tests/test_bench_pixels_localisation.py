@@ -12,8 +12,8 @@ from lookalike.viz.robot_pixels import pixel_camera
 def test_localisation_error_columns_from_pixels_and_simulated():
     camera = pixel_camera()
     pipe = RobotPipeline.from_files(None, None, camera, PipelineConfig())
-    # seed 700001: both robots in view from the first frames
-    rows, perception = pixels_table(["m3n2"], ["jpda"], 1, 12, 700_001, pipe, camera, 0.3)
+    # seed 700003: both robots in the camera's view in all 12 frames
+    rows, perception = pixels_table(["m3n2"], ["jpda"], 1, 12, 700_003, pipe, camera, 0.3)
     (row,) = rows
     assert list(row) == list(PIXEL_COLUMNS)
     for key in ("Pixels loc. (m)", "Simulated loc. (m)"):

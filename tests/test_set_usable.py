@@ -54,7 +54,7 @@ def test_node_core_identifies_with_set():
     from lookalike.node.identifier import IdentifierConfig
     from lookalike.node.teamsim import camera_messages, robot_reports, team_sequence
 
-    seq = team_sequence("m3n2", 4, 3.0)
+    seq = team_sequence("m3n2", 5, 3.0)  # both robots detected together in 10 frames or more
     node = TeamIdentifier(make_tracker("set", n_agents=2), IdentifierConfig(n_robots=2))
     events = [(t, 0, r) for j in range(2) for t, r in robot_reports(seq, j)]
     events += [(m.time, 1, m) for m in camera_messages(seq)]

@@ -69,7 +69,7 @@ def test_prepared_runs_equal_plain_runs(name: str, compiled: bool, jitter: bool)
 
 
 def test_prepare_is_dropped_by_reset_and_not_made_without_tracks() -> None:
-    n_agents, frames = _frames("m3n2", 1, False)
+    n_agents, frames = _frames("m3n2", 2, False)  # a robot detected in 10 of the first 20 frames or more
     tracker = make_tracker("kalman_ha2", n_agents=n_agents)
     tracker.prepare()  # (before any frame: nothing to predict)
     assert not tracker._ready
