@@ -86,19 +86,23 @@ def draw_traits(config: ArenaConfig, rng: np.random.Generator) -> Traits:
                   band_at=rng.uniform(0.3, 0.7, n))
 
 
-def _to_wall(config: ArenaConfig, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distance beyond the wall (px, > 0 outside) and the wall's inward normal, for centres ``xy (n, 2)`` relative to
-    the arena centre."""
-    half = config.wall_px
+def _walls(config: ArenaConfig, xy: np.ndarray, heading: np.ndarray,
+           limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Centres ``xy (n, 2)`` (px from the arena centre) put back within ``limit (n,)`` of the centre (a round arena)
+    or of each axis (a square one), and the headings of those that crossed reflected off the wall."""
+    step = np.column_stack([np.cos(heading), np.sin(heading)])
     if config.shape == "round":
         r = np.linalg.norm(xy, axis=1)
-        normal = -xy / np.maximum(r, 1e-9)[:, None]
-        return r - half, normal
-    axis = np.argmax(np.abs(xy), axis=1)
-    along = np.abs(xy[np.arange(len(xy)), axis])
-    normal = np.zeros_like(xy)
-    normal[np.arange(len(xy)), axis] = -np.sign(xy[np.arange(len(xy)), axis])
-    return along - half, normal
+        out = r > limit
+        inward = -xy / np.maximum(r, 1e-9)[:, None]
+        dot = np.minimum(np.sum(step * inward, axis=1), 0)
+        step = np.where(out[:, None], step - 2 * dot[:, None] * inward, step)
+        xy = np.where(out[:, None], -inward * limit[:, None], xy)
+    else:
+        out_axis = np.abs(xy) > limit[:, None]
+        step = np.where(out_axis, -np.sign(xy) * np.abs(step), step)
+        xy = np.clip(xy, -limit[:, None], limit[:, None])
+    return xy, np.arctan2(step[:, 1], step[:, 0])
 
 
 def _nearest_bearing(xy: np.ndarray, heading: np.ndarray, reach_px: np.ndarray) -> np.ndarray:
@@ -150,15 +154,7 @@ def simulate_motion(config: ArenaConfig, traits: Traits, rng: np.random.Generato
         speed = speed * config.glide_decay * np.where(rest > 0, 0.7, 1.0)  # resting animals stop within frames
         speed = speed + np.where(kick, burst * rng.lognormal(0, 0.3, n), 0.0)
         xy = xy + speed[:, None] * np.column_stack([np.cos(heading), np.sin(heading)])
-        over, normal = _to_wall(config, xy)
-        out_of = over > -length / 2
-        if out_of.any():
-            step = np.column_stack([np.cos(heading), np.sin(heading)])
-            dot = np.sum(step * normal, axis=1)
-            reflected = step - 2 * np.minimum(dot, 0)[:, None] * normal
-            heading = np.where(out_of, np.arctan2(reflected[:, 1], reflected[:, 0]), heading)
-            xy = xy + np.maximum(over + length / 2, 0)[:, None] * normal
-        heading = (heading + np.pi) % (2 * np.pi) - np.pi
+        xy, heading = _walls(config, xy, heading, inside)
     return out.reshape(-1, 6)
 
 
