@@ -170,7 +170,7 @@ def test_track_pipeline_robots_end_to_end(tmp_path):
         assert len(cols) == 10 and 1 <= int(cols[0]) <= 12 and 1 <= int(cols[1]) <= 2
     res = runner.invoke(app, [a for a in args if a not in ("--reports", str(seq))])
     assert res.exit_code != 0 and "--reports" in res.output
-    res = runner.invoke(app, [("sort" if a == "kalman_ha" else a) for a in args])
+    res = runner.invoke(app, [("boxtrack" if a == "kalman_ha" else a) for a in args])  # (sort, the default: set)
     assert res.exit_code != 0 and "identifier" in res.output
     res = runner.invoke(app, args + ["--detector-model", str(seq)])
     assert res.exit_code != 0 and "HOG cascade" in res.output

@@ -58,6 +58,8 @@ def test_bench_ident_scores_set_and_leaves_the_lstm_untrained(tmp_path):
 def test_bench_recovery_and_the_lstms_one_line_error():
     assert "Recovery" in _ok(["bench", "recovery", "--setups", TEAM, "--trackers", "set", "--sequences", "1",
                               "--frames", "300", "--swap-at-s", "2", "--swap-s", "4"])
+    out = _ok(["bench", "shuffle", "--setups", TEAM, "--sequences", "1", "--frames", "60"])  # default: jpda, lstm
+    assert "lstm left out" in out and "jpda" in out
     _one_line_error(["bench", "recovery", "--setups", TEAM, "--trackers", "lstm", "--sequences", "1",
                      "--frames", "300", "--swap-at-s", "2", "--swap-s", "4"], "M=7, N=4", "set identifier")
 
@@ -66,6 +68,7 @@ def test_bench_pixels_and_record_pixels(tmp_path):
     pytest.importorskip("cv2", reason="the pixel pipeline needs the 'vision' extra")
     assert "M=7, N=4" in _ok(["bench", "pixels", "--setups", TEAM, "--trackers", "set", "--sequences", "1",
                               "--frames", "4"])
+    assert "lstm left out" in _ok(["bench", "pixels", "--setups", TEAM, "--sequences", "1", "--frames", "2"])
     _ok(["record-pixels", "--preset", TEAM, "--sequences", "1", "--frames", "4", "-o", str(tmp_path)])
     assert len(list(tmp_path.glob(f"*{TEAM}*.labelled.jsonl"))) == 1
 

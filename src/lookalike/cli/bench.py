@@ -17,6 +17,7 @@ from lookalike.bench.ident import (
     ident_differences,
     ident_results,
     ident_runs,
+    weights_missing,
 )
 from lookalike.bench.ident_paper import IDENT_VARIANTS, margin_rows
 from lookalike.bench.paired import Comparison, comparison_rows, difference_title
@@ -32,11 +33,12 @@ from lookalike.cli.app import (
     fail,
     failing,
     split_list,
+    warn,
 )
 from lookalike.cli.progress import progress_bars
 from lookalike.io.results import Results
 from lookalike.sim import PRESET_NAMES, preset_label
-from lookalike.sim.presets import TEAM_HELP
+from lookalike.sim.presets import TEAM_HELP, team_size
 from lookalike.trackers import tracker_names
 
 bench_app = typer.Typer(help="Benchmarks that print tables (also written with --json/--csv).", no_args_is_help=True,
@@ -70,6 +72,19 @@ def print_differences(differences: Sequence[Comparison], baseline: str, unit: st
     """Print the difference table of :mod:`lookalike.bench.paired` comparisons (nothing when there are none)."""
     if differences:
         print_rows(difference_title(baseline, unit, figure), comparison_rows(differences, unit))
+
+
+def trained_only(trackers: list[str], default: Sequence[str], setups: list[str]) -> list[str]:
+    """``trackers``, less the LSTMs without shipped weights for one of ``setups`` when ``trackers`` is the default
+    list (a warning names them); an LSTM asked for by name stays (and fails in one line)."""
+    if trackers != list(default):
+        return trackers
+    teams = [team_size(s) for s in setups]
+    left = [t for t in trackers if any(weights_missing(t, n, m) for m, n, _ in teams)]
+    if left:
+        warn(f"{', '.join(left)} left out: no shipped weights for a team of --setups (use set, or name it in "
+             "--trackers to see the error)")
+    return [t for t in trackers if t not in left]
 
 
 def write_results(doc: Results, path: Path | None) -> None:

@@ -17,17 +17,19 @@ from lookalike.bench.experiments import (
 from lookalike.bench.ident_paper import IDENT_VARIANTS
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import check_names, check_outputs_or_fail, check_teams, command_line, fail, failing, split_list
-from lookalike.cli.bench import SETUPS_HELP, bench_app, print_differences, print_rows, write_results
+from lookalike.cli.bench import SETUPS_HELP, bench_app, print_differences, print_rows, trained_only, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.sim import PRESET_NAMES
 from lookalike.sim.presets import preset
 from lookalike.trackers import tracker_names
 
+SHUFFLE_TRACKERS, RECOVERY_TRACKERS = ("jpda", "lstm"), ("kalman_ha2", "jpda", "lstm")
+
 
 @bench_app.command("shuffle")
 def shuffle(
     setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help=SETUPS_HELP),
-    trackers: list[str] = typer.Option(["jpda", "lstm"], "--trackers",
+    trackers: list[str] = typer.Option(list(SHUFFLE_TRACKERS), "--trackers",
                                        help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(3, "--sequences", min=1, help="Test sequences per set-up."),
     frames: int = typer.Option(1000, "--frames", min=2, help="Frames per sequence."),
@@ -37,11 +39,13 @@ def shuffle(
 ) -> None:
     """Control experiment: success rate on frames in order and in random order."""
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path})
-    _check_setups_and_trackers(split_list(setups), split_list(trackers))
+    setup_list, tracker_list = split_list(setups), split_list(trackers)
+    _check_setups_and_trackers(setup_list, tracker_list)
+    tracker_list = trained_only(tracker_list, SHUFFLE_TRACKERS, setup_list)
     with failing(ValueError), progress_bars() as progress:
-        rows = shuffle_rows(split_list(setups), split_list(trackers), sequences, frames, seed, progress)
+        rows = shuffle_rows(setup_list, tracker_list, sequences, frames, seed, progress)
     print_rows("Control: frames in random order", rows)
-    write_results(experiment_results("shuffle", rows, split_list(setups), sequences, frames, seed, command_line()),
+    write_results(experiment_results("shuffle", rows, setup_list, sequences, frames, seed, command_line()),
                   json_path)
     write_rows(rows, None, csv_path)
 
@@ -49,7 +53,7 @@ def shuffle(
 @bench_app.command("recovery")
 def recovery(
     setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help=SETUPS_HELP),
-    trackers: list[str] = typer.Option(["kalman_ha2", "jpda", "lstm"], "--trackers",
+    trackers: list[str] = typer.Option(list(RECOVERY_TRACKERS), "--trackers",
                                        help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(3, "--sequences", min=1, help="Test sequences per set-up."),
     frames: int = typer.Option(900, "--frames", min=300, help="Frames per sequence."),
@@ -63,6 +67,7 @@ def recovery(
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path})
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     _check_setups_and_trackers(setup_list, tracker_list)
+    tracker_list = trained_only(tracker_list, RECOVERY_TRACKERS, setup_list)
     _check_swap(swap_at_s, swap_s, frames, setup_list)
     with failing(ValueError), progress_bars() as progress:
         rows, seconds = recovery_runs(setup_list, tracker_list, sequences, frames, swap_at_s, swap_s, seed, progress)

@@ -10,7 +10,7 @@ import typer
 from lookalike.bench.pixels import DEFAULT_SEED, PERCEPTION_COLUMNS, PIXEL_COLUMNS, pixels_results, pixels_table
 from lookalike.bench.tables import write_rows
 from lookalike.cli.app import check_names, check_outputs_or_fail, check_teams, command_line, fail, failing, split_list
-from lookalike.cli.bench import SETUPS_HELP, bench_app, print_rows, write_results
+from lookalike.cli.bench import SETUPS_HELP, bench_app, print_rows, trained_only, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
 from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera
@@ -41,6 +41,8 @@ def pixels(
     setup_list, ident_list = split_list(setups), split_list(identifiers)
     check_teams("--setups", setup_list)
     check_names("--trackers", ident_list, IDENTIFIERS, "identifier")
+    if weights is None:
+        ident_list = trained_only(ident_list, IDENTIFIERS, setup_list)
     if not setup_list or not ident_list:
         fail("--setups/--trackers: need at least one of each")
     camera = pixel_camera()
