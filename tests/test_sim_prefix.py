@@ -55,3 +55,18 @@ def test_rendered_frames_are_a_prefix_too():
     short = [f.image for f in render_robot_frames(simulate_robots(cfg, 3, 11), camera, 11)]
     long = [f.image for f in render_robot_frames(simulate_robots(cfg, 6, 11), camera, 11)]
     assert all(np.array_equal(a, b) for a, b in zip(short, long[:3]))
+
+
+def test_simulate_files_of_two_lengths_share_their_first_frames(tmp_path):
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    lines = {}
+    for frames in (20, 45):
+        out = tmp_path / str(frames)
+        result = CliRunner().invoke(app, ["simulate", "--preset", "m5n3", "--frames", str(frames), "--seed", "2",
+                                          "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        lines[frames] = (out / "m5n3-000002.jsonl").read_text().splitlines()[1:]  # (the header says the length)
+    assert len(lines[20]) == 20 and lines[20] == lines[45][:20]
