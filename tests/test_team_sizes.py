@@ -97,5 +97,9 @@ def test_track_bag_defaults_to_set_and_render_draws_it(run, tmp_path):
     assert (tmp_path / "above.mp4").stat().st_size > 0
 
 
-def test_serve_refuses_an_lstm_it_has_no_weights_for():
+def test_serve_refuses_an_lstm_it_has_no_weights_for(tmp_path):
     _one_line_error(["serve", "--tracker", "lstm", "--robots", "4", "--duration", "0.1"], "N=4", "set identifier")
+    port_file = tmp_path / "port"  # 7 robots: the shipped M=10, N=7 weights, without --set n_slots=10
+    _ok(["serve", "--tracker", "lstm", "--robots", "7", "--duration", "0.1", "--listen", "127.0.0.1:0",
+         "--port-file", str(port_file)])
+    assert port_file.read_text().startswith("127.0.0.1:")

@@ -19,7 +19,7 @@ from lookalike.io.sources import SignalStop
 from lookalike.node import Endpoint, IdentifierConfig, NodeConfig, NodeServer, TeamState, log_event, parse_address
 from lookalike.node.server import check_group, dds_node
 from lookalike.node.teamsim import SimClock, camera_messages, run_camera, run_robot, team_sequence
-from lookalike.sim.presets import TEAM_HELP
+from lookalike.sim.presets import PRESET_NAMES, TEAM_HELP, team_size
 from lookalike.trackers import tracker_parameters
 
 
@@ -46,7 +46,7 @@ def _address(text: str, option: str) -> tuple[str, int]:
 @app.command()
 def serve(
     tracker: str = typer.Option("set", "--tracker", "-t", help="Registered tracker/identifier name (set: any team "
-                                "size; lstm: the shipped sizes, with --set n_slots=M)."),
+                                "size; lstm: 2, 3 or 7 robots, or --set weights=PATH --set n_slots=M)."),
     set_: list[str] | None = typer.Option(None, "--set", "-s", help="Tracker parameter KEY=VALUE (repeatable)."),
     robots: int = typer.Option(3, help="Robots in the team (ids 0..N-1); also the tracker's n_agents unless set."),
     listen: str = typer.Option("127.0.0.1:7700", help="HOST:PORT to receive reports and detections on (port 0: any)."),
@@ -79,8 +79,12 @@ def serve(
         params = {p.name for p in tracker_parameters(tracker)}
     except KeyError as exc:
         fail(str(exc.args[0]))
-    if "n_agents" in params and not any(s.split("=", 1)[0].strip() == "n_agents" for s in settings):
+    given = {s.split("=", 1)[0].strip() for s in settings}
+    if "n_agents" in params and "n_agents" not in given:
         settings.append(f"n_agents={robots}")
+    slots = {n: m for m, n, _ in map(team_size, PRESET_NAMES)}  # the shipped LSTMs' M per team size N
+    if tracker == "lstm" and "n_slots" not in given and robots in slots:
+        settings.append(f"n_slots={slots[robots]}")
     trk = build_tracker(tracker, settings)
     log = _logger(log_level)
     try:
@@ -160,7 +164,7 @@ def robot_sim(
     the team state, and print the error of its identified position against its true one (JSON)."""
     sequence = _sequence(preset_name, seed, duration, loss, delay, jitter)
     if not 1 <= robot <= sequence.config.n_agents:
-        fail(f"--robot {robot}: preset {preset_name} has robots 1..{sequence.config.n_agents}")
+        fail(f"--robot {robot}: team {preset_name} has robots 1..{sequence.config.n_agents}")
     robot -= 1  # the wire protocol's 0-based id
     node_address, bind_address, group_address = _address(node, "--node"), _address(bind, "--bind"), _group(group)
     with failing(OSError, prefix=f"--bind {bind} / --group {group}: "):
