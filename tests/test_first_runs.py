@@ -134,14 +134,14 @@ def test_blob_detection_shows_frames_done_of_the_declared_count(monkeypatch, tmp
         for _ in range(5):
             if advance is not None:
                 advance()
-        return "rows", 5
+        return "found"
 
     monkeypatch.setattr(track_blobs, "progress_bars", fake_bars)
-    monkeypatch.setattr(track_blobs, "cached_blob_detection_rows", fake_rows)
+    monkeypatch.setattr(track_blobs, "cached_blob_detections", fake_rows)
     video = tmp_path / "v.mp4"
-    assert track_blobs._detect_with_progress(video, None, 5) == ("rows", 5)
+    assert track_blobs._detect_with_progress(video, None, 5) == "found"
     assert bars == [("detecting blobs in v.mp4", 5)] and len(steps) == 5
-    assert track_blobs._detect_with_progress(video, None, 0) == ("rows", 5) and len(bars) == 1  # count unknown
+    assert track_blobs._detect_with_progress(video, None, 0) == "found" and len(bars) == 1  # count unknown
 
 
 @pytest.mark.parametrize("columns", ["80", "130"])

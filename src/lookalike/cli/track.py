@@ -238,8 +238,11 @@ def track(
     heading_model: Path | None = typer.Option(None, "--heading-model", help="With --pipeline: `train-heading` model."),
     params_file: Path | None = typer.Option(None, "--params", help="Parameter file written by `lookalike tune` "
                                             "(for this tracker); --set overrides its values."),
-    offline: bool = typer.Option(False, "--offline", help="With --targets N: decide the N identities over the "
-                                 "whole sequence at once (offline closed set) before writing the result."),
+    offline_opt: bool | None = typer.Option(None, "--offline/--online", help="With --targets N: decide the N "
+                                            "identities over the whole sequence at once (offline closed set; on a "
+                                            "blob video, learning each target's look from the video itself), or "
+                                            "frame by frame. Default: offline for --video with --detector blob, "
+                                            "online otherwise."),
     points: Path | None = typer.Option(None, "--points", help="Anonymous points as input: a frame,x,y CSV, or "
                                        "MOTChallenge rows frame,id,x,y (tracked as small boxes; --fps, default 25)."),
     no_seqinfo_length: bool = typer.Option(False, "--no-seqinfo-length", help="Track every frame in det.txt even "
@@ -266,6 +269,8 @@ def track(
                                                                 pipeline, points)
     open_set = targets == 0  # --targets 0: an open set, no number of targets inferred (blob videos)
     targets = targets or None
+    offline = bool(offline_opt) if offline_opt is not None else (
+        targets is not None and detector == "blob" and tracker == "boxtrack" and live is None and bag is None)
     if offline and targets is None:
         fail("--offline: needs --targets N (the known number of targets)")
     if offline and branch == "pipeline":

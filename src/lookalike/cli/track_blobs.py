@@ -14,20 +14,20 @@ from lookalike.cli.track_video import run_track_onnx, run_track_video
 from lookalike.io import write_mot
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, frame_counts
 from lookalike.vision.blob_boxtrack import blob_boxtrack_config
-from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows
+from lookalike.viz.blob_video import BlobRows, auto_blob_config, cached_blob_detections
 from lookalike.viz.overlay import source_frames
 
 DETECTORS = ("blob",)
 
 
-def _detect_with_progress(video: Path, config: Any, declared: int) -> tuple[Any, int]:
-    """:func:`~lookalike.viz.blob_video.cached_blob_detection_rows` with a bar of ``declared`` frames on a terminal,
+def _detect_with_progress(video: Path, config: Any, declared: int) -> BlobRows:
+    """:func:`~lookalike.viz.blob_video.cached_blob_detections` with a bar of ``declared`` frames on a terminal,
     or a spinner when the video does not declare its frame count."""
     if declared <= 0:
         with console.status(f"detecting blobs in {video.name}"):
-            return cached_blob_detection_rows(video, config)
+            return cached_blob_detections(video, config)
     with progress_bars() as progress:
-        return cached_blob_detection_rows(video, config, progress(f"detecting blobs in {video.name}", declared))
+        return cached_blob_detections(video, config, progress(f"detecting blobs in {video.name}", declared))
 
 
 def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, detector: str,
@@ -54,7 +54,8 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
             if given:
                 console.print(f"  given with --blob: {', '.join(sorted(given))}", markup=False)
         _, declared, source_rate = source_frames(video)
-        rows, frames = _detect_with_progress(video, config, declared)
+        found = _detect_with_progress(video, config, declared)
+        rows, frames = found.rows, found.frames
         frame_rate = options.get("fps") or source_rate
     det_path = write_mot(output.with_name(output.stem + ".det.txt"), rows)
     console.print(f"blob detector: {len(rows)} boxes in {frames} frames → {det_path}", markup=False)
@@ -65,7 +66,8 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
         assert n_targets
         offline = {**{k: v for k, v in BOX_TRACKER_PARAMS.items() if tracker_name == "boxtrack"}, **offline}
         offline_video(det_path, output, n_targets, offline, float(frame_rate), frames, options["min_score"],
-                      video=video, annotate=options.get("annotate"), annotate_as=options.get("annotate_as"))
+                      video=video, annotate=options.get("annotate"), annotate_as=options.get("annotate_as"),
+                      blobs=(rows, found.shapes) if options["min_score"] <= 1 else None)
         return
     if tracker_name == "boxtrack":
         plan = blob_boxtrack_config(tracker.config, frame_counts(rows, frames), explicit, n_targets)

@@ -48,12 +48,15 @@ def table_rows(path: Path, min_score: float = float("-inf"), length: int | None 
 
 
 def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
-                    params: dict[str, Any], vel_noise: float | None = None) -> np.ndarray:
+                    params: dict[str, Any], vel_noise: float | None = None,
+                    shapes: np.ndarray | None = None) -> np.ndarray:
     """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online ``boxtrack``
-    pass's parameters (``max_targets`` dropped); ``vel_noise``: its velocity noise when not boxtrack's own. Too few
-    detections for the offline assignment get the online closed set's result instead, with a printed note."""
+    pass's parameters (``max_targets`` dropped); ``vel_noise``: its velocity noise when not boxtrack's own;
+    ``shapes``: each detection's blob shape vector (the look learned from them weighs in). Too few detections for
+    the offline assignment get the online closed set's result instead, with a printed note."""
     online = {k: v for k, v in params.items() if k != "max_targets"}
-    rows = track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise)
+    rows = track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise,
+                            shapes=shapes)
     if len(rows) or not len(det_rows):
         return rows
     frames = len(np.unique(det_rows[:, 0]))
@@ -92,13 +95,15 @@ def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, An
 
 def offline_video(det_path: Path, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
                   n_frames: int | None, min_score: float, det_format: str = "auto", *, video: Path | None = None,
-                  annotate: Path | None = None, annotate_as: Path | None = None) -> None:
-    """``--video ... --offline``: the closed set over the detections at ``det_path``, written to ``output``; with
-    ``annotate``, its identities drawn on ``video`` into that MP4 (printed as ``annotate_as``)."""
+                  annotate: Path | None = None, annotate_as: Path | None = None,
+                  blobs: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+    """``--video ... --offline``: the closed set over the detections at ``det_path`` (or ``blobs``: the detection
+    rows with their shape vectors), written to ``output``; with ``annotate``, its identities drawn on ``video`` into
+    that MP4 (printed as ``annotate_as``)."""
     with failing(FileNotFoundError, ValueError):
-        det = table_rows(det_path, min_score, det_format=det_format)
-        with console.status(f"closed set of {n_targets}"):
-            rows = closed_set_rows(det, n_targets, frame_rate, n_frames, params)
+        det, shapes = blobs if blobs is not None else (table_rows(det_path, min_score, det_format=det_format), None)
+        with console.status(f"closed set of {n_targets}" + (", learning each one's look" if blobs else "")):
+            rows = closed_set_rows(det, n_targets, frame_rate, n_frames, params, shapes=shapes)
     write_mot(output, rows)
     console.print(f"[green]boxtrack[/], offline closed set of {n_targets}: {len(np.unique(rows[:, 1]))} "
                   f"identities, {len(rows)} rows at {frame_rate:g} frames/s → {output}")

@@ -72,6 +72,7 @@ class BlobDetector:
     """Detects moving blobs in ``(h, w, 3)`` BGR frames of one static camera; one instance per video."""
 
     config: BlobConfig = field(default_factory=BlobConfig)
+    describe: bool = False  # also give each box its blob's shape vector as the detection's feature (blob_shape)
     background_: np.ndarray | None = field(default=None, init=False, repr=False)
     _buffer: deque = field(init=False, repr=False)
     _seen: int = field(default=0, init=False, repr=False)
@@ -144,22 +145,24 @@ class BlobDetector:
         return mask, diff
 
     def __call__(self, image: np.ndarray) -> Detections:
-        """Detections of one frame: boxes ``xywh`` (px) of the blobs, each scoring 1."""
+        """Detections of one frame: boxes ``xywh`` (px) of the blobs, each scoring 1 (with ``describe``, each blob's
+        :func:`~lookalike.vision.blob_shape.blob_shapes` vector as its feature)."""
         with needs("cv2"):
             import cv2
 
         cfg = self.config
-        mask, _ = self.foreground(image)
-        count, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
-        boxes = []
-        for k in range(1, count):
-            x, y, w, h, area = (int(v) for v in stats[k])
-            if not cfg.min_area_px <= area <= cfg.max_area_px:
-                continue
-            boxes.append((x, y, w, h))
-        if not boxes:
+        mask, difference = self.foreground(image)
+        count, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        keep = [k for k in range(1, count) if cfg.min_area_px <= stats[k, 4] <= cfg.max_area_px]
+        if not keep:
             return Detections.empty()
-        return Detections(xywh=np.array(boxes, dtype=float), score=np.ones(len(boxes)))
+        boxes = stats[keep, :4].astype(float)
+        if not self.describe:
+            return Detections(xywh=boxes, score=np.ones(len(keep)))
+        from lookalike.vision.blob_shape import blob_shapes
+
+        shapes = blob_shapes(labels, stats, keep, difference, as_bgr_image(image, "image"))
+        return Detections(xywh=boxes, score=np.ones(len(keep)), feature=shapes)
 
     detect = __call__
 

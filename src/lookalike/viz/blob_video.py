@@ -10,6 +10,7 @@ import json
 import math
 import os
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +20,7 @@ from lookalike._optional import needs
 from lookalike.io.outputs import write_atomic
 from lookalike.vision.blob import BlobConfig, BlobDetector, spread
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config
+from lookalike.vision.blob_shape import SHAPE_SIZE
 from lookalike.vision.onnx_detector import detect_frames
 from lookalike.viz.overlay import source_frames
 
@@ -145,41 +147,67 @@ def detection_cache_key(video: Path | str, config: BlobConfig, extra: dict[str, 
     return hashlib.sha256(payload.encode()).hexdigest()[:32]
 
 
+@dataclass(frozen=True)
+class BlobRows:
+    """A video's blob detections: MOTChallenge ``rows`` ``(n, 10)``, the number of ``frames`` and each row's
+    :func:`~lookalike.vision.blob_shape.blob_shapes` vector ``shapes`` ``(n, SHAPE_SIZE)``."""
+
+    rows: np.ndarray
+    frames: int
+    shapes: np.ndarray
+
+
 def cached_blob_detection_rows(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
                                cache: Path | None | bool = True) -> tuple[np.ndarray, int]:
     """:func:`blob_detection_rows` through the cache (``cache``: a folder, ``True`` for :func:`cache_dir`, ``False``
     or None for none)."""
+    found = cached_blob_detections(video, config, advance, cache)
+    return found.rows, found.frames
+
+
+def cached_blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
+                           cache: Path | None | bool = True) -> BlobRows:
+    """:func:`blob_detections` through the cache (as :func:`cached_blob_detection_rows`)."""
     if cache is False or cache is None:
-        return blob_detection_rows(video, config, advance)
+        return blob_detections(video, config, advance)
     folder = (cache_dir() if cache is True else Path(cache)) / "blobs"
     path = folder / f"{detection_cache_key(video, config)}.npz"
     if path.is_file():
         try:
             with np.load(path) as data:
-                return np.array(data["rows"], dtype=float).reshape(-1, 10), int(data["frames"])
+                rows = np.array(data["rows"], dtype=float).reshape(-1, 10)
+                return BlobRows(rows, int(data["frames"]), np.array(data["shapes"], dtype=float).reshape(
+                    len(rows), SHAPE_SIZE))
         except (OSError, ValueError, KeyError):
             pass
-    rows, frames = blob_detection_rows(video, config, advance)
+    found = blob_detections(video, config, advance)
     buffer = io.BytesIO()
-    np.savez(buffer, rows=rows, frames=frames)
+    np.savez(buffer, rows=found.rows, frames=found.frames, shapes=found.shapes)
     _write_atomic(path, buffer.getvalue())
-    return rows, frames
+    return found
 
 
 def blob_detection_rows(video: Path | str, config: BlobConfig,
                         advance: Callable[[], None] | None = None) -> tuple[np.ndarray, int]:
     """Blob detections of ``video`` (a file or image folder) as MOTChallenge rows ``(n, 10)``, and the frame count."""
-    detector = BlobDetector(config)
+    found = blob_detections(video, config, advance)
+    return found.rows, found.frames
+
+
+def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None) -> BlobRows:
+    """Blob detections of ``video`` (a file or image folder) with each blob's shape vector, in one pass."""
+    detector = BlobDetector(config, describe=True)
     if config.method == "median":
         frames, declared, _ = source_frames(video)
         picked = _background_sample(frames, declared, config.history)
         if not picked:
             raise ValueError(f"video: {video} has no frames")
         detector.fit(picked)
-    rows, count = detect_frames(source_frames(video)[0], detector, advance)
+    shapes: list[np.ndarray] = []
+    rows, count = detect_frames(source_frames(video)[0], detector, advance, shapes)
     if count == 0:
         raise ValueError(f"video: {video} has no frames")
-    return rows, count
+    return BlobRows(rows, count, np.vstack(shapes) if shapes else np.zeros((0, SHAPE_SIZE)))
 
 
 def _background_sample(frames: Any, declared: int, count: int) -> list[np.ndarray]:
@@ -191,5 +219,5 @@ def _background_sample(frames: Any, declared: int, count: int) -> list[np.ndarra
     return [every[k] for k in spread(len(every), count)]
 
 
-__all__ = ["CACHE_ENV", "auto_blob_config", "blob_config", "blob_detection_rows", "blob_settings", "cache_dir",
-           "cached_blob_detection_rows", "detection_cache_key"]
+__all__ = ["CACHE_ENV", "BlobRows", "auto_blob_config", "blob_config", "blob_detection_rows", "blob_detections",
+           "blob_settings", "cache_dir", "cached_blob_detection_rows", "cached_blob_detections", "detection_cache_key"]

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.trackers.offline.appearance import cut_at_merges, fit_identity_space, with_appearance
 from lookalike.trackers.offline.closed_set_config import ClosedSetConfig
 from lookalike.trackers.offline.constraints import (
     ChainConstraints,
@@ -184,12 +185,16 @@ def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[fl
 
 
 def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
-                      config: ClosedSetConfig | None = None, constraints: ChainConstraints | None = None) -> np.ndarray:
+                      config: ClosedSetConfig | None = None, constraints: ChainConstraints | None = None,
+                      shapes: np.ndarray | None = None) -> np.ndarray:
     """Result rows ``(k, 10)`` (any ids; 1-based frames, boxes in pixels) re-labelled with ids ``1..n_targets``
     by one global assignment of their tracklets (module doc); rows on no identity (clutter) are dropped
     and gaps of at most ``fill_gap_s`` inside an identity are interpolated. ``frame_rate`` in frames/s.
     ``constraints`` hold in the assignment (a tracklet fixed to identity ``j`` gets id ``j``; the other identities
-    take the free ids in order of their start); ValueError when they name no input row or cannot all hold."""
+    take the free ids in order of their start); ValueError when they name no input row or cannot all hold.
+    ``shapes``: blob shape vectors ``(n, SHAPE_SIZE)`` that column 9 of ``rows`` indexes; with them, the look
+    learned from the video weighs in every link (:mod:`~lookalike.trackers.offline.appearance`) and merged blobs
+    are only placed into gaps."""
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
@@ -200,11 +205,19 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     if not pieces:
         unchanged: np.ndarray = rows.copy()
         return unchanged
+    crossing: list[Tracklet] = []
+    if shapes is not None:
+        pieces, crossing = cut_at_merges(pieces, shapes)
     named = {tracklet_of(pieces, r) for r in constraints.rows()} if constraints is not None else set()
     tracklets = [t for i, t in enumerate(pieces) if len(t) >= cfg.min_rows or i in named] or pieces
     chained = {id(t) for t in tracklets}
     short = [t for t in pieces if len(t) < cfg.min_rows and tracklets is not pieces and id(t) not in chained]
+    short += crossing
     links = link_costs(tracklets, frame_rate, cfg)
+    space = fit_identity_space(tracklets, shapes) if shapes is not None else None
+    if space is not None:
+        assert shapes is not None
+        links = with_appearance(tracklets, links, shapes, space)
     lo, hi = rows[:, 0].min() + cfg.velocity_frames, rows[:, 0].max() - cfg.velocity_frames
     start_cost = np.array([cfg.edge_cost if t.first > lo else 0.0 for t in tracklets])
     end_cost = np.array([cfg.edge_cost if t.last < hi else 0.0 for t in tracklets])
@@ -231,6 +244,8 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
         cfg.fill_gap_s * frame_rate)
     if not len(merged):
         return merged
+    if shapes is not None:
+        merged[:, 7:10] = -1.0
     return smooth_boxes(fill_gaps(merged, max_fill), smoothing_window(merged, frame_rate, cfg))
 
 
@@ -249,12 +264,14 @@ def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfi
 
 
 def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = None,
-                tracker: str = "boxtrack", *, vel_noise: float | None = None, **params: Any) -> np.ndarray:
+                tracker: str = "boxtrack", *, vel_noise: float | None = None, index: bool = False,
+                **params: Any) -> np.ndarray:
     """Result rows of an online pass of ``tracker`` over detection rows ``(k, >=7)`` (1-based frames,
     boxes in pixels, score in column 7): only tracks matched to a detection, at that detection's box.
     ``vel_noise``: ``boxtrack``'s velocity noise (fraction of the box size per frame) when not its default
     (:class:`~lookalike.trackers.boxtrack.BoxTrack`'s hook; points as boxes use
-    :data:`lookalike.io.points.POINT_VEL_NOISE`)."""
+    :data:`lookalike.io.points.POINT_VEL_NOISE`). ``index``: column 9 holds the detection's row number in
+    ``det_rows``."""
     det_rows = checked_rows(det_rows)
     tracker_obj = make_tracker(tracker, **params)
     if vel_noise is not None:
@@ -273,19 +290,23 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
         for t in tracker_obj.update(Frame(index=k, time=k / frame_rate, detections=dets)):
             if t.detection_index is None or t.detection_index < 0:
                 continue  # coasted: no detection behind it
-            out.append([k + 1, t.track_id, *block[t.detection_index, 2:6], 1.0, -1, -1, -1])
+            row = order[bounds[k] + t.detection_index] if index else -1
+            out.append([k + 1, t.track_id, *block[t.detection_index, 2:6], 1.0, -1, -1, row])
     return np.array(out, dtype=float).reshape(-1, 10)
 
 
 def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *, n_frames: int | None = None,
                      online: dict[str, Any] | None = None, config: ClosedSetConfig | None = None,
-                     vel_noise: float | None = None) -> np.ndarray:
+                     vel_noise: float | None = None, shapes: np.ndarray | None = None) -> np.ndarray:
     """Offline closed-set tracking of detection rows ``(k, >=7)``: an open-set online ``boxtrack`` pass
     with ``n_init=1`` (every detection enters some tracklet; the assignment decides what is clutter;
     ``online`` overrides its parameters; ``vel_noise`` as in :func:`online_rows`), then
-    :func:`assign_identities`. Returns result rows ``(k, 10)`` with ids ``1..n_targets``."""
+    :func:`assign_identities` (``shapes``: one blob shape vector per detection row, or None). Returns result rows
+    ``(k, 10)`` with ids ``1..n_targets``."""
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
+    if shapes is not None and len(shapes) != len(det_rows):
+        raise ValueError(f"shapes: expected one per detection row ({len(det_rows)}), got {len(shapes)}")
     params = {"n_init": 1, **(online or {})}
-    rows = online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, **params)
-    return assign_identities(rows, n_targets, frame_rate, config)
+    rows = online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, index=shapes is not None, **params)
+    return assign_identities(rows, n_targets, frame_rate, config, shapes=shapes)

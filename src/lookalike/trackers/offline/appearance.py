@@ -1,0 +1,145 @@
+"""Identity evidence learned from one video's own blobs, without labels, for the offline closed set.
+
+Each input row carries its blob's shape vector (:mod:`lookalike.vision.blob_shape`). A row shows one animal when its
+area is near its track's typical blob's (:func:`single_rows`); tracklets are cut where that changes, so the rows of merged
+blobs form pieces of their own (:func:`cut_at_merges`). From the single-animal tracklets, :func:`fit_identity_space`
+learns a linear map in which rows of one tracklet lie close together and the mean looks of tracklets alive at the same
+time (so certainly different animals) lie far apart: Fisher's discriminant with the within-tracklet scatter against
+the scatter between concurrent pairs. :meth:`IdentitySpace.link_llr` then says, for two tracklets, how much more likely
+their looks are if they are one animal than if they are two, a log-likelihood ratio calibrated on the same video:
+"same" from the two halves of each tracklet, "different" from the concurrent pairs."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from lookalike.trackers.offline.tracklets import Tracklet
+
+__all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "single_rows", "with_appearance"]
+
+SINGLE_AREA = (0.6, 1.5)  # a blob shows one animal when its area is within these multiples of its track's median
+MIN_ROWS = 8  # single-animal rows a tracklet needs to teach or be judged by its look
+OUTLIER = 0.001  # chance that a tracklet's look is not its animal's (a bad segmentation): bounds a link's evidence
+SHAPE_COLUMN = 9  # the column of an input row that holds its shape vector's index
+
+
+def single_rows(rows: np.ndarray, shapes: np.ndarray) -> np.ndarray:
+    """Mask of the input ``rows`` (column 9 indexing ``shapes``, ``(k, SHAPE_SIZE)``) whose blob area is that of one
+    animal: within :data:`SINGLE_AREA` of the median area of the rows of the same input id."""
+    area = np.exp(shapes[rows[:, SHAPE_COLUMN].astype(int), 0])
+    ids, which = np.unique(rows[:, 1], return_inverse=True)
+    typical = np.array([np.median(area[which == k]) for k in range(len(ids))])[which] if len(ids) else area
+    mask: np.ndarray = (area >= SINGLE_AREA[0] * typical) & (area <= SINGLE_AREA[1] * typical)
+    return mask
+
+
+def cut_at_merges(tracklets: list[Tracklet], shapes: np.ndarray) -> tuple[list[Tracklet], list[Tracklet]]:
+    """``tracklets`` cut where their rows go from one animal's blob to a merged one and back (:func:`single_rows`
+    over all their rows); returns the single-animal pieces and the others."""
+    alone: list[Tracklet] = []
+    merged: list[Tracklet] = []
+    if not tracklets:
+        return alone, merged
+    every = np.vstack([t.rows for t in tracklets])
+    single = dict(zip(map(tuple, every[:, [0, SHAPE_COLUMN]].tolist()), single_rows(every, shapes).tolist()))
+    for t in tracklets:
+        flag = np.array([single[(f, k)] for f, k in t.rows[:, [0, SHAPE_COLUMN]].tolist()], dtype=bool)
+        for piece in np.split(np.arange(len(t)), np.flatnonzero(np.diff(flag.astype(int))) + 1):
+            part = Tracklet(t.rows[piece], t.source_id, t.contact or not flag[piece[0]])
+            (alone if flag[piece[0]] else merged).append(part)
+    alone.sort(key=lambda t: (t.first, t.last))
+    return alone, merged
+
+
+@dataclass(frozen=True)
+class IdentitySpace:
+    """A learned identity map: shape vectors ``x`` go to ``(x - mean) / scale @ projection``; ``drift`` is the
+    per-dimension variance between the halves of one animal's tracklet beyond sampling noise, ``between`` that of
+    two concurrent animals' means."""
+
+    mean: np.ndarray
+    scale: np.ndarray
+    projection: np.ndarray
+    drift: float
+    between: float
+
+    def embed(self, shapes: np.ndarray) -> np.ndarray:
+        """Identity coordinates ``(k, d)`` of shape vectors ``(k, SHAPE_SIZE)``."""
+        out: np.ndarray = ((shapes - self.mean) / self.scale) @ self.projection
+        return out
+
+    def link_llr(self, a: tuple[np.ndarray, int], b: tuple[np.ndarray, int]) -> float:
+        """Log-likelihood ratio, one animal against two, of two tracklets' looks, each ``(mean coordinates, rows)``;
+        either look is its animal's but with probability :data:`OUTLIER`, so the ratio stays within ±ln(1/OUTLIER)."""
+        diff2 = float(np.sum((a[0] - b[0]) ** 2))
+        d = len(a[0])
+        same = self.drift + 1.0 / a[1] + 1.0 / b[1]
+        other = max(self.between, same)
+        ratio = 0.5 * (diff2 / other - diff2 / same) + 0.5 * d * math.log(other / same)  # log N_same - log N_other
+        odds = math.exp(min(max(ratio, -50.0), 50.0))
+        return math.log(((1 - OUTLIER) * odds + OUTLIER) / ((1 - OUTLIER) + OUTLIER * odds))
+
+
+def _scatter(groups: list[np.ndarray]) -> np.ndarray:
+    centred = np.vstack([g - g.mean(axis=0) for g in groups])
+    dof = sum(len(g) - 1 for g in groups)
+    out: np.ndarray = centred.T @ centred / max(dof, 1)
+    return out
+
+
+def fit_identity_space(tracklets: list[Tracklet], shapes: np.ndarray) -> IdentitySpace | None:
+    """The identity map learned from single-animal ``tracklets`` (their rows' column 9 indexes ``shapes``), or None
+    when no two tracklets of :data:`MIN_ROWS` rows are alive at once (nothing to tell apart)."""
+    from scipy.linalg import eigh
+
+    long = [t for t in tracklets if len(t) >= MIN_ROWS]
+    if len(long) < 2:
+        return None
+    first = np.array([t.first for t in long])
+    last = np.array([t.last for t in long])
+    a, b = np.nonzero((first[:, None] <= last[None]) & (first[None] <= last[:, None]))
+    pairs = [(i, j) for i, j in zip(a.tolist(), b.tolist()) if i < j]
+    if not pairs:
+        return None
+    raw = [shapes[t.rows[:, SHAPE_COLUMN].astype(int)] for t in long]
+    every = np.vstack(raw)
+    mean, scale = every.mean(axis=0), every.std(axis=0) + 1e-6
+    groups = [(x - mean) / scale for x in raw]
+    within = _scatter(groups) + 1e-3 * np.eye(every.shape[1])
+    means = np.array([g.mean(axis=0) for g in groups])
+    diffs = np.array([means[i] - means[j] for i, j in pairs])
+    apart = diffs.T @ diffs / len(diffs)
+    values, vectors = eigh(apart, within)  # vectors.T @ within @ vectors = I
+    keep = values > 1.0  # directions where concurrent animals differ by more than a tracklet's own noise
+    if not keep.any():
+        return None
+    projection = vectors[:, keep]
+    space = IdentitySpace(mean, scale, projection, 0.0, 1.0)
+    drift, between = _calibrate(space, long, shapes, pairs)
+    return IdentitySpace(mean, scale, projection, drift, between)
+
+
+def _calibrate(space: IdentitySpace, long: list[Tracklet], shapes: np.ndarray,
+               pairs: list[tuple[int, int]]) -> tuple[float, float]:
+    """``(drift, between)`` of :class:`IdentitySpace` from the halves of each tracklet and the concurrent pairs."""
+    coords = [space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]) for t in long]
+    d = coords[0].shape[1]
+    excess = []
+    for c in coords:
+        h = len(c) // 2
+        excess.append(np.sum((c[:h].mean(axis=0) - c[h:].mean(axis=0)) ** 2) / d - 1.0 / h - 1.0 / (len(c) - h))
+    drift = max(float(np.median(excess)), 0.0)
+    between = float(np.mean([np.sum((coords[i].mean(axis=0) - coords[j].mean(axis=0)) ** 2) / d for i, j in pairs]))
+    return drift, between
+
+
+def with_appearance(tracklets: list[Tracklet], links: tuple[np.ndarray, np.ndarray, np.ndarray], shapes: np.ndarray,
+                    space: IdentitySpace) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``links`` ``(i, j, cost)`` with each cost lowered by :meth:`IdentitySpace.link_llr` of its two tracklets."""
+    src, dst, cost = links
+    looks = [(space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0), len(t)) for t in tracklets]
+    llr = np.array([space.link_llr(looks[i], looks[j]) for i, j in zip(src.tolist(), dst.tolist())])
+    return src, dst, cost - llr if len(llr) else cost

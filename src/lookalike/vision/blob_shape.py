@@ -1,0 +1,50 @@
+"""What a blob looks like, as a fixed-length vector that does not depend on where the animal is or which way it
+points: its size and shape, how dark it is and in which colour, and how its width and darkness run along its body
+axis (the body turned to one reference direction by its principal axis, the heavier end first). The offline closed
+set learns from these which animal is which (:mod:`lookalike.trackers.offline.appearance`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["PROFILE_BINS", "SHAPE_SIZE", "blob_shapes"]
+
+PROFILE_BINS = 8  # bins of the width and darkness profiles along the body axis
+SHAPE_SIZE = 7 + 2 * PROFILE_BINS
+"""Length of a blob's vector: log area (px²), log major and minor axis (px), mean difference from the background
+(grey levels), mean B, G, R (grey levels), the width profile (fraction of the area per bin) and the darkness profile
+(each bin's mean difference over the blob's mean)."""
+
+
+def blob_shapes(labels: np.ndarray, stats: np.ndarray, keep: list[int], difference: np.ndarray,
+                image: np.ndarray) -> np.ndarray:
+    """``(len(keep), SHAPE_SIZE)`` vectors of the connected components ``keep`` of ``labels`` (from
+    ``cv2.connectedComponentsWithStats``, with its ``stats``); ``difference``: ``(h, w)`` difference from the
+    background; ``image``: the ``(h, w, 3)`` BGR frame."""
+    out = np.zeros((len(keep), SHAPE_SIZE))
+    for row, k in enumerate(keep):
+        x, y, w, h = (int(v) for v in stats[k, :4])
+        mask = labels[y:y + h, x:x + w] == k
+        ys, xs = np.nonzero(mask)
+        weight = difference[y:y + h, x:x + w][mask].astype(float)
+        colour = image[y:y + h, x:x + w][mask].astype(float)
+        out[row] = _shape(xs.astype(float), ys.astype(float), weight, colour)
+    return out
+
+
+def _shape(xs: np.ndarray, ys: np.ndarray, weight: np.ndarray, colour: np.ndarray) -> np.ndarray:
+    area = len(xs)
+    pts = np.column_stack([xs - xs.mean(), ys - ys.mean()])
+    cov = pts.T @ pts / max(area, 1) + np.eye(2) / 12  # (a pixel's own spread: single-pixel blobs stay finite)
+    values, vectors = np.linalg.eigh(cov)
+    along = pts @ vectors[:, 1]
+    if np.sum(along**3) > 0:  # the heavier end first: the long thin end (a tail) runs to positive values
+        along = -along
+    half = 2 * np.sqrt(values[1])  # half the major axis (px)
+    bins = np.clip(((along / half + 1.25) / 2.5 * PROFILE_BINS).astype(int), 0, PROFILE_BINS - 1)
+    counts = np.bincount(bins, minlength=PROFILE_BINS).astype(float)
+    dark = np.bincount(bins, weights=weight, minlength=PROFILE_BINS)
+    mean_dark = float(weight.mean()) if area else 0.0
+    profile = np.where(counts > 0, dark / np.maximum(counts, 1) / max(mean_dark, 1e-6), 0.0)
+    return np.concatenate([[np.log(max(area, 1)), np.log(4 * np.sqrt(values[1])), np.log(4 * np.sqrt(values[0])),
+                            mean_dark], colour.mean(axis=0) if area else np.zeros(3), counts / max(area, 1), profile])

@@ -1,0 +1,117 @@
+"""Identities learned from the video's own blobs: shape vectors, the learned identity map and its use by the offline
+closed set (issue 50)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lookalike.trackers.offline.appearance import SHAPE_COLUMN, cut_at_merges, fit_identity_space, single_rows
+from lookalike.trackers.offline.closed_set import track_closed_set
+from lookalike.trackers.offline.tracklets import Tracklet
+from lookalike.vision.blob_shape import SHAPE_SIZE, blob_shapes
+
+cv2 = pytest.importorskip("cv2")
+
+
+def _fish(angle: float, length: float = 50.0, head: int = 60) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Labels, stats and difference image of one dark fish-like blob (a wide head, a thin tail) turned by ``angle``."""
+    img = np.zeros((160, 160), np.uint8)
+    c, s = np.cos(angle), np.sin(angle)
+    for t in np.linspace(-0.5, 0.5, 60):
+        width = 7 * (1 - (t + 0.5) ** 1.5) + 1  # widest at the head (t = -0.5)
+        x, y = 80 + t * length * c, 80 + t * length * s
+        cv2.circle(img, (int(round(x)), int(round(y))), int(round(width / 2)) + 1, 255 if t > -0.3 else head, -1)
+    count, labels, stats, _ = cv2.connectedComponentsWithStats((img > 0).astype(np.uint8), connectivity=8)
+    assert count == 2
+    return labels, stats, img.astype(np.float32)
+
+
+def test_a_blob_looks_the_same_whichever_way_it_points():
+    vectors = []
+    for angle in np.linspace(0, 2 * np.pi, 9)[:-1]:
+        labels, stats, diff = _fish(angle)
+        vectors.append(blob_shapes(labels, stats, [1], diff, np.dstack([diff] * 3))[0])
+    vectors = np.array(vectors)
+    assert vectors.shape == (8, SHAPE_SIZE)
+    spread = vectors.std(axis=0)
+    labels, stats, diff = _fish(0.3, length=60)
+    bigger = blob_shapes(labels, stats, [1], diff, np.dstack([diff] * 3))[0]
+    assert bigger[0] - vectors[:, 0].mean() > 5 * spread[0]  # a longer animal has a larger log area
+    profile = vectors[:, 7 + 8:]
+    assert np.abs(profile - profile.mean(axis=0)).max() < 0.35  # the darker head stays at one end
+
+
+def _two_animals(bounce: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Detection rows, shape vectors and true ids of two animals that meet in the middle, merge into one blob for 6
+    frames and part again: crossing over (``bounce`` False) or turning back (``bounce`` True)."""
+    rng = np.random.default_rng(0)
+    looks = np.array([rng.normal(0, 1, SHAPE_SIZE), rng.normal(0, 1, SHAPE_SIZE)])
+    looks[:, 0] = np.log(300.0)
+    rows, shapes, truth = [], [], []
+    for k in range(1, 81):
+        x = np.array([20.0 + 3 * k, 260.0 - 3 * k]) if k <= 40 or not bounce else \
+            np.array([140.0 - 3 * (k - 40), 140.0 + 3 * (k - 40)])
+        if 38 <= k <= 43:
+            rows.append([k, -1, x.mean() - 15, 95, 30, 10, 1, -1, -1, -1])
+            merged = looks.mean(axis=0)
+            merged[0] = np.log(600.0)
+            shapes.append(merged)
+            truth.append(0)
+            continue
+        for i in range(2):
+            rows.append([k, -1, x[i] - 10, 95 + rng.normal(0, 0.3), 20, 10, 1, -1, -1, -1])
+            shapes.append(looks[i] + rng.normal(0, 0.1, SHAPE_SIZE) * (np.arange(SHAPE_SIZE) > 0))
+            truth.append(i + 1)
+    return np.array(rows, float), np.array(shapes), np.array(truth)
+
+
+def _kept_apart(result: np.ndarray, rows: np.ndarray, truth: np.ndarray) -> bool:
+    """Whether each result id follows one true animal through the whole sequence."""
+    seen: dict[int, set[int]] = {}
+    for r in result:
+        same = np.flatnonzero((rows[:, 0] == r[0]) & (np.abs(rows[:, 2] - r[2]) < 1e-6) & (truth > 0))
+        for k in same:
+            seen.setdefault(int(r[1]), set()).add(int(truth[k]))
+    return len(seen) == 2 and all(len(v) == 1 for v in seen.values())
+
+
+def test_the_learned_look_keeps_two_animals_apart_when_they_turn_back_after_touching():
+    rows, shapes, truth = _two_animals(bounce=True)
+    plain = track_closed_set(rows, 2, 25.0)
+    looked = track_closed_set(rows, 2, 25.0, shapes=shapes)
+    assert not _kept_apart(plain, rows, truth)  # motion alone carries each on through the other
+    assert _kept_apart(looked, rows, truth)
+    assert set(np.unique(looked[:, 1])) == {1, 2} and np.all(looked[:, 7:10] == -1)
+
+
+def test_the_learned_look_agrees_with_motion_when_animals_cross_over():
+    rows, shapes, truth = _two_animals(bounce=False)
+    assert _kept_apart(track_closed_set(rows, 2, 25.0, shapes=shapes), rows, truth)
+
+
+def test_merged_blobs_are_cut_out_of_tracklets_and_concurrent_tracklets_teach_the_map():
+    rows, shapes, truth = _two_animals(bounce=True)
+    tracklet = np.column_stack([rows[:, :SHAPE_COLUMN], np.arange(len(rows))])
+    tracklet[:, 1] = 1
+    single = single_rows(tracklet, shapes)
+    assert not single[truth == 0].any() and single[truth > 0].all()
+    one = tracklet[(truth == 1) | (truth == 0)]
+    alone, merged = cut_at_merges([Tracklet(one, 1)], shapes)
+    assert len(alone) == 2 and len(merged) == 1 and merged[0].contact
+    other = tracklet[truth == 2]
+    space = fit_identity_space([*alone, Tracklet(other[other[:, 0] < 38], 2), Tracklet(other[other[:, 0] > 43], 2)],
+                               shapes)
+    assert space is not None
+    look = [(space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0), len(t)) for t in alone]
+    second = other[other[:, 0] > 43, SHAPE_COLUMN].astype(int)
+    assert space.link_llr(look[0], look[1]) > 0 > space.link_llr(look[0], (space.embed(shapes[second]).mean(axis=0),
+                                                                           len(second)))
+
+
+def test_nothing_to_learn_from_a_lone_animal_and_shapes_must_match_the_detections():
+    rows, shapes, truth = _two_animals(bounce=True)
+    one = np.column_stack([rows[truth == 1, :SHAPE_COLUMN], np.flatnonzero(truth == 1)])
+    assert fit_identity_space([Tracklet(one, 1)], shapes) is None
+    with pytest.raises(ValueError, match="shapes"):
+        track_closed_set(rows, 2, 25.0, shapes=shapes[:-1])
