@@ -24,7 +24,7 @@ from lookalike.cli import app
 runner = CliRunner()
 
 OUTPUT_OPTIONS = {"-o", "--json", "--csv", "--png", "--plots", "--gif", "--annotate", "--study", "--port-file",
-                  "--rerun-save"}
+                  "--rerun-save", "--log"}
 """Option names that name a file or folder a command writes (and ``label --results``, the benchmark result's folder)."""
 
 DET_ROW = "{f},-1,{x},20,20,20,0.9,-1,-1,-1\n"
@@ -104,6 +104,9 @@ SPECS: dict[str, Spec] = {
     "bench real": Spec(lambda u, o: ["bench", "real", "--data", _s(u, "gt"), "--params", _s(u, "json_in"),
                                      "--json", o["--json"], "--csv", o["--csv"], "--plots", o["--plots"]],
                        ("--json", "--csv", "--plots"), ("gt", "json_in"), folders=("--plots",)),
+    "proofread": Spec(lambda u, o: ["proofread", "--video", _s(u, "video"), "--tracks", _s(u, "res_seq"), "--export",
+                                    "-o", o["-o"], "--log", o["--log"]],
+                      ("-o", "--log"), ("video", "res_seq"), cheap=True),
 }
 
 
@@ -168,7 +171,8 @@ def _universe(root: Path) -> dict[str, Path]:
 
 
 def _names(root: Path) -> dict[str, Path]:
-    return {"gt": root / "gt", "gt_seq": root / "gt" / "S1", "res": root / "res", "video": root / "in.mp4",
+    return {"gt": root / "gt", "gt_seq": root / "gt" / "S1", "res": root / "res", "res_seq": root / "res" / "S1.txt",
+            "video": root / "in.mp4",
             "video_det": root / "in.txt", "frames": root / "frames", "robots_dir": root / "robots",
             "robots": next((root / "robots").glob("*.jsonl")), "json_in": root / "in.json",
             "model": root / "model.onnx", "model2": root / "model2.npz", "weights": root / "weights.pt"}
