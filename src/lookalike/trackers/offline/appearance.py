@@ -1,13 +1,14 @@
 """Identity evidence learned from one video's own blobs, without labels, for the offline closed set.
 
 Each input row carries its blob's shape vector (:mod:`lookalike.vision.blob_shape`). A row shows one animal when its
-area is near its track's typical blob's (:func:`single_rows`); tracklets are cut where that changes, so the rows of merged
-blobs form pieces of their own (:func:`cut_at_merges`). From the single-animal tracklets, :func:`fit_identity_space`
-learns a linear map in which rows of one tracklet lie close together and the mean looks of tracklets alive at the same
-time (so certainly different animals) lie far apart: Fisher's discriminant with the within-tracklet scatter against
-the scatter between concurrent pairs. :meth:`IdentitySpace.link_llr` then says, for two tracklets, how much more likely
-their looks are if they are one animal than if they are two, a log-likelihood ratio calibrated on the same video:
-"same" from the two halves of each tracklet, "different" from the concurrent pairs."""
+area is near its track's typical blob's (:func:`single_rows`); tracklets are cut where that changes, so the rows of
+merged blobs form pieces of their own (:func:`cut_at_merges`). From the single-animal tracklets,
+:func:`fit_identity_space` learns a linear map in which rows of one tracklet lie close together and the mean looks of
+tracklets alive at the same time (so certainly different animals) lie far apart: Fisher's discriminant with the
+within-tracklet scatter against the scatter between concurrent pairs. :meth:`IdentitySpace.link_llr` then says, for
+two tracklets, how much more likely their looks are if they are one animal than if they are two, a log-likelihood
+ratio calibrated on the same video: "same" from the two halves of each tracklet, "different" from the concurrent
+pairs."""
 
 from __future__ import annotations
 
