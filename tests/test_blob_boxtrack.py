@@ -73,7 +73,7 @@ def test_cli_and_bench_give_the_same_config(tmp_path: Path, monkeypatch: pytest.
     monkeypatch.setattr("lookalike.cli.track_blobs.run_track_video", capture)
     out = tmp_path / "tracks.txt"
     args = ["track", "--video", str(_video(tmp_path / "discs.avi")), "--detector", "blob", "-t", "boxtrack",
-            "-o", str(out)]
+            "-o", str(out), "--save-detections", str(tmp_path / "tracks.det.txt")]
     for s in settings:
         args += ["--set", s]
     result = CliRunner().invoke(app, args)

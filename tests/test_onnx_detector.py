@@ -146,7 +146,8 @@ def test_track_video_with_onnx_detector_end_to_end(pool_video, tmp_path, tracker
     video, gt, model = pool_video
     out = tmp_path / "tracks.txt"
     r = runner.invoke(app, ["track", "--video", str(video), "--detector", str(model), "--blob", "score=0.15",
-                            "-t", tracker, "--features", features, "-o", str(out)])
+                            "-t", tracker, "--features", features, "-o", str(out),
+                            "--save-detections", str(tmp_path / "tracks.det.txt")])
     assert r.exit_code == 0, r.output
     det = read_mot(tmp_path / "tracks.det.txt")
     assert len(det) >= 30 and det.conf.min() >= 0.15

@@ -155,7 +155,7 @@ def test_blob_settings_estimated_printed_and_overridden(tmp_path):
     out = tmp_path / "t.txt"
     confident = ["--set", "high_score=0.5", "--set", "birth_score=0.5"]  # 90 blobs: too few to self-calibrate
     r = runner.invoke(app, ["track", "--video", str(video), "--detector", "blob", "-t", "boxtrack", "--targets", "3",
-                            "--offline", *confident, "-o", str(out)])
+                            "--offline", *confident, "-o", str(out), "--save-detections", str(tmp_path / "t.det.txt")])
     assert r.exit_code == 0, r.output
     text = _one_line_error(r)
     assert "estimated from the video" in text and "polarity=dark" in text and "threshold=" in text

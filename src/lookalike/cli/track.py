@@ -141,15 +141,17 @@ def _speed(stats: RunStats) -> str:
 
 
 def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None], annotate: Path | None = None,
-                               video: Path | None = None) -> None:
-    """Refuse (exit 2) when the result, a file written beside it, or ``annotate`` is an input or another output."""
-    siblings = [output.with_name(output.stem + s) for s in (".health.csv", ".merges.csv", ".det.txt")]
+                               video: Path | None = None, saved: Path | None = None) -> None:
+    """Refuse (exit 2) when the result, a file written beside it, ``annotate`` or ``saved`` (--save-detections) is an
+    input or another output."""
+    siblings = [output.with_name(output.stem + s) for s in (".health.csv", ".merges.csv")]
     files = [p for p in inputs if p is not None and p.is_file()]
+    extra = {k: v for k, v in (("--annotate", annotate), ("--save-detections", saved)) if v is not None}
     with failing(ValueError):
-        refuse_inputs([output, *siblings], files)
-        if annotate is not None:
-            check_outputs({"-o/--output": output, **{f"-o/--output's {s.name}": s for s in siblings},
-                           "--annotate": annotate}, files, input_folders=[video])  # (video: an image folder)
+        refuse_inputs([output, *siblings, *extra.values()], files)
+        if extra:
+            check_outputs({"-o/--output": output, **{f"-o/--output's {s.name}": s for s in siblings}, **extra},
+                          files, input_folders=[video])  # (video: an image folder)
 
 
 def _check_branches(path: Path | None, video: Path | None, detections: Path | None, annotate: Path | None,
@@ -179,12 +181,14 @@ def _check_branches(path: Path | None, video: Path | None, detections: Path | No
     return "files"
 
 
-def _live_source(video: str | None, detector: str | None, stops: bool) -> str | None:
+def _live_source(video: str | None, detector: str | None, stops: bool, saves: bool = False) -> str | None:
     """``--video``'s text when it names a live source (a camera index, a stream URL), else None; ``stops``: whether
-    --max-frames/--seconds were given (live only)."""
+    --max-frames/--seconds were given (live only); ``saves``: whether --save-detections was (not live)."""
     from lookalike.io.sources import is_live
 
     live = video if is_live(video) else None
+    if saves and (detector is None or live is not None):
+        fail("--save-detections: only with --video FILE --detector")
     if live is None and stops:
         fail("--max-frames/--seconds: only with a live --video (a camera index or a stream URL)")
     if live is not None and detector is None:
@@ -224,8 +228,10 @@ def track(
                                  "hand-crafted, standardised on this video ('video') or with the diver calibration "
                                  "('divers'); the shipped learned embedding ('learned'); or an embedding FILE.onnx."),
     detector: str | None = typer.Option(None, "--detector", help="With --video: detect with 'blob' (static camera) "
-                                        "or an ONNX model FILE.onnx instead of reading a det.txt; boxes go to "
-                                        "<output stem>.det.txt."),
+                                        "or an ONNX model FILE.onnx instead of reading a det.txt."),
+    save_detections: Path | None = typer.Option(None, "--save-detections", help="With --detector: also write the "
+                                                "boxes found to this MOTChallenge file (track it again with "
+                                                "--detections)."),
     blob: list[str] | None = typer.Option(None, "--blob", help="Detector setting KEY=VALUE (repeatable): for 'blob' "
                                           "e.g. threshold=30 polarity=dark min_area_px=80; for FILE.onnx e.g. "
                                           "score=0.4 classes=0 layout=yolo (docs: ONNX detector how-to)."),
@@ -261,7 +267,8 @@ def track(
     seconds: float | None = typer.Option(None, "--seconds", min=0.0, help="Live --video: stop after S seconds."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
-    live = _live_source(video_arg, detector, max_frames is not None or seconds is not None)
+    live = _live_source(video_arg, detector, max_frames is not None or seconds is not None,
+                        save_detections is not None)
     video = Path(video_arg) if video_arg is not None else None
     if bag is not None and (any(x is not None for x in (path, video, detections, points, reports, detector)) or blob):
         fail("--bag: the bag is the input; drop PATH/--video/--detections/--points/--reports/--detector/--blob")
@@ -278,7 +285,7 @@ def track(
     if offline and tracker != "boxtrack":
         fail(f"--offline: the closed set's online pass is boxtrack; use -t boxtrack, not {tracker!r}")
     _refuse_overwriting_inputs(output, [path, video, detections, points, reports, params_file, detector_model,
-                                        heading_model], annotate, video)
+                                        heading_model], annotate, video, save_detections)
     settings = set_ or []
     team_size = team_size if team_size is not None else targets
     video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
@@ -324,7 +331,8 @@ def track(
 
                     run_track_blobs(video, output, trk, tracker, detector or "", blob or [],
                                     n_targets=0 if open_set else targets, offline=online,
-                                    explicit=tracker_params(tracker, settings, params_file).keys(), **video_options)
+                                    explicit=tracker_params(tracker, settings, params_file).keys(),
+                                    save_detections=save_detections, **video_options)
                 else:
                     det_path = detections or path
                     assert det_path is not None

@@ -1,5 +1,5 @@
 """The ``--video FILE --detector blob`` branch of ``lookalike track``: blob settings estimated from the video (``--blob
-KEY=VALUE`` overrides them), detections cached, written to ``<output stem>.det.txt`` and tracked (docs/blobs.md)."""
+KEY=VALUE`` overrides them), detections cached (written out with ``--save-detections``) and tracked (docs/blobs.md)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ from typing import Any
 from lookalike.cli.app import console, fail, failing
 from lookalike.cli.progress import progress_bars
 from lookalike.cli.track_closed import check_result_file, offline_video
-from lookalike.cli.track_video import run_track_onnx, run_track_video
-from lookalike.io import write_mot
+from lookalike.cli.track_video import run_track_onnx, run_track_video, save_detections
+from lookalike.io import MotTable
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, frame_counts
 from lookalike.vision.blob_boxtrack import blob_boxtrack_config
 from lookalike.viz.blob_video import BlobRows, auto_blob_config, cached_blob_detections
@@ -33,7 +33,7 @@ def _detect_with_progress(video: Path, config: Any, declared: int) -> BlobRows:
 def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, detector: str,
                     settings: list[str], *, n_targets: int | None = None, offline: dict[str, Any] | None = None,
                     explicit: Collection[str] = (), **options: Any) -> None:
-    """Detect blobs on ``video`` into ``<output stem>.det.txt``, then track them as
+    """Detect blobs on ``video`` (saved to ``options["save_detections"]`` when given), then track them as
     :func:`~lookalike.cli.track_video.run_track_video` (given ``options``) or, with ``offline`` (the online pass's
     parameters), by the offline closed set of ``n_targets`` (None: inferred from the blob counts for ``boxtrack``;
     0: an open set). ``explicit``: the tracker parameters the user gave, kept as given."""
@@ -57,17 +57,17 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
         found = _detect_with_progress(video, config, declared)
         rows, frames = found.rows, found.frames
         frame_rate = options.get("fps") or source_rate
-    det_path = write_mot(output.with_name(output.stem + ".det.txt"), rows)
-    console.print(f"blob detector: {len(rows)} boxes in {frames} frames → {det_path}", markup=False)
+    console.print(f"blob detector: {len(rows)} boxes in {frames} frames" + save_detections(rows, options),
+                  markup=False)
     if len(rows) < 2:
         fail(f"{video}: the blob detector found {len(rows)} box(es); try a lower --blob threshold=... "
              "or min_area_px=..., or polarity=dark/bright")
     if offline is not None:
         assert n_targets
         offline = {**{k: v for k, v in BOX_TRACKER_PARAMS.items() if tracker_name == "boxtrack"}, **offline}
-        offline_video(det_path, output, n_targets, offline, float(frame_rate), frames, options["min_score"],
+        offline_video(rows, output, n_targets, offline, float(frame_rate), frames, options["min_score"],
                       video=video, annotate=options.get("annotate"), annotate_as=options.get("annotate_as"),
-                      blobs=(rows, found.shapes) if options["min_score"] <= 1 else None)
+                      shapes=found.shapes)
         return
     if tracker_name == "boxtrack":
         plan = blob_boxtrack_config(tracker.config, frame_counts(rows, frames), explicit, n_targets)
@@ -77,4 +77,5 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
             options["team_size"] = plan.n_targets
         if plan.config != tracker.config:
             tracker = type(tracker)(plan.config)
-    run_track_video(video, det_path, output, tracker, tracker_name, length=frames, score_warnings=False, **options)
+    run_track_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, length=frames,
+                    score_warnings=False, **options)

@@ -93,17 +93,20 @@ def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, An
     return len(sequences)
 
 
-def offline_video(det_path: Path, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
+def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
                   n_frames: int | None, min_score: float, det_format: str = "auto", *, video: Path | None = None,
                   annotate: Path | None = None, annotate_as: Path | None = None,
-                  blobs: tuple[np.ndarray, np.ndarray] | None = None) -> None:
-    """``--video ... --offline``: the closed set over the detections at ``det_path`` (or ``blobs``: the detection
-    rows with their shape vectors), written to ``output``; with ``annotate``, its identities drawn on ``video`` into
-    that MP4 (printed as ``annotate_as``)."""
+                  shapes: np.ndarray | None = None) -> None:
+    """``--video ... --offline``: the closed set over the detections ``det`` (a file, or rows a detector found, with
+    ``shapes``: each row's blob shape vector), written to ``output``; with ``annotate``, its identities drawn on
+    ``video`` into that MP4 (printed as ``annotate_as``)."""
     with failing(FileNotFoundError, ValueError):
-        det, shapes = blobs if blobs is not None else (table_rows(det_path, min_score, det_format=det_format), None)
-        with console.status(f"closed set of {n_targets}" + (", learning each one's look" if blobs else "")):
-            rows = closed_set_rows(det, n_targets, frame_rate, n_frames, params, shapes=shapes)
+        rows = table_rows(det, min_score, det_format=det_format) if isinstance(det, Path) else \
+            det[det[:, 6] >= min_score]
+        shapes = shapes if shapes is not None and len(shapes) == len(rows) else None
+        with console.status(f"closed set of {n_targets}" + (", learning each one's look" if shapes is not None
+                                                             else "")):
+            rows = closed_set_rows(rows, n_targets, frame_rate, n_frames, params, shapes=shapes)
     write_mot(output, rows)
     console.print(f"[green]boxtrack[/], offline closed set of {n_targets}: {len(np.unique(rows[:, 1]))} "
                   f"identities, {len(rows)} rows at {frame_rate:g} frames/s → {output}")

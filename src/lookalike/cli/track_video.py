@@ -3,46 +3,54 @@ health, optional annotated video."""
 
 from __future__ import annotations
 
+import io
+import itertools
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from rich.markup import escape
 
 from lookalike.cli.app import console, fail, failing, note, warn
 from lookalike.cli.progress import bars
 from lookalike.cli.track import dropped_all
 from lookalike.cli.track_closed import check_result_file, offline_video
-from lookalike.io import read_mot, write_mot
+from lookalike.io import MotTable, read_mot, write_mot
 from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
+from lookalike.io.motchallenge import format_rows
 from lookalike.io.needs import input_kind
 from lookalike.io.outputs import atomic_path
 from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
 from lookalike.trackers.parts.health import HealthConfig
 from lookalike.viz.overlay import source_frames
+from lookalike.viz.video import video_info
 from lookalike.viz.video_tracking import fit_video_features, side_file, track_video, write_health_csv, write_merges_csv
 
 FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
 
 
-def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, tracker_name: str, *,
+def run_track_video(video: Path, detections: Path | MotTable, output: Path, tracker: Any, tracker_name: str, *,
                     annotate: Path | None, team_size: int | None, health_window: int,
                     min_score: float, fps: float | None, features: str = "video",
                     annotate_as: Path | None = None, det_format: str = "auto", length: int | None = None,
                     score_warnings: bool = True) -> None:
-    """Track ``detections`` on ``video``; write ``output``, its ``.health.csv`` (``.merges.csv`` for merging
-    trackers) and, with ``annotate``, the annotated MP4 (printed as ``annotate_as``). ``features``: ``video``,
-    ``divers``/``handcrafted``, ``learned`` or ``FILE.onnx`` (the ``--features`` option). ``length``: the video's
-    decoded frames when known; ``score_warnings``: False for a detector whose scores are all 1 by design (blobs)."""
+    """Track ``detections`` (a file, or the rows a detector found) on ``video``; write ``output``, its
+    ``.health.csv`` (``.merges.csv`` for merging trackers) and, with ``annotate``, the annotated MP4 (printed as
+    ``annotate_as``). ``features``: ``video``, ``divers``/``handcrafted``, ``learned`` or ``FILE.onnx`` (the
+    ``--features`` option). ``length``: the video's decoded frames when known (then a box tracker without
+    ``annotate`` decodes none); ``score_warnings``: False for a detector whose scores are all 1 by design (blobs)."""
     if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
         fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
     check_result_file(output)
+    found = not isinstance(detections, Path)
     with failing(ValueError, OSError):
-        fmt, notes = sniff_det(detections, det_format)
-        table = read_mot(detections) if fmt.standard() else read_det(detections, fmt)
+        if isinstance(detections, MotTable):
+            table, notes = detections, []
+        else:
+            fmt, notes = sniff_det(detections, det_format)
+            table = read_mot(detections) if fmt.standard() else read_det(detections, fmt)
         health = HealthConfig(team_size=team_size, window=health_window)
         images, total, _ = source_frames(video)
-        first = next(iter(images), None)
-        size = (first.shape[1], first.shape[0]) if first is not None else None
         if input_kind(tracker_name) == "boxes":  # reads no appearance: no features computed
             extractor: Any = None
         else:
@@ -50,10 +58,18 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
                 extractor = (fit_diver_features() if features in ("divers", "handcrafted")
                              else fit_video_features(video, table, min_score=min_score) if features == "video"
                              else diver_extractor(features))
+        stream: Any = None
+        if extractor is None and annotate is None and length is not None:  # no frame decoded: the size from the file
+            size = None if video.is_dir() else video_info(video)[2]
+        else:  # the first frame's size; the frames go on to the tracker (one decode)
+            first = next(images, None)
+            size = (first.shape[1], first.shape[0]) if first is not None else None
+            stream = itertools.chain([] if first is None else [first], images)
+    name = f"the detections in {video}" if found else detections
     for line in notes:
-        note(f"{detections}: {line}")
+        note(f"{name}: {line}")
     scores, outside = box_stats(table.xywh, table.conf, size)
-    for line in det_warnings(detections, len(table), scores if score_warnings else None, outside, size,
+    for line in det_warnings(name, len(table), scores if score_warnings else None, outside, size,
                              f"the frames of {video}"):
         warn(line)
     hint = stored_thresholds(extractor).get(tracker_name) if extractor is not None else None
@@ -65,7 +81,8 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
         with bars("tracking {task.description}") as progress:
             task = progress.add_task(video.name, total=total or None)
             result = track_video(video, table, tracker, extractor, annotate=annotate, health=health,
-                                 fps=fps, min_score=min_score, advance=lambda: progress.advance(task), length=length)
+                                 fps=fps, min_score=min_score, advance=lambda: progress.advance(task), length=length,
+                                 images=stream)
     except ValueError as exc:
         fail(str(exc))
     except KeyboardInterrupt:
@@ -74,7 +91,7 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
         raise SystemExit(130) from None
     write_mot(output, result.rows)
     if len(table) and not len(result.rows):
-        warn(dropped_all(tracker_name, detections, len(table), scores))
+        warn(dropped_all(tracker_name, name, len(table), scores))
     written = [output, side_file(output, "health")]
     with atomic_path(written[1]) as tmp:  # (the side files too appear whole, through temporary files)
         write_health_csv(tmp, result.health)
@@ -97,9 +114,9 @@ def run_track_video(video: Path, detections: Path, output: Path, tracker: Any, t
 
 def run_track_onnx(video: Path, output: Path, tracker: Any, tracker_name: str, model: Path, settings: list[str], *,
                    n_targets: int | None = None, offline: dict[str, Any] | None = None, **options: Any) -> None:
-    """``track --video V --detector FILE.onnx``: detect with the ONNX model (``settings``: ``KEY=VALUE``), write
-    ``<output stem>.det.txt``, then track as :func:`run_track_video` (given ``options``) or, with ``offline``, by
-    the offline closed set of ``n_targets``."""
+    """``track --video V --detector FILE.onnx``: detect with the ONNX model (``settings``: ``KEY=VALUE``; the boxes
+    saved to ``options["save_detections"]`` when given), then track as :func:`run_track_video` (given ``options``)
+    or, with ``offline``, by the offline closed set of ``n_targets``."""
     import time
 
     from lookalike.vision.onnx_detector import OnnxDetector, config_from_settings, detect_frames
@@ -115,15 +132,27 @@ def run_track_onnx(video: Path, output: Path, tracker: Any, tracker_name: str, m
             t0 = time.perf_counter()
             rows, frames = detect_frames(images, detector, advance=lambda: progress.advance(task))
             seconds = time.perf_counter() - t0
-    det_path = write_mot(output.with_name(output.stem + ".det.txt"), rows)
     speed = f"{frames / seconds:,.1f} frames/s" if seconds > 0 else "inf frames/s"
     console.print(f"{model.name} ({detector.layout}, input {detector.input_size[0]}x{detector.input_size[1]}): "
-                  f"{len(rows)} boxes in {frames} frames, {speed} → {det_path}")
+                  f"{len(rows)} boxes in {frames} frames, {speed}" + save_detections(rows, options))
     if len(rows) < 2:
         fail(f"{video}: the detector {model.name} found {len(rows)} box(es); try a lower score=... setting")
+    rows = as_written(rows)  # (tracked as a saved detection file would be: boxes to 1/1000 px, scores to 6 digits)
     if offline is not None:
         assert n_targets is not None
-        offline_video(det_path, output, n_targets, offline, float(options.get("fps") or rate), frames,
+        offline_video(rows, output, n_targets, offline, float(options.get("fps") or rate), frames,
                       options["min_score"])
     else:
-        run_track_video(video, det_path, output, tracker, tracker_name, **options)
+        run_track_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, length=frames, **options)
+
+
+def as_written(rows: np.ndarray) -> np.ndarray:
+    """Detection rows ``(n, 10)`` as they read back from a MOTChallenge file (:func:`~lookalike.io.write_mot`)."""
+    return np.loadtxt(io.StringIO(format_rows(rows)), delimiter=",", ndmin=2).reshape(-1, 10)
+
+
+def save_detections(rows: np.ndarray, options: dict[str, Any]) -> str:
+    """Write ``rows`` to ``options["save_detections"]`` (popped; ``--save-detections``) when given: `` → PATH`` for
+    the printed line, else ``""``."""
+    path = options.pop("save_detections", None)
+    return "" if path is None else f" → {write_mot(path, rows)}"

@@ -81,7 +81,8 @@ def _odd(value: float, lo: int, hi: int) -> int:
 
 
 def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
-    """Up to ``count`` BGR uint8 frames spread evenly over a video file or an image folder (by name), in one pass."""
+    """Up to ``count`` BGR uint8 frames spread evenly over a video file or an image folder (by name), in one pass that
+    converts only the frames kept."""
     with needs("cv2"):
         import cv2
 
@@ -105,11 +106,11 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
         wanted = set(spread(total, count).tolist()) if total > 0 else None  # None: keep all, pick after
         frames: list[np.ndarray] = []
         k = 0
-        while True:
-            ok, frame = cap.read()
-            if not ok:
-                break
+        while cap.grab():  # (a frame not kept is decoded but never converted to BGR)
             if wanted is None or k in wanted:
+                ok, frame = cap.retrieve()
+                if not ok:
+                    break
                 frames.append(frame)
             k += 1
         if wanted is None:

@@ -18,8 +18,8 @@ import numpy as np
 
 from lookalike._optional import needs
 from lookalike.io.outputs import write_atomic
-from lookalike.vision.blob import BlobConfig, BlobDetector, spread
-from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config
+from lookalike.vision.blob import BlobConfig, BlobDetector
+from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config, sample_frames
 from lookalike.vision.blob_shape import SHAPE_SIZE
 from lookalike.vision.onnx_detector import detect_frames
 from lookalike.viz.overlay import source_frames
@@ -87,7 +87,7 @@ def auto_blob_config(video: Path | str, settings: list[str], n_targets: int | No
 def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
                      cache: Path | None | bool, progress: Progress | None = None) -> BlobEstimate:
     if cache is False or cache is None:
-        return estimate_blob_config(video, n_targets, base=base, progress=progress)
+        return estimate_blob_config(_sampled(video, ESTIMATE_FRAMES), n_targets, base=base, progress=progress)
     from lookalike.vision import blob_auto
 
     path = (cache_dir() if cache is True else Path(cache)) / "blobs" / (
@@ -101,11 +101,26 @@ def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
             return BlobEstimate(**data)
         except (OSError, ValueError, TypeError, KeyError):
             pass
-    estimate = estimate_blob_config(video, n_targets, base=base, progress=progress)
+    estimate = estimate_blob_config(_sampled(video, ESTIMATE_FRAMES), n_targets, base=base, progress=progress)
     content = dataclasses.asdict(estimate)
     content["counts"] = {repr(k): v for k, v in estimate.counts.items()}
     _write_atomic(path, json.dumps(content, default=float).encode())
     return estimate
+
+
+ESTIMATE_FRAMES = 25  # frames the settings are estimated on (estimate_blob_config's sample)
+_SAMPLE: dict[tuple[Any, ...], list[np.ndarray]] = {}  # the last sample read, for the median background
+
+
+def _sampled(video: Path | str, count: int) -> list[np.ndarray]:
+    """:func:`~lookalike.vision.blob_auto.sample_frames`, the last sample kept so that one read serves the estimate
+    and the median background."""
+    stat = os.stat(video)
+    key = (str(Path(video).resolve()), stat.st_mtime_ns, stat.st_size, count)
+    if key not in _SAMPLE:
+        _SAMPLE.clear()
+        _SAMPLE[key] = sample_frames(video, count)
+    return _SAMPLE[key]
 
 
 def _write_atomic(path: Path, data: bytes) -> None:
@@ -198,25 +213,12 @@ def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[],
     """Blob detections of ``video`` (a file or image folder) with each blob's shape vector, in one pass."""
     detector = BlobDetector(config, describe=True)
     if config.method == "median":
-        frames, declared, _ = source_frames(video)
-        picked = _background_sample(frames, declared, config.history)
-        if not picked:
-            raise ValueError(f"video: {video} has no frames")
-        detector.fit(picked)
+        detector.fit(_sampled(video, config.history))
     shapes: list[np.ndarray] = []
     rows, count = detect_frames(source_frames(video)[0], detector, advance, shapes)
     if count == 0:
         raise ValueError(f"video: {video} has no frames")
     return BlobRows(rows, count, np.vstack(shapes) if shapes else np.zeros((0, SHAPE_SIZE)))
-
-
-def _background_sample(frames: Any, declared: int, count: int) -> list[np.ndarray]:
-    """Up to ``count`` frames spread evenly over the video (all of them when its length is unknown and short)."""
-    if declared > 0:
-        wanted = set(spread(declared, count).tolist())
-        return [img for k, img in enumerate(frames) if k in wanted]
-    every = list(frames)  # length unknown: keep the frames, then subsample
-    return [every[k] for k in spread(len(every), count)]
 
 
 __all__ = ["CACHE_ENV", "BlobRows", "auto_blob_config", "blob_config", "blob_detection_rows", "blob_detections",
