@@ -20,7 +20,8 @@ or on one line, the clauses separated by ``;``: ``<!-- doc-test: run; file robot
 ``run slow`` blocks only with ``LOOKALIKE_DOC_TEST_SLOW=1``. Commands run in-process through typer's test
 runner; Python blocks with the same marker run too (``exec``) in their page's folder. After a block ran,
 each expectation line is checked: ``file PATH`` (exists, not empty), optionally with ``rows N``,
-``rows A-B`` or ``rows N+`` (non-empty lines); ``output REGEX`` (found in the block's output, whitespace
+``rows A-B`` or ``rows N+`` (non-empty lines) and ``ids A,B,...`` (the ids in the second column of its
+comma-separated rows are exactly these); ``output REGEX`` (found in the block's output, whitespace
 runs read as one space; quote it with '...'); ``figure REGEX VALUE TOL`` (the number REGEX's group
 captures is within TOL of VALUE). Every block of the README and the how-to guides that holds a command
 runs with at least one expectation, or says why not (``skip WHY``).
@@ -299,6 +300,12 @@ def _in_range(n: int, spec: str) -> bool:
     return int(low) <= n <= int(high or low)
 
 
+def _ids(path: Path) -> set[str]:
+    """The distinct values of the second column of a comma-separated file's non-empty rows (MOTChallenge ids)."""
+    with path.open(encoding="utf-8") as f:
+        return {line.split(",")[1].strip() for line in f if line.strip()}
+
+
 def check_expectations(block: Block, folder: Path, output: str) -> None:
     """Every expectation of ``block`` holds for the files in ``folder`` and the block's ``output``."""
     text = " ".join(output.split())
@@ -308,9 +315,13 @@ def check_expectations(block: Block, folder: Path, output: str) -> None:
         if kind == "file":
             path = folder / args[0]
             assert path.is_file() and path.stat().st_size > 0, f"{what}, but {path} is missing or empty"
-            if args[1:2] == ["rows"]:
+            options = dict(zip(args[1::2], args[2::2]))
+            if "rows" in options:
                 n = _rows(path)
-                assert _in_range(n, args[2]), f"{what}, but it has {n} rows"
+                assert _in_range(n, options["rows"]), f"{what}, but it has {n} rows"
+            if "ids" in options:
+                ids = _ids(path)
+                assert ids == set(options["ids"].split(",")), f"{what}, but its ids are {sorted(ids)}"
         elif kind == "output":
             assert re.search(args[0], text), f"{what}; the output was:\n{output[-3000:]}"
         elif kind == "figure":
@@ -392,14 +403,17 @@ def test_expectations_are_checked():
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         (folder / "a.txt").write_text("1\n2\n\n3\n")
+        (folder / "m.txt").write_text("1,1,5\n1,2,5\n2,2,5\n")
 
         def block(*lines: str) -> Block:
             return Block(REPO / "README.md", 1, "sh", "", "run", tuple(shlex.split(x) for x in lines))
 
         check_expectations(block("file a.txt rows 3", "file a.txt rows 2-4", "file a.txt rows 1+",
+                                 "file m.txt rows 3 ids 1,2", "file m.txt ids 2,1",
                                  "output 'robot 1: [1-9]'", "figure 'lstm +([\\d.]+)%' 98.8 0.5"),
                            folder, "robot 1:\n 12\nlstm   98.6%")
         for bad in ("file b.txt", "file a.txt rows 4", "file a.txt rows 4+", "output 'robot 2'",
+                    "file m.txt ids 1", "file m.txt ids 1,2,3", "file m.txt rows 3 ids 1,3",
                     "figure 'lstm +([\\d.]+)%' 97.0 0.5"):
             with pytest.raises(AssertionError):
                 check_expectations(block(bad), folder, "robot 1: 12 lstm 98.6%")
