@@ -7,14 +7,24 @@ from collections.abc import Collection
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from lookalike.cli.app import console, fail, failing
 from lookalike.cli.progress import progress_bars
 from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.cli.track_video import run_track_onnx, run_track_video, save_detections
 from lookalike.io import MotTable
+from lookalike.io.needs import input_kind
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, frame_counts
 from lookalike.vision.blob_boxtrack import blob_boxtrack_config
-from lookalike.viz.blob_video import BlobRows, auto_blob_config, cached_blob_detections
+from lookalike.viz.blob_video import (
+    BlobRows,
+    BlobStream,
+    auto_blob_config,
+    cached_blob_detections,
+    load_blob_detections,
+    store_blob_detections,
+)
 from lookalike.viz.overlay import source_frames
 
 DETECTORS = ("blob",)
@@ -54,14 +64,27 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
             if given:
                 console.print(f"  given with --blob: {', '.join(sorted(given))}", markup=False)
         _, declared, source_rate = source_frames(video)
-        found = _detect_with_progress(video, config, declared)
-        rows, frames = found.rows, found.frames
         frame_rate = options.get("fps") or source_rate
-    console.print(f"blob detector: {len(rows)} boxes in {frames} frames" + save_detections(rows, options),
-                  markup=False)
+        found = load_blob_detections(video, config)
+        stream = BlobStream(video, config, options["min_score"]) if found is None and offline is None and \
+            _one_pass(tracker, tracker_name, explicit, n_targets, options) else None
+        if found is None and stream is None:
+            found = _detect_with_progress(video, config, declared)
+    saved = options.pop("save_detections", None)
+    if stream is not None:  # detected while tracked: the video is decoded once
+        tracker = _blob_tracker(tracker, tracker_name, np.zeros(0, int), explicit, n_targets, options)
+        run_track_video(video, stream, output, tracker, tracker_name, score_warnings=False, **options)
+        found = stream.found()
+        store_blob_detections(video, config, found)
+    assert found is not None
+    rows, frames = found.rows, found.frames
+    console.print(f"blob detector: {len(rows)} boxes in {frames} frames"
+                  + save_detections(rows, {"save_detections": saved}), markup=False)
     if len(rows) < 2:
         fail(f"{video}: the blob detector found {len(rows)} box(es); try a lower --blob threshold=... "
              "or min_area_px=..., or polarity=dark/bright")
+    if stream is not None:
+        return
     if offline is not None:
         assert n_targets
         offline = {**{k: v for k, v in BOX_TRACKER_PARAMS.items() if tracker_name == "boxtrack"}, **offline}
@@ -69,13 +92,31 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
                       video=video, annotate=options.get("annotate"), annotate_as=options.get("annotate_as"),
                       shapes=found.shapes)
         return
-    if tracker_name == "boxtrack":
-        plan = blob_boxtrack_config(tracker.config, frame_counts(rows, frames), explicit, n_targets)
-        if plan.count is not None:
-            console.print(plan.count.summary, markup=False)
-        if plan.n_targets and options.get("team_size") is None:
-            options["team_size"] = plan.n_targets
-        if plan.config != tracker.config:
-            tracker = type(tracker)(plan.config)
+    tracker = _blob_tracker(tracker, tracker_name, frame_counts(rows, frames), explicit, n_targets, options)
     run_track_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, length=frames,
                     score_warnings=False, **options)
+
+
+def _one_pass(tracker: Any, tracker_name: str, explicit: Collection[str], n_targets: int | None,
+              options: dict[str, Any]) -> bool:
+    """Whether blobs are best detected in the tracking pass: the tracker's settings need no blob counts of the whole
+    video, and the tracking decodes the frames anyway (``--annotate``, or features fitted on no video)."""
+    counts = tracker_name == "boxtrack" and tracker.config.max_targets is None and "max_targets" not in explicit \
+        and n_targets is None
+    decodes = options.get("annotate") is not None or (input_kind(tracker_name) != "boxes"
+                                                       and options.get("features", "video") != "video")
+    return decodes and not counts
+
+
+def _blob_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: Collection[str],
+                  n_targets: int | None, options: dict[str, Any]) -> Any:
+    """``tracker`` set for blob detections (``boxtrack`` only; ``counts``: blobs per frame, for a count inferred);
+    a known count becomes ``options["team_size"]`` unless given."""
+    if tracker_name != "boxtrack":
+        return tracker
+    plan = blob_boxtrack_config(tracker.config, counts, explicit, n_targets)
+    if plan.count is not None:
+        console.print(plan.count.summary, markup=False)
+    if plan.n_targets and options.get("team_size") is None:
+        options["team_size"] = plan.n_targets
+    return type(tracker)(plan.config) if plan.config != tracker.config else tracker

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import io
 import itertools
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -29,23 +30,25 @@ from lookalike.viz.video_tracking import fit_video_features, side_file, track_vi
 FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
 
 
-def run_track_video(video: Path, detections: Path | MotTable, output: Path, tracker: Any, tracker_name: str, *,
+def run_track_video(video: Path, detections: Path | MotTable | Callable[[np.ndarray], Any], output: Path,
+                    tracker: Any, tracker_name: str, *,
                     annotate: Path | None, team_size: int | None, health_window: int,
                     min_score: float, fps: float | None, features: str = "video",
                     annotate_as: Path | None = None, det_format: str = "auto", length: int | None = None,
                     score_warnings: bool = True) -> None:
-    """Track ``detections`` (a file, or the rows a detector found) on ``video``; write ``output``, its
-    ``.health.csv`` (``.merges.csv`` for merging trackers) and, with ``annotate``, the annotated MP4 (printed as
-    ``annotate_as``). ``features``: ``video``, ``divers``/``handcrafted``, ``learned`` or ``FILE.onnx`` (the
-    ``--features`` option). ``length``: the video's decoded frames when known (then a box tracker without
-    ``annotate`` decodes none); ``score_warnings``: False for a detector whose scores are all 1 by design (blobs)."""
+    """Track ``detections`` (a file, the rows a detector found, or a detector run in the same pass) on ``video``;
+    write ``output``, its ``.health.csv`` (``.merges.csv`` for merging trackers) and, with ``annotate``, the annotated
+    MP4 (printed as ``annotate_as``). ``features``: ``video``, ``divers``/``handcrafted``, ``learned`` or
+    ``FILE.onnx`` (the ``--features`` option). ``length``: the video's decoded frames when known (then a box
+    tracker without ``annotate`` decodes none); ``score_warnings``: False for a detector whose scores are all 1 by
+    design (blobs)."""
     if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
         fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
     check_result_file(output)
-    found = not isinstance(detections, Path)
+    found, detect = not isinstance(detections, Path), None if isinstance(detections, (Path, MotTable)) else detections
     with failing(ValueError, OSError):
-        if isinstance(detections, MotTable):
-            table, notes = detections, []
+        if not isinstance(detections, Path):
+            table, notes = detections if isinstance(detections, MotTable) else MotTable.from_rows(np.zeros((0, 10))), []
         else:
             fmt, notes = sniff_det(detections, det_format)
             table = read_mot(detections) if fmt.standard() else read_det(detections, fmt)
@@ -59,7 +62,7 @@ def run_track_video(video: Path, detections: Path | MotTable, output: Path, trac
                              else fit_video_features(video, table, min_score=min_score) if features == "video"
                              else diver_extractor(features))
         stream: Any = None
-        if extractor is None and annotate is None and length is not None:  # no frame decoded: the size from the file
+        if extractor is None and annotate is None and length is not None and detect is None:  # no frame decoded
             size = None if video.is_dir() else video_info(video)[2]
         else:  # the first frame's size; the frames go on to the tracker (one decode)
             first = next(images, None)
@@ -82,7 +85,7 @@ def run_track_video(video: Path, detections: Path | MotTable, output: Path, trac
             task = progress.add_task(video.name, total=total or None)
             result = track_video(video, table, tracker, extractor, annotate=annotate, health=health,
                                  fps=fps, min_score=min_score, advance=lambda: progress.advance(task), length=length,
-                                 images=stream)
+                                 images=stream, detect=detect)
     except ValueError as exc:
         fail(str(exc))
     except KeyboardInterrupt:

@@ -18,6 +18,8 @@ import numpy as np
 
 from lookalike._optional import needs
 from lookalike.io.outputs import write_atomic
+from lookalike.types import Detections
+from lookalike.types.mot_table import detection_rows
 from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config, sample_frames
 from lookalike.vision.blob_shape import SHAPE_SIZE
@@ -123,6 +125,16 @@ def _sampled(video: Path | str, count: int) -> list[np.ndarray]:
     return _SAMPLE[key]
 
 
+def _detector(video: Path | str, config: BlobConfig) -> BlobDetector:
+    """A blob detector for ``video`` giving shape vectors, its median background fitted on the sampled frames (the
+    sample then let go)."""
+    detector = BlobDetector(config, describe=True)
+    if config.method == "median":
+        detector.fit(_sampled(video, config.history))
+    _SAMPLE.clear()
+    return detector
+
+
 def _write_atomic(path: Path, data: bytes) -> None:
     try:
         write_atomic(path, data)  # (a unique temporary file, removed on any failure)
@@ -183,11 +195,23 @@ def cached_blob_detection_rows(video: Path | str, config: BlobConfig, advance: C
 def cached_blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
                            cache: Path | None | bool = True) -> BlobRows:
     """:func:`blob_detections` through the cache (as :func:`cached_blob_detection_rows`)."""
+    found = load_blob_detections(video, config, cache)
+    if found is None:
+        found = blob_detections(video, config, advance)
+        store_blob_detections(video, config, found, cache)
+    return found
+
+
+def _cache_file(video: Path | str, config: BlobConfig, cache: Path | None | bool) -> Path | None:
     if cache is False or cache is None:
-        return blob_detections(video, config, advance)
-    folder = (cache_dir() if cache is True else Path(cache)) / "blobs"
-    path = folder / f"{detection_cache_key(video, config)}.npz"
-    if path.is_file():
+        return None
+    return (cache_dir() if cache is True else Path(cache)) / "blobs" / f"{detection_cache_key(video, config)}.npz"
+
+
+def load_blob_detections(video: Path | str, config: BlobConfig, cache: Path | None | bool = True) -> BlobRows | None:
+    """``video``'s blob detections with ``config`` from the cache, or None when not there."""
+    path = _cache_file(video, config, cache)
+    if path is not None and path.is_file():
         try:
             with np.load(path) as data:
                 rows = np.array(data["rows"], dtype=float).reshape(-1, 10)
@@ -195,11 +219,43 @@ def cached_blob_detections(video: Path | str, config: BlobConfig, advance: Calla
                     len(rows), SHAPE_SIZE))
         except (OSError, ValueError, KeyError):
             pass
-    found = blob_detections(video, config, advance)
-    buffer = io.BytesIO()
-    np.savez(buffer, rows=found.rows, frames=found.frames, shapes=found.shapes)
-    _write_atomic(path, buffer.getvalue())
-    return found
+    return None
+
+
+def store_blob_detections(video: Path | str, config: BlobConfig, found: BlobRows,
+                          cache: Path | None | bool = True) -> None:
+    """Put ``found`` in the cache (nothing when ``cache`` is False or None, or the folder cannot be written)."""
+    path = _cache_file(video, config, cache)
+    if path is not None:
+        buffer = io.BytesIO()
+        np.savez(buffer, rows=found.rows, frames=found.frames, shapes=found.shapes)
+        _write_atomic(path, buffer.getvalue())
+
+
+class BlobStream:
+    """Blob detections found while the video is tracked (one decode): called on each frame in order, it gives the
+    frame's boxes scoring at least ``min_score``; :meth:`found` then holds every row, as :func:`blob_detections`."""
+
+    def __init__(self, video: Path | str, config: BlobConfig, min_score: float = -math.inf) -> None:
+        self.detector = _detector(video, config)
+        self.min_score, self.frames = min_score, 0
+        self._rows: list[np.ndarray] = []
+        self._shapes: list[np.ndarray] = []
+
+    def __call__(self, image: np.ndarray) -> Detections:
+        det = self.detector(image)
+        self.frames += 1
+        rows = detection_rows(self.frames, det.xywh, det.score)
+        if len(det):
+            self._rows.append(rows)
+            self._shapes.append(det.feature)
+        keep = rows[:, 6] >= self.min_score
+        return Detections(xywh=rows[keep, 2:6], score=rows[keep, 6])
+
+    def found(self) -> BlobRows:
+        """Every row found so far, the frames read and the rows' shape vectors."""
+        rows = np.vstack(self._rows) if self._rows else np.zeros((0, 10))
+        return BlobRows(rows, self.frames, np.vstack(self._shapes) if self._shapes else np.zeros((0, SHAPE_SIZE)))
 
 
 def blob_detection_rows(video: Path | str, config: BlobConfig,
@@ -211,9 +267,7 @@ def blob_detection_rows(video: Path | str, config: BlobConfig,
 
 def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None) -> BlobRows:
     """Blob detections of ``video`` (a file or image folder) with each blob's shape vector, in one pass."""
-    detector = BlobDetector(config, describe=True)
-    if config.method == "median":
-        detector.fit(_sampled(video, config.history))
+    detector = _detector(video, config)
     shapes: list[np.ndarray] = []
     rows, count = detect_frames(source_frames(video)[0], detector, advance, shapes)
     if count == 0:
@@ -221,5 +275,6 @@ def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[],
     return BlobRows(rows, count, np.vstack(shapes) if shapes else np.zeros((0, SHAPE_SIZE)))
 
 
-__all__ = ["CACHE_ENV", "BlobRows", "auto_blob_config", "blob_config", "blob_detection_rows", "blob_detections",
-           "blob_settings", "cache_dir", "cached_blob_detection_rows", "cached_blob_detections", "detection_cache_key"]
+__all__ = ["CACHE_ENV", "BlobRows", "BlobStream", "auto_blob_config", "blob_config", "blob_detection_rows",
+           "blob_detections", "blob_settings", "cache_dir", "cached_blob_detection_rows", "cached_blob_detections",
+           "detection_cache_key", "load_blob_detections", "store_blob_detections"]

@@ -119,17 +119,19 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
                 annotate: Path | str | None = None, health: HealthConfig | None = None,
                 fps: float | None = None, min_score: float = -np.inf, new_frames: int = 10,
                 tail: int = 25, advance: Callable[[], None] | None = None,
-                length: int | None = None, images: Iterable[np.ndarray] | None = None) -> VideoTrackingResult:
+                length: int | None = None, images: Iterable[np.ndarray] | None = None,
+                detect: Callable[[np.ndarray], Detections] | None = None) -> VideoTrackingResult:
     """Run ``tracker`` (reset first) over ``source`` (a video file or image folder) with ``detections`` (1-based
     frames, px), features from ``extractor(image, xywh)`` (None: none, for trackers that read no appearance); with
     ``annotate`` also write that MP4. ``length``: the video's frames, when known (then, with neither features nor
-    ``annotate``, no frame is decoded); ``images``: ``source``'s frames when already being read."""
+    ``annotate``, no frame is decoded); ``images``: ``source``'s frames when already being read; ``detect``: a
+    detector run on each frame in the same pass, in place of ``detections``."""
     if new_frames < 1:
         raise ValueError(f"new_frames: must be >= 1, got {new_frames}")
     frames_in: Iterable[np.ndarray | None]
     frames_in, n_declared, source_fps = source_frames(source)
     frames_in = frames_in if images is None else images
-    if extractor is None and annotate is None and length is not None:
+    if extractor is None and annotate is None and length is not None and detect is None:
         frames_in = itertools.repeat(None, length)  # the tracker reads only the boxes
     rate = fps or source_frame_rate(source) or source_fps
     if not rate > 0:
@@ -150,7 +152,8 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
     def frames() -> Iterator[Frame]:
         for k, image in enumerate(frames_in):
             found = next(det_frames, None)
-            det = found.detections if found is not None else Detections.empty()
+            det = detect(image) if detect is not None else found.detections if found is not None else \
+                Detections.empty()
             t0 = time.perf_counter()
             assert det.xywh is not None  # box detections
             feats = None if extractor is None else extractor(image, det.xywh) if len(det) else np.zeros(

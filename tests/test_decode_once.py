@@ -1,0 +1,115 @@
+"""``lookalike track`` decodes a video once (issue 45): the frames OpenCV converts to BGR are counted.
+
+A full decode is one conversion of every frame (``read``, or ``grab`` + ``retrieve``). The blob detector's settings
+estimate and median background share one cheaper sampled pass first: every frame grabbed (demuxed and decoded), only
+the sampled ones converted."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from lookalike.cli import app
+from lookalike.io import read_mot, write_mot
+from tests.test_track_blobs import FRAMES, _write_video
+
+cv2 = pytest.importorskip("cv2")
+runner = CliRunner()
+SAMPLE = 25  # frames the blob settings estimate and background read (BlobConfig.history)
+
+
+@pytest.fixture
+def counts(monkeypatch, tmp_path) -> dict[str, int]:
+    """Frames converted (``read``/``retrieve``) and only grabbed, over every ``cv2.VideoCapture`` of the test."""
+    monkeypatch.setenv("LOOKALIKE_CACHE", str(tmp_path / "cache"))
+    seen = {"converted": 0, "grabbed": 0}
+    real = cv2.VideoCapture
+
+    class Counted:
+        def __init__(self, *args, **kwargs):
+            self._cap = real(*args, **kwargs)
+
+        def read(self, *args):
+            ok, image = self._cap.read(*args)
+            seen["converted"] += bool(ok)
+            return ok, image
+
+        def grab(self):
+            ok = self._cap.grab()
+            seen["grabbed"] += bool(ok)
+            return ok
+
+        def retrieve(self, *args):
+            ok, image = self._cap.retrieve(*args)
+            seen["converted"] += bool(ok)
+            seen["grabbed"] -= bool(ok)  # (a grab converted is a read)
+            return ok, image
+
+        def __getattr__(self, name):
+            return getattr(self._cap, name)
+
+    monkeypatch.setattr(cv2, "VideoCapture", Counted)
+    return seen
+
+
+@pytest.fixture(scope="module")
+def video(tmp_path_factory) -> Path:
+    return _write_video(tmp_path_factory.mktemp("decode") / "discs.avi")
+
+
+def _track(*args: str) -> None:
+    r = runner.invoke(app, ["track", *args])
+    assert r.exit_code == 0, r.output
+
+
+BLOB = ("--detector", "blob", "--blob", "polarity=dark", "--blob", "min_area_px=20")
+
+
+@pytest.mark.parametrize("extra", [("-t", "sort"), ("-t", "boxtrack"), ("-t", "sort", "--annotate", "a.mp4"),
+                                   ("-t", "boxtrack", "--targets", "3", "--online", "--annotate", "a.mp4"),
+                                   ("-t", "deepsort", "--features", "learned")])
+def test_blob_video_is_decoded_once(video, tmp_path, counts, monkeypatch, extra):
+    monkeypatch.chdir(tmp_path)
+    _track("--video", str(video), *BLOB, *extra, "-o", "t.txt")
+    assert counts == {"converted": FRAMES + SAMPLE, "grabbed": FRAMES - SAMPLE} or (
+        # (fewer frames than the sample: the sampled pass converts every frame)
+        FRAMES <= SAMPLE and counts == {"converted": 2 * FRAMES, "grabbed": 0})
+    assert not (tmp_path / "t.det.txt").exists()
+    counts.update(converted=0, grabbed=0)  # again, the detections cached: one decode when drawing, else none
+    _track("--video", str(video), *BLOB, *extra, "-o", "t.txt")
+    assert counts == {"converted": FRAMES if "a.mp4" in extra or "deepsort" in extra else 0, "grabbed": 0}
+
+
+@pytest.mark.parametrize("extra", [(), ("--annotate", "a.mp4"), ("-t", "boxtrack", "--targets", "3")])
+def test_video_with_detections_is_decoded_once(video, tmp_path, counts, monkeypatch, extra):
+    monkeypatch.chdir(tmp_path)
+    _track("--video", str(video), *BLOB, "-t", "sort", "-o", "first.txt", "--save-detections", "d.txt")
+    counts.update(converted=0, grabbed=0)
+    _track("--video", str(video), "--detections", "d.txt", *extra, "-o", "t.txt")
+    assert counts == {"converted": FRAMES, "grabbed": 0}
+    assert len(read_mot(tmp_path / "t.txt")) > 0
+
+
+def test_onnx_detector_video_is_decoded_once(video, tmp_path, counts, monkeypatch):
+    from tests.test_onnx_detector import _darkness_grid_model
+
+    monkeypatch.chdir(tmp_path)
+    model = _darkness_grid_model(tmp_path / "dark.onnx")
+    _track("--video", str(video), "--detector", str(model), "--blob", "score=0.15", "-t", "sort", "-o", "t.txt")
+    assert counts == {"converted": FRAMES, "grabbed": 0}
+    assert not (tmp_path / "t.det.txt").exists()
+
+
+def test_saved_detections_are_the_rows_tracked(video, tmp_path, monkeypatch):
+    """--save-detections writes the boxes found; tracking that file gives the same result."""
+    monkeypatch.setenv("LOOKALIKE_CACHE", str(tmp_path / "cache"))
+    monkeypatch.chdir(tmp_path)
+    _track("--video", str(video), *BLOB, "-t", "sort", "--annotate", "a.mp4", "-o", "a.txt", "--save-detections",
+           "d.txt")
+    _track("--video", str(video), "--detections", "d.txt", "-t", "sort", "-o", "b.txt")
+    assert len(read_mot(tmp_path / "d.txt")) == 3 * FRAMES
+    np.testing.assert_array_equal(np.loadtxt("a.txt", delimiter=","), np.loadtxt("b.txt", delimiter=","))
+    write_mot(tmp_path / "x.txt", np.zeros((0, 10)))
+    r = runner.invoke(app, ["track", "x.txt", "-o", "y.txt", "--save-detections", "z.txt"])
+    assert r.exit_code == 2 and "--save-detections: only with --video FILE --detector" in r.output
