@@ -137,6 +137,27 @@ def test_points_and_eval_refusals(tmp_path):
     assert r.exit_code != 0 and "--radius" in _one_line_error(r)
 
 
+@pytest.mark.parametrize("offline", [False, True])
+def test_points_annotated_on_white_frames_or_on_their_video(tmp_path, offline):
+    """--points --annotate draws the tracks on white frames, one a point frame, or on --video's frames."""
+    from lookalike.viz.video import read_frames
+
+    points, _ = _points_csv(tmp_path)
+    base = ["track", "--points", str(points), "-t", "boxtrack", "--targets", "3", "-o", str(tmp_path / "t.txt")]
+    base += ["--offline"] if offline else []
+    r = runner.invoke(app, [*base, "--annotate", str(tmp_path / "white.mp4")])
+    assert r.exit_code == 0, r.output
+    frames = list(read_frames(tmp_path / "white.mp4"))
+    assert len(frames) == 80 and "annotated video" in r.output
+    assert (frames[0] > 200).mean() > 0.7 and (frames[-1] < 200).any()  # white (a caption band), tracks drawn
+    video = _arena(tmp_path / "arena.avi")
+    r = runner.invoke(app, [*base, "--video", str(video), "--annotate", str(tmp_path / "on.mp4")])
+    assert r.exit_code == 0, r.output
+    assert len(list(read_frames(tmp_path / "on.mp4"))) == 30
+    r = runner.invoke(app, [*base, "--video", str(video)])
+    assert r.exit_code == 2 and "--points --video: the video is only drawn on, with --annotate" in _one_line_error(r)
+
+
 def _arena(path: Path, frames: int = 30) -> Path:
     import cv2
 

@@ -148,7 +148,7 @@ def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None], annotate
     files = [p for p in inputs if p is not None and p.is_file()]
     extra = {k: v for k, v in (("--annotate", annotate), ("--save-detections", saved)) if v is not None}
     with failing(ValueError):
-        refuse_inputs([output, *siblings, *extra.values()], files)
+        refuse_inputs([output, *siblings], files)
         if extra:
             check_outputs({"-o/--output": output, **{f"-o/--output's {s.name}": s for s in siblings}, **extra},
                           files, input_folders=[video])  # (video: an image folder)
@@ -159,8 +159,10 @@ def _check_branches(path: Path | None, video: Path | None, detections: Path | No
                     points: Path | None = None) -> str:
     """Which branch of ``track`` the options select (``pipeline``, ``points``, ``blobs``, ``video``, ``files``)."""
     if points is not None:
-        if any(x is not None for x in (path, video, detections, annotate, detector, pipeline)) or blob:
-            fail("--points: the points are the input; drop PATH/--video/--detections/--detector/--blob/--pipeline")
+        if any(x is not None for x in (path, detections, detector, pipeline)) or blob:
+            fail("--points: the points are the input; drop PATH/--detections/--detector/--blob/--pipeline")
+        if video is not None and annotate is None:
+            fail("--points --video: the video is only drawn on, with --annotate")
         return "points"
     if pipeline is not None:
         if detector is not None or blob or detections is not None or path is not None:
@@ -216,7 +218,8 @@ def track(
     ),
     detections: Path | None = typer.Option(None, "--detections", help="det.txt for --video (or give it as PATH)."),
     annotate: Path | None = typer.Option(
-        None, "--annotate", help="With --video: annotated MP4 (uncertain identities dashed with '?', health banner)."
+        None, "--annotate", help="With --video: annotated MP4 (uncertain identities dashed with '?', health banner); "
+        "with --points: the tracks drawn on --video V, or on white frames."
     ),
     team_size: int | None = typer.Option(None, "--team-size", min=0, help="Known number of targets (health checks)."),
     targets: int | None = typer.Option(None, "--targets", min=0, help="Known number of targets N: a closed set of "
@@ -314,7 +317,7 @@ def track(
 
                 assert points is not None
                 track_points(points, output, trk, tracker, n_targets=targets, offline=offline, params=online or {},
-                             fps=fps)
+                             fps=fps, annotate=annotate, annotate_as=annotate_as, video=video)
             elif branch in ("blobs", "video"):
                 assert video is not None
                 if live is not None:

@@ -125,9 +125,11 @@ def read_points(path: Path) -> Any:
 
 
 def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: str, *, n_targets: int | None,
-                 offline: bool, params: dict[str, Any], fps: float | None) -> None:
+                 offline: bool, params: dict[str, Any], fps: float | None, annotate: Path | None = None,
+                 annotate_as: Path | None = None, video: Path | None = None) -> None:
     """``--points FILE``: points as boxes of half their typical spacing, tracked online by ``tracker`` or, with
-    ``offline``, by the closed set of ``n_targets``; result rows (boxes centred on the points) to ``output``."""
+    ``offline``, by the closed set of ``n_targets``; result rows (boxes centred on the points) to ``output``; with
+    ``annotate``, the tracks drawn on ``video`` (or on white frames) into that MP4 (printed as ``annotate_as``)."""
     if output.is_dir():
         fail(f"-o/--output: {output} is a folder; with --points give a result file such as tracks.txt")
     frame_rate = fps or POINTS_FPS
@@ -157,6 +159,14 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
         rows = np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
     what = f"offline closed set of {n_targets}" if offline else "online"
     console.print(f"[green]{tracker_name}[/], {what}: {len(np.unique(rows[:, 1]))} identities → {escape(str(output))}")
+    if annotate is not None:
+        from lookalike.viz.overlay import blank_frames, overlay_tracks
+
+        tracks = read_mot(output)
+        with failing(ValueError, OSError), console.status("drawing the tracks"):
+            overlay_tracks(video if video is not None else blank_frames(tracks, len(points)), tracks, annotate,
+                           fps=frame_rate)
+        console.print(f"annotated video → {escape(str(annotate_as or annotate))}")
 
 
 __all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "closed_set_rows", "offline_files", "offline_video", "point_tracker",

@@ -89,7 +89,7 @@ def auto_blob_config(video: Path | str, settings: list[str], n_targets: int | No
 def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
                      cache: Path | None | bool, progress: Progress | None = None) -> BlobEstimate:
     if cache is False or cache is None:
-        return estimate_blob_config(_sampled(video, ESTIMATE_FRAMES), n_targets, base=base, progress=progress)
+        return _estimate(video, n_targets, base, progress)
     from lookalike.vision import blob_auto
 
     path = (cache_dir() if cache is True else Path(cache)) / "blobs" / (
@@ -103,7 +103,7 @@ def _cached_estimate(video: Path | str, n_targets: int | None, base: BlobConfig,
             return BlobEstimate(**data)
         except (OSError, ValueError, TypeError, KeyError):
             pass
-    estimate = estimate_blob_config(_sampled(video, ESTIMATE_FRAMES), n_targets, base=base, progress=progress)
+    estimate = _estimate(video, n_targets, base, progress)
     content = dataclasses.asdict(estimate)
     content["counts"] = {repr(k): v for k, v in estimate.counts.items()}
     _write_atomic(path, json.dumps(content, default=float).encode())
@@ -133,6 +133,16 @@ def _detector(video: Path | str, config: BlobConfig) -> BlobDetector:
         detector.fit(_sampled(video, config.history))
     _SAMPLE.clear()
     return detector
+
+
+def _estimate(video: Path | str, n_targets: int | None, base: BlobConfig, progress: Progress | None) -> BlobEstimate:
+    """:func:`~lookalike.vision.blob_auto.estimate_blob_config` on the sampled frames, errors naming the video."""
+    try:
+        return estimate_blob_config(_sampled(video, ESTIMATE_FRAMES), n_targets, base=base, progress=progress)
+    except ValueError as exc:
+        if str(exc).startswith("frames"):
+            raise ValueError(f"video: {video}{str(exc).removeprefix('frames')}") from None
+        raise
 
 
 def _write_atomic(path: Path, data: bytes) -> None:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -56,11 +56,12 @@ def _all_frames(path: Path, declared: int) -> Iterator[np.ndarray]:
                          "(truncated or damaged?)")
 
 
-def overlay_tracks(source: Path | str, tracks: MotTable, output: Path | str, *, gif: Path | str | None = None,
-                   tail: int = 25, fps: float | None = None,
+def overlay_tracks(source: Path | str | Iterable[np.ndarray], tracks: MotTable, output: Path | str, *,
+                   gif: Path | str | None = None, tail: int = 25, fps: float | None = None,
                    advance: Callable[[], None] | None = None) -> int:
-    """Draw ``tracks`` (1-based frames, ids >= 0) on every frame of ``source`` into ``output``; returns the count."""
-    frames, _, source_fps = source_frames(source)
+    """Draw ``tracks`` (1-based frames, ids >= 0) on every frame of ``source`` (a video file, an image folder, or
+    the frames themselves, at ``fps`` or 30) into ``output``; returns the count."""
+    frames, _, source_fps = source_frames(source) if isinstance(source, (str, Path)) else (iter(source), 0, 30.0)
     keep = np.asarray(tracks.track_id) >= 0
     frame_no = np.asarray(tracks.frame)[keep].astype(int)
     ids = np.asarray(tracks.track_id)[keep].astype(int)
@@ -80,6 +81,15 @@ def overlay_tracks(source: Path | str, tracks: MotTable, output: Path | str, *, 
     if count == 0:
         raise ValueError(f"video: {source} has no frames")
     return count
+
+
+def blank_frames(tracks: MotTable, count: int, margin_px: int = 20) -> Iterator[np.ndarray]:
+    """``count`` white BGR frames wide and high enough (even sides) for every box of ``tracks`` (px) plus
+    ``margin_px``."""
+    right = np.asarray(tracks.xywh)[:, :2] + np.asarray(tracks.xywh)[:, 2:] if len(tracks) else np.zeros((1, 2))
+    width, height = (2 * ((max(int(np.ceil(v)), 0) + margin_px + 1) // 2) for v in right.max(axis=0))
+    for _ in range(count):
+        yield np.full((height, width, 3), 255, np.uint8)
 
 
 def world_positions(tracks: MotTable) -> np.ndarray:
