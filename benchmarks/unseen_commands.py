@@ -4,11 +4,11 @@ Every figure comes from running exactly a documented ``lookalike track`` command
 no hidden settings) and scoring its output file:
 
 - HexBug clips with videos: ``lookalike track --video V --detector blob -t boxtrack -o OUT`` (no other
-  flag), then with ``--targets N`` and ``--targets N --offline`` (N: the ids in the clip's CSV); mean
+  flag), then with ``--targets N --online`` and ``--targets N`` (the learned look; N: the ids in the clip's CSV); mean
   IDF1 over the clips (box centres against the CSV head points within 120 px, orientation from the
   frame bounds), over all clips, over the clips the blob rules were chosen on (:data:`CHOICE_CLIPS`)
   and over the others.
-- zebrafish test_A: ``--targets 8``, ``--targets 8 --offline`` and the plain command (the number of
+- zebrafish test_A: ``--targets 8 --online``, ``--targets 8`` and the plain command (the number of
   fish inferred from the video): frames with all 8 identities reported among the frames where the
   detector finds 8 blobs, and the number of identities.
 - pigs (whole dev video): ``lookalike track pigs/det/det.txt -t boxtrack --targets 23 --offline``:
@@ -90,7 +90,7 @@ def hexbug(root: Path, out: Path, clips: int | None) -> None:
         frame, ids, xy = read_hexbug_points(video.with_suffix(".csv"), _image_size(video))
         n = len(np.unique(ids))
         for name in variants:
-            extra = {"plain": [], "targets": ["--targets", str(n)], "offline": ["--targets", str(n), "--offline"]}[name]
+            extra = {"plain": [], "targets": ["--targets", str(n), "--online"], "offline": ["--targets", str(n)]}[name]
             result = out / f"hexbug_{video.stem}_{name}.txt"
             cmd = ["track", "--video", str(video), "--detector", "blob", "-t", "boxtrack", *extra, "-o", str(result)]
             try:
@@ -113,8 +113,8 @@ def hexbug(root: Path, out: Path, clips: int | None) -> None:
     reported = [i for i in range(len(names)) if i not in chosen_on]
     print(f"  {'all':>6s} {'choice':>7s} {'others':>7s}  (choice: {', '.join(sorted(CHOICE_CLIPS))})")
     for name, label in (("plain", "lookalike track --video V --detector blob -t boxtrack -o OUT"),
-                        ("targets", "... --targets N"), ("offline", "... --targets N --offline ("
-                                                         + CHOSEN["closed"] + ")")):
+                        ("targets", "... --targets N --online"), ("offline", "... --targets N (learned look; "
+                                                                  + CHOSEN["closed"] + ")")):
         part = [f"{np.mean([scores[name][i] for i in idx]):7.2f}" if idx else "      -"
                 for idx in (chosen_on, reported)]
         print(f"  {np.mean(scores[name]):6.2f} {' '.join(part)}  {label}")
@@ -125,7 +125,7 @@ def hexbug(root: Path, out: Path, clips: int | None) -> None:
 def zebrafish(root: Path, out: Path) -> None:
     video = root / "zebrafish" / "test_A.avi"
     print(f"\nzebrafish test_A, 8 fish, no ground truth ({CHOSEN['blob']}, with N=8):")
-    for name, extra in (("online", ["--targets", "8"]), ("offline", ["--targets", "8", "--offline"]), ("plain", [])):
+    for name, extra in (("online", ["--targets", "8", "--online"]), ("offline", ["--targets", "8"]), ("plain", [])):
         result = out / f"zebrafish_{name}.txt"
         cmd = ["track", "--video", str(video), "--detector", "blob", "-t", "boxtrack", *extra, "-o", str(result)]
         seconds = run(cmd)
