@@ -78,7 +78,7 @@ def sequences_and_targets(path: Path, output: Path) -> tuple[list[Any], list[Pat
     return sequences, result_paths(path, sequences, output)
 
 
-def dropped_all(tracker: str, det_path: Path | None, rows: int, scores: tuple[float, float] | None) -> str:
+def dropped_all(tracker: str, det_path: Path | str | None, rows: int, scores: tuple[float, float] | None) -> str:
     """The warning for a tracker that wrote no tracks from ``rows`` detections scoring ``scores``."""
     span = f" (scores {scores[0]:g} to {scores[1]:g})" if scores is not None else ""
     return (f"{tracker} wrote no tracks from the {rows} detections of {det_path}{span}: its score thresholds "

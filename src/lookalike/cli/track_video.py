@@ -45,10 +45,11 @@ def run_track_video(video: Path, detections: Path | MotTable | Callable[[np.ndar
     if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
         fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
     check_result_file(output)
-    found, detect = not isinstance(detections, Path), None if isinstance(detections, (Path, MotTable)) else detections
+    detect = None if isinstance(detections, (Path, MotTable)) else detections
     with failing(ValueError, OSError):
         if not isinstance(detections, Path):
-            table, notes = detections if isinstance(detections, MotTable) else MotTable.from_rows(np.zeros((0, 10))), []
+            table = detections if isinstance(detections, MotTable) else MotTable.from_rows(np.zeros((0, 10)))
+            notes: list[str] = []
         else:
             fmt, notes = sniff_det(detections, det_format)
             table = read_mot(detections) if fmt.standard() else read_det(detections, fmt)
@@ -68,7 +69,7 @@ def run_track_video(video: Path, detections: Path | MotTable | Callable[[np.ndar
             first = next(images, None)
             size = (first.shape[1], first.shape[0]) if first is not None else None
             stream = itertools.chain([] if first is None else [first], images)
-    name = f"the detections in {video}" if found else detections
+    name = f"the detections in {video}" if not isinstance(detections, Path) else detections
     for line in notes:
         note(f"{name}: {line}")
     scores, outside = box_stats(table.xywh, table.conf, size)

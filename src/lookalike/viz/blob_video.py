@@ -257,6 +257,7 @@ class BlobStream:
         self.frames += 1
         rows = detection_rows(self.frames, det.xywh, det.score)
         if len(det):
+            assert det.feature is not None  # (described blobs)
             self._rows.append(rows)
             self._shapes.append(det.feature)
         keep = rows[:, 6] >= self.min_score

@@ -152,8 +152,10 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
     def frames() -> Iterator[Frame]:
         for k, image in enumerate(frames_in):
             found = next(det_frames, None)
-            det = detect(image) if detect is not None else found.detections if found is not None else \
-                Detections.empty()
+            det = found.detections if found is not None else Detections.empty()
+            if detect is not None:
+                assert image is not None  # (frames are decoded when a detector runs)
+                det = detect(image)
             t0 = time.perf_counter()
             assert det.xywh is not None  # box detections
             feats = None if extractor is None else extractor(image, det.xywh) if len(det) else np.zeros(
