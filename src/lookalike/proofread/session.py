@@ -55,7 +55,13 @@ class Session:
     """Proofreading of ``tracks`` (rows or a MOTChallenge file). With ``n_targets`` corrections re-solve the closed set
     over the tracklets of ``solver_input`` (the rows the closed set was solved from), else of ``detections`` (their
     online pass, as ``--offline`` makes it), else of the tracks themselves. ``frame_rate`` in frames/s (confidence
-    windows and the solver's motion)."""
+    windows and the solver's motion).
+
+    Attributes:
+        rows: the current rows ``(k, 10)``, sorted by frame, then id.
+        initial: the rows as loaded.
+        corrections: every correction applied and not undone, in order (dropped ones too: :attr:`dropped`).
+        last_change: what the last ``apply`` or ``undo`` changed."""
 
     def __init__(self, tracks: np.ndarray | str | os.PathLike[str], *, frame_rate: float = 30.0,
                  n_targets: int | None = None, detections: np.ndarray | str | os.PathLike[str] | None = None,
