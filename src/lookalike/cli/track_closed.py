@@ -1,5 +1,5 @@
-"""The ``--targets N --offline`` and ``--points FILE`` branches of ``lookalike track``: the offline closed set
-(:func:`lookalike.trackers.offline.closed_set.track_closed_set`) and anonymous points tracked as small boxes."""
+"""The ``--targets N --offline`` and ``--points FILE`` branches of ``lookalike track``: options and printing; the work
+is :mod:`lookalike.pipeline.closed`."""
 
 from __future__ import annotations
 
@@ -11,19 +11,10 @@ from rich.markup import escape
 
 from lookalike.cli.app import console, fail, failing
 from lookalike.cli.track import input_error, sequences_and_targets
-from lookalike.io import frames_from_table, read_mot, write_mot
-from lookalike.io.det_format import read_det, sniff_det
+from lookalike.io import write_mot
 from lookalike.io.outputs import ensure_writable
-from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv, read_points_mot, typical_spacing
-from lookalike.io.stream import track_to_file
-from lookalike.trackers.boxtrack import BoxTrack
-from lookalike.trackers.offline.closed_set import online_rows, track_closed_set
-from lookalike.types.mot_table import MotTable, detection_rows
-
-POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given (frames/s)
-MAX_POINTS_PER_FRAME = 100_000
-"""Points in one frame that ``track --points`` accepts (memory grows linearly with them: about 260 MB at 10,000 a
-frame; benchmarks/points_memory.py)."""
+from lookalike.pipeline import closed
+from lookalike.pipeline.closed import MAX_POINTS_PER_FRAME, POINTS_FPS, point_tracker, read_points
 
 
 def check_result_file(output: Path, video: Path | None = None) -> None:
@@ -34,40 +25,22 @@ def check_result_file(output: Path, video: Path | None = None) -> None:
         fail(f"--video: {video} does not exist")
 
 
+def _note(line: str) -> None:
+    console.print(line, markup=False)
+
+
 def table_rows(path: Path, min_score: float = float("-inf"), length: int | None = None,
                length_name: str = "the length", det_format: str = "auto") -> np.ndarray:
-    """Detection rows ``(k, 10)`` of a detection file, those scoring below ``min_score`` dropped (``length``: frames
-    past it are an error; ``det_format``: its layout, what was assumed printed as a note)."""
-    fmt, notes = sniff_det(path, det_format)
-    for line in notes:
-        console.print(f"[cyan]note:[/] {escape(f'{path}: {line}')}", highlight=False)
-    table = read_mot(path, length=length, length_name=length_name) if fmt.standard() else \
-        read_det(path, fmt, length, length_name)
-    rows = detection_rows(table.frame, table.xywh, table.conf)
-    return rows[rows[:, 6] >= min_score]
+    """:func:`lookalike.pipeline.closed.table_rows`, what was assumed of the file's layout printed as a note."""
+    return closed.table_rows(path, min_score, length, length_name, det_format, note=lambda line: console.print(
+        f"[cyan]note:[/] {escape(line)}", highlight=False))
 
 
 def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
                     params: dict[str, Any], vel_noise: float | None = None,
                     shapes: np.ndarray | None = None) -> np.ndarray:
-    """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online ``boxtrack``
-    pass's parameters (``max_targets`` dropped); ``vel_noise``: its velocity noise when not boxtrack's own;
-    ``shapes``: each detection's blob shape vector (the look learned from them weighs in). Too few detections for
-    the offline assignment get the online closed set's result instead, with a printed note."""
-    online = {k: v for k, v in params.items() if k != "max_targets"}
-    rows = track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise,
-                            shapes=shapes)
-    if len(rows) or not len(det_rows):
-        return rows
-    frames = len(np.unique(det_rows[:, 0]))
-    console.print(f"note: {frames} frame(s) of detections are too few for the offline closed set; the online closed "
-                  f"set's result (boxtrack --targets {n_targets}) is written instead", markup=False)
-    return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, **{**online, "max_targets": n_targets})
-
-
-def point_tracker(tracker: Any) -> Any:
-    """``tracker`` for points as boxes: a ``boxtrack`` rebuilt with the points' velocity noise; others unchanged."""
-    return BoxTrack(tracker.config, vel_noise=POINT_VEL_NOISE) if isinstance(tracker, BoxTrack) else tracker
+    """:func:`lookalike.pipeline.closed.closed_set_rows`, its note printed."""
+    return closed.closed_set_rows(det_rows, n_targets, frame_rate, n_frames, params, vel_noise, shapes, note=_note)
 
 
 def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float,
@@ -119,11 +92,6 @@ def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: 
         console.print(f"annotated video → {escape(str(annotate_as or annotate))}")
 
 
-def read_points(path: Path) -> Any:
-    """Points of a ``frame,x,y`` CSV (``.csv``) or of MOTChallenge rows with a point per row (any other suffix)."""
-    return read_points_csv(path) if path.suffix.lower() == ".csv" else read_points_mot(path)
-
-
 def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: str, *, n_targets: int | None,
                  offline: bool, params: dict[str, Any], fps: float | None, annotate: Path | None = None,
                  annotate_as: Path | None = None, video: Path | None = None) -> None:
@@ -134,37 +102,23 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
         fail(f"-o/--output: {output} is a folder; with --points give a result file such as tracks.txt")
     frame_rate = fps or POINTS_FPS
     with failing(FileNotFoundError, ValueError):
-        points = read_points(points_path)
-        counts = [len(p) for p in points.points]
-        if counts and max(counts) > MAX_POINTS_PER_FRAME:
-            frame = int(np.argmax(counts)) + 1
-            raise ValueError(f"{points_path}: frame {frame} has {max(counts)} points; at most {MAX_POINTS_PER_FRAME} "
-                             "a frame are tracked")
-        spacing = typical_spacing(points)
-        det = points_to_rows(points)
-    side = float(det[0, 4]) if len(det) else 1.0
-    why = f"half the typical spacing {spacing:.3g}" if spacing > 0 else "one point a frame: twice the typical step"
-    console.print(f"points: {points.count} in {len(points)} frames, boxes of {side:.3g} ({why}), "
+        boxes = closed.point_boxes(points_path)
+    why = f"half the typical spacing {boxes.spacing:.3g}" if boxes.spacing > 0 else \
+        "one point a frame: twice the typical step"
+    console.print(f"points: {boxes.count} in {boxes.frames} frames, boxes of {boxes.side:.3g} ({why}), "
                   f"{frame_rate:g} frames/s" + ("" if fps else " (--fps to change)"))
-    if offline:
-        assert n_targets is not None
-        with failing(ValueError):
-            rows = closed_set_rows(det, n_targets, frame_rate, len(points), params, vel_noise=POINT_VEL_NOISE)
-        write_mot(output, rows)
-    else:
-        with failing(ValueError):
-            track_to_file(point_tracker(tracker), frames_from_table(MotTable.from_rows(det), len(points), frame_rate),
-                          output)
-        table = read_mot(output)
-        rows = np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
+    with failing(ValueError):
+        rows = closed.track_point_boxes(boxes, output, tracker, frame_rate, n_targets, params if offline else None,
+                                        note=_note)
     what = f"offline closed set of {n_targets}" if offline else "online"
     console.print(f"[green]{tracker_name}[/], {what}: {len(np.unique(rows[:, 1]))} identities → {escape(str(output))}")
     if annotate is not None:
+        from lookalike.io import read_mot
         from lookalike.viz.overlay import blank_frames, overlay_tracks
 
         tracks = read_mot(output)
         with failing(ValueError, OSError), console.status("drawing the tracks"):
-            overlay_tracks(video if video is not None else blank_frames(tracks, len(points)), tracks, annotate,
+            overlay_tracks(video if video is not None else blank_frames(tracks, boxes.frames), tracks, annotate,
                            fps=frame_rate)
         console.print(f"annotated video → {escape(str(annotate_as or annotate))}")
 

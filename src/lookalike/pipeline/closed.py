@@ -1,0 +1,117 @@
+"""Detection rows for the offline closed set (:func:`lookalike.trackers.offline.closed_set.track_closed_set`) and
+anonymous points tracked as small boxes (``lookalike track --offline``, ``--points``)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookalike.io import frames_from_table, read_mot, write_mot
+from lookalike.io.det_format import read_det, sniff_det
+from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv, read_points_mot, typical_spacing
+from lookalike.io.stream import track_to_file
+from lookalike.trackers.boxtrack import BoxTrack
+from lookalike.trackers.offline.closed_set import online_rows, track_closed_set
+from lookalike.types.mot_table import MotTable, detection_rows
+
+Note = Callable[[str], None]  # told each note line (plain text)
+
+POINTS_FPS = 25.0  # frame rate assumed for point files when --fps is not given (frames/s)
+MAX_POINTS_PER_FRAME = 100_000
+"""Points in one frame that ``track --points`` accepts (memory grows linearly with them: about 260 MB at 10,000 a
+frame; benchmarks/points_memory.py)."""
+
+
+def _silent(line: str) -> None:
+    return None
+
+
+def table_rows(path: Path, min_score: float = float("-inf"), length: int | None = None,
+               length_name: str = "the length", det_format: str = "auto", note: Note = _silent) -> np.ndarray:
+    """Detection rows ``(k, 10)`` of a detection file, those scoring below ``min_score`` dropped (``length``: frames
+    past it are an error; ``det_format``: its layout, what was assumed told to ``note``)."""
+    fmt, notes = sniff_det(path, det_format)
+    for line in notes:
+        note(f"{path}: {line}")
+    table = read_mot(path, length=length, length_name=length_name) if fmt.standard() else \
+        read_det(path, fmt, length, length_name)
+    rows = detection_rows(table.frame, table.xywh, table.conf)
+    return rows[rows[:, 6] >= min_score]
+
+
+def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
+                    params: dict[str, Any], vel_noise: float | None = None,
+                    shapes: np.ndarray | None = None, note: Note = _silent) -> np.ndarray:
+    """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online ``boxtrack``
+    pass's parameters (``max_targets`` dropped); ``vel_noise``: its velocity noise when not boxtrack's own;
+    ``shapes``: each detection's blob shape vector (the look learned from them weighs in). Too few detections for
+    the offline assignment get the online closed set's result instead, said to ``note``."""
+    online = {k: v for k, v in params.items() if k != "max_targets"}
+    rows = track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise,
+                            shapes=shapes)
+    if len(rows) or not len(det_rows):
+        return rows
+    frames = len(np.unique(det_rows[:, 0]))
+    note(f"note: {frames} frame(s) of detections are too few for the offline closed set; the online closed "
+         f"set's result (boxtrack --targets {n_targets}) is written instead")
+    return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, **{**online, "max_targets": n_targets})
+
+
+def point_tracker(tracker: Any) -> Any:
+    """``tracker`` for points as boxes: a ``boxtrack`` rebuilt with the points' velocity noise; others unchanged."""
+    return BoxTrack(tracker.config, vel_noise=POINT_VEL_NOISE) if isinstance(tracker, BoxTrack) else tracker
+
+
+def read_points(path: Path) -> Any:
+    """Points of a ``frame,x,y`` CSV (``.csv``) or of MOTChallenge rows with a point per row (any other suffix)."""
+    return read_points_csv(path) if path.suffix.lower() == ".csv" else read_points_mot(path)
+
+
+@dataclass(frozen=True)
+class PointBoxes:
+    """Points as detection ``rows`` ``(k, 10)``: boxes of ``side`` px centred on them, over ``frames`` frames;
+    ``count`` points, ``spacing`` their typical nearest-neighbour distance (px; 0 for one point a frame)."""
+
+    rows: np.ndarray
+    frames: int
+    count: int
+    spacing: float
+    side: float
+
+
+def point_boxes(path: Path) -> PointBoxes:
+    """The points of ``path`` as boxes of half their typical spacing; ``ValueError`` past
+    :data:`MAX_POINTS_PER_FRAME` points in a frame."""
+    points = read_points(path)
+    counts = [len(p) for p in points.points]
+    if counts and max(counts) > MAX_POINTS_PER_FRAME:
+        frame = int(np.argmax(counts)) + 1
+        raise ValueError(f"{path}: frame {frame} has {max(counts)} points; at most {MAX_POINTS_PER_FRAME} "
+                         "a frame are tracked")
+    spacing = typical_spacing(points)
+    det = points_to_rows(points)
+    return PointBoxes(det, len(points), points.count, spacing, float(det[0, 4]) if len(det) else 1.0)
+
+
+def track_point_boxes(boxes: PointBoxes, output: Path, tracker: Any, frame_rate: float, n_targets: int | None = None,
+                      params: dict[str, Any] | None = None, note: Note = _silent) -> np.ndarray:
+    """Track ``boxes`` into the result file ``output``: online by ``tracker``, or with ``params`` (the online pass's)
+    by the offline closed set of ``n_targets``; returns the result rows (their first two columns at least)."""
+    if params is not None:
+        assert n_targets is not None
+        rows = closed_set_rows(boxes.rows, n_targets, frame_rate, boxes.frames, params, vel_noise=POINT_VEL_NOISE,
+                               note=note)
+        write_mot(output, rows)
+        return rows
+    track_to_file(point_tracker(tracker), frames_from_table(MotTable.from_rows(boxes.rows), boxes.frames, frame_rate),
+                  output)
+    table = read_mot(output)
+    return np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
+
+
+__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "PointBoxes", "closed_set_rows", "point_boxes", "point_tracker",
+           "read_points", "table_rows", "track_point_boxes"]
