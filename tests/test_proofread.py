@@ -191,7 +191,10 @@ def test_each_correction_kind_re_solves_and_undoes(kind: str, refused: str | Non
 def test_log_lines_round_trip_and_bad_lines_raise():
     c = Correction("swap", 1, 2, 5)
     assert Correction.from_json(c.to_json()) == c
-    for bad in ('{"kind": "swap"}', '[1, 2]', '{"kind": "swap", "track": 1, "other": 2, "frame": 5, "x": 1}'):
+    for bad in ('{"kind": "swap"}', '[1, 2]', '{"kind": "swap", "track": 1, "other": 2, "frame": 5, "x": 1}',
+                '{"kind": "delete", "track": [1]}', '{"kind": "delete", "track": 1.5}',
+                '{"kind": "delete", "track": true}', '{"kind": "delete", "track": null}',
+                '{"kind": "swap", "track": 1, "other": 2, "frame": Infinity}'):
         with pytest.raises(ValueError):
             Correction.from_json(bad)
 

@@ -41,13 +41,17 @@ class Correction:
 
     @classmethod
     def from_json(cls, line: str) -> Correction:
+        """The correction of one JSON line (as :meth:`to_json` writes it; ids and frame integers); ValueError when
+        it is not one."""
         data = json.loads(line)
         if not isinstance(data, dict) or set(data) - {"kind", "track", "other", "frame"}:
             raise ValueError(f"correction: expected an object with kind, track[, other, frame], got {line[:80]!r}")
-        if not isinstance(data.get("kind"), str) or "track" not in data:
+        if not isinstance(data.get("kind"), str) or data.get("track") is None:
             raise ValueError(f"correction: kind (text) and track are required, got {line[:80]!r}")
-        whole = {k: int(data[k]) for k in ("other", "frame") if data.get(k) is not None}
-        return cls(data["kind"], int(data["track"]), whole.get("other"), whole.get("frame"))
+        given = {k: v for k, v in data.items() if k != "kind" and v is not None}
+        if any(type(v) is not int for v in given.values()):
+            raise ValueError(f"correction: track, other and frame must be whole numbers, got {line[:80]!r}")
+        return cls(data["kind"], data["track"], given.get("other"), given.get("frame"))
 
 
 @dataclass(frozen=True)
