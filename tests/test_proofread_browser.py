@@ -1,6 +1,7 @@
 """End to end in headless Chromium: on a two-disc video whose ids swap at frame 10, pick a box with the mouse, swap
 it back from frame 12 by keyboard (only frames >= 12 change), undo, assign with the mouse, export, go to a frame and
-id on the timeline, delete by keyboard and undo with the mouse; the page shows what the server serves."""
+id on the timeline, delete by keyboard and undo with the mouse; the page shows what the server serves. Then every
+correction and undo, each by keyboard and by mouse."""
 
 from __future__ import annotations
 
@@ -115,4 +116,68 @@ def test_proofread_page_end_to_end(tmp_path):
             page.click("#undo-btn")
             _wait_version(page, 5, 15)
             assert lane_ids(_served_rows(served), 15) == {UP: 2, DOWN: 4}
+    assert errors == []
+
+
+def _pick_and_apply(page, lane: float, kind: str, other: str | None = None, by_key: str | None = None) -> int:
+    """Click the box on ``lane``, then make the correction ``kind`` (with ``other``) by its key and Enter
+    (``by_key``) or by the form's menu and the apply button (mouse); the picked id."""
+    tid = _click_lane(page, lane)
+    if by_key is not None:
+        page.keyboard.press(by_key)
+        if other is not None:
+            page.keyboard.press("Control+a")  # replace what the field held
+            page.keyboard.type(other)
+        page.keyboard.press("Enter")
+    else:
+        page.select_option("#kind", kind)
+        if other is not None:
+            page.fill("#other", other)
+        page.click("#apply-btn")
+    return tid
+
+
+def test_every_correction_by_keyboard_and_by_mouse(tmp_path):
+    """Split, merge, swap, assign, delete and undo, each by keyboard and by mouse (ids: 1 on the upper lane and 2 on
+    the lower before frame 10, exchanged from 10 on)."""
+    page_app = open_page(tmp_path, scale=SCALE)
+    errors: list[str] = []
+    with _chromium(errors) as page:
+        with Served(page_app) as served:
+            page.goto(served.url + "#frame=15")
+            _wait_version(page, 0, 15)
+            start = _served_rows(served)
+            version = 0
+
+            def done(check) -> None:
+                nonlocal version
+                version += 1
+                _wait_version(page, version, 15)
+                rows = _served_rows(served)
+                assert check(rows), (version, page.text_content("#message"))
+
+            def split(rows) -> bool:  # 1 on the lower lane from 15 on is a new id, 3
+                return lane_ids(rows, 15)[DOWN] == lane_ids(rows, 20)[DOWN] == 3 and lane_ids(rows, 14)[DOWN] == 1
+
+            def merged(rows) -> bool:  # 1's rows joined 3
+                return 1 not in {r[1] for r in rows} and lane_ids(rows, 12)[DOWN] == lane_ids(rows, 5)[UP] == 3
+
+            for split_key, merge_key in (("x", None), (None, "m")):
+                assert _pick_and_apply(page, DOWN, "split", by_key=split_key) == 1
+                done(split)
+                assert _pick_and_apply(page, DOWN, "merge", "1", by_key=merge_key) == 3
+                done(merged)
+                page.keyboard.press("u")  # undo by keyboard, then by mouse
+                done(split)
+                page.click("#undo-btn")
+                done(lambda rows: rows == start)
+            # swap by mouse from frame 15: frames before it keep their ids
+            assert _pick_and_apply(page, UP, "swap", "1") == 2
+            done(lambda rows: lane_ids(rows, 15) == {UP: 1, DOWN: 2} and lane_ids(rows, 14) == {UP: 2, DOWN: 1})
+            assert _pick_and_apply(page, DOWN, "assign", "5", by_key="a") == 2  # assign by keyboard
+            done(lambda rows: lane_ids(rows, 15) == {UP: 1, DOWN: 5} and lane_ids(rows, 14) == {UP: 2, DOWN: 1})
+            assert _pick_and_apply(page, DOWN, "delete") == 5  # delete by mouse
+            done(lambda rows: 5 not in {r[1] for r in rows} and lane_ids(rows, 15) == {UP: 1})
+            assert page.eval_on_selector_all("#corrections li", "ls => ls.map(l => l.textContent)") == \
+                ["swap 2 1 from 15", "assign 2 5 from 15", "delete 5"]
     assert errors == []
