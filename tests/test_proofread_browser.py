@@ -1,7 +1,7 @@
 """End to end in headless Chromium: on a two-disc video whose ids swap at frame 10, pick a box with the mouse, swap
 it back from frame 12 by keyboard (only frames >= 12 change), undo, assign with the mouse, export, go to a frame and
 id on the timeline, delete by keyboard and undo with the mouse; the page shows what the server serves. Then every
-correction and undo, each by keyboard and by mouse."""
+correction and undo, each by keyboard and by mouse, and the next doubtful range by key and by its list."""
 
 from __future__ import annotations
 
@@ -11,8 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike.proofread import Correction, Doubt, Session
+from lookalike.viz.label.proofread import ProofreadApp
 from tests.test_label_browser import ARGS, _browser_or_skip
-from tests.test_proofread_page import FRAMES, Served, lane_ids, open_page
+from tests.test_proofread_page import FRAMES, Served, lane_ids, open_page, two_discs
 
 SCREENSHOT = Path(__file__).resolve().parents[1] / "docs" / "images" / "proofread-page.png"
 SCALE = 3
@@ -180,4 +182,33 @@ def test_every_correction_by_keyboard_and_by_mouse(tmp_path):
             done(lambda rows: 5 not in {r[1] for r in rows} and lane_ids(rows, 15) == {UP: 1})
             assert page.eval_on_selector_all("#corrections li", "ls => ls.map(l => l.textContent)") == \
                 ["swap 2 1 from 15", "assign 2 5 from 15", "delete 5"]
+    assert errors == []
+
+
+class _Doubting(Session):
+    """A session whose doubtful ranges are given: id 2 in frames 14-16 (most doubtful), id 1 in 4-6."""
+
+    def doubtful(self, threshold: float = 0.5) -> list[Doubt]:
+        return [Doubt(2, 14, 16, 1.0), Doubt(1, 4, 6, 0.5)]
+
+
+def test_next_doubtful_range_by_key_and_by_the_list(tmp_path):
+    video, tracks = two_discs(tmp_path, SCALE)
+    page_app = ProofreadApp(_Doubting(tracks, frame_rate=10), video, tmp_path / "two.corrections.jsonl",
+                            tmp_path / "two.proofread.txt", Correction.from_json)
+    errors: list[str] = []
+    with _chromium(errors) as page:
+        with Served(page_app) as served:
+            page.goto(served.url)
+            _wait_version(page, 0, 1)
+            assert page.eval_on_selector_all("#doubtful li", "ls => ls.map(l => l.textContent)") == \
+                ["id 2: frames 14-16", "id 1: frames 4-6"]
+            # N: the next range after the frame shown, then the most doubtful once none is after it
+            for frame, picked in ((4, "1"), (14, "2"), (14, "2")):
+                page.keyboard.press("n")
+                page.wait_for_function(f"document.body.dataset.frame === '{frame}'")
+                assert page.text_content("#picked") == picked
+            page.click("#doubtful li:nth-child(2)")
+            page.wait_for_function("document.body.dataset.frame === '4'")
+            assert page.text_content("#picked") == "1"
     assert errors == []
