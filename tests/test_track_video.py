@@ -225,13 +225,13 @@ def test_fit_video_features_links_boxes_into_chains(diver_scene):
 def test_trackers_reading_no_appearance_get_no_features(diver_scene, tmp_path, monkeypatch):
     """boxtrack and sort read boxes only: `track --video` fits and computes no appearance features for them (the
     feature code is made to fail), and their rows are those of the same detections tracked as a file."""
-    import lookalike.cli.track_video as track_video_cli
+    import lookalike.pipeline.video as video_pipeline
     import lookalike.viz.video_tracking as video_tracking
 
     def refuse(*args, **kwargs):
         raise AssertionError("appearance features computed for a tracker that reads none")
 
-    monkeypatch.setattr(track_video_cli, "fit_video_features", refuse)
+    monkeypatch.setattr(video_pipeline, "fit_video_features", refuse)
     monkeypatch.setattr(video_tracking, "fit_video_features", refuse)
     root, det = diver_scene
     for tracker in ("boxtrack", "sort"):

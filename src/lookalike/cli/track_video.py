@@ -3,9 +3,6 @@ health, optional annotated video."""
 
 from __future__ import annotations
 
-import io
-import itertools
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -16,93 +13,62 @@ from lookalike.cli.app import console, fail, failing, note, warn
 from lookalike.cli.progress import bars
 from lookalike.cli.track import dropped_all
 from lookalike.cli.track_closed import check_result_file, offline_video
-from lookalike.io import MotTable, read_mot, write_mot
-from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
-from lookalike.io.motchallenge import format_rows
-from lookalike.io.needs import input_kind
-from lookalike.io.outputs import atomic_path
-from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
+from lookalike.io import MotTable, write_mot
+from lookalike.io.det_format import box_stats
+from lookalike.pipeline.video import (
+    VideoDetections,
+    as_written,
+    check_features,
+    prepare_video,
+    threshold_hint,
+    write_video_result,
+)
 from lookalike.trackers.parts.health import HealthConfig
 from lookalike.viz.overlay import source_frames
-from lookalike.viz.video import video_info
-from lookalike.viz.video_tracking import fit_video_features, side_file, track_video, write_health_csv, write_merges_csv
+from lookalike.viz.video_tracking import track_video
 
-FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
+__all__ = ["run_track_onnx", "run_track_video", "save_detections"]
 
 
-def run_track_video(video: Path, detections: Path | MotTable | Callable[[np.ndarray], Any], output: Path,
-                    tracker: Any, tracker_name: str, *,
+def run_track_video(video: Path, detections: VideoDetections, output: Path, tracker: Any, tracker_name: str, *,
                     annotate: Path | None, team_size: int | None, health_window: int,
                     min_score: float, fps: float | None, features: str = "video",
                     annotate_as: Path | None = None, det_format: str = "auto", length: int | None = None,
                     score_warnings: bool = True) -> None:
     """Track ``detections`` (a file, the rows a detector found, or a detector run in the same pass) on ``video``;
     write ``output``, its ``.health.csv`` (``.merges.csv`` for merging trackers) and, with ``annotate``, the annotated
-    MP4 (printed as ``annotate_as``). ``features``: ``video``, ``divers``/``handcrafted``, ``learned`` or
-    ``FILE.onnx`` (the ``--features`` option). ``length``: the video's decoded frames when known (then a box
-    tracker without ``annotate`` decodes none); ``score_warnings``: False for a detector whose scores are all 1 by
-    design (blobs)."""
-    if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
-        fail(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
+    MP4 (printed as ``annotate_as``); see :func:`lookalike.pipeline.video.prepare_video`. ``score_warnings``: False
+    for a detector whose scores are all 1 by design (blobs)."""
+    with failing(ValueError):
+        check_features(features)
     check_result_file(output)
-    detect = None if isinstance(detections, (Path, MotTable)) else detections
     with failing(ValueError, OSError):
-        if not isinstance(detections, Path):
-            table = detections if isinstance(detections, MotTable) else MotTable.from_rows(np.zeros((0, 10)))
-            notes: list[str] = []
-        else:
-            fmt, notes = sniff_det(detections, det_format)
-            table = read_mot(detections) if fmt.standard() else read_det(detections, fmt)
-        health = HealthConfig(team_size=team_size, window=health_window)
-        images, total, _ = source_frames(video)
-        if input_kind(tracker_name) == "boxes":  # reads no appearance: no features computed
-            extractor: Any = None
-        else:
-            with console.status("standardising appearance features"):
-                extractor = (fit_diver_features() if features in ("divers", "handcrafted")
-                             else fit_video_features(video, table, min_score=min_score) if features == "video"
-                             else diver_extractor(features))
-        stream: Any = None
-        if extractor is None and annotate is None and length is not None and detect is None:  # no frame decoded
-            size = None if video.is_dir() else video_info(video)[2]
-        else:  # the first frame's size; the frames go on to the tracker (one decode)
-            first = next(images, None)
-            size = (first.shape[1], first.shape[0]) if first is not None else None
-            stream = itertools.chain([] if first is None else [first], images)
-    name = f"the detections in {video}" if not isinstance(detections, Path) else detections
-    for line in notes:
-        note(f"{name}: {line}")
-    scores, outside = box_stats(table.xywh, table.conf, size)
-    for line in det_warnings(name, len(table), scores if score_warnings else None, outside, size,
-                             f"the frames of {video}"):
+        found = prepare_video(video, detections, tracker_name, annotate=annotate, min_score=min_score,
+                              features=features, det_format=det_format, length=length, status=console.status)
+    for line in found.notes:
+        note(f"{found.name}: {line}")
+    for line in found.warnings(video, score_warnings):
         warn(line)
-    hint = stored_thresholds(extractor).get(tracker_name) if extractor is not None else None
+    hint = threshold_hint(found.extractor, tracker_name, features)
     if hint:
-        console.print(f"note: {tracker_name}'s thresholds were chosen for the hand-crafted features; matched to "
-                      f"{features} on the validation divers they are "
-                      + " ".join(f"--set {k}={v:g}" for k, v in hint.items()), markup=False)
+        console.print(hint, markup=False)
     try:
         with bars("tracking {task.description}") as progress:
-            task = progress.add_task(video.name, total=total or None)
-            result = track_video(video, table, tracker, extractor, annotate=annotate, health=health,
-                                 fps=fps, min_score=min_score, advance=lambda: progress.advance(task), length=length,
-                                 images=stream, detect=detect)
+            task = progress.add_task(video.name, total=found.total or None)
+            result = track_video(video, found.table, tracker, found.extractor, annotate=annotate,
+                                 health=HealthConfig(team_size=team_size, window=health_window), fps=fps,
+                                 min_score=min_score, advance=lambda: progress.advance(task), length=length,
+                                 images=found.frames, detect=found.detect)
     except ValueError as exc:
         fail(str(exc))
     except KeyboardInterrupt:
         console.print("\n[yellow]Interrupted.[/] Nothing was written"
                       + (f" ({escape(str(annotate_as or annotate))} is left as it was)." if annotate else "."))
         raise SystemExit(130) from None
-    write_mot(output, result.rows)
-    if len(table) and not len(result.rows):
-        warn(dropped_all(tracker_name, name, len(table), scores))
-    written = [output, side_file(output, "health")]
-    with atomic_path(written[1]) as tmp:  # (the side files too appear whole, through temporary files)
-        write_health_csv(tmp, result.health)
-    if hasattr(tracker, "merges"):
-        written.append(side_file(output, "merges"))
-        with atomic_path(written[-1]) as tmp:
-            write_merges_csv(tmp, result.merges)
+    written = write_video_result(output, result, tracker)
+    if len(found.table) and not len(result.rows):
+        scores = box_stats(found.table.xywh, found.table.conf, None)[0]
+        warn(dropped_all(tracker_name, found.name, len(found.table), scores))
     if annotate is not None:
         written.append(annotate_as or annotate)
     unhealthy = sum(not s.healthy for s in result.health)
@@ -148,11 +114,6 @@ def run_track_onnx(video: Path, output: Path, tracker: Any, tracker_name: str, m
                       options["min_score"])
     else:
         run_track_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, length=frames, **options)
-
-
-def as_written(rows: np.ndarray) -> np.ndarray:
-    """Detection rows ``(n, 10)`` as they read back from a MOTChallenge file (:func:`~lookalike.io.write_mot`)."""
-    return np.loadtxt(io.StringIO(format_rows(rows)), delimiter=",", ndmin=2).reshape(-1, 10)
 
 
 def save_detections(rows: np.ndarray, options: dict[str, Any]) -> str:

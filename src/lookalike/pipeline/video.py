@@ -1,0 +1,127 @@
+"""A tracker run on a video: its detections read from a file, given as rows, or found by a detector in the same
+pass; appearance features only for trackers that read them; the frames decoded once; the result and its health
+and merges files written (``lookalike track --video``)."""
+
+from __future__ import annotations
+
+import io
+import itertools
+from collections.abc import Callable, Iterable
+from contextlib import AbstractContextManager, nullcontext
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lookalike.io import MotTable, read_mot, write_mot
+from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
+from lookalike.io.motchallenge import format_rows
+from lookalike.io.needs import input_kind
+from lookalike.io.outputs import atomic_path
+from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
+from lookalike.viz.overlay import source_frames
+from lookalike.viz.video import video_info
+from lookalike.viz.video_tracking import (
+    VideoTrackingResult,
+    fit_video_features,
+    side_file,
+    write_health_csv,
+    write_merges_csv,
+)
+
+FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
+VideoDetections = Path | MotTable | Callable[[np.ndarray], Any]  # a file, rows found, or a detector run in the pass
+
+
+@dataclass
+class VideoInput:
+    """What a tracker needs from a video before its pass: the detections ``table`` (empty when a ``detect``or runs
+    in the pass), the layout ``notes`` of their file, the feature ``extractor`` (None: none computed), the frame
+    ``size`` ``(w, h)`` px, the ``frames`` to decode (None: none), the declared frame count ``total`` and a
+    ``name`` for the detections in messages."""
+
+    table: MotTable
+    notes: list[str]
+    extractor: Any
+    size: tuple[int, int] | None
+    frames: Iterable[np.ndarray] | None
+    total: int
+    detect: Callable[[np.ndarray], Any] | None
+    name: str | Path
+
+    def warnings(self, video: Path, score_warnings: bool = True) -> list[str]:
+        """Warnings on the detections: boxes outside the frame, every score equal (unless not ``score_warnings``)."""
+        scores, outside = box_stats(self.table.xywh, self.table.conf, self.size)
+        return det_warnings(self.name, len(self.table), scores if score_warnings else None, outside, self.size,
+                            f"the frames of {video}")
+
+
+def check_features(features: str) -> None:
+    """``ValueError`` unless ``features`` is one of :data:`FEATURE_CHOICES` or an ``.onnx`` file."""
+    if features not in FEATURE_CHOICES and not features.lower().endswith(".onnx"):
+        raise ValueError(f"--features: choose one of {', '.join(FEATURE_CHOICES)} or FILE.onnx, got {features!r}")
+
+
+def prepare_video(video: Path, detections: VideoDetections, tracker_name: str, *, annotate: Path | None = None,
+                  min_score: float = -np.inf, features: str = "video", det_format: str = "auto",
+                  length: int | None = None,
+                  status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()) -> VideoInput:
+    """Read ``detections`` and fit the features ``tracker_name`` reads (``features``: as ``--features``; fitting
+    shown by ``status``); with ``length`` (the video's decoded frames) known, a box tracker without ``annotate`` or
+    a detector gets no frames decoded, else the first frame gives the size and the frames go on to the tracker."""
+    detect = None if isinstance(detections, (Path, MotTable)) else detections
+    notes: list[str] = []
+    if isinstance(detections, Path):
+        fmt, notes = sniff_det(detections, det_format)
+        table = read_mot(detections) if fmt.standard() else read_det(detections, fmt)
+    else:
+        table = detections if isinstance(detections, MotTable) else MotTable.from_rows(np.zeros((0, 10)))
+    images, total, _ = source_frames(video)
+    extractor: Any = None
+    if input_kind(tracker_name) != "boxes":  # a tracker reading no appearance gets no features computed
+        with status("standardising appearance features"):
+            extractor = (fit_diver_features() if features in ("divers", "handcrafted")
+                         else fit_video_features(video, table, min_score=min_score) if features == "video"
+                         else diver_extractor(features))
+    stream: Iterable[np.ndarray] | None = None
+    if extractor is None and annotate is None and length is not None and detect is None:  # no frame decoded
+        size = None if video.is_dir() else video_info(video)[2]
+    else:  # the first frame's size; the frames go on to the tracker (one decode)
+        first = next(images, None)
+        size = (first.shape[1], first.shape[0]) if first is not None else None
+        stream = itertools.chain([] if first is None else [first], images)
+    name = detections if isinstance(detections, Path) else f"the detections in {video}"
+    return VideoInput(table, notes, extractor, size, stream, total, detect, name)
+
+
+def threshold_hint(extractor: Any, tracker_name: str, features: str) -> str | None:
+    """A note when ``tracker_name``'s thresholds were chosen for other features than ``features``, else None."""
+    hint = stored_thresholds(extractor).get(tracker_name) if extractor is not None else None
+    if not hint:
+        return None
+    return (f"note: {tracker_name}'s thresholds were chosen for the hand-crafted features; matched to {features} on "
+            "the validation divers they are " + " ".join(f"--set {k}={v:g}" for k, v in hint.items()))
+
+
+def write_video_result(output: Path, result: VideoTrackingResult, tracker: Any) -> list[Path]:
+    """``output`` (MOTChallenge rows), its ``.health.csv`` and, for a merging tracker, its ``.merges.csv``, each
+    appearing whole; returns the files written."""
+    write_mot(output, result.rows)
+    written = [output, side_file(output, "health")]
+    with atomic_path(written[1]) as tmp:
+        write_health_csv(tmp, result.health)
+    if hasattr(tracker, "merges"):
+        written.append(side_file(output, "merges"))
+        with atomic_path(written[-1]) as tmp:
+            write_merges_csv(tmp, result.merges)
+    return written
+
+
+def as_written(rows: np.ndarray) -> np.ndarray:
+    """Detection rows ``(n, 10)`` as they read back from a MOTChallenge file (:func:`~lookalike.io.write_mot`)."""
+    return np.loadtxt(io.StringIO(format_rows(rows)), delimiter=",", ndmin=2).reshape(-1, 10)
+
+
+__all__ = ["FEATURE_CHOICES", "VideoDetections", "VideoInput", "as_written", "check_features", "prepare_video",
+           "threshold_hint", "write_video_result"]
