@@ -13,27 +13,21 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 
 from lookalike.cli.app import app, console, fail, failing, note, warn
-from lookalike.io import find_sequences
-from lookalike.io.needs import box_input_problem
-from lookalike.io.outputs import atomic_path, check_outputs, ensure_writable, refuse_inputs, result_paths
-from lookalike.io.stream import sequence_stream, track_to_file
+from lookalike.io.outputs import atomic_path, check_outputs, refuse_inputs
+from lookalike.io.stream import track_to_file
 from lookalike.loop import RunStats
-from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
-from lookalike.trackers.registry import parse_parameter
+from lookalike.pipeline import files
+from lookalike.pipeline.files import dropped_all, input_error, sequences_and_targets
+from lookalike.trackers import make_tracker
+
+__all__ = ["build_tracker", "dropped_all", "input_error", "sequences_and_targets", "track", "track_files",
+           "tracker_params"]
 
 
 def tracker_params(name: str, settings: list[str], params_file: Path | None = None) -> dict[str, Any]:
-    """A tracker's parameters: those of the ``lookalike tune`` file ``params_file`` (if any), then the
-    ``KEY=VALUE`` ``settings`` on top; fails with a readable message."""
-    if name not in tracker_names():
-        fail(f"unknown tracker {name!r}; choose one of: {', '.join(tracker_names())}")
+    """:func:`lookalike.pipeline.files.tracker_params`, failing with a readable message."""
     with failing(ValueError, TypeError):
-        base: dict[str, Any] = {}
-        if params_file is not None:
-            from lookalike.tune.params_file import load_params  # imported when used: keeps the CLI's start-up short
-
-            base = load_params(params_file, name)
-        return {**base, **dict(parse_parameter(name, s) for s in settings)}
+        return files.tracker_params(name, settings, params_file)
 
 
 def build_tracker(name: str, settings: list[str], params_file: Path | None = None) -> Any:
@@ -44,46 +38,8 @@ def build_tracker(name: str, settings: list[str], params_file: Path | None = Non
         return make_tracker(name, **params)
 
 
-def _box_tracker(name: str, settings: list[str], *, video: bool = False, targets: int | None = None,
-                 params_file: Path | None = None) -> Any:
-    """:func:`build_tracker`, refusing a tracker that cannot run on boxes; ``targets``: its ``max_targets``."""
-    if targets is not None:
-        if "max_targets" not in {p.name for p in tracker_parameters(name)}:
-            fail(f"--targets: tracker {name!r} has no closed-set mode (max_targets); use -t boxtrack")
-        settings = [*settings, f"max_targets={targets}"]
-    tracker = build_tracker(name, settings, params_file)
-    problem = box_input_problem(name, video=video)
-    if problem is not None:
-        fail(problem)
-    return tracker
-
-
 _BAR_STEP = 25
 """Frames between two moves of a sequence's progress bar."""
-
-_LENGTH_HINT = " (--no-seqinfo-length tracks every frame in the file)"
-
-
-def input_error(exc: Exception) -> str:
-    """One line for a bad input; the seqLength rule names the option that lifts it."""
-    message = str(exc)
-    return message + _LENGTH_HINT if "(seqLength in" in message else message
-
-
-def sequences_and_targets(path: Path, output: Path) -> tuple[list[Any], list[Path]]:
-    """The sequences with detections at ``path`` and their result files under ``output``."""
-    sequences = [s for s in find_sequences(path) if s.det_path is not None]
-    if not sequences:
-        raise ValueError(f"{path}: no det/det.txt found")
-    return sequences, result_paths(path, sequences, output)
-
-
-def dropped_all(tracker: str, det_path: Path | str | None, rows: int, scores: tuple[float, float] | None) -> str:
-    """The warning for a tracker that wrote no tracks from ``rows`` detections scoring ``scores``."""
-    span = f" (scores {scores[0]:g} to {scores[1]:g})" if scores is not None else ""
-    return (f"{tracker} wrote no tracks from the {rows} detections of {det_path}{span}: its score thresholds "
-            f"(`lookalike trackers`) or --min-score may drop them all, or the columns are not what they seem "
-            f"(--det-format)")
 
 
 def track_files(path: Path, output: Path, tracker: Any, min_score: float,
@@ -91,28 +47,17 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float,
     """Track every sequence at ``path`` (a det.txt, a sequence folder or a folder of them) into ``output`` (a file
     for a single det.txt, else ``output/<sequence>.txt``), streaming, inputs checked and outputs decided first;
     ``use_length``: seqinfo.ini's seqLength bounds the frames; ``name``: the tracker's, for warnings."""
-    from lookalike.io.det_format import det_warnings
-
     try:
-        sequences, targets = sequences_and_targets(path, output)
-        streams = [(seq, sequence_stream(seq, min_score, use_length, det_format)) for seq in sequences]
-        ensure_writable(targets)
+        streams = files.open_sequences(path, output, min_score, use_length, det_format)
     except (FileNotFoundError, ValueError) as exc:
         fail(input_error(exc))
-    for (seq, frames), target in zip(streams, targets):
-        for line in frames.notes:
-            note(line)
-        if frames.rows == 0:
-            warn(f"{seq.det_path}: no detections; {target} will hold no tracks")
-        size_from = f"imWidth, imHeight in {seq.root / 'seqinfo.ini'}" if seq.root is not None else ""
-        for line in det_warnings(seq.det_path or "", frames.rows, frames.scores, frames.outside, seq.image_size,
-                                 size_from):
-            warn(line)
+    for seq, frames, target in streams:
+        files.sequence_warnings(seq, frames, target, warn, note)
     stats = RunStats()
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
                   console=console, transient=True) as progress:
         overall = progress.add_task("sequences", total=len(streams))
-        for (seq, frames), target in zip(streams, targets):
+        for seq, frames, target in streams:
             tracker.reset()
             task = progress.add_task(seq.name, total=frames.length)
 
@@ -309,8 +254,9 @@ def track(
                                  settings, annotate=annotate, fps=fps, min_score=min_score, annotate_as=annotate_as,
                                  bag=bag, camera_topic=camera_topic, heading_topics=heading_topics)
                 return
-            trk = _box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets,
-                               params_file=params_file)
+            with failing(ValueError, TypeError):
+                trk = files.box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets,
+                                        params_file=params_file)
             online = tracker_params(tracker, settings, params_file) if offline else None
             if branch == "points":
                 from lookalike.cli.track_closed import track_points
