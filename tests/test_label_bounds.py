@@ -15,6 +15,7 @@ from lookalike.io.outputs import write_atomic
 from lookalike.io.rules import user_mode
 from lookalike.viz.label import make_server, open_label_app
 from lookalike.viz.label.server import LISTEN_BACKLOG
+from tests.http_checks import burst_replies, post_bytes
 from tests.test_label_server import _json, _request, seq_path  # noqa: F401 (fixture)
 
 
@@ -59,18 +60,9 @@ def test_listen_backlog_takes_a_burst_of_connections(seq_path):  # noqa: F811
     try:
         assert server.request_queue_size == LISTEN_BACKLOG >= 128
         # Not serving yet: 100 connections wait in the kernel's queue instead of being refused.
-        pending = [socket.create_connection(("127.0.0.1", server.server_address[1]), timeout=5) for _ in range(100)]
-        thread = threading.Thread(target=server.serve_forever, daemon=True)
-        thread.start()
         body = json.dumps({"frame": 0, "detection": 0, "label": 0}).encode()
-        for s in pending:
-            s.sendall(b"POST /api/label HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                      b"Content-Length: %d\r\nConnection: close\r\n\r\n%s" % (len(body), body))
-        replies = [s.recv(64) for s in pending]
-        for s in pending:
-            s.close()
+        replies = burst_replies(server, post_bytes("/api/label", body))
         assert all(r.startswith(b"HTTP/1.0 200") for r in replies), {r[:20] for r in replies}
-        _stop(server, thread)
     finally:
         server.server_close()
 

@@ -8,7 +8,6 @@ import json
 import os
 import socket
 import stat
-import threading
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -16,6 +15,7 @@ from hypothesis import strategies as st
 
 from lookalike.proofread import Correction
 from lookalike.viz.label.server import LISTEN_BACKLOG
+from tests.http_checks import assert_survives_malformed, burst_replies, post_bytes
 from tests.test_label_property import json_values
 from tests.test_proofread_page import SWAP, Served, open_page
 
@@ -35,17 +35,7 @@ def test_binds_loopback_by_default(tmp_path):
 
 def test_survives_malformed_requests(tmp_path):
     with Served(open_page(tmp_path)) as s:
-        for raw in (b"GARBAGE\r\n\r\n", b"GET\r\n\r\n", b"\x00\xff\xfe nonsense\r\n\r\n",
-                    (b"POST /api/correct HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                     b"Content-Length: 999999999\r\n\r\n{}"),
-                    (b"POST /api/correct HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                     b"Content-Length: abc\r\n\r\n"),
-                    b"GET /api/meta HTTP/1.1\r\n" + b"X: " + b"a" * 70000 + b"\r\n\r\n"):
-            with socket.create_connection(("127.0.0.1", s.port), timeout=10) as conn:
-                conn.sendall(raw)
-                conn.shutdown(socket.SHUT_WR)
-                reply = conn.recv(200)
-            assert reply == b"" or reply.startswith(b"HTTP/1.") or b"Error code: 400" in reply, (raw[:30], reply)
+        assert_survives_malformed(s.port, "/api/correct")
         for path, body in [("/api/correct", {"kind": "rename", "track": 1}), ("/api/correct", {"track": 1}),
                            ("/api/correct", {"kind": "swap", "track": 1, "other": 2, "frame": 99}),
                            ("/api/correct", {"kind": "delete", "track": "one"}), ("/api/undo", {}),
@@ -63,23 +53,11 @@ def test_survives_malformed_requests(tmp_path):
 def test_listen_backlog_takes_a_burst_of_corrections(tmp_path):
     page = open_page(tmp_path)
     server = make_proofread_server(page, port=0)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
     try:
         assert server.request_queue_size == LISTEN_BACKLOG >= 128
-        # Not serving yet: 100 connections wait in the kernel's queue instead of being refused.
-        pending = [socket.create_connection(("127.0.0.1", server.server_address[1]), timeout=10) for _ in range(100)]
-        thread.start()
-        body = json.dumps(SWAP_BODY).encode()
-        for conn in pending:
-            conn.sendall(b"POST /api/correct HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                         b"Content-Length: %d\r\nConnection: close\r\n\r\n%s" % (len(body), body))
-        replies = [conn.recv(64) for conn in pending]
-        for conn in pending:
-            conn.close()
+        replies = burst_replies(server, post_bytes("/api/correct", json.dumps(SWAP_BODY).encode()))
         assert all(r.startswith(b"HTTP/1.0 200") for r in replies), {r[:20] for r in replies}
         assert page.version == 100 and len(page.session.corrections) == 100
-        server.shutdown()
-        thread.join(5)
     finally:
         server.server_close()
 
@@ -132,8 +110,7 @@ def test_writes_never_fail_with_500(served, path, body):
     s, page = served
     conn = socket.create_connection(("127.0.0.1", s.port), timeout=10)
     with conn:
-        conn.sendall(b"POST %s HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                     b"Content-Length: %d\r\nConnection: close\r\n\r\n%s" % (path.encode(), len(body), body))
+        conn.sendall(post_bytes(path, body))
         reply = b""
         while chunk := conn.recv(4096):
             reply += chunk
