@@ -13,11 +13,12 @@ from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
 
 from lookalike.cli.app import app, console, fail, failing, note, warn
-from lookalike.io.outputs import atomic_path, check_outputs, refuse_inputs
+from lookalike.io.outputs import atomic_path
 from lookalike.io.stream import track_to_file
 from lookalike.loop import RunStats
 from lookalike.pipeline import files
 from lookalike.pipeline.files import dropped_all, input_error, sequences_and_targets
+from lookalike.pipeline.request import TrackRequest
 from lookalike.trackers import make_tracker
 
 __all__ = ["build_tracker", "dropped_all", "input_error", "sequences_and_targets", "track", "track_files",
@@ -83,64 +84,6 @@ def _speed(stats: RunStats) -> str:
     if stats.frames == 0 or not math.isfinite(stats.fps):
         return f"{stats.frames} frames"
     return f"{stats.frames} frames, {stats.fps:,.0f} frames/s (tracker only)"
-
-
-def _refuse_overwriting_inputs(output: Path, inputs: list[Path | None], annotate: Path | None = None,
-                               video: Path | None = None, saved: Path | None = None) -> None:
-    """Refuse (exit 2) when the result, a file written beside it, ``annotate`` or ``saved`` (--save-detections) is an
-    input or another output."""
-    siblings = [output.with_name(output.stem + s) for s in (".health.csv", ".merges.csv")]
-    files = [p for p in inputs if p is not None and p.is_file()]
-    extra = {k: v for k, v in (("--annotate", annotate), ("--save-detections", saved)) if v is not None}
-    with failing(ValueError):
-        refuse_inputs([output, *siblings], files)
-        if extra:
-            check_outputs({"-o/--output": output, **{f"-o/--output's {s.name}": s for s in siblings}, **extra},
-                          files, input_folders=[video])  # (video: an image folder)
-
-
-def _check_branches(path: Path | None, video: Path | None, detections: Path | None, annotate: Path | None,
-                    detector: str | None, blob: list[str] | None, pipeline: str | None,
-                    points: Path | None = None) -> str:
-    """Which branch of ``track`` the options select (``pipeline``, ``points``, ``blobs``, ``video``, ``files``)."""
-    if points is not None:
-        if any(x is not None for x in (path, detections, detector, pipeline)) or blob:
-            fail("--points: the points are the input; drop PATH/--detections/--detector/--blob/--pipeline")
-        if video is not None and annotate is None:
-            fail("--points --video: the video is only drawn on, with --annotate")
-        return "points"
-    if pipeline is not None:
-        if detector is not None or blob or detections is not None or path is not None:
-            fail("--pipeline: finds its own detections; drop --detector/--blob/--detections/PATH")
-        return "pipeline"
-    if detector is not None or blob:
-        if video is None or detections is not None or path is not None or detector is None:
-            fail("--detector/--blob: use --video FILE --detector blob, without det.txt")
-        return "blobs"
-    if video is not None:
-        if (detections or path) is None or (detections is not None and path is not None):
-            fail("--video: give the detections once, as --detections det.txt (or as PATH)")
-        return "video"
-    if annotate is not None or detections is not None:
-        fail("--annotate/--detections: only with --video")
-    if path is None:
-        fail("PATH: give det.txt, a sequence folder or a folder of sequences (or --video with --detections)")
-    return "files"
-
-
-def _live_source(video: str | None, detector: str | None, stops: bool, saves: bool = False) -> str | None:
-    """``--video``'s text when it names a live source (a camera index, a stream URL), else None; ``stops``: whether
-    --max-frames/--seconds were given (live only); ``saves``: whether --save-detections was (not live)."""
-    from lookalike.io.sources import is_live
-
-    live = video if is_live(video) else None
-    if saves and (detector is None or live is not None):
-        fail("--save-detections: only with --video FILE --detector")
-    if live is None and stops:
-        fail("--max-frames/--seconds: only with a live --video (a camera index or a stream URL)")
-    if live is not None and detector is None:
-        fail(f"--video {live}: a live source needs --detector blob or --detector FILE.onnx")
-    return live
 
 
 @app.command()
@@ -215,25 +158,17 @@ def track(
     seconds: float | None = typer.Option(None, "--seconds", min=0.0, help="Live --video: stop after S seconds."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
-    live = _live_source(video_arg, detector, max_frames is not None or seconds is not None,
-                        save_detections is not None)
-    video = Path(video_arg) if video_arg is not None else None
-    if bag is not None and (any(x is not None for x in (path, video, detections, points, reports, detector)) or blob):
-        fail("--bag: the bag is the input; drop PATH/--video/--detections/--points/--reports/--detector/--blob")
-    branch = "pipeline" if bag is not None else _check_branches(path, video, detections, annotate, detector, blob,
-                                                                pipeline, points)
+    request = TrackRequest(output, tracker, path, video_arg, detections, points, bag, detector, blob or [], pipeline,
+                           reports, annotate, save_detections, targets, offline_opt,
+                           stops=max_frames is not None or seconds is not None)
+    video = request.video_path
+    with failing(ValueError):
+        live = request.live()
+        branch = request.branch()
+        offline = request.is_offline(branch, live)
+        request.check_outputs([path, video, detections, points, reports, params_file, detector_model, heading_model])
     open_set = targets == 0  # --targets 0: an open set, no number of targets inferred (blob videos)
     targets = targets or None
-    offline = bool(offline_opt) if offline_opt is not None else (
-        targets is not None and detector == "blob" and tracker == "boxtrack" and live is None and bag is None)
-    if offline and targets is None:
-        fail("--offline: needs --targets N (the known number of targets)")
-    if offline and branch == "pipeline":
-        fail("--offline: not with --pipeline (the robots' identities come from their reports, frame by frame)")
-    if offline and tracker != "boxtrack":
-        fail(f"--offline: the closed set's online pass is boxtrack; use -t boxtrack, not {tracker!r}")
-    _refuse_overwriting_inputs(output, [path, video, detections, points, reports, params_file, detector_model,
-                                        heading_model], annotate, video, save_detections)
     settings = set_ or []
     team_size = team_size if team_size is not None else targets
     video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
