@@ -127,7 +127,8 @@ def zebrafish(root: Path, out: Path) -> None:
     print(f"\nzebrafish test_A, 8 fish, no ground truth ({CHOSEN['blob']}, with N=8):")
     for name, extra in (("online", ["--targets", "8", "--online"]), ("offline", ["--targets", "8"]), ("plain", [])):
         result = out / f"zebrafish_{name}.txt"
-        cmd = ["track", "--video", str(video), "--detector", "blob", "-t", "boxtrack", *extra, "-o", str(result)]
+        cmd = ["track", "--video", str(video), "--detector", "blob", "-t", "boxtrack", *extra, "-o", str(result),
+               "--save-detections", str(result.with_name(result.stem + ".det.txt"))]
         seconds = run(cmd)
         det = read_mot(result.with_name(result.stem + ".det.txt"))
         rows = read_mot(result)
