@@ -14,9 +14,8 @@ from lookalike.cli.progress import progress_bars
 from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.cli.track_video import run_track_onnx, run_track_video, save_detections
 from lookalike.io import MotTable
-from lookalike.io.needs import input_kind
+from lookalike.pipeline.blobs import blob_tracker, estimate_lines, one_pass
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, frame_counts
-from lookalike.vision.blob_boxtrack import blob_boxtrack_config
 from lookalike.viz.blob_video import (
     BlobRows,
     BlobStream,
@@ -56,18 +55,14 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
     with failing(ValueError, OSError):
         with progress_bars() as progress:  # (steps: reading the sampled frames, the background, each threshold)
             config, estimate = auto_blob_config(video, settings, n_targets or None, progress=progress)
-        if estimate is not None:
-            given = {s.partition("=")[0].strip() for s in settings}
-            console.print("blob settings estimated from the video (override with --blob KEY=VALUE):")
-            for line in estimate.summary.splitlines():
-                console.print(f"  {line}", markup=False)
-            if given:
-                console.print(f"  given with --blob: {', '.join(sorted(given))}", markup=False)
+        for line in estimate_lines(estimate, settings) if estimate is not None else []:
+            console.print(line, markup=False)
         _, declared, source_rate = source_frames(video)
         frame_rate = options.get("fps") or source_rate
         found = load_blob_detections(video, config)
         stream = BlobStream(video, config, options["min_score"]) if found is None and offline is None and \
-            _one_pass(tracker, tracker_name, explicit, n_targets, options) else None
+            one_pass(tracker, tracker_name, explicit, n_targets, options.get("annotate") is not None,
+                     options.get("features", "video")) else None
         if found is None and stream is None:
             found = _detect_with_progress(video, config, declared)
     saved = options.pop("save_detections", None)
@@ -97,26 +92,13 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
                     score_warnings=False, **options)
 
 
-def _one_pass(tracker: Any, tracker_name: str, explicit: Collection[str], n_targets: int | None,
-              options: dict[str, Any]) -> bool:
-    """Whether blobs are best detected in the tracking pass: the tracker's settings need no blob counts of the whole
-    video, and the tracking decodes the frames anyway (``--annotate``, or features fitted on no video)."""
-    counts = tracker_name == "boxtrack" and tracker.config.max_targets is None and "max_targets" not in explicit \
-        and n_targets is None
-    decodes = options.get("annotate") is not None or (input_kind(tracker_name) != "boxes"
-                                                       and options.get("features", "video") != "video")
-    return decodes and not counts
-
-
 def _blob_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: Collection[str],
                   n_targets: int | None, options: dict[str, Any]) -> Any:
-    """``tracker`` set for blob detections (``boxtrack`` only; ``counts``: blobs per frame, for a count inferred);
-    a known count becomes ``options["team_size"]`` unless given."""
-    if tracker_name != "boxtrack":
-        return tracker
-    plan = blob_boxtrack_config(tracker.config, counts, explicit, n_targets)
-    if plan.count is not None:
-        console.print(plan.count.summary, markup=False)
-    if plan.n_targets and options.get("team_size") is None:
-        options["team_size"] = plan.n_targets
-    return type(tracker)(plan.config) if plan.config != tracker.config else tracker
+    """:func:`lookalike.pipeline.blobs.blob_tracker`, a count inferred printed; a known count becomes
+    ``options["team_size"]`` unless given."""
+    tracker, summary, known = blob_tracker(tracker, tracker_name, counts, explicit, n_targets)
+    if summary is not None:
+        console.print(summary, markup=False)
+    if known and options.get("team_size") is None:
+        options["team_size"] = known
+    return tracker

@@ -1,0 +1,44 @@
+"""Blob detections for a tracker (``lookalike track --video V --detector blob``): whether they are found in the
+tracking pass, and the tracker set for them."""
+
+from __future__ import annotations
+
+from collections.abc import Collection
+from typing import Any
+
+import numpy as np
+
+from lookalike.io.needs import input_kind
+from lookalike.vision.blob_auto import BlobEstimate
+from lookalike.vision.blob_boxtrack import blob_boxtrack_config
+
+
+def one_pass(tracker: Any, tracker_name: str, explicit: Collection[str], n_targets: int | None, annotate: bool,
+             features: str) -> bool:
+    """Whether blobs are best detected in the tracking pass: the tracker's settings need no blob counts of the whole
+    video, and the tracking decodes the frames anyway (``annotate``, or ``features`` fitted on no video)."""
+    counts = tracker_name == "boxtrack" and tracker.config.max_targets is None and "max_targets" not in explicit \
+        and n_targets is None
+    return (annotate or (input_kind(tracker_name) != "boxes" and features != "video")) and not counts
+
+
+def blob_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: Collection[str],
+                 n_targets: int | None) -> tuple[Any, str | None, int | None]:
+    """``tracker`` set for blob detections (``boxtrack`` only; ``counts``: blobs per frame, for a count inferred), the
+    summary of a count inferred (None if none) and the number of targets when known."""
+    if tracker_name != "boxtrack":
+        return tracker, None, None
+    plan = blob_boxtrack_config(tracker.config, counts, explicit, n_targets)
+    summary = plan.count.summary if plan.count is not None else None
+    return (type(tracker)(plan.config) if plan.config != tracker.config else tracker), summary, plan.n_targets
+
+
+def estimate_lines(estimate: BlobEstimate, settings: list[str]) -> list[str]:
+    """The lines telling the blob settings estimated from the video and those given with ``--blob``."""
+    given = {s.partition("=")[0].strip() for s in settings}
+    lines = ["blob settings estimated from the video (override with --blob KEY=VALUE):"]
+    lines += [f"  {line}" for line in estimate.summary.splitlines()]
+    return lines + ([f"  given with --blob: {', '.join(sorted(given))}"] if given else [])
+
+
+__all__ = ["blob_tracker", "estimate_lines", "one_pass"]
