@@ -9,10 +9,10 @@ from typing import Any
 
 from rich.markup import escape
 
-from lookalike.cli.app import console, fail, failing
+from lookalike.cli.app import console, failing
 from lookalike.io.live import LiveRun, LiveStop, prepare_live, track_live
-from lookalike.io.needs import input_kind
 from lookalike.io.sources import open_live
+from lookalike.pipeline.live import live_settings
 
 
 def run_track_live(spec: str, output: Path, tracker: Any, tracker_name: str, detector: str,
@@ -20,24 +20,8 @@ def run_track_live(spec: str, output: Path, tracker: Any, tracker_name: str, det
                    max_frames: int | None, seconds: float | None, refused: dict[str, bool]) -> None:
     """Track the live source ``spec`` into ``output`` until it ends, ``max_frames``, ``seconds`` or Ctrl-C/SIGTERM;
     ``refused``: options that do not apply to a live source (name -> given)."""
-    given = [name for name, on in refused.items() if on]
-    if given:
-        fail(f"--video {spec}: a live source; drop {', '.join(given)} (see the live camera how-to)")
-    if input_kind(tracker_name) != "boxes":
-        fail(f"--video {spec}: a live source runs trackers that read boxes alone (boxtrack, sort), not "
-             f"{tracker_name!r}")
-    if output.is_dir():
-        fail(f"-o/--output: {output} is a folder; give a result file such as tracks.txt")
-    blob: dict[str, Any] = {}
-    if detector == "blob":
-        from lookalike.viz.blob_video import blob_settings
-
-        with failing(ValueError):
-            blob = blob_settings(settings)
-    elif not detector.lower().endswith(".onnx"):
-        fail(f"--detector: choose blob or FILE.onnx, got {detector!r}")
-    elif not Path(detector).is_file():
-        fail(f"--detector: {detector} does not exist")
+    with failing(ValueError):
+        blob = live_settings(spec, output, tracker_name, detector, settings, refused)
     with failing(ValueError, OSError), LiveStop() as stop:
         with console.status(f"opening {escape(spec)}"):
             source = open_live(spec)
