@@ -10,9 +10,8 @@ import numpy as np
 from rich.markup import escape
 
 from lookalike.cli.app import console, fail, failing
-from lookalike.cli.track import input_error, sequences_and_targets
+from lookalike.cli.track import input_error
 from lookalike.io import write_mot
-from lookalike.io.outputs import ensure_writable
 from lookalike.pipeline import closed
 from lookalike.pipeline.closed import MAX_POINTS_PER_FRAME, POINTS_FPS, point_tracker, read_points
 
@@ -29,11 +28,14 @@ def _note(line: str) -> None:
     console.print(line, markup=False)
 
 
+def _file_note(line: str) -> None:
+    console.print(f"[cyan]note:[/] {escape(line)}", highlight=False)
+
+
 def table_rows(path: Path, min_score: float = float("-inf"), length: int | None = None,
                length_name: str = "the length", det_format: str = "auto") -> np.ndarray:
     """:func:`lookalike.pipeline.closed.table_rows`, what was assumed of the file's layout printed as a note."""
-    return closed.table_rows(path, min_score, length, length_name, det_format, note=lambda line: console.print(
-        f"[cyan]note:[/] {escape(line)}", highlight=False))
+    return closed.table_rows(path, min_score, length, length_name, det_format, note=_file_note)
 
 
 def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
@@ -48,22 +50,12 @@ def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, An
     """``--offline`` over every sequence at ``path`` (outputs decided first; ``use_length``: seqinfo.ini's seqLength
     bounds the frames): returns the sequences written."""
     try:
-        sequences, targets = sequences_and_targets(path, output)
-        ensure_writable(targets)
-        for seq, target in zip(sequences, targets):
-            assert seq.det_path is not None
-            length = seq.length if use_length else None
-            det = table_rows(seq.det_path, min_score, length, f"seqLength in {seq.root / 'seqinfo.ini'}"
-                             if seq.root is not None else "the length", det_format)
-            n_frames = max((seq.length if use_length else None) or 0, int(det[:, 0].max(initial=0)))
-            with console.status(f"closed set of {n_targets} on {seq.name}"):
-                rows = closed_set_rows(det, n_targets, seq.frame_rate, n_frames, params)
-            write_mot(target, rows)
+        return closed.offline_sequences(path, output, n_targets, params, min_score, use_length, det_format,
+                                        note=_note, file_note=_file_note, status=console.status)
     except (FileNotFoundError, ValueError) as exc:
         fail(input_error(exc))
     except OSError as exc:
         fail(f"output {output}: cannot write ({exc.strerror or exc})")
-    return len(sequences)
 
 
 def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,

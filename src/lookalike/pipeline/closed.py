@@ -4,6 +4,7 @@ anonymous points tracked as small boxes (``lookalike track --offline``, ``--poin
 from __future__ import annotations
 
 from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -12,6 +13,7 @@ import numpy as np
 
 from lookalike.io import frames_from_table, read_mot, write_mot
 from lookalike.io.det_format import read_det, sniff_det
+from lookalike.io.outputs import ensure_writable
 from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv, read_points_mot, typical_spacing
 from lookalike.io.stream import track_to_file
 from lookalike.trackers.boxtrack import BoxTrack
@@ -59,6 +61,29 @@ def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_f
     note(f"note: {frames} frame(s) of detections are too few for the offline closed set; the online closed "
          f"set's result (boxtrack --targets {n_targets}) is written instead")
     return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, **{**online, "max_targets": n_targets})
+
+
+def offline_sequences(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float,
+                      use_length: bool = True, det_format: str = "auto", *, note: Note = _silent,
+                      file_note: Note = _silent,
+                      status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()) -> int:
+    """The offline closed set over every sequence at ``path`` into its result file under ``output`` (outputs checked
+    writable first; ``use_length``: seqinfo.ini's seqLength bounds the frames); ``note``: the closed set's notes,
+    ``file_note``: what was assumed of a file's layout; returns the sequences written."""
+    from lookalike.pipeline.files import sequences_and_targets
+
+    sequences, targets = sequences_and_targets(path, output)
+    ensure_writable(targets)
+    for seq, target in zip(sequences, targets):
+        assert seq.det_path is not None
+        length = seq.length if use_length else None
+        det = table_rows(seq.det_path, min_score, length, f"seqLength in {seq.root / 'seqinfo.ini'}"
+                         if seq.root is not None else "the length", det_format, note=file_note)
+        n_frames = max((seq.length if use_length else None) or 0, int(det[:, 0].max(initial=0)))
+        with status(f"closed set of {n_targets} on {seq.name}"):
+            rows = closed_set_rows(det, n_targets, seq.frame_rate, n_frames, params, note=note)
+        write_mot(target, rows)
+    return len(sequences)
 
 
 def point_tracker(tracker: Any) -> Any:
@@ -113,5 +138,5 @@ def track_point_boxes(boxes: PointBoxes, output: Path, tracker: Any, frame_rate:
     return np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
 
 
-__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "PointBoxes", "closed_set_rows", "point_boxes", "point_tracker",
-           "read_points", "table_rows", "track_point_boxes"]
+__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "PointBoxes", "closed_set_rows", "offline_sequences", "point_boxes",
+           "point_tracker", "read_points", "table_rows", "track_point_boxes"]
