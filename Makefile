@@ -61,7 +61,7 @@ BENCH_VENV := .venv-bench
 $(BENCH_VENV)/.installed: pyproject.toml constraints-bench.txt
 	$(PYTHON) -m venv $(BENCH_VENV)
 	$(BENCH_VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt -e ".[vision,viz,bench,fast]"
+	$(BENCH_VENV)/bin/python -m pip install --quiet -c constraints-bench.txt -e ".[vision,viz,bench,fast,ros]"
 	touch $@
 
 # Peers whose declared requirements do not resolve next to numpy < 2 (trackers and boxmot ask numpy >= 2,

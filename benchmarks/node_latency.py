@@ -21,8 +21,9 @@ before it has read its clock (on 2 cores they did, in about half the frames).
 
 The node is run twice, one after the other: with the batched send (``serve --group``: one datagram
 per frame to a loopback multicast group that the robots and the subscriber join) and with one
-reply per robot plus the subscriber (8 sends a frame). ``--send group`` (or ``--group``) or
-``--send replies`` runs one of them only. ``--send dds`` runs the node on DDS with ROS 2's names
+reply per robot plus the subscriber (8 sends a frame), then, with the ``ros`` extra installed, on DDS (as ``make
+bench`` runs it). ``--send group`` (or ``--group``) or ``--send replies`` runs one of them only. ``--send dds`` runs the
+node on DDS with ROS 2's names
 (``serve --transport dds``, the ``ros`` extra) with the same team over DDS (each robot, the camera and the
 subscriber a participant of their own; the node's figures are those of its ``stopped`` log line), and
 ``--send group-dds`` the batched UDP run and then the DDS run, for a comparison on the same machine.
@@ -39,6 +40,7 @@ without those waits). With ``--send replies`` they are the per-robot run's, name
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import os
 import subprocess
 import sys
@@ -277,7 +279,8 @@ def main() -> None:
     parser.add_argument("--preset", default="m10n7")
     parser.add_argument("--seconds", type=float, default=20.0)
     parser.add_argument("--send", choices=("both", "group", "replies", "dds", "group-dds"), default="both",
-                        help="Batched multicast send (the targets), per-robot replies, or both one after the other; "
+                        help="Batched multicast send (the targets), per-robot replies, or both one after the "
+                        "other (and DDS with the ros extra); "
                         "dds: the node on DDS (ROS 2 names); group-dds: the batched UDP run, then the DDS run.")
     parser.add_argument("--group", action="store_true", help="The batched send only (as --send group).")
     args = parser.parse_args()
@@ -289,7 +292,10 @@ def main() -> None:
           f"M={sequence.config.max_detections}), {len(sequence)} frames at {sequence.config.frame_rate_hz:g} Hz")
     runs = {"both": (True, False), "group": (True,), "replies": (False,), "dds": (), "group-dds": (True,)}[args.send]
     results = {batched: node_run(sequence, args.tracker, batched) for batched in runs}
-    dds = dds_node_run(sequence, args.tracker) if args.send in ("dds", "group-dds") else None
+    if args.send == "both" and importlib.util.find_spec("cyclonedds") is None:
+        print("DDS run skipped: the 'ros' extra (cyclonedds) is not installed")
+    with_dds = args.send in ("dds", "group-dds") or (args.send == "both" and importlib.util.find_spec("cyclonedds"))
+    dds = dds_node_run(sequence, args.tracker) if with_dds else None
     load = os.getloadavg()[0]
     total, tracker, total_cpu = in_process(args.tracker, sequence)
     print(f"in process, no sockets: decode+identify+encode CPU time median {np.median(total_cpu):.3f} ms, "
