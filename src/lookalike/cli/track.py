@@ -5,16 +5,16 @@ from __future__ import annotations
 
 import math
 from contextlib import ExitStack
+from functools import partial
 from pathlib import Path
 from typing import Any
 
 import typer
 from rich.markup import escape
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn, TimeRemainingColumn
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from lookalike.cli.app import app, console, fail, failing, note, warn
 from lookalike.io.outputs import atomic_path
-from lookalike.io.stream import track_to_file
 from lookalike.loop import RunStats
 from lookalike.pipeline import files
 from lookalike.pipeline.files import dropped_all, input_error, sequences_and_targets
@@ -39,10 +39,6 @@ def build_tracker(name: str, settings: list[str], params_file: Path | None = Non
         return make_tracker(name, **params)
 
 
-_BAR_STEP = 25
-"""Frames between two moves of a sequence's progress bar."""
-
-
 def track_files(path: Path, output: Path, tracker: Any, min_score: float,
                 use_length: bool = True, det_format: str = "auto", name: str = "") -> tuple[int, RunStats]:
     """Track every sequence at ``path`` (a det.txt, a sequence folder or a folder of them) into ``output`` (a file
@@ -59,23 +55,14 @@ def track_files(path: Path, output: Path, tracker: Any, min_score: float,
                   console=console, transient=True) as progress:
         overall = progress.add_task("sequences", total=len(streams))
         for seq, frames, target in streams:
-            tracker.reset()
             task = progress.add_task(seq.name, total=frames.length)
-
-            def advance(f: Any, t: Any, task: TaskID = task) -> None:
-                if f.index % _BAR_STEP == _BAR_STEP - 1:  # the bar moves every _BAR_STEP frames
-                    progress.advance(task, _BAR_STEP)
-
-            try:
-                track_to_file(tracker, frames, target, advance, stats)
-            except ValueError as exc:
-                fail(f"{seq.name}: {input_error(exc)}")
-            except OSError as exc:
-                fail(f"output {target}: cannot write ({exc.strerror or exc})")
+            with failing(ValueError):
+                dropped = files.track_sequence(tracker, seq, frames, target, stats,
+                                               partial(progress.advance, task), name)
             progress.remove_task(task)
             progress.advance(overall)
-            if frames.rows and target.is_file() and target.stat().st_size == 0:
-                warn(dropped_all(name or type(tracker).__name__, seq.det_path, frames.rows, frames.scores))
+            if dropped is not None:
+                warn(dropped)
     return len(streams), stats
 
 

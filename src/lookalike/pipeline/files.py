@@ -10,11 +10,14 @@ from lookalike.io import find_sequences
 from lookalike.io.det_format import det_warnings
 from lookalike.io.needs import box_input_problem
 from lookalike.io.outputs import ensure_writable, result_paths
-from lookalike.io.stream import sequence_stream
+from lookalike.io.stream import sequence_stream, track_to_file
+from lookalike.loop import RunStats
 from lookalike.trackers import make_tracker, tracker_names, tracker_parameters
 from lookalike.trackers.registry import parse_parameter
 
 LENGTH_HINT = " (--no-seqinfo-length tracks every frame in the file)"
+BAR_STEP = 25
+"""Frames between two calls of :func:`track_sequence`'s ``advance``."""
 
 
 def tracker_params(name: str, settings: list[str], params_file: Path | None = None) -> dict[str, Any]:
@@ -90,5 +93,27 @@ def sequence_warnings(seq: Any, frames: Any, target: Path, warn: Callable[[str],
         warn(line)
 
 
-__all__ = ["box_tracker", "dropped_all", "input_error", "open_sequences", "sequence_warnings", "sequences_and_targets",
-           "tracker_params"]
+def track_sequence(tracker: Any, seq: Any, frames: Any, target: Path, stats: RunStats,
+                   advance: Callable[[int], None] | None = None, name: str = "") -> str | None:
+    """Track one of :func:`open_sequences`' streams (``seq``, ``frames``) into ``target`` with ``tracker`` reset,
+    adding to ``stats``; ``advance(BAR_STEP)`` every :data:`BAR_STEP` frames. Returns the warning for a tracker
+    (named ``name``) that wrote no tracks, else None; ``ValueError`` naming the sequence or the result file."""
+    tracker.reset()
+
+    def step(f: Any, t: Any) -> None:
+        if advance is not None and f.index % BAR_STEP == BAR_STEP - 1:
+            advance(BAR_STEP)
+
+    try:
+        track_to_file(tracker, frames, target, step, stats)
+    except ValueError as exc:
+        raise ValueError(f"{seq.name}: {input_error(exc)}") from exc
+    except OSError as exc:
+        raise ValueError(f"output {target}: cannot write ({exc.strerror or exc})") from exc
+    if frames.rows and target.is_file() and target.stat().st_size == 0:
+        return dropped_all(name or type(tracker).__name__, seq.det_path, frames.rows, frames.scores)
+    return None
+
+
+__all__ = ["BAR_STEP", "box_tracker", "dropped_all", "input_error", "open_sequences", "sequence_warnings",
+           "sequences_and_targets", "track_sequence", "tracker_params"]
