@@ -11,7 +11,7 @@ from rich.markup import escape
 
 from lookalike.cli.app import console, fail, failing
 from lookalike.cli.track import input_error
-from lookalike.io import write_mot
+from lookalike.io import MotTable, read_mot, write_mot
 from lookalike.pipeline import closed
 from lookalike.pipeline.closed import MAX_POINTS_PER_FRAME, POINTS_FPS, point_tracker, read_points
 
@@ -30,19 +30,6 @@ def _note(line: str) -> None:
 
 def _file_note(line: str) -> None:
     console.print(f"[cyan]note:[/] {escape(line)}", highlight=False)
-
-
-def table_rows(path: Path, min_score: float = float("-inf"), length: int | None = None,
-               length_name: str = "the length", det_format: str = "auto") -> np.ndarray:
-    """:func:`lookalike.pipeline.closed.table_rows`, what was assumed of the file's layout printed as a note."""
-    return closed.table_rows(path, min_score, length, length_name, det_format, note=_file_note)
-
-
-def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
-                    params: dict[str, Any], vel_noise: float | None = None,
-                    shapes: np.ndarray | None = None) -> np.ndarray:
-    """:func:`lookalike.pipeline.closed.closed_set_rows`, its note printed."""
-    return closed.closed_set_rows(det_rows, n_targets, frame_rate, n_frames, params, vel_noise, shapes, note=_note)
 
 
 def offline_files(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float,
@@ -66,21 +53,14 @@ def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: 
     ``shapes``: each row's blob shape vector), written to ``output``; with ``annotate``, its identities drawn on
     ``video`` into that MP4 (printed as ``annotate_as``)."""
     with failing(FileNotFoundError, ValueError):
-        rows = table_rows(det, min_score, det_format=det_format) if isinstance(det, Path) else \
-            det[det[:, 6] >= min_score]
-        shapes = shapes if shapes is not None and len(shapes) == len(rows) else None
-        with console.status(f"closed set of {n_targets}" + (", learning each one's look" if shapes is not None
-                                                             else "")):
-            rows = closed_set_rows(rows, n_targets, frame_rate, n_frames, params, shapes=shapes)
+        rows = closed.offline_rows(det, n_targets, params, frame_rate, n_frames, min_score, det_format, shapes,
+                                   note=_note, file_note=_file_note, status=console.status)
     write_mot(output, rows)
     console.print(f"[green]boxtrack[/], offline closed set of {n_targets}: {len(np.unique(rows[:, 1]))} "
                   f"identities, {len(rows)} rows at {frame_rate:g} frames/s → {output}")
     if annotate is not None and video is not None:
-        from lookalike.io import MotTable
-        from lookalike.viz.overlay import overlay_tracks
-
         with failing(ValueError, OSError), console.status("drawing the identities"):
-            overlay_tracks(video, MotTable.from_rows(rows), annotate, fps=frame_rate)
+            closed.draw_tracks(MotTable.from_rows(rows), annotate, frame_rate, video)
         console.print(f"annotated video → {escape(str(annotate_as or annotate))}")
 
 
@@ -105,15 +85,11 @@ def track_points(points_path: Path, output: Path, tracker: Any, tracker_name: st
     what = f"offline closed set of {n_targets}" if offline else "online"
     console.print(f"[green]{tracker_name}[/], {what}: {len(np.unique(rows[:, 1]))} identities → {escape(str(output))}")
     if annotate is not None:
-        from lookalike.io import read_mot
-        from lookalike.viz.overlay import blank_frames, overlay_tracks
-
         tracks = read_mot(output)
         with failing(ValueError, OSError), console.status("drawing the tracks"):
-            overlay_tracks(video if video is not None else blank_frames(tracks, boxes.frames), tracks, annotate,
-                           fps=frame_rate)
+            closed.draw_tracks(tracks, annotate, frame_rate, video, boxes.frames)
         console.print(f"annotated video → {escape(str(annotate_as or annotate))}")
 
 
-__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "closed_set_rows", "offline_files", "offline_video", "point_tracker",
-           "read_points", "table_rows", "track_points"]
+__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "check_result_file", "offline_files", "offline_video", "point_tracker",
+           "read_points", "track_points"]

@@ -86,6 +86,29 @@ def offline_sequences(path: Path, output: Path, n_targets: int, params: dict[str
     return len(sequences)
 
 
+def offline_rows(det: Path | np.ndarray, n_targets: int, params: dict[str, Any], frame_rate: float,
+                 n_frames: int | None, min_score: float, det_format: str = "auto", shapes: np.ndarray | None = None,
+                 *, note: Note = _silent, file_note: Note = _silent,
+                 status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()) -> np.ndarray:
+    """The offline closed set of ``n_targets`` over a video's detections ``det`` (a detection file, or rows a
+    detector found, with ``shapes``: each row's blob shape vector, used when there is one a row kept), those below
+    ``min_score`` dropped; ``frame_rate`` in frames/s. ``note`` and ``file_note`` as for :func:`offline_sequences`."""
+    rows = table_rows(det, min_score, det_format=det_format, note=file_note) if isinstance(det, Path) else \
+        det[det[:, 6] >= min_score]
+    shapes = shapes if shapes is not None and len(shapes) == len(rows) else None
+    with status(f"closed set of {n_targets}" + (", learning each one's look" if shapes is not None else "")):
+        return closed_set_rows(rows, n_targets, frame_rate, n_frames, params, shapes=shapes, note=note)
+
+
+def draw_tracks(tracks: MotTable, annotate: Path, frame_rate: float, video: Path | None = None,
+                frames: int = 0) -> None:
+    """Draw ``tracks`` on ``video`` (None: on ``frames`` white frames) into the MP4 ``annotate`` at ``frame_rate``
+    frames/s."""
+    from lookalike.viz.overlay import blank_frames, overlay_tracks
+
+    overlay_tracks(video if video is not None else blank_frames(tracks, frames), tracks, annotate, fps=frame_rate)
+
+
 def point_tracker(tracker: Any) -> Any:
     """``tracker`` for points as boxes: a ``boxtrack`` rebuilt with the points' velocity noise; others unchanged."""
     return BoxTrack(tracker.config, vel_noise=POINT_VEL_NOISE) if isinstance(tracker, BoxTrack) else tracker
@@ -138,5 +161,5 @@ def track_point_boxes(boxes: PointBoxes, output: Path, tracker: Any, frame_rate:
     return np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
 
 
-__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "PointBoxes", "closed_set_rows", "offline_sequences", "point_boxes",
-           "point_tracker", "read_points", "table_rows", "track_point_boxes"]
+__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "PointBoxes", "closed_set_rows", "draw_tracks", "offline_rows",
+           "offline_sequences", "point_boxes", "point_tracker", "read_points", "table_rows", "track_point_boxes"]
