@@ -19,12 +19,12 @@ from lookalike.pipeline.video import (
     VideoDetections,
     as_written,
     check_features,
+    open_onnx,
     prepare_video,
     threshold_hint,
     write_video_result,
 )
 from lookalike.trackers.parts.health import HealthConfig
-from lookalike.viz.overlay import source_frames
 from lookalike.viz.video_tracking import track_video
 
 __all__ = ["run_track_onnx", "run_track_video", "save_detections"]
@@ -87,30 +87,22 @@ def run_track_onnx(video: Path, output: Path, tracker: Any, tracker_name: str, m
     """``track --video V --detector FILE.onnx``: detect with the ONNX model (``settings``: ``KEY=VALUE``; the boxes
     saved to ``options["save_detections"]`` when given), then track as :func:`run_track_video` (given ``options``)
     or, with ``offline``, by the offline closed set of ``n_targets``."""
-    import time
-
-    from lookalike.vision.onnx_detector import OnnxDetector, config_from_settings, detect_frames
-
     check_result_file(output, video)
-    if not model.is_file():
-        fail(f"--detector: {model} does not exist")
     with failing(ValueError, OSError):
-        detector = OnnxDetector(model, config_from_settings(settings))
-        images, total, rate = source_frames(video)
+        run = open_onnx(video, model, settings)
         with bars("detecting {task.description}") as progress:
-            task = progress.add_task(video.name, total=total or None)
-            t0 = time.perf_counter()
-            rows, frames = detect_frames(images, detector, advance=lambda: progress.advance(task))
-            seconds = time.perf_counter() - t0
+            task = progress.add_task(video.name, total=run.total or None)
+            rows, frames, seconds = run.detect(advance=lambda: progress.advance(task))
     speed = f"{frames / seconds:,.1f} frames/s" if seconds > 0 else "inf frames/s"
-    console.print(f"{model.name} ({detector.layout}, input {detector.input_size[0]}x{detector.input_size[1]}): "
+    width, height = run.detector.input_size
+    console.print(f"{model.name} ({run.detector.layout}, input {width}x{height}): "
                   f"{len(rows)} boxes in {frames} frames, {speed}" + save_detections(rows, options))
     if len(rows) < 2:
         fail(f"{video}: the detector {model.name} found {len(rows)} box(es); try a lower score=... setting")
     rows = as_written(rows)  # (tracked as a saved detection file would be: boxes to 1/1000 px, scores to 6 digits)
     if offline is not None:
         assert n_targets is not None
-        offline_video(rows, output, n_targets, offline, float(options.get("fps") or rate), frames,
+        offline_video(rows, output, n_targets, offline, float(options.get("fps") or run.rate), frames,
                       options["min_score"])
     else:
         run_track_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, length=frames, **options)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import io
 import itertools
+import time
 from collections.abc import Callable, Iterable
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
@@ -123,5 +124,37 @@ def as_written(rows: np.ndarray) -> np.ndarray:
     return np.loadtxt(io.StringIO(format_rows(rows)), delimiter=",", ndmin=2).reshape(-1, 10)
 
 
-__all__ = ["FEATURE_CHOICES", "VideoDetections", "VideoInput", "as_written", "check_features", "prepare_video",
-           "threshold_hint", "write_video_result"]
+@dataclass
+class OnnxRun:
+    """An ONNX ``detector`` (:class:`lookalike.vision.onnx_detector.OnnxDetector`) opened on a video's ``images``
+    (``total`` frames, 0: unknown; ``rate``: its frame rate, frames/s)."""
+
+    detector: Any
+    images: Iterable[np.ndarray]
+    total: int
+    rate: float
+
+    def detect(self, advance: Callable[[], None] | None = None) -> tuple[np.ndarray, int, float]:
+        """The detection rows found in every frame (as :func:`lookalike.vision.onnx_detector.detect_frames`), the
+        frames read and the seconds it took; ``advance`` after each frame."""
+        from lookalike.vision.onnx_detector import detect_frames
+
+        t0 = time.perf_counter()
+        rows, frames = detect_frames(self.images, self.detector, advance=advance)
+        return rows, frames, time.perf_counter() - t0
+
+
+def open_onnx(video: Path, model: Path, settings: list[str]) -> OnnxRun:
+    """The ONNX ``model`` (``settings``: its ``KEY=VALUE``) opened on ``video``; ``ValueError`` naming ``--detector``
+    when the model is missing, ``ValueError``/``OSError`` for a bad model or video."""
+    from lookalike.vision.onnx_detector import OnnxDetector, config_from_settings
+
+    if not model.is_file():
+        raise ValueError(f"--detector: {model} does not exist")
+    detector = OnnxDetector(model, config_from_settings(settings))
+    images, total, rate = source_frames(video)
+    return OnnxRun(detector, images, total, rate)
+
+
+__all__ = ["FEATURE_CHOICES", "OnnxRun", "VideoDetections", "VideoInput", "as_written", "check_features", "open_onnx",
+           "prepare_video", "threshold_hint", "write_video_result"]
