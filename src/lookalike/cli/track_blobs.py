@@ -14,14 +14,12 @@ from lookalike.cli.progress import progress_bars
 from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.cli.track_video import run_track_onnx, run_track_video, save_detections
 from lookalike.io import MotTable
-from lookalike.pipeline.blobs import blob_tracker, estimate_lines, one_pass
+from lookalike.pipeline.blobs import blob_source, blob_tracker, estimate_lines
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, frame_counts
 from lookalike.viz.blob_video import (
     BlobRows,
-    BlobStream,
     auto_blob_config,
     cached_blob_detections,
-    load_blob_detections,
     store_blob_detections,
 )
 from lookalike.viz.overlay import source_frames
@@ -59,10 +57,8 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
             console.print(line, markup=False)
         _, declared, source_rate = source_frames(video)
         frame_rate = options.get("fps") or source_rate
-        found = load_blob_detections(video, config)
-        stream = BlobStream(video, config, options["min_score"]) if found is None and offline is None and \
-            one_pass(tracker, tracker_name, explicit, n_targets, options.get("annotate") is not None,
-                     options.get("features", "video")) else None
+        found, stream = blob_source(video, config, tracker, tracker_name, explicit, n_targets, offline is not None,
+                                    options)
         if found is None and stream is None:
             found = _detect_with_progress(video, config, declared)
     saved = options.pop("save_detections", None)

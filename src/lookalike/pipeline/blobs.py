@@ -4,6 +4,7 @@ tracking pass, and the tracker set for them."""
 from __future__ import annotations
 
 from collections.abc import Collection
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -11,6 +12,7 @@ import numpy as np
 from lookalike.io.needs import input_kind
 from lookalike.vision.blob_auto import BlobEstimate
 from lookalike.vision.blob_boxtrack import blob_boxtrack_config
+from lookalike.viz.blob_video import BlobRows, BlobStream, load_blob_detections
 
 
 def one_pass(tracker: Any, tracker_name: str, explicit: Collection[str], n_targets: int | None, annotate: bool,
@@ -33,6 +35,20 @@ def blob_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: 
     return (type(tracker)(plan.config) if plan.config != tracker.config else tracker), summary, plan.n_targets
 
 
+def blob_source(video: Path, config: Any, tracker: Any, tracker_name: str, explicit: Collection[str],
+                n_targets: int | None, offline: bool,
+                options: dict[str, Any]) -> tuple[BlobRows | None, BlobStream | None]:
+    """The blob detections of ``video`` stored for ``config``, else a stream that finds them in the tracking pass
+    when :func:`one_pass` says so (never ``offline``), else neither (they are found first); ``options``: the
+    ``min_score``, ``annotate`` and ``features`` the video is tracked with."""
+    found = load_blob_detections(video, config)
+    if found is None and not offline and one_pass(tracker, tracker_name, explicit, n_targets,
+                                                  options.get("annotate") is not None,
+                                                  options.get("features", "video")):
+        return None, BlobStream(video, config, options["min_score"])
+    return found, None
+
+
 def estimate_lines(estimate: BlobEstimate, settings: list[str]) -> list[str]:
     """The lines telling the blob settings estimated from the video and those given with ``--blob``."""
     given = {s.partition("=")[0].strip() for s in settings}
@@ -41,4 +57,4 @@ def estimate_lines(estimate: BlobEstimate, settings: list[str]) -> list[str]:
     return lines + ([f"  given with --blob: {', '.join(sorted(given))}"] if given else [])
 
 
-__all__ = ["blob_tracker", "estimate_lines", "one_pass"]
+__all__ = ["blob_source", "blob_tracker", "estimate_lines", "one_pass"]
