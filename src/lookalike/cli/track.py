@@ -17,12 +17,11 @@ from lookalike.cli.app import app, console, fail, failing, note, warn
 from lookalike.io.outputs import atomic_path
 from lookalike.loop import RunStats
 from lookalike.pipeline import files
-from lookalike.pipeline.files import dropped_all, input_error, sequences_and_targets
+from lookalike.pipeline.files import input_error
 from lookalike.pipeline.request import TrackRequest
 from lookalike.trackers import make_tracker
 
-__all__ = ["build_tracker", "dropped_all", "input_error", "sequences_and_targets", "track", "track_files",
-           "tracker_params"]
+__all__ = ["build_tracker", "track", "track_files", "tracker_params"]
 
 
 def tracker_params(name: str, settings: list[str], params_file: Path | None = None) -> dict[str, Any]:

@@ -90,11 +90,9 @@ def run_track_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, 
 
 def _blob_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: Collection[str],
                   n_targets: int | None, options: dict[str, Any]) -> Any:
-    """:func:`lookalike.pipeline.blobs.blob_tracker`, a count inferred printed; a known count becomes
-    ``options["team_size"]`` unless given."""
-    tracker, summary, known = blob_tracker(tracker, tracker_name, counts, explicit, n_targets)
+    """:func:`lookalike.pipeline.blobs.blob_tracker`, a count inferred printed; the team size set in ``options``."""
+    tracker, summary, options["team_size"] = blob_tracker(tracker, tracker_name, counts, explicit, n_targets,
+                                                          options.get("team_size"))
     if summary is not None:
         console.print(summary, markup=False)
-    if known and options.get("team_size") is None:
-        options["team_size"] = known
     return tracker

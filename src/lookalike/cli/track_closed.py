@@ -10,10 +10,10 @@ import numpy as np
 from rich.markup import escape
 
 from lookalike.cli.app import console, fail, failing
-from lookalike.cli.track import input_error
 from lookalike.io import MotTable, read_mot, write_mot
 from lookalike.pipeline import closed
 from lookalike.pipeline.closed import MAX_POINTS_PER_FRAME, POINTS_FPS, point_tracker, read_points
+from lookalike.pipeline.files import input_error
 
 
 def check_result_file(output: Path, video: Path | None = None) -> None:

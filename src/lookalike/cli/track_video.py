@@ -11,10 +11,8 @@ from rich.markup import escape
 
 from lookalike.cli.app import console, fail, failing, note, warn
 from lookalike.cli.progress import bars
-from lookalike.cli.track import dropped_all
 from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.io import MotTable, write_mot
-from lookalike.io.det_format import box_stats
 from lookalike.pipeline.video import (
     VideoDetections,
     as_written,
@@ -66,9 +64,9 @@ def run_track_video(video: Path, detections: VideoDetections, output: Path, trac
                       + (f" ({escape(str(annotate_as or annotate))} is left as it was)." if annotate else "."))
         raise SystemExit(130) from None
     written = write_video_result(output, result, tracker)
-    if len(found.table) and not len(result.rows):
-        scores = box_stats(found.table.xywh, found.table.conf, None)[0]
-        warn(dropped_all(tracker_name, found.name, len(found.table), scores))
+    dropped = found.dropped_all(result, tracker_name)
+    if dropped is not None:
+        warn(dropped)
     if annotate is not None:
         written.append(annotate_as or annotate)
     unhealthy = sum(not s.healthy for s in result.health)

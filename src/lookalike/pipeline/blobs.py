@@ -25,14 +25,16 @@ def one_pass(tracker: Any, tracker_name: str, explicit: Collection[str], n_targe
 
 
 def blob_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: Collection[str],
-                 n_targets: int | None) -> tuple[Any, str | None, int | None]:
+                 n_targets: int | None, team_size: int | None = None) -> tuple[Any, str | None, int | None]:
     """``tracker`` set for blob detections (``boxtrack`` only; ``counts``: blobs per frame, for a count inferred), the
-    summary of a count inferred (None if none) and the number of targets when known."""
+    summary of a count inferred (None if none) and the health checks' team size: ``team_size`` when given, else the
+    number of targets when known."""
     if tracker_name != "boxtrack":
-        return tracker, None, None
+        return tracker, None, team_size
     plan = blob_boxtrack_config(tracker.config, counts, explicit, n_targets)
     summary = plan.count.summary if plan.count is not None else None
-    return (type(tracker)(plan.config) if plan.config != tracker.config else tracker), summary, plan.n_targets
+    team_size = team_size if team_size is not None else plan.n_targets or None
+    return (type(tracker)(plan.config) if plan.config != tracker.config else tracker), summary, team_size
 
 
 def blob_source(video: Path, config: Any, tracker: Any, tracker_name: str, explicit: Collection[str],

@@ -20,6 +20,7 @@ from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
 from lookalike.io.motchallenge import format_rows
 from lookalike.io.needs import input_kind
 from lookalike.io.outputs import atomic_path
+from lookalike.pipeline.files import dropped_all
 from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
 from lookalike.viz.overlay import source_frames
 from lookalike.viz.video import video_info
@@ -56,6 +57,13 @@ class VideoInput:
         scores, outside = box_stats(self.table.xywh, self.table.conf, self.size)
         return det_warnings(self.name, len(self.table), scores if score_warnings else None, outside, self.size,
                             f"the frames of {video}")
+
+    def dropped_all(self, result: VideoTrackingResult, tracker_name: str) -> str | None:
+        """The warning for a tracker that wrote no tracks from these detections, else None."""
+        if not len(self.table) or len(result.rows):
+            return None
+        scores = box_stats(self.table.xywh, self.table.conf, None)[0]
+        return dropped_all(tracker_name, self.name, len(self.table), scores)
 
 
 def check_features(features: str) -> None:
