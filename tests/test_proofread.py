@@ -135,6 +135,61 @@ def test_conflicting_constraints_raise():
         assign_identities(on, 2, 10, constraints=ChainConstraints(identity=(((5, 1), 3),)))
 
 
+def _chain_sets(n: int, nxt: dict[int, list[int]], n_chains: int):
+    """Every set of at most ``n_chains`` disjoint chains over the links ``nxt`` (tracklet -> later tracklets)."""
+    def paths(i: int):
+        yield [i]
+        for j in nxt.get(i, []):
+            for rest in paths(j):
+                yield [i, *rest]
+
+    every = [p for i in range(n) for p in paths(i)]
+
+    def pick(start: int, used: frozenset[int], left: int):
+        yield []
+        for k in range(start, len(every)) if left else ():
+            if not used & set(every[k]):
+                for more in pick(k + 1, used | set(every[k]), left - 1):
+                    yield [every[k], *more]
+
+    return pick(0, frozenset(), n_chains)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_marked_chains_are_the_best_chains_that_hold_the_marks(seed: int):
+    """solve_chains with marks (one chain holds each mark's ``on`` and none of its ``off``) against every chain set."""
+    from lookalike.trackers.offline.closed_set import solve_chains
+
+    rng = np.random.default_rng(seed)
+    n = 7
+    pairs = [(i, j) for i in range(n) for j in range(i + 1, n) if rng.random() < 0.45]
+    src, dst = (np.array(x, int) for x in zip(*pairs))
+    cost = rng.uniform(0, 6, len(pairs))
+    lengths, start, end = rng.uniform(1, 10, n), rng.uniform(0, 3, n), rng.uniform(0, 3, n)
+    on_a, on_b = sorted(rng.choice(n, 2, replace=False).tolist()), [int(rng.integers(n))]
+    marks = [(on_a, [t for t in rng.choice(n, 2, replace=False).tolist() if t not in on_a]), (on_b, [])]
+    nxt: dict[int, list[int]] = {}
+    price = {}
+    for s_, d_, c_ in zip(src.tolist(), dst.tolist(), cost.tolist()):
+        nxt.setdefault(s_, []).append(d_)
+        price[(s_, d_)] = c_
+
+    def value(chains: list[list[int]]) -> float:
+        return sum(-(lengths[t] - 2.0) for ch in chains for t in ch) + sum(
+            price[p] for ch in chains for p in zip(ch[:-1], ch[1:])) + sum(start[ch[0]] + end[ch[-1]] for ch in chains)
+
+    def holds(chains: list[list[int]]) -> bool:
+        return all(any(set(on) <= set(ch) and not set(off) & set(ch) for ch in chains) for on, off in marks)
+
+    best = min((value(c) for c in _chain_sets(n, nxt, 2) if holds(c)), default=None)
+    if best is None:
+        with pytest.raises(ValueError, match="cannot all hold"):
+            solve_chains(lengths, (src, dst, cost), 2, 2.0, 60.0, start, end, marks)
+        return
+    chains = solve_chains(lengths, (src, dst, cost), 2, 2.0, 60.0, start, end, marks)
+    assert holds(chains) and value(chains) == pytest.approx(best)
+
+
 @pytest.mark.parametrize("propagate", [False, True])
 def test_replayed_log_gives_the_same_rows(tmp_path, propagate: bool):
     on = _crossing()

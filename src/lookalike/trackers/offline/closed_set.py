@@ -65,8 +65,9 @@ def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.nd
     conservation ``a_i + Σ_j y_ji = x_i = b_i + Σ_j y_ij`` and ``Σ a_i ≤ n_chains``.
 
     Each of ``marks`` is ``(on, off)``: one chain carries the mark, it holds every tracklet of ``on`` and none of
-    ``off`` (per mark, ``z_i`` marks tracklet ``i``: equal across a used link, ``z_i ≤ x_i``, and at most one chain
-    head marked). Tracklets in ``excluded`` are on no chain. Raises ValueError when the constraints cannot all hold."""
+    ``off`` (per mark, one unit of flow along the used links, from a chain head to a chain end, through every ``on``
+    and over only the tracklets linked to and from each of them: :func:`~.constraints.with_marks`). Tracklets in
+    ``excluded`` are on no chain. Raises ValueError when the constraints cannot all hold."""
     n = len(lengths)
     src, dst, cost = links
     m = len(src)

@@ -1,7 +1,7 @@
 """Constraints on the offline closed set from a proofreader (:class:`ChainConstraints`), and how they enter
-:func:`lookalike.trackers.offline.closed_set.solve_chains`' MILP as marks: per mark, a binary per tracklet (marked),
-equal across every used link, with at most one marked chain head, so exactly the chain holding the mark's tracklets
-carries it. Frames 1-based; rows named ``(frame, input id)``."""
+:func:`lookalike.trackers.offline.closed_set.solve_chains`' MILP as marks: per mark, one unit of flow along the chain
+that holds the mark's tracklets, over only the tracklets that can share a chain with them. Frames 1-based; rows named
+``(frame, input id)``."""
 
 from __future__ import annotations
 
@@ -39,44 +39,75 @@ class ChainConstraints:
         return [r for r, _ in self.identity] + [r for pair in self.apart for r in pair] + list(self.clutter)
 
 
+def _reach(n: int, src: np.ndarray, dst: np.ndarray, start: int) -> np.ndarray:
+    """Whether each of ``n`` tracklets can be reached from ``start`` along the links ``src -> dst`` (itself too)."""
+    from scipy import sparse
+    from scipy.sparse.csgraph import breadth_first_order
+
+    graph = sparse.csr_matrix((np.ones(len(src)), (src, dst)), shape=(n, n))
+    seen = np.zeros(n, bool)
+    seen[breadth_first_order(graph, start, return_predecessors=False)] = True
+    return seen
+
+
 def with_marks(A: Any, lo: np.ndarray, hi: np.ndarray, c: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-                n: int, links: tuple[np.ndarray, np.ndarray],
-                marks: Sequence[tuple[Collection[int], Collection[int]]]) -> tuple[Any, ...]:
+               n: int, links: tuple[np.ndarray, np.ndarray],
+               marks: Sequence[tuple[Collection[int], Collection[int]]]) -> tuple[Any, ...]:
     """The chain problem of :func:`~lookalike.trackers.offline.closed_set.solve_chains` (constraint matrix ``A``,
-    bounds ``lo``/``hi``, costs ``c``, variable bounds ``lower``/``upper``; ``n`` tracklets, ``links`` ``(src, dst)``)
-    with, per mark, variables ``z`` (tracklet marked) and ``h`` (chain head marked) after the ``4n + m`` of the
-    chains, and their constraints."""
+    bounds ``lo``/``hi``, costs ``c``, variable bounds ``lower``/``upper``; ``n`` tracklets, ``links`` ``(src, dst)``,
+    forward in time) with, per mark, one unit of flow along the chain that carries it, after the ``4n + m`` variables
+    of the chains: over the tracklets that can share a chain with all of its ``on`` and are not ``off`` (linked to or
+    from each), ``h``/``t`` (the flow starts/ends there: at most ``a``/``b``) and ``f`` per link between two of them
+    (at most ``y``); conserved at each, ``Σ h ≤ 1``, and one unit through each ``on``."""
     from scipy import sparse
 
     src, dst = links
     m = len(src)
-    base = A.shape[1]
-    blocks, los, his = [], [], []
-    for k in range(len(marks)):
-        z0 = base + 2 * n * k  # z [z0, z0+n), h [z0+n, z0+2n)
-        e = np.arange(m)
-        # a used link joins two equally marked tracklets: z_s - z_d + y ≤ 1 and z_d - z_s + y ≤ 1
-        r = np.r_[e, e, e, m + e, m + e, m + e]
-        col = np.r_[z0 + src, z0 + dst, n + e, z0 + dst, z0 + src, n + e]
-        val = np.r_[np.ones(m), -np.ones(m), np.ones(m), np.ones(m), -np.ones(m), np.ones(m)]
-        i = np.arange(n)
-        # z_i - x_i ≤ 0; a_i + z_i - h_i ≤ 1; Σ h ≤ 1
-        r = np.r_[r, 2 * m + i, 2 * m + i, 2 * m + n + i, 2 * m + n + i, 2 * m + n + i, np.full(n, 2 * m + 2 * n)]
-        col = np.r_[col, z0 + i, i, n + m + i, z0 + i, z0 + n + i, z0 + n + i]
-        val = np.r_[val, np.ones(n), -np.ones(n), np.ones(n), np.ones(n), -np.ones(n), np.ones(n)]
-        width = base + 2 * n * len(marks)
-        blocks.append(sparse.csr_matrix((val, (r, col)), shape=(2 * m + 2 * n + 1, width)))
-        los.append(np.full(2 * m + 2 * n + 1, -np.inf))
-        his.append(np.r_[np.ones(2 * m), np.zeros(n), np.ones(n), 1.0])
-    extra = 2 * n * len(marks)
-    A = sparse.vstack([sparse.hstack([A, sparse.csr_matrix((A.shape[0], extra))]), *blocks]).tocsr()
-    lower = np.r_[lower, np.zeros(extra)]
-    upper = np.r_[upper, np.ones(extra)]
-    for k, (on, off) in enumerate(marks):
-        z0 = base + 2 * n * k
-        lower[[z0 + t for t in on]] = 1.0
-        upper[[z0 + t for t in off]] = 0.0
-    return A, np.concatenate([lo, *los]), np.concatenate([hi, *his]), np.r_[c, np.zeros(extra)], lower, upper
+    blocks: list[Any] = []
+    los, his, lows, ups = [lo], [hi], [lower], [upper]
+    width = A.shape[1]
+    for on, off in marks:
+        if set(on) & set(off):
+            raise ValueError("constraint: a tracklet both carries a mark and does not")
+        keep = np.ones(n, bool)
+        for t in on:
+            keep &= _reach(n, src, dst, t) | _reach(n, dst, src, t)
+        keep[list(off)] = False
+        keep[list(on)] = True  # two of them on no common chain: no flow goes through both below
+        nodes = np.flatnonzero(keep)
+        k = len(nodes)
+        edges = np.flatnonzero(keep[src] & keep[dst])
+        e = len(edges)
+        at = np.full(n, -1)
+        at[nodes] = np.arange(k)
+        f0, h0, t0 = width, width + e, width + e + k  # f [f0, f0+e), h [h0, h0+k), t [t0, t0+k)
+        s, d = at[src[edges]], at[dst[edges]]
+        ie, ik = np.arange(e), np.arange(k)
+        # rows: conservation h + Σ f_in - t - Σ f_out = 0 (k); f - y ≤ 0 (e); h - a ≤ 0, t - b ≤ 0 (2k); Σ h ≤ 1;
+        # through each `on`: h + Σ f_in = 1
+        on_at = at[list(on)]
+        io = np.arange(len(on_at))
+        r0 = k + e + 2 * k + 1
+        into = np.isin(d, on_at)
+        pos = {int(v): q for q, v in enumerate(on_at)}
+        r = np.r_[ik, d, ik, s, k + ie, k + ie, k + e + ik, k + e + ik, k + e + k + ik, k + e + k + ik,
+                  np.full(k, k + e + 2 * k), r0 + io, r0 + np.array([pos[int(v)] for v in d[into]], int)]
+        col = np.r_[h0 + ik, f0 + ie, t0 + ik, f0 + ie, f0 + ie, n + edges, h0 + ik, n + m + nodes, t0 + ik,
+                    2 * n + m + nodes, h0 + ik, h0 + on_at, f0 + ie[into]]
+        val = np.r_[np.ones(k), np.ones(e), -np.ones(k), -np.ones(e), np.ones(e), -np.ones(e), np.ones(k), -np.ones(k),
+                    np.ones(k), -np.ones(k), np.ones(k), np.ones(len(on_at)), np.ones(int(into.sum()))]
+        rows = r0 + len(on_at)
+        blocks.append((r, col, val, rows))
+        los.append(np.r_[np.zeros(k), np.full(e + 2 * k + 1, -np.inf), np.ones(len(on_at))])
+        his.append(np.r_[np.zeros(k), np.zeros(e + 2 * k), 1.0, np.ones(len(on_at))])
+        lows.append(np.zeros(e + 2 * k))
+        ups.append(np.ones(e + 2 * k))
+        width += e + 2 * k
+    extra = width - A.shape[1]
+    mats = [sparse.csr_matrix((val, (r, col)), shape=(rows, width)) for r, col, val, rows in blocks]
+    A = sparse.vstack([sparse.hstack([A, sparse.csr_matrix((A.shape[0], extra))]), *mats]).tocsr()
+    return A, np.concatenate(los), np.concatenate(his), np.r_[c, np.zeros(extra)], np.concatenate(lows), \
+        np.concatenate(ups)
 
 
 def cut_tracklets(pieces: list[Tracklet], cuts: Sequence[Row]) -> list[Tracklet]:
