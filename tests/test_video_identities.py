@@ -115,3 +115,26 @@ def test_nothing_to_learn_from_a_lone_animal_and_shapes_must_match_the_detection
     assert fit_identity_space([Tracklet(one, 1)], shapes) is None
     with pytest.raises(ValueError, match="shapes"):
         track_closed_set(rows, 2, 25.0, shapes=shapes[:-1])
+
+
+def test_concurrent_pairs_and_single_rows_scale_to_long_videos_with_the_same_answers():
+    from lookalike.trackers.offline.appearance import _concurrent_pairs
+
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        n = int(rng.integers(0, 30))
+        first = rng.integers(0, 100, n)
+        last = first + rng.integers(0, 20, n)
+        a, b = np.nonzero((first[:, None] <= last[None]) & (first[None] <= last[:, None]))
+        assert _concurrent_pairs(first, last) == sorted((i, j) for i, j in zip(a.tolist(), b.tolist()) if i < j)
+    rows = np.zeros((3000, 10))
+    rows[:, 1] = rng.integers(0, 40, len(rows))
+    rows[:, SHAPE_COLUMN] = np.arange(len(rows))
+    shapes = np.zeros((len(rows), SHAPE_SIZE))
+    shapes[:, 0] = np.log(rng.uniform(150, 500, len(rows)))
+    area = np.exp(shapes[:, 0])
+    expected = np.zeros(len(rows), bool)
+    for i in np.unique(rows[:, 1]):
+        sel = rows[:, 1] == i
+        expected[sel] = (area[sel] >= 0.6 * np.median(area[sel])) & (area[sel] <= 1.5 * np.median(area[sel]))
+    assert np.array_equal(single_rows(rows, shapes), expected)

@@ -31,8 +31,11 @@ def single_rows(rows: np.ndarray, shapes: np.ndarray) -> np.ndarray:
     """Mask of the input ``rows`` (column 9 indexing ``shapes``, ``(k, SHAPE_SIZE)``) whose blob area is that of one
     animal: within :data:`SINGLE_AREA` of the median area of the rows of the same input id."""
     area = np.exp(shapes[rows[:, SHAPE_COLUMN].astype(int), 0])
-    ids, which = np.unique(rows[:, 1], return_inverse=True)
-    typical = np.array([np.median(area[which == k]) for k in range(len(ids))])[which] if len(ids) else area
+    order = np.argsort(rows[:, 1], kind="stable")
+    starts = np.flatnonzero(np.r_[True, np.diff(rows[order, 1]) != 0])
+    medians = [np.median(block) for block in np.split(area[order], starts[1:])] if len(rows) else []
+    typical = np.empty_like(area)
+    typical[order] = np.repeat(medians, np.diff(np.r_[starts, len(rows)])) if len(rows) else area
     mask: np.ndarray = (area >= SINGLE_AREA[0] * typical) & (area <= SINGLE_AREA[1] * typical)
     return mask
 
@@ -84,6 +87,17 @@ class IdentitySpace:
         return math.log(((1 - OUTLIER) * odds + OUTLIER) / ((1 - OUTLIER) + OUTLIER * odds))
 
 
+def _concurrent_pairs(first: np.ndarray, last: np.ndarray) -> list[tuple[int, int]]:
+    """Pairs ``(i, j)``, ``i < j``, of frame spans ``[first, last]`` that share a frame (a sweep over the starts)."""
+    order = np.argsort(first, kind="stable")
+    starts = first[order]
+    pairs = []
+    for k, i in enumerate(order.tolist()):
+        for j in order[k + 1:np.searchsorted(starts, last[i], side="right")].tolist():
+            pairs.append((min(i, j), max(i, j)))
+    return sorted(pairs)
+
+
 def _scatter(groups: list[np.ndarray]) -> np.ndarray:
     centred = np.vstack([g - g.mean(axis=0) for g in groups])
     dof = sum(len(g) - 1 for g in groups)
@@ -99,10 +113,7 @@ def fit_identity_space(tracklets: list[Tracklet], shapes: np.ndarray) -> Identit
     long = [t for t in tracklets if len(t) >= MIN_ROWS]
     if len(long) < 2:
         return None
-    first = np.array([t.first for t in long])
-    last = np.array([t.last for t in long])
-    a, b = np.nonzero((first[:, None] <= last[None]) & (first[None] <= last[:, None]))
-    pairs = [(i, j) for i, j in zip(a.tolist(), b.tolist()) if i < j]
+    pairs = _concurrent_pairs(np.array([t.first for t in long]), np.array([t.last for t in long]))
     if not pairs:
         return None
     raw = [shapes[t.rows[:, SHAPE_COLUMN].astype(int)] for t in long]
