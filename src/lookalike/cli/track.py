@@ -19,7 +19,6 @@ from lookalike.loop import RunStats
 from lookalike.pipeline import files
 from lookalike.pipeline.files import input_error
 from lookalike.pipeline.request import TrackRequest
-from lookalike.trackers import make_tracker
 
 __all__ = ["build_tracker", "track", "track_files", "tracker_params"]
 
@@ -31,11 +30,9 @@ def tracker_params(name: str, settings: list[str], params_file: Path | None = No
 
 
 def build_tracker(name: str, settings: list[str], params_file: Path | None = None) -> Any:
-    """A tracker from its name, an optional parameter file and ``KEY=VALUE`` settings (which win),
-    failing with a readable message."""
-    params = tracker_params(name, settings, params_file)
+    """:func:`lookalike.pipeline.files.build_tracker`, failing with a readable message."""
     with failing(ValueError, TypeError):
-        return make_tracker(name, **params)
+        return files.build_tracker(name, settings, params_file)
 
 
 def track_files(path: Path, output: Path, tracker: Any, min_score: float,

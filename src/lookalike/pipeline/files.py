@@ -33,6 +33,12 @@ def tracker_params(name: str, settings: list[str], params_file: Path | None = No
     return {**base, **dict(parse_parameter(name, s) for s in settings)}
 
 
+def build_tracker(name: str, settings: list[str], params_file: Path | None = None) -> Any:
+    """A tracker from its name, an optional ``lookalike tune`` parameter file and ``KEY=VALUE`` settings (which win);
+    ``ValueError`` or ``TypeError`` with a readable message."""
+    return make_tracker(name, **tracker_params(name, settings, params_file))
+
+
 def box_tracker(name: str, settings: list[str], *, video: bool = False, targets: int | None = None,
                 params_file: Path | None = None) -> Any:
     """A tracker that can run on boxes (``video``: from a video's detections), ``targets`` its ``max_targets``;
@@ -41,7 +47,7 @@ def box_tracker(name: str, settings: list[str], *, video: bool = False, targets:
         if "max_targets" not in {p.name for p in tracker_parameters(name)}:
             raise ValueError(f"--targets: tracker {name!r} has no closed-set mode (max_targets); use -t boxtrack")
         settings = [*settings, f"max_targets={targets}"]
-    tracker = make_tracker(name, **tracker_params(name, settings, params_file))
+    tracker = build_tracker(name, settings, params_file)
     problem = box_input_problem(name, video=video)
     if problem is not None:
         raise ValueError(problem)
@@ -115,5 +121,5 @@ def track_sequence(tracker: Any, seq: Any, frames: Any, target: Path, stats: Run
     return None
 
 
-__all__ = ["BAR_STEP", "box_tracker", "dropped_all", "input_error", "open_sequences", "sequence_warnings",
-           "sequences_and_targets", "track_sequence", "tracker_params"]
+__all__ = ["BAR_STEP", "box_tracker", "build_tracker", "dropped_all", "input_error", "open_sequences",
+           "sequence_warnings", "sequences_and_targets", "track_sequence", "tracker_params"]
