@@ -18,8 +18,8 @@ Data: the pig dev video with ``--targets 23`` (the closed set's rules were refin
 simulated 5-animal point arenas (``closed_points.arena``, seeds 200-219, never used for any choice; the proofreader's
 mechanics were debugged on seeds 0-9) and the 14 annotated HexBug clips through the blob detector with ``--targets N``
 (N: the clip's annotated count); and 8-animal hard arenas (``HARD``: faster, 10% missed, 0.3 false points a frame;
-seeds 300-307, eight for time: re-solves there took minutes before the flow encoding of corrections), added after the first run with the rule
-unchanged, to see propagation where errors are many. Run::
+seeds 300-307, eight for time: re-solves there took minutes before the flow encoding of corrections), added after
+the first run with the rule unchanged, to see propagation where errors are many. Run::
 
     python benchmarks/proofread_curve.py [--data ../shared/data] [--seeds 200-219] [--plot docs/images/proofread.png]
 """
