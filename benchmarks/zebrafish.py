@@ -28,7 +28,7 @@ import numpy as np
 
 from lookalike.io import frames_from_table, read_mot, write_mot
 from lookalike.trackers import make_tracker
-from lookalike.viz.blob_video import blob_config, blob_detection_rows
+from lookalike.viz.blob_video import blob_config, blob_detections
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA  # noqa: E402
@@ -111,7 +111,8 @@ def main() -> None:
         n_frames = int(cv2.VideoCapture(str(args.video)).get(cv2.CAP_PROP_FRAME_COUNT))
     else:
         t0 = time.perf_counter()
-        rows, n_frames = blob_detection_rows(args.video, blob_config(BLOB))
+        found = blob_detections(args.video, blob_config(BLOB))
+        rows, n_frames = found.rows, found.frames
         seconds = time.perf_counter() - t0
         det_path = write_mot(args.save_detections or Path("/tmp/zebrafish.det.txt"), rows)
         table = read_mot(det_path)

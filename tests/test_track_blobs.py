@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from lookalike.cli import app
 from lookalike.io import read_mot
-from lookalike.viz.blob_video import blob_config, blob_detection_rows
+from lookalike.viz.blob_video import blob_config, blob_detections
 
 runner = CliRunner()
 
@@ -44,7 +44,8 @@ def arena(tmp_path_factory) -> Path:
 
 
 def test_blob_detection_rows_find_every_disc(arena):
-    rows, n = blob_detection_rows(arena, blob_config(["polarity=dark", "min_area_px=20"]))
+    found = blob_detections(arena, blob_config(["polarity=dark", "min_area_px=20"]))
+    rows, n = found.rows, found.frames
     assert n == FRAMES
     counts = np.bincount(rows[:, 0].astype(int), minlength=FRAMES + 1)[1:]
     assert (counts == 3).all()

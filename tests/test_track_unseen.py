@@ -15,7 +15,7 @@ from lookalike.bench.runner import Entry, default_entries, job_pairs, params_ent
 from lookalike.cli import app
 from lookalike.io import read_mot, write_mot
 from lookalike.tune.params_file import save_params
-from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows, detection_cache_key
+from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections, detection_cache_key
 from lookalike.viz.video import read_frames
 
 runner = CliRunner()
@@ -203,18 +203,18 @@ def test_blob_settings_estimated_printed_and_overridden(tmp_path):
 def test_blob_cache_serves_identical_rows_and_never_stale_ones(tmp_path):
     video = _arena(tmp_path / "arena.avi")
     config, _ = auto_blob_config(video, [], cache=tmp_path / "c")
-    fresh = cached_blob_detection_rows(video, config, cache=False)
-    first = cached_blob_detection_rows(video, config, cache=tmp_path / "c")
-    again = cached_blob_detection_rows(video, config, cache=tmp_path / "c")
-    np.testing.assert_array_equal(fresh[0], first[0])
-    np.testing.assert_array_equal(first[0], again[0])
+    fresh = cached_blob_detections(video, config, cache=False)
+    first = cached_blob_detections(video, config, cache=tmp_path / "c")
+    again = cached_blob_detections(video, config, cache=tmp_path / "c")
+    np.testing.assert_array_equal(fresh.rows, first.rows)
+    np.testing.assert_array_equal(first.rows, again.rows)
     assert len(list((tmp_path / "c" / "blobs").glob("*.npz"))) == 1
     from dataclasses import replace
 
     assert detection_cache_key(video, config) != detection_cache_key(video, replace(config, threshold=99.0))
     other = _arena(tmp_path / "other.avi", frames=20)  # other content, other key
     assert detection_cache_key(video, config) != detection_cache_key(other, config)
-    assert cached_blob_detection_rows(other, config, cache=tmp_path / "c")[1] == 20
+    assert cached_blob_detections(other, config, cache=tmp_path / "c").frames == 20
 
 
 def _seq(dataset: str, name: str = "s", n_targets: int | None = None) -> RealSequence:

@@ -166,11 +166,12 @@ def hexbug_clips(root: Path) -> list[Path]:
 def detect_hexbug(video: Path, cache: Path | bool = True) -> RealSequence:
     """One HexBug clip through the blob detector with the settings ``lookalike track --detector blob`` estimates,
     with its head points; ``cache``: a folder, ``True`` for the default one, ``False`` for none."""
-    from lookalike.viz.blob_video import auto_blob_config, cached_blob_detection_rows
+    from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections
     from lookalike.viz.overlay import source_frames
 
     config, _ = auto_blob_config(video, [], cache=cache)
-    rows, length = cached_blob_detection_rows(video, config, cache=cache)
+    found = cached_blob_detections(video, config, cache=cache)
+    rows, length = found.rows, found.frames
     frames, _, fps = source_frames(video)
     height, width = next(iter(frames)).shape[:2]
     points = read_hexbug_points(video.with_suffix(".csv"), (width, height))

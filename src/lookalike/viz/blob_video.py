@@ -194,17 +194,10 @@ class BlobRows:
     shapes: np.ndarray
 
 
-def cached_blob_detection_rows(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
-                               cache: Path | None | bool = True) -> tuple[np.ndarray, int]:
-    """:func:`blob_detection_rows` through the cache (``cache``: a folder, ``True`` for :func:`cache_dir`, ``False``
-    or None for none)."""
-    found = cached_blob_detections(video, config, advance, cache)
-    return found.rows, found.frames
-
-
 def cached_blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
                            cache: Path | None | bool = True) -> BlobRows:
-    """:func:`blob_detections` through the cache (as :func:`cached_blob_detection_rows`)."""
+    """:func:`blob_detections` through the cache (``cache``: a folder, ``True`` for :func:`cache_dir`, ``False`` or
+    None for none)."""
     found = load_blob_detections(video, config, cache)
     if found is None:
         found = blob_detections(video, config, advance)
@@ -269,13 +262,6 @@ class BlobStream:
         return BlobRows(rows, self.frames, np.vstack(self._shapes) if self._shapes else np.zeros((0, SHAPE_SIZE)))
 
 
-def blob_detection_rows(video: Path | str, config: BlobConfig,
-                        advance: Callable[[], None] | None = None) -> tuple[np.ndarray, int]:
-    """Blob detections of ``video`` (a file or image folder) as MOTChallenge rows ``(n, 10)``, and the frame count."""
-    found = blob_detections(video, config, advance)
-    return found.rows, found.frames
-
-
 def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None) -> BlobRows:
     """Blob detections of ``video`` (a file or image folder) with each blob's shape vector, in one pass."""
     detector = _detector(video, config)
@@ -286,6 +272,6 @@ def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[],
     return BlobRows(rows, count, np.vstack(shapes) if shapes else np.zeros((0, SHAPE_SIZE)))
 
 
-__all__ = ["CACHE_ENV", "BlobRows", "BlobStream", "auto_blob_config", "blob_config", "blob_detection_rows",
-           "blob_detections", "blob_settings", "cache_dir", "cached_blob_detection_rows", "cached_blob_detections",
-           "detection_cache_key", "load_blob_detections", "store_blob_detections"]
+__all__ = ["CACHE_ENV", "BlobRows", "BlobStream", "auto_blob_config", "blob_config", "blob_detections",
+           "blob_settings", "cache_dir", "cached_blob_detections", "detection_cache_key", "load_blob_detections",
+           "store_blob_detections"]
