@@ -202,10 +202,8 @@ class OnnxDetector:
 
 
 def detect_frames(frames: Iterable[np.ndarray], detector: Callable[[np.ndarray], Detections],
-                  advance: Callable[[], None] | None = None,
-                  features: list[np.ndarray] | None = None) -> tuple[np.ndarray, int]:
-    """MOTChallenge detection rows ``(n, 10)`` (1-based frames, id -1, box px, score) and the number of frames;
-    ``features``, a list, gets each frame's detection features (rows in the same order)."""
+                  advance: Callable[[], None] | None = None) -> tuple[np.ndarray, int]:
+    """MOTChallenge detection rows ``(n, 10)`` (1-based frames, id -1, box px, score) and the number of frames."""
     chunks = []
     count = 0
     for k, image in enumerate(frames):
@@ -213,8 +211,6 @@ def detect_frames(frames: Iterable[np.ndarray], detector: Callable[[np.ndarray],
         if len(det):
             assert det.xywh is not None and det.score is not None
             chunks.append(detection_rows(k + 1, det.xywh, det.score))
-            if features is not None and det.feature is not None:
-                features.append(det.feature)
         count = k + 1
         if advance is not None:
             advance()

@@ -23,7 +23,6 @@ from lookalike.types.mot_table import detection_rows
 from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config, sample_frames
 from lookalike.vision.blob_shape import SHAPE_SIZE
-from lookalike.vision.onnx_detector import detect_frames
 from lookalike.viz.overlay import source_frames
 
 Progress = Callable[[str, int], Callable[[], None]]  # (description, total steps) -> called after each step
@@ -264,12 +263,14 @@ class BlobStream:
 
 def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None) -> BlobRows:
     """Blob detections of ``video`` (a file or image folder) with each blob's shape vector, in one pass."""
-    detector = _detector(video, config)
-    shapes: list[np.ndarray] = []
-    rows, count = detect_frames(source_frames(video)[0], detector, advance, shapes)
-    if count == 0:
+    stream = BlobStream(video, config)
+    for image in source_frames(video)[0]:
+        stream(image)
+        if advance is not None:
+            advance()
+    if stream.frames == 0:
         raise ValueError(f"video: {video} has no frames")
-    return BlobRows(rows, count, np.vstack(shapes) if shapes else np.zeros((0, SHAPE_SIZE)))
+    return stream.found()
 
 
 __all__ = ["CACHE_ENV", "BlobRows", "BlobStream", "auto_blob_config", "blob_config", "blob_detections",
