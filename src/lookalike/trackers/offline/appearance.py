@@ -47,10 +47,9 @@ def cut_at_merges(tracklets: list[Tracklet], shapes: np.ndarray) -> tuple[list[T
     merged: list[Tracklet] = []
     if not tracklets:
         return alone, merged
-    every = np.vstack([t.rows for t in tracklets])
-    single = dict(zip(map(tuple, every[:, [0, SHAPE_COLUMN]].tolist()), single_rows(every, shapes).tolist()))
-    for t in tracklets:
-        flag = np.array([single[(f, k)] for f, k in t.rows[:, [0, SHAPE_COLUMN]].tolist()], dtype=bool)
+    single = single_rows(np.vstack([t.rows for t in tracklets]), shapes)
+    flags = np.split(single, np.cumsum([len(t) for t in tracklets])[:-1])
+    for t, flag in zip(tracklets, flags):
         for piece in np.split(np.arange(len(t)), np.flatnonzero(np.diff(flag.astype(int))) + 1):
             part = Tracklet(t.rows[piece], t.source_id, t.contact or not flag[piece[0]])
             (alone if flag[piece[0]] else merged).append(part)
