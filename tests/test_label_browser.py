@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 import shutil
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -28,6 +30,22 @@ def _browser_or_skip():
     except ImportError:
         pytest.skip("the Python package playwright is not installed")
     return sync_playwright, str(CHROMIUM if CHROMIUM.exists() else shutil.which("chromium"))
+
+
+@contextmanager
+def chromium_page(errors: list[str], width: int, height: int) -> Iterator:
+    """A page of headless Chromium (``width`` x ``height``) whose console errors and uncaught exceptions go to
+    ``errors``; skips when Chromium or playwright is missing."""
+    sync_playwright, executable = _browser_or_skip()
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=executable, headless=True, args=ARGS)
+        try:
+            page = browser.new_page(viewport={"width": width, "height": height})
+            page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            yield page
+        finally:
+            browser.close()
 
 
 class _Served:
@@ -84,52 +102,44 @@ def _label_last_frame_and_screenshot(page, truth):
 
 
 def test_label_page_end_to_end(tmp_path):
-    sync_playwright, executable = _browser_or_skip()
     seq = simulate_robots(preset("m5n3"), 40, 11)
     path = write_robot_sequence(tmp_path / "m5n3-000011.jsonl", seq)
     k0 = _frames_with(seq, 2)[0]
     errors: list[str] = []
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=executable, headless=True, args=ARGS)
-        try:
-            page = browser.new_page(viewport={"width": 1100, "height": 720})
-            page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
-            page.on("pageerror", lambda e: errors.append(str(e)))
-            with _Served(open_label_app(path)) as served:
-                page.goto(served.url)
-                page.wait_for_selector("body[data-frame='0']")
-                for _ in range(k0):
-                    page.keyboard.press("ArrowRight")
-                page.wait_for_function(f"document.body.dataset.frame === '{k0}'")
-                n_rows = int(seq.arrays.det_valid[k0].sum())
-                page.wait_for_function(f"document.querySelectorAll('#detections tbody tr').length === {n_rows}")
-                assert [r[0] for r in _rows(page)][:2] == [-2, -2]
-                _click(page, 0)                   # unset -> robot 1
-                _click(page, 0)                   # -> robot 2
-                _click(page, 1, button="right")   # unset -> false positive
-                _click(page, 1, button="right")   # -> robot 3
-                _wait_saved(page)
-                assert [r[0] for r in _rows(page)][:2] == [1, 2]
-                page.keyboard.press("d")
-                page.wait_for_function(f"document.body.dataset.frame === '{k0 + 1}'")
-                page.keyboard.press("a")
-                page.wait_for_function(f"document.body.dataset.frame === '{k0}'")
-                page.reload()
-                page.wait_for_function(f"document.body.dataset.frame === '{k0}'")
-                assert [r[0] for r in _rows(page)][:2] == [1, 2]
-                saved = json.loads(path.with_name("m5n3-000011.labels.json").read_text())
-                assert saved["labels"][k0][:2] == [1, 2]
-                page.check("#show-truth")
-                page.click("#score-btn")
-                page.wait_for_selector("#result-rate")
-                truth = seq.true_labels()
-                expected = score_labels(saved["labels"], truth, 3)["success_rate"]
-                assert float(page.get_attribute("#result", "data-rate")) == pytest.approx(expected)
-                if SCREENSHOT.parent.is_dir() and not SCREENSHOT.exists():
-                    _label_last_frame_and_screenshot(page, truth)
-            assert errors == []
-        finally:
-            browser.close()
+    with chromium_page(errors, 1100, 720) as page:
+        with _Served(open_label_app(path)) as served:
+            page.goto(served.url)
+            page.wait_for_selector("body[data-frame='0']")
+            for _ in range(k0):
+                page.keyboard.press("ArrowRight")
+            page.wait_for_function(f"document.body.dataset.frame === '{k0}'")
+            n_rows = int(seq.arrays.det_valid[k0].sum())
+            page.wait_for_function(f"document.querySelectorAll('#detections tbody tr').length === {n_rows}")
+            assert [r[0] for r in _rows(page)][:2] == [-2, -2]
+            _click(page, 0)                   # unset -> robot 1
+            _click(page, 0)                   # -> robot 2
+            _click(page, 1, button="right")   # unset -> false positive
+            _click(page, 1, button="right")   # -> robot 3
+            _wait_saved(page)
+            assert [r[0] for r in _rows(page)][:2] == [1, 2]
+            page.keyboard.press("d")
+            page.wait_for_function(f"document.body.dataset.frame === '{k0 + 1}'")
+            page.keyboard.press("a")
+            page.wait_for_function(f"document.body.dataset.frame === '{k0}'")
+            page.reload()
+            page.wait_for_function(f"document.body.dataset.frame === '{k0}'")
+            assert [r[0] for r in _rows(page)][:2] == [1, 2]
+            saved = json.loads(path.with_name("m5n3-000011.labels.json").read_text())
+            assert saved["labels"][k0][:2] == [1, 2]
+            page.check("#show-truth")
+            page.click("#score-btn")
+            page.wait_for_selector("#result-rate")
+            truth = seq.true_labels()
+            expected = score_labels(saved["labels"], truth, 3)["success_rate"]
+            assert float(page.get_attribute("#result", "data-rate")) == pytest.approx(expected)
+            if SCREENSHOT.parent.is_dir() and not SCREENSHOT.exists():
+                _label_last_frame_and_screenshot(page, truth)
+        assert errors == []
 
 
 def test_human_benchmark_session_in_the_browser(tmp_path):

@@ -5,15 +5,13 @@ correction and undo, each by keyboard and by mouse, and the next doubtful range 
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
 from lookalike.proofread import Correction, Doubt, Session
 from lookalike.viz.label.proofread import ProofreadApp
-from tests.test_label_browser import ARGS, _browser_or_skip
+from tests.test_label_browser import chromium_page
 from tests.test_proofread_page import FRAMES, Served, lane_ids, open_page, two_discs
 
 SCREENSHOT = Path(__file__).resolve().parents[1] / "docs" / "images" / "proofread-page.png"
@@ -49,25 +47,10 @@ def _served_rows(served) -> list[list[float]]:
     return served.request("GET", f"/api/tracks?start=1&count={FRAMES}")[1]["rows"]
 
 
-@contextmanager
-def _chromium(errors: list[str]) -> Iterator:
-    """A page of headless Chromium (960 x 600) whose console errors and uncaught exceptions go to ``errors``."""
-    sync_playwright, executable = _browser_or_skip()
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=executable, headless=True, args=ARGS)
-        try:
-            page = browser.new_page(viewport={"width": 960, "height": 600})
-            page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
-            page.on("pageerror", lambda e: errors.append(str(e)))
-            yield page
-        finally:
-            browser.close()
-
-
 def test_proofread_page_end_to_end(tmp_path):
     page_app = open_page(tmp_path, scale=SCALE)
     errors: list[str] = []
-    with _chromium(errors) as page:
+    with chromium_page(errors, 960, 600) as page:
         with Served(page_app) as served:
             page.goto(served.url)
             _wait_version(page, 0, 1)
@@ -144,7 +127,7 @@ def test_every_correction_by_keyboard_and_by_mouse(tmp_path):
     the lower before frame 10, exchanged from 10 on)."""
     page_app = open_page(tmp_path, scale=SCALE)
     errors: list[str] = []
-    with _chromium(errors) as page:
+    with chromium_page(errors, 960, 600) as page:
         with Served(page_app) as served:
             page.goto(served.url + "#frame=15")
             _wait_version(page, 0, 15)
@@ -197,7 +180,7 @@ def test_next_doubtful_range_by_key_and_by_the_list(tmp_path):
     page_app = ProofreadApp(_Doubting(tracks, frame_rate=10), video, tmp_path / "two.corrections.jsonl",
                             tmp_path / "two.proofread.txt", Correction.from_json)
     errors: list[str] = []
-    with _chromium(errors) as page:
+    with chromium_page(errors, 960, 600) as page:
         with Served(page_app) as served:
             page.goto(served.url)
             _wait_version(page, 0, 1)
