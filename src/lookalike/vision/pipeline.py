@@ -43,7 +43,7 @@ class PipelineConfig:
 
     Attributes:
         identifier: registered identifier name (one of :data:`IDENTIFIERS`, or any tracker reading positions and
-            headings).
+            headings); default ``set``, which works on any team.
         n_agents: number of reporting robots N.
         max_detections: M, the most probable detections kept per frame (also the LSTM's slots).
         min_score: detector probability below which a box is dropped.
@@ -61,7 +61,7 @@ class PipelineConfig:
             its ground position by more than this factor (either way) is dropped; ``None``: no check. Boxes touching
             the top or bottom image border are not checked."""
 
-    identifier: str = "kalman_ha2"
+    identifier: str = "set"
     n_agents: int = 3
     max_detections: int = 5
     min_score: float = 0.5
