@@ -71,8 +71,8 @@ def identity_figures(rows: list[np.ndarray]) -> dict:
 
 def appearance(video: Path, table, n_frames: int) -> list[np.ndarray]:
     """Per frame, the hand-crafted appearance features of its boxes (standardised on this video)."""
+    from lookalike.pipeline.tracking import fit_video_features
     from lookalike.viz.overlay import source_frames
-    from lookalike.viz.video_tracking import fit_video_features
 
     extractor = fit_video_features(video, table)
     frames, _, _ = source_frames(video)
@@ -135,8 +135,8 @@ def annotate(video: Path, table, name: str, out: Path, n_frames: int) -> None:
     """Annotated MP4 of tracker ``name`` (``lookalike track --video``'s drawing) plus PNGs of three frames."""
     import cv2
 
+    from lookalike.pipeline.tracking import fit_video_features, track_video
     from lookalike.viz.overlay import source_frames
-    from lookalike.viz.video_tracking import fit_video_features, track_video
 
     kind, params = TRACKERS[name]
     result = track_video(video, table, make_tracker(kind, **params), fit_video_features(video, table),

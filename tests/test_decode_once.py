@@ -11,7 +11,7 @@ import pytest
 from typer.testing import CliRunner
 
 from lookalike.cli import app
-from lookalike.io import read_mot, write_mot
+from lookalike.io import MotTable, read_mot, write_mot
 from tests.test_track_blobs import FRAMES, _write_video
 
 cv2 = pytest.importorskip("cv2")
@@ -68,7 +68,7 @@ BLOB = ("--detector", "blob", "--blob", "polarity=dark", "--blob", "min_area_px=
 
 @pytest.mark.parametrize("extra", [("-t", "sort"), ("-t", "boxtrack"), ("-t", "sort", "--annotate", "a.mp4"),
                                    ("-t", "boxtrack", "--targets", "3", "--online", "--annotate", "a.mp4"),
-                                   ("-t", "deepsort", "--features", "learned")])
+                                   ("-t", "deepsort", "--features", "learned"), ("-t", "deepsort")])
 def test_blob_video_is_decoded_once(video, tmp_path, counts, monkeypatch, extra):
     monkeypatch.chdir(tmp_path)
     _track("--video", str(video), *BLOB, *extra, "-o", "t.txt")
@@ -81,7 +81,8 @@ def test_blob_video_is_decoded_once(video, tmp_path, counts, monkeypatch, extra)
     assert counts == {"converted": FRAMES if "a.mp4" in extra or "deepsort" in extra else 0, "grabbed": 0}
 
 
-@pytest.mark.parametrize("extra", [(), ("--annotate", "a.mp4"), ("-t", "boxtrack", "--targets", "3")])
+@pytest.mark.parametrize("extra", [(), ("--annotate", "a.mp4"), ("-t", "boxtrack", "--targets", "3"),
+                                   ("-t", "deepsort"), ("-t", "diversort", "--features", "handcrafted")])
 def test_video_with_detections_is_decoded_once(video, tmp_path, counts, monkeypatch, extra):
     monkeypatch.chdir(tmp_path)
     _track("--video", str(video), *BLOB, "-t", "sort", "-o", "first.txt", "--save-detections", "d.txt")
@@ -91,14 +92,69 @@ def test_video_with_detections_is_decoded_once(video, tmp_path, counts, monkeypa
     assert len(read_mot(tmp_path / "t.txt")) > 0
 
 
-def test_onnx_detector_video_is_decoded_once(video, tmp_path, counts, monkeypatch):
+@pytest.mark.parametrize("extra", [("-t", "sort"), ("-t", "sort", "--annotate", "a.mp4"), ("-t", "deepsort"),
+                                   ("-t", "diversort", "--features", "handcrafted", "--annotate", "a.mp4")])
+def test_onnx_detector_video_is_decoded_once(video, tmp_path, counts, monkeypatch, extra):
     from tests.test_onnx_detector import _darkness_grid_model
 
     monkeypatch.chdir(tmp_path)
     model = _darkness_grid_model(tmp_path / "dark.onnx")
-    _track("--video", str(video), "--detector", str(model), "--blob", "score=0.15", "-t", "sort", "-o", "t.txt")
+    _track("--video", str(video), "--detector", str(model), "--blob", "score=0.15", *extra, "-o", "t.txt")
     assert counts == {"converted": FRAMES, "grabbed": 0}
     assert not (tmp_path / "t.det.txt").exists()
+
+
+def test_features_fitted_on_the_video_draw_with_a_second_decode(video, tmp_path, counts, monkeypatch):
+    """``--features video`` is fitted on the whole video before the first frame is tracked: drawing decodes again."""
+    monkeypatch.chdir(tmp_path)
+    _track("--video", str(video), *BLOB, "-t", "sort", "-o", "first.txt", "--save-detections", "d.txt")
+    counts.update(converted=0, grabbed=0)
+    _track("--video", str(video), "--detections", "d.txt", "-t", "deepsort", "--annotate", "a.mp4", "-o", "t.txt")
+    assert counts == {"converted": 2 * FRAMES, "grabbed": 0}
+
+
+class _Seen:
+    """A tracker keeping the boxes and features it is given, and reporting no tracks."""
+
+    def __init__(self) -> None:
+        self.seen: list[np.ndarray] = []
+
+    def reset(self) -> None:
+        self.seen = []
+
+    def update(self, frame):
+        det = frame.detections
+        self.seen.append(np.hstack([det.xywh, det.feature]))
+        return []
+
+
+def test_features_fitted_in_the_pass_are_those_fitted_first(video, tmp_path, monkeypatch):
+    """A tracker given :class:`VideoFeatures` (fitted in the pass, one decode) sees the features fitted in a pass of
+    their own first, also with the detector run in the pass; boxes scored below ``min_score`` are left out of both."""
+    from lookalike.pipeline.tracking import VideoFeatures, fit_video_features, track_video
+    from lookalike.types import Detections
+
+    monkeypatch.chdir(tmp_path)
+    _track("--video", str(video), *BLOB, "-t", "sort", "-o", "first.txt", "--save-detections", "d.txt")
+    rows = np.loadtxt(tmp_path / "d.txt", delimiter=",")
+    rows[::4, 6] = 0.2  # (some boxes below min_score)
+    table = MotTable.from_rows(rows)
+    by_frame = [table.frame == k + 1 for k in range(FRAMES)]
+
+    def detect(image):
+        keep = by_frame.pop(0) & (table.conf >= 0.5)
+        return Detections(xywh=table.xywh[keep], score=table.conf[keep])
+
+    spec = VideoFeatures(max_crops=40)  # (sampled: one block of 10 frames in every few)
+    assert spec.blocks(int((table.conf >= 0.5).sum())) > 1
+    want, got, found = _Seen(), _Seen(), _Seen()
+    track_video(video, table, want, fit_video_features(video, table, min_score=0.5, max_crops=40), min_score=0.5)
+    track_video(video, table, got, spec, min_score=0.5)
+    track_video(video, MotTable.from_rows(np.zeros((0, 10))), found, spec, detect=detect)
+    assert len(want.seen) == FRAMES and sum(map(len, want.seen)) == (table.conf >= 0.5).sum()
+    for a, b, c in zip(want.seen, got.seen, found.seen):
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(a, c)
 
 
 def test_saved_detections_are_the_rows_tracked(video, tmp_path, monkeypatch):

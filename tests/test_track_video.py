@@ -10,12 +10,13 @@ from typer.testing import CliRunner
 
 from lookalike.cli import app
 from lookalike.io import MotTable, read_mot, write_mot
+from lookalike.pipeline.tracking import track_video
 from lookalike.sim.divers import DetectorModel, DiverScenario, simulate_divers
 from lookalike.trackers import DiverSort, HealthConfig, TrackStatus, make_tracker
 from lookalike.types import TrackSnapshot
 from lookalike.viz import read_frames, video_info
 from lookalike.viz.video import VideoWriter
-from lookalike.viz.video_tracking import draw_banner, side_file, track_video
+from lookalike.viz.video_tracking import draw_banner, side_file
 
 runner = CliRunner()
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -205,8 +206,8 @@ def test_mot17_mini_real_pixels(tmp_path, tracker):
 
 
 def test_fit_video_features_links_boxes_into_chains(diver_scene):
+    from lookalike.pipeline.tracking import fit_video_features
     from lookalike.vision.appearance import FeatureStats
-    from lookalike.viz.video_tracking import fit_video_features
 
     root, det = diver_scene
     table = read_mot(det)
@@ -225,14 +226,14 @@ def test_fit_video_features_links_boxes_into_chains(diver_scene):
 def test_trackers_reading_no_appearance_get_no_features(diver_scene, tmp_path, monkeypatch):
     """boxtrack and sort read boxes only: `track --video` fits and computes no appearance features for them (the
     feature code is made to fail), and their rows are those of the same detections tracked as a file."""
+    import lookalike.pipeline.tracking as tracking
     import lookalike.pipeline.video as video_pipeline
-    import lookalike.viz.video_tracking as video_tracking
 
     def refuse(*args, **kwargs):
         raise AssertionError("appearance features computed for a tracker that reads none")
 
-    monkeypatch.setattr(video_pipeline, "fit_video_features", refuse)
-    monkeypatch.setattr(video_tracking, "fit_video_features", refuse)
+    monkeypatch.setattr(video_pipeline, "VideoFeatures", refuse)
+    monkeypatch.setattr(tracking, "raw_features", refuse)
     root, det = diver_scene
     for tracker in ("boxtrack", "sort"):
         out, plain = tmp_path / f"{tracker}.txt", tmp_path / f"{tracker}-plain.txt"

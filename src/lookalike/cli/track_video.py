@@ -13,6 +13,7 @@ from lookalike.cli.app import console, fail, failing, note, warn
 from lookalike.cli.progress import bars
 from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.io import MotTable, write_mot
+from lookalike.pipeline.tracking import track_video
 from lookalike.pipeline.video import (
     VideoDetections,
     as_written,
@@ -23,7 +24,6 @@ from lookalike.pipeline.video import (
     write_video_result,
 )
 from lookalike.trackers.parts.health import HealthConfig
-from lookalike.viz.video_tracking import track_video
 
 __all__ = ["run_track_onnx", "run_track_video", "save_detections"]
 
@@ -41,8 +41,8 @@ def run_track_video(video: Path, detections: VideoDetections, output: Path, trac
         check_features(features)
     check_result_file(output)
     with failing(ValueError, OSError):
-        found = prepare_video(video, detections, tracker_name, annotate=annotate, min_score=min_score,
-                              features=features, det_format=det_format, length=length, status=console.status)
+        found = prepare_video(video, detections, tracker_name, annotate=annotate, features=features,
+                              det_format=det_format, length=length, status=console.status)
     for line in found.notes:
         note(f"{found.name}: {line}")
     for line in found.warnings(video, score_warnings):
@@ -83,20 +83,30 @@ def run_track_video(video: Path, detections: VideoDetections, output: Path, trac
 def run_track_onnx(video: Path, output: Path, tracker: Any, tracker_name: str, model: Path, settings: list[str], *,
                    n_targets: int | None = None, offline: dict[str, Any] | None = None, **options: Any) -> None:
     """``track --video V --detector FILE.onnx``: detect with the ONNX model (``settings``: ``KEY=VALUE``; the boxes
-    saved to ``options["save_detections"]`` when given), then track as :func:`run_track_video` (given ``options``)
-    or, with ``offline``, by the offline closed set of ``n_targets``."""
+    saved to ``options["save_detections"]`` when given), then track as :func:`run_track_video` (given ``options``;
+    detected in the tracking pass when it decodes the frames anyway) or, with ``offline``, by the offline closed set
+    of ``n_targets``."""
     check_result_file(output, video)
     with failing(ValueError, OSError):
         run = open_onnx(video, model, settings)
-        with bars("detecting {task.description}") as progress:
-            task = progress.add_task(video.name, total=run.total or None)
-            rows, frames, seconds = run.detect(advance=lambda: progress.advance(task))
+        stream = run.in_pass(tracker_name, options.get("annotate") is not None, offline is not None,
+                             options["min_score"])
+        saved = {"save_detections": options.pop("save_detections", None)}
+        if stream is not None:
+            run_track_video(video, stream, output, tracker, tracker_name, **options)
+            rows, frames, seconds = stream.found()
+        else:
+            with bars("detecting {task.description}") as progress:
+                task = progress.add_task(video.name, total=run.total or None)
+                rows, frames, seconds = run.detect(advance=lambda: progress.advance(task))
     speed = f"{frames / seconds:,.1f} frames/s" if seconds > 0 else "inf frames/s"
     width, height = run.detector.input_size
     console.print(f"{model.name} ({run.detector.layout}, input {width}x{height}): "
-                  f"{len(rows)} boxes in {frames} frames, {speed}" + save_detections(rows, options))
+                  f"{len(rows)} boxes in {frames} frames, {speed}" + save_detections(rows, saved))
     if len(rows) < 2:
         fail(f"{video}: the detector {model.name} found {len(rows)} box(es); try a lower score=... setting")
+    if stream is not None:
+        return
     rows = as_written(rows)  # (tracked as a saved detection file would be: boxes to 1/1000 px, scores to 6 digits)
     if offline is not None:
         assert n_targets is not None

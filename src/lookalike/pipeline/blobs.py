@@ -15,13 +15,13 @@ from lookalike.vision.blob_boxtrack import blob_boxtrack_config
 from lookalike.viz.blob_video import BlobRows, BlobStream, load_blob_detections
 
 
-def one_pass(tracker: Any, tracker_name: str, explicit: Collection[str], n_targets: int | None, annotate: bool,
-             features: str) -> bool:
+def one_pass(tracker: Any, tracker_name: str, explicit: Collection[str], n_targets: int | None,
+             annotate: bool) -> bool:
     """Whether blobs are best detected in the tracking pass: the tracker's settings need no blob counts of the whole
-    video, and the tracking decodes the frames anyway (``annotate``, or ``features`` fitted on no video)."""
+    video, and the tracking decodes the frames anyway (``annotate``, or a tracker reading appearance features)."""
     counts = tracker_name == "boxtrack" and tracker.config.max_targets is None and "max_targets" not in explicit \
         and n_targets is None
-    return (annotate or (input_kind(tracker_name) != "boxes" and features != "video")) and not counts
+    return (annotate or input_kind(tracker_name) != "boxes") and not counts
 
 
 def blob_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: Collection[str],
@@ -42,11 +42,10 @@ def blob_source(video: Path, config: Any, tracker: Any, tracker_name: str, expli
                 options: dict[str, Any]) -> tuple[BlobRows | None, BlobStream | None]:
     """The blob detections of ``video`` stored for ``config``, else a stream that finds them in the tracking pass
     when :func:`one_pass` says so (never ``offline``), else neither (they are found first); ``options``: the
-    ``min_score``, ``annotate`` and ``features`` the video is tracked with."""
+    ``min_score`` and ``annotate`` the video is tracked with."""
     found = load_blob_detections(video, config)
     if found is None and not offline and one_pass(tracker, tracker_name, explicit, n_targets,
-                                                  options.get("annotate") is not None,
-                                                  options.get("features", "video")):
+                                                  options.get("annotate") is not None):
         return None, BlobStream(video, config, options["min_score"])
     return found, None
 

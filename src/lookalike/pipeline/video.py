@@ -21,16 +21,13 @@ from lookalike.io.motchallenge import format_rows
 from lookalike.io.needs import input_kind
 from lookalike.io.outputs import atomic_path
 from lookalike.pipeline.files import dropped_all
+from lookalike.pipeline.tracking import VideoFeatures, VideoTrackingResult
 from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
+from lookalike.types import Detections
+from lookalike.types.mot_table import detection_rows
 from lookalike.viz.overlay import source_frames
 from lookalike.viz.video import video_info
-from lookalike.viz.video_tracking import (
-    VideoTrackingResult,
-    fit_video_features,
-    side_file,
-    write_health_csv,
-    write_merges_csv,
-)
+from lookalike.viz.video_tracking import side_file, write_health_csv, write_merges_csv
 
 FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")
 VideoDetections = Path | MotTable | Callable[[np.ndarray], Any]  # a file, rows found, or a detector run in the pass
@@ -73,12 +70,13 @@ def check_features(features: str) -> None:
 
 
 def prepare_video(video: Path, detections: VideoDetections, tracker_name: str, *, annotate: Path | None = None,
-                  min_score: float = -np.inf, features: str = "video", det_format: str = "auto",
+                  features: str = "video", det_format: str = "auto",
                   length: int | None = None,
                   status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()) -> VideoInput:
-    """Read ``detections`` and fit the features ``tracker_name`` reads (``features``: as ``--features``; fitting
-    shown by ``status``); with ``length`` (the video's decoded frames) known, a box tracker without ``annotate`` or
-    a detector gets no frames decoded, else the first frame gives the size and the frames go on to the tracker."""
+    """Read ``detections`` and the feature extractor ``tracker_name`` reads (``features``: as ``--features``, ``video``
+    fitted in the tracking pass; loading shown by ``status``); with ``length`` (the video's decoded frames) known, a
+    box tracker without ``annotate`` or a detector gets no frames decoded, else the first frame gives the size and
+    the frames go on to the tracker (one decode)."""
     detect = None if isinstance(detections, (Path, MotTable)) else detections
     notes: list[str] = []
     if isinstance(detections, Path):
@@ -89,10 +87,9 @@ def prepare_video(video: Path, detections: VideoDetections, tracker_name: str, *
     images, total, _ = source_frames(video)
     extractor: Any = None
     if input_kind(tracker_name) != "boxes":  # a tracker reading no appearance gets no features computed
-        with status("standardising appearance features"):
+        with status("loading appearance features"):
             extractor = (fit_diver_features() if features in ("divers", "handcrafted")
-                         else fit_video_features(video, table, min_score=min_score) if features == "video"
-                         else diver_extractor(features))
+                         else VideoFeatures() if features == "video" else diver_extractor(features))
     stream: Iterable[np.ndarray] | None = None
     if extractor is None and annotate is None and length is not None and detect is None:  # no frame decoded
         size = None if video.is_dir() else video_info(video)[2]
@@ -132,6 +129,30 @@ def as_written(rows: np.ndarray) -> np.ndarray:
     return np.loadtxt(io.StringIO(format_rows(rows)), delimiter=",", ndmin=2).reshape(-1, 10)
 
 
+class OnnxStream:
+    """An ONNX ``detector`` run in the tracking pass (one decode): called on each frame in order, it gives the
+    frame's boxes scoring at least ``min_score``, as a saved detection file holds them (:func:`as_written`);
+    :meth:`found` then holds every row, the frames read and the detector's seconds."""
+
+    def __init__(self, detector: Any, min_score: float = -np.inf) -> None:
+        self.detector, self.min_score, self.frames, self.seconds = detector, min_score, 0, 0.0
+        self._rows: list[np.ndarray] = []
+
+    def __call__(self, image: np.ndarray) -> Detections:
+        t0 = time.perf_counter()
+        det = self.detector(image)
+        self.frames += 1
+        rows = as_written(detection_rows(self.frames, det.xywh, det.score)) if len(det) else np.zeros((0, 10))
+        self._rows.append(rows)
+        self.seconds += time.perf_counter() - t0
+        keep = rows[:, 6] >= self.min_score
+        return Detections(xywh=rows[keep, 2:6], score=rows[keep, 6])
+
+    def found(self) -> tuple[np.ndarray, int, float]:
+        """Every row found so far ``(n, 10)``, the frames read and the detector's seconds."""
+        return np.vstack(self._rows) if self._rows else np.zeros((0, 10)), self.frames, self.seconds
+
+
 @dataclass
 class OnnxRun:
     """An ONNX ``detector`` (:class:`lookalike.vision.onnx_detector.OnnxDetector`) opened on a video's ``images``
@@ -151,6 +172,13 @@ class OnnxRun:
         rows, frames = detect_frames(self.images, self.detector, advance=advance)
         return rows, frames, time.perf_counter() - t0
 
+    def in_pass(self, tracker_name: str, annotate: bool, offline: bool, min_score: float) -> OnnxStream | None:
+        """The detector run in the tracking pass when that pass decodes the frames anyway (``annotate``, or a
+        tracker reading appearance features), never ``offline``; else None (the frames are detected first)."""
+        if offline or not (annotate or input_kind(tracker_name) != "boxes"):
+            return None
+        return OnnxStream(self.detector, min_score)
+
 
 def open_onnx(video: Path, model: Path, settings: list[str]) -> OnnxRun:
     """The ONNX ``model`` (``settings``: its ``KEY=VALUE``) opened on ``video``; ``ValueError`` naming ``--detector``
@@ -164,5 +192,5 @@ def open_onnx(video: Path, model: Path, settings: list[str]) -> OnnxRun:
     return OnnxRun(detector, images, total, rate)
 
 
-__all__ = ["FEATURE_CHOICES", "OnnxRun", "VideoDetections", "VideoInput", "as_written", "check_features", "open_onnx",
-           "prepare_video", "threshold_hint", "write_video_result"]
+__all__ = ["FEATURE_CHOICES", "OnnxRun", "OnnxStream", "VideoDetections", "VideoInput", "as_written", "check_features",
+           "open_onnx", "prepare_video", "threshold_hint", "write_video_result"]
