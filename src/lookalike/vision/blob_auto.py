@@ -125,9 +125,31 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
     return frames
 
 
-def _spread(stack: np.ndarray) -> float:
-    """90th percentile of the absolute differences from the per-pixel median (grey levels)."""
-    return float(np.percentile(np.abs(stack - np.median(stack, axis=0)), 90))
+def _spread(stack: np.ndarray, median: np.ndarray) -> float:
+    """90th percentile of the absolute differences of ``stack`` from its per-pixel ``median`` (grey levels)."""
+    return float(np.percentile(np.abs(stack - median), 90))
+
+
+def _dark_bright(stack: np.ndarray, background: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(n, h, w)`` float32 darkening and brightening (>= 0, the most changed channel) of a ``(n, h, w, 3)`` float32
+    ``stack`` against its ``(h, w, 3)`` float32 ``background``: ``max(-min_c(stack - background), 0)`` and
+    ``max(max_c(stack - background), 0)``, a frame at a time into one buffer."""
+    with needs("cv2"):
+        import cv2
+
+    dark = np.empty(stack.shape[:3], np.float32)
+    bright = np.empty_like(dark)
+    d = np.empty_like(background)
+    for im, lo, hi in zip(stack, dark, bright):
+        cv2.subtract(im, background, dst=d)
+        np.minimum(d[..., 0], d[..., 1], out=lo)
+        np.minimum(lo, d[..., 2], out=lo)
+        np.negative(lo, out=lo)
+        np.maximum(lo, 0, out=lo)
+        np.maximum(d[..., 0], d[..., 1], out=hi)
+        np.maximum(hi, d[..., 2], out=hi)
+        np.maximum(hi, 0, out=hi)
+    return dark, bright
 
 
 def _shifts(grey: list[np.ndarray]) -> np.ndarray:
@@ -146,7 +168,7 @@ def _components(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     with needs("cv2"):
         import cv2
 
-    _, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    _, labels, stats, _ = cv2.connectedComponentsWithStatsWithAlgorithm(mask, 8, cv2.CV_32S, cv2.CCL_BBDT)
     return stats[1:, cv2.CC_STAT_AREA].astype(float), labels
 
 
@@ -172,7 +194,8 @@ def _radii(masks: list[np.ndarray], area: float) -> list[float]:
         count = int(labels.max())
         if count:
             peak = np.zeros(count + 1)
-            np.maximum.at(peak, labels.ravel(), dist.ravel())
+            inside = np.flatnonzero(labels)  # (the background, label 0, is never kept)
+            np.maximum.at(peak, labels.ravel()[inside], dist.ravel()[inside])
             sizes = np.bincount(labels.ravel(), minlength=count + 1)
             ok = (sizes >= area * _MIN_AREA_FRACTION) & (sizes <= area * _MAX_AREA_FACTOR)
             ok[0] = False
@@ -217,29 +240,27 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     blur = base.blur_px
     height, width = as_bgr_image(picked[0], "frames[0]").shape[:2]
     scale = min(1.0, _WORK_SIDE_PX / max(height, width))  # statistics on a reduced copy, for speed
-    imgs = []
+    small = []
     for i, frame in enumerate(picked):
         img = as_bgr_image(frame, f"frames[{i}]")
         img = cv2.GaussianBlur(img, (blur, blur), 0) if blur > 1 else img
-        if scale < 1:
-            img = cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA)
-        imgs.append(img.astype(np.float32))
-    grey = [im.mean(axis=2).astype(np.float32) for im in imgs]
+        small.append(cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA) if scale < 1 else img)
+    stack: np.ndarray = np.stack(small).astype(np.float32)
+    grey = [im.mean(axis=2).astype(np.float32) for im in stack]
     moves = _shifts(grey) if len(grey) > 1 else np.zeros((1, 2))
     shake = float(np.median(np.hypot(moves[:, 0], moves[:, 1]))) / scale
-    stack: np.ndarray = np.stack(imgs)
+    background = np.median(np.stack(small), axis=0).astype(np.float32)  # (the float frames' median, faster)
+    del small
     stabilise = False
     if shake > shake_px:  # keep the alignment only if it makes the frames agree better with their median
         h, w = grey[0].shape
         aligned = np.stack([cv2.warpAffine(im, np.array([[1, 0, -dx], [0, 1, -dy]], dtype=np.float32), (w, h),
-                                           borderMode=cv2.BORDER_REPLICATE) for im, (dx, dy) in zip(imgs, moves)])
-        if _spread(aligned) < _ALIGN_GAIN * _spread(stack):
-            stack, stabilise = aligned, True
-    background = np.median(stack, axis=0)
-    diff = stack - background
-    dark = np.maximum(-diff.min(axis=3), 0)
-    bright = np.maximum(diff.max(axis=3), 0)
-    del diff, stack
+                                           borderMode=cv2.BORDER_REPLICATE) for im, (dx, dy) in zip(stack, moves)])
+        aligned_background = np.median(aligned, axis=0)
+        if _spread(aligned, aligned_background) < _ALIGN_GAIN * _spread(stack, background):
+            stack, background, stabilise = aligned, aligned_background, True
+    dark, bright = _dark_bright(stack, background)
+    del stack
     noise = max(1.4826 * float(np.median(np.maximum(dark, bright))), 0.5)
     cut = min(max(6 * noise, _THRESHOLD_RANGE[0]), _THRESHOLD_RANGE[1])
     dark_mass, bright_mass = float((dark > cut).sum()), float((bright > cut).sum())
@@ -258,10 +279,10 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     results = {}
     for thr in candidates:
         per_frame, masks = [], []
-        raw: list[np.ndarray] = [np.where(sig > thr, 255, 0).astype(np.uint8) for sig in signal]
+        raw: list[np.ndarray] = [cv2.compare(sig, thr, cv2.CMP_GT) for sig in signal]  # 255 where sig > thr
         if kernel is not None:
             raw = [cv2.morphologyEx(m, cv2.MORPH_OPEN, kernel) for m in raw]
-        persistent = np.mean(np.stack(raw) > 0, axis=0) > _PERSISTENT_SHARE
+        persistent = np.count_nonzero(np.stack(raw), axis=0) / len(raw) > _PERSISTENT_SHARE
         for mask in raw:
             areas, labels = _components(mask)
             moving = np.bincount(labels.ravel(), weights=~persistent.ravel(), minlength=len(areas) + 1)[1:]
