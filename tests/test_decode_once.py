@@ -104,13 +104,29 @@ def test_onnx_detector_video_is_decoded_once(video, tmp_path, counts, monkeypatc
     assert not (tmp_path / "t.det.txt").exists()
 
 
-def test_features_fitted_on_the_video_draw_with_a_second_decode(video, tmp_path, counts, monkeypatch):
-    """``--features video`` is fitted on the whole video before the first frame is tracked: drawing decodes again."""
+@pytest.mark.parametrize("extra", [("-t", "deepsort"), ("-t", "boxtrack", *BLOB)])
+def test_a_whole_video_step_then_drawing_decodes_twice(video, tmp_path, counts, monkeypatch, extra):
+    """Features fitted on the video (``--features video``) or a team size inferred from its blob counts are known
+    only after a pass over the whole video: drawing then decodes it again."""
     monkeypatch.chdir(tmp_path)
     _track("--video", str(video), *BLOB, "-t", "sort", "-o", "first.txt", "--save-detections", "d.txt")
     counts.update(converted=0, grabbed=0)
-    _track("--video", str(video), "--detections", "d.txt", "-t", "deepsort", "--annotate", "a.mp4", "-o", "t.txt")
-    assert counts == {"converted": 2 * FRAMES, "grabbed": 0}
+    monkeypatch.setenv("LOOKALIKE_CACHE", str(tmp_path / "fresh"))
+    source = () if "boxtrack" in extra else ("--detections", "d.txt")
+    _track("--video", str(video), *source, *extra, "--annotate", "a.mp4", "-o", "t.txt")
+    sampled = (SAMPLE, FRAMES - SAMPLE) if "boxtrack" in extra else (0, 0)  # (the blob settings' sampled pass)
+    assert counts == {"converted": 2 * FRAMES + sampled[0], "grabbed": sampled[1]}
+
+
+def test_robot_pixels_video_is_decoded_once(tmp_path, counts, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    r = runner.invoke(app, ["simulate", "--preset", "m3n2", "--frames", "12", "--seed", "3", "-o", "."])
+    assert r.exit_code == 0, r.output
+    assert runner.invoke(app, ["render-robots", "m3n2-000003.jsonl", "-o", "clip.mp4"]).exit_code == 0
+    counts.update(converted=0, grabbed=0)
+    _track("--video", "clip.mp4", "--pipeline", "robots", "--reports", "m3n2-000003.jsonl", "-t", "kalman_ha",
+           "--annotate", "a.mp4", "-o", "t.txt")
+    assert counts == {"converted": 12, "grabbed": 0}
 
 
 class _Seen:
