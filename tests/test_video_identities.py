@@ -103,10 +103,10 @@ def test_merged_blobs_are_cut_out_of_tracklets_and_concurrent_tracklets_teach_th
     space = fit_identity_space([*alone, Tracklet(other[other[:, 0] < 38], 2), Tracklet(other[other[:, 0] > 43], 2)],
                                shapes)
     assert space is not None
-    look = [(space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0), len(t)) for t in alone]
-    second = other[other[:, 0] > 43, SHAPE_COLUMN].astype(int)
-    assert space.link_llr(look[0], look[1]) > 0 > space.link_llr(look[0], (space.embed(shapes[second]).mean(axis=0),
-                                                                           len(second)))
+    look = [space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0) for t in alone]
+    second = space.embed(shapes[other[other[:, 0] > 43, SHAPE_COLUMN].astype(int)]).mean(axis=0)
+    same, two = space.link_evidence(np.array([look[0], look[0]]), np.array([look[1], second]))
+    assert same > 0 > two
 
 
 def test_nothing_to_learn_from_a_lone_animal_and_shapes_must_match_the_detections():

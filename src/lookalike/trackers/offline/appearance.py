@@ -5,10 +5,11 @@ area is near its track's typical blob's (:func:`single_rows`); tracklets are cut
 merged blobs form pieces of their own (:func:`cut_at_merges`). From the single-animal tracklets,
 :func:`fit_identity_space` learns a linear map in which rows of one tracklet lie close together and the mean looks of
 tracklets alive at the same time (so certainly different animals) lie far apart: Fisher's discriminant with the
-within-tracklet scatter against the scatter between concurrent pairs. :meth:`IdentitySpace.link_llr` then says, for
-two tracklets, how much more likely their looks are if they are one animal than if they are two, a log-likelihood
-ratio calibrated on the same video: "same" from the two halves of each tracklet, "different" from the concurrent
-pairs."""
+within-tracklet scatter against the scatter between concurrent pairs. :meth:`IdentitySpace.link_evidence` then says,
+for pairs of tracklets, how much more likely their looks are if each pair is one animal than if it is two: a
+log-likelihood ratio of the log distance between the two mean looks, calibrated on the same video. "Two animals" is
+the distribution of the concurrent pairs' distances; "one animal" is the other part of a two-part mixture fitted to
+the distances of the candidate links themselves (a look changes more across a crossing than within a tracklet)"""
 
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ SINGLE_AREA = (0.6, 1.5)  # a blob shows one animal when its area is within thes
 MIN_ROWS = 8  # single-animal rows a tracklet needs to teach or be judged by its look
 OUTLIER = 0.001  # chance that a tracklet's look is not its animal's (a bad segmentation): bounds a link's evidence
 SHAPE_COLUMN = 9  # the column of an input row that holds its shape vector's index
+MIN_SPREAD = 0.1  # smallest spread of a log look distance (a floor for the fits on few pairs)
 
 
 def single_rows(rows: np.ndarray, shapes: np.ndarray) -> np.ndarray:
@@ -59,31 +61,54 @@ def cut_at_merges(tracklets: list[Tracklet], shapes: np.ndarray) -> tuple[list[T
 
 @dataclass(frozen=True)
 class IdentitySpace:
-    """A learned identity map: shape vectors ``x`` go to ``(x - mean) / scale @ projection``; ``drift`` is the
-    per-dimension variance between the halves of one animal's tracklet beyond sampling noise, ``between`` that of
-    two concurrent animals' means."""
+    """A learned identity map: shape vectors ``x`` go to ``(x - mean) / scale @ projection``; ``other`` is the mean
+    and spread of the log per-dimension squared distance between the mean looks of two concurrent animals."""
 
     mean: np.ndarray
     scale: np.ndarray
     projection: np.ndarray
-    drift: float
-    between: float
+    other: tuple[float, float]
 
     def embed(self, shapes: np.ndarray) -> np.ndarray:
         """Identity coordinates ``(k, d)`` of shape vectors ``(k, SHAPE_SIZE)``."""
         out: np.ndarray = ((shapes - self.mean) / self.scale) @ self.projection
         return out
 
-    def link_llr(self, a: tuple[np.ndarray, int], b: tuple[np.ndarray, int]) -> float:
-        """Log-likelihood ratio, one animal against two, of two tracklets' looks, each ``(mean coordinates, rows)``;
-        either look is its animal's but with probability :data:`OUTLIER`, so the ratio stays within ±ln(1/OUTLIER)."""
-        diff2 = float(np.sum((a[0] - b[0]) ** 2))
-        d = len(a[0])
-        same = self.drift + 1.0 / a[1] + 1.0 / b[1]
-        other = max(self.between, same)
-        ratio = 0.5 * (diff2 / other - diff2 / same) + 0.5 * d * math.log(other / same)  # log N_same - log N_other
-        odds = math.exp(min(max(ratio, -50.0), 50.0))
-        return math.log(((1 - OUTLIER) * odds + OUTLIER) / ((1 - OUTLIER) + OUTLIER * odds))
+    def link_evidence(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Log-likelihood ratios, one animal against two, of the pairs of mean looks ``a[k], b[k]`` (``(k, d)``).
+
+        Each pair's statistic is its log mean squared coordinate difference, normal under either hypothesis; "two" is
+        :attr:`other`, "one" is fitted to these pairs (mixture, :func:`_fit_same`). Distances below the "one"
+        mean count as that mean, above the "two" mean as that mean (the ratio never grows with the distance). Either
+        look is its animal's but with probability :data:`OUTLIER`, so each ratio stays within ±ln(1/OUTLIER)."""
+        x = np.log(np.mean((a - b) ** 2, axis=1) + 1e-9)
+        same = _fit_same(x, self.other)
+        log_same = _log_normal(np.maximum(x, same[0]), same)
+        log_other = _log_normal(np.minimum(x, self.other[0]), self.other)
+        odds = np.exp(np.clip(log_same - log_other, -50.0, 50.0))
+        out: np.ndarray = np.log(((1 - OUTLIER) * odds + OUTLIER) / ((1 - OUTLIER) + OUTLIER * odds))
+        return out
+
+
+def _log_normal(x: np.ndarray, normal: tuple[float, float]) -> np.ndarray:
+    out: np.ndarray = -0.5 * ((x - normal[0]) / normal[1]) ** 2 - math.log(normal[1])
+    return out
+
+
+def _fit_same(x: np.ndarray, other: tuple[float, float], iterations: int = 100) -> tuple[float, float]:
+    """Mean and spread of the "one animal" part of a two-part normal mixture of ``x``, the other part fixed at
+    ``other`` (expectation-maximisation from the lowest tenth of ``x``)."""
+    mean, spread, weight = float(np.percentile(x, 10)), other[1], 0.5
+    for _ in range(iterations):
+        p_same = weight * np.exp(_log_normal(x, (mean, spread)))
+        p_other = (1 - weight) * np.exp(_log_normal(x, other))
+        g = p_same / (p_same + p_other + 1e-300)
+        if g.sum() < 1e-6:
+            break
+        weight = float(g.mean())
+        mean = float(g @ x / g.sum())
+        spread = max(math.sqrt(float(g @ (x - mean) ** 2 / g.sum())), MIN_SPREAD)
+    return min(mean, other[0]), spread
 
 
 def _concurrent_pairs(first: np.ndarray, last: np.ndarray) -> list[tuple[int, int]]:
@@ -128,29 +153,17 @@ def fit_identity_space(tracklets: list[Tracklet], shapes: np.ndarray) -> Identit
     if not keep.any():
         return None
     projection = vectors[:, keep]
-    space = IdentitySpace(mean, scale, projection, 0.0, 1.0)
-    drift, between = _calibrate(space, long, shapes, pairs)
-    return IdentitySpace(mean, scale, projection, drift, between)
-
-
-def _calibrate(space: IdentitySpace, long: list[Tracklet], shapes: np.ndarray,
-               pairs: list[tuple[int, int]]) -> tuple[float, float]:
-    """``(drift, between)`` of :class:`IdentitySpace` from the halves of each tracklet and the concurrent pairs."""
-    coords = [space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]) for t in long]
-    d = coords[0].shape[1]
-    excess = []
-    for c in coords:
-        h = len(c) // 2
-        excess.append(np.sum((c[:h].mean(axis=0) - c[h:].mean(axis=0)) ** 2) / d - 1.0 / h - 1.0 / (len(c) - h))
-    drift = max(float(np.median(excess)), 0.0)
-    between = float(np.mean([np.sum((coords[i].mean(axis=0) - coords[j].mean(axis=0)) ** 2) / d for i, j in pairs]))
-    return drift, between
+    looks = [(g @ projection).mean(axis=0) for g in groups]
+    x = np.log([np.mean((looks[i] - looks[j]) ** 2) + 1e-9 for i, j in pairs])
+    return IdentitySpace(mean, scale, projection, (float(x.mean()), max(float(x.std()), MIN_SPREAD)))
 
 
 def with_appearance(tracklets: list[Tracklet], links: tuple[np.ndarray, np.ndarray, np.ndarray], shapes: np.ndarray,
                     space: IdentitySpace) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``links`` ``(i, j, cost)`` with each cost lowered by :meth:`IdentitySpace.link_llr` of its two tracklets."""
+    """``links`` ``(i, j, cost)`` with each cost lowered by :meth:`IdentitySpace.link_evidence` of its two
+    tracklets."""
     src, dst, cost = links
-    looks = [(space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0), len(t)) for t in tracklets]
-    llr = np.array([space.link_llr(looks[i], looks[j]) for i, j in zip(src.tolist(), dst.tolist())])
-    return src, dst, cost - llr if len(llr) else cost
+    if not len(src):
+        return links
+    looks = np.array([space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0) for t in tracklets])
+    return src, dst, cost - space.link_evidence(looks[src], looks[dst])
