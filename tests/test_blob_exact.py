@@ -1,0 +1,84 @@
+"""The blob detector's and the settings estimate's OpenCV steps give exactly what the plain numpy formulas give."""
+
+import cv2
+import numpy as np
+import pytest
+
+from lookalike.vision.blob import BlobConfig, BlobDetector, spread
+from lookalike.vision.blob_auto import _dark_bright, _radii
+from lookalike.vision.blob_shape import blob_shapes
+
+
+def _frames(n: int, seed: int = 0) -> list[np.ndarray]:
+    """Dark and bright discs and small specks moving over a textured background (uint8 BGR, 90x120)."""
+    rng = np.random.default_rng(seed)
+    bg = rng.integers(90, 170, (90, 120, 3)).astype(float)
+    yy, xx = np.mgrid[:90, :120]
+    frames = []
+    for t in range(n):
+        img = bg.copy()
+        for k, (cx, cy, value) in enumerate([(10 + 3 * t, 30, 20), (100 - 2 * t, 60, 240), (60, 10 + 2 * t, 60)]):
+            img[(xx - cx) ** 2 + (yy - cy) ** 2 <= 25 + 10 * k] = (value, value - k * 10, value + k * 5)
+        img[rng.integers(0, 90, 20), rng.integers(0, 120, 20)] = rng.integers(0, 256, (20, 3))
+        frames.append(img.clip(0, 255).astype(np.uint8))
+    return frames
+
+
+def _reference(cfg: BlobConfig, fit: list[np.ndarray], image: np.ndarray):
+    """Mask, difference and detections as the plain numpy formulas give them (median method, fitted)."""
+    def prepare(im):
+        return (cv2.GaussianBlur(im, (cfg.blur_px,) * 2, 0) if cfg.blur_px > 1 else im).astype(np.float32)
+
+    background = np.median(np.stack([prepare(fit[i]) for i in spread(len(fit), cfg.history)]), axis=0)
+    d = prepare(image) - background.astype(np.float32)
+    b, g, r = d[..., 0], d[..., 1], d[..., 2]
+    diff = {"dark": lambda: np.maximum(-np.minimum(np.minimum(b, g), r), 0),
+            "bright": lambda: np.maximum(np.maximum(np.maximum(b, g), r), 0),
+            "any": lambda: np.maximum(np.maximum(np.abs(b), np.abs(g)), np.abs(r))}[cfg.polarity]()
+    mask = np.where(diff > cfg.threshold, 255, 0).astype(np.uint8)
+    for op, size in ((cv2.MORPH_OPEN, cfg.open_px), (cv2.MORPH_CLOSE, cfg.close_px)):
+        if size > 1:
+            mask = cv2.morphologyEx(mask, op, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size)))
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    keep = [k for k in range(1, count) if cfg.min_area_px <= stats[k, 4] <= cfg.max_area_px]
+    return mask, diff, stats[keep, :4].astype(float), blob_shapes(labels, stats, keep, diff, image)
+
+
+@pytest.mark.parametrize("polarity", ["dark", "bright", "any"])
+@pytest.mark.parametrize(("threshold", "blur_px", "history"), [(30.0, 5, 25), (17.3, 0, 6), (61.7, 3, 7)])
+def test_detector_gives_the_numpy_formulas_rows(polarity: str, threshold: float, blur_px: int, history: int) -> None:
+    frames = _frames(12)
+    cfg = BlobConfig(polarity=polarity, threshold=threshold, blur_px=blur_px, history=history, min_area_px=10,
+                     open_px=3, close_px=5)
+    det = BlobDetector(cfg, describe=True).fit(frames)
+    for image in frames[::3]:
+        mask, diff, boxes, shapes = _reference(cfg, frames, image)
+        got_mask, got_diff = det.foreground(image)
+        np.testing.assert_array_equal(got_mask, mask)
+        np.testing.assert_array_equal(got_diff, diff)
+        found = det(image)
+        assert len(found) == len(boxes) > 0
+        np.testing.assert_array_equal(found.xywh, boxes)
+        np.testing.assert_array_equal(found.feature, shapes)
+
+
+def test_estimate_steps_give_the_numpy_formulas() -> None:
+    stack = np.stack(_frames(7)).astype(np.float32)
+    background = np.median(stack, axis=0)
+    diff = stack - background
+    dark, bright = _dark_bright(stack, background)
+    np.testing.assert_array_equal(dark, np.maximum(-diff.min(axis=3), 0))
+    np.testing.assert_array_equal(bright, np.maximum(diff.max(axis=3), 0))
+    np.testing.assert_array_equal(np.median(np.stack(_frames(7)), axis=0).astype(np.float32), background)
+    masks = [cv2.compare(d, 25.0, cv2.CMP_GT) for d in dark]
+    for mask, sig in zip(masks, dark):
+        np.testing.assert_array_equal(mask, np.where(sig > 25.0, 255, 0).astype(np.uint8))
+    radii = []
+    for mask in masks:  # the largest inscribed radius per component, over every pixel
+        _, labels = cv2.connectedComponents(mask, connectivity=8)
+        dist = cv2.distanceTransform(mask, cv2.DIST_L2, 3)
+        peak = np.zeros(labels.max() + 1)
+        np.maximum.at(peak, labels.ravel(), dist.ravel())
+        sizes = np.bincount(labels.ravel())
+        radii.extend(peak[1:][(sizes[1:] >= 20 / 5) & (sizes[1:] <= 20 * 6)].tolist())
+    assert _radii(masks, 20.0) == radii
