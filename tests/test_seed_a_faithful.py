@@ -110,7 +110,7 @@ def test_variants_and_margins():
     rows = [{"Setup": "M=3, N=2", "Tracker": "kalman_ha", "Success rate (%)": 80.0},
             {"Setup": "M=3, N=2", "Tracker": "lstm-paper", "Success rate (%)": 95.0}]
     (m,) = margin_rows(rows, ["m3n2"], ["M=3, N=2"])
-    assert m["Margin (points)"] == 15.0 and m["Seed A's margin (points)"] == 20.6
+    assert m["Margin (points)"] == 15.0 and m["Paper's margin (points)"] == 20.6
 
 
 def test_table3_windows_and_rows():
@@ -138,4 +138,4 @@ def test_cli_options_parse(tmp_path):
         assert bad.exit_code == 2 and "\n" not in bad.output.strip(), (args, bad.output)
     ok = runner.invoke(app, ["bench", "ident", "--setups", "m3n2", "--trackers", "kalman_ha,lstm-paper",
                              "--sequences", "1", "--frames", "60", "--noise", "paper"])
-    assert ok.exit_code == 0 and "Seed A's" in ok.output, ok.output
+    assert ok.exit_code == 0 and "Paper's" in ok.output, ok.output

@@ -42,7 +42,7 @@ def margin_rows(rows: Sequence[dict[str, Any]], setups: Sequence[str], labels: S
                 continue  # not an LSTM, or no figure (weights not trained for the set-up)
             out.append({"Setup": label, "Identifier": name, "Success rate (%)": rate,
                         f"{baseline} (%)": mine[baseline], "Margin (points)": round(rate - mine[baseline], 2),
-                        "Seed A's margin (points)": round(paper_margin, 1)})
+                        "Paper's margin (points)": round(paper_margin, 1)})
     return out
 
 
