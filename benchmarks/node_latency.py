@@ -58,6 +58,7 @@ from _common import report_target
 from threadpoolctl import threadpool_limits
 
 from lookalike.node import (
+    DetectionsMessage,
     Endpoint,
     IdentifierConfig,
     Status,
@@ -99,11 +100,13 @@ def in_process(tracker_name: str, sequence) -> tuple[np.ndarray, np.ndarray, np.
         c0 = time.thread_time()
         t0 = time.perf_counter()
         message = decode(data)
+        assert isinstance(message, DetectionsMessage)
         while i < len(reports) and reports[i][0] <= message.time:
             identifier.add_report(reports[i][1])
             i += 1
         _, team = identifier.add_frame(message)
-        encode(team)
+        if team is not None:
+            encode(team)
         total_ms.append((time.perf_counter() - t0) * 1e3)
         cpu_ms.append((time.thread_time() - c0) * 1e3)
     limits.restore_original_limits()
