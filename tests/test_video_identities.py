@@ -6,7 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.trackers.offline.appearance import SHAPE_COLUMN, cut_at_merges, fit_identity_space, single_rows
+from lookalike.trackers.offline.appearance import (
+    OUTLIER,
+    SHAPE_COLUMN,
+    IdentitySpace,
+    cut_at_merges,
+    fit_identity_space,
+    single_rows,
+)
 from lookalike.trackers.offline.closed_set import track_closed_set
 from lookalike.trackers.offline.tracklets import Tracklet
 from lookalike.vision.blob_shape import SHAPE_SIZE, blob_shapes
@@ -107,6 +114,23 @@ def test_merged_blobs_are_cut_out_of_tracklets_and_concurrent_tracklets_teach_th
     second = space.embed(shapes[other[other[:, 0] > 43, SHAPE_COLUMN].astype(int)]).mean(axis=0)
     same, two = space.link_evidence(np.array([look[0], look[0]]), np.array([look[1], second]))
     assert same > 0 > two
+
+
+def test_link_evidence_learns_how_much_one_animals_look_changes_between_pieces():
+    """Each piece of an animal looks a little different (pose, light), more than a piece's rows differ among
+    themselves; the "one animal" distance is learned from the links, so same-animal links still gain and
+    different-animal links still lose."""
+    rng = np.random.default_rng(0)
+    d, animals = 3, rng.normal(0.0, 3.0, (6, 3))
+    piece = lambda a: animals[a] + rng.normal(0.0, 0.6, d)  # noqa: E731 (a piece's mean look)
+    concurrent = [(piece(a), piece(b)) for a in range(6) for b in range(a + 1, 6)]
+    x = np.log([np.mean((p - q) ** 2) for p, q in concurrent])
+    space = IdentitySpace(np.zeros(d), np.ones(d), np.eye(d), (float(x.mean()), float(x.std())))
+    pairs = [(a, a) for a in range(6) for _ in range(5)] + [(a, (a + k) % 6) for a in range(6) for k in (1, 2, 3)]
+    ev = space.link_evidence(np.array([piece(a) for a, _ in pairs]), np.array([piece(b) for _, b in pairs]))
+    same = np.array([a == b for a, b in pairs])
+    assert (ev[same] > 0).mean() >= 0.9 and (ev[~same] < 0).mean() >= 0.9
+    assert np.all(np.abs(ev) <= np.log(1 / OUTLIER) + 1e-9)
 
 
 def test_nothing_to_learn_from_a_lone_animal_and_shapes_must_match_the_detections():
