@@ -82,3 +82,19 @@ def test_estimate_steps_give_the_numpy_formulas() -> None:
         sizes = np.bincount(labels.ravel())
         radii.extend(peak[1:][(sizes[1:] >= 20 / 5) & (sizes[1:] <= 20 * 6)].tolist())
     assert _radii(masks, 20.0) == radii
+
+
+@pytest.mark.parametrize("polarity", ["dark", "bright", "any"])
+def test_the_band_of_background_grey_levels_is_the_float32_comparison(polarity: str) -> None:
+    rng = np.random.default_rng(1)
+    values = [rng.integers(0, 256, 300), rng.integers(0, 511, 300) / 2, rng.uniform(0, 255, 297), [0, 255, 127.5]]
+    background = np.concatenate(values).astype(np.float32).reshape(30, 10, 3)
+    for threshold in (0.3, 1.0, 17.3, 30.0, 61.7, 200.5, 254.9):
+        det = BlobDetector(BlobConfig(polarity=polarity, threshold=threshold))
+        det.background_, det._fitted = background, True
+        lower, upper = det._band()
+        for v in range(256):
+            d = np.float32(v) - background  # as _difference: the frame minus the background, in float32
+            darker, brighter = -d > threshold, d > threshold
+            outside = {"dark": darker, "bright": brighter, "any": darker | brighter}[polarity]
+            np.testing.assert_array_equal((v < lower) | (v > upper), outside)

@@ -81,6 +81,7 @@ class BlobDetector:
     _reference: np.ndarray | None = field(default=None, init=False, repr=False)
     _window: np.ndarray | None = field(default=None, init=False, repr=False)
     _scratch: np.ndarray | None = field(default=None, init=False, repr=False)  # the 3-channel difference
+    _bounds: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False)  # see _band
 
     def __post_init__(self) -> None:
         self._buffer = deque(maxlen=self.config.history)
@@ -94,6 +95,7 @@ class BlobDetector:
         self._fitted = False
         self._reference = None
         self._window = None
+        self._bounds = None
 
     def fit(self, frames: Iterable[np.ndarray] | np.ndarray) -> BlobDetector:
         """Median background of at most ``history`` of ``frames``, spread evenly (``median`` method only)."""
@@ -104,16 +106,24 @@ class BlobDetector:
             raise ValueError("frames: no frames to fit a background on")
         stack = np.stack([self._prepare(frames[i], f"frames[{i}]") for i in spread(len(frames), self.config.history)])
         self.background_ = np.median(stack, axis=0).astype(np.float32)  # (of uint8 frames: the same values, faster)
-        self._fitted = True
+        self._fitted, self._bounds = True, None
         return self
 
     def foreground(self, image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(mask, difference)``: ``(h, w)`` uint8 foreground (255) and float32 difference from the background."""
+        mask, diff, _ = self._foreground(image, whole=True)
+        assert diff is not None
+        return mask, diff
+
+    def _foreground(self, image: np.ndarray, whole: bool) -> tuple[np.ndarray, np.ndarray | None, np.ndarray]:
+        """:meth:`foreground`'s mask, its difference (None when not ``whole`` and not needed for the mask) and the
+        prepared frame."""
         with needs("cv2"):
             import cv2
 
         cfg = self.config
         img = self._prepare(image, "image")
+        diff = None
         if cfg.method == "mog2":
             if self._mog is None:
                 self._mog = cv2.createBackgroundSubtractorMOG2(
@@ -134,12 +144,34 @@ class BlobDetector:
                     f"image: shape {img.shape[:2]} differs from the background's "
                     f"{None if self.background_ is None else self.background_.shape[:2]}"
                 )
-            diff = self._difference(img, self.background_)
-            mask = cv2.compare(diff, cfg.threshold, cv2.CMP_GT)  # 255 where diff > threshold, else 0
+            if whole or not self._fitted or img.dtype != np.uint8:
+                diff = self._difference(img, self.background_)
+                mask = cv2.compare(diff, cfg.threshold, cv2.CMP_GT)  # 255 where diff > threshold, else 0
+            else:  # the same mask from the frame's grey levels, without the difference image
+                mask = cv2.bitwise_not(cv2.inRange(img, *self._band()))
         for op, size in ((cv2.MORPH_OPEN, cfg.open_px), (cv2.MORPH_CLOSE, cfg.close_px)):
             if size > 1:
                 mask = cv2.morphologyEx(mask, op, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (size, size)))
-        return mask, diff
+        return mask, diff, img
+
+    def _band(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(lower, upper)``: ``(h, w, 3)`` uint8 grey levels, per pixel and channel, between which a uint8 frame is
+        background: ``v`` is foreground when ``float32(background - v) > threshold`` (darker; polarity dark or any)
+        or ``float32(v - background) > threshold`` (brighter; bright or any), as :meth:`_difference` compares it."""
+        if self._bounds is None:
+            assert self.background_ is not None
+            bg, t = self.background_, np.float32(self.config.threshold)
+            low = np.clip(np.ceil(bg.astype(float) - float(t)), 0, 255).astype(np.float32)  # darker: v < low
+            high = np.clip(np.floor(bg.astype(float) + float(t)), 0, 255).astype(np.float32)  # brighter: v > high
+            for _ in range(2):  # (float32 rounding moves an edge by at most one grey level)
+                low += (low < 255) & (bg - low > t)
+                low -= (low > 0) & ~(bg - (low - 1) > t)
+                high -= (high > 0) & (high - bg > t)
+                high += (high < 255) & ~(high + 1 - bg > t)
+            polarity = self.config.polarity
+            self._bounds = (low.astype(np.uint8) if polarity != "bright" else np.zeros(bg.shape, np.uint8),
+                            high.astype(np.uint8) if polarity != "dark" else np.full(bg.shape, 255, np.uint8))
+        return self._bounds
 
     def __call__(self, image: np.ndarray) -> Detections:
         """Detections of one frame: boxes ``xywh`` (px) of the blobs, each scoring 1 (with ``describe``, each blob's
@@ -148,7 +180,7 @@ class BlobDetector:
             import cv2
 
         cfg = self.config
-        mask, difference = self.foreground(image)
+        mask, difference, img = self._foreground(image, whole=False)
         # (BBDT: the labels and stats of the default algorithm, in the same order, faster)
         count, labels, stats, _ = cv2.connectedComponentsWithStatsWithAlgorithm(mask, 8, cv2.CV_32S, cv2.CCL_BBDT)
         keep = [k for k in range(1, count) if cfg.min_area_px <= stats[k, 4] <= cfg.max_area_px]
@@ -159,6 +191,12 @@ class BlobDetector:
             return Detections(xywh=boxes, score=np.ones(len(keep)))
         from lookalike.vision.blob_shape import blob_shapes
 
+        if difference is None:  # the difference where the kept blobs lie
+            assert self.background_ is not None
+            difference = np.zeros(mask.shape, np.float32)
+            for x, y, w, h in stats[keep, :4]:
+                difference[y:y + h, x:x + w] = self._difference(img[y:y + h, x:x + w],
+                                                                self.background_[y:y + h, x:x + w])
         shapes = blob_shapes(labels, stats, keep, difference, as_bgr_image(image, "image"))
         return Detections(xywh=boxes, score=np.ones(len(keep)), feature=shapes)
 
