@@ -1,10 +1,12 @@
 """The blob detector's and the settings estimate's OpenCV steps give exactly what the plain numpy formulas give."""
 
+import itertools
+
 import cv2
 import numpy as np
 import pytest
 
-from lookalike.vision.blob import BlobConfig, BlobDetector, spread
+from lookalike.vision.blob import BlobConfig, BlobDetector, median_frame, spread
 from lookalike.vision.blob_auto import _dark_bright, _radii
 from lookalike.vision.blob_shape import blob_shapes
 
@@ -98,3 +100,14 @@ def test_the_band_of_background_grey_levels_is_the_float32_comparison(polarity: 
             darker, brighter = -d > threshold, d > threshold
             outside = {"dark": darker, "bright": brighter, "any": darker | brighter}[polarity]
             np.testing.assert_array_equal((v < lower) | (v > upper), outside)
+
+
+def test_the_median_frame_is_numpys_median() -> None:
+    rng = np.random.default_rng(2)
+    for n in range(1, 32):
+        for stack in (rng.integers(0, 4, (n, 20, 9)).astype(np.uint8), rng.integers(0, 256, (n, 5, 3)).astype(np.uint8),
+                      rng.normal(100, 50, (n, 6, 4)).astype(np.float32)):
+            np.testing.assert_array_equal(median_frame(stack), np.median(stack, axis=0).astype(np.float32))
+    for n in range(1, 14, 2):  # every 0/1 input (the 0-1 principle: the network then finds the middle of any input)
+        bits = np.array(list(itertools.product([0, 1], repeat=n)), np.uint8).T
+        np.testing.assert_array_equal(median_frame(bits), np.median(bits, axis=0).astype(np.float32))

@@ -9,6 +9,7 @@ import math
 from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +29,44 @@ _POLARITIES = ("any", "dark", "bright")
 def spread(n: int, count: int) -> np.ndarray:
     """Up to ``count`` indices spread evenly over ``range(n)``, increasing."""
     return np.unique(np.linspace(0, n - 1, min(n, count)).round().astype(int))
+
+
+def median_frame(stack: np.ndarray) -> np.ndarray:
+    """``np.median(stack, axis=0)`` as float32, for ``(n, ...)`` frames. Of an odd number of uint8 frames, the middle
+    value of a sorting network of elementwise minima and maxima over whole frames: the same value as numpy's
+    per-pixel selection, several times faster."""
+    n = len(stack)
+    if n % 2 == 0 or stack.dtype != np.uint8:
+        return np.median(stack, axis=0).astype(np.float32)
+    rows = [np.array(frame) for frame in stack]
+    spare = np.empty_like(rows[0])
+    for i, j in _median_network(n):
+        np.minimum(rows[i], rows[j], out=spare)
+        np.maximum(rows[i], rows[j], out=rows[j])
+        rows[i], spare = spare, rows[i]
+    return rows[n // 2].astype(np.float32)
+
+
+@lru_cache(maxsize=8)
+def _median_network(n: int) -> tuple[tuple[int, int], ...]:
+    """The comparators ``(i, j)``, ``i < j``, of Batcher's odd-even merge sort of ``n`` values (the smaller value goes
+    to ``i``) that the middle position ``n // 2`` depends on, in order."""
+    pairs = []
+    p = 1
+    while p < n:  # merge sorted runs of p into runs of 2p
+        k = p
+        while k >= 1:
+            for j in range(k % p, n - k, 2 * k):
+                pairs += [(i + j, i + j + k) for i in range(min(k, n - j - k))
+                          if (i + j) // (2 * p) == (i + j + k) // (2 * p)]
+            k //= 2
+        p *= 2
+    needed, kept = {n // 2}, []
+    for i, j in reversed(pairs):
+        if i in needed or j in needed:
+            kept.append((i, j))
+            needed |= {i, j}
+    return tuple(reversed(kept))
 
 
 @dataclass(frozen=True)
@@ -82,6 +121,7 @@ class BlobDetector:
     _window: np.ndarray | None = field(default=None, init=False, repr=False)
     _scratch: np.ndarray | None = field(default=None, init=False, repr=False)  # the 3-channel difference
     _bounds: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False)  # see _band
+    _boxes_difference: np.ndarray | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._buffer = deque(maxlen=self.config.history)
@@ -105,7 +145,7 @@ class BlobDetector:
         if not frames:
             raise ValueError("frames: no frames to fit a background on")
         stack = np.stack([self._prepare(frames[i], f"frames[{i}]") for i in spread(len(frames), self.config.history)])
-        self.background_ = np.median(stack, axis=0).astype(np.float32)  # (of uint8 frames: the same values, faster)
+        self.background_ = median_frame(stack)
         self._fitted, self._bounds = True, None
         return self
 
@@ -191,9 +231,11 @@ class BlobDetector:
             return Detections(xywh=boxes, score=np.ones(len(keep)))
         from lookalike.vision.blob_shape import blob_shapes
 
-        if difference is None:  # the difference where the kept blobs lie
+        if difference is None:  # the difference where the kept blobs lie (elsewhere, left from earlier frames)
             assert self.background_ is not None
-            difference = np.zeros(mask.shape, np.float32)
+            if self._boxes_difference is None or self._boxes_difference.shape != mask.shape:
+                self._boxes_difference = np.zeros(mask.shape, np.float32)
+            difference = self._boxes_difference
             for x, y, w, h in stats[keep, :4]:
                 difference[y:y + h, x:x + w] = self._difference(img[y:y + h, x:x + w],
                                                                 self.background_[y:y + h, x:x + w])

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike._optional import needs
-from lookalike.vision.blob import BlobConfig, spread
+from lookalike.vision.blob import BlobConfig, median_frame, spread
 from lookalike.vision.hog_features import as_bgr_image
 
 __all__ = ["BOX_TRACKER_PARAMS", "BlobEstimate", "TargetCount", "estimate_blob_config", "frame_counts",
@@ -249,7 +249,7 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     grey = [im.mean(axis=2).astype(np.float32) for im in stack]
     moves = _shifts(grey) if len(grey) > 1 else np.zeros((1, 2))
     shake = float(np.median(np.hypot(moves[:, 0], moves[:, 1]))) / scale
-    background = np.median(np.stack(small), axis=0).astype(np.float32)  # (the float frames' median, faster)
+    background = median_frame(np.stack(small))  # (the float frames' median, faster)
     del small
     stabilise = False
     if shake > shake_px:  # keep the alignment only if it makes the frames agree better with their median
