@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
-from typing import TYPE_CHECKING
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack, contextmanager
+from typing import TYPE_CHECKING, Any
 
 from rich.console import Console
 from rich.progress import (
@@ -18,7 +18,7 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from lookalike.cli.app import console
+from lookalike.cli.app import console, note, warn
 
 if TYPE_CHECKING:
     from lookalike.bench.progress import ProgressFactory, Step
@@ -45,4 +45,29 @@ def progress_bars() -> Iterator[ProgressFactory]:
         yield factory
 
 
-__all__ = ["bars", "progress_bars"]
+@contextmanager
+def printed_events() -> Iterator[Callable[[Any], None]]:
+    """An ``on_event`` for :func:`lookalike.pipeline.run`: notes, warnings and lines printed, steps drawn as bars
+    (from the first step on)."""
+    with ExitStack() as stack:
+        tasks: dict[str, Any] = {}
+        progress: list[Progress] = []
+
+        def on_event(event: Any) -> None:
+            kind, text = event.kind, event.text
+            if kind == "start":
+                progress[:] = progress or [stack.enter_context(bars())]
+                tasks[text] = progress[0].add_task(text, total=event.count or None)
+            elif kind == "advance":
+                progress[0].advance(tasks[text], event.count)
+            elif kind == "end":
+                progress[0].remove_task(tasks.pop(text))
+            elif kind in ("note", "warn"):
+                (note if kind == "note" else warn)(text)
+            else:
+                console.print(text, markup=False)
+
+        yield on_event
+
+
+__all__ = ["bars", "printed_events", "progress_bars"]

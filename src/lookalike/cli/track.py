@@ -4,23 +4,20 @@ output streams are :mod:`lookalike.io.stream`."""
 from __future__ import annotations
 
 import math
-from contextlib import ExitStack
-from functools import partial
+from contextlib import ExitStack, nullcontext
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import typer
 from rich.markup import escape
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from lookalike.cli.app import app, console, fail, failing, note, warn
+from lookalike.cli.app import app, console, fail, failing
 from lookalike.io.outputs import atomic_path
-from lookalike.loop import RunStats
 from lookalike.pipeline import files
-from lookalike.pipeline.files import input_error
 from lookalike.pipeline.request import TrackRequest
 
-__all__ = ["build_tracker", "track", "track_files", "tracker_params"]
+__all__ = ["build_tracker", "track", "tracker_params"]
 
 
 def tracker_params(name: str, settings: list[str], params_file: Path | None = None) -> dict[str, Any]:
@@ -35,38 +32,24 @@ def build_tracker(name: str, settings: list[str], params_file: Path | None = Non
         return files.build_tracker(name, settings, params_file)
 
 
-def track_files(path: Path, output: Path, tracker: Any, min_score: float,
-                use_length: bool = True, det_format: str = "auto", name: str = "") -> tuple[int, RunStats]:
-    """Track every sequence at ``path`` (a det.txt, a sequence folder or a folder of them) into ``output`` (a file
-    for a single det.txt, else ``output/<sequence>.txt``), streaming, inputs checked and outputs decided first;
-    ``use_length``: seqinfo.ini's seqLength bounds the frames; ``name``: the tracker's, for warnings."""
-    try:
-        streams = files.open_sequences(path, output, min_score, use_length, det_format)
-    except (FileNotFoundError, ValueError) as exc:
-        fail(input_error(exc))
-    for seq, frames, target in streams:
-        files.sequence_warnings(seq, frames, target, warn, note)
-    stats = RunStats()
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
-                  console=console, transient=True) as progress:
-        overall = progress.add_task("sequences", total=len(streams))
-        for seq, frames, target in streams:
-            task = progress.add_task(seq.name, total=frames.length)
-            with failing(ValueError):
-                dropped = files.track_sequence(tracker, seq, frames, target, stats,
-                                               partial(progress.advance, task), name)
-            progress.remove_task(task)
-            progress.advance(overall)
-            if dropped is not None:
-                warn(dropped)
-    return len(streams), stats
+def _run(request: TrackRequest, annotate_as: Path | None) -> None:
+    """:func:`lookalike.pipeline.run`, printed."""
+    from lookalike.cli.progress import printed_events
+    from lookalike.cli.track_video import interrupted, print_video_result
+    from lookalike.pipeline import run
 
-
-def _speed(stats: RunStats) -> str:
-    """``N frames, F frames/s (tracker only)``, without a rate when nothing was tracked."""
-    if stats.frames == 0 or not math.isfinite(stats.fps):
-        return f"{stats.frames} frames"
-    return f"{stats.frames} frames, {stats.fps:,.0f} frames/s (tracker only)"
+    with failing(ValueError, TypeError), interrupted(request.annotate, annotate_as) if request.branch() == "video" \
+            else nullcontext(), printed_events() as on_event:
+        result = run(request, on_event)
+    if result.branch == "video":
+        return print_video_result(result, request.tracker, annotate_as)
+    path, output = request.path, request.output
+    assert path is not None
+    where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
+    stats = result.stats
+    speed = f", {stats.fps:,.0f} frames/s (tracker only)" if stats.frames and math.isfinite(stats.fps) else ""
+    console.print(f"[green]{request.tracker}[/]: {result.sequences} sequence(s), {stats.frames} frames{speed} → "
+                  f"{where}")
 
 
 @app.command()
@@ -143,7 +126,8 @@ def track(
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
     request = TrackRequest(output, tracker, path, video_arg, detections, points, bag, detector, blob or [], pipeline,
                            reports, annotate, save_detections, targets, offline_opt,
-                           stops=max_frames is not None or seconds is not None)
+                           max_frames is not None or seconds is not None, set_ or [], params_file, min_score, fps,
+                           features, team_size, health_window, det_format, not no_seqinfo_length)
     video = request.video_path
     with failing(ValueError):
         live = request.live()
@@ -172,6 +156,11 @@ def track(
                                  settings, annotate=annotate, fps=fps, min_score=min_score, annotate_as=annotate_as,
                                  bag=bag, camera_topic=camera_topic, heading_topics=heading_topics)
                 return
+            from lookalike.cli.track_confidence import add_confidence, written_results
+
+            if branch in ("files", "video") and not offline:  # (lookalike.pipeline.run)
+                _run(replace(request, annotate=annotate), annotate_as)
+                return add_confidence(written_results(branch, path, output, video, fps))
             with failing(ValueError, TypeError):
                 trk = files.box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets,
                                         params_file=params_file)
@@ -200,39 +189,25 @@ def track(
                                     n_targets=0 if open_set else targets, offline=online,
                                     explicit=tracker_params(tracker, settings, params_file).keys(),
                                     save_detections=save_detections, **video_options)
-                else:
+                else:  # --offline on a video's detections
+                    from lookalike.cli.track_closed import check_result_file, offline_video
+                    from lookalike.viz.overlay import source_frames
+
                     det_path = detections or path
-                    assert det_path is not None
-                    if online is not None and targets is not None:
-                        from lookalike.cli.track_closed import check_result_file, offline_video
-                        from lookalike.viz.overlay import source_frames
+                    assert online is not None and targets is not None and det_path is not None
+                    check_result_file(output)
+                    with failing(ValueError, OSError):
+                        _, count, rate = source_frames(video)
+                    offline_video(det_path, output, targets, online, fps or rate, count or None,
+                                  min_score, det_format, video=video, annotate=annotate, annotate_as=annotate_as)
+            else:  # --offline over detection files
+                from lookalike.cli.track_closed import offline_files
 
-                        check_result_file(output)
-                        with failing(ValueError, OSError):
-                            _, count, rate = source_frames(video)
-                        offline_video(det_path, output, targets, online, fps or rate, count or None, min_score,
-                                      det_format, video=video, annotate=annotate, annotate_as=annotate_as)
-                    else:
-                        from lookalike.cli.track_video import run_track_video
-
-                        run_track_video(video, det_path, output, trk, tracker, det_format=det_format,
-                                        **video_options)
-            else:
-                assert path is not None
+                assert path is not None and online is not None and targets is not None
+                count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length,
+                                      det_format=det_format)
                 where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
-                if online is not None and targets is not None:
-                    from lookalike.cli.track_closed import offline_files
-
-                    count = offline_files(path, output, targets, online, min_score,
-                                          use_length=not no_seqinfo_length, det_format=det_format)
-                    console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → "
-                                  f"{where}")
-                else:
-                    count, stats = track_files(path, output, trk, min_score, use_length=not no_seqinfo_length,
-                                               det_format=det_format, name=tracker)
-                    console.print(f"[green]{tracker}[/]: {count} sequence(s), {_speed(stats)} → {where}")
-            from lookalike.cli.track_confidence import add_confidence, written_results
-
+                console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
             add_confidence(written_results(branch, path, output, video, fps, live=live is not None))
 
         except OSError as exc:  # an output that cannot be written, an input that cannot be read

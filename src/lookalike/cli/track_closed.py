@@ -18,10 +18,10 @@ from lookalike.pipeline.files import input_error
 
 def check_result_file(output: Path, video: Path | None = None) -> None:
     """Fail unless ``output`` can be the ``--video`` branch's result file and ``video`` (if given) exists."""
-    if output.is_dir():
-        fail(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
-    if video is not None and not video.exists():
-        fail(f"--video: {video} does not exist")
+    from lookalike.pipeline.video import check_result_file as check
+
+    with failing(ValueError):
+        check(output, video)
 
 
 def _note(line: str) -> None:

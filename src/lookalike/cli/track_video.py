@@ -1,74 +1,52 @@
-"""The ``--video`` branch of ``lookalike track``: features from the frames' pixels, tracks, merges, detector
-health, optional annotated video."""
+"""The ``--video`` branch of ``lookalike track``, printed: the run is :func:`lookalike.pipeline.video.run_video`
+(features from the frames' pixels, tracks, merges, detector health, optional annotated video)."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from rich.markup import escape
 
-from lookalike.cli.app import console, fail, failing, note, warn
-from lookalike.cli.progress import bars
+from lookalike.cli.app import console, fail, failing
+from lookalike.cli.progress import bars, printed_events
 from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.io import MotTable, write_mot
-from lookalike.pipeline.tracking import track_video
-from lookalike.pipeline.video import (
-    VideoDetections,
-    as_written,
-    check_features,
-    open_onnx,
-    prepare_video,
-    threshold_hint,
-    write_video_result,
-)
-from lookalike.trackers.parts.health import HealthConfig
+from lookalike.pipeline.runner import RunResult
+from lookalike.pipeline.video import VideoDetections, as_written, open_onnx, run_video
 
-__all__ = ["run_track_onnx", "run_track_video", "save_detections"]
+__all__ = ["interrupted", "print_video_result", "run_track_onnx", "run_track_video", "save_detections"]
 
 
 def run_track_video(video: Path, detections: VideoDetections, output: Path, tracker: Any, tracker_name: str, *,
-                    annotate: Path | None, team_size: int | None, health_window: int,
-                    min_score: float, fps: float | None, features: str = "video",
-                    annotate_as: Path | None = None, det_format: str = "auto", length: int | None = None,
-                    score_warnings: bool = True) -> None:
-    """Track ``detections`` (a file, the rows a detector found, or a detector run in the same pass) on ``video``;
-    write ``output``, its ``.health.csv`` (``.merges.csv`` for merging trackers) and, with ``annotate``, the annotated
-    MP4 (printed as ``annotate_as``); see :func:`lookalike.pipeline.video.prepare_video`. ``score_warnings``: False
-    for a detector whose scores are all 1 by design (blobs)."""
-    with failing(ValueError):
-        check_features(features)
-    check_result_file(output)
-    with failing(ValueError, OSError):
-        found = prepare_video(video, detections, tracker_name, annotate=annotate, features=features,
-                              det_format=det_format, length=length, status=console.status)
-    for line in found.notes:
-        note(f"{found.name}: {line}")
-    for line in found.warnings(video, score_warnings):
-        warn(line)
-    hint = threshold_hint(found.extractor, tracker_name, features)
-    if hint:
-        console.print(hint, markup=False)
+                    annotate_as: Path | None = None, **options: Any) -> None:
+    """:func:`lookalike.pipeline.video.run_video` given ``options``, printed (the ``annotate`` MP4 as
+    ``annotate_as``)."""
+    with failing(ValueError), interrupted(options.get("annotate"), annotate_as), printed_events() as on_event:
+        result = run_video(video, detections, output, tracker, tracker_name, on_event, **options)
+    annotated = options.get("annotate")
+    print_video_result(result, tracker_name, annotate_as or annotated if annotated is not None else None)
+
+
+@contextmanager
+def interrupted(annotate: Path | None, annotate_as: Path | None) -> Iterator[None]:
+    """Ctrl-C in the block: a line saying that nothing was written, exit 130."""
     try:
-        with bars("tracking {task.description}") as progress:
-            task = progress.add_task(video.name, total=found.total or None)
-            result = track_video(video, found.table, tracker, found.extractor, annotate=annotate,
-                                 health=HealthConfig(team_size=team_size, window=health_window), fps=fps,
-                                 min_score=min_score, advance=lambda: progress.advance(task), length=length,
-                                 images=found.frames, detect=found.detect)
-    except ValueError as exc:
-        fail(str(exc))
+        yield
     except KeyboardInterrupt:
         console.print("\n[yellow]Interrupted.[/] Nothing was written"
                       + (f" ({escape(str(annotate_as or annotate))} is left as it was)." if annotate else "."))
         raise SystemExit(130) from None
-    written = write_video_result(output, result, tracker)
-    dropped = found.dropped_all(result, tracker_name)
-    if dropped is not None:
-        warn(dropped)
-    if annotate is not None:
-        written.append(annotate_as or annotate)
+
+
+def print_video_result(run: RunResult, tracker_name: str, annotated: Path | None) -> None:
+    """The line telling what a video's run (:func:`lookalike.pipeline.video.run_video`) wrote (and ``annotated``)."""
+    result = run.video
+    assert result is not None
+    written = [*run.written, *([annotated] if annotated is not None else [])]
     unhealthy = sum(not s.healthy for s in result.health)
     seconds = result.tracker_s + result.feature_s
     fps_text = f"{result.frames / seconds:,.0f}" if seconds > 0 else "inf"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -13,8 +14,11 @@ class TrackRequest:
     """What ``lookalike track`` was asked: ``output``, the input (``path``, ``video`` text, ``detections``,
     ``points`` or ``bag``), the ``detector`` and its ``blob`` settings, the robots ``pipeline`` and ``reports``,
     ``annotate`` and ``save_detections`` outputs, the ``tracker`` name, ``targets`` (0: an open set), ``offline``
-    (None: the default), and whether a live stop (``stops``: --max-frames/--seconds) was given. Every check raises
-    ``ValueError`` naming the options."""
+    (None: the default), and whether a live stop (``stops``: --max-frames/--seconds) was given; how to track: the
+    tracker's ``settings`` (``KEY=VALUE``) and ``params_file``, ``min_score``, ``fps`` (None: the input's),
+    appearance ``features``, the health checks' ``team_size`` (None: ``targets``) and ``health_window`` (frames),
+    the detection files' ``det_format`` and whether seqinfo.ini's seqLength bounds them (``use_length``). Every check
+    raises ``ValueError`` naming the options."""
 
     output: Path
     tracker: str = "sort"
@@ -32,6 +36,15 @@ class TrackRequest:
     targets: int | None = None
     offline: bool | None = None
     stops: bool = False
+    settings: list[str] = field(default_factory=list)
+    params_file: Path | None = None
+    min_score: float = -math.inf
+    fps: float | None = None
+    features: str = "video"
+    team_size: int | None = None
+    health_window: int = 15
+    det_format: str = "auto"
+    use_length: bool = True
 
     @property
     def video_path(self) -> Path | None:

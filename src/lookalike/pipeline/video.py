@@ -8,7 +8,6 @@ import io
 import itertools
 import time
 from collections.abc import Callable, Iterable
-from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,9 +19,12 @@ from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
 from lookalike.io.motchallenge import format_rows
 from lookalike.io.needs import input_kind
 from lookalike.io.outputs import atomic_path
+from lookalike.loop import RunStats
 from lookalike.pipeline.files import dropped_all
-from lookalike.pipeline.tracking import VideoFeatures, VideoTrackingResult
+from lookalike.pipeline.runner import Event, RunResult
+from lookalike.pipeline.tracking import VideoFeatures, VideoTrackingResult, track_video
 from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored_thresholds
+from lookalike.trackers.parts.health import HealthConfig
 from lookalike.types import Detections
 from lookalike.types.mot_table import detection_rows
 from lookalike.viz.overlay import source_frames
@@ -70,11 +72,9 @@ def check_features(features: str) -> None:
 
 
 def prepare_video(video: Path, detections: VideoDetections, tracker_name: str, *, annotate: Path | None = None,
-                  features: str = "video", det_format: str = "auto",
-                  length: int | None = None,
-                  status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()) -> VideoInput:
+                  features: str = "video", det_format: str = "auto", length: int | None = None) -> VideoInput:
     """Read ``detections`` and the feature extractor ``tracker_name`` reads (``features``: as ``--features``, ``video``
-    fitted in the tracking pass; loading shown by ``status``); with ``length`` (the video's decoded frames) known, a
+    fitted in the tracking pass); with ``length`` (the video's decoded frames) known, a
     box tracker without ``annotate`` or a detector gets no frames decoded, else the first frame gives the size and
     the frames go on to the tracker (one decode)."""
     detect = None if isinstance(detections, (Path, MotTable)) else detections
@@ -87,9 +87,8 @@ def prepare_video(video: Path, detections: VideoDetections, tracker_name: str, *
     images, total, _ = source_frames(video)
     extractor: Any = None
     if input_kind(tracker_name) != "boxes":  # a tracker reading no appearance gets no features computed
-        with status("loading appearance features"):
-            extractor = (fit_diver_features() if features in ("divers", "handcrafted")
-                         else VideoFeatures() if features == "video" else diver_extractor(features))
+        extractor = (fit_diver_features() if features in ("divers", "handcrafted")
+                     else VideoFeatures() if features == "video" else diver_extractor(features))
     stream: Iterable[np.ndarray] | None = None
     if extractor is None and annotate is None and length is not None and detect is None:  # no frame decoded
         size = None if video.is_dir() else video_info(video)[2]
@@ -108,6 +107,51 @@ def threshold_hint(extractor: Any, tracker_name: str, features: str) -> str | No
         return None
     return (f"note: {tracker_name}'s thresholds were chosen for the hand-crafted features; matched to {features} on "
             "the validation divers they are " + " ".join(f"--set {k}={v:g}" for k, v in hint.items()))
+
+
+def check_result_file(output: Path, video: Path | None = None) -> None:
+    """``ValueError`` unless ``output`` can be a video's result file and ``video`` (if given) exists."""
+    if output.is_dir():
+        raise ValueError(f"-o/--output: {output} is a folder; with --video give a result file such as tracks.txt")
+    if video is not None and not video.exists():
+        raise ValueError(f"--video: {video} does not exist")
+
+
+def run_video(video: Path, detections: VideoDetections, output: Path, tracker: Any, tracker_name: str,
+              on_event: Callable[[Event], None], *, annotate: Path | None = None, team_size: int | None = None,
+              health_window: int = 15, min_score: float = -np.inf, fps: float | None = None, features: str = "video",
+              det_format: str = "auto", length: int | None = None, score_warnings: bool = True) -> RunResult:
+    """Track ``detections`` (see :func:`prepare_video`) on ``video`` with ``tracker`` (registered as
+    ``tracker_name``), telling ``on_event`` (:class:`~lookalike.pipeline.runner.Event`) its notes, warnings and
+    progress; write ``output``, its ``.health.csv`` (health checks of ``team_size`` over ``health_window`` frames),
+    ``.merges.csv`` for merging trackers, and the ``annotate`` MP4. ``score_warnings``: False for a detector whose
+    scores are all 1 by design (blobs). ``ValueError`` for a bad input, ``OSError`` for an output not written."""
+    check_features(features)
+    check_result_file(output)
+    try:
+        found = prepare_video(video, detections, tracker_name, annotate=annotate, features=features,
+                              det_format=det_format, length=length)
+    except OSError as exc:
+        raise ValueError(str(exc)) from exc
+    for line in found.notes:
+        on_event(Event("note", f"{found.name}: {line}"))
+    for line in found.warnings(video, score_warnings):
+        on_event(Event("warn", line))
+    hint = threshold_hint(found.extractor, tracker_name, features)
+    if hint:
+        on_event(Event("line", hint))
+    step = f"tracking {video.name}"
+    on_event(Event("start", step, found.total))
+    result = track_video(video, found.table, tracker, found.extractor, annotate=annotate,
+                         health=HealthConfig(team_size=team_size, window=health_window), fps=fps, min_score=min_score,
+                         advance=lambda: on_event(Event("advance", step, 1)), length=length, images=found.frames,
+                         detect=found.detect)
+    on_event(Event("end", step))
+    written = write_video_result(output, result, tracker)
+    dropped = found.dropped_all(result, tracker_name)
+    if dropped is not None:
+        on_event(Event("warn", dropped))
+    return RunResult("video", written, 1, RunStats(result.frames, result.tracker_s), result)
 
 
 def write_video_result(output: Path, result: VideoTrackingResult, tracker: Any) -> list[Path]:
@@ -193,4 +237,4 @@ def open_onnx(video: Path, model: Path, settings: list[str]) -> OnnxRun:
 
 
 __all__ = ["FEATURE_CHOICES", "OnnxRun", "OnnxStream", "VideoDetections", "VideoInput", "as_written", "check_features",
-           "open_onnx", "prepare_video", "threshold_hint", "write_video_result"]
+           "check_result_file", "open_onnx", "prepare_video", "run_video", "threshold_hint", "write_video_result"]
