@@ -127,7 +127,8 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
 
 def _spread(stack: np.ndarray, median: np.ndarray) -> float:
     """90th percentile of the absolute differences of ``stack`` from its per-pixel ``median`` (grey levels)."""
-    return float(np.percentile(np.abs(stack - median), 90))
+    diff = stack - median
+    return float(np.percentile(np.abs(diff, out=diff), 90, overwrite_input=True))
 
 
 def _dark_bright(stack: np.ndarray, background: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -245,23 +246,27 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
         img = as_bgr_image(frame, f"frames[{i}]")
         img = cv2.GaussianBlur(img, (blur, blur), 0) if blur > 1 else img
         small.append(cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA) if scale < 1 else img)
-    stack: np.ndarray = np.stack(small).astype(np.float32)
+    frames8 = np.stack(small)
+    del small
+    stack: np.ndarray = frames8.astype(np.float32)
     grey = [im.mean(axis=2).astype(np.float32) for im in stack]
     moves = _shifts(grey) if len(grey) > 1 else np.zeros((1, 2))
     shake = float(np.median(np.hypot(moves[:, 0], moves[:, 1]))) / scale
-    background = median_frame(np.stack(small))  # (the float frames' median, faster)
-    del small
+    background = median_frame(frames8)  # (the float frames' median, faster)
+    del frames8
     stabilise = False
     if shake > shake_px:  # keep the alignment only if it makes the frames agree better with their median
         h, w = grey[0].shape
-        aligned = np.stack([cv2.warpAffine(im, np.array([[1, 0, -dx], [0, 1, -dy]], dtype=np.float32), (w, h),
-                                           borderMode=cv2.BORDER_REPLICATE) for im, (dx, dy) in zip(stack, moves)])
+        aligned = np.empty_like(stack)
+        for im, (dx, dy), out in zip(stack, moves, aligned):
+            cv2.warpAffine(im, np.array([[1, 0, -dx], [0, 1, -dy]], dtype=np.float32), (w, h), dst=out,
+                           borderMode=cv2.BORDER_REPLICATE)
         aligned_background = np.median(aligned, axis=0)
         if _spread(aligned, aligned_background) < _ALIGN_GAIN * _spread(stack, background):
             stack, background, stabilise = aligned, aligned_background, True
     dark, bright = _dark_bright(stack, background)
     del stack
-    noise = max(1.4826 * float(np.median(np.maximum(dark, bright))), 0.5)
+    noise = max(1.4826 * float(np.median(np.maximum(dark, bright), overwrite_input=True)), 0.5)
     cut = min(max(6 * noise, _THRESHOLD_RANGE[0]), _THRESHOLD_RANGE[1])
     dark_mass, bright_mass = float((dark > cut).sum()), float((bright > cut).sum())
     dark_share = dark_mass / max(dark_mass + bright_mass, 1.0)
