@@ -133,6 +133,24 @@ def test_link_evidence_learns_how_much_one_animals_look_changes_between_pieces()
     assert np.all(np.abs(ev) <= np.log(1 / OUTLIER) + 1e-9)
 
 
+def test_proofreading_re_solves_with_the_look_and_may_name_a_merged_blob():
+    from lookalike.proofread import Correction, Session
+
+    rows, shapes, truth = _two_animals(bounce=True)
+    plain = track_closed_set(rows, 2, 25.0)  # motion alone: each carried on through the other
+    first = int(plain[0, 1])
+    for look in (None, shapes):
+        s = Session(plain, frame_rate=25.0, n_targets=2, detections=rows, shapes=look)
+        s.apply(Correction("assign", first, 3 - first, 1))  # any correction re-solves the whole set
+        assert _kept_apart(s.rows, rows, truth) == (look is not None)
+    merged_frame = int(rows[truth == 0, 0][0])
+    on_merge = int(s.rows[s.rows[:, 0] == merged_frame, 1][0])
+    s.apply(Correction("assign", on_merge, 3 - on_merge, merged_frame))  # a correction on a merged blob's row
+    assert set(np.unique(s.rows[:, 1])) == {1, 2}
+    with pytest.raises(ValueError, match="shapes"):
+        Session(plain, frame_rate=25.0, n_targets=2, shapes=shapes)
+
+
 def test_nothing_to_learn_from_a_lone_animal_and_shapes_must_match_the_detections():
     rows, shapes, truth = _two_animals(bounce=True)
     one = np.column_stack([rows[truth == 1, :SHAPE_COLUMN], np.flatnonzero(truth == 1)])

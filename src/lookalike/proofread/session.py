@@ -55,7 +55,9 @@ class Session:
     """Proofreading of ``tracks`` (rows or a MOTChallenge file). With ``n_targets`` corrections re-solve the closed set
     over the tracklets of ``solver_input`` (the rows the closed set was solved from), else of ``detections`` (their
     online pass, as ``--offline`` makes it), else of the tracks themselves. ``frame_rate`` in frames/s (confidence
-    windows and the solver's motion).
+    windows and the solver's motion). ``shapes``: blob shape vectors ``(k, SHAPE_SIZE)`` of the detections, which
+    column 9 of ``solver_input`` indexes (``detections``: one per row); with them each re-solve weighs the look learned
+    from the video, as ``track --targets N`` on a blob video does.
 
     Attributes:
         rows: the current rows ``(k, 10)``, sorted by frame, then id.
@@ -65,7 +67,8 @@ class Session:
 
     def __init__(self, tracks: np.ndarray | str | os.PathLike[str], *, frame_rate: float = 30.0,
                  n_targets: int | None = None, detections: np.ndarray | str | os.PathLike[str] | None = None,
-                 solver_input: np.ndarray | None = None, config: ClosedSetConfig | None = None) -> None:
+                 solver_input: np.ndarray | None = None, config: ClosedSetConfig | None = None,
+                 shapes: np.ndarray | None = None) -> None:
         if not frame_rate > 0:
             raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
         if n_targets is not None and int(n_targets) < 1:
@@ -82,9 +85,17 @@ class Session:
                 self._solver_rows = _rows_of(solver_input)
             elif detections is not None:
                 det = _rows_of(detections)
-                self._solver_rows = online_rows(det, self.frame_rate, int(det[:, 0].max()), n_init=1)
+                self._solver_rows = online_rows(det, self.frame_rate, int(det[:, 0].max()), n_init=1,
+                                                index=shapes is not None)
             else:
                 self._solver_rows = self.initial.copy()
+        if shapes is not None:
+            index = None if self._solver_rows is None or solver_input is None and detections is None else \
+                self._solver_rows[:, 9]
+            if index is None or (len(index) and not (0 <= index.min() and index.max() < len(shapes))):
+                raise ValueError("shapes: need n_targets and detections or solver_input whose column 9 indexes "
+                                 f"them ({len(shapes)} shapes)")
+        self._shapes = shapes
         self.rows = self.initial.copy()
         self.corrections: list[Correction] = []
         self._parts: list[ChainConstraints | None] = []  # per correction its constraints; None: dropped
@@ -239,7 +250,7 @@ class Session:
     def _solve(self, cons: ChainConstraints) -> np.ndarray:
         """The closed set under ``cons``, its free identities renamed to the current ids they overlap most."""
         assert self._solver_rows is not None and self.n_targets is not None
-        new = assign_identities(self._solver_rows, self.n_targets, self.frame_rate, self.config, cons)
+        new = assign_identities(self._solver_rows, self.n_targets, self.frame_rate, self.config, cons, self._shapes)
         fixed = {j for _, j in cons.identity}
         free_new = sorted(set(np.unique(new[:, 1]).astype(int).tolist()) - fixed)
         free_old = sorted(set(np.unique(self.rows[:, 1]).astype(int).tolist()) - fixed)

@@ -32,6 +32,7 @@ from lookalike.trackers.offline.constraints import (
     chain_ids,
     constraint_marks,
     cut_tracklets,
+    holds,
     tracklet_of,
     with_marks,
 )
@@ -209,6 +210,10 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     crossing: list[Tracklet] = []
     if shapes is not None:
         pieces, crossing = cut_at_merges(pieces, shapes)
+        if constraints is not None:  # a merged piece that a constraint names is chained like the others
+            named_merged = {tracklet_of(crossing, r) for r in constraints.rows() if holds(crossing, r)}
+            pieces += [crossing[i] for i in sorted(named_merged)]
+            crossing = [c for i, c in enumerate(crossing) if i not in named_merged]
     named = {tracklet_of(pieces, r) for r in constraints.rows()} if constraints is not None else set()
     tracklets = [t for i, t in enumerate(pieces) if len(t) >= cfg.min_rows or i in named] or pieces
     chained = {id(t) for t in tracklets}

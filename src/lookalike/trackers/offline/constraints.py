@@ -14,7 +14,8 @@ import numpy as np
 from lookalike.trackers.offline.closed_set_config import ClosedSetConfig
 from lookalike.trackers.offline.tracklets import Tracklet
 
-__all__ = ["ChainConstraints", "Row", "chain_ids", "constraint_marks", "cut_tracklets", "tracklet_of", "with_marks"]
+__all__ = ["ChainConstraints", "Row", "chain_ids", "constraint_marks", "cut_tracklets", "holds", "tracklet_of",
+           "with_marks"]
 
 Row = tuple[int, int]  # (1-based frame, input id): one input row
 
@@ -127,13 +128,25 @@ def cut_tracklets(pieces: list[Tracklet], cuts: Sequence[Row]) -> list[Tracklet]
     return out
 
 
-def tracklet_of(tracklets: list[Tracklet], row: Row) -> int:
-    """Index of the tracklet holding the input row ``(frame, input id)``; ValueError when none does."""
+def _holder(tracklets: list[Tracklet], row: Row) -> int | None:
     frame, source = int(row[0]), int(row[1])
     for i, t in enumerate(tracklets):
         if t.source_id == source and t.first <= frame <= t.last and np.any(t.rows[:, 0] == frame):
             return i
-    raise ValueError(f"constraint: no input row of id {source} at frame {frame}")
+    return None
+
+
+def holds(tracklets: list[Tracklet], row: Row) -> bool:
+    """Whether one of ``tracklets`` holds the input row ``(frame, input id)``."""
+    return _holder(tracklets, row) is not None
+
+
+def tracklet_of(tracklets: list[Tracklet], row: Row) -> int:
+    """Index of the tracklet holding the input row ``(frame, input id)``; ValueError when none does."""
+    i = _holder(tracklets, row)
+    if i is None:
+        raise ValueError(f"constraint: no input row of id {int(row[1])} at frame {int(row[0])}")
+    return i
 
 
 def constraint_marks(tracklets: list[Tracklet], cons: ChainConstraints, n_targets: int,
