@@ -17,9 +17,11 @@ back (undo) but counted.
 Data: the pig dev video with ``--targets 23`` (the closed set's rules were refined on this video: issue 43),
 simulated 5-animal point arenas (``closed_points.arena``, seeds 200-219, never used for any choice; the proofreader's
 mechanics were debugged on seeds 0-9) and the 14 annotated HexBug clips through the blob detector with ``--targets N``
-(N: the clip's annotated count); and 8-animal hard arenas (``HARD``: faster, 10% missed, 0.3 false points a frame;
-seeds 300-307, eight for time: re-solves there took minutes before the flow encoding of corrections), added after
-the first run with the rule unchanged, to see propagation where errors are many. Run::
+(N: the clip's annotated count; each bug's look learned from the clip weighs in the start and every re-solve, as
+``track --targets N`` on a blob video does since the look became its default); and 8-animal hard arenas (``HARD``:
+faster, 10% missed, 0.3 false points a frame; seeds 300-307, eight for time: re-solves there took minutes before the
+flow encoding of corrections), added after the first run with the rule unchanged, to see propagation where errors are
+many. Run::
 
     python benchmarks/proofread_curve.py [--data ../shared/data] [--seeds 200-219] [--plot docs/images/proofread.png]
 """
@@ -62,6 +64,7 @@ class Case:
     gt_geom: np.ndarray  # (n, 4) boxes px or (n, 2) points px
     score: Callable[[np.ndarray], float]
     radius: float = RADIUS_PX  # points: a row's box centre matches within this (px)
+    shapes: np.ndarray | None = None  # blob shape vectors that column 9 of solver_input indexes (the learned look)
 
 
 def judge(rows: np.ndarray, case: Case) -> tuple[np.ndarray, np.ndarray, dict[int, int]]:
@@ -147,7 +150,7 @@ def _key(c: Correction) -> object:
 def proofread(case: Case, propagate: bool, max_corrections: int = STEPS[-1]) -> list[float]:
     """IDF1 (%) after 0..``max_corrections`` corrections (the last value repeated once nothing is left to correct)."""
     s = Session(case.rows, frame_rate=case.frame_rate, n_targets=case.n_targets if propagate else None,
-                solver_input=case.solver_input if propagate else None)
+                solver_input=case.solver_input if propagate else None, shapes=case.shapes if propagate else None)
     curve = [100 * case.score(s.rows)]
     tried: set[object] = set()
     looked: set[tuple[int, int, int]] = set()
@@ -211,17 +214,21 @@ def arena_case(seed: int, n: int = 5, **kwargs: float) -> Case:
 
 def hexbug_cases(root: Path) -> list[Case]:
     """The HexBug clips with annotations, through the blob detector (``--detector blob``) and the closed set of the
-    clip's annotated count (``--targets N --offline``)."""
+    clip's annotated count with the look learned from the clip (``--targets N``, the default on a blob video)."""
+    from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections
+
     out = []
     for video in hexbug_clips(root / "hexbug"):
         seq = detect_hexbug(video)
         assert seq.gt_points is not None
         frame, ids, xy = seq.gt_points
         n = len(np.unique(ids))
-        on = online_rows(det_rows(seq), seq.frame_rate, seq.length, n_init=1)
-        rows = assign_identities(on, n, seq.frame_rate)
+        found = cached_blob_detections(video, auto_blob_config(video, [])[0])  # (detect_hexbug's, from the cache)
+        on = online_rows(found.rows, seq.frame_rate, seq.length, n_init=1, index=True)
+        rows = assign_identities(on, n, seq.frame_rate, shapes=found.shapes)
         out.append(Case(f"hexbug {seq.name}", rows, on, n, seq.frame_rate, frame, ids, xy,
-                        lambda r, seq=seq: float(score_rows(seq, r)["IDF1"]), HEXBUG_RADIUS_PX))  # type: ignore[misc]
+                        lambda r, seq=seq: float(score_rows(seq, r)["IDF1"]), HEXBUG_RADIUS_PX,  # type: ignore[misc]
+                        found.shapes))
     return out
 
 
