@@ -32,19 +32,30 @@ def spread(n: int, count: int) -> np.ndarray:
 
 
 def median_frame(stack: np.ndarray) -> np.ndarray:
-    """``np.median(stack, axis=0)`` as float32, for ``(n, ...)`` frames. Of an odd number of uint8 frames, the middle
-    value of a sorting network of elementwise minima and maxima over whole frames: the same value as numpy's
-    per-pixel selection, several times faster."""
+    """``np.median(stack, axis=0)`` as float32, for ``(n, ...)`` uint8 or float32 frames without NaN. Of an odd number
+    of frames, the middle value of a sorting network of elementwise minima and maxima, run on blocks of pixels small
+    enough to stay in the CPU's cache: the same value as numpy's per-pixel selection, several times faster."""
     n = len(stack)
-    if n % 2 == 0 or stack.dtype != np.uint8:
+    if n % 2 == 0 or stack.dtype not in (np.uint8, np.float32):
         return np.median(stack, axis=0).astype(np.float32)
-    rows = [np.array(frame) for frame in stack]
-    spare = np.empty_like(rows[0])
-    for i, j in _median_network(n):
-        np.minimum(rows[i], rows[j], out=spare)
-        np.maximum(rows[i], rows[j], out=rows[j])
-        rows[i], spare = spare, rows[i]
-    return rows[n // 2].astype(np.float32)
+    flat = stack.reshape(n, -1)
+    out = np.empty(flat.shape[1], stack.dtype)
+    buffer = np.empty((n + 1, _MEDIAN_BLOCK), stack.dtype)
+    for start in range(0, flat.shape[1], _MEDIAN_BLOCK):
+        size = min(_MEDIAN_BLOCK, flat.shape[1] - start)
+        rows = list(buffer[:, :size])
+        for row, frame in zip(rows, flat[:, start:start + size]):
+            row[...] = frame
+        spare = rows.pop()
+        for i, j in _median_network(n):
+            np.minimum(rows[i], rows[j], out=spare)
+            np.maximum(rows[i], rows[j], out=rows[j])
+            rows[i], spare = spare, rows[i]
+        out[start:start + size] = rows[n // 2]
+    return out.reshape(stack.shape[1:]).astype(np.float32, copy=False)
+
+
+_MEDIAN_BLOCK = 16384  # pixel values per block of median_frame
 
 
 @lru_cache(maxsize=8)
@@ -177,7 +188,7 @@ class BlobDetector:
             if not self._fitted:
                 if self._seen % cfg.sample_every == 0:
                     self._buffer.append(np.array(img))  # (a copy: img may be the caller's frame)
-                    self.background_ = np.median(np.stack(self._buffer), axis=0).astype(np.float32)
+                    self.background_ = median_frame(np.stack(self._buffer))
                 self._seen += 1
             if self.background_ is None or self.background_.shape != img.shape:
                 raise ValueError(

@@ -158,7 +158,7 @@ def _shifts(grey: list[np.ndarray]) -> np.ndarray:
     with needs("cv2"):
         import cv2
 
-    reference = np.median(np.stack(grey), axis=0).astype(np.float32)
+    reference = median_frame(np.stack(grey))
     window = cv2.createHanningWindow(reference.shape[::-1], cv2.CV_32F)
     moves = np.array([cv2.phaseCorrelate(reference, g, window)[0] for g in grey])
     return moves - moves[0]
@@ -261,7 +261,7 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
         for im, (dx, dy), out in zip(stack, moves, aligned):
             cv2.warpAffine(im, np.array([[1, 0, -dx], [0, 1, -dy]], dtype=np.float32), (w, h), dst=out,
                            borderMode=cv2.BORDER_REPLICATE)
-        aligned_background = np.median(aligned, axis=0)
+        aligned_background = median_frame(aligned)
         if _spread(aligned, aligned_background) < _ALIGN_GAIN * _spread(stack, background):
             stack, background, stabilise = aligned, aligned_background, True
     dark, bright = _dark_bright(stack, background)
