@@ -113,12 +113,18 @@ def load_set_weights(path: str | os.PathLike[str]) -> SetWeights:
     return weights
 
 
-def _relu(x: np.ndarray) -> np.ndarray:
-    return np.asarray(np.maximum(x, 0.0))
+def _relu_(x: np.ndarray) -> np.ndarray:
+    """``max(x, 0)`` in place (``x`` a new array); ``x``."""
+    return np.maximum(x, 0.0, out=x)
 
 
-def _sigmoid(x: np.ndarray) -> np.ndarray:
-    return 0.5 * (1.0 + np.tanh(0.5 * x))
+def _sigmoid_(x: np.ndarray) -> np.ndarray:
+    """``0.5 (1 + tanh(x / 2))`` in place (``x`` a new array); ``x``."""
+    x *= 0.5
+    np.tanh(x, out=x)
+    x += 1.0
+    x *= 0.5
+    return x
 
 
 class NumpySetAssociator:
@@ -132,6 +138,7 @@ class NumpySetAssociator:
         h = weights.memory
         self._gru_b = w["gru.bias_ih"].copy()
         self._gru_b[: 2 * h] += w["gru.bias_hh"][: 2 * h]
+        self._gru_bn = w["gru.bias_hh"][2 * h :].copy()
         self._scale = np.array([1 / POSITION_SCALE_M, 1 / POSITION_SCALE_M, 1.0, 1.0, 1.0])
         self.reset(1)
 
@@ -169,30 +176,37 @@ class NumpySetAssociator:
         n = self.n_agents
         if agents.shape != (n, 4):
             raise ValueError(f"agents must have shape ({n}, 4), got {agents.shape}")
-        u = _relu((dets * self._scale) @ t["det.weight"] + b["det.bias"])
-        a = _relu(np.concatenate([agents, self.m, np.log1p(self.s), self.h], axis=1) @ t["agent.weight"]
-                  + b["agent.bias"])
+        u = _relu_((dets * self._scale) @ t["det.weight"] + b["det.bias"])
+        a = _relu_(np.concatenate([agents, self.m, np.log1p(self.s), self.h], axis=1) @ t["agent.weight"]
+                   + b["agent.bias"])
         c_phi, s_phi = dets[:, 2:3], dets[:, 3:4]
-        c_psi, s_psi = agents[None, :, 0], agents[None, :, 1]
-        mj = self.m[None, :, 0]
+        c_psi, s_psi = agents[:, 0], agents[:, 1]
+        mj = self.m[:, 0]
         off = dets[:, None, :2] - self.p[None]
-        dist = np.sqrt((off * off).sum(-1) + 1e-6)
+        sq = off * off
         k = len(dets)
-        q = np.stack([c_phi * c_psi + s_phi * s_psi, s_phi * c_psi - c_phi * s_psi,
-                      off[..., 0] * mj / OFFSET_SCALE_M, off[..., 1] * mj / OFFSET_SCALE_M,
-                      dist * mj / OFFSET_SCALE_M, np.broadcast_to(mj, (k, n))], axis=-1)
-        e = _relu((u @ t["pair_d.weight"])[:, None] + (a @ t["pair_a.weight"])[None]
-                  + q @ t["pair_q.weight"] + b["pair_q.bias"])
-        e2 = _relu(e @ t["pair2.weight"] + b["pair2.bias"])  # (K,N,F)
+        q = np.empty((k, n, 6))  # (pair features: heading agreement, offset, distance, weight)
+        q[..., 0] = c_phi * c_psi + s_phi * s_psi
+        q[..., 1] = s_phi * c_psi - c_phi * s_psi
+        q[..., 2:4] = off * self.m / OFFSET_SCALE_M
+        q[..., 4] = np.sqrt(sq[..., 0] + sq[..., 1] + 1e-6) * mj / OFFSET_SCALE_M
+        q[..., 5] = mj
+        e = (u @ t["pair_d.weight"])[:, None] + (a @ t["pair_a.weight"])[None]
+        e += q @ t["pair_q.weight"]
+        e += b["pair_q.bias"]
+        e2 = _relu_(e) @ t["pair2.weight"]
+        e2 += b["pair2.bias"]
+        e2 = _relu_(e2)  # (K,N,F)
         score = (e2 @ t["score.weight"])[..., 0] + b["score.bias"][0]
         if k:
             fp_in = np.concatenate([u, e2.max(axis=1)], axis=1)
-            fp = _relu(fp_in @ t["fp1.weight"] + b["fp1.bias"]) @ t["fp2.weight"] + b["fp2.bias"]
+            fp = _relu_(fp_in @ t["fp1.weight"] + b["fp1.bias"]) @ t["fp2.weight"] + b["fp2.bias"]
         else:
             fp = np.zeros((0, 1))
         logits = np.concatenate([score, fp], axis=1)
-        logits = logits - logits.max(axis=1, keepdims=True) if k else logits
-        prob = np.exp(logits)
+        if k:
+            logits -= logits.max(axis=1, keepdims=True)
+        prob = np.exp(logits, out=logits)
         prob /= np.maximum(prob.sum(axis=1, keepdims=True), 1e-300)
         w = prob[:, :n]  # (K,N)
         total = w.sum(0)[:, None]
@@ -206,8 +220,13 @@ class NumpySetAssociator:
         hd = self.weights.memory
         gi = x @ t["gru.weight_ih"] + self._gru_b
         gh = self.h @ t["gru.weight_hh"]
-        r = _sigmoid(gi[:, :hd] + gh[:, :hd])
-        z = _sigmoid(gi[:, hd : 2 * hd] + gh[:, hd : 2 * hd])
-        cand = np.tanh(gi[:, 2 * hd :] + r * (gh[:, 2 * hd :] + b["gru.bias_hh"][2 * hd :]))
-        self.h = (1.0 - z) * cand + z * self.h
+        rz = _sigmoid_(gi[:, : 2 * hd] + gh[:, : 2 * hd])
+        r, z = rz[:, :hd], rz[:, hd:]
+        cand = gh[:, 2 * hd :] + self._gru_bn
+        cand *= r
+        cand += gi[:, 2 * hd :]
+        np.tanh(cand, out=cand)
+        cand *= 1.0 - z
+        cand += z * self.h
+        self.h = cand
         return np.asarray(prob)

@@ -61,6 +61,7 @@ class KalmanLocaliserConfig:
 
 
 _H = np.hstack([np.eye(2), np.zeros((2, 2))])
+_EYE2 = np.eye(2)
 
 
 class KalmanLocaliser:
@@ -82,8 +83,13 @@ class KalmanLocaliser:
         self._rejects = np.zeros(n, dtype=int)
         self._last_seen = np.full(n, -np.inf)
         self._time: float | None = None
+        self._transitions: dict[float, tuple[np.ndarray, np.ndarray]] = {}
 
     def _transition(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """``F, Q`` over ``dt`` seconds (kept for the last few distinct ``dt``: frame intervals repeat)."""
+        cached = self._transitions.get(dt)
+        if cached is not None:
+            return cached
         cfg = self.config
         decay = float(np.exp(-dt / cfg.velocity_decay_s))
         gain = cfg.velocity_decay_s * (1.0 - decay)  # ∫ velocity over dt
@@ -95,6 +101,9 @@ class KalmanLocaliser:
         Q = np.zeros((4, 4))
         Q[np.ix_([0, 2], [0, 2])] = q1
         Q[np.ix_([1, 3], [1, 3])] = q1
+        if len(self._transitions) >= 64:
+            self._transitions.clear()
+        self._transitions[dt] = F, Q
         return F, Q
 
     def update(self, time_s: float, measured: np.ndarray, weight: np.ndarray) -> np.ndarray:
@@ -105,11 +114,12 @@ class KalmanLocaliser:
         if dt > 0:
             F, Q = self._transition(dt)
             self._mean, self._cov = kalman.predict(self._mean, self._cov, F, Q)
-        seen = np.isfinite(measured).all(axis=1) & (np.asarray(weight) >= cfg.ignore_below)
+        weight = np.asarray(weight)
+        seen = np.logical_and.reduce(np.isfinite(measured), axis=1) & (weight >= cfg.ignore_below)
         z = np.where(seen[:, None], measured, 0.0)
-        std = (cfg.std0_m + cfg.std_per_m * np.hypot(z[:, 0], z[:, 1])) / np.clip(
-            weight, cfg.min_weight, 1.0) ** (cfg.weight_power / 2)
-        R = (std**2)[:, None, None] * np.eye(2)
+        std = (cfg.std0_m + cfg.std_per_m * np.hypot(z[:, 0], z[:, 1])) / np.minimum(
+            np.maximum(weight, cfg.min_weight), 1.0) ** (cfg.weight_power / 2)
+        R = (std**2)[:, None, None] * _EYE2
         start = seen & ~self._started
         self._started |= start
         live = np.flatnonzero(seen & ~start)
@@ -119,12 +129,16 @@ class KalmanLocaliser:
             d = zj - zhat
             d2 = np.einsum("ki,ki->k", d, np.linalg.solve(S, d[..., None])[..., 0])
             accept = d2 <= self._gate
-            restart = ~accept & (self._rejects[live] + 1 >= cfg.max_rejects)
-            if accept.any():
-                mu, Pu = kalman.update(m[accept], P[accept], zj[accept], _H, Rj[accept])
-                self._mean[live[accept]], self._cov[live[accept]] = mu, Pu
-            start[live[restart]] = True
-            self._rejects[live] = np.where(accept | restart, 0, self._rejects[live] + 1)
+            if accept.all():
+                self._mean[live], self._cov[live] = kalman.update_projected(m, P, zj, _H, zhat, S)
+                self._rejects[live] = 0
+            else:
+                restart = ~accept & (self._rejects[live] + 1 >= cfg.max_rejects)
+                if accept.any():
+                    mu, Pu = kalman.update_projected(m[accept], P[accept], zj[accept], _H, zhat[accept], S[accept])
+                    self._mean[live[accept]], self._cov[live[accept]] = mu, Pu
+                start[live[restart]] = True
+                self._rejects[live] = np.where(accept | restart, 0, self._rejects[live] + 1)
         for j in np.flatnonzero(start):  # (new filters, and those restarted)
             self._mean[j] = (z[j, 0], z[j, 1], 0.0, 0.0)
             self._cov[j] = np.diag([std[j] ** 2, std[j] ** 2, 0.5, 0.5])
