@@ -17,7 +17,9 @@ def proofread(
     targets: int | None = typer.Option(
         None, "--targets", min=1,
         help="Known number of identities: each correction re-solves the offline closed set of N (as `track "
-             "--targets N --offline`), so later frames that depended on it change too. Without: plain edits."),
+             "--targets N --offline`), so later frames that depended on it change too; tracks of `track --detector "
+             "blob --targets N` re-solve from the video's cached blobs, with each animal's look. Without: plain "
+             "edits."),
     detections: Path | None = typer.Option(
         None, "--detections", help="With --targets: the detections the tracks came from (the closed set is built "
                                    "from their online pass, as --offline does; default: from the tracks)."),
@@ -54,8 +56,17 @@ def proofread(
     check_outputs_or_fail({"--output": output, "--log": log}, [video, tracks, detections])
     with failing(ValueError, prefix="--video: "):
         fps = video_info(video)[1]
+    solver = None
+    if targets is not None and detections is None:  # (tracks of `track --detector blob --targets N`: with the look)
+        from lookalike.pipeline.proofread_input import blob_solver_input
+
+        with failing(ValueError, OSError):
+            solver = blob_solver_input(video, tracks, targets, frame_rate or fps)
+        if solver is not None:
+            console.print("corrections re-solve from the video's cached blobs, with each animal's look", markup=False)
     with failing(ValueError):
-        session = Session(tracks, frame_rate=frame_rate or fps, n_targets=targets, detections=detections)
+        session = Session(tracks, frame_rate=frame_rate or fps, n_targets=targets, detections=detections,
+                          **({"solver_input": solver[0], "shapes": solver[1]} if solver else {}))
     if fresh and log.exists():
         os.replace(log, log.with_name(log.name + ".bak"))
     elif log.exists():
