@@ -69,6 +69,8 @@ def test_estimate_steps_give_the_numpy_formulas() -> None:
     background = np.median(stack, axis=0)
     diff = stack - background
     dark, bright = _dark_bright(stack, background)
+    for got, want in zip(_dark_bright(np.stack(_frames(7)), background), (dark, bright)):  # uint8 frames: the same
+        np.testing.assert_array_equal(got, want)
     np.testing.assert_array_equal(dark, np.maximum(-diff.min(axis=3), 0))
     np.testing.assert_array_equal(bright, np.maximum(diff.max(axis=3), 0))
     np.testing.assert_array_equal(np.median(np.stack(_frames(7)), axis=0).astype(np.float32), background)

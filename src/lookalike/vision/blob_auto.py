@@ -132,9 +132,9 @@ def _spread(stack: np.ndarray, median: np.ndarray) -> float:
 
 
 def _dark_bright(stack: np.ndarray, background: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(n, h, w)`` float32 darkening and brightening (>= 0, the most changed channel) of a ``(n, h, w, 3)`` float32
-    ``stack`` against its ``(h, w, 3)`` float32 ``background``: ``max(-min_c(stack - background), 0)`` and
-    ``max(max_c(stack - background), 0)``, a frame at a time into one buffer."""
+    """``(n, h, w)`` float32 darkening and brightening (>= 0, the most changed channel) of a ``(n, h, w, 3)`` uint8 or
+    float32 ``stack`` against its ``(h, w, 3)`` float32 ``background``: ``max(-min_c(stack - background), 0)`` and
+    ``max(max_c(stack - background), 0)`` in float32, a frame at a time into one buffer."""
     with needs("cv2"):
         import cv2
 
@@ -142,7 +142,7 @@ def _dark_bright(stack: np.ndarray, background: np.ndarray) -> tuple[np.ndarray,
     bright = np.empty_like(dark)
     d = np.empty_like(background)
     for im, lo, hi in zip(stack, dark, bright):
-        cv2.subtract(im, background, dst=d)
+        cv2.subtract(im, background, dst=d, dtype=cv2.CV_32F)
         np.minimum(d[..., 0], d[..., 1], out=lo)
         np.minimum(lo, d[..., 2], out=lo)
         np.negative(lo, out=lo)
@@ -246,17 +246,16 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
         img = as_bgr_image(frame, f"frames[{i}]")
         img = cv2.GaussianBlur(img, (blur, blur), 0) if blur > 1 else img
         small.append(cv2.resize(img, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA) if scale < 1 else img)
-    frames8 = np.stack(small)
+    stack: np.ndarray = np.stack(small)  # uint8; float32 once aligned
     del small
-    stack: np.ndarray = frames8.astype(np.float32)
-    grey = [im.mean(axis=2).astype(np.float32) for im in stack]
+    grey = [im.astype(np.float32).mean(axis=2) for im in stack]
     moves = _shifts(grey) if len(grey) > 1 else np.zeros((1, 2))
     shake = float(np.median(np.hypot(moves[:, 0], moves[:, 1]))) / scale
-    background = median_frame(frames8)  # (the float frames' median, faster)
-    del frames8
+    background = median_frame(stack)
     stabilise = False
     if shake > shake_px:  # keep the alignment only if it makes the frames agree better with their median
         h, w = grey[0].shape
+        stack = stack.astype(np.float32)
         aligned = np.empty_like(stack)
         for im, (dx, dy), out in zip(stack, moves, aligned):
             cv2.warpAffine(im, np.array([[1, 0, -dx], [0, 1, -dy]], dtype=np.float32), (w, h), dst=out,
