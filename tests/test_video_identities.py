@@ -151,6 +151,22 @@ def test_proofreading_re_solves_with_the_look_and_may_name_a_merged_blob():
         Session(plain, frame_rate=25.0, n_targets=2, shapes=shapes)
 
 
+def test_animals_interpolated_through_a_merged_blob_move_to_its_ends():
+    from lookalike.trackers.offline.appearance import place_in_merges
+
+    # two animals 10x4 px pass each other inside one merged blob 30x6 px (left 100..130, top 50..56): interpolated
+    # both sit near its middle, in their order along x
+    rows = np.array([[5, 1, 100, 50, 10, 4], [5, 2, 120, 52, 10, 4],  # measured before the merge
+                     [6, 1, 109, 51, 10, 4], [6, 2, 111, 51, 10, 4],  # interpolated inside the merge
+                     [7, 1, 120, 51, 10, 4]], float)  # a lone interpolated row: no second animal in its blob
+    measured = np.array([True, True, False, False, False])
+    merged = np.array([[6, -1, 100, 50, 30, 6], [7, -1, 100, 50, 30, 6]], float)
+    out = place_in_merges(rows, measured, merged)
+    centres = out[:, 2:4] + out[:, 4:6] / 2
+    assert np.allclose(centres[2], [105, 53]) and np.allclose(centres[3], [125, 53])  # 5 px in from each end
+    assert np.array_equal(out[[0, 1, 4]], rows[[0, 1, 4]]) and np.array_equal(out[:, 4:6], rows[:, 4:6])
+
+
 def test_nothing_to_learn_from_a_lone_animal_and_shapes_must_match_the_detections():
     rows, shapes, truth = _two_animals(bounce=True)
     one = np.column_stack([rows[truth == 1, :SHAPE_COLUMN], np.flatnonzero(truth == 1)])

@@ -20,13 +20,15 @@ import numpy as np
 
 from lookalike.trackers.offline.tracklets import Tracklet
 
-__all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "single_rows", "with_appearance"]
+__all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "place_in_merges", "single_rows",
+           "with_appearance"]
 
 SINGLE_AREA = (0.6, 1.5)  # a blob shows one animal when its area is within these multiples of its track's median
 MIN_ROWS = 8  # single-animal rows a tracklet needs to teach or be judged by its look
 OUTLIER = 0.001  # chance that a tracklet's look is not its animal's (a bad segmentation): bounds a link's evidence
 SHAPE_COLUMN = 9  # the column of an input row that holds its shape vector's index
 MIN_SPREAD = 0.1  # smallest spread of a log look distance (a floor for the fits on few pairs)
+MERGE_REACH = 0.25  # an interpolated centre this many blob sizes sqrt(w*h) outside a merged blob's box is not in it
 
 
 def single_rows(rows: np.ndarray, shapes: np.ndarray) -> np.ndarray:
@@ -167,3 +169,38 @@ def with_appearance(tracklets: list[Tracklet], links: tuple[np.ndarray, np.ndarr
         return links
     looks = np.array([space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0) for t in tracklets])
     return src, dst, cost - space.link_evidence(looks[src], looks[dst])
+
+
+def place_in_merges(rows: np.ndarray, measured: np.ndarray, merged: np.ndarray) -> np.ndarray:
+    """Result ``rows`` ``(k, >= 6)`` (1-based frame, id, ``x, y, w, h`` px) with the identities that share a merged
+    blob moved to its two ends. ``measured``: mask of the rows that hold a detection (the others were interpolated
+    across a gap); ``merged``: rows of the merged blobs (frame, -, box). In each merged blob's frame the interpolated
+    rows whose centres lie within its box (:data:`MERGE_REACH`) are its animals; the two farthest apart keep their
+    order along the line between them and move to the box's ends on that line, each its own typical size (median
+    measured ``w, h``) inside the box; any others stay interpolated."""
+    out = np.array(rows, dtype=float, copy=True)
+    ids = out[:, 1].astype(int)
+    size = {i: np.median(out[measured & (ids == i), 4:6], axis=0) if np.any(measured & (ids == i)) else None
+            for i in np.unique(ids).tolist()}
+    loose = np.flatnonzero(~measured)
+    frames = out[loose, 0].astype(int)
+    for f, x0, y0, w, h in zip(merged[:, 0].astype(int), *merged[:, 2:6].T):
+        centre, reach = np.array([x0 + w / 2, y0 + h / 2]), MERGE_REACH * math.sqrt(w * h)
+        ks = loose[frames == f]
+        c = out[ks, 2:4] + out[ks, 4:6] / 2
+        inside = np.all(np.abs(c - centre) <= np.array([w, h]) / 2 + reach, axis=1)
+        ks, c = ks[inside], c[inside]
+        if len(ks) < 2:
+            continue
+        gaps = np.linalg.norm(c[:, None] - c[None], axis=2)
+        a, b = np.unravel_index(np.argmax(gaps), gaps.shape)
+        if gaps[a, b] < 1.0:
+            continue
+        d = (c[b] - c[a]) / gaps[a, b]
+        extent = abs(d[0]) * w + abs(d[1]) * h  # the box's width along d
+        for k, side in ((ks[a], -1.0), (ks[b], 1.0)):
+            own = size[int(out[k, 1])]
+            own = out[k, 4:6] if own is None else own
+            out[k, 2:4] = centre + side * d * max(extent - abs(d[0]) * own[0] - abs(d[1]) * own[1], 0.0) / 2 \
+                - out[k, 4:6] / 2
+    return out

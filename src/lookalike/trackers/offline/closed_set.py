@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.trackers.offline.appearance import cut_at_merges, fit_identity_space, with_appearance
+from lookalike.trackers.offline.appearance import cut_at_merges, fit_identity_space, place_in_merges, with_appearance
 from lookalike.trackers.offline.closed_set_config import ClosedSetConfig
 from lookalike.trackers.offline.constraints import (
     ChainConstraints,
@@ -195,8 +195,9 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     ``constraints`` hold in the assignment (a tracklet fixed to identity ``j`` gets id ``j``; the other identities
     take the free ids in order of their start); ValueError when they name no input row or cannot all hold.
     ``shapes``: blob shape vectors ``(n, SHAPE_SIZE)`` that column 9 of ``rows`` indexes; with them, the look
-    learned from the video weighs in every link (:mod:`~lookalike.trackers.offline.appearance`) and merged blobs
-    are only placed into gaps."""
+    learned from the video weighs in every link (:mod:`~lookalike.trackers.offline.appearance`), merged blobs
+    are left out of the tracklets and the identities interpolated through one are moved to its ends
+    (:func:`~lookalike.trackers.offline.appearance.place_in_merges`)."""
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
@@ -218,7 +219,6 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     tracklets = [t for i, t in enumerate(pieces) if len(t) >= cfg.min_rows or i in named] or pieces
     chained = {id(t) for t in tracklets}
     short = [t for t in pieces if len(t) < cfg.min_rows and tracklets is not pieces and id(t) not in chained]
-    short += crossing
     links = link_costs(tracklets, frame_rate, cfg)
     space = fit_identity_space(tracklets, shapes) if shapes is not None else None
     if space is not None:
@@ -250,9 +250,14 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
         cfg.fill_gap_s * frame_rate)
     if not len(merged):
         return merged
+    filled = fill_gaps(merged, max_fill)
     if shapes is not None:
-        merged[:, 7:10] = -1.0
-    return smooth_boxes(fill_gaps(merged, max_fill), smoothing_window(merged, frame_rate, cfg))
+        filled[:, 7:10] = -1.0
+        if crossing:  # the identities interpolated through a merged blob, moved to its ends
+            measured = np.isin(filled[:, 0] * (n_targets + 1) + filled[:, 1], merged[:, 0] * (n_targets + 1)
+                               + merged[:, 1])
+            filled = place_in_merges(filled, measured, np.vstack([t.rows for t in crossing]))
+    return smooth_boxes(filled, smoothing_window(merged, frame_rate, cfg))
 
 
 def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfig | None = None) -> int:
