@@ -668,7 +668,7 @@ def test_nms_memory_is_linear_in_the_boxes_and_keeps_the_same_boxes():
 
 
 def test_points_above_the_per_frame_limit_are_one_line_naming_the_frame(tmp_path):
-    from lookalike.cli.track_closed import MAX_POINTS_PER_FRAME
+    from lookalike.pipeline.closed import MAX_POINTS_PER_FRAME
 
     points = tmp_path / "p.csv"
     rows = [f"1,{i},{i}\n" for i in range(10)] + [f"2,{i},{2 * i}\n" for i in range(MAX_POINTS_PER_FRAME + 1)]

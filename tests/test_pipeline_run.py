@@ -36,7 +36,8 @@ def test_files_and_video_runs_tell_and_return_what_they_wrote(scene, tmp_path):
     assert files.stats.frames == FRAMES
     assert any(e.kind == "warn" and "score" in e.text for e in events)  # (blob scores: all 1)
     starts = [e for e in events if e.kind == "start"]
-    assert starts[0] == Event("start", "sequences", 1) and events[-1] == Event("end", "sequences")
+    assert starts[0] == Event("start", "sequences", 1) and Event("end", "sequences") in events
+    assert events[-1].kind == "result" and events[-1].text.startswith(": 1 sequence(s), 30 frames")
     assert 0 < sum(e.count for e in events if e.kind == "advance" and e.text == starts[1].text) <= FRAMES
     events.clear()
     vid = run(TrackRequest(tmp_path / "v.txt", "deepsort", video=str(video), detections=det), events.append)
@@ -52,11 +53,33 @@ def test_files_and_video_runs_tell_and_return_what_they_wrote(scene, tmp_path):
                                   np.column_stack([got.frame, got.track_id, got.xywh]))
 
 
+def test_offline_and_point_runs(scene, tmp_path):
+    """The closed set over a file and over a video's detections, and points tracked and drawn: one result each."""
+    video, det = scene
+    events: list[Event] = []
+    closed = run(TrackRequest(tmp_path / "c.txt", "boxtrack", path=det, targets=3, offline=True), events.append)
+    on_video = run(TrackRequest(tmp_path / "cv.txt", "boxtrack", video=str(video), detections=det, targets=3,
+                                offline=True, annotate=tmp_path / "cv.mp4"), events.append)
+    assert closed.written == [tmp_path / "c.txt"] and on_video.written == [tmp_path / "cv.txt"]
+    assert set(read_mot(tmp_path / "c.txt").track_id) == set(read_mot(tmp_path / "cv.txt").track_id) == {1, 2, 3}
+    assert (tmp_path / "cv.mp4").stat().st_size > 0
+    rows = read_mot(det)
+    centres = np.column_stack([rows.frame, rows.xywh[:, :2] + rows.xywh[:, 2:] / 2])
+    np.savetxt(tmp_path / "p.csv", centres, delimiter=",", fmt="%g")
+    points = run(TrackRequest(tmp_path / "p.txt", "boxtrack", points=tmp_path / "p.csv", targets=3,
+                              annotate=tmp_path / "p.mp4"), events.append)
+    assert points.branch == "points" and len(read_mot(tmp_path / "p.txt")) == len(rows)
+    results = [e.text for e in events if e.kind == "result"]
+    assert results[0] == f", offline closed set of 3: 1 sequence(s) → {tmp_path / 'c.txt'}"
+    assert results[1].startswith(", offline closed set of 3: 3 identities") and results[2].startswith(", online: 3")
+    assert Event("line", f"annotated video → {tmp_path / 'p.mp4'}") in events
+
+
 def test_bad_requests_are_refused_in_one_line(scene, tmp_path):
     video, det = scene
     with pytest.raises(ValueError, match="--features"):
         run(TrackRequest(tmp_path / "v.txt", "deepsort", video=str(video), detections=det, features="nope"))
-    with pytest.raises(ValueError, match="takes the online files and video branches, not blobs"):
+    with pytest.raises(ValueError, match="takes the files, video, points branches, not blobs"):
         run(TrackRequest(tmp_path / "b.txt", video=str(video), detector="blob"))
     with pytest.raises(ValueError, match="unknown tracker"):
         run(TrackRequest(tmp_path / "f.txt", "nope", path=det))

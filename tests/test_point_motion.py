@@ -8,8 +8,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from lookalike.cli.track_closed import point_tracker, track_points
 from lookalike.io.points import POINT_VEL_NOISE
+from lookalike.pipeline import TrackRequest, run
+from lookalike.pipeline.closed import point_tracker
 from lookalike.trackers import boxtrack_config as const
 from lookalike.trackers.boxtrack import BoxTrack
 from lookalike.trackers.registry import make_tracker
@@ -48,8 +49,7 @@ def test_point_path_builds_boxtrack_with_point_noise(tmp_path: Path, monkeypatch
 
     monkeypatch.setattr(BoxTrack, "__init__", spy)
     out = tmp_path / "tracks.txt"
-    track_points(_points_csv(tmp_path / "p.csv"), out, make_tracker("boxtrack", max_targets=3), "boxtrack",
-                 n_targets=3, offline=offline, params={}, fps=None)
+    run(TrackRequest(out, "boxtrack", points=_points_csv(tmp_path / "p.csv"), targets=3, offline=offline))
     assert POINT_VEL_NOISE in seen
     rows = np.loadtxt(out, delimiter=",", ndmin=2)
     assert len(np.unique(rows[:, 1])) == 3

@@ -8,6 +8,7 @@ from contextlib import ExitStack, contextmanager
 from typing import TYPE_CHECKING, Any
 
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import (
     BarColumn,
     MofNCompleteColumn,
@@ -17,6 +18,7 @@ from rich.progress import (
     TimeElapsedColumn,
     TimeRemainingColumn,
 )
+from rich.status import Status
 
 from lookalike.cli.app import console, note, warn
 
@@ -46,24 +48,36 @@ def progress_bars() -> Iterator[ProgressFactory]:
 
 
 @contextmanager
-def printed_events() -> Iterator[Callable[[Any], None]]:
-    """An ``on_event`` for :func:`lookalike.pipeline.run`: notes, warnings and lines printed, steps drawn as bars
-    (from the first step on)."""
+def printed_events(tracker: str) -> Iterator[Callable[[Any], None]]:
+    """An ``on_event`` for :func:`lookalike.pipeline.run`: notes, warnings and lines printed, the result after the
+    ``tracker``'s name, steps drawn as bars while any is on (a spinner for a step of unknown length)."""
     with ExitStack() as stack:
         tasks: dict[str, Any] = {}
-        progress: list[Progress] = []
+        progress = ExitStack()
+        stack.push(progress)
+        bar: list[Progress] = []
 
         def on_event(event: Any) -> None:
             kind, text = event.kind, event.text
-            if kind == "start":
-                progress[:] = progress or [stack.enter_context(bars())]
-                tasks[text] = progress[0].add_task(text, total=event.count or None)
+            if kind == "busy":
+                tasks[text] = console.status(text)
+                tasks[text].start()
+                stack.callback(tasks[text].stop)
+            elif kind == "start":
+                bar[:] = bar or [progress.enter_context(bars())]
+                tasks[text] = bar[0].add_task(text, total=event.count or None)
             elif kind == "advance":
-                progress[0].advance(tasks[text], event.count)
+                bar[0].advance(tasks[text], event.count)
             elif kind == "end":
-                progress[0].remove_task(tasks.pop(text))
+                task = tasks.pop(text)
+                task.stop() if isinstance(task, Status) else bar[0].remove_task(task)
+                if bar and not bar[0].task_ids:
+                    progress.close()
+                    bar.clear()
             elif kind in ("note", "warn"):
                 (note if kind == "note" else warn)(text)
+            elif kind == "result":
+                console.print(f"[green]{escape(tracker)}[/]" + escape(text))
             else:
                 console.print(text, markup=False)
 

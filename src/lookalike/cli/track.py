@@ -3,16 +3,13 @@ output streams are :mod:`lookalike.io.stream`."""
 
 from __future__ import annotations
 
-import math
-from contextlib import ExitStack, nullcontext
-from dataclasses import replace
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
 import typer
-from rich.markup import escape
 
-from lookalike.cli.app import app, console, fail, failing
+from lookalike.cli.app import app, fail, failing
 from lookalike.io.outputs import atomic_path
 from lookalike.pipeline import files
 from lookalike.pipeline.request import TrackRequest
@@ -32,24 +29,14 @@ def build_tracker(name: str, settings: list[str], params_file: Path | None = Non
         return files.build_tracker(name, settings, params_file)
 
 
-def _run(request: TrackRequest, annotate_as: Path | None) -> None:
+def _run(request: TrackRequest) -> None:
     """:func:`lookalike.pipeline.run`, printed."""
     from lookalike.cli.progress import printed_events
-    from lookalike.cli.track_video import interrupted, print_video_result
+    from lookalike.cli.track_video import interrupted
     from lookalike.pipeline import run
 
-    with failing(ValueError, TypeError), interrupted(request.annotate, annotate_as) if request.branch() == "video" \
-            else nullcontext(), printed_events() as on_event:
-        result = run(request, on_event)
-    if result.branch == "video":
-        return print_video_result(result, request.tracker, annotate_as)
-    path, output = request.path, request.output
-    assert path is not None
-    where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
-    stats = result.stats
-    speed = f", {stats.fps:,.0f} frames/s (tracker only)" if stats.frames and math.isfinite(stats.fps) else ""
-    console.print(f"[green]{request.tracker}[/]: {result.sequences} sequence(s), {stats.frames} frames{speed} → "
-                  f"{where}")
+    with failing(ValueError, TypeError), interrupted(request.annotate), printed_events(request.tracker) as on_event:
+        run(request, on_event)
 
 
 @app.command()
@@ -143,7 +130,8 @@ def track(
     # the video, pixel, blob and closed-set paths are imported in their branch: keeps the CLI's start-up short
     with ExitStack() as stack:
         annotate_as = annotate
-        if annotate is not None:  # (the video is written to a temporary file, renamed into place when complete)
+        if annotate is not None and branch in ("pipeline", "blobs"):  # (lookalike.pipeline.run does it for others)
+            # (the video is written to a temporary file, renamed into place when complete)
             annotate = video_options["annotate"] = stack.enter_context(atomic_path(annotate))
             video_options["annotate_as"] = annotate_as
         try:
@@ -158,56 +146,29 @@ def track(
                 return
             from lookalike.cli.track_confidence import add_confidence, written_results
 
-            if branch in ("files", "video") and not offline:  # (lookalike.pipeline.run)
-                _run(replace(request, annotate=annotate), annotate_as)
+            if branch in ("files", "video", "points"):  # (lookalike.pipeline.run)
+                _run(request)
                 return add_confidence(written_results(branch, path, output, video, fps))
             with failing(ValueError, TypeError):
-                trk = files.box_tracker(tracker, settings, video=branch in ("blobs", "video"), targets=targets,
-                                        params_file=params_file)
-            online = tracker_params(tracker, settings, params_file) if offline else None
-            if branch == "points":
-                from lookalike.cli.track_closed import track_points
+                trk = files.box_tracker(tracker, settings, video=True, targets=targets, params_file=params_file)
+            assert video is not None
+            if live is not None:
+                from lookalike.cli.track_live import run_track_live
 
-                assert points is not None
-                track_points(points, output, trk, tracker, n_targets=targets, offline=offline, params=online or {},
-                             fps=fps, annotate=annotate, annotate_as=annotate_as, video=video)
-            elif branch in ("blobs", "video"):
-                assert video is not None
-                if live is not None:
-                    from lookalike.cli.track_live import run_track_live
+                run_track_live(live, output, trk, tracker, detector or "", blob or [],
+                               n_targets=0 if open_set else targets,
+                               explicit=tracker_params(tracker, settings, params_file).keys(),
+                               min_score=min_score, max_frames=max_frames, seconds=seconds,
+                               refused={"--annotate": annotate is not None, "--offline": offline,
+                                        "--features": features != "video", "--fps": fps is not None})
+            else:
+                from lookalike.cli.track_blobs import run_track_blobs
 
-                    run_track_live(live, output, trk, tracker, detector or "", blob or [],
-                                   n_targets=0 if open_set else targets,
-                                   explicit=tracker_params(tracker, settings, params_file).keys(),
-                                   min_score=min_score, max_frames=max_frames, seconds=seconds,
-                                   refused={"--annotate": annotate is not None, "--offline": offline,
-                                            "--features": features != "video", "--fps": fps is not None})
-                elif branch == "blobs":
-                    from lookalike.cli.track_blobs import run_track_blobs
-
-                    run_track_blobs(video, output, trk, tracker, detector or "", blob or [],
-                                    n_targets=0 if open_set else targets, offline=online,
-                                    explicit=tracker_params(tracker, settings, params_file).keys(),
-                                    save_detections=save_detections, **video_options)
-                else:  # --offline on a video's detections
-                    from lookalike.cli.track_closed import check_result_file, offline_video
-                    from lookalike.viz.overlay import source_frames
-
-                    det_path = detections or path
-                    assert online is not None and targets is not None and det_path is not None
-                    check_result_file(output)
-                    with failing(ValueError, OSError):
-                        _, count, rate = source_frames(video)
-                    offline_video(det_path, output, targets, online, fps or rate, count or None,
-                                  min_score, det_format, video=video, annotate=annotate, annotate_as=annotate_as)
-            else:  # --offline over detection files
-                from lookalike.cli.track_closed import offline_files
-
-                assert path is not None and online is not None and targets is not None
-                count = offline_files(path, output, targets, online, min_score, use_length=not no_seqinfo_length,
-                                      det_format=det_format)
-                where = escape(str(output) if path.is_file() else f"{output}/<sequence>.txt")
-                console.print(f"[green]{tracker}[/], offline closed set of {targets}: {count} sequence(s) → {where}")
+                run_track_blobs(video, output, trk, tracker, detector or "", blob or [],
+                                n_targets=0 if open_set else targets,
+                                offline=tracker_params(tracker, settings, params_file) if offline else None,
+                                explicit=tracker_params(tracker, settings, params_file).keys(),
+                                save_detections=save_detections, **video_options)
             add_confidence(written_results(branch, path, output, video, fps, live=live is not None))
 
         except OSError as exc:  # an output that cannot be written, an input that cannot be read

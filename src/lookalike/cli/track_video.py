@@ -15,24 +15,21 @@ from lookalike.cli.app import console, fail, failing
 from lookalike.cli.progress import bars, printed_events
 from lookalike.cli.track_closed import check_result_file, offline_video
 from lookalike.io import MotTable, write_mot
-from lookalike.pipeline.runner import RunResult
 from lookalike.pipeline.video import VideoDetections, as_written, open_onnx, run_video
 
-__all__ = ["interrupted", "print_video_result", "run_track_onnx", "run_track_video", "save_detections"]
+__all__ = ["interrupted", "run_track_onnx", "run_track_video", "save_detections"]
 
 
 def run_track_video(video: Path, detections: VideoDetections, output: Path, tracker: Any, tracker_name: str, *,
                     annotate_as: Path | None = None, **options: Any) -> None:
     """:func:`lookalike.pipeline.video.run_video` given ``options``, printed (the ``annotate`` MP4 as
     ``annotate_as``)."""
-    with failing(ValueError), interrupted(options.get("annotate"), annotate_as), printed_events() as on_event:
-        result = run_video(video, detections, output, tracker, tracker_name, on_event, **options)
-    annotated = options.get("annotate")
-    print_video_result(result, tracker_name, annotate_as or annotated if annotated is not None else None)
+    with failing(ValueError), interrupted(options.get("annotate"), annotate_as), printed_events(tracker_name) as tell:
+        run_video(video, detections, output, tracker, tracker_name, tell, annotate_as=annotate_as, **options)
 
 
 @contextmanager
-def interrupted(annotate: Path | None, annotate_as: Path | None) -> Iterator[None]:
+def interrupted(annotate: Path | None, annotate_as: Path | None = None) -> Iterator[None]:
     """Ctrl-C in the block: a line saying that nothing was written, exit 130."""
     try:
         yield
@@ -40,22 +37,6 @@ def interrupted(annotate: Path | None, annotate_as: Path | None) -> Iterator[Non
         console.print("\n[yellow]Interrupted.[/] Nothing was written"
                       + (f" ({escape(str(annotate_as or annotate))} is left as it was)." if annotate else "."))
         raise SystemExit(130) from None
-
-
-def print_video_result(run: RunResult, tracker_name: str, annotated: Path | None) -> None:
-    """The line telling what a video's run (:func:`lookalike.pipeline.video.run_video`) wrote (and ``annotated``)."""
-    result = run.video
-    assert result is not None
-    written = [*run.written, *([annotated] if annotated is not None else [])]
-    unhealthy = sum(not s.healthy for s in result.health)
-    seconds = result.tracker_s + result.feature_s
-    fps_text = f"{result.frames / seconds:,.0f}" if seconds > 0 else "inf"
-    console.print(f"[green]{tracker_name}[/]: {result.frames} frames, {len(result.merges)} merge(s), {unhealthy} "
-                  f"frame(s) flagged unhealthy, {fps_text} frames/s (features + tracker) → "
-                  + escape(", ".join(str(p) for p in written)))
-    if result.ignored_rows:
-        console.print(f"[yellow]note:[/] {result.ignored_rows} detection row(s) are past the video's "
-                      f"{result.frames} frames and were ignored")
 
 
 def run_track_onnx(video: Path, output: Path, tracker: Any, tracker_name: str, model: Path, settings: list[str], *,

@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +17,7 @@ from lookalike.io.det_format import read_det, sniff_det
 from lookalike.io.outputs import ensure_writable
 from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv, read_points_mot, typical_spacing
 from lookalike.io.stream import track_to_file
+from lookalike.pipeline.runner import Event, step, telling
 from lookalike.trackers.boxtrack import BoxTrack
 from lookalike.trackers.offline.closed_set import online_rows, track_closed_set
 from lookalike.types.mot_table import MotTable, detection_rows
@@ -66,10 +68,10 @@ def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_f
 def offline_sequences(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float,
                       use_length: bool = True, det_format: str = "auto", *, note: Note = _silent,
                       file_note: Note = _silent,
-                      status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()) -> int:
+                      status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()) -> list[Path]:
     """The offline closed set over every sequence at ``path`` into its result file under ``output`` (outputs checked
     writable first; ``use_length``: seqinfo.ini's seqLength bounds the frames); ``note``: the closed set's notes,
-    ``file_note``: what was assumed of a file's layout; returns the sequences written."""
+    ``file_note``: what was assumed of a file's layout; returns the files written."""
     from lookalike.pipeline.files import sequences_and_targets
 
     sequences, targets = sequences_and_targets(path, output)
@@ -83,7 +85,7 @@ def offline_sequences(path: Path, output: Path, n_targets: int, params: dict[str
         with status(f"closed set of {n_targets} on {seq.name}"):
             rows = closed_set_rows(det, n_targets, seq.frame_rate, n_frames, params, note=note)
         write_mot(target, rows)
-    return len(sequences)
+    return targets
 
 
 def offline_rows(det: Path | np.ndarray, n_targets: int, params: dict[str, Any], frame_rate: float,
@@ -98,6 +100,37 @@ def offline_rows(det: Path | np.ndarray, n_targets: int, params: dict[str, Any],
     shapes = shapes if shapes is not None and len(shapes) == len(rows) else None
     with status(f"closed set of {n_targets}" + (", learning each one's look" if shapes is not None else "")):
         return closed_set_rows(rows, n_targets, frame_rate, n_frames, params, shapes=shapes, note=note)
+
+
+def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
+                  n_frames: int | None, min_score: float, on_event: Callable[[Event], None], det_format: str = "auto",
+                  *, video: Path | None = None, annotate: Path | None = None, annotate_as: Path | None = None,
+                  shapes: np.ndarray | None = None) -> np.ndarray:
+    """``track --video ... --offline``: the closed set over a video's detections (see :func:`offline_rows`) written
+    to ``output``; with ``annotate``, its identities drawn on ``video`` into that MP4 (told as ``annotate_as``);
+    what it does told to ``on_event``; returns the result rows. ``ValueError`` for a bad input or video."""
+    line = telling(on_event, "line")
+    try:
+        rows = offline_rows(det, n_targets, params, frame_rate, n_frames, min_score, det_format, shapes, note=line,
+                            file_note=telling(on_event, "note"), status=partial(step, on_event))
+    except FileNotFoundError as exc:
+        raise ValueError(str(exc)) from exc
+    write_mot(output, rows)
+    on_event(Event("result", f", offline closed set of {n_targets}: {len(np.unique(rows[:, 1]))} identities, "
+                             f"{len(rows)} rows at {frame_rate:g} frames/s → {output}"))
+    if annotate is not None and video is not None:
+        draw_step(on_event, "drawing the identities", MotTable.from_rows(rows), annotate, frame_rate, video)
+        line(f"annotated video → {annotate_as or annotate}")
+    return rows
+
+
+def draw_step(on_event: Callable[[Event], None], what: str, *args: Any) -> None:
+    """:func:`draw_tracks` (``args``) as the step ``what``; ``ValueError`` for a video that cannot be read."""
+    try:
+        with step(on_event, what):
+            draw_tracks(*args)
+    except OSError as exc:
+        raise ValueError(str(exc)) from exc
 
 
 def draw_tracks(tracks: MotTable, annotate: Path, frame_rate: float, video: Path | None = None,
@@ -161,5 +194,6 @@ def track_point_boxes(boxes: PointBoxes, output: Path, tracker: Any, frame_rate:
     return np.column_stack([table.frame, table.track_id]) if len(table) else np.zeros((0, 2))
 
 
-__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "PointBoxes", "closed_set_rows", "draw_tracks", "offline_rows",
-           "offline_sequences", "point_boxes", "point_tracker", "read_points", "table_rows", "track_point_boxes"]
+__all__ = ["MAX_POINTS_PER_FRAME", "POINTS_FPS", "PointBoxes", "closed_set_rows", "draw_step", "draw_tracks",
+           "offline_rows", "offline_sequences", "offline_video", "point_boxes", "point_tracker", "read_points",
+           "table_rows", "track_point_boxes"]

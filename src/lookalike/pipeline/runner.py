@@ -3,12 +3,14 @@ tells what happens through ``on_event`` and returns what it wrote; the command l
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from lookalike.io.outputs import atomic_path
 from lookalike.loop import RunStats
 from lookalike.pipeline import files
 from lookalike.pipeline.request import TrackRequest
@@ -16,15 +18,16 @@ from lookalike.pipeline.request import TrackRequest
 if TYPE_CHECKING:
     from lookalike.pipeline.tracking import VideoTrackingResult
 
-BRANCHES = ("files", "video")
-"""The branches :func:`run` takes (online trackers; see :meth:`TrackRequest.branch`)."""
+BRANCHES = ("files", "video", "points")
+"""The branches :func:`run` takes (see :meth:`TrackRequest.branch`), online or ``--offline``."""
 
 
 @dataclass(frozen=True)
 class Event:
     """Something a run tells as it goes. ``kind``: ``note`` (an assumption made), ``warn`` (something looks wrong),
-    ``line`` (a plain line), ``start`` (a step named ``text`` of ``count`` frames, 0: unknown), ``advance`` (step
-    ``text`` went ``count`` frames further) or ``end`` (step ``text`` is over)."""
+    ``line`` (a plain line), ``result`` (what the tracker wrote: the line's text after the tracker's name), ``start``
+    (a step named ``text`` of ``count`` frames, 0: unknown), ``advance`` (step ``text`` went ``count`` frames
+    further), ``busy`` (a step named ``text`` that tells no progress) or ``end`` (step ``text`` is over)."""
 
     kind: str
     text: str = ""
@@ -33,8 +36,8 @@ class Event:
 
 @dataclass
 class RunResult:
-    """What :func:`run` did on ``branch``: the ``written`` files, the ``sequences`` tracked, the tracker's ``stats``
-    (frames, seconds) and, on a video, the tracking pass's ``video`` result."""
+    """What :func:`run` did on ``branch``: the ``written`` result files, the tracker's ``stats`` (frames, seconds;
+    online file runs) and, on a video tracked online, the tracking pass's ``video`` result."""
 
     branch: str
     written: list[Path] = field(default_factory=list)
@@ -44,27 +47,42 @@ class RunResult:
 
 
 def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) -> RunResult:
-    """Run ``request`` (a branch of :data:`BRANCHES`, not offline) and return what it wrote; ``ValueError`` (bad
-    options or inputs, one readable line) or ``OSError`` (an output that cannot be written)."""
+    """Run ``request`` (a branch of :data:`BRANCHES`) and return what it wrote; the ``annotate`` MP4 appears whole
+    or not at all. ``ValueError`` or ``TypeError`` (bad options or inputs, one readable line), ``OSError`` (an
+    output that cannot be written)."""
     tell = on_event or (lambda event: None)
+    live = request.live()
     branch = request.branch()
-    if branch not in BRANCHES or request.is_offline(branch, request.live()):
-        raise ValueError(f"lookalike.pipeline.run: takes the online {' and '.join(BRANCHES)} branches, not {branch}")
-    tracker = files.box_tracker(request.tracker, request.settings, video=branch == "video",
-                                targets=request.targets or None, params_file=request.params_file)
-    if branch == "video":
-        from lookalike.pipeline.video import run_video
+    offline = request.is_offline(branch, live)
+    if branch not in BRANCHES or live is not None:
+        raise ValueError(f"lookalike.pipeline.run: takes the {', '.join(BRANCHES)} branches, not {branch}")
+    targets = request.targets or None
+    tracker = files.box_tracker(request.tracker, request.settings, video=branch == "video", targets=targets,
+                                params_file=request.params_file)
+    params = files.tracker_params(request.tracker, request.settings, request.params_file) if offline else None
+    with ExitStack() as stack:
+        annotate = None if request.annotate is None else stack.enter_context(atomic_path(request.annotate))
+        if branch == "points":
+            return _points(request, tracker, params, annotate, tell)
+        if branch == "video":
+            return _video(request, tracker, params, annotate, tell)
+        return _offline_files(request, params, tell) if params is not None else _files(request, tracker, tell)
 
-        assert request.video_path is not None
-        team_size = request.team_size if request.team_size is not None else request.targets or None
-        return run_video(request.video_path, request.detections or request.path or Path(), request.output, tracker,
-                         request.tracker, tell, annotate=request.annotate, team_size=team_size,
-                         health_window=request.health_window, min_score=request.min_score, fps=request.fps,
-                         features=request.features, det_format=request.det_format)
-    return _track_files(request, tracker, tell)
+
+@contextmanager
+def step(on_event: Callable[[Event], None], text: str) -> Iterator[None]:
+    """A step named ``text`` that tells no progress, told to ``on_event`` as it starts and ends."""
+    on_event(Event("busy", text))
+    yield
+    on_event(Event("end", text))
 
 
-def _track_files(request: TrackRequest, tracker: Any, tell: Callable[[Event], None]) -> RunResult:
+def _where(request: TrackRequest) -> str:
+    assert request.path is not None
+    return str(request.output) if request.path.is_file() else f"{request.output}/<sequence>.txt"
+
+
+def _files(request: TrackRequest, tracker: Any, tell: Callable[[Event], None]) -> RunResult:
     """Every sequence at ``request.path`` tracked into ``request.output`` (a file for one det.txt, else
     ``<output>/<sequence>.txt``), inputs checked and outputs decided first."""
     assert request.path is not None
@@ -74,8 +92,7 @@ def _track_files(request: TrackRequest, tracker: Any, tell: Callable[[Event], No
     except (FileNotFoundError, ValueError) as exc:
         raise ValueError(files.input_error(exc)) from exc
     for seq, frames, target in streams:
-        files.sequence_warnings(seq, frames, target, lambda s: tell(Event("warn", s)),
-                                lambda s: tell(Event("note", s)))
+        files.sequence_warnings(seq, frames, target, telling(tell, "warn"), telling(tell, "note"))
     result = RunResult("files", [target for _, _, target in streams], len(streams))
     tell(Event("start", "sequences", len(streams)))
     for seq, frames, target in streams:
@@ -87,11 +104,97 @@ def _track_files(request: TrackRequest, tracker: Any, tell: Callable[[Event], No
         if dropped is not None:
             tell(Event("warn", dropped))
     tell(Event("end", "sequences"))
+    stats = result.stats
+    speed = f", {stats.fps:,.0f} frames/s (tracker only)" if stats.frames and stats.seconds > 0 else ""
+    tell(Event("result", f": {len(streams)} sequence(s), {stats.frames} frames{speed} → {_where(request)}"))
     return result
 
 
-def _advance(tell: Callable[[Event], None], step: str, frames: int) -> None:
-    tell(Event("advance", step, frames))
+def _offline_files(request: TrackRequest, params: dict[str, Any], tell: Callable[[Event], None]) -> RunResult:
+    """``--offline`` over every sequence at ``request.path`` (outputs decided first)."""
+    from lookalike.pipeline.closed import offline_sequences
+
+    assert request.path is not None and request.targets
+    try:
+        written = offline_sequences(request.path, request.output, request.targets, params, request.min_score,
+                                    request.use_length, request.det_format, note=telling(tell, "line"),
+                                    file_note=telling(tell, "note"), status=partial(step, tell))
+    except (FileNotFoundError, ValueError) as exc:
+        raise ValueError(files.input_error(exc)) from exc
+    except OSError as exc:
+        raise ValueError(f"output {request.output}: cannot write ({exc.strerror or exc})") from exc
+    tell(Event("result", f", offline closed set of {request.targets}: {len(written)} sequence(s) → "
+                         f"{_where(request)}"))
+    return RunResult("files", written, len(written))
 
 
-__all__ = ["BRANCHES", "Event", "RunResult", "run"]
+def _video(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, annotate: Path | None,
+           tell: Callable[[Event], None]) -> RunResult:
+    """A video and its detections: tracked online, or with ``params`` (the online pass's) by the offline closed
+    set."""
+    from lookalike.pipeline.video import check_result_file, run_video
+
+    video, det = request.video_path, request.detections or request.path
+    assert video is not None and det is not None
+    if params is None:
+        team_size = request.team_size if request.team_size is not None else request.targets or None
+        return run_video(video, det, request.output, tracker, request.tracker, tell, annotate=annotate,
+                         team_size=team_size, health_window=request.health_window, min_score=request.min_score,
+                         fps=request.fps, features=request.features, det_format=request.det_format,
+                         annotate_as=request.annotate)
+    from lookalike.pipeline.closed import offline_video
+    from lookalike.viz.overlay import source_frames
+
+    assert request.targets
+    check_result_file(request.output)
+    try:
+        _, count, rate = source_frames(video)
+    except OSError as exc:
+        raise ValueError(str(exc)) from exc
+    offline_video(det, request.output, request.targets, params, request.fps or rate, count or None, request.min_score,
+                  tell, request.det_format, video=video, annotate=annotate, annotate_as=request.annotate)
+    return RunResult("video", [request.output], 1)
+
+
+def _points(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, annotate: Path | None,
+            tell: Callable[[Event], None]) -> RunResult:
+    """Points as boxes of half their typical spacing, tracked online by ``tracker`` or, with ``params``, by the
+    offline closed set; the tracks drawn on ``request.video`` (or white frames) with ``annotate``."""
+    import numpy as np
+
+    from lookalike.io import read_mot
+    from lookalike.pipeline.closed import POINTS_FPS, draw_step, point_boxes, track_point_boxes
+
+    output, points = request.output, request.points
+    assert points is not None
+    if output.is_dir():
+        raise ValueError(f"-o/--output: {output} is a folder; with --points give a result file such as tracks.txt")
+    frame_rate = request.fps or POINTS_FPS
+    try:
+        boxes = point_boxes(points)
+    except FileNotFoundError as exc:
+        raise ValueError(str(exc)) from exc
+    why = f"half the typical spacing {boxes.spacing:.3g}" if boxes.spacing > 0 else \
+        "one point a frame: twice the typical step"
+    tell(Event("line", f"points: {boxes.count} in {boxes.frames} frames, boxes of {boxes.side:.3g} ({why}), "
+                       f"{frame_rate:g} frames/s" + ("" if request.fps else " (--fps to change)")))
+    rows = track_point_boxes(boxes, output, tracker, frame_rate, request.targets or None, params,
+                             note=telling(tell, "line"))
+    what = f"offline closed set of {request.targets}" if params is not None else "online"
+    tell(Event("result", f", {what}: {len(np.unique(rows[:, 1]))} identities → {output}"))
+    if annotate is not None:
+        draw_step(tell, "drawing the tracks", read_mot(output), annotate, frame_rate, request.video_path, boxes.frames)
+        tell(Event("line", f"annotated video → {request.annotate}"))
+    return RunResult("points", [output], 1)
+
+
+def telling(on_event: Callable[[Event], None], kind: str) -> Callable[[str], None]:
+    """A callable telling ``on_event`` each line it is given as an event of ``kind``."""
+    return lambda text: on_event(Event(kind, text))
+
+
+def _advance(on_event: Callable[[Event], None], name: str, frames: int) -> None:
+    on_event(Event("advance", name, frames))
+
+
+__all__ = ["BRANCHES", "Event", "RunResult", "run", "step", "telling"]

@@ -120,12 +120,14 @@ def check_result_file(output: Path, video: Path | None = None) -> None:
 def run_video(video: Path, detections: VideoDetections, output: Path, tracker: Any, tracker_name: str,
               on_event: Callable[[Event], None], *, annotate: Path | None = None, team_size: int | None = None,
               health_window: int = 15, min_score: float = -np.inf, fps: float | None = None, features: str = "video",
-              det_format: str = "auto", length: int | None = None, score_warnings: bool = True) -> RunResult:
+              det_format: str = "auto", length: int | None = None, score_warnings: bool = True,
+              annotate_as: Path | None = None) -> RunResult:
     """Track ``detections`` (see :func:`prepare_video`) on ``video`` with ``tracker`` (registered as
     ``tracker_name``), telling ``on_event`` (:class:`~lookalike.pipeline.runner.Event`) its notes, warnings and
     progress; write ``output``, its ``.health.csv`` (health checks of ``team_size`` over ``health_window`` frames),
-    ``.merges.csv`` for merging trackers, and the ``annotate`` MP4. ``score_warnings``: False for a detector whose
-    scores are all 1 by design (blobs). ``ValueError`` for a bad input, ``OSError`` for an output not written."""
+    ``.merges.csv`` for merging trackers, and the ``annotate`` MP4 (told as ``annotate_as``). ``score_warnings``: False
+    for a detector whose scores are all 1 by design (blobs). ``ValueError`` for a bad input, ``OSError`` for an
+    output not written."""
     check_features(features)
     check_result_file(output)
     try:
@@ -151,6 +153,15 @@ def run_video(video: Path, detections: VideoDetections, output: Path, tracker: A
     dropped = found.dropped_all(result, tracker_name)
     if dropped is not None:
         on_event(Event("warn", dropped))
+    shown = [*written, *([annotate_as or annotate] if annotate is not None else [])]
+    unhealthy = sum(not s.healthy for s in result.health)
+    seconds = result.tracker_s + result.feature_s
+    fps_text = f"{result.frames / seconds:,.0f}" if seconds > 0 else "inf"
+    on_event(Event("result", f": {result.frames} frames, {len(result.merges)} merge(s), {unhealthy} frame(s) flagged "
+                             f"unhealthy, {fps_text} frames/s (features + tracker) → " + ", ".join(map(str, shown))))
+    if result.ignored_rows:
+        on_event(Event("note", f"{result.ignored_rows} detection row(s) are past the video's {result.frames} frames "
+                               "and were ignored"))
     return RunResult("video", written, 1, RunStats(result.frames, result.tracker_s), result)
 
 
