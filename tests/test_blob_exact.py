@@ -114,3 +114,18 @@ def test_the_median_frame_is_numpys_median() -> None:
     for n in range(1, 14, 2):  # every 0/1 input (the 0-1 principle: the network then finds the middle of any input)
         bits = np.array(list(itertools.product([0, 1], repeat=n)), np.uint8).T
         np.testing.assert_array_equal(median_frame(bits), np.median(bits, axis=0).astype(np.float32))
+
+
+def test_shape_means_are_numpys_means() -> None:
+    rng = np.random.default_rng(3)
+    mask = (cv2.GaussianBlur(rng.uniform(0, 1, (80, 90)), (9, 9), 0) > 0.52).astype(np.uint8)
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+    difference = rng.uniform(0, 90, mask.shape).astype(np.float32)
+    image = rng.integers(0, 256, (*mask.shape, 3)).astype(np.uint8)
+    keep = list(range(1, count))
+    shapes = blob_shapes(labels, stats, keep, difference, image)
+    assert len(keep) > 3
+    for k, row in zip(keep, shapes):
+        inside = labels == k
+        assert row[3] == np.mean(difference[inside].astype(float))  # mean darkness
+        np.testing.assert_array_equal(row[4:7], image[inside].astype(float).mean(axis=0))  # mean B, G, R

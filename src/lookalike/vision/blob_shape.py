@@ -33,8 +33,8 @@ def blob_shapes(labels: np.ndarray, stats: np.ndarray, keep: list[int], differen
 
 
 def _shape(xs: np.ndarray, ys: np.ndarray, weight: np.ndarray, colour: np.ndarray) -> np.ndarray:
-    area = len(xs)
-    pts = np.column_stack([xs - xs.mean(), ys - ys.mean()])
+    area = len(xs)  # (means as sum / count: numpy's mean, without its per-call overhead)
+    pts = np.column_stack([xs - xs.sum() / area, ys - ys.sum() / area])
     cov = pts.T @ pts / max(area, 1) + np.eye(2) / 12  # (a pixel's own spread: single-pixel blobs stay finite)
     values, vectors = np.linalg.eigh(cov)
     along = pts @ vectors[:, 1]
@@ -44,7 +44,8 @@ def _shape(xs: np.ndarray, ys: np.ndarray, weight: np.ndarray, colour: np.ndarra
     bins = np.clip(((along / half + 1.25) / 2.5 * PROFILE_BINS).astype(int), 0, PROFILE_BINS - 1)
     counts = np.bincount(bins, minlength=PROFILE_BINS).astype(float)
     dark = np.bincount(bins, weights=weight, minlength=PROFILE_BINS)
-    mean_dark = float(weight.mean()) if area else 0.0
+    mean_dark = float(weight.sum() / area) if area else 0.0
     profile = np.where(counts > 0, dark / np.maximum(counts, 1) / max(mean_dark, 1e-6), 0.0)
+    colour_mean = colour.sum(axis=0) / area if area else np.zeros(3)
     return np.concatenate([[np.log(max(area, 1)), np.log(4 * np.sqrt(values[1])), np.log(4 * np.sqrt(values[0])),
-                            mean_dark], colour.mean(axis=0) if area else np.zeros(3), counts / max(area, 1), profile])
+                            mean_dark], colour_mean, counts / max(area, 1), profile])
