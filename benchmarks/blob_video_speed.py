@@ -67,9 +67,9 @@ def track_runs(video: Path, targets: int, extra: list[str], label: str, env: dic
         for run in ("fresh cache", "warm"):
             cpu, wall = timed(command, {**env, "LOOKALIKE_CACHE": tmp})
             rates[run] = frames / cpu
+            share = f"; decoding once is {100 * decode_s / cpu:.0f}% of its CPU" if run == "fresh cache" else ""
             print(f"{video.name} {label}, {run}: {cpu:.2f} s CPU ({frames / cpu:.0f} frames/s), {wall:.2f} s wall "
-                  f"({frames / wall:.0f} frames/s); decoding once is {100 * decode_s / cpu:.0f}% of its CPU",
-                  flush=True)
+                  f"({frames / wall:.0f} frames/s){share}", flush=True)
     return rates
 
 
