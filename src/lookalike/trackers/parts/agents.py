@@ -4,6 +4,8 @@ localiser)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from lookalike.trackers.parts.identity.localiser import make_localiser
@@ -19,7 +21,7 @@ class BeaconMemory:
 
     def add(self, frame: Frame) -> None:
         b = frame.beacons
-        for agent, t_sent, heading in zip(b.agent_id, b.t_sent, b.heading):
+        for agent, t_sent, heading in zip(b.agent_id.tolist(), b.t_sent.tolist(), b.heading.tolist()):
             if agent < len(self.heading) and t_sent > self.t_sent[agent]:
                 self.t_sent[agent] = t_sent
                 self.heading[agent] = heading
@@ -50,36 +52,40 @@ class AgentIdentifier:
         return dt
 
     def _snapshots(self, labels: np.ndarray, conf: np.ndarray, position: np.ndarray, heading: np.ndarray,
-                   frame: Frame) -> list[TrackSnapshot]:
+                   frame: Frame, det_of_agent: np.ndarray | None = None) -> list[TrackSnapshot]:
         """One snapshot per agent seen so far from the frame's detection labels (-1: false positive), their
         probabilities ``conf``, positions ``(n, 2)`` m and headings ``(n,)`` rad; each agent's most confident
-        detection updates the localiser and the frame each agent last took a detection (-1: never)."""
+        detection (``det_of_agent``: :func:`agent_detections`' when given) updates the localiser and the frame each
+        agent last took a detection (-1: never)."""
         last_seen = self._last_seen
         n_agents = len(last_seen)
-        det_of_agent = agent_detections(labels, conf, n_agents)
+        if det_of_agent is None:
+            det_of_agent = agent_detections(labels, conf, n_agents)
         assigned = det_of_agent >= 0
         measured = np.full((n_agents, 2), np.nan)
         weight = np.zeros(n_agents)
-        measured[assigned] = position[det_of_agent[assigned]]
-        weight[assigned] = conf[det_of_agent[assigned]]
+        taken = det_of_agent[assigned]
+        measured[assigned] = position[taken]
+        weight[assigned] = conf[taken]
         located = self._localiser.update(frame.time, measured, weight)
-        fallback = assigned & ~np.isfinite(located).all(axis=1)  # labels never depend on the localiser
-        located[fallback] = measured[fallback]
+        finite = np.logical_and.reduce(np.isfinite(located), axis=1)
+        fallback = assigned & ~finite  # labels never depend on the localiser
+        if fallback.any():
+            located[fallback] = measured[fallback]
+            finite = np.logical_and.reduce(np.isfinite(located), axis=1)
+        last_seen[assigned] = frame.index
         snapshots = []
-        for j in range(n_agents):
-            k = det_of_agent[j]
-            if k >= 0:
-                last_seen[j] = frame.index
-            if last_seen[j] < 0 or not np.isfinite(located[j]).all():
-                continue  # never seen, or lost for longer than the localiser keeps a position
+        for j in np.flatnonzero((last_seen >= 0) & finite).tolist():  # (unseen, or lost beyond the localiser: none)
+            k = int(det_of_agent[j])
+            seen = k >= 0
             snapshots.append(TrackSnapshot(
                 track_id=j + 1,
-                status=TrackStatus.CONFIRMED if k >= 0 else TrackStatus.LOST,
+                status=TrackStatus.CONFIRMED if seen else TrackStatus.LOST,
                 position=located[j].copy(),
-                heading=float(heading[k]) if k >= 0 else None,
+                heading=float(heading[k]) if seen else None,
                 agent_id=j,
-                identity_prob=float(conf[k]) if k >= 0 else None,
-                detection_index=int(k),
+                identity_prob=float(conf[k]) if seen else None,
+                detection_index=k,
             ))
         return snapshots
 
@@ -96,21 +102,34 @@ def decode(prob: np.ndarray, used: np.ndarray, n: int, one_to_one: bool) -> tupl
         labels[used], conf[used] = np.where(label == n_agents, -1, label), p[np.arange(k), label]
         return labels, conf
     # Each detection may be a false positive; each agent takes at most one detection.
-    cost = -np.log(np.clip(np.hstack([p[:, :n_agents], np.repeat(p[:, n_agents:], k, axis=1)]), 1e-12, 1))
-    from scipy.optimize import linear_sum_assignment  # imported on first use (slow to import)
-
-    rows, cols = linear_sum_assignment(cost)
+    cost = -np.log(np.minimum(np.maximum(np.concatenate([p[:, :n_agents], np.repeat(p[:, n_agents:], k, axis=1)],
+                                                        axis=1), 1e-12), 1))
+    rows, cols = _assignment()(cost)
     label = np.full(k, -1)
     label[rows] = np.where(cols < n_agents, cols, -1)
     labels[used], conf[used] = label, np.where(label >= 0, p[np.arange(k), np.maximum(label, 0)], p[:, n_agents])
     return labels, conf
 
 
+def _assignment() -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """``scipy.optimize.linear_sum_assignment``, imported on first use (slow to import)."""
+    global _LINEAR_SUM_ASSIGNMENT
+    if _LINEAR_SUM_ASSIGNMENT is None:
+        from scipy.optimize import linear_sum_assignment
+
+        _LINEAR_SUM_ASSIGNMENT = linear_sum_assignment
+    return _LINEAR_SUM_ASSIGNMENT
+
+
+_LINEAR_SUM_ASSIGNMENT: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None
+
+
 def agent_detections(labels: np.ndarray, conf: np.ndarray, n_agents: int) -> np.ndarray:
     """``(n_agents,)`` each agent's most confident detection (index into ``labels``), -1 for none."""
-    det_of_agent = np.full(n_agents, -1)
-    for k in np.argsort(-conf):
-        j = labels[k]
+    det_of_agent = [-1] * n_agents
+    label = labels.tolist()
+    for k in np.argsort(-conf).tolist():
+        j = label[k]
         if j >= 0 and det_of_agent[j] < 0:
             det_of_agent[j] = k
-    return det_of_agent
+    return np.array(det_of_agent)

@@ -36,12 +36,12 @@ def agent_tokens(heading_rad: np.ndarray, age_s: np.ndarray, max_age_s: float = 
     age = np.asarray(age_s, dtype=float)
     known = np.isfinite(heading) & np.isfinite(age)
     h = np.where(known, heading, 0.0)
-    return np.stack([
-        np.where(known, np.cos(h), 0.0),
-        np.where(known, np.sin(h), 0.0),
-        np.where(known, np.clip(age, 0.0, max_age_s) / max_age_s, 1.0),
-        known.astype(float),
-    ], axis=-1)
+    out = np.empty((*known.shape, AGENT_FEATURES))
+    out[..., 0] = np.where(known, np.cos(h), 0.0)
+    out[..., 1] = np.where(known, np.sin(h), 0.0)
+    out[..., 2] = np.where(known, np.minimum(np.maximum(age, 0.0), max_age_s) / max_age_s, 1.0)
+    out[..., 3] = known
+    return out
 
 
 def detection_tokens(position_m: np.ndarray, heading_rad: np.ndarray, probability: np.ndarray) -> np.ndarray:

@@ -9,6 +9,7 @@ returned (one stream alone, a robot turning fast, does not pass). :func:`for_tea
 
 from __future__ import annotations
 
+import math
 from collections import deque
 
 import numpy as np
@@ -25,6 +26,11 @@ MAX_AGENTS = 7  # larger teams run no report-exchange detector
 
 def _wrap(angle: np.ndarray) -> np.ndarray:
     return (angle + np.pi) % (2 * np.pi) - np.pi
+
+
+def _wrap_float(angle: float) -> float:
+    """:func:`_wrap` of one angle (radians; the same arithmetic on a Python float)."""
+    return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
 class ReportExchange:
@@ -53,36 +59,37 @@ class ReportExchange:
 
     def _update(self, a: int, t: float, heading: float) -> None:
         """Advance agent ``a``'s track to ``t`` and correct it with ``heading``."""
-        if np.isnan(self.t[a]):
+        t_a = float(self.t[a])
+        if math.isnan(t_a):
             self.x[a], self.p[a], self.t[a] = (heading, 0.0), np.diag([self.r, 1.0]), t
             return
-        dt = t - self.t[a]
+        dt = t - t_a
         f = np.array([[1.0, dt], [0.0, 1.0]])
         q = self.q * np.array([[dt ** 3 / 3, dt ** 2 / 2], [dt ** 2 / 2, dt]])
         x, p = f @ self.x[a], f @ self.p[a] @ f.T + q
         gain = p[:, 0] / (p[0, 0] + self.r)
-        x = x + gain * float(_wrap(np.asarray(heading - x[0])))
-        self.x[a] = (float(_wrap(np.asarray(x[0]))), x[1])
-        self.p[a], self.t[a] = p - np.outer(gain, p[0]), t
+        x = x + gain * _wrap_float(heading - float(x[0]))
+        self.x[a] = (_wrap_float(float(x[0])), x[1])
+        self.p[a], self.t[a] = p - gain[:, None] * p[0], t
 
     def add(self, agent: int, t_sent: float, heading: float, scale: np.ndarray | None = None) -> tuple[int, int] | None:
         """Take one report (send time s, heading rad; ignored unless newer than the agent's newest); ``scale (n,)``: a
         factor on the threshold of each pair with ``agent`` (None: 1). Returns the pair ``(agent, other)`` when this
         report completes an exchange (the tracks exchanged already), else None."""
         a = agent
-        if not (t_sent > self.newest[a] and np.isfinite(heading)):
+        if not (t_sent > self.newest[a] and math.isfinite(heading)):
             return None
         self.newest[a] = t_sent
         if t_sent > self.clock:
             if np.isfinite(self.clock):
                 self.evidence *= np.exp(-(t_sent - self.clock) / self.memory_s)
             self.clock = t_sent
-        for c in range(self.n):
-            queue = self.queue[c]
-            while queue and queue[0][0] < t_sent - self.lag_s:
+        oldest = t_sent - self.lag_s
+        for c, queue in enumerate(self.queue):
+            while queue and queue[0][0] < oldest:
                 self._update(c, *queue.popleft())
         self.queue[a].append((t_sent, heading))
-        if np.isnan(self.t[a]):
+        if math.isnan(self.t[a]):
             return None
         mean, var = self._predict(t_sent)
         nu2 = _wrap(heading - mean) ** 2 / var

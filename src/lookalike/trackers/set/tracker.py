@@ -103,6 +103,7 @@ class SetIdentifier(AgentIdentifier):
         self.exchanges = 0  # memories exchanged by the report-exchange detector so far (for tests and analysis)
         self.visual_exchanges = 0  # the same, by the visual-exchange detector
         self._exchanged_at = np.full((n, n), -np.inf)  # frame time (s) of each pair's latest exchange (undo)
+        self._latest_exchange = -np.inf  # the latest time set in _exchanged_at
 
     def update(self, frame: Frame) -> list[TrackSnapshot]:
         """Label the frame's detections and return one snapshot per agent seen so far."""
@@ -133,10 +134,13 @@ class SetIdentifier(AgentIdentifier):
         if self.fp_rate is not None:
             weight = 1.0 - math.exp(-dt / FP_PRIOR_S)
             self.fp_rate += weight * (int((labels[used] < 0).sum()) - self.fp_rate)
+        held = agent_detections(labels, conf, self.config.n_agents)
         if self._visual is not None:
-            labels = self._visual_exchanges(labels, conf, heading, age, dt)
+            swapped = self._visual_exchanges(labels, held, heading, age, dt)
+            if swapped is not labels:
+                labels, held = swapped, agent_detections(swapped, conf, self.config.n_agents)
         self.last_labels, self.last_probabilities = labels, conf
-        return self._snapshots(labels, conf, position, heading, frame)
+        return self._snapshots(labels, conf, position, heading, frame, held)
 
     def _fp_prior(self, prob: np.ndarray) -> np.ndarray:
         """``prob (slots, N+1)`` with the false-positive column scaled by the running rate over ``fp_prior_ref`` (a
@@ -184,6 +188,7 @@ class SetIdentifier(AgentIdentifier):
         self._exchanged_at[:, [a, b]] = -np.inf
         if not undone:
             self._exchanged_at[a, b] = self._exchanged_at[b, a] = self._last_time
+            self._latest_exchange = self._last_time
 
     def _threshold_scale(self, agent: int | None = None) -> np.ndarray | None:
         """The factor on the exchange thresholds per pair, or of ``agent`` with each other agent (None: no undo)."""
@@ -193,6 +198,12 @@ class SetIdentifier(AgentIdentifier):
         since = self._last_time - (self._exchanged_at if agent is None else self._exchanged_at[agent])
         return np.where(since <= UNDO_S, factor, 1.0)
 
+    def _recent_scale(self, agent: int | None = None) -> np.ndarray | None:
+        """:meth:`_threshold_scale`, or None (the same thresholds) when no pair was exchanged within ``UNDO_S``."""
+        if self._last_time - self._latest_exchange > UNDO_S:
+            return None
+        return self._threshold_scale(agent)
+
     def _report_exchanges(self, frame: Frame) -> None:
         """Feed the frame's reports to the report-exchange detector and exchange the memories of each pair it finds."""
         assert self._exchange is not None
@@ -200,19 +211,19 @@ class SetIdentifier(AgentIdentifier):
         for agent, t_sent, heading in zip(b.agent_id.tolist(), b.t_sent.tolist(), b.heading.tolist()):
             if not 0 <= agent < self.config.n_agents:
                 continue
-            pair = self._exchange.add(agent, t_sent, heading, self._threshold_scale(agent))
+            pair = self._exchange.add(agent, t_sent, heading, self._recent_scale(agent))
             if pair is not None:
                 self._swap_network(*pair)
                 self.exchanges += 1
                 if self._jumps is not None:
                     self._jumps.exchanged(pair, t_sent)
 
-    def _visual_exchanges(self, labels: np.ndarray, conf: np.ndarray, heading: np.ndarray, age: np.ndarray,
+    def _visual_exchanges(self, labels: np.ndarray, held: np.ndarray, heading: np.ndarray, age: np.ndarray,
                           dt: float) -> np.ndarray:
-        """Exchange the memories and this frame's labels of the pairs the visual-exchange detector finds; the labels."""
+        """Exchange the memories and this frame's labels of the pairs the visual-exchange detector finds (``held``:
+        :func:`agent_detections` of ``labels``); the labels (``labels`` itself when no pair)."""
         assert self._visual is not None
-        held = agent_detections(labels, conf, self.config.n_agents)
-        pairs = self._visual.update(held, heading, self._beacons.heading, age, dt, self._threshold_scale())
+        pairs = self._visual.update(held, heading, self._beacons.heading, age, dt, self._recent_scale())
         self.visual_exchanges += len(pairs)
         out = labels
         for j, k in pairs:
