@@ -78,15 +78,12 @@ class AgentIdentifier:
         for j in np.flatnonzero((last_seen >= 0) & finite).tolist():  # (unseen, or lost beyond the localiser: none)
             k = int(det_of_agent[j])
             seen = k >= 0
-            snapshots.append(TrackSnapshot(
-                track_id=j + 1,
-                status=TrackStatus.CONFIRMED if seen else TrackStatus.LOST,
-                position=located[j].copy(),
-                heading=float(heading[k]) if seen else None,
-                agent_id=j,
-                identity_prob=float(conf[k]) if seen else None,
-                detection_index=k,
-            ))
+            snapshot = object.__new__(TrackSnapshot)  # (every field set directly: TrackSnapshot checks nothing)
+            snapshot.__dict__.update(
+                track_id=j + 1, status=TrackStatus.CONFIRMED if seen else TrackStatus.LOST, xywh=None,
+                position=located[j].copy(), velocity=None, heading=float(heading[k]) if seen else None, agent_id=j,
+                identity_prob=float(conf[k]) if seen else None, detection_index=k)
+            snapshots.append(snapshot)
         return snapshots
 
 

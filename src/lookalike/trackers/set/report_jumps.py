@@ -34,12 +34,15 @@ class ReportJumps:
         actions: list[Action] = []
         fresh = np.isfinite(old) & np.isfinite(new) & (t_new > t_old)
         if fresh.any():
-            turn = np.abs(np.angle(np.exp(1j * (new - old))))
+            step = np.exp(1j * (new - old))
+            turn = np.abs(np.arctan2(step.imag, step.real))  # (np.angle's arithmetic)
             gap = np.where(fresh, t_new - np.where(fresh, t_old, 0.0), 0.0)
             jumped = fresh & (turn > self.jump + self.turn_rate * gap)
             if jumped.any():
                 self._swap(np.flatnonzero(jumped), old, t_old, new, t_new, actions)
-            self._after_silence(np.flatnonzero(fresh & ~jumped & (turn > self.jump)), old, new, t_new, actions)
+            silence = fresh & ~jumped & (turn > self.jump)
+            if silence.any():
+                self._after_silence(np.flatnonzero(silence), old, new, t_new, actions)
         if self.pending or self.silent:  # waiting jumps expire after PAIR_WAIT_S: forgotten, or (silent) dropped
             wait = PAIR_WAIT_S
             self.silent = {a: v for a, v in self.silent.items() if now - v[2] <= wait}

@@ -54,7 +54,8 @@ class VisualExchange:
         """Log-likelihood of visual headings given robot headings ``reported``, noise ``sigma`` (None: ``noise_rad``);
         radians, broadcast."""
         sigma = self.sigma if sigma is None else np.asarray(sigma)
-        d = np.angle(np.exp(1j * (np.asarray(visual) - np.asarray(reported))))
+        turn = np.exp(1j * (np.asarray(visual) - np.asarray(reported)))
+        d = np.arctan2(turn.imag, turn.real)  # (np.angle's arithmetic)
         flipped = np.pi - np.abs(d)
         norm = 1.0 / (np.sqrt(2 * np.pi) * sigma)
         keep, flip, uniform = self.weights
@@ -70,13 +71,20 @@ class VisualExchange:
         self.evidence *= np.exp(-max(dt, 0.0) / self.memory_s)
         usable = (held >= 0) & np.isfinite(reported) & np.isfinite(age)
         live = np.flatnonzero(usable)
-        if len(live) < 2:
+        k = len(live)
+        if k < 2:
             return []
         sigma = np.hypot(self.sigma, self.stale_rad_s * np.maximum(age[live] - self.fresh_s, 0.0))[None, :]
         fit = self.log_likelihood(visual[held[live]][:, None], reported[live][None, :], sigma)  # [i, j]: i's det., j
-        own = np.diag(fit)
-        gain = np.clip(fit + fit.T - own[:, None] - own[None, :], -self.max_step, self.max_step)
-        block = np.maximum(self.evidence[np.ix_(live, live)] + gain, 0.0)
-        np.fill_diagonal(block, 0.0)
-        self.evidence[np.ix_(live, live)] = block
+        own = fit.diagonal()
+        gain = fit + fit.T
+        gain -= own[:, None]
+        gain -= own[None, :]
+        np.minimum(np.maximum(gain, -self.max_step, out=gain), self.max_step, out=gain)
+        rows, cols = live[:, None], live[None, :]
+        block = self.evidence[rows, cols]
+        block += gain
+        np.maximum(block, 0.0, out=block)
+        block.ravel()[:: k + 1] = 0.0
+        self.evidence[rows, cols] = block
         return take_pairs(self.evidence, self.threshold if scale is None else self.threshold * scale)
