@@ -127,17 +127,23 @@ class TeamIdentifier:
 
     def _take_reports(self) -> list[HeadingReport]:
         """Empty the queues; the reports in arrival order."""
-        self._columns = ([], [], [])
-        self._columns_plain = self._columns_whole = True
         if self._queued == 0:
+            self._clear_reports()
             return []
         items = [item for queue in self._pending if queue for item in queue]
-        for queue in self._pending:
-            queue.clear()
-        self._queued = 0
+        self._clear_reports()
         if len(items) > 1:
             items.sort(key=_first)
         return [report for _, report in items]
+
+    def _clear_reports(self) -> None:
+        """Empty the queues and their columns."""
+        self._columns = ([], [], [])
+        self._columns_plain = self._columns_whole = True
+        if self._queued:
+            for queue in self._pending:
+                queue.clear()
+            self._queued = 0
 
     def add_frame(self, message: DetectionsMessage) -> tuple[str, TeamState | None]:
         """Track one camera frame with the reports queued since the previous one."""
@@ -215,7 +221,7 @@ class TeamIdentifier:
             headings = [r.heading for r in reports]
             plain = all(map(_plain_report, reports))
         else:
-            self._take_reports()
+            self._clear_reports()
         if not robots:
             beacons = Beacons.empty()
         else:

@@ -199,17 +199,17 @@ class NumpySetAssociator:
         e2 = _relu_(e2)  # (K,N,F)
         score = (e2 @ t["score.weight"])[..., 0] + b["score.bias"][0]
         if k:
-            fp_in = np.concatenate([u, e2.max(axis=1)], axis=1)
+            fp_in = np.concatenate([u, np.maximum.reduce(e2, axis=1)], axis=1)
             fp = _relu_(fp_in @ t["fp1.weight"] + b["fp1.bias"]) @ t["fp2.weight"] + b["fp2.bias"]
         else:
             fp = np.zeros((0, 1))
         logits = np.concatenate([score, fp], axis=1)
         if k:
-            logits -= logits.max(axis=1, keepdims=True)
+            logits -= np.maximum.reduce(logits, axis=1, keepdims=True)
         prob = np.exp(logits, out=logits)
-        prob /= np.maximum(prob.sum(axis=1, keepdims=True), 1e-300)
+        prob /= np.maximum(np.add.reduce(prob, axis=1, keepdims=True), 1e-300)
         w = prob[:, :n]  # (K,N)
-        total = w.sum(0)[:, None]
+        total = np.add.reduce(w, axis=0)[:, None]
         g = np.minimum(total, 1.0)
         mean_pos = (w.T @ dets[:, :2]) / (total + 1e-6)
         self.p = self.p + g * (mean_pos - self.p)

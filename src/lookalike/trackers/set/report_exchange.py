@@ -65,7 +65,8 @@ class ReportExchange:
             return
         dt = t - t_a
         f = np.array([[1.0, dt], [0.0, 1.0]])
-        q = self.q * np.array([[dt ** 3 / 3, dt ** 2 / 2], [dt ** 2 / 2, dt]])
+        q, q3, q2 = self.q, dt ** 3 / 3, dt ** 2 / 2
+        q = np.array([[q * q3, q * q2], [q * q2, q * dt]])
         x, p = f @ self.x[a], f @ self.p[a] @ f.T + q
         gain = p[:, 0] / (p[0, 0] + self.r)
         x = x + gain * _wrap_float(heading - float(x[0]))
@@ -97,7 +98,7 @@ class ReportExchange:
         known = ~np.isnan(self.t)  # agents with a track
         known[a] = False
         row = self.evidence[a]
-        row[known] = np.maximum(row[known] + gain[known], 0.0)
+        row[:] = np.where(known, np.maximum(row + gain, 0.0), row)
         col = self.evidence[:, a]
         threshold = self.threshold if scale is None else self.threshold * scale
         both = known & (row + col > 2 * threshold) & (np.minimum(row, col) > threshold / 4)

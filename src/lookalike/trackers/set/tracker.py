@@ -148,7 +148,8 @@ class SetIdentifier(AgentIdentifier):
         assert self.fp_rate is not None and self.config.fp_prior_ref is not None
         out = prob.copy()
         out[:, -1] *= min(max(self.fp_rate / self.config.fp_prior_ref, FP_PRIOR_CLIP[0]), FP_PRIOR_CLIP[1])
-        return np.asarray(out / np.maximum(out.sum(axis=1, keepdims=True), 1e-12))
+        out /= np.maximum(np.add.reduce(out, axis=1, keepdims=True), 1e-12)
+        return out
 
     def _hide_stale(self, reported: np.ndarray, age: np.ndarray, position: np.ndarray,
                     heading: np.ndarray) -> np.ndarray:

@@ -14,6 +14,7 @@ import numpy as np
 MEMORY_S = 10.0  # time constant of the evidence's decay, seconds
 NOISE_RAD = 0.28  # a visual heading's noise around its robot's heading (10 classes, 12 degrees of noise), radians
 STALE_RAD_S = 0.5  # widening of an older report's noise, radians per second of age beyond fresh_s
+_SQRT_2PI = float(np.sqrt(2 * np.pi))
 
 
 def take_pairs(evidence: np.ndarray, threshold: float | np.ndarray) -> list[tuple[int, int]]:
@@ -57,7 +58,7 @@ class VisualExchange:
         turn = np.exp(1j * (np.asarray(visual) - np.asarray(reported)))
         d = np.arctan2(turn.imag, turn.real)  # (np.angle's arithmetic)
         flipped = np.pi - np.abs(d)
-        norm = 1.0 / (np.sqrt(2 * np.pi) * sigma)
+        norm = 1.0 / (_SQRT_2PI * sigma)
         keep, flip, uniform = self.weights
         z, zf = d / sigma, flipped / sigma
         density = norm * (keep * np.exp(-0.5 * z * z) + flip * np.exp(-0.5 * zf * zf))

@@ -123,14 +123,19 @@ class KalmanLocaliser:
         start = seen & ~self._started
         self._started |= start
         live = np.flatnonzero(seen & ~start)
+        every = len(live) == self.n_agents  # (every agent's filter updated: no copies of the rows)
         if len(live):
-            m, P, zj, Rj = self._mean[live], self._cov[live], z[live], R[live]
+            m, P, zj, Rj = ((self._mean, self._cov, z, R) if every
+                            else (self._mean[live], self._cov[live], z[live], R[live]))
             zhat, S = kalman.project(m, P, _H, Rj)
             d = zj - zhat
             d2 = np.einsum("ki,ki->k", d, np.linalg.solve(S, d[..., None])[..., 0])
             accept = d2 <= self._gate
             if accept.all():
-                self._mean[live], self._cov[live] = kalman.update_projected(m, P, zj, _H, zhat, S)
+                if every:
+                    self._mean, self._cov = kalman.update_projected(m, P, zj, _H, zhat, S)
+                else:
+                    self._mean[live], self._cov[live] = kalman.update_projected(m, P, zj, _H, zhat, S)
                 self._rejects[live] = 0
             else:
                 restart = ~accept & (self._rejects[live] + 1 >= cfg.max_rejects)
