@@ -197,7 +197,7 @@ class BlobDetector:
                 )
             if whole or not self._fitted or img.dtype != np.uint8:
                 diff = self._difference(img, self.background_)
-                mask = cv2.compare(diff, cfg.threshold, cv2.CMP_GT)  # 255 where diff > threshold, else 0
+                mask = cv2.compare(diff, np.array([cfg.threshold]), cv2.CMP_GT)  # 255 where diff > threshold
             else:  # the same mask from the frame's grey levels, without the difference image
                 mask = cv2.bitwise_not(cv2.inRange(img, *self._band()))
         for op, size in ((cv2.MORPH_OPEN, cfg.open_px), (cv2.MORPH_CLOSE, cfg.close_px)):

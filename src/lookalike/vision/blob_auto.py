@@ -283,7 +283,7 @@ def estimate_blob_config(frames: str | Path | Iterable[np.ndarray], n_targets: i
     results = {}
     for thr in candidates:
         per_frame, masks = [], []
-        raw: list[np.ndarray] = [cv2.compare(sig, thr, cv2.CMP_GT) for sig in signal]  # 255 where sig > thr
+        raw: list[np.ndarray] = [cv2.compare(sig, np.array([thr]), cv2.CMP_GT) for sig in signal]  # 255: sig > thr
         if kernel is not None:
             raw = [cv2.morphologyEx(m, cv2.MORPH_OPEN, kernel) for m in raw]
         persistent = np.count_nonzero(np.stack(raw), axis=0) / len(raw) > _PERSISTENT_SHARE
