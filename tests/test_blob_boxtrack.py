@@ -67,10 +67,13 @@ def test_cli_and_bench_give_the_same_config(tmp_path: Path, monkeypatch: pytest.
     monkeypatch.setenv("LOOKALIKE_CACHE", str(tmp_path / "cache"))
     ran: dict[str, Any] = {}
 
-    def capture(video: Path, det: Path, output: Path, tracker: Any, name: str, **options: Any) -> None:
-        ran["config"] = tracker.config
+    def capture(video: Path, det: Path, output: Path, tracker: Any, name: str, *args: Any, **options: Any) -> Any:
+        from lookalike.pipeline import RunResult
 
-    monkeypatch.setattr("lookalike.cli.track_blobs.run_track_video", capture)
+        ran["config"] = tracker.config
+        return RunResult("video")
+
+    monkeypatch.setattr("lookalike.pipeline.video.run_video", capture)
     out = tmp_path / "tracks.txt"
     args = ["track", "--video", str(_video(tmp_path / "discs.avi")), "--detector", "blob", "-t", "boxtrack",
             "-o", str(out), "--save-detections", str(tmp_path / "tracks.det.txt")]

@@ -114,34 +114,16 @@ def test_identification_figures_do_not_change_with_the_warm_up():
     assert figures["detections"] == sum(len(x) for x in labels)  # type: ignore[arg-type]
 
 
-def test_blob_detection_shows_frames_done_of_the_declared_count(monkeypatch, tmp_path):
-    from contextlib import contextmanager
+def test_blob_detection_shows_frames_done_of_the_declared_count():
+    from lookalike.pipeline.blobs import steps
+    from lookalike.pipeline.runner import Event
 
-    from lookalike.cli import track_blobs
-
-    bars: list[tuple[str, int]] = []
-    steps: list[int] = []
-
-    @contextmanager
-    def fake_bars():
-        def factory(description: str, total: int):
-            bars.append((description, total))
-            return lambda: steps.append(1)
-
-        yield factory
-
-    def fake_rows(video, config, advance=None):
-        for _ in range(5):
-            if advance is not None:
-                advance()
-        return "found"
-
-    monkeypatch.setattr(track_blobs, "progress_bars", fake_bars)
-    monkeypatch.setattr(track_blobs, "cached_blob_detections", fake_rows)
-    video = tmp_path / "v.mp4"
-    assert track_blobs._detect_with_progress(video, None, 5) == "found"
-    assert bars == [("detecting blobs in v.mp4", 5)] and len(steps) == 5
-    assert track_blobs._detect_with_progress(video, None, 0) == "found" and len(bars) == 1  # count unknown
+    events: list[Event] = []
+    name = "detecting blobs in v.mp4"
+    advance = steps(events.append)(name, 5)
+    for _ in range(5):
+        advance()
+    assert events == [Event("start", name, 5), *[Event("advance", name, 1)] * 5, Event("end", name)]
 
 
 @pytest.mark.parametrize("columns", ["80", "130"])

@@ -75,11 +75,28 @@ def test_offline_and_point_runs(scene, tmp_path):
     assert Event("line", f"annotated video → {tmp_path / 'p.mp4'}") in events
 
 
+def test_a_detector_run_finds_and_tracks_in_one_pass(scene, tmp_path, monkeypatch):
+    """Blobs found while tracked: the rows of the detections saved, tracked as a file."""
+    video, det = scene
+    monkeypatch.setenv("LOOKALIKE_CACHE", str(tmp_path / "cache"))
+    events: list[Event] = []
+    found = run(TrackRequest(tmp_path / "b.txt", "sort", video=str(video), detector="blob", blob=["polarity=dark",
+                             "min_area_px=20"], annotate=tmp_path / "b.mp4", save_detections=tmp_path / "d.txt"),
+                events.append)
+    assert found.branch == "blobs" and found.video is not None and found.video.frames == FRAMES
+    assert Event("line", f"blob detector: 90 boxes in {FRAMES} frames → {tmp_path / 'd.txt'}") in events
+    run(TrackRequest(tmp_path / "f.txt", "sort", path=tmp_path / "d.txt"))
+    np.testing.assert_array_equal(np.loadtxt(tmp_path / "b.txt", delimiter=","),
+                                  np.loadtxt(tmp_path / "f.txt", delimiter=","))
+
+
 def test_bad_requests_are_refused_in_one_line(scene, tmp_path):
     video, det = scene
     with pytest.raises(ValueError, match="--features"):
         run(TrackRequest(tmp_path / "v.txt", "deepsort", video=str(video), detections=det, features="nope"))
-    with pytest.raises(ValueError, match="takes the files, video, points branches, not blobs"):
-        run(TrackRequest(tmp_path / "b.txt", video=str(video), detector="blob"))
+    with pytest.raises(ValueError, match="takes the files, video, points, blobs branches, not pipeline"):
+        run(TrackRequest(tmp_path / "b.txt", "set", video=str(video), pipeline="robots"))
+    with pytest.raises(ValueError, match="--detector: choose one of blob or FILE.onnx"):
+        run(TrackRequest(tmp_path / "b.txt", video=str(video), detector="yolo"))
     with pytest.raises(ValueError, match="unknown tracker"):
         run(TrackRequest(tmp_path / "f.txt", "nope", path=det))

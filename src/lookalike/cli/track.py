@@ -1,5 +1,5 @@
-"""``lookalike track``: argument parsing and printing; the frame loop is :func:`lookalike.loop.run`, the input and
-output streams are :mod:`lookalike.io.stream`."""
+"""``lookalike track``: argument parsing and printing; the run is :func:`lookalike.pipeline.run` (robots from pixels:
+:mod:`lookalike.cli.track_pixels`; live sources: :mod:`lookalike.cli.track_live`)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,9 @@ from pathlib import Path
 from typing import Any
 
 import typer
+from rich.markup import escape
 
-from lookalike.cli.app import app, fail, failing
+from lookalike.cli.app import app, console, fail, failing
 from lookalike.io.outputs import atomic_path
 from lookalike.pipeline import files
 from lookalike.pipeline.request import TrackRequest
@@ -30,13 +31,17 @@ def build_tracker(name: str, settings: list[str], params_file: Path | None = Non
 
 
 def _run(request: TrackRequest) -> None:
-    """:func:`lookalike.pipeline.run`, printed."""
+    """:func:`lookalike.pipeline.run`, printed; Ctrl-C: a line saying that nothing was written, exit 130."""
     from lookalike.cli.progress import printed_events
-    from lookalike.cli.track_video import interrupted
     from lookalike.pipeline import run
 
-    with failing(ValueError, TypeError), interrupted(request.annotate), printed_events(request.tracker) as on_event:
-        run(request, on_event)
+    try:
+        with failing(ValueError, TypeError), printed_events(request.tracker) as on_event:
+            run(request, on_event)
+    except KeyboardInterrupt:
+        console.print("\n[yellow]Interrupted.[/] Nothing was written" + (
+            f" ({escape(str(request.annotate))} is left as it was)." if request.annotate is not None else "."))
+        raise SystemExit(130) from None
 
 
 @app.command()
@@ -121,19 +126,12 @@ def track(
         branch = request.branch()
         offline = request.is_offline(branch, live)
         request.check_outputs([path, video, detections, points, reports, params_file, detector_model, heading_model])
-    open_set = targets == 0  # --targets 0: an open set, no number of targets inferred (blob videos)
-    targets = targets or None
     settings = set_ or []
-    team_size = team_size if team_size is not None else targets
-    video_options: dict[str, Any] = dict(annotate=annotate, team_size=team_size, health_window=health_window,
-                                         min_score=min_score, fps=fps, features=features)
-    # the video, pixel, blob and closed-set paths are imported in their branch: keeps the CLI's start-up short
+    # the pixel and live paths are imported in their branch: keeps the CLI's start-up short
     with ExitStack() as stack:
         annotate_as = annotate
-        if annotate is not None and branch in ("pipeline", "blobs"):  # (lookalike.pipeline.run does it for others)
-            # (the video is written to a temporary file, renamed into place when complete)
-            annotate = video_options["annotate"] = stack.enter_context(atomic_path(annotate))
-            video_options["annotate_as"] = annotate_as
+        if annotate is not None and branch == "pipeline":  # (lookalike.pipeline.run does it for the others)
+            annotate = stack.enter_context(atomic_path(annotate))  # (renamed into place when complete)
         try:
             if branch == "pipeline":
                 from lookalike.cli.track_pixels import run_track_pixels
@@ -144,32 +142,20 @@ def track(
                                  settings, annotate=annotate, fps=fps, min_score=min_score, annotate_as=annotate_as,
                                  bag=bag, camera_topic=camera_topic, heading_topics=heading_topics)
                 return
-            from lookalike.cli.track_confidence import add_confidence, written_results
-
-            if branch in ("files", "video", "points"):  # (lookalike.pipeline.run)
-                _run(request)
-                return add_confidence(written_results(branch, path, output, video, fps))
-            with failing(ValueError, TypeError):
-                trk = files.box_tracker(tracker, settings, video=True, targets=targets, params_file=params_file)
-            assert video is not None
             if live is not None:
                 from lookalike.cli.track_live import run_track_live
 
-                run_track_live(live, output, trk, tracker, detector or "", blob or [],
-                               n_targets=0 if open_set else targets,
-                               explicit=tracker_params(tracker, settings, params_file).keys(),
-                               min_score=min_score, max_frames=max_frames, seconds=seconds,
-                               refused={"--annotate": annotate is not None, "--offline": offline,
-                                        "--features": features != "video", "--fps": fps is not None})
-            else:
-                from lookalike.cli.track_blobs import run_track_blobs
+                with failing(ValueError, TypeError):
+                    trk = files.box_tracker(tracker, settings, video=True, targets=targets or None,
+                                            params_file=params_file)
+                return run_track_live(live, output, trk, tracker, detector or "", blob or [], n_targets=targets,
+                                      explicit=tracker_params(tracker, settings, params_file).keys(),
+                                      min_score=min_score, max_frames=max_frames, seconds=seconds,
+                                      refused={"--annotate": annotate is not None, "--offline": offline,
+                                               "--features": features != "video", "--fps": fps is not None})
+            from lookalike.cli.track_confidence import add_confidence, written_results
 
-                run_track_blobs(video, output, trk, tracker, detector or "", blob or [],
-                                n_targets=0 if open_set else targets,
-                                offline=tracker_params(tracker, settings, params_file) if offline else None,
-                                explicit=tracker_params(tracker, settings, params_file).keys(),
-                                save_detections=save_detections, **video_options)
-            add_confidence(written_results(branch, path, output, video, fps, live=live is not None))
-
+            _run(request)
+            add_confidence(written_results(branch, path, output, video, fps))
         except OSError as exc:  # an output that cannot be written, an input that cannot be read
             fail(f"{exc.filename or output}: {exc.strerror or exc}")

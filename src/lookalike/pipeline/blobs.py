@@ -1,18 +1,29 @@
-"""Blob detections for a tracker (``lookalike track --video V --detector blob``): whether they are found in the
-tracking pass, and the tracker set for them."""
+"""Blob detections for a tracker (``lookalike track --video V --detector blob``): the settings estimated from the
+video, the detections found in the tracking pass or first (cached), the tracker set for them, and the run."""
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Callable, Collection
+from contextlib import nullcontext as _nothing
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from lookalike.io import MotTable, write_mot
 from lookalike.io.needs import input_kind
-from lookalike.vision.blob_auto import BlobEstimate
+from lookalike.pipeline.runner import Event, RunResult, step
+from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, BlobEstimate, frame_counts
 from lookalike.vision.blob_boxtrack import blob_boxtrack_config
-from lookalike.viz.blob_video import BlobRows, BlobStream, load_blob_detections
+from lookalike.viz.blob_video import (
+    BlobRows,
+    BlobStream,
+    auto_blob_config,
+    cached_blob_detections,
+    load_blob_detections,
+    store_blob_detections,
+)
+from lookalike.viz.overlay import source_frames
 
 
 def one_pass(tracker: Any, tracker_name: str, explicit: Collection[str], n_targets: int | None,
@@ -58,4 +69,82 @@ def estimate_lines(estimate: BlobEstimate, settings: list[str]) -> list[str]:
     return lines + ([f"  given with --blob: {', '.join(sorted(given))}"] if given else [])
 
 
-__all__ = ["blob_source", "blob_tracker", "estimate_lines", "one_pass"]
+def run_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, settings: list[str],
+              on_event: Callable[[Event], None], *, n_targets: int | None = None,
+              offline: dict[str, Any] | None = None, explicit: Collection[str] = (),
+              save_detections: Path | None = None, **options: Any) -> RunResult:
+    """Detect blobs on ``video`` (``settings``: ``--blob KEY=VALUE`` over those estimated; the boxes written to
+    ``save_detections`` when given), then track them as :func:`lookalike.pipeline.video.run_video` (given
+    ``options``) or, with ``offline`` (the online pass's parameters), by the offline closed set of ``n_targets``
+    (None: inferred from the blob counts for ``boxtrack``; 0: an open set); ``explicit``: the tracker parameters
+    given, kept as given. What it does is told to ``on_event``; ``ValueError`` for a bad input."""
+    from lookalike.pipeline.closed import offline_video
+    from lookalike.pipeline.video import check_result_file, run_video
+
+    check_result_file(output, video)
+    try:
+        config, estimate = auto_blob_config(video, settings, n_targets or None, progress=steps(on_event))
+        for line in estimate_lines(estimate, settings) if estimate is not None else []:
+            on_event(Event("line", line))
+        _, declared, source_rate = source_frames(video)
+        found, stream = blob_source(video, config, tracker, tracker_name, explicit, n_targets, offline is not None,
+                                    options)
+        if found is None and stream is None:
+            with step(on_event, f"detecting blobs in {video.name}") if declared <= 0 else _nothing():
+                found = cached_blob_detections(video, config, None if declared <= 0 else steps(on_event)(
+                    f"detecting blobs in {video.name}", declared))
+    except OSError as exc:
+        raise ValueError(str(exc)) from exc
+    result = RunResult("blobs", [output], 1)
+    if stream is not None:  # detected while tracked: the video is decoded once
+        tracker = _set_tracker(tracker, tracker_name, np.zeros(0, int), explicit, n_targets, options, on_event)
+        result = run_video(video, stream, output, tracker, tracker_name, on_event, score_warnings=False, **options)
+        found = stream.found()
+        store_blob_detections(video, config, found)
+    assert found is not None
+    rows, frames = found.rows, found.frames
+    saved = "" if save_detections is None else f" → {write_mot(save_detections, rows)}"
+    on_event(Event("line", f"blob detector: {len(rows)} boxes in {frames} frames{saved}"))
+    if len(rows) < 2:
+        raise ValueError(f"{video}: the blob detector found {len(rows)} box(es); try a lower --blob threshold=... "
+                         "or min_area_px=..., or polarity=dark/bright")
+    if stream is not None:
+        return result
+    if offline is not None:
+        assert n_targets
+        offline = {**{k: v for k, v in BOX_TRACKER_PARAMS.items() if tracker_name == "boxtrack"}, **offline}
+        offline_video(rows, output, n_targets, offline, float(options.get("fps") or source_rate), frames,
+                      options["min_score"], on_event, video=video, annotate=options.get("annotate"),
+                      annotate_as=options.get("annotate_as"), shapes=found.shapes)
+        return result
+    tracker = _set_tracker(tracker, tracker_name, frame_counts(rows, frames), explicit, n_targets, options, on_event)
+    return run_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, on_event, length=frames,
+                     score_warnings=False, **options)
+
+
+def steps(on_event: Callable[[Event], None]) -> Callable[[str, int], Callable[[], None]]:
+    """A progress factory (``(description, total) -> step``) telling ``on_event`` each step and its end."""
+    def factory(description: str, total: int) -> Callable[[], None]:
+        on_event(Event("start", description, total))
+        done = [0]
+
+        def advance() -> None:
+            done[0] += 1
+            on_event(Event("advance", description, 1))
+            if done[0] == total:
+                on_event(Event("end", description))
+        return advance
+    return factory
+
+
+def _set_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: Collection[str],
+                 n_targets: int | None, options: dict[str, Any], on_event: Callable[[Event], None]) -> Any:
+    """:func:`blob_tracker`, a count inferred told; the team size set in ``options``."""
+    tracker, summary, options["team_size"] = blob_tracker(tracker, tracker_name, counts, explicit, n_targets,
+                                                          options.get("team_size"))
+    if summary is not None:
+        on_event(Event("line", summary))
+    return tracker
+
+
+__all__ = ["blob_source", "blob_tracker", "estimate_lines", "one_pass", "run_blobs", "steps"]

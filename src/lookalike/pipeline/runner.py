@@ -18,7 +18,7 @@ from lookalike.pipeline.request import TrackRequest
 if TYPE_CHECKING:
     from lookalike.pipeline.tracking import VideoTrackingResult
 
-BRANCHES = ("files", "video", "points")
+BRANCHES = ("files", "video", "points", "blobs")
 """The branches :func:`run` takes (see :meth:`TrackRequest.branch`), online or ``--offline``."""
 
 
@@ -57,16 +57,18 @@ def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) 
     if branch not in BRANCHES or live is not None:
         raise ValueError(f"lookalike.pipeline.run: takes the {', '.join(BRANCHES)} branches, not {branch}")
     targets = request.targets or None
-    tracker = files.box_tracker(request.tracker, request.settings, video=branch == "video", targets=targets,
+    tracker = files.box_tracker(request.tracker, request.settings, video=branch in ("video", "blobs"), targets=targets,
                                 params_file=request.params_file)
     params = files.tracker_params(request.tracker, request.settings, request.params_file) if offline else None
     with ExitStack() as stack:
         annotate = None if request.annotate is None else stack.enter_context(atomic_path(request.annotate))
-        if branch == "points":
-            return _points(request, tracker, params, annotate, tell)
-        if branch == "video":
-            return _video(request, tracker, params, annotate, tell)
-        return _offline_files(request, params, tell) if params is not None else _files(request, tracker, tell)
+        if branch in ("points", "video", "blobs"):
+            run_branch = {"points": _points, "video": _video, "blobs": _detected}[branch]
+            result = run_branch(request, tracker, params, annotate, tell)
+        else:
+            result = _offline_files(request, params, tell) if params is not None else _files(request, tracker, tell)
+    result.branch = branch
+    return result
 
 
 @contextmanager
@@ -154,6 +156,28 @@ def _video(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, a
     offline_video(det, request.output, request.targets, params, request.fps or rate, count or None, request.min_score,
                   tell, request.det_format, video=video, annotate=annotate, annotate_as=request.annotate)
     return RunResult("video", [request.output], 1)
+
+
+def _detected(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, annotate: Path | None,
+              tell: Callable[[Event], None]) -> RunResult:
+    """A video's boxes found by ``request.detector`` (``blob`` or an ONNX model), then tracked."""
+    from lookalike.pipeline.blobs import run_blobs
+    from lookalike.pipeline.video import run_onnx
+
+    video, detector = request.video_path, request.detector or ""
+    assert video is not None
+    team_size = request.team_size if request.team_size is not None else request.targets or None
+    options: dict[str, Any] = dict(annotate=annotate, annotate_as=request.annotate, team_size=team_size,
+                                   min_score=request.min_score, health_window=request.health_window, fps=request.fps,
+                                   features=request.features, save_detections=request.save_detections,
+                                   n_targets=request.targets, offline=params)
+    if detector.lower().endswith(".onnx"):
+        return run_onnx(video, request.output, tracker, request.tracker, Path(detector), request.blob, tell, **options)
+    if detector != "blob":
+        raise ValueError(f"--detector: choose one of blob or FILE.onnx, got {detector!r}")
+    explicit = files.tracker_params(request.tracker, request.settings, request.params_file).keys()
+    return run_blobs(video, request.output, tracker, request.tracker, request.blob, tell, explicit=explicit,
+                     **options)
 
 
 def _points(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, annotate: Path | None,

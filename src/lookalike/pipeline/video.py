@@ -247,5 +247,53 @@ def open_onnx(video: Path, model: Path, settings: list[str]) -> OnnxRun:
     return OnnxRun(detector, images, total, rate)
 
 
+def run_onnx(video: Path, output: Path, tracker: Any, tracker_name: str, model: Path, settings: list[str],
+             on_event: Callable[[Event], None], *, n_targets: int | None = None, offline: dict[str, Any] | None = None,
+             save_detections: Path | None = None, **options: Any) -> RunResult:
+    """``track --video V --detector FILE.onnx``: detect with the ONNX ``model`` (``settings``: ``KEY=VALUE``; the
+    boxes written to ``save_detections`` when given), then track as :func:`run_video` (given ``options``; detected in
+    the tracking pass when it decodes the frames anyway) or, with ``offline`` (the online pass's parameters), by
+    the offline closed set of ``n_targets``. What it does is told to ``on_event``; ``ValueError`` for a bad input."""
+    from lookalike.pipeline.closed import offline_video
+
+    check_result_file(output, video)
+    try:
+        run = open_onnx(video, model, settings)
+    except OSError as exc:
+        raise ValueError(str(exc)) from exc
+    stream = run.in_pass(tracker_name, options.get("annotate") is not None, offline is not None, options["min_score"])
+    result = RunResult("blobs", [output], 1)
+    if stream is not None:
+        result = run_video(video, stream, output, tracker, tracker_name, on_event, **options)
+        rows, frames, seconds = stream.found()
+    else:
+        name = f"detecting {video.name}"
+        on_event(Event("start", name, run.total))
+        try:
+            rows, frames, seconds = run.detect(advance=lambda: on_event(Event("advance", name, 1)))
+        except OSError as exc:
+            raise ValueError(str(exc)) from exc
+        on_event(Event("end", name))
+    speed = f"{frames / seconds:,.1f} frames/s" if seconds > 0 else "inf frames/s"
+    width, height = run.detector.input_size
+    saved = "" if save_detections is None else f" → {write_mot(save_detections, rows)}"
+    on_event(Event("line", f"{model.name} ({run.detector.layout}, input {width}x{height}): {len(rows)} boxes in "
+                           f"{frames} frames, {speed}{saved}"))
+    if len(rows) < 2:
+        raise ValueError(f"{video}: the detector {model.name} found {len(rows)} box(es); try a lower score=... setting")
+    if stream is not None:
+        return result
+    rows = as_written(rows)  # (tracked as a saved detection file would be: boxes to 1/1000 px, scores to 6 digits)
+    if offline is not None:
+        assert n_targets is not None
+        offline_video(rows, output, n_targets, offline, float(options.get("fps") or run.rate), frames,
+                      options["min_score"], on_event, video=video, annotate=options.get("annotate"),
+                      annotate_as=options.get("annotate_as"))
+        return result
+    return run_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, on_event, length=frames,
+                     **options)
+
+
 __all__ = ["FEATURE_CHOICES", "OnnxRun", "OnnxStream", "VideoDetections", "VideoInput", "as_written", "check_features",
-           "check_result_file", "open_onnx", "prepare_video", "run_video", "threshold_hint", "write_video_result"]
+           "check_result_file", "open_onnx", "prepare_video", "run_onnx", "run_video", "threshold_hint",
+           "write_video_result"]
