@@ -115,7 +115,8 @@ def load_set_weights(path: str | os.PathLike[str]) -> SetWeights:
 
 def _relu_(x: np.ndarray) -> np.ndarray:
     """``max(x, 0)`` in place (``x`` a new array); ``x``."""
-    return np.maximum(x, 0.0, out=x)
+    np.maximum(x, 0.0, out=x)
+    return x
 
 
 def _sigmoid_(x: np.ndarray) -> np.ndarray:

@@ -65,8 +65,8 @@ class ReportExchange:
             return
         dt = t - t_a
         f = np.array([[1.0, dt], [0.0, 1.0]])
-        q, q3, q2 = self.q, dt ** 3 / 3, dt ** 2 / 2
-        q = np.array([[q * q3, q * q2], [q * q2, q * dt]])
+        psd, q3, q2 = self.q, dt ** 3 / 3, dt ** 2 / 2
+        q = np.array([[psd * q3, psd * q2], [psd * q2, psd * dt]])
         x, p = f @ self.x[a], f @ self.p[a] @ f.T + q
         gain = p[:, 0] / (p[0, 0] + self.r)
         x = x + gain * _wrap_float(heading - float(x[0]))

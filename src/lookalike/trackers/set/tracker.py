@@ -146,7 +146,7 @@ class SetIdentifier(AgentIdentifier):
         """``prob (slots, N+1)`` with the false-positive column scaled by the running rate over ``fp_prior_ref`` (a
         prior-shift correction), rows normalised again."""
         assert self.fp_rate is not None and self.config.fp_prior_ref is not None
-        out = prob.copy()
+        out: np.ndarray = prob.copy()
         out[:, -1] *= min(max(self.fp_rate / self.config.fp_prior_ref, FP_PRIOR_CLIP[0]), FP_PRIOR_CLIP[1])
         out /= np.maximum(np.add.reduce(out, axis=1, keepdims=True), 1e-12)
         return out
