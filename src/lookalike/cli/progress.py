@@ -48,9 +48,9 @@ def progress_bars() -> Iterator[ProgressFactory]:
 
 
 @contextmanager
-def printed_events(tracker: str) -> Iterator[Callable[[Any], None]]:
-    """An ``on_event`` for :func:`lookalike.pipeline.run`: notes, warnings and lines printed, the result after the
-    ``tracker``'s name, steps drawn as bars while any is on (a spinner for a step of unknown length)."""
+def printed_events() -> Iterator[Callable[[Any], None]]:
+    """An ``on_event`` for :func:`lookalike.pipeline.run`: notes, warnings and lines printed, a result after its
+    tracker's name in green, steps drawn as bars while any is on (a spinner for a step that tells no progress)."""
     with ExitStack() as stack:
         tasks: dict[str, Any] = {}
         progress = ExitStack()
@@ -77,7 +77,7 @@ def printed_events(tracker: str) -> Iterator[Callable[[Any], None]]:
             elif kind in ("note", "warn"):
                 (note if kind == "note" else warn)(text)
             elif kind == "result":
-                console.print(f"[green]{escape(tracker)}[/]" + escape(text))
+                console.print(f"[green]{escape(event.name)}[/]" + escape(text))
             else:
                 console.print(text, markup=False)
 

@@ -1,9 +1,8 @@
-"""``lookalike track``: argument parsing and printing; the run is :func:`lookalike.pipeline.run` (robots from pixels:
-:mod:`lookalike.cli.track_pixels`; live sources: :mod:`lookalike.cli.track_live`)."""
+"""``lookalike track``: argument parsing and printing; the run is :func:`lookalike.pipeline.run` (live sources:
+:mod:`lookalike.cli.track_live`)."""
 
 from __future__ import annotations
 
-from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
@@ -11,7 +10,6 @@ import typer
 from rich.markup import escape
 
 from lookalike.cli.app import app, console, fail, failing
-from lookalike.io.outputs import atomic_path
 from lookalike.pipeline import files
 from lookalike.pipeline.request import TrackRequest
 
@@ -36,7 +34,7 @@ def _run(request: TrackRequest) -> None:
     from lookalike.pipeline import run
 
     try:
-        with failing(ValueError, TypeError), printed_events(request.tracker) as on_event:
+        with failing(ValueError, TypeError), printed_events() as on_event:
             run(request, on_event)
     except KeyboardInterrupt:
         console.print("\n[yellow]Interrupted.[/] Nothing was written" + (
@@ -119,43 +117,31 @@ def track(
     request = TrackRequest(output, tracker, path, video_arg, detections, points, bag, detector, blob or [], pipeline,
                            reports, annotate, save_detections, targets, offline_opt,
                            max_frames is not None or seconds is not None, set_ or [], params_file, min_score, fps,
-                           features, team_size, health_window, det_format, not no_seqinfo_length)
+                           features, team_size, health_window, det_format, not no_seqinfo_length, detector_model,
+                           heading_model, camera_topic, heading_topics)
     video = request.video_path
     with failing(ValueError):
         live = request.live()
         branch = request.branch()
         offline = request.is_offline(branch, live)
         request.check_outputs([path, video, detections, points, reports, params_file, detector_model, heading_model])
-    settings = set_ or []
-    # the pixel and live paths are imported in their branch: keeps the CLI's start-up short
-    with ExitStack() as stack:
-        annotate_as = annotate
-        if annotate is not None and branch == "pipeline":  # (lookalike.pipeline.run does it for the others)
-            annotate = stack.enter_context(atomic_path(annotate))  # (renamed into place when complete)
-        try:
-            if branch == "pipeline":
-                from lookalike.cli.track_pixels import run_track_pixels
+    try:
+        if live is not None:  # (imported here: keeps the CLI's start-up short)
+            from lookalike.cli.track_live import run_track_live
 
-                if params_file is not None:
-                    settings = [*(f"{k}={v}" for k, v in tracker_params(tracker, [], params_file).items()), *settings]
-                run_track_pixels(video, output, pipeline or "robots", reports, detector_model, heading_model, tracker,
-                                 settings, annotate=annotate, fps=fps, min_score=min_score, annotate_as=annotate_as,
-                                 bag=bag, camera_topic=camera_topic, heading_topics=heading_topics)
-                return
-            if live is not None:
-                from lookalike.cli.track_live import run_track_live
-
-                with failing(ValueError, TypeError):
-                    trk = files.box_tracker(tracker, settings, video=True, targets=targets or None,
-                                            params_file=params_file)
-                return run_track_live(live, output, trk, tracker, detector or "", blob or [], n_targets=targets,
-                                      explicit=tracker_params(tracker, settings, params_file).keys(),
-                                      min_score=min_score, max_frames=max_frames, seconds=seconds,
-                                      refused={"--annotate": annotate is not None, "--offline": offline,
-                                               "--features": features != "video", "--fps": fps is not None})
+            settings = set_ or []
+            with failing(ValueError, TypeError):
+                trk = files.box_tracker(tracker, settings, video=True, targets=targets or None,
+                                        params_file=params_file)
+            return run_track_live(live, output, trk, tracker, detector or "", blob or [], n_targets=targets,
+                                  explicit=tracker_params(tracker, settings, params_file).keys(),
+                                  min_score=min_score, max_frames=max_frames, seconds=seconds,
+                                  refused={"--annotate": annotate is not None, "--offline": offline,
+                                           "--features": features != "video", "--fps": fps is not None})
+        _run(request)
+        if branch != "pipeline":
             from lookalike.cli.track_confidence import add_confidence, written_results
 
-            _run(request)
             add_confidence(written_results(branch, path, output, video, fps))
-        except OSError as exc:  # an output that cannot be written, an input that cannot be read
-            fail(f"{exc.filename or output}: {exc.strerror or exc}")
+    except OSError as exc:  # an output that cannot be written, an input that cannot be read
+        fail(f"{exc.filename or output}: {exc.strerror or exc}")

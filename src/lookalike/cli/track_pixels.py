@@ -1,41 +1,15 @@
-"""``lookalike track --video FILE --pipeline robots`` and ``--bag DIR`` (robot identities from pixels, run by
-:mod:`lookalike.pipeline.robots`): options checked and the run printed; and ``lookalike render-robots``."""
+"""``lookalike render-robots``: a simulated robot sequence drawn through the robot camera, the input of ``lookalike
+track --video FILE --pipeline robots`` (run by :func:`lookalike.pipeline.robots.run_robots`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 import typer
-from rich.markup import escape
 
 from lookalike.cli.app import app, check_outputs_or_fail, console, failing
 from lookalike.cli.progress import bars
-from lookalike.pipeline.robots import check_robots, dropped, identify_robots, prepare_robots, robot_video
-
-
-def run_track_pixels(video: Path | None, output: Path, pipeline: str, reports: Path | None, detector_model: Path | None,
-                     heading_model: Path | None, identifier: str, settings: list[str], *,
-                     annotate: Path | None = None, fps: float | None = None, min_score: float = 0.5,
-                     annotate_as: Path | None = None, bag: Path | None = None, camera_topic: str | None = None,
-                     heading_topics: str | None = None) -> None:
-    """Run pipeline ``pipeline`` over ``video`` with the reports of ``reports`` (or over the rosbag2 folder ``bag``:
-    images of ``camera_topic``, headings of the comma-separated ``heading_topics``); write MOTChallenge rows to
-    ``output`` and, with ``annotate``, an annotated MP4 (printed as ``annotate_as``). ``min_score``: detector
-    probability (-inf: 0.5)."""
-    with failing(ValueError):
-        identifier = check_robots(video, pipeline, reports, identifier, output, bag, camera_topic)
-    with failing(ValueError, OSError, TypeError, prefix="" if bag is None else "--bag: "):
-        run = prepare_robots(video, reports, identifier, settings, detector_model, heading_model, min_score, bag=bag,
-                             camera_topic=camera_topic, heading_topics=heading_topics)
-    with failing(ValueError), bars("identifying robots") as progress:
-        task = progress.add_task(run.source.name, total=run.total or None)
-        stats = identify_robots(run, output, annotate, fps, advance=lambda: progress.advance(task))
-    speed = f"{stats.fps:,.1f}" if stats.seconds > 0 else "inf"
-    where = escape(f"{output}" + (f", {annotate_as or annotate}" if annotate else ""))
-    console.print(f"[green]{identifier}[/] from pixels: {stats.frames} frames, {speed} frames/s (detector + heading + "
-                  f"identifier) → {where}")
-    if dropped(run.pipe):
-        console.print(f"dropped as implausible: {dropped(run.pipe)}", markup=False)
+from lookalike.pipeline.robots import robot_video
 
 
 @app.command("render-robots")

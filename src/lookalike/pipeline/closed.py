@@ -117,7 +117,7 @@ def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: 
         raise ValueError(str(exc)) from exc
     write_mot(output, rows)
     on_event(Event("result", f", offline closed set of {n_targets}: {len(np.unique(rows[:, 1]))} identities, "
-                             f"{len(rows)} rows at {frame_rate:g} frames/s → {output}"))
+                             f"{len(rows)} rows at {frame_rate:g} frames/s → {output}", name="boxtrack"))
     if annotate is not None and video is not None:
         draw_step(on_event, "drawing the identities", MotTable.from_rows(rows), annotate, frame_rate, video)
         line(f"annotated video → {annotate_as or annotate}")

@@ -17,8 +17,9 @@ class TrackRequest:
     (None: the default), and whether a live stop (``stops``: --max-frames/--seconds) was given; how to track: the
     tracker's ``settings`` (``KEY=VALUE``) and ``params_file``, ``min_score``, ``fps`` (None: the input's),
     appearance ``features``, the health checks' ``team_size`` (None: ``targets``) and ``health_window`` (frames),
-    the detection files' ``det_format`` and whether seqinfo.ini's seqLength bounds them (``use_length``). Every check
-    raises ``ValueError`` naming the options."""
+    the detection files' ``det_format`` and whether seqinfo.ini's seqLength bounds them (``use_length``); for robots
+    from pixels the ``detector_model`` and ``heading_model`` (None: shipped), and a bag's ``camera_topic`` and
+    comma-separated ``heading_topics``. Every check raises ``ValueError`` naming the options."""
 
     output: Path
     tracker: str = "sort"
@@ -45,6 +46,10 @@ class TrackRequest:
     health_window: int = 15
     det_format: str = "auto"
     use_length: bool = True
+    detector_model: Path | None = None
+    heading_model: Path | None = None
+    camera_topic: str | None = None
+    heading_topics: str | None = None
 
     @property
     def video_path(self) -> Path | None:

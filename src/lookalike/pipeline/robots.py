@@ -12,6 +12,8 @@ from typing import Any
 import numpy as np
 
 from lookalike.io.robot_sequences import read_robot_sequence
+from lookalike.pipeline.request import TrackRequest
+from lookalike.pipeline.runner import Event, RunResult
 from lookalike.sim import RobotSequence
 from lookalike.trackers.registry import parse_parameter
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
@@ -128,6 +130,38 @@ def identify_robots(run: RobotRun, output: Path, annotate: Path | None = None, f
             writer.close()
 
 
+def run_robots(request: TrackRequest, annotate: Path | None, on_event: Callable[[Event], None]) -> RunResult:
+    """``track --video V --pipeline robots --reports R`` (or ``--bag``): robots found, oriented, placed and identified
+    by ``request.tracker`` (``sort``: ``set``) into ``request.output`` and, with ``annotate``, an annotated MP4 (told
+    as ``request.annotate``); what it does told to ``on_event``. ``ValueError`` or ``TypeError`` for a bad input."""
+    from lookalike.pipeline.files import tracker_params
+
+    video, bag, output = request.video_path, request.bag, request.output
+    identifier = check_robots(video, request.pipeline or "robots", request.reports, request.tracker, output, bag,
+                              request.camera_topic)
+    settings = request.settings
+    if request.params_file is not None:
+        settings = [*(f"{k}={v}" for k, v in tracker_params(request.tracker, [], request.params_file).items()),
+                    *settings]
+    try:
+        run = prepare_robots(video, request.reports, identifier, settings, request.detector_model,
+                             request.heading_model, request.min_score, bag=bag, camera_topic=request.camera_topic,
+                             heading_topics=request.heading_topics)
+    except (ValueError, OSError, TypeError) as exc:
+        raise ValueError(f"{'' if bag is None else '--bag: '}{exc}") from exc
+    name = f"identifying robots in {run.source.name}"
+    on_event(Event("start", name, run.total))
+    stats = identify_robots(run, output, annotate, request.fps, advance=lambda: on_event(Event("advance", name, 1)))
+    on_event(Event("end", name))
+    speed = f"{stats.fps:,.1f}" if stats.seconds > 0 else "inf"
+    where = f"{output}" + (f", {request.annotate}" if annotate is not None else "")
+    on_event(Event("result", f" from pixels: {stats.frames} frames, {speed} frames/s (detector + heading + "
+                             f"identifier) → {where}", name=identifier))
+    if dropped(run.pipe):
+        on_event(Event("line", f"dropped as implausible: {dropped(run.pipe)}"))
+    return RunResult("pipeline", [output], 1)
+
+
 def dropped(pipe: RobotPipeline) -> str:
     """The detections ``pipe`` dropped as implausible, ``N why`` comma-separated (empty if none)."""
     return ", ".join(f"{n} {why}" for why, n in pipe.dropped.items() if n)
@@ -141,4 +175,4 @@ def robot_video(sequence: Path, seed: int = 0) -> tuple[RobotSequence, Iterator[
 
 
 __all__ = ["PIPELINES", "SIZE_TOLERANCE", "RobotRun", "check_robots", "dropped", "identify_robots", "prepare_robots",
-           "robot_video"]
+           "robot_video", "run_robots"]

@@ -18,20 +18,21 @@ from lookalike.pipeline.request import TrackRequest
 if TYPE_CHECKING:
     from lookalike.pipeline.tracking import VideoTrackingResult
 
-BRANCHES = ("files", "video", "points", "blobs")
-"""The branches :func:`run` takes (see :meth:`TrackRequest.branch`), online or ``--offline``."""
+BRANCHES = ("files", "video", "points", "blobs", "pipeline")
+"""The branches :func:`run` takes (see :meth:`TrackRequest.branch`), online or ``--offline``, from files (not live)."""
 
 
 @dataclass(frozen=True)
 class Event:
     """Something a run tells as it goes. ``kind``: ``note`` (an assumption made), ``warn`` (something looks wrong),
-    ``line`` (a plain line), ``result`` (what the tracker wrote: the line's text after the tracker's name), ``start``
+    ``line`` (a plain line), ``result`` (what the tracker ``name`` wrote: the line's text after the name), ``start``
     (a step named ``text`` of ``count`` frames, 0: unknown), ``advance`` (step ``text`` went ``count`` frames
     further), ``busy`` (a step named ``text`` that tells no progress) or ``end`` (step ``text`` is over)."""
 
     kind: str
     text: str = ""
     count: int = 0
+    name: str = ""
 
 
 @dataclass
@@ -54,14 +55,17 @@ def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) 
     live = request.live()
     branch = request.branch()
     offline = request.is_offline(branch, live)
-    if branch not in BRANCHES or live is not None:
-        raise ValueError(f"lookalike.pipeline.run: takes the {', '.join(BRANCHES)} branches, not {branch}")
-    targets = request.targets or None
-    tracker = files.box_tracker(request.tracker, request.settings, video=branch in ("video", "blobs"), targets=targets,
-                                params_file=request.params_file)
-    params = files.tracker_params(request.tracker, request.settings, request.params_file) if offline else None
+    if live is not None:
+        raise ValueError(f"lookalike.pipeline.run: a live source ({live}) runs through lookalike.io.live.track_live")
     with ExitStack() as stack:
         annotate = None if request.annotate is None else stack.enter_context(atomic_path(request.annotate))
+        if branch == "pipeline":
+            from lookalike.pipeline.robots import run_robots
+
+            return run_robots(request, annotate, tell)
+        tracker = files.box_tracker(request.tracker, request.settings, video=branch in ("video", "blobs"),
+                                    targets=request.targets or None, params_file=request.params_file)
+        params = files.tracker_params(request.tracker, request.settings, request.params_file) if offline else None
         if branch in ("points", "video", "blobs"):
             run_branch = {"points": _points, "video": _video, "blobs": _detected}[branch]
             result = run_branch(request, tracker, params, annotate, tell)
@@ -108,7 +112,8 @@ def _files(request: TrackRequest, tracker: Any, tell: Callable[[Event], None]) -
     tell(Event("end", "sequences"))
     stats = result.stats
     speed = f", {stats.fps:,.0f} frames/s (tracker only)" if stats.frames and stats.seconds > 0 else ""
-    tell(Event("result", f": {len(streams)} sequence(s), {stats.frames} frames{speed} → {_where(request)}"))
+    tell(Event("result", f": {len(streams)} sequence(s), {stats.frames} frames{speed} → {_where(request)}",
+               name=request.tracker))
     return result
 
 
@@ -126,7 +131,7 @@ def _offline_files(request: TrackRequest, params: dict[str, Any], tell: Callable
     except OSError as exc:
         raise ValueError(f"output {request.output}: cannot write ({exc.strerror or exc})") from exc
     tell(Event("result", f", offline closed set of {request.targets}: {len(written)} sequence(s) → "
-                         f"{_where(request)}"))
+                         f"{_where(request)}", name=request.tracker))
     return RunResult("files", written, len(written))
 
 
@@ -205,7 +210,7 @@ def _points(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, 
     rows = track_point_boxes(boxes, output, tracker, frame_rate, request.targets or None, params,
                              note=telling(tell, "line"))
     what = f"offline closed set of {request.targets}" if params is not None else "online"
-    tell(Event("result", f", {what}: {len(np.unique(rows[:, 1]))} identities → {output}"))
+    tell(Event("result", f", {what}: {len(np.unique(rows[:, 1]))} identities → {output}", name=request.tracker))
     if annotate is not None:
         draw_step(tell, "drawing the tracks", read_mot(output), annotate, frame_rate, request.video_path, boxes.frames)
         tell(Event("line", f"annotated video → {request.annotate}"))

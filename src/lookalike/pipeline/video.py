@@ -158,7 +158,8 @@ def run_video(video: Path, detections: VideoDetections, output: Path, tracker: A
     seconds = result.tracker_s + result.feature_s
     fps_text = f"{result.frames / seconds:,.0f}" if seconds > 0 else "inf"
     on_event(Event("result", f": {result.frames} frames, {len(result.merges)} merge(s), {unhealthy} frame(s) flagged "
-                             f"unhealthy, {fps_text} frames/s (features + tracker) → " + ", ".join(map(str, shown))))
+                             f"unhealthy, {fps_text} frames/s (features + tracker) → " + ", ".join(map(str, shown)),
+                       name=tracker_name))
     if result.ignored_rows:
         on_event(Event("note", f"{result.ignored_rows} detection row(s) are past the video's {result.frames} frames "
                                "and were ignored"))
