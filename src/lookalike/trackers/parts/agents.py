@@ -4,6 +4,7 @@ localiser)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -47,7 +48,7 @@ class AgentIdentifier:
         """Seconds since the previous frame (0 at the first); ``ValueError`` when time goes backwards."""
         if frame.time < self._last_time:
             raise ValueError(f"frame time went backwards: {self._last_time} s then {frame.time} s")
-        dt = 0.0 if not np.isfinite(self._last_time) else frame.time - self._last_time
+        dt = 0.0 if not math.isfinite(self._last_time) else frame.time - self._last_time
         self._last_time = frame.time
         return dt
 
@@ -75,14 +76,16 @@ class AgentIdentifier:
             finite = np.logical_and.reduce(np.isfinite(located), axis=1)
         last_seen[assigned] = frame.index
         snapshots = []
-        for j in np.flatnonzero((last_seen >= 0) & finite).tolist():  # (unseen, or lost beyond the localiser: none)
-            k = int(det_of_agent[j])
+        shown = np.flatnonzero((last_seen >= 0) & finite).tolist()  # (unseen, or lost beyond the localiser: none)
+        taken_by, headings, probabilities = det_of_agent.tolist(), heading.tolist(), conf.tolist()
+        for j in shown:
+            k = taken_by[j]
             seen = k >= 0
             snapshot = object.__new__(TrackSnapshot)  # (every field set directly: TrackSnapshot checks nothing)
             snapshot.__dict__.update(
                 track_id=j + 1, status=TrackStatus.CONFIRMED if seen else TrackStatus.LOST, xywh=None,
-                position=located[j].copy(), velocity=None, heading=float(heading[k]) if seen else None, agent_id=j,
-                identity_prob=float(conf[k]) if seen else None, detection_index=k)
+                position=located[j].copy(), velocity=None, heading=headings[k] if seen else None, agent_id=j,
+                identity_prob=probabilities[k] if seen else None, detection_index=k)
             snapshots.append(snapshot)
         return snapshots
 
