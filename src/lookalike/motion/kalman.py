@@ -22,12 +22,6 @@ def update(mean: np.ndarray, cov: np.ndarray, z: np.ndarray, H: np.ndarray, R: n
            ) -> tuple[np.ndarray, np.ndarray]:
     """Measurement update with ``z (k, m)``: the posterior ``(mean, cov)``, ``P' = (I - K H) P``."""
     z_hat, S = project(mean, cov, H, R)
-    return update_projected(mean, cov, z, H, z_hat, S)
-
-
-def update_projected(mean: np.ndarray, cov: np.ndarray, z: np.ndarray, H: np.ndarray, z_hat: np.ndarray,
-                     S: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`update` given :func:`project`'s ``z_hat, S`` for these tracks."""
     PHt = cov @ H.T  # (k, n, m)
     # K = PHt S^-1  <=>  S K^T = PHt^T (S symmetric)
     K = np.swapaxes(np.linalg.solve(S, np.swapaxes(PHt, -1, -2)), -1, -2)

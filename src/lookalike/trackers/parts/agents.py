@@ -9,6 +9,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from lookalike.trackers.kernels.world import filled
 from lookalike.trackers.parts.identity.localiser import make_localiser
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
@@ -63,7 +64,7 @@ class AgentIdentifier:
         if det_of_agent is None:
             det_of_agent = agent_detections(labels, conf, n_agents)
         assigned = det_of_agent >= 0
-        measured = np.full((n_agents, 2), np.nan)
+        measured = filled((n_agents, 2), np.nan)
         weight = np.zeros(n_agents)
         taken = det_of_agent[assigned]
         measured[assigned] = position[taken]
@@ -76,7 +77,7 @@ class AgentIdentifier:
             finite = np.logical_and.reduce(np.isfinite(located), axis=1)
         last_seen[assigned] = frame.index
         snapshots = []
-        shown = np.flatnonzero((last_seen >= 0) & finite).tolist()  # (unseen, or lost beyond the localiser: none)
+        shown = ((last_seen >= 0) & finite).nonzero()[0].tolist()  # (unseen, or lost beyond the localiser: none)
         taken_by, headings, probabilities = det_of_agent.tolist(), heading.tolist(), conf.tolist()
         for j in shown:
             k = taken_by[j]
@@ -93,7 +94,7 @@ class AgentIdentifier:
 def decode(prob: np.ndarray, used: np.ndarray, n: int, one_to_one: bool) -> tuple[np.ndarray, np.ndarray]:
     """Labels ``(n,)`` of a frame's ``n`` detections (agent or -1) and their probabilities (0 where unused) from the
     probabilities ``(M, N+1)`` of the slots holding detections ``used``."""
-    labels, conf = np.full(n, -1), np.zeros(n)
+    labels, conf = filled(n, -1, int), np.zeros(n)
     k = len(used)
     p = prob[:k]
     n_agents = p.shape[1] - 1
@@ -105,7 +106,7 @@ def decode(prob: np.ndarray, used: np.ndarray, n: int, one_to_one: bool) -> tupl
     cost = -np.log(np.minimum(np.maximum(np.concatenate([p[:, :n_agents], np.repeat(p[:, n_agents:], k, axis=1)],
                                                         axis=1), 1e-12), 1))
     rows, cols = _assignment()(cost)
-    label = np.full(k, -1)
+    label = filled(k, -1, int)
     label[rows] = np.where(cols < n_agents, cols, -1)
     labels[used], conf[used] = label, np.where(label >= 0, p[np.arange(k), np.maximum(label, 0)], p[:, n_agents])
     return labels, conf

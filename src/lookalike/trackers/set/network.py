@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.trackers.kernels.world import einsum
 from lookalike.trackers.parts.weights_io import CheckpointError, read_metadata, write_weights
 
 FORMAT = "lookalike-set-associator"
@@ -216,7 +217,7 @@ class NumpySetAssociator:
         self.p = self.p + g * (mean_pos - self.p)
         self.m = self.m + g * (1.0 - self.m)
         self.s = (1.0 - g) * (self.s + dt_s)
-        msg = np.einsum("kn,knf->nf", w, e2)
+        msg = einsum("kn,knf->nf", w, e2)
         x = np.concatenate([msg, g, agents], axis=1)
         hd = self.weights.memory
         gi = x @ t["gru.weight_ih"] + self._gru_b

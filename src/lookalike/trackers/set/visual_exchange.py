@@ -71,7 +71,7 @@ class VisualExchange:
         the last frame, ``scale (n, n)`` a factor on each pair's threshold (None: 1). Returns :func:`take_pairs`'."""
         self.evidence *= np.exp(-max(dt, 0.0) / self.memory_s)
         usable = (held >= 0) & np.isfinite(reported) & np.isfinite(age)
-        live = np.flatnonzero(usable)
+        live = usable.nonzero()[0]
         k = len(live)
         if k < 2:
             return []

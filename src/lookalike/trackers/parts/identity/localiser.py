@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from lookalike.motion import chi2_gate, kalman
+from lookalike.trackers.kernels.world import einsum, solve
 
 LOCALISERS = ("lowpass", "kalman")
 
@@ -122,34 +123,43 @@ class KalmanLocaliser:
         R = (std**2)[:, None, None] * _EYE2
         start = seen & ~self._started
         self._started |= start
-        live = np.flatnonzero(seen & ~start)
+        live = (seen & ~start).nonzero()[0]
         every = len(live) == self.n_agents  # (every agent's filter updated: no copies of the rows)
         if len(live):
             m, P, zj, Rj = ((self._mean, self._cov, z, R) if every
                             else (self._mean[live], self._cov[live], z[live], R[live]))
             zhat, S = kalman.project(m, P, _H, Rj)
             d = zj - zhat
-            d2 = np.einsum("ki,ki->k", d, np.linalg.solve(S, d[..., None])[..., 0])
+            d2 = einsum("ki,ki->k", d, solve(S, d[..., None])[..., 0])
             accept = d2 <= self._gate
             if accept.all():
                 if every:
-                    self._mean, self._cov = kalman.update_projected(m, P, zj, _H, zhat, S)
+                    self._mean, self._cov = _corrected(m, P, zj, zhat, S)
                 else:
-                    self._mean[live], self._cov[live] = kalman.update_projected(m, P, zj, _H, zhat, S)
+                    self._mean[live], self._cov[live] = _corrected(m, P, zj, zhat, S)
                 self._rejects[live] = 0
             else:
                 restart = ~accept & (self._rejects[live] + 1 >= cfg.max_rejects)
                 if accept.any():
-                    mu, Pu = kalman.update_projected(m[accept], P[accept], zj[accept], _H, zhat[accept], S[accept])
+                    mu, Pu = _corrected(m[accept], P[accept], zj[accept], zhat[accept], S[accept])
                     self._mean[live[accept]], self._cov[live[accept]] = mu, Pu
                 start[live[restart]] = True
                 self._rejects[live] = np.where(accept | restart, 0, self._rejects[live] + 1)
-        for j in np.flatnonzero(start):  # (new filters, and those restarted)
+        for j in start.nonzero()[0]:  # (new filters, and those restarted)
             self._mean[j] = (z[j, 0], z[j, 1], 0.0, 0.0)
             self._cov[j] = np.diag([std[j] ** 2, std[j] ** 2, 0.5, 0.5])
         self._last_seen = np.where(seen, time_s, self._last_seen)
         fresh = self._started & (time_s - self._last_seen <= cfg.max_coast_s)
         return np.where(fresh[:, None], self._mean[:, :2], np.nan)
+
+
+def _corrected(mean: np.ndarray, cov: np.ndarray, z: np.ndarray, z_hat: np.ndarray, S: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """``kalman.update(mean, cov, z, _H, R)`` given its projection ``z_hat, S``: the same arithmetic, with numpy's
+    solve and einsum kernels called without their wrappers."""
+    PHt_T = (cov @ _H.T).swapaxes(-1, -2)
+    K = solve(S, PHt_T).swapaxes(-1, -2)
+    return mean + einsum("kij,kj->ki", K, z - z_hat), cov - K @ PHt_T
 
 
 def make_localiser(name: str, n_agents: int, config: KalmanLocaliserConfig | None = None
