@@ -103,7 +103,7 @@ def decode(prob: np.ndarray, used: np.ndarray, n: int, one_to_one: bool) -> tupl
         labels[used], conf[used] = np.where(label == n_agents, -1, label), p[np.arange(k), label]
         return labels, conf
     # Each detection may be a false positive; each agent takes at most one detection.
-    cost = -np.log(np.minimum(np.maximum(np.concatenate([p[:, :n_agents], np.repeat(p[:, n_agents:], k, axis=1)],
+    cost = -np.log(np.minimum(np.maximum(np.concatenate([p[:, :n_agents], p[:, n_agents:].repeat(k, axis=1)],
                                                         axis=1), 1e-12), 1))
     rows, cols = _assignment()(cost)
     label = filled(k, -1, int)
@@ -129,7 +129,7 @@ def agent_detections(labels: np.ndarray, conf: np.ndarray, n_agents: int) -> np.
     """``(n_agents,)`` each agent's most confident detection (index into ``labels``), -1 for none."""
     det_of_agent = [-1] * n_agents
     label = labels.tolist()
-    for k in np.argsort(-conf).tolist():
+    for k in (-conf).argsort().tolist():
         j = label[k]
         if j >= 0 and det_of_agent[j] < 0:
             det_of_agent[j] = k

@@ -121,7 +121,7 @@ class SetIdentifier(AgentIdentifier):
         position = det.position if det.position is not None and n else np.zeros((0, 2))
         heading = det.heading if det.heading is not None and n else np.zeros(0)
         score = det.score if det.score is not None and n else np.zeros(0)
-        used = np.argsort(-score, kind="stable")[: self.config.n_slots]
+        used = (-score).argsort(kind="stable")[: self.config.n_slots]
         age = self._beacons.age(frame.time)
         reported = self._beacons.heading
         if self.config.stale_s is not None:
