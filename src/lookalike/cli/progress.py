@@ -59,10 +59,12 @@ def printed_events() -> Iterator[Callable[[Any], None]]:
 
         def on_event(event: Any) -> None:
             kind, text = event.kind, event.text
-            if kind == "busy":
-                tasks[text] = console.status(text)
-                tasks[text].start()
-                stack.callback(tasks[text].stop)
+            if kind == "busy" and (event.name or text) in tasks:
+                tasks[event.name or text].update(escape(text))
+            elif kind == "busy":
+                tasks[event.name or text] = console.status(escape(text))
+                tasks[event.name or text].start()
+                stack.callback(tasks[event.name or text].stop)
             elif kind == "start":
                 bar[:] = bar or [progress.enter_context(bars())]
                 tasks[text] = bar[0].add_task(text, total=event.count or None)

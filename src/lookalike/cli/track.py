@@ -1,5 +1,4 @@
-"""``lookalike track``: argument parsing and printing; the run is :func:`lookalike.pipeline.run` (live sources:
-:mod:`lookalike.cli.track_live`)."""
+"""``lookalike track``: argument parsing and printing; the run is :func:`lookalike.pipeline.run`."""
 
 from __future__ import annotations
 
@@ -116,32 +115,20 @@ def track(
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
     request = TrackRequest(output, tracker, path, video_arg, detections, points, bag, detector, blob or [], pipeline,
                            reports, annotate, save_detections, targets, offline_opt,
-                           max_frames is not None or seconds is not None, set_ or [], params_file, min_score, fps,
+                           max_frames, seconds, set_ or [], params_file, min_score, fps,
                            features, team_size, health_window, det_format, not no_seqinfo_length, detector_model,
                            heading_model, camera_topic, heading_topics)
     video = request.video_path
     with failing(ValueError):
         live = request.live()
         branch = request.branch()
-        offline = request.is_offline(branch, live)
+        request.is_offline(branch, live)
         request.check_outputs([path, video, detections, points, reports, params_file, detector_model, heading_model])
     try:
-        if live is not None:  # (imported here: keeps the CLI's start-up short)
-            from lookalike.cli.track_live import run_track_live
-
-            settings = set_ or []
-            with failing(ValueError, TypeError):
-                trk = files.box_tracker(tracker, settings, video=True, targets=targets or None,
-                                        params_file=params_file)
-            return run_track_live(live, output, trk, tracker, detector or "", blob or [], n_targets=targets,
-                                  explicit=tracker_params(tracker, settings, params_file).keys(),
-                                  min_score=min_score, max_frames=max_frames, seconds=seconds,
-                                  refused={"--annotate": annotate is not None, "--offline": offline,
-                                           "--features": features != "video", "--fps": fps is not None})
         _run(request)
         if branch != "pipeline":
             from lookalike.cli.track_confidence import add_confidence, written_results
 
-            add_confidence(written_results(branch, path, output, video, fps))
+            add_confidence(written_results(branch, path, output, video, fps, live=live is not None))
     except OSError as exc:  # an output that cannot be written, an input that cannot be read
         fail(f"{exc.filename or output}: {exc.strerror or exc}")

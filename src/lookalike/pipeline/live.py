@@ -1,11 +1,15 @@
-"""A live camera or stream checked before it is opened (``lookalike track --video 0|URL``)."""
+"""A live camera or stream (``lookalike track --video 0|URL``): checked before it is opened, then tracked until it
+ends or is stopped (:mod:`lookalike.io.live`)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from lookalike.io.needs import input_kind
+from lookalike.pipeline.request import TrackRequest
+from lookalike.pipeline.runner import Event, RunResult
 
 
 def live_settings(spec: str, output: Path, tracker_name: str, detector: str, settings: list[str],
@@ -32,4 +36,54 @@ def live_settings(spec: str, output: Path, tracker_name: str, detector: str, set
     return {}
 
 
-__all__ = ["live_settings"]
+def run_live(request: TrackRequest, on_event: Callable[[Event], None]) -> RunResult:
+    """Track the live source ``request.video`` into ``request.output`` until it ends, ``max_frames``,
+    ``seconds`` or Ctrl-C/SIGTERM (the file then holds every whole frame); what it does told to ``on_event``.
+    ``ValueError`` or ``TypeError`` for a bad request or a source that cannot be opened."""
+    from lookalike.io.live import LiveRun, LiveStop, prepare_live, track_live
+    from lookalike.io.sources import open_live
+    from lookalike.pipeline.files import box_tracker, tracker_params
+
+    spec, output, name, detector = request.video or "", request.output, request.tracker, request.detector or ""
+    refused = {"--annotate": request.annotate is not None, "--offline": bool(request.offline),
+               "--features": request.features != "video", "--fps": request.fps is not None}
+    blob = live_settings(spec, output, name, detector, request.blob, refused)
+    tracker = box_tracker(name, request.settings, video=True, targets=request.targets or None,
+                          params_file=request.params_file)
+    explicit = tracker_params(name, request.settings, request.params_file).keys()
+    try:
+        with LiveStop() as stop:
+            on_event(Event("busy", f"opening {spec}"))
+            source = open_live(spec)
+            on_event(Event("end", f"opening {spec}"))
+            with source:
+                if detector == "blob":
+                    on_event(Event("line", f"{spec}: blob settings from the first frames (about 2 s)"))
+                plan = prepare_live(source, detector, tracker, name, blob=blob, onnx=request.blob,
+                                    n_targets=request.targets, explicit=explicit, min_score=request.min_score,
+                                    stop=stop)
+                for line in plan.estimate.summary.splitlines() if plan.estimate is not None else []:
+                    on_event(Event("line", f"  {line}"))
+                if plan.count is not None:
+                    on_event(Event("line", plan.count.summary.replace("the video", "the first frames")))
+                on_event(Event("busy", "tracking (Ctrl-C stops and keeps the result)", name="tracking"))
+
+                def show(run: LiveRun) -> None:
+                    if run.frames % 25 == 0:
+                        on_event(Event("busy", f"tracking {spec}: {run.frames} frames, {run.fps:.1f} frames/s, "
+                                               f"{source.dropped} dropped (Ctrl-C stops and keeps the result)",
+                                       name="tracking"))
+
+                run = track_live(source, plan, output, max_frames=request.max_frames, seconds=request.seconds,
+                                 stop=stop, on_frame=show)
+                on_event(Event("end", "tracking"))
+    except OSError as exc:
+        raise ValueError(str(exc)) from exc
+    setup = f" ({run.dropped_before} while setting up)" if run.dropped_before else ""
+    on_event(Event("result", f": {run.frames} frames in {run.wall_s:.1f} s ({run.fps:.1f} frames/s; detector + "
+                             f"tracker {run.busy_fps:,.0f} frames/s), {run.dropped} of {run.delivered} dropped while "
+                             f"busy{setup}, times from the {run.clock}; stopped: {run.stopped} → {output}", name=name))
+    return RunResult("live", [output], 1)
+
+
+__all__ = ["live_settings", "run_live"]

@@ -14,7 +14,7 @@ class TrackRequest:
     """What ``lookalike track`` was asked: ``output``, the input (``path``, ``video`` text, ``detections``,
     ``points`` or ``bag``), the ``detector`` and its ``blob`` settings, the robots ``pipeline`` and ``reports``,
     ``annotate`` and ``save_detections`` outputs, the ``tracker`` name, ``targets`` (0: an open set), ``offline``
-    (None: the default), and whether a live stop (``stops``: --max-frames/--seconds) was given; how to track: the
+    (None: the default), a live source's stops (``max_frames``, ``seconds`` of stream time); how to track: the
     tracker's ``settings`` (``KEY=VALUE``) and ``params_file``, ``min_score``, ``fps`` (None: the input's),
     appearance ``features``, the health checks' ``team_size`` (None: ``targets``) and ``health_window`` (frames),
     the detection files' ``det_format`` and whether seqinfo.ini's seqLength bounds them (``use_length``); for robots
@@ -36,7 +36,8 @@ class TrackRequest:
     save_detections: Path | None = None
     targets: int | None = None
     offline: bool | None = None
-    stops: bool = False
+    max_frames: int | None = None
+    seconds: float | None = None
     settings: list[str] = field(default_factory=list)
     params_file: Path | None = None
     min_score: float = -math.inf
@@ -62,7 +63,7 @@ class TrackRequest:
         live = self.video if is_live(self.video) else None
         if self.save_detections is not None and (self.detector is None or live is not None):
             raise ValueError("--save-detections: only with --video FILE --detector")
-        if live is None and self.stops:
+        if live is None and (self.max_frames is not None or self.seconds is not None):
             raise ValueError("--max-frames/--seconds: only with a live --video (a camera index or a stream URL)")
         if live is not None and self.detector is None:
             raise ValueError(f"--video {live}: a live source needs --detector blob or --detector FILE.onnx")

@@ -19,7 +19,8 @@ if TYPE_CHECKING:
     from lookalike.pipeline.tracking import VideoTrackingResult
 
 BRANCHES = ("files", "video", "points", "blobs", "pipeline")
-"""The branches :func:`run` takes (see :meth:`TrackRequest.branch`), online or ``--offline``, from files (not live)."""
+"""The branches :func:`run` takes (see :meth:`TrackRequest.branch`), online or ``--offline``; a live source is
+tracked on the ``blobs`` branch (:func:`lookalike.pipeline.live.run_live`)."""
 
 
 @dataclass(frozen=True)
@@ -27,7 +28,8 @@ class Event:
     """Something a run tells as it goes. ``kind``: ``note`` (an assumption made), ``warn`` (something looks wrong),
     ``line`` (a plain line), ``result`` (what the tracker ``name`` wrote: the line's text after the name), ``start``
     (a step named ``text`` of ``count`` frames, 0: unknown), ``advance`` (step ``text`` went ``count`` frames
-    further), ``busy`` (a step named ``text`` that tells no progress) or ``end`` (step ``text`` is over)."""
+    further), ``busy`` (a step that tells no progress, named ``name`` or else ``text``; told again with the same
+    ``name``, its ``text`` changes) or ``end`` (the step named ``text`` is over)."""
 
     kind: str
     text: str = ""
@@ -56,7 +58,9 @@ def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) 
     branch = request.branch()
     offline = request.is_offline(branch, live)
     if live is not None:
-        raise ValueError(f"lookalike.pipeline.run: a live source ({live}) runs through lookalike.io.live.track_live")
+        from lookalike.pipeline.live import run_live
+
+        return run_live(request, tell)
     with ExitStack() as stack:
         annotate = None if request.annotate is None else stack.enter_context(atomic_path(request.annotate))
         if branch == "pipeline":
