@@ -133,7 +133,7 @@ class SetIdentifier(AgentIdentifier):
         labels, conf = decode(prob, used, n, True)
         if self.fp_rate is not None:
             weight = 1.0 - math.exp(-dt / FP_PRIOR_S)
-            self.fp_rate += weight * (int((labels[used] < 0).sum()) - self.fp_rate)
+            self.fp_rate += weight * (np.count_nonzero(labels[used] < 0) - self.fp_rate)
         held = agent_detections(labels, conf, self.config.n_agents)
         if self._visual is not None:
             swapped = self._visual_exchanges(labels, held, heading, age, dt)
