@@ -167,6 +167,21 @@ def test_animals_interpolated_through_a_merged_blob_move_to_its_ends():
     assert np.array_equal(out[[0, 1, 4]], rows[[0, 1, 4]]) and np.array_equal(out[:, 4:6], rows[:, 4:6])
 
 
+def test_blobs_that_rarely_show_one_animal_get_the_online_closed_set():
+    from lookalike.trackers.offline.closed_set import online_rows
+
+    rows, shapes, _ = _two_animals(bounce=True)
+    notes: list[str] = []
+    kept = track_closed_set(rows, 2, 25.0, shapes=shapes, note=notes.append)
+    assert not notes  # 6 merged blobs of 166: the look is learned
+    varied = shapes.copy()
+    varied[::3, 0] += np.log(3.0)  # a third of the blobs three times an animal's size (shadows, merges)
+    fallback = track_closed_set(rows, 2, 25.0, shapes=varied, note=notes.append)
+    assert len(notes) == 1 and "--online" in notes[0]
+    assert np.array_equal(fallback, online_rows(rows, 25.0, reported=True, max_targets=2))
+    assert not np.array_equal(kept[:, :6], fallback[:, :6])
+
+
 def test_nothing_to_learn_from_a_lone_animal_and_shapes_must_match_the_detections():
     rows, shapes, truth = _two_animals(bounce=True)
     one = np.column_stack([rows[truth == 1, :SHAPE_COLUMN], np.flatnonzero(truth == 1)])

@@ -56,7 +56,7 @@ def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_f
     the offline assignment get the online closed set's result instead, said to ``note``."""
     online = {k: v for k, v in params.items() if k != "max_targets"}
     rows = track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise,
-                            shapes=shapes)
+                            shapes=shapes, note=note)
     if len(rows) or not len(det_rows):
         return rows
     frames = len(np.unique(det_rows[:, 0]))

@@ -28,6 +28,7 @@ MIN_ROWS = 8  # single-animal rows a tracklet needs to teach or be judged by its
 OUTLIER = 0.001  # chance that a tracklet's look is not its animal's (a bad segmentation): bounds a link's evidence
 SHAPE_COLUMN = 9  # the column of an input row that holds its shape vector's index
 MIN_SPREAD = 0.1  # smallest spread of a log look distance (a floor for the fits on few pairs)
+UNTRUSTED_SHARE = 0.135  # more of the online pass's rows not one animal's size: no look (research/appearance/rule4.md)
 MERGE_REACH = 0.25  # an interpolated centre this many blob sizes sqrt(w*h) outside a merged blob's box is not in it
 
 

@@ -20,12 +20,19 @@ pixels. The method and its parameters: docs/closed-set.md."""
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Callable, Collection, Sequence
 from typing import Any
 
 import numpy as np
 
-from lookalike.trackers.offline.appearance import cut_at_merges, fit_identity_space, place_in_merges, with_appearance
+from lookalike.trackers.offline.appearance import (
+    UNTRUSTED_SHARE,
+    cut_at_merges,
+    fit_identity_space,
+    place_in_merges,
+    single_rows,
+    with_appearance,
+)
 from lookalike.trackers.offline.closed_set_config import ClosedSetConfig
 from lookalike.trackers.offline.constraints import (
     ChainConstraints,
@@ -49,6 +56,7 @@ from lookalike.trackers.offline.tracklets import (
 )
 from lookalike.trackers.registry import make_tracker, tracker_class
 from lookalike.types import Detections, Frame
+from lookalike.types.mot_table import tracks_to_rows
 
 __all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale",
            "place_short", "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
@@ -276,13 +284,13 @@ def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfi
 
 def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = None,
                 tracker: str = "boxtrack", *, vel_noise: float | None = None, index: bool = False,
-                **params: Any) -> np.ndarray:
+                reported: bool = False, **params: Any) -> np.ndarray:
     """Result rows of an online pass of ``tracker`` over detection rows ``(k, >=7)`` (1-based frames,
     boxes in pixels, score in column 7): only tracks matched to a detection, at that detection's box.
     ``vel_noise``: ``boxtrack``'s velocity noise (fraction of the box size per frame) when not its default
     (:class:`~lookalike.trackers.boxtrack.BoxTrack`'s hook; points as boxes use
     :data:`lookalike.io.points.POINT_VEL_NOISE`). ``index``: column 9 holds the detection's row number in
-    ``det_rows``."""
+    ``det_rows``. ``reported``: instead, every track the tracker reports, as ``lookalike track`` writes it."""
     det_rows = checked_rows(det_rows)
     tracker_obj = make_tracker(tracker, **params)
     if vel_noise is not None:
@@ -298,7 +306,11 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
     for k in range(n_frames):
         block = det_rows[bounds[k]:bounds[k + 1]]
         dets = Detections(xywh=block[:, 2:6], score=block[:, 6]) if len(block) else Detections.empty()
-        for t in tracker_obj.update(Frame(index=k, time=k / frame_rate, detections=dets)):
+        tracks = tracker_obj.update(Frame(index=k, time=k / frame_rate, detections=dets))
+        if reported:
+            out.extend(tracks_to_rows(k, tracks).tolist())
+            continue
+        for t in tracks:
             if t.detection_index is None or t.detection_index < 0:
                 continue  # coasted: no detection behind it
             row = order[bounds[k] + t.detection_index] if index else -1
@@ -308,16 +320,28 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
 
 def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *, n_frames: int | None = None,
                      online: dict[str, Any] | None = None, config: ClosedSetConfig | None = None,
-                     vel_noise: float | None = None, shapes: np.ndarray | None = None) -> np.ndarray:
+                     vel_noise: float | None = None, shapes: np.ndarray | None = None,
+                     note: Callable[[str], None] | None = None) -> np.ndarray:
     """Offline closed-set tracking of detection rows ``(k, >=7)``: an open-set online ``boxtrack`` pass
     with ``n_init=1`` (every detection enters some tracklet; the assignment decides what is clutter;
     ``online`` overrides its parameters; ``vel_noise`` as in :func:`online_rows`), then
     :func:`assign_identities` (``shapes``: one blob shape vector per detection row, or None). Returns result rows
-    ``(k, 10)`` with ids ``1..n_targets``."""
+    ``(k, 10)`` with ids ``1..n_targets``. With ``shapes``, when more than
+    :data:`~lookalike.trackers.offline.appearance.UNTRUSTED_SHARE` of the pass's blobs are not one animal's size, the
+    online closed set's rows (``boxtrack`` with ``max_targets``, as ``track --targets N --online`` writes them) are
+    returned instead, and ``note`` told why."""
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
     if shapes is not None and len(shapes) != len(det_rows):
         raise ValueError(f"shapes: expected one per detection row ({len(det_rows)}), got {len(shapes)}")
     params = {"n_init": 1, **(online or {})}
     rows = online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, index=shapes is not None, **params)
+    share = 1.0 - float(single_rows(rows, shapes).mean()) if shapes is not None and len(rows) else 0.0
+    if share > UNTRUSTED_SHARE:
+        if note is not None:
+            note(f"note: {100 * share:.0f}% of the blobs are not one animal's size (merged, cut by the border or "
+                 f"shadowed), too many to learn each one's look; the online closed set's result (--targets "
+                 f"{n_targets} --online) is written instead")
+        return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, reported=True,
+                           **{**(online or {}), "max_targets": int(n_targets)})
     return assign_identities(rows, n_targets, frame_rate, config, shapes=shapes)
