@@ -67,11 +67,13 @@ class ReportExchange:
         f = np.array([[1.0, dt], [0.0, 1.0]])
         psd, q3, q2 = self.q, dt ** 3 / 3, dt ** 2 / 2
         q = np.array([[psd * q3, psd * q2], [psd * q2, psd * dt]])
-        x, p = f @ self.x[a], f @ self.p[a] @ f.T + q
-        gain = p[:, 0] / (p[0, 0] + self.r)
-        x = x + gain * _wrap_float(heading - float(x[0]))
-        self.x[a] = (_wrap_float(float(x[0])), x[1])
-        self.p[a], self.t[a] = p - gain[:, None] * p[0], t
+        (x0, x1), ((p00, p01), (p10, p11)) = (f @ self.x[a]).tolist(), (f @ self.p[a] @ f.T + q).tolist()
+        s = p00 + self.r  # (the gain and correction on floats: numpy's elementwise arithmetic, the same values)
+        g0, g1 = p00 / s, p10 / s
+        w = _wrap_float(heading - x0)
+        self.x[a] = (_wrap_float(x0 + g0 * w), x1 + g1 * w)
+        self.p[a] = ((p00 - g0 * p00, p01 - g0 * p01), (p10 - g1 * p00, p11 - g1 * p01))
+        self.t[a] = t
 
     def add(self, agent: int, t_sent: float, heading: float, scale: np.ndarray | None = None) -> tuple[int, int] | None:
         """Take one report (send time s, heading rad; ignored unless newer than the agent's newest); ``scale (n,)``: a
