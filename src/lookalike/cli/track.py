@@ -119,13 +119,9 @@ def track(
                            features, team_size, health_window, det_format, not no_seqinfo_length, detector_model,
                            heading_model, camera_topic, heading_topics)
     video = request.video_path
-    with failing(ValueError):
-        live = request.live()
-        branch = request.branch()
-        request.is_offline(branch, live)
-        request.check_outputs([path, video, detections, points, reports, params_file, detector_model, heading_model])
     try:
         _run(request)
+        live, branch = request.live(), request.branch()
         if branch != "pipeline":
             from lookalike.cli.track_confidence import add_confidence, written_results
 

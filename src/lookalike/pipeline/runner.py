@@ -50,13 +50,15 @@ class RunResult:
 
 
 def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) -> RunResult:
-    """Run ``request`` (a branch of :data:`BRANCHES`) and return what it wrote; the ``annotate`` MP4 appears whole
-    or not at all. ``ValueError`` or ``TypeError`` (bad options or inputs, one readable line), ``OSError`` (an
-    output that cannot be written)."""
+    """Run ``request`` (a branch of :data:`BRANCHES`; its options and outputs checked first) and return what it
+    wrote; the ``annotate`` MP4 appears whole or not at all. ``ValueError`` or ``TypeError`` (bad options or inputs,
+    one readable line), ``OSError`` (an output that cannot be written)."""
     tell = on_event or (lambda event: None)
     live = request.live()
     branch = request.branch()
     offline = request.is_offline(branch, live)
+    request.check_outputs([request.path, request.video_path, request.detections, request.points, request.reports,
+                           request.params_file, request.detector_model, request.heading_model])
     if live is not None:
         from lookalike.pipeline.live import run_live
 
