@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -25,7 +26,7 @@ def blob_solver_input(video: Path, tracks: Path, n_targets: int, frame_rate: flo
     found = load_blob_detections(video, auto_blob_config(video, [], n_targets)[0])
     if found is None or found.shapes is None or len(found.rows) < 2:
         return None
-    params = {"n_init": 1, **BOX_TRACKER_PARAMS}
+    params: dict[str, Any] = {"n_init": 1, **BOX_TRACKER_PARAMS}
     solver = online_rows(found.rows, frame_rate, found.frames, index=True, **params)
     again = assign_identities(solver, n_targets, frame_rate, shapes=found.shapes)
     table = read_mot(tracks)
