@@ -37,7 +37,9 @@ def test_files_and_video_runs_tell_and_return_what_they_wrote(scene, tmp_path):
     assert any(e.kind == "warn" and "score" in e.text for e in events)  # (blob scores: all 1)
     starts = [e for e in events if e.kind == "start"]
     assert starts[0] == Event("start", "sequences", 1) and Event("end", "sequences") in events
-    assert events[-1].kind == "result" and events[-1].text.startswith(": 1 sequence(s), 30 frames")
+    result = next(e for e in events if e.kind == "result")
+    assert result.name == "boxtrack" and result.text.startswith(": 1 sequence(s), 30 frames")
+    assert events[-1].kind == "line" and events[-1].text.startswith("doubtful: ")  # (each row's confidence added)
     assert 0 < sum(e.count for e in events if e.kind == "advance" and e.text == starts[1].text) <= FRAMES
     events.clear()
     vid = run(TrackRequest(tmp_path / "v.txt", "deepsort", video=str(video), detections=det), events.append)
@@ -47,10 +49,7 @@ def test_files_and_video_runs_tell_and_return_what_they_wrote(scene, tmp_path):
     r = runner.invoke(app, ["track", "--video", str(video), "--detections", str(det), "-t", "deepsort", "-o",
                             str(tmp_path / "cli.txt")])
     assert r.exit_code == 0, r.output
-    cli = read_mot(tmp_path / "cli.txt")  # (the command also writes each row's confidence)
-    got = read_mot(tmp_path / "v.txt")
-    np.testing.assert_array_equal(np.column_stack([cli.frame, cli.track_id, cli.xywh]),
-                                  np.column_stack([got.frame, got.track_id, got.xywh]))
+    assert (tmp_path / "cli.txt").read_bytes() == (tmp_path / "v.txt").read_bytes()
 
 
 def test_offline_and_point_runs(scene, tmp_path):
@@ -86,8 +85,9 @@ def test_a_detector_run_finds_and_tracks_in_one_pass(scene, tmp_path, monkeypatc
     assert found.branch == "blobs" and found.video is not None and found.video.frames == FRAMES
     assert Event("line", f"blob detector: 90 boxes in {FRAMES} frames → {tmp_path / 'd.txt'}") in events
     run(TrackRequest(tmp_path / "f.txt", "sort", path=tmp_path / "d.txt"))
-    np.testing.assert_array_equal(np.loadtxt(tmp_path / "b.txt", delimiter=","),
-                                  np.loadtxt(tmp_path / "f.txt", delimiter=","))
+    video_rows, file_rows = (np.loadtxt(tmp_path / f, delimiter=",") for f in ("b.txt", "f.txt"))
+    keep = [0, 1, 2, 3, 4, 5, 7, 8, 9]  # (column 7, the identity confidence, depends on the frame rate: 10 vs 30)
+    np.testing.assert_array_equal(video_rows[:, keep], file_rows[:, keep])
 
 
 def test_bad_requests_are_refused_in_one_line(scene, tmp_path):

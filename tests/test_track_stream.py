@@ -136,7 +136,7 @@ def test_writer_leaves_nothing_when_the_run_fails(tmp_path):
 
 
 def test_track_cli_streams_the_same_file_as_the_old_loop(tmp_path):
-    from lookalike.cli.track_confidence import add_confidence
+    from lookalike.pipeline.results import add_confidence
 
     path = _det_file(tmp_path / "det.txt", frames=120)
     result = runner.invoke(app, ["track", "-t", "sort", str(path), "-o", str(tmp_path / "out.txt")])

@@ -118,13 +118,7 @@ def track(
                            max_frames, seconds, set_ or [], params_file, min_score, fps,
                            features, team_size, health_window, det_format, not no_seqinfo_length, detector_model,
                            heading_model, camera_topic, heading_topics)
-    video = request.video_path
     try:
         _run(request)
-        live, branch = request.live(), request.branch()
-        if branch != "pipeline":
-            from lookalike.cli.track_confidence import add_confidence, written_results
-
-            add_confidence(written_results(branch, path, output, video, fps, live=live is not None))
     except OSError as exc:  # an output that cannot be written, an input that cannot be read
         fail(f"{exc.filename or output}: {exc.strerror or exc}")

@@ -51,8 +51,10 @@ class RunResult:
 
 def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) -> RunResult:
     """Run ``request`` (a branch of :data:`BRANCHES`; its options and outputs checked first) and return what it
-    wrote; the ``annotate`` MP4 appears whole or not at all. ``ValueError`` or ``TypeError`` (bad options or inputs,
-    one readable line), ``OSError`` (an output that cannot be written)."""
+    wrote, each result row's identity confidence in column 7 (:mod:`lookalike.pipeline.results`; not for robots or
+    live sources), the doubtful ranges told as lines; the ``annotate`` MP4 appears whole or not at all.
+    ``ValueError`` or ``TypeError`` (bad options or inputs, one readable line), ``OSError`` (an output that cannot
+    be written)."""
     tell = on_event or (lambda event: None)
     live = request.live()
     branch = request.branch()
@@ -62,7 +64,7 @@ def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) 
     if live is not None:
         from lookalike.pipeline.live import run_live
 
-        return run_live(request, tell)
+        return run_live(request, tell)  # (rows written as they come: no confidence column)
     with ExitStack() as stack:
         annotate = None if request.annotate is None else stack.enter_context(atomic_path(request.annotate))
         if branch == "pipeline":
@@ -78,6 +80,11 @@ def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) 
         else:
             result = _offline_files(request, params, tell) if params is not None else _files(request, tracker, tell)
     result.branch = branch
+    from lookalike.pipeline.results import add_confidence, written_results
+
+    found = written_results(branch, request.path, request.output, request.video_path, request.fps)
+    for line in add_confidence(found):  # each row's identity confidence in column 7
+        tell(Event("line", line))
     return result
 
 
