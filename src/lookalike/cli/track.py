@@ -12,13 +12,7 @@ from lookalike.cli.app import app, console, fail, failing
 from lookalike.pipeline import files
 from lookalike.pipeline.request import TrackRequest
 
-__all__ = ["build_tracker", "track", "tracker_params"]
-
-
-def tracker_params(name: str, settings: list[str], params_file: Path | None = None) -> dict[str, Any]:
-    """:func:`lookalike.pipeline.files.tracker_params`, failing with a readable message."""
-    with failing(ValueError, TypeError):
-        return files.tracker_params(name, settings, params_file)
+__all__ = ["build_tracker", "track"]
 
 
 def build_tracker(name: str, settings: list[str], params_file: Path | None = None) -> Any:

@@ -39,15 +39,14 @@ def build_tracker(name: str, settings: list[str], params_file: Path | None = Non
     return make_tracker(name, **tracker_params(name, settings, params_file))
 
 
-def box_tracker(name: str, settings: list[str], *, video: bool = False, targets: int | None = None,
-                params_file: Path | None = None) -> Any:
-    """A tracker that can run on boxes (``video``: from a video's detections), ``targets`` its ``max_targets``;
-    ``ValueError`` or ``TypeError`` otherwise."""
+def box_tracker(name: str, params: dict[str, Any], *, video: bool = False, targets: int | None = None) -> Any:
+    """A tracker of its parameters ``params`` (:func:`tracker_params`) that can run on boxes (``video``: from a
+    video's detections), ``targets`` its ``max_targets``; ``ValueError`` or ``TypeError`` otherwise."""
     if targets is not None:
         if "max_targets" not in {p.name for p in tracker_parameters(name)}:
             raise ValueError(f"--targets: tracker {name!r} has no closed-set mode (max_targets); use -t boxtrack")
-        settings = [*settings, f"max_targets={targets}"]
-    tracker = build_tracker(name, settings, params_file)
+        params = {**params, "max_targets": targets}
+    tracker = make_tracker(name, **params)
     problem = box_input_problem(name, video=video)
     if problem is not None:
         raise ValueError(problem)

@@ -48,9 +48,9 @@ def run_live(request: TrackRequest, on_event: Callable[[Event], None]) -> RunRes
     refused = {"--annotate": request.annotate is not None, "--offline": bool(request.offline),
                "--features": request.features != "video", "--fps": request.fps is not None}
     blob = live_settings(spec, output, name, detector, request.blob, refused)
-    tracker = box_tracker(name, request.settings, video=True, targets=request.targets or None,
-                          params_file=request.params_file)
-    explicit = tracker_params(name, request.settings, request.params_file).keys()
+    given = tracker_params(name, request.settings, request.params_file)
+    tracker = box_tracker(name, given, video=True, targets=request.targets or None)
+    explicit = given.keys()
     try:
         with LiveStop() as stop:
             on_event(Event("busy", f"opening {spec}"))

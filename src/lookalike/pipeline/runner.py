@@ -3,7 +3,7 @@ tells what happens through ``on_event`` and returns what it wrote; the command l
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field
 from functools import partial
@@ -71,12 +71,14 @@ def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) 
             from lookalike.pipeline.robots import run_robots
 
             return run_robots(request, annotate, tell)
-        tracker = files.box_tracker(request.tracker, request.settings, video=branch in ("video", "blobs"),
-                                    targets=request.targets or None, params_file=request.params_file)
-        params = files.tracker_params(request.tracker, request.settings, request.params_file) if offline else None
+        given = files.tracker_params(request.tracker, request.settings, request.params_file)  # (parsed once)
+        tracker = files.box_tracker(request.tracker, given, video=branch in ("video", "blobs"),
+                                    targets=request.targets or None)
+        params = given if offline else None
         if branch in ("points", "video", "blobs"):
-            run_branch = {"points": _points, "video": _video, "blobs": _detected}[branch]
-            result = run_branch(request, tracker, params, annotate, tell)
+            run_branch: dict[str, Callable[..., RunResult]] = {
+                "points": _points, "video": _video, "blobs": partial(_detected, explicit=given.keys())}
+            result = run_branch[branch](request, tracker, params, annotate, tell)
         else:
             result = _offline_files(request, params, tell) if params is not None else _files(request, tracker, tell)
     result.branch = branch
@@ -177,8 +179,9 @@ def _video(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, a
 
 
 def _detected(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, annotate: Path | None,
-              tell: Callable[[Event], None]) -> RunResult:
-    """A video's boxes found by ``request.detector`` (``blob`` or an ONNX model), then tracked."""
+              tell: Callable[[Event], None], explicit: Collection[str] = ()) -> RunResult:
+    """A video's boxes found by ``request.detector`` (``blob`` or an ONNX model), then tracked (``explicit``: the
+    tracker parameters given, kept as given)."""
     from lookalike.pipeline.blobs import run_blobs
     from lookalike.pipeline.video import run_onnx
 
@@ -193,7 +196,6 @@ def _detected(request: TrackRequest, tracker: Any, params: dict[str, Any] | None
         return run_onnx(video, request.output, tracker, request.tracker, Path(detector), request.blob, tell, **options)
     if detector != "blob":
         raise ValueError(f"--detector: choose one of blob or FILE.onnx, got {detector!r}")
-    explicit = files.tracker_params(request.tracker, request.settings, request.params_file).keys()
     return run_blobs(video, request.output, tracker, request.tracker, request.blob, tell, explicit=explicit,
                      **options)
 
