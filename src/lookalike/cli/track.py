@@ -22,7 +22,8 @@ def build_tracker(name: str, settings: list[str], params_file: Path | None = Non
 
 
 def _run(request: TrackRequest) -> None:
-    """:func:`lookalike.pipeline.run`, printed; Ctrl-C: a line saying that nothing was written, exit 130."""
+    """:func:`lookalike.pipeline.run`, printed; Ctrl-C: a line saying that the result in progress was not written,
+    exit 130."""
     from lookalike.cli.progress import printed_events
     from lookalike.pipeline import run
 
@@ -30,8 +31,9 @@ def _run(request: TrackRequest) -> None:
         with failing(ValueError, TypeError), printed_events() as on_event:
             run(request, on_event)
     except KeyboardInterrupt:
-        console.print("\n[yellow]Interrupted.[/] Nothing was written" + (
-            f" ({escape(str(request.annotate))} is left as it was)." if request.annotate is not None else "."))
+        console.print("\n[yellow]Interrupted.[/] The result in progress was not written; files finished before are "
+                      "kept" + (f" ({escape(str(request.annotate))} is left as it was)."
+                                if request.annotate is not None else "."))
         raise SystemExit(130) from None
 
 
