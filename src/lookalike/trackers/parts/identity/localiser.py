@@ -3,6 +3,7 @@ have ``update(time_s, measured (N, 2), weight (N,)) -> (N, 2)`` (NaN rows: not d
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -11,6 +12,7 @@ from lookalike.motion import chi2_gate, kalman
 from lookalike.trackers.kernels.world import einsum, solve
 
 LOCALISERS = ("lowpass", "kalman")
+TRANSITIONS = 16  # distinct frame intervals whose Kalman transition is kept
 
 
 class LowPassLocaliser:
@@ -84,13 +86,16 @@ class KalmanLocaliser:
         self._rejects = np.zeros(n, dtype=int)
         self._last_seen = np.full(n, -np.inf)
         self._time: float | None = None
-        self._transitions: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        # ``F, Q`` of the last TRANSITIONS distinct ``dt`` (frame intervals repeat), in fixed storage (no growth)
+        self._dts: list[float] = [math.nan] * TRANSITIONS
+        self._fq = np.zeros((TRANSITIONS, 2, 4, 4))
+        self._slot = 0
 
     def _transition(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        """``F, Q`` over ``dt`` seconds (kept for the last few distinct ``dt``: frame intervals repeat)."""
-        cached = self._transitions.get(dt)
-        if cached is not None:
-            return cached
+        """``F, Q`` over ``dt`` seconds."""
+        if dt in self._dts:
+            k = self._dts.index(dt)
+            return self._fq[k, 0], self._fq[k, 1]
         cfg = self.config
         decay = float(np.exp(-dt / cfg.velocity_decay_s))
         gain = cfg.velocity_decay_s * (1.0 - decay)  # ∫ velocity over dt
@@ -102,10 +107,10 @@ class KalmanLocaliser:
         Q = np.zeros((4, 4))
         Q[np.ix_([0, 2], [0, 2])] = q1
         Q[np.ix_([1, 3], [1, 3])] = q1
-        if len(self._transitions) >= 64:
-            self._transitions.clear()
-        self._transitions[dt] = F, Q
-        return F, Q
+        k, self._slot = self._slot, (self._slot + 1) % TRANSITIONS
+        self._dts[k] = dt
+        self._fq[k, 0], self._fq[k, 1] = F, Q
+        return self._fq[k, 0], self._fq[k, 1]
 
     def update(self, time_s: float, measured: np.ndarray, weight: np.ndarray) -> np.ndarray:
         """Filtered positions ``(N, 2)`` after this frame's assigned detections."""
