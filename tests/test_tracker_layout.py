@@ -46,3 +46,32 @@ def test_parts_kernels_and_offline_are_separate_subpackages() -> None:
         assert (TRACKERS / sub / "__init__.py").exists()
     compiled = [p.name for p in (TRACKERS / "parts").rglob("*.py") if "import numba" in p.read_text()]
     assert not compiled, f"compiled code belongs in trackers/kernels/, not in parts: {compiled}"
+
+
+def test_each_tracker_declares_what_it_needs_beyond_boxes(monkeypatch: pytest.MonkeyPatch) -> None:
+    from dataclasses import dataclass
+
+    from lookalike.io.needs import box_input_problem, input_kind
+    from lookalike.trackers import registry
+    from lookalike.trackers.base import NEEDS_APPEARANCE, NEEDS_ROBOTS
+
+    kinds = {name: input_kind(name) for name in registry.tracker_names()}
+    assert {n for n, k in kinds.items() if k == "boxes + video"} == {"deepsort", "diversort"}
+    assert {n for n, k in kinds.items() if k == "robot positions"} >= {"kalman_ha", "kalman_ha2", "jpda", "lstm", "set"}
+    assert {"sort", "boxtrack"} <= {n for n, k in kinds.items() if k == "boxes"}
+    for name in kinds:
+        assert getattr(registry.tracker_class(name), "needs", None) in (None, NEEDS_APPEARANCE, NEEDS_ROBOTS)
+
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))  # (the test tracker goes with the test)
+
+    @registry.register_tracker("test-needs-pixels")
+    class Pixels:  # a tracker of one's own that reads appearance features says so the same way
+        needs = NEEDS_APPEARANCE
+
+        @dataclass(frozen=True)
+        class Config:
+            pass
+
+    assert input_kind("test-needs-pixels") == "boxes + video"
+    assert box_input_problem("test-needs-pixels", video=True) is None
+    assert "--video" in (box_input_problem("test-needs-pixels") or "")

@@ -14,10 +14,16 @@ import numpy as np
 
 from lookalike.types import Frame, TrackSnapshot
 
+NEEDS_APPEARANCE = "appearance features from the pixels: give the video with --video VIDEO"
+NEEDS_ROBOTS = ("ground positions, headings and heading reports of robots (a `lookalike simulate` sequence, "
+                "or --video V --pipeline robots --reports FILE)")
+
 
 @runtime_checkable
 class Tracker(Protocol):
-    """A tracker consumes frames in time order and returns the tracks it reports for each."""
+    """A tracker consumes frames in time order and returns the tracks it reports for each. A tracker that needs more
+    than boxes and scores says what in a class attribute ``needs`` (:data:`NEEDS_APPEARANCE`, :data:`NEEDS_ROBOTS`
+    or a phrase of its own); the pipeline computes appearance features only for :data:`NEEDS_APPEARANCE`."""
 
     name: ClassVar[str]
     config: Any

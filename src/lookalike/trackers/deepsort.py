@@ -8,6 +8,7 @@ confirmed ones after ``max_age`` frames. Defaults: docs/trackers/deepsort.md."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -17,7 +18,7 @@ from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion import kalman
 from lookalike.motion.gating import chi2_gate
 from lookalike.motion.spaces import BoxXYAH, xyah_to_xywh, xywh_to_xyah
-from lookalike.trackers.base import COUNT, POSITIVE, PROBABILITY, Range, check_params, param
+from lookalike.trackers.base import COUNT, NEEDS_APPEARANCE, POSITIVE, PROBABILITY, Range, check_params, param
 from lookalike.trackers.parts.lifecycle import Lifecycle
 from lookalike.trackers.parts.table import TrackTable
 from lookalike.trackers.parts.timing import FrameClock
@@ -30,6 +31,8 @@ __all__ = ["DeepSort", "require_features", "xyah_to_xywh", "xywh_to_xyah"]
 @register_tracker("deepsort")
 class DeepSort:
     """Deep SORT style tracking on boxes (pixels) and appearance features."""
+
+    needs: ClassVar[str] = NEEDS_APPEARANCE
 
     @dataclass(frozen=True)
     class Config:

@@ -13,6 +13,8 @@ paper's seven mechanisms (defaults and their sources: docs/trackers/diversort.md
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 
 from lookalike.association.appearance import FeatureGallery, require_features
@@ -20,6 +22,7 @@ from lookalike.association.stages import Stage, run_plan
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.motion import kalman
 from lookalike.motion.spaces import CentreCV
+from lookalike.trackers.base import NEEDS_APPEARANCE
 from lookalike.trackers.diversort_config import DiverSortConfig, Merge
 from lookalike.trackers.parts.lifecycle import Lifecycle
 from lookalike.trackers.parts.table import TrackTable
@@ -37,6 +40,7 @@ class DiverSort:
     """Diver SORT on boxes (pixels) and appearance features (``frame.detections.feature``)."""
 
     Config = DiverSortConfig
+    needs: ClassVar[str] = NEEDS_APPEARANCE
 
     def __init__(self, config: DiverSortConfig | None = None) -> None:
         self.config = cfg = config or DiverSortConfig()

@@ -6,9 +6,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import ClassVar
 
 import numpy as np
 
+from lookalike.trackers.base import NEEDS_ROBOTS
 from lookalike.trackers.kernels.world import filled
 from lookalike.trackers.parts.identity.localiser import make_localiser
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
@@ -36,6 +38,8 @@ class BeaconMemory:
 
 class AgentIdentifier:
     """The learned identifiers' state besides their network: reports, positions, the frame time, the latest labels."""
+
+    needs: ClassVar[str] = NEEDS_ROBOTS
 
     def _reset_agents(self, n_agents: int, localiser: str) -> None:
         self._beacons = BeaconMemory(n_agents)

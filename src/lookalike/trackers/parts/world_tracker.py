@@ -10,6 +10,7 @@ import numpy as np
 from lookalike.motion import chi2_gate
 from lookalike.motion.models import constant_acceleration
 from lookalike.motion.spaces import WorldCA
+from lookalike.trackers.base import NEEDS_ROBOTS
 from lookalike.trackers.kernels.world import (
     cholesky,
     compiled,
@@ -34,6 +35,7 @@ class WorldTracker:
     (returns the detection index per track, -1 for a miss)."""
 
     name: ClassVar[str] = "world"
+    needs: ClassVar[str] = NEEDS_ROBOTS
 
     def __init__(self, config: WorldConfig, rules: WorldRules) -> None:
         self.config = config

@@ -54,9 +54,6 @@ UNDO_S = 30.0  # how long a pair's exchange can be undone on less evidence, seco
 class SetIdentifier(AgentIdentifier):
     """The set associator: per-detection identities for any number of agents and detections (see the module)."""
 
-    needs = ("ground positions, headings and heading reports of robots (a `lookalike simulate` sequence, "
-             "or --video V --pipeline robots --reports FILE)")
-
     @dataclass(frozen=True)
     class Config:
         # the network
