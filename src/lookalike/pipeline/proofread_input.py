@@ -4,12 +4,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from lookalike.io.motchallenge import read_mot
-from lookalike.trackers.offline.closed_set import assign_identities, online_rows
+from lookalike.trackers.offline.closed_set import assign_identities, closed_set_input
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
 from lookalike.viz.blob_video import auto_blob_config, load_blob_detections
 
@@ -26,8 +25,7 @@ def blob_solver_input(video: Path, tracks: Path, n_targets: int, frame_rate: flo
     found = load_blob_detections(video, auto_blob_config(video, [], n_targets)[0])
     if found is None or found.shapes is None or len(found.rows) < 2:
         return None
-    params: dict[str, Any] = {"n_init": 1, **BOX_TRACKER_PARAMS}
-    solver = online_rows(found.rows, frame_rate, found.frames, index=True, **params)
+    solver = closed_set_input(found.rows, frame_rate, found.frames, online=dict(BOX_TRACKER_PARAMS), index=True)
     again = assign_identities(solver, n_targets, frame_rate, shapes=found.shapes)
     table = read_mot(tracks)
     given = np.column_stack([table.frame, table.track_id, table.xywh])

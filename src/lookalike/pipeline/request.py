@@ -56,6 +56,11 @@ class TrackRequest:
     def video_path(self) -> Path | None:
         return Path(self.video) if self.video is not None else None
 
+    @property
+    def health_team_size(self) -> int | None:
+        """The team size the health checks expect: ``team_size``, else ``targets`` (None: unknown)."""
+        return self.team_size if self.team_size is not None else self.targets or None
+
     def live(self) -> str | None:
         """``video``'s text when it names a live source (a camera index, a stream URL), else None."""
         from lookalike.io.sources import is_live

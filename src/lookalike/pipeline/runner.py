@@ -159,11 +159,10 @@ def _video(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, a
     video, det = request.video_path, request.detections or request.path
     assert video is not None and det is not None
     if params is None:
-        team_size = request.team_size if request.team_size is not None else request.targets or None
         return run_video(video, det, request.output, tracker, request.tracker, tell, annotate=annotate,
-                         team_size=team_size, health_window=request.health_window, min_score=request.min_score,
-                         fps=request.fps, features=request.features, det_format=request.det_format,
-                         annotate_as=request.annotate)
+                         team_size=request.health_team_size, health_window=request.health_window,
+                         min_score=request.min_score, fps=request.fps, features=request.features,
+                         det_format=request.det_format, annotate_as=request.annotate)
     from lookalike.pipeline.closed import offline_video
     from lookalike.viz.overlay import source_frames
 
@@ -187,8 +186,7 @@ def _detected(request: TrackRequest, tracker: Any, params: dict[str, Any] | None
 
     video, detector = request.video_path, request.detector or ""
     assert video is not None
-    team_size = request.team_size if request.team_size is not None else request.targets or None
-    options: dict[str, Any] = dict(annotate=annotate, annotate_as=request.annotate, team_size=team_size,
+    options: dict[str, Any] = dict(annotate=annotate, annotate_as=request.annotate, team_size=request.health_team_size,
                                    min_score=request.min_score, health_window=request.health_window, fps=request.fps,
                                    features=request.features, save_detections=request.save_detections,
                                    n_targets=request.targets, offline=params)

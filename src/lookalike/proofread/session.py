@@ -18,7 +18,7 @@ import numpy as np
 from lookalike.io.motchallenge import read_mot, write_mot
 from lookalike.io.outputs import write_atomic
 from lookalike.proofread.edits import Change, Correction, apply_edit, changes, check, colocated
-from lookalike.trackers.offline.closed_set import ClosedSetConfig, assign_identities, online_rows
+from lookalike.trackers.offline.closed_set import ClosedSetConfig, assign_identities, closed_set_input
 from lookalike.trackers.offline.confidence import DOUBTFUL_BELOW, assignment_confidence, doubtful_ranges
 from lookalike.trackers.offline.constraints import ChainConstraints, Row
 
@@ -85,8 +85,8 @@ class Session:
                 self._solver_rows = _rows_of(solver_input)
             elif detections is not None:
                 det = _rows_of(detections)
-                self._solver_rows = online_rows(det, self.frame_rate, int(det[:, 0].max()), n_init=1,
-                                                index=shapes is not None)
+                self._solver_rows = closed_set_input(det, self.frame_rate, int(det[:, 0].max()),
+                                                     index=shapes is not None)
             else:
                 self._solver_rows = self.initial.copy()
         if shapes is not None:

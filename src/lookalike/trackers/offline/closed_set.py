@@ -58,8 +58,8 @@ from lookalike.trackers.registry import make_tracker, tracker_class
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import tracks_to_rows
 
-__all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities", "link_costs", "motion_scale",
-           "place_short", "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
+__all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities", "closed_set_input", "link_costs",
+           "motion_scale", "place_short", "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
 
 
 def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
@@ -318,13 +318,22 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
     return np.array(out, dtype=float).reshape(-1, 10)
 
 
+def closed_set_input(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = None, *,
+                     online: dict[str, Any] | None = None, vel_noise: float | None = None,
+                     index: bool = False) -> np.ndarray:
+    """The rows :func:`assign_identities` starts from: an open-set online ``boxtrack`` pass over detection rows with
+    ``n_init=1`` (every detection enters some tracklet; the assignment decides what is clutter); ``online`` overrides
+    its parameters, ``vel_noise`` and ``index`` as in :func:`online_rows`."""
+    return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, index=index,
+                       **{"n_init": 1, **(online or {})})
+
+
 def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *, n_frames: int | None = None,
                      online: dict[str, Any] | None = None, config: ClosedSetConfig | None = None,
                      vel_noise: float | None = None, shapes: np.ndarray | None = None,
                      note: Callable[[str], None] | None = None) -> np.ndarray:
-    """Offline closed-set tracking of detection rows ``(k, >=7)``: an open-set online ``boxtrack`` pass
-    with ``n_init=1`` (every detection enters some tracklet; the assignment decides what is clutter;
-    ``online`` overrides its parameters; ``vel_noise`` as in :func:`online_rows`), then
+    """Offline closed-set tracking of detection rows ``(k, >=7)``: :func:`closed_set_input` (``online``,
+    ``vel_noise``), then
     :func:`assign_identities` (``shapes``: one blob shape vector per detection row, or None). Returns result rows
     ``(k, 10)`` with ids ``1..n_targets``. With ``shapes``, when more than
     :data:`~lookalike.trackers.offline.appearance.UNTRUSTED_SHARE` of the pass's blobs are not one animal's size, the
@@ -334,8 +343,8 @@ def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *,
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
     if shapes is not None and len(shapes) != len(det_rows):
         raise ValueError(f"shapes: expected one per detection row ({len(det_rows)}), got {len(shapes)}")
-    params = {"n_init": 1, **(online or {})}
-    rows = online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, index=shapes is not None, **params)
+    rows = closed_set_input(det_rows, frame_rate, n_frames, online=online, vel_noise=vel_noise,
+                            index=shapes is not None)
     share = 1.0 - float(single_rows(rows, shapes).mean()) if shapes is not None and len(rows) else 0.0
     if share > UNTRUSTED_SHARE:
         if note is not None:
