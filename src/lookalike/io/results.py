@@ -206,24 +206,5 @@ def validate(document: Mapping[str, Any]) -> None:
     jsonschema.validate(dict(document), schema())
 
 
-def load_results(path: Path) -> dict[str, Any]:
-    """A results document read from ``path``; ``ValueError`` naming the file when it is not one."""
-    try:
-        data = json.loads(Path(path).read_text())
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{path}: not JSON ({exc.msg}, line {exc.lineno})") from None
-    if not isinstance(data, dict) or data.get("schema") != SCHEMA_ID:
-        raise ValueError(f"{path}: not a lookalike results file (no \"schema\": \"{SCHEMA_ID}\")")
-    return data
-
-
-def rows(document: Mapping[str, Any], table: str | None = None) -> list[dict[str, Any]]:
-    """The rows of ``table`` (default: the first table) of a results document."""
-    tables = document["tables"]
-    if table is None:
-        return list(next(iter(tables.values()), []))
-    return list(tables.get(table, []))
-
-
 __all__ = ["FRACTIONS", "SCHEMA_ID", "SCHEMA_PATH", "Results", "add_printed_rows", "clean_metrics", "is_fraction",
-           "load_results", "lookalike_version", "metric_key", "percent_row_metrics", "rows", "schema", "validate"]
+           "lookalike_version", "metric_key", "percent_row_metrics", "schema", "validate"]
