@@ -190,8 +190,8 @@ def test_recovery_rows_give_the_recovery_where_the_reports_tell_the_pair_apart(m
         np.where(t >= 0, t, -1) for t in s.true_labels()])
     key, count = "Recovery, reports >= 0.2 rad apart, mean (s)", "Sequences with reports >= 0.2 rad apart"
     monkeypatch.setattr(experiments, "restore_gap", lambda q, *a: 1.0)
-    row = experiments.recovery_rows(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)[0]
+    row = experiments.recovery_runs(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)[0][0]
     assert row[count] == row["Sequences measured"] > 0 and row[key] == row["Recovery, mean (s)"]
     monkeypatch.setattr(experiments, "restore_gap", lambda q, *a: float("nan"))  # a pair member silent: not apart
-    row = experiments.recovery_rows(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)[0]
+    row = experiments.recovery_runs(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)[0][0]
     assert row[count] == 0 and np.isnan(row[key])

@@ -19,7 +19,6 @@ from lookalike.bench.runner import (
     Entry,
     default_entries,
     job_pairs,
-    map_jobs,
     run_jobs,
     score_rows,
     sequence_params,
@@ -27,6 +26,7 @@ from lookalike.bench.runner import (
 )
 from lookalike.cli import app
 from lookalike.io import MotTable
+from lookalike.parallel import JobPool
 from lookalike.trackers import make_tracker
 from lookalike.trackers.offline.gap_fill import OfflineConfig, postprocess
 from lookalike.types import Detections, Frame
@@ -109,6 +109,12 @@ def test_boxtrack_config_rejects_bad_values() -> None:
 
 def _square(x: int) -> int:
     return x * x
+
+
+def map_jobs(fn, items, *, workers=1, backend="local"):
+    """``[fn(x) for x in items]`` through a :class:`~lookalike.parallel.JobPool` of ``workers`` (in order)."""
+    with JobPool(min(workers, max(len(items), 1)), backend) as pool:
+        return pool.map(fn, items)
 
 
 def test_map_jobs_processes_equal_serial_in_order() -> None:

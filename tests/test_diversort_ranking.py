@@ -7,14 +7,14 @@ import dataclasses
 from lookalike.eval.api import combine, evaluate_sequence
 from lookalike.io.motchallenge import MotTable
 from lookalike.sim.divers import SCENARIOS
-from lookalike.sim.divers_run import fit_diver_features, prepare, run_tracker
+from lookalike.sim.divers_run import fit_diver_features, prepare_features, run_tracker
 
 
 def test_diversort_beats_deepsort_beats_sort_on_identical_detections() -> None:
     extractor = fit_diver_features(every=10)
     scores: dict[str, list[dict[str, float]]] = {"sort": [], "deepsort": [], "diversort": []}
     for sc in SCENARIOS[::2]:  # four scenarios, shortened
-        prepared = prepare(dataclasses.replace(sc, frames=150), extractor)
+        prepared = prepare_features(dataclasses.replace(sc, frames=150), {"": extractor})[""]
         gt = MotTable.from_rows(prepared.gt)
         for name, per_scenario in scores.items():
             rows, _ = run_tracker(name, prepared.frames)
@@ -26,7 +26,7 @@ def test_diversort_beats_deepsort_beats_sort_on_identical_detections() -> None:
 
 def test_merges_are_reported_with_source_and_target() -> None:
     extractor = fit_diver_features(every=10)
-    prepared = prepare(dataclasses.replace(SCENARIOS[3], frames=300), extractor)
+    prepared = prepare_features(dataclasses.replace(SCENARIOS[3], frames=300), {"": extractor})[""]
     rows, tracker = run_tracker("diversort", prepared.frames)
     assert tracker.merges, "this scenario has returning divers that should be merged back"
     reported = set(rows[:, 1].astype(int))

@@ -10,10 +10,15 @@ from lookalike.trackers.parts.health import (
     TOO_MANY,
     UNDERCOUNT,
     UNHEALTHY_FRAMES,
-    assess,
     health_row,
 )
 from lookalike.types import Detections, Frame
+
+
+def assess(frames: list[Frame], config: HealthConfig | None = None) -> list[HealthStatus]:
+    """:class:`HealthStatus` of each of ``frames`` (in order) from a fresh :class:`HealthMonitor`."""
+    monitor = HealthMonitor(config)
+    return [monitor.update(f) for f in frames]
 
 
 def _frame(index: int, n: int, score: float = 0.9, fps: float = 10.0, time: float | None = None) -> Frame:

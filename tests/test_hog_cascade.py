@@ -2,7 +2,12 @@ import numpy as np
 import pytest
 
 from lookalike.vision.hog_cascade import CascadeConfig, HogCascade, block_pool, nms, train_cascade, window_features
-from lookalike.vision.hog_features import augment_windows, integral_maps, orientation_maps, rect_sums
+from lookalike.vision.hog_features import augment_windows, integral_maps, orientation_maps
+
+
+def rect_sums(integral, x0, y0, x1, y1):
+    """Sums over rectangles ``[y0, y1) × [x0, x1)`` (px) of ``integral (c, h+1, w+1)``."""
+    return integral[:, y1, x1] - integral[:, y0, x1] - integral[:, y1, x0] + integral[:, y0, x0]
 
 
 def _window(rng, positive):

@@ -6,11 +6,12 @@ import pytest
 
 from lookalike.bench.pixels import perception_pipeline
 from lookalike.geometry.camera import Camera, Pose2D
-from lookalike.sim.render_robots import RobotRenderer, random_walk_poses
+from lookalike.sim.render_robots import RobotRenderer
 from lookalike.vision.detection_probability import DetectionProbability, fit_quantile_map
 from lookalike.vision.heading import HeadingClassifier
 from lookalike.vision.hog_cascade import HogCascade
 from lookalike.vision.pipeline import PipelineConfig, RobotPipeline, shipped_model_path
+from tests.test_render_robots import random_walk_poses
 
 
 def test_quantile_map_is_monotone_and_matches_the_target_distribution():

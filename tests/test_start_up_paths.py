@@ -7,7 +7,13 @@ import pytest
 
 from lookalike.io import MotWriter
 from lookalike.io.motchallenge import format_rows
-from lookalike.types.mot_table import format_row
+
+
+def format_row(row: np.ndarray) -> str:
+    """One result row as a line of a MOTChallenge file (boxes to 1/1000 px), newline included: the plain
+    formatting :func:`format_rows` must equal."""
+    return (f"{int(row[0])},{int(row[1])},{row[2]:.3f},{row[3]:.3f},{row[4]:.3f},"
+            f"{row[5]:.3f},{row[6]:g},{row[7]:g},{row[8]:g},{row[9]:g}\n")
 
 
 def test_lsap_is_scipys_function_with_the_same_results():

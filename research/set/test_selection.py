@@ -83,13 +83,13 @@ def test_stage2_candidates_are_step_multiples_and_their_late_mean(tmp_path):
 def test_tuning_recovery_is_bench_recoverys_measure():
     from set_select import set_recovery_s
 
-    from lookalike.bench.experiments import recovery_rows
+    from lookalike.bench.experiments import recovery_runs
     from lookalike.learn.set_tracker import SHIPPED_SET_WEIGHTS
     from lookalike.sim import preset, simulate_robots
 
     seq = simulate_robots(preset("m3n2"), 300, 55_001)
     mine = set_recovery_s(SHIPPED_SET_WEIGHTS, seq, swap_at_s=2.0, swap_s=3.0)
-    row = recovery_rows(["m3n2"], ["set"], 1, 300, 2.0, 3.0, seed=55_001)[0]
+    row = recovery_runs(["m3n2"], ["set"], 1, 300, 2.0, 3.0, seed=55_001)[0][0]
     assert round(mine, 2) == row["Recovery, mean (s)"]
 
 

@@ -184,20 +184,13 @@ def _seen_mean(rates: np.ndarray) -> float:
     return float(seen.mean()) if seen.size else float("nan")
 
 
-def recovery_rows(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,
-                  swap_s: float, seed: int = DEFAULT_SEED,
-                  progress: ProgressFactory = no_progress) -> list[dict[str, Any]]:
-    """Per set-up and identifier: success on the swapped pair while swapped (and without the swap), the mean and
-    worst recovery time (s) over the :func:`measurable` sequences, and their count."""
-    return recovery_runs(setups, trackers, sequences, frames, swap_at_s, swap_s, seed, progress)[0]
-
-
 def recovery_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, frames: int, swap_at_s: float,
                   swap_s: float, seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress,
                   options: Mapping[str, Mapping[str, Any]] | None = None
                   ) -> tuple[list[dict[str, Any]], dict[tuple[str, str], list[float]]]:
-    """:func:`recovery_rows`'s rows and per (set-up, identifier) each sequence's recovery seconds (inf: never);
-    ``options``: identifier -> its parameters."""
+    """Rows per set-up and identifier: success on the swapped pair while swapped (and without the swap), the mean
+    and worst recovery time (s) over the :func:`measurable` sequences, and their count; and per (set-up, identifier)
+    each sequence's recovery seconds (inf: never). ``options``: identifier -> its parameters."""
     rows, runs = swap_runs(setups, trackers, sequences, frames, swap_at_s, swap_s, seed, progress, options)
     recovery = SwapRun._fields.index("recovery_s")
     return rows, {key: [float(v) for v in run[:, recovery]] for key, run in runs.items()}
@@ -207,7 +200,7 @@ def swap_runs(setups: Sequence[str], trackers: Sequence[str], sequences: int, fr
               swap_s: float, seed: int = DEFAULT_SEED, progress: ProgressFactory = no_progress,
               options: Mapping[str, Mapping[str, Any]] | None = None
               ) -> tuple[list[dict[str, Any]], dict[tuple[str, str], np.ndarray]]:
-    """:func:`recovery_rows`'s rows and per (set-up, identifier) an array of :class:`SwapRun` (sequences x fields)."""
+    """:func:`recovery_runs`' rows and per (set-up, identifier) an array of :class:`SwapRun` (sequences x fields)."""
     rows = []
     runs_of: dict[tuple[str, str], np.ndarray] = {}
     for setup in setups:
@@ -278,7 +271,7 @@ EXPERIMENT_KEYS = {"In order (%)": "success_rate_in_order", "Random order (%)": 
 def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[str], sequences: int, frames: int,
                        seed: int = DEFAULT_SEED, command: str = "", options: dict[str, Any] | None = None,
                        differences: Sequence[Comparison] = ()) -> Results:
-    """Rows of :func:`shuffle_rows` or :func:`recovery_rows` as a results document (table ``kind``; success rates as
+    """Rows of :func:`shuffle_rows` or :func:`recovery_runs` as a results document (table ``kind``; success rates as
     fractions, seconds, ``null`` when never); ``differences`` go in table ``<kind>_difference`` (seconds)."""
     doc, names = setup_results(f"bench {kind}", setups, sequences, frames, seed, command, options)
     add_printed_rows(doc, kind, rows, datasets=names, rename=EXPERIMENT_KEYS)
@@ -288,5 +281,5 @@ def experiment_results(kind: str, rows: list[dict[str, Any]], setups: Sequence[s
 
 __all__ = ["AFTER_S", "APART_RAD", "DEFAULT_SEED", "EXPERIMENT_KEYS", "SwapRun", "experiment_results", "hit_rate",
            "longest_recovery_s", "measured_sequences", "most_seen_pair", "pair_hits", "recovery_differences",
-           "recovery_rows", "recovery_runs", "recovery_s", "reindex", "restore_gap", "shuffle_rows", "swap_frames",
+           "recovery_runs", "recovery_s", "reindex", "restore_gap", "shuffle_rows", "swap_frames",
            "swap_recovery", "swap_reports", "swap_runs", "swapped_pair"]

@@ -5,7 +5,7 @@ scored data; on blob detections ``boxtrack`` runs as ``lookalike track --detecto
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -158,13 +158,6 @@ def _run_pair(entry: Entry, seq: RealSequence) -> dict[str, Any]:
     return run_job((entry, seq))
 
 
-def map_jobs(fn: Callable[[Any], Any], items: Sequence[Any], *, workers: int = 1,
-             backend: str = "local", address: str | None = None) -> list[Any]:
-    """``[fn(x) for x in items]`` serially, in ``workers`` processes, or as Ray tasks (in order)."""
-    with JobPool(min(workers, max(len(items), 1)), backend, address) as pool:
-        return pool.map(fn, items)
-
-
 def job_pairs(entries: Sequence[Entry], sequences: Sequence[RealSequence]) -> list[tuple[Entry, RealSequence]]:
     """``(entry, sequence)`` per sequence and entry that can run there (a known count, chosen parameters)."""
     return [(e, s) for s in sequences for e in entries
@@ -185,5 +178,5 @@ def run_jobs(entries: Sequence[Entry], sequences: Sequence[RealSequence], *, wor
 __all__ = ["BLOB_DATASETS", "HEXBUG_RADIUS_PX", "SEQUENCE_PARAMS", "TUNED_LABEL", "TUNED_PARAMS",
            "Entry", "base_name", "blob_tracker_config",
            "default_entries", "detection_rows", "entry_params", "params_entry", "job_pairs",
-           "map_jobs", "run_job", "run_jobs", "score_rows",
+           "run_job", "run_jobs", "score_rows",
            "sequence_params", "track_rows"]

@@ -145,7 +145,8 @@ def write_mot(path: str | os.PathLike[str], rows: Iterable[np.ndarray] | np.ndar
 
 
 def format_rows(rows: np.ndarray) -> str:
-    """Result rows ``(k, >= 10)`` as MOTChallenge lines (:func:`~lookalike.types.mot_table.format_row`'s text)."""
+    """Result rows ``(k, >= 10)`` as MOTChallenge lines: frame and id as integers, boxes to 1/1000 px, the other
+    four columns as ``%g``, each line ending in a newline."""
     data = np.asarray(rows, dtype=float)
     if data.ndim != 2 or data.shape[1] < ROW_WIDTH:
         raise ValueError(f"result rows need shape (k, {ROW_WIDTH}) or wider, got {data.shape}")

@@ -142,15 +142,10 @@ def _distances_of(extractor: FeatureExtractor) -> np.ndarray:
     return _DISTANCES[key]
 
 
-def prepare(sc: DiverScenario, extractor: FeatureExtractor, detector: DetectorModel | None = None,
-            detector_seed: int | None = None) -> PreparedScenario:
-    """Simulate, render, detect (``detector``: the scenario's own) and extract the detections' features."""
-    return prepare_features(sc, {"": extractor}, detector, detector_seed)[""]
-
-
 def prepare_features(sc: DiverScenario, extractors: dict[str, FeatureExtractor], detector: DetectorModel | None = None,
                      detector_seed: int | None = None) -> dict[str, PreparedScenario]:
-    """:func:`prepare` for several feature sets at once (each frame rendered once): name -> scenario."""
+    """Simulate, render, detect (``detector``: the scenario's own) and extract the detections' features with each of
+    ``extractors`` (each frame rendered once): name -> scenario."""
     scene = simulate_divers(sc)
     frames: dict[str, list[Frame]] = {name: [] for name in extractors}
     for frame in scene.frames(detector, detector_seed):

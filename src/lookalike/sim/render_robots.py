@@ -8,7 +8,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lookalike._optional import needs
-from lookalike.geometry.angles import wrap_angle
 from lookalike.geometry.camera import Camera, Pose2D
 
 BGR = tuple[int, int, int]
@@ -219,29 +218,3 @@ class RobotRenderer:
         out = out * self._gain[None, None, :].astype(np.float32)
         out += rng.normal(0.0, cfg.noise_std, out.shape).astype(np.float32)
         return np.clip(out, 0, 255).astype(np.uint8)
-
-
-def random_walk_poses(
-    n_frames: int, n_robots: int, seed: int, field_m: tuple[float, float] = (9.0, 6.0), dt_s: float = 0.1
-) -> tuple[np.ndarray, np.ndarray]:
-    """Bounded random motion on the field: fixed-frame positions ``(T, N, 2)`` (m) and headings ``(T, N)`` (rad)."""
-    if n_frames < 1 or n_robots < 0:
-        raise ValueError(f"n_frames/n_robots: need n_frames >= 1 and n_robots >= 0, got {n_frames}, {n_robots}")
-    rng = np.random.default_rng(seed)
-    half = 0.5 * np.array(field_m) - 0.3
-    pos = rng.uniform(-half, half, (n_robots, 2))
-    head = rng.uniform(-np.pi, np.pi, n_robots)
-    vel = np.zeros((n_robots, 2))
-    omega = np.zeros(n_robots)
-    out_p = np.empty((n_frames, n_robots, 2))
-    out_h = np.empty((n_frames, n_robots))
-    for t in range(n_frames):
-        out_p[t], out_h[t] = pos, head
-        vel = np.clip(vel + rng.normal(0.0, 0.6, vel.shape) * dt_s, -0.4, 0.4)
-        omega = np.clip(omega + rng.normal(0.0, 3.0, n_robots) * dt_s, -1.5, 1.5)
-        pos = pos + vel * dt_s
-        bounce = np.abs(pos) > half
-        vel[bounce] *= -1.0
-        pos = np.clip(pos, -half, half)
-        head = np.asarray(wrap_angle(head + omega * dt_s))
-    return out_p, out_h

@@ -75,16 +75,10 @@ def detection_rows(frame: int | np.ndarray, xywh: np.ndarray, score: np.ndarray 
     return rows
 
 
-def format_row(row: np.ndarray) -> str:
-    """One result row as a line of a MOTChallenge file (boxes to 1/1000 px), newline included."""
-    return (f"{int(row[0])},{int(row[1])},{row[2]:.3f},{row[3]:.3f},{row[4]:.3f},"
-            f"{row[5]:.3f},{row[6]:g},{row[7]:g},{row[8]:g},{row[9]:g}\n")
-
-
 def stack_rows(chunks: Iterable[np.ndarray]) -> np.ndarray:
     """Row blocks ``(k_i, 10)`` stacked into ``(sum k_i, 10)`` (``(0, 10)`` when there are none)."""
     parts = [np.asarray(c, dtype=float).reshape(-1, ROW_WIDTH) for c in chunks]
     return np.vstack(parts) if parts else np.zeros((0, ROW_WIDTH))
 
 
-__all__ = ["ROW_WIDTH", "MotTable", "detection_rows", "format_row", "stack_rows", "table_from_array", "tracks_to_rows"]
+__all__ = ["ROW_WIDTH", "MotTable", "detection_rows", "stack_rows", "table_from_array", "tracks_to_rows"]

@@ -184,11 +184,6 @@ def integral_maps(maps: np.ndarray) -> np.ndarray:
     return out
 
 
-def rect_sums(integral: np.ndarray, x0: np.ndarray, y0: np.ndarray, x1: np.ndarray, y1: np.ndarray) -> np.ndarray:
-    """Sums ``(c,) + broadcast shape`` over rectangles ``[y0, y1) × [x0, x1)`` (px) of ``integral (c, h+1, w+1)``."""
-    return integral[:, y1, x1] - integral[:, y0, x1] - integral[:, y1, x0] + integral[:, y0, x0]
-
-
 def block_descriptor(cell_sums: np.ndarray, eps: float = 1e-3) -> np.ndarray:
     """L2-normalised block descriptors ``(4 * bins, ...)`` of 2×2 cell sums ``(4, bins, ...)``; ``eps`` keeps flat
     regions near zero."""

@@ -173,12 +173,6 @@ class HealthMonitor:
         return found
 
 
-def assess(frames: list[Frame], config: HealthConfig | None = None) -> list[HealthStatus]:
-    """:class:`HealthStatus` of each of ``frames`` (in order) from a fresh :class:`HealthMonitor`."""
-    monitor = HealthMonitor(config)
-    return [monitor.update(f) for f in frames]
-
-
 HEALTH_CSV_HEADER = ("frame", "n_detections", "mean_score", "dropped", "frame_healthy", "window_healthy",
                      "flags", "window_flags", "reasons")
 
