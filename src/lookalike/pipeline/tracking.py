@@ -1,13 +1,15 @@
 """The tracking pass over a video's frames: detections from a table or a detector run on each frame, appearance
 features for trackers that read them, the detector-health monitor and an optional annotated video, the frames
 decoded once. Features standardised on the video itself (:class:`VideoFeatures`) are fitted from the raw features
-of that same pass; the tracker then runs on the stored raw features (a second decode only to draw)."""
+of that same pass; the tracker then runs on those raw features, kept in a temporary file meanwhile (a second decode
+only to draw)."""
 
 from __future__ import annotations
 
 import itertools
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -18,6 +20,7 @@ from lookalike.association.solver import assign
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.io import MotTable, frames_from_table, read_seqinfo, tracks_to_rows
 from lookalike.loop import run
+from lookalike.pipeline.spill import FrameSpill
 from lookalike.trackers.parts.health import HealthConfig, HealthMonitor, HealthStatus
 from lookalike.types import Detections, Frame, TrackSnapshot, TrackStatus
 from lookalike.vision.appearance import RAW_DIM, HandcraftedFeatures, crop_boxes, fit_stats, raw_features
@@ -48,16 +51,18 @@ class VideoFeatures:
     """Hand-crafted features standardised on the tracked video's own detections (``--features video``): up to
     ``max_crops`` boxes (every frame, or every other block of 10 frames, ...) chained frame to frame by IoU >=
     ``link_iou`` serve as identity labels for :func:`~lookalike.vision.appearance.fit_stats`; crops ``crop_px``
-    px. Given to :func:`track_video` as the extractor, fitted in its pass (about 0.45 kB kept per detection)."""
+    px. Given to :func:`track_video` as the extractor, fitted in its pass (the raw features, about 0.45 kB per
+    detection, kept in a temporary file rather than in memory)."""
 
     max_crops: int = 3000
     crop_px: int = 32
     link_iou: float = 0.6
 
-    def fit(self, frames: Sequence[tuple[np.ndarray, np.ndarray | None]], boxes_total: int,
+    def fit(self, frames: Iterable[tuple[np.ndarray, np.ndarray | None]], boxes_total: int,
             source: Path | str) -> HandcraftedFeatures:
         """The features fitted on ``frames`` (per frame: its kept boxes ``(n, 4)`` px and their raw features, None
-        where not sampled) of ``source``, whose detections hold ``boxes_total`` kept boxes."""
+        where not sampled; read once, in order) of ``source``, whose detections hold ``boxes_total`` kept boxes.
+        Only the sampled frames' features are kept (:meth:`blocks`)."""
         if self.max_crops < 2:
             raise ValueError(f"max_crops: must be >= 2, got {self.max_crops}")
         if boxes_total < 2:
@@ -105,12 +110,14 @@ def fit_video_features(source: Path | str, detections: MotTable, *, min_score: f
     keep = detections.conf >= min_score
     frames, xywh = detections.frame[keep].astype(int), detections.xywh[keep]
     blocks = spec.blocks(len(frames))
-    stored: list[tuple[np.ndarray, np.ndarray | None]] = []
-    for k, image in enumerate(source_frames(source)[0] if len(frames) >= 2 else []):
-        boxes = xywh[frames == k + 1]
-        sampled = not (k // 10) % blocks and len(boxes)
-        stored.append((boxes, raw_features(crop_boxes(image, boxes, crop_px)) if sampled else None))
-    return spec.fit(stored, len(frames), source)
+
+    def read() -> Iterator[tuple[np.ndarray, np.ndarray | None]]:
+        for k, image in enumerate(source_frames(source)[0] if len(frames) >= 2 else []):
+            boxes = xywh[frames == k + 1]
+            sampled = not (k // 10) % blocks and len(boxes)
+            yield boxes, raw_features(crop_boxes(image, boxes, crop_px)) if sampled else None
+
+    return spec.fit(read(), len(frames), source)
 
 
 def source_frame_rate(source: Path | str) -> float | None:
@@ -174,8 +181,8 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
     def frames() -> Iterator[Frame]:
         fitted = isinstance(extractor, VideoFeatures)
         counted = None if detect is not None else int((detections.conf >= min_score).sum())
-        stream = _fitted_in_pass(extractor, detected(), source, counted, current, advance,
-                                 annotate) if fitted else detected()
+        stream = _fitted_in_pass(extractor, detected(), opened.enter_context(FrameSpill()), source, counted,
+                                 current, advance, annotate) if fitted else detected()
         for k, (image, det) in enumerate(stream):
             t0 = time.perf_counter()
             feats = None if extractor is None else current["extractor"].normalise(det.feature) if fitted else (
@@ -203,11 +210,10 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
         if advance is not None and not isinstance(extractor, VideoFeatures):
             advance()
 
-    try:
-        stats = run(tracker, frames(), sink)
-    finally:
+    with ExitStack() as opened:  # the MP4 finalised and the temporary file removed, also on an error or Ctrl-C
         if writer is not None:
-            writer.close()
+            opened.enter_context(writer)
+        stats = run(tracker, frames(), sink)
     count, tracker_s, feature_s = stats.frames, stats.seconds, float(current["feature_s"])
     if count == 0:
         raise ValueError(f"video: {source} has no frames")
@@ -218,26 +224,26 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
 
 
 def _fitted_in_pass(spec: VideoFeatures, detected: Iterable[tuple[np.ndarray | None, Detections]],
-                    source: Path | str, counted: int | None, current: dict[str, Any],
+                    spill: FrameSpill, source: Path | str, counted: int | None, current: dict[str, Any],
                     advance: Callable[[], None] | None,
                     annotate: Path | str | None) -> Iterator[tuple[np.ndarray | None, Detections]]:
     """The frames and detections of ``detected`` (their raw features as ``feature``) once every frame is read and
     ``spec`` fitted on them (``current["extractor"]``; ``counted``: the kept boxes of the whole detection table, None:
-    those detected); the frames decoded again only to ``annotate``."""
-    stored: list[tuple[np.ndarray, Detections, np.ndarray]] = []
+    those detected); the frames decoded again only to ``annotate``. Every frame's detections (boxes, scores, ...)
+    and raw features wait in ``spill``, on disk: memory holds one frame, and the fit's sample."""
     for image, det in detected:
         assert image is not None and det.xywh is not None  # (frames decoded for the features)
         t0 = time.perf_counter()
         raw = raw_features(crop_boxes(image, det.xywh, spec.crop_px)) if len(det) else np.zeros((0, RAW_DIM))
-        stored.append((det.xywh, det, raw))
+        spill.append(det, raw)
         current["feature_s"] += time.perf_counter() - t0
         if advance is not None:
             advance()
-    total = sum(len(det) for _, det, _ in stored) if counted is None else counted
-    current["extractor"] = spec.fit([(xywh, raw) for xywh, _, raw in stored], total, source)
+    total = spill.boxes if counted is None else counted
+    current["extractor"] = spec.fit(((det.xywh, det.feature) for det in spill.read()), total, source)
     images = source_frames(source)[0] if annotate is not None else itertools.repeat(None)
-    for (_, det, raw), image in zip(stored, images):
-        yield image, det.replace(feature=raw)
+    for det, image in zip(spill.read(), images):
+        yield image, det
 
 
 def _uncertain(tracker: Any, t: TrackSnapshot, first_seen: dict[int, int], k: int, new_frames: int) -> bool:
