@@ -206,7 +206,7 @@ def test_correct_equals_the_update_columns() -> None:
     z = np.vstack([det[:, 0:2].T + det[:, 2:4].T / 2.0, det[:, 2:4].T])[:, det_of_track[matched]]
     sub = want[:, matched]
     innovation, s = space.innovation_columns(sub, z)
-    space.update_columns(sub, z)
+    space.correct_columns(sub, innovation, s)
     want[:, matched] = sub
     got, m2, u2, h2, c2 = x.copy(), misses.copy(), unseen.copy(), hits.copy(), confirmed.copy()
     fit, back = np.empty((4, k)), np.empty(k, dtype=np.int64)

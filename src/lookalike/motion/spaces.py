@@ -137,20 +137,6 @@ class BoxCXCYWH:
     # diagonals of the covariance, p11 (8-11), p12 (12-15), p21 (16-19), p22 (20-23); the numbers are
     # those of the full-covariance methods above, bit for bit.
 
-    @staticmethod
-    def to_columns(mean: np.ndarray, cov: np.ndarray) -> np.ndarray:
-        """The column table ``(24, k)`` of states ``mean (k, 8)`` and full covariances ``cov (k, 8, 8)``."""
-        p11, p12, p21, p22 = _blocks(np.ascontiguousarray(cov))
-        return np.concatenate((mean.T, p11.T, p12.T, p21.T, p22.T))
-
-    @staticmethod
-    def from_columns(columns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """States ``(k, 8)`` and full covariances ``(k, 8, 8)`` of a column table ``(24, k)``."""
-        cov = np.zeros((columns.shape[1], 8, 8))
-        for b, view in enumerate(_blocks(cov)):
-            view[...] = columns[8 + 4 * b: 12 + 4 * b].T
-        return columns[:8].T.copy(), cov
-
     def initial_rows(self, z: np.ndarray) -> np.ndarray:
         """New tracks at measurements ``z (n, 4)`` as rows ``(n, 24)`` of the column table (its transpose)."""
         n = len(z)
@@ -210,10 +196,6 @@ class BoxCXCYWH:
         x[0:8] += (gain * innovation).reshape(8, m)
         blocks = x[8:24].reshape(2, 2, 4, m)  # [[p11, p12], [p21, p22]]
         blocks -= gain[:, None] * blocks[None, :, 0]  # - gain ⊗ [p11, p21]
-
-    def update_columns(self, columns: np.ndarray, z: np.ndarray) -> None:
-        """:meth:`update` on ``columns (24, m)`` with measurement columns ``z (4, m)``, in place."""
-        self.correct_columns(columns, *self.innovation_columns(columns, z))
 
 
 @dataclass(frozen=True)
