@@ -14,6 +14,7 @@ import time
 from collections.abc import Callable, Hashable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import TypeVar
 
 from lookalike.node.counters import NodeCounters, log_event
 from lookalike.node.identifier import IdentifierConfig, TeamIdentifier
@@ -123,6 +124,9 @@ class NodeConfig:
             check_group(self.group)
 
 
+_Node = TypeVar("_Node", bound="NodeCore")
+
+
 class NodeCore(abc.ABC):
     """What every transport of the node shares: the identifier, counters, rate limits, camera timer and status log.
     A transport reads messages, calls :meth:`accept` and :meth:`handle_message`, and implements ``poll`` and
@@ -157,7 +161,7 @@ class NodeCore(abc.ABC):
     def poll(self, timeout_s: float) -> int:
         """Wait up to ``timeout_s`` for messages, handle them; return how many."""
 
-    def __enter__(self) -> NodeCore:  # noqa: PYI034
+    def __enter__(self: _Node) -> _Node:
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -291,12 +295,6 @@ class NodeServer(NodeCore):
     def address(self) -> Address:
         """The bound ``(host, port)``."""
         return self.sock.getsockname()
-
-    def __enter__(self) -> NodeServer:  # noqa: PYI034
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
     def close(self) -> None:
         """Log the final counters and close the socket."""
