@@ -65,6 +65,7 @@ class Case:
     score: Callable[[np.ndarray], float]
     radius: float = RADIUS_PX  # points: a row's box centre matches within this (px)
     shapes: np.ndarray | None = None  # blob shape vectors that column 9 of solver_input indexes (the learned look)
+    parts: np.ndarray | None = None  # the blobs' parts vectors, indexed as shapes
 
 
 def judge(rows: np.ndarray, case: Case) -> tuple[np.ndarray, np.ndarray, dict[int, int]]:
@@ -150,7 +151,8 @@ def _key(c: Correction) -> object:
 def proofread(case: Case, propagate: bool, max_corrections: int = STEPS[-1]) -> list[float]:
     """IDF1 (%) after 0..``max_corrections`` corrections (the last value repeated once nothing is left to correct)."""
     s = Session(case.rows, frame_rate=case.frame_rate, n_targets=case.n_targets if propagate else None,
-                solver_input=case.solver_input if propagate else None, shapes=case.shapes if propagate else None)
+                solver_input=case.solver_input if propagate else None, shapes=case.shapes if propagate else None,
+                parts=case.parts if propagate else None)
     curve = [100 * case.score(s.rows)]
     tried: set[object] = set()
     looked: set[tuple[int, int, int]] = set()
@@ -225,10 +227,10 @@ def hexbug_cases(root: Path) -> list[Case]:
         n = len(np.unique(ids))
         found = cached_blob_detections(video, auto_blob_config(video, [])[0])  # (detect_hexbug's, from the cache)
         on = online_rows(found.rows, seq.frame_rate, seq.length, n_init=1, index=True)
-        rows = assign_identities(on, n, seq.frame_rate, shapes=found.shapes)
+        rows = assign_identities(on, n, seq.frame_rate, shapes=found.shapes, parts=found.parts)
         out.append(Case(f"hexbug {seq.name}", rows, on, n, seq.frame_rate, frame, ids, xy,
                         lambda r, seq=seq: float(score_rows(seq, r)["IDF1"]), HEXBUG_RADIUS_PX,  # type: ignore[misc]
-                        found.shapes))
+                        found.shapes, found.parts))
     return out
 
 

@@ -27,8 +27,8 @@ def test_tracks_of_the_blob_command_re_solve_with_the_look_and_edited_ones_do_no
     assert r.exit_code == 0, r.output
     found = blob_solver_input(video, tracks, 3, cfg.frame_rate_hz)
     assert found is not None
-    solver, shapes = found
-    assert solver.shape[1] == 10 and solver[:, 9].max() < len(shapes)
+    solver, shapes, parts = found
+    assert solver.shape[1] == 10 and solver[:, 9].max() < len(shapes) == len(parts)
     t = read_mot(tracks)
     edited = np.column_stack([t.frame, t.track_id, t.xywh, t.conf, np.full((len(t), 3), -1.0)])
     late = edited[:, 0] > 30

@@ -1,6 +1,7 @@
 """Development runs of research/appearance/rule5.md (arena seeds 0-9, the 14 HexBug clips): round 4's default
-against the merged blobs' identities placed on their pixel split's centroids (variants A and B, repair A2). Not a scoring run.
-Usage: dev5.py [arenas] [hexbug]"""
+against the merged blobs' identities placed on their pixel split's centroids (variants A and B, repair A2; "shipped":
+the package's own). Not a scoring run.
+Usage: dev5.py [arenas,hexbug] [MODE,MODE...]"""
 import math
 import sys
 import tempfile
@@ -28,9 +29,19 @@ _collected: list[np.ndarray] = []
 _plain_shapes = blob_shape.blob_shapes
 
 
+_areas: list[float] = []
+GATE = 1.4  # parts only for blobs this many times the median area of the last 512 blobs (the current frame's too)
+
+
 def _shapes_and_parts(labels, stats, keep, difference, image):
+    _areas.extend(float(stats[k, 4]) for k in keep)
+    del _areas[:-512]
+    reference = float(np.median(_areas))
     for k in keep:
         x, y, w, h = (int(v) for v in stats[k, :4])
+        if stats[k, 4] < GATE * reference:
+            _collected.append(np.full(blob_shape.PART_SIZE, np.nan))
+            continue
         ys, xs = np.nonzero(labels[y:y + h, x:x + w] == k)
         _collected.append(blob_shape.blob_parts(xs + x, ys + y))
     return _plain_shapes(labels, stats, keep, difference, image)
@@ -39,6 +50,7 @@ def _shapes_and_parts(labels, stats, keep, difference, image):
 def detections_with_parts(video):
     config, _ = auto_blob_config(video, [], N[0])
     _collected.clear()
+    _areas.clear()
     blob_shape.blob_shapes = _shapes_and_parts
     try:
         found = blob_detections(video, config)
@@ -53,7 +65,7 @@ def placer(parts, mode, areas=None):
     if mode == "A2":
         return frame_placer(parts, areas)
 
-    def place(rows, measured, merged):
+    def place(rows, measured, merged, *_):
         before = np.array(rows, dtype=float)
         out = place_in_merges(rows, measured, merged)
         loose = np.flatnonzero(~measured)
@@ -91,7 +103,7 @@ def frame_placer(parts, areas):
     none); an identity farther than one blob size outside a blob's box cannot take its parts."""
     single = float(np.median(areas))
 
-    def place(rows, measured, merged):
+    def place(rows, measured, merged, *_):
         before = np.array(rows, dtype=float)
         out = place_in_merges(rows, measured, merged)
         loose = np.flatnonzero(~measured)
@@ -109,11 +121,15 @@ def frame_placer(parts, areas):
                 x0, y0, w, h = row[2:6]
                 count = int(np.clip(round(areas[int(row[9])] / single), 2, 3))
                 part = parts[int(row[9])]
+                if np.isnan(part).any():
+                    continue
                 cent = part[:4].reshape(2, 2) if count == 2 else part[4:].reshape(3, 2)
                 reach = math.sqrt(w * h)
                 ok = np.all(np.abs(c - np.array([x0 + w / 2, y0 + h / 2])) <= np.array([w, h]) / 2 + reach, axis=1)
                 slots.extend(cent)
                 allowed.extend([ok] * count)
+            if not slots:
+                continue
             slots_a, allowed_a = np.array(slots), np.array(allowed).T
             prev = c.copy()
             for i, k in enumerate(ks):
@@ -134,7 +150,7 @@ def frame_placer(parts, areas):
 
 
 N = [0]
-MODES = ("round4", "A", "B", "A2")
+MODES = tuple(sys.argv[2].split(",")) if len(sys.argv) > 2 else ("round4", "A", "B", "A2")
 
 
 def run(video, n):
@@ -143,11 +159,12 @@ def run(video, n):
     fps = source_frames(video)[2] or 25.0
     out = []
     areas = np.exp(found.shapes[:, 0])
-    for mode in MODES:
-        closed_set.place_in_merges = place_in_merges if mode == "round4" else placer(parts, mode, areas)
+    for mode in MODES:  # "shipped": the package's own (found.parts from its detector)
+        closed_set.place_in_merges = place_in_merges if mode in ("round4", "shipped") else placer(parts, mode, areas)
         try:
             out.append(closed_set.track_closed_set(found.rows, n, fps, n_frames=found.frames,
-                                                   online=dict(BOX_TRACKER_PARAMS), shapes=found.shapes))
+                                                   online=dict(BOX_TRACKER_PARAMS), shapes=found.shapes,
+                                                   parts=found.parts if mode == "shipped" else None))
         finally:
             closed_set.place_in_merges = place_in_merges
     return out
@@ -192,7 +209,7 @@ def summary(name, t):
 
 
 if __name__ == "__main__":
-    which = sys.argv[1:] or ["arenas", "hexbug"]
+    which = sys.argv[1].split(",") if len(sys.argv) > 1 else ["arenas", "hexbug"]
     if "arenas" in which:
         summary("arenas 0-9", arenas(range(10)))
     if "hexbug" in which:

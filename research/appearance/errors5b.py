@@ -2,10 +2,10 @@
 a detection (measured), an identity placed in a merged blob, or another interpolated row -- and how far it is."""
 import sys
 
+import dev5
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-import dev5
 from lookalike.io.arena_files import write_arena
 from lookalike.trackers.offline import closed_set
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS

@@ -66,7 +66,8 @@ def proofread(
             console.print("corrections re-solve from the video's cached blobs, with each animal's look", markup=False)
     with failing(ValueError):
         session = Session(tracks, frame_rate=frame_rate or fps, n_targets=targets, detections=detections,
-                          solver_input=solver[0] if solver else None, shapes=solver[1] if solver else None)
+                          solver_input=solver[0] if solver else None, shapes=solver[1] if solver else None,
+                          parts=solver[2] if solver else None)
     if fresh and log.exists():
         os.replace(log, log.with_name(log.name + ".bak"))
     elif log.exists():

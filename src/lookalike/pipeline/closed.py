@@ -49,14 +49,16 @@ def table_rows(path: Path, min_score: float = float("-inf"), length: int | None 
 
 def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
                     params: dict[str, Any], vel_noise: float | None = None,
-                    shapes: np.ndarray | None = None, note: Note = _silent) -> np.ndarray:
+                    shapes: np.ndarray | None = None, parts: np.ndarray | None = None,
+                    note: Note = _silent) -> np.ndarray:
     """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online ``boxtrack``
     pass's parameters (``max_targets`` dropped); ``vel_noise``: its velocity noise when not boxtrack's own;
-    ``shapes``: each detection's blob shape vector (the look learned from them weighs in). Too few detections for
+    ``shapes``, ``parts``: each detection's blob shape and parts vectors (the look learned from them weighs in; merged
+    blobs' animals go on their parts). Too few detections for
     the offline assignment get the online closed set's result instead, said to ``note``."""
     online = {k: v for k, v in params.items() if k != "max_targets"}
     rows = track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise,
-                            shapes=shapes, note=note)
+                            shapes=shapes, parts=parts, note=note)
     if len(rows) or not len(det_rows):
         return rows
     frames = len(np.unique(det_rows[:, 0]))
@@ -90,28 +92,31 @@ def offline_sequences(path: Path, output: Path, n_targets: int, params: dict[str
 
 def offline_rows(det: Path | np.ndarray, n_targets: int, params: dict[str, Any], frame_rate: float,
                  n_frames: int | None, min_score: float, det_format: str = "auto", shapes: np.ndarray | None = None,
-                 *, note: Note = _silent, file_note: Note = _silent,
+                 parts: np.ndarray | None = None, *, note: Note = _silent, file_note: Note = _silent,
                  status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()) -> np.ndarray:
     """The offline closed set of ``n_targets`` over a video's detections ``det`` (a detection file, or rows a
-    detector found, with ``shapes``: each row's blob shape vector, used when there is one a row kept), those below
+    detector found, with ``shapes`` and ``parts``: each row's blob shape and parts vectors, used when there is one a
+    row kept), those below
     ``min_score`` dropped; ``frame_rate`` in frames/s. ``note`` and ``file_note`` as for :func:`offline_sequences`."""
     rows = table_rows(det, min_score, det_format=det_format, note=file_note) if isinstance(det, Path) else \
         det[det[:, 6] >= min_score]
     shapes = shapes if shapes is not None and len(shapes) == len(rows) else None
+    parts = parts if shapes is not None and parts is not None and len(parts) == len(rows) else None
     with status(f"closed set of {n_targets}" + (", learning each one's look" if shapes is not None else "")):
-        return closed_set_rows(rows, n_targets, frame_rate, n_frames, params, shapes=shapes, note=note)
+        return closed_set_rows(rows, n_targets, frame_rate, n_frames, params, shapes=shapes, parts=parts, note=note)
 
 
 def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
                   n_frames: int | None, min_score: float, on_event: Callable[[Event], None], det_format: str = "auto",
                   *, video: Path | None = None, annotate: Path | None = None, annotate_as: Path | None = None,
-                  shapes: np.ndarray | None = None) -> np.ndarray:
+                  shapes: np.ndarray | None = None, parts: np.ndarray | None = None) -> np.ndarray:
     """``track --video ... --offline``: the closed set over a video's detections (see :func:`offline_rows`) written
     to ``output``; with ``annotate``, its identities drawn on ``video`` into that MP4 (told as ``annotate_as``);
     what it does told to ``on_event``; returns the result rows. ``ValueError`` for a bad input or video."""
     line = telling(on_event, "line")
     try:
-        rows = offline_rows(det, n_targets, params, frame_rate, n_frames, min_score, det_format, shapes, note=line,
+        rows = offline_rows(det, n_targets, params, frame_rate, n_frames, min_score, det_format, shapes, parts,
+                            note=line,
                             file_note=telling(on_event, "note"), status=partial(step, on_event))
     except FileNotFoundError as exc:
         raise ValueError(str(exc)) from exc

@@ -57,7 +57,8 @@ class Session:
     online pass, as ``--offline`` makes it), else of the tracks themselves. ``frame_rate`` in frames/s (confidence
     windows and the solver's motion). ``shapes``: blob shape vectors ``(k, SHAPE_SIZE)`` of the detections, which
     column 9 of ``solver_input`` indexes (``detections``: one per row); with them each re-solve weighs the look learned
-    from the video, as ``track --targets N`` on a blob video does.
+    from the video, as ``track --targets N`` on a blob video does; ``parts``: the blobs' parts vectors (one per shape
+    vector), on which the animals of a merged blob are placed.
 
     Attributes:
         rows: the current rows ``(k, 10)``, sorted by frame, then id.
@@ -68,7 +69,7 @@ class Session:
     def __init__(self, tracks: np.ndarray | str | os.PathLike[str], *, frame_rate: float = 30.0,
                  n_targets: int | None = None, detections: np.ndarray | str | os.PathLike[str] | None = None,
                  solver_input: np.ndarray | None = None, config: ClosedSetConfig | None = None,
-                 shapes: np.ndarray | None = None) -> None:
+                 shapes: np.ndarray | None = None, parts: np.ndarray | None = None) -> None:
         if not frame_rate > 0:
             raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
         if n_targets is not None and int(n_targets) < 1:
@@ -95,7 +96,9 @@ class Session:
             if index is None or (len(index) and not (0 <= index.min() and index.max() < len(shapes))):
                 raise ValueError("shapes: need n_targets and detections or solver_input whose column 9 indexes "
                                  f"them ({len(shapes)} shapes)")
-        self._shapes = shapes
+            if parts is not None and len(parts) != len(shapes):
+                raise ValueError(f"parts: expected one per shape vector ({len(shapes)}), got {len(parts)}")
+        self._shapes, self._blob_parts = shapes, parts if shapes is not None else None
         self.rows = self.initial.copy()
         self.corrections: list[Correction] = []
         self._parts: list[ChainConstraints | None] = []  # per correction its constraints; None: dropped
@@ -250,7 +253,8 @@ class Session:
     def _solve(self, cons: ChainConstraints) -> np.ndarray:
         """The closed set under ``cons``, its free identities renamed to the current ids they overlap most."""
         assert self._solver_rows is not None and self.n_targets is not None
-        new = assign_identities(self._solver_rows, self.n_targets, self.frame_rate, self.config, cons, self._shapes)
+        new = assign_identities(self._solver_rows, self.n_targets, self.frame_rate, self.config, cons, self._shapes,
+                                 self._blob_parts)
         fixed = {j for _, j in cons.identity}
         free_new = sorted(set(np.unique(new[:, 1]).astype(int).tolist()) - fixed)
         free_old = sorted(set(np.unique(self.rows[:, 1]).astype(int).tolist()) - fixed)

@@ -122,8 +122,9 @@ class BlobDetector:
     """Detects moving blobs in ``(h, w, 3)`` BGR frames of one static camera; one instance per video."""
 
     config: BlobConfig = field(default_factory=BlobConfig)
-    describe: bool = False  # also give each box its blob's shape vector as the detection's feature (blob_shape)
+    describe: bool = False  # each box's feature: its blob's shape vector; parts_: the last frame's parts (blob_shape)
     background_: np.ndarray | None = field(default=None, init=False, repr=False)
+    parts_: np.ndarray | None = field(default=None, init=False, repr=False)
     _buffer: deque = field(init=False, repr=False)
     _seen: int = field(default=0, init=False, repr=False)
     _mog: Any = field(default=None, init=False, repr=False)
@@ -133,9 +134,13 @@ class BlobDetector:
     _scratch: np.ndarray | None = field(default=None, init=False, repr=False)  # the 3-channel difference
     _bounds: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False)  # see _band
     _boxes_difference: np.ndarray | None = field(default=None, init=False, repr=False)
+    _areas: deque = field(init=False, repr=False)  # the recent blobs' areas (px²), for the parts' gate
 
     def __post_init__(self) -> None:
+        from lookalike.vision.blob_shape import PART_WINDOW
+
         self._buffer = deque(maxlen=self.config.history)
+        self._areas = deque(maxlen=PART_WINDOW)
 
     def reset(self) -> None:
         """Forget the background model."""
@@ -147,6 +152,7 @@ class BlobDetector:
         self._reference = None
         self._window = None
         self._bounds = None
+        self._areas.clear()
 
     def fit(self, frames: Iterable[np.ndarray] | np.ndarray) -> BlobDetector:
         """Median background of at most ``history`` of ``frames``, spread evenly (``median`` method only)."""
@@ -226,11 +232,13 @@ class BlobDetector:
 
     def __call__(self, image: np.ndarray) -> Detections:
         """Detections of one frame: boxes ``xywh`` (px) of the blobs, each scoring 1 (with ``describe``, each blob's
-        :func:`~lookalike.vision.blob_shape.blob_shapes` vector as its feature)."""
+        :func:`~lookalike.vision.blob_shape.blob_shapes` vector as its feature, and its
+        :func:`~lookalike.vision.blob_shape.blob_part_vectors` vector as a row of ``parts_``)."""
         with needs("cv2"):
             import cv2
 
         cfg = self.config
+        self.parts_ = None
         mask, difference, img = self._foreground(image, whole=False)
         # (BBDT: the labels and stats of the default algorithm, in the same order, faster)
         count, labels, stats, _ = cv2.connectedComponentsWithStatsWithAlgorithm(mask, 8, cv2.CV_32S, cv2.CCL_BBDT)
@@ -240,7 +248,7 @@ class BlobDetector:
         boxes = stats[keep, :4].astype(float)
         if not self.describe:
             return Detections(xywh=boxes, score=np.ones(len(keep)))
-        from lookalike.vision.blob_shape import blob_shapes
+        from lookalike.vision.blob_shape import blob_part_vectors, blob_shapes
 
         if difference is None:  # the difference where the kept blobs lie (elsewhere, left from earlier frames)
             assert self.background_ is not None
@@ -251,6 +259,8 @@ class BlobDetector:
                 difference[y:y + h, x:x + w] = self._difference(img[y:y + h, x:x + w],
                                                                 self.background_[y:y + h, x:x + w])
         shapes = blob_shapes(labels, stats, keep, difference, as_bgr_image(image, "image"))
+        self._areas.extend(stats[keep, 4].tolist())
+        self.parts_ = blob_part_vectors(labels, stats, keep, float(np.median(self._areas)))
         return Detections(xywh=boxes, score=np.ones(len(keep)), feature=shapes)
 
     detect = __call__

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["PROFILE_BINS", "SHAPE_SIZE", "blob_shapes"]
+__all__ = ["PART_AREA", "PART_COUNTS", "PART_SIZE", "PART_WINDOW", "PROFILE_BINS", "SHAPE_SIZE", "blob_part_vectors",
+           "blob_parts", "blob_shapes"]
 
 PROFILE_BINS = 8  # bins of the width and darkness profiles along the body axis
 SHAPE_SIZE = 7 + 2 * PROFILE_BINS
@@ -49,3 +50,51 @@ def _shape(xs: np.ndarray, ys: np.ndarray, weight: np.ndarray, colour: np.ndarra
     colour_mean = colour.sum(axis=0) / area if area else np.zeros(3)
     return np.concatenate([[np.log(max(area, 1)), np.log(4 * np.sqrt(values[1])), np.log(4 * np.sqrt(values[0])),
                             mean_dark], colour_mean, counts / max(area, 1), profile])
+
+
+PART_COUNTS = (2, 3)  # the splits of a blob that may hold several animals
+PART_SIZE = 2 * sum(PART_COUNTS)
+"""Length of a blob's parts vector: the centroids ``x, y`` (px, image frame) of its 2-part split, then of its 3-part."""
+PART_AREA = 1.4  # a blob is split when its area is at least this many times the median of the recent blobs'
+PART_WINDOW = 512  # the recent blobs: this many, the current frame's included
+
+
+def blob_part_vectors(labels: np.ndarray, stats: np.ndarray, keep: list[int], reference_area: float) -> np.ndarray:
+    """``(len(keep), PART_SIZE)`` :func:`blob_parts` vectors of the components ``keep`` of ``labels`` (as
+    :func:`blob_shapes`) whose area is at least :data:`PART_AREA` times ``reference_area`` (px²); NaN for the others."""
+    out = np.full((len(keep), PART_SIZE), np.nan)
+    for row, k in enumerate(keep):
+        if stats[k, 4] >= PART_AREA * reference_area:
+            x, y, w, h = (int(v) for v in stats[k, :4])
+            ys, xs = np.nonzero(labels[y:y + h, x:x + w] == k)
+            out[row] = blob_parts(xs + x, ys + y)
+    return out
+
+
+def blob_parts(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarray:
+    """The :data:`PART_SIZE` vector of the pixels ``xs, ys`` (px) of one blob: for each count k in
+    :data:`PART_COUNTS`, the centroids of a k-means split of the pixel coordinates, started evenly along the major
+    and along the minor principal axis (the start with the smaller within-part spread kept), ordered along the major
+    axis."""
+    pts = np.column_stack([xs, ys]).astype(float)
+    centre = pts.mean(axis=0)
+    cov = np.cov((pts - centre).T) if len(pts) > 1 else np.eye(2)
+    values, vectors = np.linalg.eigh(cov + np.eye(2) / 12)
+    out = []
+    for k in PART_COUNTS:
+        best, best_cost = np.repeat(centre[None], k, axis=0), np.inf
+        for axis in (1, 0):
+            offsets = np.linspace(-1.0, 1.0, k) * np.sqrt(values[axis])
+            centres = centre + offsets[:, None] * vectors[:, axis]
+            for _ in range(iterations):
+                label = np.argmin(((pts[:, None] - centres[None]) ** 2).sum(axis=2), axis=1)
+                counts = np.bincount(label, minlength=k)
+                if np.any(counts == 0):
+                    break
+                centres = np.column_stack([np.bincount(label, weights=pts[:, d], minlength=k) for d in (0, 1)]) \
+                    / counts[:, None]
+            cost = float(((pts - centres[label]) ** 2).sum()) if np.all(counts > 0) else np.inf
+            if cost < best_cost:
+                best, best_cost = centres, cost
+        out.append(best[np.argsort(best @ vectors[:, 1])])
+    return np.concatenate([c.ravel() for c in out])

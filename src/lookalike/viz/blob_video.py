@@ -20,9 +20,10 @@ from lookalike._optional import needs
 from lookalike.io.outputs import write_atomic
 from lookalike.types import Detections
 from lookalike.types.mot_table import detection_rows
+from lookalike.vision import blob_shape
 from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config, sample_frames
-from lookalike.vision.blob_shape import SHAPE_SIZE
+from lookalike.vision.blob_shape import PART_SIZE, SHAPE_SIZE
 from lookalike.viz.overlay import source_frames
 
 Progress = Callable[[str, int], Callable[[], None]]  # (description, total steps) -> called after each step
@@ -32,7 +33,8 @@ _BOOL_FALSE = ("0", "false", "no", "off")
 
 
 CACHE_ENV = "LOOKALIKE_CACHE"
-_SOURCE_HASH = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()  # this module as imported
+_SOURCE_HASH = hashlib.sha256(Path(__file__).read_bytes() + Path(blob_shape.__file__).read_bytes()).hexdigest()
+# (this module and the blob descriptions' as imported)
 
 
 def blob_config(settings: list[str]) -> BlobConfig:
@@ -185,12 +187,14 @@ def detection_cache_key(video: Path | str, config: BlobConfig, extra: dict[str, 
 
 @dataclass(frozen=True)
 class BlobRows:
-    """A video's blob detections: MOTChallenge ``rows`` ``(n, 10)``, the number of ``frames`` and each row's
-    :func:`~lookalike.vision.blob_shape.blob_shapes` vector ``shapes`` ``(n, SHAPE_SIZE)``."""
+    """A video's blob detections: MOTChallenge ``rows`` ``(n, 10)``, the number of ``frames``, each row's
+    :func:`~lookalike.vision.blob_shape.blob_shapes` vector ``shapes`` ``(n, SHAPE_SIZE)`` and its
+    :func:`~lookalike.vision.blob_shape.blob_part_vectors` vector ``parts`` ``(n, PART_SIZE)`` (NaN: not split)."""
 
     rows: np.ndarray
     frames: int
     shapes: np.ndarray
+    parts: np.ndarray
 
 
 def cached_blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
@@ -217,8 +221,9 @@ def load_blob_detections(video: Path | str, config: BlobConfig, cache: Path | No
         try:
             with np.load(path) as data:
                 rows = np.array(data["rows"], dtype=float).reshape(-1, 10)
-                return BlobRows(rows, int(data["frames"]), np.array(data["shapes"], dtype=float).reshape(
-                    len(rows), SHAPE_SIZE))
+                return BlobRows(rows, int(data["frames"]),
+                                np.array(data["shapes"], dtype=float).reshape(len(rows), SHAPE_SIZE),
+                                np.array(data["parts"], dtype=float).reshape(len(rows), PART_SIZE))
         except (OSError, ValueError, KeyError):
             pass
     return None
@@ -230,7 +235,7 @@ def store_blob_detections(video: Path | str, config: BlobConfig, found: BlobRows
     path = _cache_file(video, config, cache)
     if path is not None:
         buffer = io.BytesIO()
-        np.savez(buffer, rows=found.rows, frames=found.frames, shapes=found.shapes)
+        np.savez(buffer, rows=found.rows, frames=found.frames, shapes=found.shapes, parts=found.parts)
         _write_atomic(path, buffer.getvalue())
 
 
@@ -243,6 +248,7 @@ class BlobStream:
         self.min_score, self.frames = min_score, 0
         self._rows: list[np.ndarray] = []
         self._shapes: list[np.ndarray] = []
+        self._parts: list[np.ndarray] = []
 
     def __call__(self, image: np.ndarray) -> Detections:
         det = self.detector(image)
@@ -251,14 +257,17 @@ class BlobStream:
         if len(det):
             assert det.feature is not None  # (described blobs)
             self._rows.append(rows)
+            assert self.detector.parts_ is not None
             self._shapes.append(det.feature)
+            self._parts.append(self.detector.parts_)
         keep = rows[:, 6] >= self.min_score
         return Detections(xywh=rows[keep, 2:6], score=rows[keep, 6])
 
     def found(self) -> BlobRows:
-        """Every row found so far, the frames read and the rows' shape vectors."""
+        """Every row found so far, the frames read and the rows' shape and parts vectors."""
         rows = np.vstack(self._rows) if self._rows else np.zeros((0, 10))
-        return BlobRows(rows, self.frames, np.vstack(self._shapes) if self._shapes else np.zeros((0, SHAPE_SIZE)))
+        return BlobRows(rows, self.frames, np.vstack(self._shapes) if self._shapes else np.zeros((0, SHAPE_SIZE)),
+                        np.vstack(self._parts) if self._parts else np.zeros((0, PART_SIZE)))
 
 
 def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None) -> BlobRows:

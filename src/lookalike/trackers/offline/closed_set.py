@@ -196,7 +196,7 @@ def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[fl
 
 def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
                       config: ClosedSetConfig | None = None, constraints: ChainConstraints | None = None,
-                      shapes: np.ndarray | None = None) -> np.ndarray:
+                      shapes: np.ndarray | None = None, parts: np.ndarray | None = None) -> np.ndarray:
     """Result rows ``(k, 10)`` (any ids; 1-based frames, boxes in pixels) re-labelled with ids ``1..n_targets``
     by one global assignment of their tracklets (module doc); rows on no identity (clutter) are dropped
     and gaps of at most ``fill_gap_s`` inside an identity are interpolated. ``frame_rate`` in frames/s.
@@ -204,7 +204,8 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     take the free ids in order of their start); ValueError when they name no input row or cannot all hold.
     ``shapes``: blob shape vectors ``(n, SHAPE_SIZE)`` that column 9 of ``rows`` indexes; with them, the look
     learned from the video weighs in every link (:mod:`~lookalike.trackers.offline.appearance`), merged blobs
-    are left out of the tracklets and the identities interpolated through one are moved to its ends
+    are left out of the tracklets and the identities interpolated through one are moved to its ends, or with
+    ``parts`` (``(n, PART_SIZE)``, indexed as ``shapes``) onto its parts
     (:func:`~lookalike.trackers.offline.appearance.place_in_merges`)."""
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
@@ -264,7 +265,7 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
         if crossing:  # the identities interpolated through a merged blob, moved to its ends
             measured = np.isin(filled[:, 0] * (n_targets + 1) + filled[:, 1], merged[:, 0] * (n_targets + 1)
                                + merged[:, 1])
-            filled = place_in_merges(filled, measured, np.vstack([t.rows for t in crossing]))
+            filled = place_in_merges(filled, measured, np.vstack([t.rows for t in crossing]), shapes, parts)
     return smooth_boxes(filled, smoothing_window(merged, frame_rate, cfg))
 
 
@@ -331,18 +332,20 @@ def closed_set_input(det_rows: np.ndarray, frame_rate: float, n_frames: int | No
 def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *, n_frames: int | None = None,
                      online: dict[str, Any] | None = None, config: ClosedSetConfig | None = None,
                      vel_noise: float | None = None, shapes: np.ndarray | None = None,
-                     note: Callable[[str], None] | None = None) -> np.ndarray:
+                     parts: np.ndarray | None = None, note: Callable[[str], None] | None = None) -> np.ndarray:
     """Offline closed-set tracking of detection rows ``(k, >=7)``: :func:`closed_set_input` (``online``,
     ``vel_noise``), then
-    :func:`assign_identities` (``shapes``: one blob shape vector per detection row, or None). Returns result rows
+    :func:`assign_identities` (``shapes``, ``parts``: one blob shape and parts vector per detection row, or None).
+    Returns result rows
     ``(k, 10)`` with ids ``1..n_targets``. With ``shapes``, when more than
     :data:`~lookalike.trackers.offline.appearance.UNTRUSTED_SHARE` of the pass's blobs are not one animal's size, the
     online closed set's rows (``boxtrack`` with ``max_targets``, as ``track --targets N --online`` writes them) are
     returned instead, and ``note`` told why."""
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
-    if shapes is not None and len(shapes) != len(det_rows):
-        raise ValueError(f"shapes: expected one per detection row ({len(det_rows)}), got {len(shapes)}")
+    for name, given in (("shapes", shapes), ("parts", parts)):
+        if given is not None and len(given) != len(det_rows):
+            raise ValueError(f"{name}: expected one per detection row ({len(det_rows)}), got {len(given)}")
     rows = closed_set_input(det_rows, frame_rate, n_frames, online=online, vel_noise=vel_noise,
                             index=shapes is not None)
     share = 1.0 - float(single_rows(rows, shapes).mean()) if shapes is not None and len(rows) else 0.0
@@ -353,4 +356,4 @@ def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *,
                  f"{n_targets} --online) is written instead")
         return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, reported=True,
                            **{**(online or {}), "max_targets": int(n_targets)})
-    return assign_identities(rows, n_targets, frame_rate, config, shapes=shapes)
+    return assign_identities(rows, n_targets, frame_rate, config, shapes=shapes, parts=parts)

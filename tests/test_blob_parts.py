@@ -1,0 +1,71 @@
+"""A merged blob's pixels split into its animals, and the animals interpolated through it placed on those parts."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lookalike.trackers.offline.appearance import place_in_merges
+from lookalike.vision.blob_shape import PART_SIZE, blob_parts
+
+cv2 = pytest.importorskip("cv2")
+
+
+def _pixels(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    ys, xs = np.nonzero(mask)
+    return xs, ys
+
+
+def test_bodies_that_touch_split_into_their_own_centres():
+    img = np.zeros((60, 80), np.uint8)
+    cv2.ellipse(img, (25, 30), (14, 5), 0, 0, 360, 255, -1)  # two bodies crossing at an angle, touching
+    cv2.ellipse(img, (48, 30), (14, 5), 60, 0, 360, 255, -1)
+    two = blob_parts(*_pixels(img > 0))[:4].reshape(2, 2)
+    assert np.allclose(two[np.argsort(two[:, 0])], [[25, 30], [48, 30]], atol=3)
+    img[:] = 0
+    for cx in (15, 40, 65):  # three nose to tail
+        cv2.ellipse(img, (cx, 30), (13, 5), 0, 0, 360, 255, -1)
+    vec = blob_parts(*_pixels(img > 0))
+    assert vec.shape == (PART_SIZE,)
+    three = vec[4:].reshape(3, 2)
+    assert np.allclose(three[np.argsort(three[:, 0])], [[15, 30], [40, 30], [65, 30]], atol=2)
+
+
+def test_the_detector_splits_only_blobs_much_larger_than_the_recent_ones():
+    from lookalike.vision.blob import BlobConfig, BlobDetector
+
+    background = np.full((120, 200, 3), 200, np.uint8)
+    frame = background.copy()
+    for cx in (20, 60, 100):
+        cv2.circle(frame, (cx, 30), 8, (40, 40, 40), -1)  # three animals alone
+    cv2.circle(frame, (60, 90), 8, (40, 40, 40), -1)  # two touching: one blob twice the size
+    cv2.circle(frame, (75, 90), 8, (40, 40, 40), -1)
+    det = BlobDetector(BlobConfig(min_area_px=20, blur_px=0, open_px=0, close_px=0), describe=True)
+    det.fit(np.stack([background] * 5))
+    found = det(frame)
+    assert det.parts_ is not None and det.parts_.shape == (len(found), PART_SIZE)
+    big = np.argmax(found.xywh[:, 2])
+    assert np.isnan(np.delete(det.parts_, big, axis=0)).all()
+    assert np.allclose(sorted(det.parts_[big, 0:4:2]), [60, 75], atol=2)
+
+
+def test_animals_in_a_merged_blob_take_its_parts_and_keep_them_from_frame_to_frame():
+    # two animals 10x4 px side by side in a merged blob (box 100..130 x 50..60); their interpolated centres lie
+    # between the parts, each nearer its own part; in frame 7 the parts move a little and each animal follows its own,
+    # though its interpolated centre is now nearer the other's
+    rows = np.array([[5, 1, 100, 50, 10, 4], [5, 2, 118, 56, 10, 4],  # measured before the merge
+                     [6, 1, 106, 51, 10, 4], [6, 2, 113, 55, 10, 4],  # interpolated inside it
+                     [7, 1, 111, 54, 10, 4], [7, 2, 109, 53, 10, 4]], float)
+    measured = np.array([True, True, False, False, False, False])
+    merged = np.array([[6, -1, 100, 50, 30, 10, 1, -1, -1, 0], [7, -1, 100, 50, 30, 10, 1, -1, -1, 1]], float)
+    shapes = np.zeros((5, 4))
+    shapes[:, 0] = np.log([200.0, 200.0, 100.0, 100.0, 100.0])  # the merged blobs twice the median blob
+    parts = np.full((5, PART_SIZE), np.nan)
+    parts[0, :4] = [106, 52, 124, 58]
+    parts[1, :4] = [123, 58, 108, 53]
+    out = place_in_merges(rows, measured, merged, shapes, parts)
+    centres = out[:, 2:4] + out[:, 4:6] / 2
+    assert np.allclose(centres[2:], [[106, 52], [124, 58], [108, 53], [123, 58]])
+    assert np.array_equal(out[:2], rows[:2]) and np.array_equal(out[:, 4:6], rows[:, 4:6])
+    parts[1] = np.nan  # no split for frame 7's blob: its animals go to the box's ends as without parts
+    again = place_in_merges(rows, measured, merged, shapes, parts)
+    assert np.array_equal(again[4:], place_in_merges(rows, measured, merged)[4:])
