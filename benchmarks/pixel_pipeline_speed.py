@@ -28,8 +28,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import report_target  # noqa: E402
 
 from lookalike.sim import preset, simulate_robots
+from lookalike.sim.robot_camera import identifier_settings, pixel_camera, world_for_camera
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
-from lookalike.viz.robot_pixels import identifier_settings, pixel_camera, render_robot_frames, world_for_camera
+from lookalike.viz.robot_pixels import render_robot_frames
 
 
 def main() -> None:

@@ -217,7 +217,7 @@ def arena_case(seed: int, n: int = 5, **kwargs: float) -> Case:
 def hexbug_cases(root: Path) -> list[Case]:
     """The HexBug clips with annotations, through the blob detector (``--detector blob``) and the closed set of the
     clip's annotated count with the look learned from the clip (``--targets N``, the default on a blob video)."""
-    from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections
+    from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections
 
     out = []
     for video in hexbug_clips(root / "hexbug"):

@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.io import frames_from_table, read_mot, write_mot
+from lookalike.pipeline.blob_detections import blob_config, blob_detections
 from lookalike.trackers import make_tracker
-from lookalike.viz.blob_video import blob_config, blob_detections
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA  # noqa: E402
@@ -71,8 +71,8 @@ def identity_figures(rows: list[np.ndarray]) -> dict:
 
 def appearance(video: Path, table, n_frames: int) -> list[np.ndarray]:
     """Per frame, the hand-crafted appearance features of its boxes (standardised on this video)."""
+    from lookalike.io.video_frames import source_frames
     from lookalike.pipeline.tracking import fit_video_features
-    from lookalike.viz.overlay import source_frames
 
     extractor = fit_video_features(video, table)
     frames, _, _ = source_frames(video)
@@ -135,8 +135,8 @@ def annotate(video: Path, table, name: str, out: Path, n_frames: int) -> None:
     """Annotated MP4 of tracker ``name`` (``lookalike track --video``'s drawing) plus PNGs of three frames."""
     import cv2
 
+    from lookalike.io.video_frames import source_frames
     from lookalike.pipeline.tracking import fit_video_features, track_video
-    from lookalike.viz.overlay import source_frames
 
     kind, params = TRACKERS[name]
     result = track_video(video, table, make_tracker(kind, **params), fit_video_features(video, table),

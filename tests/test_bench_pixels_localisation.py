@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 
 from lookalike.bench.pixels import PIXEL_COLUMNS, PIXEL_KEYS, pixels_results, pixels_table
+from lookalike.sim.robot_camera import pixel_camera
 from lookalike.vision.pipeline import PipelineConfig, RobotPipeline
-from lookalike.viz.robot_pixels import pixel_camera
 
 
 def test_localisation_error_columns_from_pixels_and_simulated():

@@ -3,9 +3,9 @@ from itertools import islice
 import numpy as np
 import pytest
 
+from lookalike.io.video_frames import read_frames
 from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.hog_features import as_bgr_image
-from lookalike.viz.video import read_frames
 from tests.conftest import SHARED_DATA
 
 

@@ -11,12 +11,12 @@ from lookalike.cli import app
 from lookalike.eval import identification_success_rate
 from lookalike.geometry.camera import Camera, Pose2D
 from lookalike.io.results import validate
+from lookalike.io.video_frames import video_info
 from lookalike.sim.render_robots import ROBOT_HEIGHT_M, ROBOT_WIDTH_M, RobotRenderer
 from lookalike.types import Beacons, Detections
 from lookalike.vision.heading import HeadingClassifier
 from lookalike.vision.hog_cascade import HogCascade
 from lookalike.vision.pipeline import PipelineConfig, RobotPipeline, check_image, labelled_rows, shipped_model_path
-from lookalike.viz.video import video_info
 from tests.test_render_robots import random_walk_poses
 
 runner = CliRunner()

@@ -70,16 +70,11 @@ def test_bag_opens_in_rosbags_own_reader_with_ros_types(run):
 
 def test_bag_with_images_replays_through_the_pixel_pipeline(tmp_path):
     pytest.importorskip("cv2", reason="the pixel pipeline needs the 'vision' extra")
+    from lookalike.pipeline.robots import identify_video, pixel_frames
     from lookalike.sim import preset, simulate_robots
+    from lookalike.sim.robot_camera import identifier_settings, pixel_camera, world_for_camera
     from lookalike.vision.pipeline import PipelineConfig, RobotPipeline
-    from lookalike.viz.robot_pixels import (
-        identifier_settings,
-        identify_video,
-        pixel_camera,
-        pixel_frames,
-        render_robot_frames,
-        world_for_camera,
-    )
+    from lookalike.viz.robot_pixels import render_robot_frames
 
     camera = pixel_camera()
     sequence = simulate_robots(world_for_camera(preset("m3n2"), camera), 12, 3)
@@ -124,7 +119,8 @@ def test_track_bag_matches_track_video_on_the_same_frames(tmp_path):
     from typer.testing import CliRunner
 
     from lookalike.cli import app
-    from lookalike.viz.robot_pixels import pixel_camera, render_robot_frames
+    from lookalike.sim.robot_camera import pixel_camera
+    from lookalike.viz.robot_pixels import render_robot_frames
 
     runner = CliRunner()
     made = runner.invoke(app, ["simulate", "--preset", "m3n2", "--frames", "12", "--seed", "4", "--bag", "--images",

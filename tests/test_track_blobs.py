@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from lookalike.cli import app
 from lookalike.io import read_mot
-from lookalike.viz.blob_video import blob_config, blob_detections
+from lookalike.pipeline.blob_detections import blob_config, blob_detections
 
 runner = CliRunner()
 

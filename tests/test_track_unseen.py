@@ -14,9 +14,9 @@ from lookalike.bench.datasets import RealSequence
 from lookalike.bench.runner import Entry, default_entries, job_pairs, params_entry, track_rows
 from lookalike.cli import app
 from lookalike.io import read_mot, write_mot
+from lookalike.io.video_frames import read_frames
+from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections, detection_cache_key
 from lookalike.tune.params_file import save_params
-from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections, detection_cache_key
-from lookalike.viz.video import read_frames
 
 runner = CliRunner()
 
@@ -140,7 +140,7 @@ def test_points_and_eval_refusals(tmp_path):
 @pytest.mark.parametrize("offline", [False, True])
 def test_points_annotated_on_white_frames_or_on_their_video(tmp_path, offline):
     """--points --annotate draws the tracks on white frames, one a point frame, or on --video's frames."""
-    from lookalike.viz.video import read_frames
+    from lookalike.io.video_frames import read_frames
 
     points, _ = _points_csv(tmp_path)
     base = ["track", "--points", str(points), "-t", "boxtrack", "--targets", "3", "-o", str(tmp_path / "t.txt")]

@@ -8,10 +8,10 @@ import numpy as np
 
 from lookalike.bench.datasets import read_hexbug_points
 from lookalike.eval import evaluate_points
+from lookalike.io.video_frames import source_frames
+from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections
 from lookalike.trackers.offline.closed_set import track_closed_set
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
-from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections
-from lookalike.viz.overlay import source_frames
 
 
 def score(rows, gt, radius, n_frames):

@@ -13,10 +13,10 @@ from video_identities import identity_scores, run_track  # noqa: E402
 from lookalike.bench.datasets import read_hexbug_points  # noqa: E402
 from lookalike.eval import evaluate_points  # noqa: E402
 from lookalike.io.arena_files import write_arena  # noqa: E402
+from lookalike.io.video_frames import source_frames  # noqa: E402
+from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections  # noqa: E402
 from lookalike.trackers.offline.closed_set import track_closed_set  # noqa: E402
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS  # noqa: E402
-from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections  # noqa: E402
-from lookalike.viz.overlay import source_frames  # noqa: E402
 
 work = Path(tempfile.mkdtemp(prefix="appearance-dev-"))
 

@@ -10,10 +10,10 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from lookalike.io.arena_files import write_arena
+from lookalike.io.video_frames import source_frames
+from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections
 from lookalike.trackers.offline.closed_set import track_closed_set
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
-from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections
-from lookalike.viz.overlay import source_frames
 
 R = 15.0
 work = Path(tempfile.mkdtemp(prefix="errors5-"))

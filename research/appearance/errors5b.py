@@ -7,9 +7,9 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from lookalike.io.arena_files import write_arena
+from lookalike.io.video_frames import source_frames
 from lookalike.trackers.offline import closed_set
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
-from lookalike.viz.overlay import source_frames
 
 captured = {}
 

@@ -12,11 +12,11 @@ from _common import SHARED_DATA  # noqa: E402
 
 from lookalike.bench.datasets import read_hexbug_points  # noqa: E402
 from lookalike.io.arena_files import write_arena  # noqa: E402
+from lookalike.io.video_frames import source_frames  # noqa: E402
+from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections  # noqa: E402
 from lookalike.trackers.offline.appearance import single_rows  # noqa: E402
 from lookalike.trackers.offline.closed_set import online_rows  # noqa: E402
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS  # noqa: E402
-from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections  # noqa: E402
-from lookalike.viz.overlay import source_frames  # noqa: E402
 
 # IDF1 (%) of round 3: `unseen_commands.py --only hexbug` (online = --targets N --online, default = --targets N)
 HEXBUG = {"training010": (64.53, 80.77), "training035": (81.55, 77.98), "training042": (62.82, 80.65),

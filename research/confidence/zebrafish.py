@@ -17,8 +17,8 @@ import numpy as np
 from fit import ROOT, THRESHOLD, Result, auc, ece, label_rows, switch_share
 
 from lookalike.io import read_mot
+from lookalike.io.video_frames import source_frames
 from lookalike.trackers.offline.confidence import assignment_confidence, row_features
-from lookalike.viz.overlay import source_frames
 
 RADIUS_PX = 15.0
 

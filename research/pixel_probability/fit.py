@@ -23,10 +23,12 @@ from typing import Any
 import numpy as np
 
 from lookalike.geometry.camera import Camera
+from lookalike.pipeline.robots import one_blas_thread
 from lookalike.sim import PRESET_NAMES, preset, simulate_robots
+from lookalike.sim.robot_camera import pixel_camera, world_for_camera
 from lookalike.vision.detection_probability import DetectionProbability, fit_quantile_map
 from lookalike.vision.pipeline import PipelineConfig, RobotPipeline
-from lookalike.viz.robot_pixels import one_blas_thread, pixel_camera, render_robot_frames, world_for_camera
+from lookalike.viz.robot_pixels import render_robot_frames
 
 FIT_SEED = 800_000
 

@@ -166,8 +166,8 @@ def hexbug_clips(root: Path) -> list[Path]:
 def detect_hexbug(video: Path, cache: Path | bool = True) -> RealSequence:
     """One HexBug clip through the blob detector with the settings ``lookalike track --detector blob`` estimates,
     with its head points; ``cache``: a folder, ``True`` for the default one, ``False`` for none."""
-    from lookalike.viz.blob_video import auto_blob_config, cached_blob_detections
-    from lookalike.viz.overlay import source_frames
+    from lookalike.io.video_frames import source_frames
+    from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections
 
     config, _ = auto_blob_config(video, [], cache=cache)
     found = cached_blob_detections(video, config, cache=cache)

@@ -16,10 +16,10 @@ from lookalike.eval import identification_success_rate
 from lookalike.geometry.camera import Camera
 from lookalike.io.robot_sequences import write_robot_sequence
 from lookalike.sim import RobotSequence, preset, simulate_robots
+from lookalike.sim.robot_camera import world_for_camera
 from lookalike.trackers import make_tracker
 from lookalike.trackers.parts.identity import labels_from_tracks
 from lookalike.vision.pipeline import RobotPipeline
-from lookalike.viz.robot_pixels import world_for_camera
 
 SUFFIX = ".labelled.jsonl"
 

@@ -21,11 +21,12 @@ from lookalike.geometry.camera import Camera
 from lookalike.io.results import Results, add_printed_rows
 from lookalike.loop import RunStats, run
 from lookalike.sim import RobotSequence, preset, preset_label, simulate_robots
+from lookalike.sim.robot_camera import identifier_settings, world_for_camera
 from lookalike.trackers import make_tracker
 from lookalike.trackers.parts.identity import agent_positions
 from lookalike.types import Beacons, Detections
 from lookalike.vision.pipeline import PipelineConfig, PipelineResult, RobotPipeline
-from lookalike.viz.robot_pixels import identifier_settings, render_robot_frames, world_for_camera
+from lookalike.viz.robot_pixels import render_robot_frames
 
 DEFAULT_SEED = 700_000
 PIXEL_COLUMNS = ("Setup", "Identifier", "Pixels (%)", "Simulated (%)", "Gap (pp)", "Pixels robots (%)",

@@ -42,9 +42,9 @@ def proofread(
     Corrections: assign an identity, swap two ids, merge, split, delete, undo. With --targets N each correction
     re-solves the closed set and the latest correction wins over earlier ones that contradict it. The log is saved
     after every action; export (the button or --export) writes the corrected tracks."""
+    from lookalike.io.video_frames import video_info
     from lookalike.proofread import Correction, Session
     from lookalike.viz.label.proofread import ProofreadApp, make_proofread_server
-    from lookalike.viz.video import video_info
 
     for option, path in (("--video", video), ("--tracks", tracks), ("--detections", detections)):
         if path is not None and not path.is_file():

@@ -12,7 +12,8 @@ from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing
 from lookalike.cli.progress import bars
 from lookalike.io import read_mot
 from lookalike.io.outputs import atomic_path
-from lookalike.viz.overlay import birdseye_video, overlay_tracks, source_frames
+from lookalike.io.video_frames import source_frames
+from lookalike.viz.overlay import birdseye_video, overlay_tracks
 
 
 @app.command()

@@ -12,7 +12,8 @@ from lookalike.io.robot_sequences import write_robot_sequence
 from lookalike.io.rosbag import write_bag
 from lookalike.sim import DEFAULT_NOISE, NOISE_MODELS, preset, simulate_robots
 from lookalike.sim.presets import TEAM_HELP
-from lookalike.viz.robot_pixels import pixel_camera, render_robot_frames
+from lookalike.sim.robot_camera import pixel_camera
+from lookalike.viz.robot_pixels import render_robot_frames
 
 
 @app.command()

@@ -12,10 +12,8 @@ import numpy as np
 
 from lookalike.io import MotTable, write_mot
 from lookalike.io.needs import input_kind
-from lookalike.pipeline.runner import Event, RunResult, step
-from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, BlobEstimate, frame_counts
-from lookalike.vision.blob_boxtrack import blob_boxtrack_config
-from lookalike.viz.blob_video import (
+from lookalike.io.video_frames import source_frames
+from lookalike.pipeline.blob_detections import (
     BlobRows,
     BlobStream,
     auto_blob_config,
@@ -23,7 +21,9 @@ from lookalike.viz.blob_video import (
     load_blob_detections,
     store_blob_detections,
 )
-from lookalike.viz.overlay import source_frames
+from lookalike.pipeline.runner import Event, RunResult, step
+from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, BlobEstimate, frame_counts
+from lookalike.vision.blob_boxtrack import blob_boxtrack_config
 
 
 def one_pass(tracker: Any, tracker_name: str, explicit: Collection[str], n_targets: int | None,

@@ -26,7 +26,7 @@ def live_settings(spec: str, output: Path, tracker_name: str, detector: str, set
     if output.is_dir():
         raise ValueError(f"-o/--output: {output} is a folder; give a result file such as tracks.txt")
     if detector == "blob":
-        from lookalike.viz.blob_video import blob_settings
+        from lookalike.pipeline.blob_detections import blob_settings
 
         return blob_settings(settings)
     if not detector.lower().endswith(".onnx"):

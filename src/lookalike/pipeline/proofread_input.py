@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.io.motchallenge import read_mot
+from lookalike.pipeline.blob_detections import auto_blob_config, load_blob_detections
 from lookalike.trackers.offline.closed_set import assign_identities, closed_set_input
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
-from lookalike.viz.blob_video import auto_blob_config, load_blob_detections
 
 __all__ = ["blob_solver_input"]
 

@@ -22,7 +22,7 @@ def written_results(branch: str, path: Path | None, output: Path, video: Path | 
     if branch == "points":
         return [(output, fps or POINTS_FPS)]
     if branch in ("blobs", "video"):
-        from lookalike.viz.overlay import source_frames
+        from lookalike.io.video_frames import source_frames
 
         rate = fps or (source_frames(video)[2] if video is not None else None)
         return [(output, float(rate or 25.0))]

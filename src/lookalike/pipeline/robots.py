@@ -5,6 +5,7 @@ the detector, heading estimator and identifier of :class:`lookalike.vision.pipel
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -12,19 +13,17 @@ from typing import Any
 import numpy as np
 
 from lookalike.io.robot_sequences import read_robot_sequence
+from lookalike.io.stream import MotWriter
+from lookalike.loop import RunStats
+from lookalike.loop import run as run_loop
 from lookalike.pipeline.request import TrackRequest
 from lookalike.pipeline.runner import Event, RunResult
 from lookalike.sim import RobotSequence
+from lookalike.sim.robot_camera import identifier_settings, pixel_camera
 from lookalike.trackers.registry import parse_parameter
-from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
-from lookalike.viz.robot_pixels import (
-    annotate_frame,
-    identifier_settings,
-    identify_video,
-    pixel_camera,
-    pixel_frames,
-    render_robot_frames,
-)
+from lookalike.types import Frame
+from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, PipelineResult, RobotPipeline, labelled_rows
+from lookalike.viz.robot_pixels import annotate_frame, render_robot_frames
 
 PIPELINES = ("robots",)
 SIZE_TOLERANCE = 2.0  # box height vs a robot's at its ground position; true boxes 0.79-1.48 on m5n3 seeds 11-12
@@ -74,7 +73,7 @@ def prepare_robots(video: Path | None, reports: Path | None, identifier: str, se
     comma-separated ``heading_topics``), load the models (None: the shipped ones) and open the frames; ``settings``:
     the identifier's ``KEY=VALUE``; ``min_score``: detector probability (-inf: 0.5). Raises ``ValueError``,
     ``OSError`` or ``TypeError`` for a bad input."""
-    from lookalike.viz.overlay import source_frames
+    from lookalike.io.video_frames import source_frames
 
     camera = pixel_camera()
     if bag is not None:
@@ -104,11 +103,72 @@ def prepare_robots(video: Path | None, reports: Path | None, identifier: str, se
     return RobotRun(identifier, source, reports or source, seq, pipe, images, total, fps)
 
 
+@contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """Limit BLAS to one thread inside the block (threadpoolctl, when installed): faster for the heading SVM."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:
+        yield
+        return
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield
+
+
+@dataclass(frozen=True)
+class PixelFrame:
+    """One video frame with the sequence's frame of the same index (reports, time), observer yaw (rad) and the
+    observer's field position ``(x, y)`` (m; ``None``: unknown)."""
+
+    index: int
+    image: np.ndarray
+    frame: Frame
+    yaw_rad: float
+    xy_m: tuple[float, float] | None = None
+
+
+def pixel_frames(images: Iterable[np.ndarray], reports: RobotSequence, source: str = "video") -> Iterator[PixelFrame]:
+    """The video's frames paired with the report sequence's; ``ValueError`` when the video is longer."""
+    for k, image in enumerate(images):
+        if k >= len(reports):
+            raise ValueError(f"{source}: the reports have {len(reports)} frames, the video more")
+        x, y, yaw = (float(v) for v in reports.arrays.observer[k])
+        yield PixelFrame(k, image, reports.frame(k), yaw, (x, y))
+
+
+class PipelineStep:
+    """The pipeline as a tracker of :class:`PixelFrame` objects (for :func:`lookalike.loop.run`)."""
+
+    def __init__(self, pipe: RobotPipeline) -> None:
+        self.pipe = pipe
+
+    def update(self, frame: PixelFrame) -> PipelineResult:
+        """Perceive and identify one frame."""
+        return self.pipe.update(frame.image, frame.frame.beacons, frame.frame.time, frame.yaw_rad, frame.xy_m)
+
+
+def identify_video(pipe: RobotPipeline, frames: Iterable[PixelFrame], output: Path, *,
+                   annotate: Callable[[PixelFrame, PipelineResult], None] | None = None,
+                   advance: Callable[[], None] | None = None) -> RunStats:
+    """Run the pipeline over ``frames``, streaming its rows (:func:`labelled_rows`) to ``output``; ``annotate(frame,
+    result)`` sees every frame."""
+    with MotWriter(output) as writer:
+        def sink(frame: PixelFrame, result: PipelineResult) -> None:
+            writer.write_rows(labelled_rows(frame.index, result.detections, result.labels, result.tracks))
+            if annotate is not None:
+                annotate(frame, result)
+            if advance is not None:
+                advance()
+
+        with one_blas_thread():
+            return run_loop(PipelineStep(pipe), frames, sink)
+
+
 def identify_robots(run: RobotRun, output: Path, annotate: Path | None = None, fps: float | None = None,
                     advance: Callable[[], None] | None = None) -> Any:
     """Run ``run`` into ``output`` (MOTChallenge rows) and, with ``annotate``, an annotated MP4 at ``fps`` frames/s
-    (None: the source's); ``advance`` after each frame. Returns :func:`lookalike.viz.robot_pixels.identify_video`'s
-    statistics; ``ValueError`` naming the source for frames that do not fit the reports."""
+    (None: the source's); ``advance`` after each frame. Returns :func:`identify_video`'s statistics; ``ValueError``
+    naming the source for frames that do not fit the reports."""
     from lookalike.viz.video import VideoWriter
 
     writer = VideoWriter(annotate, fps=fps or run.fps) if annotate is not None else None
@@ -174,5 +234,6 @@ def robot_video(sequence: Path, seed: int = 0) -> tuple[RobotSequence, Iterator[
     return seq, (frame.image for frame in render_robot_frames(seq, pixel_camera(), seed))
 
 
-__all__ = ["PIPELINES", "SIZE_TOLERANCE", "RobotRun", "check_robots", "dropped", "identify_robots", "prepare_robots",
-           "robot_video", "run_robots"]
+__all__ = ["PIPELINES", "SIZE_TOLERANCE", "PipelineStep", "PixelFrame", "RobotRun", "check_robots", "dropped",
+           "identify_robots", "identify_video", "one_blas_thread", "pixel_frames", "prepare_robots", "robot_video",
+           "run_robots"]

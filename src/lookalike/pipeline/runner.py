@@ -163,8 +163,8 @@ def _video(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, a
                          team_size=request.health_team_size, health_window=request.health_window,
                          min_score=request.min_score, fps=request.fps, features=request.features,
                          det_format=request.det_format, annotate_as=request.annotate)
+    from lookalike.io.video_frames import source_frames
     from lookalike.pipeline.closed import offline_video
-    from lookalike.viz.overlay import source_frames
 
     assert request.targets
     check_result_file(request.output)

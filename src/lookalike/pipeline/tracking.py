@@ -19,13 +19,13 @@ import numpy as np
 from lookalike.association.solver import assign
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.io import MotTable, frames_from_table, read_seqinfo, tracks_to_rows
+from lookalike.io.video_frames import source_frames
 from lookalike.loop import run
 from lookalike.pipeline.spill import FrameSpill
 from lookalike.trackers.parts.health import HealthConfig, HealthMonitor, HealthStatus
 from lookalike.types import Detections, Frame, TrackSnapshot, TrackStatus
 from lookalike.vision.appearance import RAW_DIM, HandcraftedFeatures, crop_boxes, fit_stats, raw_features
 from lookalike.viz.annotate import Tails
-from lookalike.viz.overlay import source_frames
 from lookalike.viz.video import VideoWriter
 from lookalike.viz.video_tracking import draw_tracking_frame
 

@@ -19,6 +19,7 @@ from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
 from lookalike.io.motchallenge import format_rows
 from lookalike.io.needs import input_kind
 from lookalike.io.outputs import atomic_path
+from lookalike.io.video_frames import source_frames, video_info
 from lookalike.loop import RunStats
 from lookalike.pipeline.files import dropped_all
 from lookalike.pipeline.runner import Event, RunResult
@@ -27,8 +28,6 @@ from lookalike.sim.divers_run import diver_extractor, fit_diver_features, stored
 from lookalike.trackers.parts.health import HealthConfig
 from lookalike.types import Detections
 from lookalike.types.mot_table import detection_rows
-from lookalike.viz.overlay import source_frames
-from lookalike.viz.video import video_info
 from lookalike.viz.video_tracking import side_file, write_health_csv, write_merges_csv
 
 FEATURE_CHOICES = ("video", "divers", "handcrafted", "learned")

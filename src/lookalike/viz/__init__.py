@@ -1,6 +1,7 @@
 """Visual output: drawing on frames, videos and GIFs, plots, the HTML report and the demo scenes (OpenCV, matplotlib and
 Pillow imported lazily)."""
 
+from lookalike.io.video_frames import read_frames, video_info
 from lookalike.viz.annotate import (
     LabelSpace,
     Tails,
@@ -14,7 +15,7 @@ from lookalike.viz.annotate import (
 from lookalike.viz.colors import identity_colour, rgb_hex
 from lookalike.viz.plots import birdseye_plot, grouped_bar_chart
 from lookalike.viz.report import HtmlReport
-from lookalike.viz.video import VideoWriter, read_frames, video_info, write_gif
+from lookalike.viz.video import VideoWriter, write_gif
 
 __all__ = [
     "HtmlReport",

@@ -9,6 +9,7 @@ import numpy as np
 
 from lookalike._optional import needs
 from lookalike.io import MotTable
+from lookalike.io.video_frames import source_frames
 from lookalike.viz.annotate import (
     Tails,
     draw_box_tracks,
@@ -17,43 +18,7 @@ from lookalike.viz.annotate import (
     draw_tail,
 )
 from lookalike.viz.colors import identity_colour
-from lookalike.viz.video import VideoWriter, read_frames, video_info
-
-IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")
-
-
-def source_frames(source: Path | str) -> tuple[Iterator[np.ndarray], int, float]:
-    """Frames of a video file or image folder (by name), the frame count and rate (30 for folders)."""
-    with needs("cv2"):
-        import cv2
-
-    p = Path(source)
-    if p.is_dir():
-        paths = sorted(q for q in p.iterdir() if q.suffix.lower() in IMAGE_SUFFIXES)
-        if not paths:
-            raise ValueError(f"video: folder {p} holds no images ({', '.join(IMAGE_SUFFIXES)})")
-
-        def images() -> Iterator[np.ndarray]:
-            for q in paths:
-                img = cv2.imread(str(q), cv2.IMREAD_COLOR)
-                if img is None:
-                    raise ValueError(f"video: cannot read image {q}")
-                yield img
-
-        return images(), len(paths), 30.0
-    n, fps, _ = video_info(p)
-    return _all_frames(p, n), n, fps
-
-
-def _all_frames(path: Path, declared: int) -> Iterator[np.ndarray]:
-    """:func:`read_frames`, then ``ValueError`` when it stopped well short of the ``declared`` count."""
-    count = 0
-    for img in read_frames(path):
-        count += 1
-        yield img
-    if declared > 0 and count < declared - max(2, declared // 20):
-        raise ValueError(f"video: {path} declares {declared} frames but only {count} could be read "
-                         "(truncated or damaged?)")
+from lookalike.viz.video import VideoWriter
 
 
 def overlay_tracks(source: Path | str | Iterable[np.ndarray], tracks: MotTable, output: Path | str, *,

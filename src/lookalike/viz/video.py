@@ -1,10 +1,9 @@
-"""Writing annotated videos and animated GIFs, reading videos. MP4s are H.264 through PyAV (the ``viz`` extra) so
-browsers play them, else OpenCV's ``mp4v``; PyAV, OpenCV and Pillow are imported lazily."""
+"""Writing annotated videos and animated GIFs (reading videos: :mod:`lookalike.io.video_frames`). MP4s are H.264
+through PyAV (the ``viz`` extra) so browsers play them, else OpenCV's ``mp4v``; PyAV, OpenCV and Pillow are imported
+lazily."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
 from fractions import Fraction
 from pathlib import Path
 from types import TracebackType
@@ -138,43 +137,3 @@ def write_gif(path: Path | str, images: list[np.ndarray], fps: float) -> Path:
     frames[0].save(out, format="GIF", save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0,
                    optimize=False)
     return out
-
-
-@contextmanager
-def _capture(path: Path | str) -> Iterator[Any]:
-    """An open ``cv2.VideoCapture`` of ``path``, released on exit; a clear error when it cannot open."""
-    with needs("cv2"):
-        import cv2
-
-    p = Path(path)
-    if not p.is_file():
-        raise ValueError(f"video: no such file {p}")
-    cap = cv2.VideoCapture(str(p))
-    if not cap.isOpened():
-        raise ValueError(f"video: OpenCV cannot open {p}")
-    try:
-        yield cap
-    finally:
-        cap.release()
-
-
-def read_frames(path: Path | str) -> Iterator[np.ndarray]:
-    """The frames of a video file, ``(h, w, 3)`` uint8 BGR, in order."""
-    with _capture(path) as cap:
-        while True:
-            ok, img = cap.read()
-            if not ok:
-                break
-            yield img
-
-
-def video_info(path: Path | str) -> tuple[int, float, tuple[int, int]]:
-    """Frame count (as the container says), frames per second and ``(width, height)`` of a video."""
-    with needs("cv2"):
-        import cv2
-
-    with _capture(path) as cap:
-        n = int(cap.get(cv2.CAP_PROP_FRAME_COUNT))
-        fps = float(cap.get(cv2.CAP_PROP_FPS)) or 30.0
-        size = (int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT)))
-    return n, fps, size

@@ -29,6 +29,7 @@ import numpy as np
 
 from lookalike._optional import needs
 from lookalike.io.outputs import write_atomic
+from lookalike.io.video_frames import video_info
 from lookalike.viz.colors import PALETTE, rgb_hex
 from lookalike.viz.label.server import (
     BODY_TIMEOUT_S,
@@ -38,7 +39,6 @@ from lookalike.viz.label.server import (
     _BadRequest,
     _int,
 )
-from lookalike.viz.video import video_info
 
 __all__ = ["ProofreadApp", "make_proofread_server"]
 

@@ -18,13 +18,13 @@ import numpy as np
 
 from lookalike._optional import needs
 from lookalike.io.outputs import write_atomic
+from lookalike.io.video_frames import source_frames
 from lookalike.types import Detections
 from lookalike.types.mot_table import detection_rows
 from lookalike.vision import blob_shape
 from lookalike.vision.blob import BlobConfig, BlobDetector
 from lookalike.vision.blob_auto import BlobEstimate, estimate_blob_config, sample_frames
 from lookalike.vision.blob_shape import PART_SIZE, SHAPE_SIZE
-from lookalike.viz.overlay import source_frames
 
 Progress = Callable[[str, int], Callable[[], None]]  # (description, total steps) -> called after each step
 
