@@ -72,7 +72,7 @@ class BlobEstimate:
 
 
 MIN_SIDE_PX = 16  # frames narrower or lower than this cannot hold a blob against a background (pixels)
-_IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")  # image files of a folder given as the video (as viz reads them)
+_IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")  # image files of a folder given as the video (as io.video_frames reads them)
 
 
 def _odd(value: float, lo: int, hi: int) -> int:
@@ -115,7 +115,7 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
             k += 1
         if wanted is None:
             frames = [frames[i] for i in spread(len(frames), count)]
-        elif k < total - max(2, total // 20):  # (as viz.overlay.source_frames says it)
+        elif k < total - max(2, total // 20):  # (as io.video_frames.source_frames says it)
             raise ValueError(f"video: {video} declares {total} frames but only {k} could be read "
                              "(truncated or damaged?)")
     finally:
