@@ -1,6 +1,6 @@
 """What a blob looks like, as a fixed-length vector that does not depend on where the animal is or which way it
 points: its size and shape, how dark it is and in which colour, and how its width and darkness run along its body
-axis (the body turned to one reference direction by its principal axis, the heavier end first). The offline closed
+axis (the body turned to one reference direction by its principal axis, the thin end first). The offline closed
 set learns from these which animal is which (:mod:`lookalike.trackers.offline.appearance`)."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ PROFILE_BINS = 8  # bins of the width and darkness profiles along the body axis
 SHAPE_SIZE = 7 + 2 * PROFILE_BINS
 """Length of a blob's vector: log area (px²), log major and minor axis (px), mean difference from the background
 (grey levels), mean B, G, R (grey levels), the width profile (fraction of the area per bin) and the darkness profile
-(each bin's mean difference over the blob's mean)."""
+(each bin's mean difference over the blob's mean), both from the thin end."""
 
 
 def blob_shapes(labels: np.ndarray, stats: np.ndarray, keep: list[int], difference: np.ndarray,
@@ -39,7 +39,7 @@ def _shape(xs: np.ndarray, ys: np.ndarray, weight: np.ndarray, colour: np.ndarra
     cov = pts.T @ pts / max(area, 1) + np.eye(2) / 12  # (a pixel's own spread: single-pixel blobs stay finite)
     values, vectors = np.linalg.eigh(cov)
     along = pts @ vectors[:, 1]
-    if np.sum(along**3) > 0:  # the heavier end first: the long thin end (a tail) runs to positive values
+    if np.sum(along**3) > 0:  # the thin end first: the long thin end (a tail) runs to negative values
         along = -along
     half = 2 * np.sqrt(values[1])  # half the major axis (px)
     bins = np.clip(((along / half + 1.25) / 2.5 * PROFILE_BINS).astype(int), 0, PROFILE_BINS - 1)
