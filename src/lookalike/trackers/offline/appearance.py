@@ -26,6 +26,7 @@ __all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "place_in_mer
 SINGLE_AREA = (0.6, 1.5)  # a blob shows one animal when its area is within these multiples of its track's median
 MIN_ROWS = 8  # single-animal rows a tracklet needs to teach or be judged by its look
 OUTLIER = 0.001  # chance that a tracklet's look is not its animal's (a bad segmentation): bounds a link's evidence
+LOOK_WEIGHT = 2.0  # a link's cost is lowered by this times its look's log-likelihood ratio (rule7.md in research/)
 SHAPE_COLUMN = 9  # the column of an input row that holds its shape vector's index
 MIN_SPREAD = 0.1  # smallest spread of a log look distance (a floor for the fits on few pairs)
 UNTRUSTED_SHARE = 0.135  # more of the online pass's rows not one animal's size: no look (research/appearance/rule4.md)
@@ -163,13 +164,13 @@ def fit_identity_space(tracklets: list[Tracklet], shapes: np.ndarray) -> Identit
 
 def with_appearance(tracklets: list[Tracklet], links: tuple[np.ndarray, np.ndarray, np.ndarray], shapes: np.ndarray,
                     space: IdentitySpace) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``links`` ``(i, j, cost)`` with each cost lowered by :meth:`IdentitySpace.link_evidence` of its two
-    tracklets."""
+    """``links`` ``(i, j, cost)`` with each cost lowered by :data:`LOOK_WEIGHT` times
+    :meth:`IdentitySpace.link_evidence` of its two tracklets."""
     src, dst, cost = links
     if not len(src):
         return links
     looks = np.array([space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0) for t in tracklets])
-    return src, dst, cost - space.link_evidence(looks[src], looks[dst])
+    return src, dst, cost - LOOK_WEIGHT * space.link_evidence(looks[src], looks[dst])
 
 
 def place_in_merges(rows: np.ndarray, measured: np.ndarray, merged: np.ndarray, shapes: np.ndarray | None = None,
