@@ -72,7 +72,7 @@ class BlobEstimate:
 
 
 MIN_SIDE_PX = 16  # frames narrower or lower than this cannot hold a blob against a background (pixels)
-_IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")  # image files of a folder given as the video (as io.video_frames reads them)
+_IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp")  # a folder given as the video: its images (as io.video_frames)
 
 
 def _odd(value: float, lo: int, hi: int) -> int:
