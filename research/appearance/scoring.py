@@ -1,0 +1,57 @@
+"""Scoring loops shared by the development harnesses (dev5.py, dev6.py, dev7.py): each takes ``run(video, n)``, which
+returns one result table per mode, and prints one line per video and a paired summary against the first mode."""
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+from _common import SHARED_DATA  # noqa: E402
+from video_identities import identity_scores  # noqa: E402
+
+from lookalike.bench.datasets import read_hexbug_points  # noqa: E402
+from lookalike.eval import evaluate_points  # noqa: E402
+from lookalike.io.arena_files import write_arena  # noqa: E402
+from lookalike.io.video_frames import source_frames  # noqa: E402
+
+HEXBUG_RADIUS_PX = 120.0
+
+
+def arenas(seeds, run, modes, work: Path) -> np.ndarray:
+    """IDF1 (15 px) per arena seed and mode."""
+    table = []
+    for seed in seeds:
+        files = write_arena(work / f"arena{seed}", seed=seed)
+        truth = np.loadtxt(files.gt, delimiter=",", ndmin=2)
+        ref = np.column_stack([truth[:, :2], truth[:, 2:4] + truth[:, 4:6] / 2])
+        n = len(np.unique(truth[:, 1]))
+        row = [identity_scores(r, ref, n)["IDF1"] for r in run(files.video, n)]
+        table.append(row)
+        print(f"arena {seed}: " + " ".join(f"{m} {v:.4f}" for m, v in zip(modes, row)), flush=True)
+    return np.array(table)
+
+
+def hexbug(run, modes) -> np.ndarray:
+    """IDF1 (within 120 px of the head) per HexBug clip and mode."""
+    table = []
+    for video in sorted((SHARED_DATA / "hexbug").glob("*.mp4")):
+        img = next(iter(source_frames(video)[0]))
+        gt = read_hexbug_points(video.with_suffix(".csv"), (img.shape[1], img.shape[0]))
+        n = len(np.unique(gt[1]))
+        row = []
+        for rows in run(video, n):
+            c = rows[:, 2:4] + rows[:, 4:6] / 2
+            m = evaluate_points(gt[0], gt[1], gt[2], rows[:, 0].astype(int), rows[:, 1].astype(int), c,
+                                radius=HEXBUG_RADIUS_PX, num_frames=101)
+            row.append(m["IDF1"])
+        table.append(row)
+        print(f"hexbug {video.stem} (N={n}): " + " ".join(f"{m} {v:.4f}" for m, v in zip(modes, row)), flush=True)
+    return np.array(table)
+
+
+def summary(name: str, t: np.ndarray, modes) -> None:
+    """Each mode's mean and its paired difference from the first mode's (standard error, seeds up and down)."""
+    for j in range(1, len(modes)):
+        d = t[:, j] - t[:, 0]
+        print(f"{name}: {modes[0]} {t[:, 0].mean():.4f} {modes[j]} {t[:, j].mean():.4f} diff {d.mean():+.4f} "
+              f"(se {d.std(ddof=1) / np.sqrt(len(d)):.4f}; up {(d > 0).sum()}, down {(d < 0).sum()})")
