@@ -69,3 +69,13 @@ def test_animals_in_a_merged_blob_take_its_parts_and_keep_them_from_frame_to_fra
     parts[1] = np.nan  # no split for frame 7's blob: its animals go to the box's ends as without parts
     again = place_in_merges(rows, measured, merged, shapes, parts)
     assert np.array_equal(again[4:], place_in_merges(rows, measured, merged)[4:])
+
+
+def test_parts_must_match_the_shape_vectors():
+    from lookalike.trackers.offline.closed_set import assign_identities
+
+    rows = np.array([[f, 1, 10.0 + f, 10, 5, 5, 1, -1, -1, f - 1] for f in range(1, 6)])
+    with pytest.raises(ValueError, match="parts"):
+        assign_identities(rows, 1, 25.0, shapes=np.zeros((5, 23)), parts=np.zeros((4, PART_SIZE)))
+    with pytest.raises(ValueError, match="parts"):
+        assign_identities(rows, 1, 25.0, parts=np.zeros((5, PART_SIZE)))

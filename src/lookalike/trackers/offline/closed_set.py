@@ -218,6 +218,9 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
         unchanged: np.ndarray = rows.copy()
         return unchanged
     crossing: list[Tracklet] = []
+    if parts is not None and (shapes is None or len(parts) != len(shapes)):
+        raise ValueError(f"parts: expected one per shape vector ({'no shapes' if shapes is None else len(shapes)}), "
+                         f"got {len(parts)}")
     if shapes is not None:
         pieces, crossing = cut_at_merges(pieces, shapes)
         if constraints is not None:  # a merged piece that a constraint names is chained like the others
