@@ -79,3 +79,41 @@ def test_parts_must_match_the_shape_vectors():
         assign_identities(rows, 1, 25.0, shapes=np.zeros((5, 23)), parts=np.zeros((4, PART_SIZE)))
     with pytest.raises(ValueError, match="parts"):
         assign_identities(rows, 1, 25.0, parts=np.zeros((5, PART_SIZE)))
+
+
+def _parts_every_round(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarray:
+    """blob_parts without stopping at convergence: all its rounds, every time (the reference)."""
+    from lookalike.vision.blob_shape import PART_COUNTS
+
+    pts = np.column_stack([xs, ys]).astype(float)
+    centre = pts.mean(axis=0)
+    values, vectors = np.linalg.eigh(np.cov((pts - centre).T) + np.eye(2) / 12)
+    out = []
+    for k in PART_COUNTS:
+        best, best_cost = np.repeat(centre[None], k, axis=0), np.inf
+        for axis in (1, 0):
+            centres = centre + (np.linspace(-1.0, 1.0, k) * np.sqrt(values[axis]))[:, None] * vectors[:, axis]
+            for _ in range(iterations):
+                label = np.argmin(((pts[:, None] - centres[None]) ** 2).sum(axis=2), axis=1)
+                counts = np.bincount(label, minlength=k)
+                if np.any(counts == 0):
+                    break
+                centres = np.column_stack([np.bincount(label, weights=pts[:, d], minlength=k) for d in (0, 1)]) \
+                    / counts[:, None]
+            cost = float(((pts - centres[label]) ** 2).sum()) if np.all(counts > 0) else np.inf
+            if cost < best_cost:
+                best, best_cost = centres, cost
+        out.append(best[np.argsort(best @ vectors[:, 1])])
+    return np.concatenate([c.ravel() for c in out])
+
+
+def test_stopping_at_convergence_gives_the_same_parts():
+    rng = np.random.default_rng(0)
+    for _ in range(60):
+        img = np.zeros((160, 160), np.uint8)
+        for _ in range(int(rng.integers(1, 4))):
+            centre = tuple(int(v) for v in rng.integers(40, 120, 2))
+            axes = (int(rng.integers(5, 40)), int(rng.integers(3, 15)))
+            cv2.ellipse(img, centre, axes, float(rng.uniform(0, 180)), 0, 360, 255, -1)
+        xs, ys = _pixels(img > 0)
+        assert np.array_equal(blob_parts(xs, ys), _parts_every_round(xs, ys))

@@ -86,8 +86,12 @@ def blob_parts(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarra
         for axis in (1, 0):
             offsets = np.linspace(-1.0, 1.0, k) * np.sqrt(values[axis])
             centres = centre + offsets[:, None] * vectors[:, axis]
+            previous = None
             for _ in range(iterations):
                 label = np.argmin(((pts[:, None] - centres[None]) ** 2).sum(axis=2), axis=1)
+                if previous is not None and np.array_equal(label, previous):
+                    break  # converged: more rounds would give the same parts
+                previous = label
                 counts = np.bincount(label, minlength=k)
                 if np.any(counts == 0):
                     break
