@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.geometry.camera import Camera
-from lookalike.pipeline.robots import one_blas_thread
+from lookalike.parallel import one_blas_thread
 from lookalike.sim import PRESET_NAMES, preset, simulate_robots
 from lookalike.sim.robot_camera import pixel_camera, world_for_camera
 from lookalike.vision.detection_probability import DetectionProbability, fit_quantile_map

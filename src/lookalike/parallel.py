@@ -4,8 +4,9 @@ results."""
 from __future__ import annotations
 
 import multiprocessing
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
+from contextlib import contextmanager
 from typing import Any
 
 from lookalike._optional import needs
@@ -83,3 +84,16 @@ def init_ray(address: str | None, workers: int) -> Any:
             ray.init(num_cpus=workers if workers > 1 else None, ignore_reinit_error=True,
                      include_dashboard=False, log_to_driver=False)
     return ray
+
+
+@contextmanager
+def one_blas_thread() -> Iterator[None]:
+    """BLAS and LAPACK on the calling thread only inside the block (threadpoolctl, when installed): faster for the
+    small matrices of the heading SVM and the node's per-frame work than a pool's hand-offs."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover (scikit-learn, a core dependency, requires it)
+        yield
+        return
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield

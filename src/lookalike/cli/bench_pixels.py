@@ -12,7 +12,7 @@ from lookalike.bench.tables import write_rows
 from lookalike.cli.app import check_names, check_outputs_or_fail, check_teams, command_line, fail, failing, split_list
 from lookalike.cli.bench import SETUPS_HELP, bench_app, print_rows, trained_only, write_results
 from lookalike.cli.progress import progress_bars
-from lookalike.pipeline.robots import one_blas_thread
+from lookalike.parallel import one_blas_thread
 from lookalike.sim.robot_camera import pixel_camera
 from lookalike.vision.pipeline import IDENTIFIERS, PipelineConfig, RobotPipeline
 

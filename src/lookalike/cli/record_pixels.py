@@ -33,7 +33,7 @@ def record_pixels(
     from lookalike.bench.pixel_recordings import record_pixels as record
     from lookalike.bench.pixel_recordings import write_recording
     from lookalike.cli.progress import progress_bars
-    from lookalike.pipeline.robots import one_blas_thread
+    from lookalike.parallel import one_blas_thread
     from lookalike.sim.robot_camera import pixel_camera
     from lookalike.vision.pipeline import PipelineConfig, RobotPipeline
 

@@ -11,8 +11,7 @@ import logging
 import selectors
 import socket
 import time
-from collections.abc import Callable, Hashable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 from typing import TypeVar
 
@@ -29,6 +28,7 @@ from lookalike.node.messages import (
     decode,
     encode,
 )
+from lookalike.parallel import one_blas_thread
 
 Address = tuple[str, int]
 LOCALHOST = "127.0.0.1"
@@ -43,18 +43,6 @@ def _preload() -> None:
 
     linear_sum_assignment(np.zeros((1, 1)))
     warm()
-
-
-@contextmanager
-def _one_blas_thread() -> Iterator[None]:
-    """BLAS and LAPACK on the calling thread only inside the block (threadpoolctl, when installed)."""
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover (scikit-learn, a core dependency, requires it)
-        yield
-        return
-    with threadpool_limits(limits=1, user_api="blas"):
-        yield
 
 
 def parse_address(text: str, default_host: str = LOCALHOST) -> Address:
@@ -151,7 +139,7 @@ class NodeCore(abc.ABC):
         gc.collect()
         gc.freeze()
         try:
-            with _one_blas_thread():
+            with one_blas_thread():
                 while not stop():
                     self.poll(tick_s)
         finally:

@@ -5,7 +5,6 @@ the detector, heading estimator and identifier of :class:`lookalike.vision.pipel
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -16,6 +15,7 @@ from lookalike.io.robot_sequences import read_robot_sequence
 from lookalike.io.stream import MotWriter
 from lookalike.loop import RunStats
 from lookalike.loop import run as run_loop
+from lookalike.parallel import one_blas_thread
 from lookalike.pipeline.request import TrackRequest
 from lookalike.pipeline.runner import Event, RunResult
 from lookalike.sim import RobotSequence
@@ -101,18 +101,6 @@ def prepare_robots(video: Path | None, reports: Path | None, identifier: str, se
     source = bag if bag is not None else video
     assert source is not None
     return RobotRun(identifier, source, reports or source, seq, pipe, images, total, fps)
-
-
-@contextmanager
-def one_blas_thread() -> Iterator[None]:
-    """Limit BLAS to one thread inside the block (threadpoolctl, when installed): faster for the heading SVM."""
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        yield
-        return
-    with threadpool_limits(limits=1, user_api="blas"):
-        yield
 
 
 @dataclass(frozen=True)
@@ -235,5 +223,5 @@ def robot_video(sequence: Path, seed: int = 0) -> tuple[RobotSequence, Iterator[
 
 
 __all__ = ["PIPELINES", "SIZE_TOLERANCE", "PipelineStep", "PixelFrame", "RobotRun", "check_robots", "dropped",
-           "identify_robots", "identify_video", "one_blas_thread", "pixel_frames", "prepare_robots", "robot_video",
+           "identify_robots", "identify_video", "pixel_frames", "prepare_robots", "robot_video",
            "run_robots"]
