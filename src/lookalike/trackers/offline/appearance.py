@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lookalike.association.solver import assign_pairs
 from lookalike.trackers.offline.tracklets import Tracklet
 
 __all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "place_in_merges", "single_rows",
@@ -223,8 +224,6 @@ def _on_parts(out: np.ndarray, before: np.ndarray, loose: np.ndarray, merged: np
     take the parts by one assignment of least total cost: the distance from an identity's interpolated centre (in
     ``before``) plus the distance from its part in the previous frame (the interpolated centre again if it had
     none); an identity more than one blob size ``sqrt(w*h)`` outside a blob's box cannot take its parts."""
-    from scipy.optimize import linear_sum_assignment
-
     single = float(np.median(areas))
     frames = before[loose, 0].astype(int)
     last: dict[int, tuple[int, np.ndarray]] = {}
@@ -254,7 +253,6 @@ def _on_parts(out: np.ndarray, before: np.ndarray, loose: np.ndarray, merged: np
             if seen is not None and seen[0] == f - 1:
                 prev[i] = seen[1]
         cost = np.linalg.norm(c[:, None] - at[None], axis=2) + np.linalg.norm(prev[:, None] - at[None], axis=2)
-        for i, j in zip(*linear_sum_assignment(np.where(ok, cost, 1e9))):
-            if ok[i, j]:
-                out[ks[i], 2:4] = at[j] - out[ks[i], 4:6] / 2
-                last[int(before[ks[i], 1])] = (f, at[j])
+        for i, j in assign_pairs(np.where(ok, cost, np.inf)):
+            out[ks[i], 2:4] = at[j] - out[ks[i], 4:6] / 2
+            last[int(before[ks[i], 1])] = (f, at[j])
