@@ -10,8 +10,6 @@ from pathlib import Path
 import scoring
 
 import lookalike.trackers.offline.closed_set as closed_set
-from lookalike.io.video_frames import source_frames
-from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections
 from lookalike.trackers.offline.appearance import head_first
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
 from lookalike.vision.blob_shape import LOOK_SIZE
@@ -21,9 +19,7 @@ MODES = ("round5", "round6")
 
 
 def run(video, n):
-    config, _ = auto_blob_config(video, [], n)
-    found = cached_blob_detections(video, config, cache=work / "cache")
-    fps = source_frames(video)[2] or 25.0
+    found, fps = scoring.detected(video, n, work)
     out = []
     for mode in MODES:
         closed_set.head_first = head_first if mode == "round6" else (lambda rows, shapes: shapes[:, :LOOK_SIZE])

@@ -8,8 +8,6 @@ from pathlib import Path
 import scoring
 
 import lookalike.trackers.offline.appearance as appearance
-from lookalike.io.video_frames import source_frames
-from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections
 from lookalike.trackers.offline.closed_set import track_closed_set
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
 
@@ -19,9 +17,7 @@ MODES = tuple(f"w={w:g}" for w in WEIGHTS)
 
 
 def run(video, n):
-    config, _ = auto_blob_config(video, [], n)
-    found = cached_blob_detections(video, config, cache=work / "cache")
-    fps = source_frames(video)[2] or 25.0
+    found, fps = scoring.detected(video, n, work)
     out = []
     for w in WEIGHTS:
         appearance.LOOK_WEIGHT = w

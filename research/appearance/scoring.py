@@ -13,8 +13,16 @@ from lookalike.bench.datasets import read_hexbug_points  # noqa: E402
 from lookalike.eval import evaluate_points  # noqa: E402
 from lookalike.io.arena_files import write_arena  # noqa: E402
 from lookalike.io.video_frames import source_frames  # noqa: E402
+from lookalike.pipeline.blob_detections import BlobRows, auto_blob_config, cached_blob_detections  # noqa: E402
 
 HEXBUG_RADIUS_PX = 120.0
+
+
+def detected(video: Path, n: int, work: Path) -> tuple[BlobRows, float]:
+    """The blobs of ``video`` with the settings estimated for ``n`` animals (cached under ``work``), and its frame
+    rate."""
+    found = cached_blob_detections(video, auto_blob_config(video, [], n)[0], cache=work / "cache")
+    return found, source_frames(video)[2] or 25.0
 
 
 def arenas(seeds, run, modes, work: Path) -> np.ndarray:
