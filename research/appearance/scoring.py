@@ -14,6 +14,8 @@ from lookalike.eval import evaluate_points  # noqa: E402
 from lookalike.io.arena_files import write_arena  # noqa: E402
 from lookalike.io.video_frames import source_frames  # noqa: E402
 from lookalike.pipeline.blob_detections import BlobRows, auto_blob_config, cached_blob_detections  # noqa: E402
+from lookalike.trackers.offline.closed_set import track_closed_set  # noqa: E402
+from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS  # noqa: E402
 
 HEXBUG_RADIUS_PX = 120.0
 
@@ -23,6 +25,29 @@ def detected(video: Path, n: int, work: Path) -> tuple[BlobRows, float]:
     rate."""
     found = cached_blob_detections(video, auto_blob_config(video, [], n)[0], cache=work / "cache")
     return found, source_frames(video)[2] or 25.0
+
+
+def with_each(found: BlobRows, fps: float, n: int, module, name: str, values) -> list[np.ndarray]:
+    """The closed set (the command's parameters, with the look and the parts) once per value of ``module.name``,
+    restored afterwards."""
+    kept, out = getattr(module, name), []
+    try:
+        for value in values:
+            setattr(module, name, value)
+            out.append(track_closed_set(found.rows, n, fps, n_frames=found.frames, online=dict(BOX_TRACKER_PARAMS),
+                                        shapes=found.shapes, parts=found.parts))
+    finally:
+        setattr(module, name, kept)
+    return out
+
+
+def main(run, modes, work: Path, seeds=(*range(10), *range(4000, 4020))) -> None:
+    """``dev*.py [arenas,hexbug]``: the arenas ``seeds`` and the HexBug clips, each mode against the first."""
+    which = sys.argv[1].split(",") if len(sys.argv) > 1 else ["arenas", "hexbug"]
+    if "arenas" in which:
+        summary(f"arenas {seeds[0]}-{seeds[-1]} ({len(seeds)})", arenas(seeds, run, modes, work), modes)
+    if "hexbug" in which:
+        summary("hexbug", hexbug(run, modes), modes)
 
 
 def arenas(seeds, run, modes, work: Path) -> np.ndarray:
