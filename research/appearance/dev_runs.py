@@ -5,66 +5,23 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import scoring  # (puts benchmarks/ on the path)
+from video_identities import run_track
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-from _common import SHARED_DATA  # noqa: E402
-from video_identities import identity_scores, run_track  # noqa: E402
-
-from lookalike.bench.datasets import read_hexbug_points  # noqa: E402
-from lookalike.eval import evaluate_points  # noqa: E402
-from lookalike.io.arena_files import write_arena  # noqa: E402
-from lookalike.io.video_frames import source_frames  # noqa: E402
-from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections  # noqa: E402
-from lookalike.trackers.offline.closed_set import track_closed_set  # noqa: E402
-from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS  # noqa: E402
+from lookalike.trackers.offline.closed_set import track_closed_set
+from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
 
 work = Path(tempfile.mkdtemp(prefix="appearance-dev-"))
+MODES = ("online", "offline", "offline+look")
 
 
-def offline(video: Path, n: int):
-    config, _ = auto_blob_config(video, [], n)
-    found = cached_blob_detections(video, config)
-    fps = source_frames(video)[2] or 25.0
-    out = []
-    for use in (False, True):
-        out.append(track_closed_set(found.rows, n, fps, n_frames=found.frames, online=dict(BOX_TRACKER_PARAMS),
-                                    shapes=found.shapes if use else None))
-    return out
-
-
-def arenas(seeds):
-    table = []
-    for seed in seeds:
-        files = write_arena(work / f"arena{seed}", seed=seed)
-        truth = np.loadtxt(files.gt, delimiter=",", ndmin=2)
-        ref = np.column_stack([truth[:, :2], truth[:, 2:4] + truth[:, 4:6] / 2])
-        n = len(np.unique(truth[:, 1]))
-        online, _ = run_track(files.video, n, [], work / f"on{seed}.txt", work / "cache")
-        plain, look = offline(files.video, n)
-        row = [identity_scores(r, ref, n)["IDF1"] for r in (online, plain, look)]
-        table.append(row)
-        print(f"arena {seed}: online {row[0]:.4f} offline {row[1]:.4f} offline+look {row[2]:.4f}", flush=True)
-    return np.array(table)
-
-
-def hexbug():
-    table = []
-    for video in sorted((SHARED_DATA / "hexbug").glob("*.mp4")):
-        frames, _, _ = source_frames(video)
-        img = next(iter(frames))
-        gt = read_hexbug_points(video.with_suffix(".csv"), (img.shape[1], img.shape[0]))
-        n = len(np.unique(gt[1]))
-        online, _ = run_track(video, n, [], work / f"{video.stem}.txt", work / "cache")
-        row = []
-        for rows in (online, *offline(video, n)):
-            c = rows[:, 2:4] + rows[:, 4:6] / 2
-            m = evaluate_points(gt[0], gt[1], gt[2], rows[:, 0].astype(int), rows[:, 1].astype(int), c, radius=120.0,
-                                num_frames=101)
-            row.append(m["IDF1"])
-        table.append(row)
-        print(f"hexbug {video.stem} (N={n}): online {row[0]:.4f} offline {row[1]:.4f} offline+look {row[2]:.4f}",
-              flush=True)
-    return np.array(table)
+def run(video: Path, n: int):
+    """The online closed set (the command), then the offline one without and with the learned look (the package,
+    the command's parameters; the package as it now is, without the merged blobs' parts)."""
+    online, _ = run_track(video, n, ["--online"], work / f"{video.stem}-online.txt", work / "cache")
+    found, fps = scoring.detected(video, n, work)
+    return [online, *(track_closed_set(found.rows, n, fps, n_frames=found.frames, online=dict(BOX_TRACKER_PARAMS),
+                                       shapes=found.shapes if use else None) for use in (False, True))]
 
 
 def summary(name, t):
@@ -77,6 +34,6 @@ def summary(name, t):
 if __name__ == "__main__":
     which = sys.argv[1:] or ["arenas", "hexbug"]
     if "arenas" in which:
-        summary("arenas 0-9", arenas(range(10)))
+        summary("arenas 0-9", scoring.arenas(range(10), run, MODES, work))
     if "hexbug" in which:
-        summary("hexbug", hexbug())
+        summary("hexbug", scoring.hexbug(run, MODES))
