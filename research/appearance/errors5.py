@@ -1,7 +1,8 @@
 """Where the default's identity errors are on the development arenas (seeds 0-9): each reference point, under the
 global id mapping of IDF1, is right (mapped id within 15 px), swapped (another id within 15 px), misplaced (no id
 within 15 px, the mapped one present) or missing; split by whether the animal touches another (its reference
-centre within CONTACT body lengths of another's). Not a scoring run."""
+centre within CONTACT body lengths of another's). Not a scoring run. Runs the command's default closed set (with
+the detector's parts since round 5; the round-5 diagnosis in rule5.md ran before parts existed). Arguments: seeds."""
 import sys
 import tempfile
 from pathlib import Path
@@ -65,7 +66,7 @@ for seed in (range(10) if len(sys.argv) < 2 else [int(s) for s in sys.argv[1:]])
     found = cached_blob_detections(files.video, config)
     fps = source_frames(files.video)[2] or 25.0
     rows = track_closed_set(found.rows, n, fps, n_frames=found.frames, online=dict(BOX_TRACKER_PARAMS),
-                            shapes=found.shapes)
+                            shapes=found.shapes, parts=found.parts)
     counts = classify(rows, truth)
     for k, v in counts.items():
         total[k] = total.get(k, 0) + v
