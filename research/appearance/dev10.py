@@ -1,0 +1,54 @@
+"""Development runs of research/appearance/rule10.md (arena seeds 0-9 and 4000-4019, the 14 HexBug clips): round 7's
+look (a normal on the log look distance, clamped below the "one animal" mean; `appearance.py` as of 423b986, read from
+git) against round 10's (the distance a gamma under either hypothesis, no clamp; the package's). Not a scoring run.
+Usage: dev10.py [arenas,hexbug]. Round 10 was not kept:
+this compares the two only on a tree with its code (`git apply research/appearance/round10.patch`), as rule10.md
+says; without it both columns are round 7's."""
+import importlib.util
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import scoring
+
+import lookalike.trackers.offline.appearance as appearance
+import lookalike.trackers.offline.closed_set as closed_set
+
+work = Path(tempfile.mkdtemp(prefix="appearance-dev10-"))
+MODES = ("round7", "round10")
+BASELINE = "423b986"
+
+
+def baseline_module():
+    """Round 7's appearance module, from git, under a name of its own."""
+    root = Path(__file__).resolve().parents[2]
+    text = subprocess.run(["git", "-C", str(root), "show", f"{BASELINE}:src/lookalike/trackers/offline/appearance.py"],
+                          capture_output=True, text=True, check=True).stdout
+    path = work / "appearance_round7.py"
+    path.write_text(text)
+    spec = importlib.util.spec_from_file_location("appearance_round7", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+ROUND7 = baseline_module()
+
+
+def run(video, n):
+    found, fps = scoring.detected(video, n, work)
+    out = []
+    for module in (ROUND7, appearance):
+        kept = closed_set.with_appearance
+        closed_set.with_appearance = module.with_appearance
+        try:
+            out += scoring.with_each(found, fps, n, closed_set, "fit_identity_space", [module.fit_identity_space])
+        finally:
+            closed_set.with_appearance = kept
+    return out
+
+
+if __name__ == "__main__":
+    scoring.main(run, MODES, work)
