@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.trackers.offline.appearance import place_in_merges
+from lookalike.trackers.offline.merges import place_in_merges
 from lookalike.vision.blob_shape import PART_SIZE, blob_parts
 
 cv2 = pytest.importorskip("cv2")
@@ -69,6 +69,28 @@ def test_animals_in_a_merged_blob_take_its_parts_and_keep_them_from_frame_to_fra
     parts[1] = np.nan  # no split for frame 7's blob: its animals go to the box's ends as without parts
     again = place_in_merges(rows, measured, merged, shapes, parts)
     assert np.array_equal(again[4:], place_in_merges(rows, measured, merged)[4:])
+
+
+def test_animals_that_cross_inside_a_merged_blob_leave_it_on_the_sides_they_come_out_on():
+    # two animals 10x4 px swap sides inside a merged blob (frames 6-8) whose two parts stand still at x 105 and 125;
+    # frame by frame, each would keep the part it took first; over the whole contact, the placement of the last frame
+    # agrees with where each is seen right after it (frame 9)
+    rows = np.array([[5, 1, 95, 50, 10, 4], [5, 2, 125, 50, 10, 4],  # measured before: 1 left, 2 right
+                     *[[f, i, 0, 50, 10, 4] for f in (6, 7, 8) for i in (1, 2)],  # interpolated inside
+                     [9, 1, 125, 50, 10, 4], [9, 2, 95, 50, 10, 4]], float)  # measured after: 1 right, 2 left
+    for k, f in enumerate((6, 7, 8)):  # the straight line from before to after
+        rows[2 + 2 * k, 2] = 95 + 30 * (f - 5) / 4
+        rows[3 + 2 * k, 2] = 125 - 30 * (f - 5) / 4
+    measured = np.array([True, True, *[False] * 6, True, True])
+    merged = np.array([[f, -1, 100, 49, 30, 6, 1, -1, -1, k] for k, f in enumerate((6, 7, 8))], float)
+    shapes = np.zeros((5, 4))
+    shapes[:, 0] = np.log([200.0, 200.0, 200.0, 100.0, 100.0])  # the merged blobs twice the median blob
+    parts = np.full((5, PART_SIZE), np.nan)
+    parts[:3, :4] = [105, 52, 125, 52]
+    out = place_in_merges(rows, measured, merged, shapes, parts)
+    x = dict(zip(map(tuple, out[:, :2].astype(int).tolist()), (out[:, 2] + out[:, 4] / 2).tolist()))
+    assert (x[6, 1], x[6, 2]) == (105, 125)  # as they came in
+    assert (x[8, 1], x[8, 2]) == (125, 105)  # as they go out
 
 
 def test_parts_must_match_the_shape_vectors():

@@ -152,7 +152,7 @@ def test_proofreading_re_solves_with_the_look_and_may_name_a_merged_blob():
 
 
 def test_animals_interpolated_through_a_merged_blob_move_to_its_ends():
-    from lookalike.trackers.offline.appearance import place_in_merges
+    from lookalike.trackers.offline.merges import place_in_merges
 
     # two animals 10x4 px pass each other inside one merged blob 30x6 px (left 100..130, top 50..56): interpolated
     # both sit near its middle, in their order along x

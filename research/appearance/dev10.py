@@ -4,9 +4,6 @@ git) against round 10's (the distance a gamma under either hypothesis, no clamp;
 Usage: dev10.py [arenas,hexbug]. Round 10 was not kept:
 this compares the two only on a tree with its code (`git apply research/appearance/round10.patch`), as rule10.md
 says; without it both columns are round 7's."""
-import importlib.util
-import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
@@ -20,21 +17,7 @@ MODES = ("round7", "round10")
 BASELINE = "423b986"
 
 
-def baseline_module():
-    """Round 7's appearance module, from git, under a name of its own."""
-    root = Path(__file__).resolve().parents[2]
-    text = subprocess.run(["git", "-C", str(root), "show", f"{BASELINE}:src/lookalike/trackers/offline/appearance.py"],
-                          capture_output=True, text=True, check=True).stdout
-    path = work / "appearance_round7.py"
-    path.write_text(text)
-    spec = importlib.util.spec_from_file_location("appearance_round7", path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-ROUND7 = baseline_module()
+ROUND7 = scoring.module_at(BASELINE, "src/lookalike/trackers/offline/appearance.py", work)
 
 
 def run(video, n):

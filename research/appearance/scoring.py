@@ -1,5 +1,7 @@
-"""Scoring loops shared by the development harnesses (dev5.py, dev6.py, dev7.py): each takes ``run(video, n)``, which
+"""Scoring loops shared by the development harnesses (dev5.py to dev11.py): each takes ``run(video, n)``, which
 returns one result table per mode, and prints one line per video and a paired summary against the first mode."""
+import importlib.util
+import subprocess
 import sys
 from pathlib import Path
 
@@ -25,6 +27,21 @@ def detected(video: Path, n: int, work: Path) -> tuple[BlobRows, float]:
     rate."""
     found = cached_blob_detections(video, auto_blob_config(video, [], n)[0], cache=work / "cache")
     return found, source_frames(video)[2] or 25.0
+
+
+def module_at(commit: str, path: str, work: Path):
+    """The package module at ``path`` (e.g. src/lookalike/trackers/offline/appearance.py) as of ``commit``, read from
+    git and loaded under a name of its own (``<stem>_<commit>``), for a baseline beside the working tree's."""
+    root = Path(__file__).resolve().parents[2]
+    text = subprocess.run(["git", "-C", str(root), "show", f"{commit}:{path}"], capture_output=True, text=True,
+                          check=True).stdout
+    name = f"{Path(path).stem}_{commit}"
+    (work / f"{name}.py").write_text(text)
+    spec = importlib.util.spec_from_file_location(name, work / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
 
 
 def with_each(found: BlobRows, fps: float, n: int, module, name: str, values) -> list[np.ndarray]:

@@ -18,11 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.association.solver import assign_pairs
 from lookalike.trackers.offline.tracklets import Tracklet
 
-__all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "place_in_merges", "single_rows",
-           "with_appearance"]
+__all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "single_rows", "with_appearance"]
 
 SINGLE_AREA = (0.6, 1.5)  # a blob shows one animal when its area is within these multiples of its track's median
 MIN_ROWS = 8  # single-animal rows a tracklet needs to teach or be judged by its look
@@ -31,7 +29,6 @@ LOOK_WEIGHT = 2.0  # a link's cost is lowered by this times its look's log-likel
 SHAPE_COLUMN = 9  # the column of an input row that holds its shape vector's index
 MIN_SPREAD = 0.1  # smallest spread of a log look distance (a floor for the fits on few pairs)
 UNTRUSTED_SHARE = 0.135  # more of the online pass's rows not one animal's size: no look (research/appearance/rule4.md)
-MERGE_REACH = 0.25  # an interpolated centre this many blob sizes sqrt(w*h) outside a merged blob's box is not in it
 
 
 def single_rows(rows: np.ndarray, shapes: np.ndarray) -> np.ndarray:
@@ -172,87 +169,3 @@ def with_appearance(tracklets: list[Tracklet], links: tuple[np.ndarray, np.ndarr
         return links
     looks = np.array([space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0) for t in tracklets])
     return src, dst, cost - LOOK_WEIGHT * space.link_evidence(looks[src], looks[dst])
-
-
-def place_in_merges(rows: np.ndarray, measured: np.ndarray, merged: np.ndarray, shapes: np.ndarray | None = None,
-                    parts: np.ndarray | None = None) -> np.ndarray:
-    """Result ``rows`` ``(k, >= 6)`` (1-based frame, id, ``x, y, w, h`` px) with the identities that share a merged
-    blob moved onto it. ``measured``: mask of the rows that hold a detection (the others were interpolated across a
-    gap); ``merged``: rows of the merged blobs (frame, -, box, ..., column 9 indexing ``shapes`` and ``parts``).
-
-    In each merged blob's frame the interpolated rows whose centres lie within its box (:data:`MERGE_REACH`) are its
-    animals; the two farthest apart keep their order along the line between them and move to the box's ends on that
-    line, each its own typical size (median measured ``w, h``) inside the box; any others stay interpolated. With the
-    blobs' ``parts`` (:func:`~lookalike.vision.blob_shape.blob_part_vectors`) and ``shapes``, the identities then
-    take the parts' centroids instead (:func:`_on_parts`)."""
-    out = np.array(rows, dtype=float, copy=True)
-    ids = out[:, 1].astype(int)
-    size = {i: np.median(out[measured & (ids == i), 4:6], axis=0) if np.any(measured & (ids == i)) else None
-            for i in np.unique(ids).tolist()}
-    loose = np.flatnonzero(~measured)
-    frames = out[loose, 0].astype(int)
-    for f, x0, y0, w, h in zip(merged[:, 0].astype(int), *merged[:, 2:6].T):
-        centre, reach = np.array([x0 + w / 2, y0 + h / 2]), MERGE_REACH * math.sqrt(w * h)
-        ks = loose[frames == f]
-        c = out[ks, 2:4] + out[ks, 4:6] / 2
-        inside = np.all(np.abs(c - centre) <= np.array([w, h]) / 2 + reach, axis=1)
-        ks, c = ks[inside], c[inside]
-        if len(ks) < 2:
-            continue
-        gaps = np.linalg.norm(c[:, None] - c[None], axis=2)
-        a, b = np.unravel_index(np.argmax(gaps), gaps.shape)
-        if gaps[a, b] < 1.0:
-            continue
-        d = (c[b] - c[a]) / gaps[a, b]
-        extent = abs(d[0]) * w + abs(d[1]) * h  # the box's width along d
-        for k, side in ((ks[a], -1.0), (ks[b], 1.0)):
-            own = size[int(out[k, 1])]
-            own = out[k, 4:6] if own is None else own
-            out[k, 2:4] = centre + side * d * max(extent - abs(d[0]) * own[0] - abs(d[1]) * own[1], 0.0) / 2 \
-                - out[k, 4:6] / 2
-    if parts is not None and shapes is not None and len(merged):
-        _on_parts(out, np.asarray(rows, dtype=float), loose, merged, np.exp(shapes[:, 0]), parts)
-    return out
-
-
-def _on_parts(out: np.ndarray, before: np.ndarray, loose: np.ndarray, merged: np.ndarray, areas: np.ndarray,
-              parts: np.ndarray) -> None:
-    """Move the interpolated rows ``loose`` of ``out`` onto the parts of the merged blobs, frame by frame in order.
-
-    A merged blob holds 2 or 3 animals, its area (px², ``areas`` by column 9) over the median blob's, rounded; its
-    parts are the centroids of that split (no parts: left as they are). In each frame, the interpolated identities
-    take the parts by one assignment of least total cost: the distance from an identity's interpolated centre (in
-    ``before``) plus the distance from its part in the previous frame (the interpolated centre again if it had
-    none); an identity more than one blob size ``sqrt(w*h)`` outside a blob's box cannot take its parts."""
-    single = float(np.median(areas))
-    frames = before[loose, 0].astype(int)
-    last: dict[int, tuple[int, np.ndarray]] = {}
-    merged = merged[np.argsort(merged[:, 0], kind="stable")]
-    for f in np.unique(merged[:, 0]).astype(int):
-        ks = loose[frames == f]
-        if not len(ks):
-            continue
-        c = before[ks, 2:4] + before[ks, 4:6] / 2
-        slots, allowed = [], []
-        for row in merged[merged[:, 0] == f]:
-            x0, y0, w, h = row[2:6]
-            count = int(np.clip(round(areas[int(row[SHAPE_COLUMN])] / single), 2, 3))
-            part = parts[int(row[SHAPE_COLUMN])]
-            part = part[:4] if count == 2 else part[4:]
-            if np.isnan(part).any():
-                continue
-            near = np.all(np.abs(c - [x0 + w / 2, y0 + h / 2]) <= np.array([w, h]) / 2 + math.sqrt(w * h), axis=1)
-            slots.extend(part.reshape(count, 2))
-            allowed.extend([near] * count)
-        if not slots:
-            continue
-        at, ok = np.array(slots), np.array(allowed).T
-        prev = c.copy()
-        for i, k in enumerate(ks):
-            seen = last.get(int(before[k, 1]))
-            if seen is not None and seen[0] == f - 1:
-                prev[i] = seen[1]
-        cost = np.linalg.norm(c[:, None] - at[None], axis=2) + np.linalg.norm(prev[:, None] - at[None], axis=2)
-        for i, j in assign_pairs(np.where(ok, cost, np.inf)):
-            out[ks[i], 2:4] = at[j] - out[ks[i], 4:6] / 2
-            last[int(before[ks[i], 1])] = (f, at[j])

@@ -29,7 +29,6 @@ from lookalike.trackers.offline.appearance import (
     UNTRUSTED_SHARE,
     cut_at_merges,
     fit_identity_space,
-    place_in_merges,
     single_rows,
     with_appearance,
 )
@@ -44,6 +43,7 @@ from lookalike.trackers.offline.constraints import (
     with_marks,
 )
 from lookalike.trackers.offline.gap_fill import fill_gaps, smooth_boxes
+from lookalike.trackers.offline.merges import place_in_merges
 from lookalike.trackers.offline.tracklets import (
     Tracklet,
     checked_rows,
@@ -206,7 +206,7 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     learned from the video weighs in every link (:mod:`~lookalike.trackers.offline.appearance`), merged blobs
     are left out of the tracklets and the identities interpolated through one are moved to its ends, or with
     ``parts`` (``(n, PART_SIZE)``, indexed as ``shapes``) onto its parts
-    (:func:`~lookalike.trackers.offline.appearance.place_in_merges`)."""
+    (:func:`~lookalike.trackers.offline.merges.place_in_merges`)."""
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
