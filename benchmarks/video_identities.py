@@ -8,7 +8,7 @@ within ``RADIUS_PX``; one global one-to-one mapping of result ids to reference i
 animals has its mapped id within reach. CPU time is the command's, learning included, on a fresh detection cache.
 
 Arenas: ``lookalike simulate --arena`` defaults, seeds ``--seeds`` (7000-7019 by default: never used for any choice;
-research/appearance/rule7.md). test_A: ``../shared/data/zebrafish/test_A.avi`` against ``idtracker_test_A.csv``.
+research/appearance/rule11.md). test_A: ``../shared/data/zebrafish/test_A.avi`` against ``idtracker_test_A.csv``.
 
     python benchmarks/video_identities.py [--seeds 7000-7019] [--no-test-a] [--no-arenas] [--modes default online]
 """
