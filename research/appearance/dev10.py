@@ -10,7 +10,6 @@ from pathlib import Path
 import scoring
 
 import lookalike.trackers.offline.appearance as appearance
-import lookalike.trackers.offline.closed_set as closed_set
 
 work = Path(tempfile.mkdtemp(prefix="appearance-dev10-"))
 MODES = ("round7", "round10")
@@ -22,15 +21,7 @@ ROUND7 = scoring.module_at(BASELINE, "src/lookalike/trackers/offline/appearance.
 
 def run(video, n):
     found, fps = scoring.detected(video, n, work)
-    out = []
-    for module in (ROUND7, appearance):
-        kept = closed_set.with_appearance
-        closed_set.with_appearance = module.with_appearance
-        try:
-            out += scoring.with_each(found, fps, n, closed_set, "fit_identity_space", [module.fit_identity_space])
-        finally:
-            closed_set.with_appearance = kept
-    return out
+    return scoring.with_looks(found, fps, n, (ROUND7, appearance))
 
 
 if __name__ == "__main__":

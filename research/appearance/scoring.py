@@ -58,6 +58,22 @@ def with_each(found: BlobRows, fps: float, n: int, module, name: str, values) ->
     return out
 
 
+def with_looks(found: BlobRows, fps: float, n: int, modules) -> list[np.ndarray]:
+    """The closed set (as :func:`with_each`) once with each appearance module's look (``fit_identity_space`` and
+    ``with_appearance``, patched into the closed set and restored afterwards)."""
+    import lookalike.trackers.offline.closed_set as closed_set
+
+    out = []
+    for module in modules:
+        kept = closed_set.with_appearance
+        closed_set.with_appearance = module.with_appearance
+        try:
+            out += with_each(found, fps, n, closed_set, "fit_identity_space", [module.fit_identity_space])
+        finally:
+            closed_set.with_appearance = kept
+    return out
+
+
 def main(run, modes, work: Path, seeds=(*range(10), *range(4000, 4020))) -> None:
     """``dev*.py [arenas,hexbug]``: the arenas ``seeds`` and the HexBug clips, each mode against the first."""
     which = sys.argv[1].split(",") if len(sys.argv) > 1 else ["arenas", "hexbug"]
