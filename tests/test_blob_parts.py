@@ -93,6 +93,27 @@ def test_animals_that_cross_inside_a_merged_blob_leave_it_on_the_sides_they_come
     assert (x[8, 1], x[8, 2]) == (125, 105)  # as they go out
 
 
+def test_placement_over_separate_contacts_with_more_animals_than_parts():
+    # three animals near one merged blob split in 2 (frame 6), then again after a frame without a merge (frame 8):
+    # each frame places two of them on the two parts, the third stays where it was interpolated; rows never change
+    # size, and the frame between the contacts is left alone
+    rows = np.array([[f, i, 100 + 10 * i, 50, 10, 4] for f in (5, 6, 7, 8, 9) for i in (1, 2, 3)], float)
+    measured = np.isin(rows[:, 0], (5, 9))
+    merged = np.array([[6, -1, 105, 49, 30, 6, 1, -1, -1, 0], [8, -1, 105, 49, 30, 6, 1, -1, -1, 1]], float)
+    shapes = np.zeros((4, 4))
+    shapes[:, 0] = np.log([200.0, 200.0, 100.0, 100.0])
+    parts = np.full((4, PART_SIZE), np.nan)
+    parts[:2, :4] = [112, 52, 128, 52]
+    out = place_in_merges(rows, measured, merged, shapes, parts)
+    centres = out[:, 2:4] + out[:, 4:6] / 2
+    for f in (6, 8):
+        at = centres[rows[:, 0] == f]
+        assert sum(any(np.allclose(c, p) for p in ([112, 52], [128, 52])) for c in at) == 2
+        assert len({tuple(c) for c in at}) == 3  # no two animals on one part
+    assert np.array_equal(out[rows[:, 0] == 7], rows[rows[:, 0] == 7]) and np.array_equal(out[:, 4:6], rows[:, 4:6])
+    assert np.array_equal(out[measured], rows[measured])
+
+
 def test_parts_must_match_the_shape_vectors():
     from lookalike.trackers.offline.closed_set import assign_identities
 
