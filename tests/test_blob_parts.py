@@ -114,6 +114,20 @@ def test_placement_over_separate_contacts_with_more_animals_than_parts():
     assert np.array_equal(out[measured], rows[measured])
 
 
+def test_the_cheapest_placements_are_those_of_the_full_list():
+    # where animals crowd round many parts, the placements are ranked (Murty) instead of listed one by one: the
+    # same cheapest placements, in the same order, as the full list sorted by cost
+    from lookalike.trackers.offline.merges import _cheapest_placements, _placements
+
+    rng = np.random.default_rng(3)
+    for n_ids, n_parts in ((2, 2), (3, 2), (4, 6), (5, 3)):
+        cost = rng.uniform(1, 50, (n_ids, n_parts))
+        ok = rng.uniform(size=cost.shape) < 0.7
+        listed = sorted(_placements(ok, cost), key=lambda p: sum(cost[i, j] for i, j in p))
+        ranked = _cheapest_placements(np.where(ok, cost, np.inf), 10)
+        assert [sorted(p) for p in ranked] == [sorted(p) for p in listed[:10]]
+
+
 def test_parts_must_match_the_shape_vectors():
     from lookalike.trackers.offline.closed_set import assign_identities
 

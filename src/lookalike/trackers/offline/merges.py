@@ -4,6 +4,7 @@ the frames (Viterbi smoothing), so each frame's placement weighs the frames befo
 
 from __future__ import annotations
 
+import heapq
 import math
 
 import numpy as np
@@ -14,6 +15,7 @@ __all__ = ["place_in_merges"]
 
 MERGE_REACH = 0.25  # an interpolated centre this many blob sizes sqrt(w*h) outside a merged blob's box is not in it
 MAX_STATES = 120  # placements kept per frame (the least own cost first)
+MAX_LEAVES = 20_000  # placements listed one by one up to about this many; beyond, the MAX_STATES cheapest (Murty)
 
 
 def place_in_merges(rows: np.ndarray, measured: np.ndarray, merged: np.ndarray, shapes: np.ndarray | None = None,
@@ -57,9 +59,12 @@ def place_in_merges(rows: np.ndarray, measured: np.ndarray, merged: np.ndarray, 
     return out
 
 
-def _placements(ok: np.ndarray) -> list[list[tuple[int, int]]]:
-    """Every one-to-one placement of identities (rows of ``ok``) on parts (columns) with as many pairs as any allowed
-    placement has; ``ok[i, j]``: identity ``i`` may take part ``j``."""
+def _placements(ok: np.ndarray, cost: np.ndarray) -> list[list[tuple[int, int]]]:
+    """The one-to-one placements of identities (rows of ``ok``) on parts (columns) with as many pairs as any allowed
+    placement has; ``ok[i, j]``: identity ``i`` may take part ``j`` at ``cost[i, j]``. Every one where they are few
+    (:data:`MAX_LEAVES`), else the :data:`MAX_STATES` of least total cost (:func:`_cheapest_placements`)."""
+    if np.prod(1.0 + ok.sum(axis=1)) > MAX_LEAVES:
+        return _cheapest_placements(np.where(ok, cost, np.inf), MAX_STATES)
     found: list[list[tuple[int, int]]] = []
 
     def extend(i: int, used: frozenset[int], pairs: list[tuple[int, int]]) -> None:
@@ -74,6 +79,52 @@ def _placements(ok: np.ndarray) -> list[list[tuple[int, int]]]:
     extend(0, frozenset(), [])
     most = max(len(p) for p in found)
     return [p for p in found if len(p) == most]
+
+
+def _cheapest_placements(cost: np.ndarray, k: int) -> list[list[tuple[int, int]]]:
+    """Up to ``k`` one-to-one placements of rows on columns of ``cost`` (inf: not allowed) with as many allowed pairs
+    as any has, least total cost first: Murty's ranking of assignments, each subproblem solved by scipy."""
+    from scipy.optimize import linear_sum_assignment
+
+    allowed = np.isfinite(cost)
+    unplaced = float(cost[allowed].sum()) + 1.0  # a pair on a part not allowed: worse than any allowed placement
+    barred = unplaced * (min(cost.shape) + 1)  # a pair a subproblem excludes: never in a solution below this
+
+    def solve(forced: tuple[tuple[int, int], ...], banned: tuple[tuple[int, int], ...]
+              ) -> tuple[float, list[tuple[int, int]]] | None:
+        c = np.where(allowed, cost, unplaced)
+        for i, j in banned:
+            c[i, j] = barred
+        for i, j in forced:
+            keep = c[i, j]
+            c[i, :], c[:, j] = barred, barred
+            c[i, j] = keep
+        rows, cols = linear_sum_assignment(c)
+        total = float(c[rows, cols].sum())
+        return None if total >= barred else (total, list(zip(rows.tolist(), cols.tolist())))
+
+    first = solve((), ())
+    if first is None:
+        return [[]]
+    most = sum(allowed[i, j] for i, j in first[1])
+    Pairs = tuple[tuple[int, int], ...]
+    queue: list[tuple[float, int, Pairs, Pairs, list[tuple[int, int]]]] = [(first[0], 0, (), (), first[1])]
+    out: list[list[tuple[int, int]]] = []
+    seen: set[frozenset[tuple[int, int]]] = set()
+    count = 1
+    while queue and len(out) < k:
+        _, _, forced, banned, pairs = heapq.heappop(queue)
+        placed = [(i, j) for i, j in pairs if allowed[i, j]]
+        if len(placed) == most and frozenset(placed) not in seen:
+            seen.add(frozenset(placed))
+            out.append(placed)
+        free = [p for p in pairs if p not in forced]
+        for t, pair in enumerate(free):
+            branch = solve((*forced, *free[:t]), (*banned, pair))
+            if branch is not None:
+                heapq.heappush(queue, (branch[0], count, (*forced, *free[:t]), (*banned, pair), branch[1]))
+                count += 1
+    return out
 
 
 def _transition(prev: np.ndarray, now: np.ndarray, exit_to: np.ndarray, enter_from: np.ndarray) -> np.ndarray:
@@ -125,7 +176,7 @@ def _on_parts(out: np.ndarray, before: np.ndarray, loose: np.ndarray, merged: np
         if not slots:
             continue
         at = np.array(slots)
-        options = _placements(np.array(allowed).T)
+        options = _placements(np.array(allowed).T, np.linalg.norm(c[:, None] - at[None], axis=2))
         at_of = np.full((len(options), len(ks), 2), np.nan)
         for s, pairs in enumerate(options):
             for i, j in pairs:
