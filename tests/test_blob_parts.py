@@ -128,6 +128,23 @@ def test_the_cheapest_placements_are_those_of_the_full_list():
         assert [sorted(p) for p in ranked] == [sorted(p) for p in listed[:10]]
 
 
+def test_an_animal_that_ends_the_video_in_a_merged_blob_keeps_its_identity_there():
+    from lookalike.trackers.offline.merges import hold_in_merges
+
+    # identity 1 ends at frame 5 next to a merged blob that lasts to the end (frames 6-8); identity 2 starts at frame
+    # 4 out of another merged piece (frames 1-3); identity 3 ends at frame 5 far from any merged blob
+    rows = np.array([[4, 2, 300, 50, 10, 4], [5, 1, 100, 50, 10, 4], [5, 2, 302, 50, 10, 4], [5, 3, 600, 50, 10, 4]],
+                    float)
+    ahead = np.array([[f, -1, 94 + 2 * f, 48, 30, 8] for f in (6, 7, 8)], float)
+    behind = np.array([[f, -1, 290, 48, 30, 8] for f in (1, 2, 3)], float)
+    held = hold_in_merges(rows, [ahead, behind])
+    one, two, three = (held[held[:, 1] == i] for i in (1, 2, 3))
+    assert one[:, 0].tolist() == [5, 6, 7, 8] and two[:, 0].tolist() == [1, 2, 3, 4, 5]
+    assert np.allclose(one[1:, 2:4] + one[1:, 4:6] / 2, ahead[:, 2:4] + ahead[:, 4:6] / 2)  # the blob's centre
+    assert np.array_equal(one[1:, 4:6], np.tile([10, 4], (3, 1)))  # its own size
+    assert three[:, 0].tolist() == [5]
+    assert np.array_equal(held[:, 0], np.sort(held[:, 0]))
+
 def test_parts_must_match_the_shape_vectors():
     from lookalike.trackers.offline.closed_set import assign_identities
 

@@ -43,7 +43,7 @@ from lookalike.trackers.offline.constraints import (
     with_marks,
 )
 from lookalike.trackers.offline.gap_fill import fill_gaps, smooth_boxes
-from lookalike.trackers.offline.merges import place_in_merges
+from lookalike.trackers.offline.merges import hold_in_merges, place_in_merges
 from lookalike.trackers.offline.tracklets import (
     Tracklet,
     checked_rows,
@@ -60,6 +60,7 @@ from lookalike.types.mot_table import tracks_to_rows
 
 __all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities", "closed_set_input", "link_costs",
            "motion_scale", "place_short", "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
+
 
 
 def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
@@ -204,8 +205,9 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     take the free ids in order of their start); ValueError when they name no input row or cannot all hold.
     ``shapes``: blob shape vectors ``(n, SHAPE_SIZE)`` that column 9 of ``rows`` indexes; with them, the look
     learned from the video weighs in every link (:mod:`~lookalike.trackers.offline.appearance`), merged blobs
-    are left out of the tracklets and the identities interpolated through one are moved to its ends, or with
-    ``parts`` (``(n, PART_SIZE)``, indexed as ``shapes``) onto its parts
+    are left out of the tracklets, an identity whose first or last row leads into one stays in it
+    (:func:`~lookalike.trackers.offline.merges.hold_in_merges`), and the identities in one are moved to its ends,
+    or with ``parts`` (``(n, PART_SIZE)``, indexed as ``shapes``) onto its parts
     (:func:`~lookalike.trackers.offline.merges.place_in_merges`)."""
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
@@ -265,7 +267,8 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     filled = fill_gaps(merged, max_fill)
     if shapes is not None:
         filled[:, 7:10] = -1.0
-        if crossing:  # the identities interpolated through a merged blob, moved to its ends
+        if crossing:  # the identities interpolated through (or held in) a merged blob, moved to its ends or parts
+            filled = hold_in_merges(filled, [t.rows for t in crossing])
             measured = np.isin(filled[:, 0] * (n_targets + 1) + filled[:, 1], merged[:, 0] * (n_targets + 1)
                                + merged[:, 1])
             filled = place_in_merges(filled, measured, np.vstack([t.rows for t in crossing]), shapes, parts)

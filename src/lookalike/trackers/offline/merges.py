@@ -11,7 +11,7 @@ import numpy as np
 
 from lookalike.trackers.offline.appearance import SHAPE_COLUMN
 
-__all__ = ["place_in_merges"]
+__all__ = ["hold_in_merges", "place_in_merges"]
 
 MERGE_REACH = 0.25  # an interpolated centre this many blob sizes sqrt(w*h) outside a merged blob's box is not in it
 MAX_STATES = 120  # placements kept per frame (the least own cost first)
@@ -57,6 +57,38 @@ def place_in_merges(rows: np.ndarray, measured: np.ndarray, merged: np.ndarray, 
     if parts is not None and shapes is not None and len(merged):
         _on_parts(out, np.asarray(rows, dtype=float), loose, merged, np.exp(shapes[:, 0]), parts)
     return out
+
+
+def hold_in_merges(rows: np.ndarray, pieces: list[np.ndarray]) -> np.ndarray:
+    """Result ``rows`` ``(k, >= 6)`` (1-based frame, id, ``x, y, w, h`` px) with each identity continued through the
+    merged piece its first or last row leads into: where a row of a merged piece (``pieces``: rows of merged blobs,
+    one per frame, in order) in the frame after an identity's last row holds its centre (the blob's box widened by
+    :data:`MERGE_REACH` blob sizes), the identity follows the piece to its end, one row a frame at the blob's centre
+    with its own last size; the same backwards from its first row. Returns the rows, new ones included, by frame
+    and id."""
+    found: dict[int, list[tuple[int, int]]] = {}  # frame -> (piece, row)
+    for p, piece in enumerate(pieces):
+        for k, f in enumerate(piece[:, 0].astype(int).tolist()):
+            found.setdefault(f, []).append((p, k))
+    out = [rows]
+    ids = rows[:, 1].astype(int)
+    for i in np.unique(ids).tolist():
+        mine = rows[ids == i]
+        mine = mine[np.argsort(mine[:, 0], kind="stable")]
+        for end, step in ((mine[-1], 1), (mine[0], -1)):
+            c = end[2:4] + end[4:6] / 2
+            for p, k in found.get(int(end[0]) + step, []):
+                x0, y0, w, h = pieces[p][k, 2:6]
+                reach = MERGE_REACH * math.sqrt(w * h)
+                if abs(c[0] - x0 - w / 2) <= w / 2 + reach and abs(c[1] - y0 - h / 2) <= h / 2 + reach:
+                    follow = pieces[p][k:] if step > 0 else pieces[p][:k + 1]
+                    new = np.repeat(end[None], len(follow), axis=0)
+                    new[:, 0] = follow[:, 0]
+                    new[:, 2:4] = follow[:, 2:4] + follow[:, 4:6] / 2 - end[4:6] / 2
+                    out.append(new)
+                    break
+    held = np.vstack(out)
+    return held[np.lexsort((held[:, 1], held[:, 0]))]
 
 
 def _placements(ok: np.ndarray, cost: np.ndarray) -> list[list[tuple[int, int]]]:
