@@ -1,6 +1,7 @@
-"""Animals inside merged blobs, for the offline closed set: the identities interpolated through a contact are moved onto
-the merged blob (:func:`place_in_merges`), on its parts where the detector split it, by one least-cost path over all
-the frames (Viterbi smoothing), so each frame's placement weighs the frames before and after it."""
+"""Animals inside merged blobs, for the offline closed set: an identity whose first or last row leads into a merged blob
+stays in it (:func:`hold_in_merges`); the identities interpolated through (or held in) a contact are moved onto the
+merged blob (:func:`place_in_merges`), on its parts where the detector split it, by one least-cost path over all the
+frames (Viterbi smoothing), so each frame's placement weighs the frames before and after it."""
 
 from __future__ import annotations
 
