@@ -94,10 +94,11 @@ def test_animals_that_cross_inside_a_merged_blob_leave_it_on_the_sides_they_come
 
 
 def test_placement_over_separate_contacts_with_more_animals_than_parts():
-    # three animals near one merged blob split in 2 (frame 6), then again after a frame without a merge (frame 8):
-    # each frame places two of them on the two parts, the third stays where it was interpolated; rows never change
-    # size, and the frame between the contacts is left alone
-    rows = np.array([[f, i, 100 + 10 * i, 50, 10, 4] for f in (5, 6, 7, 8, 9) for i in (1, 2, 3)], float)
+    # three animals near one merged blob split in 2 (frame 6), then again after a frame without a merge (frame 8),
+    # two of them inside its box: each frame places two of them on the two parts, the third stays where it was
+    # interpolated; rows never change size, and the frame between the contacts is left alone
+    rows = np.array([[f, i, 100 + 10 * i + 5 * (i == 3), 50, 10, 4] for f in (5, 6, 7, 8, 9) for i in (1, 2, 3)],
+                    float)
     measured = np.isin(rows[:, 0], (5, 9))
     merged = np.array([[6, -1, 105, 49, 30, 6, 1, -1, -1, 0], [8, -1, 105, 49, 30, 6, 1, -1, -1, 1]], float)
     shapes = np.zeros((4, 4))
@@ -144,6 +145,23 @@ def test_an_animal_that_ends_the_video_in_a_merged_blob_keeps_its_identity_there
     assert np.array_equal(one[1:, 4:6], np.tile([10, 4], (3, 1)))  # its own size
     assert three[:, 0].tolist() == [5]
     assert np.array_equal(held[:, 0], np.sort(held[:, 0]))
+
+def test_a_merged_blob_holds_as_many_animals_as_the_identities_inside_it():
+    # a blob three times the median blob (the area says 3 animals) holds the two identities interpolated into it:
+    # they take its split in 2 (halves at x 110 and 130), not two of its thirds
+    rows = np.array([[5, 1, 95, 50, 10, 4], [5, 2, 125, 50, 10, 4],
+                     [6, 1, 105, 50, 10, 4], [6, 2, 125, 50, 10, 4]], float)
+    measured = np.array([True, True, False, False])
+    merged = np.array([[6, -1, 100, 48, 40, 8, 1, -1, -1, 0]], float)
+    shapes = np.zeros((4, 4))
+    shapes[:, 0] = np.log([300.0, 100.0, 100.0, 100.0])
+    parts = np.full((4, PART_SIZE), np.nan)
+    parts[0, :4] = [110, 52, 130, 52]
+    parts[0, 4:10] = [106, 52, 120, 52, 134, 52]
+    out = place_in_merges(rows, measured, merged, shapes, parts)
+    centres = out[2:, 2:4] + out[2:, 4:6] / 2
+    assert np.allclose(centres, [[110, 52], [130, 52]])
+
 
 def test_parts_must_match_the_shape_vectors():
     from lookalike.trackers.offline.closed_set import assign_identities

@@ -179,12 +179,13 @@ def _on_parts(out: np.ndarray, before: np.ndarray, loose: np.ndarray, merged: np
              parts: np.ndarray) -> None:
     """Move the interpolated rows ``loose`` of ``out`` onto the parts of the merged blobs, all frames at once.
 
-    A merged blob holds 2 or 3 animals, its area (px², ``areas`` by column 9) over the median blob's, rounded; its
-    parts are the centroids of that split (no parts: left as they are); an identity more than one blob size
-    ``sqrt(w*h)`` outside a blob's box cannot take its parts. The placement of every frame is one path of least
-    total cost: in each frame the distances from the placed identities' interpolated centres (in ``before``) to their
-    parts, and between consecutive frames the distance each identity moves (from or to its centre in ``before`` where
-    it is placed in one of the two frames only)."""
+    A merged blob holds as many animals as the interpolated identities inside its box (widened by
+    :data:`MERGE_REACH` blob sizes) when they are 2 or 3, else its area (px², ``areas`` by column 9) over the median
+    blob's, rounded, 2 or 3; its parts are the centroids of that split (no parts: left as they are); an identity more
+    than one blob size ``sqrt(w*h)`` outside a blob's box cannot take its parts. The placement of every frame is one
+    path of least total cost: in each frame the distances from the placed identities' interpolated centres (in
+    ``before``) to their parts, and between consecutive frames the distance each identity moves (from or to its centre
+    in ``before`` where it is placed in one of the two frames only)."""
     single = float(np.median(areas))
     frames = before[loose, 0].astype(int)
     centre = {(int(f), int(i)): (x + w / 2, y + h / 2) for f, i, x, y, w, h in before[:, :6]}
@@ -198,7 +199,9 @@ def _on_parts(out: np.ndarray, before: np.ndarray, loose: np.ndarray, merged: np
         slots, allowed = [], []
         for row in merged[merged[:, 0] == f]:
             x0, y0, w, h = row[2:6]
-            count = int(np.clip(round(areas[int(row[SHAPE_COLUMN])] / single), 2, 3))
+            inside = int(np.count_nonzero(np.all(np.abs(c - [x0 + w / 2, y0 + h / 2])
+                                                 <= np.array([w, h]) / 2 + MERGE_REACH * math.sqrt(w * h), axis=1)))
+            count = inside if 2 <= inside <= 3 else int(np.clip(round(areas[int(row[SHAPE_COLUMN])] / single), 2, 3))
             part = parts[int(row[SHAPE_COLUMN])]
             part = part[:4] if count == 2 else part[4:]
             if np.isnan(part).any():
