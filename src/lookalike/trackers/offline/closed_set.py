@@ -62,7 +62,6 @@ __all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities
            "motion_scale", "place_short", "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
 
 
-
 def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
                  tracklet_cost: float, time_limit_s: float = 60.0, start_cost: np.ndarray | None = None,
                  end_cost: np.ndarray | None = None, marks: Sequence[tuple[Collection[int], Collection[int]]] = (),

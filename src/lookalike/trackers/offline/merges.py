@@ -36,11 +36,12 @@ def place_in_merges(rows: np.ndarray, measured: np.ndarray, merged: np.ndarray, 
             for i in np.unique(ids).tolist()}
     loose = np.flatnonzero(~measured)
     frames = out[loose, 0].astype(int)
-    for f, x0, y0, w, h in zip(merged[:, 0].astype(int), *merged[:, 2:6].T):
-        centre, reach = np.array([x0 + w / 2, y0 + h / 2]), MERGE_REACH * math.sqrt(w * h)
+    for f, box in zip(merged[:, 0].astype(int), merged[:, 2:6]):
+        x0, y0, w, h = box
+        centre = np.array([x0 + w / 2, y0 + h / 2])
         ks = loose[frames == f]
         c = out[ks, 2:4] + out[ks, 4:6] / 2
-        inside = np.all(np.abs(c - centre) <= np.array([w, h]) / 2 + reach, axis=1)
+        inside = _within(c, box, MERGE_REACH)
         ks, c = ks[inside], c[inside]
         if len(ks) < 2:
             continue
@@ -79,9 +80,7 @@ def hold_in_merges(rows: np.ndarray, pieces: list[np.ndarray]) -> np.ndarray:
         for end, step in ((mine[-1], 1), (mine[0], -1)):
             c = end[2:4] + end[4:6] / 2
             for p, k in found.get(int(end[0]) + step, []):
-                x0, y0, w, h = pieces[p][k, 2:6]
-                reach = MERGE_REACH * math.sqrt(w * h)
-                if abs(c[0] - x0 - w / 2) <= w / 2 + reach and abs(c[1] - y0 - h / 2) <= h / 2 + reach:
+                if _within(c, pieces[p][k, 2:6], MERGE_REACH)[0]:
                     follow = pieces[p][k:] if step > 0 else pieces[p][:k + 1]
                     new = np.repeat(end[None], len(follow), axis=0)
                     new[:, 0] = follow[:, 0]
@@ -90,6 +89,15 @@ def hold_in_merges(rows: np.ndarray, pieces: list[np.ndarray]) -> np.ndarray:
                     break
     held = np.vstack(out)
     return held[np.lexsort((held[:, 1], held[:, 0]))]
+
+
+def _within(centres: np.ndarray, box: np.ndarray, reach: float) -> np.ndarray:
+    """Mask of the ``centres`` ``(k, 2)`` (px) inside ``box`` (left, top, w, h; px) widened on every side by ``reach``
+    blob sizes ``sqrt(w*h)``."""
+    x0, y0, w, h = box
+    out: np.ndarray = np.all(np.abs(np.reshape(centres, (-1, 2)) - [x0 + w / 2, y0 + h / 2])
+                             <= np.array([w, h]) / 2 + reach * math.sqrt(w * h), axis=1)
+    return out
 
 
 def _placements(ok: np.ndarray, cost: np.ndarray) -> list[list[tuple[int, int]]]:
@@ -198,17 +206,14 @@ def _on_parts(out: np.ndarray, before: np.ndarray, loose: np.ndarray, merged: np
         c = before[ks, 2:4] + before[ks, 4:6] / 2
         slots, allowed = [], []
         for row in merged[merged[:, 0] == f]:
-            x0, y0, w, h = row[2:6]
-            inside = int(np.count_nonzero(np.all(np.abs(c - [x0 + w / 2, y0 + h / 2])
-                                                 <= np.array([w, h]) / 2 + MERGE_REACH * math.sqrt(w * h), axis=1)))
+            inside = int(np.count_nonzero(_within(c, row[2:6], MERGE_REACH)))
             count = inside if 2 <= inside <= 3 else int(np.clip(round(areas[int(row[SHAPE_COLUMN])] / single), 2, 3))
             part = parts[int(row[SHAPE_COLUMN])]
             part = part[:4] if count == 2 else part[4:]
             if np.isnan(part).any():
                 continue
-            near = np.all(np.abs(c - [x0 + w / 2, y0 + h / 2]) <= np.array([w, h]) / 2 + math.sqrt(w * h), axis=1)
             slots.extend(part.reshape(count, 2))
-            allowed.extend([near] * count)
+            allowed.extend([_within(c, row[2:6], 1.0)] * count)
         if not slots:
             continue
         at = np.array(slots)
