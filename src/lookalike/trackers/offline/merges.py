@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from lookalike.trackers.offline.appearance import SHAPE_COLUMN
+from lookalike.trackers.offline.tracklets import row_centres
 
 __all__ = ["hold_in_merges", "place_in_merges"]
 
@@ -40,7 +41,7 @@ def place_in_merges(rows: np.ndarray, measured: np.ndarray, merged: np.ndarray, 
         x0, y0, w, h = box
         centre = np.array([x0 + w / 2, y0 + h / 2])
         ks = loose[frames == f]
-        c = out[ks, 2:4] + out[ks, 4:6] / 2
+        c = row_centres(out[ks])
         inside = _within(c, box, MERGE_REACH)
         ks, c = ks[inside], c[inside]
         if len(ks) < 2:
@@ -78,13 +79,13 @@ def hold_in_merges(rows: np.ndarray, pieces: list[np.ndarray]) -> np.ndarray:
         mine = rows[ids == i]
         mine = mine[np.argsort(mine[:, 0], kind="stable")]
         for end, step in ((mine[-1], 1), (mine[0], -1)):
-            c = end[2:4] + end[4:6] / 2
+            c = row_centres(end[None])
             for p, k in found.get(int(end[0]) + step, []):
                 if _within(c, pieces[p][k, 2:6], MERGE_REACH)[0]:
                     follow = pieces[p][k:] if step > 0 else pieces[p][:k + 1]
                     new = np.repeat(end[None], len(follow), axis=0)
                     new[:, 0] = follow[:, 0]
-                    new[:, 2:4] = follow[:, 2:4] + follow[:, 4:6] / 2 - end[4:6] / 2
+                    new[:, 2:4] = row_centres(follow) - end[4:6] / 2
                     out.append(new)
                     break
     held = np.vstack(out)
@@ -203,7 +204,7 @@ def _on_parts(out: np.ndarray, before: np.ndarray, loose: np.ndarray, merged: np
         ks = loose[frames == f]
         if not len(ks):
             continue
-        c = before[ks, 2:4] + before[ks, 4:6] / 2
+        c = row_centres(before[ks])
         slots, allowed = [], []
         for row in merged[merged[:, 0] == f]:
             inside = int(np.count_nonzero(_within(c, row[2:6], MERGE_REACH)))
