@@ -30,6 +30,16 @@ def test_bodies_that_touch_split_into_their_own_centres():
     assert np.allclose(three[np.argsort(three[:, 0])], [[15, 30], [40, 30], [65, 30]], atol=2)
 
 
+def test_the_parts_of_a_t_follow_its_two_long_thin_bodies():
+    # a body (56 x 9 px) whose end touches the middle of another, crosswise: k-means puts the crosswise body's part
+    # 9 px beyond its centre (the two parts share the pixels evenly); the mixture's elongated parts follow the bodies
+    img = np.zeros((100, 110), np.uint8)
+    cv2.ellipse(img, (50, 30), (28, 5), 0, 0, 360, 255, -1)
+    cv2.ellipse(img, (50, 52), (28, 5), 90, 0, 360, 255, -1)
+    two = blob_parts(*_pixels(img > 0))[:4].reshape(2, 2)
+    assert np.allclose(two[np.argsort(two[:, 1])], [[50, 30], [50, 52]], atol=4)
+
+
 def test_the_detector_splits_only_blobs_much_larger_than_the_recent_ones():
     from lookalike.vision.blob import BlobConfig, BlobDetector
 
@@ -174,15 +184,16 @@ def test_parts_must_match_the_shape_vectors():
 
 
 def _parts_every_round(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarray:
-    """blob_parts without stopping at convergence: all its rounds, every time (the reference)."""
-    from lookalike.vision.blob_shape import PART_COUNTS
+    """blob_parts without stopping k-means at convergence: all its rounds, every time (the reference), then the
+    same mixture."""
+    from lookalike.vision.blob_shape import PART_COUNTS, _mixture
 
     pts = np.column_stack([xs, ys]).astype(float)
     centre = pts.mean(axis=0)
     values, vectors = np.linalg.eigh(np.cov((pts - centre).T) + np.eye(2) / 12)
     out = []
     for k in PART_COUNTS:
-        best, best_cost = np.repeat(centre[None], k, axis=0), np.inf
+        best, best_cost, best_label = np.repeat(centre[None], k, axis=0), np.inf, None
         for axis in (1, 0):
             centres = centre + (np.linspace(-1.0, 1.0, k) * np.sqrt(values[axis]))[:, None] * vectors[:, axis]
             for _ in range(iterations):
@@ -194,7 +205,9 @@ def _parts_every_round(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> n
                     / counts[:, None]
             cost = float(((pts - centres[label]) ** 2).sum()) if np.all(counts > 0) else np.inf
             if cost < best_cost:
-                best, best_cost = centres, cost
+                best, best_cost, best_label = centres, cost, label
+        if best_label is not None:
+            best = _mixture(pts, best_label, k, best)
         out.append(best[np.argsort(best @ vectors[:, 1])])
     return np.concatenate([c.ravel() for c in out])
 

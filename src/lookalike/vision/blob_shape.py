@@ -5,6 +5,8 @@ set learns from these which animal is which (:mod:`lookalike.trackers.offline.ap
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 __all__ = ["PART_AREA", "PART_COUNTS", "PART_SIZE", "PART_WINDOW", "PROFILE_BINS", "SHAPE_SIZE", "blob_part_vectors",
@@ -73,16 +75,16 @@ def blob_part_vectors(labels: np.ndarray, stats: np.ndarray, keep: list[int], re
 
 def blob_parts(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarray:
     """The :data:`PART_SIZE` vector of the pixels ``xs, ys`` (px) of one blob: for each count k in
-    :data:`PART_COUNTS`, the centroids of a k-means split of the pixel coordinates, started evenly along the major
-    and along the minor principal axis (the start with the smaller within-part spread kept), ordered along the major
-    axis."""
+    :data:`PART_COUNTS`, the means of a Gaussian mixture with k full-covariance components (:func:`_mixture`)
+    started from a k-means split of the pixel coordinates (started evenly along the major and along the minor
+    principal axis, the start with the smaller within-part spread kept), ordered along the major axis."""
     pts = np.column_stack([xs, ys]).astype(float)
     centre = pts.mean(axis=0)
     cov = np.cov((pts - centre).T) if len(pts) > 1 else np.eye(2)
     values, vectors = np.linalg.eigh(cov + np.eye(2) / 12)
     out = []
     for k in PART_COUNTS:
-        best, best_cost = np.repeat(centre[None], k, axis=0), np.inf
+        best, best_cost, best_label = np.repeat(centre[None], k, axis=0), np.inf, None
         for axis in (1, 0):
             offsets = np.linspace(-1.0, 1.0, k) * np.sqrt(values[axis])
             centres = centre + offsets[:, None] * vectors[:, axis]
@@ -99,6 +101,31 @@ def blob_parts(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarra
                     / counts[:, None]
             cost = float(((pts - centres[label]) ** 2).sum()) if np.all(counts > 0) else np.inf
             if cost < best_cost:
-                best, best_cost = centres, cost
+                best, best_cost, best_label = centres, cost, label
+        if best_label is not None:
+            best = _mixture(pts, best_label, k, best)
         out.append(best[np.argsort(best @ vectors[:, 1])])
     return np.concatenate([c.ravel() for c in out])
+
+
+
+def _mixture(pts: np.ndarray, label: np.ndarray, k: int, centres: np.ndarray) -> np.ndarray:
+    """``(k, 2)`` means (px) of sklearn's full-covariance Gaussian mixture of ``pts`` started from the split
+    ``label`` (its parts' shares, ``centres`` and pixel covariances plus 1/12 px² of pixel quantisation);
+    ``centres`` where a part has fewer than 3 pixels or the mixture cannot be fitted. Long thin animals that touch
+    side by side or cross are cut into front and back halves by k-means; elongated components follow the bodies."""
+    from sklearn.exceptions import ConvergenceWarning
+    from sklearn.mixture import GaussianMixture
+
+    counts = np.bincount(label, minlength=k)
+    if np.any(counts < 3):
+        return centres
+    precisions = np.array([np.linalg.inv(np.cov(pts[label == j].T) + np.eye(2) / 12) for j in range(k)])
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ConvergenceWarning)  # (the means after the iteration cap are kept)
+            mixture = GaussianMixture(k, covariance_type="full", weights_init=counts / len(pts), means_init=centres,
+                                      precisions_init=precisions, init_params="random", random_state=0).fit(pts)
+    except (ValueError, np.linalg.LinAlgError):
+        return centres
+    return np.asarray(mixture.means_, dtype=float)
