@@ -1,7 +1,9 @@
 """Diagnosis (development arenas only, not a scoring run): how close the detector's parts of a merged blob are to the
-animals inside it. For every blob holding 2 or 3 reference centres, the centroids of the k-means split the detector
+animals inside it (run at bb6d380, before round 16 put the mixture into `blob_parts`). For every blob holding 2 or 3
+reference centres, the centroids of the k-means split the detector
 ships (``blob_parts``) and those of a full-covariance Gaussian mixture started from them (sklearn) are matched to the
-reference centres (Hungarian); printed: mean distance (px) and the share farther than 15 px. Arguments: seeds."""
+reference centres (Hungarian); printed (cumulative over the seeds): mean distance (px) and the shares farther
+than 8 and 12 px. Arguments: seeds."""
 import sys
 import tempfile
 from pathlib import Path
@@ -53,5 +55,5 @@ for seed in [int(s) for s in sys.argv[1:]] or range(10):
                 g = GaussianMixture(len(ref), covariance_type=cov, means_init=km, max_iter=50, random_state=0).fit(xy)
                 errors[name] += matched(g.means_, ref).tolist()
             count_seed += 1
-    print(seed, count_seed, " ".join(f"{k} {np.mean(v):.2f} px >8: {np.mean(np.array(v) > 8):.3f} >12: {np.mean(np.array(v) > 12):.3f}"
-                                      for k, v in errors.items()), flush=True)
+    print(seed, count_seed, " ".join(f"{k} {np.mean(v):.2f} px >8: {np.mean(np.array(v) > 8):.3f} "
+                                      f">12: {np.mean(np.array(v) > 12):.3f}" for k, v in errors.items()), flush=True)

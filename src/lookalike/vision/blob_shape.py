@@ -9,6 +9,8 @@ import warnings
 
 import numpy as np
 
+from lookalike._optional import needs
+
 __all__ = ["PART_AREA", "PART_COUNTS", "PART_SIZE", "PART_WINDOW", "PROFILE_BINS", "SHAPE_SIZE", "blob_part_vectors",
            "blob_parts", "blob_shapes"]
 
@@ -108,14 +110,15 @@ def blob_parts(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarra
     return np.concatenate([c.ravel() for c in out])
 
 
-
 def _mixture(pts: np.ndarray, label: np.ndarray, k: int, centres: np.ndarray) -> np.ndarray:
     """``(k, 2)`` means (px) of sklearn's full-covariance Gaussian mixture of ``pts`` started from the split
     ``label`` (its parts' shares, ``centres`` and pixel covariances plus 1/12 px² of pixel quantisation);
-    ``centres`` where a part has fewer than 3 pixels or the mixture cannot be fitted. Long thin animals that touch
-    side by side or cross are cut into front and back halves by k-means; elongated components follow the bodies."""
-    from sklearn.exceptions import ConvergenceWarning
-    from sklearn.mixture import GaussianMixture
+    ``centres`` where a part has fewer than 3 pixels or the mixture cannot be fitted. k-means shares the pixels of long
+    thin animals in a T or a V evenly between the parts; elongated components follow the bodies (two lying side by
+    side stay cut front and back: that symmetric split does not move)."""
+    with needs("sklearn"):
+        from sklearn.exceptions import ConvergenceWarning
+        from sklearn.mixture import GaussianMixture
 
     counts = np.bincount(label, minlength=k)
     if np.any(counts < 3):
