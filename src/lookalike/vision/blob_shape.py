@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 
 from lookalike._optional import needs
+from lookalike.parallel import one_blas_thread
 
 __all__ = ["PART_AREA", "PART_COUNTS", "PART_SIZE", "PART_WINDOW", "PROFILE_BINS", "SHAPE_SIZE", "blob_part_vectors",
            "blob_parts", "blob_shapes"]
@@ -61,17 +62,20 @@ PART_SIZE = 2 * sum(PART_COUNTS)
 """Length of a blob's parts vector: the centroids ``x, y`` (px, image frame) of its 2-part split, then of its 3-part."""
 PART_AREA = 1.4  # a blob is split when its area is at least this many times the median of the recent blobs'
 PART_WINDOW = 512  # the recent blobs: this many, the current frame's included
+MIXTURE_PIXELS = 4000  # a larger blob's mixture is fitted on a regular grid of its pixels, about this many (work)
 
 
 def blob_part_vectors(labels: np.ndarray, stats: np.ndarray, keep: list[int], reference_area: float) -> np.ndarray:
     """``(len(keep), PART_SIZE)`` :func:`blob_parts` vectors of the components ``keep`` of ``labels`` (as
     :func:`blob_shapes`) whose area is at least :data:`PART_AREA` times ``reference_area`` (px²); NaN for the others."""
     out = np.full((len(keep), PART_SIZE), np.nan)
-    for row, k in enumerate(keep):
-        if stats[k, 4] >= PART_AREA * reference_area:
-            x, y, w, h = (int(v) for v in stats[k, :4])
-            ys, xs = np.nonzero(labels[y:y + h, x:x + w] == k)
-            out[row] = blob_parts(xs + x, ys + y)
+    split = [(row, k) for row, k in enumerate(keep) if stats[k, 4] >= PART_AREA * reference_area]
+    if split:
+        with one_blas_thread():  # (the mixtures' 2 x 2 solves: a BLAS pool's hand-offs cost more than the work)
+            for row, k in split:
+                x, y, w, h = (int(v) for v in stats[k, :4])
+                ys, xs = np.nonzero(labels[y:y + h, x:x + w] == k)
+                out[row] = blob_parts(xs + x, ys + y)
     return out
 
 
@@ -113,13 +117,19 @@ def blob_parts(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarra
 def _mixture(pts: np.ndarray, label: np.ndarray, k: int, centres: np.ndarray) -> np.ndarray:
     """``(k, 2)`` means (px) of sklearn's full-covariance Gaussian mixture of ``pts`` started from the split
     ``label`` (its parts' shares, ``centres`` and pixel covariances plus 1/12 px² of pixel quantisation);
-    ``centres`` where a part has fewer than 3 pixels or the mixture cannot be fitted. k-means shares the pixels of long
-    thin animals in a T or a V evenly between the parts; elongated components follow the bodies (two lying side by
-    side stay cut front and back: that symmetric split does not move)."""
+    ``centres`` where a part has fewer than 3 pixels or the mixture cannot be fitted. A blob of more than
+    :data:`MIXTURE_PIXELS` pixels is fitted on those on every s-th row and column (s the smallest step leaving at most
+    about that many). k-means shares the pixels of long thin animals in a T or a V evenly between the parts;
+    elongated components follow the bodies (two lying side by side stay cut front and back: that symmetric split
+    does not move)."""
     with needs("sklearn"):
         from sklearn.exceptions import ConvergenceWarning
         from sklearn.mixture import GaussianMixture
 
+    step = int(np.ceil(np.sqrt(len(pts) / MIXTURE_PIXELS)))
+    if step > 1:  # a large blob: the pixels on every step-th row and column
+        on = np.all(pts % step == 0, axis=1)
+        pts, label = pts[on], label[on]
     counts = np.bincount(label, minlength=k)
     if np.any(counts < 3):
         return centres
