@@ -40,6 +40,16 @@ def test_the_parts_of_a_t_follow_its_two_long_thin_bodies():
     assert np.allclose(two[np.argsort(two[:, 1])], [[50, 30], [50, 52]], atol=4)
 
 
+def test_two_long_thin_bodies_side_by_side_split_between_them_not_front_and_back():
+    # touching along their whole length: k-means' tighter split is front and back, each part 14 px from both
+    # centres; the mixture started from the split across them is the more likely one, and it finds the bodies
+    img = np.zeros((80, 100), np.uint8)
+    cv2.ellipse(img, (50, 35), (28, 5), 0, 0, 360, 255, -1)
+    cv2.ellipse(img, (50, 44), (28, 5), 0, 0, 360, 255, -1)
+    two = blob_parts(*_pixels(img > 0))[:4].reshape(2, 2)
+    assert np.allclose(two[np.argsort(two[:, 1])], [[50, 35], [50, 44]], atol=1.5)
+
+
 def test_the_detector_splits_only_blobs_much_larger_than_the_recent_ones():
     from lookalike.vision.blob import BlobConfig, BlobDetector
 
@@ -185,7 +195,7 @@ def test_parts_must_match_the_shape_vectors():
 
 def _parts_every_round(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarray:
     """blob_parts without stopping k-means at convergence: all its rounds, every time (the reference), then the
-    same mixture."""
+    same mixtures."""
     from lookalike.vision.blob_shape import PART_COUNTS, _mixture
 
     pts = np.column_stack([xs, ys]).astype(float)
@@ -193,7 +203,7 @@ def _parts_every_round(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> n
     values, vectors = np.linalg.eigh(np.cov((pts - centre).T) + np.eye(2) / 12)
     out = []
     for k in PART_COUNTS:
-        best, best_cost, best_label = np.repeat(centre[None], k, axis=0), np.inf, None
+        best, best_cost, fitted, fitted_score = np.repeat(centre[None], k, axis=0), np.inf, None, -np.inf
         for axis in (1, 0):
             centres = centre + (np.linspace(-1.0, 1.0, k) * np.sqrt(values[axis]))[:, None] * vectors[:, axis]
             for _ in range(iterations):
@@ -203,11 +213,15 @@ def _parts_every_round(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> n
                     break
                 centres = np.column_stack([np.bincount(label, weights=pts[:, d], minlength=k) for d in (0, 1)]) \
                     / counts[:, None]
-            cost = float(((pts - centres[label]) ** 2).sum()) if np.all(counts > 0) else np.inf
+            if np.any(counts == 0):
+                continue
+            cost = float(((pts - centres[label]) ** 2).sum())
             if cost < best_cost:
-                best, best_cost, best_label = centres, cost, label
-        if best_label is not None:
-            best = _mixture(pts, best_label, k, best)
+                best, best_cost = centres, cost
+            mixture = _mixture(pts, label, k, centres)
+            if mixture is not None and mixture[1] > fitted_score:
+                fitted, fitted_score = mixture
+        best = best if fitted is None else fitted
         out.append(best[np.argsort(best @ vectors[:, 1])])
     return np.concatenate([c.ravel() for c in out])
 

@@ -81,16 +81,18 @@ def blob_part_vectors(labels: np.ndarray, stats: np.ndarray, keep: list[int], re
 
 def blob_parts(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarray:
     """The :data:`PART_SIZE` vector of the pixels ``xs, ys`` (px) of one blob: for each count k in
-    :data:`PART_COUNTS`, the means of a Gaussian mixture with k full-covariance components (:func:`_mixture`)
-    started from a k-means split of the pixel coordinates (started evenly along the major and along the minor
-    principal axis, the start with the smaller within-part spread kept), ordered along the major axis."""
+    :data:`PART_COUNTS`, the means of a Gaussian mixture with k full-covariance components (:func:`_mixture`),
+    started from each of two k-means splits of the pixel coordinates (started evenly along the major and along the
+    minor principal axis), the more likely mixture kept (the major axis's on ties; where neither can be fitted, the
+    k-means split with the smaller within-part spread), ordered along the major axis."""
     pts = np.column_stack([xs, ys]).astype(float)
     centre = pts.mean(axis=0)
     cov = np.cov((pts - centre).T) if len(pts) > 1 else np.eye(2)
     values, vectors = np.linalg.eigh(cov + np.eye(2) / 12)
     out = []
     for k in PART_COUNTS:
-        best, best_cost, best_label = np.repeat(centre[None], k, axis=0), np.inf, None
+        best, best_cost = np.repeat(centre[None], k, axis=0), np.inf
+        fitted, fitted_score = None, -np.inf
         for axis in (1, 0):
             offsets = np.linspace(-1.0, 1.0, k) * np.sqrt(values[axis])
             centres = centre + offsets[:, None] * vectors[:, axis]
@@ -105,23 +107,28 @@ def blob_parts(xs: np.ndarray, ys: np.ndarray, iterations: int = 8) -> np.ndarra
                     break
                 centres = np.column_stack([np.bincount(label, weights=pts[:, d], minlength=k) for d in (0, 1)]) \
                     / counts[:, None]
-            cost = float(((pts - centres[label]) ** 2).sum()) if np.all(counts > 0) else np.inf
+            if not np.all(counts > 0):
+                continue
+            cost = float(((pts - centres[label]) ** 2).sum())
             if cost < best_cost:
-                best, best_cost, best_label = centres, cost, label
-        if best_label is not None:
-            best = _mixture(pts, best_label, k, best)
+                best, best_cost = centres, cost
+            mixture = _mixture(pts, label, k, centres)
+            if mixture is not None and mixture[1] > fitted_score:
+                fitted, fitted_score = mixture
+        if fitted is not None:
+            best = fitted
         out.append(best[np.argsort(best @ vectors[:, 1])])
     return np.concatenate([c.ravel() for c in out])
 
 
-def _mixture(pts: np.ndarray, label: np.ndarray, k: int, centres: np.ndarray) -> np.ndarray:
-    """``(k, 2)`` means (px) of sklearn's full-covariance Gaussian mixture of ``pts`` started from the split
-    ``label`` (its parts' shares, ``centres`` and pixel covariances plus 1/12 px² of pixel quantisation);
-    ``centres`` where a part has fewer than 3 pixels or the mixture cannot be fitted. A blob of more than
-    :data:`MIXTURE_PIXELS` pixels is fitted on those on every s-th row and column (s the smallest step leaving at most
-    about that many). k-means shares the pixels of long thin animals in a T or a V evenly between the parts;
-    elongated components follow the bodies (two lying side by side stay cut front and back: that symmetric split
-    does not move)."""
+def _mixture(pts: np.ndarray, label: np.ndarray, k: int, centres: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """``((k, 2) means (px), mean log-likelihood of the pixels fitted)`` of sklearn's full-covariance Gaussian mixture
+    of ``pts`` started from the split ``label`` (its parts' shares, ``centres`` and pixel covariances plus 1/12 px² of
+    pixel quantisation); None where a part has fewer than 3 pixels or the mixture cannot be fitted. A blob of more
+    than :data:`MIXTURE_PIXELS` pixels is fitted on those on every s-th row and column (s the smallest step leaving at
+    most about that many). k-means shares the pixels of long thin animals in a T or a V evenly between the parts, and
+    cuts two lying side by side into front and back halves; elongated components follow the bodies (from the split
+    across them, for the side by side)."""
     with needs("sklearn"):
         from sklearn.exceptions import ConvergenceWarning
         from sklearn.mixture import GaussianMixture
@@ -132,13 +139,13 @@ def _mixture(pts: np.ndarray, label: np.ndarray, k: int, centres: np.ndarray) ->
         pts, label = pts[on], label[on]
     counts = np.bincount(label, minlength=k)
     if np.any(counts < 3):
-        return centres
+        return None
     precisions = np.array([np.linalg.inv(np.cov(pts[label == j].T) + np.eye(2) / 12) for j in range(k)])
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ConvergenceWarning)  # (the means after the iteration cap are kept)
             mixture = GaussianMixture(k, covariance_type="full", weights_init=counts / len(pts), means_init=centres,
                                       precisions_init=precisions, init_params="random", random_state=0).fit(pts)
+            return np.asarray(mixture.means_, dtype=float), float(mixture.score(pts))
     except (ValueError, np.linalg.LinAlgError):
-        return centres
-    return np.asarray(mixture.means_, dtype=float)
+        return None
