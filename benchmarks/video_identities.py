@@ -7,10 +7,10 @@ within ``RADIUS_PX``; one global one-to-one mapping of result ids to reference i
 (IDTP); IDF1 = 2 IDTP / (reference points + result boxes); "all right" counts the frames where every one of the N
 animals has its mapped id within reach. CPU time is the command's, learning included, on a fresh detection cache.
 
-Arenas: ``lookalike simulate --arena`` defaults, seeds ``--seeds`` (6000-6019 by default: never used for any choice;
-research/appearance/rule16.md). test_A: ``../shared/data/zebrafish/test_A.avi`` against ``idtracker_test_A.csv``.
+Arenas: ``lookalike simulate --arena`` defaults, seeds ``--seeds`` (10000-10019 by default: never used for any choice;
+research/appearance/rule17.md). test_A: ``../shared/data/zebrafish/test_A.avi`` against ``idtracker_test_A.csv``.
 
-    python benchmarks/video_identities.py [--seeds 6000-6019] [--no-test-a] [--no-arenas] [--modes default online]
+    python benchmarks/video_identities.py [--seeds 10000-10019] [--no-test-a] [--no-arenas] [--modes default online]
 """
 
 from __future__ import annotations
@@ -102,7 +102,7 @@ def run_track(video: Path, n: int, extra: list[str], out: Path, cache: Path) -> 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seeds", default="6000-6019", help="arena seeds, LO-HI")
+    parser.add_argument("--seeds", default="10000-10019", help="arena seeds, LO-HI")
     parser.add_argument("--modes", nargs="*", default=list(MODES), choices=list(MODES))
     parser.add_argument("--no-test-a", action="store_true")
     parser.add_argument("--no-arenas", action="store_true")
