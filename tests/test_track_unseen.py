@@ -15,7 +15,12 @@ from lookalike.bench.runner import Entry, default_entries, job_pairs, params_ent
 from lookalike.cli import app
 from lookalike.io import read_mot, write_mot
 from lookalike.io.video_frames import read_frames
-from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections, detection_cache_key
+from lookalike.pipeline.blob_detections import (
+    auto_blob_config,
+    cached_blob_detections,
+    detection_cache_key,
+    load_blob_detections,
+)
 from lookalike.tune.params_file import save_params
 
 runner = CliRunner()
@@ -215,6 +220,32 @@ def test_blob_cache_serves_identical_rows_and_never_stale_ones(tmp_path):
     other = _arena(tmp_path / "other.avi", frames=20)  # other content, other key
     assert detection_cache_key(video, config) != detection_cache_key(other, config)
     assert cached_blob_detections(other, config, cache=tmp_path / "c").frames == 20
+
+
+def test_blobs_are_split_into_parts_only_for_a_reader_of_parts(tmp_path):
+    import cv2
+
+    video = tmp_path / "cross.avi"  # two animals that meet and merge into one blob
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 10, (160, 120))
+    for k in range(40):
+        img = np.full((120, 160, 3), 215, np.uint8)
+        for x, vx in ((20, 3), (140, -3)):
+            cv2.circle(img, (int(x + vx * k), 60), 7, (35, 35, 35), -1)
+        writer.write(img)
+    writer.release()
+    config, _ = auto_blob_config(video, [], 2, cache=tmp_path / "c")
+    cache = tmp_path / "c"
+    plain = cached_blob_detections(video, config, cache=cache, split=False)  # e.g. --online: nothing reads parts
+    assert not plain.split and np.isnan(plain.parts).all()
+    assert load_blob_detections(video, config, cache, split=False) is not None
+    assert load_blob_detections(video, config, cache) is None  # a reader of parts does not take them
+    split = cached_blob_detections(video, config, cache=cache)  # detected again, with parts, and stored
+    assert split.split and not np.isnan(split.parts).all()
+    np.testing.assert_array_equal(split.rows, plain.rows)
+    np.testing.assert_array_equal(split.shapes, plain.shapes)
+    again = load_blob_detections(video, config, cache, split=False)  # parts serve every run after that
+    assert again is not None and again.split
+    np.testing.assert_array_equal(again.parts, split.parts)
 
 
 def _seq(dataset: str, name: str = "s", n_targets: int | None = None) -> RealSequence:

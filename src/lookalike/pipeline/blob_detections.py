@@ -126,10 +126,10 @@ def _sampled(video: Path | str, count: int) -> list[np.ndarray]:
     return _SAMPLE[key]
 
 
-def _detector(video: Path | str, config: BlobConfig) -> BlobDetector:
-    """A blob detector for ``video`` giving shape vectors, its median background fitted on the sampled frames (the
-    sample then let go)."""
-    detector = BlobDetector(config, describe=True)
+def _detector(video: Path | str, config: BlobConfig, split: bool = True) -> BlobDetector:
+    """A blob detector for ``video`` giving shape vectors (and parts, with ``split``), its median background fitted on
+    the sampled frames (the sample then let go)."""
+    detector = BlobDetector(config, describe=True, split=split)
     if config.method == "median":
         detector.fit(_sampled(video, config.history))
     _SAMPLE.clear()
@@ -189,21 +189,23 @@ def detection_cache_key(video: Path | str, config: BlobConfig, extra: dict[str, 
 class BlobRows:
     """A video's blob detections: MOTChallenge ``rows`` ``(n, 10)``, the number of ``frames``, each row's
     :func:`~lookalike.vision.blob_shape.blob_shapes` vector ``shapes`` ``(n, SHAPE_SIZE)`` and its
-    :func:`~lookalike.vision.blob_shape.blob_part_vectors` vector ``parts`` ``(n, PART_SIZE)`` (NaN: not split)."""
+    :func:`~lookalike.vision.blob_shape.blob_part_vectors` vector ``parts`` ``(n, PART_SIZE)`` (NaN: not split);
+    ``split``: whether large blobs were split at all (False: every part NaN, detected where no parts are read)."""
 
     rows: np.ndarray
     frames: int
     shapes: np.ndarray
     parts: np.ndarray
+    split: bool = True
 
 
 def cached_blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
-                           cache: Path | None | bool = True) -> BlobRows:
+                           cache: Path | None | bool = True, split: bool = True) -> BlobRows:
     """:func:`blob_detections` through the cache (``cache``: a folder, ``True`` for :func:`cache_dir`, ``False`` or
-    None for none)."""
-    found = load_blob_detections(video, config, cache)
+    None for none; ``split``: as for :func:`load_blob_detections`)."""
+    found = load_blob_detections(video, config, cache, split)
     if found is None:
-        found = blob_detections(video, config, advance)
+        found = blob_detections(video, config, advance, split)
         store_blob_detections(video, config, found, cache)
     return found
 
@@ -214,16 +216,21 @@ def _cache_file(video: Path | str, config: BlobConfig, cache: Path | None | bool
     return (cache_dir() if cache is True else Path(cache)) / "blobs" / f"{detection_cache_key(video, config)}.npz"
 
 
-def load_blob_detections(video: Path | str, config: BlobConfig, cache: Path | None | bool = True) -> BlobRows | None:
-    """``video``'s blob detections with ``config`` from the cache, or None when not there."""
+def load_blob_detections(video: Path | str, config: BlobConfig, cache: Path | None | bool = True,
+                         split: bool = True) -> BlobRows | None:
+    """``video``'s blob detections with ``config`` from the cache, or None when not there (with ``split``, also when
+    they were stored without parts)."""
     path = _cache_file(video, config, cache)
     if path is not None and path.is_file():
         try:
             with np.load(path) as data:
                 rows = np.array(data["rows"], dtype=float).reshape(-1, 10)
+                stored_split = bool(data["split"])
+                if split and not stored_split:
+                    return None
                 return BlobRows(rows, int(data["frames"]),
                                 np.array(data["shapes"], dtype=float).reshape(len(rows), SHAPE_SIZE),
-                                np.array(data["parts"], dtype=float).reshape(len(rows), PART_SIZE))
+                                np.array(data["parts"], dtype=float).reshape(len(rows), PART_SIZE), stored_split)
         except (OSError, ValueError, KeyError):
             pass
     return None
@@ -235,7 +242,8 @@ def store_blob_detections(video: Path | str, config: BlobConfig, found: BlobRows
     path = _cache_file(video, config, cache)
     if path is not None:
         buffer = io.BytesIO()
-        np.savez(buffer, rows=found.rows, frames=found.frames, shapes=found.shapes, parts=found.parts)
+        np.savez(buffer, rows=found.rows, frames=found.frames, shapes=found.shapes, parts=found.parts,
+                 split=found.split)
         _write_atomic(path, buffer.getvalue())
 
 
@@ -243,8 +251,9 @@ class BlobStream:
     """Blob detections found while the video is tracked (one decode): called on each frame in order, it gives the
     frame's boxes scoring at least ``min_score``; :meth:`found` then holds every row, as :func:`blob_detections`."""
 
-    def __init__(self, video: Path | str, config: BlobConfig, min_score: float = -math.inf) -> None:
-        self.detector = _detector(video, config)
+    def __init__(self, video: Path | str, config: BlobConfig, min_score: float = -math.inf,
+                 split: bool = True) -> None:
+        self.detector = _detector(video, config, split)
         self.min_score, self.frames = min_score, 0
         self._rows: list[np.ndarray] = []
         self._shapes: list[np.ndarray] = []
@@ -267,12 +276,14 @@ class BlobStream:
         """Every row found so far, the frames read and the rows' shape and parts vectors."""
         rows = np.vstack(self._rows) if self._rows else np.zeros((0, 10))
         return BlobRows(rows, self.frames, np.vstack(self._shapes) if self._shapes else np.zeros((0, SHAPE_SIZE)),
-                        np.vstack(self._parts) if self._parts else np.zeros((0, PART_SIZE)))
+                        np.vstack(self._parts) if self._parts else np.zeros((0, PART_SIZE)), self.detector.split)
 
 
-def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None) -> BlobRows:
-    """Blob detections of ``video`` (a file or image folder) with each blob's shape vector, in one pass."""
-    stream = BlobStream(video, config)
+def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
+                    split: bool = True) -> BlobRows:
+    """Blob detections of ``video`` (a file or image folder) with each blob's shape vector (and parts, with
+    ``split``), in one pass."""
+    stream = BlobStream(video, config, split=split)
     for image in source_frames(video)[0]:
         stream(image)
         if advance is not None:

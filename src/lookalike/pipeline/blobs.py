@@ -51,13 +51,14 @@ def blob_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: 
 def blob_source(video: Path, config: Any, tracker: Any, tracker_name: str, explicit: Collection[str],
                 n_targets: int | None, offline: bool,
                 options: dict[str, Any]) -> tuple[BlobRows | None, BlobStream | None]:
-    """The blob detections of ``video`` stored for ``config``, else a stream that finds them in the tracking pass
-    when :func:`one_pass` says so (never ``offline``), else neither (they are found first); ``options``: the
-    ``min_score`` and ``annotate`` the video is tracked with."""
-    found = load_blob_detections(video, config)
+    """The blob detections of ``video`` stored for ``config`` (with the large blobs' parts when ``offline``, the only
+    reader of parts), else a stream that finds them in the tracking pass when :func:`one_pass` says so (never
+    ``offline``), else neither (they are found first); ``options``: the ``min_score`` and ``annotate`` the video is
+    tracked with."""
+    found = load_blob_detections(video, config, split=offline)
     if found is None and not offline and one_pass(tracker, tracker_name, explicit, n_targets,
                                                   options.get("annotate") is not None):
-        return None, BlobStream(video, config, options["min_score"])
+        return None, BlobStream(video, config, options["min_score"], split=False)
     return found, None
 
 
@@ -92,7 +93,7 @@ def run_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, settin
         if found is None and stream is None:
             with step(on_event, f"detecting blobs in {video.name}") if declared <= 0 else _nothing():
                 found = cached_blob_detections(video, config, None if declared <= 0 else steps(on_event)(
-                    f"detecting blobs in {video.name}", declared))
+                    f"detecting blobs in {video.name}", declared), split=offline is not None)
     except OSError as exc:
         raise ValueError(str(exc)) from exc
     result = RunResult("blobs", [output], 1)

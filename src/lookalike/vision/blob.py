@@ -123,6 +123,7 @@ class BlobDetector:
 
     config: BlobConfig = field(default_factory=BlobConfig)
     describe: bool = False  # each box's feature: its blob's shape vector; parts_: the last frame's parts (blob_shape)
+    split: bool = True  # with describe: parts_ of the large blobs (False: all NaN, cheaper where none is read)
     background_: np.ndarray | None = field(default=None, init=False, repr=False)
     parts_: np.ndarray | None = field(default=None, init=False, repr=False)
     _buffer: deque = field(init=False, repr=False)
@@ -248,7 +249,7 @@ class BlobDetector:
         boxes = stats[keep, :4].astype(float)
         if not self.describe:
             return Detections(xywh=boxes, score=np.ones(len(keep)))
-        from lookalike.vision.blob_shape import blob_part_vectors, blob_shapes
+        from lookalike.vision.blob_shape import PART_SIZE, blob_part_vectors, blob_shapes
 
         if difference is None:  # the difference where the kept blobs lie (elsewhere, left from earlier frames)
             assert self.background_ is not None
@@ -260,7 +261,8 @@ class BlobDetector:
                                                                 self.background_[y:y + h, x:x + w])
         shapes = blob_shapes(labels, stats, keep, difference, as_bgr_image(image, "image"))
         self._areas.extend(stats[keep, 4].tolist())
-        self.parts_ = blob_part_vectors(labels, stats, keep, float(np.median(self._areas)))
+        self.parts_ = blob_part_vectors(labels, stats, keep, float(np.median(self._areas))) if self.split \
+            else np.full((len(keep), PART_SIZE), np.nan)
         return Detections(xywh=boxes, score=np.ones(len(keep)), feature=shapes)
 
     detect = __call__
