@@ -1,40 +1,21 @@
 """Development runs of research/appearance/rule16.md (arena seeds 0-9 and 4000-4019, the 14 HexBug clips): the
-k-means parts (1d0021c) against the parts refined by a Gaussian mixture, in one process, each arm detecting through a
-cache folder of its own (the development run switched a flag, since taken out; this patches 1d0021c's `blob_parts`
-from git into `blob_shape`). Rows and shape vectors are the same in both; only the parts differ. Not a scoring run.
-Usage: dev16.py [arenas,hexbug]"""
+k-means parts (1d0021c's `blob_parts`) against the parts refined by a Gaussian mixture (634f3bb's, with the repair),
+both read from git, in one process, each arm detecting through a cache folder of its own (`scoring.with_parts`; the
+development run switched a flag, since taken out). Rows and shape vectors are the same in both; only the parts
+differ. Not a scoring run. Usage: dev16.py [arenas,hexbug]"""
 import tempfile
 from pathlib import Path
 
-import numpy as np
 import scoring
-
-from lookalike.io.video_frames import source_frames
-from lookalike.pipeline.blob_detections import auto_blob_config, cached_blob_detections
-from lookalike.trackers.offline.closed_set import track_closed_set
-from lookalike.vision import blob_shape
-from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS
 
 work = Path(tempfile.mkdtemp(prefix="appearance-dev16-"))
 MODES = ("kmeans", "mixture")
 PARTS = {"kmeans": scoring.module_at("1d0021c", "src/lookalike/vision/blob_shape.py", work).blob_parts,
-         "mixture": blob_shape.blob_parts}
+         "mixture": scoring.module_at("634f3bb", "src/lookalike/vision/blob_shape.py", work).blob_parts}
 
 
 def run(video, n):
-    config, fps = auto_blob_config(video, [], n, cache=work / "cache")[0], source_frames(video)[2] or 25.0
-    out, rows = [], None
-    try:
-        for mode in MODES:
-            blob_shape.blob_parts = PARTS[mode]
-            found = cached_blob_detections(video, config, cache=work / f"cache-{mode}")
-            assert rows is None or np.array_equal(rows, found.rows)
-            rows = found.rows
-            out.append(track_closed_set(found.rows, n, fps, n_frames=found.frames, online=dict(BOX_TRACKER_PARAMS),
-                                        shapes=found.shapes, parts=found.parts))
-    finally:
-        blob_shape.blob_parts = PARTS["mixture"]
-    return out
+    return scoring.with_parts(video, n, work, PARTS)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""Scoring loops shared by the development harnesses (dev5.py to dev11.py): each takes ``run(video, n)``, which
+"""Scoring loops shared by the development harnesses (dev5.py to dev17.py): each takes ``run(video, n)``, which
 returns one result table per mode, and prints one line per video and a paired summary against the first mode."""
 import importlib.util
 import subprocess
@@ -121,3 +121,24 @@ def summary(name: str, t: np.ndarray, modes) -> None:
         d = t[:, j] - t[:, 0]
         print(f"{name}: {modes[0]} {t[:, 0].mean():.4f} {modes[j]} {t[:, j].mean():.4f} diff {d.mean():+.4f} "
               f"(se {d.std(ddof=1) / np.sqrt(len(d)):.4f}; up {(d > 0).sum()}, down {(d < 0).sum()})")
+
+
+def with_parts(video: Path, n: int, work: Path, parts: dict) -> list[np.ndarray]:
+    """The closed set (the command's parameters, with the look and the parts) once per ``blob_parts`` function of
+    ``parts`` (mode name -> function, patched into ``blob_shape`` and restored afterwards), each mode detecting
+    through a cache folder of its own under ``work``; rows and shape vectors are checked to be the same in all."""
+    from lookalike.vision import blob_shape
+
+    config, fps = auto_blob_config(video, [], n, cache=work / "cache")[0], source_frames(video)[2] or 25.0
+    kept, out, first = blob_shape.blob_parts, [], None
+    try:
+        for mode, function in parts.items():
+            blob_shape.blob_parts = function
+            found = cached_blob_detections(video, config, cache=work / f"cache-{mode}")
+            first = first or found
+            assert np.array_equal(first.rows, found.rows) and np.array_equal(first.shapes, found.shapes)
+            out.append(track_closed_set(found.rows, n, fps, n_frames=found.frames, online=dict(BOX_TRACKER_PARAMS),
+                                        shapes=found.shapes, parts=found.parts))
+    finally:
+        blob_shape.blob_parts = kept
+    return out
