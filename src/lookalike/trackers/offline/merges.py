@@ -241,10 +241,10 @@ def _on_parts(out: np.ndarray, before: np.ndarray, loose: np.ndarray, merged: np
             back.append(np.argmin(cost, axis=0))
             total = cost.min(axis=0) + own
         else:  # a gap: the earlier frame leaves towards its next frame, this one enters from its previous
-            best = int(np.argmin(total + _ends(p_at, pids, centre, pf + 1)))
+            leave = total + _ends(p_at, pids, centre, pf + 1)
+            best = int(np.argmin(leave))
             back.append(np.full(len(own), best))
-            total = (total[best] + _ends(p_at[best:best + 1], pids, centre, pf + 1)[0] + own
-                     + _ends(at_of, ids, centre, f - 1))
+            total = leave[best] + own + _ends(at_of, ids, centre, f - 1)
     last = steps[-1]
     total = total + _ends(last[3], last[2], centre, last[0] + 1)
     s = int(np.argmin(total))
