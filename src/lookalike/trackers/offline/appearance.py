@@ -14,13 +14,14 @@ the distances of the candidate links themselves (a look changes more across a cr
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from lookalike.trackers.offline.tracklets import Tracklet
 
-__all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "single_rows", "with_appearance"]
+__all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "look_margins", "single_rows", "with_appearance"]
 
 SINGLE_AREA = (0.6, 1.5)  # a blob shows one animal when its area is within these multiples of its track's median
 MIN_ROWS = 8  # single-animal rows a tracklet needs to teach or be judged by its look
@@ -28,6 +29,7 @@ OUTLIER = 0.001  # chance that a tracklet's look is not its animal's (a bad segm
 LOOK_WEIGHT = 2.0  # a link's cost is lowered by this times its look's log-likelihood ratio (rule7.md in research/)
 SHAPE_COLUMN = 9  # the column of an input row that holds its shape vector's index
 MIN_SPREAD = 0.1  # smallest spread of a log look distance (a floor for the fits on few pairs)
+MARGIN_CLIP = 3.0  # bound of a tracklet's look margin (log distance ratio; look_margins)
 UNTRUSTED_SHARE = 0.135  # more of the online pass's rows not one animal's size: no look (research/appearance/rule4.md)
 
 
@@ -169,3 +171,30 @@ def with_appearance(tracklets: list[Tracklet], links: tuple[np.ndarray, np.ndarr
         return links
     looks = np.array([space.embed(shapes[t.rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0) for t in tracklets])
     return src, dst, cost - LOOK_WEIGHT * space.link_evidence(looks[src], looks[dst])
+
+
+def look_margins(tracklets: list[Tracklet], chains: Sequence[Sequence[int]], shapes: np.ndarray,
+                 space: IdentitySpace) -> np.ndarray:
+    """Per tracklet, how much better its identity's look fits it than any other identity's: the log mean squared
+    distance from its mean look to the nearest other identity's mean look minus that to its own identity's (the
+    rows-weighted mean of its other tracklets), clipped to ±:data:`MARGIN_CLIP`. ``chains``: each identity's
+    tracklet indices. NaN for tracklets of fewer than :data:`MIN_ROWS` rows, on no chain, or with nothing to
+    compare (no other tracklet on their identity, or no other identity with one)."""
+    out = np.full(len(tracklets), np.nan)
+    members = [[int(i) for i in chain if len(tracklets[i]) >= MIN_ROWS] for chain in chains]
+    looks = {i: space.embed(shapes[tracklets[i].rows[:, SHAPE_COLUMN].astype(int)]).mean(axis=0)
+             for chain in members for i in chain}
+    total = [sum((len(tracklets[i]) * looks[i] for i in chain), np.zeros(space.projection.shape[1]))
+             for chain in members]
+    count = [sum(len(tracklets[i]) for i in chain) for chain in members]
+    for c, chain in enumerate(members):
+        others = [total[k] / count[k] for k in range(len(members)) if k != c and count[k]]
+        for i in chain:
+            rest = count[c] - len(tracklets[i])
+            if not rest or not others:
+                continue
+            own = (total[c] - len(tracklets[i]) * looks[i]) / rest
+            x_own = math.log(float(np.mean((looks[i] - own) ** 2)) + 1e-9)
+            x_other = min(math.log(float(np.mean((looks[i] - o) ** 2)) + 1e-9) for o in others)
+            out[i] = min(max(x_other - x_own, -MARGIN_CLIP), MARGIN_CLIP)
+    return out

@@ -29,6 +29,7 @@ from lookalike.trackers.offline.appearance import (
     UNTRUSTED_SHARE,
     cut_at_merges,
     fit_identity_space,
+    look_margins,
     single_rows,
     with_appearance,
 )
@@ -58,7 +59,8 @@ from lookalike.trackers.registry import make_tracker, tracker_class
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import tracks_to_rows
 
-__all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities", "closed_set_input", "link_costs",
+__all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities", "closed_set_and_look",
+           "closed_set_input", "link_costs",
            "motion_scale", "place_short", "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
 
 
@@ -208,6 +210,14 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     (:func:`~lookalike.trackers.offline.merges.hold_in_merges`), and the identities in one are moved to its ends,
     or with ``parts`` (``(n, PART_SIZE)``, indexed as ``shapes``) onto its parts
     (:func:`~lookalike.trackers.offline.merges.place_in_merges`)."""
+    return _assign(rows, n_targets, frame_rate, config, constraints, shapes, parts)[0]
+
+
+def _assign(rows: np.ndarray, n_targets: int, frame_rate: float, config: ClosedSetConfig | None,
+            constraints: ChainConstraints | None, shapes: np.ndarray | None,
+            parts: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`assign_identities`'s rows and, where a look was learned, each row's look margin (the
+    :func:`~lookalike.trackers.offline.appearance.look_margins` of the tracklet it came from; 0 for rows of none)."""
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
@@ -216,8 +226,7 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     if constraints is not None:
         pieces = cut_tracklets(pieces, constraints.cut)
     if not pieces:
-        unchanged: np.ndarray = rows.copy()
-        return unchanged
+        return rows.copy(), None
     crossing: list[Tracklet] = []
     if parts is not None and (shapes is None or len(parts) != len(shapes)):
         raise ValueError(f"parts: expected one per shape vector ({'no shapes' if shapes is None else len(shapes)}), "
@@ -251,6 +260,7 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     blocks = [np.vstack([tracklets[i].rows for i in chain]) for chain in chains]
     placed = place_short(short, blocks, motion_scale(tracklets), cfg)
     ids = chain_ids(chains, fixed, int(n_targets))
+    margin = None if space is None or shapes is None else look_margins(tracklets, chains, shapes, space)
     out = []
     for c, block in enumerate(blocks):
         extra = [short[p].rows for p in np.flatnonzero(placed == c)]
@@ -262,7 +272,7 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
     max_fill = len(np.unique(merged[:, 0])) + int(merged[:, 0].max(initial=0)) if math.isinf(cfg.fill_gap_s) else round(
         cfg.fill_gap_s * frame_rate)
     if not len(merged):
-        return merged
+        return merged, None
     filled = fill_gaps(merged, max_fill)
     if shapes is not None:
         filled[:, 7:10] = -1.0
@@ -271,7 +281,27 @@ def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
             measured = np.isin(filled[:, 0] * (n_targets + 1) + filled[:, 1], merged[:, 0] * (n_targets + 1)
                                + merged[:, 1])
             filled = place_in_merges(filled, measured, np.vstack([t.rows for t in crossing]), shapes, parts)
-    return smooth_boxes(filled, smoothing_window(merged, frame_rate, cfg))
+    result = smooth_boxes(filled, smoothing_window(merged, frame_rate, cfg))
+    if margin is None:
+        return result, None
+    keys = [(tracklets[i].rows[:, 0], np.full(len(tracklets[i]), ids[c]), np.full(len(tracklets[i]), margin[i]))
+            for c, chain in enumerate(chains) for i in chain]
+    return result, _by_frame_and_id(result, np.vstack([np.column_stack(k) for k in keys]))
+
+
+def _by_frame_and_id(rows: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Per row of ``rows`` the value of ``values`` ``(m, 3)`` (frame, id, value) with its frame and id; 0 where there
+    is none or it is NaN."""
+    out = np.zeros(len(rows))
+    if not len(values) or not len(rows):
+        return out
+    width = max(rows[:, 1].max(), values[:, 1].max()) + 1
+    key, at = values[:, 0] * width + values[:, 1], rows[:, 0] * width + rows[:, 1]
+    order = np.argsort(key, kind="stable")
+    pos = np.clip(np.searchsorted(key[order], at), 0, len(key) - 1)
+    found = key[order][pos] == at
+    out[found] = np.nan_to_num(values[order][pos[found], 2])
+    return out
 
 
 def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfig | None = None) -> int:
@@ -346,6 +376,17 @@ def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *,
     :data:`~lookalike.trackers.offline.appearance.UNTRUSTED_SHARE` of the pass's blobs are not one animal's size, the
     online closed set's rows (``boxtrack`` with ``max_targets``, as ``track --targets N --online`` writes them) are
     returned instead, and ``note`` told why."""
+    return closed_set_and_look(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, config=config,
+                               vel_noise=vel_noise, shapes=shapes, parts=parts, note=note)[0]
+
+
+def closed_set_and_look(det_rows: np.ndarray, n_targets: int, frame_rate: float, *, n_frames: int | None = None,
+                        online: dict[str, Any] | None = None, config: ClosedSetConfig | None = None,
+                        vel_noise: float | None = None, shapes: np.ndarray | None = None,
+                        parts: np.ndarray | None = None,
+                        note: Callable[[str], None] | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    """:func:`track_closed_set`'s rows and, where it learned a look, each row's look margin (0 for a row of no
+    tracklet it judged; None without a look)."""
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
     for name, given in (("shapes", shapes), ("parts", parts)):
@@ -360,5 +401,5 @@ def track_closed_set(det_rows: np.ndarray, n_targets: int, frame_rate: float, *,
                  f"shadowed), too many to learn each one's look; the online closed set's result (--targets "
                  f"{n_targets} --online) is written instead")
         return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, reported=True,
-                           **{**(online or {}), "max_targets": int(n_targets)})
-    return assign_identities(rows, n_targets, frame_rate, config, shapes=shapes, parts=parts)
+                           **{**(online or {}), "max_targets": int(n_targets)}), None
+    return _assign(rows, n_targets, frame_rate, config, None, shapes, parts)
