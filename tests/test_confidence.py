@@ -8,6 +8,7 @@ import pytest
 from lookalike.trackers.offline.confidence import (
     FEATURES,
     assignment_confidence,
+    by_frame_and_id,
     describe_ranges,
     doubtful_ranges,
     row_features,
@@ -104,3 +105,23 @@ def test_bad_input_is_refused() -> None:
         row_features(np.zeros((3, 4)), FPS)
     with pytest.raises(ValueError, match="confidence"):
         doubtful_ranges(np.zeros((2, 10)), np.zeros(3), FPS)
+
+
+def test_the_look_margin_moves_the_confidence_its_way_and_zero_leaves_it() -> None:
+    rows = _rows(_crossing(60, 30))
+    plain = assignment_confidence(rows, FPS)
+    np.testing.assert_allclose(assignment_confidence(rows, FPS, look=np.zeros(len(rows))), plain)
+    look = np.where(rows[:, 1] == 1, 2.0, np.where(rows[:, 1] == 2, -2.0, 0.0))
+    p = assignment_confidence(rows, FPS, look=look)
+    assert np.all(p[rows[:, 1] == 1] > plain[rows[:, 1] == 1]) and np.all(p[rows[:, 1] == 2] < plain[rows[:, 1] == 2])
+    np.testing.assert_allclose(p[rows[:, 1] == 3], plain[rows[:, 1] == 3])
+    with pytest.raises(ValueError, match="look"):
+        assignment_confidence(rows, FPS, look=np.zeros(3))
+
+
+def test_values_found_by_frame_and_id() -> None:
+    rows = _rows({1: [(1, 0, 0), (2, 0, 0)], 7: [(1, 50, 50), (3, 50, 50)]})
+    keyed = np.array([[2, 1, 0.5], [1, 7, -1.5], [3, 7, np.nan], [9, 1, 4.0]])
+    by_row = dict(zip(map(tuple, rows[:, :2].astype(int).tolist()), by_frame_and_id(rows, keyed)))
+    assert by_row == {(1, 1): 0.0, (2, 1): 0.5, (1, 7): -1.5, (3, 7): 0.0}
+    assert by_frame_and_id(rows, np.zeros((0, 3))).tolist() == [0.0] * 4

@@ -38,3 +38,23 @@ def test_tracks_of_the_blob_command_re_solve_with_the_look_and_edited_ones_do_no
     r = runner.invoke(app, ["proofread", "--video", str(video), "--tracks", str(tracks), "--targets", "3",
                             "--export"])
     assert r.exit_code == 0 and "with each animal's look" in r.output, r.output
+
+
+def test_the_blob_closed_set_writes_a_confidence_that_weighs_each_rows_look(tmp_path, monkeypatch):
+    from lookalike.pipeline import TrackRequest, run
+    from lookalike.trackers.offline.confidence import assignment_confidence, by_frame_and_id
+
+    monkeypatch.setenv("LOOKALIKE_CACHE", str(tmp_path / "cache"))
+    cfg = ArenaConfig(n_animals=3, frames=60, image_px=300, body_length_px=40.0, body_width_px=7.0)
+    video = write_arena(tmp_path / "arena", cfg, seed=2).video
+    out = tmp_path / "t.txt"
+    result = run(TrackRequest(out, "boxtrack", video=str(video), detector="blob", targets=3))
+    look = result.looks[out]
+    t = read_mot(out)
+    rows = np.column_stack([t.frame, t.track_id, t.xywh, t.conf, np.full((len(t), 3), -1.0)])
+    margin = by_frame_and_id(rows, look)
+    assert look.shape[1] == 3 and np.any(margin != 0)
+    np.testing.assert_allclose(t.conf, np.round(assignment_confidence(rows, cfg.frame_rate_hz, look=margin), 3))
+    plain = np.round(assignment_confidence(rows, cfg.frame_rate_hz), 3)
+    assert np.all(t.conf[margin > 0] >= plain[margin > 0]) and np.all(t.conf[margin < 0] <= plain[margin < 0])
+    assert not np.array_equal(t.conf, plain)

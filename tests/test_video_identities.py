@@ -7,14 +7,16 @@ import numpy as np
 import pytest
 
 from lookalike.trackers.offline.appearance import (
+    MARGIN_CLIP,
     OUTLIER,
     SHAPE_COLUMN,
     IdentitySpace,
     cut_at_merges,
     fit_identity_space,
+    look_margins,
     single_rows,
 )
-from lookalike.trackers.offline.closed_set import track_closed_set
+from lookalike.trackers.offline.closed_set import closed_set_and_look, track_closed_set
 from lookalike.trackers.offline.tracklets import Tracklet
 from lookalike.vision.blob_shape import SHAPE_SIZE, blob_shapes
 
@@ -114,6 +116,30 @@ def test_merged_blobs_are_cut_out_of_tracklets_and_concurrent_tracklets_teach_th
     second = space.embed(shapes[other[other[:, 0] > 43, SHAPE_COLUMN].astype(int)]).mean(axis=0)
     same, two = space.link_evidence(np.array([look[0], look[0]]), np.array([look[1], second]))
     assert same > 0 > two
+
+
+def test_a_tracklet_on_its_own_animals_identity_has_a_positive_look_margin_and_a_swapped_one_a_negative():
+    rows, shapes, truth = _two_animals(bounce=True)
+    tracklet = np.column_stack([rows[:, :SHAPE_COLUMN], np.arange(len(rows))])
+    pieces = [Tracklet(tracklet[(truth == a) & side], a) for a in (1, 2)
+              for side in (tracklet[:, 0] < 38, tracklet[:, 0] > 43)]  # animal 1 before, after; animal 2 before, after
+    space = fit_identity_space(pieces, shapes)
+    assert space is not None
+    right = look_margins(pieces, [[0, 1], [2, 3]], shapes, space)
+    swapped = look_margins(pieces, [[0, 3], [2, 1]], shapes, space)
+    assert np.all(right > 0) and np.all(swapped < 0) and np.all(np.abs(swapped) <= MARGIN_CLIP)
+    alone = look_margins(pieces, [[0], [2, 3], [1]], shapes, space)  # nothing else on its identity: no margin
+    assert np.isnan(alone[0]) and np.isnan(alone[1]) and alone[2] > 0
+
+
+def test_the_closed_set_gives_the_look_margin_of_each_row_it_judged():
+    rows, shapes, truth = _two_animals(bounce=True)
+    result, look = closed_set_and_look(rows, 2, 25.0, shapes=shapes)
+    assert look is not None and look.shape == (len(result),)
+    merged = (result[:, 0] >= 38) & (result[:, 0] <= 43)
+    assert np.all(look[~merged] > 0) and np.all(look[merged] == 0)
+    assert np.array_equal(result, track_closed_set(rows, 2, 25.0, shapes=shapes))
+    assert closed_set_and_look(rows, 2, 25.0)[1] is None  # no shapes: no look
 
 
 def test_link_evidence_learns_how_much_one_animals_look_changes_between_pieces():

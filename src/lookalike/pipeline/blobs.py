@@ -114,9 +114,11 @@ def run_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, settin
     if offline is not None:
         assert n_targets
         offline = {**{k: v for k, v in BOX_TRACKER_PARAMS.items() if tracker_name == "boxtrack"}, **offline}
-        offline_video(rows, output, n_targets, offline, float(options.get("fps") or source_rate), frames,
-                      options["min_score"], on_event, video=video, annotate=options.get("annotate"),
-                      annotate_as=options.get("annotate_as"), shapes=found.shapes, parts=found.parts)
+        look = offline_video(rows, output, n_targets, offline, float(options.get("fps") or source_rate), frames,
+                             options["min_score"], on_event, video=video, annotate=options.get("annotate"),
+                             annotate_as=options.get("annotate_as"), shapes=found.shapes, parts=found.parts)
+        if look is not None:
+            result.looks[output] = look
         return result
     tracker = _set_tracker(tracker, tracker_name, frame_counts(rows, frames), explicit, n_targets, options, on_event)
     return run_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, on_event, length=frames,

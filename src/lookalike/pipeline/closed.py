@@ -19,7 +19,7 @@ from lookalike.io.points import POINT_VEL_NOISE, points_to_rows, read_points_csv
 from lookalike.io.stream import track_to_file
 from lookalike.pipeline.runner import Event, step, telling
 from lookalike.trackers.boxtrack import BoxTrack
-from lookalike.trackers.offline.closed_set import online_rows, track_closed_set
+from lookalike.trackers.offline.closed_set import closed_set_and_look, online_rows
 from lookalike.types.mot_table import MotTable, detection_rows
 
 Note = Callable[[str], None]  # told each note line (plain text)
@@ -50,21 +50,23 @@ def table_rows(path: Path, min_score: float = float("-inf"), length: int | None 
 def closed_set_rows(det_rows: np.ndarray, n_targets: int, frame_rate: float, n_frames: int | None,
                     params: dict[str, Any], vel_noise: float | None = None,
                     shapes: np.ndarray | None = None, parts: np.ndarray | None = None,
-                    note: Note = _silent) -> np.ndarray:
-    """Offline closed-set result rows (ids ``1..n_targets``) of detection rows; ``params``: the online ``boxtrack``
+                    note: Note = _silent) -> tuple[np.ndarray, np.ndarray | None]:
+    """Offline closed-set result rows (ids ``1..n_targets``) of detection rows, and each row's look margin where a
+    look was learned (else None); ``params``: the online ``boxtrack``
     pass's parameters (``max_targets`` dropped); ``vel_noise``: its velocity noise when not boxtrack's own;
     ``shapes``, ``parts``: each detection's blob shape and parts vectors (the look learned from them weighs in; merged
     blobs' animals go on their parts). Too few detections for
     the offline assignment get the online closed set's result instead, said to ``note``."""
     online = {k: v for k, v in params.items() if k != "max_targets"}
-    rows = track_closed_set(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online, vel_noise=vel_noise,
-                            shapes=shapes, parts=parts, note=note)
+    rows, look = closed_set_and_look(det_rows, n_targets, frame_rate, n_frames=n_frames, online=online,
+                                     vel_noise=vel_noise, shapes=shapes, parts=parts, note=note)
     if len(rows) or not len(det_rows):
-        return rows
+        return rows, look
     frames = len(np.unique(det_rows[:, 0]))
     note(f"note: {frames} frame(s) of detections are too few for the offline closed set; the online closed "
          f"set's result (boxtrack --targets {n_targets}) is written instead")
-    return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, **{**online, "max_targets": n_targets})
+    rows = online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, **{**online, "max_targets": n_targets})
+    return rows, None
 
 
 def offline_sequences(path: Path, output: Path, n_targets: int, params: dict[str, Any], min_score: float,
@@ -85,7 +87,7 @@ def offline_sequences(path: Path, output: Path, n_targets: int, params: dict[str
                          if seq.root is not None else "the length", det_format, note=file_note)
         n_frames = max((seq.length if use_length else None) or 0, int(det[:, 0].max(initial=0)))
         with status(f"closed set of {n_targets} on {seq.name}"):
-            rows = closed_set_rows(det, n_targets, seq.frame_rate, n_frames, params, note=note)
+            rows = closed_set_rows(det, n_targets, seq.frame_rate, n_frames, params, note=note)[0]
         write_mot(target, rows)
     return targets
 
@@ -93,11 +95,13 @@ def offline_sequences(path: Path, output: Path, n_targets: int, params: dict[str
 def offline_rows(det: Path | np.ndarray, n_targets: int, params: dict[str, Any], frame_rate: float,
                  n_frames: int | None, min_score: float, det_format: str = "auto", shapes: np.ndarray | None = None,
                  parts: np.ndarray | None = None, *, note: Note = _silent, file_note: Note = _silent,
-                 status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()) -> np.ndarray:
+                 status: Callable[[str], AbstractContextManager[Any]] = lambda text: nullcontext()
+                 ) -> tuple[np.ndarray, np.ndarray | None]:
     """The offline closed set of ``n_targets`` over a video's detections ``det`` (a detection file, or rows a
     detector found, with ``shapes`` and ``parts``: each row's blob shape and parts vectors, used when there is one a
     row kept), those below
-    ``min_score`` dropped; ``frame_rate`` in frames/s. ``note`` and ``file_note`` as for :func:`offline_sequences`."""
+    ``min_score`` dropped; ``frame_rate`` in frames/s. ``note`` and ``file_note`` as for :func:`offline_sequences`.
+    Returns the rows and their look margins as :func:`closed_set_rows`."""
     rows = table_rows(det, min_score, det_format=det_format, note=file_note) if isinstance(det, Path) else \
         det[det[:, 6] >= min_score]
     shapes = shapes if shapes is not None and len(shapes) == len(rows) else None
@@ -109,13 +113,14 @@ def offline_rows(det: Path | np.ndarray, n_targets: int, params: dict[str, Any],
 def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: dict[str, Any], frame_rate: float,
                   n_frames: int | None, min_score: float, on_event: Callable[[Event], None], det_format: str = "auto",
                   *, video: Path | None = None, annotate: Path | None = None, annotate_as: Path | None = None,
-                  shapes: np.ndarray | None = None, parts: np.ndarray | None = None) -> np.ndarray:
+                  shapes: np.ndarray | None = None, parts: np.ndarray | None = None) -> np.ndarray | None:
     """``track --video ... --offline``: the closed set over a video's detections (see :func:`offline_rows`) written
     to ``output``; with ``annotate``, its identities drawn on ``video`` into that MP4 (told as ``annotate_as``);
-    what it does told to ``on_event``; returns the result rows. ``ValueError`` for a bad input or video."""
+    what it does told to ``on_event``; returns the written rows' look margins as ``(frame, id, margin)`` rows where
+    the closed set learned a look, else None. ``ValueError`` for a bad input or video."""
     line = telling(on_event, "line")
     try:
-        rows = offline_rows(det, n_targets, params, frame_rate, n_frames, min_score, det_format, shapes, parts,
+        rows, look = offline_rows(det, n_targets, params, frame_rate, n_frames, min_score, det_format, shapes, parts,
                             note=line,
                             file_note=telling(on_event, "note"), status=partial(step, on_event))
     except FileNotFoundError as exc:
@@ -126,7 +131,7 @@ def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: 
     if annotate is not None and video is not None:
         draw_step(on_event, "drawing the identities", MotTable.from_rows(rows), annotate, frame_rate, video)
         line(f"annotated video → {annotate_as or annotate}")
-    return rows
+    return None if look is None else np.column_stack([rows[:, :2], look])
 
 
 def draw_step(on_event: Callable[[Event], None], what: str, *args: Any) -> None:
@@ -190,7 +195,7 @@ def track_point_boxes(boxes: PointBoxes, output: Path, tracker: Any, frame_rate:
     if params is not None:
         assert n_targets is not None
         rows = closed_set_rows(boxes.rows, n_targets, frame_rate, boxes.frames, params, vel_noise=POINT_VEL_NOISE,
-                               note=note)
+                               note=note)[0]
         write_mot(output, rows)
         return rows
     track_to_file(point_tracker(tracker), frames_from_table(MotTable.from_rows(boxes.rows), boxes.frames, frame_rate),

@@ -16,6 +16,8 @@ from lookalike.pipeline import files
 from lookalike.pipeline.request import TrackRequest
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from lookalike.pipeline.tracking import VideoTrackingResult
 
 BRANCHES = ("files", "video", "points", "blobs", "pipeline")
@@ -40,13 +42,15 @@ class Event:
 @dataclass
 class RunResult:
     """What :func:`run` did on ``branch``: the ``written`` result files, the tracker's ``stats`` (frames, seconds;
-    online file runs) and, on a video tracked online, the tracking pass's ``video`` result."""
+    online file runs), on a video tracked online the tracking pass's ``video`` result, and per result file of a
+    closed set that learned a look its rows' look margins (``looks``: ``(frame, id, margin)`` rows)."""
 
     branch: str
     written: list[Path] = field(default_factory=list)
     sequences: int = 0
     stats: RunStats = field(default_factory=RunStats)
     video: VideoTrackingResult | None = None
+    looks: dict[Path, np.ndarray] = field(default_factory=dict)
 
 
 def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) -> RunResult:
@@ -85,7 +89,7 @@ def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) 
     from lookalike.pipeline.results import add_confidence, written_results
 
     found = written_results(branch, request.path, request.output, request.video_path, request.fps)
-    for line in add_confidence(found):  # each row's identity confidence in column 7
+    for line in add_confidence(found, result.looks):  # each row's identity confidence in column 7
         tell(Event("line", line))
     return result
 

@@ -34,6 +34,7 @@ from lookalike.trackers.offline.appearance import (
     with_appearance,
 )
 from lookalike.trackers.offline.closed_set_config import ClosedSetConfig
+from lookalike.trackers.offline.confidence import by_frame_and_id
 from lookalike.trackers.offline.constraints import (
     ChainConstraints,
     chain_ids,
@@ -286,22 +287,7 @@ def _assign(rows: np.ndarray, n_targets: int, frame_rate: float, config: ClosedS
         return result, None
     keys = [(tracklets[i].rows[:, 0], np.full(len(tracklets[i]), ids[c]), np.full(len(tracklets[i]), margin[i]))
             for c, chain in enumerate(chains) for i in chain]
-    return result, _by_frame_and_id(result, np.vstack([np.column_stack(k) for k in keys]))
-
-
-def _by_frame_and_id(rows: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Per row of ``rows`` the value of ``values`` ``(m, 3)`` (frame, id, value) with its frame and id; 0 where there
-    is none or it is NaN."""
-    out = np.zeros(len(rows))
-    if not len(values) or not len(rows):
-        return out
-    width = max(rows[:, 1].max(), values[:, 1].max()) + 1
-    key, at = values[:, 0] * width + values[:, 1], rows[:, 0] * width + rows[:, 1]
-    order = np.argsort(key, kind="stable")
-    pos = np.clip(np.searchsorted(key[order], at), 0, len(key) - 1)
-    found = key[order][pos] == at
-    out[found] = np.nan_to_num(values[order][pos[found], 2])
-    return out
+    return result, by_frame_and_id(result, np.vstack([np.column_stack(k) for k in keys]))
 
 
 def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfig | None = None) -> int:

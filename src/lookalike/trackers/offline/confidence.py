@@ -8,7 +8,9 @@ over the identity's rows within ±W frames; ``since`` and ``until``, log(1 + sec
 gap and to its end or next gap (clipped at 30 s); ``length``, log(1 + the identity's rows in seconds, clipped at
 300 s); ``jump``, the largest |log| size ratio of consecutive rows within ±W frames (clipped at 1). A logistic model
 maps them to a probability; :data:`COEFFICIENTS` were fitted by ``research/confidence/fit.py`` as
-``research/confidence/rule.md`` fixes it."""
+``research/confidence/rule.md`` fixes it. Rows of the offline closed set that learned a look may add one more term,
+:data:`LOOK_COEFFICIENT` times each row's look margin (:func:`~lookalike.trackers.offline.appearance.look_margins`;
+``research/confidence/look-rule.md``)."""
 
 from __future__ import annotations
 
@@ -19,6 +21,7 @@ FEATURES = ("crowd_now", "crowd_window", "since", "until", "length", "jump")
 # default (online) results on mot15, pigs, mot17-synth and HexBug and of the offline closed set on pigs and HexBug,
 # each dataset weighted equally (research/confidence/rule.md, fit-result.txt).
 COEFFICIENTS = (0.4865, -0.2975, 0.4194, 0.7158, 0.7521, -0.2170, -3.3267)
+LOOK_COEFFICIENT = 0.6797  # the look margin's weight, fitted on arenas and HexBug (research/confidence/look-rule.md)
 DOUBTFUL_BELOW = 0.5  # a row is doubtful below this probability (research/confidence/rule.md)
 _CROWD_CLIP, _EDGE_CLIP_S, _LENGTH_CLIP_S, _JUMP_CLIP = 2.0, 30.0, 300.0, 1.0
 _PAIR_BUDGET = 1 << 22  # distances computed at once in crowd_now
@@ -115,9 +118,32 @@ def logistic(features: np.ndarray, coefficients: tuple[float, ...] | np.ndarray 
 
 
 def assignment_confidence(rows: np.ndarray, frame_rate: float,
-                          coefficients: tuple[float, ...] | np.ndarray = COEFFICIENTS) -> np.ndarray:
-    """``(k,)`` probability in [0, 1] that each row's identity is right, in the rows' order."""
-    return logistic(row_features(rows, frame_rate), coefficients)
+                          coefficients: tuple[float, ...] | np.ndarray = COEFFICIENTS,
+                          look: np.ndarray | None = None) -> np.ndarray:
+    """``(k,)`` probability in [0, 1] that each row's identity is right, in the rows' order; ``look``: each row's
+    look margin (``(k,)``, 0 where there is none) when the closed set learned a look."""
+    features, coef = row_features(rows, frame_rate), np.asarray(coefficients, dtype=float)
+    if look is not None:
+        look = np.asarray(look, dtype=float)
+        if look.shape != (len(features),):
+            raise ValueError(f"look: expected ({len(features)},), got shape {look.shape}")
+        features, coef = np.column_stack([features, np.nan_to_num(look)]), np.r_[coef, LOOK_COEFFICIENT]
+    return logistic(features, coef)
+
+
+def by_frame_and_id(rows: np.ndarray, keyed: np.ndarray) -> np.ndarray:
+    """Per row of ``rows`` (1-based frame, id, ...) the value of the row of ``keyed`` ``(m, 3)`` (frame, id, value)
+    with its frame and id; 0 where there is none or it is NaN."""
+    out = np.zeros(len(rows))
+    if not len(keyed) or not len(rows):
+        return out
+    width = max(rows[:, 1].max(), keyed[:, 1].max()) + 1
+    key, at = keyed[:, 0] * width + keyed[:, 1], rows[:, 0] * width + rows[:, 1]
+    order = np.argsort(key, kind="stable")
+    pos = np.clip(np.searchsorted(key[order], at), 0, len(key) - 1)
+    found = key[order][pos] == at
+    out[found] = np.nan_to_num(keyed[order][pos[found], 2])
+    return out
 
 
 def doubtful_ranges(rows: np.ndarray, confidence: np.ndarray, frame_rate: float,
