@@ -122,6 +122,7 @@ def test_the_look_margin_moves_the_confidence_its_way_and_zero_leaves_it() -> No
 def test_values_found_by_frame_and_id() -> None:
     rows = _rows({1: [(1, 0, 0), (2, 0, 0)], 7: [(1, 50, 50), (3, 50, 50)]})
     keyed = np.array([[2, 1, 0.5], [1, 7, -1.5], [3, 7, np.nan], [9, 1, 4.0]])
-    by_row = dict(zip(map(tuple, rows[:, :2].astype(int).tolist()), by_frame_and_id(rows, keyed)))
-    assert by_row == {(1, 1): 0.0, (2, 1): 0.5, (1, 7): -1.5, (3, 7): 0.0}
-    assert by_frame_and_id(rows, np.zeros((0, 3))).tolist() == [0.0] * 4
+    by_row = dict(zip(map(tuple, rows[:, :2].astype(int).tolist()), np.nan_to_num(by_frame_and_id(rows, keyed), nan=9)))
+    assert by_row == {(1, 1): 9, (2, 1): 0.5, (1, 7): -1.5, (3, 7): 9}
+    assert np.isnan(by_frame_and_id(rows, np.zeros((0, 3)))).all()
+

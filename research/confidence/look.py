@@ -38,8 +38,8 @@ def one(name: str, video: Path, n: int, truth: tuple[np.ndarray, np.ndarray, np.
     label, switches = label_rows(seq, rows, radius)
     x = row_features(rows, fps)
     base = COEFFICIENTS[0] + x @ np.asarray(COEFFICIENTS[1:])
-    margin = np.zeros(len(rows)) if look is None else look
-    print(f"{name}: rows {len(rows)} right {np.mean(label[label >= 0]):.3f} look on {np.mean(margin != 0):.1%} "
+    margin = np.full(len(rows), np.nan) if look is None else look
+    print(f"{name}: rows {len(rows)} right {np.mean(label[label >= 0]):.3f} look on {np.mean(~np.isnan(margin)):.1%} "
           f"switches {len(switches)}", flush=True)
     return Result(name.split()[0], "closed", name, fps, rows, x, label, switches, np.nan), base, margin
 
@@ -78,7 +78,7 @@ def fit_weight(items: list[tuple[Result, np.ndarray, np.ndarray]]) -> float:
         part = [(r, b, k) for r, b, k in items if r.dataset == d]
         keep = [r.label >= 0 for r, _, _ in part]
         z.append(np.concatenate([b[s] for (_, b, _), s in zip(part, keep)]))
-        m.append(np.concatenate([k[s] for (_, _, k), s in zip(part, keep)]))
+        m.append(np.concatenate([np.nan_to_num(k[s]) for (_, _, k), s in zip(part, keep)]))
         y.append(np.concatenate([r.label[s] for (r, _, _), s in zip(part, keep)]).astype(float))
         v.append(np.full(len(y[-1]), 1.0 / len(y[-1])))
     zz, mm, yy, vv = map(np.concatenate, (z, m, y, v))
@@ -97,7 +97,7 @@ def fit_weight(items: list[tuple[Result, np.ndarray, np.ndarray]]) -> float:
 def measure(label: str, items: list[tuple[Result, np.ndarray, np.ndarray]], w: float) -> dict[str, float]:
     out = {}
     for arm, weight in (("without the look", 0.0), ("with the look", w)):
-        probs = [logistic(np.column_stack([b + weight * k]), (0.0, 1.0)) for _, b, k in items]
+        probs = [logistic(np.column_stack([b + weight * np.nan_to_num(k)]), (0.0, 1.0)) for _, b, k in items]
         keep = [r.label >= 0 for r, _, _ in items]
         p = np.concatenate([q[s] for q, s in zip(probs, keep)])
         y = np.concatenate([r.label[s] for (r, _, _), s in zip(items, keep)]).astype(float)

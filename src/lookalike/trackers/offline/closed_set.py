@@ -218,7 +218,8 @@ def _assign(rows: np.ndarray, n_targets: int, frame_rate: float, config: ClosedS
             constraints: ChainConstraints | None, shapes: np.ndarray | None,
             parts: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
     """:func:`assign_identities`'s rows and, where a look was learned, each row's look margin (the
-    :func:`~lookalike.trackers.offline.appearance.look_margins` of the tracklet it came from; 0 for rows of none)."""
+    :func:`~lookalike.trackers.offline.appearance.look_margins` of the tracklet it came from; NaN for a row the look
+    did not judge)."""
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
@@ -371,8 +372,8 @@ def closed_set_and_look(det_rows: np.ndarray, n_targets: int, frame_rate: float,
                         vel_noise: float | None = None, shapes: np.ndarray | None = None,
                         parts: np.ndarray | None = None,
                         note: Callable[[str], None] | None = None) -> tuple[np.ndarray, np.ndarray | None]:
-    """:func:`track_closed_set`'s rows and, where it learned a look, each row's look margin (0 for a row of no
-    tracklet it judged; None without a look)."""
+    """:func:`track_closed_set`'s rows and, where it learned a look, each row's look margin (NaN for a row the look
+    did not judge: merged blobs, short pieces, filled gaps; None without a look)."""
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
     for name, given in (("shapes", shapes), ("parts", parts)):

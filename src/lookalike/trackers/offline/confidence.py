@@ -121,7 +121,7 @@ def assignment_confidence(rows: np.ndarray, frame_rate: float,
                           coefficients: tuple[float, ...] | np.ndarray = COEFFICIENTS,
                           look: np.ndarray | None = None) -> np.ndarray:
     """``(k,)`` probability in [0, 1] that each row's identity is right, in the rows' order; ``look``: each row's
-    look margin (``(k,)``, 0 where there is none) when the closed set learned a look."""
+    look margin (``(k,)``, NaN where there is none) when the closed set learned a look."""
     features, coef = row_features(rows, frame_rate), np.asarray(coefficients, dtype=float)
     if look is not None:
         look = np.asarray(look, dtype=float)
@@ -133,8 +133,8 @@ def assignment_confidence(rows: np.ndarray, frame_rate: float,
 
 def by_frame_and_id(rows: np.ndarray, keyed: np.ndarray) -> np.ndarray:
     """Per row of ``rows`` (1-based frame, id, ...) the value of the row of ``keyed`` ``(m, 3)`` (frame, id, value)
-    with its frame and id; 0 where there is none or it is NaN."""
-    out = np.zeros(len(rows))
+    with its frame and id; NaN where there is none."""
+    out = np.full(len(rows), np.nan)
     if not len(keyed) or not len(rows):
         return out
     width = max(rows[:, 1].max(), keyed[:, 1].max()) + 1
@@ -142,7 +142,7 @@ def by_frame_and_id(rows: np.ndarray, keyed: np.ndarray) -> np.ndarray:
     order = np.argsort(key, kind="stable")
     pos = np.clip(np.searchsorted(key[order], at), 0, len(key) - 1)
     found = key[order][pos] == at
-    out[found] = np.nan_to_num(keyed[order][pos[found], 2])
+    out[found] = keyed[order][pos[found], 2]
     return out
 
 
