@@ -13,31 +13,20 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from fit import switch_share
 from look import arenas, hexbug, test_a
 
-from lookalike.trackers.offline.confidence import DOUBTFUL_BELOW, LOOK_COEFFICIENT, doubtful_ranges, logistic
+from lookalike.trackers.offline.confidence import DOUBTFUL_BELOW, LOOK_COEFFICIENT, logistic
 
 
 def shares(items, unjudged: bool) -> tuple[int, int, float]:
-    """(switches inside a doubtful range, switches, share of rows inside one) with the shipped confidence."""
-    inside = total = rows_in = rows_all = 0
-    for r, base, look in items:
+    """(switches inside a doubtful range, switches, share of rows inside one) with the shipped confidence; with
+    ``unjudged``, a row the look could not judge counts as doubtful (its probability as 0 for the ranges)."""
+    probs = []
+    for _, base, look in items:
         p = logistic(np.column_stack([base + LOOK_COEFFICIENT * np.nan_to_num(look)]), (0.0, 1.0))
-        if unjudged:  # a row the look could not judge counts as doubtful: its probability as 0 for the ranges
-            p = np.where(np.isnan(look), 0.0, p)
-        ranges = doubtful_ranges(r.rows, p, r.fps, DOUBTFUL_BELOW)
-
-        def covered(i: int, f: int, ranges: dict[int, list[tuple[int, int]]] = ranges) -> bool:
-            return any(a <= f <= b for a, b in ranges.get(i, []))
-
-        for old, f_old, new, f in r.switches:
-            total += 1
-            inside += covered(new, f) or covered(old, f_old)
-        for i, spans in ranges.items():
-            sel = r.rows[r.rows[:, 1] == i, 0]
-            rows_in += sum(int(((sel >= a) & (sel <= b)).sum()) for a, b in spans)
-        rows_all += len(r.rows)
-    return inside, total, rows_in / max(rows_all, 1)
+        probs.append(np.where(np.isnan(look), 0.0, p) if unjudged else p)
+    return switch_share([r for r, _, _ in items], probs, DOUBTFUL_BELOW)
 
 
 def report(name: str, items) -> tuple[float, float, float]:

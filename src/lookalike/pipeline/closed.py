@@ -121,8 +121,7 @@ def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: 
     line = telling(on_event, "line")
     try:
         rows, look = offline_rows(det, n_targets, params, frame_rate, n_frames, min_score, det_format, shapes, parts,
-                            note=line,
-                            file_note=telling(on_event, "note"), status=partial(step, on_event))
+                                  note=line, file_note=telling(on_event, "note"), status=partial(step, on_event))
     except FileNotFoundError as exc:
         raise ValueError(str(exc)) from exc
     write_mot(output, rows)

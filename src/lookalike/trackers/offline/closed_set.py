@@ -61,8 +61,8 @@ from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import tracks_to_rows
 
 __all__ = ["ChainConstraints", "ClosedSetConfig", "Tracklet", "assign_identities", "closed_set_and_look",
-           "closed_set_input", "link_costs",
-           "motion_scale", "place_short", "smoothing_window", "solve_chains", "split_tracklets", "track_closed_set"]
+           "closed_set_input", "link_costs", "motion_scale", "place_short", "smoothing_window", "solve_chains",
+           "split_tracklets", "track_closed_set"]
 
 
 def solve_chains(lengths: np.ndarray, links: tuple[np.ndarray, np.ndarray, np.ndarray], n_chains: int,
