@@ -6,6 +6,8 @@ Scoring as the release checks do it: a result box stands for its centre; it matc
 within ``RADIUS_PX``; one global one-to-one mapping of result ids to reference ids maximises the matched frames
 (IDTP); IDF1 = 2 IDTP / (reference points + result boxes); "all right" counts the frames where every one of the N
 animals has its mapped id within reach. CPU time is the command's, learning included, on a fresh detection cache.
+A row is right when its mapped animal is within reach in its frame; the row confidence (column 7) is scored by its
+expected calibration error over 10 bins.
 
 Arenas: ``lookalike simulate --arena`` defaults, seeds ``--seeds`` (10000-10019 by default: never used for any choice;
 research/appearance/rule17.md). test_A: ``../shared/data/zebrafish/test_A.avi`` against ``idtracker_test_A.csv``.
@@ -60,11 +62,23 @@ def identity_scores(result: np.ndarray, reference: np.ndarray, n: int) -> dict[s
             hits.setdefault((int(res_idx[r]), int(ref_idx[g])), set()).add(f)
     a, b = linear_sum_assignment(-near)
     idtp = float(near[a, b].sum())
+    mapped = dict(zip(a.tolist(), b.tolist()))
+    right = np.array([f in hits.get((int(i), mapped.get(int(i), -1)), ()) for i, f in
+                      zip(res_idx, result[:, 0].astype(int))], dtype=bool)  # on its mapped animal, within reach
     frames = np.unique(reference[:, 0].astype(int))
     full = [f for f in frames if np.sum(reference[:, 0] == f) == n]
-    right = sum(all(f in hits.get((int(i), int(j)), ()) for i, j in zip(a, b)) and len(b) == n for f in full)
-    return {"IDF1": 2 * idtp / (len(reference) + len(result)), "all_right": right, "full_frames": len(full),
+    all_right = sum(all(f in hits.get((int(i), int(j)), ()) for i, j in zip(a, b)) and len(b) == n for f in full)
+    return {"IDF1": 2 * idtp / (len(reference) + len(result)), "all_right": all_right, "full_frames": len(full),
+            "ece": calibration_error(result[:, 6], right) if result.shape[1] > 6 else float("nan"),
             "switch_events": _switches(result, reference, dict(zip(b.tolist(), a.tolist())), ref_idx, res_ids)}
+
+
+def calibration_error(confidence: np.ndarray, right: np.ndarray, bins: int = 10) -> float:
+    """Expected calibration error of per-row confidences (column 7 of a result) against whether each row is right:
+    ``bins`` equal-width bins on [0, 1], rows-weighted mean |mean confidence - share right|."""
+    b = np.minimum((np.asarray(confidence) * bins).astype(int), bins - 1)
+    gap = np.abs(np.bincount(b, confidence, bins) - np.bincount(b, right.astype(float), bins))
+    return float(gap.sum() / max(len(b), 1)) if len(b) else float("nan")
 
 
 def _switches(result: np.ndarray, reference: np.ndarray, mapping: dict[int, int], ref_idx: np.ndarray,
@@ -122,7 +136,8 @@ def main() -> None:
                 s = identity_scores(rows, reference, n)
                 scores[mode].append(s["IDF1"])
                 print(f"arena seed {seed} {mode:8s} IDF1 {s['IDF1']:.4f}  all {n} right {s['all_right']}/"
-                      f"{s['full_frames']}  switches {s['switch_events']}  CPU {cpu:.1f} s", flush=True)
+                      f"{s['full_frames']}  switches {s['switch_events']}  confidence ECE {s['ece']:.3f}  "
+                      f"CPU {cpu:.1f} s", flush=True)
         for mode in args.modes:
             mean = float(np.mean(scores[mode]))
             print(f"arenas {args.seeds} {mode}: mean IDF1 {mean:.4f}, min {min(scores[mode]):.4f}")
@@ -137,8 +152,11 @@ def main() -> None:
                                   work / f"cache-zf-{mode}")
             s = identity_scores(rows, ref, 8)
             print(f"test_A {mode:8s} IDF1 {s['IDF1']:.4f}  all 8 right {s['all_right']}/{s['full_frames']}  "
-                  f"switches {s['switch_events']}  CPU {cpu:.1f} s (fresh cache)", flush=True)
+                  f"switches {s['switch_events']}  confidence ECE {s['ece']:.3f}  CPU {cpu:.1f} s (fresh cache)",
+                  flush=True)
             if mode == "default":
+                report_target("test_A --targets 8: row confidence, expected calibration error", s["ece"], 0.05,
+                              higher_is_better=False)
                 report_target("test_A --targets 8: IDF1 vs idtracker.ai", s["IDF1"], 0.99)
                 report_target("test_A --targets 8: share of frames with all 8 right", s["all_right"] /
                               max(s["full_frames"], 1), 0.95)
