@@ -125,4 +125,6 @@ def test_values_found_by_frame_and_id() -> None:
     by_row = dict(zip(map(tuple, rows[:, :2].astype(int).tolist()), np.nan_to_num(by_frame_and_id(rows, keyed), nan=9)))
     assert by_row == {(1, 1): 9, (2, 1): 0.5, (1, 7): -1.5, (3, 7): 9}
     assert np.isnan(by_frame_and_id(rows, np.zeros((0, 3)))).all()
+    odd = np.array([[1, -1, 0, 0, 1, 1], [1, 5, 0, 0, 1, 1], [2, -1, 0, 0, 1, 1]], float)  # ids of any sign
+    np.testing.assert_array_equal(by_frame_and_id(odd, np.array([[2, -1, 3.0], [1, 5, 4.0]])), [np.nan, 4.0, 3.0])
 

@@ -137,8 +137,9 @@ def by_frame_and_id(rows: np.ndarray, keyed: np.ndarray) -> np.ndarray:
     out = np.full(len(rows), np.nan)
     if not len(keyed) or not len(rows):
         return out
-    width = max(rows[:, 1].max(), keyed[:, 1].max()) + 1
-    key, at = keyed[:, 0] * width + keyed[:, 1], rows[:, 0] * width + rows[:, 1]
+    lo = min(rows[:, 1].min(), keyed[:, 1].min())  # (ids made >= 0, so that each (frame, id) has its own key)
+    width = max(rows[:, 1].max(), keyed[:, 1].max()) - lo + 1
+    key, at = keyed[:, 0] * width + keyed[:, 1] - lo, rows[:, 0] * width + rows[:, 1] - lo
     order = np.argsort(key, kind="stable")
     pos = np.clip(np.searchsorted(key[order], at), 0, len(key) - 1)
     found = key[order][pos] == at
