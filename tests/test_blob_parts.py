@@ -30,24 +30,28 @@ def test_bodies_that_touch_split_into_their_own_centres():
     assert np.allclose(three[np.argsort(three[:, 0])], [[15, 30], [40, 30], [65, 30]], atol=2)
 
 
+def _two_long_bodies(size: tuple[int, int], bodies: list[tuple[tuple[int, int], int]]) -> np.ndarray:
+    """The 2-part split of one blob drawn as long thin bodies (56 x 9 px) at (centre, angle in degrees), its parts
+    sorted top to bottom."""
+    img = np.zeros(size, np.uint8)
+    for centre, angle in bodies:
+        cv2.ellipse(img, centre, (28, 5), angle, 0, 360, 255, -1)
+    two = blob_parts(*_pixels(img > 0))[:4].reshape(2, 2)
+    return two[np.argsort(two[:, 1])]
+
+
 def test_the_parts_of_a_t_follow_its_two_long_thin_bodies():
     # a body (56 x 9 px) whose end touches the middle of another, crosswise: k-means puts the crosswise body's part
     # 9 px beyond its centre (the two parts share the pixels evenly); the mixture's elongated parts follow the bodies
-    img = np.zeros((100, 110), np.uint8)
-    cv2.ellipse(img, (50, 30), (28, 5), 0, 0, 360, 255, -1)
-    cv2.ellipse(img, (50, 52), (28, 5), 90, 0, 360, 255, -1)
-    two = blob_parts(*_pixels(img > 0))[:4].reshape(2, 2)
-    assert np.allclose(two[np.argsort(two[:, 1])], [[50, 30], [50, 52]], atol=4)
+    two = _two_long_bodies((100, 110), [((50, 30), 0), ((50, 52), 90)])
+    assert np.allclose(two, [[50, 30], [50, 52]], atol=4)
 
 
 def test_two_long_thin_bodies_side_by_side_split_between_them_not_front_and_back():
     # touching along their whole length: k-means' tighter split is front and back, each part 14 px from both
     # centres; the mixture started from the split across them is the more likely one, and it finds the bodies
-    img = np.zeros((80, 100), np.uint8)
-    cv2.ellipse(img, (50, 35), (28, 5), 0, 0, 360, 255, -1)
-    cv2.ellipse(img, (50, 44), (28, 5), 0, 0, 360, 255, -1)
-    two = blob_parts(*_pixels(img > 0))[:4].reshape(2, 2)
-    assert np.allclose(two[np.argsort(two[:, 1])], [[50, 35], [50, 44]], atol=1.5)
+    two = _two_long_bodies((80, 100), [((50, 35), 0), ((50, 44), 0)])
+    assert np.allclose(two, [[50, 35], [50, 44]], atol=1.5)
 
 
 def test_the_detector_splits_only_blobs_much_larger_than_the_recent_ones():
