@@ -290,3 +290,17 @@ def test_a_source_without_stamps_is_timed_by_the_wall_clock_on_its_frame_period(
     assert source.clock == "wall clock" and len(times) + source.dropped == 12
     assert times == sorted(times) and times[-1] > 0
     assert np.allclose(np.asarray(times) * 50, np.round(np.asarray(times) * 50))  # whole frame periods
+
+
+def test_a_live_closed_set_of_blobs_learns_the_look_and_keeps_each_disc_in_its_lane(tmp_path):
+    from lookalike.trackers.offline.online_look import LookIdentities
+
+    out = tmp_path / "t.txt"
+    source = _source([scene_frame(k) for k in range(120)])
+    plan = prepare_live(source, "blob", make_tracker("boxtrack"), "boxtrack", n_targets=3)
+    assert isinstance(plan.tracker, LookIdentities) and plan.tracker.frame_rate == RATE
+    run = track_live(source, plan, out)
+    assert run.frames == 120 and plan.tracker.looks.frame == 120
+    assert max(len(p.shapes) for p in plan.tracker.looks.pieces.values()) > 8  # shapes came after the sample
+    rows = np.loadtxt(out, delimiter=",", ndmin=2)
+    assert set(np.unique(rows[:, 1]).astype(int)) == {1, 2, 3} and max(_lanes(rows).values()) < 5

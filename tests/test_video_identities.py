@@ -204,7 +204,7 @@ def test_blobs_that_rarely_show_one_animal_get_the_online_closed_set():
     varied[::3, 0] += np.log(3.0)  # a third of the blobs three times an animal's size (shadows, merges)
     fallback = track_closed_set(rows, 2, 25.0, shapes=varied, note=notes.append)
     assert len(notes) == 1 and "--online" in notes[0]
-    assert np.array_equal(fallback, online_rows(rows, 25.0, reported=True, max_targets=2))
+    assert np.array_equal(fallback, online_rows(rows, 25.0, reported=True, shapes=varied, max_targets=2))
     assert not np.array_equal(kept[:, :6], fallback[:, :6])
 
 

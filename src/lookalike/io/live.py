@@ -15,6 +15,7 @@ import numpy as np
 
 from lookalike.io.sources import LiveFrame, LiveSource, SignalStop
 from lookalike.io.stream import MotWriter
+from lookalike.trackers.offline.online_look import LookIdentities
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import tracks_to_rows
 from lookalike.vision.blob import BlobConfig, BlobDetector
@@ -210,7 +211,18 @@ def prepare_live(source: LiveSource, detector: str, tracker: Any, tracker_name: 
         plan.count, plan.n_targets = boxes.count, boxes.n_targets
         if boxes.config != tracker.config:
             plan.tracker = type(tracker)(boxes.config)
+        if plan.n_targets:  # the slots re-assigned by the look learned from the frames after the sample
+            blobs.describe, blobs.split = True, False
+            plan.tracker = LookIdentities(plan.tracker, plan.n_targets, _frame_rate(source, sample))
     return plan
+
+
+def _frame_rate(source: LiveSource, sample: list[LiveFrame]) -> float:
+    """The source's frames per second: as it declares, else from the sample's times (25 when they say nothing)."""
+    if source.frame_rate:
+        return float(source.frame_rate)
+    span = sample[-1].time - sample[0].time if len(sample) > 1 else 0.0
+    return (len(sample) - 1) / span if span > 0 else 25.0
 
 
 def _min_score(detector: Callable[[Any], Detections], min_score: float) -> Callable[[Any], Detections]:

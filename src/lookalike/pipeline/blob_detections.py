@@ -19,6 +19,7 @@ import numpy as np
 from lookalike._optional import needs
 from lookalike.io.outputs import write_atomic
 from lookalike.io.video_frames import source_frames
+from lookalike.trackers.offline.online_look import shapes_by_box
 from lookalike.types import Detections
 from lookalike.types.mot_table import detection_rows
 from lookalike.vision import blob_shape
@@ -272,11 +273,33 @@ class BlobStream:
         keep = rows[:, 6] >= self.min_score
         return Detections(xywh=rows[keep, 2:6], score=rows[keep, 6])
 
+    def shapes_at(self, index: int, boxes: np.ndarray) -> np.ndarray:
+        """The shape vectors ``(k, SHAPE_SIZE)`` of the blobs with ``boxes`` ``(k, 4)`` in the 0-based frame ``index``,
+        the latest read (NaN rows for boxes not found there)."""
+        if self._rows and int(self._rows[-1][0, 0]) == index + 1:
+            return shapes_by_box(self._rows[-1][:, 2:6], self._shapes[-1], boxes)
+        return np.full((len(boxes), SHAPE_SIZE), np.nan)
+
     def found(self) -> BlobRows:
         """Every row found so far, the frames read and the rows' shape and parts vectors."""
         rows = np.vstack(self._rows) if self._rows else np.zeros((0, 10))
         return BlobRows(rows, self.frames, np.vstack(self._shapes) if self._shapes else np.zeros((0, SHAPE_SIZE)),
                         np.vstack(self._parts) if self._parts else np.zeros((0, PART_SIZE)), self.detector.split)
+
+
+def shape_lookup(found: BlobRows) -> Callable[[int, np.ndarray], np.ndarray]:
+    """``(frame index, boxes (k, 4)) -> (k, SHAPE_SIZE)``: the shape vectors of ``found``'s blobs with those boxes in
+    that 0-based frame (NaN rows for boxes not found there)."""
+    order = np.argsort(found.rows[:, 0], kind="stable")
+    rows, shapes = found.rows[order], found.shapes[order]
+    bounds = np.searchsorted(rows[:, 0], np.arange(1, found.frames + 2))
+
+    def lookup(index: int, boxes: np.ndarray) -> np.ndarray:
+        if not 0 <= index < found.frames:
+            return np.full((len(boxes), shapes.shape[1]), np.nan)
+        a, b = bounds[index], bounds[index + 1]
+        return shapes_by_box(rows[a:b, 2:6], shapes[a:b], boxes)
+    return lookup
 
 
 def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
@@ -295,4 +318,4 @@ def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[],
 
 __all__ = ["CACHE_ENV", "BlobRows", "BlobStream", "auto_blob_config", "blob_config", "blob_detections",
            "blob_settings", "cache_dir", "cached_blob_detections", "detection_cache_key", "load_blob_detections",
-           "store_blob_detections"]
+           "shape_lookup", "store_blob_detections"]

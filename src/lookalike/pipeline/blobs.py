@@ -19,9 +19,11 @@ from lookalike.pipeline.blob_detections import (
     auto_blob_config,
     cached_blob_detections,
     load_blob_detections,
+    shape_lookup,
     store_blob_detections,
 )
 from lookalike.pipeline.runner import Event, RunResult, step
+from lookalike.trackers.offline.online_look import LookIdentities, ShapeLookup
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, BlobEstimate, frame_counts
 from lookalike.vision.blob_boxtrack import blob_boxtrack_config
 
@@ -97,8 +99,10 @@ def run_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, settin
     except OSError as exc:
         raise ValueError(str(exc)) from exc
     result = RunResult("blobs", [output], 1)
+    rate = float(options.get("fps") or source_rate)
     if stream is not None:  # detected while tracked: the video is decoded once
         tracker = _set_tracker(tracker, tracker_name, np.zeros(0, int), explicit, n_targets, options, on_event)
+        tracker = with_look(tracker, tracker_name, rate, stream.shapes_at)
         result = run_video(video, stream, output, tracker, tracker_name, on_event, score_warnings=False, **options)
         found = stream.found()
         store_blob_detections(video, config, found)
@@ -114,15 +118,23 @@ def run_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, settin
     if offline is not None:
         assert n_targets
         offline = {**{k: v for k, v in BOX_TRACKER_PARAMS.items() if tracker_name == "boxtrack"}, **offline}
-        look = offline_video(rows, output, n_targets, offline, float(options.get("fps") or source_rate), frames,
+        look = offline_video(rows, output, n_targets, offline, rate, frames,
                              options["min_score"], on_event, video=video, annotate=options.get("annotate"),
                              annotate_as=options.get("annotate_as"), shapes=found.shapes, parts=found.parts)
         if look is not None:
             result.looks[output] = look
         return result
     tracker = _set_tracker(tracker, tracker_name, frame_counts(rows, frames), explicit, n_targets, options, on_event)
+    tracker = with_look(tracker, tracker_name, rate, shape_lookup(found))
     return run_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, on_event, length=frames,
                      score_warnings=False, **options)
+
+
+def with_look(tracker: Any, tracker_name: str, frame_rate: float, shapes: ShapeLookup) -> Any:
+    """``tracker`` with its slots' identities re-assigned by the blobs' look (:class:`LookIdentities`) when it is an
+    online closed set (``boxtrack`` with ``max_targets``); ``shapes`` finds each detection's shape vector."""
+    n = tracker.config.max_targets if tracker_name == "boxtrack" else None
+    return LookIdentities(tracker, n, frame_rate, shapes) if n else tracker
 
 
 def steps(on_event: Callable[[Event], None]) -> Callable[[str, int], Callable[[], None]]:
@@ -150,4 +162,4 @@ def _set_tracker(tracker: Any, tracker_name: str, counts: np.ndarray, explicit: 
     return tracker
 
 
-__all__ = ["blob_source", "blob_tracker", "estimate_lines", "one_pass", "run_blobs", "steps"]
+__all__ = ["blob_source", "blob_tracker", "estimate_lines", "one_pass", "run_blobs", "steps", "with_look"]

@@ -46,6 +46,7 @@ from lookalike.trackers.offline.constraints import (
 )
 from lookalike.trackers.offline.gap_fill import fill_gaps, smooth_boxes
 from lookalike.trackers.offline.merges import hold_in_merges, place_in_merges
+from lookalike.trackers.offline.online_look import LookIdentities, shapes_by_box
 from lookalike.trackers.offline.tracklets import (
     Tracklet,
     checked_rows,
@@ -307,13 +308,15 @@ def smoothing_window(rows: np.ndarray, frame_rate: float, config: ClosedSetConfi
 
 def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = None,
                 tracker: str = "boxtrack", *, vel_noise: float | None = None, index: bool = False,
-                reported: bool = False, **params: Any) -> np.ndarray:
+                reported: bool = False, shapes: np.ndarray | None = None, **params: Any) -> np.ndarray:
     """Result rows of an online pass of ``tracker`` over detection rows ``(k, >=7)`` (1-based frames,
     boxes in pixels, score in column 7): only tracks matched to a detection, at that detection's box.
     ``vel_noise``: ``boxtrack``'s velocity noise (fraction of the box size per frame) when not its default
     (:class:`~lookalike.trackers.boxtrack.BoxTrack`'s hook; points as boxes use
     :data:`lookalike.io.points.POINT_VEL_NOISE`). ``index``: column 9 holds the detection's row number in
-    ``det_rows``. ``reported``: instead, every track the tracker reports, as ``lookalike track`` writes it."""
+    ``det_rows``. ``reported``: instead, every track the tracker reports, as ``lookalike track`` writes it; then with
+    ``shapes`` (one blob shape vector per detection row) and ``max_targets``, the slots' identities re-assigned by the
+    look as ``--online`` does on blobs (:class:`~lookalike.trackers.offline.online_look.LookIdentities`)."""
     det_rows = checked_rows(det_rows)
     tracker_obj = make_tracker(tracker, **params)
     if vel_noise is not None:
@@ -325,6 +328,12 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
     order = np.argsort(det_rows[:, 0], kind="stable")
     det_rows = det_rows[order]
     bounds = np.searchsorted(det_rows[:, 0], np.arange(1, n_frames + 2))
+    if reported and shapes is not None and params.get("max_targets"):
+        looks = np.asarray(shapes)[order]
+
+        def lookup(k: int, boxes: np.ndarray) -> np.ndarray:
+            return shapes_by_box(det_rows[bounds[k]:bounds[k + 1], 2:6], looks[bounds[k]:bounds[k + 1]], boxes)
+        tracker_obj = LookIdentities(tracker_obj, params["max_targets"], frame_rate, lookup)
     out = []
     for k in range(n_frames):
         block = det_rows[bounds[k]:bounds[k + 1]]
@@ -387,6 +396,6 @@ def closed_set_and_look(det_rows: np.ndarray, n_targets: int, frame_rate: float,
             note(f"note: {100 * share:.0f}% of the blobs are not one animal's size (merged, cut by the border or "
                  f"shadowed), too many to learn each one's look; the online closed set's result (--targets "
                  f"{n_targets} --online) is written instead")
-        return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, reported=True,
+        return online_rows(det_rows, frame_rate, n_frames, vel_noise=vel_noise, reported=True, shapes=shapes,
                            **{**(online or {}), "max_targets": int(n_targets)}), None
     return _assign(rows, n_targets, frame_rate, config, None, shapes, parts)

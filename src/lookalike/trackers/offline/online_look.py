@@ -1,0 +1,191 @@
+"""Identities by the look while tracking: an online closed set's slots re-assigned after a crossing.
+
+A motion-only closed set (``boxtrack`` with ``max_targets``) keeps N slots but cannot tell which animal leaves a
+contact on which slot. :class:`LookIdentities` wraps it and learns, as the video plays, what each identity looks like
+(the identity map of :func:`~lookalike.trackers.offline.appearance.fit_identity_space`, refitted every second), from
+*pieces*: runs of one slot's rows on one animal's blob (:data:`~lookalike.trackers.offline.appearance.SINGLE_AREA` of
+the slot's median area so far). When a new piece reaches
+:data:`~lookalike.trackers.offline.appearance.MIN_ROWS` rows, the slots whose pieces began near it (a crossing's)
+are given the identities their looks fit best, if that fits better by more than :data:`LOOK_THRESHOLD`. Rows already
+reported keep their identity; nothing looks ahead. Chosen and measured in ``research/online_look/``."""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from lookalike.trackers.offline.appearance import MIN_ROWS, SINGLE_AREA, IdentitySpace, fit_identity_space
+from lookalike.trackers.offline.tracklets import Tracklet
+from lookalike.types import Frame, Tracks
+
+__all__ = ["LOOK_THRESHOLD", "LookIdentities", "ShapeLookup", "SlotLooks", "shapes_by_box"]
+
+LOOK_THRESHOLD = 0.5  # a crossing's slots change identities when that lowers their summed log distance this much
+GROUP_FRAMES = 8  # pieces that began within this many frames of each other may come from one crossing ...
+GROUP_SIZES = 3.0  # ... and within this many sizes (sqrt(w h) of the new piece's first box) of each other
+MIN_JUDGE_ROWS = 3  # rows a piece needs to be weighed
+AREA_HISTORY = 500  # latest blob areas of a slot whose median is its one-animal area
+
+ShapeLookup = Callable[[int, np.ndarray], np.ndarray]
+"""``(frame index, boxes (k, 4) px) -> (k, SHAPE_SIZE)`` shape vectors of the frame's blobs with those boxes (NaN
+rows where none)."""
+
+
+def shapes_by_box(xywh: np.ndarray, shapes: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """The rows of ``shapes`` (one per box of ``xywh``, ``(n, 4)``) whose boxes equal ``boxes`` ``(k, 4)``, NaN rows
+    where none does."""
+    out = np.full((len(boxes), shapes.shape[1]), np.nan)
+    for k, box in enumerate(np.asarray(boxes, dtype=float).reshape(-1, 4)):
+        hit = np.flatnonzero((xywh == box).all(axis=1))
+        if len(hit):
+            out[k] = shapes[hit[0]]
+    return out
+
+
+class _Piece:
+    def __init__(self, frame: int, centre: np.ndarray, size: float) -> None:
+        self.first, self.centre, self.size = frame, centre, size
+        self.shapes: list[np.ndarray] = []
+
+
+class SlotLooks:
+    """Slot ids in, identities out, frame by frame; the identities are a permutation of the slot ids ``1..n_slots``
+    (other ids pass unchanged). ``frame_rate``: frames per second (the map is refitted once a second)."""
+
+    def __init__(self, n_slots: int, frame_rate: float, threshold: float = LOOK_THRESHOLD) -> None:
+        self.n_slots, self.threshold = int(n_slots), float(threshold)
+        self.refit_every = max(int(round(frame_rate)), 1)
+        self.identity: dict[int, int] = {}
+        self.areas: dict[int, list[float]] = {}
+        self.pieces: dict[int, _Piece] = {}
+        self.done: list[tuple[int, np.ndarray, int]] = []  # identity, shape vectors, first frame
+        self.space: IdentitySpace | None = None
+        self.frame = 0
+        self.changes = 0  # re-assignments made
+
+    def update(self, slots: np.ndarray, boxes: np.ndarray, shapes: np.ndarray) -> np.ndarray:
+        """The identities of this frame's ``slots`` ``(k,)``; ``boxes`` ``(k, 4)`` xywh px; ``shapes``
+        ``(k, SHAPE_SIZE)`` of the blob that updated each slot (NaN rows where none did)."""
+        self.frame += 1
+        fresh, seen = [], set()
+        for slot, box, shape in zip(np.asarray(slots, dtype=int).tolist(), boxes, shapes):
+            if not 1 <= slot <= self.n_slots:
+                continue
+            self.identity.setdefault(slot, slot)
+            seen.add(slot)
+            if not self._alone(slot, shape):
+                self._close(slot)
+                continue
+            if slot not in self.pieces:
+                size = float(np.sqrt(max(box[2] * box[3], 1.0)))
+                self.pieces[slot] = _Piece(self.frame, box[:2] + box[2:4] / 2, size)
+            self.pieces[slot].shapes.append(shape)
+            if len(self.pieces[slot].shapes) == MIN_ROWS:
+                fresh.append(slot)
+        for slot in [s for s in self.pieces if s not in seen]:
+            self._close(slot)
+        if self.frame % self.refit_every == 0:
+            self._refit()
+        if self.space is not None:
+            for slot in fresh:
+                self._judge(slot, self.space)
+        return np.array([self.identity.get(s, s) for s in np.asarray(slots, dtype=int).tolist()], dtype=int)
+
+    def _alone(self, slot: int, shape: np.ndarray) -> bool:
+        if np.isnan(shape[0]):
+            return False
+        history = self.areas.setdefault(slot, [])
+        history.append(float(np.exp(shape[0])))
+        del history[:-AREA_HISTORY]
+        typical = float(np.median(history))
+        return SINGLE_AREA[0] * typical <= history[-1] <= SINGLE_AREA[1] * typical
+
+    def _close(self, slot: int) -> None:
+        piece = self.pieces.pop(slot, None)
+        if piece is not None and len(piece.shapes) >= MIN_ROWS:
+            self.done.append((self.identity[slot], np.array(piece.shapes), piece.first))
+
+    def _refit(self) -> None:
+        blocks = [(s, first) for _, s, first in self.done]
+        blocks += [(np.array(p.shapes), p.first) for p in self.pieces.values() if len(p.shapes) >= MIN_ROWS]
+        if len(blocks) < 2:
+            return
+        tracklets, start = [], 0
+        for s, first in blocks:
+            rows = np.zeros((len(s), 10))
+            rows[:, 0] = first + np.arange(len(s))
+            rows[:, 9] = start + np.arange(len(s))
+            tracklets.append(Tracklet(rows))
+            start += len(s)
+        space = fit_identity_space(tracklets, np.vstack([s for s, _ in blocks]))
+        if space is not None:
+            self.space = space
+
+    def _looks(self, space: IdentitySpace) -> dict[int, np.ndarray]:
+        """Each identity's look: the mean embedded shape of its finished pieces."""
+        total: dict[int, np.ndarray] = {}
+        count: dict[int, int] = {}
+        for identity, s, _ in self.done:
+            e = space.embed(s)
+            total[identity] = total.get(identity, 0) + e.sum(axis=0)
+            count[identity] = count.get(identity, 0) + len(e)
+        return {k: total[k] / count[k] for k in total}
+
+    def _judge(self, slot: int, space: IdentitySpace) -> None:
+        """Re-assign the identities of ``slot``'s crossing (its new piece's group) by their looks."""
+        piece, looks = self.pieces[slot], self._looks(space)
+        group = [s for s, p in self.pieces.items()
+                 if abs(p.first - piece.first) <= GROUP_FRAMES and len(p.shapes) >= MIN_JUDGE_ROWS
+                 and self.identity[s] in looks
+                 and (s == slot or np.hypot(*(p.centre - piece.centre)) <= GROUP_SIZES * piece.size)]
+        if slot not in group or len(group) < 2:
+            return
+        ids = [self.identity[s] for s in group]
+        mine = np.array([space.embed(np.array(self.pieces[s].shapes)).mean(axis=0) for s in group])
+        theirs = np.array([looks[k] for k in ids])
+        cost = np.log(np.mean((mine[:, None, :] - theirs[None, :, :]) ** 2, axis=2) + 1e-9)
+        rows, cols = linear_sum_assignment(cost)
+        if np.trace(cost) - cost[rows, cols].sum() > self.threshold and (cols != rows).any():
+            for a, b in zip(rows, cols):
+                self.identity[group[a]] = ids[b]
+            self.changes += 1
+
+
+class LookIdentities:
+    """``tracker`` (an online closed set of ``n_targets`` slots) with its reported ids re-assigned by
+    :class:`SlotLooks`; ``shapes`` finds the shape vector of the blob behind each detection (None: the detections'
+    ``feature``, as a describing blob detector gives them). Every other attribute is the tracker's."""
+
+    def __init__(self, tracker: Any, n_targets: int, frame_rate: float, shapes: ShapeLookup | None = None) -> None:
+        self.tracker, self.n_targets, self.frame_rate, self.shapes = tracker, int(n_targets), frame_rate, shapes
+        self.looks = SlotLooks(self.n_targets, frame_rate)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.tracker, name)
+
+    def reset(self) -> None:
+        self.tracker.reset()
+        self.looks = SlotLooks(self.n_targets, self.frame_rate)
+
+    def update(self, frame: Frame) -> Tracks:
+        tracks = self.tracker.update(frame)
+        if not isinstance(tracks, Tracks):
+            tracks = Tracks.from_snapshots(list(tracks))
+        boxes = np.zeros((len(tracks), 4)) if tracks.xywh is None else np.asarray(tracks.xywh, dtype=float)
+        used = tracks.detection_index >= 0
+        index, feature = tracks.detection_index[used], frame.detections.feature
+        if self.shapes is not None:
+            found = self.shapes(frame.index, np.asarray(frame.detections.xywh)[index])
+        elif feature is not None:
+            found = np.asarray(feature, dtype=float)[index]
+        else:
+            found = np.full((len(index), 1), np.nan)
+        shapes = np.full((len(tracks), found.shape[1]), np.nan)
+        shapes[used] = found
+        out = copy.copy(tracks)
+        out.id = self.looks.update(tracks.id, boxes, shapes)
+        return out
