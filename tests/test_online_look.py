@@ -108,3 +108,18 @@ def test_the_online_pass_over_rows_re_assigns_slots_as_the_command_does():
     looked = online_rows(rows, 25.0, reported=True, shapes=shapes, max_targets=2, n_init=2)
     assert np.array_equal(looked[:, [0, 1, 2]], _online(rows, shapes, True))
     assert not np.array_equal(plain[:, 1], looked[:, 1]) and np.array_equal(plain[:, 2:6], looked[:, 2:6])
+
+
+def test_memory_stays_bounded_on_a_long_run(monkeypatch):
+    from lookalike.trackers.offline import online_look
+
+    monkeypatch.setattr(online_look, "MAX_PIECES", 5)
+    monkeypatch.setattr(online_look, "MAX_PIECE_ROWS", 12)
+    looks = SlotLooks(1, 25.0)
+    box, alone, broken = np.array([[0.0, 0.0, 10.0, 10.0]]), np.zeros((1, 4)), np.full((1, 4), np.nan)
+    for _ in range(30):
+        for _ in range(20):
+            looks.update(np.array([1]), box, alone)
+        assert len(looks.pieces[1].shapes) == 12
+        looks.update(np.array([1]), box, broken)
+    assert len(looks.done) == 5 and all(len(s) == 12 for _, s, _ in looks.done)

@@ -12,6 +12,7 @@ reported keep their identity; nothing looks ahead. Chosen and measured in ``rese
 from __future__ import annotations
 
 import copy
+from collections import deque
 from collections.abc import Callable
 from typing import Any
 
@@ -29,6 +30,8 @@ GROUP_FRAMES = 8  # pieces that began within this many frames of each other may 
 GROUP_SIZES = 3.0  # ... and within this many sizes (sqrt(w h) of the new piece's first box) of each other
 MIN_JUDGE_ROWS = 3  # rows a piece needs to be weighed
 AREA_HISTORY = 500  # latest blob areas of a slot whose median is its one-animal area
+MAX_PIECES = 400  # finished pieces kept (the latest), which bounds memory and the refit on long or live videos
+MAX_PIECE_ROWS = 1000  # shape vectors kept per piece
 
 ShapeLookup = Callable[[int, np.ndarray], np.ndarray]
 """``(frame index, boxes (k, 4) px) -> (k, SHAPE_SIZE)`` shape vectors of the frame's blobs with those boxes (NaN
@@ -62,8 +65,9 @@ class SlotLooks:
         self.identity: dict[int, int] = {}
         self.areas: dict[int, list[float]] = {}
         self.pieces: dict[int, _Piece] = {}
-        self.done: list[tuple[int, np.ndarray, int]] = []  # identity, shape vectors, first frame
+        self.done: deque[tuple[int, np.ndarray, int]] = deque(maxlen=MAX_PIECES)  # identity, shapes, first frame
         self.space: IdentitySpace | None = None
+        self._looks: dict[int, np.ndarray] | None = None  # each identity's look in ``space`` (None: to compute)
         self.frame = 0
         self.changes = 0  # re-assignments made
 
@@ -83,7 +87,8 @@ class SlotLooks:
             if slot not in self.pieces:
                 size = float(np.sqrt(max(box[2] * box[3], 1.0)))
                 self.pieces[slot] = _Piece(self.frame, box[:2] + box[2:4] / 2, size)
-            self.pieces[slot].shapes.append(shape)
+            if len(self.pieces[slot].shapes) < MAX_PIECE_ROWS:
+                self.pieces[slot].shapes.append(shape)
             if len(self.pieces[slot].shapes) == MIN_ROWS:
                 fresh.append(slot)
         for slot in [s for s in self.pieces if s not in seen]:
@@ -108,6 +113,7 @@ class SlotLooks:
         piece = self.pieces.pop(slot, None)
         if piece is not None and len(piece.shapes) >= MIN_ROWS:
             self.done.append((self.identity[slot], np.array(piece.shapes), piece.first))
+            self._looks = None
 
     def _refit(self) -> None:
         blocks = [(s, first) for _, s, first in self.done]
@@ -123,21 +129,24 @@ class SlotLooks:
             start += len(s)
         space = fit_identity_space(tracklets, np.vstack([s for s, _ in blocks]))
         if space is not None:
-            self.space = space
+            self.space, self._looks = space, None
 
-    def _looks(self, space: IdentitySpace) -> dict[int, np.ndarray]:
+    def looks(self, space: IdentitySpace) -> dict[int, np.ndarray]:
         """Each identity's look: the mean embedded shape of its finished pieces."""
+        if self._looks is not None:
+            return self._looks
         total: dict[int, np.ndarray] = {}
         count: dict[int, int] = {}
         for identity, s, _ in self.done:
             e = space.embed(s)
             total[identity] = total.get(identity, 0) + e.sum(axis=0)
             count[identity] = count.get(identity, 0) + len(e)
-        return {k: total[k] / count[k] for k in total}
+        self._looks = {k: total[k] / count[k] for k in total}
+        return self._looks
 
     def _judge(self, slot: int, space: IdentitySpace) -> None:
         """Re-assign the identities of ``slot``'s crossing (its new piece's group) by their looks."""
-        piece, looks = self.pieces[slot], self._looks(space)
+        piece, looks = self.pieces[slot], self.looks(space)
         group = [s for s, p in self.pieces.items()
                  if abs(p.first - piece.first) <= GROUP_FRAMES and len(p.shapes) >= MIN_JUDGE_ROWS
                  and self.identity[s] in looks
