@@ -25,7 +25,8 @@ def spy(self, *args, **kwargs):
 
 
 online_look.LookIdentities.__init__ = spy
-online_rows(found.rows, fps, found.frames, reported=True, shapes=found.shapes, **{**BOX_TRACKER_PARAMS, "max_targets": 8})
+online_rows(found.rows, fps, found.frames, reported=True, shapes=found.shapes,
+            **{**BOX_TRACKER_PARAMS, "max_targets": 8})
 looks = made[0].looks
 sizes = [len(s) for _, s, _ in looks.done]
 print(f"frames {looks.frame}, re-assignments {looks.changes}, finished pieces {len(looks.done)} "

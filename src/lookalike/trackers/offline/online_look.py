@@ -11,14 +11,15 @@ reported keep their identity; nothing looks ahead. Chosen and measured in ``rese
 
 from __future__ import annotations
 
+import bisect
 import copy
 from collections import deque
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
+from lookalike.association.solver import linear_sum_assignment
 from lookalike.trackers.offline.appearance import MIN_ROWS, SINGLE_AREA, IdentitySpace, fit_identity_space
 from lookalike.trackers.offline.tracklets import Tracklet
 from lookalike.types import Frame, Tracks
@@ -41,11 +42,11 @@ rows where none)."""
 def shapes_by_box(xywh: np.ndarray, shapes: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     """The rows of ``shapes`` (one per box of ``xywh``, ``(n, 4)``) whose boxes equal ``boxes`` ``(k, 4)``, NaN rows
     where none does."""
-    out = np.full((len(boxes), shapes.shape[1]), np.nan)
-    for k, box in enumerate(np.asarray(boxes, dtype=float).reshape(-1, 4)):
-        hit = np.flatnonzero((xywh == box).all(axis=1))
-        if len(hit):
-            out[k] = shapes[hit[0]]
+    same = (np.asarray(boxes, dtype=float).reshape(-1, 1, 4) == np.asarray(xywh).reshape(1, -1, 4)).all(axis=2)
+    out = np.full((len(same), shapes.shape[1]), np.nan)
+    found = same.any(axis=1)
+    if found.any():
+        out[found] = shapes[same[found].argmax(axis=1)]
     return out
 
 
@@ -63,7 +64,7 @@ class SlotLooks:
         self.n_slots, self.threshold = int(n_slots), float(threshold)
         self.refit_every = max(int(round(frame_rate)), 1)
         self.identity: dict[int, int] = {}
-        self.areas: dict[int, list[float]] = {}
+        self.areas: dict[int, tuple[deque[float], list[float]]] = {}
         self.pieces: dict[int, _Piece] = {}
         self.done: deque[tuple[int, np.ndarray, int]] = deque(maxlen=MAX_PIECES)  # identity, shapes, first frame
         self.space: IdentitySpace | None = None
@@ -101,13 +102,19 @@ class SlotLooks:
         return np.array([self.identity.get(s, s) for s in np.asarray(slots, dtype=int).tolist()], dtype=int)
 
     def _alone(self, slot: int, shape: np.ndarray) -> bool:
+        """Whether ``shape``'s blob is one animal's size: its area within :data:`SINGLE_AREA` of the median of the
+        slot's latest :data:`AREA_HISTORY` areas (kept in arrival order and sorted)."""
         if np.isnan(shape[0]):
             return False
-        history = self.areas.setdefault(slot, [])
-        history.append(float(np.exp(shape[0])))
-        del history[:-AREA_HISTORY]
-        typical = float(np.median(history))
-        return SINGLE_AREA[0] * typical <= history[-1] <= SINGLE_AREA[1] * typical
+        order, ranked = self.areas.setdefault(slot, (deque(), []))
+        area = float(np.exp(shape[0]))
+        order.append(area)
+        bisect.insort(ranked, area)
+        if len(order) > AREA_HISTORY:
+            del ranked[bisect.bisect_left(ranked, order.popleft())]
+        n = len(ranked)
+        typical = ranked[n // 2] if n % 2 else (ranked[n // 2 - 1] + ranked[n // 2]) / 2
+        return SINGLE_AREA[0] * typical <= area <= SINGLE_AREA[1] * typical
 
     def _close(self, slot: int) -> None:
         piece = self.pieces.pop(slot, None)
@@ -131,7 +138,7 @@ class SlotLooks:
         if space is not None:
             self.space, self._looks = space, None
 
-    def looks(self, space: IdentitySpace) -> dict[int, np.ndarray]:
+    def identity_looks(self, space: IdentitySpace) -> dict[int, np.ndarray]:
         """Each identity's look: the mean embedded shape of its finished pieces."""
         if self._looks is not None:
             return self._looks
@@ -146,7 +153,7 @@ class SlotLooks:
 
     def _judge(self, slot: int, space: IdentitySpace) -> None:
         """Re-assign the identities of ``slot``'s crossing (its new piece's group) by their looks."""
-        piece, looks = self.pieces[slot], self.looks(space)
+        piece, looks = self.pieces[slot], self.identity_looks(space)
         group = [s for s, p in self.pieces.items()
                  if abs(p.first - piece.first) <= GROUP_FRAMES and len(p.shapes) >= MIN_JUDGE_ROWS
                  and self.identity[s] in looks
@@ -174,6 +181,8 @@ class LookIdentities:
         self.looks = SlotLooks(self.n_targets, frame_rate)
 
     def __getattr__(self, name: str) -> Any:
+        if name == "tracker":  # not set yet (a copy being made)
+            raise AttributeError(name)
         return getattr(self.tracker, name)
 
     def reset(self) -> None:
