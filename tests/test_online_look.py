@@ -123,3 +123,20 @@ def test_memory_stays_bounded_on_a_long_run(monkeypatch):
         assert len(looks.pieces[1].shapes) == 12
         looks.update(np.array([1]), box, broken)
     assert len(looks.done) == 5 and all(len(s) == 12 for _, s, _ in looks.done)
+
+
+def test_rows_on_their_own_animals_identity_get_a_positive_look_margin():
+    rows, shapes, truth = _two_animals(bounce=True)
+    found = BlobRows(rows, int(rows[:, 0].max()), shapes, np.full((len(rows), PART_SIZE), np.nan))
+    tracker = LookIdentities(make_tracker("boxtrack", max_targets=2, n_init=2), 2, 25.0, shape_lookup(found),
+                             keep_margins=True)
+    reported = 0
+    for k in range(found.frames):
+        block = rows[rows[:, 0] == k + 1]
+        reported += len(tracker.update(Frame(index=k, time=k / 25.0, detections=Detections(xywh=block[:, 2:6]))))
+    margins = tracker.margin_rows()
+    assert len(margins) == reported and set(np.unique(margins[:, 1])) == {1, 2}
+    judged = margins[~np.isnan(margins[:, 2])]
+    assert len(judged) > 20 and judged[:, 0].min() > 43  # only once both animals have a finished piece
+    assert np.all(judged[:, 2] > 0) and np.all(np.abs(judged[:, 2]) <= 3.0)
+    assert not LookIdentities(make_tracker("boxtrack", max_targets=2), 2, 25.0).margin_rows().size

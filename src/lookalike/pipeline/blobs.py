@@ -103,7 +103,8 @@ def run_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, settin
     if stream is not None:  # detected while tracked: the video is decoded once
         tracker = _set_tracker(tracker, tracker_name, np.zeros(0, int), explicit, n_targets, options, on_event)
         tracker = with_look(tracker, tracker_name, rate, stream.shapes_at)
-        result = run_video(video, stream, output, tracker, tracker_name, on_event, score_warnings=False, **options)
+        result = _with_margins(run_video(video, stream, output, tracker, tracker_name, on_event, score_warnings=False,
+                                         **options), tracker, output)
         found = stream.found()
         store_blob_detections(video, config, found)
     assert found is not None
@@ -126,15 +127,22 @@ def run_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, settin
         return result
     tracker = _set_tracker(tracker, tracker_name, frame_counts(rows, frames), explicit, n_targets, options, on_event)
     tracker = with_look(tracker, tracker_name, rate, shape_lookup(found))
-    return run_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, on_event, length=frames,
-                     score_warnings=False, **options)
+    return _with_margins(run_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, on_event,
+                                   length=frames, score_warnings=False, **options), tracker, output)
 
 
 def with_look(tracker: Any, tracker_name: str, frame_rate: float, shapes: ShapeLookup) -> Any:
     """``tracker`` with its slots' identities re-assigned by the blobs' look (:class:`LookIdentities`) when it is an
     online closed set (``boxtrack`` with ``max_targets``); ``shapes`` finds each detection's shape vector."""
     n = tracker.config.max_targets if tracker_name == "boxtrack" else None
-    return LookIdentities(tracker, n, frame_rate, shapes) if n else tracker
+    return LookIdentities(tracker, n, frame_rate, shapes, keep_margins=True) if n else tracker
+
+
+def _with_margins(result: RunResult, tracker: Any, output: Path) -> RunResult:
+    """``result`` with the look margins of ``tracker``'s rows (for their confidence) when it learned a look."""
+    if isinstance(tracker, LookIdentities):
+        result.looks[output] = tracker.margin_rows()
+    return result
 
 
 def steps(on_event: Callable[[Event], None]) -> Callable[[str, int], Callable[[], None]]:

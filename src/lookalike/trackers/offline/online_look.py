@@ -20,7 +20,13 @@ from typing import Any
 import numpy as np
 
 from lookalike.association.solver import linear_sum_assignment
-from lookalike.trackers.offline.appearance import MIN_ROWS, SINGLE_AREA, IdentitySpace, fit_identity_space
+from lookalike.trackers.offline.appearance import (
+    MARGIN_CLIP,
+    MIN_ROWS,
+    SINGLE_AREA,
+    IdentitySpace,
+    fit_identity_space,
+)
 from lookalike.trackers.offline.tracklets import Tracklet
 from lookalike.types import Frame, Tracks
 
@@ -54,6 +60,7 @@ class _Piece:
     def __init__(self, frame: int, centre: np.ndarray, size: float) -> None:
         self.first, self.centre, self.size = frame, centre, size
         self.shapes: list[np.ndarray] = []
+        self.total: np.ndarray | float = 0.0  # the sum of its shape vectors
 
 
 class SlotLooks:
@@ -90,6 +97,7 @@ class SlotLooks:
                 self.pieces[slot] = _Piece(self.frame, box[:2] + box[2:4] / 2, size)
             if len(self.pieces[slot].shapes) < MAX_PIECE_ROWS:
                 self.pieces[slot].shapes.append(shape)
+                self.pieces[slot].total = self.pieces[slot].total + shape
             if len(self.pieces[slot].shapes) == MIN_ROWS:
                 fresh.append(slot)
         for slot in [s for s in self.pieces if s not in seen]:
@@ -100,6 +108,26 @@ class SlotLooks:
             for slot in fresh:
                 self._judge(slot, self.space)
         return np.array([self.identity.get(s, s) for s in np.asarray(slots, dtype=int).tolist()], dtype=int)
+
+    def margins(self, slots: np.ndarray) -> np.ndarray:
+        """Per slot of ``slots`` ``(k,)``, after :meth:`update`: how much better its identity's look fits its current
+        piece than the nearest other identity's (the log mean squared distance to that one minus to its own, within
+        ±:data:`~lookalike.trackers.offline.appearance.MARGIN_CLIP`); NaN where the piece is under
+        :data:`~lookalike.trackers.offline.appearance.MIN_ROWS` rows or a look is missing."""
+        out = np.full(len(slots), np.nan)
+        if self.space is None:
+            return out
+        looks = self.identity_looks(self.space)
+        for r, slot in enumerate(np.asarray(slots, dtype=int).tolist()):
+            piece, own = self.pieces.get(slot), looks.get(self.identity.get(slot, slot))
+            others = [v for k, v in looks.items() if k != self.identity.get(slot, slot)]
+            if piece is None or len(piece.shapes) < MIN_ROWS or own is None or not others:
+                continue
+            mine = self.space.embed(np.asarray(piece.total)[None, :] / len(piece.shapes))[0]
+            x_own = np.log(np.mean((mine - own) ** 2) + 1e-9)
+            x_other = min(np.log(np.mean((mine - o) ** 2) + 1e-9) for o in others)
+            out[r] = min(max(x_other - x_own, -MARGIN_CLIP), MARGIN_CLIP)
+        return out
 
     def _alone(self, slot: int, shape: np.ndarray) -> bool:
         """Whether ``shape``'s blob is one animal's size: its area within :data:`SINGLE_AREA` of the median of the
@@ -176,9 +204,12 @@ class LookIdentities:
     :class:`SlotLooks`; ``shapes`` finds the shape vector of the blob behind each detection (None: the detections'
     ``feature``, as a describing blob detector gives them). Every other attribute is the tracker's."""
 
-    def __init__(self, tracker: Any, n_targets: int, frame_rate: float, shapes: ShapeLookup | None = None) -> None:
+    def __init__(self, tracker: Any, n_targets: int, frame_rate: float, shapes: ShapeLookup | None = None,
+                 keep_margins: bool = False) -> None:
         self.tracker, self.n_targets, self.frame_rate, self.shapes = tracker, int(n_targets), frame_rate, shapes
+        self.keep_margins = keep_margins
         self.looks = SlotLooks(self.n_targets, frame_rate)
+        self._margins: list[np.ndarray] = []
 
     def __getattr__(self, name: str) -> Any:
         if name == "tracker":  # not set yet (a copy being made)
@@ -188,6 +219,12 @@ class LookIdentities:
     def reset(self) -> None:
         self.tracker.reset()
         self.looks = SlotLooks(self.n_targets, self.frame_rate)
+        self._margins = []
+
+    def margin_rows(self) -> np.ndarray:
+        """With ``keep_margins``, every reported row's look margin so far (:meth:`SlotLooks.margins`) as
+        ``(frame, id, margin)`` rows (1-based frames), for the row confidence."""
+        return np.vstack(self._margins) if self._margins else np.zeros((0, 3))
 
     def update(self, frame: Frame) -> Tracks:
         tracks = self.tracker.update(frame)
@@ -206,4 +243,7 @@ class LookIdentities:
         shapes[used] = found
         out = copy.copy(tracks)
         out.id = self.looks.update(tracks.id, boxes, shapes)
+        if self.keep_margins and len(out.id) and out.xywh is not None:
+            self._margins.append(np.column_stack([np.full(len(out.id), frame.index + 1.0), out.id,
+                                                  self.looks.margins(tracks.id)]))
         return out
