@@ -115,18 +115,25 @@ class SlotLooks:
         ±:data:`~lookalike.trackers.offline.appearance.MARGIN_CLIP`); NaN where the piece is under
         :data:`~lookalike.trackers.offline.appearance.MIN_ROWS` rows or a look is missing."""
         out = np.full(len(slots), np.nan)
-        if self.space is None:
+        looks = self.identity_looks(self.space) if self.space is not None else {}
+        if self.space is None or len(looks) < 2:
             return out
-        looks = self.identity_looks(self.space)
+        keys = list(looks)
+        rows, own, mean_shapes = [], [], []
         for r, slot in enumerate(np.asarray(slots, dtype=int).tolist()):
-            piece, own = self.pieces.get(slot), looks.get(self.identity.get(slot, slot))
-            others = [v for k, v in looks.items() if k != self.identity.get(slot, slot)]
-            if piece is None or len(piece.shapes) < MIN_ROWS or own is None or not others:
-                continue
-            mine = self.space.embed(np.asarray(piece.total)[None, :] / len(piece.shapes))[0]
-            x_own = np.log(np.mean((mine - own) ** 2) + 1e-9)
-            x_other = min(np.log(np.mean((mine - o) ** 2) + 1e-9) for o in others)
-            out[r] = min(max(x_other - x_own, -MARGIN_CLIP), MARGIN_CLIP)
+            piece, identity = self.pieces.get(slot), self.identity.get(slot, slot)
+            if piece is not None and len(piece.shapes) >= MIN_ROWS and identity in looks:
+                rows.append(r)
+                own.append(keys.index(identity))
+                mean_shapes.append(np.asarray(piece.total) / len(piece.shapes))
+        if not rows:
+            return out
+        mine = self.space.embed(np.array(mean_shapes))
+        x = np.log(np.mean((mine[:, None, :] - np.array([looks[k] for k in keys])[None]) ** 2, axis=2) + 1e-9)
+        at = np.arange(len(rows))
+        x_own = x[at, own]
+        x[at, own] = np.inf
+        out[rows] = np.clip(x.min(axis=1) - x_own, -MARGIN_CLIP, MARGIN_CLIP)
         return out
 
     def _alone(self, slot: int, shape: np.ndarray) -> bool:
