@@ -1,5 +1,6 @@
 """Development run of rule.md: the `--online` rows (boxtrack with `max_targets`, as the command runs it) without and
-with the look layer (layer.py) at each threshold, on the 30 development arenas and the 14 HexBug clips. Run from the
+with the look layer at each threshold (the development run scored `layer.py`, in git at 345c696; this runs the
+shipped `SlotLooks`, which gives the same ids), on the 30 development arenas and the 14 HexBug clips. Run from the
 repository root: ``OMP_NUM_THREADS=1 .venv/bin/python research/online_look/dev.py [arenas,hexbug] [SEEDS]``"""
 import sys
 import tempfile
@@ -9,8 +10,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "appearance"))
 import scoring  # noqa: E402
-from layer import OnlineLook  # noqa: E402
 
+from lookalike.trackers.offline.online_look import SlotLooks  # noqa: E402
 from lookalike.trackers.registry import make_tracker  # noqa: E402
 from lookalike.types import Detections, Frame  # noqa: E402
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS  # noqa: E402
@@ -41,7 +42,7 @@ def online(found, fps, n):
 
 
 def relabel(rows, vecs, fps, threshold):
-    layer = OnlineLook(fps, threshold)
+    layer = SlotLooks(int(rows[:, 1].max()), fps, threshold)
     out = rows.copy()
     starts = np.flatnonzero(np.r_[True, np.diff(rows[:, 0]) != 0, True])
     for a, b in zip(starts[:-1], starts[1:]):
