@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lookalike.pipeline.blob_detections import BlobRows, shape_lookup
+from lookalike.pipeline.blob_detections import BlobRows
 from lookalike.pipeline.blobs import with_look
-from lookalike.trackers.offline.online_look import LookIdentities, SlotLooks
+from lookalike.trackers.offline.online_look import LookIdentities, SlotLooks, shape_lookup
 from lookalike.trackers.registry import make_tracker
 from lookalike.types import Detections, Frame, Tracks
 from lookalike.vision.blob_shape import PART_SIZE
@@ -19,7 +19,7 @@ def _online(rows: np.ndarray, shapes: np.ndarray, look: bool) -> np.ndarray:
     tracker = make_tracker("boxtrack", max_targets=2, n_init=2)
     found = BlobRows(rows, int(rows[:, 0].max()), shapes, np.full((len(rows), PART_SIZE), np.nan))
     if look:
-        tracker = LookIdentities(tracker, 2, 25.0, shape_lookup(found))
+        tracker = LookIdentities(tracker, 2, 25.0, shape_lookup(found.rows, found.shapes, found.frames))
     tracker.reset()
     out = []
     for k in range(found.frames):
@@ -70,7 +70,7 @@ def test_shape_lookup_finds_each_box_in_its_frame_and_nan_elsewhere():
     rows = np.array([[1, -1, 0, 0, 5, 5, 1, -1, -1, -1], [2, -1, 3, 4, 5, 5, 1, -1, -1, -1],
                      [2, -1, 9, 9, 5, 5, 1, -1, -1, -1]], float)
     shapes = np.arange(6, dtype=float).reshape(3, 2)
-    find = shape_lookup(BlobRows(rows, 3, shapes, np.zeros((3, PART_SIZE))))
+    find = shape_lookup(rows, shapes, 3)
     got = find(1, np.array([[9, 9, 5, 5], [3, 4, 5, 5], [0, 0, 5, 5]], float))
     assert got[:2].tolist() == [[4, 5], [2, 3]] and np.isnan(got[2]).all()
     assert np.isnan(find(2, rows[:1, 2:6])).all() and np.isnan(find(7, rows[:1, 2:6])).all()
@@ -128,8 +128,8 @@ def test_memory_stays_bounded_on_a_long_run(monkeypatch):
 def test_rows_on_their_own_animals_identity_get_a_positive_look_margin():
     rows, shapes, truth = _two_animals(bounce=True)
     found = BlobRows(rows, int(rows[:, 0].max()), shapes, np.full((len(rows), PART_SIZE), np.nan))
-    tracker = LookIdentities(make_tracker("boxtrack", max_targets=2, n_init=2), 2, 25.0, shape_lookup(found),
-                             keep_margins=True)
+    tracker = LookIdentities(make_tracker("boxtrack", max_targets=2, n_init=2), 2, 25.0,
+                             shape_lookup(found.rows, found.shapes, found.frames), keep_margins=True)
     reported = 0
     for k in range(found.frames):
         block = rows[rows[:, 0] == k + 1]

@@ -12,14 +12,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "confidence"))
 import look  # noqa: E402
 from fit import Result, label_rows  # noqa: E402
 
-from lookalike.pipeline.blob_detections import shape_lookup  # noqa: E402
 from lookalike.trackers.offline.confidence import (  # noqa: E402
     COEFFICIENTS,
     LOOK_COEFFICIENT,
     by_frame_and_id,
     row_features,
 )
-from lookalike.trackers.offline.online_look import LookIdentities  # noqa: E402
+from lookalike.trackers.offline.online_look import (
+    LookIdentities,  # noqa: E402
+    shape_lookup,  # noqa: E402
+)
 from lookalike.trackers.registry import make_tracker  # noqa: E402
 from lookalike.types import Detections, Frame  # noqa: E402
 from lookalike.types.mot_table import tracks_to_rows  # noqa: E402
@@ -30,7 +32,7 @@ def one_online(name, video, n, truth, radius, work):
     """The `--online` rows with the look on ``video``: (result with labels, base logit, look margin)."""
     found, fps = look.detected(video, n, work)
     tracker = LookIdentities(make_tracker("boxtrack", **{**BOX_TRACKER_PARAMS, "max_targets": n}), n, fps,
-                             shape_lookup(found), keep_margins=True)
+                             shape_lookup(found.rows, found.shapes, found.frames), keep_margins=True)
     det = found.rows[np.argsort(found.rows[:, 0], kind="stable")]
     bounds = np.searchsorted(det[:, 0], np.arange(1, found.frames + 2))
     out = []

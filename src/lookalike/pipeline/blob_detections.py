@@ -287,21 +287,6 @@ class BlobStream:
                         np.vstack(self._parts) if self._parts else np.zeros((0, PART_SIZE)), self.detector.split)
 
 
-def shape_lookup(found: BlobRows) -> Callable[[int, np.ndarray], np.ndarray]:
-    """``(frame index, boxes (k, 4)) -> (k, SHAPE_SIZE)``: the shape vectors of ``found``'s blobs with those boxes in
-    that 0-based frame (NaN rows for boxes not found there)."""
-    order = np.argsort(found.rows[:, 0], kind="stable")
-    rows, shapes = found.rows[order], found.shapes[order]
-    bounds = np.searchsorted(rows[:, 0], np.arange(1, found.frames + 2))
-
-    def lookup(index: int, boxes: np.ndarray) -> np.ndarray:
-        if not 0 <= index < found.frames:
-            return np.full((len(boxes), shapes.shape[1]), np.nan)
-        a, b = bounds[index], bounds[index + 1]
-        return shapes_by_box(rows[a:b, 2:6], shapes[a:b], boxes)
-    return lookup
-
-
 def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[], None] | None = None,
                     split: bool = True) -> BlobRows:
     """Blob detections of ``video`` (a file or image folder) with each blob's shape vector (and parts, with
@@ -318,4 +303,4 @@ def blob_detections(video: Path | str, config: BlobConfig, advance: Callable[[],
 
 __all__ = ["CACHE_ENV", "BlobRows", "BlobStream", "auto_blob_config", "blob_config", "blob_detections",
            "blob_settings", "cache_dir", "cached_blob_detections", "detection_cache_key", "load_blob_detections",
-           "shape_lookup", "store_blob_detections"]
+           "store_blob_detections"]

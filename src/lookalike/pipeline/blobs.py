@@ -19,11 +19,10 @@ from lookalike.pipeline.blob_detections import (
     auto_blob_config,
     cached_blob_detections,
     load_blob_detections,
-    shape_lookup,
     store_blob_detections,
 )
 from lookalike.pipeline.runner import Event, RunResult, step
-from lookalike.trackers.offline.online_look import LookIdentities, ShapeLookup
+from lookalike.trackers.offline.online_look import LookIdentities, ShapeLookup, shape_lookup
 from lookalike.vision.blob_auto import BOX_TRACKER_PARAMS, BlobEstimate, frame_counts
 from lookalike.vision.blob_boxtrack import blob_boxtrack_config
 
@@ -126,7 +125,7 @@ def run_blobs(video: Path, output: Path, tracker: Any, tracker_name: str, settin
             result.looks[output] = look
         return result
     tracker = _set_tracker(tracker, tracker_name, frame_counts(rows, frames), explicit, n_targets, options, on_event)
-    tracker = with_look(tracker, tracker_name, rate, shape_lookup(found))
+    tracker = with_look(tracker, tracker_name, rate, shape_lookup(found.rows, found.shapes, frames))
     return _with_margins(run_video(video, MotTable.from_rows(rows), output, tracker, tracker_name, on_event,
                                    length=frames, score_warnings=False, **options), tracker, output)
 

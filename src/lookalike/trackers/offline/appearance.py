@@ -21,7 +21,8 @@ import numpy as np
 
 from lookalike.trackers.offline.tracklets import Tracklet
 
-__all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "look_margins", "single_rows", "with_appearance"]
+__all__ = ["IdentitySpace", "cut_at_merges", "fit_identity_space", "log_distance", "look_margin", "look_margins",
+           "single_rows", "with_appearance"]
 
 SINGLE_AREA = (0.6, 1.5)  # a blob shows one animal when its area is within these multiples of its track's median
 MIN_ROWS = 8  # single-animal rows a tracklet needs to teach or be judged by its look
@@ -85,13 +86,25 @@ class IdentitySpace:
         :attr:`other`, "one" is fitted to these pairs (mixture, :func:`_fit_same`). Distances below the "one"
         mean count as that mean, above the "two" mean as that mean (the ratio never grows with the distance). Either
         look is its animal's but with probability :data:`OUTLIER`, so each ratio stays within ±ln(1/OUTLIER)."""
-        x = np.log(np.mean((a - b) ** 2, axis=1) + 1e-9)
+        x = log_distance(a, b)
         same = _fit_same(x, self.other)
         log_same = _log_normal(np.maximum(x, same[0]), same)
         log_other = _log_normal(np.minimum(x, self.other[0]), self.other)
         odds = np.exp(np.clip(log_same - log_other, -50.0, 50.0))
         out: np.ndarray = np.log(((1 - OUTLIER) * odds + OUTLIER) / ((1 - OUTLIER) + OUTLIER * odds))
         return out
+
+
+def log_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The log mean squared difference of looks ``a`` and ``b`` along their last axis (broadcast)."""
+    out: np.ndarray = np.log(np.mean((a - b) ** 2, axis=-1) + 1e-9)
+    return out
+
+
+def look_margin(mine: np.ndarray, own: np.ndarray, others: np.ndarray) -> float:
+    """How much better the look ``own`` fits the look ``mine`` (``(d,)``) than the nearest of ``others``
+    (``(m, d)``): the difference of their :func:`log_distance`, within ±:data:`MARGIN_CLIP`."""
+    return float(np.clip(log_distance(mine, others).min() - log_distance(mine, own), -MARGIN_CLIP, MARGIN_CLIP))
 
 
 def _log_normal(x: np.ndarray, normal: tuple[float, float]) -> np.ndarray:
@@ -193,8 +206,5 @@ def look_margins(tracklets: list[Tracklet], chains: Sequence[Sequence[int]], sha
             rest = count[c] - len(tracklets[i])
             if not rest or not others:
                 continue
-            own = (total[c] - len(tracklets[i]) * looks[i]) / rest
-            x_own = math.log(float(np.mean((looks[i] - own) ** 2)) + 1e-9)
-            x_other = min(math.log(float(np.mean((looks[i] - o) ** 2)) + 1e-9) for o in others)
-            out[i] = min(max(x_other - x_own, -MARGIN_CLIP), MARGIN_CLIP)
+            out[i] = look_margin(looks[i], (total[c] - len(tracklets[i]) * looks[i]) / rest, np.array(others))
     return out

@@ -46,7 +46,7 @@ from lookalike.trackers.offline.constraints import (
 )
 from lookalike.trackers.offline.gap_fill import fill_gaps, smooth_boxes
 from lookalike.trackers.offline.merges import hold_in_merges, place_in_merges
-from lookalike.trackers.offline.online_look import LookIdentities, shapes_by_box
+from lookalike.trackers.offline.online_look import LookIdentities, shape_lookup
 from lookalike.trackers.offline.tracklets import (
     Tracklet,
     checked_rows,
@@ -329,10 +329,7 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
     det_rows = det_rows[order]
     bounds = np.searchsorted(det_rows[:, 0], np.arange(1, n_frames + 2))
     if reported and shapes is not None and params.get("max_targets"):
-        looks = np.asarray(shapes)[order]
-
-        def lookup(k: int, boxes: np.ndarray) -> np.ndarray:
-            return shapes_by_box(det_rows[bounds[k]:bounds[k + 1], 2:6], looks[bounds[k]:bounds[k + 1]], boxes)
+        lookup = shape_lookup(det_rows, np.asarray(shapes)[order], n_frames)
         tracker_obj = LookIdentities(tracker_obj, params["max_targets"], frame_rate, lookup)
     out = []
     for k in range(n_frames):

@@ -21,16 +21,17 @@ import numpy as np
 
 from lookalike.association.solver import linear_sum_assignment
 from lookalike.trackers.offline.appearance import (
-    MARGIN_CLIP,
     MIN_ROWS,
     SINGLE_AREA,
     IdentitySpace,
     fit_identity_space,
+    log_distance,
+    look_margin,
 )
 from lookalike.trackers.offline.tracklets import Tracklet
 from lookalike.types import Frame, Tracks
 
-__all__ = ["LOOK_THRESHOLD", "LookIdentities", "ShapeLookup", "SlotLooks", "shapes_by_box"]
+__all__ = ["LOOK_THRESHOLD", "LookIdentities", "ShapeLookup", "SlotLooks", "shape_lookup", "shapes_by_box"]
 
 LOOK_THRESHOLD = 0.5  # a crossing's slots change identities when that lowers their summed log distance this much
 GROUP_FRAMES = 8  # pieces that began within this many frames of each other may come from one crossing ...
@@ -54,6 +55,21 @@ def shapes_by_box(xywh: np.ndarray, shapes: np.ndarray, boxes: np.ndarray) -> np
     if found.any():
         out[found] = shapes[same[found].argmax(axis=1)]
     return out
+
+
+def shape_lookup(rows: np.ndarray, shapes: np.ndarray, n_frames: int) -> ShapeLookup:
+    """A :data:`ShapeLookup` over detection ``rows`` ``(k, >=6)`` (1-based frames, boxes in px) of ``n_frames``
+    frames and their ``shapes`` ``(k, SHAPE_SIZE)``."""
+    order = np.argsort(rows[:, 0], kind="stable")
+    boxes, looks = rows[order, 2:6], np.asarray(shapes)[order]
+    bounds = np.searchsorted(rows[order, 0], np.arange(1, n_frames + 2))
+
+    def lookup(index: int, wanted: np.ndarray) -> np.ndarray:
+        if not 0 <= index < n_frames:
+            return np.full((len(wanted), looks.shape[1]), np.nan)
+        a, b = bounds[index], bounds[index + 1]
+        return shapes_by_box(boxes[a:b], looks[a:b], wanted)
+    return lookup
 
 
 class _Piece:
@@ -118,22 +134,11 @@ class SlotLooks:
         looks = self.identity_looks(self.space) if self.space is not None else {}
         if self.space is None or len(looks) < 2:
             return out
-        keys = list(looks)
-        rows, own, mean_shapes = [], [], []
         for r, slot in enumerate(np.asarray(slots, dtype=int).tolist()):
             piece, identity = self.pieces.get(slot), self.identity.get(slot, slot)
             if piece is not None and len(piece.shapes) >= MIN_ROWS and identity in looks:
-                rows.append(r)
-                own.append(keys.index(identity))
-                mean_shapes.append(np.asarray(piece.total) / len(piece.shapes))
-        if not rows:
-            return out
-        mine = self.space.embed(np.array(mean_shapes))
-        x = np.log(np.mean((mine[:, None, :] - np.array([looks[k] for k in keys])[None]) ** 2, axis=2) + 1e-9)
-        at = np.arange(len(rows))
-        x_own = x[at, own]
-        x[at, own] = np.inf
-        out[rows] = np.clip(x.min(axis=1) - x_own, -MARGIN_CLIP, MARGIN_CLIP)
+                mine = self.space.embed(np.asarray(piece.total)[None, :] / len(piece.shapes))[0]
+                out[r] = look_margin(mine, looks[identity], np.array([v for k, v in looks.items() if k != identity]))
         return out
 
     def _alone(self, slot: int, shape: np.ndarray) -> bool:
@@ -198,7 +203,7 @@ class SlotLooks:
         ids = [self.identity[s] for s in group]
         mine = np.array([space.embed(np.array(self.pieces[s].shapes)).mean(axis=0) for s in group])
         theirs = np.array([looks[k] for k in ids])
-        cost = np.log(np.mean((mine[:, None, :] - theirs[None, :, :]) ** 2, axis=2) + 1e-9)
+        cost = log_distance(mine[:, None, :], theirs[None, :, :])
         rows, cols = linear_sum_assignment(cost)
         if np.trace(cost) - cost[rows, cols].sum() > self.threshold and (cols != rows).any():
             for a, b in zip(rows, cols):
@@ -235,8 +240,6 @@ class LookIdentities:
 
     def update(self, frame: Frame) -> Tracks:
         tracks = self.tracker.update(frame)
-        if not isinstance(tracks, Tracks):
-            tracks = Tracks.from_snapshots(list(tracks))
         boxes = np.zeros((len(tracks), 4)) if tracks.xywh is None else np.asarray(tracks.xywh, dtype=float)
         used = tracks.detection_index >= 0
         index, feature = tracks.detection_index[used], frame.detections.feature
