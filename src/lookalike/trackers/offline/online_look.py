@@ -239,7 +239,7 @@ class LookIdentities:
         return np.vstack(self._margins) if self._margins else np.zeros((0, 3))
 
     def update(self, frame: Frame) -> Tracks:
-        tracks = self.tracker.update(frame)
+        tracks: Tracks = self.tracker.update(frame)
         boxes = np.zeros((len(tracks), 4)) if tracks.xywh is None else np.asarray(tracks.xywh, dtype=float)
         used = tracks.detection_index >= 0
         index, feature = tracks.detection_index[used], frame.detections.feature
