@@ -40,6 +40,21 @@ def test_import_lookalike_does_not_import_numba() -> None:
     assert out.stdout.strip() == "False"
 
 
+def test_a_default_tracker_takes_the_numpy_path_until_loading_pays(monkeypatch: pytest.MonkeyPatch) -> None:
+    switch = bk._SWITCH
+    monkeypatch.setattr(switch, "_loaded", False)
+    monkeypatch.setattr(switch, "_spent", 0.0)
+    monkeypatch.setattr(switch, "_load", lambda: pytest.fail("the kernels were loaded before they paid"))
+    tracker = BoxTrack()
+    for frame in _awkward(0, frames=30):
+        tracker.update(frame)
+    assert not tracker.compiled and 0 < switch._spent < bk.LOAD_AFTER_S
+    monkeypatch.setattr(switch, "_load", lambda: None)  # numba absent: once due, the numpy path for good
+    monkeypatch.setattr(switch, "_load_after_s", 0.0)
+    tracker.update(_awkward(0, frames=31)[-1])
+    assert not tracker.compiled and tracker._compiled is False and switch._loaded
+
+
 numba_missing = pytest.mark.skipif(
     bk.module() is None,
     reason="numba (the `fast` extra) is not installed: only the numpy path runs")
@@ -62,6 +77,26 @@ def _run_both(frames: list[Frame], config: BoxTrackConfig | None = None, vel_noi
         assert got.dtype == want.dtype
         reported += len(got)
     return reported
+
+
+@numba_missing
+def test_a_tracker_that_switches_to_the_kernels_midway_gives_the_numpy_rows(monkeypatch: pytest.MonkeyPatch) -> None:
+    frames = _awkward(1)
+    bk.use_compiled(False)
+    plain = BoxTrack()
+    want = [_rows(plain.update(frame)) for frame in frames]
+    bk.use_compiled(None)
+    switch = bk._SWITCH
+    monkeypatch.setattr(switch, "_loaded", False)
+    monkeypatch.setattr(switch, "_spent", 0.0)
+    tracker = BoxTrack()
+    assert not tracker.compiled
+    for k, frame in enumerate(frames):
+        if k == 40:
+            monkeypatch.setattr(switch, "_load_after_s", 0.0)  # loading pays from now on
+        got = _rows(tracker.update(frame))
+        assert np.array_equal(got, want[k], equal_nan=True), f"frame {frame.index}"
+        assert tracker.compiled == (k >= 40)
 
 
 def _awkward(seed: int, frames: int = 120) -> list[Frame]:

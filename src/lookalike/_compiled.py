@@ -16,6 +16,7 @@ from typing import Any, Generic, TypeVar, cast
 from lookalike._optional import needs
 
 K = TypeVar("K")
+T = TypeVar("T")
 F = TypeVar("F", bound=Callable[..., Any])
 
 
@@ -121,14 +122,17 @@ class KernelSwitch(Generic[K]):
     ``load`` imports them once, when first needed (an ``ImportError`` or ``None``: not available); ``env``: the
     environment variable that switches them off when ``0``; ``decide_once``: :meth:`compiled` reads the forcing and
     the environment once (until :meth:`use_compiled`); ``warm``: "module:function" compiling them, for
-    :data:`compile_aside`."""
+    :data:`compile_aside`; ``load_after_s``: :meth:`due` waits until the numpy path has taken this long in the
+    process (:meth:`timed`), about what importing numba and loading the kernels costs (None: no wait)."""
 
     def __init__(self, env: str, load: Callable[[], K | None], *, decide_once: bool = False,
-                 warm: str | None = None) -> None:
+                 warm: str | None = None, load_after_s: float | None = None) -> None:
         self.env = env
         self._load = load
         self._decide_once = decide_once
         self._warm = warm
+        self._load_after_s = load_after_s
+        self._spent = 0.0
         self._forced: bool | None = None
         self._loaded = False
         self._kernels: K | None = None
@@ -141,6 +145,21 @@ class KernelSwitch(Generic[K]):
         self._forced = None if flag is None else bool(flag)
         self._decided = False
         self._active = None
+
+    def timed(self, numpy_path: Callable[..., T], *args: Any) -> T:
+        """``numpy_path(*args)``, its time counted towards :meth:`due` (the numpy path while not decided)."""
+        start = time.perf_counter()
+        try:
+            return numpy_path(*args)
+        finally:
+            self._spent += time.perf_counter() - start
+
+    def due(self) -> bool:
+        """Whether to ask :meth:`compiled` now: it costs nothing (forced either way, switched off, already loaded)
+        or loading the kernels pays (the numpy path has taken ``load_after_s``). Both paths give the same
+        numbers, so this decides only speed."""
+        return (self._forced is not None or self._loaded or os.environ.get(self.env, "1") == "0"
+                or self._load_after_s is None or self._spent >= self._load_after_s)
 
     def compiled(self) -> K | None:
         """The kernels, or ``None`` when they are off or do not load."""

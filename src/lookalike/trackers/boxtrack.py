@@ -8,8 +8,8 @@ start tentative tracks. Reported: confirmed tracks matched this frame (filtered 
 present (predicted box, ``detection_index`` -1). Mechanisms and defaults: docs/trackers/boxtrack.md.
 
 States live in one quantity-major ``(24, k)`` column table (the track table's ``mean`` and ``cov`` are views of it).
-With numba installed a frame runs the compiled kernels of :mod:`lookalike.trackers.kernels.boxtrack`
-(``LOOKALIKE_BOXTRACK_NUMBA=0`` switches them off), with the same numbers as the numpy path."""
+With numba installed, frames run the compiled kernels of :mod:`lookalike.trackers.kernels.boxtrack` once loading
+them pays, with the same numbers as the numpy path."""
 
 from __future__ import annotations
 
@@ -68,9 +68,14 @@ class BoxTrack:
         self._lifecycle = lifecycle.closed_set() if cfg.max_targets is not None else lifecycle
         self._slots = None if cfg.max_targets is None else ClosedSlots(
             cfg.max_targets, cfg.closed_distance, const.CLOSED_GATE_GROWTH, refill_s=cfg.max_age_s)
-        # the compiled kernels (boxtrack_kernels) when on; they need IoU gates (match_iou > 0)
-        self._compiled = cfg.match_iou > 0 and boxtrack_kernels.compiled() is not None
+        # the compiled kernels (boxtrack_kernels) when on (None: not decided yet); they need IoU gates (match_iou > 0)
+        self._compiled: bool | None = None if cfg.match_iou > 0 else False
+        self._decide()
         self.reset()
+
+    def _decide(self) -> None:
+        if self._compiled is None and boxtrack_kernels.due():
+            self._compiled = boxtrack_kernels.compiled() is not None
 
     def reset(self) -> None:
         """Forget every track; ids restart at 1."""
@@ -92,8 +97,8 @@ class BoxTrack:
 
     @property
     def compiled(self) -> bool:
-        """Whether this tracker runs the compiled kernels (:mod:`lookalike.trackers.kernels.boxtrack`)."""
-        return self._compiled
+        """Whether this tracker runs the compiled kernels (:mod:`lookalike.trackers.kernels.boxtrack`) now."""
+        return bool(self._compiled)
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
@@ -102,6 +107,13 @@ class BoxTrack:
             # (float64 columns, as Detections makes them: the kernels' arithmetic is the numpy path's; the
             # module is looked up, not kept, so the tracker stays picklable)
             return self._update_compiled(frame, boxtrack_kernels.module())
+        if self._compiled is not None:
+            return self._update_numpy(frame)
+        out = boxtrack_kernels.timed(self._update_numpy, frame)  # (its time counts towards loading the kernels)
+        self._decide()
+        return out
+
+    def _update_numpy(self, frame: Frame) -> Tracks:
         t, clock = self._tracks, self._clock
         steps, dt, det_xywh, score, det_idx, x = self._begin(frame)
         z = self._measure(det_xywh.T)
