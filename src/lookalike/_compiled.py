@@ -147,12 +147,13 @@ class KernelSwitch(Generic[K]):
         self._active = None
 
     def timed(self, numpy_path: Callable[..., T], *args: Any) -> T:
-        """``numpy_path(*args)``, its time counted towards :meth:`due` (the numpy path while not decided)."""
+        """``numpy_path(*args)``, its time counted towards :meth:`due` (the numpy path while not decided), at most
+        0.05 s a call: a one-off import inside a call (such as scipy's solver) is not work the kernels would save."""
         start = time.perf_counter()
         try:
             return numpy_path(*args)
         finally:
-            self._spent += time.perf_counter() - start
+            self._spent += min(time.perf_counter() - start, 0.05)
 
     def due(self) -> bool:
         """Whether to ask :meth:`compiled` now: it costs nothing (forced either way, switched off, already loaded)
