@@ -55,6 +55,18 @@ def test_a_default_tracker_takes_the_numpy_path_until_loading_pays(monkeypatch: 
     assert not tracker.compiled and tracker._compiled is False and switch._loaded
 
 
+def test_a_run_announced_long_loads_the_kernels_at_its_start(monkeypatch: pytest.MonkeyPatch) -> None:
+    switch, loads = bk._SWITCH, []
+    monkeypatch.setattr(switch, "_loaded", False)
+    monkeypatch.setattr(switch, "_spent", 0.0)
+    monkeypatch.setattr(switch, "_load", lambda: loads.append(1))  # (None: as without numba)
+    tracker = BoxTrack()
+    tracker.expect(bk.EAGER_FRAMES - 1)
+    assert not loads and tracker._compiled is None  # short: still the numpy path, undecided
+    tracker.expect(bk.EAGER_FRAMES)
+    assert loads == [1] and tracker._compiled is False  # long: loaded and decided at once
+
+
 numba_missing = pytest.mark.skipif(
     bk.module() is None,
     reason="numba (the `fast` extra) is not installed: only the numpy path runs")

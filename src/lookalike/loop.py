@@ -53,6 +53,14 @@ def run(tracker: Updating, frames: Iterable[Any], sink: Sink | None = None, *,
     return stats
 
 
+def expect(tracker: Any, frames: int) -> None:
+    """Tell ``tracker`` that about ``frames`` frames follow (all its sequences together), when it takes the hint
+    (``expect``: ``boxtrack``, to decide whether its compiled kernels pay)."""
+    hint = getattr(tracker, "expect", None)
+    if hint is not None:
+        hint(frames)
+
+
 def warm_up(make: Callable[[], Updating], frames: Iterable[Any], n: int = 10) -> None:
     """Run a throw-away tracker from ``make()`` over the first ``n`` of ``frames``, so that one-off costs (imports,
     numba compiles) stay out of a frames/s figure."""

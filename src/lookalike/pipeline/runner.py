@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from lookalike.io.outputs import atomic_path
-from lookalike.loop import RunStats
+from lookalike.loop import RunStats, expect
 from lookalike.pipeline import files
 from lookalike.pipeline.request import TrackRequest
 
@@ -119,6 +119,7 @@ def _files(request: TrackRequest, tracker: Any, tell: Callable[[Event], None]) -
     for seq, frames, target in streams:
         files.sequence_warnings(seq, frames, target, telling(tell, "warn"), telling(tell, "note"))
     result = RunResult("files", [target for _, _, target in streams], len(streams))
+    expect(tracker, sum(frames.length or 0 for _, frames, _ in streams))
     tell(Event("start", "sequences", len(streams)))
     for seq, frames, target in streams:
         tell(Event("start", seq.name, frames.length))

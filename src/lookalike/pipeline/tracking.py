@@ -20,7 +20,7 @@ from lookalike.association.solver import assign
 from lookalike.geometry.boxes import iou_matrix
 from lookalike.io import MotTable, frames_from_table, read_seqinfo, tracks_to_rows
 from lookalike.io.video_frames import source_frames
-from lookalike.loop import run
+from lookalike.loop import expect, run
 from lookalike.pipeline.spill import FrameSpill
 from lookalike.trackers.parts.health import HealthConfig, HealthMonitor, HealthStatus
 from lookalike.types import Detections, Frame, TrackSnapshot, TrackStatus
@@ -158,6 +158,7 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
     last_det = int(detections.frame.max()) if len(detections) else 0
     det_frames = frames_from_table(detections, max(n_declared, last_det), rate, min_score)
     tracker.reset()
+    expect(tracker, max(n_declared, last_det, length or 0))
     monitor = HealthMonitor(health)
     writer = VideoWriter(annotate, fps=rate) if annotate is not None else None
     tails = Tails(length=max(tail, 1))

@@ -77,6 +77,11 @@ class BoxTrack:
         if self._compiled is None and boxtrack_kernels.due():
             self._compiled = boxtrack_kernels.compiled() is not None
 
+    def expect(self, frames: int) -> None:
+        """A hint that about ``frames`` frames follow (:func:`lookalike.trackers.kernels.boxtrack.expect`)."""
+        boxtrack_kernels.expect(frames)
+        self._decide()
+
     def reset(self) -> None:
         """Forget every track; ids restart at 1."""
         cfg = self.config

@@ -4,8 +4,9 @@ update with bookkeeping, and the report with the lifecycle.
 
 They do the numpy path's operations one track or pair at a time in the same order, so rows are bit for bit the same
 (``tests/test_boxtrack_kernels.py``). Used when numba is installed unless ``LOOKALIKE_BOXTRACK_NUMBA=0``. Importing
-numba and loading the kernels costs about a second, more than they save on a short run: trackers take the numpy path
-until it has taken :data:`LOAD_AFTER_S` in the process (unless the kernels are forced on or already loaded). Run as
+numba and loading the kernels costs about a second, more than they save on a short run: a run of known length loads
+them at its start when it is long (:func:`expect`); otherwise trackers take the numpy path until it has taken
+:data:`LOAD_AFTER_S` in the process (unless the kernels are forced on or already loaded). Run as
 the ``lookalike`` program with nothing in numba's cache, :func:`warm` then compiles them in a separate process while
 that run stays on the numpy path."""
 
@@ -45,6 +46,10 @@ def warm() -> None:
         tracker.update(Frame(index=k, time=k / 30, detections=Detections(xywh=xywh, score=score)))
 
 
+EAGER_FRAMES = 3000
+"""A run announced (:func:`expect`) with at least this many frames loads the kernels at its start: about where the
+0.3-0.4 ms they save a frame of a few boxes repays loading them."""
+
 LOAD_AFTER_S = 1.0
 """Seconds of the numpy path in a process after which the kernels are loaded (about their load time on one core:
 numba's import 0.35 s, the cached kernels' first calls 0.9 s; they then save about 0.4 ms a frame of 8 boxes)."""
@@ -54,4 +59,11 @@ _SWITCH: KernelSwitch[ModuleType] = KernelSwitch("LOOKALIKE_BOXTRACK_NUMBA", _lo
 use_compiled = _SWITCH.use_compiled  # (trackers built from now on)
 compiled = _SWITCH.compiled  # the kernels' module, or None when they are off or numba is not installed
 due, timed = _SWITCH.due, _SWITCH.timed  # (whether to decide now; the numpy path, its time counted)
+
+
+def expect(frames: int) -> None:
+    """About ``frames`` frames follow in this process: with at least :data:`EAGER_FRAMES`, load the kernels now
+    (unless switched off)."""
+    if frames >= EAGER_FRAMES:
+        compiled()
 module = _SWITCH.kernels  # the kernels' module whatever the switch says, None when numba is not installed
