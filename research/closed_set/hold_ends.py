@@ -2,6 +2,9 @@
 run; output in ``hold-ends-result.txt``). Run from the repository root with ../shared/data beside it::
 
     OMP_NUM_THREADS=1 .venv/bin/python research/closed_set/hold_ends.py | tee research/closed_set/hold-ends-result.txt
+
+Not shipped: the switch left the package after this run. To rerun it, check out the commit that had it
+(`git worktree add /tmp/hold 72f4276`, then `PYTHONPATH=/tmp/hold/src`).
 """
 
 from __future__ import annotations

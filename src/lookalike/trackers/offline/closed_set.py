@@ -44,7 +44,7 @@ from lookalike.trackers.offline.constraints import (
     tracklet_of,
     with_marks,
 )
-from lookalike.trackers.offline.gap_fill import fill_gaps, hold_ends, smooth_boxes
+from lookalike.trackers.offline.gap_fill import fill_gaps, smooth_boxes
 from lookalike.trackers.offline.merges import hold_in_merges, place_in_merges
 from lookalike.trackers.offline.online_look import LookIdentities, shape_lookup
 from lookalike.trackers.offline.tracklets import (
@@ -277,8 +277,6 @@ def _assign(rows: np.ndarray, n_targets: int, frame_rate: float, config: ClosedS
     if not len(merged):
         return merged, None
     filled = fill_gaps(merged, max_fill)
-    if cfg.hold_ends:
-        filled = hold_ends(filled, int(rows[:, 0].min()), int(rows[:, 0].max()))
     if shapes is not None:
         filled[:, 7:10] = -1.0
         if crossing:  # the identities interpolated through (or held in) a merged blob, moved to its ends or parts

@@ -33,8 +33,6 @@ class ClosedSetConfig:
     min_rows: int = param(5, "tracklets with fewer rows are not chained but placed into the chains' gaps")
     fill_gap_s: float = param(math.inf, "longest gap (seconds) inside an identity filled by interpolation "
                                         "(a closed set's targets are always there)")
-    hold_ends: bool = param(False, "repeat each identity's first box back to the input's first frame and its last "
-                                   "box on to its last frame")
     smooth_s: float = param(1.0, "longest window (seconds) of the running median of each identity's box "
                                  "centres and sizes (0: none)")
     smooth_move: float = param(0.25, "... and no longer than the frames in which a target typically moves this "

@@ -128,22 +128,6 @@ def fill_gaps(rows: np.ndarray, max_gap: int) -> np.ndarray:
     return merged[np.lexsort((merged[:, 1], merged[:, 0]))]
 
 
-def hold_ends(rows: np.ndarray, first: int, last: int) -> np.ndarray:
-    """``rows`` plus, for each id, its first box in every frame from ``first`` up to its first row and its last box
-    from its last row to ``last`` (1-based frames; sorted by frame, then id)."""
-    rows = _check_rows(rows)
-    out = [rows]
-    for i in np.unique(rows[:, 1]):
-        sel = rows[rows[:, 1] == i]
-        a, b = sel[np.argmin(sel[:, 0])], sel[np.argmax(sel[:, 0])]
-        for row, frames in ((a, np.arange(first, a[0])), (b, np.arange(b[0] + 1, last + 1))):
-            new = np.repeat(row[None, :], len(frames), axis=0)
-            new[:, 0] = frames
-            out.append(new)
-    merged = np.vstack(out)
-    return merged[np.lexsort((merged[:, 1], merged[:, 0]))]
-
-
 def smooth_boxes(rows: np.ndarray, window: int) -> np.ndarray:
     """``rows`` with each id's box centres and widths/heights replaced by their running median over ``window``
     consecutive rows of that id (1 or less: unchanged; the first and last rows repeated beyond the ends)."""
