@@ -68,19 +68,12 @@ class BoxTrack:
         self._lifecycle = lifecycle.closed_set() if cfg.max_targets is not None else lifecycle
         self._slots = None if cfg.max_targets is None else ClosedSlots(
             cfg.max_targets, cfg.closed_distance, const.CLOSED_GATE_GROWTH, refill_s=cfg.max_age_s)
-        # the compiled kernels (boxtrack_kernels) when on (None: not decided yet); they need IoU gates (match_iou > 0)
-        self._compiled: bool | None = None if cfg.match_iou > 0 else False
-        self._decide()
+        self._path = boxtrack_kernels.PathChoice(allowed=cfg.match_iou > 0)  # (the kernels need IoU gates)
         self.reset()
-
-    def _decide(self) -> None:
-        if self._compiled is None and boxtrack_kernels.due():
-            self._compiled = boxtrack_kernels.compiled() is not None
 
     def expect(self, frames: int) -> None:
         """A hint that about ``frames`` frames follow (:func:`lookalike.trackers.kernels.boxtrack.expect`)."""
-        boxtrack_kernels.expect(frames)
-        self._decide()
+        self._path.expect(frames)
 
     def reset(self) -> None:
         """Forget every track; ids restart at 1."""
@@ -103,20 +96,16 @@ class BoxTrack:
     @property
     def compiled(self) -> bool:
         """Whether this tracker runs the compiled kernels (:mod:`lookalike.trackers.kernels.boxtrack`) now."""
-        return bool(self._compiled)
+        return bool(self._path.compiled)
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
         dets = frame.detections
-        if self._compiled and dets.xywh.dtype is _F64 and dets.score.dtype is _F64 and not self._large(len(dets)):
+        if self._path.compiled and dets.xywh.dtype is _F64 and dets.score.dtype is _F64 and not self._large(len(dets)):
             # (float64 columns, as Detections makes them: the kernels' arithmetic is the numpy path's; the
             # module is looked up, not kept, so the tracker stays picklable)
             return self._update_compiled(frame, boxtrack_kernels.module())
-        if self._compiled is not None:
-            return self._update_numpy(frame)
-        out = boxtrack_kernels.timed(self._update_numpy, frame)  # (its time counts towards loading the kernels)
-        self._decide()
-        return out
+        return self._path.numpy(self._update_numpy, frame)
 
     def _update_numpy(self, frame: Frame) -> Tracks:
         t, clock = self._tracks, self._clock

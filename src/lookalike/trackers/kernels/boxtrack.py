@@ -12,9 +12,13 @@ that run stays on the numpy path."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from types import ModuleType
+from typing import Any, TypeVar
 
 from lookalike._compiled import KernelSwitch
+
+T = TypeVar("T")
 
 
 def _load() -> ModuleType:
@@ -66,4 +70,32 @@ def expect(frames: int) -> None:
     (unless switched off)."""
     if frames >= EAGER_FRAMES:
         compiled()
+
+
+class PathChoice:
+    """Which path one tracker's frames take: the kernels (:attr:`compiled` True), the numpy path (False), or not
+    decided yet (None: the numpy path, its time counted until loading the kernels pays). ``allowed``: whether the
+    tracker's settings let the kernels run at all."""
+
+    def __init__(self, allowed: bool = True) -> None:
+        self.compiled: bool | None = None if allowed else False
+        self.decide()
+
+    def decide(self) -> None:
+        """Settle the path when asking costs nothing or loading pays (:func:`due`)."""
+        if self.compiled is None and due():
+            self.compiled = compiled() is not None
+
+    def expect(self, frames: int) -> None:
+        """About ``frames`` frames follow (:func:`expect`)."""
+        expect(frames)
+        self.decide()
+
+    def numpy(self, update: Callable[[Any], T], frame: Any) -> T:
+        """``update(frame)``, the numpy path, timed towards the decision while it is not made."""
+        if self.compiled is not None:
+            return update(frame)
+        out = timed(update, frame)
+        self.decide()
+        return out
 module = _SWITCH.kernels  # the kernels' module whatever the switch says, None when numba is not installed

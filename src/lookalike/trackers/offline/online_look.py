@@ -37,7 +37,6 @@ LOOK_THRESHOLD = 0.5  # a crossing's slots change identities when that lowers th
 GROUP_FRAMES = 8  # pieces that began within this many frames of each other may come from one crossing ...
 GROUP_SIZES = 3.0  # ... and within this many sizes (sqrt(w h) of the new piece's first box) of each other
 MIN_JUDGE_ROWS = 3  # rows a piece needs to be weighed
-JUDGE_AT = (MIN_ROWS,)  # a new piece's lengths (rows) at which its crossing is judged
 AREA_HISTORY = 500  # latest blob areas of a slot whose median is its one-animal area
 MAX_PIECES = 400  # finished pieces kept (the latest), which bounds memory and the refit on long or live videos
 MAX_PIECE_ROWS = 1000  # shape vectors kept per piece
@@ -115,7 +114,7 @@ class SlotLooks:
             if len(self.pieces[slot].shapes) < MAX_PIECE_ROWS:
                 self.pieces[slot].shapes.append(shape)
                 self.pieces[slot].total = self.pieces[slot].total + shape
-            if len(self.pieces[slot].shapes) in JUDGE_AT:
+            if len(self.pieces[slot].shapes) == MIN_ROWS:
                 fresh.append(slot)
         for slot in [s for s in self.pieces if s not in seen]:
             self._close(slot)
