@@ -100,3 +100,21 @@ def test_bad_requests_are_refused_in_one_line(scene, tmp_path):
         run(TrackRequest(tmp_path / "b.txt", video=str(video), detector="yolo"))
     with pytest.raises(ValueError, match="unknown tracker"):
         run(TrackRequest(tmp_path / "f.txt", "nope", path=det))
+
+
+def test_file_and_video_runs_announce_their_length_to_boxtrack(scene, tmp_path, monkeypatch):
+    """A run of known length tells the tracker how many frames follow (boxtrack decides from it whether its compiled
+    kernels pay); the rows do not depend on it."""
+    from lookalike.trackers.boxtrack import BoxTrack
+
+    video, det = scene
+    seq = tmp_path / "data" / "discs"
+    (seq / "det").mkdir(parents=True)
+    (seq / "det" / "det.txt").write_bytes(det.read_bytes())
+    (seq / "seqinfo.ini").write_text(f"[Sequence]\nname=discs\nframeRate=30\nseqLength={FRAMES + 5}\n")
+    heard: list[int] = []
+    monkeypatch.setattr(BoxTrack, "expect", lambda self, frames: heard.append(frames))
+    run(TrackRequest(tmp_path / "out", "boxtrack", path=seq.parent, min_score=0.5), lambda e: None)
+    run(TrackRequest(tmp_path / "f.txt", "boxtrack", path=det, min_score=0.5), lambda e: None)
+    run(TrackRequest(tmp_path / "v.txt", "boxtrack", video=str(video), detections=det), lambda e: None)
+    assert heard == [FRAMES + 5, 0, FRAMES]  # (a lone file's length is unknown until read: 0, nothing decided)

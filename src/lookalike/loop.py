@@ -96,4 +96,4 @@ class Sinks:
             sink(frame, tracks)
 
 
-__all__ = ["RowCollector", "RunStats", "Sink", "Sinks", "Updating", "run"]
+__all__ = ["RowCollector", "RunStats", "Sink", "Sinks", "Updating", "expect", "run"]
