@@ -282,12 +282,3 @@ def test_the_kernels_maximum_and_minimum_are_numpys() -> None:  # (NaN when eith
                 got, want = np.float64(mine(a, b)), theirs(np.float64(a), np.float64(b))
                 # (equal values: of two zeros of opposite sign the kernels return the first, numpy may not)
                 assert got == want or (np.isnan(got) and np.isnan(want)), (a, b)
-
-
-@numba_missing
-@pytest.mark.parametrize("config", [BoxTrackConfig(), BoxTrackConfig(max_targets=5)])
-def test_compiled_rows_equal_the_numpy_paths_with_reid_by_the_size_last_seen(config, monkeypatch) -> None:
-    from lookalike.trackers import boxtrack_config
-
-    monkeypatch.setattr(boxtrack_config, "REID_SEEN_SIZE", True)
-    assert _run_both(_awkward(4, frames=120), config) > 50

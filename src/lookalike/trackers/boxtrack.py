@@ -78,7 +78,7 @@ class BoxTrack:
     def reset(self) -> None:
         """Forget every track; ids restart at 1."""
         cfg = self.config
-        self._tracks = TrackTable(8, cov_shape=(4, 4), extra={"seen_wh": ((2,), float)})  # cov: 2×2-block diagonals
+        self._tracks = TrackTable(8, cov_shape=(4, 4))  # cov: the 2×2-block diagonals [p11, p12, p21, p22]
         self._columns = np.zeros((24, 0))  # BoxCXCYWH's column form; mean and cov are its views (_state)
         self._views: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
         self._frame_count = 0
@@ -210,8 +210,6 @@ class BoxTrack:
         n_fit, n_back = kern.correct(x, det_of_track, det_xywh, self._space.pos_noise, t.confirmed, t.misses,
                                      t.unseen_s, t.hits, slots is None, dt, cfg.n_init, self._frame_count == 1,
                                      fit, back)
-        matched = det_of_track >= 0
-        t["seen_wh"][matched] = x[2:4, matched].T
         if n_fit:
             self._fit.observe_columns(fit[0:2, :n_fit], fit[2:4, :n_fit])
         if n_back:
@@ -390,10 +388,9 @@ class BoxTrack:
         a turning target keeps its size), its gate in box heights (``(k, 1)``, or one for all) and the largest size
         ratio. Open set: in fitted standard deviations, so a model that fits badly (MotionFit) widens the gate."""
         cfg, t, slots = self.config, self._tracks, self._slots
-        box = np.column_stack((t.mean[:, :2], t["seen_wh"])) if const.REID_SEEN_SIZE else t.mean[:, :4]
         if slots is not None:
-            return slots.squared(box), slots.gate(t.unseen_s + dt), max(cfg.reid_scale, const.CLOSED_SCALE)
-        return box, const.REID_DISTANCE * math.sqrt(self._fit.scale), cfg.reid_scale
+            return slots.squared(t.mean[:, :4]), slots.gate(t.unseen_s + dt), max(cfg.reid_scale, const.CLOSED_SCALE)
+        return t.mean[:, :4], const.REID_DISTANCE * math.sqrt(self._fit.scale), cfg.reid_scale
 
     def _correct(self, x: np.ndarray, matched: np.ndarray, z: np.ndarray) -> None:
         """Kalman update of the tracks ``matched`` (columns of ``x``) with their measurements ``z (4, m)``; the centre
@@ -407,7 +404,6 @@ class BoxTrack:
         space.correct_columns(sub, innovation, s)
         if not every:
             x[:, matched] = sub
-        t["seen_wh"][matched] = sub[2:4].T
         misses = t.misses[matched]
         if np.count_nonzero(misses):
             back = confirmed & (misses > 0)
@@ -431,7 +427,7 @@ class BoxTrack:
         if len(new):
             rows = self._space.initial_rows(z[:, new].T)
             first = self._frame_count == 1
-            t.add(rows[:, :8], rows[:, 8:].reshape(-1, 4, 4), hits=1, seen_wh=rows[:, 2:4],
+            t.add(rows[:, :8], rows[:, 8:].reshape(-1, 4, 4), hits=1,
                   confirmed=first or (cfg.n_init <= 1 and self._slots is None))
         return new
 

@@ -24,7 +24,6 @@ CLUTTER_IOU = 0.5  # a detection overlapping a previous-frame detection this muc
 CLUTTER_MIN_COUNT = 10  # detections judged before the clutter share is used
 CLOSED_GATE_GROWTH = 1.0  # closed set: recovery gate grows at least this many sizes per second lost
 CLOSED_SCALE = 3.0  # closed set: a recovered detection's sqrt(area) within this factor of its slot's
-REID_SEEN_SIZE = False  # re-identification measures a lost track by its last matched size (seen-size-rule.md)
 
 
 @dataclass(frozen=True)

@@ -69,8 +69,7 @@ class ClosedSlots:
             return det_of_track
         src = ready[: len(lost)]
         for s, d in zip(src, lost):
-            table.copy_row(int(s), int(d), ("mean", "cov", "hits", "misses", "unseen_s",
-                                            *(c for c in ("seen_wh",) if c in table.columns)))
+            table.copy_row(int(s), int(d), ("mean", "cov", "hits", "misses", "unseen_s"))
             det_of_track[d] = det_of_track[s]
         kept = np.ones(len(table), dtype=bool)
         kept[src] = False
