@@ -52,7 +52,7 @@ def test_a_default_tracker_takes_the_numpy_path_until_loading_pays(monkeypatch: 
     monkeypatch.setattr(switch, "_load", lambda: None)  # numba absent: once due, the numpy path for good
     monkeypatch.setattr(switch, "_load_after_s", 0.0)
     tracker.update(_awkward(0, frames=31)[-1])
-    assert not tracker.compiled and tracker._path.compiled is False and switch._loaded
+    assert not tracker.compiled and tracker._path.kernels is False and switch._loaded
 
 
 def test_a_run_announced_long_loads_the_kernels_at_its_start(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -62,9 +62,9 @@ def test_a_run_announced_long_loads_the_kernels_at_its_start(monkeypatch: pytest
     monkeypatch.setattr(switch, "_load", lambda: loads.append(1))  # (None: as without numba)
     tracker = BoxTrack()
     tracker.expect(bk.EAGER_FRAMES - 1)
-    assert not loads and tracker._path.compiled is None  # short: still the numpy path, undecided
+    assert not loads and tracker._path.kernels is None  # short: still the numpy path, undecided
     tracker.expect(bk.EAGER_FRAMES)
-    assert loads == [1] and tracker._path.compiled is False  # long: loaded and decided at once
+    assert loads == [1] and tracker._path.kernels is False  # long: loaded and decided at once
 
 
 numba_missing = pytest.mark.skipif(

@@ -96,12 +96,12 @@ class BoxTrack:
     @property
     def compiled(self) -> bool:
         """Whether this tracker runs the compiled kernels (:mod:`lookalike.trackers.kernels.boxtrack`) now."""
-        return bool(self._path.compiled)
+        return bool(self._path.kernels)
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
         dets = frame.detections
-        if self._path.compiled and dets.xywh.dtype is _F64 and dets.score.dtype is _F64 and not self._large(len(dets)):
+        if self._path.kernels and dets.xywh.dtype is _F64 and dets.score.dtype is _F64 and not self._large(len(dets)):
             # (float64 columns, as Detections makes them: the kernels' arithmetic is the numpy path's; the
             # module is looked up, not kept, so the tracker stays picklable)
             return self._update_compiled(frame, boxtrack_kernels.module())

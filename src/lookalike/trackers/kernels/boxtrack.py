@@ -52,7 +52,7 @@ def warm() -> None:
 
 EAGER_FRAMES = 3000
 """A run announced (:func:`expect`) with at least this many frames loads the kernels at its start: about where the
-0.3-0.4 ms they save a frame of a few boxes repays loading them."""
+0.2-0.4 ms they save a frame of a few boxes repays loading them."""
 
 LOAD_AFTER_S = 1.0
 """Seconds of the numpy path in a process after which the kernels are loaded (about their load time on one core:
@@ -73,18 +73,18 @@ def expect(frames: int) -> None:
 
 
 class PathChoice:
-    """Which path one tracker's frames take: the kernels (:attr:`compiled` True), the numpy path (False), or not
+    """Which path one tracker's frames take: the kernels (:attr:`kernels` True), the numpy path (False), or not
     decided yet (None: the numpy path, its time counted until loading the kernels pays). ``allowed``: whether the
     tracker's settings let the kernels run at all."""
 
     def __init__(self, allowed: bool = True) -> None:
-        self.compiled: bool | None = None if allowed else False
+        self.kernels: bool | None = None if allowed else False
         self.decide()
 
     def decide(self) -> None:
         """Settle the path when asking costs nothing or loading pays (:func:`due`)."""
-        if self.compiled is None and due():
-            self.compiled = compiled() is not None
+        if self.kernels is None and due():
+            self.kernels = compiled() is not None
 
     def expect(self, frames: int) -> None:
         """About ``frames`` frames follow (:func:`expect`)."""
@@ -93,7 +93,7 @@ class PathChoice:
 
     def numpy(self, update: Callable[[Any], T], frame: Any) -> T:
         """``update(frame)``, the numpy path, timed towards the decision while it is not made."""
-        if self.compiled is not None:
+        if self.kernels is not None:
             return update(frame)
         out = timed(update, frame)
         self.decide()
