@@ -137,6 +137,21 @@ class BoxCXCYWH:
     # diagonals of the covariance, p11 (8-11), p12 (12-15), p21 (16-19), p22 (20-23); the numbers are
     # those of the full-covariance methods above, bit for bit.
 
+    @staticmethod
+    def measure_columns(xywh: np.ndarray) -> np.ndarray:
+        """:meth:`measure`'s numbers on columns: ``(4, n)`` cx, cy, w, h of boxes given as columns ``xywh (4, n)``."""
+        z = np.empty(xywh.shape)
+        np.add(xywh[0:2], xywh[2:4] / 2.0, out=z[0:2])
+        z[2:4] = xywh[2:4]
+        return z
+
+    @staticmethod
+    def box_columns(columns: np.ndarray, out: np.ndarray) -> None:
+        """:meth:`box`'s numbers on columns: rows 0-3 (cx, cy, w, h) of ``columns`` written into ``out (4, m)`` as
+        left, top, width, height, sizes floored at 1e-3 pixels."""
+        size = np.maximum(columns[2:4], 1e-3, out=out[2:4])
+        np.subtract(columns[0:2], size / 2, out=out[0:2])
+
     def initial_rows(self, z: np.ndarray) -> np.ndarray:
         """New tracks at measurements ``z (n, 4)`` as rows ``(n, 24)`` of the column table (its transpose)."""
         n = len(z)

@@ -42,13 +42,6 @@ _F64 = np.dtype(np.float64)
 LARGE_PAIRS = 1 << 20  # frames with more (track + previous box) × detection pairs are associated in batches
 
 
-def _xywh_columns(cxcywh: np.ndarray, out: np.ndarray) -> None:
-    """:func:`cxcywh_to_xywh`'s numbers on columns: boxes ``cxcywh`` (rows 0-3 cx, cy, w, h; pixels) written
-    into ``out (4, m)`` as left, top, width, height, sizes floored at 1e-3 pixels."""
-    size = np.maximum(cxcywh[2:4], 1e-3, out=out[2:4])
-    np.subtract(cxcywh[0:2], size / 2, out=out[0:2])
-
-
 @register_tracker("boxtrack")
 class BoxTrack:
     """Motion-only box tracker: score-split association, motion re-identification, closed sets."""
@@ -110,7 +103,7 @@ class BoxTrack:
     def _update_numpy(self, frame: Frame) -> Tracks:
         t, clock = self._tracks, self._clock
         steps, dt, det_xywh, score, det_idx, x = self._begin(frame)
-        z = self._measure(det_xywh.T)
+        z = BoxCXCYWH.measure_columns(det_xywh.T)
         was_tracked = t.unseen_s == 0
         if len(t):
             if self._slots is not None:
@@ -220,7 +213,7 @@ class BoxTrack:
             t.record(hit, dt)
             det_of_track = slots.refill(t, self._ready(), det_of_track)
         new = (matching.free & (score >= birth_score)).nonzero()[0]
-        born = self._births(new, self._measure(det_xywh.T) if len(new) else _NO_BOXES.T)
+        born = self._births(new, BoxCXCYWH.measure_columns(det_xywh.T) if len(new) else _NO_BOXES.T)
         coasting, life = self._coasting, self._lifecycle
         present = self._never if coasting.report_prob is None else coasting.returns.present_table(
             coasting.report_prob, coasting.min_count)
@@ -244,7 +237,7 @@ class BoxTrack:
         stage = kern.gated_stages(iou, 0, *args)
         if stage > 4:
             return
-        det_box = self._measure(det_xywh.T).T
+        det_box = BoxCXCYWH.measure_columns(det_xywh.T).T
         if stage < 4:
             stages = self._plan(iou, None, det_box, score, high_score, t.unseen_s == 0, dt)
             while stage < 4:  # competing pairs: this stage's costs decide
@@ -267,15 +260,6 @@ class BoxTrack:
             self._columns, self._views = x, (t.mean, t.cov)
         return self._columns
 
-    @staticmethod
-    def _measure(xywh: np.ndarray) -> np.ndarray:
-        """Measurement columns ``(4, n)`` (cx, cy, w, h) of boxes given as columns ``xywh (4, n)``
-        (:meth:`BoxCXCYWH.measure`'s numbers)."""
-        z = np.empty(xywh.shape)
-        np.add(xywh[0:2], xywh[2:4] / 2.0, out=z[0:2])
-        z[2:4] = xywh[2:4]
-        return z
-
     def _overlaps(self, x: np.ndarray, det_xywh: np.ndarray) -> tuple[np.ndarray | None, np.ndarray | None]:
         """One IoU matrix of the predicted track boxes (state columns ``x``) and the previous frame's
         detections (rows) against this frame's detections (columns): the clutter share counts from the
@@ -289,7 +273,7 @@ class BoxTrack:
             return None, None
         boxes = np.empty((4, k + p))  # left, top, width, height as columns
         if k:  # the predicted boxes
-            _xywh_columns(x, boxes[:, :k])
+            BoxCXCYWH.box_columns(x, boxes[:, :k])
         if p:
             boxes[:, k:] = previous.T  # type: ignore[union-attr]
         iou = iou_columns(boxes, det_xywh.T)
@@ -314,7 +298,7 @@ class BoxTrack:
         (:mod:`~lookalike.trackers.parts.batches`); no stage can match across groups, so the matches are the same."""
         k = x.shape[1]
         boxes = np.empty((4, k))
-        _xywh_columns(x, boxes)
+        BoxCXCYWH.box_columns(x, boxes)
         i, j = overlapping_pairs(boxes.T, det_xywh)
         track_box, gate, _ = self._reid_gate(dt)
         radius = np.ravel(gate * np.maximum(track_box[:, 3:4], 1.0)) * (1 + 1e-9)  # (a hair wide: no pair too few)
@@ -450,7 +434,7 @@ class BoxTrack:
         m = len(shown)
         x = t.mean.T[:6].take(shown, axis=1)  # box and velocity rows (after births, not yet a view of _columns)
         boxes, velocity, status = np.empty((m, 4)), np.empty((m, 2)), np.empty(m, dtype=np.int8)
-        _xywh_columns(x, boxes.T)
+        BoxCXCYWH.box_columns(x, boxes.T)
         np.divide(x[4:6], self._clock.interval, out=velocity.T)
         status.fill(1)
         return Tracks.trusted(t.ids[shown], status, boxes, velocity, original)
