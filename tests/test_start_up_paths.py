@@ -100,3 +100,14 @@ def test_the_library_leaves_blas_threads_alone():
     env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
     assert out.strip() == "None"
+
+
+def test_the_trackers_solver_does_not_import_scipy_optimize():
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np; from lookalike.association.solver import assign; "
+            "m = assign(np.array([[1.0, 2.0], [1.0, 3.0]])).matches.tolist(); "
+            "print(m, 'scipy.optimize' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[[0, 1], [1, 0]] False"  # a real solve (the pairs overlap), scipy.optimize left alone

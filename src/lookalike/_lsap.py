@@ -37,10 +37,15 @@ def _load() -> Callable[..., Any]:
     return found
 
 
-def linear_sum_assignment(cost: Any, maximize: bool = False) -> tuple[Any, Any]:
-    """``scipy.optimize.linear_sum_assignment(cost, maximize)``: row and column indices (int arrays)
-    of a minimum-cost (maximum with ``maximize``) complete assignment of the smaller side."""
+def solver() -> Callable[..., Any]:
+    """scipy's ``linear_sum_assignment`` function itself, loaded on first use."""
     global _solver
     if _solver is None:
         _solver = _load()
-    return _solver(cost, maximize)  # type: ignore[no-any-return]
+    return _solver
+
+
+def linear_sum_assignment(cost: Any, maximize: bool = False) -> tuple[Any, Any]:
+    """``scipy.optimize.linear_sum_assignment(cost, maximize)``: row and column indices (int arrays)
+    of a minimum-cost (maximum with ``maximize``) complete assignment of the smaller side."""
+    return solver()(cost, maximize)  # type: ignore[no-any-return]

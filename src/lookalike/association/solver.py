@@ -11,8 +11,8 @@ import numpy as np
 
 
 def linear_sum_assignment(cost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """scipy's solver, imported on first use (scipy.optimize takes a noticeable time to import)."""
-    from scipy.optimize import linear_sum_assignment as solve
+    """scipy's solver, loaded on first use without importing ``scipy.optimize`` (:mod:`lookalike._lsap`)."""
+    from lookalike._lsap import linear_sum_assignment as solve
 
     rows, cols = solve(cost)
     return rows, cols

@@ -259,7 +259,7 @@ class Session:
         free_new = sorted(set(np.unique(new[:, 1]).astype(int).tolist()) - fixed)
         free_old = sorted(set(np.unique(self.rows[:, 1]).astype(int).tolist()) - fixed)
         if free_new and free_old:
-            from scipy.optimize import linear_sum_assignment
+            from lookalike._lsap import linear_sum_assignment
 
             ia, ib = colocated(self.rows, new)
             overlap = np.zeros((len(free_old), len(free_new)))

@@ -13,7 +13,7 @@ from types import ModuleType
 import numpy as np
 
 from lookalike._compiled import KernelSwitch
-from lookalike.association.solver import linear_sum_assignment, solve_allowed
+from lookalike.association.solver import solve_allowed
 
 try:  # numpy's gufuncs behind np.linalg.cholesky / np.linalg.solve (the same kernels, no wrapper)
     from numpy.linalg import _umath_linalg as _kernels
@@ -91,10 +91,9 @@ _solver: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None
 def _load_solver() -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
     """scipy's ``linear_sum_assignment`` (what ``association.solver``'s wrapper calls), kept after its first use."""
     global _solver
-    linear_sum_assignment(np.zeros((1, 1)))  # (imports it, as the wrapper does)
-    from scipy.optimize import linear_sum_assignment as solver
+    from lookalike._lsap import solver
 
-    found: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] = solver
+    found: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] = solver()
     _solver = found
     return found
 

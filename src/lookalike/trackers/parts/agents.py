@@ -5,11 +5,11 @@ localiser)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import ClassVar
 
 import numpy as np
 
+from lookalike._lsap import linear_sum_assignment
 from lookalike.trackers.base import NEEDS_ROBOTS
 from lookalike.trackers.kernels.world import filled
 from lookalike.trackers.parts.identity.localiser import make_localiser
@@ -109,24 +109,11 @@ def decode(prob: np.ndarray, used: np.ndarray, n: int, one_to_one: bool) -> tupl
     # Each detection may be a false positive; each agent takes at most one detection.
     cost = -np.log(np.minimum(np.maximum(np.concatenate([p[:, :n_agents], p[:, n_agents:].repeat(k, axis=1)],
                                                         axis=1), 1e-12), 1))
-    rows, cols = _assignment()(cost)
+    rows, cols = linear_sum_assignment(cost)
     label = filled(k, -1, int)
     label[rows] = np.where(cols < n_agents, cols, -1)
     labels[used], conf[used] = label, np.where(label >= 0, p[np.arange(k), np.maximum(label, 0)], p[:, n_agents])
     return labels, conf
-
-
-def _assignment() -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
-    """``scipy.optimize.linear_sum_assignment``, imported on first use (slow to import)."""
-    global _LINEAR_SUM_ASSIGNMENT
-    if _LINEAR_SUM_ASSIGNMENT is None:
-        from scipy.optimize import linear_sum_assignment
-
-        _LINEAR_SUM_ASSIGNMENT = linear_sum_assignment
-    return _LINEAR_SUM_ASSIGNMENT
-
-
-_LINEAR_SUM_ASSIGNMENT: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None
 
 
 def agent_detections(labels: np.ndarray, conf: np.ndarray, n_agents: int) -> np.ndarray:
