@@ -136,6 +136,7 @@ def _cases() -> list[tuple[str, list[str], str]]:
         ("matplotlib", ["demo", "--quick", "-o", "demo"], "viz"),
         ("onnxruntime", ["track", "-t", "deepsort", "--features", "learned", *video], "vision"),
         ("sklearn", ["train-heading", "-o", "heading.npz"], "vision"),
+        ("sklearn", ["train-detector", "-o", "detector.npz"], "vision"),
         ("optuna", ["tune", "-t", "boxtrack", str(DATA / "mot15" / "TUD-Campus"), "-o", "p.json"], "tune"),
         ("rerun", ["demo", "--quick", "-o", "demo", "--rerun-save", "d.rrd"], "rerun"),
         ("ray", ["tune", "-t", "boxtrack", str(DATA / "mot15" / "TUD-Campus"), "-o", "p.json", "--backend", "ray"],
