@@ -77,6 +77,40 @@ def test_write_round_trip_and_atomicity(tmp_path):
     assert [p.name for p in out.parent.iterdir()] == ["seq.txt"]  # no temporary left behind
 
 
+def test_a_link_is_written_through_and_a_named_pipe_is_written_into(tmp_path):
+    """A result written to a symbolic link lands in the file it points at (the link stays); one written to a named
+    pipe reaches its reader, and the pipe stays a pipe (renaming a finished file onto it would replace it, as it
+    would replace ``/dev/null``)."""
+    import os
+    import stat
+    import threading
+
+    from lookalike.io.outputs import write_atomic
+
+    snaps = [TrackSnapshot(track_id=3, status=TrackStatus.CONFIRMED, xywh=np.array([1.5, 2, 3, 4]))]
+    real = tmp_path / "real.txt"
+    real.write_text("old\n")
+    link = tmp_path / "link.txt"
+    link.symlink_to(real.name)
+    write_mot(link, [tracks_to_rows(0, snaps)])
+    assert link.is_symlink() and read_mot(real).track_id.tolist() == [3]
+    write_atomic(link, "text\n")
+    assert link.is_symlink() and real.read_text() == "text\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.txt", "real.txt"]
+
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    for write, lines in ((lambda: write_mot(pipe, [tracks_to_rows(0, snaps), tracks_to_rows(1, snaps)]), 2),
+                         (lambda: write_atomic(pipe, "text\n"), 1)):
+        got: list[bytes] = []
+        reader = threading.Thread(target=lambda out=got: out.append(pipe.read_bytes()))
+        reader.start()
+        write()
+        reader.join(timeout=30)
+        assert got and got[0].count(b"\n") == lines and stat.S_ISFIFO(os.stat(pipe).st_mode)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.txt", "pipe", "real.txt"]
+
+
 def _make_sequence(root: Path, name: str, length: int = 5) -> Path:
     seq = root / name
     _write(seq / "seqinfo.ini", f"[Sequence]\nname={name}\nframeRate=10\nseqLength={length}\nimWidth=64\nimHeight=48\n")

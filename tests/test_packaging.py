@@ -14,9 +14,12 @@ from pathlib import Path
 
 import pytest
 
+import lookalike
+
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
 PROJECT = PYPROJECT["project"]
+VERSION = lookalike.__version__  # pyproject.toml reads it from lookalike/_version.py (its version is dynamic)
 EXTRAS: dict[str, list[str]] = PROJECT["optional-dependencies"]
 USER_EXTRAS = ("vision", "viz", "fast", "train", "tune", "rerun", "ray")
 DEVELOPER_TOOLS = ("pytest", "hypothesis", "mypy", "ruff", "import-linter", "mkdocs", "playwright", "build")
@@ -56,7 +59,17 @@ def test_make_demo_installs_the_demo_extras_only() -> None:
 def test_the_version_has_a_changelog_entry() -> None:
     changelog = (ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
     first = re.search(r"^## (\S+)", changelog, flags=re.M)
-    assert first is not None and first.group(1) == PROJECT["version"]
+    assert first is not None and first.group(1) == VERSION
+
+
+def test_one_version_everywhere() -> None:
+    from importlib.metadata import version
+
+    from lookalike.io.results import lookalike_version
+
+    assert PROJECT["dynamic"] == ["version"] and PYPROJECT["tool"]["setuptools"]["dynamic"]["version"] == {
+        "attr": "lookalike._version.__version__"}
+    assert version("lookalike") == lookalike_version() == VERSION  # (the environment was installed from here)
 
 
 def test_docs_never_install_from_pypi() -> None:
@@ -80,7 +93,7 @@ def dist(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_wheel_and_sdist_hold_the_shipped_files(dist: Path) -> None:
-    version = PROJECT["version"]
+    version = VERSION
     wheel = dist / f"lookalike-{version}-py3-none-any.whl"
     sdist = dist / f"lookalike-{version}.tar.gz"
     assert wheel.is_file() and sdist.is_file(), sorted(p.name for p in dist.iterdir())
@@ -90,6 +103,7 @@ def test_wheel_and_sdist_hold_the_shipped_files(dist: Path) -> None:
     for path in SHIPPED:
         assert path in names, f"{path} is not in the wheel"
     metadata = zipfile.ZipFile(wheel).read(f"lookalike-{version}.dist-info/METADATA").decode()
+    assert f"\nVersion: {version}\n" in metadata
     for extra in (*USER_EXTRAS, "dev"):
         assert f"Provides-Extra: {extra}" in metadata
     with tarfile.open(sdist) as tar:

@@ -9,13 +9,12 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from lookalike._lazy import lazy_attributes
+from lookalike._version import __version__
 
 if TYPE_CHECKING:
     from lookalike.io import find_sequences, frames_from_table, read_mot, tracks_to_rows, write_mot
     from lookalike.trackers import Sort, make_tracker, tracker_names, tracker_parameters
     from lookalike.types import Beacons, Detections, Frame, TrackSnapshot, TrackStatus
-
-__version__ = "0.1.0"
 
 _HOME = {name: home for home, names in {
     "lookalike.io": ("find_sequences", "frames_from_table", "read_mot", "tracks_to_rows", "write_mot"),

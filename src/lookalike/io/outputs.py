@@ -8,7 +8,7 @@ from collections.abc import Collection, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
-from lookalike.io.rules import temp_beside
+from lookalike.io.rules import is_special, temp_beside, write_target
 from lookalike.io.sequences import MotSequence
 
 
@@ -77,8 +77,12 @@ def _check_folder(folder: Path) -> None:
 @contextmanager
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """A temporary file (:func:`~lookalike.io.rules.temp_beside`) to write instead of ``path``: renamed onto ``path``
-    when the block ends, removed when it raises (``KeyboardInterrupt`` and SIGTERM's ``SystemExit`` included)."""
-    target = Path(path)
+    (onto the file a symbolic link points at) when the block ends, removed when it raises (``KeyboardInterrupt`` and
+    SIGTERM's ``SystemExit`` included). A device or named pipe (``/dev/null``) is itself written into."""
+    target = write_target(Path(path))
+    if is_special(target):
+        yield target
+        return
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = temp_beside(target)
     try:

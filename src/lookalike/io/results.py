@@ -31,13 +31,10 @@ _UNITS = {"(m)": "_m", "(s)": "_s", "(deg)": "_deg", "(px)": "_px"}
 
 
 def lookalike_version() -> str:
-    """The installed lookalike version (``"unknown"`` when not installed)."""
-    from importlib.metadata import PackageNotFoundError, version
+    """The version of the lookalike that runs (``lookalike.__version__``, which the package metadata also reads)."""
+    from lookalike._version import __version__
 
-    try:
-        return version("lookalike")
-    except PackageNotFoundError:
-        return "unknown"
+    return __version__
 
 
 def metric_key(name: str) -> str:

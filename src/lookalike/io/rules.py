@@ -5,6 +5,7 @@ with the user's umask."""
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
 from pathlib import Path
 
@@ -85,4 +86,20 @@ def temp_beside(path: Path) -> tuple[int, Path]:
     return fd, Path(tmp)
 
 
-__all__ = ["GAP_FACTOR", "MIN_GAP", "frame_problems", "read_text", "temp_beside", "user_mode"]
+def write_target(path: Path) -> Path:
+    """Where writing ``path`` lands: the file a symbolic link points at (the link stays a link), else ``path``."""
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
+
+
+def is_special(path: Path) -> bool:
+    """Whether ``path`` is a device, named pipe or socket (``/dev/null``): written into directly, since renaming a
+    finished temporary file onto it would replace it."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return False
+    return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
+
+
+__all__ = ["GAP_FACTOR", "MIN_GAP", "frame_problems", "is_special", "read_text", "temp_beside", "user_mode",
+           "write_target"]

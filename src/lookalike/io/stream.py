@@ -15,7 +15,7 @@ import numpy as np
 
 from lookalike.io.det_format import box_stats, read_det, sniff_det
 from lookalike.io.motchallenge import format_rows, frames_from_table, read_mot, row_problem
-from lookalike.io.rules import temp_beside
+from lookalike.io.rules import is_special, temp_beside, write_target
 from lookalike.io.sequences import MotSequence
 from lookalike.loop import RunStats, Sink, Sinks, Updating, run
 from lookalike.types import Detections, Frame
@@ -161,13 +161,19 @@ class DetectionStream:
 
 class MotWriter:
     """A sink for :func:`lookalike.loop.run` writing result rows to a temporary file that :meth:`close` renames to
-    ``path`` (leaving a ``with`` block on an exception deletes it)."""
+    ``path``, or to the file a symbolic link ``path`` points at (leaving a ``with`` block on an exception deletes
+    it). A device or named pipe (``/dev/null``) is written into directly."""
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd, self._tmp = temp_beside(self.path)
-        self._fh: TextIO | None = os.fdopen(fd, "w")
+        self._target = write_target(self.path)
+        self._tmp: Path | None = None
+        if is_special(self._target):
+            self._fh: TextIO | None = open(self._target, "w")  # noqa: SIM115 (closed by close/abort)
+        else:
+            self._target.parent.mkdir(parents=True, exist_ok=True)
+            fd, self._tmp = temp_beside(self._target)
+            self._fh = os.fdopen(fd, "w")
         self._pending: list[np.ndarray] = []  # rows not yet written (at most WRITE_ROWS)
         self._pending_rows = 0
         self.rows = 0
@@ -213,9 +219,11 @@ class MotWriter:
             fh, self._fh = self._fh, None
             try:
                 fh.close()
-                os.replace(self._tmp, self.path)
+                if self._tmp is not None:
+                    os.replace(self._tmp, self._target)
             except BaseException:
-                self._tmp.unlink(missing_ok=True)
+                if self._tmp is not None:
+                    self._tmp.unlink(missing_ok=True)
                 raise
         return self.path
 
@@ -225,7 +233,8 @@ class MotWriter:
         if self._fh is not None:
             self._fh.close()
             self._fh = None
-            self._tmp.unlink(missing_ok=True)
+            if self._tmp is not None:
+                self._tmp.unlink(missing_ok=True)
 
     def __enter__(self) -> MotWriter:
         return self

@@ -176,12 +176,12 @@ def detection_cache_key(video: Path | str, config: BlobConfig, extra: dict[str, 
     with needs("cv2"):
         import cv2
 
-    from lookalike import __version__
+    from lookalike._version import __version__
     from lookalike.vision import blob
 
     code = blob.SOURCE_HASH + _SOURCE_HASH  # the code as imported: a long run never files old rows under new code
     payload = json.dumps({"video": _file_hash(Path(video)), "config": dataclasses.asdict(config),
-                          "version": str(__version__), "code": code, "opencv": cv2.__version__, **(extra or {})},
+                          "version": __version__, "code": code, "opencv": cv2.__version__, **(extra or {})},
                          sort_keys=True, default=str)
     return hashlib.sha256(payload.encode()).hexdigest()[:32]
 

@@ -2,7 +2,7 @@
 
     {"tracker": "boxtrack", "params": {"high_score": 0.85, ...},
      "chosen_on": ["mot15/ADL-Rundle-6", ...], "criterion": "hota+idf1+mota",
-     "trials": 60, "lookalike_version": "0.1.0"}
+     "trials": 60, "lookalike_version": "0.2.0"}
 
 (extra keys kept)."""
 
@@ -39,9 +39,9 @@ class TunedParams:
 
 
 def _version() -> str:
-    from lookalike import __version__
+    from lookalike._version import __version__
 
-    return str(__version__)
+    return __version__
 
 
 def save_params(path: str | Path, tracker: str, params: dict[str, Any], *, chosen_on: list[str],
