@@ -750,3 +750,25 @@ def test_an_output_beside_the_inputs_that_is_not_read_may_be_replaced(tmp_path):
     r = _eval(gt, res, "--json", res / "scores.json")
     assert r.exit_code == 0, r.output
     assert (res / "scores.json").read_text().startswith("{")
+
+
+def test_a_folder_given_as_a_file_and_a_file_given_as_the_results_folder_are_named(tmp_path):
+    from lookalike.eval.folders import evaluate_folders
+    from lookalike.io import read_mot
+    from lookalike.io.stream import DetectionStream
+
+    with pytest.raises(FileNotFoundError, match="is a folder, not a file"):
+        read_mot(tmp_path)
+    with pytest.raises(FileNotFoundError, match="is a folder, not a file"):
+        DetectionStream(tmp_path).check()
+    with pytest.raises(FileNotFoundError, match="no such file"):
+        read_mot(tmp_path / "missing.txt")
+    seq = tmp_path / "seq"
+    (seq / "gt").mkdir(parents=True)
+    (seq / "gt" / "gt.txt").write_text("1,1,10,10,20,20,1,1,1\n")
+    (seq / "seqinfo.ini").write_text("[Sequence]\nname=seq\nseqLength=1\nframeRate=10\nimWidth=100\nimHeight=100\n")
+    result = tmp_path / "seq.txt"
+    result.write_text("1,1,10,10,20,20,1,-1,-1,-1\n")
+    with pytest.raises(ValueError, match=r"seq\.txt: is a file; give the folder .*\(seq\.txt, \.\.\.\)"):
+        evaluate_folders(seq, result)
+    assert evaluate_folders(seq, tmp_path)["COMBINED"]["IDF1"] == pytest.approx(1.0)  # the folder is scored

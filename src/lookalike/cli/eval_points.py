@@ -8,13 +8,14 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.eval import evaluate_points
+from lookalike.io.rules import not_a_file
 
 
 def read_id_points(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(frame (n,), id (n,), xy (n, 2))`` of a ``frame,id,x,y`` file, or box centres of MOTChallenge
     rows (7 or more columns: ``frame,id,left,top,width,height,score,...``)."""
     if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
+        raise not_a_file(path)
     rows: list[list[float]] = []
     for no, line in enumerate(path.read_text().splitlines(), start=1):
         fields = [f.strip() for f in line.split(",")] if line.strip() and not line.startswith("#") else []

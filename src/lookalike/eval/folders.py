@@ -41,6 +41,9 @@ def evaluate_folders(gt_root: str | os.PathLike[str], results: str | os.PathLike
     if not sequences:
         raise ValueError(f"{gt_root}: no sequence with gt/gt.txt")
     results = Path(results)
+    if results.is_file():
+        raise ValueError(f"{results}: is a file; give the folder that holds a <sequence>.txt for each sequence of "
+                         f"{gt_root} ({sequences[0].name}.txt, ...)")
     if not results.is_dir():
         raise ValueError(f"{results}: results folder not found")
     jobs = [(s, _result_file(results, s.name), benchmark, tuple(metrics), iou_threshold) for s in sequences]

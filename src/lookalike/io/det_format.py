@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.io.motchallenge import row_problem
-from lookalike.io.rules import read_text
+from lookalike.io.rules import not_a_file, read_text
 from lookalike.types.mot_table import MotTable, table_from_array
 
 MOT_COLUMNS = "frame,id,left,top,width,height,score[,x,y,z]"
@@ -120,7 +120,7 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
     0-based). ``ValueError`` when the lines cannot be read as detections."""
     path = Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
+        raise not_a_file(path)
     lines = []
     with open(path, encoding="utf-8", errors="replace") as fh:
         for line in fh:

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.io.rules import GAP_FACTOR, MIN_GAP, frame_problems, read_text
+from lookalike.io.rules import GAP_FACTOR, MIN_GAP, frame_problems, not_a_file, read_text
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import ROW_WIDTH, MotTable, stack_rows, table_from_array, tracks_to_rows
 
@@ -26,7 +26,7 @@ def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | N
     ``positive_size``), or a frame number breaking :mod:`lookalike.io.rules` or past ``length``."""
     path = Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
+        raise not_a_file(path)
     fast = _parse_fast(path, min_columns)
     if fast is not None and row_problem(fast, length=length, positive_size=positive_size) is None:
         return table_from_array(fast, path)

@@ -15,11 +15,16 @@ MIN_GAP = 10_000  # frames: a jump up to this is always allowed
 GAP_FACTOR = 10  # ... and up to this times the largest frame number seen before it
 
 
+def not_a_file(path: Path) -> FileNotFoundError:
+    """The error for reading ``path`` that is no file: a folder, or nothing."""
+    return FileNotFoundError(f"{path}: {'is a folder, not a file' if path.is_dir() else 'no such file'}")
+
+
 def read_text(path: str | os.PathLike[str]) -> str:
     """The UTF-8 text of ``path``; ``FileNotFoundError``/``ValueError`` naming the file otherwise."""
     path = Path(path)
     if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
+        raise not_a_file(path)
     try:
         data = path.read_bytes()
     except OSError as exc:
@@ -101,5 +106,5 @@ def is_special(path: Path) -> bool:
     return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
 
 
-__all__ = ["GAP_FACTOR", "MIN_GAP", "frame_problems", "is_special", "read_text", "temp_beside", "user_mode",
-           "write_target"]
+__all__ = ["GAP_FACTOR", "MIN_GAP", "frame_problems", "is_special", "not_a_file", "read_text", "temp_beside",
+           "user_mode", "write_target"]

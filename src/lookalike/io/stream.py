@@ -15,7 +15,7 @@ import numpy as np
 
 from lookalike.io.det_format import box_stats, read_det, sniff_det
 from lookalike.io.motchallenge import format_rows, frames_from_table, read_mot, row_problem
-from lookalike.io.rules import is_special, temp_beside, write_target
+from lookalike.io.rules import is_special, not_a_file, temp_beside, write_target
 from lookalike.io.sequences import MotSequence
 from lookalike.loop import RunStats, Sink, Sinks, Updating, run
 from lookalike.types import Detections, Frame
@@ -78,7 +78,7 @@ class DetectionStream:
         """Read the file once (constant memory); raise ``ValueError`` / ``FileNotFoundError`` as
         :func:`~lookalike.io.read_mot` does for a malformed file (with ``length``). Returns ``self``."""
         if not self.path.is_file():
-            raise FileNotFoundError(f"{self.path}: no such file")
+            raise not_a_file(self.path)
         last, width, rows = 0.0, None, 0
         self._single = None
         chunks: list[np.ndarray] = []
