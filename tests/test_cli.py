@@ -110,3 +110,18 @@ def test_bench_options_mean_the_same_everywhere():
                 if opt in ("--sequences", "--frames", "--setups", "--trackers", "--seed", "--json"):
                     kinds.setdefault(opt, set()).add((p.multiple, str(p.bare_type())))
     assert all(len(v) == 1 for v in kinds.values()), kinds
+
+
+def test_piped_output_keeps_each_message_on_one_line(tmp_path):
+    """Redirected to a file or a pipe, a long message is not wrapped at 80 columns (scripts read it by line)."""
+    import os
+    import subprocess
+    import sys
+
+    det = tmp_path / "det.txt"
+    det.write_text("".join(f"{f},-1,{10 + f},20,30,40,0.9,-1,-1,-1\n" for f in range(1, 6)))
+    out = tmp_path / ("a-result-file-with-a-name-long-enough-to-pass-eighty-columns-" + "x" * 40 + ".txt")
+    env = {k: v for k, v in os.environ.items() if k != "COLUMNS"}
+    done = subprocess.run([sys.executable, "-m", "lookalike", "track", "-t", "sort", str(det), "-o", str(out)],
+                          capture_output=True, text=True, env=env, check=True)
+    assert any(line.endswith(f"→ {out}") for line in done.stdout.splitlines()), done.stdout

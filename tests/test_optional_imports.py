@@ -159,9 +159,12 @@ def test_a_command_without_its_package_names_the_extra(hidden: str, args: list[s
         args = [args[0], str(next((tmp_path / "sims").glob("*.jsonl"))), *args[2:]]
     if args[0] == "track" and "v.mp4" in args:
         (tmp_path / "v.mp4").write_bytes(b"")
+    before = set(tmp_path.rglob("*"))
     result = _lookalike(args, [hidden], tmp_path)
     lines = [ln for ln in result.stderr.splitlines() if ln.strip()]
     assert result.returncode == 2, result.stderr[-2000:]
+    assert not result.stdout.strip(), result.stdout[-2000:]  # it stops before any work or output ...
+    assert set(tmp_path.rglob("*")) == before  # ... and leaves no file or folder behind
     assert "Traceback" not in result.stderr and len(lines) == 1, result.stderr[-2000:]
     named = "--rerun-save: needs" if "--rerun-save" in args else f"lookalike {args[0]}: needs"  # (names its option)
     assert named in lines[0] and f"'{extra}' extra" in lines[0] and f"[{extra}]'" in lines[0]

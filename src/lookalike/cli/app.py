@@ -54,6 +54,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 console = Console()
+console.soft_wrap = not console.is_terminal  # piped or redirected: each message one line, however long
 err_console = Console(stderr=True, soft_wrap=True)  # an error stays one line
 
 
@@ -86,6 +87,18 @@ def failing(*errors: type[Exception], prefix: str = "") -> Iterator[None]:
         yield
     except errors as exc:
         fail(f"{prefix}{exc}")
+
+
+def require(*modules: str) -> None:
+    """Before any work or output: a missing optional package among ``modules`` ends the command in one line naming
+    its extra (exit 2)."""
+    import importlib
+
+    from lookalike._optional import needs
+
+    for module in modules:
+        with needs(module):
+            importlib.import_module(module)
 
 
 def check_names(option: str, names: list[str], known: Sequence[str], what: str) -> None:

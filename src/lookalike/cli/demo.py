@@ -11,7 +11,8 @@ import typer
 from rich.markup import escape
 from rich.progress import TimeRemainingColumn
 
-from lookalike.cli.app import app, check_names, check_outputs_or_fail, command_line, console, failing
+from lookalike._optional import MissingExtra
+from lookalike.cli.app import app, check_names, check_outputs_or_fail, command_line, console, failing, require
 from lookalike.cli.bench import rich_table
 from lookalike.cli.progress import bars
 from lookalike.demo import DIVER_COLS, IDENT_COLS, QUICK, DemoSize, lstm_status, run_demo
@@ -23,7 +24,6 @@ __all__ = ["QUICK", "demo", "lstm_status", "run_demo"]
 def _open_rerun(rerun: bool, rerun_save: Path | None) -> object | None:
     if not rerun and rerun_save is None:
         return None
-    from lookalike._optional import MissingExtra
     from lookalike.viz.rerun_log import open_rerun
 
     with failing(ValueError, OSError, MissingExtra, prefix="--rerun: " if rerun else "--rerun-save: "):
@@ -61,6 +61,10 @@ def demo(
     rerun_save: Path | None = typer.Option(None, "--rerun-save", help="Also write a Rerun recording (.rrd) here."),
 ) -> None:
     """Simulate robots and divers, run every relevant tracker, write videos, plots and an HTML report."""
+    require("cv2", "matplotlib")
+    if rerun or rerun_save is not None:
+        with failing(MissingExtra, prefix="--rerun: " if rerun else "--rerun-save: "):
+            require("rerun")
     check_outputs_or_fail({"-o/--output": output, "--rerun-save": rerun_save}, folders={"-o/--output"})
     check_names("--robot-preset", [robot_preset], PRESET_NAMES, "preset")
     logger = _open_rerun(rerun, rerun_save)

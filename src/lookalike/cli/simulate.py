@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_names, check_outputs_or_fail, check_teams, console, fail, failing
+from lookalike.cli.app import app, check_names, check_outputs_or_fail, check_teams, console, fail, failing, require
 from lookalike.io.robot_sequences import write_robot_sequence
 from lookalike.io.rosbag import write_bag
 from lookalike.sim import DEFAULT_NOISE, NOISE_MODELS, preset, simulate_robots
@@ -40,6 +40,7 @@ def simulate(
 
     Format: see ``lookalike.io.robot_sequences`` (a header line, then one object per frame with detections, received
     reports and the truth)."""
+    require(*(["cv2"] if arena is not None or (bag and images) else []), *(["rosbags"] if bag else []))
     check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})
     if arena is not None:
         if bag:

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, failing
+from lookalike.cli.app import app, check_outputs_or_fail, console, failing, require
 from lookalike.cli.progress import bars
 from lookalike.pipeline.robots import robot_video
 
@@ -22,6 +22,7 @@ def render_robots(
     `lookalike track --video FILE --pipeline robots --reports SEQUENCE`."""
     from lookalike.viz.video import VideoWriter
 
+    require("cv2")
     check_outputs_or_fail({"-o/--output": output}, [sequence])
     with failing(ValueError, OSError):
         seq, frames = robot_video(sequence, seed)

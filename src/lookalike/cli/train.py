@@ -14,7 +14,7 @@ import typer
 from rich.progress import TextColumn
 
 from lookalike._optional import needs
-from lookalike.cli.app import app, check_outputs_or_fail, check_study_or_fail, console, fail, failing
+from lookalike.cli.app import app, check_outputs_or_fail, check_study_or_fail, console, fail, failing, require
 from lookalike.cli.progress import bars
 
 if TYPE_CHECKING:
@@ -109,10 +109,9 @@ def train(
         fail(f"--minutes: a time limit > 0, got {minutes:g}")
     from lookalike.io.outputs import sqlite_file
 
+    require("torch")
     check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)},
                           [recordings, init_from, validation_folder], folders={"-o/--output"})
-    with needs("torch"):
-        import torch  # noqa: F401 (fails early without the 'train' extra)
     if model not in ("lstm", "set"):
         fail(f"--model: unknown model {model!r}; known: lstm, set")
     if recordings is not None and search is not None:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing, require
 
 
 @app.command("train-appearance")
@@ -23,6 +23,7 @@ def train_appearance(
     """Train the small CNN embedding on crops of new rendered divers and export it to ONNX.
 
     The shipped model (lookalike/vision/models_data/diver_reid.onnx) is this command's defaults."""
+    require("torch")
     check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})
     if output.exists() and not output.is_dir():
         fail(f"-o/--output: {output} is a file; give a folder")

@@ -11,7 +11,16 @@ from rich.markup import escape
 from rich.progress import TaskID, TimeRemainingColumn
 from rich.table import Table
 
-from lookalike.cli.app import app, check_choice, check_outputs_or_fail, check_study_or_fail, console, fail, failing
+from lookalike.cli.app import (
+    app,
+    check_choice,
+    check_outputs_or_fail,
+    check_study_or_fail,
+    console,
+    fail,
+    failing,
+    require,
+)
 from lookalike.cli.progress import bars
 from lookalike.parallel import BACKENDS
 
@@ -66,6 +75,7 @@ def tune(
     check_choice("--backend", backend, BACKENDS)
     if resume and study is None:
         fail("--resume: needs --study (the storage the study was saved in)")
+    require("optuna", *(["ray"] if backend == "ray" else []))
     from lookalike.io.outputs import sqlite_file
 
     check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)}, _data_inputs(data, space_path))

@@ -10,8 +10,7 @@ import numpy as np
 import typer
 from rich.progress import Progress, TextColumn
 
-from lookalike._optional import needs
-from lookalike.cli.app import app, check_outputs_or_fail, console, failing
+from lookalike.cli.app import app, check_outputs_or_fail, console, failing, require
 from lookalike.cli.progress import bars
 from lookalike.io.outputs import atomic_path
 from lookalike.learn.vision_train import train_robot_detector
@@ -37,8 +36,7 @@ def train_detector(
 ) -> None:
     """Train the HOG cascade robot detector and save it."""
     check_outputs_or_fail({"-o/--output": output}, input_folders=[data])
-    with needs("sklearn"):
-        import sklearn  # noqa: F401 (fails before the renders without the 'vision' extra)
+    require("sklearn")
     with failing(ValueError):
         with _progress() as bar:
             def step(description: str, total: int) -> Callable[[int, str], None]:
@@ -69,8 +67,7 @@ def train_heading_command(
 ) -> None:
     """Train the heading classifier on rendered robots, report its held-out error and save it."""
     check_outputs_or_fail({"-o/--output": output})
-    with needs("sklearn"):
-        import sklearn  # noqa: F401 (fails before the renders without the 'vision' extra)
+    require("sklearn")
     from lookalike.learn.vision_train import rendered_heading_samples
     from lookalike.vision.heading import HeadingConfig, mean_abs_error_deg, train_heading
 
