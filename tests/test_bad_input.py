@@ -772,3 +772,38 @@ def test_a_folder_given_as_a_file_and_a_file_given_as_the_results_folder_are_nam
     with pytest.raises(ValueError, match=r"seq\.txt: is a file; give the folder .*\(seq\.txt, \.\.\.\)"):
         evaluate_folders(seq, result)
     assert evaluate_folders(seq, tmp_path)["COMBINED"]["IDF1"] == pytest.approx(1.0)  # the folder is scored
+
+
+def test_the_python_api_names_bad_rows_reports_features_and_boxes(tmp_path):
+    import numpy as np
+
+    import lookalike as la
+    from lookalike.types import Beacons, Detections, Frame
+
+    out = tmp_path / "w.txt"
+    with pytest.raises(ValueError, match=r"w.txt: rows\[0\]: result rows need shape \(k, 10\), got \(2, 5\)"):
+        la.write_mot(out, [np.zeros((2, 5))])  # (once reshaped into one row of ten)
+    row = np.array([[1, 1, 10, 10, 20, 20, 1, -1, -1, -1.0]])
+    for column, value, why in ((0, 0, "invalid frame"), (4, -20, "negative width or height")):
+        wrong = row.copy()
+        wrong[0, column] = value
+        with pytest.raises(ValueError, match=why):
+            la.write_mot(out, wrong)  # what read_mot would refuse is never written
+    assert not out.exists()
+
+    tracker = la.make_tracker("set", n_agents=3)
+    reports = Beacons(agent_id=[1, 2, 3], t_sent=[0.0, 0.0, 0.0], t_received=[0.0, 0.0, 0.0], heading=[0.1, 0.2, 0.3])
+    with pytest.raises(ValueError, match=r"Beacons.agent_id: 3 is no agent of this tracker \(n_agents=3"):
+        tracker.update(Frame(index=0, time=0.0, detections=Detections.empty(), beacons=reports))
+
+    for name in ("deepsort", "diversort"):
+        tracker = la.make_tracker(name)
+        box = np.array([[10.0, 10, 20, 20]])
+        tracker.update(Frame(index=0, time=0.0, detections=Detections(xywh=box, feature=np.ones((1, 16)) / 4)))
+        with pytest.raises(ValueError, match="Detections.feature: vectors of length 8, but .* length 16"):
+            tracker.update(Frame(index=1, time=0.1, detections=Detections(xywh=box, feature=np.ones((1, 8)) / 8**0.5)))
+
+    for name in ("sort", "deepsort"):  # (boxtrack takes degenerate boxes: test_boxtrack_kernels)
+        with pytest.raises(ValueError, match=f"{name}: Detections.xywh row 1 is 0 wide and 5 high"):
+            la.make_tracker(name).update(Frame(index=0, time=0.0, detections=Detections(
+                xywh=np.array([[1.0, 1, 5, 5], [2, 2, 0, 5]]), feature=np.eye(2))))

@@ -125,3 +125,19 @@ def test_piped_output_keeps_each_message_on_one_line(tmp_path):
     done = subprocess.run([sys.executable, "-m", "lookalike", "track", "-t", "sort", str(det), "-o", str(out)],
                           capture_output=True, text=True, env=env, check=True)
     assert any(line.endswith(f"→ {out}") for line in done.stdout.splitlines()), done.stdout
+
+
+def test_tracker_details_print_every_parameter_name_whole_at_80_columns():
+    """The names ``--set`` takes are never cut with an ellipsis, however narrow the output."""
+    import os
+    import subprocess
+    import sys
+
+    from lookalike.trackers import tracker_parameters
+
+    env = {**os.environ, "COLUMNS": "80"}
+    for name in ("boxtrack", "diversort"):
+        done = subprocess.run([sys.executable, "-m", "lookalike", "trackers", "--details", name], capture_output=True,
+                              text=True, env=env, check=True)
+        cells = {cell.strip() for line in done.stdout.splitlines() for cell in line.split("│")}
+        assert {p.name for p in tracker_parameters(name)} <= cells, done.stdout

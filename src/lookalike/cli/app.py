@@ -8,7 +8,7 @@ import sys
 from collections.abc import Collection, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 import typer
 from rich.console import Console
@@ -19,6 +19,9 @@ from typer._click.globals import get_current_context
 from typer.core import TyperGroup
 
 from lookalike.cli.coercion import install
+
+if TYPE_CHECKING:
+    from rich.table import Table
 from lookalike.cli.program import run_as_program
 
 install()  # plain option values converted without pydantic (same values and errors as typer's)
@@ -99,6 +102,13 @@ def require(*modules: str) -> None:
     for module in modules:
         with needs(module):
             importlib.import_module(module)
+
+
+def print_whole(table: Table) -> None:
+    """Print a rich table whose cells fit no narrower than they are (or that would squeeze a column below its
+    ``min_width``) wider than the console rather than cut."""
+    size = Console(width=10_000).measure(table)
+    (console if size.minimum <= console.width else Console(width=size.maximum)).print(table)
 
 
 def check_names(option: str, names: list[str], known: Sequence[str], what: str) -> None:

@@ -7,7 +7,6 @@ from pathlib import Path
 from typing import Any
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from lookalike.bench.ident import (
@@ -29,9 +28,9 @@ from lookalike.cli.app import (
     check_outputs_or_fail,
     check_teams,
     command_line,
-    console,
     fail,
     failing,
+    print_whole,
     split_list,
     warn,
 )
@@ -63,9 +62,7 @@ def rich_table(title: str | None, rows: list[dict[str, Any]], columns: Sequence[
 
 def print_rows(title: str | None, rows: list[dict[str, Any]], columns: Sequence[str] | None = None) -> None:
     """Print table rows (dicts) with rich (:func:`rich_table`); wider than the terminal rather than cut."""
-    table = rich_table(title, rows, columns)
-    size = Console(width=10_000).measure(table)  # minimum: every cell whole, headers wrapped at spaces
-    (console if size.minimum <= console.width else Console(width=size.maximum)).print(table)
+    print_whole(rich_table(title, rows, columns))  # (minimum: every cell whole, headers wrapped at spaces)
 
 
 def print_differences(differences: Sequence[Comparison], baseline: str, unit: str, figure: str = "") -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import typer
 
-from lookalike.cli.app import app, console, fail
+from lookalike.cli.app import app, console, fail, print_whole
 from lookalike.trackers.registry import tracker_class, tracker_names, tracker_parameters
 
 WIDTH = 80
@@ -36,11 +36,12 @@ def _details(name: str) -> None:
     from rich.table import Table
 
     table = Table(title=f"[bold]{name}[/]: {summary(name)}", title_justify="left", show_lines=False)
-    for column in ("parameter", "type", "default", "allowed", "meaning"):
-        table.add_column(column)
+    for column in ("parameter", "type", "default", "allowed"):
+        table.add_column(column, no_wrap=True)  # whole: what --set takes
+    table.add_column("meaning", min_width=24)
     for p in tracker_parameters(name):
         table.add_row(p.name, p.type, repr(p.default), p.allowed(), p.doc)
-    console.print(table)
+    print_whole(table)
     console.print("Set any parameter with [bold]--set KEY=VALUE[/] on `lookalike track`.")
 
 

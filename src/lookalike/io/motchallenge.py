@@ -137,10 +137,17 @@ def frames_from_table(
 
 
 def write_mot(path: str | os.PathLike[str], rows: Iterable[np.ndarray] | np.ndarray) -> Path:
-    """Write result rows ``(n, 10)`` atomically: a failure never leaves a half-written file."""
+    """Write result rows ``(n, 10)`` (or blocks of them) atomically: a failure never leaves a half-written file.
+    ``ValueError`` naming ``path`` for another shape or a row :func:`read_mot` would refuse; nothing is written."""
     from lookalike.io.outputs import write_atomic
 
-    data = np.asarray(rows, dtype=float) if isinstance(rows, np.ndarray) else stack_rows(rows)
+    try:
+        data = stack_rows([rows] if isinstance(rows, np.ndarray) else rows)
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}; nothing written") from None
+    problem = row_problem(data)
+    if problem is not None:
+        raise ValueError(f"{path}: the row of frame {data[problem[0], 0]:g}: {problem[1]}; nothing written")
     return write_atomic(path, format_rows(data))
 
 

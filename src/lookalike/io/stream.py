@@ -19,7 +19,7 @@ from lookalike.io.rules import is_special, not_a_file, temp_beside, write_target
 from lookalike.io.sequences import MotSequence
 from lookalike.loop import RunStats, Sink, Sinks, Updating, run
 from lookalike.types import Detections, Frame
-from lookalike.types.mot_table import MotTable, tracks_to_rows
+from lookalike.types.mot_table import ROW_WIDTH, MotTable, tracks_to_rows
 
 CHUNK_LINES = 8_192
 WRITE_ROWS = 4_096
@@ -182,15 +182,20 @@ class MotWriter:
         self.write_rows(tracks_to_rows(frame.index, tracks))
 
     def write_rows(self, rows: np.ndarray) -> None:
-        """Append result rows ``(k, 10)``; ``ValueError`` naming the frame of a NaN or infinite value."""
+        """Append result rows ``(k, 10)`` (wider ones cut to 10 columns); ``ValueError`` for another shape, and (when
+        written) for a NaN or infinite value, naming its frame."""
         if self._fh is None:
             raise ValueError(f"{self.path}: writer already closed")
-        if len(rows):
-            self._pending.append(np.array(rows, dtype=float))  # a copy: the caller may reuse its array
-            self._pending_rows += len(rows)
-            if self._pending_rows >= WRITE_ROWS:
-                self._flush()
-        self.rows += len(rows)
+        block = np.array(rows, dtype=float)  # a copy: the caller may reuse its array
+        if block.size == 0:
+            return
+        if block.ndim != 2 or block.shape[1] < ROW_WIDTH:
+            raise ValueError(f"{self.path}: result rows need shape (k, {ROW_WIDTH}), got {block.shape}")
+        self._pending.append(block[:, :ROW_WIDTH])
+        self._pending_rows += len(block)
+        if self._pending_rows >= WRITE_ROWS:
+            self._flush()
+        self.rows += len(block)
 
     def _flush(self) -> None:
         if self._fh is not None and self._pending:

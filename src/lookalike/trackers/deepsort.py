@@ -70,6 +70,7 @@ class DeepSort:
         """Advance all tracks to ``frame`` and match its detections (which need ``feature``)."""
         cfg, t, space = self.config, self._tracks, self._space
         det = frame.detections
+        det.require_sizes("deepsort")
         features = require_features(det, "deepsort")
         steps = self._clock.steps(frame.time)
         if len(t):

@@ -68,6 +68,7 @@ class DiverSort:
         """Advance all tracks to ``frame`` and match its detections (which need ``feature``)."""
         cfg, t = self.config, self._tracks
         det = frame.detections
+        det.require_sizes("diversort")
         features = require_features(det, "diversort")
         self._frame += 1
         steps = self._clock.steps(frame.time)

@@ -42,6 +42,7 @@ class Sort:
 
     def update(self, frame: Frame) -> Tracks:
         """Advance all tracks to ``frame`` and match its detections."""
+        frame.detections.require_sizes("sort")
         steps = self._clock.steps(frame.time)
         ids, confirmed, xywh, velocity, det_index = self._tracks.step(frame.detections.xywh, steps)
         return Tracks.trusted(ids, confirmed.astype(np.int8), xywh, velocity / self._clock.interval, det_index)

@@ -45,6 +45,12 @@ class Beacons:
     def __len__(self) -> int:
         return int(self.agent_id.shape[0])
 
+    def require_agents(self, n_agents: int) -> None:
+        """``ValueError`` for a report from an agent id outside ``0 .. n_agents - 1`` (a tracker of ``n_agents``)."""
+        if len(self.agent_id) and int(self.agent_id.max()) >= n_agents:
+            raise ValueError(f"Beacons.agent_id: {int(self.agent_id.max())} is no agent of this tracker "
+                             f"(n_agents={n_agents}: ids 0 to {n_agents - 1})")
+
     @classmethod
     def empty(cls) -> Beacons:
         """No reports (one shared, read-only instance)."""

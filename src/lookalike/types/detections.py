@@ -119,6 +119,15 @@ class Detections:
         values: dict[str, Any] = {name: None if col is None else col[index] for name, col in columns.items()}
         return Detections(**values)
 
+    def require_sizes(self, tracker: str) -> None:
+        """``ValueError`` naming the first box without a positive width and height (a box tracker measures sizes)."""
+        sized = self.xywh[:, 2:4] > 0
+        if not sized.all():
+            row = int(np.flatnonzero(~sized.all(axis=1))[0])
+            w, h = self.xywh[row, 2:4].tolist()
+            raise ValueError(f"{tracker}: Detections.xywh row {row} is {w:g} wide and {h:g} high; box trackers need "
+                             "positive sizes (give points a small box)")
+
     def replace(self, **changes: Any) -> Detections:
         """A copy with some columns replaced (validated again)."""
         reject_unknown("Detections", changes, tuple(f.name for f in dataclasses.fields(self)))

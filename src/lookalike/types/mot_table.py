@@ -76,8 +76,13 @@ def detection_rows(frame: int | np.ndarray, xywh: np.ndarray, score: np.ndarray 
 
 
 def stack_rows(chunks: Iterable[np.ndarray]) -> np.ndarray:
-    """Row blocks ``(k_i, 10)`` stacked into ``(sum k_i, 10)`` (``(0, 10)`` when there are none)."""
-    parts = [np.asarray(c, dtype=float).reshape(-1, ROW_WIDTH) for c in chunks]
+    """Row blocks ``(k_i, 10)`` stacked into ``(sum k_i, 10)`` (``(0, 10)`` when there are none); ``ValueError``
+    naming a block of another shape."""
+    parts = [np.asarray(c, dtype=float) for c in chunks]
+    for i, p in enumerate(parts):
+        if p.size and (p.ndim != 2 or p.shape[1] != ROW_WIDTH):
+            raise ValueError(f"rows[{i}]: result rows need shape (k, {ROW_WIDTH}), got {p.shape}")
+    parts = [p.reshape(-1, ROW_WIDTH) for p in parts]
     return np.vstack(parts) if parts else np.zeros((0, ROW_WIDTH))
 
 

@@ -182,4 +182,4 @@ def describe_ranges(ranges: dict[int, list[tuple[int, int]]], max_ids: int = 8, 
         more = len(ranges[i]) - max_ranges
         parts.append(f"id {i} frames {', '.join(spans)}" + (f" (+{more} more)" if more > 0 else ""))
     rest = len(ranges) - len(shown)
-    return "doubtful: " + "; ".join(parts) + (f"; {rest} more ids" if rest > 0 else "")
+    return "doubtful: " + "; ".join(parts) + (f"; {rest} more id{'s' if rest > 1 else ''}" if rest > 0 else "")

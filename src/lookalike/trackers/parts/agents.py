@@ -25,8 +25,9 @@ class BeaconMemory:
 
     def add(self, frame: Frame) -> None:
         b = frame.beacons
+        b.require_agents(len(self.heading))
         for agent, t_sent, heading in zip(b.agent_id.tolist(), b.t_sent.tolist(), b.heading.tolist()):
-            if agent < len(self.heading) and t_sent > self.t_sent[agent]:
+            if t_sent > self.t_sent[agent]:
                 self.t_sent[agent] = t_sent
                 self.heading[agent] = heading
 

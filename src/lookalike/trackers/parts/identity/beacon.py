@@ -60,9 +60,11 @@ class BeaconIdentifier:
     # -- inputs ------------------------------------------------------------------------------
 
     def begin_frame(self, time_s: float, beacons: Beacons) -> None:
-        """Start a frame at ``time_s``: store its received reports and open a window slot."""
+        """Start a frame at ``time_s``: store its received reports and open a window slot; ``ValueError`` for a report
+        from an agent id outside ``0 .. n_agents - 1``."""
         r, n = self.config.history, self.config.n_agents
         agent_id = beacons.agent_id
+        beacons.require_agents(n)
         if len(agent_id):
             kernels = compiled()
             if kernels is not None:  # (the common case, checked and shifted in one compiled call)
@@ -71,8 +73,6 @@ class BeaconIdentifier:
                 shifted = self._shift_common(agent_id, beacons.t_sent, beacons.heading)
             if not shifted:
                 for a in sorted(set(agent_id.tolist())):
-                    if a >= n:
-                        continue
                     mine = agent_id == a
                     self._store(a, beacons.t_sent[mine], beacons.heading[mine], r)
         self._slot = (self._slot + 1) % self.config.window_frames
