@@ -19,10 +19,10 @@ from typer._click.globals import get_current_context
 from typer.core import TyperGroup
 
 from lookalike.cli.coercion import install
+from lookalike.cli.program import run_as_program
 
 if TYPE_CHECKING:
     from rich.table import Table
-from lookalike.cli.program import run_as_program
 
 install()  # plain option values converted without pydantic (same values and errors as typer's)
 
@@ -105,8 +105,8 @@ def require(*modules: str) -> None:
 
 
 def print_whole(table: Table) -> None:
-    """Print a rich table whose cells fit no narrower than they are (or that would squeeze a column below its
-    ``min_width``) wider than the console rather than cut."""
+    """Print a rich table wider than the console rather than cut a cell or squeeze a column below its
+    ``min_width``."""
     size = Console(width=10_000).measure(table)
     (console if size.minimum <= console.width else Console(width=size.maximum)).print(table)
 

@@ -169,7 +169,7 @@ class MotWriter:
         self._target = write_target(self.path)
         self._tmp: Path | None = None
         if is_special(self._target):
-            self._fh: TextIO | None = open(self._target, "w")  # noqa: SIM115 (closed by close/abort)
+            self._fh: TextIO | None = open(self._target, "w")  # (closed by close or abort)
         else:
             self._target.parent.mkdir(parents=True, exist_ok=True)
             fd, self._tmp = temp_beside(self._target)
