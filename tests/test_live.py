@@ -292,6 +292,42 @@ def test_a_source_without_stamps_is_timed_by_the_wall_clock_on_its_frame_period(
     assert np.allclose(np.asarray(times) * 50, np.round(np.asarray(times) * 50))  # whole frame periods
 
 
+def test_stream_stamps_that_leave_the_wall_clock_give_way_to_it():
+    """An MJPEG stream through FFmpeg is stamped at an invented 25 frames/s: at 10 real frames a second its stamps
+    run at 0.4x real time. After STAMP_CHECK_S of a live source the wall clock takes over, without a jump; stamps
+    that keep to the wall clock (and any stamps of a source not live) are kept."""
+    from lookalike.io.sources import STAMP_CHECK_S
+
+    def run(stamp_period: float, realtime: bool) -> tuple[list[float], str]:
+        wall = [0.0]
+        images = iter([scene_frame(k % 4) for k in range(60)])
+        count = [0]
+
+        def read():
+            image = next(images, None)
+            if image is None:
+                return None
+            wall[0] += 0.1  # 10 frames a second of real time
+            count[0] += 1
+            return image, count[0] * stamp_period
+
+        source = LiveSource(read, "mjpeg", 25.0, realtime=realtime, now=lambda: wall[0])
+        times = []
+        while (frame := source.next(timeout=5.0)) is not None:
+            times.append(frame.time)
+        source.close()
+        return times, source.clock
+
+    times, clock = run(0.04, realtime=True)
+    assert clock == "wall clock (the stream's stamps ran at 0.40× real time)"
+    # (frames replaced before they were taken are dropped, but the last one is always taken): 2.4 s of stamps would
+    # end at 2.36; the wall clock from the switch (2 s in, at the stamps' 0.76 s) ends at 0.76 + 5.9 - 2.0
+    assert times == sorted(times) and 4.55 < times[-1] < 4.7 and STAMP_CHECK_S == 2.0
+    kept, clock = run(0.1, realtime=True)
+    assert clock == "stream" and kept[-1] == pytest.approx(5.9)
+    assert run(0.04, realtime=False)[1] == "stream"
+
+
 def test_a_live_closed_set_of_blobs_learns_the_look_and_keeps_each_disc_in_its_lane(tmp_path):
     from lookalike.trackers.offline.online_look import LookIdentities
 

@@ -20,6 +20,8 @@ from lookalike._optional import needs
 __all__ = ["LiveFrame", "LiveSource", "SignalStop", "is_live", "open_live", "replay_camera"]
 
 _URL = re.compile(r"^(rtsp|rtsps|rtmp|http|https|udp|tcp|srt)://", re.IGNORECASE)
+STAMP_CHECK_S = 2.0  # seconds of a live stream before its stamps are compared with the wall clock
+STAMP_DRIFT = 0.1  # the share by which they may differ (jitter; 30 frames/s stamped as 25 is 0.17)
 _OPEN_TIMEOUT_S = 10.0  # OpenCV's own open timeout is longer; a stream that sends nothing in this time is refused
 
 
@@ -51,12 +53,16 @@ class LiveSource:
     """The newest frame of a source read on its own thread. Iterating yields :class:`LiveFrame` objects as they
     come, waiting for the next one; a frame replaced before it was taken counts in :attr:`dropped`. Stamps: the stream's
     own (``clock == "stream"``) when ``read`` gives them, else the wall clock (rounded to the period of
-    ``frame_rate`` when given); never decreasing."""
+    ``frame_rate`` when given); never decreasing. With ``realtime`` (a camera or a live stream), stream stamps that
+    have drifted from the wall clock by more than :data:`STAMP_DRIFT` after :data:`STAMP_CHECK_S` seconds (FFmpeg
+    invents 25 frames/s for an MJPEG stream) give way to the wall clock from then on. ``now``: the wall clock (s)."""
 
     def __init__(self, read: Read, name: str, frame_rate: float | None = None,
-                 release: Callable[[], None] | None = None) -> None:
+                 release: Callable[[], None] | None = None, *, realtime: bool = False,
+                 now: Callable[[], float] = time.monotonic) -> None:
         self.name, self.frame_rate = name, frame_rate
         self._read, self._release = read, release
+        self._realtime, self._now = realtime, now
         self._cond = threading.Condition()
         self._slot: LiveFrame | None = None
         self._ended = self._closed = False
@@ -69,21 +75,30 @@ class LiveSource:
         self._thread.start()
 
     def _run(self) -> None:
-        start = time.monotonic()
+        start = self._now()
         first: float | None = None
-        last = 0.0
+        last = first_wall = offset = 0.0
+        trusted = True  # the stream's stamps, while they keep to the wall clock
         try:
             while not self._closed:
                 got = self._read()
                 if got is None:
                     break
                 image, stamp = got
+                wall = self._now() - start
                 if stamp is not None and first is None:
-                    first = stamp
-                if stamp is not None and first is not None:
+                    first, first_wall = stamp, wall
+                if stamp is not None and first is not None and trusted:
                     t, self.clock = stamp - first, "stream"
+                    since = wall - first_wall
+                    if self._realtime and since >= STAMP_CHECK_S and abs(t - since) > STAMP_DRIFT * since:
+                        trusted, offset = False, last - wall  # the wall clock on from here, without a jump
+                        self.clock = f"wall clock (the stream's stamps ran at {t / since:.2f}× real time)"
+                        t = wall + offset
+                elif first is not None and not trusted:
+                    t = wall + offset
                 else:  # on the source's nominal frame period when it declares one (steady steps for the tracker)
-                    t = time.monotonic() - start
+                    t = wall
                     if self.frame_rate:
                         t = round(t * self.frame_rate) / self.frame_rate
                 last = max(last, t)
@@ -164,7 +179,7 @@ def open_live(spec: str) -> LiveSource:
         msec = float(cap.get(cv2.CAP_PROP_POS_MSEC) or 0.0)
         return image, (msec / 1000.0 if msec > 0 else None)
 
-    return LiveSource(read, spec, rate if 0 < rate < 1000 else None, cap.release)
+    return LiveSource(read, spec, rate if 0 < rate < 1000 else None, cap.release, realtime=True)
 
 
 def replay_camera(path: str | Path, speed: float = 1.0, frame_rate: float | None = None) -> LiveSource:
