@@ -277,3 +277,17 @@ def test_the_latest_correction_wins_and_drops_the_earlier_conflicting_one(tmp_pa
     assert again.dropped == s.dropped
     s.undo()  # the dropped correction comes back with the undo
     assert s.dropped == [False, False] and s.last_change.rows > 0
+
+
+def test_a_change_counts_the_rows_it_removes():
+    on = _crossing()
+    base = assign_identities(on, 2, 10)
+    b = _at(base, 10, 85)
+    s = Session(base, frame_rate=10, n_targets=2, solver_input=on)
+    change = s.apply(Correction("split", b, frame=50))  # both identities are taken from frame 50 on
+    assert change.removed == len(base) - len(s.rows) > 0 and f"({change.removed} of them removed)" in change.describe()
+    assert s.undo().removed == 0 and len(s.rows) == len(base)
+    plain = Session(base, frame_rate=10)
+    assert plain.apply(Correction("split", b, frame=50)).removed == 0  # a new id, nothing lost
+    held = int((plain.rows[:, 1] == b).sum())
+    assert plain.apply(Correction("delete", b)).removed == held > 0

@@ -178,3 +178,18 @@ def test_a_body_that_never_comes_gets_408_and_the_server_goes_on(tmp_path):
             reply = slow.recv(4096)
         assert b" 408 " in reply.split(b"\r\n")[0]
         assert s.request("GET", "/api/state")[0] == 200
+
+
+def test_a_log_replays_with_its_own_targets_and_names_a_cut_line(tmp_path):
+    video, tracks = two_discs(tmp_path)
+    log = tmp_path / "two.corrections.jsonl"
+    head = '{"lookalike_proofread": 1, "n_targets": 2, "frame_rate": 10.0}\n'
+    log.write_text(head + Correction("swap", 2, 1, SWAP).to_json() + "\n")
+    r = CliRunner().invoke(app, ["proofread", "--video", str(video), "--tracks", str(tracks), "--export"])
+    assert r.exit_code == 0 and "made with --targets 2" in r.output and "replayed 1 corrections" in r.output, r.output
+    assert '"n_targets": 2' in log.read_text().splitlines()[0]  # the log keeps its setting
+    r = CliRunner().invoke(app, ["proofread", "--video", str(video), "--tracks", str(tracks), "--targets", "3"])
+    assert r.exit_code == 2 and "made with n_targets=2, but this session has n_targets=3" in r.output, r.output
+    log.write_text(head + Correction("swap", 2, 1, SWAP).to_json() + '\n{"kind": "sw\n')
+    r = CliRunner().invoke(app, ["proofread", "--video", str(video), "--tracks", str(tracks), "--export"])
+    assert r.exit_code == 2 and "two.corrections.jsonl:3:" in r.output and "cut short" in r.output, r.output

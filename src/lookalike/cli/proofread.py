@@ -54,6 +54,15 @@ def proofread(
     log = log or tracks.with_name(f"{tracks.stem}.corrections.jsonl")
     output = output or tracks.with_name(f"{tracks.stem}.proofread.txt")
     check_outputs_or_fail({"--output": output, "--log": log}, [video, tracks, detections])
+    if targets is None and not fresh and log.is_file():
+        from lookalike.proofread.session import log_header
+
+        with failing(ValueError, OSError, prefix=f"{log}: "):
+            logged = (log_header(log) or {}).get("n_targets")
+        if logged is not None:
+            targets = int(logged)
+            console.print(f"{log.name} was made with --targets {targets}: corrections re-solve with it (--fresh to "
+                          "start over)", markup=False)
     with failing(ValueError, prefix="--video: "):
         fps = video_info(video)[1]
     solver = None
@@ -71,7 +80,7 @@ def proofread(
     if fresh and log.exists():
         os.replace(log, log.with_name(log.name + ".bak"))
     elif log.exists():
-        with failing(ValueError, prefix=f"{log}: "):
+        with failing(ValueError):
             session.replay(log)
         console.print(f"replayed {len(session.corrections)} corrections from {log.name}", markup=False)
     page = ProofreadApp(session, video, log, output, Correction.from_json)

@@ -57,12 +57,14 @@ class Correction:
 @dataclass(frozen=True)
 class Change:
     """What a correction changed: the frames (sorted, 1-based) and ids (sorted) whose rows moved, appeared or went,
-    how many rows, and the earlier corrections it ``dropped`` because they conflicted with it."""
+    how many rows, how many of the old rows are ``removed`` (no row left where they were: a deletion, or a closed set
+    with no identity free for them), and the earlier corrections it ``dropped`` because they conflicted with it."""
 
     frames: tuple[int, ...]
     ids: tuple[int, ...]
     rows: int
     dropped: tuple[Correction, ...] = ()
+    removed: int = 0
 
     def describe(self, max_spans: int = 6) -> str:
         """One line: ``changed 120 rows, ids 3, 7, frames 200-260, 400-410``, then the dropped corrections."""
@@ -74,7 +76,8 @@ class Change:
         ends = np.r_[starts[1:] - 1, len(f) - 1]
         spans = [f"{f[a]}-{f[b]}" if f[b] > f[a] else f"{f[a]}" for a, b in zip(starts, ends)]
         more = f" (+{len(spans) - max_spans} more)" if len(spans) > max_spans else ""
-        return (f"changed {self.rows} rows, ids {', '.join(map(str, self.ids))}, frames "
+        gone = f" ({self.removed} of them removed)" if self.removed else ""
+        return (f"changed {self.rows} rows{gone}, ids {', '.join(map(str, self.ids))}, frames "
                 f"{', '.join(spans[:max_spans])}{more}{drop}")
 
 
@@ -176,4 +179,4 @@ def changes(old: np.ndarray, new: np.ndarray) -> Change:
     kept_a[ia[same]], kept_b[ib[same]] = True, True
     diff = np.vstack([old[~kept_a, :2], new[~kept_b, :2]])
     return Change(tuple(np.unique(diff[:, 0]).astype(int).tolist()), tuple(np.unique(diff[:, 1]).astype(int).tolist()),
-                  int(len(diff)))
+                  int(len(diff)), removed=len(old) - len(ia))

@@ -12,6 +12,7 @@ import json
 import os
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -290,19 +291,41 @@ class Session:
 
     def replay(self, log: str | os.PathLike[str] | list[Correction]) -> Change:
         """Apply the corrections of a log (a path, or corrections) in order; the session must hold the same input the
-        log was made on (ValueError on a correction that does not apply)."""
+        log was made on, with its ``n_targets`` (ValueError otherwise, on a line that is no correction, and on a
+        correction that does not apply)."""
         if isinstance(log, list):
             todo = log
         else:
-            lines = [ln for ln in Path(log).read_text(encoding="utf-8").splitlines() if ln.strip()]
-            todo = [Correction.from_json(ln) for ln in lines if "lookalike_proofread" not in ln]
+            logged = log_header(log)
+            if logged is not None and logged.get("n_targets") != self.n_targets:
+                raise ValueError(f"{log}: made with n_targets={logged.get('n_targets')}, but this session has "
+                                 f"n_targets={self.n_targets}")
+            todo = []
+            for number, line in enumerate(Path(log).read_text(encoding="utf-8").splitlines(), 1):
+                if line.strip() and "lookalike_proofread" not in line:
+                    try:
+                        todo.append(Correction.from_json(line))
+                    except ValueError as exc:
+                        raise ValueError(f"{log}:{number}: {exc} (a line cut short? remove it to go on)") from None
         before = self.rows
         for k, c in enumerate(todo):
             try:
                 self.apply(c)
             except ValueError as exc:
-                raise ValueError(f"replay: correction {k + 1} ({c.to_json()}): {exc}") from exc
+                where = "replay" if isinstance(log, list) else str(log)
+                raise ValueError(f"{where}: correction {k + 1} ({c.to_json()}): {exc}") from exc
         return changes(before, self.rows)
+
+
+def log_header(log: str | os.PathLike[str]) -> dict[str, Any] | None:
+    """The header of a corrections log (``n_targets``, ``frame_rate``), or None when its first line is none."""
+    with open(log, encoding="utf-8") as fh:
+        first = fh.readline()
+    try:
+        head = json.loads(first)
+    except ValueError:
+        return None
+    return head if isinstance(head, dict) and "lookalike_proofread" in head else None
 
 
 def _joined(parts: list[ChainConstraints | None]) -> ChainConstraints:
