@@ -96,6 +96,8 @@ def test_bad_requests_are_refused_in_one_line(scene, tmp_path):
         run(TrackRequest(tmp_path / "v.txt", "deepsort", video=str(video), detections=det, features="nope"))
     with pytest.raises(ValueError, match="a live source; drop --fps"):
         run(TrackRequest(tmp_path / "b.txt", video="0", detector="blob", fps=10.0))
+    with pytest.raises(ValueError, match="a live source; drop --offline"):  # (not first "needs --targets N")
+        run(TrackRequest(tmp_path / "b.txt", video="0", detector="blob", offline=True))
     with pytest.raises(ValueError, match="--detector: choose one of blob or FILE.onnx"):
         run(TrackRequest(tmp_path / "b.txt", video=str(video), detector="yolo"))
     with pytest.raises(ValueError, match="unknown tracker"):

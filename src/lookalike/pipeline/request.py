@@ -115,6 +115,8 @@ class TrackRequest:
         offline = bool(self.offline) if self.offline is not None else (
             targets is not None and self.detector == "blob" and self.tracker == "boxtrack" and live is None
             and self.bag is None)
+        if offline and live is not None:
+            raise ValueError(f"--video {live}: a live source; drop --offline (see the live camera how-to)")
         if offline and targets is None:
             raise ValueError("--offline: needs --targets N (the known number of targets)")
         if offline and branch == "pipeline":
