@@ -807,3 +807,15 @@ def test_the_python_api_names_bad_rows_reports_features_and_boxes(tmp_path):
         with pytest.raises(ValueError, match=f"{name}: Detections.xywh row 1 is 0 wide and 5 high"):
             la.make_tracker(name).update(Frame(index=0, time=0.0, detections=Detections(
                 xywh=np.array([[1.0, 1, 5, 5], [2, 2, 0, 5]]), feature=np.eye(2))))
+
+
+def test_an_integer_column_given_fractions_is_refused_not_truncated():
+    import numpy as np
+
+    from lookalike.types import Beacons, Detections
+
+    with pytest.raises(ValueError, match="Detections.label: 0.5 is not a whole number"):
+        Detections(xywh=np.ones((2, 4)), label=[0.5, 1])
+    with pytest.raises(ValueError, match="Beacons.agent_id: 1.5 is not a whole number"):
+        Beacons(agent_id=[1.5], t_sent=[0.0], t_received=[0.0], heading=[0.0])
+    assert Detections(xywh=np.ones((2, 4)), label=[0.0, 1.0]).label.tolist() == [0, 1]  # whole floats are fine

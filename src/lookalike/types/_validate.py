@@ -10,7 +10,13 @@ import numpy as np
 def as_column(
     owner: str, name: str, value: Any, n: int | None, width: int | None, dtype: type = float
 ) -> np.ndarray:
-    """``value`` as a read-only array ``(n,)`` or ``(n, width)``; ``ValueError`` naming ``owner.name`` otherwise."""
+    """``value`` as a read-only array ``(n,)`` or ``(n, width)``; ``ValueError`` naming ``owner.name`` otherwise (and
+    for an ``int`` column given numbers that are not whole)."""
+    if dtype is int and isinstance(value, (np.ndarray, list, tuple)):
+        given = np.asarray(value)
+        if given.dtype.kind in "fc" and given.size and not (np.isfinite(given) & (given == np.round(given))).all():
+            bad = given.ravel()[~(np.isfinite(given) & (given == np.round(given))).ravel()][0]
+            raise ValueError(f"{owner}.{name}: {bad} is not a whole number")
     try:
         arr: np.ndarray = np.array(value, dtype=dtype, copy=True)
     except (TypeError, ValueError) as exc:
