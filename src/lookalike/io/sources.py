@@ -95,7 +95,7 @@ class LiveSource:
                         trusted, offset = False, last - wall  # the wall clock on from here, without a jump
                         self.clock = f"wall clock (the stream's stamps ran at {t / since:.2f}× real time)"
                         t = wall + offset
-                elif first is not None and not trusted:
+                elif not trusted:
                     t = wall + offset
                 else:  # on the source's nominal frame period when it declares one (steady steps for the tracker)
                     t = wall

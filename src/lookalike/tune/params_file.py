@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from lookalike._version import __version__
 from lookalike.trackers.registry import make_tracker, tracker_names
 from lookalike.tune.space import config_hints
 
@@ -38,17 +39,11 @@ class TunedParams:
                 **self.extra}
 
 
-def _version() -> str:
-    from lookalike._version import __version__
-
-    return __version__
-
-
 def save_params(path: str | Path, tracker: str, params: dict[str, Any], *, chosen_on: list[str],
                 criterion: str, trials: int, **extra: Any) -> Path:
     """Write a parameter file (checked by :func:`check_params` first); returns its path."""
     check_params(tracker, params, source=str(path))
-    content = TunedParams(tracker, dict(params), list(chosen_on), criterion, int(trials), _version(), dict(extra))
+    content = TunedParams(tracker, dict(params), list(chosen_on), criterion, int(trials), __version__, dict(extra))
     from lookalike.io.outputs import write_atomic
 
     return write_atomic(path, json.dumps(content.to_json(), indent=2) + "\n")

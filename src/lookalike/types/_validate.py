@@ -14,9 +14,10 @@ def as_column(
     for an ``int`` column given numbers that are not whole)."""
     if dtype is int and isinstance(value, (np.ndarray, list, tuple)):
         given = np.asarray(value)
-        if given.dtype.kind in "fc" and given.size and not (np.isfinite(given) & (given == np.round(given))).all():
-            bad = given.ravel()[~(np.isfinite(given) & (given == np.round(given))).ravel()][0]
-            raise ValueError(f"{owner}.{name}: {bad} is not a whole number")
+        if given.dtype.kind in "fc" and given.size:
+            whole = np.isfinite(given) & (given == np.round(given))
+            if not whole.all():
+                raise ValueError(f"{owner}.{name}: {given[~whole][0]} is not a whole number")
     try:
         arr: np.ndarray = np.array(value, dtype=dtype, copy=True)
     except (TypeError, ValueError) as exc:
