@@ -9,6 +9,7 @@ from lookalike.eval import evaluate_points
 from lookalike.io.points import (
     PointFrames,
     points_to_rows,
+    read_id_points,
     read_points_csv,
     read_points_mot,
     rows_to_points,
@@ -48,6 +49,39 @@ def test_bad_lines_name_file_and_line(tmp_path: Path, text: str, message: str) -
     p.write_text(text)
     with pytest.raises(ValueError, match=f"bad.csv{message}"):
         read_points_csv(p)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("frame,id,x,y\n1,1,5,5\n2.7,1,6,5\n", ":3: frame must be an integer >= 1"),
+    ("1,1,5,5\n2,1.5,6,5\n", ":2: invalid id: not a whole number"),
+    ("1,1,5,5\n2,1,nan,5\n", ":2: NaN"),
+    ("1,1,5,5\n1000000000,1,6,5\n", ":2: invalid frame: frame 1000000000 jumps"),
+    ("1,1,5,5\n2,1,1e300,5\n", ":2: a coordinate beyond"),
+    ("1,1,5,5,-1,4,1,-1,-1,-1\n", ":1: invalid box"),
+])
+def test_eval_points_bad_lines_name_file_and_line(tmp_path: Path, text: str, message: str) -> None:
+    """`eval --points` files keep the input rules: never a truncated frame or id, nor a run over a stray frame."""
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    p = tmp_path / "bad.csv"
+    p.write_text(text)
+    with pytest.raises(ValueError, match=f"bad.csv{message}"):
+        read_id_points(p)
+    good = tmp_path / "gt.csv"
+    good.write_text("frame,id,x,y\n1,1,5,5\n2,1,6,5\n")
+    r = CliRunner().invoke(app, ["eval", "--points", "--gt", str(good), "--results", str(p), "--radius", "5"])
+    assert r.exit_code == 2 and f"bad.csv:{message.split(':')[1]}:" in r.output, r.output
+
+
+def test_read_id_points_centres_boxes(tmp_path: Path) -> None:
+    p = tmp_path / "res.txt"
+    p.write_text("frame,id,x,y\n1,3,10,20\n")
+    f, i, xy = read_id_points(p)
+    assert f.tolist() == [1] and i.tolist() == [3] and xy.tolist() == [[10, 20]]
+    p.write_text("1,3,10,20,4,6,0.9,-1,-1,-1\n")
+    assert read_id_points(p)[2].tolist() == [[12, 23]]
 
 
 def test_missing_file_and_short_n_frames(tmp_path: Path) -> None:

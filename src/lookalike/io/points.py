@@ -10,11 +10,11 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.io.rules import frame_problems, read_text
+from lookalike.io.rules import frame_problems, not_a_file, read_text
 from lookalike.types.mot_table import detection_rows
 
-__all__ = ["POINT_VEL_NOISE", "PointFrames", "points_to_rows", "read_points_csv", "read_points_mot", "rows_to_points",
-           "typical_spacing", "typical_step"]
+__all__ = ["POINT_VEL_NOISE", "PointFrames", "points_to_rows", "read_id_points", "read_points_csv", "read_points_mot",
+           "rows_to_points", "typical_spacing", "typical_step"]
 
 # boxtrack's velocity noise (box sides per frame) for points as boxes, chosen on the simulated arenas of
 # benchmarks/closed_points.py, seeds 0-29 (docs/closed-set.md).
@@ -40,9 +40,11 @@ class PointFrames:
 MAX_COORDINATE = 1e9  # pixels: a point or box value beyond this (in absolute value) is an error naming its line
 
 
-def _parse(path: Path, columns: int, first_coordinate: int = 1) -> list[tuple[int, list[float]]]:
-    """``(line number, values)`` of the data lines (blank lines and one leading header skipped); columns from
-    ``first_coordinate`` on are pixels, at most :data:`MAX_COORDINATE` in absolute value."""
+def _parse(path: Path, columns: int, first_coordinate: int = 1,
+           keep: int | None = None) -> list[tuple[int, list[float]]]:
+    """``(line number, values)`` of the data lines (blank lines and one leading header skipped): at least ``columns``
+    values, at most ``keep`` (default ``columns``) read; values from ``first_coordinate`` on are pixels, at most
+    :data:`MAX_COORDINATE` in absolute value."""
     if path.is_dir():
         raise ValueError(f"{path}: is a folder; expected a points file (frame,x,y CSV or MOTChallenge rows)")
     if not path.is_file():
@@ -64,7 +66,7 @@ def _parse(path: Path, columns: int, first_coordinate: int = 1) -> list[tuple[in
             raise ValueError(f"{path}:{no}: expected at least {columns} comma-separated columns, got "
                              f"{len(fields)}: {text!r}")
         try:
-            values = [float(f) for f in fields[:columns]]
+            values = [float(f) for f in fields[:keep or columns]]
         except ValueError:
             raise ValueError(f"{path}:{no}: not a number in {text!r}") from None
         if not all(math.isfinite(v) for v in values):
@@ -116,6 +118,29 @@ def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *
     else:
         xy = data[:, 2:4]
     return _group(path, data[:, 0].astype(int), xy, n_frames)
+
+
+def read_id_points(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(frame (n,), id (n,), xy (n, 2))`` of a ``frame,id,x,y`` file, or the box centres of MOTChallenge rows (7 or
+    more columns: ``frame,id,left,top,width,height,score,...``); ``ValueError`` naming the file and line of a bad
+    row."""
+    path = Path(path)
+    if not path.is_file():
+        raise not_a_file(path)
+    parsed = _parse(path, 4, first_coordinate=2, keep=7)
+    for no, values in parsed:
+        if values[1] != int(values[1]):
+            raise ValueError(f"{path}:{no}: invalid id: not a whole number: {values[1]:g}")
+    if not parsed:
+        return np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2))
+    width = min(len(v) for _, v in parsed)
+    data = np.array([v[:width] for _, v in parsed], dtype=float)
+    if width < 7:
+        return data[:, 0].astype(int), data[:, 1].astype(int), data[:, 2:4]
+    bad = np.flatnonzero((data[:, 4:6] < 0).any(axis=1))
+    if len(bad):
+        raise ValueError(f"{path}:{parsed[int(bad[0])][0]}: invalid box: negative width or height")
+    return data[:, 0].astype(int), data[:, 1].astype(int), data[:, 2:4] + data[:, 4:6] / 2
 
 
 def typical_spacing(points: PointFrames | list[np.ndarray]) -> float:
