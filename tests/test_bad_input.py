@@ -772,6 +772,8 @@ def test_a_folder_given_as_a_file_and_a_file_given_as_the_results_folder_are_nam
     with pytest.raises(ValueError, match=r"seq\.txt: is a file; give the folder .*\(seq\.txt, \.\.\.\)"):
         evaluate_folders(seq, result)
     assert evaluate_folders(seq, tmp_path)["COMBINED"]["IDF1"] == pytest.approx(1.0)  # the folder is scored
+    with pytest.raises(ValueError, match=r"gt\.txt: is a file; give the sequence folder that holds gt/gt\.txt"):
+        evaluate_folders(seq / "gt" / "gt.txt", tmp_path)  # (it said "no sequence with gt/gt.txt")
 
 
 def test_the_python_api_names_bad_rows_reports_features_and_boxes(tmp_path):

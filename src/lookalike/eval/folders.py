@@ -37,6 +37,8 @@ def evaluate_folders(gt_root: str | os.PathLike[str], results: str | os.PathLike
     needs a result file; ``workers`` processes."""
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
+    if Path(gt_root).is_file():
+        raise ValueError(f"{gt_root}: is a file; give the sequence folder that holds gt/gt.txt, or a folder of them")
     sequences = [s for s in find_sequences(gt_root) if s.gt_path is not None]
     if not sequences:
         raise ValueError(f"{gt_root}: no sequence with gt/gt.txt")
