@@ -143,6 +143,17 @@ def test_eval_results_with_some_metrics_only(tmp_path):
         load_results(path)
 
 
+def test_report_names_a_binary_file_or_a_folder(tmp_path):
+    from lookalike.viz.results import load_results
+
+    video = tmp_path / "v.mp4"
+    video.write_bytes(b"\x00\x00\x00\x18ftypmp42\xe8\xff")
+    with pytest.raises(ValueError, match=r"v\.mp4:1: not UTF-8 text"):  # (was the codec's message, no file)
+        load_results(video)
+    with pytest.raises(ValueError, match="results: a folder, not a file"):
+        load_results(tmp_path)
+
+
 def test_tails_break_at_jumps_and_keep_a_limited_length():
     from lookalike.viz import Tails
 

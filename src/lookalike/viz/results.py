@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from lookalike.io.results import SCHEMA_ID
+from lookalike.io.rules import read_text
 from lookalike.viz.plots import grouped_bar_chart
 from lookalike.viz.report import HtmlReport
 
@@ -53,9 +54,9 @@ def load_results(path: Path | str) -> tuple[str, list[dict[str, Any]]]:
     """``(kind, rows)`` of a results file; kind is ``"ident"``, ``"divers"`` or ``"eval"``."""
     p = Path(path)
     if not p.is_file():
-        raise ValueError(f"results: no such file {p}")
+        raise ValueError(f"results: {'a folder, not a file:' if p.is_dir() else 'no such file'} {p}")
     try:
-        data = json.loads(p.read_text())
+        data = json.loads(read_text(p))
     except json.JSONDecodeError as exc:
         raise ValueError(f"results: {p} is not JSON ({exc})") from None
     except RecursionError:
