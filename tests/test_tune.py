@@ -141,6 +141,22 @@ def test_parameter_file_refused_with_clear_errors(tmp_path: Path):
         load_params(bad)
     with pytest.raises(ValueError, match="not found"):
         load_params(tmp_path / "missing.json")
+    bad.write_bytes(b"\x00\x00\x00\x18ftypmp42\xe8\xff")  # a video given by mistake
+    with pytest.raises(ValueError, match=r"bad\.json:1: not UTF-8 text"):
+        load_params(bad)
+    with pytest.raises(ValueError, match="is a folder, not a parameter file"):
+        load_params(tmp_path)
+
+
+def test_tune_space_file_that_is_binary_is_named(tmp_path: Path):
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    space = tmp_path / "space.json"
+    space.write_bytes(b"\xe8\xff{}")
+    r = CliRunner().invoke(app, ["tune", "-t", "boxtrack", str(tmp_path), "--space", str(space)])
+    assert r.exit_code == 2 and "--space: " in r.output and "space.json:1: not UTF-8 text" in r.output, r.output
     with pytest.raises(ValueError, match="no parameter"):
         check_params("boxtrack", {"speed": 1})
 

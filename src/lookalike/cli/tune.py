@@ -92,6 +92,7 @@ def tune(
 
 def _load_space(tracker: str, space_path: Path | None) -> Any:
     """The tracker's search space: its default one, or the one in ``space_path``."""
+    from lookalike.io.rules import read_text
     from lookalike.trackers import tracker_names
     from lookalike.tune import default_space, space_from_json
 
@@ -100,7 +101,7 @@ def _load_space(tracker: str, space_path: Path | None) -> Any:
     with failing(OSError, ValueError, prefix="--space: "):
         space = default_space(tracker)
         if space_path is not None:
-            space = space_from_json(json.loads(space_path.read_text()), tracker)
+            space = space_from_json(json.loads(read_text(space_path)), tracker)
     return space
 
 

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from lookalike._version import __version__
+from lookalike.io.rules import read_text
 from lookalike.trackers.registry import make_tracker, tracker_names
 from lookalike.tune.space import config_hints
 
@@ -67,8 +68,10 @@ def check_params(tracker: str, params: dict[str, Any], source: str = "params") -
 def read_params(path: str | Path) -> TunedParams:
     """Read a parameter file; ``ValueError`` (naming the file) when it is not one."""
     p = Path(path)
+    if p.is_dir():
+        raise ValueError(f"{p}: is a folder, not a parameter file")
     try:
-        data = json.loads(p.read_text())
+        data = json.loads(read_text(p))
     except FileNotFoundError:
         raise ValueError(f"{p}: parameter file not found") from None
     except json.JSONDecodeError as exc:
