@@ -75,6 +75,25 @@ def test_eval_points_bad_lines_name_file_and_line(tmp_path: Path, text: str, mes
     assert r.exit_code == 2 and f"bad.csv:{message.split(':')[1]}:" in r.output, r.output
 
 
+def test_eval_points_applies_metrics_and_refuses_box_options(tmp_path: Path) -> None:
+    """--metrics restricts the files as for boxes; --iou-threshold and --benchmark, which points ignore, are refused."""
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    gt = tmp_path / "gt.csv"
+    gt.write_text("frame,id,x,y\n1,1,5,5\n2,1,6,5\n")
+    args = ["eval", "--points", "--gt", str(gt), "--results", str(gt), "--radius", "5"]
+    out = tmp_path / "s.csv"
+    r = CliRunner().invoke(app, [*args, "--metrics", "Identity", "--csv", str(out)])
+    assert r.exit_code == 0 and "points within 5 px" in r.output, r.output
+    header = out.read_text().splitlines()[0].split(",")
+    assert "IDF1" in header and not any(k.startswith(("HOTA", "MOTA", "CLR")) for k in header), header
+    for extra in (["--iou-threshold", "0.7"], ["--benchmark", "MOT17"]):
+        r = CliRunner().invoke(app, [*args, *extra])
+        assert r.exit_code == 2 and "are for boxes" in r.output, r.output
+
+
 def test_read_id_points_centres_boxes(tmp_path: Path) -> None:
     p = tmp_path / "res.txt"
     p.write_text("frame,id,x,y\n1,3,10,20\n")

@@ -40,7 +40,7 @@ def eval_command(
     radius: float | None = typer.Option(None, "--radius", min=0.0, help="With --points: match distance in pixels."),
     benchmark: str = typer.Option("MOT15", help=f"Ground-truth rules: {', '.join(BENCHMARKS)}."),
     metrics: list[str] | None = typer.Option(None, "--metrics", help=_METRICS_HELP),
-    iou_threshold: float = typer.Option(0.5, help="IoU a CLEAR/identity match needs."),
+    iou_threshold: float = typer.Option(0.5, help="IoU a CLEAR/identity match needs (boxes)."),
     workers: int = typer.Option(1, help="Processes scoring sequences in parallel."),
     json_path: Path | None = typer.Option(None, "--json", help="Write every value as JSON here."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Write every value as CSV here "
@@ -51,6 +51,8 @@ def eval_command(
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, _eval_inputs(gt, results))
     if (points or radius is not None) and (not points or radius is None or radius <= 0):
         fail("--points and --radius PX go together (point ground truth matched within PX pixels)")
+    if points and (benchmark != "MOT15" or iou_threshold != 0.5):
+        fail("--benchmark and --iou-threshold are for boxes; --points matches within --radius PX")
     names = [p.name or str(p) for p in results]
     if len(set(names)) != len(names):
         names = [str(p) for p in results]
@@ -61,18 +63,19 @@ def eval_command(
                 from lookalike.cli.eval_points import score_points  # imported when used: a short start-up
 
                 assert radius is not None
-                scores[name] = {COMBINED: score_points(gt, folder, radius)}
+                scores[name] = {COMBINED: score_points(gt, folder, radius, chosen)}
             else:
                 scores[name] = evaluate_folders(gt, folder, benchmark=benchmark, metrics=chosen,
                                                 iou_threshold=iou_threshold, workers=workers)
     columns = _columns(chosen)
+    rules = f"points within {radius:g} px" if points else benchmark
     if len(scores) == 1:
         name, per_seq = next(iter(scores.items()))
-        table = _table(f"{name} ({benchmark})", "sequence", columns)
+        table = _table(f"{name} ({rules})", "sequence", columns)
         for seq, values in per_seq.items():
             table.add_row(seq, *[_cell(c, values[c]) for c in columns], style="bold" if seq == COMBINED else None)
     else:
-        table = _table(f"trackers, combined over sequences ({benchmark})", "tracker", columns)
+        table = _table(f"trackers, combined over sequences ({rules})", "tracker", columns)
         for name, per_seq in scores.items():
             table.add_row(name, *[_cell(c, per_seq[COMBINED][c]) for c in columns])
     console.print(table)
