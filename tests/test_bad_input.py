@@ -433,6 +433,8 @@ def test_no_combination_of_output_paths_modifies_an_input(tmp_path, command, fir
     (["bench", "shuffle", "--trackers", "nosuch"], ["--trackers", "'nosuch'"]),
     (["bench", "shuffle", "--setups", "nosuch"], ["--setups", "'nosuch'"]),
     (["bench", "recovery", "--trackers", "nosuch"], ["--trackers", "'nosuch'"]),
+    (["bench", "recovery", "--trackers", "boxtrack"], ["--trackers", "unknown identifier 'boxtrack'"]),
+    (["bench", "ident", "--trackers", "sort", "--sequences", "1", "--frames", "5"], ["unknown identifier 'sort'"]),
     (["bench", "recovery", "--swap-at-s", "100"], ["--swap-at-s 100", "end before the sequences do"]),
     (["bench", "recovery", "--swap-s", "-1"], ["--swap-s -1"]),
     (["bench", "recovery", "--swap-at-s", "-2"], ["--swap-at-s -2"]),

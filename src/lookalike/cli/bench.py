@@ -35,10 +35,10 @@ from lookalike.cli.app import (
     warn,
 )
 from lookalike.cli.progress import progress_bars
+from lookalike.io.needs import identifier_names
 from lookalike.io.results import Results
 from lookalike.sim import PRESET_NAMES, preset_label
 from lookalike.sim.presets import TEAM_HELP, team_size
-from lookalike.trackers import tracker_names
 
 bench_app = typer.Typer(help="Benchmarks that print tables (also written with --json/--csv).", no_args_is_help=True,
                         cls=SortedGroup, rich_markup_mode=None)
@@ -125,7 +125,7 @@ def ident(
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, [weights], input_folders=[recordings, human])
     setup_list, tracker_list = split_list(setups), split_list(trackers)
     check_teams("--setups", setup_list)
-    check_names("--trackers", tracker_list, [*tracker_names(), *IDENT_VARIANTS], "tracker")
+    check_names("--trackers", tracker_list, [*identifier_names(), *IDENT_VARIANTS], "identifier")
     check_names("--noise", [noise], ("paper", "ours"), "noise model")
     if weights is not None and (lengths is not None or recordings is not None or human is not None):
         fail("--weights: for Table I only (not with --lengths, --recordings or --human)")

@@ -19,9 +19,9 @@ from lookalike.bench.tables import write_rows
 from lookalike.cli.app import check_names, check_outputs_or_fail, check_teams, command_line, fail, failing, split_list
 from lookalike.cli.bench import SETUPS_HELP, bench_app, print_differences, print_rows, trained_only, write_results
 from lookalike.cli.progress import progress_bars
+from lookalike.io.needs import identifier_names
 from lookalike.sim import PRESET_NAMES
 from lookalike.sim.presets import preset
-from lookalike.trackers import tracker_names
 
 SHUFFLE_TRACKERS, RECOVERY_TRACKERS = ("jpda", "lstm"), ("kalman_ha2", "jpda", "lstm")
 
@@ -83,7 +83,7 @@ def recovery(
 def _check_setups_and_trackers(setups: list[str], trackers: list[str]) -> None:
     """Fail in one line naming a team or identifier that does not exist."""
     check_teams("--setups", setups)
-    check_names("--trackers", trackers, [*tracker_names(), *IDENT_VARIANTS], "tracker")
+    check_names("--trackers", trackers, [*identifier_names(), *IDENT_VARIANTS], "identifier")
 
 
 def _check_swap(swap_at_s: float, swap_s: float, frames: int, setups: list[str]) -> None:

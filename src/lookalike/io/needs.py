@@ -5,7 +5,7 @@ that and refuses early in one line."""
 from __future__ import annotations
 
 from lookalike.trackers.base import NEEDS_APPEARANCE
-from lookalike.trackers.registry import tracker_class
+from lookalike.trackers.registry import tracker_class, tracker_names
 
 
 def _need(name: str) -> str | None:
@@ -29,4 +29,9 @@ def input_kind(name: str) -> str:
     return "boxes + video" if need == NEEDS_APPEARANCE else "robot positions"
 
 
-__all__ = ["box_input_problem", "input_kind"]
+def identifier_names() -> list[str]:
+    """The registered trackers that read robot positions (the robot identifiers), in registry order."""
+    return [n for n in tracker_names() if input_kind(n) == "robot positions"]
+
+
+__all__ = ["box_input_problem", "identifier_names", "input_kind"]
