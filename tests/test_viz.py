@@ -87,6 +87,28 @@ def test_overlay_keeps_the_input_frame_count(tmp_path):
     assert change(4) > change(22)
 
 
+def test_render_warns_when_tracks_are_not_drawn(tmp_path):
+    """A detection file (ids -1), an empty file or tracks past the video's end used to render a plain copy silently."""
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    folder = tmp_path / "img1"
+    folder.mkdir()
+    for k, f in enumerate(_frames(3)):
+        cv2.imwrite(str(folder / f"{k + 1:06d}.jpg"), f)
+    row = "1,1,5,5,20,20,1,-1,-1,-1\n"
+    cases = {"1,-1,5,5,20,20,0.9,-1,-1,-1\n": "every id is negative (a detection file?)", "": "no rows",
+             row + "9" + row[1:]: "1 rows of frames 4-9 lie past the video's 3 frames", row: None}
+    for text, needle in cases.items():
+        tracks = tmp_path / "t.txt"
+        tracks.write_text(text)
+        r = CliRunner().invoke(app, ["render", "--tracks", str(tracks), "--video", str(folder),
+                                     "-o", str(tmp_path / "o.mp4")])
+        assert r.exit_code == 0, r.output
+        assert (needle in r.output) if needle else "warning" not in r.output, r.output
+
+
 def test_overlay_reads_image_folders(tmp_path):
     folder = tmp_path / "img1"
     folder.mkdir()

@@ -8,12 +8,12 @@ from pathlib import Path
 import typer
 from rich.markup import escape
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing, warn
 from lookalike.cli.progress import bars
 from lookalike.io import read_mot
 from lookalike.io.outputs import atomic_path
 from lookalike.io.video_frames import source_frames
-from lookalike.viz.overlay import birdseye_video, overlay_tracks
+from lookalike.viz.overlay import birdseye_video, overlay_tracks, undrawn
 
 
 @app.command()
@@ -59,3 +59,6 @@ def render(
         console.print(f"\n[yellow]Interrupted.[/] {escape(str(output))} holds the frames written so far.")
         raise typer.Exit(130)
     console.print(f"wrote {output} ({n} frames)" + (f" and {gif}" if gif else ""), markup=False)
+    problem = None if birdseye else undrawn(table, n)
+    if problem is not None:
+        warn(f"{tracks}: {problem}")

@@ -48,6 +48,21 @@ def overlay_tracks(source: Path | str | Iterable[np.ndarray], tracks: MotTable, 
     return count
 
 
+def undrawn(tracks: MotTable, frames: int) -> str | None:
+    """Why :func:`overlay_tracks` drew some rows of ``tracks`` on ``frames`` frames nowhere (no rows, ids all < 0 as in
+    a detection file, rows past the last frame), else None."""
+    ids, frame_no = np.asarray(tracks.track_id), np.asarray(tracks.frame)
+    if not len(ids):
+        return "no rows; nothing was drawn"
+    if not (ids >= 0).any():
+        return "every id is negative (a detection file?); nothing was drawn"
+    past = int(((frame_no > frames) & (ids >= 0)).sum())
+    if past:
+        last = int(frame_no.max())
+        return f"{past} rows of frames {frames + 1}-{last} lie past the video's {frames} frames; not drawn"
+    return None
+
+
 def blank_frames(tracks: MotTable, count: int, margin_px: int = 20) -> Iterator[np.ndarray]:
     """``count`` white BGR frames wide and high enough (even sides) for every box of ``tracks`` (px) plus
     ``margin_px``."""
