@@ -17,4 +17,4 @@ def score_points(gt: Path, result: Path, radius: float, metrics: Sequence[str] =
     return evaluate_points(*g, *r, radius=radius, metrics=metrics, num_frames=frames)
 
 
-__all__ = ["read_id_points", "score_points"]
+__all__ = ["score_points"]
