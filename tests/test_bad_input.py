@@ -248,6 +248,16 @@ def _eval(gt: Path, res: Path, *extra):
     return runner.invoke(app, ["eval", "--gt", str(gt), "--results", str(res), "--metrics", "CLEAR", *map(str, extra)])
 
 
+def test_eval_benchmark_names_any_case_and_refuses_others_before_scoring(tmp_path):
+    gt, res = _gt_folder(tmp_path)
+    ok = _eval(gt, res, "--benchmark", "mot17")
+    assert ok.exit_code == 0, ok.output
+    assert "(MOT17)" in ok.output
+    r = _eval(gt, tmp_path / "missing", "--benchmark", "mot18")
+    assert r.exit_code != 0
+    assert "--benchmark: unknown benchmark 'mot18'; known: MOT15, MOT16, MOT17, MOT20, custom" in r.output
+
+
 def _snapshot(*paths: Path) -> dict[Path, bytes]:
     return {p: p.read_bytes() for root in paths for p in ([root] if root.is_file() else sorted(root.rglob("*")))
             if p.is_file()}

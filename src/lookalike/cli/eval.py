@@ -49,6 +49,8 @@ def eval_command(
     """Score trackers with HOTA, CLEAR MOT and identity metrics (values shown in %)."""
     chosen = _chosen(metrics)
     check_outputs_or_fail({"--json": json_path, "--csv": csv_path}, _eval_inputs(gt, results))
+    benchmark = next((b for b in BENCHMARKS if b.lower() == benchmark.lower()), benchmark)
+    check_names("--benchmark", [benchmark], BENCHMARKS, "benchmark")
     if (points or radius is not None) and (not points or radius is None or radius <= 0):
         fail("--points and --radius PX go together (point ground truth matched within PX pixels)")
     if points and (benchmark != "MOT15" or iou_threshold != 0.5):
