@@ -335,3 +335,13 @@ def test_mot17_synth2_is_the_same_truth_with_other_detections() -> None:
     assert first[0].gt is not None and second[0].gt is not None
     np.testing.assert_array_equal(first[0].gt.xywh, second[0].gt.xywh)
     assert not np.array_equal(first[0].det_score[10], second[0].det_score[10])
+
+
+def test_a_selection_that_matches_no_sequence_names_the_known_ones() -> None:
+    root = _need_data("mot15")
+    from lookalike.bench.datasets import load_datasets
+
+    with pytest.raises(ValueError, match=r"no sequence selected: 'TUD-Campos' not in mot15; known: .*TUD-Campus"):
+        load_datasets(root.parent, ["mot15"], sequences=["TUD-Campos"])
+    assert [s.name for s in load_datasets(root.parent, ["mot15"], sequences=["TUD-Campus", "TUD-Campos"])] == \
+        ["TUD-Campus"]

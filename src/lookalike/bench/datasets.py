@@ -190,22 +190,27 @@ def load_datasets(root: Path, names: Sequence[str], *, sequences: Sequence[str] 
     """The sequences of datasets ``names`` under ``root``; ``sequences``: only these names (a dataset's name: all of
     it); ``max_clips``: at most this many HexBug clips, detected on the chosen backend."""
     out: list[RealSequence] = []
+    known: list[str] = []  # every sequence name of the datasets, to name a selection that matches none
     for name in names:
         if name not in DATASETS:
             raise ValueError(f"datasets: unknown dataset {name!r}; known: {', '.join(DATASETS)}")
         folder = root / "mot17" / "gt" if name in SYNTH_SEEDS else root / name
         if not folder.is_dir():
             raise FileNotFoundError(f"{folder}: dataset folder not found (set --data)")
-        if name in SYNTH_SEEDS:
-            out += _selected(load_mot17_synth(folder, SYNTH_SEEDS[name], name), name, sequences)
-        elif name == "hexbug":
-            clips = [c for c in hexbug_clips(folder) if not sequences or c.stem in sequences][:max_clips]
+        if name == "hexbug":
+            every = hexbug_clips(folder)
+            known += [c.stem for c in every]
+            clips = [c for c in every if not sequences or c.stem in sequences][:max_clips]
             with JobPool(min(workers, max(len(clips), 1)), backend, address) as pool:
                 out += pool.map(detect_hexbug, clips)
-        else:
-            out += _selected(load_boxes(folder, name), name, sequences)
+            continue
+        seqs = load_mot17_synth(folder, SYNTH_SEEDS[name], name) if name in SYNTH_SEEDS else load_boxes(folder, name)
+        known += [q.name for q in seqs]
+        out += _selected(seqs, name, sequences)
     if not out:
-        raise ValueError("no sequence selected")
+        unknown = [q for q in sequences or () if q not in known and q not in names]
+        raise ValueError(f"no sequence selected: {', '.join(map(repr, unknown))} not in {', '.join(names)}; known: "
+                         f"{', '.join(known)}" if unknown else "no sequence selected")
     return out
 
 
