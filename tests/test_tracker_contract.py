@@ -204,6 +204,11 @@ def test_time_going_backwards_is_refused(name: str) -> None:
         tracker.update(_frame(k, kind=kind))
     with pytest.raises(ValueError, match="time|backwards"):
         tracker.update(_frame(6, kind=kind, time_s=2 / FPS))
+    # the refused frame leaves no trace: the next frames give what a tracker that never saw it gives
+    untouched = make_tracker(name)
+    _run(untouched, [_frame(k, kind=kind) for k in range(6)])
+    later = [_frame(k, kind=kind) for k in range(6, 10)]
+    assert [_summary(f) for f in _run(tracker, later)] == [_summary(f) for f in _run(untouched, later)]
 
 
 def _deep_size(root: object) -> int:

@@ -19,13 +19,15 @@ class FrameClock:
         self._seen_step = False
 
     def steps(self, time_s: float) -> float:
-        """Nominal intervals elapsed since the previous call (1.0 on the first call)."""
-        last, self._last = self._last, float(time_s)
+        """Nominal intervals elapsed since the previous call (1.0 on the first call); a refused time changes nothing."""
+        last, now = self._last, float(time_s)
         if last is None:
+            self._last = now
             return 1.0
-        dt = self._last - last
+        dt = now - last
         if not math.isfinite(dt) or dt < 0:
             raise ValueError(f"frame time went backwards: {last} s then {time_s} s")
+        self._last = now
         if dt == 0:
             return 0.0
         if self._fixed is None and (not self._seen_step or dt < self.interval):
