@@ -211,6 +211,24 @@ def test_time_going_backwards_is_refused(name: str) -> None:
     assert [_summary(f) for f in _run(tracker, later)] == [_summary(f) for f in _run(untouched, later)]
 
 
+@pytest.mark.parametrize("name", [n for n in NAMES if KINDS.get(n) == APPEARANCE])
+def test_a_frame_refused_for_its_feature_length_leaves_no_trace(name: str) -> None:
+    """Features of another length are refused before anything changes: the next frames (whose new look only
+    the boxes can follow) give what a tracker that never saw the refused frame gives."""
+    def frame(k: int, feature: np.ndarray) -> Frame:
+        return dataclasses.replace(_frame(k, kind=APPEARANCE), detections=_frame(k, kind=APPEARANCE).detections
+                                   .replace(feature=feature))
+
+    refused, untouched = make_tracker(name), make_tracker(name)
+    first = [_frame(k, kind=APPEARANCE) for k in range(6)]
+    _run(refused, first)
+    _run(untouched, first)
+    with pytest.raises(ValueError, match="length 5"):
+        refused.update(frame(6, np.eye(5)[:N_TARGETS]))
+    later = [frame(k, np.eye(FEATURE_DIM)[N_TARGETS:2 * N_TARGETS]) for k in range(6, 10)]
+    assert [_summary(f) for f in _run(refused, later)] == [_summary(f) for f in _run(untouched, later)]
+
+
 def _deep_size(root: object) -> int:
     """Bytes of everything reachable from ``root`` through attributes and containers (arrays with their data)."""
     skip = (type, types.ModuleType, types.FunctionType, types.BuiltinFunctionType, types.MethodType)

@@ -40,8 +40,8 @@ class FeatureGallery:
         self._store: dict[int, np.ndarray] = {}
         self._width: int | None = None  # every feature's length, fixed by the first one
 
-    def _check(self, features: np.ndarray) -> None:
-        """``ValueError`` when ``features (k, d)`` are not as long as those seen before."""
+    def check(self, features: np.ndarray) -> None:
+        """``ValueError`` when ``features (k, d)`` are not as long as those seen before (the first ones fix it)."""
         if not features.size:
             return
         if self._width is None:
@@ -59,7 +59,7 @@ class FeatureGallery:
     def add(self, track_id: int, feature: np.ndarray) -> None:
         """Append one feature ``(d,)`` (or several ``(k, d)``) to a track, keeping the newest ``budget``."""
         new = np.atleast_2d(np.asarray(feature, dtype=float))
-        self._check(new)
+        self.check(new)
         old = self._store.get(track_id)
         stacked = new if old is None else np.vstack([old, new])
         self._store[track_id] = stacked[-self.budget :]
@@ -85,7 +85,7 @@ class FeatureGallery:
         out = np.full((len(track_ids), len(feats)), np.inf)
         if not len(feats):
             return out
-        self._check(feats)
+        self.check(feats)
         for row, tid in enumerate(track_ids):
             gallery = self._store.get(int(tid))
             if gallery is not None and len(gallery):

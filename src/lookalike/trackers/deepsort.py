@@ -72,6 +72,7 @@ class DeepSort:
         det = frame.detections
         det.require_sizes("deepsort")
         features = require_features(det, "deepsort")
+        self._gallery.check(features)  # before any change: a refused frame leaves the tracks as they were
         steps = self._clock.steps(frame.time)
         if len(t):
             t.mean, t.cov = space.predict(t.mean, t.cov, steps)

@@ -70,6 +70,7 @@ class DiverSort:
         det = frame.detections
         det.require_sizes("diversort")
         features = require_features(det, "diversort")
+        self._gallery.check(features)  # before any change: a refused frame leaves the tracks as they were
         self._frame += 1
         steps = self._clock.steps(frame.time)
         if len(t):
