@@ -4,6 +4,7 @@ and a tiny training run exported to ONNX."""
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -74,6 +75,24 @@ def test_extractor_names() -> None:
         diver_extractor("deep")
     with pytest.raises(FileNotFoundError):
         diver_extractor("missing.onnx")
+
+
+@pytest.mark.parametrize("channels, dtype, says", [(1, "FLOAT", "1 channel"), (3, "UINT8", "tensor(uint8)")])
+def test_an_embedding_whose_input_lookalike_cannot_feed_is_named(tmp_path, channels, dtype, says) -> None:
+    onnx = pytest.importorskip("onnx")
+    from onnx import TensorProto, helper
+
+    x = helper.make_tensor_value_info("crops", getattr(TensorProto, dtype), ["n", channels, 32, 64])
+    y = helper.make_tensor_value_info("embedding", TensorProto.FLOAT, ["n", channels])
+    nodes = [helper.make_node("Cast", ["crops"], ["f"], to=TensorProto.FLOAT),
+             helper.make_node("ReduceMean", ["f"], ["embedding"], keepdims=0, axes=[2, 3])]
+    model = helper.make_model(helper.make_graph(nodes, "odd_crops", [x], [y]),
+                              opset_imports=[helper.make_opsetid("", 13)])
+    model.ir_version = 8
+    path = tmp_path / "odd.onnx"
+    onnx.save(model, str(path))
+    with pytest.raises(ValueError, match=f"odd.onnx: .*{re.escape(says)}"):
+        OnnxAppearance(path)
 
 
 def test_tiny_training_run_exports_onnx(tmp_path) -> None:
