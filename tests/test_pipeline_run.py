@@ -102,6 +102,9 @@ def test_bad_requests_are_refused_in_one_line(scene, tmp_path):
         run(TrackRequest(tmp_path / "b.txt", video=str(video), detector="yolo"))
     with pytest.raises(ValueError, match="unknown tracker"):
         run(TrackRequest(tmp_path / "f.txt", "nope", path=det))
+    with pytest.raises(ValueError, match="--features learned: only with --video"):  # (was ignored)
+        run(TrackRequest(tmp_path / "f.txt", "deepsort", path=det, features="learned"))
+    assert not (tmp_path / "f.txt").exists()
 
 
 def test_file_and_video_runs_announce_their_length_to_boxtrack(scene, tmp_path, monkeypatch):

@@ -76,6 +76,12 @@ class TrackRequest:
 
     def branch(self) -> str:
         """Which branch the options select: ``pipeline``, ``points``, ``blobs``, ``video`` or ``files``."""
+        branch = self._branch()
+        if self.features != "video" and branch not in ("video", "blobs"):
+            raise ValueError(f"--features {self.features}: only with --video (features come from the pixels)")
+        return branch
+
+    def _branch(self) -> str:
         path, video, det, detector, blob = self.path, self.video, self.detections, self.detector, self.blob
         if self.bag is not None:
             if any(x is not None for x in (path, video, det, self.points, self.reports, detector)) or blob:
