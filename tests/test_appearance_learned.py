@@ -95,6 +95,23 @@ def test_an_embedding_whose_input_lookalike_cannot_feed_is_named(tmp_path, chann
         OnnxAppearance(path)
 
 
+def test_a_device_torch_cannot_use_is_refused_before_any_work(tmp_path, monkeypatch) -> None:
+    torch = pytest.importorskip("torch")
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+    from lookalike.learn.appearance_train import AppearanceTrainConfig, torch_device, train_appearance
+
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    assert torch_device("auto").type == "cpu"
+    for device, says in (("gpu", "choose cpu, cuda"), ("cuda", "this PyTorch sees no CUDA device")):
+        with pytest.raises(ValueError, match=f"device '{device}': {says}"):
+            train_appearance(AppearanceTrainConfig(scenarios=1, frames=10, epochs=1, device=device), tmp_path / "m")
+        r = CliRunner().invoke(app, ["train-appearance", "-o", str(tmp_path / "m"), "--device", device])
+        assert r.exit_code == 2 and f"--device '{device}': {says}" in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "m").exists()
+
+
 def test_tiny_training_run_exports_onnx(tmp_path) -> None:
     pytest.importorskip("torch")
     from lookalike.learn.appearance_train import AppearanceTrainConfig, train_appearance

@@ -24,11 +24,13 @@ def train_appearance(
 
     The shipped model (lookalike/vision/models_data/diver_reid.onnx) is this command's defaults."""
     require("torch")
+    from lookalike.learn.appearance_train import AppearanceTrainConfig, torch_device
+    from lookalike.learn.appearance_train import train_appearance as run
+    with failing(ValueError, prefix="--"):
+        torch_device(device)  # before the output folder is made and the crops rendered
     check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})
     if output.exists() and not output.is_dir():
         fail(f"-o/--output: {output} is a file; give a folder")
-    from lookalike.learn.appearance_train import AppearanceTrainConfig
-    from lookalike.learn.appearance_train import train_appearance as run
     with failing(ValueError, RuntimeError):
         config = AppearanceTrainConfig(scenarios=scenarios, frames=frames, epochs=epochs, minutes=minutes, seed=seed,
                                        threads=threads, device=device)

@@ -54,6 +54,21 @@ def _torch() -> Any:
     return torch
 
 
+def torch_device(name: str) -> Any:
+    """The ``torch.device`` of ``name`` (``cpu``, ``cuda``, ``cuda:N`` or ``auto``: cuda where PyTorch sees one);
+    ``ValueError`` naming it when PyTorch does not know it or sees no CUDA device for it."""
+    torch = _torch()
+    if name == "auto":
+        name = "cuda" if torch.cuda.is_available() else "cpu"
+    try:
+        device = torch.device(name)
+    except RuntimeError:
+        raise ValueError(f"device {name!r}: choose cpu, cuda, cuda:N or auto") from None
+    if device.type == "cuda" and not torch.cuda.is_available():
+        raise ValueError(f"device {name!r}: this PyTorch sees no CUDA device (use cpu)")
+    return device
+
+
 def build_net(embedding: int = 32, channels: int = 16) -> Any:
     """The embedding network (a ``torch.nn.Module``; input ``(n, 3, 32, 64)`` BGR in [0, 1])."""
     torch = _torch()
@@ -143,8 +158,7 @@ def train_appearance(config: AppearanceTrainConfig, output: Path,
     start = time.perf_counter()
     torch.manual_seed(config.seed)
     torch.set_num_threads(config.threads)
-    device = torch.device("cuda" if config.device == "auto" and torch.cuda.is_available()
-                          else ("cpu" if config.device == "auto" else config.device))
+    device = torch_device(config.device)
     train = diver_crops(training_scenarios(config.scenarios, config.frames), every=config.every, seed=config.seed)
     val = diver_crops(VALIDATION_SCENARIOS, every=config.validation_every, jitter=0.05, seed=config.seed + 1)
     ids, labels = np.unique(train.labels, return_inverse=True)
