@@ -31,6 +31,8 @@ def test_empty_is_valid_everywhere():
         ({"xywh": [[0, 0, 1]]}, "xywh: expected shape (n, 4)"),
         ({"xywh": [[0, 0, 1, 1]], "position": [[np.nan, 0]]}, "position: row 0"),
         ({"xywh": [[0, 0, 1, 1]], "heading": [np.nan]}, "heading: row 0"),
+        ({"xywh": [[0, 0, 1, 1]] * 2, "feature": np.zeros((2, 0))}, "feature: 2 rows of length 0"),  # (not "0 rows")
+        ({"xywh": [[0, 0, 1, 1]] * 2, "feature": np.zeros((0, 8))}, "feature: has 0 rows"),
     ],
 )
 def test_detections_reject_bad_columns(kwargs, message):

@@ -67,6 +67,8 @@ class Detections:
                     feat = feat.reshape(0, 0)
                 else:
                     raise ValueError(f"{own}.feature: expected shape (n, d), got {feat.shape}")
+            if n and feat.shape == (n, 0):
+                raise ValueError(f"{own}.feature: {n} rows of length 0; each detection needs a feature vector")
             feat = as_column(own, "feature", feat, n, feat.shape[1])
             require_finite(own, "feature", feat)
             object.__setattr__(self, "feature", feat)
