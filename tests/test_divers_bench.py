@@ -87,3 +87,19 @@ def test_feature_sets_by_name_and_onnx_file(tmp_path) -> None:
                                    "--features", str(model), "--tracker", "diversort/reid2"])
     assert out.exit_code == 0, out.output
     assert "diversort/reid2" in out.output
+
+
+def test_matched_thresholds_of_a_model_with_tiny_distances_are_not_zero(monkeypatch) -> None:
+    """An embedding whose same-diver distances are all under 1e-4 gets thresholds a tracker accepts."""
+    import numpy as np
+
+    from lookalike.sim import divers_run
+    from lookalike.trackers import make_tracker
+
+    monkeypatch.setattr(divers_run, "_reference_distances", lambda: np.linspace(0.0, 0.5, 101))
+    monkeypatch.setattr(divers_run, "_distances_of", lambda extractor: np.linspace(0.0, 5e-5, 101))
+    extractor = object()  # (any extractor other than the hand-crafted one, without stored thresholds)
+    for tracker in ("deepsort", "diversort"):
+        found = divers_run.matched_thresholds(extractor, tracker)  # type: ignore[arg-type]
+        assert found and all(0 < v < 1e-4 for v in found.values()), found
+        make_tracker(tracker, **found)

@@ -109,7 +109,13 @@ def matched_thresholds(extractor: FeatureExtractor, tracker: str) -> dict[str, f
         return dict(stored)
     ref = _reference_distances()
     own = _distances_of(extractor)
-    return {k: round(float(np.quantile(own, float(np.mean(ref <= t)))), 4) for k, t in names.items()}
+    return {k: _rounded(float(np.quantile(own, float(np.mean(ref <= t))))) for k, t in names.items()}
+
+
+def _rounded(distance: float) -> float:
+    """A cosine distance to 4 decimals, or to 4 significant digits where 4 decimals would make it 0 (no tracker
+    takes a threshold of 0)."""
+    return round(distance, 4) or float(f"{distance:.4g}")
 
 
 def stored_thresholds(extractor: FeatureExtractor) -> dict[str, dict[str, float]]:
