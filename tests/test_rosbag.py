@@ -141,3 +141,18 @@ def test_track_bag_matches_track_video_on_the_same_frames(tmp_path):
     assert rows.strip() and rows == (tmp_path / "video.txt").read_text()
     refused = runner.invoke(app, ["track", "--bag", str(bag), "-t", "set", "-o", str(tmp_path / "x.txt")])
     assert refused.exit_code != 0 and "--camera-topic" in refused.output
+
+
+def test_a_wrong_topic_type_or_no_bag_is_named(run):
+    _, jsonl, bag = run
+    with pytest.raises(ValueError, match="sensor_msgs/msg/Imu expected"):
+        read_bag(bag, heading_topics=["/lookalike/detections"])
+    with pytest.raises(ValueError, match="sensor_msgs/msg/Image expected"):
+        read_bag(bag, camera_topic="/robot_0/imu")
+    with pytest.raises(ValueError, match="sensor_msgs/msg/Image expected"):
+        next(bag_images(bag, "/robot_0/imu"))
+    for path in (jsonl, jsonl.parent / "missing"):
+        with pytest.raises(ValueError, match="not a readable rosbag2 folder"):
+            read_bag(path)
+        with pytest.raises(ValueError, match="not a readable rosbag2 folder"):
+            bag_topics(path)

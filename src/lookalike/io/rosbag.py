@@ -20,6 +20,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
@@ -160,11 +161,33 @@ class BagRun:
     frame_ns: tuple[int, ...]
 
 
+@contextmanager
+def _reader(path: Path) -> Iterator[Any]:
+    """rosbags' reader of the bag at ``path``, open in the block; ``ValueError`` naming ``path`` when it is no
+    rosbag2 folder."""
+    with needs("rosbags"):
+        from rosbags.rosbag2 import Reader, ReaderError
+    try:
+        reader = Reader(path)
+        reader.open()
+    except (ReaderError, FileNotFoundError) as exc:
+        raise ValueError(f"{path}: not a readable rosbag2 folder ({exc})") from None
+    try:
+        yield reader
+    finally:
+        reader.close()
+
+
+def _check_type(path: Path, reader: Any, topic: str, msgtype: str) -> None:
+    """``ValueError`` unless every connection of ``topic`` carries ``msgtype`` messages."""
+    found = {c.msgtype for c in reader.connections if c.topic == topic}
+    if found - {msgtype}:
+        raise ValueError(f"{path}: topic {topic} has {', '.join(sorted(found))} messages; {msgtype} expected")
+
+
 def bag_topics(path: str | Path) -> dict[str, str]:
     """Topic → ROS 2 message type of every connection of the bag at ``path`` (rosbags' own reader)."""
-    with needs("rosbags"):
-        from rosbags.rosbag2 import Reader
-    with Reader(Path(path)) as reader:
+    with _reader(Path(path)) as reader:
         return {c.topic: c.msgtype for c in reader.connections}
 
 
@@ -172,12 +195,11 @@ def read_bag(path: str | Path, camera_topic: str | None = None, heading_topics: 
              topics: Topics | None = None) -> BagRun:
     """Read a rosbag2 run. Frames: the messages of ``camera_topic`` when given, else of the detections topic.
     ``heading_topics``: robot ``j``'s ``sensor_msgs/Imu`` topic is the ``j``-th (default: the template's topics
-    ``/robot_0/imu``, ``/robot_1/imu``, ... present in the bag). Raises ``ValueError`` naming what is missing."""
-    with needs("rosbags"):
-        from rosbags.rosbag2 import Reader
+    ``/robot_0/imu``, ``/robot_1/imu``, ... present in the bag). Raises ``ValueError`` naming what is missing, a
+    topic of another message type, or a path that is no rosbag2 folder."""
     topics, path = topics or Topics(), Path(path)
     store = _typestore()
-    with Reader(path) as reader:
+    with _reader(path) as reader:
         present = {c.topic: c for c in reader.connections}
         if heading_topics is None:
             heading_topics = []
@@ -188,6 +210,10 @@ def read_bag(path: str | Path, camera_topic: str | None = None, heading_topics: 
         if missing or not heading_topics:
             raise ValueError(f"{path}: no topic {', '.join(missing) or 'of robot headings'}; the bag has "
                              f"{', '.join(sorted(present))}")
+        for name in heading_topics:
+            _check_type(path, reader, name, IMU)
+        if camera_topic is not None:
+            _check_type(path, reader, camera_topic, IMAGE)
         robot_of = {name: j for j, name in enumerate(heading_topics)}
         wanted = [present[name] for name in {frame_topic, *heading_topics, topics.detections, OBSERVER_TOPIC,
                                              TRUTH_RECORD_TOPIC} if name in present]
@@ -272,27 +298,21 @@ def _no_truth(n: int, detections: int, observer: tuple[float, float, float]) -> 
 def read_labelled_bag(path: str | Path) -> RobotSequence:
     """A bag with per-detection labels (its ``/lookalike/truth_record`` topic, as ``simulate --bag`` writes) as a
     sequence, for training; ``ValueError`` naming the bag when it has no labels or cannot be read."""
-    with needs("rosbags"):
-        from rosbags.rosbag2 import ReaderError
-    try:
-        if TRUTH_RECORD_TOPIC not in bag_topics(path):
-            raise ValueError(f"{path}: no labels (topic {TRUTH_RECORD_TOPIC} of std_msgs/String, the frames' truth "
-                             "records as `lookalike simulate --bag` writes them)")
-        return read_bag(path).sequence
-    except ReaderError as exc:
-        raise ValueError(f"{path}: not a readable rosbag2 folder ({exc})") from None
+    if TRUTH_RECORD_TOPIC not in bag_topics(path):
+        raise ValueError(f"{path}: no labels (topic {TRUTH_RECORD_TOPIC} of std_msgs/String, the frames' truth "
+                         "records as `lookalike simulate --bag` writes them)")
+    return read_bag(path).sequence
 
 
 def bag_images(path: str | Path, camera_topic: str = CAMERA_TOPIC) -> Iterator[np.ndarray]:
     """The ``sensor_msgs/Image`` frames of ``camera_topic`` in log-time order, as BGR ``uint8`` arrays
     (``bgr8``, ``rgb8`` and ``mono8`` images)."""
-    with needs("rosbags"):
-        from rosbags.rosbag2 import Reader
     store = _typestore()
-    with Reader(Path(path)) as reader:
+    with _reader(Path(path)) as reader:
         wanted = [c for c in reader.connections if c.topic == camera_topic]
         if not wanted:
             raise ValueError(f"{path}: no topic {camera_topic}")
+        _check_type(Path(path), reader, camera_topic, IMAGE)
         for connection, _, raw in reader.messages(connections=wanted):
             msg = store.deserialize_cdr(raw, connection.msgtype)
             rows = np.asarray(msg.data, dtype=np.uint8).reshape(msg.height, msg.step)
