@@ -148,7 +148,7 @@ def robot_sim(
                               "(its messages carry the 0-based id robot - 1)."),
     node: str = typer.Option("127.0.0.1:7700", help="The node's HOST:PORT."),
     preset_name: str = typer.Option("m5n3", "--preset", help=_PRESET_HELP),
-    seed: int = typer.Option(0, help="Seed of the shared simulated sequence."),
+    seed: int = typer.Option(0, min=0, help="Seed of the shared simulated sequence."),
     duration: float = typer.Option(20.0, help="Simulated seconds."),
     loss: float | None = typer.Option(None, help="Report loss probability (default: the preset's)."),
     delay: float | None = typer.Option(None, help="Report delay, seconds (default: the preset's)."),
@@ -191,7 +191,7 @@ def robot_sim(
 def camera_sim(
     node: str = typer.Option("127.0.0.1:7700", help="The node's HOST:PORT."),
     preset_name: str = typer.Option("m5n3", "--preset", help=_PRESET_HELP),
-    seed: int = typer.Option(0, help="Seed of the shared simulated sequence."),
+    seed: int = typer.Option(0, min=0, help="Seed of the shared simulated sequence."),
     duration: float = typer.Option(20.0, help="Simulated seconds."),
     loss: float | None = typer.Option(None, help="Report loss probability of the team (keeps the sequence shared)."),
     delay: float | None = typer.Option(None, help="Report delay of the team, seconds."),

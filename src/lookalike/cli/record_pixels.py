@@ -18,7 +18,7 @@ def record_pixels(
     preset_name: str = typer.Option("m10n7", "--preset", help=f"The team: {TEAM_HELP}."),
     sequences: int = typer.Option(3, "--sequences", min=1, help="Recordings to make."),
     frames: int = typer.Option(300, "--frames", min=1, help="Frames per recording (30 Hz)."),
-    seed: int = typer.Option(700_000, "--seed", help="Base seed (recording k: seed + 1000·preset index + k, as "
+    seed: int = typer.Option(700_000, "--seed", min=0, help="Base seed (recording k: seed + 1000·preset index + k, as "
                              "`bench pixels`; the shipped detector and heading models train on seeds below 400000)."),
     max_detections: int | None = typer.Option(
         None, "--max-detections", min=1, help="Most probable pixel detections kept per frame (default: the "

@@ -22,7 +22,7 @@ def simulate(
     frames: int | None = typer.Option(None, "--frames", min=1, show_default=False,
                                       help="Frames per sequence (robots: 1000 at 30 Hz; --arena: 500 at 28 Hz)."),
     sequences: int = typer.Option(1, "--sequences", min=1, help="Number of sequences (seeds seed, seed+1, ...)."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the first sequence."),
+    seed: int = typer.Option(0, "--seed", min=0, help="Seed of the first sequence."),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for the .jsonl files."),
     noise: str = typer.Option(DEFAULT_NOISE, "--noise",
                               help="Position-noise model: paper (the robot-identification paper's, larger across the "

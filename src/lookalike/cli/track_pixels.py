@@ -16,7 +16,7 @@ from lookalike.pipeline.robots import robot_video
 def render_robots(
     sequence: Path = typer.Argument(..., help="A robot sequence written by `lookalike simulate` (.jsonl)."),
     output: Path = typer.Option(..., "-o", "--output", help="MP4 to write."),
-    seed: int = typer.Option(0, help="Seed of the lighting, blur and pixel noise."),
+    seed: int = typer.Option(0, min=0, help="Seed of the lighting, blur and pixel noise."),
 ) -> None:
     """Draw a simulated robot sequence through the robot camera (640×480, 70°) as a video: the input of
     `lookalike track --video FILE --pipeline robots --reports SEQUENCE`."""

@@ -29,7 +29,7 @@ def train_detector(
     stages: int = typer.Option(20, help="Cascade stages."),
     negatives: int = typer.Option(2000, help="Hard negatives per stage."),
     copies: int = typer.Option(2, help="Augmented copies per positive (rotation ±15°, scale, flip, cut-outs)."),
-    seed: int = typer.Option(0, help="Seed of rendering, augmentation and boosting."),
+    seed: int = typer.Option(0, min=0, help="Seed of rendering, augmentation and boosting."),
     validation_frames: int = typer.Option(100, help="Held-out rendered frames (seed + 1000003) that choose the "
                                           "cascade prefix and pyramid start and calibrate the probability "
                                           "(without --data; 0: keep every stage)."),
@@ -63,7 +63,7 @@ def train_heading_command(
     frames: int = typer.Option(400, help="Rendered training frames (4 robots each)."),
     test_frames: int = typer.Option(100, help="Rendered held-out frames for the reported error (0: none)."),
     folds: int = typer.Option(3, help="Folds of the grid search."),
-    seed: int = typer.Option(0, help="Seed of the training renders; held-out renders use seed + 1000003."),
+    seed: int = typer.Option(0, min=0, help="Seed of the training renders; held-out renders use seed + 1000003."),
 ) -> None:
     """Train the heading classifier on rendered robots, report its held-out error and save it."""
     check_outputs_or_fail({"-o/--output": output})

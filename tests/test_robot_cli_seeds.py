@@ -1,0 +1,26 @@
+"""The robot commands refuse a negative ``--seed`` by name before any work (numpy's seeds are non-negative)."""
+
+from __future__ import annotations
+
+import pytest
+from typer.testing import CliRunner
+
+from lookalike.cli import app
+
+
+@pytest.mark.parametrize("args", [
+    ["simulate", "--preset", "m3n2", "--frames", "2"],
+    ["simulate", "--arena", "2", "--frames", "2"],
+    ["render-robots", "missing.jsonl"],
+    ["record-pixels", "--preset", "m3n2", "--sequences", "1", "--frames", "1"],
+    ["robot-sim", "--robot", "1", "--duration", "1"],
+    ["camera-sim", "--duration", "1"],
+    ["train-detector"],
+    ["train-heading"],
+])
+def test_negative_seed_is_refused_by_name(tmp_path, args):
+    result = CliRunner().invoke(app, [*args, "--seed", "-1", "-o", str(tmp_path / "out")]
+                                if args[0] not in ("robot-sim", "camera-sim") else [*args, "--seed", "-1"])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert "Invalid value for '--seed'" in result.output
+    assert not (tmp_path / "out").exists()
