@@ -12,7 +12,7 @@ from typing import Any
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, fail, failing
+from lookalike.cli.app import app, check_outputs_or_fail, check_teams, fail, failing
 from lookalike.cli.track import build_tracker
 from lookalike.io.outputs import write_atomic
 from lookalike.io.sources import SignalStop
@@ -138,7 +138,8 @@ _START_HELP = "Wall time of simulated t=0: now, a UNIX time, or stdin (print 're
 
 def _sequence(preset_name: str, seed: int, duration: float, loss: float | None, delay: float | None,
               jitter: float | None) -> Any:
-    with failing(ValueError, prefix="--preset: "):
+    check_teams("--preset", [preset_name])
+    with failing(ValueError, prefix="--duration / --loss / --delay / --jitter: "):
         return team_sequence(preset_name, seed, duration, loss, delay, jitter)
 
 

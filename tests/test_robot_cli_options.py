@@ -1,4 +1,5 @@
-"""The robot commands refuse a negative ``--seed`` by name before any work (numpy's seeds are non-negative)."""
+"""The robot commands name the option a bad value came from, before any work (a negative ``--seed``: numpy's seeds
+are non-negative)."""
 
 from __future__ import annotations
 
@@ -24,3 +25,11 @@ def test_negative_seed_is_refused_by_name(tmp_path, args):
     assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
     assert "Invalid value for '--seed'" in result.output
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("command", [["robot-sim", "--robot", "1"], ["camera-sim"]])
+@pytest.mark.parametrize("option", [["--duration", "0"], ["--loss", "2"], ["--delay", "-1"], ["--jitter", "-1"]])
+def test_simulated_team_options_are_named(command, option):
+    result = CliRunner().invoke(app, [*command, *option])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert option[0] in result.output and "--preset" not in result.output
