@@ -33,3 +33,12 @@ def test_simulated_team_options_are_named(command, option):
     result = CliRunner().invoke(app, [*command, *option])
     assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
     assert option[0] in result.output and "--preset" not in result.output
+
+
+@pytest.mark.parametrize("option", [["--threads", "0"], ["--batch-size", "0"], ["--device", "gpu0"]])
+def test_train_options_are_named(tmp_path, option):
+    if option[0] == "--device":
+        pytest.importorskip("torch", reason="train needs the 'train' extra")
+    result = CliRunner().invoke(app, ["train", "--steps", "1", *option, "-o", str(tmp_path / "run")])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert option[0] in result.output

@@ -30,7 +30,7 @@ def train(
     steps: int = typer.Option(3000, help="Maximum optimisation steps (batches of sequences)."),
     minutes: float | None = typer.Option(None, help="Stop after this many minutes."),
     cell: str = typer.Option("lstm", help="Recurrent cell: lstm or gru (the paper's comparison)."),
-    batch_size: int = typer.Option(16, help="Sequences per batch."),
+    batch_size: int = typer.Option(16, min=1, help="Sequences per batch."),
     sequence_length: int = typer.Option(600, help="Frames per training sequence (multiple of 150)."),
     hidden: int = typer.Option(64, help="Units per recurrent layer."),
     layers: int = typer.Option(5, help="Stacked recurrent layers."),
@@ -38,7 +38,7 @@ def train(
     relative: bool = typer.Option(True, help="Add slot-minus-agent heading differences to the input (ours)."),
     patience: int = typer.Option(12, min=1,
                                  help="Stop after this many validations (every 50 steps) without a new best."),
-    threads: int = typer.Option(1, help="Torch threads."),
+    threads: int = typer.Option(1, min=1, help="Torch threads."),
     learning_rate: float | None = typer.Option(
         None, help="Adam's initial learning rate (default: the paper's 0.004 for lstm, 0.003 for set; with "
         "--model set --resume, a lower one cools the run down)."),
@@ -252,6 +252,10 @@ def torch_device(device: str) -> str:
 
     if device == "auto":
         device = "cuda" if torch.cuda.is_available() else "cpu"
+    try:
+        torch.device(device)
+    except RuntimeError:
+        fail(f"--device {device}: expected cpu, cuda, cuda:N or auto")
     if device.startswith("cuda") and not torch.cuda.is_available():
         fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
     return device
