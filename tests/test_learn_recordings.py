@@ -140,3 +140,12 @@ def test_train_recordings_validates_on_a_folder_of_its_own(app, tmp_path):
     bad = runner.invoke(app, ["train", "--recordings", str(tmp_path / "rec"), "-o", str(tmp_path / "bad"),
                               "--steps", "1", "--validation", str(tmp_path / "none")])
     assert bad.exit_code == 2 and "--validation" in bad.output
+
+
+@pytest.mark.parametrize("option", ["--validation", "--test"])
+def test_train_recordings_refuses_to_hold_out_its_training_recordings(app, tmp_path, option):
+    _recordings(tmp_path / "rec", n=2)
+    r = runner.invoke(app, ["train", "--recordings", str(tmp_path / "rec"), "-o", str(tmp_path / "out"), "--steps",
+                            "1", "--sequence-length", "150", "--batch-size", "2", option, str(tmp_path / "rec")])
+    assert r.exit_code == 2 and option in r.output and "holds 2 of the --recordings" in r.output, r.output
+    assert not (tmp_path / "out" / "model.npz").exists()

@@ -59,6 +59,16 @@ def read_recordings(folder: Path, option: str) -> list[RobotSequence]:
     return recordings
 
 
+def _check_held_out(training: list[Path], folder: Path | None, option: str) -> None:
+    """Fail when ``folder`` holds one of the ``training`` recordings (it would score the network on what it learnt)."""
+    if folder is None or not folder.is_dir():
+        return
+    shared = {p.resolve() for p in training} & {p.resolve() for p in recording_paths(folder)}
+    if shared:
+        fail(f"{option}: {folder} holds {len(shared)} of the --recordings recordings (e.g. {min(shared).name}); "
+             "give a folder of other recordings")
+
+
 def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     """Fine-tune on the recordings of ``folder`` (split by recording, or all of them with ``opt.validation``,
     the folder of the validation recordings), write ``OUTPUT/model.npz``; with ``opt.test``, print the
@@ -74,6 +84,8 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     recordings = read_recordings(folder, "--recordings")
     tests = read_recordings(opt.test, "--test") if opt.test is not None else []
     paths = recording_paths(folder)
+    _check_held_out(paths, opt.validation, "--validation")
+    _check_held_out(paths, opt.test, "--test")
     if opt.validation is not None:  # every recording of the folder trains; these validate
         recordings += read_recordings(opt.validation, "--validation")
         paths += recording_paths(opt.validation)
