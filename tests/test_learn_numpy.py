@@ -71,6 +71,19 @@ def test_wrong_shaped_weights_are_refused(tmp_path):
         load_weights(path)
 
 
+def test_non_finite_or_missing_layer_weights_are_refused(tmp_path):
+    path = _saved(tmp_path)
+    data = dict(np.load(path))
+    data["layer1.w_hh"] = np.full(data["layer1.w_hh"].shape, np.nan)
+    np.savez(path, **data)
+    with pytest.raises(CheckpointError, match=r"m.npz: weights: layer1.w_hh holds NaN or infinity"):
+        load_weights(path)
+    del data["layer1.w_hh"]
+    np.savez(path, **data)
+    with pytest.raises(CheckpointError, match=r"layer1.w_hh is missing"):
+        load_weights(path)
+
+
 def test_encoding_layout():
     spec = EncodingSpec(n_agents=2, n_slots=2)
     det = Detections(position=[[1.0, 2.0], [3.0, 4.0], [5.0, 6.0]], heading=[0.0, np.pi / 2, np.pi],

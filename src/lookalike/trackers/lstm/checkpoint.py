@@ -45,9 +45,12 @@ class NetworkWeights:
             shapes = {"w_ih": (g * h, width), "w_hh": (g * h, h), "b_ih": (g * h,), "b_hh": (g * h,)}
             for name, shape in shapes.items():
                 arr = layer.get(name)
-                got = () if arr is None else np.shape(arr)
-                if got != shape:
-                    raise CheckpointError(f"weights: layer{i}.{name} has shape {got}, expected {shape}")
+                if arr is None:
+                    raise CheckpointError(f"weights: layer{i}.{name} is missing")
+                if np.shape(arr) != shape:
+                    raise CheckpointError(f"weights: layer{i}.{name} has shape {np.shape(arr)}, expected {shape}")
+                if not np.isfinite(arr).all():
+                    raise CheckpointError(f"weights: layer{i}.{name} holds NaN or infinity")
         checks = {"head.weight": (w.head_weight, (expected_out, h)), "head.bias": (w.head_bias, (expected_out,)),
                   "input_mean": (w.input_mean, (n_in,)), "input_std": (w.input_std, (n_in,))}
         for name, (arr, shape) in checks.items():
