@@ -145,3 +145,18 @@ def test_scene_mining_finds_hard_negatives_away_from_true_boxes():
     assert found.shape[1:] == (66, 34)
     truth_crop = scenes[0][0][13 - 1 : 13 + 65, 10 - 1 : 10 + 33]
     assert not any(np.allclose(f, truth_crop, atol=1.0) for f in found)
+
+
+@pytest.mark.parametrize("edit, problem", [
+    (lambda a: {**a, "s0_index": a["s0_index"] + 100_000}, "feature indices"),
+    (lambda a: {**a, "s0_weight": a["s0_weight"] * np.nan}, "NaN or infinity"),
+    (lambda a: {**a, "s0_weight": a["s0_weight"][:1]}, "differ in shape"),
+])
+def test_stages_that_do_not_fit_are_refused(tmp_path, edit, problem):
+    from lookalike.vision.pipeline import MODELS_DIR, SHIPPED_MODELS
+
+    with np.load(MODELS_DIR / SHIPPED_MODELS["detector"]) as data:
+        arrays = {k: data[k] for k in data.files}
+    np.savez(tmp_path / "bad.npz", **edit(arrays))
+    with pytest.raises(ValueError, match=f"bad.npz: corrupt HOG cascade model \\(stage 0: .*{problem}"):
+        HogCascade.load(tmp_path / "bad.npz")

@@ -242,6 +242,7 @@ class HogCascade:
             config = CascadeConfig(**{**cfg, "window_px": tuple(cfg["window_px"])})
             stages = [Stage(arrays[f"s{k}_index"], arrays[f"s{k}_threshold"], arrays[f"s{k}_sign"],
                             arrays[f"s{k}_weight"], float(b)) for k, b in enumerate(header["biases"])]
+            _check_stages(stages, len(arrays["blocks"]) * 4 * BINS, tuple(header["calibration"]))
             model = cls(config, arrays["blocks"], stages, tuple(header["calibration"]))
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"{path}: corrupt HOG cascade model ({exc})") from None
@@ -249,6 +250,21 @@ class HogCascade:
         if not np.array_equal(expected, model.blocks):
             raise ValueError(f"{path}: block pool does not match window {config.window_px}")
         return model
+
+
+def _check_stages(stages: list[Stage], n_features: int, calibration: tuple[float, ...]) -> None:
+    """``ValueError`` naming the first stage whose arrays disagree in shape, index a feature outside
+    ``0 .. n_features-1`` or hold a non-finite number (or a non-finite calibration)."""
+    for k, s in enumerate(stages):
+        n = len(s.index)
+        if not (s.index.ndim == 1 and s.threshold.shape == s.sign.shape == s.weight.shape == (n,)):
+            raise ValueError(f"stage {k}: index, threshold, sign and weight differ in shape")
+        if n and (not np.issubdtype(s.index.dtype, np.integer) or s.index.min() < 0 or s.index.max() >= n_features):
+            raise ValueError(f"stage {k}: feature indices must be integers in 0..{n_features - 1}")
+        if not (np.isfinite(s.threshold).all() and np.isfinite(s.weight).all() and np.isfinite(s.bias)):
+            raise ValueError(f"stage {k}: holds NaN or infinity")
+    if len(calibration) != 2 or not np.isfinite(calibration).all():
+        raise ValueError(f"calibration must be two finite numbers, got {calibration}")
 
 
 def _margin(features: np.ndarray, stage: Stage) -> np.ndarray:
