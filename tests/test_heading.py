@@ -150,3 +150,15 @@ def test_rare_class_still_trains():
     f[0, 0:20:2], f[0, 1:20:2] = 3 * np.cos(h[0]), 3 * np.sin(h[0])
     model = train_heading(f, h, SMALL, seed=0)
     np.testing.assert_allclose(model.estimate(f).prob.sum(axis=1), 1.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", ["mean", "support", "prob_a"])
+def test_non_finite_arrays_are_refused(tmp_path, name):
+    from lookalike.vision.pipeline import MODELS_DIR, SHIPPED_MODELS
+
+    with np.load(MODELS_DIR / SHIPPED_MODELS["heading"]) as data:
+        arrays = {k: data[k] for k in data.files}
+    arrays[name] = np.where(np.arange(arrays[name].size).reshape(arrays[name].shape) == 0, np.nan, arrays[name])
+    np.savez(tmp_path / "bad.npz", **arrays)
+    with pytest.raises(ValueError, match=r"bad.npz: corrupt heading model \(holds NaN or infinity\)"):
+        HeadingClassifier.load(tmp_path / "bad.npz")

@@ -226,6 +226,9 @@ def _check_shapes(m: HeadingClassifier, d: int) -> None:
         raise ValueError("pairwise arrays disagree with the number of classes")
     if k and (m.classes.min() < 0 or m.classes.max() >= m.config.classes):
         raise ValueError("class indices out of range")
+    if not all(np.isfinite(a).all() for a in (m.mean, m.scale, m.support, m.dual_coef, m.intercept, m.prob_a, m.prob_b,
+                                               m.gamma)):
+        raise ValueError("holds NaN or infinity")
 
 
 def train_heading(
