@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 
 import numpy as np
 import pytest
@@ -40,6 +41,27 @@ def test_malformed_files(tmp_path):
     path = write_robot_sequence(tmp_path / "t.jsonl", simulate_robots(preset("m3n2"), 10, seed=1))
     path.write_text("\n".join(path.read_text().splitlines()[:-1]) + "\n")
     with pytest.raises(ValueError, match="frames"):
+        read_robot_sequence(path)
+
+
+def _beacons(rows):
+    return next(r["beacons"] for r in rows[1:] if r["beacons"]["agent_id"])
+
+
+@pytest.mark.parametrize("edit, problem", [
+    (lambda rows: rows[3].update(time=float("nan")), "time must be a finite number"),
+    (lambda rows: _beacons(rows)["heading"].__setitem__(0, float("nan")), "NaN or infinity in a report"),
+    (lambda rows: _beacons(rows)["heading"].append(0.0), "differ in length"),
+    (lambda rows: _beacons(rows)["agent_id"].__setitem__(0, 0.5), "agent ids must be whole numbers from 0 to 1"),
+    (lambda rows: _beacons(rows)["agent_id"].__setitem__(0, 2), "agent ids must be whole numbers from 0 to 1"),
+    (lambda rows: rows[3]["truth"]["observer"].__setitem__(0, float("inf")), "observer's pose"),
+])
+def test_reports_times_and_poses_are_checked(tmp_path, edit, problem):
+    path = write_robot_sequence(tmp_path / "s.jsonl", simulate_robots(preset("m3n2"), 40, seed=5))
+    rows = [json.loads(line) for line in path.read_text().splitlines()]
+    edit(rows)
+    path.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    with pytest.raises(ValueError, match=f"s.jsonl:\\d+: malformed frame record \\(frame \\d+: .*{problem}"):
         read_robot_sequence(path)
 
 

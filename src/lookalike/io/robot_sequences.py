@@ -143,6 +143,8 @@ def _read_record(k: int, row: dict, N: int, M: int, time: np.ndarray, valid: np.
     if row["frame"] != k:
         raise ValueError(f"frame records out of order: record {k} is frame {row['frame']}")
     time[k] = row["time"]
+    if not np.isfinite(time[k]):
+        raise ValueError(f"frame {k}: time must be a finite number of seconds, got {row['time']}")
     d = row["detections"]
     n = len(d["label"])
     if n > M:
@@ -157,8 +159,20 @@ def _read_record(k: int, row: dict, N: int, M: int, time: np.ndarray, valid: np.
         if not all(np.isfinite(a[k, :n]).all() for a in (pos, head, score)):
             raise ValueError(f"frame {k}: NaN or infinity in a detection")
     b = row["beacons"]
+    m = len(b["agent_id"])
+    if any(len(b[key]) != m for key in b_parts):
+        raise ValueError(f"frame {k}: the reports' agent_id, t_sent, t_received and heading differ in length")
+    if m:
+        ids = np.asarray(b["agent_id"], dtype=float)
+        if not ((ids == np.floor(ids)) & (ids >= 0) & (ids < N)).all():
+            raise ValueError(f"frame {k}: report agent ids must be whole numbers from 0 to {N - 1}, "
+                             f"got {b['agent_id']}"[:160])
+        if not np.isfinite(np.asarray([b["t_sent"], b["t_received"], b["heading"]], dtype=float)).all():
+            raise ValueError(f"frame {k}: NaN or infinity in a report")
     for key, values in b_parts.items():
         values.extend(b[key])
-    offsets[k + 1] = offsets[k] + len(b["agent_id"])
+    offsets[k + 1] = offsets[k] + m
+    if not np.isfinite(np.asarray(row["truth"]["observer"], dtype=float)).all():
+        raise ValueError(f"frame {k}: NaN or infinity in the observer's pose")
     for key, values in truth.items():
         values.append(row["truth"][key])
