@@ -75,3 +75,14 @@ def test_simulate_command(tmp_path):
     assert len(seq) == 30 and seq.config.n_agents == 2
     bad = CliRunner().invoke(app, ["simulate", "--preset", "nope", "-o", str(tmp_path)])
     assert bad.exit_code != 0
+
+
+@pytest.mark.parametrize("column, value", [("heading", [0.5]), ("score", [0.5]), ("position", [[1.0], [2.0]])])
+def test_detection_columns_of_another_length_are_refused(tmp_path, column, value):
+    path = write_robot_sequence(tmp_path / "s.jsonl", simulate_robots(preset("m3n2"), 40, seed=5))
+    rows = [json.loads(line) for line in path.read_text().splitlines()]
+    row = next(r for r in rows[1:] if len(r["detections"]["label"]) == 2)
+    row["detections"][column] = value
+    path.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    with pytest.raises(ValueError, match="malformed frame record .*2 labels but position, heading and score"):
+        read_robot_sequence(path)

@@ -150,6 +150,9 @@ def _read_record(k: int, row: dict, N: int, M: int, time: np.ndarray, valid: np.
     if n > M:
         raise ValueError(f"frame {k}: {n} detections exceed max_detections {M}")
     valid[k, :n] = True
+    if np.shape(d["position"]) != ((n, 2) if n else (0,)) or not len(d["heading"]) == len(d["score"]) == n:
+        raise ValueError(f"frame {k}: {n} labels but position, heading and score of shapes {np.shape(d['position'])}, "
+                         f"{np.shape(d['heading'])}, {np.shape(d['score'])} (expected ({n}, 2), ({n},), ({n},))")
     if n:
         labels = np.asarray(d["label"], dtype=float)
         if labels.shape != (n,) or not ((labels == np.floor(labels)) & (labels >= -1) & (labels < N)).all():
