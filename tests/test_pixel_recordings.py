@@ -31,3 +31,9 @@ def test_record_pixels_writes_readable_labelled_recordings(tmp_path):
 def test_record_pixels_refuses_an_unknown_preset(tmp_path):
     r = CliRunner().invoke(app, ["record-pixels", "-o", str(tmp_path), "--preset", "m99"])
     assert r.exit_code == 2 and "--preset" in r.output
+
+
+def test_record_pixels_refuses_more_detections_than_the_team_keeps(tmp_path):
+    r = CliRunner().invoke(app, ["record-pixels", "-o", str(tmp_path), "--preset", "m3n2", "--max-detections", "4"])
+    assert r.exit_code == 2 and "--max-detections 4" in r.output and "M=3" in r.output
+    assert not list(tmp_path.glob("*.labelled.jsonl"))

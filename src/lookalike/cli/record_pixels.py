@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, check_teams, console, failing
+from lookalike.cli.app import app, check_outputs_or_fail, check_teams, console, fail, failing
 from lookalike.sim import preset
 from lookalike.sim.presets import TEAM_HELP
 
@@ -21,8 +21,8 @@ def record_pixels(
     seed: int = typer.Option(700_000, "--seed", min=0, help="Base seed (recording k: seed + 1000·preset index + k, as "
                              "`bench pixels`; the shipped detector and heading models train on seeds below 400000)."),
     max_detections: int | None = typer.Option(
-        None, "--max-detections", min=1, help="Most probable pixel detections kept per frame (default: the "
-        "preset's M)."),
+        None, "--max-detections", min=1, help="Most probable pixel detections kept per frame, at most the "
+        "preset's M (default: M)."),
     detector_model: Path | None = typer.Option(None, "--detector-model", help="HOG cascade (default: shipped)."),
     heading_model: Path | None = typer.Option(None, "--heading-model", help="Heading classifier (default: shipped)."),
     min_iou: float = typer.Option(0.3, "--min-iou", min=0.0, max=1.0, help="IoU for a detection to be a robot."),
@@ -39,6 +39,9 @@ def record_pixels(
 
     check_teams("--preset", [preset_name])
     world = preset(preset_name)
+    if max_detections is not None and max_detections > world.max_detections:
+        fail(f"--max-detections {max_detections}: a recording of {preset_name} keeps at most its "
+             f"M={world.max_detections} detections a frame")
     camera = pixel_camera()
     with failing(ValueError, OSError):
         config = PipelineConfig(n_agents=world.n_agents, max_detections=max_detections or world.max_detections)
