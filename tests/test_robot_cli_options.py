@@ -42,3 +42,16 @@ def test_train_options_are_named(tmp_path, option):
     result = CliRunner().invoke(app, ["train", "--steps", "1", *option, "-o", str(tmp_path / "run")])
     assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
     assert option[0] in result.output
+
+
+def test_track_pipeline_help_names_every_identifier():
+    import re
+
+    import typer
+
+    from lookalike.vision.pipeline import IDENTIFIERS
+
+    track = typer.main.get_command(app).commands["track"]
+    (help_text,) = [p.help for p in track.params if p.name == "pipeline"]
+    named = re.search(r"-t ([\w|]+)", help_text).group(1).split("|")
+    assert sorted(named) == sorted(IDENTIFIERS)

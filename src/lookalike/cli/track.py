@@ -78,7 +78,7 @@ def track(
                                           "e.g. threshold=30 polarity=dark min_area_px=80; for FILE.onnx e.g. "
                                           "score=0.4 classes=0 layout=yolo (docs: ONNX detector how-to)."),
     pipeline: str | None = typer.Option(None, "--pipeline", help="With --video: 'robots' finds, orients, places and "
-                                        "identifies (-t kalman_ha|kalman_ha2|jpda|lstm) robots from the pixels."),
+                                        "identifies (-t set|kalman_ha|kalman_ha2|jpda|lstm) robots from the pixels."),
     reports: Path | None = typer.Option(None, "--reports",
                                         help="With --pipeline: heading reports (`simulate` .jsonl)."),
     detector_model: Path | None = typer.Option(None, "--detector-model",
