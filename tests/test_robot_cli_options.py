@@ -55,3 +55,13 @@ def test_track_pipeline_help_names_every_identifier():
     (help_text,) = [p.help for p in track.params if p.name == "pipeline"]
     named = re.search(r"-t ([\w|]+)", help_text).group(1).split("|")
     assert sorted(named) == sorted(IDENTIFIERS)
+
+
+@pytest.mark.parametrize("option", [["--publish", "127.0.0.1:7800"], ["--group", "239.255.77.1:7701"],
+                                    ["--port-file", "port.txt"]])
+def test_serve_over_dds_refuses_udp_options(tmp_path, option):
+    args = [option[0], str(tmp_path / option[1])] if option[0] == "--port-file" else option
+    result = CliRunner().invoke(app, ["serve", "--transport", "dds", "--duration", "0.1", *args])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert f"{option[0]}: with --transport udp only" in result.output
+    assert not (tmp_path / "port.txt").exists()

@@ -70,6 +70,11 @@ def serve(
     """Run the observer node: receive heading reports and detections over UDP (or DDS), identify the
     robots with a tracker, publish their positions at the camera rate. Logs are JSON Lines on
     stderr; send a status_request message for the counters."""
+    udp_only = [name for name, value in (("--publish", publish), ("--group", group), ("--port-file", port_file))
+                if value]
+    if transport == "dds" and udp_only:
+        fail(f"{', '.join(udp_only)}: with --transport udp only (over DDS the node has no addresses: it uses ROS 2 "
+             "topics in --domain-id)")
     listen_address = _address(listen, "--listen")
     check_outputs_or_fail({"--port-file": port_file})
     group_address = _group(group)
