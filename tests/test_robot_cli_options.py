@@ -65,3 +65,11 @@ def test_serve_over_dds_refuses_udp_options(tmp_path, option):
     assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
     assert f"{option[0]}: with --transport udp only" in result.output
     assert not (tmp_path / "port.txt").exists()
+
+
+@pytest.mark.parametrize("option", [["--duration", "-1"], ["--duration", "nan"], ["--status-interval", "-1"],
+                                    ["--status-interval", "nan"]])
+def test_serve_refuses_negative_or_nan_times(option):
+    result = CliRunner().invoke(app, ["serve", "--listen", "127.0.0.1:0", *option])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert option[0].lstrip("-").split("-")[0] in result.output and "listening" not in result.output

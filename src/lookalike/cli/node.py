@@ -75,6 +75,8 @@ def serve(
     if transport == "dds" and udp_only:
         fail(f"{', '.join(udp_only)}: with --transport udp only (over DDS the node has no addresses: it uses ROS 2 "
              "topics in --domain-id)")
+    if not duration >= 0:
+        fail(f"--duration: wall seconds >= 0 (0: until SIGINT/SIGTERM), got {duration}")
     listen_address = _address(listen, "--listen")
     check_outputs_or_fail({"--port-file": port_file})
     group_address = _group(group)

@@ -106,6 +106,9 @@ class NodeConfig:
                 raise ValueError(f"NodeConfig.{name} must be > 0, got {getattr(self, name)}")
         if not self.sender_burst >= 1:  # (a sender needs one whole token a packet: below 1 nothing passes)
             raise ValueError(f"NodeConfig.sender_burst (--burst) must be >= 1 packet, got {self.sender_burst:g}")
+        if not self.status_interval_s >= 0:
+            raise ValueError(f"NodeConfig.status_interval_s (--status-interval) must be >= 0 (0: never), got "
+                             f"{self.status_interval_s}")
         if self.max_senders < 1 or self.batch < 1:
             raise ValueError("NodeConfig.max_senders and NodeConfig.batch must be >= 1")
         if self.group is not None:
