@@ -160,3 +160,9 @@ def test_stages_that_do_not_fit_are_refused(tmp_path, edit, problem):
     np.savez(tmp_path / "bad.npz", **edit(arrays))
     with pytest.raises(ValueError, match=f"bad.npz: corrupt HOG cascade model \\(stage 0: .*{problem}"):
         HogCascade.load(tmp_path / "bad.npz")
+
+
+@pytest.mark.parametrize("negatives", [0, -5])
+def test_a_cascade_needs_negatives(negatives):
+    with pytest.raises(ValueError, match="negatives_per_stage .*must be >= 1"):
+        CascadeConfig(negatives_per_stage=negatives)

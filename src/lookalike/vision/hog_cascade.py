@@ -59,6 +59,9 @@ class CascadeConfig:
             raise ValueError(f"CascadeConfig.stages: must be in 1..100, got {self.stages}")
         if not 0.5 < self.stage_hit_rate <= 1:
             raise ValueError(f"CascadeConfig.stage_hit_rate: must be in (0.5, 1], got {self.stage_hit_rate}")
+        if self.negatives_per_stage < 1:
+            raise ValueError(f"CascadeConfig.negatives_per_stage (--negatives): must be >= 1, got "
+                             f"{self.negatives_per_stage}")
         if self.max_draws_per_stage < 1 or self.min_hard_negatives < 1:
             raise ValueError("CascadeConfig.max_draws_per_stage/min_hard_negatives: must be >= 1")
         if not 0 <= self.target_false_positive_rate < 1:
