@@ -100,7 +100,8 @@ def test_a_device_torch_cannot_use_is_refused_before_any_work(tmp_path, monkeypa
     from typer.testing import CliRunner
 
     from lookalike.cli import app
-    from lookalike.learn.appearance_train import AppearanceTrainConfig, torch_device, train_appearance
+    from lookalike.learn.appearance_train import AppearanceTrainConfig, train_appearance
+    from lookalike.learn.device import torch_device
 
     monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
     assert torch_device("auto").type == "cpu"

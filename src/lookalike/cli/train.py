@@ -246,19 +246,14 @@ def _finish(result: Any, output: Path, ship_to: Path | None, detail: str = "") -
 
 
 def torch_device(device: str) -> str:
-    """``--device`` resolved (``auto``: cuda where PyTorch sees one), failing on a CUDA device PyTorch does not see."""
-    with needs("torch"):
-        import torch
+    """``--device`` resolved (``auto``: cuda where PyTorch sees one), failing in one line on a device PyTorch cannot
+    use."""
+    from lookalike.learn.device import torch_device as resolve
 
-    if device == "auto":
-        device = "cuda" if torch.cuda.is_available() else "cpu"
     try:
-        torch.device(device)
-    except RuntimeError:
-        fail(f"--device {device}: expected cpu, cuda, cuda:N or auto")
-    if device.startswith("cuda") and not torch.cuda.is_available():
-        fail(f"--device {device}: this PyTorch sees no CUDA device (use --device cpu)")
-    return device
+        return str(resolve(device))
+    except ValueError as exc:
+        fail(f"--{exc}")
 
 
 def _with_progress(description: str, steps: int, pool: JobPool, threads: int,

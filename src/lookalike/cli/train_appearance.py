@@ -24,8 +24,9 @@ def train_appearance(
 
     The shipped model (lookalike/vision/models_data/diver_reid.onnx) is this command's defaults."""
     require("torch")
-    from lookalike.learn.appearance_train import AppearanceTrainConfig, torch_device
+    from lookalike.learn.appearance_train import AppearanceTrainConfig
     from lookalike.learn.appearance_train import train_appearance as run
+    from lookalike.learn.device import torch_device
     with failing(ValueError, prefix="--"):
         torch_device(device)  # before the output folder is made and the crops rendered
     check_outputs_or_fail({"-o/--output": output}, folders={"-o/--output"})

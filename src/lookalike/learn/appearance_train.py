@@ -15,6 +15,7 @@ import numpy as np
 
 from lookalike._optional import needs
 from lookalike.learn.appearance_data import CROP_SIZE, CropSet, diver_crops
+from lookalike.learn.device import torch_device
 
 MODEL_NAME = "diver_reid"
 
@@ -52,21 +53,6 @@ def _torch() -> Any:
     with needs("torch"):
         import torch
     return torch
-
-
-def torch_device(name: str) -> Any:
-    """The ``torch.device`` of ``name`` (``cpu``, ``cuda``, ``cuda:N`` or ``auto``: cuda where PyTorch sees one);
-    ``ValueError`` naming it when PyTorch does not know it or sees no CUDA device for it."""
-    torch = _torch()
-    if name == "auto":
-        name = "cuda" if torch.cuda.is_available() else "cpu"
-    try:
-        device = torch.device(name)
-    except RuntimeError:
-        raise ValueError(f"device {name!r}: choose cpu, cuda, cuda:N or auto") from None
-    if device.type == "cuda" and not torch.cuda.is_available():
-        raise ValueError(f"device {name!r}: this PyTorch sees no CUDA device (use cpu)")
-    return device
 
 
 def build_net(embedding: int = 32, channels: int = 16) -> Any:
