@@ -14,6 +14,7 @@ from lookalike.trackers.parts.coasting import Coasting
 from lookalike.trackers.parts.lifecycle import Lifecycle
 from lookalike.trackers.parts.self_calibration import ScoreCalibration
 from lookalike.trackers.parts.table import TrackTable
+from lookalike.trackers.parts.timing import FrameClock
 from lookalike.types import TrackStatus
 
 
@@ -151,3 +152,20 @@ def test_boxtrack_config_names_the_bad_field() -> None:
                 {"max_age_s": 0}):
         with pytest.raises(ValueError, match=next(iter(bad))):
             BoxTrackConfig(**bad)
+
+
+def test_frame_clock_counts_regular_and_skipped_frames_and_ignores_frames_delivered_together() -> None:
+    clock = FrameClock()
+    assert [clock.steps(i / 30) for i in (1, 2, 3, 5, 6)] == pytest.approx([1, 1, 1, 2, 1])
+    # A live camera delivering two frames 1 ms apart: the pair's step is a fraction of a frame, and the frames after
+    # it still count as one step each (taking 1 ms as the interval made each count as 33).
+    clock, t, steps = FrameClock(), 0.0, []
+    for k in range(40):
+        t += 0.001 if k == 20 else 1 / 30
+        steps.append(clock.steps(t))
+    assert steps[20] == pytest.approx(0.03)
+    assert steps[21:] == pytest.approx([1.0] * 19)
+    # The same when the pair comes first.
+    clock = FrameClock()
+    steps = [clock.steps(t) for t in (0.0, 0.001, *(0.001 + k / 30 for k in range(1, 10)))]
+    assert steps[-5:] == pytest.approx([1.0] * 5)
