@@ -70,9 +70,9 @@ def sequences_and_targets(path: Path, output: Path) -> tuple[list[Any], list[Pat
 def dropped_all(tracker: str, det_path: Path | str | None, rows: int, scores: tuple[float, float] | None) -> str:
     """The warning for a tracker that wrote no tracks from ``rows`` detections scoring ``scores``."""
     span = f" (scores {scores[0]:g} to {scores[1]:g})" if scores is not None else ""
-    return (f"{tracker} wrote no tracks from the {rows} detections of {det_path}{span}: its score thresholds "
-            f"(`lookalike trackers`) or --min-score may drop them all, or the columns are not what they seem "
-            f"(--det-format)")
+    return (f"{tracker} wrote no tracks from the {rows} detections of {det_path}{span}: its score thresholds, the "
+            f"frames a track needs before it is reported (`lookalike trackers --details {tracker}`) or --min-score "
+            f"may drop them all, or the columns are not what they seem (--det-format)")
 
 
 def open_sequences(path: Path, output: Path, min_score: float, use_length: bool = True,

@@ -30,9 +30,11 @@ CLOSED_SCALE = 3.0  # closed set: a recovered detection's sqrt(area) within this
 class BoxTrackConfig:
     """BoxTrack's parameters (pixels, seconds, scores in [0, 1]); validated on construction."""
 
-    high_score: float = param(0.9, "detections scoring at least this are matched first to confirmed tracks", range=UNIT)
+    high_score: float = param(0.9, "ceiling of the high threshold (detections scoring at least the threshold are "
+                                   "matched first to confirmed tracks)", range=UNIT)
     low_score: float = param(0.1, "detections below this are ignored", range=UNIT)
-    birth_score: float = param(0.95, "detections scoring at least this may start tracks", range=UNIT)
+    birth_score: float = param(0.95, "ceiling of the birth threshold (detections scoring at least the "
+                                     "threshold may start tracks)", range=UNIT)
     clutter_factor: float | None = param(
         2.0, "if set, birth_score is lowered to the quantile of the scores seen so far equal to this times the "
              "share of detections overlapping none of the previous frame's (at least the 0.1-quantile)", range=POSITIVE)

@@ -59,7 +59,8 @@ class DiverSort:
         self.shortcut_matches = 0  # detections matched by the IoU shortcut (a diagnostic)
 
     def uncertain(self, track_id: int) -> bool:
-        """True while a confirmed track is young enough to be merged (its identity is not yet settled)."""
+        """True while a track, tentative or confirmed, is young enough to be merged (its identity is not yet
+        settled)."""
         t = self._tracks
         rows = np.flatnonzero(t.ids == track_id)
         return bool(len(rows)) and self._frame - int(t["born"][rows[0]]) < self.config.recovery_window
