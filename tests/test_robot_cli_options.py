@@ -73,3 +73,10 @@ def test_serve_refuses_negative_or_nan_times(option):
     result = CliRunner().invoke(app, ["serve", "--listen", "127.0.0.1:0", *option])
     assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
     assert option[0].lstrip("-").split("-")[0] in result.output and "listening" not in result.output
+
+
+def test_train_refuses_a_bad_protocol_before_making_its_output_folder(tmp_path):
+    pytest.importorskip("torch", reason="train needs the 'train' extra")
+    result = CliRunner().invoke(app, ["train", "--steps", "1", "--protocol", "bogus", "-o", str(tmp_path / "run")])
+    assert result.exit_code == 2 and "--protocol: unknown protocol 'bogus'" in result.output, result.output
+    assert not (tmp_path / "run").exists()

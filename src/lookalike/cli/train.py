@@ -110,6 +110,9 @@ def train(
     from lookalike.io.outputs import sqlite_file
 
     require("torch")
+    device = torch_device(device)  # every option checked before the output folder is made
+    if protocol not in ("ours", "paper"):
+        fail(f"--protocol: unknown protocol {protocol!r}; known: ours, paper")
     check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)},
                           [recordings, init_from, validation_folder], folders={"-o/--output"})
     if model not in ("lstm", "set"):
@@ -149,9 +152,6 @@ def train(
     from lookalike.trackers.lstm.encoding import EncodingSpec
     from lookalike.trackers.lstm.weights import WEIGHTS_DIR
 
-    device = torch_device(device)
-    if protocol not in ("ours", "paper"):
-        fail(f"--protocol: unknown protocol {protocol!r}; known: ours, paper")
     if protocol == "paper" and (relative or swap_prob > 0):
         relative, swap_prob = False, 0.0  # the paper's inputs; no augmentation beyond slot shuffling
     with failing(ValueError):
