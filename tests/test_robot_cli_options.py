@@ -80,3 +80,14 @@ def test_train_refuses_a_bad_protocol_before_making_its_output_folder(tmp_path):
     result = CliRunner().invoke(app, ["train", "--steps", "1", "--protocol", "bogus", "-o", str(tmp_path / "run")])
     assert result.exit_code == 2 and "--protocol: unknown protocol 'bogus'" in result.output, result.output
     assert not (tmp_path / "run").exists()
+
+
+def test_a_simulated_team_too_long_for_memory_names_duration(monkeypatch):
+    import lookalike.cli.node as node
+
+    def too_big(*args, **kwargs):
+        raise MemoryError("Unable to allocate 1.2 TiB")
+
+    monkeypatch.setattr(node, "team_sequence", too_big)
+    result = CliRunner().invoke(app, ["robot-sim", "--robot", "1", "--duration", "1e9"])
+    assert result.exit_code == 2 and "--duration 1e+09: the simulated sequence does not fit in memory" in result.output

@@ -147,7 +147,10 @@ def _sequence(preset_name: str, seed: int, duration: float, loss: float | None, 
               jitter: float | None) -> Any:
     check_teams("--preset", [preset_name])
     with failing(ValueError, prefix="--duration / --loss / --delay / --jitter: "):
-        return team_sequence(preset_name, seed, duration, loss, delay, jitter)
+        try:
+            return team_sequence(preset_name, seed, duration, loss, delay, jitter)
+        except MemoryError:
+            fail(f"--duration {duration:g}: the simulated sequence does not fit in memory; give fewer seconds")
 
 
 @app.command("robot-sim")
