@@ -259,3 +259,17 @@ def test_report_embeds_small_videos_and_links_large_ones(tmp_path, monkeypatch):
     assert 'src="v.mp4"' in html and "data:video" not in html and "played from" in html
     with pytest.raises(ValueError, match="video"):
         doc.video(tmp_path / "none.mp4", "clip")
+
+
+@pytest.mark.parametrize("suffix", [".avi", ".mkv", ".mp4"])
+def test_video_writer_gives_each_container_only_its_own_options(tmp_path, capfd, suffix):
+    pytest.importorskip("av")
+    from lookalike.io.video_frames import source_frames
+    from lookalike.viz.video import VideoWriter
+
+    path = tmp_path / f"v{suffix}"
+    with VideoWriter(path, fps=10) as writer:
+        for k in range(4):
+            writer.write(np.full((24, 32, 3), 60 * k, np.uint8))
+    assert "options were not used" not in capfd.readouterr().err
+    assert source_frames(path)[1] == 4

@@ -72,6 +72,9 @@ class VideoWriter:
         self.close()
 
 
+MP4_SUFFIXES = (".mp4", ".m4v", ".mov")
+
+
 class _H264Writer:
     """H.264 MP4 through PyAV: yuv420p, even size (padded), ``+faststart`` for streaming."""
 
@@ -80,10 +83,12 @@ class _H264Writer:
             import av
 
         self.width, self.height = size[0] + size[0] % 2, size[1] + size[1] % 2
+        faststart = {"movflags": "+faststart"}  # an MP4's or QuickTime file's option only (AVI, MKV: none)
         try:
-            self.container: Any = av.open(str(path), mode="w", options={"movflags": "+faststart"})
+            self.container: Any = av.open(str(path), mode="w",
+                                          options=faststart if path.suffix.lower() in MP4_SUFFIXES else {})
         except ValueError:  # FFmpeg cannot tell a container from the name (no or an unknown suffix): an MP4
-            self.container = av.open(str(path), mode="w", format="mp4", options={"movflags": "+faststart"})
+            self.container = av.open(str(path), mode="w", format="mp4", options=faststart)
         self.stream: Any = self.container.add_stream("libx264", rate=Fraction(fps).limit_denominator(1001))
         self.stream.width, self.stream.height, self.stream.pix_fmt = self.width, self.height, "yuv420p"
         self.stream.options = {"crf": "23", "preset": "veryfast"}
