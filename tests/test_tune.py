@@ -161,6 +161,18 @@ def test_tune_space_file_that_is_binary_is_named(tmp_path: Path):
         check_params("boxtrack", {"speed": 1})
 
 
+def test_tune_refuses_an_unknown_metric_before_loading_anything(tmp_path: Path):
+    pytest.importorskip("optuna")
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    r = CliRunner().invoke(app, ["tune", str(tmp_path / "nothing-here"), "--metric", "idf2", "-o",
+                                 str(tmp_path / "p.json")])
+    assert r.exit_code == 2 and "--metric: expected one of hota+idf1+mota, hota, idf1, got 'idf2'" in r.output, r.output
+    assert "sequence(s)" not in r.output
+
+
 # -- selection never looks at the left-out sequence ----------------------------------------------------
 
 

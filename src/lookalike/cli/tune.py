@@ -69,9 +69,10 @@ def tune(
         fail("DATA: give at least one sequence folder or bench dataset")
     if output is None:
         fail("-o/--output: give the parameter file to write")
-    from lookalike.tune import SAMPLERS
+    from lookalike.tune import CRITERIA, SAMPLERS
 
     check_choice("--sampler", sampler, SAMPLERS)
+    check_choice("--metric", metric, list(CRITERIA))
     check_choice("--backend", backend, BACKENDS)
     if resume and study is None:
         fail("--resume: needs --study (the storage the study was saved in)")
