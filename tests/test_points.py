@@ -58,6 +58,7 @@ def test_bad_lines_name_file_and_line(tmp_path: Path, text: str, message: str) -
     ("1,1,5,5\n1000000000,1,6,5\n", ":2: invalid frame: frame 1000000000 jumps"),
     ("1,1,5,5\n2,1,1e300,5\n", ":2: a coordinate beyond"),
     ("1,1,5,5,-1,4,1,-1,-1,-1\n", ":1: invalid box"),
+    ("frame,id,x,y\n1,1,5,5\n2,1,6,5\n1,2,9,9\n2,1,7,5\n", ":5: id 1 appears twice in frame 2 \\(line 3 too\\)"),
 ])
 def test_eval_points_bad_lines_name_file_and_line(tmp_path: Path, text: str, message: str) -> None:
     """`eval --points` files keep the input rules: never a truncated frame or id, nor a run over a stray frame."""

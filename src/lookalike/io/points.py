@@ -135,6 +135,12 @@ def read_id_points(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray
         return np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2))
     width = min(len(v) for _, v in parsed)
     data = np.array([v[:width] for _, v in parsed], dtype=float)
+    order = np.lexsort((data[:, 1], data[:, 0]))
+    twice = np.flatnonzero(np.all(np.diff(data[order, :2], axis=0) == 0, axis=1))
+    if len(twice):
+        first, second = sorted(parsed[int(order[k])][0] for k in (twice[0], twice[0] + 1))
+        raise ValueError(f"{path}:{second}: id {int(data[order[twice[0]], 1])} appears twice in frame "
+                         f"{int(data[order[twice[0]], 0])} (line {first} too)")
     if width < 7:
         return data[:, 0].astype(int), data[:, 1].astype(int), data[:, 2:4]
     bad = np.flatnonzero((data[:, 4:6] < 0).any(axis=1))
