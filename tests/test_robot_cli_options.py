@@ -91,3 +91,11 @@ def test_a_simulated_team_too_long_for_memory_names_duration(monkeypatch):
     monkeypatch.setattr(node, "team_sequence", too_big)
     result = CliRunner().invoke(app, ["robot-sim", "--robot", "1", "--duration", "1e9"])
     assert result.exit_code == 2 and "--duration 1e+09: the simulated sequence does not fit in memory" in result.output
+
+
+@pytest.mark.parametrize("option", [["--test", "."], ["--validation-fraction", "0.5"], ["--mix-sim", "0.2"]])
+def test_train_refuses_fine_tuning_options_without_recordings(tmp_path, option):
+    pytest.importorskip("torch", reason="train needs the 'train' extra")
+    result = CliRunner().invoke(app, ["train", "--steps", "1", *option, "-o", str(tmp_path / "run")])
+    assert result.exit_code == 2 and f"{option[0]}: only with --recordings" in result.output, result.output
+    assert not (tmp_path / "run").exists()

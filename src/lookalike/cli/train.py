@@ -113,12 +113,19 @@ def train(
     device = torch_device(device)  # every option checked before the output folder is made
     if protocol not in ("ours", "paper"):
         fail(f"--protocol: unknown protocol {protocol!r}; known: ours, paper")
-    check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)},
-                          [recordings, init_from, validation_folder], folders={"-o/--output"})
     if model not in ("lstm", "set"):
         fail(f"--model: unknown model {model!r}; known: lstm, set")
     if recordings is not None and search is not None:
         fail("--recordings and --search: choose one")
+    if recordings is None:
+        given = [name for name, value, default in (
+            ("--mix-sim", mix_sim, 0.0), ("--mix-sim-fit", mix_sim_fit, False),
+            ("--validation-fraction", validation_fraction, 0.25), ("--validation", validation_folder, None),
+            ("--test", test, None)) if value != default]
+        if given:
+            fail(f"{', '.join(given)}: only with --recordings (fine-tuning on labelled recordings)")
+    check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)},
+                          [recordings, init_from, validation_folder], folders={"-o/--output"})
     if search is not None:
         check_study_or_fail(study)
     run: dict[str, Any] = dict(  # the options every training run shares (cli.train_options.RunOptions)
