@@ -221,6 +221,11 @@ def test_fit_video_features_links_boxes_into_chains(diver_scene):
     r = runner.invoke(app, ["track", "--video", str(root / "divers.mp4"), "--detections", str(det),
                             "-o", str(root / "x.txt"), "--features", "nope"])
     assert r.exit_code == 2 and "--features" in r.output
+    one = root / "one.txt"
+    one.write_text("1,-1,0,0,5,5,1,-1,-1,-1\n")
+    r = runner.invoke(app, ["track", "--video", str(root / "divers.mp4"), "--detections", str(one), "-t",
+                            "diversort", "-o", str(root / "y.txt")])
+    assert r.exit_code == 2 and "one.txt: fewer than 2 boxes" in r.output, r.output
 
 
 def test_trackers_reading_no_appearance_get_no_features(diver_scene, tmp_path, monkeypatch):

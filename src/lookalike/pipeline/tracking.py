@@ -59,14 +59,15 @@ class VideoFeatures:
     link_iou: float = 0.6
 
     def fit(self, frames: Iterable[tuple[np.ndarray, np.ndarray | None]], boxes_total: int,
-            source: Path | str) -> HandcraftedFeatures:
+            source: Path | str, what: str = "detections") -> HandcraftedFeatures:
         """The features fitted on ``frames`` (per frame: its kept boxes ``(n, 4)`` px and their raw features, None
-        where not sampled; read once, in order) of ``source``, whose detections hold ``boxes_total`` kept boxes.
-        Only the sampled frames' features are kept (:meth:`blocks`)."""
+        where not sampled; read once, in order) of ``source``, whose detections (``what``: their file, for errors)
+        hold ``boxes_total`` kept boxes. Only the sampled frames' features are kept (:meth:`blocks`)."""
         if self.max_crops < 2:
             raise ValueError(f"max_crops: must be >= 2, got {self.max_crops}")
         if boxes_total < 2:
-            raise ValueError("detections: fewer than 2 boxes to standardise the appearance features on")
+            raise ValueError(f"{what}: fewer than 2 boxes (scoring at least --min-score) to standardise the "
+                             "appearance features on")
         blocks = self.blocks(boxes_total)
         raws, labels = [], []
         prev_boxes, prev_labels, next_label = np.zeros((0, 4)), np.zeros(0, dtype=int), 0
@@ -86,7 +87,7 @@ class VideoFeatures:
             prev_boxes, prev_labels = boxes, lab
         raw_all = np.vstack(raws) if raws else np.zeros((0, RAW_DIM))
         if len(raw_all) < 2:
-            raise ValueError(f"detections: fewer than 2 boxes fall on the frames of {source}")
+            raise ValueError(f"{what}: fewer than 2 boxes fall on the frames of {source}")
         label = np.concatenate(labels)
         ids, counts = np.unique(label, return_counts=True)
         chained = np.isin(label, ids[counts >= 2])
@@ -100,6 +101,11 @@ class VideoFeatures:
     def blocks(self, boxes_total: int) -> int:
         """One block of 10 frames in this many is sampled, for ``boxes_total`` boxes."""
         return max(int(np.ceil(boxes_total / self.max_crops)), 1)
+
+
+def _name(detections: MotTable | None) -> str:
+    """The detections' file for errors ("detections" when read from elsewhere)."""
+    return str(detections.path) if detections is not None and detections.path is not None else "detections"
 
 
 def fit_video_features(source: Path | str, detections: MotTable, *, min_score: float = -np.inf,
@@ -117,7 +123,7 @@ def fit_video_features(source: Path | str, detections: MotTable, *, min_score: f
             sampled = not (k // 10) % blocks and len(boxes)
             yield boxes, raw_features(crop_boxes(image, boxes, crop_px)) if sampled else None
 
-    return spec.fit(read(), len(frames), source)
+    return spec.fit(read(), len(frames), source, _name(detections))
 
 
 def source_frame_rate(source: Path | str) -> float | None:
@@ -183,7 +189,7 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
         fitted = isinstance(extractor, VideoFeatures)
         counted = None if detect is not None else int((detections.conf >= min_score).sum())
         stream = _fitted_in_pass(extractor, detected(), opened.enter_context(FrameSpill()), source, counted,
-                                 current, advance, annotate) if fitted else detected()
+                                 current, advance, annotate, _name(detections)) if fitted else detected()
         for k, (image, det) in enumerate(stream):
             t0 = time.perf_counter()
             feats = None if extractor is None else current["extractor"].normalise(det.feature) if fitted else (
@@ -226,8 +232,8 @@ def track_video(source: Path | str, detections: MotTable, tracker: Any, extracto
 
 def _fitted_in_pass(spec: VideoFeatures, detected: Iterable[tuple[np.ndarray | None, Detections]],
                     spill: FrameSpill, source: Path | str, counted: int | None, current: dict[str, Any],
-                    advance: Callable[[], None] | None,
-                    annotate: Path | str | None) -> Iterator[tuple[np.ndarray | None, Detections]]:
+                    advance: Callable[[], None] | None, annotate: Path | str | None,
+                    what: str) -> Iterator[tuple[np.ndarray | None, Detections]]:
     """The frames and detections of ``detected`` (their raw features as ``feature``) once every frame is read and
     ``spec`` fitted on them (``current["extractor"]``; ``counted``: the kept boxes of the whole detection table, None:
     those detected); the frames decoded again only to ``annotate``. Every frame's detections (boxes, scores, ...)
@@ -241,7 +247,7 @@ def _fitted_in_pass(spec: VideoFeatures, detected: Iterable[tuple[np.ndarray | N
         if advance is not None:
             advance()
     total = spill.boxes if counted is None else counted
-    current["extractor"] = spec.fit(((det.xywh, det.feature) for det in spill.read()), total, source)
+    current["extractor"] = spec.fit(((det.xywh, det.feature) for det in spill.read()), total, source, what)
     images = source_frames(source)[0] if annotate is not None else itertools.repeat(None)
     for det, image in zip(spill.read(), images):
         yield image, det
