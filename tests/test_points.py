@@ -159,3 +159,15 @@ def test_closed_set_tracks_anonymous_points_better_than_online() -> None:
                                        radius=10.0, num_frames=len(pts))["IDF1"]
     assert scores["offline"] > 0.95
     assert scores["offline"] >= scores["online"]
+
+
+def test_read_points_csv_takes_x_and_y_named_by_its_header(tmp_path: Path) -> None:
+    # simulate --arena writes points.csv as frame,id,x,y: the id column was read as x and x as y
+    p = tmp_path / "points.csv"
+    p.write_text("frame,id,x,y\n1,7,10.5,20.5\n1,8,30,40\n2,7,11,21\n")
+    pf = read_points_csv(p)
+    np.testing.assert_array_equal(pf.points[0], [[10.5, 20.5], [30, 40]])
+    np.testing.assert_array_equal(pf.points[1], [[11, 21]])
+    q = tmp_path / "yx.csv"
+    q.write_text("frame,y,x\n1,2,3\n")
+    np.testing.assert_array_equal(read_points_csv(q).points[0], [[3, 2]])

@@ -95,12 +95,29 @@ def _group(path: Path, frames: np.ndarray, xy: np.ndarray, n_frames: int | None)
     return PointFrames([xy[bounds[k]:bounds[k + 1]].copy() for k in range(length)], path)
 
 
+def _xy_columns(path: Path) -> tuple[int, int]:
+    """The columns of x and y in a points CSV: those its header names ``x`` and ``y`` (as ``frame,id,x,y``), else 1
+    and 2."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            text = next((t for t in map(str.strip, fh) if t and not t.startswith("#")), "")
+    except OSError:
+        return 1, 2  # (reading the file again names the problem)
+    names = [f.strip().lower() for f in text.split(",")]
+    if "x" in names and "y" in names and min(names.index("x"), names.index("y")) > 0:
+        return names.index("x"), names.index("y")
+    return 1, 2
+
+
 def read_points_csv(path: str | os.PathLike[str], n_frames: int | None = None) -> PointFrames:
-    """Points from a ``frame,x,y`` CSV (optional header, extra columns ignored), padded to ``n_frames``."""
+    """Points from a ``frame,x,y`` CSV (optional header; a header naming ``x`` and ``y`` elsewhere, as
+    ``frame,id,x,y``, picks those columns; extra columns ignored), padded to ``n_frames``."""
     path = Path(path)
-    parsed = _parse(path, 3)
-    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 3)
-    return _group(path, data[:, 0].astype(int), data[:, 1:3], n_frames)
+    x, y = _xy_columns(path) if path.is_file() else (1, 2)
+    width = max(x, y, 2) + 1
+    parsed = _parse(path, width)
+    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, width)
+    return _group(path, data[:, 0].astype(int), data[:, [x, y]], n_frames)
 
 
 def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *,
