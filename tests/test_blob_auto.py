@@ -109,3 +109,19 @@ def test_estimate_reports_its_steps_and_gives_the_same_settings() -> None:
     with_bar = estimate_blob_config(frames, progress=progress)
     assert len(bars) == 1 and len(steps) == bars[0][1]  # every step of the declared total, no more
     assert with_bar == estimate_blob_config(frames)
+
+
+def test_image_folder_whose_frames_change_size_is_refused_naming_the_image(tmp_path):
+    # numpy's "all input arrays must have the same shape" named no input
+    import cv2
+
+    from lookalike.io.video_frames import source_frames
+    from lookalike.vision.blob_auto import sample_frames
+
+    for k in range(6):
+        size = (40, 50) if k < 4 else (48, 60)
+        cv2.imwrite(str(tmp_path / f"{k + 1:06d}.png"), np.full((*size, 3), 200, np.uint8))
+    with pytest.raises(ValueError, match=r"000005\.png is 60x48 px, the folder's first image 50x40"):
+        sample_frames(tmp_path, 25)
+    with pytest.raises(ValueError, match=r"000005\.png is 60x48 px, the folder's first image 50x40"):
+        list(source_frames(tmp_path)[0])

@@ -27,10 +27,15 @@ def source_frames(source: Path | str) -> tuple[Iterator[np.ndarray], int, float]
             raise ValueError(f"video: folder {p} holds no images ({', '.join(IMAGE_SUFFIXES)})")
 
         def images() -> Iterator[np.ndarray]:
+            first = None
             for q in paths:
                 img = cv2.imread(str(q), cv2.IMREAD_COLOR)
                 if img is None:
                     raise ValueError(f"video: cannot read image {q}")
+                first = img.shape if first is None else first
+                if img.shape != first:
+                    raise ValueError(f"video: {q} is {img.shape[1]}x{img.shape[0]} px, the folder's first image "
+                                     f"{first[1]}x{first[0]}; every frame needs one size")
                 yield img
 
         return images(), len(paths), 30.0

@@ -94,6 +94,9 @@ def sample_frames(video: str | Path, count: int) -> list[np.ndarray]:
             image = cv2.imread(str(paths[i]), cv2.IMREAD_COLOR)
             if image is None:
                 raise ValueError(f"video: {paths[i]} is not a readable image")
+            if images and image.shape != images[0].shape:
+                raise ValueError(f"video: {paths[i]} is {image.shape[1]}x{image.shape[0]} px, the folder's first "
+                                 f"image {images[0].shape[1]}x{images[0].shape[0]}; every frame needs one size")
             images.append(image)
         if not images:
             raise ValueError(f"video: folder {folder} holds no readable images ({', '.join(_IMAGE_SUFFIXES)})")
