@@ -133,6 +133,15 @@ def test_bad_input_is_refused() -> None:
     assert assign_identities(np.zeros((0, 10)), 2, FPS).shape == (0, 10)
 
 
+@pytest.mark.parametrize("rate", [0.0, -1.0, float("nan"), float("inf")])
+def test_a_frame_rate_not_above_zero_or_not_finite_is_refused(rate: float) -> None:
+    # 0 ended in ZeroDivisionError, NaN in a message about Frame.time, infinity was taken
+    _, det = _crossing(frames=12, hidden=0)
+    for call in (lambda: track_closed_set(det, 2, rate), lambda: assign_identities(online_rows(det, FPS), 2, rate)):
+        with pytest.raises(ValueError, match="frame_rate must be > 0 frames/s"):
+            call()
+
+
 def test_a_broken_track_stays_one_identity_when_identities_are_spare() -> None:
     """Two targets, N = 3: one target's track breaks for 6 frames; starting a spare identity mid-video costs
     ``edge_cost``, so the motion-consistent link wins and the target keeps one identity."""
