@@ -133,6 +133,19 @@ def test_bad_input_is_refused() -> None:
     assert assign_identities(np.zeros((0, 10)), 2, FPS).shape == (0, 10)
 
 
+@pytest.mark.parametrize("column, value", [(4, np.nan), (2, np.inf), (0, 0.0), (0, 2.5)])
+def test_a_row_with_a_nan_box_or_a_bad_frame_is_refused_naming_it(column: int, value: float) -> None:
+    # a NaN width came out as NaN rows; frame 0 or 2.5 was dropped without a word
+    _, det = _crossing(frames=12, hidden=0)
+    det[3, column] = value
+    with pytest.raises(ValueError, match=r"rows\[3\]: needs a whole frame >= 1 and a finite id and box"):
+        track_closed_set(det, 2, FPS)
+    result = online_rows(np.delete(det, 3, axis=0), FPS)
+    result[3, column] = value
+    with pytest.raises(ValueError, match=r"rows\[3\]"):
+        assign_identities(result, 2, FPS)
+
+
 @pytest.mark.parametrize("rate", [0.0, -1.0, float("nan"), float("inf")])
 def test_a_frame_rate_not_above_zero_or_not_finite_is_refused(rate: float) -> None:
     # 0 ended in ZeroDivisionError, NaN in a message about Frame.time, infinity was taken

@@ -47,9 +47,16 @@ def row_sizes(rows: np.ndarray) -> np.ndarray:
 
 
 def checked_rows(rows: np.ndarray) -> np.ndarray:
+    """``rows`` as float MOTChallenge rows ``(k, 10)`` (missing columns -1); ``ValueError`` for another shape or a row
+    whose frame is not a whole number >= 1 or whose id or box (pixels) is not finite."""
     arr = np.asarray(rows, dtype=float)
     if arr.ndim != 2 or (arr.size and arr.shape[1] < 6):
         raise ValueError(f"rows: expected MOTChallenge rows (k, >=6), got shape {arr.shape}")
+    bad = np.flatnonzero(~np.isfinite(arr[:, :6]).all(axis=1) | (arr[:, 0] < 1) | (arr[:, 0] % 1 != 0)) \
+        if arr.size else []
+    if len(bad):
+        raise ValueError(f"rows[{bad[0]}]: needs a whole frame >= 1 and a finite id and box, got "
+                         f"{arr[bad[0], :6].tolist()}")
     if arr.size and arr.shape[1] < 10:
         arr = np.hstack([arr, np.full((len(arr), 10 - arr.shape[1]), -1.0)])
     return arr.reshape(-1, 10) if not arr.size else arr
