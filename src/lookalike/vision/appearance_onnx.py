@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.vision.appearance import crop_boxes
-from lookalike.vision.onnx_session import open_session
+from lookalike.vision.onnx_session import check_image_input, open_session
 
 LEARNED_MODEL = Path(__file__).parent / "models_data" / "diver_reid.onnx"
 
@@ -22,13 +22,7 @@ class OnnxAppearance:
         inputs, outputs = self.session.get_inputs(), self.session.get_outputs()
         if len(inputs) != 1 or len(inputs[0].shape) != 4 or len(outputs[0].shape) != 2:
             raise ValueError(f"{self.path}: expected crops (n, 3, h, w) in and embeddings (n, d) out")
-        channels = inputs[0].shape[1]
-        if isinstance(channels, int) and channels != 3:
-            raise ValueError(f"{self.path}: the crop input has {channels} channel(s) {inputs[0].shape}; lookalike "
-                             "feeds 3 (BGR)")
-        if inputs[0].type != "tensor(float)":
-            raise ValueError(f"{self.path}: the crop input is {inputs[0].type}; lookalike feeds tensor(float) "
-                             "(BGR in [0, 1])")
+        check_image_input(self.path, inputs[0], "crop", "BGR in [0, 1]")
         _, _, h, w = inputs[0].shape
         self.crop_size = (w, h) if isinstance(w, int) and isinstance(h, int) else (64, 32)
         d = outputs[0].shape[1]

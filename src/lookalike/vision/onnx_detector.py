@@ -17,7 +17,7 @@ from lookalike._optional import needs
 from lookalike.types import Detections
 from lookalike.types.mot_table import detection_rows
 from lookalike.vision.nms import nms
-from lookalike.vision.onnx_session import open_session
+from lookalike.vision.onnx_session import check_image_input, open_session
 
 LAYOUTS = ("auto", "yolo", "yolo-obj", "ssd")
 
@@ -113,13 +113,7 @@ class OnnxDetector:
         if len(inp) != 1 or len(inp[0].shape) != 4:
             raise ValueError(f"{self.path}: expected one NCHW image input, got {[i.shape for i in inp]}")
         self.input_name = inp[0].name
-        channels = inp[0].shape[1]
-        if isinstance(channels, int) and channels != 3:
-            raise ValueError(f"{self.path}: the image input has {channels} channel(s) {inp[0].shape}; lookalike "
-                             "feeds 3 (RGB, or BGR with rgb=0)")
-        if inp[0].type != "tensor(float)":
-            raise ValueError(f"{self.path}: the image input is {inp[0].type}; lookalike feeds tensor(float) "
-                             "(pixels times scale=...)")
+        check_image_input(self.path, inp[0], "image", "RGB, or BGR with rgb=0, pixels times scale=...")
         h, w = inp[0].shape[2:]
         if isinstance(h, int) and isinstance(w, int):
             self.input_size = (w, h)

@@ -53,7 +53,7 @@ def checked_rows(rows: np.ndarray) -> np.ndarray:
     if arr.ndim != 2 or (arr.size and arr.shape[1] < 6):
         raise ValueError(f"rows: expected MOTChallenge rows (k, >=6), got shape {arr.shape}")
     bad = np.flatnonzero(~np.isfinite(arr[:, :6]).all(axis=1) | (arr[:, 0] < 1) | (arr[:, 0] % 1 != 0)) \
-        if arr.size else []
+        if arr.size else np.zeros(0, int)
     if len(bad):
         raise ValueError(f"rows[{bad[0]}]: needs a whole frame >= 1 and a finite id and box, got "
                          f"{arr[bad[0], :6].tolist()}")
