@@ -155,3 +155,18 @@ def test_bad_inputs_name_file_and_line(tmp_path: Path) -> None:
         evaluate_sequence(read_mot(gt_path), read_mot(late), metrics=("MOTA!",))
     with pytest.raises(ValueError, match="iou_threshold"):
         evaluate_sequence(read_mot(gt_path), read_mot(late), iou_threshold=1.5)
+
+
+def test_similarities_refuse_rows_of_another_width() -> None:
+    from lookalike.eval import box_iou, point_similarity
+
+    # (2, 6) holds 12 numbers: read as (3, 4) boxes it gave three rows of nonsense instead of an error.
+    with pytest.raises(ValueError, match=r"gt_xywh: expected shape \(k, 4\), got \(2, 6\)"):
+        box_iou(np.zeros((2, 6)), np.ones((1, 4)))
+    with pytest.raises(ValueError, match="tr_xy: expected shape"):
+        point_similarity(np.zeros((1, 2)), np.zeros((2, 3)), 1.0)
+    with pytest.raises(ValueError, match="result_xy: expected shape"):
+        evaluate_points([1, 1, 2], [1, 2, 1], [[0, 0]] * 3, [1, 1, 2], [4, 5, 4], np.zeros((2, 3)), radius=1.0)
+    # one box or point as a flat row, and empty input, are still taken
+    assert box_iou(np.array(A), np.array([A, FAR])).tolist() == [[1.0, 0.0]]
+    assert point_similarity(np.zeros(0), np.zeros((1, 2)), 1.0).shape == (0, 1)

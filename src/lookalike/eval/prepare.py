@@ -12,7 +12,7 @@ import numpy as np
 
 from lookalike.eval.data import Pairs, SequenceData
 from lookalike.eval.matching import conflicted_frames, negated_matrices, solve_matrices
-from lookalike.eval.similarity import pair_iou, point_similarity
+from lookalike.eval.similarity import pair_iou, point_similarity, rows_of
 from lookalike.types.mot_table import MotTable as MotTableData
 
 
@@ -242,7 +242,7 @@ def _per_frame(gt: MotTable, res: MotTable, n: int, sim_fn: Callable[..., np.nda
 def _point_table(frame: np.ndarray, ids: np.ndarray, xy: np.ndarray, name: str) -> MotTable:
     frame = np.asarray(frame).astype(int).ravel()
     ids = np.asarray(ids).astype(int).ravel()
-    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    xy = rows_of(xy, 2, f"{name}_xy")
     if not len(frame) == len(ids) == len(xy):
         raise ValueError(f"{name}: frame, id and xy lengths differ ({len(frame)}, {len(ids)}, {len(xy)})")
     if len(frame) and (frame.min() < 1 or not np.isfinite(xy).all()):

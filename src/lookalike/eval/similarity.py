@@ -8,8 +8,18 @@ import numpy as np
 _EPS = np.finfo(float).eps
 
 
+def rows_of(values: np.ndarray, width: int, name: str) -> np.ndarray:
+    """``values`` as float rows ``(k, width)`` (one row ``(width,)`` too); ``ValueError`` naming ``name`` for another
+    shape, which a reshape would otherwise cut into rows of the wrong values."""
+    a = np.asarray(values, dtype=float)
+    if a.ndim > 2 or (a.size and a.shape[-1] != width):
+        raise ValueError(f"{name}: expected shape (k, {width}), got {a.shape}")
+    return a.reshape(-1, width)
+
+
 def box_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
-    """IoU ``(n, m)`` of ``(n, 4)`` and ``(m, 4)`` xywh boxes (px); 0 for zero area or no union."""
+    """IoU ``(n, m)`` of ``(n, 4)`` and ``(m, 4)`` xywh boxes (px); 0 for zero area or no union; ``ValueError`` naming
+    the argument of another shape."""
     return _corner_iou(gt_xywh, tr_xywh, outer=True)
 
 
@@ -20,8 +30,8 @@ def pair_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
 
 def _corner_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray, outer: bool) -> np.ndarray:
     """IoU through corner coordinates: of every pair ``(n, m)`` (``outer``), or of row ``i`` with row ``i``."""
-    a = np.asarray(gt_xywh, dtype=float).reshape(-1, 4)
-    b = np.asarray(tr_xywh, dtype=float).reshape(-1, 4)
+    a = rows_of(gt_xywh, 4, "gt_xywh")
+    b = rows_of(tr_xywh, 4, "tr_xywh")
     ax0, ay0 = a[:, 0], a[:, 1]
     ax1, ay1 = ax0 + a[:, 2], ay0 + a[:, 3]
     bx0, by0 = b[:, 0], b[:, 1]
@@ -42,11 +52,12 @@ def _corner_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray, outer: bool) -> np.nda
 
 
 def point_similarity(gt_xy: np.ndarray, tr_xy: np.ndarray, radius: float) -> np.ndarray:
-    """Distance score ``(n, m)`` of ``(n, 2)`` and ``(m, 2)`` points: ``max(0, 1 - d / (2 * radius))``."""
+    """Distance score ``(n, m)`` of ``(n, 2)`` and ``(m, 2)`` points: ``max(0, 1 - d / (2 * radius))``; ``ValueError``
+    naming the argument of another shape."""
     if not radius > 0:
         raise ValueError(f"radius must be positive, got {radius}")
-    a = np.asarray(gt_xy, dtype=float).reshape(-1, 2)
-    b = np.asarray(tr_xy, dtype=float).reshape(-1, 2)
+    a = rows_of(gt_xy, 2, "gt_xy")
+    b = rows_of(tr_xy, 2, "tr_xy")
     d = np.sqrt(((a[:, None, :] - b[None, :, :]) ** 2).sum(axis=-1))
     result: np.ndarray = np.maximum(0.0, 1.0 - d / (2.0 * radius))
     return result
