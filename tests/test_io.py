@@ -24,6 +24,21 @@ def test_read_detection_file(tmp_path):
     assert len(list(frames_from_table(t, min_score=0.6))[2].detections) == 0
 
 
+@pytest.mark.parametrize("kwargs, message", [
+    ({"frame_rate": float("nan")}, "frame_rate must be a finite number above 0"),
+    ({"frame_rate": float("inf")}, "frame_rate must be a finite number above 0"),  # every frame was at time 0
+    ({"frame_rate": 0.0}, "frame_rate"),
+    ({"length": 2.5}, "length must be a whole number"),  # a TypeError from range()
+    ({"length": -2}, "length must be a whole number"),  # no frames, silently
+    ({"min_score": float("nan")}, "min_score"),  # every detection dropped, silently
+])
+def test_frames_from_table_refuses_bad_arguments(tmp_path, kwargs, message):
+    t = read_mot(_write(tmp_path / "det.txt", "1,-1,10,20,30,40,0.9,-1,-1,-1\n"))
+    with pytest.raises(ValueError, match=message):
+        list(frames_from_table(t, **kwargs))
+    assert len(list(frames_from_table(t, length=np.int64(2), frame_rate=25))) == 2
+
+
 def test_read_gt_with_class_and_visibility(tmp_path):
     p = _write(tmp_path / "gt.txt", "1,1,10,20,30,40,1,1,0.8\n1,2,0,0,5,5,0,7,1.0\n")
     t = read_mot(p)

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Iterable, Iterator
@@ -120,9 +121,14 @@ def frames_from_table(
     table: MotTable, length: int | None = None, frame_rate: float = 30.0, min_score: float = -np.inf
 ) -> Iterator[Frame]:
     """One :class:`Frame` per frame ``0 .. length-1`` (file frame ``k`` is index ``k-1``; ``time = index /
-    frame_rate``), boxes scored below ``min_score`` dropped."""
-    if frame_rate <= 0:
-        raise ValueError(f"frame_rate must be positive, got {frame_rate}")
+    frame_rate``), boxes scored below ``min_score`` dropped. ``ValueError`` for a ``frame_rate`` that is not a finite
+    number above 0 (frames per second), a ``length`` that is not a whole number >= 0, or a NaN ``min_score``."""
+    if not (math.isfinite(frame_rate) and frame_rate > 0):
+        raise ValueError(f"frame_rate must be a finite number above 0 (frames per second), got {frame_rate}")
+    if length is not None and not (isinstance(length, (int, np.integer)) and length >= 0):
+        raise ValueError(f"length must be a whole number of frames >= 0, got {length!r}")
+    if math.isnan(min_score):
+        raise ValueError("min_score must be a number, got nan")
     if length is None:
         length = int(table.frame.max()) if len(table) else 0
     keep = table.conf >= min_score
