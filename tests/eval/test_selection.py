@@ -41,3 +41,13 @@ def test_ties_choose_the_first_candidate_and_bad_shapes_are_refused() -> None:
         leave_one_out([[HALF, HALF], [HALF]])
     with pytest.raises(ValueError, match="at least one"):
         leave_one_out([])
+
+
+def test_missing_scores_are_named() -> None:
+    # a dict without the criterion's metrics, or results of different kinds, ended in a KeyError
+    with pytest.raises(ValueError, match="scores: lacks 'HOTA'"):
+        headline({"IDF1": 1.0, "MOTA": 1.0})
+    with pytest.raises(ValueError, match="scores: lacks"):
+        leave_one_out([[{}, {}]])
+    with pytest.raises(ValueError, match="per_sequence: a result lacks 'Dets'"):
+        combine([PERFECT, {}])

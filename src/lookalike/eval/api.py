@@ -82,6 +82,8 @@ def combine(per_sequence: list[dict[str, float]]) -> dict[str, float]:
     out: dict[str, float] = {}
     for f in COUNT_FIELDS:
         if f in first:
+            if any(f not in r for r in per_sequence):
+                raise ValueError(f"per_sequence: a result lacks {f!r}")
             out[f] = sum(r[f] for r in per_sequence)
     if "HOTA_TP___5" in first:
         out.update(hota.flatten(hota.hota_final(hota.hota_combine([hota.unflatten(r) for r in per_sequence]))))

@@ -8,8 +8,12 @@ from lookalike.eval.api import combine
 
 
 def headline(scores: dict[str, float]) -> float:
-    """HOTA + IDF1 + MOTA: the criterion lookalike's benchmarks choose parameters by."""
-    return scores["HOTA"] + scores["IDF1"] + scores["MOTA"]
+    """HOTA + IDF1 + MOTA: the criterion lookalike's benchmarks choose parameters by; ``ValueError`` naming a missing
+    one."""
+    try:
+        return scores["HOTA"] + scores["IDF1"] + scores["MOTA"]
+    except KeyError as exc:
+        raise ValueError(f"scores: lacks {exc.args[0]!r} (headline needs HOTA, IDF1 and MOTA)") from None
 
 
 def leave_one_out(scores: Sequence[Sequence[dict[str, float]]],
