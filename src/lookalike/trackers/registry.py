@@ -83,7 +83,8 @@ def _config_class(name: str) -> Any:
 
 
 def tracker_parameters(name: str) -> list[ParameterInfo]:
-    """The parameters of tracker ``name`` with their defaults and descriptions."""
+    """The parameters of tracker ``name`` with their defaults and descriptions (``KeyError`` for an unknown
+    ``name``, as :func:`tracker_class`)."""
     from lookalike.trackers.base import field_specs
 
     config_cls = _config_class(name)
@@ -96,7 +97,8 @@ def tracker_parameters(name: str) -> list[ParameterInfo]:
 def make_tracker(name: str, **params: Any) -> Any:
     """Build tracker ``name`` with config overrides; an unknown parameter, or a value outside its
     declared type, range or choices (:func:`~lookalike.trackers.base.param`), raises ``ValueError``
-    (``TypeError`` for a wrong type) in one line naming the tracker and the parameter."""
+    (``TypeError`` for a wrong type) in one line naming the tracker and the parameter. An unknown
+    ``name`` raises ``KeyError`` listing the known ones (:func:`tracker_class`)."""
     from lookalike.trackers.base import check_value, field_specs
 
     config_cls = _config_class(name)
