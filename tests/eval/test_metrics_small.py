@@ -170,3 +170,16 @@ def test_similarities_refuse_rows_of_another_width() -> None:
     # one box or point as a flat row, and empty input, are still taken
     assert box_iou(np.array(A), np.array([A, FAR])).tolist() == [[1.0, 0.0]]
     assert point_similarity(np.zeros(0), np.zeros((1, 2)), 1.0).shape == (0, 1)
+
+
+def test_points_refuse_frames_and_ids_that_are_not_whole() -> None:
+    # frame 1.5 was truncated to frame 1 and id 2.7 to id 2: scored as if they were those
+    with pytest.raises(ValueError, match=r"gt_frame\[0\]: 1.5 is not a whole number"):
+        evaluate_points([1.5], [1], [[0, 0]], [1], [1], [[0, 0]], radius=1.0)
+    with pytest.raises(ValueError, match=r"result_id\[1\]: 2.7 is not a whole number"):
+        evaluate_points([1], [1], [[0, 0]], [1, 1], [1, 2.7], [[0, 0], [5, 5]], radius=1.0)
+    with pytest.raises(ValueError, match=r"result_frame\[0\]: nan"):
+        evaluate_points([1], [1], [[0, 0]], [np.nan], [1], [[0, 0]], radius=1.0)
+    # whole numbers held as floats are taken as before
+    r = evaluate_points(np.array([1.0]), np.array([1.0]), [[0, 0]], [1], [1], [[0, 0]], radius=1.0)
+    assert r["CLR_TP"] == 1

@@ -239,9 +239,20 @@ def _per_frame(gt: MotTable, res: MotTable, n: int, sim_fn: Callable[..., np.nda
     return _finish(gt_ids, tr_ids, sims)
 
 
+def _whole(values: np.ndarray, name: str) -> np.ndarray:
+    """``values`` as integers; ``ValueError`` naming ``name`` and the first value that is not a whole number."""
+    raw = np.asarray(values).ravel()
+    if raw.size and not np.issubdtype(raw.dtype, np.integer):
+        v = raw.astype(float)
+        bad = np.flatnonzero(~np.isfinite(v) | (np.floor(v) != v))
+        if len(bad):
+            raise ValueError(f"{name}[{bad[0]}]: {raw[bad[0]]} is not a whole number")
+    return raw.astype(int)
+
+
 def _point_table(frame: np.ndarray, ids: np.ndarray, xy: np.ndarray, name: str) -> MotTable:
-    frame = np.asarray(frame).astype(int).ravel()
-    ids = np.asarray(ids).astype(int).ravel()
+    frame = _whole(frame, f"{name}_frame")
+    ids = _whole(ids, f"{name}_id")
     xy = rows_of(xy, 2, f"{name}_xy")
     if not len(frame) == len(ids) == len(xy):
         raise ValueError(f"{name}: frame, id and xy lengths differ ({len(frame)}, {len(ids)}, {len(xy)})")
