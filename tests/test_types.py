@@ -111,3 +111,16 @@ def test_tracks_batch_reads_like_a_list_of_snapshots_and_writes_rows() -> None:
         tracks[2]
     with pytest.raises(ValueError):
         Tracks(np.array([1, 2]), TrackStatus.CONFIRMED, xywh=np.zeros((1, 4)))
+
+
+def test_tracks_columns_of_another_length_or_status_code_are_named() -> None:
+    from lookalike.types import Tracks
+
+    # a numpy reshape error that named no column, or (status 5) an IndexError when the statuses were read
+    with pytest.raises(ValueError, match="Tracks.status: has 1 values but the batch has 2"):
+        Tracks(np.array([1, 2]), np.array([0]), xywh=np.zeros((2, 4)))
+    with pytest.raises(ValueError, match="Tracks.detection_index: has 3 values"):
+        Tracks(np.array([1, 2]), np.array([0, 1]), detection_index=np.array([0, 1, 2]))
+    with pytest.raises(ValueError, match=r"Tracks.status: codes are 0 .* got \[1, 5\]"):
+        Tracks(np.array([1, 2]), np.array([1, 5]))
+    assert Tracks(np.array([[3]]), [2]).statuses()[0].value == "lost"

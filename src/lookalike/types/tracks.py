@@ -49,6 +49,14 @@ _STATUS = (TrackStatus.TENTATIVE, TrackStatus.CONFIRMED, TrackStatus.LOST)
 _STATUS_CODE = {s: i for i, s in enumerate(_STATUS)}
 
 
+def _column(name: str, values: np.ndarray, dtype: type, k: int) -> np.ndarray:
+    """``values`` as ``(k,)`` of ``dtype``; ``ValueError`` naming ``Tracks.<name>`` for another number of values."""
+    column = np.asarray(values, dtype=dtype)
+    if column.size != k:
+        raise ValueError(f"Tracks.{name}: has {column.size} values but the batch has {k}")
+    return column.reshape(k)
+
+
 class Tracks(Sequence[TrackSnapshot]):
     """The tracks a tracker reports for one frame, as columns; iterating or indexing gives :class:`TrackSnapshot`s.
 
@@ -75,11 +83,14 @@ class Tracks(Sequence[TrackSnapshot]):
         if isinstance(status, TrackStatus):
             self.status = np.full(k, _STATUS_CODE[status], dtype=np.int8)
         else:
-            self.status = np.asarray(status, dtype=np.int8).reshape(k)
+            self.status = _column("status", status, np.int8, k)
+            if ((self.status < 0) | (self.status >= len(_STATUS))).any():
+                raise ValueError(f"Tracks.status: codes are 0 (tentative), 1 (confirmed) or 2 (lost), got "
+                                 f"{sorted(set(self.status.tolist()))}")
         self.xywh, self.position, self.velocity, self.heading = xywh, position, velocity, heading
         self.agent_id, self.identity_prob = agent_id, identity_prob
         self.detection_index = (np.full(k, -1, dtype=int) if detection_index is None
-                                else np.asarray(detection_index, dtype=int).reshape(k))
+                                else _column("detection_index", detection_index, int, k))
         for name in ("xywh", "position", "velocity", "heading", "agent_id", "identity_prob"):
             col = getattr(self, name)
             if col is not None and len(col) != k:
