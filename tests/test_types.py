@@ -124,3 +124,11 @@ def test_tracks_columns_of_another_length_or_status_code_are_named() -> None:
     with pytest.raises(ValueError, match=r"Tracks.status: codes are 0 .* got \[1, 5\]"):
         Tracks(np.array([1, 2]), np.array([1, 5]))
     assert Tracks(np.array([[3]]), [2]).statuses()[0].value == "lost"
+
+
+@pytest.mark.parametrize("index, time, field", [("a", 0.0, "Frame.index"), (None, 0.0, "Frame.index"),
+                                                (0, None, "Frame.time"), (0, "soon", "Frame.time")])
+def test_frame_names_an_index_or_time_that_is_no_number(index, time, field) -> None:
+    # a TypeError from float(None), or int()'s "invalid literal" naming no field
+    with pytest.raises(ValueError, match=field):
+        Frame(index=index, time=time)

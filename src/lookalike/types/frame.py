@@ -29,9 +29,17 @@ class Frame:
     image: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        if int(self.index) != self.index or self.index < 0:
+        try:
+            index_ok = int(self.index) == self.index and self.index >= 0
+        except (TypeError, ValueError):
+            index_ok = False
+        if not index_ok:
             raise ValueError(f"Frame.index: expected a non-negative integer, got {self.index!r}")
-        if not math.isfinite(float(self.time)):
+        try:
+            time_ok = math.isfinite(float(self.time))
+        except (TypeError, ValueError):
+            time_ok = False
+        if not time_ok:
             raise ValueError(f"Frame.time: expected a finite number of seconds, got {self.time!r}")
         if not isinstance(self.detections, Detections):
             raise ValueError(f"Frame.detections: expected Detections, got {type(self.detections).__name__}")
