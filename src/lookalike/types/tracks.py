@@ -51,7 +51,7 @@ _STATUS_CODE = {s: i for i, s in enumerate(_STATUS)}
 
 def _column(name: str, values: np.ndarray, dtype: type, k: int) -> np.ndarray:
     """``values`` as ``(k,)`` of ``dtype``; ``ValueError`` naming ``Tracks.<name>`` for another number of values."""
-    column = np.asarray(values, dtype=dtype)
+    column: np.ndarray = np.asarray(values, dtype=dtype)
     if column.size != k:
         raise ValueError(f"Tracks.{name}: has {column.size} values but the batch has {k}")
     return column.reshape(k)
