@@ -123,3 +123,15 @@ def test_file_and_video_runs_announce_their_length_to_boxtrack(scene, tmp_path, 
     run(TrackRequest(tmp_path / "f.txt", "boxtrack", path=det, min_score=0.5), lambda e: None)
     run(TrackRequest(tmp_path / "v.txt", "boxtrack", video=str(video), detections=det), lambda e: None)
     assert heard == [FRAMES + 5, 0, FRAMES]  # (a lone file's length is unknown until read: 0, nothing decided)
+
+
+def test_a_video_too_short_for_the_offline_closed_set_says_the_online_one_was_written(tmp_path):
+    from lookalike.pipeline.closed import offline_video
+
+    det = np.array([[1, -1, 10 + 30 * k, 20, 12, 12, 0.9, -1, -1, -1] for k in range(2)], float)  # one frame
+    events: list[Event] = []
+    offline_video(det, tmp_path / "o.txt", 2, {}, 10.0, 1, 0.0, events.append)
+    lines = [e.text for e in events if e.kind == "line"]
+    result = next(e.text for e in events if e.kind == "result")
+    assert any("online closed set's result" in text for text in lines), lines
+    assert result.startswith(", online closed set (the note above) of 2:"), result

@@ -119,13 +119,20 @@ def offline_video(det: Path | np.ndarray, output: Path, n_targets: int, params: 
     what it does told to ``on_event``; returns the written rows' look margins as ``(frame, id, margin)`` rows where
     the closed set learned a look, else None. ``ValueError`` for a bad input or video."""
     line = telling(on_event, "line")
+    fell_back: list[str] = []  # the note of a fall-back to the online closed set, if any
+
+    def noted(text: str) -> None:
+        fell_back.append(text)
+        line(text)
+
     try:
         rows, look = offline_rows(det, n_targets, params, frame_rate, n_frames, min_score, det_format, shapes, parts,
-                                  note=line, file_note=telling(on_event, "note"), status=partial(step, on_event))
+                                  note=noted, file_note=telling(on_event, "note"), status=partial(step, on_event))
     except FileNotFoundError as exc:
         raise ValueError(str(exc)) from exc
     write_mot(output, rows)
-    on_event(Event("result", f", offline closed set of {n_targets}: {len(np.unique(rows[:, 1]))} identities, "
+    what = "online closed set (the note above)" if fell_back else "offline closed set"
+    on_event(Event("result", f", {what} of {n_targets}: {len(np.unique(rows[:, 1]))} identities, "
                              f"{len(rows)} rows at {frame_rate:g} frames/s → {output}", name="boxtrack"))
     if annotate is not None and video is not None:
         draw_step(on_event, "drawing the identities", MotTable.from_rows(rows), annotate, frame_rate, video)
