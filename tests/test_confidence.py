@@ -105,6 +105,8 @@ def test_bad_input_is_refused() -> None:
         row_features(np.zeros((3, 4)), FPS)
     with pytest.raises(ValueError, match="confidence"):
         doubtful_ranges(np.zeros((2, 10)), np.zeros(3), FPS)
+    with pytest.raises(ValueError, match="confidence: NaN at row 1"):  # (NaN is below no threshold: never doubtful)
+        doubtful_ranges(np.ones((2, 10)), np.array([0.9, np.nan]), FPS)
 
 
 def test_the_look_margin_moves_the_confidence_its_way_and_zero_leaves_it() -> None:

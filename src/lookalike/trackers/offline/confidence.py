@@ -155,6 +155,8 @@ def doubtful_ranges(rows: np.ndarray, confidence: np.ndarray, frame_rate: float,
     confidence = np.asarray(confidence, dtype=float)
     if confidence.shape != (len(rows),):
         raise ValueError(f"confidence: expected ({len(rows)},), got shape {confidence.shape}")
+    if np.isnan(confidence).any():
+        raise ValueError(f"confidence: NaN at row {int(np.flatnonzero(np.isnan(confidence))[0])}")
     low = rows[confidence < threshold][:, :2].astype(np.int64)
     low = low[np.lexsort((low[:, 0], low[:, 1]))]
     if not len(low):
