@@ -24,7 +24,7 @@ cv2 = pytest.importorskip("cv2")
 
 from lookalike.cli import app  # noqa: E402
 from lookalike.io import read_mot  # noqa: E402
-from lookalike.io.live import LiveStop, prepare_live, track_live  # noqa: E402
+from lookalike.io.live import LivePlan, LiveStop, prepare_live, track_live  # noqa: E402
 from lookalike.io.sources import LiveSource, is_live, open_live, replay_camera  # noqa: E402
 from lookalike.trackers import make_tracker  # noqa: E402
 
@@ -340,3 +340,43 @@ def test_a_live_closed_set_of_blobs_learns_the_look_and_keeps_each_disc_in_its_l
     assert max(len(p.shapes) for p in plan.tracker.looks.pieces.values()) > 8  # shapes came after the sample
     rows = np.loadtxt(out, delimiter=",", ndmin=2)
     assert set(np.unique(rows[:, 1]).astype(int)) == {1, 2, 3} and max(_lanes(rows).values()) < 5
+
+
+def _plan_without_detections() -> LivePlan:
+    """A plan of no sample that finds nothing in any frame (the stops need no detector)."""
+    from lookalike.types import Detections
+
+    return LivePlan(lambda image: Detections.empty(), make_tracker("sort"))
+
+
+def test_a_stop_while_the_source_stalls_ends_the_run_without_waiting_for_a_frame(tmp_path):
+    """A stream that stalls (no frame, no end) is stopped by Ctrl-C/SIGTERM at once: it waited for the next frame,
+    longer than ``docker stop`` waits before it kills (the file then left unfinished)."""
+    stalled, resume = threading.Event(), threading.Event()
+    count = [0]
+
+    def read():
+        if count[0] == 5:
+            stalled.set()
+            resume.wait(10.0)  # (the test ends the stall when it is done)
+            return None
+        count[0] += 1
+        return scene_frame(count[0]), count[0] / RATE
+
+    stop = LiveStop()
+    source = LiveSource(read, "stalling", RATE)
+    original = source.next
+
+    def take(timeout=None):  # the stop comes while the run waits on the stalled source
+        if stalled.is_set():
+            stop.set("SIGTERM")
+        return original(timeout)
+
+    source.next = take
+    out = tmp_path / "t.txt"
+    try:
+        run = track_live(source, _plan_without_detections(), out, stop=stop)
+        assert run.stopped == "SIGTERM" and 1 <= run.frames <= 5 and out.exists()
+    finally:
+        resume.set()
+        source.close()

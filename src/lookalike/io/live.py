@@ -29,6 +29,7 @@ SAMPLE_S = 2.0
 """Seconds of a live source's first frames that set the blob detector (its settings and median background)."""
 SAMPLE_FRAMES = 50
 """At most this many frames in that sample (memory: 50 frames of 1080p are 300 MB)."""
+_WAIT_S = 0.5  # seconds between looks at the stop while a stalled source sends nothing
 
 
 class LiveStop(SignalStop):
@@ -119,14 +120,20 @@ def live_blob_detector(sample: list[LiveFrame], given: dict[str, Any], n_targets
 
 
 def _frames(source: LiveSource, detector: Callable[[Any], Detections], sample: list[LiveFrame],
-            sampled: list[Detections]) -> Iterator[tuple[Frame, float]]:
+            sampled: list[Detections], stop: SignalStop) -> Iterator[tuple[Frame, float]]:
     """The tracker's frames: the sample's (detected already; the lists are emptied once tracked, freeing the
-    images), then the source's as they come; with the seconds spent detecting each."""
+    images), then the source's as they come, until it ends or ``stop`` is set (looked at every
+    :data:`_WAIT_S` s while the source sends nothing); with the seconds spent detecting each."""
     for live, det in zip(sample, sampled):
         yield Frame(index=live.number, time=live.time, detections=det), 0.0
     sample.clear()
     sampled.clear()
-    for live in source:
+    while not stop:
+        live = source.next(timeout=_WAIT_S)
+        if live is None:
+            if source.ended:
+                return
+            continue
         t0 = time.perf_counter()
         det = detector(live.image)
         yield Frame(index=live.number, time=live.time, detections=det), time.perf_counter() - t0
@@ -151,7 +158,7 @@ def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_fr
     exiting: SystemExit | None = None
     with MotWriter(output) as writer:
         try:
-            for frame, detect_s in _frames(source, plan.detector, plan.sample, plan.sampled):
+            for frame, detect_s in _frames(source, plan.detector, plan.sample, plan.sampled, stop):
                 t0 = time.perf_counter()
                 tracks = plan.tracker.update(frame)
                 rows = tracks_to_rows(frame.index, tracks)
@@ -177,7 +184,9 @@ def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_fr
         except SystemExit as exc:  # SIGTERM through the command line's handler
             run.stopped, exiting = f"exit {exc.code}", exc
         finally:
-            if source.error is not None and run.stopped == "end of stream":
+            if stop and run.stopped == "end of stream":  # set while the source sent nothing
+                run.stopped = stop.reason or "stopped"
+            elif source.error is not None and run.stopped == "end of stream":
                 run.stopped = f"source error: {source.error}"
             run.wall_s = time.monotonic() - start
             run.delivered, run.dropped, run.clock = source.delivered, source.dropped, source.clock
