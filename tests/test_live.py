@@ -380,3 +380,16 @@ def test_a_stop_while_the_source_stalls_ends_the_run_without_waiting_for_a_frame
     finally:
         resume.set()
         source.close()
+
+
+def test_a_frame_the_detector_refuses_ends_the_run_keeping_the_frames_tracked(tmp_path):
+    """A source whose frames change size after the blob background was fitted: the run ends on that frame, saying
+    why, and the result file holds every frame before it (it was deleted, the error raised)."""
+    bigger = [cv2.resize(scene_frame(k), (400, 300)) for k in range(80, 90)]
+    out = tmp_path / "t.txt"
+    with _source([scene_frame(k) for k in range(80)] + bigger) as source:
+        plan = prepare_live(source, "blob", make_tracker("boxtrack"), "boxtrack", n_targets=3)
+        run = track_live(source, plan, out)
+    assert run.frames == 80 and run.stopped.startswith("error: image: shape (300, 400) differs")
+    assert np.loadtxt(out, delimiter=",", ndmin=2)[:, 0].max() == 80
+    assert [p.name for p in tmp_path.iterdir()] == ["t.txt"]

@@ -148,8 +148,8 @@ def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_fr
     stream time have passed, or ``stop`` is set (or ``KeyboardInterrupt``). Rows reach a temporary file beside
     ``output`` as each frame ends; whatever stops the run, the file is completed up to the last whole frame and
     renamed onto ``output`` (a ``KeyboardInterrupt`` ends the run like ``stop``; a ``SystemExit`` is raised again
-    once the file is complete). The plan's sample frames, read and detected already, are tracked first, then
-    emptied from the plan.
+    once the file is complete; an error of the detector or tracker ends it, told in ``stopped``). The plan's sample
+    frames, read and detected already, are tracked first, then emptied from the plan.
     ``on_frame``: called with the running totals after each frame."""
     stop = stop if stop is not None else LiveStop()
     run = LiveRun(output=Path(output))
@@ -183,6 +183,8 @@ def track_live(source: LiveSource, plan: LivePlan, output: str | Path, *, max_fr
             run.stopped = "KeyboardInterrupt"
         except SystemExit as exc:  # SIGTERM through the command line's handler
             run.stopped, exiting = f"exit {exc.code}", exc
+        except Exception as exc:  # noqa: BLE001 (a frame the detector or tracker refuses, e.g. of another size)
+            run.stopped = f"error: {exc}"
         finally:
             if stop and run.stopped == "end of stream":  # set while the source sent nothing
                 run.stopped = stop.reason or "stopped"
