@@ -393,3 +393,22 @@ def test_a_frame_the_detector_refuses_ends_the_run_keeping_the_frames_tracked(tm
     assert run.frames == 80 and run.stopped.startswith("error: image: shape (300, 400) differs")
     assert np.loadtxt(out, delimiter=",", ndmin=2)[:, 0].max() == 80
     assert [p.name for p in tmp_path.iterdir()] == ["t.txt"]
+
+
+def test_a_setup_cut_short_says_what_cut_it(tmp_path):
+    """A stop (Ctrl-C, SIGTERM), an error or the end of the source within the first frames leaves too few frames to
+    set the blob detector: the error says so (it blamed the scene: 'is the camera static ...?')."""
+    with _source([scene_frame(k) for k in range(100)]) as source, LiveStop() as stop:
+        stop.set("SIGTERM")
+        with pytest.raises(ValueError, match=r"stopped \(SIGTERM\) after 1 frame\(s\) of the first 2 s"):
+            prepare_live(source, "blob", make_tracker("boxtrack"), "boxtrack", stop=stop)
+    with _source([scene_frame(0)]) as source:
+        with pytest.raises(ValueError, match=r"the source ended after 1 frame\(s\)"):
+            prepare_live(source, "blob", make_tracker("boxtrack"), "boxtrack")
+
+    def failing():
+        raise OSError("camera unplugged")
+
+    with LiveSource(failing, "unplugged", RATE) as source:
+        with pytest.raises(ValueError, match=r"the source failed \(camera unplugged\) after 0 frame\(s\)"):
+            prepare_live(source, "blob", make_tracker("boxtrack"), "boxtrack")

@@ -212,7 +212,14 @@ def prepare_live(source: LiveSource, detector: str, tracker: Any, tracker_name: 
         model = OnnxDetector(Path(detector), config_from_settings(onnx or []))
         return LivePlan(_min_score(model, min_score), tracker, n_targets=n_targets or None)
     sample = sample_frames(source, sample_s, stop=stop)
-    blobs, estimate = live_blob_detector(sample, blob or {}, n_targets or None)
+    try:
+        blobs, estimate = live_blob_detector(sample, blob or {}, n_targets or None)
+    except ValueError as exc:
+        cut = _sample_cut(source, sample, sample_s, stop)
+        if not cut:
+            raise
+        raise ValueError(f"video: {cut} after {len(sample)} frame(s) of the first {sample_s:g} s, before the blob "
+                         f"detector was set ({exc}); nothing tracked") from exc
     find = _min_score(blobs, min_score)
     sampled = [find(f.image) for f in sample]
     plan = LivePlan(find, tracker, sample, sampled, estimate, n_targets=n_targets or None)
@@ -226,6 +233,18 @@ def prepare_live(source: LiveSource, detector: str, tracker: Any, tracker_name: 
             blobs.describe, blobs.split = True, False
             plan.tracker = LookIdentities(plan.tracker, plan.n_targets, _frame_rate(source, sample))
     return plan
+
+
+def _sample_cut(source: LiveSource, sample: list[LiveFrame], seconds: float, stop: SignalStop | None) -> str:
+    """What ended ``sample`` before its ``seconds`` (s) or :data:`SAMPLE_FRAMES` frames: the stop, an error or the
+    end of the source; '' when it is whole."""
+    if len(sample) >= SAMPLE_FRAMES or (sample and sample[-1].time >= seconds):
+        return ""
+    if stop:
+        return f"stopped ({stop.reason or 'stop'})"
+    if source.error is not None:
+        return f"the source failed ({source.error})"
+    return "the source ended" if source.ended else ""
 
 
 def _frame_rate(source: LiveSource, sample: list[LiveFrame]) -> float:
