@@ -412,3 +412,30 @@ def test_a_setup_cut_short_says_what_cut_it(tmp_path):
     with LiveSource(failing, "unplugged", RATE) as source:
         with pytest.raises(ValueError, match=r"the source failed \(camera unplugged\) after 0 frame\(s\)"):
             prepare_live(source, "blob", make_tracker("boxtrack"), "boxtrack")
+
+
+def test_closing_a_stalled_source_does_not_release_it_under_a_read(monkeypatch):
+    """OpenCV's capture is not made to be released while another thread reads it: a source closed while its read
+    hangs (a stalled stream) is released by the reader once the read returns, not under it."""
+    stalled, resume = threading.Event(), threading.Event()
+    reading, released_while_reading = [False], []
+
+    def read():
+        reading[0] = True
+        stalled.set()
+        resume.wait(10.0)
+        reading[0] = False
+        return None
+
+    def release():
+        released_while_reading.append(reading[0])
+
+    real_join = threading.Thread.join
+    monkeypatch.setattr(threading.Thread, "join", lambda self, timeout=None: real_join(self, 0.0))  # no 5 s wait
+    source = LiveSource(read, "stalled", RATE, release)
+    assert stalled.wait(10.0)
+    source.close()
+    assert released_while_reading == []  # not yet: the read is under way
+    resume.set()
+    real_join(source._thread, 10.0)
+    assert released_while_reading == [False]  # once, after the read

@@ -114,6 +114,15 @@ class LiveSource:
             with self._cond:
                 self._ended = True
                 self._cond.notify_all()
+            if self._closed:  # closed while this read was under way: released now that it has returned
+                self._release_once()
+
+    def _release_once(self) -> None:
+        """Release the source, once (from :meth:`close` or from the reader, whichever comes last)."""
+        with self._cond:
+            release, self._release = self._release, None
+        if release is not None:
+            release()
 
     def next(self, timeout: float | None = None) -> LiveFrame | None:
         """The newest frame not yet taken, waiting up to ``timeout`` s (None: until one comes); None at the end of
@@ -139,14 +148,15 @@ class LiveSource:
                 return
 
     def close(self) -> None:
-        """Stop reading and release the source (the frame waiting, if any, is neither taken nor dropped)."""
+        """Stop reading and release the source (the frame waiting, if any, is neither taken nor dropped). A read
+        still under way after 5 s (a stalled stream) is not cut: the reader releases the source when it returns."""
         with self._cond:
             self._closed = True
             self._slot = None
             self._cond.notify_all()
         self._thread.join(timeout=5.0)
-        if self._release is not None:
-            self._release()
+        if not self._thread.is_alive():
+            self._release_once()
 
     def __enter__(self) -> LiveSource:
         return self
