@@ -400,7 +400,7 @@ def test_a_setup_cut_short_says_what_cut_it(tmp_path):
     set the blob detector: the error says so (it blamed the scene: 'is the camera static ...?')."""
     with _source([scene_frame(k) for k in range(100)]) as source, LiveStop() as stop:
         stop.set("SIGTERM")
-        with pytest.raises(ValueError, match=r"stopped \(SIGTERM\) after 1 frame\(s\) of the first 2 s"):
+        with pytest.raises(ValueError, match=r"stopped \(SIGTERM\) after 0 frame\(s\) of the first 2 s"):
             prepare_live(source, "blob", make_tracker("boxtrack"), "boxtrack", stop=stop)
     with _source([scene_frame(0)]) as source:
         with pytest.raises(ValueError, match=r"the source ended after 1 frame\(s\)"):
@@ -439,3 +439,37 @@ def test_closing_a_stalled_source_does_not_release_it_under_a_read(monkeypatch):
     resume.set()
     real_join(source._thread, 10.0)
     assert released_while_reading == [False]  # once, after the read
+
+
+def test_a_stop_while_the_source_stalls_in_the_first_frames_ends_the_sample():
+    """Ctrl-C/SIGTERM while the first frames are read from a stalled source ends the sample at once, the read still
+    hanging (it waited for the next frame or the source's end)."""
+    from lookalike.io.live import sample_frames
+
+    stalled, resume = threading.Event(), threading.Event()
+    count = [0]
+
+    def read():
+        if count[0] == 3:
+            stalled.set()
+            resume.wait(10.0)
+            return None
+        count[0] += 1
+        return scene_frame(count[0]), count[0] / RATE
+
+    stop = LiveStop()
+    source = LiveSource(read, "stalling", RATE)
+    original = source.next
+
+    def take(timeout=None):
+        if stalled.is_set():
+            stop.set("SIGINT")
+        return original(timeout)
+
+    source.next = take
+    try:
+        frames = sample_frames(source, stop=stop)
+        assert not source.ended and 1 <= len(frames) <= 3  # back while the read still hangs
+    finally:
+        resume.set()
+        source.close()

@@ -90,7 +90,7 @@ def sample_frames(source: LiveSource, seconds: float = SAMPLE_S, count: int = SA
     """The source's first frames: those of its first ``seconds`` (stream time), at most ``count``; fewer when the
     source ends or ``stop`` is set."""
     frames: list[LiveFrame] = []
-    for frame in source:
+    for frame in _arriving(source, stop):
         frames.append(frame)
         if len(frames) >= count or frame.time >= seconds or stop:
             break
@@ -119,21 +119,26 @@ def live_blob_detector(sample: list[LiveFrame], given: dict[str, Any], n_targets
     return detector, estimate
 
 
+def _arriving(source: LiveSource, stop: SignalStop | None) -> Iterator[LiveFrame]:
+    """The source's frames as they come, until it ends or ``stop`` is set (looked at every :data:`_WAIT_S` s while
+    the source sends nothing)."""
+    while not stop:
+        live = source.next(timeout=_WAIT_S)
+        if live is not None:
+            yield live
+        elif source.ended:
+            return
+
+
 def _frames(source: LiveSource, detector: Callable[[Any], Detections], sample: list[LiveFrame],
             sampled: list[Detections], stop: SignalStop) -> Iterator[tuple[Frame, float]]:
     """The tracker's frames: the sample's (detected already; the lists are emptied once tracked, freeing the
-    images), then the source's as they come, until it ends or ``stop`` is set (looked at every
-    :data:`_WAIT_S` s while the source sends nothing); with the seconds spent detecting each."""
+    images), then the source's as they come (:func:`_arriving`); with the seconds spent detecting each."""
     for live, det in zip(sample, sampled):
         yield Frame(index=live.number, time=live.time, detections=det), 0.0
     sample.clear()
     sampled.clear()
-    while not stop:
-        live = source.next(timeout=_WAIT_S)
-        if live is None:
-            if source.ended:
-                return
-            continue
+    for live in _arriving(source, stop):
         t0 = time.perf_counter()
         det = detector(live.image)
         yield Frame(index=live.number, time=live.time, detections=det), time.perf_counter() - t0
