@@ -33,11 +33,14 @@ def main() -> None:
     parser.add_argument("--weights", type=Path, default=None, help="set weights (.npz; default: the shipped ones)")
     args = parser.parse_args()
     names = args.trackers.split(",")
+    wanted = {"presets", "unseen"} if args.teams == "both" else set(args.teams.split(","))
+    if not wanted or not wanted <= {"presets", "unseen"}:
+        parser.error(f"--teams: presets, unseen, presets,unseen or both, got {args.teams!r}")
     teams = []
-    if "presets" in args.teams:
+    if "presets" in wanted:
         teams += [(preset(p), [DEFAULT_SEED + 1000 * PRESET_NAMES.index(p) + k for k in range(args.sequences)])
                   for p in PRESET_NAMES]
-    if "unseen" in args.teams:
+    if "unseen" in wanted:
         teams += [(world(n, m, fp), [UNSEEN_SEED + 1000 * n + k for k in range(args.sequences)])
                   for n, m, fp in UNSEEN_TEAMS]
     print(f"{args.sequences} sequences x {args.frames} frames per team; success rate (%), frames/s")
