@@ -86,6 +86,8 @@ def main() -> None:
     parser.add_argument("--load", type=Path, default=None, help="a table saved by --save: select, do not run")
     parser.add_argument("--peers", default="all", help="peers run beside: 'all' installed, 'none', or names")
     args = parser.parse_args()
+    if args.load is None and len({d.strip() for d in args.datasets.split(",") if d.strip()}) < 2:
+        parser.error(f"--datasets: leaving one dataset out needs at least two, got {args.datasets!r}")
     for spec in args.set:
         name, value = spec.split("=", 1)
         if not hasattr(boxtrack_config, name):
@@ -94,6 +96,9 @@ def main() -> None:
         print(f"constant {name} = {getattr(boxtrack_config, name)}")
     if args.load is not None:
         cands, table, keys, groups = pickle.loads(args.load.read_bytes())
+        if len(set(groups)) < 2:
+            parser.error(f"--load {args.load}: leaving one dataset out needs at least two datasets, the table "
+                         f"has {len(set(groups))}")
     else:
         cands, table, keys, groups = _score(args.datasets.split(","), args.min_counts, args.grid)
     if args.save is not None:
