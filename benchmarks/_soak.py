@@ -102,7 +102,7 @@ class SoakResult:
 
 
 def rss_mb() -> float:
-    """Resident memory of this process in MB (NaN where /proc is missing)."""
+    """Resident memory of this process in MiB (2**20 bytes; NaN where /proc is missing)."""
     try:
         with open("/proc/self/statm") as fh:
             pages = int(fh.read().split()[1])

@@ -27,7 +27,7 @@ def main() -> None:
     ok = result.alive and result.consistent() and result.final_ok
     report_target("node soak alive, counters consistent, final team state right", float(ok), 1.0)
     report_target("node soak resident memory growth", result.rss_peak_mb - result.rss_start_mb, 64.0,
-                  higher_is_better=False, unit=" MB")
+                  higher_is_better=False, unit=" MiB")
 
 
 if __name__ == "__main__":
