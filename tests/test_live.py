@@ -349,14 +349,14 @@ def _plan_without_detections() -> LivePlan:
     return LivePlan(lambda image: Detections.empty(), make_tracker("sort"))
 
 
-def test_a_stop_while_the_source_stalls_ends_the_run_without_waiting_for_a_frame(tmp_path):
-    """A stream that stalls (no frame, no end) is stopped by Ctrl-C/SIGTERM at once: it waited for the next frame,
-    longer than ``docker stop`` waits before it kills (the file then left unfinished)."""
+def _stalling(frames: int, signal: str) -> tuple[LiveSource, LiveStop, threading.Event]:
+    """A live source that sends ``frames`` frames, then stalls (no frame, no end) until the returned event is set,
+    and a stop that ``signal`` sets while the consumer waits on the stall."""
     stalled, resume = threading.Event(), threading.Event()
     count = [0]
 
     def read():
-        if count[0] == 5:
+        if count[0] == frames:
             stalled.set()
             resume.wait(10.0)  # (the test ends the stall when it is done)
             return None
@@ -367,12 +367,19 @@ def test_a_stop_while_the_source_stalls_ends_the_run_without_waiting_for_a_frame
     source = LiveSource(read, "stalling", RATE)
     original = source.next
 
-    def take(timeout=None):  # the stop comes while the run waits on the stalled source
+    def take(timeout=None):
         if stalled.is_set():
-            stop.set("SIGTERM")
+            stop.set(signal)
         return original(timeout)
 
     source.next = take
+    return source, stop, resume
+
+
+def test_a_stop_while_the_source_stalls_ends_the_run_without_waiting_for_a_frame(tmp_path):
+    """A stream that stalls (no frame, no end) is stopped by Ctrl-C/SIGTERM at once: it waited for the next frame,
+    longer than ``docker stop`` waits before it kills (the file then left unfinished)."""
+    source, stop, resume = _stalling(5, "SIGTERM")
     out = tmp_path / "t.txt"
     try:
         run = track_live(source, _plan_without_detections(), out, stop=stop)
@@ -446,27 +453,7 @@ def test_a_stop_while_the_source_stalls_in_the_first_frames_ends_the_sample():
     hanging (it waited for the next frame or the source's end)."""
     from lookalike.io.live import sample_frames
 
-    stalled, resume = threading.Event(), threading.Event()
-    count = [0]
-
-    def read():
-        if count[0] == 3:
-            stalled.set()
-            resume.wait(10.0)
-            return None
-        count[0] += 1
-        return scene_frame(count[0]), count[0] / RATE
-
-    stop = LiveStop()
-    source = LiveSource(read, "stalling", RATE)
-    original = source.next
-
-    def take(timeout=None):
-        if stalled.is_set():
-            stop.set("SIGINT")
-        return original(timeout)
-
-    source.next = take
+    source, stop, resume = _stalling(3, "SIGINT")
     try:
         frames = sample_frames(source, stop=stop)
         assert not source.ended and 1 <= len(frames) <= 3  # back while the read still hangs
