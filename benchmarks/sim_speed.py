@@ -9,6 +9,8 @@ from __future__ import annotations
 import argparse
 import time
 
+from _common import report_target
+
 from lookalike.sim import PRESET_NAMES, preset, simulate_arrays, simulate_robots
 
 
@@ -31,6 +33,8 @@ def main() -> None:
         frame_fps = n / (time.perf_counter() - t0)
         print(f"{name:6s} N={cfg.n_agents} M={cfg.max_detections}: simulate_arrays {fps:10,.0f} frames/s; "
               f"as Frame objects {frame_fps:8,.0f} frames/s")
+        if cfg.n_agents == 7:
+            report_target(f"simulate_arrays {name}", fps, 50_000, unit=" frames/s")
 
 
 if __name__ == "__main__":
