@@ -178,3 +178,17 @@ def test_fast_and_careful_parsers_agree(tmp_path):
     rows = [(i + 1, ln) for i, ln in enumerate(p.read_text().splitlines()) if ln.strip()]
     np.testing.assert_array_equal(fast.xywh, _parse_slowly(p, rows, 6)[:, 2:6])
     np.testing.assert_array_equal(fast.extra, [[1, 0.5], [7, 1]])
+
+
+def test_detection_stream_and_evaluate_data_name_their_bad_arguments(tmp_path: Path) -> None:
+    from lookalike.eval import evaluate_data, prepare_boxes
+    from lookalike.io import DetectionStream, MotTable
+
+    with pytest.raises(ValueError, match="length must be a whole number of frames >= 0, got 2.5"):
+        DetectionStream(tmp_path / "det.txt", length=2.5)
+    table = MotTable.from_rows(np.array([[1, -1, 0, 0, 5, 5, 1, -1, -1, -1]], float))
+    with pytest.raises(ValueError, match="needs the file a table was read from"):
+        DetectionStream.from_table(table)
+    data = prepare_boxes(table, table)
+    with pytest.raises(ValueError, match=r"^threshold must be in \(0, 1\]"):
+        evaluate_data(data, threshold=0.0)

@@ -25,14 +25,14 @@ def _metric_names(metrics: Iterable[str]) -> tuple[str, ...]:
     return tuple(dict.fromkeys(chosen))
 
 
-def _check_threshold(threshold: float) -> None:
+def _check_threshold(threshold: float, name: str = "iou_threshold") -> None:
     if not 0.0 < threshold <= 1.0:
-        raise ValueError(f"iou_threshold must be in (0, 1], got {threshold}")
+        raise ValueError(f"{name} must be in (0, 1], got {threshold}")
 
 
 def evaluate_data(data: SequenceData, *, threshold: float = 0.5, metrics: Sequence[str] = METRICS) -> dict[str, float]:
     """Score prepared data: ``threshold`` is the similarity a CLEAR/identity match needs."""
-    _check_threshold(threshold)
+    _check_threshold(threshold, "threshold")
     chosen = _metric_names(metrics)
     out: dict[str, float] = {
         "Dets": data.num_tracker_dets, "GT_Dets": data.num_gt_dets,

@@ -51,8 +51,8 @@ class DetectionStream:
                  image_size: tuple[int, int] | None = None) -> None:
         if not (np.isfinite(frame_rate) and frame_rate > 0):
             raise ValueError(f"frame_rate must be a positive number, got {frame_rate}")
-        if length is not None and length < 0:
-            raise ValueError(f"length must be >= 0, got {length}")
+        if length is not None and not (length >= 0 and length == int(length)):
+            raise ValueError(f"length must be a whole number of frames >= 0, got {length}")
         self.path, self.length, self.frame_rate = Path(path), length, frame_rate
         self.min_score, self.chunk_lines, self.length_name = min_score, chunk_lines, length_name
         self._streamable: bool | None = None
@@ -68,7 +68,9 @@ class DetectionStream:
     def from_table(cls, table: MotTable, length: int | None = None, frame_rate: float = 30.0,
                    min_score: float = -np.inf, image_size: tuple[int, int] | None = None) -> DetectionStream:
         """The frames of detections read already (checked: :func:`~lookalike.io.det_format.read_det`)."""
-        assert table.path is not None
+        if table.path is None:
+            raise ValueError("table: a DetectionStream needs the file a table was read from (read_det or read_mot); "
+                             "frames_from_table streams a table built in memory")
         stream = cls(table.path, length, frame_rate, min_score, image_size=image_size)
         stream._table, stream._streamable, stream.rows = table, False, len(table)
         stream.scores, stream.outside = box_stats(table.xywh, table.conf, image_size)
