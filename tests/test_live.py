@@ -176,11 +176,11 @@ def _source(images: list[np.ndarray], rate: float = RATE) -> LiveSource:
     """A source handing ``images`` as fast as taken (waits for the consumer: nothing dropped)."""
     pending = iter(images)
     gate = threading.Semaphore(1)
-    count = [0]
+    count, closing = [0], [False]
 
     def read():
         gate.acquire()
-        image = next(pending, None)
+        image = None if closing[0] else next(pending, None)
         count[0] += 1
         return None if image is None else (image, (count[0] - 1) / rate)
 
@@ -194,7 +194,12 @@ def _source(images: list[np.ndarray], rate: float = RATE) -> LiveSource:
             gate.release()
         return frame
 
-    source.next = take
+    def close():  # a reader waiting for a take ends at once (a camera's read returns within a frame)
+        closing[0] = True
+        gate.release()
+        original_close()
+
+    source.next, original_close, source.close = take, source.close, close
     return source
 
 
@@ -392,7 +397,7 @@ def test_a_stop_while_the_source_stalls_ends_the_run_without_waiting_for_a_frame
 def test_a_frame_the_detector_refuses_ends_the_run_keeping_the_frames_tracked(tmp_path):
     """A source whose frames change size after the blob background was fitted: the run ends on that frame, saying
     why, and the result file holds every frame before it (it was deleted, the error raised)."""
-    bigger = [cv2.resize(scene_frame(k), (400, 300)) for k in range(80, 90)]
+    bigger = [cv2.resize(scene_frame(80), (400, 300))]  # (the source ends after it: its reader is not left waiting)
     out = tmp_path / "t.txt"
     with _source([scene_frame(k) for k in range(80)] + bigger) as source:
         plan = prepare_live(source, "blob", make_tracker("boxtrack"), "boxtrack", n_targets=3)
@@ -405,7 +410,8 @@ def test_a_frame_the_detector_refuses_ends_the_run_keeping_the_frames_tracked(tm
 def test_a_setup_cut_short_says_what_cut_it(tmp_path):
     """A stop (Ctrl-C, SIGTERM), an error or the end of the source within the first frames leaves too few frames to
     set the blob detector: the error says so (it blamed the scene: 'is the camera static ...?')."""
-    with _source([scene_frame(k) for k in range(100)]) as source, LiveStop() as stop:
+    frames = iter([(scene_frame(k), k / RATE) for k in range(5)])
+    with LiveSource(lambda: next(frames, None), "frames", RATE) as source, LiveStop() as stop:
         stop.set("SIGTERM")
         with pytest.raises(ValueError, match=r"stopped \(SIGTERM\) after 0 frame\(s\) of the first 2 s"):
             prepare_live(source, "blob", make_tracker("boxtrack"), "boxtrack", stop=stop)
