@@ -34,7 +34,7 @@ from lookalike.trackers.offline.appearance import (
     with_appearance,
 )
 from lookalike.trackers.offline.closed_set_config import ClosedSetConfig
-from lookalike.trackers.offline.confidence import by_frame_and_id
+from lookalike.trackers.offline.confidence import by_frame_and_id, require_frame_rate
 from lookalike.trackers.offline.constraints import (
     ChainConstraints,
     chain_ids,
@@ -198,12 +198,6 @@ def place_short(short: list[Tracklet], chains: list[np.ndarray], scale: tuple[fl
     return out
 
 
-def _check_rate(frame_rate: float) -> None:
-    """``ValueError`` unless ``frame_rate`` (frames/s) is a finite number above 0."""
-    if not (math.isfinite(frame_rate) and frame_rate > 0):
-        raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
-
-
 def assign_identities(rows: np.ndarray, n_targets: int, frame_rate: float,
                       config: ClosedSetConfig | None = None, constraints: ChainConstraints | None = None,
                       shapes: np.ndarray | None = None, parts: np.ndarray | None = None) -> np.ndarray:
@@ -230,7 +224,7 @@ def _assign(rows: np.ndarray, n_targets: int, frame_rate: float, config: ClosedS
     cfg = config or ClosedSetConfig()
     if int(n_targets) < 1:
         raise ValueError(f"n_targets must be >= 1, got {n_targets}")
-    _check_rate(frame_rate)
+    require_frame_rate(frame_rate)
     rows = checked_rows(rows)
     pieces = split_tracklets(rows, cfg)
     if constraints is not None:
@@ -324,7 +318,7 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
     ``det_rows``. ``reported``: instead, every track the tracker reports, as ``lookalike track`` writes it; then with
     ``shapes`` (one blob shape vector per detection row) and ``max_targets``, the slots' identities re-assigned by the
     look as ``--online`` does on blobs (:class:`~lookalike.trackers.offline.online_look.LookIdentities`)."""
-    _check_rate(frame_rate)
+    require_frame_rate(frame_rate)
     det_rows = checked_rows(det_rows)
     tracker_obj = make_tracker(tracker, **params)
     if vel_noise is not None:

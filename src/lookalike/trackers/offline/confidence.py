@@ -27,12 +27,17 @@ _CROWD_CLIP, _EDGE_CLIP_S, _LENGTH_CLIP_S, _JUMP_CLIP = 2.0, 30.0, 300.0, 1.0
 _PAIR_BUDGET = 1 << 22  # distances computed at once in crowd_now
 
 
+def require_frame_rate(frame_rate: float) -> None:
+    """``ValueError`` unless ``frame_rate`` (frames/s) is a finite number above 0."""
+    if not np.isfinite(frame_rate) or frame_rate <= 0:
+        raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
+
+
 def _check(rows: np.ndarray, frame_rate: float) -> np.ndarray:
     rows = np.asarray(rows, dtype=float)
     if rows.ndim != 2 or (len(rows) and rows.shape[1] < 6):
         raise ValueError(f"rows: expected (k, >= 6) MOTChallenge rows, got shape {rows.shape}")
-    if not np.isfinite(frame_rate) or frame_rate <= 0:
-        raise ValueError(f"frame_rate must be > 0 frames/s, got {frame_rate}")
+    require_frame_rate(frame_rate)
     return rows
 
 
