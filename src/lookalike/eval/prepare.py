@@ -13,6 +13,7 @@ import numpy as np
 from lookalike.eval.data import Pairs, SequenceData
 from lookalike.eval.matching import conflicted_frames, negated_matrices, solve_matrices
 from lookalike.eval.similarity import pair_iou, point_similarity, rows_of
+from lookalike.types._validate import first_fraction
 from lookalike.types.mot_table import MotTable as MotTableData
 
 
@@ -242,11 +243,9 @@ def _per_frame(gt: MotTable, res: MotTable, n: int, sim_fn: Callable[..., np.nda
 def _whole(values: np.ndarray, name: str) -> np.ndarray:
     """``values`` as integers; ``ValueError`` naming ``name`` and the first value that is not a whole number."""
     raw = np.asarray(values).ravel()
-    if raw.size and not np.issubdtype(raw.dtype, np.integer):
-        v = raw.astype(float)
-        bad = np.flatnonzero(~np.isfinite(v) | (np.floor(v) != v))
-        if len(bad):
-            raise ValueError(f"{name}[{bad[0]}]: {raw[bad[0]]} is not a whole number")
+    k = first_fraction(raw)
+    if k is not None:
+        raise ValueError(f"{name}[{k}]: {raw[k]} is not a whole number")
     return raw.astype(int)
 
 

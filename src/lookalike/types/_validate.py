@@ -7,17 +7,25 @@ from typing import Any
 import numpy as np
 
 
+def first_fraction(values: Any) -> int | None:
+    """The flat index of the first of ``values`` that is not a finite whole number (a fraction, NaN or infinity);
+    None when all are (integer arrays always)."""
+    given = np.asarray(values)
+    if given.dtype.kind not in "fc" or not given.size:
+        return None
+    bad = np.flatnonzero(~(np.isfinite(given) & (given == np.round(given))))
+    return int(bad[0]) if len(bad) else None
+
+
 def as_column(
     owner: str, name: str, value: Any, n: int | None, width: int | None, dtype: type = float
 ) -> np.ndarray:
     """``value`` as a read-only array ``(n,)`` or ``(n, width)``; ``ValueError`` naming ``owner.name`` otherwise (and
     for an ``int`` column given numbers that are not whole)."""
     if dtype is int and isinstance(value, (np.ndarray, list, tuple)):
-        given = np.asarray(value)
-        if given.dtype.kind in "fc" and given.size:
-            whole = np.isfinite(given) & (given == np.round(given))
-            if not whole.all():
-                raise ValueError(f"{owner}.{name}: {given[~whole][0]} is not a whole number")
+        k = first_fraction(value)
+        if k is not None:
+            raise ValueError(f"{owner}.{name}: {np.asarray(value).ravel()[k]} is not a whole number")
     try:
         arr: np.ndarray = np.array(value, dtype=dtype, copy=True)
     except (TypeError, ValueError) as exc:
