@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.io.rules import frame_problems, not_a_file, read_text
+from lookalike.types._validate import first_fraction
 from lookalike.types.mot_table import detection_rows
 
 __all__ = ["POINT_VEL_NOISE", "PointFrames", "points_to_rows", "read_id_points", "read_points_csv", "read_points_mot",
@@ -145,13 +146,13 @@ def read_id_points(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray
     if not path.is_file():
         raise not_a_file(path)
     parsed = _parse(path, 4, first_coordinate=2, keep=7)
-    for no, values in parsed:
-        if values[1] != int(values[1]):
-            raise ValueError(f"{path}:{no}: invalid id: not a whole number: {values[1]:g}")
     if not parsed:
         return np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2))
     width = min(len(v) for _, v in parsed)
     data = np.array([v[:width] for _, v in parsed], dtype=float)
+    k = first_fraction(data[:, 1])
+    if k is not None:
+        raise ValueError(f"{path}:{parsed[k][0]}: invalid id: not a whole number: {data[k, 1]:g}")
     order = np.lexsort((data[:, 1], data[:, 0]))
     twice = np.flatnonzero(np.all(np.diff(data[order, :2], axis=0) == 0, axis=1))
     if len(twice):
