@@ -407,6 +407,22 @@ def test_a_frame_the_detector_refuses_ends_the_run_keeping_the_frames_tracked(tm
     assert [p.name for p in tmp_path.iterdir()] == ["t.txt"]
 
 
+def test_the_command_exits_1_when_an_error_ends_the_live_run(tmp_path, monkeypatch):
+    """The same refused frame through `track`: the result line, then an error naming the file that keeps the frames
+    tracked before, and exit status 1 (it was 0, so a script could not tell)."""
+    import lookalike.io.sources as sources
+
+    bigger = [cv2.resize(scene_frame(80), (400, 300))]
+    monkeypatch.setattr(sources, "open_live", lambda spec: _source([scene_frame(k) for k in range(80)] + bigger))
+    out = tmp_path / "t.txt"
+    result = runner.invoke(app, ["track", "--video", "0", "--detector", "blob", "-t", "boxtrack", "--targets", "3",
+                                 "-o", str(out)])
+    assert result.exit_code == 1, result.output
+    assert "stopped: error: image: shape (300, 400)" in result.output
+    assert "stopped on an error (image: shape" in result.output and "holds every frame tracked" in result.output
+    assert np.loadtxt(out, delimiter=",", ndmin=2)[:, 0].max() == 80
+
+
 def test_a_setup_cut_short_says_what_cut_it(tmp_path):
     """A stop (Ctrl-C, SIGTERM), an error or the end of the source within the first frames leaves too few frames to
     set the blob detector: the error says so (it blamed the scene: 'is the camera static ...?')."""

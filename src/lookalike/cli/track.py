@@ -23,18 +23,22 @@ def build_tracker(name: str, settings: list[str], params_file: Path | None = Non
 
 def _run(request: TrackRequest) -> None:
     """:func:`lookalike.pipeline.run`, printed; Ctrl-C: a line saying that the result in progress was not written,
-    exit 130."""
+    exit 130; a live run ended by an error: exit 1 after its result line."""
     from lookalike.cli.progress import printed_events
     from lookalike.pipeline import run
 
     try:
         with failing(ValueError, TypeError), printed_events() as on_event:
-            run(request, on_event)
+            result = run(request, on_event)
     except KeyboardInterrupt:
         console.print("\n[yellow]Interrupted.[/] The result in progress was not written; files finished before are "
                       "kept" + (f" ({escape(str(request.annotate))} is left as it was)."
                                 if request.annotate is not None else "."))
         raise SystemExit(130) from None
+    if result.failure is not None:
+        kind, _, why = result.failure.partition(": ")
+        fail(f"the live run stopped on {'a source error' if kind == 'source error' else 'an error'} ({why}); "
+             f"{request.output} holds every frame tracked before it", code=1)
 
 
 @app.command()

@@ -83,7 +83,8 @@ def run_live(request: TrackRequest, on_event: Callable[[Event], None]) -> RunRes
     on_event(Event("result", f": {run.frames} frames in {run.wall_s:.1f} s ({run.fps:.1f} frames/s; detector + "
                              f"tracker {run.busy_fps:,.0f} frames/s), {run.dropped} of {run.delivered} dropped while "
                              f"busy{setup}, times from the {run.clock}; stopped: {run.stopped} → {output}", name=name))
-    return RunResult("live", [output], 1)
+    failed = run.stopped.startswith(("error: ", "source error: "))
+    return RunResult("live", [output], 1, failure=run.stopped if failed else None)
 
 
 __all__ = ["live_settings", "run_live"]

@@ -43,7 +43,8 @@ class Event:
 class RunResult:
     """What :func:`run` did on ``branch``: the ``written`` result files, the tracker's ``stats`` (frames, seconds;
     online file runs), on a video tracked online the tracking pass's ``video`` result, and per result file of a
-    closed set that learned a look its rows' look margins (``looks``: ``(frame, id, margin)`` rows)."""
+    closed set that learned a look its rows' look margins (``looks``: ``(frame, id, margin)`` rows); ``failure``: why a
+    live run ended early on an error (its file holds every frame tracked before), None when it did not."""
 
     branch: str
     written: list[Path] = field(default_factory=list)
@@ -51,6 +52,7 @@ class RunResult:
     stats: RunStats = field(default_factory=RunStats)
     video: VideoTrackingResult | None = None
     looks: dict[Path, np.ndarray] = field(default_factory=dict)
+    failure: str | None = None
 
 
 def run(request: TrackRequest, on_event: Callable[[Event], None] | None = None) -> RunResult:
