@@ -146,6 +146,14 @@ def test_a_row_with_a_nan_box_or_a_bad_frame_is_refused_naming_it(column: int, v
         assign_identities(result, 2, FPS)
 
 
+def test_rows_past_n_frames_are_refused_not_dropped() -> None:
+    # frames after n_frames were left out of the result without a word
+    _, det = _crossing(frames=12, hidden=0)
+    with pytest.raises(ValueError, match=r"det_rows: frame 12 is past n_frames \(10\)"):
+        track_closed_set(det, 2, FPS, n_frames=10)
+    assert track_closed_set(det, 2, FPS, n_frames=14)[:, 0].max() == 12  # a longer sequence is fine
+
+
 @pytest.mark.parametrize("rate", [0.0, -1.0, float("nan"), float("inf")])
 def test_a_frame_rate_not_above_zero_or_not_finite_is_refused(rate: float) -> None:
     # 0 ended in ZeroDivisionError, NaN in a message about Frame.time, infinity was taken

@@ -327,6 +327,9 @@ def online_rows(det_rows: np.ndarray, frame_rate: float, n_frames: int | None = 
         boxtrack: Any = tracker_class(tracker)
         tracker_obj = boxtrack(tracker_obj.config, vel_noise=vel_noise)
     n_frames = int(det_rows[:, 0].max()) if n_frames is None and len(det_rows) else int(n_frames or 0)
+    if len(det_rows) and det_rows[:, 0].max() > n_frames:
+        raise ValueError(f"det_rows: frame {int(det_rows[:, 0].max())} is past n_frames ({n_frames}); give the "
+                         "sequence's length, or None to take the last frame of the rows")
     order = np.argsort(det_rows[:, 0], kind="stable")
     det_rows = det_rows[order]
     bounds = np.searchsorted(det_rows[:, 0], np.arange(1, n_frames + 2))
