@@ -2,8 +2,8 @@
 
 Each tracker gets the input it needs: box trackers boxes and scores, appearance trackers also
 unit feature vectors, world trackers ground positions (m), headings (rad) and beacon reports.
-Cases: an empty frame, reset, permuted detection order, the ``detection_index`` round trip, time
-going backwards, 10,000 frames without memory growth, bad parameter values. A tracker registered
+Cases: an empty frame, reset, a copy or pickle mid-sequence, permuted detection order, the ``detection_index``
+round trip, time going backwards, 10,000 frames without memory growth, bad parameter values. A tracker registered
 without a kind here fails :func:`test_every_tracker_has_a_kind`, so a new tracker joins the contract.
 
 Known gaps are ``xfail(strict=True)`` entries in ``KNOWN_GAPS``: when a tracker is fixed, its
@@ -13,8 +13,10 @@ entry turns into a failure (XPASS) and must be removed.
 from __future__ import annotations
 
 import collections
+import copy
 import dataclasses
 import math
+import pickle
 import sys
 import tracemalloc
 import types
@@ -146,6 +148,18 @@ def test_reset_gives_the_output_of_a_fresh_tracker(name: str) -> None:
     used.reset()
     again = _run(used, frames)
     assert [_summary(f) for f in again] == [_summary(f) for f in fresh]
+
+
+@pytest.mark.parametrize("name", _params("copy"))
+def test_a_copy_or_pickle_taken_mid_sequence_continues_as_the_original(name: str) -> None:
+    kind = _kind(name)
+    frames = [_frame(k, kind=kind) for k in range(12)]
+    whole = [_summary(f) for f in _run(make_tracker(name), frames)]
+    tracker = make_tracker(name)
+    _run(tracker, frames[:4])
+    for twin in (copy.deepcopy(tracker), pickle.loads(pickle.dumps(tracker))):
+        assert [_summary(f) for f in _run(twin, frames[4:])] == whole[4:]
+    assert [_summary(f) for f in _run(tracker, frames[4:])] == whole[4:]  # the copies shared no state
 
 
 @pytest.mark.parametrize("name", _params("permuted"))

@@ -86,6 +86,12 @@ class BoxTrack:
         self._buffers = (np.empty((4, 16)), np.empty(16, dtype=np.int64))  # the compiled update's outputs
         self._never = np.zeros(self._coasting.returns.longest + 2, dtype=bool)  # no coasted report
 
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        """After ``copy.deepcopy`` or unpickling, the table's ``mean`` and ``cov`` are copies, no longer views of
+        the column table: forget the link so that the next frame rebuilds the table from them."""
+        self.__dict__.update(state)
+        self._views = (None, None)
+
     @property
     def compiled(self) -> bool:
         """Whether this tracker runs the compiled kernels (:mod:`lookalike.trackers.kernels.boxtrack`) now."""
