@@ -48,6 +48,17 @@ def test_table_ages_and_records_misses_in_frames_and_seconds() -> None:
         t.add(np.zeros((1, 2)), np.zeros((1, 2, 2)), nope=1)
 
 
+def test_table_refuses_columns_of_another_length_and_stays_as_it_was() -> None:
+    t = _table(2)
+    for bad in ({"box": np.ones((1, 4))}, {"box": np.ones((3, 3))}, {"hits": np.ones(5)}):
+        with pytest.raises(ValueError, match=f"column '{next(iter(bad))}'"):
+            t.add(np.zeros((3, 2)), np.zeros((3, 2, 2)), **bad)
+    with pytest.raises(ValueError, match="column 'cov'"):
+        t.add(np.zeros((3, 2)), np.zeros((2, 2, 2)))
+    assert {name: len(t[name]) for name in t.columns} == dict.fromkeys(t.columns, 2)
+    assert t.add(np.zeros((1, 2)), np.zeros((1, 2, 2))).tolist() == [2] and t.ids.tolist() == [1, 2, 3]
+
+
 def test_lifecycle_confirms_coasts_and_deletes() -> None:
     t = _table(3)
     t.hits[:] = [1, 3, 3]

@@ -66,7 +66,8 @@ class TrackTable:
         setattr(self, name, value)
 
     def add(self, mean: np.ndarray, cov: np.ndarray, **values: Any) -> np.ndarray:
-        """Append tracks with new ids; columns not given start at zero (scalars broadcast).
+        """Append tracks with new ids; columns not given start at zero (scalars broadcast). A column of another
+        shape than ``(len(mean),) + its row shape`` raises ``ValueError`` naming it, and leaves the table as it was.
 
         Returns the row indices of the new tracks."""
         n = len(mean)
@@ -76,13 +77,19 @@ class TrackTable:
         start = len(self.ids)
         given = {**values, "mean": mean, "cov": cov,
                  "ids": np.arange(self.next_id, self.next_id + n)}
-        self.next_id += n
+        rows: dict[str, np.ndarray] = {}
         for name, (shape, dtype) in self._spec.items():
             new = given.get(name)
             if new is None:
                 new = np.zeros((n,) + shape, dtype=dtype)
             elif np.ndim(new) == 0:
                 new = np.full((n,) + shape, new, dtype=dtype)
+            elif np.shape(new) != (n,) + shape:
+                raise ValueError(f"TrackTable.add: column {name!r} has shape {np.shape(new)}, expected "
+                                 f"{(n,) + shape} ({n} new tracks)")
+            rows[name] = new
+        self.next_id += n
+        for name, new in rows.items():
             setattr(self, name, np.concatenate([getattr(self, name), new]))
         return np.arange(start, start + n)
 
