@@ -15,7 +15,7 @@ from lookalike.trackers.parts.lifecycle import Lifecycle
 from lookalike.trackers.parts.self_calibration import ScoreCalibration
 from lookalike.trackers.parts.table import TrackTable
 from lookalike.trackers.parts.timing import FrameClock
-from lookalike.types import TrackStatus
+from lookalike.types import Tracks, TrackStatus
 
 
 def _table(n: int = 3) -> TrackTable:
@@ -76,6 +76,20 @@ def test_lifecycle_confirms_coasts_and_deletes() -> None:
     assert Lifecycle(n_init=1).born_confirmed() and Lifecycle(n_init=3).born_confirmed(first_frame=True)
     with pytest.raises(ValueError):
         Lifecycle(n_init=0)
+
+
+def test_lifecycle_statuses_make_a_tracks_batch() -> None:
+    t = _table(3)
+    t.hits[:] = [1, 3, 3]
+    t.misses[:] = [0, 0, 1]
+    policy = Lifecycle(n_init=3)
+    policy.confirm(t)
+    status = policy.status(t, np.arange(3))
+    tracks = Tracks(t.ids, status, xywh=t["box"])
+    assert tracks.statuses() == [TrackStatus.TENTATIVE, TrackStatus.CONFIRMED, TrackStatus.LOST]
+    assert tracks.status.tolist() == [0, 1, 2] and Tracks(t.ids, list(status)).status.tolist() == [0, 1, 2]
+    with pytest.raises(ValueError, match="Tracks.status: give TrackStatus values"):
+        Tracks(t.ids, np.array([TrackStatus.LOST, "lost", None], dtype=object))
 
 
 def test_plan_runs_stages_in_order_on_what_is_left() -> None:

@@ -57,12 +57,27 @@ def _column(name: str, values: np.ndarray, dtype: type, k: int) -> np.ndarray:
     return column.reshape(k)
 
 
+def _status_codes(status: np.ndarray | Sequence[TrackStatus]) -> np.ndarray:
+    """Status codes from codes, or from :class:`TrackStatus` values (as ``Lifecycle.status`` gives them)."""
+    values = np.asarray(status)
+    if values.dtype != object:
+        return values
+    codes = []
+    for value in values.reshape(-1).tolist():
+        if not isinstance(value, TrackStatus):
+            raise ValueError(f"Tracks.status: give TrackStatus values or codes 0 (tentative), 1 (confirmed), "
+                             f"2 (lost), got {value!r}")
+        codes.append(_STATUS_CODE[value])
+    return np.array(codes, dtype=np.int8)
+
+
 class Tracks(Sequence[TrackSnapshot]):
     """The tracks a tracker reports for one frame, as columns; iterating or indexing gives :class:`TrackSnapshot`s.
 
     Attributes:
         id: ``(k,)`` track ids.
-        status: ``(k,)`` status codes (0 tentative, 1 confirmed, 2 lost; :meth:`statuses` as enums).
+        status: ``(k,)`` status codes (0 tentative, 1 confirmed, 2 lost; :meth:`statuses` as enums); the
+            constructor also takes one :class:`TrackStatus` for all, or one per track.
         xywh: ``(k, 4)`` boxes in pixels, or None for world-only trackers.
         position: ``(k, 2)`` ground positions in metres, or None.
         velocity: ``(k, d)`` velocities (pixels/s or metres/s), or None.
@@ -74,8 +89,8 @@ class Tracks(Sequence[TrackSnapshot]):
     __slots__ = ("id", "status", "xywh", "position", "velocity", "heading", "agent_id", "identity_prob",
                  "detection_index")
 
-    def __init__(self, id: np.ndarray, status: np.ndarray | TrackStatus, *, xywh: np.ndarray | None = None,
-                 position: np.ndarray | None = None, velocity: np.ndarray | None = None,
+    def __init__(self, id: np.ndarray, status: np.ndarray | TrackStatus | Sequence[TrackStatus], *,
+                 xywh: np.ndarray | None = None, position: np.ndarray | None = None, velocity: np.ndarray | None = None,
                  heading: np.ndarray | None = None, agent_id: np.ndarray | None = None,
                  identity_prob: np.ndarray | None = None, detection_index: np.ndarray | None = None) -> None:
         self.id = np.asarray(id, dtype=int).reshape(-1)
@@ -83,7 +98,7 @@ class Tracks(Sequence[TrackSnapshot]):
         if isinstance(status, TrackStatus):
             self.status = np.full(k, _STATUS_CODE[status], dtype=np.int8)
         else:
-            self.status = _column("status", status, np.int8, k)
+            self.status = _column("status", _status_codes(status), np.int8, k)
             if ((self.status < 0) | (self.status >= len(_STATUS))).any():
                 raise ValueError(f"Tracks.status: codes are 0 (tentative), 1 (confirmed) or 2 (lost), got "
                                  f"{sorted(set(self.status.tolist()))}")
