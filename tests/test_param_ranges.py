@@ -59,6 +59,24 @@ def test_direct_construction_checks_ranges_and_finiteness(tracker):
                     config(**{p.name: bad})
 
 
+# Range ends refused for a reason of their own, each in a message naming the parameter: another parameter's default
+# (boxtrack's scores, the k-of-n confirmation) or the LSTM's shipped weights (sizes it was trained for).
+_ENDS_OF_THEIR_OWN = {("boxtrack", "high_score"), ("boxtrack", "low_score"), ("jpda", "confirm_hits"),
+                      ("jpda", "confirm_window"), ("kalman_ha2", "confirm_hits"), ("kalman_ha2", "confirm_window"),
+                      ("lstm", "n_agents"), ("lstm", "n_slots")}
+
+
+@pytest.mark.parametrize("tracker", tracker_names())
+def test_every_allowed_range_end_builds_the_tracker(tracker):
+    for p, kind in _numeric(tracker):
+        if (tracker, p.name) in _ENDS_OF_THEIR_OWN:
+            continue
+        r = p.range
+        ends = [v for v, is_open in ((r.low, r.low_open), (r.high, r.high_open)) if v is not None and not is_open]
+        for value in ends:
+            make_tracker(tracker, **{p.name: kind(value)})
+
+
 def test_make_tracker_names_the_tracker_parameter_and_expectation():
     with pytest.raises(TypeError, match=r"^tracker 'sort': max_age='3' must be an int$"):
         make_tracker("sort", max_age="3")

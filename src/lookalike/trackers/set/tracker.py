@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lookalike.trackers.base import check_params, param
+from lookalike.trackers.base import Range, check_params, param
 from lookalike.trackers.parts.agents import AgentIdentifier, agent_detections, decode
 from lookalike.trackers.parts.identity.localiser import LOCALISERS
 from lookalike.trackers.registry import register_tracker
@@ -75,7 +75,8 @@ class SetIdentifier(AgentIdentifier):
         exchange_llr: float | None = param(8.0, "log-likelihood ratio at which two agents' report streams count "
                                            "as exchanged (teams of up to 7; None: never)", range=(0.0, 1000.0))
         visual_exchange: float | None = param(8.0, "log-likelihood ratio at which two agents' detections' visual "
-                                              "headings count as exchanged (None: never)", range=(0.0, 1e4))
+                                              "headings count as exchanged (None: never)",
+                                              range=Range(0.0, 1e4, low_open=True))
         undo_factor: float | None = param(0.5, "fraction of that evidence that undoes a pair's exchange within "
                                           f"{UNDO_S:g} s (None: the full evidence)", range=(1e-3, 1.0))
 
