@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from lookalike.association.solver import assign
-from lookalike.association.stages import Stage, cascade, run_plan
+from lookalike.association.stages import Matching, Stage, cascade, run_plan, run_stage
 from lookalike.motion.models import constant_velocity, kinematic_transition
 from lookalike.motion.spaces import BoxCXCYWH, BoxXYAH, CentreCV, WorldCA, xyah_to_xywh, xywh_to_xyah
 from lookalike.trackers.parts.coasting import Coasting
@@ -106,6 +106,21 @@ def test_plan_runs_stages_in_order_on_what_is_left() -> None:
     run_plan([first, probe], 2, 3)
     assert seen == [[0]]
     assert run_plan([Stage(np.zeros(0, dtype=bool), np.ones(3, dtype=bool), fn)], 0, 3).det_of_track.tolist() == []
+
+
+def test_plan_names_the_stage_whose_cost_mask_or_gate_does_not_fit() -> None:
+    cost = np.array([[0.1, 0.9], [0.8, 0.2], [0.5, 0.5]])
+    fn = lambda r, c: cost[np.ix_(r, c)]  # noqa: E731
+    transposed = Stage(None, None, lambda r, c: fn(r, c).T, name="by IoU")
+    with pytest.raises(ValueError, match=r"stage 0 \(by IoU\): its cost has shape \(2, 3\), expected \(3, 2\)"):
+        run_plan([transposed], 3, 2)
+    with pytest.raises(ValueError, match=r"stage 1: the tracks mask has shape \(2,\), expected \(3,\)"):
+        run_plan([Stage(None, np.zeros(2, dtype=bool), fn), Stage(np.ones(2, dtype=bool), None, fn)], 3, 2)
+    with pytest.raises(ValueError, match=r"the gate has shape \(2, 2\), expected \(3, 2\)"):
+        run_stage(Stage(None, None, fn, gate=np.eye(2, dtype=bool)), Matching.empty(3, 2))
+    gate = np.array([[True, False], [False, True], [False, False]])
+    listed = run_plan([Stage([True, True, True], [True, True], fn, gate=gate)], 3, 2)  # lists work as arrays
+    assert listed.det_of_track.tolist() == [0, 1, -1]
 
 
 def test_cascade_matches_recent_tracks_first() -> None:

@@ -127,8 +127,36 @@ class _PlanLists:
         return True
 
 
+def _label(stage: Stage, index: int) -> str:
+    return f"association stage {index}" + (f" ({stage.name})" if stage.name else "")
+
+
+def _checked(stage: Stage, n_tracks: int, n_detections: int, index: int) -> Stage:
+    """``stage`` with list selectors as arrays; ``ValueError`` naming it when a mask or the gate does not fit
+    ``n_tracks`` × ``n_detections``."""
+    tracks, detections = stage.tracks, stage.detections
+    if tracks is not None and type(tracks) is not np.ndarray:
+        tracks = np.asarray(tracks)
+    if detections is not None and type(detections) is not np.ndarray:
+        detections = np.asarray(detections)
+    for what, selector, size in (("tracks", tracks, n_tracks), ("detections", detections, n_detections)):
+        if selector is not None and selector.dtype == bool and selector.shape != (size,):
+            raise ValueError(f"{_label(stage, index)}: the {what} mask has shape {selector.shape}, expected "
+                             f"({size},)")
+    if stage.gate is not None and stage.gate.shape != (n_tracks, n_detections):
+        raise ValueError(f"{_label(stage, index)}: the gate has shape {stage.gate.shape}, expected "
+                         f"({n_tracks}, {n_detections}) (tracks × detections)")
+    if tracks is stage.tracks and detections is stage.detections:
+        return stage
+    return stage._replace(tracks=tracks, detections=detections)
+
+
 def run_stage(stage: Stage, matching: Matching, index: int = 0, _lists: _PlanLists | None = None) -> Matching:
-    """Run one stage on what ``matching`` left over (updated in place and returned)."""
+    """Run one stage on what ``matching`` left over (updated in place and returned). A mask or gate that does not
+    fit the tracks and detections, or a cost of another shape than eligible tracks × detections, raises
+    ``ValueError`` naming the stage."""
+    if _lists is None:  # (run_plan checked its stages)
+        stage = _checked(stage, len(matching.det_of_track), len(matching.free), index)
     gate = stage.gate if stage.solve is None else None
     if gate is not None and (stage.tracks is None or stage.tracks.dtype == bool) and (
             stage.detections is None or stage.detections.dtype == bool):
@@ -153,6 +181,9 @@ def run_stage(stage: Stage, matching: Matching, index: int = 0, _lists: _PlanLis
             matching.stage_of_track[r] = index
             return matching
     cost = stage.cost(rows, cols)
+    if cost.shape != (len(rows), len(cols)):
+        raise ValueError(f"{_label(stage, index)}: its cost has shape {cost.shape}, expected ({len(rows)}, "
+                         f"{len(cols)}) (eligible tracks × detections)")
     found = stage.solve(cost) if stage.solve is not None else assign_pairs(cost, stage.max_cost)
     if len(found):
         r, c = rows[found[:, 0]], cols[found[:, 1]]
@@ -166,10 +197,13 @@ def run_stage(stage: Stage, matching: Matching, index: int = 0, _lists: _PlanLis
 
 def run_plan(stages: list[Stage], n_tracks: int, n_detections: int,
              start: Matching | None = None) -> Matching:
-    """Run ``stages`` in order on the tracks and detections (or on what ``start`` left over)."""
+    """Run ``stages`` in order on the tracks and detections (or on what ``start`` left over); ``ValueError`` naming
+    the stage for a mask, gate or cost that does not fit (:func:`run_stage`)."""
     matching = start if start is not None else Matching.empty(n_tracks, n_detections)
+    k, n = len(matching.det_of_track), len(matching.free)
+    checked = [_checked(stage, k, n, i) for i, stage in enumerate(stages)]  # (kept: the lists key on them)
     lists = _PlanLists()  # what the gated stages share, found once per plan
-    for i, stage in enumerate(stages):
+    for i, stage in enumerate(checked):
         run_stage(stage, matching, i, lists)
     return matching
 
