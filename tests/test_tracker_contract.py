@@ -243,6 +243,23 @@ def test_a_frame_refused_for_its_feature_length_leaves_no_trace(name: str) -> No
     assert [_summary(f) for f in _run(refused, later)] == [_summary(f) for f in _run(untouched, later)]
 
 
+@pytest.mark.parametrize("name", [n for n in NAMES if KINDS.get(n) == WORLD])
+def test_a_frame_refused_for_an_unknown_agent_or_missing_columns_leaves_no_trace(name: str) -> None:
+    refused, untouched = make_tracker(name), make_tracker(name)
+    first = [_frame(k, kind=WORLD) for k in range(5)]
+    _run(refused, first)
+    _run(untouched, first)
+    stranger = Beacons(agent_id=np.array([0, N_TARGETS]), t_sent=np.full(2, 5 / FPS - 0.02),
+                       t_received=np.full(2, 5 / FPS), heading=np.zeros(2))
+    with pytest.raises(ValueError, match="is no agent of this tracker"):
+        refused.update(dataclasses.replace(_frame(5, kind=WORLD), beacons=stranger, time=5.5 / FPS))
+    boxes_only = Detections(xywh=np.tile([10.0, 10.0, 5.0, 5.0], (2, 1)))
+    with pytest.raises(ValueError, match="position"):
+        refused.update(dataclasses.replace(_frame(5, kind=WORLD), detections=boxes_only, time=5.7 / FPS))
+    later = [_frame(k, kind=WORLD) for k in range(5, 10)]
+    assert [_summary(f) for f in _run(refused, later)] == [_summary(f) for f in _run(untouched, later)]
+
+
 def _deep_size(root: object) -> int:
     """Bytes of everything reachable from ``root`` through attributes and containers (arrays with their data)."""
     skip = (type, types.ModuleType, types.FunctionType, types.BuiltinFunctionType, types.MethodType)

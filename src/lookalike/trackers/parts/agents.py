@@ -41,6 +41,7 @@ class AgentIdentifier:
     """The learned identifiers' state besides their network: reports, positions, the frame time, the latest labels."""
 
     needs: ClassVar[str] = NEEDS_ROBOTS
+    name: ClassVar[str] = "identifier"  # (the registered name of a subclass)
 
     def _reset_agents(self, n_agents: int, localiser: str) -> None:
         self._beacons = BeaconMemory(n_agents)
@@ -51,7 +52,12 @@ class AgentIdentifier:
         self._last_time = -np.inf
 
     def _step_time(self, frame: Frame) -> float:
-        """Seconds since the previous frame (0 at the first); ``ValueError`` when time goes backwards."""
+        """Seconds since the previous frame (0 at the first). ``ValueError``, changing nothing, when time goes
+        backwards, for a report from an unknown agent, or for detections without position, heading and score."""
+        det = frame.detections
+        if len(det) and (det.position is None or det.heading is None or det.score is None):
+            raise ValueError(f"{self.name}: frame.detections need position (m), heading (rad) and score columns")
+        frame.beacons.require_agents(len(self._last_seen))
         if frame.time < self._last_time:
             raise ValueError(f"frame time went backwards: {self._last_time} s then {frame.time} s")
         dt = 0.0 if not math.isfinite(self._last_time) else frame.time - self._last_time

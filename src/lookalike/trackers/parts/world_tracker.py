@@ -70,6 +70,7 @@ class WorldTracker:
         dt = 0.0 if self._time is None else frame.time - self._time
         if dt < 0:
             raise ValueError(f"frame {frame.index}: time went backwards ({self._time} s then {frame.time} s)")
+        self._identifier.begin_frame(frame.time, frame.beacons)  # (first: it refuses unknown agents, changing nothing)
         self._time = frame.time
         if dt > 0:
             if dt in self._intervals:
@@ -77,7 +78,6 @@ class WorldTracker:
             if not self._intervals or dt != self._intervals[0]:
                 self._intervals = [dt, *self._intervals[:1]]
                 self._repeated.intersection_update(self._intervals)
-        self._identifier.begin_frame(frame.time, frame.beacons)
         ready, self._ready = self._ready.get(dt), {}  # (made for this interval from this table: prepare)
         if ready is not None:
             t.mean, t.cov = ready.mean, ready.cov

@@ -113,9 +113,7 @@ class SetIdentifier(AgentIdentifier):
         if self._exchange is not None:
             self._report_exchanges(frame)
         det = frame.detections
-        n = len(det)
-        if n and (det.position is None or det.heading is None or det.score is None):
-            raise ValueError("set: frame.detections need position (m), heading (rad) and score columns")
+        n = len(det)  # (_step_time checked the columns)
         position = det.position if det.position is not None and n else np.zeros((0, 2))
         heading = det.heading if det.heading is not None and n else np.zeros(0)
         score = det.score if det.score is not None and n else np.zeros(0)
