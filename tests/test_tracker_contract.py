@@ -138,6 +138,17 @@ def test_empty_frames_are_harmless(name: str) -> None:
     tracker.update(_frame(9, kind=kind))  # and it carries on
 
 
+@pytest.mark.parametrize("name", _params("empty_without_columns"))
+def test_an_empty_frame_needs_no_columns(name: str) -> None:
+    """``Detections.empty()`` (no position, heading or feature column) is an empty frame like any other."""
+    kind = _kind(name)
+    frames = [_frame(k, kind=kind) if k != 6 else _empty(k, kind) for k in range(10)]
+    bare = [dataclasses.replace(f, detections=Detections.empty()) if k in (0, 6) else f for k, f in enumerate(frames)]
+    frames[0] = _empty(0, kind)
+    assert [_summary(f) for f in _run(make_tracker(name), bare)] == [
+        _summary(f) for f in _run(make_tracker(name), frames)]
+
+
 @pytest.mark.parametrize("name", _params("reset"))
 def test_reset_gives_the_output_of_a_fresh_tracker(name: str) -> None:
     kind = _kind(name)

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from lookalike.trackers.base import check_params, param
 from lookalike.trackers.lstm.checkpoint import load_weights
 from lookalike.trackers.lstm.encoding import PROTOCOLS, EncodingSpec, encode_frame
@@ -15,7 +17,10 @@ from lookalike.trackers.lstm.weights import shipped_weights_path
 from lookalike.trackers.parts.agents import AgentIdentifier, decode
 from lookalike.trackers.parts.identity.localiser import LOCALISERS
 from lookalike.trackers.registry import register_tracker
-from lookalike.types import Frame, TrackSnapshot
+from lookalike.types import Detections, Frame, TrackSnapshot
+
+_NONE_SEEN = Detections(position=np.zeros((0, 2)), heading=np.zeros(0), score=np.zeros(0))
+"""An empty frame's detections with the columns the encoding reads."""
 
 
 @register_tracker("lstm")
@@ -54,7 +59,7 @@ class LstmIdentifier(AgentIdentifier):
         """Label the frame's detections and return one snapshot per agent seen so far."""
         self._step_time(frame)
         self._beacons.add(frame)
-        det = frame.detections
+        det = frame.detections if len(frame.detections) else _NONE_SEEN  # (an empty frame may lack the columns)
         x, used = encode_frame(self.spec, det, self._beacons.heading, self._beacons.age(frame.time))
         labels, conf = decode(self.net.step(x), used, len(det), self.config.one_to_one)
         self.last_labels, self.last_probabilities = labels, conf
