@@ -126,6 +126,19 @@ def test_tracks_columns_of_another_length_or_status_code_are_named() -> None:
     assert Tracks(np.array([[3]]), [2]).statuses()[0].value == "lost"
 
 
+def test_tracks_refuse_boxes_of_another_width_and_fractional_ids() -> None:
+    from lookalike.types import Tracks
+
+    # boxes of 3 numbers failed only when written (a numpy broadcast error); id 1.7 was truncated to 1
+    with pytest.raises(ValueError, match=r"Tracks.xywh: rows of 4 numbers expected, got shape \(2, 3\)"):
+        Tracks(np.array([1, 2]), np.array([1, 1]), xywh=np.zeros((2, 3)))
+    with pytest.raises(ValueError, match=r"Tracks.position: rows of 2 numbers expected, got shape \(1, 3\)"):
+        Tracks(np.array([1]), np.array([1]), position=np.zeros((1, 3)))
+    with pytest.raises(ValueError, match=r"Tracks.id: row 1 is not a whole number \(.*1.7\)"):
+        Tracks(np.array([1.0, 1.7]), np.array([1, 1]))
+    assert Tracks(np.array([1.0, 2.0]), np.array([1, 1]), xywh=[[0, 0, 1, 1]] * 2).to_rows(0)[:, 1].tolist() == [1, 2]
+
+
 @pytest.mark.parametrize("index, time, field", [("a", 0.0, "Frame.index"), (None, 0.0, "Frame.index"),
                                                 (0, None, "Frame.time"), (0, "soon", "Frame.time")])
 def test_frame_names_an_index_or_time_that_is_no_number(index, time, field) -> None:

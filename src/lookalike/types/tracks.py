@@ -10,6 +10,8 @@ from typing import overload
 
 import numpy as np
 
+from lookalike.types._validate import first_fraction
+
 
 class TrackStatus(enum.Enum):
     """Lifecycle of a track."""
@@ -93,6 +95,9 @@ class Tracks(Sequence[TrackSnapshot]):
                  xywh: np.ndarray | None = None, position: np.ndarray | None = None, velocity: np.ndarray | None = None,
                  heading: np.ndarray | None = None, agent_id: np.ndarray | None = None,
                  identity_prob: np.ndarray | None = None, detection_index: np.ndarray | None = None) -> None:
+        fraction = first_fraction(id)
+        if fraction is not None:
+            raise ValueError(f"Tracks.id: row {fraction} is not a whole number ({np.ravel(id)[fraction]!r})")
         self.id = np.asarray(id, dtype=int).reshape(-1)
         k = len(self.id)
         if isinstance(status, TrackStatus):
@@ -110,6 +115,10 @@ class Tracks(Sequence[TrackSnapshot]):
             col = getattr(self, name)
             if col is not None and len(col) != k:
                 raise ValueError(f"Tracks.{name}: has {len(col)} rows but the batch has {k}")
+        for name, width in (("xywh", 4), ("position", 2)):
+            col = getattr(self, name)
+            if col is not None and np.shape(col)[1:] != (width,):
+                raise ValueError(f"Tracks.{name}: rows of {width} numbers expected, got shape {np.shape(col)}")
 
     @classmethod
     def trusted(cls, id: np.ndarray, status: np.ndarray, xywh: np.ndarray, velocity: np.ndarray,
