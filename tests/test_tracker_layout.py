@@ -75,3 +75,22 @@ def test_each_tracker_declares_what_it_needs_beyond_boxes(monkeypatch: pytest.Mo
     assert input_kind("test-needs-pixels") == "boxes + video"
     assert box_input_problem("test-needs-pixels", video=True) is None
     assert "--video" in (box_input_problem("test-needs-pixels") or "")
+
+
+def test_a_tracker_of_ones_own_cannot_take_a_built_in_name(monkeypatch) -> None:
+    """Registered before the built-in module was imported, it used to win, and importing that module later (any
+    lookup of an unknown name imports them all) failed with 'already registered'."""
+    from dataclasses import dataclass
+
+    from lookalike.trackers import registry
+
+    monkeypatch.setattr(registry, "_REGISTRY", {k: v for k, v in registry._REGISTRY.items() if k != "jpda"})
+    with pytest.raises(ValueError, match="'jpda' is the name of a built-in tracker; register Mine under another"):
+
+        @registry.register_tracker("jpda")
+        class Mine:
+            @dataclass(frozen=True)
+            class Config:
+                pass
+
+    assert "jpda" not in registry._REGISTRY  # (refused: the built-in one registers when its module is imported)

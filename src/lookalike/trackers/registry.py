@@ -38,13 +38,16 @@ class ParameterInfo:
 
 
 def register_tracker(name: str) -> Callable[[type], type]:
-    """Class decorator: register a tracker class (which has a ``Config`` dataclass) under ``name``."""
+    """Class decorator: register a tracker class (which has a ``Config`` dataclass) under ``name``; ``ValueError`` for a
+    name already taken, by another registered class or by a built-in tracker (:data:`BUILTIN_TRACKERS`)."""
 
     def decorate(cls: type) -> type:
         from lookalike.trackers.base import name_config
 
         if name in _REGISTRY and _REGISTRY[name] is not cls:
             raise ValueError(f"a tracker named {name!r} is already registered")
+        if BUILTIN_TRACKERS.get(name, cls.__module__) != cls.__module__:  # (before its module is imported)
+            raise ValueError(f"{name!r} is the name of a built-in tracker; register {cls.__name__} under another")
         if not dataclasses.is_dataclass(getattr(cls, "Config", None)):
             raise TypeError(f"tracker {name!r} needs a dataclass attribute 'Config'")
         setattr(cls, "name", name)  # noqa: B010 (a class attribute the protocol declares)
