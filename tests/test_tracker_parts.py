@@ -76,6 +76,11 @@ def test_lifecycle_confirms_coasts_and_deletes() -> None:
     assert Lifecycle(n_init=1).born_confirmed() and Lifecycle(n_init=3).born_confirmed(first_frame=True)
     with pytest.raises(ValueError):
         Lifecycle(n_init=0)
+    # limits that would delete every track, even one matched this frame, were taken silently
+    for bad in ({"tentative_max_misses": 0}, {"max_misses": -1}, {"max_unseen_s": float("nan")},
+                {"tentative_max_unseen_s": -0.5}):
+        with pytest.raises(ValueError, match=f"Lifecycle.{next(iter(bad))} must be >= "):
+            Lifecycle(**bad)
 
 
 def test_lifecycle_statuses_make_a_tracks_batch() -> None:

@@ -18,7 +18,7 @@ class Lifecycle:
 
     Attributes:
         n_init: hits that confirm a track (1: confirmed at birth).
-        tentative_max_misses: consecutive missed frames that delete a tentative track (None: no limit).
+        tentative_max_misses: consecutive missed frames that delete a tentative track, at least 1 (None: no limit).
         tentative_max_unseen_s: seconds unseen beyond which a tentative track is deleted (None: no limit).
         max_misses: frames a confirmed track survives without an update (None: no limit).
         max_unseen_s: seconds a confirmed track survives without an update (None: no limit).
@@ -34,6 +34,11 @@ class Lifecycle:
     def __post_init__(self) -> None:
         if self.n_init < 1:
             raise ValueError(f"Lifecycle.n_init must be >= 1, got {self.n_init}")
+        for name, low in (("tentative_max_misses", 1), ("tentative_max_unseen_s", 0), ("max_misses", 0),
+                          ("max_unseen_s", 0)):
+            value = getattr(self, name)
+            if value is not None and not value >= low:  # (NaN too: no track would survive it)
+                raise ValueError(f"Lifecycle.{name} must be >= {low} or None, got {value}")
 
     def closed_set(self) -> Lifecycle:
         """The same rules for a closed set: confirmed tracks never die."""
