@@ -3,6 +3,9 @@ score calibration."""
 
 from __future__ import annotations
 
+import math
+import re
+
 import numpy as np
 import pytest
 
@@ -154,6 +157,17 @@ def test_state_spaces_round_trip_boxes_and_share_the_transition() -> None:
     assert cov[0, 0, 0] == pytest.approx((0.05 + 0.04 * 5) ** 2)
     F, _ = constant_velocity(4, 0.5)
     np.testing.assert_array_equal(kinematic_transition(4, 1, 0.5), F)
+
+
+def test_state_spaces_refuse_noises_that_make_every_state_nan() -> None:
+    cases = ((lambda: BoxCXCYWH(0.0, 0.01), "BoxCXCYWH.pos_noise must be a finite number > 0"),
+             (lambda: BoxXYAH(0.05, math.nan, 0.01), "BoxXYAH.velocity_std_frac"),
+             (lambda: CentreCV(0.1, -1.0), "CentreCV.accel_std_frac"),
+             (lambda: WorldCA(4.0, -0.05, 0.0, 0.5, 1.0), "WorldCA.meas_std0_m must be a finite number >= 0"))
+    for make, field in cases:
+        with pytest.raises(ValueError, match=re.escape(field)):
+            make()
+    assert WorldCA(0.0, 0.0, 0.0, 0.0, 0.0).q_jerk == 0.0  # zeros are a world model's limits, not an error
 
 
 def test_coasting_reports_only_misses_that_usually_end_in_a_return() -> None:

@@ -4,6 +4,7 @@ for ``WorldCA``."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -46,6 +47,15 @@ def cxcywh_to_xywh(cxcywh: np.ndarray) -> np.ndarray:
     return out
 
 
+def _require_noises(space: object, low_open: bool = True) -> None:
+    """``ValueError`` naming the first of ``space``'s numbers (its dataclass fields) that is not finite and > 0 (``>=
+    0`` without ``low_open``): a zero or NaN noise makes every state NaN."""
+    for name, value in vars(space).items():
+        if not (math.isfinite(value) and (value > 0 if low_open else value >= 0)):
+            bound = "> 0" if low_open else ">= 0"
+            raise ValueError(f"{type(space).__name__}.{name} must be a finite number {bound}, got {value}")
+
+
 _P, _V = np.arange(4), np.arange(4, 8)  # the value and velocity rows of an 8-number box state
 
 
@@ -64,6 +74,9 @@ class BoxCXCYWH:
     pos_noise: float
     vel_noise: float
     H = _observe_first(4, 8)
+
+    def __post_init__(self) -> None:
+        _require_noises(self)
 
     @staticmethod
     def measure(xywh: np.ndarray) -> np.ndarray:
@@ -223,6 +236,9 @@ class BoxXYAH:
     aspect_std: float
     H = _observe_first(4, 8)
 
+    def __post_init__(self) -> None:
+        _require_noises(self)
+
     @staticmethod
     def measure(xywh: np.ndarray) -> np.ndarray:
         return xywh_to_xyah(xywh)
@@ -263,6 +279,9 @@ class CentreCV:
     position_std_frac: float
     accel_std_frac: float
     H = _observe_first(2, 4)
+
+    def __post_init__(self) -> None:
+        _require_noises(self)
 
     @staticmethod
     def measure(xywh: np.ndarray) -> np.ndarray:
@@ -305,6 +324,9 @@ class WorldCA:
     init_velocity_std: float
     init_accel_std: float
     H = _observe_first(2, 6)
+
+    def __post_init__(self) -> None:
+        _require_noises(self, low_open=False)
 
     def R(self, position: np.ndarray) -> np.ndarray:
         """Measurement covariances ``(k, 2, 2)`` for positions ``(k, 2)`` in metres."""
