@@ -13,6 +13,7 @@ from lookalike._lsap import linear_sum_assignment
 from lookalike.trackers.base import NEEDS_ROBOTS
 from lookalike.trackers.kernels.world import filled
 from lookalike.trackers.parts.identity.localiser import make_localiser
+from lookalike.trackers.parts.timing import RESET_HINT
 from lookalike.types import Frame, TrackSnapshot, TrackStatus
 
 
@@ -59,7 +60,7 @@ class AgentIdentifier:
             raise ValueError(f"{self.name}: frame.detections need position (m), heading (rad) and score columns")
         frame.beacons.require_agents(len(self._last_seen))
         if frame.time < self._last_time:
-            raise ValueError(f"frame time went backwards: {self._last_time} s then {frame.time} s")
+            raise ValueError(f"frame time went backwards: {self._last_time} s then {frame.time} s{RESET_HINT}")
         dt = 0.0 if not math.isfinite(self._last_time) else frame.time - self._last_time
         self._last_time = frame.time
         return dt

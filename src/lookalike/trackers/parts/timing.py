@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from collections import deque
 
+RESET_HINT = "; a new sequence needs the tracker's reset() first"
+"""Ends the message of a time going backwards: the usual cause is one tracker object fed a second sequence."""
 RECENT_STEPS = 64  # the latest positive steps whose median says how long a frame's step is
 
 
@@ -32,7 +34,7 @@ class FrameClock:
             return 1.0
         dt = now - last
         if not math.isfinite(dt) or dt < 0:
-            raise ValueError(f"frame time went backwards: {last} s then {time_s} s")
+            raise ValueError(f"frame time went backwards: {last} s then {time_s} s{RESET_HINT}")
         self._last = now
         if dt == 0:
             return 0.0

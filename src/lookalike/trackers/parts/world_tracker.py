@@ -24,6 +24,7 @@ from lookalike.trackers.kernels.world import (
 )
 from lookalike.trackers.parts.identity import BeaconIdentifier, IdentifierConfig
 from lookalike.trackers.parts.table import TrackTable
+from lookalike.trackers.parts.timing import RESET_HINT
 from lookalike.trackers.parts.world_rules import WorldConfig, WorldRules, headings, positions
 from lookalike.types import Detections, Frame, Tracks
 
@@ -69,7 +70,8 @@ class WorldTracker:
             raise ValueError(f"frame {frame.index}: {self.name} needs detections with position and heading")
         dt = 0.0 if self._time is None else frame.time - self._time
         if dt < 0:
-            raise ValueError(f"frame {frame.index}: time went backwards ({self._time} s then {frame.time} s)")
+            raise ValueError(f"frame {frame.index}: time went backwards ({self._time} s then {frame.time} s)"
+                             f"{RESET_HINT}")
         self._identifier.begin_frame(frame.time, frame.beacons)  # (first: it refuses unknown agents, changing nothing)
         self._time = frame.time
         if dt > 0:
