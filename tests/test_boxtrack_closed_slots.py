@@ -95,3 +95,26 @@ def test_the_gate_grows_with_the_targets_typical_speed_and_sizes_ignore_turning(
     assert slots.gate(np.array([1.0])).ravel().tolist() == [12.0]  # 8 + 2 x 2 sizes/s x 1 s
     turned = ClosedSlots.squared(np.array([[0.0, 0.0, 40.0, 10.0]]))
     assert turned[0, 2:].tolist() == [20.0, 20.0] == ClosedSlots.squared(mean[:1, :4])[0, 2:].tolist()
+
+
+def test_reset_forgets_the_typical_speed_of_the_previous_sequence() -> None:
+    # Targets fast in the first sequence; in the second one a slow target is lost for 1 s and comes back 15
+    # sizes away: a fresh tracker's gate (from the slow speed) does not reach it, the previous speed's would.
+    def scene(speed: float, lost: range = range(0), jump: float = 0.0) -> list[Frame]:
+        frames = []
+        for k in range(40):
+            boxes = [[50.0 + speed * k, 100.0, 20.0, 20.0], [400.0 + speed * k + (jump if k >= lost.stop else 0.0),
+                                                               100.0, 20.0, 20.0]]
+            frames.append(_frame(k, boxes[:1] if k in lost else boxes))
+        return frames
+
+    second = scene(1.0, lost=range(10, 20), jump=300.0)
+    fresh = make_tracker("boxtrack", max_targets=2)
+    expected = [_ids(fresh.update(f)) for f in second]
+    used = make_tracker("boxtrack", max_targets=2)
+    for f in scene(60.0):
+        used.update(f)
+    used.reset()
+    got = [_ids(used.update(f)) for f in second]
+    assert [sorted(g) for g in got] == [sorted(e) for e in expected]
+    assert all(np.allclose(g[i], e[i]) for g, e in zip(got, expected) for i in e)

@@ -59,8 +59,6 @@ class BoxTrack:
         lifecycle = Lifecycle(n_init=cfg.n_init, tentative_max_misses=None, tentative_max_unseen_s=0.0,
                               max_unseen_s=cfg.max_age_s)
         self._lifecycle = lifecycle.closed_set() if cfg.max_targets is not None else lifecycle
-        self._slots = None if cfg.max_targets is None else ClosedSlots(
-            cfg.max_targets, cfg.closed_distance, const.CLOSED_GATE_GROWTH, refill_s=cfg.max_age_s)
         self._path = boxtrack_kernels.PathChoice(allowed=cfg.match_iou > 0)  # (the kernels need IoU gates)
         self.reset()
 
@@ -76,6 +74,8 @@ class BoxTrack:
         self._views: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
         self._frame_count = 0
         self._clock = FrameClock(cfg.frame_interval_s)
+        self._slots = None if cfg.max_targets is None else ClosedSlots(  # (it learns the slots' typical speed)
+            cfg.max_targets, cfg.closed_distance, const.CLOSED_GATE_GROWTH, refill_s=cfg.max_age_s)
         self._calibration = ScoreCalibration(
             cfg.high_score, cfg.birth_score, high_quantile=const.HIGH_QUANTILE, high_match_ratio=cfg.high_match_ratio,
             calib_min_count=const.CALIB_MIN_COUNT, clutter_factor=cfg.clutter_factor, clutter_floor=const.CLUTTER_FLOOR)
