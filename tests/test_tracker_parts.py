@@ -131,6 +131,17 @@ def test_plan_names_the_stage_whose_cost_mask_or_gate_does_not_fit() -> None:
     assert listed.det_of_track.tolist() == [0, 1, -1]
 
 
+def test_plan_refuses_index_arrays_with_repeated_or_outside_indices() -> None:
+    cost = np.array([[0.1, 0.2], [0.5, 0.5]])
+    fn = lambda r, c: cost[np.ix_(r, c)]  # noqa: E731
+    # a repeated detection was given to two tracks; -1 took the last track silently
+    with pytest.raises(ValueError, match="detections indices must be distinct, from 0 to 1; got one twice"):
+        run_plan([Stage(None, np.array([1, 1]), fn)], 2, 2)
+    with pytest.raises(ValueError, match="tracks indices must be distinct, from 0 to 1; got -1"):
+        run_plan([Stage(np.array([-1]), None, fn)], 2, 2)
+    assert run_plan([Stage(np.array([1, 0]), np.array([], dtype=int), fn)], 2, 2).det_of_track.tolist() == [-1, -1]
+
+
 def test_cascade_matches_recent_tracks_first() -> None:
     age = np.array([2, 1, 1])
     cost = np.array([[0.1], [0.2], [0.3]])

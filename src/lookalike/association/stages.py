@@ -132,17 +132,26 @@ def _label(stage: Stage, index: int) -> str:
 
 
 def _checked(stage: Stage, n_tracks: int, n_detections: int, index: int) -> Stage:
-    """``stage`` with list selectors as arrays; ``ValueError`` naming it when a mask or the gate does not fit
-    ``n_tracks`` × ``n_detections``."""
+    """``stage`` with list selectors as arrays; ``ValueError`` naming it when a mask, an index array (distinct indices
+    in range) or the gate does not fit ``n_tracks`` × ``n_detections``."""
     tracks, detections = stage.tracks, stage.detections
     if tracks is not None and type(tracks) is not np.ndarray:
         tracks = np.asarray(tracks)
     if detections is not None and type(detections) is not np.ndarray:
         detections = np.asarray(detections)
     for what, selector, size in (("tracks", tracks, n_tracks), ("detections", detections, n_detections)):
-        if selector is not None and selector.dtype == bool and selector.shape != (size,):
-            raise ValueError(f"{_label(stage, index)}: the {what} mask has shape {selector.shape}, expected "
-                             f"({size},)")
+        if selector is None:
+            continue
+        if selector.dtype == bool:
+            if selector.shape != (size,):
+                raise ValueError(f"{_label(stage, index)}: the {what} mask has shape {selector.shape}, expected "
+                                 f"({size},)")
+        elif len(selector):
+            low, high = int(selector.min()), int(selector.max())
+            if low < 0 or high >= size or len(np.unique(selector)) < len(selector):
+                bad = low if low < 0 else high if high >= size else "one twice"
+                raise ValueError(f"{_label(stage, index)}: the {what} indices must be distinct, from 0 to {size - 1}; "
+                                 f"got {bad}")
     if stage.gate is not None and stage.gate.shape != (n_tracks, n_detections):
         raise ValueError(f"{_label(stage, index)}: the gate has shape {stage.gate.shape}, expected "
                          f"({n_tracks}, {n_detections}) (tracks × detections)")
