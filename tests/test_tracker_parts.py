@@ -62,6 +62,14 @@ def test_table_refuses_columns_of_another_length_and_stays_as_it_was() -> None:
     assert t.add(np.zeros((1, 2)), np.zeros((1, 2, 2))).tolist() == [2] and t.ids.tolist() == [1, 2, 3]
 
 
+def test_table_refuses_extra_columns_named_like_its_own_columns_or_methods() -> None:
+    # a column 'age' replaced the age() method (then: 'numpy.ndarray' object is not callable); 'ids' changed its dtype
+    for name in ("age", "keep", "ids", "mean", "_spec", "next_id"):
+        with pytest.raises(ValueError, match=f"column name\\(s\\) \\['{name}'\\] are taken"):
+            TrackTable(2, {name: ((), int)})
+    assert TrackTable(2, {"age_s": ((), float)}).columns[-1] == "age_s"
+
+
 def test_lifecycle_confirms_coasts_and_deletes() -> None:
     t = _table(3)
     t.hits[:] = [1, 3, 3]

@@ -33,9 +33,14 @@ class TrackTable:
 
     def __init__(self, state_dim: int, extra: dict[str, ColumnSpec] | None = None,
                  cov_shape: tuple[int, ...] | None = None) -> None:
-        """A table for states of ``state_dim`` numbers plus ``extra`` columns (name → (trailing shape, dtype));
+        """A table for states of ``state_dim`` numbers plus ``extra`` columns (name → (trailing shape, dtype); a name
+        of a standard column or of a method, such as ``age``, raises ``ValueError``);
         ``cov_shape``: the covariance's trailing shape when the motion space keeps it compact (default
         ``(state_dim, state_dim)``)."""
+        taken = sorted(name for name in extra or {} if name in _CORE or name in ("mean", "cov", "next_id")
+                       or name.startswith("_") or hasattr(TrackTable, name))
+        if taken:
+            raise ValueError(f"TrackTable: column name(s) {taken} are taken by the table's own columns or methods")
         cov = (state_dim, state_dim) if cov_shape is None else tuple(cov_shape)
         self._spec: dict[str, ColumnSpec] = {
             **_CORE, "mean": ((state_dim,), float), "cov": (cov, float), **(extra or {})}
