@@ -285,3 +285,15 @@ def test_video_and_gif_outputs_without_a_known_suffix_are_written(template, tmp_
     assert (tmp_path / "annotated").read_bytes()[4:8] == b"ftyp"
     assert (tmp_path / "preview.out").read_bytes()[:6] == b"GIF89a"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["annotated", "preview.out"]
+
+
+def test_write_mot_onto_a_folder_names_the_folder_not_a_temporary_file(tmp_path):
+    import numpy as np
+
+    from lookalike.io import write_mot
+
+    folder = tmp_path / "results"
+    folder.mkdir()
+    with pytest.raises(IsADirectoryError, match=r"is a folder; give a file name: '.*results'") as caught:
+        write_mot(folder, np.array([[1, 1, 0, 0, 5, 5, 1, -1, -1, -1.0]]))
+    assert ".tmp" not in str(caught.value) and list(tmp_path.iterdir()) == [folder] and not any(folder.iterdir())

@@ -3,6 +3,7 @@ one file, a writable folder), and files written through a temporary file renamed
 
 from __future__ import annotations
 
+import errno
 import os
 from collections.abc import Collection, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
@@ -78,11 +79,14 @@ def _check_folder(folder: Path) -> None:
 def atomic_path(path: str | os.PathLike[str]) -> Iterator[Path]:
     """A temporary file (:func:`~lookalike.io.rules.temp_beside`) to write instead of ``path``: renamed onto ``path``
     (onto the file a symbolic link points at) when the block ends, removed when it raises (``KeyboardInterrupt`` and
-    SIGTERM's ``SystemExit`` included). A device or named pipe (``/dev/null``) is itself written into."""
+    SIGTERM's ``SystemExit`` included). A device or named pipe (``/dev/null``) is itself written into; an existing
+    folder raises ``IsADirectoryError`` naming ``path``, before anything is written."""
     target = write_target(Path(path))
     if is_special(target):
         yield target
         return
+    if target.is_dir():  # (else the rename failed naming the temporary file)
+        raise IsADirectoryError(errno.EISDIR, "is a folder; give a file name", str(path))
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = temp_beside(target)
     try:
