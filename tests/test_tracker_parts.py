@@ -51,6 +51,17 @@ def test_table_ages_and_records_misses_in_frames_and_seconds() -> None:
         t.add(np.zeros((1, 2)), np.zeros((1, 2, 2)), nope=1)
 
 
+def test_table_records_only_a_boolean_mask_of_hits() -> None:
+    t = _table(3)
+    det_of_track = np.array([-1, 0, 2])  # detection indices: -1 (missed) read as a hit, 0 as a miss
+    with pytest.raises(ValueError, match=r"record: hit must be a boolean mask of shape \(3,\), got int64"):
+        t.record(det_of_track, 0.1)
+    with pytest.raises(ValueError, match="boolean mask of shape"):
+        t.record(np.array([True, False]), 0.1)
+    t.record(det_of_track >= 0, 0.1)
+    assert t.misses.tolist() == [1, 0, 0]
+
+
 def test_table_refuses_columns_of_another_length_and_stays_as_it_was() -> None:
     t = _table(2)
     for bad in ({"box": np.ones((1, 4))}, {"box": np.ones((3, 3))}, {"hits": np.ones(5)}):

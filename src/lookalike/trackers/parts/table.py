@@ -108,8 +108,12 @@ class TrackTable:
         self.misses += 1
 
     def record(self, hit: np.ndarray, dt: float) -> None:
-        """After matching: tracks with ``hit`` were updated (``misses``, ``unseen_s`` reset), the
-        others missed one more frame of ``dt`` seconds."""
+        """After matching: tracks with ``hit`` (a boolean mask ``(k,)``; else ``ValueError``) were updated (``misses``,
+        ``unseen_s`` reset), the others missed one more frame of ``dt`` seconds."""
+        if not isinstance(hit, np.ndarray) or hit.dtype != np.bool_ or hit.shape != self.misses.shape:
+            given = f"{getattr(hit, 'dtype', type(hit).__name__)} of shape {np.shape(hit)}"
+            raise ValueError(f"TrackTable.record: hit must be a boolean mask of shape {self.misses.shape}, got "
+                             f"{given} (a matching's det_of_track >= 0, not the indices themselves)")
         self.misses = np.where(hit, 0, self.misses + 1)
         self.unseen_s = np.where(hit, 0.0, self.unseen_s + dt)
 
