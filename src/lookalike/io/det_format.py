@@ -122,7 +122,7 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
     if not path.is_file():
         raise not_a_file(path)
     lines = []
-    with open(path, encoding="utf-8", errors="replace") as fh:
+    with open(path, encoding="utf-8-sig", errors="replace") as fh:
         for line in fh:
             if line.strip():
                 lines.append(line)

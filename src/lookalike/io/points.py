@@ -100,7 +100,7 @@ def _xy_columns(path: Path) -> tuple[int, int]:
     """The columns of x and y in a points CSV: those its header names ``x`` and ``y`` (as ``frame,id,x,y``), else 1
     and 2."""
     try:
-        with open(path, encoding="utf-8", errors="replace") as fh:
+        with open(path, encoding="utf-8-sig", errors="replace") as fh:
             text = next((t for t in map(str.strip, fh) if t and not t.startswith("#")), "")
     except OSError:
         return 1, 2  # (reading the file again names the problem)

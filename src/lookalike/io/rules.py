@@ -21,7 +21,8 @@ def not_a_file(path: Path) -> FileNotFoundError:
 
 
 def read_text(path: str | os.PathLike[str]) -> str:
-    """The UTF-8 text of ``path``; ``FileNotFoundError``/``ValueError`` naming the file otherwise."""
+    """The UTF-8 text of ``path`` (a leading byte order mark dropped, as Windows editors and spreadsheets write one);
+    ``FileNotFoundError``/``ValueError`` naming the file otherwise."""
     path = Path(path)
     if not path.is_file():
         raise not_a_file(path)
@@ -30,7 +31,7 @@ def read_text(path: str | os.PathLike[str]) -> str:
     except OSError as exc:
         raise ValueError(f"{path}: cannot read ({exc.strerror or exc})") from None
     try:
-        return data.decode("utf-8")
+        return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = data.count(b"\n", 0, exc.start) + 1
         raise ValueError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x}); "

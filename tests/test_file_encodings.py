@@ -1,0 +1,50 @@
+"""Input files as real tools save them: a UTF-8 byte order mark (Windows editors, spreadsheets) is read as the same
+text as without one, by every reader and by ``lookalike track``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from typer.testing import CliRunner
+
+from lookalike.cli import app
+from lookalike.io import read_mot, read_seqinfo
+from lookalike.io.points import read_id_points, read_points_csv
+
+runner = CliRunner()
+BOM = b"\xef\xbb\xbf"
+_DET = "".join(f"{f},-1,{50 + 5 * f},60,40,80,0.9,-1,-1,-1\n{f},-1,{300 + 4 * f},100,30,60,0.8,-1,-1,-1\n"
+               for f in range(1, 7))
+
+
+def test_a_byte_order_mark_is_not_part_of_the_first_value(tmp_path: Path) -> None:
+    plain, marked = tmp_path / "plain.txt", tmp_path / "marked.txt"
+    plain.write_text(_DET)
+    marked.write_bytes(BOM + _DET.encode())
+    a, b = read_mot(marked), read_mot(plain)
+    np.testing.assert_array_equal(a.frame, b.frame)
+    np.testing.assert_array_equal(a.xywh, b.xywh)
+
+    points = tmp_path / "points.csv"  # no header: the first row is a point, not a header to skip
+    points.write_bytes(BOM + b"1,5,10\n1,20,30\n2,6,11\n")
+    assert read_points_csv(points).count == 3
+    ids = tmp_path / "ids.csv"
+    ids.write_bytes(BOM + b"1,1,5,10\n2,1,6,11\n")
+    assert read_id_points(ids)[0].tolist() == [1, 2]
+
+    info = tmp_path / "seqinfo.ini"
+    info.write_bytes(BOM + b"[Sequence]\r\nname=S\r\nseqLength=6\r\n")
+    assert read_seqinfo(info)["seqLength"] == "6"
+
+
+def test_track_reads_a_marked_file_and_sequence_as_the_plain_one(tmp_path: Path) -> None:
+    for name, mark in (("plain", b""), ("marked", BOM)):
+        seq = tmp_path / name
+        (seq / "det").mkdir(parents=True)
+        (seq / "det" / "det.txt").write_bytes(mark + _DET.encode())
+        (seq / "seqinfo.ini").write_bytes(mark + b"[Sequence]\nname=S\nframeRate=25\nseqLength=6\n")
+        result = runner.invoke(app, ["track", "-t", "sort", str(seq), "-o", str(tmp_path / f"{name}-out")])
+        assert result.exit_code == 0, result.output
+    plain = (tmp_path / "plain-out" / "S.txt").read_text()
+    assert plain and (tmp_path / "marked-out" / "S.txt").read_text() == plain
