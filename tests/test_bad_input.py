@@ -137,6 +137,9 @@ def test_a_binary_file_names_the_file(tmp_path):
     det = tmp_path / "det.txt"
     det.write_bytes(b"1,-1,1,1,1,1,1\n\xd0\xcf\x11\xe0\x00\x01binary")
     _one_error_line(_track(det, "-o", tmp_path / "o.txt"), str(det), "not UTF-8")
+    video = tmp_path / "clip.mp4"  # binary from the first line: was sniffed as a 'header line' and printed raw
+    video.write_bytes(b"\x00\x00\x00 ftypisom\x00\x00\x02\x00isomiso2avc1mp41\x00\x08free\xae\xff\x10\n\x01\x02")
+    _one_error_line(_track(video, "-o", tmp_path / "o.txt"), f"{video}:1: not UTF-8")
     seq = _seq(tmp_path / "S")
     (seq / "seqinfo.ini").write_bytes(b"[Sequence]\nname=\xff\xfe\n")
     _one_error_line(_track(seq, "-o", tmp_path / "res"), "seqinfo.ini", "not UTF-8")

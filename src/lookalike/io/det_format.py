@@ -122,12 +122,16 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
     if not path.is_file():
         raise not_a_file(path)
     lines = []
-    with open(path, encoding="utf-8-sig", errors="replace") as fh:
-        for line in fh:
-            if line.strip():
-                lines.append(line)
-                if len(lines) >= _SNIFF_LINES:
-                    break
+    try:
+        with open(path, encoding="utf-8-sig") as fh:
+            for line in fh:
+                if line.strip():
+                    lines.append(line)
+                    if len(lines) >= _SNIFF_LINES:
+                        break
+    except UnicodeDecodeError:  # a binary file (a video given as detections): named with its line, never sniffed
+        read_text(path)
+        raise
     if not lines:
         return MOT, []
     first = lines[0]
