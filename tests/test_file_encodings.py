@@ -1,8 +1,9 @@
-"""Input files as real tools save them: a UTF-8 byte order mark (Windows editors, spreadsheets) is read as the same
-text as without one, by every reader and by ``lookalike track``."""
+"""Input files as real tools save them: a UTF-8 byte order mark (Windows editors, spreadsheets) and gzip compression
+are read as the plain text, by every reader and by ``lookalike track`` and ``eval``."""
 
 from __future__ import annotations
 
+import gzip
 from pathlib import Path
 
 import numpy as np
@@ -48,3 +49,42 @@ def test_track_reads_a_marked_file_and_sequence_as_the_plain_one(tmp_path: Path)
         assert result.exit_code == 0, result.output
     plain = (tmp_path / "plain-out" / "S.txt").read_text()
     assert plain and (tmp_path / "marked-out" / "S.txt").read_text() == plain
+
+
+def test_gzip_compressed_files_are_read_as_their_text(tmp_path: Path) -> None:
+    plain = tmp_path / "plain.txt"
+    plain.write_text(_DET)
+    results = {}
+    for name in ("plain.txt", "det.txt.gz", "det.txt"):  # compressed under either name
+        path = tmp_path / "in" / name
+        path.parent.mkdir(exist_ok=True)
+        path.write_bytes(_DET.encode() if name == "plain.txt" else gzip.compress(_DET.encode()))
+        np.testing.assert_array_equal(read_mot(path).xywh, read_mot(plain).xywh)
+        out = tmp_path / f"{name}.res"
+        result = runner.invoke(app, ["track", "-t", "sort", str(path), "-o", str(out)])
+        assert result.exit_code == 0, result.output
+        results[name] = out.read_text()
+    assert results["plain.txt"] and len(set(results.values())) == 1
+
+    points = tmp_path / "points.csv.gz"  # its header names the columns: x and y are columns 3 and 4, not 2 and 3
+    points.write_bytes(gzip.compress(b"frame,id,x,y\n1,1,5,10\n1,2,20,30\n2,1,6,11\n"))
+    assert read_points_csv(points).points[0].tolist() == [[5, 10], [20, 30]]
+
+    cut = tmp_path / "cut.txt.gz"
+    cut.write_bytes(gzip.compress(_DET.encode())[:40])
+    result = runner.invoke(app, ["track", "-t", "sort", str(cut), "-o", str(tmp_path / "cut.res")])
+    assert result.exit_code == 2 and f"{cut}: a damaged or truncated gzip file" in result.output, result.output
+    assert not (tmp_path / "cut.res").exists()
+
+
+def test_eval_names_the_line_of_a_compressed_ground_truth(tmp_path: Path) -> None:
+    seq = tmp_path / "S"
+    (seq / "gt").mkdir(parents=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nname=S\nseqLength=6\n")
+    gt = "".join(f"{f},{k},{50 + 100 * k},60,40,80,1,1,1\n" for f in range(1, 7) for k in (1, 2))
+    (seq / "gt" / "gt.txt").write_bytes(gzip.compress((gt + gt.splitlines()[0] + "\n").encode()))
+    (tmp_path / "res").mkdir()
+    (tmp_path / "res" / "S.txt").write_text(gt)
+    result = runner.invoke(app, ["eval", "--gt", str(seq), "--results", str(tmp_path / "res")])
+    assert result.exit_code == 2, result.output
+    assert "gt.txt:13: id 1 appears twice in frame 1" in result.output, result.output

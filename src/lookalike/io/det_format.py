@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import os
 import re
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from lookalike.io.motchallenge import row_problem
-from lookalike.io.rules import not_a_file, read_text
+from lookalike.io.rules import not_a_file, open_text, read_text
 from lookalike.types.mot_table import MotTable, table_from_array
 
 MOT_COLUMNS = "frame,id,left,top,width,height,score[,x,y,z]"
@@ -123,14 +124,14 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
         raise not_a_file(path)
     lines = []
     try:
-        with open(path, encoding="utf-8-sig") as fh:
+        with open_text(path) as fh:
             for line in fh:
                 if line.strip():
                     lines.append(line)
                     if len(lines) >= _SNIFF_LINES:
                         break
-    except UnicodeDecodeError:  # a binary file (a video given as detections): named with its line, never sniffed
-        read_text(path)
+    except (UnicodeDecodeError, OSError, EOFError, zlib.error):
+        read_text(path)  # a binary file (a video given as detections) or a damaged gzip: named, never sniffed
         raise
     if not lines:
         return MOT, []

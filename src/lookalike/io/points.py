@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import math
 import os
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from lookalike.io.rules import frame_problems, not_a_file, read_text
+from lookalike.io.rules import frame_problems, not_a_file, open_text, read_text
 from lookalike.types._validate import first_fraction
 from lookalike.types.mot_table import detection_rows
 
@@ -100,9 +101,9 @@ def _xy_columns(path: Path) -> tuple[int, int]:
     """The columns of x and y in a points CSV: those its header names ``x`` and ``y`` (as ``frame,id,x,y``), else 1
     and 2."""
     try:
-        with open(path, encoding="utf-8-sig", errors="replace") as fh:
+        with open_text(path, errors="replace") as fh:
             text = next((t for t in map(str.strip, fh) if t and not t.startswith("#")), "")
-    except OSError:
+    except (OSError, EOFError, zlib.error):
         return 1, 2  # (reading the file again names the problem)
     names = [f.strip().lower() for f in text.split(",")]
     if "x" in names and "y" in names and min(names.index("x"), names.index("y")) > 0:

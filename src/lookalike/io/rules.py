@@ -4,15 +4,19 @@ with the user's umask."""
 
 from __future__ import annotations
 
+import gzip
 import os
 import stat
 import tempfile
+import zlib
 from pathlib import Path
+from typing import TextIO
 
 import numpy as np
 
 MIN_GAP = 10_000  # frames: a jump up to this is always allowed
 GAP_FACTOR = 10  # ... and up to this times the largest frame number seen before it
+GZIP_MAGIC = b"\x1f\x8b"  # the first bytes of a gzip-compressed file
 
 
 def not_a_file(path: Path) -> FileNotFoundError:
@@ -21,8 +25,8 @@ def not_a_file(path: Path) -> FileNotFoundError:
 
 
 def read_text(path: str | os.PathLike[str]) -> str:
-    """The UTF-8 text of ``path`` (a leading byte order mark dropped, as Windows editors and spreadsheets write one);
-    ``FileNotFoundError``/``ValueError`` naming the file otherwise."""
+    """The UTF-8 text of ``path`` (a leading byte order mark dropped, as Windows editors and spreadsheets write one;
+    a gzip-compressed file decompressed); ``FileNotFoundError``/``ValueError`` naming the file otherwise."""
     path = Path(path)
     if not path.is_file():
         raise not_a_file(path)
@@ -30,12 +34,27 @@ def read_text(path: str | os.PathLike[str]) -> str:
         data = path.read_bytes()
     except OSError as exc:
         raise ValueError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    if data.startswith(GZIP_MAGIC):
+        try:
+            data = gzip.decompress(data)
+        except (OSError, EOFError, zlib.error) as exc:
+            raise ValueError(f"{path}: a damaged or truncated gzip file ({exc})") from None
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = data.count(b"\n", 0, exc.start) + 1
         raise ValueError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x}); "
                          "expected a text file") from None
+
+
+def open_text(path: Path, errors: str = "strict") -> TextIO:
+    """``path`` opened as UTF-8 text to read line by line, as :func:`read_text` reads it (a byte order mark dropped,
+    a gzip-compressed file decompressed); ``errors`` as :func:`open`'s."""
+    with open(path, "rb") as fh:
+        gzipped = fh.read(2) == GZIP_MAGIC
+    if gzipped:
+        return gzip.open(path, "rt", encoding="utf-8-sig", errors=errors)
+    return open(path, encoding="utf-8-sig", errors=errors)
 
 
 def frame_problems(frames: np.ndarray, previous_max: float = 0.0, length: int | None = None,
@@ -107,5 +126,5 @@ def is_special(path: Path) -> bool:
     return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
 
 
-__all__ = ["GAP_FACTOR", "MIN_GAP", "frame_problems", "is_special", "not_a_file", "read_text", "temp_beside",
-           "user_mode", "write_target"]
+__all__ = ["GAP_FACTOR", "GZIP_MAGIC", "MIN_GAP", "frame_problems", "is_special", "not_a_file", "open_text",
+           "read_text", "temp_beside", "user_mode", "write_target"]
