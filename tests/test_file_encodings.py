@@ -1,5 +1,5 @@
-"""Input files as real tools save them: a UTF-8 byte order mark (Windows editors, spreadsheets) and gzip compression
-are read as the plain text, by every reader and by ``lookalike track`` and ``eval``."""
+"""Input files as real tools save them: a UTF-8 byte order mark (Windows editors, spreadsheets), gzip compression and
+``#`` comment lines are read as the plain text, by every reader and by ``lookalike track`` and ``eval``."""
 
 from __future__ import annotations
 
@@ -88,3 +88,39 @@ def test_eval_names_the_line_of_a_compressed_ground_truth(tmp_path: Path) -> Non
     result = runner.invoke(app, ["eval", "--gt", str(seq), "--results", str(tmp_path / "res")])
     assert result.exit_code == 2, result.output
     assert "gt.txt:13: id 1 appears twice in frame 1" in result.output, result.output
+
+
+def _commented(text: str) -> str:
+    lines = text.splitlines(keepends=True)
+    return "# written by my detector\n" + "".join(lines[:3]) + "  # a note\n" + "".join(lines[3:])
+
+
+def test_comment_lines_are_skipped_and_errors_keep_their_line(tmp_path: Path) -> None:
+    outputs = []
+    for name, text in (("plain.txt", _DET), ("comma.txt", _commented(_DET)),
+                       ("spaces.txt", _commented(_DET.replace(",", " ")))):
+        path = tmp_path / name
+        path.write_text(text)
+        result = runner.invoke(app, ["track", "-t", "sort", str(path), "-o", str(tmp_path / f"{name}.res")])
+        assert result.exit_code == 0, result.output
+        outputs.append((tmp_path / f"{name}.res").read_text())
+    assert outputs[0] and outputs[1] == outputs[0] and outputs[2] == outputs[0]
+
+    bad = tmp_path / "bad.txt"  # line 7 (the 5th data line, after two comment lines) has a NaN score
+    lines = _DET.splitlines(keepends=True)
+    bad.write_text(_commented("".join(lines[:4] + [lines[4].replace(",0.9,", ",nan,")] + lines[5:])))
+    for spec in ("auto", "frame,id,left,top,width,height,score"):
+        result = runner.invoke(app, ["track", str(bad), "--det-format", spec, "-o", str(tmp_path / "bad.res")])
+        assert result.exit_code == 2 and f"{bad}:7: NaN" in result.output, result.output
+
+
+def test_eval_names_the_line_past_comment_lines(tmp_path: Path) -> None:
+    seq = tmp_path / "S"
+    (seq / "gt").mkdir(parents=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nname=S\nseqLength=6\n")
+    gt = "".join(f"{f},{k},{50 + 100 * k},60,40,80,1,1,1\n" for f in range(1, 7) for k in (1, 2))
+    (seq / "gt" / "gt.txt").write_text(_commented(gt + gt.splitlines()[0] + "\n"))
+    (tmp_path / "res").mkdir()
+    (tmp_path / "res" / "S.txt").write_text(gt)
+    result = runner.invoke(app, ["eval", "--gt", str(seq), "--results", str(tmp_path / "res")])
+    assert result.exit_code == 2 and "gt.txt:15: id 1 appears twice in frame 1" in result.output, result.output

@@ -47,13 +47,13 @@ def where(table: MotTable, row: int, name: str) -> str:
     """``path:line`` (or ``name row k``) of a table's 0-based ``row``, for error messages."""
     if table.path is None:
         return f"{name} row {row + 1}"
-    from lookalike.io.rules import read_text
+    from lookalike.io.rules import is_data_line, read_text
 
     try:
         lines = read_text(table.path).splitlines()
     except (OSError, ValueError):
         return f"{table.path} row {row + 1}"
-    numbers = [i + 1 for i, ln in enumerate(lines) if ln.strip()]
+    numbers = [i + 1 for i, ln in enumerate(lines) if is_data_line(ln)]
     return f"{table.path}:{numbers[row] if row < len(numbers) else '?'}"
 
 

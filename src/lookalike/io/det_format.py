@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.io.motchallenge import row_problem
-from lookalike.io.rules import not_a_file, open_text, read_text
+from lookalike.io.rules import is_data_line, not_a_file, open_text, read_text
 from lookalike.types.mot_table import MotTable, table_from_array
 
 MOT_COLUMNS = "frame,id,left,top,width,height,score[,x,y,z]"
@@ -126,7 +126,7 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
     try:
         with open_text(path) as fh:
             for line in fh:
-                if line.strip():
+                if is_data_line(line):
                     lines.append(line)
                     if len(lines) >= _SNIFF_LINES:
                         break
@@ -175,7 +175,7 @@ def read_det(path: str | os.PathLike[str], fmt: DetFormat, length: int | None = 
     numbers: list[list[float]] = []
     line_nos: list[int] = []
     for line_no, line in enumerate(read_text(path).splitlines(), start=1):
-        if not line.strip():
+        if not is_data_line(line):
             continue
         if fmt.header and not line_nos and not numbers and _numbers(_split(line, fmt.separator)) is None:
             fmt = DetFormat(fmt.roles, fmt.separator, False)  # the header: skipped once

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.io.rules import GAP_FACTOR, MIN_GAP, frame_problems, not_a_file, read_text
+from lookalike.io.rules import GAP_FACTOR, MIN_GAP, frame_problems, is_data_line, not_a_file, read_text
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import ROW_WIDTH, MotTable, stack_rows, table_from_array, tracks_to_rows
 
@@ -22,16 +22,17 @@ _COLUMNS = "columns: frame,id,left,top,width,height,score[,x,y,z]"
 
 def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | None = None,
              length_name: str = "the length", positive_size: bool = False) -> MotTable:
-    """Read a MOTChallenge text file (UTF-8); ``ValueError`` naming the file and line of a malformed one: too few
-    columns, a non-number, NaN or infinity in frame, id, box or score, an id not whole, a negative size (zero too with
-    ``positive_size``), or a frame number breaking :mod:`lookalike.io.rules` or past ``length``."""
+    """Read a MOTChallenge text file (UTF-8; blank and ``#`` comment lines skipped); ``ValueError`` naming the file
+    and line of a malformed one: too few columns, a non-number, NaN or infinity in frame, id, box or score, an id not
+    whole, a negative size (zero too with ``positive_size``), or a frame number breaking :mod:`lookalike.io.rules` or
+    past ``length``."""
     path = Path(path)
     if not path.is_file():
         raise not_a_file(path)
     fast = _parse_fast(path, min_columns)
     if fast is not None and row_problem(fast, length=length, positive_size=positive_size) is None:
         return table_from_array(fast, path)
-    rows = [(i + 1, ln) for i, ln in enumerate(read_text(path).splitlines()) if ln.strip()]
+    rows = [(i + 1, ln) for i, ln in enumerate(read_text(path).splitlines()) if is_data_line(ln)]
     if not rows:
         return table_from_array(np.zeros((0, 7)), path)
     data = _parse_slowly(path, rows, min_columns)

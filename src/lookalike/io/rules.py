@@ -47,6 +47,12 @@ def read_text(path: str | os.PathLike[str]) -> str:
                          "expected a text file") from None
 
 
+def is_data_line(line: str) -> bool:
+    """Whether a line of a text input holds data: not blank, not a ``#`` comment."""
+    text = line.strip()
+    return bool(text) and not text.startswith("#")
+
+
 def open_text(path: Path, errors: str = "strict") -> TextIO:
     """``path`` opened as UTF-8 text to read line by line, as :func:`read_text` reads it (a byte order mark dropped,
     a gzip-compressed file decompressed); ``errors`` as :func:`open`'s."""
@@ -126,5 +132,5 @@ def is_special(path: Path) -> bool:
     return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
 
 
-__all__ = ["GAP_FACTOR", "GZIP_MAGIC", "MIN_GAP", "frame_problems", "is_special", "not_a_file", "open_text",
-           "read_text", "temp_beside", "user_mode", "write_target"]
+__all__ = ["GAP_FACTOR", "GZIP_MAGIC", "MIN_GAP", "frame_problems", "is_data_line", "is_special", "not_a_file",
+           "open_text", "read_text", "temp_beside", "user_mode", "write_target"]
