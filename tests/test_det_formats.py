@@ -124,6 +124,21 @@ def test_warnings_boxes_outside_equal_scores_and_no_tracks(tmp_path: Path) -> No
     assert result.exit_code == 0 and "wrote no tracks from the 12 detections" in result.output, result.output
 
 
+def test_normalised_coordinates_are_warned_about(tmp_path: Path) -> None:
+    """Boxes in [0, 1] (normalised, as YOLO writes them) lie inside any frame: a warning says so; pixels warn not."""
+    seq = tmp_path / "seq"
+    (seq / "det").mkdir(parents=True)
+    (seq / "seqinfo.ini").write_text("[Sequence]\nname=seq\nframeRate=25\nseqLength=6\nimWidth=640\nimHeight=480\n")
+    for name, rows in (("pixels", _ROWS), ("normalised", _ROWS / np.array([1, 640, 480, 640, 480, 1]))):
+        for det_format in ("auto", "frame,id,left,top,width,height,score"):  # streamed, and read whole
+            (seq / "det" / "det.txt").write_text(_mot_text(rows))
+            result = runner.invoke(app, ["track", "-t", "sort", str(seq), "-o", str(tmp_path / "out"),
+                                         "--det-format", det_format])
+            assert result.exit_code == 0, result.output
+            warned = "no box is wider or higher than 1 px: are the coordinates normalised" in result.output
+            assert warned == (name == "normalised"), result.output
+
+
 @pytest.mark.skipif(not MOT15.is_dir(), reason="needs ../shared/data")
 def test_motchallenge_files_are_streamed_as_before() -> None:
     """Standard files: no note, no warning, the streaming reader."""

@@ -205,10 +205,14 @@ def read_det(path: str | os.PathLike[str], fmt: DetFormat, length: int | None = 
 
 
 def det_warnings(path: Path | str, count: int, scores: tuple[float, float] | None, outside: int,
-                 image_size: tuple[int, int] | None, size_from: str = "") -> list[str]:
-    """Warnings: ``outside`` of ``count`` boxes centred outside ``image_size`` (from ``size_from``), or every score
-    equal (``scores``: lowest and highest)."""
+                 image_size: tuple[int, int] | None, size_from: str = "", largest: float | None = None) -> list[str]:
+    """Warnings: ``outside`` of ``count`` boxes centred outside ``image_size`` (from ``size_from``), every score
+    equal (``scores``: lowest and highest), or no box wider or higher than 1 px (``largest``: the largest side, px):
+    coordinates normalised to [0, 1]."""
     found = []
+    if count and largest is not None and largest <= 1:
+        found.append(f"{path}: no box is wider or higher than 1 px: are the coordinates normalised to [0, 1]? "
+                     "Boxes are in pixels: multiply left and width by the image width, top and height by its height")
     if outside and image_size is not None:
         found.append(f"{path}: {outside} of {count} boxes are centred outside the {image_size[0]}x{image_size[1]} "
                      f"frame{f' ({size_from})' if size_from else ''}; are the columns {MOT_COLUMNS}? "
@@ -218,6 +222,11 @@ def det_warnings(path: Path | str, count: int, scores: tuple[float, float] | Non
         found.append(f"{path}: every score is {what}: is the score column the right one? (--min-score and the "
                      "trackers' score thresholds see no difference between boxes)")
     return found
+
+
+def largest_side(xywh: np.ndarray) -> float:
+    """The largest width or height of boxes ``(n, 4)`` px (0 without boxes)."""
+    return float(np.max(xywh[:, 2:4])) if len(xywh) else 0.0
 
 
 def box_stats(xywh: np.ndarray, conf: np.ndarray, image_size: tuple[int, int] | None) -> tuple[
@@ -232,5 +241,5 @@ def box_stats(xywh: np.ndarray, conf: np.ndarray, image_size: tuple[int, int] | 
     return (float(conf.min()), float(conf.max())), outside
 
 
-__all__ = ["EXPECTED", "MOT", "MOT_COLUMNS", "DetFormat", "box_stats", "det_warnings", "parse_columns", "read_det",
-           "sniff_det"]
+__all__ = ["EXPECTED", "MOT", "MOT_COLUMNS", "DetFormat", "box_stats", "det_warnings", "largest_side", "parse_columns",
+           "read_det", "sniff_det"]

@@ -13,7 +13,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from lookalike.io.det_format import box_stats, read_det, sniff_det
+from lookalike.io.det_format import box_stats, largest_side, read_det, sniff_det
 from lookalike.io.motchallenge import format_rows, frames_from_table, read_mot, row_problem
 from lookalike.io.rules import is_special, not_a_file, temp_beside, write_target
 from lookalike.io.sequences import MotSequence
@@ -61,6 +61,7 @@ class DetectionStream:
         self.image_size = image_size
         self.scores: tuple[float, float] | None = None  # lowest and highest score (known after check())
         self.outside = 0  # boxes centred outside image_size (known after check())
+        self.largest = 0.0  # the largest box width or height in px (known after check())
         self.notes: list[str] = []  # what was assumed about the file's layout (sequence_stream)
         self._table: MotTable | None = None  # rows read already (from_table)
 
@@ -74,6 +75,7 @@ class DetectionStream:
         stream = cls(table.path, length, frame_rate, min_score, image_size=image_size)
         stream._table, stream._streamable, stream.rows = table, False, len(table)
         stream.scores, stream.outside = box_stats(table.xywh, table.conf, image_size)
+        stream.largest = largest_side(table.xywh)
         return stream
 
     def check(self) -> DetectionStream:
@@ -84,7 +86,7 @@ class DetectionStream:
         last, width, rows = 0.0, None, 0
         self._single = None
         chunks: list[np.ndarray] = []
-        low, high, outside = np.inf, -np.inf, 0
+        low, high, outside, largest = np.inf, -np.inf, 0, 0.0
         try:
             for data in _chunks(self.path, self.chunk_lines):
                 if len(chunks) < 2:
@@ -100,8 +102,9 @@ class DetectionStream:
                                         self.image_size)
                 if scores is not None:
                     low, high, outside = min(low, scores[0]), max(high, scores[1]), outside + out
+                largest = max(largest, largest_side(data[:, 2:6]))
             self._streamable, self.rows = True, rows
-            self.scores, self.outside = ((low, high) if rows else None), outside
+            self.scores, self.outside, self.largest = ((low, high) if rows else None), outside, largest
             if len(chunks) == 1:  # the whole file was one chunk: kept, not parsed again
                 self._single = chunks[0]
         except ValueError:
@@ -109,6 +112,7 @@ class DetectionStream:
             table = read_mot(self.path, length=self.length, length_name=self.length_name, positive_size=True)
             self.rows = len(table)
             self.scores, self.outside = box_stats(table.xywh, table.conf, self.image_size)
+            self.largest = largest_side(table.xywh)
             self._streamable = False
         return self
 

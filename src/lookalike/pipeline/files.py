@@ -94,7 +94,8 @@ def sequence_warnings(seq: Any, frames: Any, target: Path, warn: Callable[[str],
     if frames.rows == 0:
         warn(f"{seq.det_path}: no detections; {target} will hold no tracks")
     size_from = f"imWidth, imHeight in {seq.root / 'seqinfo.ini'}" if seq.root is not None else ""
-    for line in det_warnings(seq.det_path or "", frames.rows, frames.scores, frames.outside, seq.image_size, size_from):
+    for line in det_warnings(seq.det_path or "", frames.rows, frames.scores, frames.outside, seq.image_size, size_from,
+                             frames.largest):
         warn(line)
 
 

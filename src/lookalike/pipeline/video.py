@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.io import MotTable, read_mot, write_mot
-from lookalike.io.det_format import box_stats, det_warnings, read_det, sniff_det
+from lookalike.io.det_format import box_stats, det_warnings, largest_side, read_det, sniff_det
 from lookalike.io.motchallenge import format_rows
 from lookalike.io.needs import input_kind
 from lookalike.io.outputs import atomic_path
@@ -54,7 +54,7 @@ class VideoInput:
         """Warnings on the detections: boxes outside the frame, every score equal (unless not ``score_warnings``)."""
         scores, outside = box_stats(self.table.xywh, self.table.conf, self.size)
         return det_warnings(self.name, len(self.table), scores if score_warnings else None, outside, self.size,
-                            f"the frames of {video}")
+                            f"the frames of {video}", largest_side(self.table.xywh))
 
     def dropped_all(self, result: VideoTrackingResult, tracker_name: str) -> str | None:
         """The warning for a tracker that wrote no tracks from these detections, else None."""
