@@ -67,9 +67,13 @@ class DetFormat:
 MOT = DetFormat(("frame", "id", "left", "top", "width", "height", "score", "-", "-", "-"))
 
 
-def parse_columns(text: str, where: str = "--det-format") -> tuple[str, ...]:
-    """Roles of a list of column names (``_ALIASES``); ``ValueError`` naming ``where`` without frame and box."""
-    names = [n.strip().lower() for n in re.split(r"[,\s;]+", text.strip()) if n.strip()]
+def parse_columns(text: str, where: str = "--det-format", separator: str | None = "any") -> tuple[str, ...]:
+    """Roles of a list of column names (``_ALIASES``); ``ValueError`` naming ``where`` without frame
+    and box. ``separator``: ``any`` (commas, semicolons, whitespace), or a file's (None: whitespace), where an empty
+    name (a spreadsheet's unnamed index column) is a column skipped."""
+    parts = [n for n in re.split(r"[,\s;]+", text.strip()) if n.strip()] if separator == "any" else \
+        _split(text, separator)
+    names = [n.strip().lower() for n in parts]
     roles = [_ROLE.get(n, "-") for n in names]
     if "left" not in roles and "top" not in roles:  # x, y name the corner only where nothing else does
         roles = ["left" if n == "x" else "top" if n == "y" else r for n, r in zip(names, roles)]
@@ -144,7 +148,7 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
     if spec not in ("auto", "mot"):
         roles, note = parse_columns(spec), f"columns read as {DetFormat(parse_columns(spec)).describe()} (--det-format)"
     elif header and spec == "auto":
-        roles = parse_columns(first, f"{path}:1 (header line)")
+        roles = parse_columns(first, f"{path}:1 (header line)", separator)
         note = f"header line: columns read as {DetFormat(roles).describe()}"
     else:
         width = min((len(p) for p in sample), default=len(MOT.roles))
