@@ -43,6 +43,8 @@ def _layouts() -> dict[str, tuple[str, str]]:
         "whitespace": (_mot_text().replace(",", " "), "whitespace"),
         "tabs and xyxy": (_xyxy_text(sep="\t"), "whitespace"),
         "0-based frames": (_mot_text(_ROWS - np.array([1, 0, 0, 0, 0, 0])), "0-based"),
+        "quoted header (R)": ('"frame","id","bb_left","bb_top","bb_width","bb_height","conf","x","y","z"\n'
+                               + _mot_text(), "header line"),
         # pandas' to_csv without index=False: an unnamed first column (was dropped, shifting every name one column)
         "an unnamed index column": (",frame,x1,y1,x2,y2,score,class\n" + "".join(
             f"{k},{line}" for k, line in enumerate(_xyxy_text().splitlines(keepends=True))), "-,frame,x1"),

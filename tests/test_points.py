@@ -171,3 +171,6 @@ def test_read_points_csv_takes_x_and_y_named_by_its_header(tmp_path: Path) -> No
     q = tmp_path / "yx.csv"
     q.write_text("frame,y,x\n1,2,3\n")
     np.testing.assert_array_equal(read_points_csv(q).points[0], [[3, 2]])
+    quoted = tmp_path / "quoted.csv"  # R's write.csv quotes the header: x was read from the id column, silently
+    quoted.write_text('"frame","id","x","y"\n1,7,10.5,20.5\n1,8,30,40\n2,7,11,21\n')
+    np.testing.assert_array_equal(read_points_csv(quoted).points[0], [[10.5, 20.5], [30, 40]])

@@ -68,12 +68,12 @@ MOT = DetFormat(("frame", "id", "left", "top", "width", "height", "score", "-", 
 
 
 def parse_columns(text: str, where: str = "--det-format", separator: str | None = "any") -> tuple[str, ...]:
-    """Roles of a list of column names (``_ALIASES``); ``ValueError`` naming ``where`` without frame
+    """Roles of a list of column names (``_ALIASES``, quotes dropped); ``ValueError`` naming ``where`` without frame
     and box. ``separator``: ``any`` (commas, semicolons, whitespace), or a file's (None: whitespace), where an empty
     name (a spreadsheet's unnamed index column) is a column skipped."""
     parts = [n for n in re.split(r"[,\s;]+", text.strip()) if n.strip()] if separator == "any" else \
         _split(text, separator)
-    names = [n.strip().lower() for n in parts]
+    names = [n.strip().strip("\"'").lower() for n in parts]
     roles = [_ROLE.get(n, "-") for n in names]
     if "left" not in roles and "top" not in roles:  # x, y name the corner only where nothing else does
         roles = ["left" if n == "x" else "top" if n == "y" else r for n, r in zip(names, roles)]

@@ -105,7 +105,7 @@ def _xy_columns(path: Path) -> tuple[int, int]:
             text = next((t for t in map(str.strip, fh) if t and not t.startswith("#")), "")
     except (OSError, EOFError, zlib.error):
         return 1, 2  # (reading the file again names the problem)
-    names = [f.strip().lower() for f in text.split(",")]
+    names = [f.strip().strip("\"'").lower() for f in text.split(",")]
     if "x" in names and "y" in names and min(names.index("x"), names.index("y")) > 0:
         return names.index("x"), names.index("y")
     return 1, 2
