@@ -146,6 +146,18 @@ def test_parameter_file_refused_with_clear_errors(tmp_path: Path):
         load_params(bad)
     with pytest.raises(ValueError, match="is a folder, not a parameter file"):
         load_params(tmp_path)
+    # hand-edited bookkeeping fields: were an OverflowError or TypeError naming no file
+    for extra, message in (({"trials": 1e400}, "'trials' must be a whole number"),
+                           ({"trials": None}, "'trials' must be a whole number"),
+                           ({"chosen_on": 5}, "'chosen_on' must be a list")):
+        bad.write_text(json.dumps({"tracker": "sort", "params": {}, **extra}).replace("Infinity", "1e400"))
+        with pytest.raises(ValueError, match=f"bad.json: {message}"):
+            load_params(bad)
+    bad.write_text("[" * 100_000 + "]" * 100_000)  # was a RecursionError
+    with pytest.raises(ValueError, match="bad.json: not a JSON parameter file"):
+        load_params(bad)
+    bad.write_text(json.dumps({"tracker": "sort", "params": {}, "trials": 60.0}))
+    assert read_params(bad).trials == 60
 
 
 def test_tune_space_file_that_is_binary_is_named(tmp_path: Path):

@@ -74,14 +74,19 @@ def read_params(path: str | Path) -> TunedParams:
         data = json.loads(read_text(p))
     except FileNotFoundError:
         raise ValueError(f"{p}: parameter file not found") from None
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{p}: not a JSON parameter file ({exc})") from None
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise ValueError(f"{p}: not a JSON parameter file ({str(exc)[:100]})") from None
     if not isinstance(data, dict) or any(k not in data for k in REQUIRED) or not isinstance(data["params"], dict):
         raise ValueError(f"{p}: expected a JSON object with 'tracker' and 'params' (written by `lookalike tune`)")
+    chosen_on, trials = data.get("chosen_on", []), data.get("trials", 0)
+    if not isinstance(chosen_on, list):
+        raise ValueError(f"{p}: 'chosen_on' must be a list of sequence names, got {str(chosen_on)[:60]!r}")
+    if isinstance(trials, bool) or not (isinstance(trials, int) or isinstance(trials, float) and trials.is_integer()):
+        raise ValueError(f"{p}: 'trials' must be a whole number, got {str(trials)[:60]!r}")
     known = {"tracker", "params", "chosen_on", "criterion", "trials", "lookalike_version"}
-    return TunedParams(str(data["tracker"]), dict(data["params"]), list(data.get("chosen_on", [])),
-                       str(data.get("criterion", "")), int(data.get("trials", 0)),
-                       str(data.get("lookalike_version", "")), {k: v for k, v in data.items() if k not in known})
+    extra = {k: v for k, v in data.items() if k not in known}
+    return TunedParams(str(data["tracker"]), dict(data["params"]), list(chosen_on), str(data.get("criterion", "")),
+                       int(trials), str(data.get("lookalike_version", "")), extra)
 
 
 def load_params(path: str | Path, tracker: str | None = None) -> dict[str, Any]:
