@@ -169,6 +169,10 @@ def test_tune_space_file_that_is_binary_is_named(tmp_path: Path):
     space.write_bytes(b"\xe8\xff{}")
     r = CliRunner().invoke(app, ["tune", "-t", "boxtrack", str(tmp_path), "--space", str(space)])
     assert r.exit_code == 2 and "--space: " in r.output and "space.json:1: not UTF-8 text" in r.output, r.output
+    for text in ("[" * 100_000 + "]" * 100_000, "{not json"):  # a RecursionError traceback; a message naming no file
+        space.write_text(text)
+        r = CliRunner().invoke(app, ["tune", "-t", "boxtrack", str(tmp_path), "--space", str(space)])
+        assert r.exit_code == 2 and f"--space: {space}: not a JSON search space" in r.output, r.output
     with pytest.raises(ValueError, match="no parameter"):
         check_params("boxtrack", {"speed": 1})
 

@@ -93,16 +93,15 @@ def tune(
 
 def _load_space(tracker: str, space_path: Path | None) -> Any:
     """The tracker's search space: its default one, or the one in ``space_path``."""
-    from lookalike.io.rules import read_text
     from lookalike.trackers import tracker_names
-    from lookalike.tune import default_space, space_from_json
+    from lookalike.tune.space import default_space, read_space
 
     if tracker not in tracker_names():
         fail(f"unknown tracker {tracker!r}; choose one of: {', '.join(tracker_names())}")
     with failing(OSError, ValueError, prefix="--space: "):
         space = default_space(tracker)
         if space_path is not None:
-            space = space_from_json(json.loads(read_text(space_path)), tracker)
+            space = read_space(space_path, tracker)
     return space
 
 

@@ -12,7 +12,9 @@ JSON form (:func:`space_from_json`)::
 
 from __future__ import annotations
 
+import json
 import math
+import os
 import typing
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -152,6 +154,18 @@ def default_space(tracker: str) -> Space:
     return {k: v for k, v in DEFAULT_SPACES[tracker].items() if k in known}
 
 
+def read_space(path: str | os.PathLike[str], tracker: str) -> Space:
+    """The search space in the JSON file ``path`` (:func:`space_from_json`); ``ValueError`` naming the file for one
+    that is not JSON (or nested too deeply to be a space)."""
+    from lookalike.io.rules import read_text
+
+    try:
+        spec = json.loads(read_text(path))
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise ValueError(f"{path}: not a JSON search space ({str(exc)[:100]})") from None
+    return space_from_json(spec, tracker)
+
+
 def space_from_json(spec: Mapping[str, Any], tracker: str) -> Space:
     """A space from its JSON form (module docstring); ``ValueError`` naming an unknown parameter or bad entry."""
     if not isinstance(spec, Mapping):
@@ -257,4 +271,4 @@ def grid(dim: Dim, points: int = 5) -> list[Any]:
 
 
 __all__ = ["DEFAULT_SPACES", "Dim", "NOT_SEARCHED", "Space", "default_space", "fixed", "generic_space", "grid",
-           "sample", "searched", "space_from_json", "space_to_json", "suggest", "trial_values"]
+           "read_space", "sample", "searched", "space_from_json", "space_to_json", "suggest", "trial_values"]
