@@ -57,6 +57,9 @@ def test_read_gt_with_class_and_visibility(tmp_path):
         ("1,-1,10,20,30,40,0.9\n2.7,-1,10,20,30,40,0.9\n", ":2: invalid frame: frame 2.7 is not an integer"),
         ("1,-1,10,20,30,40,nan\n", ":1: NaN or infinity"),
         ("1,-1,10,20,30,40,0.9\n99999,-1,10,20,30,40,0.9\n", ":2: invalid frame: frame 99999 jumps"),
+        # ids past 2^53 read as floats: 1e17+1 and 1e17+2 became one id, 1e20 the int64 minimum
+        ("1,9007199254740992,1,2,3,4,1\n1,100000000000000001,1,2,3,4,1\n", ":2: invalid id: beyond"),
+        ("1,-1e20,10,20,30,40,0.9\n", ":1: invalid id: beyond"),
     ],
 )
 def test_malformed_lines_name_file_and_line(tmp_path, text, message):

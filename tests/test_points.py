@@ -54,6 +54,7 @@ def test_bad_lines_name_file_and_line(tmp_path: Path, text: str, message: str) -
 @pytest.mark.parametrize("text, message", [
     ("frame,id,x,y\n1,1,5,5\n2.7,1,6,5\n", ":3: frame must be an integer >= 1"),
     ("1,1,5,5\n2,1.5,6,5\n", ":2: invalid id: not a whole number"),
+    ("1,1,5,5\n2,1e20,6,5\n", ":2: invalid id: beyond"),
     ("1,1,5,5\n2,1,nan,5\n", ":2: NaN"),
     ("1,1,5,5\n1000000000,1,6,5\n", ":2: invalid frame: frame 1000000000 jumps"),
     ("1,1,5,5\n2,1,1e300,5\n", ":2: a coordinate beyond"),

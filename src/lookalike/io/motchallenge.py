@@ -18,6 +18,7 @@ from lookalike.types.mot_table import ROW_WIDTH, MotTable, stack_rows, table_fro
 _ROW_FORMAT = "%d,%d,%.3f,%.3f,%.3f,%.3f,%g,%g,%g,%g\n"
 _FORMAT_BLOCK = 4096
 _COLUMNS = "columns: frame,id,left,top,width,height,score[,x,y,z]"
+MAX_ID = 2**53  # beyond this a number read as a float no longer tells neighbouring ids apart
 
 
 def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | None = None,
@@ -55,8 +56,11 @@ def row_problem(data: np.ndarray, previous_max: float = 0.0, length: int | None 
     frame = frame_problems(data[:, 0], previous_max, length, length_name)
     ids = np.where(box, 0.0, data[:, 1])
     fraction = np.floor(ids) != ids  # (an id is a whole number: 1.2 and 1.7 are not one track, nor two)
+    huge = np.abs(ids) > MAX_ID
     first = [(int(np.flatnonzero(box)[0]), "NaN or infinity in frame, id, box or score") if box.any() else None,
              (int(np.flatnonzero(fraction)[0]), "invalid id: not a whole number") if fraction.any() else None,
+             (int(np.flatnonzero(huge)[0]), f"invalid id: beyond ±2^53 = {MAX_ID}, where ids are no longer told apart")
+             if huge.any() else None,
              (int(np.flatnonzero(size)[0]), size_reason) if size.any() else None,
              (frame[0], f"invalid frame: {frame[1]}") if frame is not None else None]
     found = [p for p in first if p is not None]
@@ -72,7 +76,7 @@ def _rows_fine(data: np.ndarray, previous_max: float, length: int | None, positi
     sizes = data[:, 4:6].min()
     if not (sizes > 0 if positive_size else sizes >= 0):
         return False
-    if not (np.floor(data[:, 1]) == data[:, 1]).all():
+    if not ((np.floor(data[:, 1]) == data[:, 1]).all() and np.abs(data[:, 1]).max() <= MAX_ID):
         return False
     frames = data[:, 0]
     first, last = float(frames.min()), float(frames.max())
@@ -172,4 +176,4 @@ def format_rows(rows: np.ndarray) -> str:
     return "".join(parts)
 
 
-__all__ = ["MotTable", "format_rows", "frames_from_table", "read_mot", "tracks_to_rows", "write_mot"]
+__all__ = ["MAX_ID", "MotTable", "format_rows", "frames_from_table", "read_mot", "tracks_to_rows", "write_mot"]

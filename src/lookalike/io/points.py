@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lookalike.io.motchallenge import MAX_ID
 from lookalike.io.rules import frame_problems, not_a_file, open_text, read_text
 from lookalike.types._validate import first_fraction
 from lookalike.types.mot_table import detection_rows
@@ -154,6 +155,10 @@ def read_id_points(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray
     k = first_fraction(data[:, 1])
     if k is not None:
         raise ValueError(f"{path}:{parsed[k][0]}: invalid id: not a whole number: {data[k, 1]:g}")
+    huge = np.flatnonzero(np.abs(data[:, 1]) > MAX_ID)
+    if len(huge):
+        raise ValueError(f"{path}:{parsed[int(huge[0])][0]}: invalid id: beyond ±2^53 = {MAX_ID}, where ids are no "
+                         "longer told apart")
     order = np.lexsort((data[:, 1], data[:, 0]))
     twice = np.flatnonzero(np.all(np.diff(data[order, :2], axis=0) == 0, axis=1))
     if len(twice):
