@@ -50,7 +50,8 @@ def test_read_gt_with_class_and_visibility(tmp_path):
     "text, message",
     [
         ("1,-1,10,20,30,40,0.9\n1,-1,10,20\n", ":2: expected at least 6"),
-        ("1,-1,10,20,30,40,0.9\n2,-1,10,x,30,40,0.9\n", ":2: not a number"),
+        ("1,-1,10,20,30,40,0.9\n2,-1,10,x,30,40,0.9\n", ":2: column 4 is not a number \\('x'\\)"),
+        ("1,-1,10,20,30,40,0.9\n2,-1,10,,30,40,0.9\n", ":2: column 4 is empty"),
         ("1,-1,10,20,30,40,0.9\n\n2,-1,10,nan,30,40,0.9\n", ":3: NaN or infinity"),
         ("1,-1,10,20,-30,40,0.9\n", ":1: invalid box"),
         ("0,-1,10,20,30,40,0.9\n", ":1: invalid frame"),
@@ -66,6 +67,17 @@ def test_malformed_lines_name_file_and_line(tmp_path, text, message):
     p = _write(tmp_path / "bad.txt", text)
     with pytest.raises(ValueError, match=f"bad.txt{message}"):
         read_mot(p)
+
+
+def test_a_trailing_comma_or_empty_xyz_columns_are_absent_columns(tmp_path):
+    """Exporters write ``...,0.9,`` or leave x, y, z empty: read as the row without them (was 'not a number')."""
+    plain = read_mot(_write(tmp_path / "plain.txt", "1,-1,10,20,30,40,0.9\n2,3,11,21,31,41,0.8\n"))
+    for text in ("1,-1,10,20,30,40,0.9,\n2,3,11,21,31,41,0.8,\n", "1,-1,10,20,30,40,0.9,,,\n2,3,11,21,31,41,0.8,,,\n"):
+        table = read_mot(_write(tmp_path / "comma.txt", text))
+        np.testing.assert_array_equal(table.frame, plain.frame)
+        np.testing.assert_array_equal(table.track_id, plain.track_id)
+        np.testing.assert_array_equal(table.xywh, plain.xywh)
+        np.testing.assert_array_equal(table.conf, plain.conf)
 
 
 def test_missing_file(tmp_path):

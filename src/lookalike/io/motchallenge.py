@@ -108,6 +108,8 @@ def _parse_slowly(path: Path, rows: list[tuple[int, str]], min_columns: int) -> 
     width = None
     for line_no, line in rows:
         fields = [f.strip() for f in line.split(",")]
+        while len(fields) > max(min_columns, 7) and not fields[-1]:
+            fields.pop()  # a trailing comma, or x, y, z left empty: the optional columns are absent
         if len(fields) < min_columns:
             raise ValueError(
                 f"{path}:{line_no}: expected at least {min_columns} comma-separated columns, "
@@ -116,10 +118,21 @@ def _parse_slowly(path: Path, rows: list[tuple[int, str]], min_columns: int) -> 
         try:
             values = [float(f) for f in fields]
         except ValueError:
-            raise ValueError(f"{path}:{line_no}: not a number in {line.strip()!r} ({_COLUMNS})") from None
+            column = next(k for k, f in enumerate(fields, 1) if not _is_number(f))
+            what = "is empty" if not fields[column - 1] else f"is not a number ({fields[column - 1][:20]!r})"
+            raise ValueError(f"{path}:{line_no}: column {column} {what} in {line.strip()[:80]!r} ({_COLUMNS})") \
+                from None
         width = len(values) if width is None else min(width, len(values))
         parsed.append(values)
     return np.array([v[:width] for v in parsed], dtype=float)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def frames_from_table(
