@@ -1,9 +1,12 @@
-"""Input files as real tools save them: a UTF-8 byte order mark (Windows editors, spreadsheets), gzip compression and
-``#`` comment lines are read as the plain text, by every reader and by ``lookalike track`` and ``eval``."""
+"""Input files as real tools save them: a UTF-8 byte order mark (Windows editors, spreadsheets), compression (gzip,
+bzip2, xz, told by the content) and ``#`` comment lines are read as the plain text, by every reader and by
+``lookalike track`` and ``eval``."""
 
 from __future__ import annotations
 
+import bz2
 import gzip
+import lzma
 from pathlib import Path
 
 import numpy as np
@@ -124,3 +127,23 @@ def test_eval_names_the_line_past_comment_lines(tmp_path: Path) -> None:
     (tmp_path / "res" / "S.txt").write_text(gt)
     result = runner.invoke(app, ["eval", "--gt", str(seq), "--results", str(tmp_path / "res")])
     assert result.exit_code == 2 and "gt.txt:15: id 1 appears twice in frame 1" in result.output, result.output
+
+
+def test_compression_is_decided_by_the_content_not_the_name(tmp_path: Path) -> None:
+    """A plain file named .gz or .bz2 is plain text (numpy chose a decompressor by the name: a traceback); bzip2 and
+    xz files are read as gzip ones are, by ``read_mot`` and ``track`` alike."""
+    plain = tmp_path / "plain.txt"
+    plain.write_text(_DET)
+    expected = read_mot(plain).xywh
+    files = {"named.txt.gz": _DET.encode(), "named.txt.bz2": _DET.encode(), "packed.bz2": bz2.compress(_DET.encode()),
+             "packed.txt.xz": lzma.compress(_DET.encode()), "packed.txt": lzma.compress(_DET.encode())}
+    for name, data in files.items():
+        path = tmp_path / name
+        path.write_bytes(data)
+        np.testing.assert_array_equal(read_mot(path).xywh, expected)
+        result = runner.invoke(app, ["track", "-t", "sort", str(path), "-o", str(tmp_path / "out.txt")])
+        assert result.exit_code == 0 and "note:" not in result.output, result.output
+    cut = tmp_path / "cut.bz2"
+    cut.write_bytes(bz2.compress(_DET.encode())[:60])
+    result = runner.invoke(app, ["track", "-t", "sort", str(cut), "-o", str(tmp_path / "cut.res")])
+    assert result.exit_code == 2 and f"{cut}: a damaged or truncated bzip2 file" in result.output, result.output

@@ -6,14 +6,13 @@ from __future__ import annotations
 
 import os
 import re
-import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from lookalike.io.motchallenge import row_problem
-from lookalike.io.rules import is_data_line, not_a_file, open_text, read_text
+from lookalike.io.rules import DECOMPRESS_ERRORS, is_data_line, not_a_file, open_text, read_text
 from lookalike.types.mot_table import MotTable, table_from_array
 
 MOT_COLUMNS = "frame,id,left,top,width,height,score[,x,y,z]"
@@ -134,7 +133,7 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
                     lines.append(line)
                     if len(lines) >= _SNIFF_LINES:
                         break
-    except (UnicodeDecodeError, OSError, EOFError, zlib.error):
+    except (UnicodeDecodeError, *DECOMPRESS_ERRORS):
         read_text(path)  # a binary file (a video given as detections) or a damaged gzip: named, never sniffed
         raise
     if not lines:

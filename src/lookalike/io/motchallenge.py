@@ -11,7 +11,16 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.io.rules import GAP_FACTOR, MIN_GAP, frame_problems, is_data_line, not_a_file, read_text
+from lookalike.io.rules import (
+    DECOMPRESS_ERRORS,
+    GAP_FACTOR,
+    MIN_GAP,
+    frame_problems,
+    is_data_line,
+    not_a_file,
+    open_text,
+    read_text,
+)
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import ROW_WIDTH, MotTable, stack_rows, table_from_array, tracks_to_rows
 
@@ -90,12 +99,12 @@ def _rows_fine(data: np.ndarray, previous_max: float, length: int | None, positi
 
 def _parse_fast(path: Path, min_columns: int) -> np.ndarray | None:
     """numpy's C parser for regular files; None when anything needs a closer look."""
-    try:
-        with warnings.catch_warnings():
+    try:  # (opened here: numpy would pick a decompressor by the name's suffix, .gz, .bz2, .xz, not the content)
+        with warnings.catch_warnings(), open_text(path) as fh:
             warnings.simplefilter("ignore")  # an empty file warns
-            data = np.loadtxt(path, delimiter=",", ndmin=2)
-    except ValueError:
-        return None
+            data = np.loadtxt(fh, delimiter=",", ndmin=2)
+    except (ValueError, *DECOMPRESS_ERRORS):
+        return None  # (the careful parser names the problem)
     if data.shape[0] == 0:
         return np.zeros((0, 7)) if not read_text(path).strip() else None
     if data.shape[1] < min_columns:

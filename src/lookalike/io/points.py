@@ -5,14 +5,13 @@ from __future__ import annotations
 
 import math
 import os
-import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from lookalike.io.motchallenge import MAX_ID
-from lookalike.io.rules import frame_problems, not_a_file, open_text, read_text
+from lookalike.io.rules import DECOMPRESS_ERRORS, frame_problems, not_a_file, open_text, read_text
 from lookalike.types._validate import first_fraction
 from lookalike.types.mot_table import detection_rows
 
@@ -104,7 +103,7 @@ def _xy_columns(path: Path) -> tuple[int, int]:
     try:
         with open_text(path, errors="replace") as fh:
             text = next((t for t in map(str.strip, fh) if t and not t.startswith("#")), "")
-    except (OSError, EOFError, zlib.error):
+    except DECOMPRESS_ERRORS:
         return 1, 2  # (reading the file again names the problem)
     names = [f.strip().strip("\"'").lower() for f in text.split(",")]
     if "x" in names and "y" in names and min(names.index("x"), names.index("y")) > 0:

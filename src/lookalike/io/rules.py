@@ -4,19 +4,31 @@ with the user's umask."""
 
 from __future__ import annotations
 
+import bz2
 import gzip
+import lzma
 import os
 import stat
 import tempfile
 import zlib
 from pathlib import Path
+from types import ModuleType
 from typing import TextIO
 
 import numpy as np
 
 MIN_GAP = 10_000  # frames: a jump up to this is always allowed
 GAP_FACTOR = 10  # ... and up to this times the largest frame number seen before it
-GZIP_MAGIC = b"\x1f\x8b"  # the first bytes of a gzip-compressed file
+COMPRESSIONS: tuple[tuple[bytes, ModuleType, str], ...] = (
+    (b"\x1f\x8b", gzip, "gzip"), (b"BZh", bz2, "bzip2"), (b"\xfd7zXZ\x00", lzma, "xz"))
+"""The first bytes of a compressed file, the module that reads it and the name of its format."""
+DECOMPRESS_ERRORS = (OSError, EOFError, ValueError, zlib.error, lzma.LZMAError)
+"""What reading a damaged or truncated compressed file raises."""
+
+
+def _compression(head: bytes) -> tuple[ModuleType, str] | None:
+    """The module and format name of a file beginning with ``head``, None for an uncompressed one."""
+    return next(((module, name) for magic, module, name in COMPRESSIONS if head.startswith(magic)), None)
 
 
 def not_a_file(path: Path) -> FileNotFoundError:
@@ -26,7 +38,8 @@ def not_a_file(path: Path) -> FileNotFoundError:
 
 def read_text(path: str | os.PathLike[str]) -> str:
     """The UTF-8 text of ``path`` (a leading byte order mark dropped, as Windows editors and spreadsheets write one;
-    a gzip-compressed file decompressed); ``FileNotFoundError``/``ValueError`` naming the file otherwise."""
+    a gzip-, bzip2- or xz-compressed file decompressed); ``FileNotFoundError``/``ValueError`` naming the file
+    otherwise."""
     path = Path(path)
     if not path.is_file():
         raise not_a_file(path)
@@ -34,11 +47,12 @@ def read_text(path: str | os.PathLike[str]) -> str:
         data = path.read_bytes()
     except OSError as exc:
         raise ValueError(f"{path}: cannot read ({exc.strerror or exc})") from None
-    if data.startswith(GZIP_MAGIC):
+    compressed = _compression(data[:6])
+    if compressed is not None:
         try:
-            data = gzip.decompress(data)
-        except (OSError, EOFError, zlib.error) as exc:
-            raise ValueError(f"{path}: a damaged or truncated gzip file ({exc})") from None
+            data = compressed[0].decompress(data)
+        except DECOMPRESS_ERRORS as exc:
+            raise ValueError(f"{path}: a damaged or truncated {compressed[1]} file ({exc})") from None
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -55,11 +69,13 @@ def is_data_line(line: str) -> bool:
 
 def open_text(path: Path, errors: str = "strict") -> TextIO:
     """``path`` opened as UTF-8 text to read line by line, as :func:`read_text` reads it (a byte order mark dropped,
-    a gzip-compressed file decompressed); ``errors`` as :func:`open`'s."""
+    a compressed file decompressed); ``errors`` as :func:`open`'s. Reading a damaged compressed file raises one of
+    :data:`DECOMPRESS_ERRORS`."""
     with open(path, "rb") as fh:
-        gzipped = fh.read(2) == GZIP_MAGIC
-    if gzipped:
-        return gzip.open(path, "rt", encoding="utf-8-sig", errors=errors)
+        compressed = _compression(fh.read(6))
+    if compressed is not None:
+        stream: TextIO = compressed[0].open(path, "rt", encoding="utf-8-sig", errors=errors)
+        return stream
     return open(path, encoding="utf-8-sig", errors=errors)
 
 
@@ -132,5 +148,5 @@ def is_special(path: Path) -> bool:
     return not (stat.S_ISREG(mode) or stat.S_ISDIR(mode))
 
 
-__all__ = ["GAP_FACTOR", "GZIP_MAGIC", "MIN_GAP", "frame_problems", "is_data_line", "is_special", "not_a_file",
-           "open_text", "read_text", "temp_beside", "user_mode", "write_target"]
+__all__ = ["COMPRESSIONS", "DECOMPRESS_ERRORS", "GAP_FACTOR", "MIN_GAP", "frame_problems", "is_data_line", "is_special",
+           "not_a_file", "open_text", "read_text", "temp_beside", "user_mode", "write_target"]

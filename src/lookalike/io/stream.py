@@ -15,7 +15,7 @@ import numpy as np
 
 from lookalike.io.det_format import box_stats, largest_side, read_det, sniff_det
 from lookalike.io.motchallenge import format_rows, frames_from_table, read_mot, row_problem
-from lookalike.io.rules import is_special, not_a_file, temp_beside, write_target
+from lookalike.io.rules import DECOMPRESS_ERRORS, is_special, not_a_file, open_text, temp_beside, write_target
 from lookalike.io.sequences import MotSequence
 from lookalike.loop import RunStats, Sink, Sinks, Updating, run
 from lookalike.types import Detections, Frame
@@ -28,7 +28,7 @@ WRITE_ROWS = 4_096
 
 def _chunks(path: Path, lines: int) -> Iterator[np.ndarray]:
     """The file's rows ``(k, c)``, ``lines`` lines at a time (``ValueError`` for anything numpy cannot parse)."""
-    with open(path, encoding="utf-8") as fh:
+    with open_text(path) as fh:
         while True:
             block = list(itertools.islice(fh, lines))
             if not block:
@@ -107,7 +107,7 @@ class DetectionStream:
             self.scores, self.outside, self.largest = ((low, high) if rows else None), outside, largest
             if len(chunks) == 1:  # the whole file was one chunk: kept, not parsed again
                 self._single = chunks[0]
-        except ValueError:
+        except (ValueError, *DECOMPRESS_ERRORS):
             # raises the precise error, or the file is valid but irregular (read whole)
             table = read_mot(self.path, length=self.length, length_name=self.length_name, positive_size=True)
             self.rows = len(table)
