@@ -172,6 +172,11 @@ def test_read_points_csv_takes_x_and_y_named_by_its_header(tmp_path: Path) -> No
     q = tmp_path / "yx.csv"
     q.write_text("frame,y,x\n1,2,3\n")
     np.testing.assert_array_equal(read_points_csv(q).points[0], [[3, 2]])
+    other = tmp_path / "points.txt"  # MOTChallenge-style rows, read as frame,id,x,y unless the header names x and y
+    other.write_text("frame,x,y,area\n1,10.5,20.5,50\n1,30,40,55\n2,11,21,50\n")
+    np.testing.assert_array_equal(read_points_mot(other).points[0], [[10.5, 20.5], [30, 40]])
+    other.write_text("1,7,10.5,20.5\n")
+    np.testing.assert_array_equal(read_points_mot(other).points[0], [[10.5, 20.5]])
     quoted = tmp_path / "quoted.csv"  # R's write.csv quotes the header: x was read from the id column, silently
     quoted.write_text('"frame","id","x","y"\n1,7,10.5,20.5\n1,8,30,40\n2,7,11,21\n')
     np.testing.assert_array_equal(read_points_csv(quoted).points[0], [[10.5, 20.5], [30, 40]])

@@ -97,25 +97,27 @@ def _group(path: Path, frames: np.ndarray, xy: np.ndarray, n_frames: int | None)
     return PointFrames([xy[bounds[k]:bounds[k + 1]].copy() for k in range(length)], path)
 
 
-def _xy_columns(path: Path) -> tuple[int, int]:
-    """The columns of x and y in a points CSV: those its header names ``x`` and ``y`` (as ``frame,id,x,y``), else 1
-    and 2."""
+def _xy_columns(path: Path, default: tuple[int, int] = (1, 2)) -> tuple[int, int]:
+    """The columns of x and y in a points file: those its header names ``x`` and ``y`` (as ``frame,id,x,y``), else
+    ``default``."""
+    if not path.is_file():
+        return default
     try:
         with open_text(path, errors="replace") as fh:
             text = next((t for t in map(str.strip, fh) if t and not t.startswith("#")), "")
     except DECOMPRESS_ERRORS:
-        return 1, 2  # (reading the file again names the problem)
+        return default  # (reading the file again names the problem)
     names = [f.strip().strip("\"'").lower() for f in text.split(",")]
     if "x" in names and "y" in names and min(names.index("x"), names.index("y")) > 0:
         return names.index("x"), names.index("y")
-    return 1, 2
+    return default
 
 
 def read_points_csv(path: str | os.PathLike[str], n_frames: int | None = None) -> PointFrames:
     """Points from a ``frame,x,y`` CSV (optional header; a header naming ``x`` and ``y`` elsewhere, as
     ``frame,id,x,y``, picks those columns; extra columns ignored), padded to ``n_frames``."""
     path = Path(path)
-    x, y = _xy_columns(path) if path.is_file() else (1, 2)
+    x, y = _xy_columns(path)
     width = max(x, y, 2) + 1
     parsed = _parse(path, width)
     data = np.array([v for _, v in parsed], dtype=float).reshape(-1, width)
@@ -124,10 +126,13 @@ def read_points_csv(path: str | os.PathLike[str], n_frames: int | None = None) -
 
 def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *,
                     centre: bool = False) -> PointFrames:
-    """Points from rows ``frame, id, x, y, ...``, or with ``centre=True`` the centres of MOTChallenge boxes."""
+    """Points from rows ``frame, id, x, y, ...`` (a header naming ``x`` and ``y`` elsewhere, as ``frame,x,y,area``,
+    picks those columns), or with ``centre=True`` the centres of MOTChallenge boxes."""
     path = Path(path)
-    parsed = _parse(path, 6 if centre else 4, first_coordinate=2)
-    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 6 if centre else 4)
+    x, y = (2, 3) if centre else _xy_columns(path, (2, 3))
+    width = 6 if centre else max(x, y, 3) + 1
+    parsed = _parse(path, width, first_coordinate=min(x, y))
+    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, width)
     if centre:
         bad = np.flatnonzero((data[:, 4:6] < 0).any(axis=1))
         if len(bad):
@@ -135,7 +140,7 @@ def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *
             raise ValueError(f"{path}:{no}: negative box size")
         xy = data[:, 2:4] + data[:, 4:6] / 2
     else:
-        xy = data[:, 2:4]
+        xy = data[:, [x, y]]
     return _group(path, data[:, 0].astype(int), xy, n_frames)
 
 
