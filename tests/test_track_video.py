@@ -179,6 +179,11 @@ def test_cli_video_errors(diver_scene, tmp_path):
     r = runner.invoke(app, ["track", "--video", str(tmp_path / "none.mp4"), "--detections", str(det),
                             "-o", str(tmp_path / "o.txt")])
     assert r.exit_code == 2 and "none.mp4" in r.output
+    zero = tmp_path / "zero.txt"  # a zero-width box: the tracker's error named neither the file nor the line
+    zero.write_text(det.read_text().split("\n", 1)[0] + "\n2,-1,10,10,0,20,0.9,-1,-1,-1\n")
+    r = runner.invoke(app, ["track", "-t", "sort", "--video", str(root / "divers.mp4"), "--detections", str(zero),
+                            "-o", str(tmp_path / "o.txt")])
+    assert r.exit_code == 2 and f"{zero}:2: invalid box: zero or negative width" in r.output, r.output
 
 
 def test_draw_banner_cuts_long_text():

@@ -80,7 +80,7 @@ def prepare_video(video: Path, detections: VideoDetections, tracker_name: str, *
     notes: list[str] = []
     if isinstance(detections, Path):
         fmt, notes = sniff_det(detections, det_format)
-        table = read_mot(detections) if fmt.standard() else read_det(detections, fmt)
+        table = read_mot(detections, positive_size=True) if fmt.standard() else read_det(detections, fmt)
     else:
         table = detections if isinstance(detections, MotTable) else MotTable.from_rows(np.zeros((0, 10)))
     images, total, _ = source_frames(video)
