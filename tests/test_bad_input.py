@@ -125,6 +125,9 @@ def test_frames_past_seqlength_are_an_error_unless_no_seqinfo_length(tmp_path):
 def test_non_integer_frames_and_nan_scores_are_errors_naming_the_line(tmp_path, line, needle):
     det = _det(tmp_path / "det.txt", range(1, 3), extra=line + "\n")
     _one_error_line(_track(det, "-o", tmp_path / "o.txt"), "det.txt:3", needle)
+    # the offline closed set reads the file its own way: the same rules (a zero-size box was taken silently)
+    offline = _track(det, "-o", tmp_path / "o.txt", "-t", "boxtrack", "--targets", "1", "--offline")
+    _one_error_line(offline, "det.txt:3", needle)
 
 
 @pytest.mark.parametrize("rate", ["0", "nan", "-25", "inf", "fast"])

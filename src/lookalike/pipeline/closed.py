@@ -41,7 +41,7 @@ def table_rows(path: Path, min_score: float = float("-inf"), length: int | None 
     fmt, notes = sniff_det(path, det_format)
     for line in notes:
         note(f"{path}: {line}")
-    table = read_mot(path, length=length, length_name=length_name) if fmt.standard() else \
+    table = read_mot(path, length=length, length_name=length_name, positive_size=True) if fmt.standard() else \
         read_det(path, fmt, length, length_name)
     rows = detection_rows(table.frame, table.xywh, table.conf)
     return rows[rows[:, 6] >= min_score]
