@@ -117,6 +117,18 @@ def test_comment_lines_are_skipped_and_errors_keep_their_line(tmp_path: Path) ->
         assert result.exit_code == 2 and f"{bad}:7: NaN" in result.output, result.output
 
 
+def test_a_comment_after_the_values_is_dropped_by_every_parser(tmp_path: Path) -> None:
+    """numpy's fast reader dropped ``# ...`` after the values, the careful one (used when a line is wrong) did not: it
+    blamed the comment's line instead of the wrong one."""
+    det = tmp_path / "det.txt"
+    det.write_text("1,-1,10,10,20,40,0.9  # the first box\n2,-1,10,10,20,40,0.9\n3,-1,10,10,20,40,nan\n")
+    result = runner.invoke(app, ["track", str(det), "-o", str(tmp_path / "o.txt")])
+    assert result.exit_code == 2 and f"{det}:3: NaN or infinity" in result.output, result.output
+    points = tmp_path / "points.csv"
+    points.write_text("frame,x,y\n1,5,10 # head\n2,6,11\n")
+    assert read_points_csv(points).count == 2
+
+
 def test_eval_names_the_line_past_comment_lines(tmp_path: Path) -> None:
     seq = tmp_path / "S"
     (seq / "gt").mkdir(parents=True)

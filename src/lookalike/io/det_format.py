@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.io.motchallenge import row_problem
-from lookalike.io.rules import DECOMPRESS_ERRORS, is_data_line, not_a_file, open_text, read_text
+from lookalike.io.rules import DECOMPRESS_ERRORS, is_data_line, not_a_file, open_text, read_text, without_comment
 from lookalike.types.mot_table import MotTable, table_from_array
 
 MOT_COLUMNS = "frame,id,left,top,width,height,score[,x,y,z]"
@@ -183,7 +183,7 @@ def read_det(path: str | os.PathLike[str], fmt: DetFormat, length: int | None = 
         if fmt.header and not line_nos and not numbers and _numbers(_split(line, fmt.separator)) is None:
             fmt = DetFormat(fmt.roles, fmt.separator, False)  # the header: skipped once
             continue
-        fields = _split(line, fmt.separator)
+        fields = _split(without_comment(line), fmt.separator)
         values = _numbers(fields[:need]) if len(fields) >= need else None
         if values is None:
             what = f"{len(fields)} column(s)" if len(fields) < need else "not a number"

@@ -20,6 +20,7 @@ from lookalike.io.rules import (
     not_a_file,
     open_text,
     read_text,
+    without_comment,
 )
 from lookalike.types import Detections, Frame
 from lookalike.types.mot_table import ROW_WIDTH, MotTable, stack_rows, table_from_array, tracks_to_rows
@@ -116,7 +117,7 @@ def _parse_slowly(path: Path, rows: list[tuple[int, str]], min_columns: int) -> 
     parsed: list[list[float]] = []
     width = None
     for line_no, line in rows:
-        fields = [f.strip() for f in line.split(",")]
+        fields = [f.strip() for f in without_comment(line).split(",")]
         while len(fields) > max(min_columns, 7) and not fields[-1]:
             fields.pop()  # a trailing comma, or x, y, z left empty: the optional columns are absent
         if len(fields) < min_columns:

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike.io.motchallenge import MAX_ID
-from lookalike.io.rules import DECOMPRESS_ERRORS, frame_problems, not_a_file, open_text, read_text
+from lookalike.io.rules import DECOMPRESS_ERRORS, frame_problems, not_a_file, open_text, read_text, without_comment
 from lookalike.types._validate import first_fraction
 from lookalike.types.mot_table import detection_rows
 
@@ -54,8 +54,8 @@ def _parse(path: Path, columns: int, first_coordinate: int = 1,
     out = []
     first = True
     for no, line in enumerate(read_text(path).splitlines(), start=1):
-        text = line.strip()
-        if not text or text.startswith("#"):
+        text = without_comment(line).strip()
+        if not text:
             continue
         fields = [f.strip() for f in text.split(",")]
         if first:

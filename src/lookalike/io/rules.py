@@ -67,6 +67,11 @@ def is_data_line(line: str) -> bool:
     return bool(text) and not text.startswith("#")
 
 
+def without_comment(line: str) -> str:
+    """``line`` up to a ``#`` (a comment after the values, as numpy's reader also drops)."""
+    return line.split("#", 1)[0]
+
+
 def open_text(path: Path, errors: str = "strict") -> TextIO:
     """``path`` opened as UTF-8 text to read line by line, as :func:`read_text` reads it (a byte order mark dropped,
     a compressed file decompressed); ``errors`` as :func:`open`'s. Reading a damaged compressed file raises one of
@@ -149,4 +154,5 @@ def is_special(path: Path) -> bool:
 
 
 __all__ = ["COMPRESSIONS", "DECOMPRESS_ERRORS", "GAP_FACTOR", "MIN_GAP", "frame_problems", "is_data_line", "is_special",
-           "not_a_file", "open_text", "read_text", "temp_beside", "user_mode", "write_target"]
+           "not_a_file", "open_text", "read_text", "temp_beside", "user_mode", "without_comment",
+           "write_target"]
