@@ -193,3 +193,29 @@ def test_a_log_replays_with_its_own_targets_and_names_a_cut_line(tmp_path):
     log.write_text(head + Correction("swap", 2, 1, SWAP).to_json() + '\n{"kind": "sw\n')
     r = CliRunner().invoke(app, ["proofread", "--video", str(video), "--tracks", str(tracks), "--export"])
     assert r.exit_code == 2 and "two.corrections.jsonl:3:" in r.output and "cut short" in r.output, r.output
+
+
+def test_detections_in_any_layout_track_reads_solve_the_same(tmp_path):
+    """``--detections`` in the layouts ``track`` reads (a header, x1,y1,x2,y2 corners): a note and the export of the
+    MOTChallenge file (a header-less corner file was read as MOTChallenge columns, silently, and a header refused);
+    a file without detections is one error line (was numpy's 'zero-size array')."""
+    video, tracks = two_discs(tmp_path)
+    rows = np.loadtxt(tracks, delimiter=",")
+    corners = [[r[0], r[2], r[3], r[2] + r[4], r[3] + r[5], 1, 0] for r in rows]
+    files = {"det.txt": "".join(f"{int(r[0])},-1,{r[2]:g},{r[3]:g},{r[4]:g},{r[5]:g},1,-1,-1,-1\n" for r in rows),
+             "corners.txt": "".join(",".join(f"{v:g}" for v in c) + "\n" for c in corners)}
+    files["header.csv"] = "frame,x1,y1,x2,y2,score,class\n" + files["corners.txt"]
+    exported = {}
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+        out = tmp_path / f"{name}.proofread.txt"
+        r = CliRunner().invoke(app, ["proofread", "--video", str(video), "--tracks", str(tracks), "--targets", "2",
+                                     "--detections", str(tmp_path / name), "--export", "-o", str(out),
+                                     "--log", str(tmp_path / f"{name}.log")])
+        assert r.exit_code == 0 and ("note:" in r.output) == (name != "det.txt"), r.output
+        exported[name] = out.read_text()
+    assert exported["det.txt"] and len(set(exported.values())) == 1
+    (tmp_path / "empty.txt").write_text("")
+    r = CliRunner().invoke(app, ["proofread", "--video", str(video), "--tracks", str(tracks), "--targets", "2",
+                                 "--detections", str(tmp_path / "empty.txt"), "--export"])
+    assert r.exit_code == 2 and "--detections: " in r.output and "no detections" in r.output, r.output

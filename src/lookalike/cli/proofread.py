@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing, note
 
 
 @app.command()
@@ -73,8 +73,18 @@ def proofread(
             solver = blob_solver_input(video, tracks, targets, frame_rate or fps)
         if solver is not None:
             console.print("corrections re-solve from the video's cached blobs, with each animal's look", markup=False)
+    det_table = None
+    if detections is not None:  # read as `track` read them (another layout: a note says what was assumed)
+        from lookalike.io.det_format import read_detections
+
+        with failing(ValueError):
+            det_table, notes = read_detections(detections)
+        for line in notes:
+            note(f"{detections}: {line}")
+        if det_table is not None and not len(det_table):
+            fail(f"--detections: {detections}: no detections to solve the closed set from")
     with failing(ValueError):
-        session = Session(tracks, frame_rate=frame_rate or fps, n_targets=targets, detections=detections,
+        session = Session(tracks, frame_rate=frame_rate or fps, n_targets=targets, detections=det_table,
                           solver_input=solver[0] if solver else None, shapes=solver[1] if solver else None,
                           parts=solver[2] if solver else None)
     if fresh and log.exists():

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lookalike.io.motchallenge import row_problem
+from lookalike.io.motchallenge import read_mot, row_problem
 from lookalike.io.rules import DECOMPRESS_ERRORS, is_data_line, not_a_file, open_text, read_text, without_comment
 from lookalike.types.mot_table import MotTable, table_from_array
 
@@ -207,6 +207,14 @@ def read_det(path: str | os.PathLike[str], fmt: DetFormat, length: int | None = 
     return table_from_array(rows, path)
 
 
+def read_detections(path: str | os.PathLike[str], spec: str = "auto") -> tuple[MotTable, list[str]]:
+    """The detections of ``path`` in any layout ``lookalike track`` reads (:func:`sniff_det`; ``spec`` as there) and
+    the notes on what was assumed; ``ValueError`` naming file and line as :func:`read_det` (sizes must be > 0)."""
+    fmt, notes = sniff_det(path, spec)
+    table = read_mot(path, positive_size=True) if fmt.standard() else read_det(path, fmt)
+    return table, notes
+
+
 def det_warnings(path: Path | str, count: int, scores: tuple[float, float] | None, outside: int,
                  image_size: tuple[int, int] | None, size_from: str = "", largest: float | None = None) -> list[str]:
     """Warnings: ``outside`` of ``count`` boxes centred outside ``image_size`` (from ``size_from``), every score
@@ -245,4 +253,4 @@ def box_stats(xywh: np.ndarray, conf: np.ndarray, image_size: tuple[int, int] | 
 
 
 __all__ = ["EXPECTED", "MOT", "MOT_COLUMNS", "DetFormat", "box_stats", "det_warnings", "largest_side", "parse_columns",
-           "read_det", "sniff_det"]
+           "read_det", "read_detections", "sniff_det"]

@@ -16,12 +16,14 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.io.det_format import read_detections
 from lookalike.io.motchallenge import read_mot, write_mot
 from lookalike.io.outputs import write_atomic
 from lookalike.proofread.edits import Change, Correction, apply_edit, changes, check, colocated
 from lookalike.trackers.offline.closed_set import ClosedSetConfig, assign_identities, closed_set_input
 from lookalike.trackers.offline.confidence import DOUBTFUL_BELOW, assignment_confidence, doubtful_ranges
 from lookalike.trackers.offline.constraints import ChainConstraints, Row
+from lookalike.types.mot_table import MotTable
 
 __all__ = ["Doubt", "Session"]
 
@@ -37,9 +39,9 @@ class Doubt:
     doubt: float
 
 
-def _rows_of(table_or_rows: np.ndarray | str | os.PathLike[str]) -> np.ndarray:
-    if isinstance(table_or_rows, (str, os.PathLike)):
-        t = read_mot(table_or_rows)
+def _rows_of(table_or_rows: np.ndarray | MotTable | str | os.PathLike[str]) -> np.ndarray:
+    if isinstance(table_or_rows, (str, os.PathLike, MotTable)):
+        t = table_or_rows if isinstance(table_or_rows, MotTable) else read_mot(table_or_rows)
         rows = np.column_stack([t.frame, t.track_id, t.xywh, t.conf, np.full((len(t), 3), -1.0)])
     else:
         rows = np.asarray(table_or_rows, dtype=float)
@@ -54,12 +56,13 @@ def _rows_of(table_or_rows: np.ndarray | str | os.PathLike[str]) -> np.ndarray:
 
 class Session:
     """Proofreading of ``tracks`` (rows or a MOTChallenge file). With ``n_targets`` corrections re-solve the closed set
-    over the tracklets of ``solver_input`` (the rows the closed set was solved from), else of ``detections`` (their
-    online pass, as ``--offline`` makes it), else of the tracks themselves. ``frame_rate`` in frames/s (confidence
-    windows and the solver's motion). ``shapes``: blob shape vectors ``(k, SHAPE_SIZE)`` of the detections, which
-    column 9 of ``solver_input`` indexes (``detections``: one per row); with them each re-solve weighs the look learned
-    from the video, as ``track --targets N`` on a blob video does; ``parts``: the blobs' parts vectors (one per shape
-    vector), on which the animals of a merged blob are placed.
+    over the tracklets of ``solver_input`` (the rows the closed set was solved from), else of ``detections`` (rows, a
+    table, or a file in any layout ``lookalike track`` reads; their online pass, as ``--offline`` makes it), else of
+    the tracks themselves. ``frame_rate`` in frames/s (confidence windows and the solver's motion). ``shapes``: blob
+    shape vectors ``(k, SHAPE_SIZE)`` of the detections, which column 9 of ``solver_input`` indexes (``detections``:
+    one per row); with them each re-solve weighs the look learned from the video, as ``track --targets N`` on a blob
+    video does; ``parts``: the blobs' parts vectors (one per shape vector), on which the animals of a merged blob are
+    placed.
 
     Attributes:
         rows: the current rows ``(k, 10)``, sorted by frame, then id.
@@ -68,7 +71,8 @@ class Session:
         last_change: what the last ``apply`` or ``undo`` changed."""
 
     def __init__(self, tracks: np.ndarray | str | os.PathLike[str], *, frame_rate: float = 30.0,
-                 n_targets: int | None = None, detections: np.ndarray | str | os.PathLike[str] | None = None,
+                 n_targets: int | None = None,
+                 detections: np.ndarray | MotTable | str | os.PathLike[str] | None = None,
                  solver_input: np.ndarray | None = None, config: ClosedSetConfig | None = None,
                  shapes: np.ndarray | None = None, parts: np.ndarray | None = None) -> None:
         if not frame_rate > 0:
@@ -86,7 +90,10 @@ class Session:
             if solver_input is not None:
                 self._solver_rows = _rows_of(solver_input)
             elif detections is not None:
-                det = _rows_of(detections)
+                det = _rows_of(read_detections(detections)[0] if isinstance(detections, (str, os.PathLike))
+                               else detections)
+                if not len(det):
+                    raise ValueError("detections: no rows")
                 self._solver_rows = closed_set_input(det, self.frame_rate, int(det[:, 0].max()),
                                                      index=shapes is not None)
             else:
