@@ -163,6 +163,8 @@ def test_proofread_command_replays_the_log_and_exports(tmp_path):
     assert set(out[(out[:, 3] < 60), 1].astype(int)) == {1}  # the upper lane is 1 throughout
     r = CliRunner().invoke(app, ["proofread", "--video", str(tmp_path / "none.avi"), "--tracks", str(tracks)])
     assert r.exit_code == 2 and "no such file" in r.output
+    r = CliRunner().invoke(app, ["proofread", "--video", str(tmp_path), "--tracks", str(tracks)])  # said no such file
+    assert r.exit_code == 2 and "is a folder, not a file (the page reads a video file" in r.output, r.output
     r = CliRunner().invoke(app, ["proofread", "--video", str(video), "--tracks", str(tracks), "--fresh", "--export"])
     assert r.exit_code == 0 and log.with_name(log.name + ".bak").exists()
     out = np.loadtxt(tmp_path / "two.proofread.txt", delimiter=",")

@@ -42,13 +42,15 @@ def proofread(
     Corrections: assign an identity, swap two ids, merge, split, delete, undo. With --targets N each correction
     re-solves the closed set and the latest correction wins over earlier ones that contradict it. The log is saved
     after every action; export (the button or --export) writes the corrected tracks."""
+    from lookalike.io.rules import not_a_file
     from lookalike.io.video_frames import video_info
     from lookalike.proofread import Correction, Session
     from lookalike.viz.label.proofread import ProofreadApp, make_proofread_server
 
     for option, path in (("--video", video), ("--tracks", tracks), ("--detections", detections)):
         if path is not None and not path.is_file():
-            fail(f"{option}: {path}: no such file")
+            fail(f"{option}: {not_a_file(path)}" + (" (the page reads a video file, not a folder of images)"
+                                                     if option == "--video" and path.is_dir() else ""))
     if detections is not None and targets is None:
         fail("--detections needs --targets N (plain edits use the tracks alone)")
     log = log or tracks.with_name(f"{tracks.stem}.corrections.jsonl")
