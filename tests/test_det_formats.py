@@ -102,6 +102,9 @@ def test_det_format_option_names_the_columns(tmp_path: Path) -> None:
     ("1,-1,10,20\n", "auto", "frame,id,left,top,width,height,score"),
     ("1,-1,10,20,30,40\n", "frame,foo", "frame,id,left,top,width,height,score"),
     ("1,-1,10,x,30,40\n", "mot", "frame,id,left,top,width,height,score"),
+    # a spreadsheet's export with ';' (and decimal commas): was a 'header line' naming no columns
+    ("1;-1;10,5;20;30;40;0,9\n", "auto", "det.txt:1: columns separated by ';' (decimal commas?)"),
+    ("frame;id;left;top;width;height\n1;-1;10;20;30;40\n", "auto", "det.txt:1: columns separated by ';'"),
 ])
 def test_an_unreadable_file_is_refused_with_the_expected_columns(text: str, spec: str, expected: str,
                                                                  tmp_path: Path) -> None:

@@ -121,7 +121,7 @@ def test_a_comment_after_the_values_is_dropped_by_every_parser(tmp_path: Path) -
     """numpy's fast reader dropped ``# ...`` after the values, the careful one (used when a line is wrong) did not: it
     blamed the comment's line instead of the wrong one."""
     det = tmp_path / "det.txt"
-    det.write_text("1,-1,10,10,20,40,0.9  # the first box\n2,-1,10,10,20,40,0.9\n3,-1,10,10,20,40,nan\n")
+    det.write_text("1,-1,10,10,20,40,0.9  # the first box; a;b;c;d;e\n2,-1,10,10,20,40,0.9\n3,-1,10,10,20,40,nan\n")
     result = runner.invoke(app, ["track", str(det), "-o", str(tmp_path / "o.txt")])
     assert result.exit_code == 2 and f"{det}:3: NaN or infinity" in result.output, result.output
     points = tmp_path / "points.csv"

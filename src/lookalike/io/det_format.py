@@ -118,13 +118,8 @@ def _guess_roles(sample: np.ndarray) -> tuple[tuple[str, ...], str | None]:
     return mot, None
 
 
-def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetFormat, list[str]]:
-    """The layout of detection file ``path`` and notes on what was assumed; ``spec``: ``auto`` (from the first lines),
-    ``mot`` (separator and header still detected) or column names (``frame,x1,y1,x2,y2,score,class``; ``frame0``:
-    0-based). ``ValueError`` when the lines cannot be read as detections."""
-    path = Path(path)
-    if not path.is_file():
-        raise not_a_file(path)
+def _first_lines(path: Path) -> list[str]:
+    """The first :data:`_SNIFF_LINES` data lines of ``path`` (:func:`~lookalike.io.rules.is_data_line`)."""
     lines = []
     try:
         with open_text(path) as fh:
@@ -136,12 +131,32 @@ def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetForm
     except (UnicodeDecodeError, *DECOMPRESS_ERRORS):
         read_text(path)  # a binary file (a video given as detections) or a damaged gzip: named, never sniffed
         raise
+    return lines
+
+
+def _refuse_semicolons(path: Path, first: str) -> None:
+    """``ValueError`` for a first line of six or more columns separated by ``;`` (a spreadsheet's export, its numbers
+    perhaps with decimal commas), which would read as one column, or as a header naming none."""
+    if len(without_comment(first).split(";")) >= 6:
+        raise ValueError(f"{path}:1: columns separated by ';' (decimal commas?) in {first.strip()[:80]!r}; {EXPECTED}, "
+                         "with decimal points")
+
+
+def sniff_det(path: str | os.PathLike[str], spec: str = "auto") -> tuple[DetFormat, list[str]]:
+    """The layout of detection file ``path`` and notes on what was assumed; ``spec``: ``auto`` (from the first lines),
+    ``mot`` (separator and header still detected) or column names (``frame,x1,y1,x2,y2,score,class``; ``frame0``:
+    0-based). ``ValueError`` when the lines cannot be read as detections."""
+    path = Path(path)
+    if not path.is_file():
+        raise not_a_file(path)
+    lines = _first_lines(path)
     if not lines:
         return MOT, []
     first = lines[0]
     separator = "," if "," in first else None
     notes = [] if separator == "," else ["whitespace-separated columns"]
     header = all(_numbers([f]) is None for f in _split(first, separator) if f)  # names only, no number
+    _refuse_semicolons(path, first)
     rows = lines[1:] if header else lines
     sample = [p for p in (_numbers(_split(ln, separator)) for ln in rows) if p is not None]
     if spec not in ("auto", "mot"):
