@@ -80,6 +80,12 @@ def test_a_trailing_comma_or_empty_xyz_columns_are_absent_columns(tmp_path):
         np.testing.assert_array_equal(table.conf, plain.conf)
 
 
+def test_min_columns_below_a_box_is_refused(tmp_path):
+    p = _write(tmp_path / "three.txt", "1,2,3\n2,2,3\n")  # was numpy's 'zero-size array to reduction operation'
+    with pytest.raises(ValueError, match="min_columns must be a whole number >= 6"):
+        read_mot(p, min_columns=2)
+
+
 def test_missing_file(tmp_path):
     with pytest.raises(FileNotFoundError, match="nope.txt"):
         read_mot(tmp_path / "nope.txt")

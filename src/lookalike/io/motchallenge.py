@@ -36,7 +36,9 @@ def read_mot(path: str | os.PathLike[str], min_columns: int = 6, length: int | N
     """Read a MOTChallenge text file (UTF-8; blank and ``#`` comment lines skipped); ``ValueError`` naming the file
     and line of a malformed one: too few columns, a non-number, NaN or infinity in frame, id, box or score, an id not
     whole, a negative size (zero too with ``positive_size``), or a frame number breaking :mod:`lookalike.io.rules` or
-    past ``length``."""
+    past ``length``. ``min_columns``: at least 6 (frame, id and the box)."""
+    if not (isinstance(min_columns, int) and min_columns >= 6):
+        raise ValueError(f"min_columns must be a whole number >= 6 (frame, id and the box), got {min_columns!r}")
     path = Path(path)
     if not path.is_file():
         raise not_a_file(path)
