@@ -1,6 +1,6 @@
-"""Input files as real tools save them: a UTF-8 byte order mark (Windows editors, spreadsheets), compression (gzip,
-bzip2, xz, told by the content) and ``#`` comment lines are read as the plain text, by every reader and by
-``lookalike track`` and ``eval``."""
+"""Input files as real tools save them: a UTF-8 byte order mark (Windows editors, spreadsheets), UTF-16 with its
+mark (PowerShell), compression (gzip, bzip2, xz, told by the content) and ``#`` comments are read as the plain text,
+by every reader and by ``lookalike track`` and ``eval``."""
 
 from __future__ import annotations
 
@@ -159,3 +159,22 @@ def test_compression_is_decided_by_the_content_not_the_name(tmp_path: Path) -> N
     cut.write_bytes(bz2.compress(_DET.encode())[:60])
     result = runner.invoke(app, ["track", "-t", "sort", str(cut), "-o", str(tmp_path / "cut.res")])
     assert result.exit_code == 2 and f"{cut}: a damaged or truncated bzip2 file" in result.output, result.output
+
+
+def test_utf16_text_as_powershell_writes_it(tmp_path: Path) -> None:
+    """PowerShell's ``>`` writes UTF-16 with a byte order mark: read as its text (was 'not UTF-8 text (byte 0xff)');
+    without the mark its NUL characters are named as such (were a 'header line' of '\\x001\\x00,...')."""
+    plain, wide = tmp_path / "plain.txt", tmp_path / "wide.txt"
+    plain.write_text(_DET)
+    wide.write_bytes(_DET.encode("utf-16"))
+    np.testing.assert_array_equal(read_mot(wide).xywh, read_mot(plain).xywh)
+    outputs = []
+    for path in (plain, wide):
+        result = runner.invoke(app, ["track", "-t", "sort", str(path), "-o", str(tmp_path / f"{path.stem}.res")])
+        assert result.exit_code == 0, result.output
+        outputs.append((tmp_path / f"{path.stem}.res").read_text())
+    assert outputs[0] and outputs[1] == outputs[0]
+    bare = tmp_path / "bare.txt"
+    bare.write_bytes(_DET.encode("utf-16-be"))
+    result = runner.invoke(app, ["track", "-t", "sort", str(bare), "-o", str(tmp_path / "bare.res")])
+    assert result.exit_code == 2 and f"{bare}:1: not UTF-8 text (a NUL character" in result.output, result.output

@@ -131,6 +131,8 @@ def _first_lines(path: Path) -> list[str]:
     except (UnicodeDecodeError, *DECOMPRESS_ERRORS):
         read_text(path)  # a binary file (a video given as detections) or a damaged gzip: named, never sniffed
         raise
+    if any("\0" in line for line in lines):
+        read_text(path)  # (refuses the NUL character, naming its line)
     return lines
 
 

@@ -5,6 +5,7 @@ with the user's umask."""
 from __future__ import annotations
 
 import bz2
+import codecs
 import gzip
 import lzma
 import os
@@ -38,8 +39,8 @@ def not_a_file(path: Path) -> FileNotFoundError:
 
 def read_text(path: str | os.PathLike[str]) -> str:
     """The UTF-8 text of ``path`` (a leading byte order mark dropped, as Windows editors and spreadsheets write one;
-    a gzip-, bzip2- or xz-compressed file decompressed); ``FileNotFoundError``/``ValueError`` naming the file
-    otherwise."""
+    UTF-16 with its byte order mark, as Windows PowerShell's ``>`` writes, read too; a gzip-, bzip2- or
+    xz-compressed file decompressed); ``FileNotFoundError``/``ValueError`` naming the file otherwise."""
     path = Path(path)
     if not path.is_file():
         raise not_a_file(path)
@@ -53,12 +54,24 @@ def read_text(path: str | os.PathLike[str]) -> str:
             data = compressed[0].decompress(data)
         except DECOMPRESS_ERRORS as exc:
             raise ValueError(f"{path}: a damaged or truncated {compressed[1]} file ({exc})") from None
+    encoding = _encoding(data[:2])
     try:
-        return data.decode("utf-8-sig")
+        text = data.decode(encoding)
     except UnicodeDecodeError as exc:
         line = data.count(b"\n", 0, exc.start) + 1
-        raise ValueError(f"{path}:{line}: not UTF-8 text (byte 0x{data[exc.start]:02x}); "
-                         "expected a text file") from None
+        raise ValueError(f"{path}:{line}: not {'UTF-16' if encoding == 'utf-16' else 'UTF-8'} text (byte "
+                         f"0x{data[exc.start]:02x}); expected a text file") from None
+    nul = text.find("\0")
+    if nul >= 0:
+        raise ValueError(f"{path}:{text.count(chr(10), 0, nul) + 1}: not UTF-8 text (a NUL character: UTF-16 without "
+                         "its byte order mark, or a binary file?); expected a text file")
+    return text
+
+
+def _encoding(head: bytes) -> str:
+    """The encoding of text beginning with ``head``: UTF-16 after its byte order mark, else UTF-8 (with or without
+    one)."""
+    return "utf-16" if head[:2] in (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE) else "utf-8-sig"
 
 
 def is_data_line(line: str) -> bool:
@@ -77,11 +90,12 @@ def open_text(path: Path, errors: str = "strict") -> TextIO:
     a compressed file decompressed); ``errors`` as :func:`open`'s. Reading a damaged compressed file raises one of
     :data:`DECOMPRESS_ERRORS`."""
     with open(path, "rb") as fh:
-        compressed = _compression(fh.read(6))
+        head = fh.read(6)
+    compressed = _compression(head)
     if compressed is not None:
         stream: TextIO = compressed[0].open(path, "rt", encoding="utf-8-sig", errors=errors)
         return stream
-    return open(path, encoding="utf-8-sig", errors=errors)
+    return open(path, encoding=_encoding(head), errors=errors)
 
 
 def frame_problems(frames: np.ndarray, previous_max: float = 0.0, length: int | None = None,
