@@ -112,15 +112,21 @@ def print_whole(table: Table) -> None:
 
 
 def check_names(option: str, names: list[str], known: Sequence[str], what: str) -> None:
-    """Fail naming the first of ``names`` not in ``known``."""
+    """Fail naming the first of ``names`` not in ``known``, or when there is none (an option given as ``,``)."""
+    if not names:
+        fail(f"{option}: no {what} given; known: {', '.join(known)}")
     for n in names:
         if n not in known:
             fail(f"{option}: unknown {what} {n!r}; known: {', '.join(known)}")
 
 
 def check_teams(option: str, names: list[str]) -> None:
-    """Fail naming the first of ``names`` that is no team (:func:`lookalike.sim.presets.team_size`)."""
-    from lookalike.sim.presets import team_size
+    """Fail naming the first of ``names`` that is no team (:func:`lookalike.sim.presets.team_size`), or when there is
+    none."""
+    from lookalike.sim.presets import TEAM_HELP, team_size
+
+    if not names:
+        fail(f"{option}: no team given; give {TEAM_HELP}")
 
     with failing(ValueError, prefix=f"{option}: "):
         for n in names:

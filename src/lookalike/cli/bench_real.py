@@ -87,8 +87,12 @@ def real(
     for t in tracker_list:
         if t not in BOX_TRACKERS:
             fail(f"--trackers: {t!r} is not a box tracker; choose from {', '.join(BOX_TRACKERS)}")
-    with failing(ValueError, FileNotFoundError):
+    with failing(ValueError):
         status = peer_status(peer_list)
+    if not tracker_list and params_file is None and all(why is not None for why in status.values()):
+        fail("nothing to run: --trackers names no tracker and no peer of --peers is installed (the peers: "
+             "`make bench-env`, then .venv-bench/bin/lookalike bench real)")
+    with failing(ValueError, FileNotFoundError):
         seqs = load_datasets(resolve_data_root(data), split_list(datasets), sequences=split_list(sequence) or None,
                              max_clips=max_clips, workers=workers, backend=backend, address=address)
     seqs = [cut_sequence(s, part) for s in seqs]
