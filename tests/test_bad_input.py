@@ -844,3 +844,19 @@ def test_an_integer_column_given_fractions_is_refused_not_truncated():
     with pytest.raises(ValueError, match="Beacons.agent_id: 1.5 is not a whole number"):
         Beacons(agent_id=[1.5], t_sent=[0.0], t_received=[0.0], heading=[0.0])
     assert Detections(xywh=np.ones((2, 4)), label=[0.0, 1.0]).label.tolist() == [0, 1]  # whole floats are fine
+
+
+@pytest.mark.parametrize("command", [["bench", "ident"], ["bench", "shuffle"], ["bench", "recovery"],
+                                     ["bench", "pixels"], ["demo", "--quick", "-o", "{tmp}/out"]])
+def test_a_negative_seed_is_refused_naming_the_option(tmp_path, command):
+    r = runner.invoke(app, [a.format(tmp=tmp_path) for a in command] + ["--seed", "-1"])
+    assert r.exit_code == 2 and "Traceback" not in r.output and "--seed" in r.output, r.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_run_demo_refuses_a_negative_seed_before_writing(tmp_path):
+    from lookalike.demo import QUICK, run_demo
+
+    with pytest.raises(ValueError, match="seed: a whole number >= 0, got -1"):
+        run_demo(tmp_path / "out", -1, QUICK, "m3n2")
+    assert not (tmp_path / "out").exists()

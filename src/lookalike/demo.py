@@ -113,6 +113,8 @@ def run_demo(output: Path, seed: int, size: DemoSize, robot_preset: str, rerun: 
              step: Step = _silent, command: str = "") -> DemoResult:
     """Run the whole demo into ``output``. ``rerun``: an optional :class:`~lookalike.viz.rerun_log.RerunLogger` for
     the video scenes; ``command``: the command line recorded in the JSON files' header."""
+    if seed < 0:
+        raise ValueError(f"seed: a whole number >= 0, got {seed}")
     output.mkdir(parents=True, exist_ok=True)
     notes = {s: lstm_status(s) for s in PRESET_NAMES}
     video_tracker = "lstm" if notes[robot_preset] is None else "kalman_ha2"

@@ -101,7 +101,7 @@ def ident(
                                        help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(10, "--sequences", min=1, help="Test sequences per set-up."),
     frames: int = typer.Option(1000, "--frames", min=1, help="Frames per sequence."),
-    seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the test sequences."),
+    seed: int = typer.Option(DEFAULT_SEED, "--seed", min=0, help="Base seed of the test sequences."),
     json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
     noise: str = typer.Option("ours", "--noise",

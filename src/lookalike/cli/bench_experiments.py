@@ -33,7 +33,7 @@ def shuffle(
                                        help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(3, "--sequences", min=1, help="Test sequences per set-up."),
     frames: int = typer.Option(1000, "--frames", min=2, help="Frames per sequence."),
-    seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the test sequences."),
+    seed: int = typer.Option(DEFAULT_SEED, "--seed", min=0, help="Base seed of the test sequences."),
     json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON (results schema)."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
 ) -> None:
@@ -59,7 +59,7 @@ def recovery(
     frames: int = typer.Option(900, "--frames", min=300, help="Frames per sequence."),
     swap_at_s: float = typer.Option(5.0, "--swap-at-s", help="When the swap starts, seconds."),
     swap_s: float = typer.Option(10.0, "--swap-s", help="How long reports stay swapped, seconds."),
-    seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the test sequences."),
+    seed: int = typer.Option(DEFAULT_SEED, "--seed", min=0, help="Base seed of the test sequences."),
     json_path: Path | None = typer.Option(None, "--json", help="Also write the rows as JSON (results schema)."),
     csv_path: Path | None = typer.Option(None, "--csv", help="Also write the rows as CSV."),
 ) -> None:

@@ -24,7 +24,7 @@ def pixels(
                                           help="Identifiers (comma-separated or repeated)."),
     sequences: int = typer.Option(2, "--sequences", min=1, help="Held-out sequences per set-up."),
     frames: int = typer.Option(150, "--frames", min=1, help="Frames per sequence (30 Hz)."),
-    seed: int = typer.Option(DEFAULT_SEED, "--seed", help="Base seed of the held-out sequences."),
+    seed: int = typer.Option(DEFAULT_SEED, "--seed", min=0, help="Base seed of the held-out sequences."),
     detector_model: Path | None = typer.Option(None, "--detector-model", help="HOG cascade (`lookalike "
                                                "train-detector`); default: the shipped one."),
     heading_model: Path | None = typer.Option(None, "--heading-model", help="Heading classifier (`lookalike "

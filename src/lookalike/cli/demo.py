@@ -52,7 +52,7 @@ def _run(output: Path, seed: int, size: DemoSize, robot_preset: str, logger: obj
 @app.command()
 def demo(
     output: Path = typer.Option(Path("demo-out"), "-o", "--output", help="Folder for the results."),
-    seed: int = typer.Option(0, help="Seed of the simulated scenes."),
+    seed: int = typer.Option(0, min=0, help="Seed of the simulated scenes."),
     quick: bool = typer.Option(False, "--quick", help="A reduced run (seconds): fewer frames and scenarios."),
     robot_preset: str = typer.Option("m5n3", "--robot-preset",
                                      help=f"Robot set-up of the video: {', '.join(PRESET_NAMES)}."),
