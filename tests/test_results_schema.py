@@ -107,3 +107,32 @@ def test_bench_real_json(tmp_path):
           "--trackers", "sort", "--json", str(tmp_path / "b.json")])
     doc = _valid(tmp_path / "b.json")
     assert doc["header"]["sequences"] == 1 and doc["header"]["frames"] > 0
+
+
+def test_bench_ident_lengths_json_is_a_results_document(tmp_path):
+    _run(["bench", "ident", "--setups", "m3n2", "--trackers", "kalman_ha", "--sequences", "1", "--frames", "60",
+          "--lengths", "20,40", "--draws", "1", "--json", str(tmp_path / "t3.json")])
+    doc = _valid(tmp_path / "t3.json")
+    assert doc["header"]["kind"] == "bench ident" and doc["header"]["options"]["lengths"] == [20, 40]
+    (row,) = doc["tables"]["ident_lengths"]
+    assert row["dataset"] == "m3n2" and row["tracker"] == "kalman_ha"
+    assert set(row["metrics"]) == {"success_rate_20_frames", "success_rate_40_frames", "success_rate",
+                                   "localisation_error_m"}
+    assert 0 <= row["metrics"]["success_rate"] <= 1
+
+
+def test_bench_ident_lengths_json_on_recordings_with_a_human_row(tmp_path):
+    from lookalike.bench.table3 import HUMAN, table3_results
+    from lookalike.io.robot_sequences import write_robot_sequence
+    from lookalike.sim import preset, simulate_robots
+
+    write_robot_sequence(tmp_path / "m3n2-000001.jsonl", simulate_robots(preset("m3n2"), 50, 1))
+    rows = [{"Setup": tmp_path.name, "Tracker": "kalman_ha", "20 frames (%)": 80.0, "Total, 50 frames (%)": 75.5,
+             "Localisation error (m)": 0.2},
+            {"Setup": tmp_path.name, "Tracker": HUMAN, "20 frames (%)": "—", "Total, 50 frames (%)": 90.0,
+             "Localisation error (m)": "—"}]
+    doc = table3_results(rows, [], 1, 50, 0, "ours", [20], 1, recordings=tmp_path, command="lookalike bench ident")
+    data = _valid(doc.write(tmp_path / "t3.json"))
+    assert data["header"]["seeds"] == [] and data["header"]["sequences"] == 1 and data["header"]["frames"] == 50
+    assert [r["metrics"] for r in data["tables"]["ident_lengths"]] == [
+        {"success_rate_20_frames": 0.8, "success_rate": 0.755, "localisation_error_m": 0.2}, {"success_rate": 0.9}]

@@ -10,9 +10,10 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.bench.ident import build_identifier, run_labels, sequence_seeds
+from lookalike.bench.ident import build_identifier, run_labels, sequence_seeds, setup_results
 from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.eval import identification_success_rate, localisation_error
+from lookalike.io.results import Results, percent_row_metrics
 from lookalike.io.robot_sequences import read_robot_sequence
 from lookalike.sim import RobotSequence, preset, preset_label, simulate_robots
 from lookalike.viz.label.human import HumanResult, read_human_results
@@ -157,5 +158,32 @@ def table3_table(setups: Sequence[str], trackers: Sequence[str], sequences: int,
     return rows
 
 
+def _total_frames(row: dict[str, Any]) -> int:
+    """The frame count of a :func:`table3_table` row's ``Total, N frames (%)`` column."""
+    return next(int(k.split()[1]) for k in row if k.startswith("Total, "))
+
+
+def table3_results(rows: list[dict[str, Any]], setups: Sequence[str], sequences: int, frames: int, seed: int,
+                   noise: str, lengths: Sequence[int], draws: int, recordings: Path | None = None,
+                   command: str = "") -> Results:
+    """:func:`table3_table`'s rows as a results document (kind ``bench ident``): table ``ident_lengths`` with
+    ``success_rate_<n>_frames`` per window length, ``success_rate`` over the whole recordings (fractions) and
+    ``localisation_error_m``; the human row has no figure where it prints one of :data:`NO_VALUE`."""
+    options = {"lengths": list(lengths), "draws": draws, "seed": seed}
+    if recordings is None:
+        doc, names = setup_results("bench ident", setups, sequences, frames, seed, command, {"noise": noise, **options})
+    else:
+        names = {}
+        totals = {str(r["Setup"]): _total_frames(r) for r in rows}
+        doc = Results("bench ident", command=command, sequences=len(recording_files(recordings)),
+                      frames=sum(totals.values()), options={"recordings": str(recordings), **options})
+    for r in rows:
+        rename = {f"{n} frames (%)": f"success_rate_{n}_frames" for n in lengths}
+        rename.update({k: "success_rate" for k in r if k.startswith("Total, ")})
+        doc.add("ident_lengths", dataset=names.get(str(r["Setup"]), str(r["Setup"])), tracker=str(r["Tracker"]),
+                metrics=percent_row_metrics(r, skip=("Setup", "Tracker"), rename=rename))
+    return doc
+
+
 __all__ = ["DEFAULT_DRAWS", "DEFAULT_LENGTHS", "HUMAN", "NO_VALUE", "draw_windows", "human_row", "human_sessions",
-           "recording_files", "table3_rows", "table3_table"]
+           "recording_files", "table3_results", "table3_rows", "table3_table"]

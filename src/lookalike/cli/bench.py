@@ -157,7 +157,7 @@ def table3_command(setups: list[str], trackers: list[str], sequences: int, frame
                    csv_path: Path | None, human: Path | None = None) -> None:
     """``bench ident --lengths/--recordings/--human``: the paper's Table III per set-up (or on the recordings),
     with the human benchmark's sessions when there are result files."""
-    from lookalike.bench.table3 import DEFAULT_LENGTHS, table3_table
+    from lookalike.bench.table3 import DEFAULT_LENGTHS, table3_results, table3_table
 
     try:
         length_list = [int(v) for v in split_list([lengths])] if lengths else list(DEFAULT_LENGTHS)
@@ -171,7 +171,9 @@ def table3_command(setups: list[str], trackers: list[str], sequences: int, frame
                "length, then whole recordings)", rows)
     if sessions:
         print_rows("Human benchmark sessions (lookalike label --benchmark): the 'human' rows", sessions)
-    write_rows(rows, json_path, csv_path)
+    write_results(table3_results(rows, setups, sequences, frames, seed, noise, length_list, draws, recordings,
+                                 command_line()), json_path)
+    write_rows(rows, None, csv_path)
 
 
 __all__ = ["bench_app", "print_rows", "rich_table", "write_results"]
