@@ -274,3 +274,22 @@ def test_video_writer_gives_each_container_only_its_own_options(tmp_path, capfd,
     said = capfd.readouterr().err + "".join(r.getMessage() for r in caplog.records)  # PyAV warns through logging
     assert "options were not used" not in said
     assert source_frames(path)[1] == 4
+
+
+def test_divers_results_of_both_detection_levels_keep_each_level_apart(tmp_path):
+    from lookalike.bench.divers import diver_results
+    from lookalike.viz.results import load_results
+
+    def rows(idf1: float) -> list[dict]:
+        cells = {"Location": "pool", "DP": 90.0, "DR": 70.0, "IDF1": idf1, "IDP": 80.0, "IDR": 60.0, "IDSW": 1,
+                 "Frag": 2}
+        return [{"Scenario": s, "Tracker": "sort", **cells} for s in ("pool_pair", "ALL")]
+
+    path = diver_results({"sim": rows(50.0), "paper": rows(20.0)}, 30, 0, "lookalike bench divers").write(
+        tmp_path / "d.json")
+    kind, table = load_results(path)
+    assert kind == "divers"
+    assert [(r["Scenario"], r["IDF1"]) for r in table] == [
+        ("pool_pair (sim)", 50.0), ("ALL (sim)", 50.0), ("pool_pair (paper)", 20.0), ("ALL (paper)", 20.0)]
+    one = diver_results({"sim": rows(50.0)}, 30, 0, "lookalike bench divers").write(tmp_path / "one.json")
+    assert [r["Scenario"] for r in load_results(one)[1]] == ["pool_pair", "ALL"]

@@ -30,9 +30,13 @@ def _from_schema(path: Path, data: dict[str, Any]) -> tuple[str, list[dict[str, 
                           "Frames/s": r["metrics"].get("frames_per_s")} for r in tables["ident"]]
     if tables.get("divers"):
         rows = []
+        levels = len({r["dataset"] for r in tables["divers"]}) > 1  # `bench divers --detections both`
         for r in tables["divers"]:
             m = r["metrics"]
-            row: dict[str, Any] = {"Scenario": "ALL" if r["combined"] else r["sequence"], "Tracker": r["tracker"]}
+            scenario = "ALL" if r["combined"] else r["sequence"]
+            if levels:  # one bar and row per detection level, not the last level's over the first's
+                scenario = f"{scenario} ({str(r['dataset']).removeprefix('divers-')})"
+            row: dict[str, Any] = {"Scenario": scenario, "Tracker": r["tracker"]}
             row.update({k.upper(): _percent(m, k) for k in ("idf1", "hota", "mota", "idp", "idr") if k in m})
             row.update({k.upper(): m[k] for k in ("idsw",) if k in m})
             rows.append(row)
