@@ -64,6 +64,11 @@ def test_trackers_listing():
     assert r.exit_code == 2 and "registered:" in r.output
 
 
+def test_trackers_names_with_details_is_refused_not_half_ignored():
+    r = runner.invoke(app, ["trackers", "--names", "--details", "sort"])
+    assert r.exit_code == 2 and r.output.startswith("error: --names and --details sort: give one"), r.output
+
+
 def test_demo_runs(tmp_path):
     r = runner.invoke(app, ["demo", "--quick", "-o", str(tmp_path / "demo")])
     assert r.exit_code == 0, r.output

@@ -54,6 +54,9 @@ def trackers(
 ) -> None:
     """List the registered trackers, one line each (what each reads, what it is); --details NAME gives one
     tracker's parameters."""
+    if names and details is not None:
+        fail(f"--names and --details {details}: give one (--names lists every name, --details one tracker's "
+             "parameters)")
     if names:  # the names alone: no tracker module is imported
         typer.echo("\n".join(tracker_names()))
         return
