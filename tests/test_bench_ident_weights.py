@@ -39,3 +39,17 @@ def test_cli_weights_errors_are_one_line(tmp_path):
     res = runner.invoke(app, ["bench", "ident", "--setups", "m3n2", "--trackers", "lstm", "--sequences", "1",
                               "--frames", "5", "--weights", str(weights.shipped_weights_path(3, 5))])
     assert res.exit_code == 2 and "n_agents" in res.output
+
+
+def test_weights_no_row_uses_are_refused_not_ignored(tmp_path):
+    from lookalike.bench.ident import check_weights
+
+    model = str(weights.shipped_weights_path(2, 3))
+    res = CliRunner().invoke(app, ["bench", "ident", "--setups", "m3n2", "--trackers", "kalman_ha,lstm-paper",
+                                   "--sequences", "1", "--frames", "5", "--weights", model])
+    assert res.exit_code == 2 and res.output.startswith("error: weights:"), res.output
+    assert "for the lstm and lstm-lowpass rows; none of kalman_ha, lstm-paper uses them" in res.output
+    with pytest.raises(ValueError, match="none of jpda uses them"):  # bench pixels' check too
+        check_weights(model, ["m3n2"], ["jpda"])
+    check_weights(model, ["m3n2"], ["jpda", "lstm-lowpass"])
+    check_weights(None, ["m3n2", "m5n3"], ["jpda"])

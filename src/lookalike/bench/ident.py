@@ -37,6 +37,18 @@ def uses_weights(name: str) -> bool:
     return base == "lstm" and extra.get("protocol", "ours") == "ours"
 
 
+def check_weights(weights: str | None, setups: Sequence[str], trackers: Sequence[str]) -> None:
+    """Refuse exported LSTM ``weights`` for more than one set-up, or when no identifier of ``trackers`` uses them
+    (:func:`uses_weights`): they would be ignored."""
+    if not weights:
+        return
+    if len(setups) != 1:
+        raise ValueError(f"weights: {weights} are for one set-up; got {len(setups)} set-ups")
+    if not any(uses_weights(t) for t in trackers):
+        raise ValueError(f"weights: {weights} are for the lstm and lstm-lowpass rows; none of {', '.join(trackers)} "
+                         "uses them")
+
+
 def weights_missing(name: str, n_agents: int, n_slots: int, weights: str | None = None) -> bool:
     """Whether identifier ``name`` needs shipped LSTM weights for N, M and none ship (``weights`` given: never)."""
     base, extra = resolve_identifier(name)
@@ -148,8 +160,7 @@ def ident_runs(setups: list[str], trackers: list[str], sequences: int, frames: i
                seed: int = DEFAULT_SEED, noise: str = DEFAULT_NOISE, progress: ProgressFactory = no_progress,
                weights: str | None = None) -> tuple[list[dict[str, Any]], SequenceCounts]:
     """:func:`ident_table`'s rows and per (set-up, identifier) that ran, per-sequence (correct labels, detections)."""
-    if weights and len(setups) != 1:
-        raise ValueError(f"weights: {weights} are for one set-up; got {len(setups)} set-ups")
+    check_weights(weights, setups, trackers)
     rows = []
     counts: SequenceCounts = {}
     step = progress("bench ident", len(setups) * len(trackers) * sequences)
@@ -195,6 +206,6 @@ def ident_results(rows: list[dict[str, Any]], setups: list[str], sequences: int,
 
 
 __all__ = ["DEFAULT_SEED", "IDENT_COLUMNS", "IDENT_TRACKERS", "NOT_TRAINED", "SequenceCounts", "build_identifier",
-           "ident_differences", "ident_results", "ident_runs", "ident_table", "identify", "run_identifier",
-           "run_identifier_by_sequence", "run_labels", "sequence_seeds", "setup_results", "uses_weights",
-           "weights_missing"]
+           "check_weights", "ident_differences", "ident_results", "ident_runs", "ident_table", "identify",
+           "run_identifier", "run_identifier_by_sequence", "run_labels", "sequence_seeds", "setup_results",
+           "uses_weights", "weights_missing"]

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.bench.ident import run_labels, sequence_seeds, setup_results, uses_weights
+from lookalike.bench.ident import check_weights, run_labels, sequence_seeds, setup_results, uses_weights
 from lookalike.bench.progress import ProgressFactory
 from lookalike.eval import identification_success_rate, localisation_error, robot_success_rate
 from lookalike.geometry.boxes import iou_matrix
@@ -185,8 +185,7 @@ def pixels_table(setups: list[str], identifiers: list[str], sequences: int, fram
                  ) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     """Rows of the identification (:data:`PIXEL_COLUMNS`) and perception (:data:`PERCEPTION_COLUMNS`) tables;
     ``weights``: exported LSTM .npz for the ``lstm`` rows on both sides (one set-up only)."""
-    if weights and len(setups) != 1:
-        raise ValueError(f"weights: {weights} are for one set-up; got {len(setups)} set-ups")
+    check_weights(weights, setups, identifiers)
     rows, perception = [], []
     for setup in setups:
         cfg = world_for_camera(preset(setup), camera)
