@@ -103,3 +103,16 @@ def test_matched_thresholds_of_a_model_with_tiny_distances_are_not_zero(monkeypa
         found = divers_run.matched_thresholds(extractor, tracker)  # type: ignore[arg-type]
         assert found and all(0 < v < 1e-4 for v in found.values()), found
         make_tracker(tracker, **found)
+
+
+def test_cli_scenarios_and_trackers_take_comma_separated_lists_as_the_other_benches(tmp_path):
+    runner = CliRunner()
+    out = tmp_path / "d.json"
+    r = runner.invoke(app, ["bench", "divers", "--scenarios", "pool_pair,ocean_pair_clear", "--frames", "10",
+                            "--trackers", "sort", "--json", str(out)])
+    assert r.exit_code == 0, r.output
+    rows = json.loads(out.read_text())["tables"]["divers"]
+    assert {(r["sequence"], r["tracker"]) for r in rows if not r["combined"]} == {
+        ("pool_pair", "sort"), ("ocean_pair_clear", "sort")}
+    r = runner.invoke(app, ["bench", "divers", "--tracker", ",", "--frames", "10"])
+    assert r.exit_code == 2 and "--trackers: no name given" in r.output, r.output

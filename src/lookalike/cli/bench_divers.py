@@ -11,19 +11,20 @@ from rich.table import Column, Table
 
 from lookalike.bench.divers import COLUMNS, TRACKERS, bar_chart, diver_results, diver_table, pearson
 from lookalike.bench.tables import write_rows
-from lookalike.cli.app import check_outputs_or_fail, command_line, console, fail, failing
+from lookalike.cli.app import check_outputs_or_fail, command_line, console, fail, failing, split_list
 from lookalike.cli.bench import bench_app, write_results
 from lookalike.sim.divers_paper import DETECTION_LEVELS
 
 GROUPED = ("Scenario", "Location", "DP", "DR")  # printed once per scenario
-ENTRY_HELP = f"Entry (repeatable): {', '.join(TRACKERS)}."
+ENTRY_HELP = f"Entries (comma-separated or repeated): {', '.join(TRACKERS)}."
 
 
 @bench_app.command("divers")
 def divers(
-    scenario_names: list[str] | None = typer.Option(None, "--scenario", help="Scenario name (repeatable)."),
+    scenario_names: list[str] | None = typer.Option(None, "--scenario", "--scenarios",
+                                                    help="Scenario names (comma-separated or repeated)."),
     frames: int | None = typer.Option(None, min=10, help="Shorten every scenario to this many frames."),
-    trackers: list[str] | None = typer.Option(None, "--tracker", help=ENTRY_HELP),
+    trackers: list[str] | None = typer.Option(None, "--trackers", "--tracker", help=ENTRY_HELP),
     features: list[str] | None = typer.Option(None, "--features", help="Feature set (repeatable): handcrafted, "
                                               "learned or FILE.onnx; deep SORT and diver SORT run with each "
                                               "(default: handcrafted and learned, the entries above)."),
@@ -39,8 +40,12 @@ def divers(
     levels = list(DETECTION_LEVELS) if detections == "both" else [detections]
     if detections != "both" and detections not in DETECTION_LEVELS:
         fail(f"--detections: choose one of {', '.join(DETECTION_LEVELS)} or both, got {detections!r}")
+    scenario_list, entries = split_list(scenario_names), split_list(trackers)
+    for option, given, names in (("--scenario", scenario_names, scenario_list), ("--trackers", trackers, entries)):
+        if given and not names:
+            fail(f"{option}: no name given (leave the option out for every one)")
     with failing(ValueError, FileNotFoundError):
-        tables = {level: diver_table(scenario_names, tuple(trackers) if trackers else None, frames=frames,
+        tables = {level: diver_table(scenario_list or None, tuple(entries) or None, frames=frames,
                                      detections=level, seed=seed,
                                      features=tuple(features) if features else ("handcrafted", "learned"))
                   for level in levels}
