@@ -116,3 +116,9 @@ def test_cli_scenarios_and_trackers_take_comma_separated_lists_as_the_other_benc
         ("pool_pair", "sort"), ("ocean_pair_clear", "sort")}
     r = runner.invoke(app, ["bench", "divers", "--tracker", ",", "--frames", "10"])
     assert r.exit_code == 2 and "--trackers: no name given" in r.output, r.output
+
+
+def test_cli_frames_help_says_what_the_option_does_beyond_300_frames():
+    r = CliRunner().invoke(app, ["bench", "divers", "--help"], env={"COLUMNS": "200"})
+    assert {sc.frames for sc in SCENARIOS} == {300}
+    assert "each scenario's 300; fewer cuts it short, more draws it longer" in " ".join(r.output.split())

@@ -23,7 +23,8 @@ ENTRY_HELP = f"Entries (comma-separated or repeated): {', '.join(TRACKERS)}."
 def divers(
     scenario_names: list[str] | None = typer.Option(None, "--scenario", "--scenarios",
                                                     help="Scenario names (comma-separated or repeated)."),
-    frames: int | None = typer.Option(None, min=10, help="Shorten every scenario to this many frames."),
+    frames: int | None = typer.Option(None, min=10, help="Frames per scenario (default: each scenario's 300; fewer "
+                                      "cuts it short, more draws it longer)."),
     trackers: list[str] | None = typer.Option(None, "--trackers", "--tracker", help=ENTRY_HELP),
     features: list[str] | None = typer.Option(None, "--features", help="Feature set (repeatable): handcrafted, "
                                               "learned or FILE.onnx; deep SORT and diver SORT run with each "
