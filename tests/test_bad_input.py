@@ -459,6 +459,7 @@ def test_no_combination_of_output_paths_modifies_an_input(tmp_path, command, fir
     (["bench", "shuffle", "--setups", " , "], ["--setups: no team given"]),
     (["bench", "recovery", "--trackers", ","], ["--trackers: no identifier given"]),
     (["bench", "real", "--trackers", ",", "--peers", "none"], ["nothing to run", "--trackers"]),
+    (["bench", "real", "--address", "10.0.0.1:6379"], ["--address 10.0.0.1:6379", "for --backend ray"]),
     (["serve", "--burst", "0.5", "--duration", "0.1"], ["--burst", "0.5"]),
     (["train", "--steps", "-5", "-o", "{tmp}/run"], ["--steps", "-5"]),
     (["train", "--minutes", "0", "-o", "{tmp}/run"], ["--minutes"]),

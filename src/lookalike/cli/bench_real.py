@@ -84,6 +84,8 @@ def real(
     tracker_list, peer_list = split_list(trackers), [p for p in split_list(peers) if p != "none"]
     check_choice("--part", part, PARTS)
     check_choice("--backend", backend, BACKENDS)
+    if address is not None and backend != "ray":
+        fail(f"--address {address}: a Ray cluster address is for --backend ray (got --backend {backend})")
     for t in tracker_list:
         if t not in BOX_TRACKERS:
             fail(f"--trackers: {t!r} is not a box tracker; choose from {', '.join(BOX_TRACKERS)}")
