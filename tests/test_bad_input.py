@@ -459,6 +459,8 @@ def test_no_combination_of_output_paths_modifies_an_input(tmp_path, command, fir
     (["bench", "shuffle", "--setups", " , "], ["--setups: no team given"]),
     (["bench", "recovery", "--trackers", ","], ["--trackers: no identifier given"]),
     (["bench", "real", "--trackers", ",", "--peers", "none"], ["nothing to run", "--trackers"]),
+    (["bench", "ident", "--lengths", ",", "--setups", "m3n2", "--trackers", "kalman_ha", "--sequences", "1",
+      "--frames", "30"], ["--lengths: no frame count given (e.g. 200,400,800)"]),
     (["bench", "real", "--address", "10.0.0.1:6379"], ["--address 10.0.0.1:6379", "for --backend ray"]),
     (["serve", "--burst", "0.5", "--duration", "0.1"], ["--burst", "0.5"]),
     (["train", "--steps", "-5", "-o", "{tmp}/run"], ["--steps", "-5"]),

@@ -163,6 +163,8 @@ def table3_command(setups: list[str], trackers: list[str], sequences: int, frame
         length_list = [int(v) for v in split_list([lengths])] if lengths else list(DEFAULT_LENGTHS)
     except ValueError:
         fail(f"--lengths: expected comma-separated frame counts, got {lengths!r}")
+    if not length_list:
+        fail(f"--lengths: no frame count given (e.g. {','.join(map(str, DEFAULT_LENGTHS))})")
     sessions: list[dict[str, Any]] = []
     with failing(ValueError, FileNotFoundError), progress_bars() as progress:
         rows = table3_table(setups, trackers, sequences, frames, seed, noise, length_list, draws, recordings,
