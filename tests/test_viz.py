@@ -293,3 +293,29 @@ def test_divers_results_of_both_detection_levels_keep_each_level_apart(tmp_path)
         ("pool_pair (sim)", 50.0), ("ALL (sim)", 50.0), ("pool_pair (paper)", 20.0), ("ALL (paper)", 20.0)]
     one = diver_results({"sim": rows(50.0)}, 30, 0, "lookalike bench divers").write(tmp_path / "one.json")
     assert [r["Scenario"] for r in load_results(one)[1]] == ["pool_pair", "ALL"]
+
+
+def test_report_shows_the_tables_of_any_bench_results_file(tmp_path):
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+    from lookalike.io.results import Results
+    from lookalike.viz.results import load_results
+
+    doc = Results("bench real", command="lookalike bench real")
+    doc.add("datasets", dataset="mot15", tracker="sort", combined=True,
+            metrics={"hota": 0.4526, "mota": -0.125, "idsw": 6, "frames_per_s": 651.8})
+    doc.add("sequences", dataset="mot15", sequence="TUD-Campus", tracker="sort", metrics={"idf1": 0.6065})
+    doc.add("ranking", dataset=None, tracker="sort", combined=True, metrics={"rank": 1, "mean_rank": None})
+    path = doc.write(tmp_path / "real.json")
+    kind, rows = load_results(path)
+    assert kind == "tables"
+    assert rows[0] == {"Table": "datasets", "Dataset": "mot15", "Tracker": "sort", "hota (%)": 45.26,
+                       "mota (%)": -12.5, "idsw": 6, "frames_per_s": 651.8}
+    assert rows[1]["Sequence"] == "TUD-Campus" and rows[2] == {"Table": "ranking", "Dataset": "all", "Tracker": "sort",
+                                                               "rank": 1, "mean_rank": ""}
+    r = CliRunner().invoke(app, ["report", str(path), "-o", str(tmp_path / "r.html")])
+    assert r.exit_code == 0, r.output
+    html = (tmp_path / "r.html").read_text()
+    assert all(f"<h2>real.json: {t}</h2>" in html for t in ("datasets", "sequences", "ranking"))
+    assert "<th>hota (%)</th>" in html and ">45.26<" in html

@@ -14,9 +14,9 @@ from lookalike.viz.results import add_results, load_results
 
 @app.command()
 def report(
-    results: list[Path] = typer.Argument(..., help="JSON files from `lookalike eval --json`, `bench ident --json`, "
-                                                   "`bench divers --json` (or the demo's "
-                                                   "robots-ident.json/divers.json)."),
+    results: list[Path] = typer.Argument(..., help="JSON files from `lookalike eval --json` or any `bench ... "
+                                                   "--json` (or the demo's robots-ident.json/divers.json); charts "
+                                                   "for eval, bench ident and bench divers."),
     output: Path = typer.Option(Path("report.html"), "-o", "--output", help="HTML file to write."),
     title: str = typer.Option("lookalike results", help="Title of the report."),
 ) -> None:

@@ -1,5 +1,6 @@
-"""``eval``/``bench`` JSON outputs (results documents with a table ``ident``, ``divers`` or ``scores``, or the older
-row lists and ``{tracker: {sequence: {metric: fraction}}}``) as tables and charts (in %) of an :class:`HtmlReport`."""
+"""``eval``/``bench`` JSON outputs (results documents with a table ``ident``, ``divers`` or ``scores``, any other
+results document's tables, or the older row lists and ``{tracker: {sequence: {metric: fraction}}}``) as tables and
+charts (in %) of an :class:`HtmlReport`."""
 
 from __future__ import annotations
 
@@ -7,12 +8,13 @@ import json
 from pathlib import Path
 from typing import Any
 
-from lookalike.io.results import SCHEMA_ID
+from lookalike.io.results import SCHEMA_ID, is_fraction
 from lookalike.io.rules import read_text
 from lookalike.viz.plots import grouped_bar_chart
 from lookalike.viz.report import HtmlReport
 
 EVAL_COLUMNS = ("IDF1", "HOTA", "MOTA", "IDSW")
+SIGNED_FRACTIONS = ("mota", "moda", "gap")  # fractions that may be negative, shown in % too
 
 
 def _percent(metrics: dict[str, Any], key: str) -> float | None:
@@ -51,11 +53,34 @@ def _from_schema(path: Path, data: dict[str, Any]) -> tuple[str, list[dict[str, 
                 row["IDSW"] = m["idsw"]
             out.append(row)
         return "eval", out
-    raise ValueError(f"results: {path} has none of the tables ident, divers, scores (see `lookalike report --help`)")
+    rows = _any_tables(tables)
+    if rows:
+        return "tables", rows
+    raise ValueError(f"results: {path} has no table rows (see `lookalike report --help`)")
+
+
+def _any_tables(tables: dict[str, Any]) -> list[dict[str, Any]]:
+    """The rows of any other bench's tables (``bench real``, ``pixels``, ``shuffle``, ``recovery``, ``ident
+    --lengths``): table, data set, sequence (where one is named), tracker and every metric, fractions in %."""
+    rows = []
+    for name, table in tables.items():
+        named = any(r["sequence"] is not None for r in table)
+        for r in table:
+            row: dict[str, Any] = {"Table": name, "Dataset": r["dataset"] or "all"}
+            if named:
+                row["Sequence"] = r["sequence"] or "all"
+            row["Tracker"] = r["tracker"]
+            for key, value in r["metrics"].items():
+                percent = is_fraction(key) or key in SIGNED_FRACTIONS
+                row[f"{key} (%)" if percent else key] = (
+                    "" if value is None else round(100 * float(value), 2) if percent else value)
+            rows.append(row)
+    return rows
 
 
 def load_results(path: Path | str) -> tuple[str, list[dict[str, Any]]]:
-    """``(kind, rows)`` of a results file; kind is ``"ident"``, ``"divers"`` or ``"eval"``."""
+    """``(kind, rows)`` of a results file; kind is ``"ident"``, ``"divers"``, ``"eval"`` or ``"tables"`` (any other
+    results document: one table per ``Table``, no chart)."""
     p = Path(path)
     if not p.is_file():
         raise ValueError(f"results: {'a folder, not a file:' if p.is_dir() else 'no such file'} {p}")
@@ -121,6 +146,12 @@ def add_results(report: HtmlReport, kind: str, rows: list[dict[str, Any]], chart
         chart = grouped_bar_chart(charts_dir / f"{stem}.png", rows, "Sequence", "Tracker", metric,
                                   ylabel=f"{metric} (%)", ylim=None, title=f"{metric} per sequence")
         report.image(chart, f"{metric} (%) per sequence and tracker")
+    elif kind == "tables":
+        for name in dict.fromkeys(r["Table"] for r in rows):
+            report.heading(f"{title}: {name}" if title else name)
+            mine = [{k: v for k, v in r.items() if k != "Table"} for r in rows if r["Table"] == name]
+            report.table(mine, list(dict.fromkeys(k for r in mine for k in r)))
+        return []
     else:
-        raise ValueError(f"kind: unknown results kind {kind!r}; known: ident, divers, eval")
+        raise ValueError(f"kind: unknown results kind {kind!r}; known: ident, divers, eval, tables")
     return [chart]
