@@ -32,3 +32,21 @@ def test_heuristics_and_jpda_beat_kalman_ha():
     rate = {r["Tracker"]: r["Success rate (%)"] for r in rows}
     assert rate["kalman_ha2"] > rate["kalman_ha"] + 3
     assert rate["jpda"] > rate["kalman_ha"] + 3
+
+
+def test_a_name_given_twice_runs_and_counts_once(tmp_path):
+    import json
+
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+    from lookalike.cli.app import split_list
+
+    assert split_list(["mot15,pigs", " mot15", "pigs,,"]) == ["mot15", "pigs"]
+    out = tmp_path / "i.json"
+    r = CliRunner().invoke(app, ["bench", "ident", "--setups", "m3n2,m3n2", "--trackers", "kalman_ha",
+                                 "--trackers", "kalman_ha", "--sequences", "1", "--frames", "20", "--json", str(out)])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(out.read_text())
+    assert [(row["dataset"], row["tracker"]) for row in doc["tables"]["ident"]] == [("m3n2", "kalman_ha")]
+    assert doc["header"]["seeds"] == [900000] and doc["header"]["sequences"] == 1

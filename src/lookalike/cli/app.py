@@ -184,8 +184,9 @@ def sequence_files(path: Path) -> list[Path]:
 
 
 def split_list(values: list[str] | None) -> list[str]:
-    """Option values given repeated and/or comma-separated, as one list (blanks dropped)."""
-    return [v.strip() for item in values or [] for v in item.split(",") if v.strip()]
+    """Option values given repeated and/or comma-separated, as one list (blanks and repeats dropped: a data set,
+    set-up or tracker named twice would run and count twice)."""
+    return list(dict.fromkeys(v.strip() for item in values or [] for v in item.split(",") if v.strip()))
 
 
 def command_line() -> str:
