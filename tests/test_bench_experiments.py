@@ -195,3 +195,23 @@ def test_recovery_rows_give_the_recovery_where_the_reports_tell_the_pair_apart(m
     monkeypatch.setattr(experiments, "restore_gap", lambda q, *a: float("nan"))  # a pair member silent: not apart
     row = experiments.recovery_runs(["m3n2"], ["perfect"], 2, 300, 2.0, 3.0)[0][0]
     assert row[count] == 0 and np.isnan(row[key])
+
+
+def test_a_csv_that_cannot_be_written_at_the_end_is_one_line_and_keeps_the_json(tmp_path, monkeypatch):
+    import errno
+    from contextlib import contextmanager
+
+    import lookalike.bench.tables as tables
+
+    @contextmanager
+    def disk_full(path):
+        raise OSError(errno.ENOSPC, "No space left on device")
+        yield path
+
+    monkeypatch.setattr(tables, "atomic_path", disk_full)
+    out, csv = tmp_path / "s.json", tmp_path / "s.csv"
+    r = CliRunner().invoke(app, ["bench", "shuffle", "--setups", "m3n2", "--trackers", "kalman_ha2", "--sequences",
+                                 "1", "--frames", "20", "--json", str(out), "--csv", str(csv)])
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert r.output.strip().splitlines()[-1] == f"error: --csv: cannot write {csv}: No space left on device"
+    assert json.loads(out.read_text())["tables"]["shuffle"] and not csv.exists()

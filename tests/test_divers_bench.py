@@ -122,3 +122,20 @@ def test_cli_frames_help_says_what_the_option_does_beyond_300_frames():
     r = CliRunner().invoke(app, ["bench", "divers", "--help"], env={"COLUMNS": "200"})
     assert {sc.frames for sc in SCENARIOS} == {300}
     assert "each scenario's 300; fewer cuts it short, more draws it longer" in " ".join(r.output.split())
+
+
+def test_cli_png_that_cannot_be_written_is_one_line(tmp_path, monkeypatch):
+    import errno
+
+    import lookalike.cli.bench_divers as cli_divers
+
+    def disk_full(rows, path):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(cli_divers, "bar_chart", disk_full)
+    png = tmp_path / "idf1.png"
+    r = CliRunner().invoke(app, ["bench", "divers", "--scenario", "pool_pair", "--frames", "10", "--trackers", "sort",
+                                 "--png", str(png), "--json", str(tmp_path / "d.json")])
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert r.output.strip().splitlines()[-1] == f"error: --png: cannot write {png}: No space left on device"
+    assert (tmp_path / "d.json").is_file()

@@ -94,6 +94,17 @@ def write_results(doc: Results, path: Path | None) -> None:
         fail(f"--json: cannot write {path}: {exc.strerror or exc}")
 
 
+def write_csv(rows: list[dict[str, Any]], path: Path | None, columns: Sequence[str] | None = None) -> None:
+    """Write table rows as CSV to ``path`` (if given); a one-line error when it cannot be written (the tables are
+    printed and any --json written by then)."""
+    if path is None:
+        return
+    try:
+        write_rows(rows, None, path, columns)
+    except OSError as exc:
+        fail(f"--csv: cannot write {path}: {exc.strerror or exc}")
+
+
 @bench_app.command("ident")
 def ident(
     setups: list[str] = typer.Option(list(PRESET_NAMES), "--setups", help=SETUPS_HELP),
@@ -149,7 +160,7 @@ def ident(
     print_differences(differences, tracker_list[0], "points")
     write_results(ident_results(rows, setup_list, sequences, frames, seed, command_line(), noise,
                                 str(weights) if weights else None, differences), json_path)
-    write_rows(rows, None, csv_path)
+    write_csv(rows, csv_path)
 
 
 def table3_command(setups: list[str], trackers: list[str], sequences: int, frames: int, seed: int, noise: str,
@@ -175,7 +186,7 @@ def table3_command(setups: list[str], trackers: list[str], sequences: int, frame
         print_rows("Human benchmark sessions (lookalike label --benchmark): the 'human' rows", sessions)
     write_results(table3_results(rows, setups, sequences, frames, seed, noise, length_list, draws, recordings,
                                  command_line()), json_path)
-    write_rows(rows, None, csv_path)
+    write_csv(rows, csv_path)
 
 
-__all__ = ["bench_app", "print_rows", "rich_table", "write_results"]
+__all__ = ["bench_app", "print_rows", "rich_table", "write_csv", "write_results"]

@@ -10,9 +10,8 @@ from rich.console import Console
 from rich.table import Column, Table
 
 from lookalike.bench.divers import COLUMNS, TRACKERS, bar_chart, diver_results, diver_table, pearson
-from lookalike.bench.tables import write_rows
 from lookalike.cli.app import check_outputs_or_fail, command_line, console, fail, failing, split_list
-from lookalike.cli.bench import bench_app, write_results
+from lookalike.cli.bench import bench_app, write_csv, write_results
 from lookalike.sim.divers_paper import DETECTION_LEVELS
 
 GROUPED = ("Scenario", "Location", "DP", "DR")  # printed once per scenario
@@ -62,6 +61,10 @@ def divers(
     frames_run = frames or 300
     write_results(diver_results(tables, frames_run, seed, command_line()), json_path)
     all_rows = [{"Detections": level, **r} for level, rows in tables.items() for r in rows]
-    write_rows(all_rows, None, csv_path, ("Detections", *COLUMNS))
+    write_csv(all_rows, csv_path, ("Detections", *COLUMNS))
     if png:
-        console.print(f"bar chart → {bar_chart(tables[levels[-1]], png)}", markup=False)
+        try:
+            chart = bar_chart(tables[levels[-1]], png)
+        except OSError as exc:
+            fail(f"--png: cannot write {png}: {exc.strerror or exc}")
+        console.print(f"bar chart → {chart}", markup=False)

@@ -15,9 +15,16 @@ from lookalike.bench.experiments import (
     shuffle_rows,
 )
 from lookalike.bench.ident_paper import IDENT_VARIANTS
-from lookalike.bench.tables import write_rows
 from lookalike.cli.app import check_names, check_outputs_or_fail, check_teams, command_line, fail, failing, split_list
-from lookalike.cli.bench import SETUPS_HELP, bench_app, print_differences, print_rows, trained_only, write_results
+from lookalike.cli.bench import (
+    SETUPS_HELP,
+    bench_app,
+    print_differences,
+    print_rows,
+    trained_only,
+    write_csv,
+    write_results,
+)
 from lookalike.cli.progress import progress_bars
 from lookalike.io.needs import identifier_names
 from lookalike.sim import PRESET_NAMES
@@ -47,7 +54,7 @@ def shuffle(
     print_rows("Control: frames in random order", rows)
     write_results(experiment_results("shuffle", rows, setup_list, sequences, frames, seed, command_line()),
                   json_path)
-    write_rows(rows, None, csv_path)
+    write_csv(rows, csv_path)
 
 
 @bench_app.command("recovery")
@@ -77,7 +84,7 @@ def recovery(
     options = {"swap_at_s": swap_at_s, "swap_s": swap_s}
     write_results(experiment_results("recovery", rows, setup_list, sequences, frames, seed, command_line(),
                                      options, differences), json_path)
-    write_rows(rows, None, csv_path)
+    write_csv(rows, csv_path)
 
 
 def _check_setups_and_trackers(setups: list[str], trackers: list[str]) -> None:

@@ -8,9 +8,8 @@ from pathlib import Path
 import typer
 
 from lookalike.bench.pixels import DEFAULT_SEED, PERCEPTION_COLUMNS, PIXEL_COLUMNS, pixels_results, pixels_table
-from lookalike.bench.tables import write_rows
 from lookalike.cli.app import check_names, check_outputs_or_fail, check_teams, command_line, fail, failing, split_list
-from lookalike.cli.bench import SETUPS_HELP, bench_app, print_rows, trained_only, write_results
+from lookalike.cli.bench import SETUPS_HELP, bench_app, print_rows, trained_only, write_csv, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.parallel import one_blas_thread
 from lookalike.sim.robot_camera import pixel_camera
@@ -60,4 +59,4 @@ def pixels(
                "heading_model": heading_model, **({"weights": weights} if weights else {})}
     write_results(pixels_results(rows, perception, setup_list, sequences, frames, seed, command_line(), options),
                   json_path)
-    write_rows(rows, None, csv_path)
+    write_csv(rows, csv_path)

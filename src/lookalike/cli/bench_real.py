@@ -15,9 +15,8 @@ from lookalike.bench.datasets import DATASETS, PARTS, cut_sequence, load_dataset
 from lookalike.bench.leaderboard import COLUMNS, leaderboard, leaderboard_results, plot_leaderboard, run_with_progress
 from lookalike.bench.peers import PEERS, peer_status
 from lookalike.bench.runner import default_entries, params_entry
-from lookalike.bench.tables import write_rows
 from lookalike.cli.app import check_choice, check_outputs_or_fail, command_line, console, fail, failing, split_list
-from lookalike.cli.bench import bench_app, write_results
+from lookalike.cli.bench import bench_app, write_csv, write_results
 from lookalike.cli.progress import progress_bars
 from lookalike.parallel import BACKENDS
 from lookalike.tune.params_file import load_params, read_params
@@ -121,9 +120,13 @@ def real(
     if json_path is not None:
         write_results(leaderboard_results(part, rows, combined, per_seq, status, seqs, command_line(),
                                           {"datasets": split_list(datasets), "workers": workers}), json_path)
-    write_rows(rows, None, csv_path, [*COLUMNS, "Error"])
+    write_csv(rows, csv_path, [*COLUMNS, "Error"])
     if plots is not None:
-        for p in plot_leaderboard([r for r in rows if "Error" not in r], plots):
+        try:
+            written = plot_leaderboard([r for r in rows if "Error" not in r], plots)
+        except OSError as exc:
+            fail(f"--plots: cannot write into {plots}: {exc.strerror or exc}")
+        for p in written:
             console.print(f"plot: {p}", markup=False)
 
 
