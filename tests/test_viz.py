@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -319,3 +321,59 @@ def test_report_shows_the_tables_of_any_bench_results_file(tmp_path):
     html = (tmp_path / "r.html").read_text()
     assert all(f"<h2>real.json: {t}</h2>" in html for t in ("datasets", "sequences", "ranking"))
     assert "<th>hota (%)</th>" in html and ">45.26<" in html
+
+
+def test_an_atomic_video_interrupted_keeps_the_earlier_one_and_leaves_no_temporary(tmp_path):
+    from lookalike.viz.video import VideoWriter
+
+    mp4, gif = tmp_path / "robots.mp4", tmp_path / "robots.gif"
+    mp4.write_bytes(b"earlier video")
+    gif.write_bytes(b"earlier gif")
+    frame = np.full((32, 48, 3), 200, np.uint8)
+    with pytest.raises(KeyboardInterrupt):
+        with VideoWriter(mp4, fps=10, gif=gif, atomic=True) as video:
+            video.write(frame)
+            video.write(frame)
+            raise KeyboardInterrupt
+    assert mp4.read_bytes() == b"earlier video" and gif.read_bytes() == b"earlier gif"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["robots.gif", "robots.mp4"]
+    with VideoWriter(mp4, fps=10, gif=gif, atomic=True) as video:
+        video.write(frame)
+    assert mp4.read_bytes() != b"earlier video" and gif.read_bytes()[:3] == b"GIF"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["robots.gif", "robots.mp4"]
+
+
+def test_a_gif_interrupted_while_saved_keeps_the_earlier_one(tmp_path, monkeypatch):
+    from PIL import Image
+
+    from lookalike.viz.video import write_gif
+
+    gif = tmp_path / "robots.gif"
+    gif.write_bytes(b"earlier gif")
+
+    def interrupted(self, fp, *args, **kwargs):
+        Path(fp).write_bytes(b"GIF89a, half")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Image.Image, "save", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        write_gif(gif, [np.zeros((8, 8, 3), np.uint8)] * 2, fps=5)
+    assert gif.read_bytes() == b"earlier gif" and [p.name for p in tmp_path.iterdir()] == ["robots.gif"]
+
+
+def test_an_interrupted_robot_scene_keeps_the_earlier_video(tmp_path):
+    from lookalike.viz.robots_scene import run_robot_scene
+
+    (tmp_path / "robots.mp4").write_bytes(b"earlier video")
+    calls = []
+
+    def advance():
+        calls.append(1)
+        if len(calls) == 12:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_robot_scene(tmp_path, preset_name="m3n2", frames=20, trackers=["kalman_ha2"], video_tracker="kalman_ha2",
+                        render_width=64, scale=1, advance=advance)
+    assert (tmp_path / "robots.mp4").read_bytes() == b"earlier video"
+    assert not (tmp_path / "robots.gif").exists() and not list(tmp_path.glob(".*"))

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from contextlib import nullcontext
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -63,11 +64,12 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
         out_dir.mkdir(parents=True, exist_ok=True)
         files = {"video": out_dir / "divers.mp4", "gif": out_dir / "divers.gif",
                  "still": out_dir / "divers-still.png", "raw": out_dir / "divers-raw.mp4"}
-        video = VideoWriter(files["video"], fps=sc.frame_rate, gif=files["gif"], gif_every=2, gif_frames=80)
-        raw = VideoWriter(files["raw"], fps=sc.frame_rate)
+        video = VideoWriter(files["video"], fps=sc.frame_rate, gif=files["gif"], gif_every=2, gif_frames=80,
+                            atomic=True)
+        raw = VideoWriter(files["raw"], fps=sc.frame_rate, atomic=True)
     clip = _Clip(sc, video_tracker, len(frames), video, files.get("still"))
     warmed = False
-    try:
+    with video or nullcontext(), raw or nullcontext():  # (atomic: interrupted, no unfinished video replaces one)
         for frame in frames:
             k = frame.index
             image = scene.image(k)
@@ -90,11 +92,7 @@ def run_diver_scenario(sc: DiverScenario, extractor: Any, trackers: list[str], *
                 clip.add(k, frame.time, image, scene.gt[scene.gt[:, 0] == k + 1], shown, scene.image)
             if advance is not None:
                 advance()
-    finally:
-        if video is not None:
-            video.close()
-        if raw is not None:
-            raw.close()
+
     gt = MotTable.from_rows(scene.gt)
     rows = []
     for name in trackers:

@@ -104,7 +104,8 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
     warm = (f"frames 1-{start} ({a.time[start]:.1f} s): {why}" if start
             else "every frame shown" + ("" if settled else ": labels not settled by half-way"))
     correct = total = 0
-    with VideoWriter(files["video"], fps=cfg.frame_rate_hz, gif=files["gif"], gif_every=4, gif_frames=120) as video:
+    with VideoWriter(files["video"], fps=cfg.frame_rate_hz, gif=files["gif"], gif_every=4, gif_frames=120,
+                     atomic=True) as video:  # interrupted: an earlier robots.mp4 and .gif stay
         for k, rendered in enumerate(render_robot_frames(seq, camera, seed)):
             det = seq.frame(k).detections
             pose = a.observer[k]

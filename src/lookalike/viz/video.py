@@ -4,6 +4,7 @@ lazily."""
 
 from __future__ import annotations
 
+import os
 from fractions import Fraction
 from pathlib import Path
 from types import TracebackType
@@ -12,14 +13,18 @@ from typing import Any
 import numpy as np
 
 from lookalike._optional import needs
+from lookalike.io.outputs import atomic_path
+from lookalike.io.rules import temp_beside, write_target
 
 
 class VideoWriter:
     """An H.264 MP4 written frame by frame (``(h, w, 3)`` uint8 BGR, odd sizes padded); a context manager. ``gif``
-    also gets every ``gif_every``-th of the first ``gif_frames`` frames, ``gif_width`` px wide."""
+    also gets every ``gif_every``-th of the first ``gif_frames`` frames, ``gif_width`` px wide. ``atomic``: the MP4 is
+    written beside ``path`` and renamed onto it by :meth:`close`; a block that raises (Ctrl-C included) or
+    :meth:`abort` removes it and writes no GIF, so a video already at ``path`` stays as it was."""
 
     def __init__(self, path: Path | str, fps: float, gif: Path | str | None = None, gif_every: int = 2,
-                 gif_frames: int = 120, gif_width: int = 640) -> None:
+                 gif_frames: int = 120, gif_width: int = 640, atomic: bool = False) -> None:
         if not fps > 0:
             raise ValueError(f"fps: must be positive, got {fps!r}")
         if gif_every < 1 or gif_frames < 1 or gif_width < 16:
@@ -31,6 +36,8 @@ class VideoWriter:
         self._writer: Any = None  # an _H264Writer (or cv2.VideoWriter) once the first frame fixes the size
         self._size: tuple[int, int] | None = None
         self._gif_images: list[np.ndarray] = []
+        self.atomic = atomic
+        self._tmp: Path | None = None  # (atomic) the file written until close() renames it onto path
 
     def write(self, image: np.ndarray) -> None:
         """Append one frame."""
@@ -43,7 +50,12 @@ class VideoWriter:
         size = (img.shape[1], img.shape[0])
         if self._writer is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            self._writer = _open_writer(self.path, self.fps, size)
+            target = self.path
+            if self.atomic:
+                fd, self._tmp = temp_beside(write_target(self.path))
+                os.close(fd)
+                target = self._tmp
+            self._writer = _open_writer(target, self.fps, size)
             self._size = size
         elif size != self._size:
             raise ValueError(f"image: frame {self.count} is {size}, earlier frames {self._size}")
@@ -60,16 +72,34 @@ class VideoWriter:
         if self._writer is not None:
             self._writer.release()
             self._writer = None
+        if self._tmp is not None:
+            os.replace(self._tmp, write_target(self.path))
+            self._tmp = None
         if self.gif is not None and self._gif_images:
             write_gif(self.gif, self._gif_images, fps=self.fps / self.gif_every)
             self._gif_images = []
+
+    def abort(self) -> None:
+        """Stop without finishing: no GIF; with ``atomic`` the unfinished MP4 is removed (``path`` untouched)."""
+        self._gif_images = []
+        try:
+            if self._writer is not None:
+                self._writer.release()
+        finally:
+            self._writer = None
+            if self._tmp is not None:
+                self._tmp.unlink(missing_ok=True)
+                self._tmp = None
 
     def __enter__(self) -> VideoWriter:
         return self
 
     def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
                  tb: TracebackType | None) -> None:
-        self.close()
+        if exc_type is not None and self.atomic:
+            self.abort()
+        else:
+            self.close()
 
 
 MP4_SUFFIXES = (".mp4", ".m4v", ".mov")
@@ -138,7 +168,7 @@ def write_gif(path: Path | str, images: list[np.ndarray], fps: float) -> Path:
         raise ValueError(f"fps: must be positive, got {fps!r}")
     frames = [Image.fromarray(np.ascontiguousarray(im[..., ::-1])).quantize(colors=128) for im in images]
     out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    frames[0].save(out, format="GIF", save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0,
-                   optimize=False)
+    with atomic_path(out) as tmp:  # interrupted: no half-written GIF, an earlier one stays
+        frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:], duration=round(1000 / fps),
+                       loop=0, optimize=False)
     return out
