@@ -62,6 +62,11 @@ def test_bad_model_files_are_refused(tmp_path):
     junk.write_bytes(b"not a model")
     with pytest.raises(ValueError, match="not a readable HOG cascade"):
         HogCascade.load(junk)
+    text = tmp_path / "README.md"
+    text.write_text("# notes\n")
+    with pytest.raises(ValueError) as caught:  # numpy's own text said to trust the file and unpickle it
+        HogCascade.load(text)
+    assert str(caught.value) == f"{text}: not a readable HOG cascade model (not an .npz archive)"
     other = tmp_path / "other.npz"
     np.savez(other, header=np.array('{"format": "something-else", "version": 1}'))
     with pytest.raises(ValueError, match="not a HOG cascade model"):

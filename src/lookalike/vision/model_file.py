@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +28,8 @@ def load_model_file(
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """The header and arrays of a :func:`save_model_file` file; ``ValueError`` when unreadable, of another format
     (``what`` names the expected kind) or version."""
+    if Path(path).is_file() and not zipfile.is_zipfile(path):  # (numpy would say to trust it and unpickle it)
+        raise ValueError(f"{path}: not a readable {what} (not an .npz archive)")
     try:
         with np.load(path, allow_pickle=False) as data:
             header = json.loads(str(data["header"]))
