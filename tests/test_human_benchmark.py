@@ -109,3 +109,14 @@ def test_cli_label_export_and_bench_ident_human(tmp_path):
     assert "human" in res.output and "Human benchmark sessions" in res.output
     res = runner.invoke(app, ["bench", "ident", "--human", str(tmp_path / "none")])
     assert res.exit_code == 2 and "--human" in res.output
+
+
+def test_an_explicit_human_folder_without_a_matching_result_says_why_there_is_no_human_row(tmp_path):
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    with pytest.raises(ValueError, match=r"--human: no result files \(\*\.human-\*\.json"):
+        table3_table(["m3n2"], ["kalman_ha"], 1, 60, 5, "ours", [30], 1, human=empty)
+    other = tmp_path / "other"
+    write_human_result(other / "b.human-bob.json", _result(50, 100, 70, labeller="bob", n_agents=3, max_detections=5))
+    with pytest.raises(ValueError, match=r"are for M=5, N=3, not for the table's set-up\(s\) M=3, N=2"):
+        table3_table(["m3n2"], ["kalman_ha"], 1, 60, 5, "ours", [30], 1, human=other)

@@ -16,7 +16,7 @@ from lookalike.eval import identification_success_rate, localisation_error
 from lookalike.io.results import Results, percent_row_metrics
 from lookalike.io.robot_sequences import read_robot_sequence
 from lookalike.sim import RobotSequence, preset, preset_label, simulate_robots
-from lookalike.viz.label.human import HumanResult, read_human_results
+from lookalike.viz.label.human import RESULT_GLOB, HumanResult, read_human_results
 
 DEFAULT_LENGTHS = (200, 400, 800)
 DEFAULT_DRAWS = 4
@@ -132,6 +132,8 @@ def table3_table(setups: Sequence[str], trackers: Sequence[str], sequences: int,
     if any(n < 1 for n in lengths):
         raise ValueError(f"--lengths: frame counts must be positive, got {list(lengths)}")
     people = read_human_results(human) if human is not None else []
+    if human is not None and not people:  # asked for by name: say why no 'human' row follows
+        raise ValueError(f"--human: no result files ({RESULT_GLOB}, `lookalike label --benchmark`) in {human}")
     groups: list[tuple[str, list[RobotSequence]]] = []
     if recordings is not None:
         files = recording_files(recordings)
@@ -155,6 +157,10 @@ def table3_table(setups: Sequence[str], trackers: Sequence[str], sequences: int,
             if sessions is not None:
                 sessions += human_sessions(mine, label)
         rows += [{"Setup": label, **r} for r in group]
+    if human is not None and not any(r["Tracker"] == HUMAN for r in rows):
+        teams = sorted({f"M={r.max_detections}, N={r.n_agents}" for r in people})
+        raise ValueError(f"--human: the result files in {human} are for {'; '.join(teams)}, not for the table's "
+                         f"set-up(s) {', '.join(label for label, _ in groups)}")
     return rows
 
 
