@@ -99,3 +99,20 @@ def test_train_refuses_fine_tuning_options_without_recordings(tmp_path, option):
     result = CliRunner().invoke(app, ["train", "--steps", "1", *option, "-o", str(tmp_path / "run")])
     assert result.exit_code == 2 and f"{option[0]}: only with --recordings" in result.output, result.output
     assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize(("mode", "option"), [
+    (["--recordings", "."], ["--model", "set"]), (["--recordings", "."], ["--ship"]),
+    (["--recordings", "."], ["--hidden", "8"]), (["--recordings", "."], ["--preset", "m10n7"]),
+    (["--search", "1"], ["--init-from", "model.npz"]), (["--search", "1"], ["--learning-rate", "0.1"]),
+    (["--search", "1"], ["--ship"]), (["--model", "set"], ["--hidden", "8"]),
+    (["--model", "set"], ["--sequence-length", "300"]), (["--model", "set"], ["--init-from", "model.npz"]),
+])
+def test_train_refuses_options_its_kind_of_run_would_ignore(tmp_path, mode, option):
+    """They were accepted and silently ignored (``--recordings --model set`` fine-tuned an LSTM, ``--search --ship``
+    shipped nothing, ``--model set --hidden 8`` trained the default widths)."""
+    pytest.importorskip("torch", reason="train needs the 'train' extra")
+    result = CliRunner().invoke(app, ["train", "--steps", "1", *mode, *option, "-o", str(tmp_path / "run")])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert f"{option[0]}: not with {mode[0] if mode[0] != '--model' else '--model set'}" in result.output
+    assert not (tmp_path / "run").exists()

@@ -67,8 +67,9 @@ def train(
                               "(each sequence draws one from its seed)."),
     model: str = typer.Option(
         "lstm", "--model", help="lstm (one network per --preset), or set: one set associator for every team size "
-        "(N 1-12, M up to 2N+3, drawn per batch; --preset, --cell, --layers, --relative, --protocol, --noise, "
-        "--init-from do not apply, --hidden is its memory width; shipped as set_any)."),
+        "(N 1-12, M up to 2N+3, drawn per batch; shipped as set_any; --preset, --cell, --hidden, --layers, "
+        "--relative, --protocol, --noise, --swap-prob, --init-from, --sequence-length and --validate-every "
+        "do not apply and are refused)."),
     recordings: Path | None = typer.Option(
         None, "--recordings", help="Fine-tune on the labelled recordings (*.labelled.jsonl, the labelling page's "
         "export) of this folder instead of simulated sequences: N and M from the recordings, the network from "
@@ -110,13 +111,20 @@ def train(
     from lookalike.io.outputs import sqlite_file
 
     require("torch")
-    device = torch_device(device)  # every option checked before the output folder is made
+    device_given, device = device, torch_device(device)  # every option checked before the output folder is made
     if protocol not in ("ours", "paper"):
         fail(f"--protocol: unknown protocol {protocol!r}; known: ours, paper")
     if model not in ("lstm", "set"):
         fail(f"--model: unknown model {model!r}; known: lstm, set")
     if recordings is not None and search is not None:
         fail("--recordings and --search: choose one")
+    _refuse_unused(recordings is not None, search is not None, model, {
+        "--model": model != "lstm", "--preset": preset_name != "m3n2", "--cell": cell != "lstm",
+        "--hidden": hidden != 64, "--layers": layers != 5, "--no-relative": not relative,
+        "--protocol": protocol != "ours", "--noise": noise != "ours", "--swap-prob": swap_prob != 0.0,
+        "--init-from": init_from is not None, "--init-transfer": init_transfer, "--ship": ship, "--resume": resume,
+        "--learning-rate": learning_rate is not None, "--device": device_given != "cpu",
+        "--sequence-length": sequence_length != 600, "--validate-every": validate_every != 50})
     if recordings is None:
         given = [name for name, value, default in (
             ("--mix-sim", mix_sim, 0.0), ("--mix-sim-fit", mix_sim_fit, False),
@@ -183,6 +191,31 @@ def train(
         info={"transferred_from": init.info["transferred_from"]} if init is not None and init_transfer else None))
     stem = "lstm_paper" if protocol == "paper" else "lstm"
     _finish(result, output, WEIGHTS_DIR / f"{stem}_m{world.max_detections}_n{world.n_agents}.npz" if ship else None)
+
+
+_UNUSED = {  # the options each kind of run does not read, and why
+    "--recordings": (("--model", "--preset", "--cell", "--hidden", "--layers", "--no-relative", "--protocol",
+                      "--noise", "--swap-prob", "--init-transfer", "--ship"),
+                     "the network is --init-from's, else the shipped one for the recordings' N and M"),
+    "--search": (("--model", "--init-from", "--init-transfer", "--ship", "--resume", "--learning-rate", "--hidden",
+                  "--layers", "--protocol", "--noise", "--swap-prob", "--device"),
+                 "each trial trains a new LSTM on the CPU with the size and learning rate it draws; a study "
+                 "continues by itself"),
+    "--model set": (("--preset", "--cell", "--hidden", "--layers", "--no-relative", "--protocol", "--noise",
+                     "--swap-prob", "--init-from", "--init-transfer", "--sequence-length", "--validate-every"),
+                    "the set associator has its own sizes, data and schedule"),
+}
+
+
+def _refuse_unused(recordings: bool, search: bool, model: str, given: dict[str, bool]) -> None:
+    """Fail (before any work) when an option that ``given`` marks as set does not apply to this kind of run."""
+    mode = "--recordings" if recordings else "--search" if search else "--model set" if model == "set" else None
+    if mode is None:
+        return
+    names, why = _UNUSED[mode]
+    unused = [name for name in names if given.get(name)]
+    if unused:
+        fail(f"{', '.join(unused)}: not with {mode} ({why})")
 
 
 def _sim_samplers(world: Any, worlds: Any, spec: Any, noise: str, swap_prob: float) -> tuple[Any, Any]:
