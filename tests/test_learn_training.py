@@ -62,6 +62,30 @@ def test_resume_continues_where_it_stopped(tmp_path):
         train(_config(steps=20, validation_every=5), toy_sampler, tmp_path, resume=True)
 
 
+def test_an_interrupted_checkpoint_write_keeps_the_previous_checkpoint(tmp_path, monkeypatch):
+    """Ctrl-C while the checkpoint was written left it cut short, and ``--resume`` then ended in a torch
+    traceback; now the previous checkpoint stays whole and a damaged one is refused in one line naming it."""
+    torch.set_num_threads(1)
+    train(_config(steps=5, validation_every=5), toy_sampler, tmp_path)
+    checkpoint = tmp_path / "checkpoint.pt"
+    before = checkpoint.read_bytes()
+
+    def cut_short(state, f, *args, **kwargs):
+        with open(f, "wb") as fh:
+            fh.write(b"PK\x03\x04 half a checkpoint")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(torch, "save", cut_short)
+    with pytest.raises(KeyboardInterrupt):
+        train(_config(steps=10, validation_every=5), toy_sampler, tmp_path, resume=False)
+    monkeypatch.undo()
+    assert checkpoint.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
+    checkpoint.write_bytes(before[: len(before) // 2])
+    with pytest.raises(ValueError, match="checkpoint.pt: not a readable training checkpoint .*drop --resume"):
+        train(_config(steps=5, validation_every=5), toy_sampler, tmp_path, resume=True)
+
+
 def test_batches_made_in_worker_processes_train_identically(tmp_path):
     from lookalike.parallel import JobPool
 

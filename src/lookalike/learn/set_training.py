@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike._optional import needs
+from lookalike.learn.checkpoints import load_checkpoint, save_checkpoint
 from lookalike.learn.data import IGNORE
 from lookalike.learn.set_data import SetBatchMaker, TeamSizes
 from lookalike.learn.set_model import SetAssociator, SetSizes
@@ -161,7 +162,7 @@ def train_set(config: SetTrainConfig, out_dir: str | Path, resume: bool = False,
     step, best, best_step = 0, -1.0, 0
     history: list[dict] = []
     if resume and ckpt_path.is_file():
-        state = torch.load(ckpt_path, weights_only=False, map_location=device)
+        state = load_checkpoint(ckpt_path, device)
         if _run_shape(state["config"]) != _run_shape(asdict(config)):
             raise ValueError(f"{ckpt_path}: was made with another configuration; remove it or drop --resume")
         model.load_state_dict(state["model"])
@@ -213,9 +214,9 @@ def train_set(config: SetTrainConfig, out_dir: str | Path, resume: bool = False,
             if config.keep_snapshots:
                 save_set_weights(_export(model, config, {"val_success": row["val_success"], "step": step}),
                                  out / f"set_step{step}.npz")
-            torch.save({"config": asdict(config), "model": model.state_dict(), "optimiser": optimiser.state_dict(),
-                        "schedule": schedule.state_dict(), "step": step, "best": best, "best_step": best_step,
-                        "history": history}, ckpt_path)
+            save_checkpoint({"config": asdict(config), "model": model.state_dict(),
+                             "optimiser": optimiser.state_dict(), "schedule": schedule.state_dict(), "step": step,
+                             "best": best, "best_step": best_step, "history": history}, ckpt_path)
             _write_log(log_path, history)
         if on_step is not None:
             on_step(row)

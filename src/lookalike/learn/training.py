@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from lookalike._optional import needs
+from lookalike.learn.checkpoints import load_checkpoint, save_checkpoint
 from lookalike.learn.data import IGNORE, success_rate
 from lookalike.learn.model import AssociationNet
 from lookalike.parallel import JobPool
@@ -141,7 +142,7 @@ def train(config: TrainConfig, sample: Sampler, out_dir: str | Path, resume: boo
     weights_path = out / "model.npz"
     step, best, best_step, history = 0, -1.0, 0, []
     if resume and ckpt_path.is_file():
-        state = torch.load(ckpt_path, weights_only=False, map_location=device)
+        state = load_checkpoint(ckpt_path, device)
         if state["config"] != asdict(config):
             raise ValueError(f"{ckpt_path}: was made with another configuration; remove it or drop --resume")
         model.load_state_dict(state["model"])
@@ -185,7 +186,7 @@ def train(config: TrainConfig, sample: Sampler, out_dir: str | Path, resume: boo
                 save_weights(model.export(meta), weights_path)
             else:
                 stale += 1
-            torch.save(
+            save_checkpoint(
                 {"config": asdict(config), "model": model.state_dict(), "optimiser": optimiser.state_dict(),
                  "schedule": schedule.state_dict(), "step": step, "best": best, "best_step": best_step,
                  "history": history},
