@@ -36,7 +36,7 @@ def test_search_saves_the_study_continues_it_and_records_the_choice(tmp_path):
     more = run_search(_base(), preset("m3n2"), tmp_path, 3, space=SPACE, sampler="random", check_sequences=2,
                       progress=lambda done, total, row: rows.append(row))
     assert more.trials == 3 and [r["trial"] for r in rows] == [0, 1, 2]  # only the missing trial ran
-    with pytest.raises(ValueError, match="another base"):
+    with pytest.raises(ValueError, match=r"other settings: steps 2 \(now 3\); continue it"):
         run_search(TrainConfig(**{**_base().__dict__, "steps": 3}), preset("m3n2"), tmp_path, 4, space=SPACE)
 
 

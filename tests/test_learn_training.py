@@ -58,7 +58,7 @@ def test_resume_continues_where_it_stopped(tmp_path):
     train(_config(steps=10, validation_every=5), toy_sampler, tmp_path)
     resumed = train(_config(steps=10, validation_every=5), toy_sampler, tmp_path, resume=True)
     assert resumed.steps == 10 and len(resumed.history) == 2  # nothing left to do
-    with pytest.raises(ValueError, match="another configuration"):
+    with pytest.raises(ValueError, match=r"other settings: steps 10 \(now 20\); run with the same settings"):
         train(_config(steps=20, validation_every=5), toy_sampler, tmp_path, resume=True)
 
 

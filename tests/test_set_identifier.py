@@ -123,7 +123,7 @@ def test_training_writes_loadable_weights_and_resumes(tmp_path):
     first = train_set(config, tmp_path)
     assert first.steps == 2 and 0.0 <= first.best_success <= 1.0
     NumpySetAssociator(load_set_weights(first.weights_path))
-    with pytest.raises(ValueError, match="another configuration"):
+    with pytest.raises(ValueError, match=r"other settings: pair 12 \(now 10\); run with the same settings"):
         train_set(replace(config, pair=10), tmp_path, resume=True)
     cooled = train_set(replace(config, steps=3, learning_rate=0.001), tmp_path, resume=True)  # one step more
     assert cooled.steps == 3 and [h["step"] for h in cooled.history] == [1, 2, 3]

@@ -57,7 +57,8 @@ def train(
     workers: int = typer.Option(1, min=1, help="Processes (or Ray CPUs) generating batches ahead."),
     backend: str = typer.Option("local", help="Batch generation: local (processes) or ray."),
     address: str | None = typer.Option(None, help="Ray cluster address (default: a local ray.init())."),
-    resume: bool = typer.Option(False, help="Continue from OUTPUT/checkpoint.pt."),
+    resume: bool = typer.Option(False, help="Continue from OUTPUT/checkpoint.pt, made with the same settings (with "
+                                "--model set, --steps, --minutes, --patience and --learning-rate may change)."),
     ship: bool = typer.Option(False, help="Copy the best weights into the package's shipped weights."),
     protocol: str = typer.Option(
         "ours", help="Input layout: ours, or paper (the robot-identification paper's N + 4M inputs, no ages, no "

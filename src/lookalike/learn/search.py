@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from lookalike._optional import needs
+from lookalike.learn.checkpoints import changed_settings
 from lookalike.parallel import JobPool
 from lookalike.sim import RobotWorldConfig
 
@@ -120,8 +121,11 @@ def _open_study(storage: str, name: str, meta: dict[str, Any]) -> Any:
     old = study.user_attrs
     for key, value in meta.items():
         if old and old.get(key) != value:
-            raise ValueError(f"{storage}: study {name!r} was run with another {key} ({old.get(key)!r}, now "
-                             f"{value!r}); continue it with the same settings or give another --study")
+            was = old.get(key)
+            changed = (changed_settings(was, value) if isinstance(was, dict) and isinstance(value, dict)
+                       else f"{key} {was!r} (now {value!r})")
+            raise ValueError(f"{storage}: study {name!r} was run with other settings: {changed}; continue it with "
+                             "the same settings or give another --study")
         if not old:
             study.set_user_attr(key, value)
     return study

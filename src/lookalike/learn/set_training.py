@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from lookalike._optional import needs
-from lookalike.learn.checkpoints import load_checkpoint, save_checkpoint
+from lookalike.learn.checkpoints import changed_settings, load_checkpoint, save_checkpoint
 from lookalike.learn.data import IGNORE
 from lookalike.learn.set_data import SetBatchMaker, TeamSizes
 from lookalike.learn.set_model import SetAssociator, SetSizes
@@ -164,7 +164,9 @@ def train_set(config: SetTrainConfig, out_dir: str | Path, resume: bool = False,
     if resume and ckpt_path.is_file():
         state = load_checkpoint(ckpt_path, device)
         if _run_shape(state["config"]) != _run_shape(asdict(config)):
-            raise ValueError(f"{ckpt_path}: was made with another configuration; remove it or drop --resume")
+            changed = changed_settings(_run_shape(state["config"]), _run_shape(asdict(config)))
+            raise ValueError(f"{ckpt_path}: was made with other settings: {changed}; run with the same settings, or "
+                             "remove it or drop --resume")
         model.load_state_dict(state["model"])
         optimiser.load_state_dict(state["optimiser"])
         schedule.load_state_dict(state["schedule"])

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from lookalike._optional import needs
-from lookalike.learn.checkpoints import load_checkpoint, save_checkpoint
+from lookalike.learn.checkpoints import changed_settings, load_checkpoint, save_checkpoint
 from lookalike.learn.data import IGNORE, success_rate
 from lookalike.learn.model import AssociationNet
 from lookalike.parallel import JobPool
@@ -144,7 +144,9 @@ def train(config: TrainConfig, sample: Sampler, out_dir: str | Path, resume: boo
     if resume and ckpt_path.is_file():
         state = load_checkpoint(ckpt_path, device)
         if state["config"] != asdict(config):
-            raise ValueError(f"{ckpt_path}: was made with another configuration; remove it or drop --resume")
+            changed = changed_settings(state["config"], asdict(config))
+            raise ValueError(f"{ckpt_path}: was made with other settings: {changed}; run with the same settings, or "
+                             "remove it or drop --resume")
         model.load_state_dict(state["model"])
         optimiser.load_state_dict(state["optimiser"])
         schedule.load_state_dict(state["schedule"])
