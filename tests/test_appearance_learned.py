@@ -124,3 +124,42 @@ def test_tiny_training_run_exports_onnx(tmp_path) -> None:
     assert json.loads((tmp_path / "diver_reid.json").read_text())["config"]["embedding"] == 8
     ex = OnnxAppearance(tmp_path / "diver_reid.onnx")
     assert ex.dim == 8 and ex.crop_size == (64, 32)
+
+
+def test_retraining_into_a_model_folder_measures_its_own_thresholds_and_an_interruption_keeps_the_old(
+        tmp_path, monkeypatch) -> None:
+    """The new model's thresholds were read from the earlier model's JSON beside it (silently wrong for track and
+    bench divers), and Ctrl-C after the export left the new ONNX beside the earlier JSON."""
+    pytest.importorskip("torch")
+    import lookalike.learn.appearance_train as appearance_train
+    import lookalike.sim.divers_run as divers_run
+    from lookalike.learn.appearance_data import CropSet
+    from lookalike.learn.appearance_train import AppearanceTrainConfig, train_appearance
+
+    rng = np.random.default_rng(0)  # crops of three made-up divers (rendering them is not under test)
+    crops = CropSet(rng.integers(0, 256, (12, 32, 64, 3), dtype=np.uint8), np.repeat([10, 20, 30], 4))
+    monkeypatch.setattr(appearance_train, "diver_crops", lambda *args, **kwargs: crops)
+
+    earlier = {"model": "diver_reid.onnx", "matched_thresholds": {"deepsort": {"max_cosine_distance": 0.987}}}
+    (tmp_path / "diver_reid.onnx").write_bytes(b"the earlier model")
+    (tmp_path / "diver_reid.json").write_text(json.dumps(earlier))
+    config = AppearanceTrainConfig(scenarios=1, frames=10, every=5, epochs=1, channels=4, embedding=8,
+                                   validation_every=60)
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    with monkeypatch.context() as m:
+        m.setattr(divers_run, "matched_thresholds", interrupted)
+        with pytest.raises(KeyboardInterrupt):
+            train_appearance(config, tmp_path, log=lambda _: None)
+    assert (tmp_path / "diver_reid.onnx").read_bytes() == b"the earlier model"
+    assert json.loads((tmp_path / "diver_reid.json").read_text()) == earlier
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["diver_reid.json", "diver_reid.onnx"]
+    distances = np.linspace(0.0, 0.5, 101)  # (the measured distances, cheap: the matching itself is not under test)
+    monkeypatch.setattr(divers_run, "_reference_distances", lambda: distances)
+    monkeypatch.setattr(divers_run, "_distances_of", lambda extractor: distances)
+    train_appearance(config, tmp_path, log=lambda _: None)
+    stored = json.loads((tmp_path / "diver_reid.json").read_text())["matched_thresholds"]["deepsort"]
+    assert stored["max_cosine_distance"] != 0.987
+    assert OnnxAppearance(tmp_path / "diver_reid.onnx").dim == 8

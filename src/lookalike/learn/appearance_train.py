@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import shutil
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
@@ -136,7 +139,8 @@ def verification_auc(emb: np.ndarray, labels: np.ndarray) -> float:
 
 def train_appearance(config: AppearanceTrainConfig, output: Path,
                      log: Callable[[str], None] = print) -> dict[str, Any]:
-    """Train, keep the best validation epoch, write ``output/diver_reid.onnx`` and ``.json``; the JSON dict."""
+    """Train, keep the best validation epoch, write ``output/diver_reid.onnx`` and ``.json`` (both made aside and
+    renamed into place at the end, so an interrupted run leaves an earlier model whole); the JSON dict."""
     torch = _torch()
     from lookalike.sim.divers import VALIDATION_SCENARIOS
     from lookalike.sim.divers_train import training_scenarios
@@ -188,29 +192,35 @@ def train_appearance(config: AppearanceTrainConfig, output: Path,
             break
     net.load_state_dict(best[1])
     output.mkdir(parents=True, exist_ok=True)
-    onnx_path = export_onnx(net.cpu(), output / f"{MODEL_NAME}.onnx")
-    info: dict[str, Any] = {
-        "model": f"{MODEL_NAME}.onnx",
-        "input": {"name": "crops", "layout": "NCHW", "channels": "BGR", "range": [0, 1],
-                  "width": CROP_SIZE[0], "height": CROP_SIZE[1]},
-        "output": {"name": "embedding", "dim": config.embedding, "normalised": True},
-        "config": asdict(config),
-        "training": {"crops": int(len(train.labels)), "identities": int(len(ids)),
-                     "scenario_seeds": sorted({int(v) // 10 for v in ids})},
-        "validation": {"scenarios": [s.name for s in VALIDATION_SCENARIOS], "crops": int(len(val.labels)),
-                       "best_auc": best[0]},
-        "history": history,
-        "minutes": (time.perf_counter() - start) / 60,
-        "torch": str(torch.__version__),
-    }
-    if config.match_thresholds:
-        from lookalike.sim.divers_run import HANDCRAFTED_THRESHOLDS, matched_thresholds
-        from lookalike.vision.appearance_onnx import OnnxAppearance
+    staging = Path(tempfile.mkdtemp(prefix=".train-appearance-", dir=output))  # no JSON of an earlier model beside it
+    try:
+        onnx_path = export_onnx(net.cpu(), staging / f"{MODEL_NAME}.onnx")
+        info: dict[str, Any] = {
+            "model": f"{MODEL_NAME}.onnx",
+            "input": {"name": "crops", "layout": "NCHW", "channels": "BGR", "range": [0, 1],
+                      "width": CROP_SIZE[0], "height": CROP_SIZE[1]},
+            "output": {"name": "embedding", "dim": config.embedding, "normalised": True},
+            "config": asdict(config),
+            "training": {"crops": int(len(train.labels)), "identities": int(len(ids)),
+                         "scenario_seeds": sorted({int(v) // 10 for v in ids})},
+            "validation": {"scenarios": [s.name for s in VALIDATION_SCENARIOS], "crops": int(len(val.labels)),
+                           "best_auc": best[0]},
+            "history": history,
+            "minutes": (time.perf_counter() - start) / 60,
+            "torch": str(torch.__version__),
+        }
+        if config.match_thresholds:
+            from lookalike.sim.divers_run import HANDCRAFTED_THRESHOLDS, matched_thresholds
+            from lookalike.vision.appearance_onnx import OnnxAppearance
 
-        model = OnnxAppearance(onnx_path)
-        info["matched_thresholds"] = {t: matched_thresholds(model, t) for t in HANDCRAFTED_THRESHOLDS}
-    (output / f"{MODEL_NAME}.json").write_text(json.dumps(info, indent=1))
-    log(f"best validation AUC {best[0]:.4f} → {onnx_path}")
+            model = OnnxAppearance(onnx_path)
+            info["matched_thresholds"] = {t: matched_thresholds(model, t) for t in HANDCRAFTED_THRESHOLDS}
+        onnx_path.with_suffix(".json").write_text(json.dumps(info, indent=1))
+        for name in (f"{MODEL_NAME}.onnx", f"{MODEL_NAME}.json"):  # the earlier model stays whole until here
+            os.replace(staging / name, output / name)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    log(f"best validation AUC {best[0]:.4f} → {output / f'{MODEL_NAME}.onnx'}")
     return info
 
 
