@@ -50,6 +50,22 @@ def test_wrong_setup_is_refused(tmp_path):
         LstmIdentifier(LstmIdentifier.Config(n_agents=9, n_slots=4))
 
 
+def test_a_file_that_is_not_exported_weights_is_named_as_given(tmp_path):
+    """A training run's checkpoint.pt was reported as 'checkpoint.npz: expected checkpoint.npz and checkpoint.json',
+    naming a file the user never gave; a missing .npz and a missing .json are told apart."""
+    from lookalike.trackers.lstm import load_weights
+
+    path = _random_weights(tmp_path)
+    (tmp_path / "checkpoint.pt").write_bytes(b"torch checkpoint")
+    with pytest.raises(CheckpointError, match=r"checkpoint.pt: not exported weights .*model.npz"):
+        load_weights(tmp_path / "checkpoint.pt")
+    with pytest.raises(CheckpointError, match=r"other.npz: no such file"):
+        load_weights(tmp_path / "other.npz")
+    path.with_suffix(".json").unlink()
+    with pytest.raises(CheckpointError, match=rf"{path.with_suffix('.json').name}: missing"):
+        load_weights(path)
+
+
 def test_beacon_memory_keeps_newest_and_ignores_late_reports():
     mem = BeaconMemory(2)
     mem.add(Frame(0, 0.0, beacons=Beacons(agent_id=[0], t_sent=[1.0], t_received=[1.1], heading=[0.5])))

@@ -21,10 +21,17 @@ def read_metadata(path: str | os.PathLike[str], fmt: str, what: str) -> tuple[Pa
     """``(weights .npz path, metadata .json path, parsed metadata)`` of weights stored as an ``.npz``
     with a ``.json`` beside it; :class:`CheckpointError` naming the file when either is missing, the
     JSON is invalid or its ``format`` is not ``fmt`` (``what`` names the expected kind in the message)."""
-    path = Path(path).with_suffix(".npz")
+    given = Path(path)
+    if given.suffix not in ("", ".npz", ".json"):
+        raise CheckpointError(f"{given}: not exported weights (an .npz with its .json beside it, such as a training "
+                              "run's model.npz)")
+    path = given.with_suffix(".npz")
     meta_path = path.with_suffix(".json")
-    if not path.is_file() or not meta_path.is_file():
-        raise CheckpointError(f"{path}: expected {path.name} and {meta_path.name} side by side")
+    if not path.is_file():
+        raise CheckpointError(f"{path}: no such file (exported weights are an .npz with its .json beside it)")
+    if not meta_path.is_file():
+        raise CheckpointError(f"{meta_path}: missing; exported weights are {path.name} and {meta_path.name} side by "
+                              "side")
     try:
         meta = json.loads(meta_path.read_text())
     except json.JSONDecodeError as exc:
