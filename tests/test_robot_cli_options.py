@@ -116,3 +116,21 @@ def test_train_refuses_options_its_kind_of_run_would_ignore(tmp_path, mode, opti
     assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
     assert f"{option[0]}: not with {mode[0] if mode[0] != '--model' else '--model set'}" in result.output
     assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize(("args", "earlier"), [
+    (["--sequence-length", "150"], "model.npz"), (["--sequence-length", "150"], "checkpoint.pt"),
+    (["--model", "set"], "set.npz"), (["--recordings", "."], "model.npz"),
+])
+def test_train_refuses_to_start_over_an_earlier_run(tmp_path, args, earlier):
+    """A new run into a folder holding an earlier run's weights replaced them at its first validation (hours of
+    training lost to a command run again without --resume)."""
+    pytest.importorskip("torch", reason="train needs the 'train' extra")
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / earlier).write_bytes(b"an earlier run's weights")
+    result = CliRunner().invoke(app, ["train", "--steps", "1", "--batch-size", "1", *args, "-o", str(run)])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert f"holds an earlier run ({earlier})" in result.output and "--resume continues it" in result.output
+    assert sorted(p.name for p in run.iterdir()) == [earlier]
+    assert (run / earlier).read_bytes() == b"an earlier run's weights"

@@ -26,7 +26,8 @@ from lookalike.sim.presets import TEAM_HELP
 @app.command()
 def train(
     preset_name: str = typer.Option("m3n2", "--preset", help=f"The team an LSTM is trained for: {TEAM_HELP}."),
-    output: Path = typer.Option(..., "-o", "--output", help="Folder for model.npz/.json, log and checkpoint."),
+    output: Path = typer.Option(..., "-o", "--output", help="Folder for model.npz/.json, log and checkpoint (one "
+                                "that holds an earlier run's is refused unless --resume continues it)."),
     steps: int = typer.Option(3000, help="Maximum optimisation steps (batches of sequences)."),
     minutes: float | None = typer.Option(None, help="Stop after this many minutes."),
     cell: str = typer.Option("lstm", help="Recurrent cell: lstm or gru (the paper's comparison)."),
@@ -137,6 +138,8 @@ def train(
                           [recordings, init_from, validation_folder], folders={"-o/--output"})
     if search is not None:
         check_study_or_fail(study)
+    _refuse_earlier_run(output, None if search is not None or resume else
+                        "set.npz" if model == "set" and recordings is None else "model.npz")
     run: dict[str, Any] = dict(  # the options every training run shares (cli.train_options.RunOptions)
         steps=steps, minutes=minutes, batch_size=batch_size, sequence_length=sequence_length, seed=seed,
         patience=patience, validate_every=validate_every, threads=threads, workers=workers, backend=backend,
@@ -209,7 +212,10 @@ _UNUSED = {  # the options each kind of run does not read, and why
 
 
 def _refuse_unused(recordings: bool, search: bool, model: str, given: dict[str, bool]) -> None:
-    """Fail (before any work) when an option that ``given`` marks as set does not apply to this kind of run."""
+    """Fail (before any work) when an option that ``given`` marks as set does not apply to this kind of run, or
+    lacks the option it needs."""
+    if given.get("--init-transfer") and not given.get("--init-from"):
+        fail("--init-transfer needs --init-from")
     mode = "--recordings" if recordings else "--search" if search else "--model set" if model == "set" else None
     if mode is None:
         return
@@ -217,6 +223,17 @@ def _refuse_unused(recordings: bool, search: bool, model: str, given: dict[str, 
     unused = [name for name in names if given.get(name)]
     if unused:
         fail(f"{', '.join(unused)}: not with {mode} ({why})")
+
+
+def _refuse_earlier_run(output: Path, weights: str | None) -> None:
+    """Fail when ``output`` holds an earlier run's checkpoint or ``weights``, which a new run would replace (``weights``
+    None: a run that continues what the folder holds)."""
+    if weights is None:
+        return
+    earlier = [name for name in ("checkpoint.pt", weights) if (output / name).exists()]
+    if earlier:
+        fail(f"-o/--output {output}: holds an earlier run ({', '.join(earlier)}); --resume continues it, or remove "
+             "them or give another folder to start over (nothing was written)")
 
 
 def _sim_samplers(world: Any, worlds: Any, spec: Any, noise: str, swap_prob: float) -> tuple[Any, Any]:
