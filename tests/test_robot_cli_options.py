@@ -134,3 +134,13 @@ def test_train_refuses_to_start_over_an_earlier_run(tmp_path, args, earlier):
     assert f"holds an earlier run ({earlier})" in result.output and "--resume continues it" in result.output
     assert sorted(p.name for p in run.iterdir()) == [earlier]
     assert (run / earlier).read_bytes() == b"an earlier run's weights"
+
+
+@pytest.mark.parametrize("option", [["--sampler", "random"], ["--space", "hidden=4:8"], ["--study", "sqlite:///s.db"]])
+def test_train_refuses_search_options_without_search(tmp_path, option):
+    """They were accepted and ignored: one training run, no search, no study."""
+    pytest.importorskip("torch", reason="train needs the 'train' extra")
+    result = CliRunner().invoke(app, ["train", "--steps", "1", "--sequence-length", "150", "--batch-size", "1",
+                                      *option, "-o", str(tmp_path / "run")])
+    assert result.exit_code == 2 and f"{option[0]}: only with --search" in result.output, result.output
+    assert not (tmp_path / "run").exists() and not (tmp_path / "s.db").exists()

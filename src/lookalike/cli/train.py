@@ -22,6 +22,8 @@ if TYPE_CHECKING:
 from lookalike.sim import preset
 from lookalike.sim.presets import TEAM_HELP
 
+SPACE = "hidden=16:256,layers=1:6,learning_rate=3e-4:3e-2"  # --search's default ranges
+
 
 @app.command()
 def train(
@@ -98,7 +100,7 @@ def train(
         "a resumed study included) over hidden size, depth and learning rate in log space (--space), each a training "
         "run of --steps/--minutes validated on held-out simulator seeds; trials run --workers at a time."),
     sampler: str = typer.Option("tpe", "--sampler", help="With --search: tpe or random."),
-    space: str = typer.Option("hidden=16:256,layers=1:6,learning_rate=3e-4:3e-2", "--space",
+    space: str = typer.Option(SPACE, "--space",
                               help="With --search: the ranges searched (log space)."),
     study: str | None = typer.Option(
         None, "--study", help="With --search: Optuna storage URL (default sqlite:///OUTPUT/search.db); an "
@@ -127,13 +129,10 @@ def train(
         "--init-from": init_from is not None, "--init-transfer": init_transfer, "--ship": ship, "--resume": resume,
         "--learning-rate": learning_rate is not None, "--device": device_given != "cpu",
         "--sequence-length": sequence_length != 600, "--validate-every": validate_every != 50})
-    if recordings is None:
-        given = [name for name, value, default in (
-            ("--mix-sim", mix_sim, 0.0), ("--mix-sim-fit", mix_sim_fit, False),
-            ("--validation-fraction", validation_fraction, 0.25), ("--validation", validation_folder, None),
-            ("--test", test, None)) if value != default]
-        if given:
-            fail(f"{', '.join(given)}: only with --recordings (fine-tuning on labelled recordings)")
+    _refuse_misplaced(recordings is not None, search is not None, {
+        "--mix-sim": mix_sim != 0.0, "--mix-sim-fit": mix_sim_fit, "--validation-fraction": validation_fraction != 0.25,
+        "--validation": validation_folder is not None, "--test": test is not None, "--sampler": sampler != "tpe",
+        "--space": space != SPACE, "--study": study is not None})
     check_outputs_or_fail({"-o/--output": output, "--study": sqlite_file(study)},
                           [recordings, init_from, validation_folder], folders={"-o/--output"})
     if search is not None:
@@ -223,6 +222,22 @@ def _refuse_unused(recordings: bool, search: bool, model: str, given: dict[str, 
     unused = [name for name in names if given.get(name)]
     if unused:
         fail(f"{', '.join(unused)}: not with {mode} ({why})")
+
+
+_ONLY_WITH = {  # the options of one kind of run, and what that run is
+    "--recordings": (("--mix-sim", "--mix-sim-fit", "--validation-fraction", "--validation", "--test"),
+                     "fine-tuning on labelled recordings"),
+    "--search": (("--sampler", "--space", "--study"), "the hyper-parameter search"),
+}
+
+
+def _refuse_misplaced(recordings: bool, search: bool, given: dict[str, bool]) -> None:
+    """Fail (before any work) when an option of ``--recordings`` or ``--search`` runs is set without it."""
+    for mode, on in (("--recordings", recordings), ("--search", search)):
+        names, what = _ONLY_WITH[mode]
+        misplaced = [name for name in names if given.get(name)]
+        if misplaced and not on:
+            fail(f"{', '.join(misplaced)}: only with {mode} ({what})")
 
 
 def _refuse_earlier_run(output: Path, weights: str | None) -> None:
