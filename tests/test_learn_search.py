@@ -40,6 +40,23 @@ def test_search_saves_the_study_continues_it_and_records_the_choice(tmp_path):
         run_search(TrainConfig(**{**_base().__dict__, "steps": 3}), preset("m3n2"), tmp_path, 4, space=SPACE)
 
 
+def test_an_interrupted_trial_runs_again_and_is_not_counted_as_a_failure(tmp_path):
+    """A trial cut short by Ctrl-C counted as one of the N trials and as 'failed': --search 3 after an interruption
+    gave 2 finished trials and said 1 failed."""
+    import optuna
+
+    run_search(_base(), preset("m3n2"), tmp_path, 1, space=SPACE, sampler="random", check_sequences=2)
+    study = optuna.load_study(study_name="lstm", storage=f"sqlite:///{tmp_path / 'search.db'}")
+    cut_short = study.ask()  # a trial left running, as Ctrl-C leaves it
+    SPACE.suggest(cut_short)
+    rows = []
+    result = run_search(_base(), preset("m3n2"), tmp_path, 3, space=SPACE, sampler="random", check_sequences=2,
+                        progress=lambda done, total, row: rows.append(row))
+    assert result.trials == 3 and result.failed == 0
+    assert [r["trial"] for r in rows] == [2, 3] and rows[0]["hidden"] == cut_short.params["hidden"]
+    assert json.loads(result.summary_path.read_text())["failed"] == 0
+
+
 def test_train_search_command(tmp_path):
     from lookalike.cli import app
 

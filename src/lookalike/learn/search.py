@@ -131,6 +131,16 @@ def _open_study(storage: str, name: str, meta: dict[str, Any]) -> Any:
     return study
 
 
+def _counted(study: Any) -> list[Any]:
+    """The trials that count towards ``--search N``: completed, pruned, or failed with an error; not those cut short
+    by an interruption (failed without one), which run again."""
+    with needs("optuna"):
+        from optuna.trial import TrialState
+
+    return [t for t in study.get_trials(deepcopy=False) if t.state in (TrialState.COMPLETE, TrialState.PRUNED)
+            or (t.state == TrialState.FAIL and "error" in t.user_attrs)]
+
+
 def _sampler(name: str, seed: int) -> Any:
     with needs("optuna"):
         import optuna
@@ -164,8 +174,7 @@ def run_search(base: Any, world: RobotWorldConfig, out_dir: str | Path, trials: 
     for stale in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
         study.tell(stale.number, state=TrialState.FAIL)  # cut short by an interruption: run it again
         study.enqueue_trial(stale.params, skip_if_exists=False)
-    finished = (TrialState.COMPLETE, TrialState.FAIL, TrialState.PRUNED)
-    done = len(study.get_trials(deepcopy=False, states=finished))
+    done = len(_counted(study))
     study.sampler = _sampler(sampler, base.seed + done)  # a fresh seed per session: no redrawn points
     errors: list[str] = []
     with JobPool(max(1, min(workers, trials - done)), backend, address) as pool:
@@ -201,8 +210,8 @@ def run_search(base: Any, world: RobotWorldConfig, out_dir: str | Path, trials: 
     summary = {
         "chosen": chosen, "validation_success": float(best.value), "best_trial": best.number,
         "check_success": check, "check_sequences": check_sequences, "check_seed_base": CHECK_SEED_BASE,
-        "trials": len(study.get_trials(deepcopy=False, states=finished)),
-        "failed": len(study.get_trials(deepcopy=False, states=(TrialState.FAIL,))),
+        "trials": len(_counted(study)),
+        "failed": sum(t.state == TrialState.FAIL for t in _counted(study)),
         "sampler": sampler, "storage": storage, "study": study_name, "space": dataclasses.asdict(space),
         "base": fixed, "weights": str(weights),
         "all_trials": [{"trial": t.number, **t.params, "value": t.value, **t.user_attrs} for t in complete],
