@@ -143,6 +143,7 @@ def _cases() -> list[tuple[str, list[str], str]]:
          "ray"),
         ("torch", ["train", "-o", "runs"], "train"),
         ("torch", ["train-appearance", "-o", "runs"], "train"),
+        ("onnxruntime", ["train-appearance", "-o", "runs"], "vision"),
         ("cyclonedds", ["serve", "-t", "set", "--transport", "dds", "--duration", "1"], "ros"),
         ("rosbags", ["simulate", "--frames", "3", "--bag", "-o", "sims"], "ros"),
         ("rosbags", ["track", "--bag", "run", "--camera-topic", "/c", "-t", "set", "-o", "t.txt"], "ros"),
@@ -168,3 +169,13 @@ def test_a_command_without_its_package_names_the_extra(hidden: str, args: list[s
     assert "Traceback" not in result.stderr and len(lines) == 1, result.stderr[-2000:]
     named = "--rerun-save: needs" if "--rerun-save" in args else f"lookalike {args[0]}: needs"  # (names its option)
     assert named in lines[0] and f"'{extra}' extra" in lines[0] and f"[{extra}]'" in lines[0]
+
+
+def test_train_appearance_without_onnx_stops_before_training(tmp_path: Path) -> None:
+    """torch exports ONNX only with the onnx package: without it the command trained (18 minutes by default), then
+    ended in torch's 'Module onnx is not installed!' with nothing written."""
+    result = _lookalike(["train-appearance", "-o", "runs"], ["onnx"], tmp_path)
+    lines = [ln for ln in result.stderr.splitlines() if ln.strip()]
+    assert result.returncode == 2 and not result.stdout.strip(), result.stderr[-2000:]
+    assert len(lines) == 1 and "needs the onnx package" in lines[0] and "pip install" in lines[0], result.stderr
+    assert not (tmp_path / "runs").exists()

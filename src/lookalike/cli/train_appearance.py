@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 from pathlib import Path
 
 import typer
@@ -23,7 +24,9 @@ def train_appearance(
     """Train the small CNN embedding on crops of new rendered divers and export it to ONNX.
 
     The shipped model (lookalike/vision/models_data/diver_reid.onnx) is this command's defaults."""
-    require("torch")
+    require("torch", "onnxruntime")  # (ONNX Runtime measures the exported model's tracker thresholds)
+    if not _installed("onnx"):  # torch's ONNX export needs it; it comes with no user extra
+        fail("train-appearance: needs the onnx package to export the model; install it: pip install 'onnx>=1.15'")
     from lookalike.learn.appearance_train import AppearanceTrainConfig
     from lookalike.learn.appearance_train import train_appearance as run
     from lookalike.learn.device import torch_device
@@ -38,3 +41,11 @@ def train_appearance(
         info = run(config, output, log=lambda line: console.print(line, markup=False))
     console.print(f"[green]trained[/] in {info['minutes']:.1f} min: validation AUC {info['validation']['best_auc']:.4f}"
                   f" → {output / info['model']}")
+
+
+def _installed(module: str) -> bool:
+    """Whether ``module`` can be found (without importing it)."""
+    try:
+        return importlib.util.find_spec(module) is not None
+    except ImportError:
+        return False
