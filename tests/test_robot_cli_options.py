@@ -144,3 +144,12 @@ def test_train_refuses_search_options_without_search(tmp_path, option):
                                       *option, "-o", str(tmp_path / "run")])
     assert result.exit_code == 2 and f"{option[0]}: only with --search" in result.output, result.output
     assert not (tmp_path / "run").exists() and not (tmp_path / "s.db").exists()
+
+
+def test_train_resume_without_a_checkpoint_says_it_starts_a_new_run(tmp_path):
+    """``--resume`` into a folder with nothing to continue (a mistyped -o) trained from scratch without a word."""
+    pytest.importorskip("torch", reason="train needs the 'train' extra")
+    result = CliRunner().invoke(app, ["train", "--steps", "1", "--sequence-length", "150", "--batch-size", "1",
+                                      "--resume", "-o", str(tmp_path / "run")])
+    assert result.exit_code == 0, result.output
+    assert "--resume: " in result.output and "holds no checkpoint.pt to continue; starting a new run" in result.output

@@ -14,7 +14,7 @@ import typer
 from rich.progress import TextColumn
 
 from lookalike._optional import needs
-from lookalike.cli.app import app, check_outputs_or_fail, check_study_or_fail, console, fail, failing, require
+from lookalike.cli.app import app, check_outputs_or_fail, check_study_or_fail, console, fail, failing, require, warn
 from lookalike.cli.progress import bars
 
 if TYPE_CHECKING:
@@ -137,8 +137,8 @@ def train(
                           [recordings, init_from, validation_folder], folders={"-o/--output"})
     if search is not None:
         check_study_or_fail(study)
-    _refuse_earlier_run(output, None if search is not None or resume else
-                        "set.npz" if model == "set" and recordings is None else "model.npz")
+    _check_earlier_run(output, None if search is not None else
+                       "set.npz" if model == "set" and recordings is None else "model.npz", resume)
     run: dict[str, Any] = dict(  # the options every training run shares (cli.train_options.RunOptions)
         steps=steps, minutes=minutes, batch_size=batch_size, sequence_length=sequence_length, seed=seed,
         patience=patience, validate_every=validate_every, threads=threads, workers=workers, backend=backend,
@@ -240,10 +240,15 @@ def _refuse_misplaced(recordings: bool, search: bool, given: dict[str, bool]) ->
             fail(f"{', '.join(misplaced)}: only with {mode} ({what})")
 
 
-def _refuse_earlier_run(output: Path, weights: str | None) -> None:
-    """Fail when ``output`` holds an earlier run's checkpoint or ``weights``, which a new run would replace (``weights``
-    None: a run that continues what the folder holds)."""
+def _check_earlier_run(output: Path, weights: str | None, resume: bool) -> None:
+    """Without ``resume``, fail when ``output`` holds an earlier run's checkpoint or ``weights``, which a new run would
+    replace; with it, warn when there is no checkpoint to continue (``weights`` None: a search, which continues
+    its study by itself)."""
     if weights is None:
+        return
+    if resume:
+        if not (output / "checkpoint.pt").is_file():
+            warn(f"--resume: {output} holds no checkpoint.pt to continue; starting a new run")
         return
     earlier = [name for name in ("checkpoint.pt", weights) if (output / name).exists()]
     if earlier:
