@@ -36,6 +36,16 @@ def test_train_detector_from_folder_and_refusals(tmp_path):
     assert res.exit_code != 0 and "not a readable image" in res.output
 
 
+def test_train_detector_refuses_rendering_options_with_data(tmp_path):
+    """--frames and --validation-frames were accepted with --data and ignored (no rendering, no held-out choice)."""
+    (tmp_path / "data" / "positives").mkdir(parents=True)
+    out = tmp_path / "det.npz"
+    res = runner.invoke(app, ["train-detector", "--data", str(tmp_path / "data"), "-o", str(out), "--frames", "50",
+                              "--validation-frames", "20"])
+    assert res.exit_code == 2 and "--frames, --validation-frames: only without --data" in res.output, res.output
+    assert not out.exists()
+
+
 def test_train_detector_on_rendered_frames(tmp_path):
     out = tmp_path / "det.npz"
     res = runner.invoke(app, ["train-detector", "-o", str(out), "--frames", "8", "--stages", "2",

@@ -10,7 +10,7 @@ import numpy as np
 import typer
 from rich.progress import Progress, TextColumn
 
-from lookalike.cli.app import app, check_outputs_or_fail, console, failing, require
+from lookalike.cli.app import app, check_outputs_or_fail, console, fail, failing, require
 from lookalike.cli.progress import bars
 from lookalike.io.outputs import atomic_path
 from lookalike.learn.vision_train import train_robot_detector
@@ -35,6 +35,11 @@ def train_detector(
                                           "(without --data; 0: keep every stage)."),
 ) -> None:
     """Train the HOG cascade robot detector and save it."""
+    rendered = [name for name, value, default in (("--frames", frames, 300), ("--validation-frames", validation_frames,
+                                                                            100)) if value != default]
+    if data is not None and rendered:
+        fail(f"{', '.join(rendered)}: only without --data (rendered robots; --data trains on its images and keeps "
+             "every stage)")
     check_outputs_or_fail({"-o/--output": output}, input_folders=[data])
     require("sklearn")
     with failing(ValueError):
