@@ -110,6 +110,24 @@ def test_train_recordings_refuses_bad_input_in_one_line(app, tmp_path, case):
     assert len(r.output.strip().splitlines()) == 1, r.output
 
 
+def test_train_recordings_warns_of_a_recording_without_robots(app, tmp_path):
+    """An export of a sequence nobody labelled (every detection a false positive) trained without a word."""
+    import dataclasses
+
+    from lookalike.sim import RobotSequence
+
+    _recordings(tmp_path / "rec", n=2)
+    sequence = simulate_robots(preset("m3n2"), 60, 77)
+    arrays = dataclasses.replace(sequence.arrays, det_label=np.full_like(sequence.arrays.det_label, -1))
+    write_robot_sequence(tmp_path / "rec" / "nobody.labelled.jsonl", RobotSequence(sequence.config, sequence.seed,
+                                                                                    arrays))
+    r = runner.invoke(app, ["train", "--recordings", str(tmp_path / "rec"), "-o", str(tmp_path / "out"), "--steps",
+                            "1", "--sequence-length", "150", "--batch-size", "2"])
+    assert r.exit_code == 0, r.output
+    assert "nobody.labelled.jsonl: no detection is labelled as a robot" in r.output
+    assert r.output.count("no detection is labelled") == 1
+
+
 def test_train_recordings_simulates_the_measured_detector(app, tmp_path):
     _recordings(tmp_path / "rec")
     _recordings(tmp_path / "test", n=1)

@@ -8,7 +8,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
-from lookalike.cli.app import console, fail, failing
+from lookalike.cli.app import console, fail, failing, warn
 from lookalike.cli.train_options import RunOptions
 from lookalike.sim import RobotSequence
 
@@ -74,7 +74,13 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     the folder of the validation recordings), write ``OUTPUT/model.npz``; with ``opt.test``, print the
     starting and fine-tuned success rates on the test recordings."""
     from lookalike.cli.train import _with_progress, torch_device
-    from lookalike.learn.recordings import RecordingSampler, check_recordings, split_recordings, validation_arrays
+    from lookalike.learn.recordings import (
+        RecordingSampler,
+        check_recordings,
+        split_recordings,
+        validation_arrays,
+        without_robots,
+    )
     from lookalike.learn.training import TrainConfig, plot_log
     from lookalike.learn.training import train as run_training
     from lookalike.parallel import JobPool
@@ -97,6 +103,9 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
         init = load_weights(init_path)
         spec = init.spec
         check_recordings(spec, recordings, names)
+        for name in without_robots(recordings, names):
+            warn(f"{name}: no detection is labelled as a robot, so it teaches only false positives (an export of "
+                 "an unlabelled sequence writes every detection as one)")
         check_recordings(spec, tests, [str(p) for p in recording_paths(opt.test)] if opt.test else [])
         if opt.validation is not None:
             n_train = len(recording_paths(folder))

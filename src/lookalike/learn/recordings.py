@@ -33,6 +33,13 @@ def check_recordings(spec: EncodingSpec, recordings: Sequence[RobotSequence], na
             raise ValueError(f"{name}: holds no detection to learn from")
 
 
+def without_robots(recordings: Sequence[RobotSequence], names: Sequence[str]) -> list[str]:
+    """The names of the recordings none of whose detections is labelled as a robot: they teach only false positives
+    (the robots out of view throughout, or an export of a sequence nobody labelled)."""
+    return [name for rec, name in zip(recordings, names)
+            if not (rec.arrays.det_label[rec.arrays.det_valid] >= 0).any()]
+
+
 def split_recordings(n: int, validation_fraction: float, seed: int = 0) -> tuple[list[int], list[int]]:
     """Indices ``(training, validation)`` of ``n`` >= 2 recordings, ``round(fraction·n)`` >= 1 for validation."""
     if n < 2:
@@ -92,4 +99,5 @@ def validation_arrays(spec: EncodingSpec, recordings: Sequence[RobotArrays], bpt
     return np.stack(xs), np.stack(ys)
 
 
-__all__ = ["RecordingSampler", "check_recordings", "recording_arrays", "split_recordings", "validation_arrays"]
+__all__ = ["RecordingSampler", "check_recordings", "recording_arrays", "split_recordings", "validation_arrays",
+           "without_robots"]
