@@ -153,3 +153,18 @@ def test_train_resume_without_a_checkpoint_says_it_starts_a_new_run(tmp_path):
                                       "--resume", "-o", str(tmp_path / "run")])
     assert result.exit_code == 0, result.output
     assert "--resume: " in result.output and "holds no checkpoint.pt to continue; starting a new run" in result.output
+
+
+def test_train_ship_into_a_folder_it_cannot_write_is_one_line(tmp_path, monkeypatch):
+    """It ended in a FileNotFoundError traceback after the training (the weights were kept, the message did not
+    say where)."""
+    pytest.importorskip("torch", reason="train needs the 'train' extra")
+    import lookalike.trackers.lstm.weights as weights
+
+    blocker = tmp_path / "a file"
+    blocker.write_text("not a folder\n")
+    monkeypatch.setattr(weights, "WEIGHTS_DIR", blocker / "weights")
+    result = CliRunner().invoke(app, ["train", "--steps", "1", "--sequence-length", "150", "--batch-size", "1",
+                                      "--ship", "-o", str(tmp_path / "run")])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert "--ship: cannot write" in result.output and f"{tmp_path / 'run' / 'model.npz'}" in result.output

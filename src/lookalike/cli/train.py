@@ -317,9 +317,13 @@ def _finish(result: Any, output: Path, ship_to: Path | None, detail: str = "") -
                   f"{result.best_step} of {result.steps}; weights {result.weights_path}, log {result.log_path}, "
                   f"plot {png}")
     if ship_to is not None:
-        ship_to.parent.mkdir(exist_ok=True)
-        shutil.copy(result.weights_path, ship_to)
-        shutil.copy(result.weights_path.with_suffix(".json"), ship_to.with_suffix(".json"))
+        try:
+            ship_to.parent.mkdir(exist_ok=True)
+            shutil.copy(result.weights_path, ship_to)
+            shutil.copy(result.weights_path.with_suffix(".json"), ship_to.with_suffix(".json"))
+        except OSError as exc:
+            fail(f"--ship: cannot write {ship_to} ({exc.strerror or exc}); the trained weights are "
+                 f"{result.weights_path}")
         console.print(f"shipped as {ship_to}", markup=False)
 
 
