@@ -67,3 +67,11 @@ def test_train_heading_reports_error(tmp_path):
     assert model.support.shape[1] == len(model.mean)
     res = runner.invoke(app, ["train-heading", "-o", str(out), "--frames", "0"])
     assert res.exit_code != 0 and "--frames" in res.output
+
+
+def test_train_heading_with_too_few_frames_names_the_option(tmp_path):
+    """It said 'heading_rad: need >= 6 samples over >= 2 classes, got 5', naming neither option nor robots."""
+    out = tmp_path / "h.npz"
+    res = runner.invoke(app, ["train-heading", "-o", str(out), "--frames", "1", "--test-frames", "0"])
+    assert res.exit_code == 2 and "--frames 1: " in res.output and "give more --frames or fewer --folds" in res.output
+    assert not out.exists()

@@ -88,6 +88,9 @@ def train_heading_command(
                 parts.append(rendered_heading_samples(n, seed * 7919 + start, config))
                 bar.advance(task, n)
             f, h = (np.concatenate(columns) for columns in zip(*parts))
+            if len(f) < 2 * folds:
+                raise ValueError(f"--frames {frames}: {len(f)} robots rendered; the {folds}-fold grid search needs at "
+                                 f"least {2 * folds} (give more --frames or fewer --folds)")
             ft, ht = (rendered_heading_samples(test_frames, seed + 1000003, config) if test_frames
                       else (np.zeros((0, f.shape[1])), np.zeros(0)))
             bar.advance(task, test_frames)
