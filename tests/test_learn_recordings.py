@@ -167,3 +167,14 @@ def test_train_recordings_refuses_to_hold_out_its_training_recordings(app, tmp_p
                             "1", "--sequence-length", "150", "--batch-size", "2", option, str(tmp_path / "rec")])
     assert r.exit_code == 2 and option in r.output and "holds 2 of the --recordings" in r.output, r.output
     assert not (tmp_path / "out" / "model.npz").exists()
+
+
+def test_train_recordings_refuses_to_test_on_its_validation_recordings(app, tmp_path):
+    """--test on the --validation folder scored the weights on the recordings they were chosen on, as a test."""
+    _recordings(tmp_path / "rec", n=2)
+    _recordings(tmp_path / "val", n=1)
+    r = runner.invoke(app, ["train", "--recordings", str(tmp_path / "rec"), "-o", str(tmp_path / "out"), "--steps",
+                            "1", "--sequence-length", "150", "--batch-size", "2", "--validation", str(tmp_path / "val"),
+                            "--test", str(tmp_path / "val")])
+    assert r.exit_code == 2 and "--test: " in r.output and "holds 1 of the --validation recordings" in r.output
+    assert not (tmp_path / "out" / "model.npz").exists()

@@ -59,13 +59,14 @@ def read_recordings(folder: Path, option: str) -> list[RobotSequence]:
     return recordings
 
 
-def _check_held_out(training: list[Path], folder: Path | None, option: str) -> None:
-    """Fail when ``folder`` holds one of the ``training`` recordings (it would score the network on what it learnt)."""
+def _check_held_out(training: list[Path], folder: Path | None, option: str, against: str = "--recordings") -> None:
+    """Fail when ``folder`` holds one of the ``training`` recordings (those of option ``against``): it would score
+    the network on what it learnt, or was chosen on."""
     if folder is None or not folder.is_dir():
         return
     shared = {p.resolve() for p in training} & {p.resolve() for p in recording_paths(folder)}
     if shared:
-        fail(f"{option}: {folder} holds {len(shared)} of the --recordings recordings (e.g. {min(shared).name}); "
+        fail(f"{option}: {folder} holds {len(shared)} of the {against} recordings (e.g. {min(shared).name}); "
              "give a folder of other recordings")
 
 
@@ -92,6 +93,8 @@ def train_recordings(folder: Path, output: Path, opt: RecordingOptions) -> None:
     paths = recording_paths(folder)
     _check_held_out(paths, opt.validation, "--validation")
     _check_held_out(paths, opt.test, "--test")
+    if opt.validation is not None:  # (the weights are chosen on the validation recordings)
+        _check_held_out(recording_paths(opt.validation), opt.test, "--test", "--validation")
     if opt.validation is not None:  # every recording of the folder trains; these validate
         recordings += read_recordings(opt.validation, "--validation")
         paths += recording_paths(opt.validation)
