@@ -135,6 +135,36 @@ def test_writer_leaves_nothing_when_the_run_fails(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]
 
 
+def test_a_signal_before_the_writer_holds_its_file_leaves_no_temporary_file(tmp_path, monkeypatch):
+    """SIGTERM (or Ctrl-C) between making the temporary file and entering the ``with`` block left it behind (seen
+    under load: ``.out.x8anya5v.tmp.txt``). The file is now made on entering, and one interrupted while being made
+    is removed."""
+    import os
+
+    from lookalike.io import rules
+
+    target = tmp_path / "out.txt"
+    target.write_text("old\n")
+    writer = MotWriter(target)  # (a signal here, before the with block, has nothing to leave behind)
+    assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]
+    with writer:
+        writer.write_rows(np.array([[1, 1, 0, 0, 5, 5, 1, -1, -1, -1]], dtype=float))
+    assert target.read_text().startswith("1,1,")
+
+    def interrupted(fd, mode):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(os, "fchmod", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        rules.temp_beside(target)
+    assert [p.name for p in tmp_path.iterdir()] == ["out.txt"]
+    monkeypatch.undo()
+    unused = MotWriter(tmp_path / "empty.txt")  # closed without rows or a with block: an empty file all the same
+    assert unused.close() == tmp_path / "empty.txt" and (tmp_path / "empty.txt").read_text() == ""
+    with pytest.raises(ValueError, match="writer already closed"):
+        unused.write_rows(np.zeros((1, 10)))
+
+
 def test_track_cli_streams_the_same_file_as_the_old_loop(tmp_path):
     from lookalike.pipeline.results import add_confidence
 

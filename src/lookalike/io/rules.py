@@ -149,6 +149,10 @@ def temp_beside(path: Path) -> tuple[int, Path]:
         os.fchmod(fd, user_mode())
     except OSError:
         pass  # a file system without modes
+    except BaseException:  # Ctrl-C or SIGTERM before the caller holds the file: it would be left behind
+        os.close(fd)
+        os.unlink(tmp)
+        raise
     return fd, Path(tmp)
 
 

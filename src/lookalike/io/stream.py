@@ -168,18 +168,17 @@ class DetectionStream:
 class MotWriter:
     """A sink for :func:`lookalike.loop.run` writing result rows to a temporary file that :meth:`close` renames to
     ``path``, or to the file a symbolic link ``path`` points at (leaving a ``with`` block on an exception deletes
-    it). A device or named pipe (``/dev/null``) is written into directly."""
+    it). A device or named pipe (``/dev/null``) is written into directly. The file is made on entering the ``with``
+    block (or at the first write), so nothing is left behind by a signal before it."""
 
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
         self._target = write_target(self.path)
         self._tmp: Path | None = None
-        if is_special(self._target):
-            self._fh: TextIO | None = open(self._target, "w")  # (closed by close or abort)
-        else:
+        self._fh: TextIO | None = None  # (opened by __enter__ or the first write; closed by close or abort)
+        self._ended = False
+        if not is_special(self._target):
             self._target.parent.mkdir(parents=True, exist_ok=True)
-            fd, self._tmp = temp_beside(self._target)
-            self._fh = os.fdopen(fd, "w")
         self._pending: list[np.ndarray] = []  # rows not yet written (at most WRITE_ROWS)
         self._pending_rows = 0
         self.rows = 0
@@ -187,11 +186,29 @@ class MotWriter:
     def __call__(self, frame: Frame, tracks: Any) -> None:
         self.write_rows(tracks_to_rows(frame.index, tracks))
 
+    def _open(self) -> TextIO:
+        """The file written to, opened at the first need (in ``__enter__``, not ``__init__``: a signal arriving between
+        the two would leave the temporary file behind); ``ValueError`` once closed or aborted."""
+        if self._ended:
+            raise ValueError(f"{self.path}: writer already closed")
+        if self._fh is None:
+            if is_special(self._target):
+                self._fh = open(self._target, "w")
+            else:
+                fd, tmp = temp_beside(self._target)
+                try:
+                    self._fh = os.fdopen(fd, "w")
+                except BaseException:
+                    os.close(fd)
+                    tmp.unlink(missing_ok=True)
+                    raise
+                self._tmp = tmp
+        return self._fh
+
     def write_rows(self, rows: np.ndarray) -> None:
         """Append result rows ``(k, 10)`` (wider ones cut to 10 columns); ``ValueError`` for another shape, and (when
         written) for a NaN or infinite value, naming its frame."""
-        if self._fh is None:
-            raise ValueError(f"{self.path}: writer already closed")
+        self._open()
         block = np.array(rows, dtype=float)  # a copy: the caller may reuse its array
         if block.size == 0:
             return
@@ -221,13 +238,15 @@ class MotWriter:
 
     def close(self) -> Path:
         """Finish the file: rename the temporary file to ``path``. Returns ``path``."""
-        if self._fh is not None:
+        if not self._ended:
+            fh = self._open()
+            self._ended = True
             try:
                 self._flush()
             except BaseException:
                 self.abort()
                 raise
-            fh, self._fh = self._fh, None
+            self._fh = None
             try:
                 fh.close()
                 if self._tmp is not None:
@@ -241,6 +260,7 @@ class MotWriter:
     def abort(self) -> None:
         """Drop the temporary file; ``path`` is left as it was."""
         self._pending, self._pending_rows = [], 0
+        self._ended = True
         if self._fh is not None:
             self._fh.close()
             self._fh = None
@@ -248,6 +268,7 @@ class MotWriter:
                 self._tmp.unlink(missing_ok=True)
 
     def __enter__(self) -> MotWriter:
+        self._open()
         return self
 
     def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
