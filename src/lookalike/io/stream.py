@@ -195,14 +195,13 @@ class MotWriter:
             if is_special(self._target):
                 self._fh = open(self._target, "w")
             else:
-                fd, tmp = temp_beside(self._target)
+                fd, self._tmp = temp_beside(self._target)
                 try:
                     self._fh = os.fdopen(fd, "w")
                 except BaseException:
                     os.close(fd)
-                    tmp.unlink(missing_ok=True)
+                    self._tmp.unlink(missing_ok=True)
                     raise
-                self._tmp = tmp
         return self._fh
 
     def write_rows(self, rows: np.ndarray) -> None:
@@ -268,7 +267,11 @@ class MotWriter:
                 self._tmp.unlink(missing_ok=True)
 
     def __enter__(self) -> MotWriter:
-        self._open()
+        try:
+            self._open()
+        except BaseException:  # (a signal inside: __exit__ will not run)
+            self.abort()
+            raise
         return self
 
     def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
