@@ -137,3 +137,24 @@ def test_train_refuses_an_unknown_model_in_one_line(tmp_path):
 
     result = CliRunner().invoke(app, ["train", "--model", "nope", "-o", str(tmp_path)])
     assert result.exit_code == 2 and "--model" in result.output and "Traceback" not in result.output
+
+
+def test_weights_save_killed_between_its_two_files_is_refused_not_mismatched(tmp_path, monkeypatch):
+    path = save_set_weights(random_weights(seed=0), tmp_path / "set.npz")
+
+    def killed(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(np, "savez_compressed", killed)  # the .json of the new weights is written, then the kill
+    with pytest.raises(KeyboardInterrupt):
+        save_set_weights(random_weights(seed=1, pair=10), path)
+    monkeypatch.undo()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["set.json", "set.npz"]
+    with pytest.raises(CheckpointError, match=r"set\.npz and .*set\.json are not one pair"):
+        load_set_weights(path)
+    save_set_weights(random_weights(seed=1, pair=10), path)  # saved again: one pair
+    assert load_set_weights(path).pair == 10
+    other = save_set_weights(random_weights(seed=2), tmp_path / "other.npz")
+    other.with_suffix(".json").replace(path.with_suffix(".json"))  # files of two saves put side by side
+    with pytest.raises(CheckpointError, match="not one pair"):
+        load_set_weights(path)

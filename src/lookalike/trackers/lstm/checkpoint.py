@@ -1,8 +1,9 @@
 """Exported network weights: a ``.npz`` of arrays plus a JSON metadata file beside it.
 
 ``model.npz`` holds ``layer{i}.w_ih``, ``layer{i}.w_hh``, ``layer{i}.b_ih``, ``layer{i}.b_hh`` (PyTorch's gate order:
-LSTM ``i, f, g, o``; GRU ``r, z, n``), ``head.weight``, ``head.bias``, ``input_mean`` and ``input_std``. ``model.json``
-records the format version, cell type, sizes, the encoding version and free-form training information."""
+LSTM ``i, f, g, o``; GRU ``r, z, n``), ``head.weight``, ``head.bias``, ``input_mean``, ``input_std`` and
+``save_id``. ``model.json`` records the format version, cell type, sizes, the encoding version, free-form training
+information and the ``save_id`` of its ``.npz`` (a pair whose ``save_id`` differs is refused)."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.trackers.lstm.encoding import ENCODING_VERSION, EncodingSpec
-from lookalike.trackers.parts.weights_io import CheckpointError, read_metadata, write_weights
+from lookalike.trackers.parts.weights_io import CheckpointError, read_arrays, read_metadata, write_weights
 
 FORMAT_VERSION = 1
 GATES = {"lstm": 4, "gru": 3}
@@ -97,11 +98,7 @@ def load_weights(path: str | os.PathLike[str], n_agents: int | None = None,
     for key, wanted in (("n_agents", n_agents), ("n_slots", n_slots)):
         if wanted is not None and meta.get(key) != wanted:
             raise CheckpointError(f"{meta_path}: trained for {key}={meta.get(key)}, but {wanted} was requested")
-    try:
-        with np.load(path) as data:
-            arrays = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
-        raise CheckpointError(f"{path}: cannot read the weights ({exc})") from None
+    arrays = read_arrays(path, meta_path, meta)
     get: Any = arrays.get  # (None where missing: the shape check rejects it)
     try:
         spec = EncodingSpec(int(meta["n_agents"]), int(meta["n_slots"]), float(meta["max_age_s"]),

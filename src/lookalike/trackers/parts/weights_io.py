@@ -1,16 +1,24 @@
 """Network weights stored as an ``.npz`` with a ``.json`` of metadata beside it: reading the metadata, and the error
-a corrupt or mismatched file raises."""
+a corrupt or mismatched file raises.
+
+Each save marks both files with one new random ``save_id`` (an array of the ``.npz``, a field of the ``.json``) and
+writes the ``.json`` first: a save killed between the two files leaves a pair whose marks differ, which
+:func:`read_arrays` refuses instead of loading one network's arrays with another's metadata."""
 
 from __future__ import annotations
 
 import json
 import os
 import tempfile
+import uuid
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, BinaryIO
 
 import numpy as np
+
+SAVE_ID = "save_id"
+"""The array of the ``.npz`` and the field of the ``.json`` that mark the two files of one save."""
 
 
 class CheckpointError(ValueError):
@@ -42,13 +50,32 @@ def read_metadata(path: str | os.PathLike[str], fmt: str, what: str) -> tuple[Pa
     return path, meta_path, meta
 
 
+def read_arrays(path: Path, meta_path: Path, meta: dict[str, Any]) -> dict[str, np.ndarray]:
+    """The arrays of the weights ``path`` whose metadata ``meta`` was read from ``meta_path`` (the ``save_id`` mark
+    left out); :class:`CheckpointError` when the file cannot be read or the two files are not of one save."""
+    try:
+        with np.load(path) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (OSError, ValueError) as exc:
+        raise CheckpointError(f"{path}: cannot read the weights ({exc})") from None
+    mark = arrays.pop(SAVE_ID, None)
+    wanted = meta.get(SAVE_ID)
+    if wanted is not None and (mark is None or str(mark) != str(wanted)):
+        raise CheckpointError(f"{path} and {meta_path} are not one pair: they were written by different saves (one "
+                              "interrupted between the two files?); save or copy both files again")
+    return arrays
+
+
 def write_weights(path: Path, arrays: dict[str, Any], meta: dict[str, Any], *, compressed: bool = False) -> None:
-    """Write ``path`` (``.npz``) and its ``.json`` metadata, each through a unique temporary file in the same folder
-    renamed into place (a killed run leaves the old files whole and no temporary behind)."""
+    """Write ``path`` (``.npz``) and its ``.json`` metadata, both marked with a new ``save_id``, each through a unique
+    temporary file in the same folder renamed into place, the ``.json`` first (a killed run leaves no temporary
+    behind, and either the old pair, the new pair or a pair that :func:`read_arrays` refuses)."""
+    save_id = uuid.uuid4().hex
     save = np.savez_compressed if compressed else np.savez
-    _replace(path, lambda f: save(f, **arrays))
-    text = json.dumps(meta, indent=2, sort_keys=True) + "\n"
+    text = json.dumps({**meta, SAVE_ID: save_id}, indent=2, sort_keys=True) + "\n"
     _replace(path.with_suffix(".json"), lambda f: f.write(text.encode()))
+    marked: dict[str, Any] = {**arrays, SAVE_ID: np.array(save_id)}
+    _replace(path, lambda f: save(f, **marked))
 
 
 def _replace(target: Path, write: Callable[[BinaryIO], object]) -> None:

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from lookalike.trackers.kernels.world import einsum
-from lookalike.trackers.parts.weights_io import CheckpointError, read_metadata, write_weights
+from lookalike.trackers.parts.weights_io import CheckpointError, read_arrays, read_metadata, write_weights
 
 FORMAT = "lookalike-set-associator"
 FORMAT_VERSION = 1
@@ -95,10 +95,10 @@ def load_set_weights(path: str | os.PathLike[str]) -> SetWeights:
     if meta.get("format_version") != FORMAT_VERSION:
         raise CheckpointError(f"{meta_path}: format_version {meta.get('format_version')} is not supported "
                               f"(this lookalike reads {FORMAT_VERSION})")
+    loaded = read_arrays(path, meta_path, meta)
     try:
-        with np.load(path) as data:
-            arrays = {k: data[k].astype(np.float64) for k in data.files}
-    except (OSError, ValueError) as exc:
+        arrays = {k: v.astype(np.float64) for k, v in loaded.items()}
+    except (TypeError, ValueError) as exc:
         raise CheckpointError(f"{path}: cannot read the weights ({exc})") from None
     try:
         weights = SetWeights(arrays, int(meta["token"]), int(meta["pair"]), int(meta["memory"]),
