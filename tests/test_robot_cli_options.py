@@ -3,6 +3,8 @@ are non-negative)."""
 
 from __future__ import annotations
 
+import os
+
 import pytest
 from typer.testing import CliRunner
 
@@ -168,3 +170,23 @@ def test_train_ship_into_a_folder_it_cannot_write_is_one_line(tmp_path, monkeypa
                                       "--ship", "-o", str(tmp_path / "run")])
     assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
     assert "--ship: cannot write" in result.output and f"{tmp_path / 'run' / 'model.npz'}" in result.output
+
+
+def test_train_ship_replaces_the_shipped_pair_through_a_rename(tmp_path, monkeypatch):
+    """The weights were copied into the package folder in place: a copy cut short left a half-written .npz under
+    the shipped name."""
+    pytest.importorskip("torch", reason="train needs the 'train' extra")
+    import lookalike.trackers.lstm.weights as weights
+    from lookalike.trackers.lstm import load_weights
+
+    shipped = tmp_path / "weights" / "lstm_m3_n2.npz"
+    shipped.parent.mkdir()
+    shipped.write_bytes(b"earlier weights")
+    os.link(shipped, tmp_path / "earlier.npz")  # a second name: a copy into the file itself changes it too
+    monkeypatch.setattr(weights, "WEIGHTS_DIR", shipped.parent)
+    result = CliRunner().invoke(app, ["train", "--steps", "1", "--sequence-length", "150", "--batch-size", "1",
+                                      "--ship", "-o", str(tmp_path / "run")])
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "earlier.npz").read_bytes() == b"earlier weights"
+    assert load_weights(shipped).spec.n_agents == 2
+    assert sorted(p.name for p in shipped.parent.iterdir()) == ["lstm_m3_n2.json", "lstm_m3_n2.npz"]

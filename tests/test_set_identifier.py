@@ -1,4 +1,5 @@
 import json
+import os
 
 import numpy as np
 import pytest
@@ -158,3 +159,31 @@ def test_weights_save_killed_between_its_two_files_is_refused_not_mismatched(tmp
     other.with_suffix(".json").replace(path.with_suffix(".json"))  # files of two saves put side by side
     with pytest.raises(CheckpointError, match="not one pair"):
         load_set_weights(path)
+
+
+def test_copied_weights_replace_the_old_pair_whole_or_are_refused(tmp_path, monkeypatch):
+    from lookalike.trackers.parts import weights_io
+
+    old = save_set_weights(random_weights(seed=0), tmp_path / "old" / "set.npz")
+    new = save_set_weights(random_weights(seed=1, pair=10), tmp_path / "new.npz")
+    keep = tmp_path / "old" / "kept.npz"
+    os.link(old, keep)  # a second name of the old file: written in place, it would change too
+    writes = []
+
+    def killed_at_the_npz(target, write):
+        writes.append(target.name)
+        if target.suffix == ".npz":
+            raise KeyboardInterrupt
+        real(target, write)
+
+    real = weights_io.replace_file
+    monkeypatch.setattr(weights_io, "replace_file", killed_at_the_npz)
+    with pytest.raises(KeyboardInterrupt):
+        weights_io.copy_weights(new, old)
+    monkeypatch.undo()
+    assert writes == ["set.json", "set.npz"]
+    with pytest.raises(CheckpointError, match="not one pair"):
+        load_set_weights(old)
+    weights_io.copy_weights(new, old)
+    assert load_set_weights(old).pair == 10 and keep.read_bytes() != old.read_bytes()
+    assert sorted(p.name for p in old.parent.iterdir()) == ["kept.npz", "set.json", "set.npz"]

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import shutil
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -311,6 +310,7 @@ def _train_set(output: Path, steps: int, minutes: float | None, batch_size: int,
 def _finish(result: Any, output: Path, ship_to: Path | None, detail: str = "") -> None:
     """Plot the training log, print the best validation and, with ``ship_to`` (an ``.npz``), ship the weights."""
     from lookalike.learn.training import plot_log
+    from lookalike.trackers.parts.weights_io import copy_weights
 
     png = plot_log(result.log_path, output / "training_log.png")
     console.print(f"best validation success rate [bold]{100 * result.best_success:.1f}%[/]{detail} at step "
@@ -319,8 +319,7 @@ def _finish(result: Any, output: Path, ship_to: Path | None, detail: str = "") -
     if ship_to is not None:
         try:
             ship_to.parent.mkdir(exist_ok=True)
-            shutil.copy(result.weights_path, ship_to)
-            shutil.copy(result.weights_path.with_suffix(".json"), ship_to.with_suffix(".json"))
+            copy_weights(result.weights_path, ship_to)
         except OSError as exc:
             fail(f"--ship: cannot write {ship_to} ({exc.strerror or exc}); the trained weights are "
                  f"{result.weights_path}")

@@ -6,7 +6,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import shutil
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -19,6 +18,7 @@ from lookalike._optional import needs
 from lookalike.learn.checkpoints import changed_settings
 from lookalike.parallel import JobPool
 from lookalike.sim import RobotWorldConfig
+from lookalike.trackers.parts.weights_io import copy_weights, write_bytes
 
 SAMPLERS = ("tpe", "random")
 CHECK_SEED_BASE = 1_800_000_000  # held-out seeds that score the chosen network (neither training nor validation)
@@ -202,8 +202,7 @@ def run_search(base: Any, world: RobotWorldConfig, out_dir: str | Path, trials: 
     best = study.best_trial
     source = out / f"trial-{best.number:04d}" / "model.npz"
     weights = out / "model.npz"
-    shutil.copy(source, weights)
-    shutil.copy(source.with_suffix(".json"), weights.with_suffix(".json"))
+    copy_weights(source, weights)
     check = check_success(weights, world, check_sequences, base.sequence_length)
     chosen = {"hidden": int(best.params["hidden"]), "num_layers": int(best.params["num_layers"]),
               "learning_rate": float(best.params["learning_rate"])}
@@ -217,7 +216,7 @@ def run_search(base: Any, world: RobotWorldConfig, out_dir: str | Path, trials: 
         "all_trials": [{"trial": t.number, **t.params, "value": t.value, **t.user_attrs} for t in complete],
     }
     summary_path = out / "search.json"
-    summary_path.write_text(json.dumps(summary, indent=2, default=_json_default) + "\n")
+    write_bytes(summary_path, (json.dumps(summary, indent=2, default=_json_default) + "\n").encode())
     return SearchResult(chosen, float(best.value), check, check_sequences, summary["trials"], summary["failed"],
                         best.number, weights, summary_path, errors)
 

@@ -73,12 +73,27 @@ def write_weights(path: Path, arrays: dict[str, Any], meta: dict[str, Any], *, c
     save_id = uuid.uuid4().hex
     save = np.savez_compressed if compressed else np.savez
     text = json.dumps({**meta, SAVE_ID: save_id}, indent=2, sort_keys=True) + "\n"
-    _replace(path.with_suffix(".json"), lambda f: f.write(text.encode()))
+    write_bytes(path.with_suffix(".json"), text.encode())
     marked: dict[str, Any] = {**arrays, SAVE_ID: np.array(save_id)}
-    _replace(path, lambda f: save(f, **marked))
+    replace_file(path, lambda f: save(f, **marked))
 
 
-def _replace(target: Path, write: Callable[[BinaryIO], object]) -> None:
+def copy_weights(source: Path, target: Path) -> Path:
+    """Copy the weights ``source`` (``.npz``) and its ``.json`` onto ``target`` (``.npz``) as :func:`write_weights`
+    writes them: the ``.json`` first, each file through a temporary file renamed into place; returns ``target``."""
+    for suffix in (".json", ".npz"):
+        write_bytes(target.with_suffix(suffix), source.with_suffix(suffix).read_bytes())
+    return target
+
+
+def write_bytes(target: Path, data: bytes) -> None:
+    """Write ``data`` to ``target`` through :func:`replace_file`."""
+    replace_file(target, lambda f: f.write(data))
+
+
+def replace_file(target: Path, write: Callable[[BinaryIO], object]) -> None:
+    """Call ``write`` on a new temporary file beside ``target`` and rename it onto ``target``: a killed or failed
+    ``write`` leaves the old ``target`` whole and no temporary file behind."""
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     try:
         with os.fdopen(fd, "wb") as f:
