@@ -296,3 +296,18 @@ def test_write_mot_onto_a_folder_names_the_folder_not_a_temporary_file(tmp_path)
     with pytest.raises(IsADirectoryError, match=r"is a folder; give a file name: '.*results'") as caught:
         write_mot(folder, np.array([[1, 1, 0, 0, 5, 5, 1, -1, -1, -1.0]]))
     assert ".tmp" not in str(caught.value) and list(tmp_path.iterdir()) == [folder] and not any(folder.iterdir())
+
+
+def test_track_output_ending_in_a_slash_is_a_folder_not_a_file(tmp_path):
+    """``-o newdir/`` for one det.txt wrote a file named ``newdir`` (the option parser dropped the slash)."""
+    det = tmp_path / "det.txt"
+    det.write_text("".join(DET_ROW.format(f=f, x=10 + f) for f in range(1, 6)))
+    r = runner.invoke(app, ["track", str(det), "-o", f"{tmp_path / 'newdir'}/"])
+    assert r.exit_code == 2 and r.output.startswith("error: -o/--output") and "ends in '/'" in r.output, r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["det.txt"]
+    sequences = tmp_path / "seqs"
+    (sequences / "S1" / "det").mkdir(parents=True)
+    det.replace(sequences / "S1" / "det" / "det.txt")
+    r = runner.invoke(app, ["track", str(sequences), "-o", f"{tmp_path / 'res'}/"])  # a folder of sequences: fine
+    assert r.exit_code == 0, r.output
+    assert [p.name for p in (tmp_path / "res").iterdir()] == ["S1.txt"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -46,7 +47,8 @@ def track(
     path: Path | None = typer.Argument(
         None, help="det.txt, a sequence folder, or a folder of sequences (with --video: the det.txt)."
     ),
-    output: Path = typer.Option(..., "-o", "--output", help="Result file (single det.txt or --video) or folder."),
+    output: str = typer.Option(..., "-o", "--output", metavar="PATH",
+                               help="Result file (single det.txt or --video) or folder."),
     tracker: str = typer.Option("sort", "--tracker", "-t", help="Registered tracker name (with --pipeline or --bag: "
                                 "an identifier, default set)."),
     set_: list[str] | None = typer.Option(
@@ -113,11 +115,12 @@ def track(
     seconds: float | None = typer.Option(None, "--seconds", min=0.0, help="Live --video: stop after S seconds."),
 ) -> None:
     """Run a tracker over MOTChallenge detections and write MOTChallenge results (on a video with --video)."""
-    request = TrackRequest(output, tracker, path, video_arg, detections, points, bag, detector, blob or [], pipeline,
-                           reports, annotate, save_detections, targets, offline_opt,
+    request = TrackRequest(Path(output), tracker, path, video_arg, detections, points, bag, detector, blob or [],
+                           pipeline, reports, annotate, save_detections, targets, offline_opt,
                            max_frames, seconds, set_ or [], params_file, min_score, fps,
                            features, team_size, health_window, det_format, not no_seqinfo_length, detector_model,
-                           heading_model, camera_topic, heading_topics)
+                           heading_model, camera_topic, heading_topics,
+                           output_folder=output.endswith(("/", os.sep)))
     try:
         _run(request)
     except OSError as exc:  # an output that cannot be written, an input that cannot be read

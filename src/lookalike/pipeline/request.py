@@ -19,7 +19,8 @@ class TrackRequest:
     appearance ``features``, the health checks' ``team_size`` (None: ``targets``) and ``health_window`` (frames),
     the detection files' ``det_format`` and whether seqinfo.ini's seqLength bounds them (``use_length``); for robots
     from pixels the ``detector_model`` and ``heading_model`` (None: shipped), and a bag's ``camera_topic`` and
-    comma-separated ``heading_topics``. Every check raises ``ValueError`` naming the options."""
+    comma-separated ``heading_topics``; ``output_folder``: the output was given ending in ``/`` (a folder, which
+    only a folder of sequences is tracked into). Every check raises ``ValueError`` naming the options."""
 
     output: Path
     tracker: str = "sort"
@@ -51,6 +52,7 @@ class TrackRequest:
     heading_model: Path | None = None
     camera_topic: str | None = None
     heading_topics: str | None = None
+    output_folder: bool = False
 
     @property
     def video_path(self) -> Path | None:
@@ -77,6 +79,10 @@ class TrackRequest:
     def branch(self) -> str:
         """Which branch the options select: ``pipeline``, ``points``, ``blobs``, ``video`` or ``files``."""
         branch = self._branch()
+        if self.output_folder and not (branch == "files" and self.path is not None and self.path.is_dir()):
+            what = "a single detection file" if branch == "files" else "this input"
+            raise ValueError(f"-o/--output {self.output}/: a folder (it ends in '/'), but {what} is tracked into one "
+                             f"result file; give a file name, e.g. {self.output / 'tracks.txt'} (nothing was written)")
         if self.features != "video" and branch not in ("video", "blobs"):
             raise ValueError(f"--features {self.features}: only with --video (features come from the pixels)")
         return branch
