@@ -377,3 +377,18 @@ def test_an_interrupted_robot_scene_keeps_the_earlier_video(tmp_path):
                         render_width=64, scale=1, advance=advance)
     assert (tmp_path / "robots.mp4").read_bytes() == b"earlier video"
     assert not (tmp_path / "robots.gif").exists() and not list(tmp_path.glob(".*"))
+
+
+def test_an_interrupted_merges_csv_leaves_the_earlier_file_whole(tmp_path):
+    from lookalike.viz.video_tracking import write_merges_csv
+
+    path = write_merges_csv(tmp_path / "res.merges.csv", [(3, 1, 2)])
+    before = path.read_text()
+
+    def rows():
+        yield (4, 5, 6)
+        raise KeyboardInterrupt  # Ctrl-C halfway through the rows
+
+    with pytest.raises(KeyboardInterrupt):
+        write_merges_csv(path, rows())
+    assert path.read_text() == before and [p.name for p in tmp_path.iterdir()] == ["res.merges.csv"]

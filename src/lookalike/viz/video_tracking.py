@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from lookalike._optional import needs
+from lookalike.io.outputs import atomic_path
 from lookalike.trackers.parts.health import (
     HEALTH_CSV_HEADER,
     HealthStatus,
@@ -94,9 +95,10 @@ def write_health_csv(path: Path | str, statuses: list[HealthStatus]) -> Path:
 
 
 def _write_csv(path: Path | str, header: Any, rows: Any) -> Path:
+    """Write ``header`` and ``rows`` through :func:`~lookalike.io.outputs.atomic_path` (an interrupted write leaves
+    the earlier file whole)."""
     p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
-    with p.open("w", newline="") as fh:
+    with atomic_path(p) as tmp, tmp.open("w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(header)
         w.writerows(rows)
