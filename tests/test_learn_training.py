@@ -129,3 +129,22 @@ def test_noise_mix_keeps_identity_swaps_for_our_protocol():
         assert np.array_equal(x0, x1) and np.array_equal(y0, y1)  # without swaps: the same sequences
         differs += not np.array_equal(swapped(seed, 300, np.random.default_rng([seed, 1]))[1], y0)
     assert differs > 0
+
+
+def test_a_run_killed_while_rewriting_its_log_keeps_the_earlier_log(tmp_path):
+    """The log was rewritten in place at every validation: a kill then left it cut short, the earlier rows lost."""
+    from lookalike.learn.training import _write_log
+
+    class Interrupting:
+        def __str__(self) -> str:
+            raise KeyboardInterrupt
+
+    log = tmp_path / "training_log.csv"
+    _write_log(log, [{"step": 1, "loss": 0.5, "val_success": 0.2}])
+    before = log.read_bytes()
+    with pytest.raises(KeyboardInterrupt):
+        _write_log(log, [{"step": 1, "loss": Interrupting(), "val_success": 0.2}])
+    assert log.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["training_log.csv"]
+    png = plot_log(log, tmp_path / "training_log.png")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["training_log.csv", "training_log.png"]

@@ -5,6 +5,7 @@ of their seeds, made ahead by a :class:`~lookalike.parallel.JobPool`."""
 from __future__ import annotations
 
 import csv
+import io
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -21,6 +22,7 @@ from lookalike.learn.model import AssociationNet
 from lookalike.parallel import JobPool
 from lookalike.trackers.lstm.checkpoint import NetworkWeights, save_weights
 from lookalike.trackers.lstm.encoding import EncodingSpec
+from lookalike.trackers.parts.weights_io import replace_file, write_bytes
 
 with needs("torch"):
     import torch
@@ -211,10 +213,13 @@ def train(config: TrainConfig, sample: Sampler, out_dir: str | Path, resume: boo
 
 
 def _write_log(path: Path, history: list[dict]) -> None:
-    with path.open("w", newline="") as fh:
-        writer = csv.DictWriter(fh, fieldnames=list(history[0]))
-        writer.writeheader()
-        writer.writerows(history)
+    """Write the whole ``history`` to ``path`` through a temporary file renamed into place (a run killed while
+    writing it keeps the earlier log whole)."""
+    text = io.StringIO(newline="")
+    writer = csv.DictWriter(text, fieldnames=list(history[0]))
+    writer.writeheader()
+    writer.writerows(history)
+    write_bytes(path, text.getvalue().encode())
 
 
 def plot_log(log_path: str | Path, png_path: str | Path) -> Path:
@@ -238,6 +243,6 @@ def plot_log(log_path: str | Path, png_path: str | Path) -> Path:
     ax2.set_ylabel("validation success rate (%)")
     fig.legend(loc="upper right")
     fig.tight_layout()
-    fig.savefig(png_path, dpi=100)
+    replace_file(Path(png_path), lambda f: fig.savefig(f, dpi=100, format="png"))
     plt.close(fig)
     return Path(png_path)
