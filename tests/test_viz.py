@@ -392,3 +392,20 @@ def test_an_interrupted_merges_csv_leaves_the_earlier_file_whole(tmp_path):
     with pytest.raises(KeyboardInterrupt):
         write_merges_csv(path, rows())
     assert path.read_text() == before and [p.name for p in tmp_path.iterdir()] == ["res.merges.csv"]
+
+
+def test_an_interrupted_plot_leaves_the_earlier_png_whole(tmp_path, monkeypatch):
+    from matplotlib.figure import Figure
+
+    rows = [{"S": "a", "T": "x", "V": 50.0}, {"S": "b", "T": "x", "V": 10.0}]
+    path = grouped_bar_chart(tmp_path / "g.png", rows, "S", "T", "V")
+    before = path.read_bytes()
+
+    def cut_short(self, fname, **kwargs):
+        Path(fname).write_bytes(before[:100])  # part of a PNG, then Ctrl-C
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Figure, "savefig", cut_short)
+    with pytest.raises(KeyboardInterrupt):
+        grouped_bar_chart(path, rows, "S", "T", "V")
+    assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["g.png"]

@@ -12,6 +12,7 @@ import numpy as np
 
 from lookalike.bench.tables import pyplot
 from lookalike.eval.api import combine, evaluate_sequence
+from lookalike.io.outputs import atomic_path
 from lookalike.io.results import Results
 from lookalike.sim.divers import SCENARIOS, detection_quality, scenario
 from lookalike.sim.divers_paper import redraw, with_detections
@@ -146,8 +147,8 @@ def bar_chart(rows: list[dict[str, Any]], path: Path) -> Path:
     ax.set_ylim(0, 100)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120, format="png")  # --png: a PNG whatever the name (matplotlib would add .png)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=120, format="png")  # --png: a PNG whatever the name (matplotlib would add .png)
     plt.close(fig)
     return path
 

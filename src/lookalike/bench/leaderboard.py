@@ -14,6 +14,7 @@ from lookalike.bench.progress import ProgressFactory, no_progress
 from lookalike.bench.runner import Entry, job_pairs, run_jobs
 from lookalike.bench.tables import pyplot
 from lookalike.eval import combine
+from lookalike.io.outputs import atomic_path
 from lookalike.io.results import Results
 
 COLUMNS = ("Dataset", "Tracker", "HOTA", "IDF1", "MOTA", "IDSW", "Frames/s", "Rank")
@@ -165,7 +166,8 @@ def plot_leaderboard(rows: list[dict[str, Any]], folder: Path) -> list[Path]:
         ax.grid(axis="y", alpha=0.3)
         fig.tight_layout()
         path = folder / f"bench_real_{dataset}.png"
-        fig.savefig(path, dpi=110)
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110, format="png")
         plt.close(fig)
         paths.append(path)
     return paths

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from lookalike._optional import needs
+from lookalike.io.outputs import atomic_path
 from lookalike.viz.colors import identity_colour, rgb_hex
 
 
@@ -92,8 +93,10 @@ def grouped_bar_chart(path: Path | str, rows: Sequence[Mapping[str, Any]], group
 
 
 def _save(fig: Any, plt: Any, path: Path | str) -> Path:
+    """Save ``fig`` to ``path`` (in the format its suffix names, PNG without one) through
+    :func:`~lookalike.io.outputs.atomic_path`: an interrupted save leaves the earlier file whole."""
     out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=100)
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, dpi=100, format=out.suffix[1:].lower() or "png")
     plt.close(fig)
     return out
