@@ -409,3 +409,22 @@ def test_an_interrupted_plot_leaves_the_earlier_png_whole(tmp_path, monkeypatch)
     with pytest.raises(KeyboardInterrupt):
         grouped_bar_chart(path, rows, "S", "T", "V")
     assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["g.png"]
+
+
+def test_an_interrupted_still_leaves_the_earlier_png_whole(tmp_path, monkeypatch):
+    """The demos' ``-still.png`` was written in place by ``cv2.imwrite``."""
+    from lookalike.viz.video import write_png
+
+    path = write_png(tmp_path / "robots-still.png", np.full((20, 30, 3), 200, np.uint8))
+    before = path.read_bytes()
+    assert cv2.imread(str(path)).shape == (20, 30, 3)
+
+    def cut_short(self, data):
+        Path.write_text(self, "half")  # part of the image, then Ctrl-C
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Path, "write_bytes", cut_short)
+    with pytest.raises(KeyboardInterrupt):
+        write_png(path, np.zeros((20, 30, 3), np.uint8))
+    monkeypatch.undo()
+    assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["robots-still.png"]

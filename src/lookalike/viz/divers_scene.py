@@ -29,7 +29,7 @@ from lookalike.viz.annotate import (
     with_header,
 )
 from lookalike.viz.colors import BGR
-from lookalike.viz.video import VideoWriter
+from lookalike.viz.video import VideoWriter, write_png
 
 FALSE_TRACK: BGR = (40, 40, 235)  # red: a track on no diver
 MISSED: BGR = (255, 255, 255)  # white: a visible diver without a track
@@ -202,10 +202,7 @@ class _Clip:
         if self.video is not None:
             self.video.write(img)
         if j == self.start and self.still is not None:
-            with needs("cv2"):
-                import cv2
-
-            cv2.imwrite(str(self.still), img)
+            write_png(self.still, img)
 
 
 def _annotated(image: np.ndarray, k: int, gt_rows: np.ndarray, shown: list[Any], tails: Tails,

@@ -24,7 +24,7 @@ from lookalike.viz.annotate import LabelSpace, Tails, draw_box, draw_box_label, 
 from lookalike.viz.colors import identity_colour
 from lookalike.viz.plots import birdseye_plot
 from lookalike.viz.robot_pixels import render_robot_frames
-from lookalike.viz.video import VideoWriter
+from lookalike.viz.video import VideoWriter, write_png
 
 WRONG = (0, 0, 230)  # BGR red outline of a wrongly identified detection
 LEGEND = [("robot N (a colour per identity)", identity_colour(0), False),
@@ -133,7 +133,7 @@ def run_robot_scene(out_dir: Path, *, preset_name: str = "m5n3", frames: int = 3
                     warm], LEGEND)
                 video.write(img)
                 if k == start:  # the poster: the clip's first frame
-                    cv2.imwrite(str(files["still"]), img)
+                    write_png(files["still"], img)
             if advance is not None:
                 advance()
     truth_pos = seq.true_positions_visible()

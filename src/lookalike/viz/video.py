@@ -1,6 +1,6 @@
-"""Writing annotated videos and animated GIFs (reading videos: :mod:`lookalike.io.video_frames`). MP4s are H.264
-through PyAV (the ``viz`` extra) so browsers play them, else OpenCV's ``mp4v``; PyAV, OpenCV and Pillow are imported
-lazily."""
+"""Writing annotated videos, animated GIFs and still images (reading videos: :mod:`lookalike.io.video_frames`).
+MP4s are H.264 through PyAV (the ``viz`` extra) so browsers play them, else OpenCV's ``mp4v``; PyAV, OpenCV and
+Pillow are imported lazily."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from lookalike._optional import needs
-from lookalike.io.outputs import atomic_path
+from lookalike.io.outputs import atomic_path, write_atomic
 from lookalike.io.rules import temp_beside, write_target
 
 
@@ -172,3 +172,15 @@ def write_gif(path: Path | str, images: list[np.ndarray], fps: float) -> Path:
         frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:], duration=round(1000 / fps),
                        loop=0, optimize=False)
     return out
+
+
+def write_png(path: Path | str, image: np.ndarray) -> Path:
+    """A PNG of the BGR ``image``, whatever the name, through :func:`~lookalike.io.outputs.write_atomic` (interrupted:
+    no half-written image, an earlier one stays)."""
+    with needs("cv2"):
+        import cv2
+
+    done, data = cv2.imencode(".png", np.ascontiguousarray(image))
+    if not done:
+        raise ValueError(f"{path}: OpenCV cannot encode this image as PNG (shape {np.shape(image)})")
+    return write_atomic(path, data.tobytes())
