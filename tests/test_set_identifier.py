@@ -187,3 +187,17 @@ def test_copied_weights_replace_the_old_pair_whole_or_are_refused(tmp_path, monk
     weights_io.copy_weights(new, old)
     assert load_set_weights(old).pair == 10 and keep.read_bytes() != old.read_bytes()
     assert sorted(p.name for p in old.parent.iterdir()) == ["kept.npz", "set.json", "set.npz"]
+
+
+@pytest.mark.parametrize("mask", [0o022, 0o077])
+def test_saved_weights_follow_the_umask(tmp_path, mask):
+    """They were made with mkstemp's mode 0600 whatever the umask (unreadable to the group, shipped or not)."""
+    import stat
+
+    old = os.umask(mask)
+    try:
+        path = save_set_weights(random_weights(), tmp_path / "set.npz")
+    finally:
+        os.umask(old)
+    for p in (path, path.with_suffix(".json")):
+        assert stat.S_IMODE(p.stat().st_mode) == 0o666 & ~mask

@@ -10,13 +10,14 @@ import gzip
 import lzma
 import os
 import stat
-import tempfile
 import zlib
 from pathlib import Path
 from types import ModuleType
 from typing import TextIO
 
 import numpy as np
+
+from lookalike._files import temp_beside, user_mode
 
 MIN_GAP = 10_000  # frames: a jump up to this is always allowed
 GAP_FACTOR = 10  # ... and up to this times the largest frame number seen before it
@@ -125,35 +126,6 @@ def frame_problems(frames: np.ndarray, previous_max: float = 0.0, length: int | 
     prev = int(before[i])
     return i, (f"frame {int(f)} jumps {int(f) - prev} frames past frame {prev} (at most "
                f"max({MIN_GAP}, {GAP_FACTOR} x {prev}) allowed; is the frame number a typo?)")
-
-
-def user_mode() -> int:
-    """The mode a new file gets from ``open()``: ``0o666`` less the process umask."""
-    status = Path("/proc/self/status")
-    try:
-        for line in status.read_text().splitlines():
-            if line.startswith("Umask:"):
-                return 0o666 & ~int(line.split()[1], 8)
-    except (OSError, ValueError, IndexError):
-        pass
-    mask = os.umask(0o022)  # no other way to read it; restored at once
-    os.umask(mask)
-    return 0o666 & ~mask
-
-
-def temp_beside(path: Path) -> tuple[int, Path]:
-    """A new temporary file beside ``path`` (same folder and suffix, so that ``os.replace`` is atomic), with the mode
-    a file created by ``open()`` gets (:func:`user_mode`), not ``mkstemp``'s 0600."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".tmp{path.suffix}", dir=path.parent)
-    try:
-        os.fchmod(fd, user_mode())
-    except OSError:
-        pass  # a file system without modes
-    except BaseException:  # Ctrl-C or SIGTERM before the caller holds the file: it would be left behind
-        os.close(fd)
-        os.unlink(tmp)
-        raise
-    return fd, Path(tmp)
 
 
 def write_target(path: Path) -> Path:

@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 import uuid
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, BinaryIO
 
 import numpy as np
+
+from lookalike._files import temp_beside
 
 SAVE_ID = "save_id"
 """The array of the ``.npz`` and the field of the ``.json`` that mark the two files of one save."""
@@ -94,7 +95,7 @@ def write_bytes(target: Path, data: bytes) -> None:
 def replace_file(target: Path, write: Callable[[BinaryIO], object]) -> None:
     """Call ``write`` on a new temporary file beside ``target`` and rename it onto ``target``: a killed or failed
     ``write`` leaves the old ``target`` whole and no temporary file behind."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    fd, tmp = temp_beside(target)
     try:
         with os.fdopen(fd, "wb") as f:
             write(f)
