@@ -171,3 +171,29 @@ def test_stages_that_do_not_fit_are_refused(tmp_path, edit, problem):
 def test_a_cascade_needs_negatives(negatives):
     with pytest.raises(ValueError, match="negatives_per_stage .*must be >= 1"):
         CascadeConfig(negatives_per_stage=negatives)
+
+
+def test_an_interrupted_model_save_leaves_the_earlier_file_whole(tmp_path, monkeypatch):
+    """Model files (and the detection probability map) were written in place: a Ctrl-C mid-save left half an
+    archive under the model's name."""
+    from lookalike.vision.detection_probability import DetectionProbability
+    from lookalike.vision.model_file import load_model_file, save_model_file
+
+    path = save_model_file(tmp_path / "m.npz", "fmt", 1, {"k": 1}, {"a": np.arange(5.0)})
+    before = path.read_bytes()
+
+    def cut_short(file, *args, **kwargs):
+        file.write(before[:40])
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(np, "savez_compressed", cut_short)
+    with pytest.raises(KeyboardInterrupt):
+        save_model_file(path, "fmt", 1, {"k": 2}, {"a": np.arange(6.0)})
+    monkeypatch.undo()
+    assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["m.npz"]
+    assert load_model_file(path, "fmt", 1, "model")[0]["k"] == 1
+    DetectionProbability((0.0, 1.0), (0.1, 0.9)).save(tmp_path / "p.json")
+    (tmp_path / "p-earlier.json").hardlink_to(tmp_path / "p.json")  # a second name: kept if the save renames
+    DetectionProbability((0.0, 1.0), (0.2, 0.8)).save(tmp_path / "p.json")
+    assert DetectionProbability.load(tmp_path / "p-earlier.json").probability == (0.1, 0.9)
+    assert DetectionProbability.load(tmp_path / "p.json").probability == (0.2, 0.8)

@@ -10,6 +10,8 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.trackers.parts.weights_io import write_bytes
+
 SHIPPED_PROBABILITY = Path(__file__).resolve().parent / "models_data" / "robot_detection_probability.json"
 
 
@@ -37,9 +39,9 @@ class DetectionProbability:
         return np.interp(np.asarray(margins, float), np.asarray(self.margin), np.asarray(self.probability))
 
     def save(self, path: str | Path) -> None:
-        """Write the knots and ``fitted_on`` as JSON."""
+        """Write the knots and ``fitted_on`` as JSON, through a temporary file renamed into place."""
         doc = {"margin": list(self.margin), "probability": list(self.probability), "fitted_on": self.fitted_on}
-        Path(path).write_text(json.dumps(doc, indent=1) + "\n")
+        write_bytes(Path(path), (json.dumps(doc, indent=1) + "\n").encode())
 
     @classmethod
     def load(cls, path: str | Path) -> DetectionProbability:

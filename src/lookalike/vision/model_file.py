@@ -10,16 +10,18 @@ from typing import Any
 
 import numpy as np
 
+from lookalike.trackers.parts.weights_io import replace_file
+
 
 def save_model_file(path: str | Path, fmt: str, version: int, header: dict[str, Any],
                     arrays: dict[str, np.ndarray]) -> Path:
-    """Write ``header`` (plus ``format`` and ``version``) and ``arrays`` to ``path``."""
+    """Write ``header`` (plus ``format`` and ``version``) and ``arrays`` to ``path``, through a temporary file
+    renamed into place (an interrupted save leaves the earlier file whole)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     full = {"format": fmt, "version": version, **header}
-    with open(path, "wb") as fh:
-        payload: dict[str, Any] = {"header": np.array(json.dumps(full)), **arrays}
-        np.savez_compressed(fh, **payload)
+    payload: dict[str, Any] = {"header": np.array(json.dumps(full)), **arrays}
+    replace_file(path, lambda fh: np.savez_compressed(fh, **payload))
     return path
 
 
