@@ -162,6 +162,7 @@ def test_weights_save_killed_between_its_two_files_is_refused_not_mismatched(tmp
 
 
 def test_copied_weights_replace_the_old_pair_whole_or_are_refused(tmp_path, monkeypatch):
+    from lookalike import _files
     from lookalike.trackers.parts import weights_io
 
     old = save_set_weights(random_weights(seed=0), tmp_path / "old" / "set.npz")
@@ -176,8 +177,8 @@ def test_copied_weights_replace_the_old_pair_whole_or_are_refused(tmp_path, monk
             raise KeyboardInterrupt
         real(target, write)
 
-    real = weights_io.replace_file
-    monkeypatch.setattr(weights_io, "replace_file", killed_at_the_npz)
+    real = _files.replace_file
+    monkeypatch.setattr(_files, "replace_file", killed_at_the_npz)
     with pytest.raises(KeyboardInterrupt):
         weights_io.copy_weights(new, old)
     monkeypatch.undo()

@@ -1,12 +1,14 @@
-"""Temporary files beside an output, with the mode a file created by ``open()`` gets: the one helper of every layer
-that writes a file through a rename (:mod:`lookalike.io.outputs` for the outputs of the commands, the weights of
-:mod:`lookalike.trackers.parts.weights_io`)."""
+"""Files written through a temporary file beside them, renamed into place, with the mode a file created by ``open()``
+gets: the helpers of every layer that writes a file whole (:mod:`lookalike.io.outputs` for the outputs of the
+commands; the weights, models and training logs of the lower layers, which may not import ``io``)."""
 
 from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
+from typing import BinaryIO
 
 
 def user_mode() -> int:
@@ -36,3 +38,21 @@ def temp_beside(path: Path) -> tuple[int, Path]:
         os.unlink(tmp)
         raise
     return fd, Path(tmp)
+
+
+def write_bytes(target: Path, data: bytes) -> None:
+    """Write ``data`` to ``target`` through :func:`replace_file`."""
+    replace_file(target, lambda f: f.write(data))
+
+
+def replace_file(target: Path, write: Callable[[BinaryIO], object]) -> None:
+    """Call ``write`` on a new temporary file beside ``target`` and rename it onto ``target``: a killed or failed
+    ``write`` leaves the old ``target`` whole and no temporary file behind."""
+    fd, tmp = temp_beside(target)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

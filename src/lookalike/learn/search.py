@@ -14,11 +14,12 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._files import write_bytes
 from lookalike._optional import needs
 from lookalike.learn.checkpoints import changed_settings
 from lookalike.parallel import JobPool
 from lookalike.sim import RobotWorldConfig
-from lookalike.trackers.parts.weights_io import copy_weights, write_bytes
+from lookalike.trackers.parts.weights_io import copy_weights
 
 SAMPLERS = ("tpe", "random")
 CHECK_SEED_BASE = 1_800_000_000  # held-out seeds that score the chosen network (neither training nor validation)

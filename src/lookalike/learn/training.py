@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from lookalike._files import replace_file, write_bytes
 from lookalike._optional import needs
 from lookalike.learn.checkpoints import changed_settings, load_checkpoint, save_checkpoint
 from lookalike.learn.data import IGNORE, success_rate
@@ -22,7 +23,6 @@ from lookalike.learn.model import AssociationNet
 from lookalike.parallel import JobPool
 from lookalike.trackers.lstm.checkpoint import NetworkWeights, save_weights
 from lookalike.trackers.lstm.encoding import EncodingSpec
-from lookalike.trackers.parts.weights_io import replace_file, write_bytes
 
 with needs("torch"):
     import torch

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.trackers.parts.weights_io import write_bytes
+from lookalike._files import write_bytes
 
 SHIPPED_PROBABILITY = Path(__file__).resolve().parent / "models_data" / "robot_detection_probability.json"
 

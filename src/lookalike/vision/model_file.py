@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from lookalike.trackers.parts.weights_io import replace_file
+from lookalike._files import replace_file
 
 
 def save_model_file(path: str | Path, fmt: str, version: int, header: dict[str, Any],

@@ -10,13 +10,12 @@ from __future__ import annotations
 import json
 import os
 import uuid
-from collections.abc import Callable
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any
 
 import numpy as np
 
-from lookalike._files import temp_beside
+from lookalike._files import replace_file, write_bytes
 
 SAVE_ID = "save_id"
 """The array of the ``.npz`` and the field of the ``.json`` that mark the two files of one save."""
@@ -85,21 +84,3 @@ def copy_weights(source: Path, target: Path) -> Path:
     for suffix in (".json", ".npz"):
         write_bytes(target.with_suffix(suffix), source.with_suffix(suffix).read_bytes())
     return target
-
-
-def write_bytes(target: Path, data: bytes) -> None:
-    """Write ``data`` to ``target`` through :func:`replace_file`."""
-    replace_file(target, lambda f: f.write(data))
-
-
-def replace_file(target: Path, write: Callable[[BinaryIO], object]) -> None:
-    """Call ``write`` on a new temporary file beside ``target`` and rename it onto ``target``: a killed or failed
-    ``write`` leaves the old ``target`` whole and no temporary file behind."""
-    fd, tmp = temp_beside(target)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            write(f)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
