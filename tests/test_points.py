@@ -40,7 +40,8 @@ def test_read_points_mot_points_and_box_centres(tmp_path: Path) -> None:
 @pytest.mark.parametrize("text, message", [
     ("frame,x,y\n1,2\n", ":2: expected at least 3"),
     ("1,2,3\n1,a,3\n", ":2: not a number"),
-    ("0,2,3\n", ":1: frame must be an integer >= 1"),
+    ("1,2,3\n0,2,3\n", ":2: frame must be an integer >= 1, got '0' \\(a file is read as 0-based only when its first"),
+    ("0,2,3\n-1,2,3\n", ":2: frame must be an integer >= 0, got '-1' \\(0-based frames"),
     ("1.5,2,3\n", ":1: frame must be"),
     ("1,nan,3\n", ":1: NaN"),
 ])
@@ -94,6 +95,35 @@ def test_eval_points_applies_metrics_and_refuses_box_options(tmp_path: Path) -> 
     for extra in (["--iou-threshold", "0.7"], ["--benchmark", "MOT17"]):
         r = CliRunner().invoke(app, [*args, *extra])
         assert r.exit_code == 2 and "are for boxes" in r.output, r.output
+
+
+HEXBUG = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "hexbug" / "training01.csv"
+
+
+def test_pandas_csv_with_named_columns_and_0_based_frames(tmp_path: Path) -> None:
+    """A header's named columns are read wherever they are (an unnamed index column skipped); frame 0 on the first
+    line makes the file 0-based, as for detection files. Was: refused at line 2, "frame must be >= 1, got '0'"."""
+    p = tmp_path / "bugs.csv"
+    p.write_text(",t,hexbug,x,y\n0,0,0,10.5,20\n1,0,1,30,40\n2,2,0,12,21\n")
+    f, i, xy = read_id_points(p)
+    assert f.tolist() == [1, 1, 3] and i.tolist() == [0, 1, 0] and xy.tolist() == [[10.5, 20], [30, 40], [12, 21]]
+    pf = read_points_csv(p)
+    assert [len(k) for k in pf.points] == [2, 0, 1] and pf.points[2].tolist() == [[12, 21]]
+    q = tmp_path / "bugs.txt"
+    q.write_text("y,x,frame\n1,2,1\n3,4,2\n")
+    assert read_points_mot(q).points[1].tolist() == [[4, 3]]
+    q.write_text("frame,x,y\n1,2,3\n")
+    with pytest.raises(ValueError, match="bugs.txt:1: the header names no id column"):
+        read_id_points(q)
+    q.write_text("frame,px,py\n1,7,2,3\n")  # columns past the header's names are taken by their place
+    assert read_points_mot(q).points[0].tolist() == [[2, 3]]
+    q.write_text("frame,id,x,y,w,h,conf\n1,3,10,20,4,6,0.9\n")  # x, y beside a box size: a box's corner
+    assert read_id_points(q)[2].tolist() == [[12, 23]]
+    if HEXBUG.is_file():  # a real pandas-written file, copied
+        real = tmp_path / "real.csv"
+        real.write_bytes(HEXBUG.read_bytes())
+        f, i, xy = read_id_points(real)
+        assert f.min() == 1 and len(read_points_csv(real)) == f.max() and set(i.tolist()) <= {0, 1, 2, 3}
 
 
 def test_read_id_points_centres_boxes(tmp_path: Path) -> None:

@@ -15,8 +15,8 @@ from lookalike.io.rules import DECOMPRESS_ERRORS, frame_problems, not_a_file, op
 from lookalike.types._validate import first_fraction
 from lookalike.types.mot_table import detection_rows
 
-__all__ = ["POINT_VEL_NOISE", "PointFrames", "points_to_rows", "read_id_points", "read_points_csv", "read_points_mot",
-           "rows_to_points", "typical_spacing", "typical_step"]
+__all__ = ["COLUMN_NAMES", "POINT_VEL_NOISE", "PointFrames", "points_to_rows", "read_id_points", "read_points_csv",
+           "read_points_mot", "rows_to_points", "typical_spacing", "typical_step"]
 
 # boxtrack's velocity noise (box sides per frame) for points as boxes, chosen on the simulated arenas of
 # benchmarks/closed_points.py, seeds 0-29 (docs/closed-set.md).
@@ -41,18 +41,74 @@ class PointFrames:
 
 MAX_COORDINATE = 1e9  # pixels: a point or box value beyond this (in absolute value) is an error naming its line
 
+# The header names each column of a points file is recognised by (case and quotes ignored); an unnamed column, as
+# pandas' index column, and any other name are columns skipped.
+COLUMN_NAMES: dict[str, tuple[str, ...]] = {
+    "frame": ("frame", "t", "frame_id", "frameid", "frame_no"),
+    "id": ("id", "track_id", "trackid", "object_id", "obj_id", "hexbug"),
+    "x": ("x",),
+    "y": ("y",),
+}
 
-def _parse(path: Path, columns: int, first_coordinate: int = 1,
-           keep: int | None = None) -> list[tuple[int, list[float]]]:
-    """``(line number, values)`` of the data lines (blank lines and one leading header skipped): at least ``columns``
-    values, at most ``keep`` (default ``columns``) read; values from ``first_coordinate`` on are pixels, at most
+_BOX_NAMES = {"w", "h", "width", "height", "bb_width", "bb_height"}  # a header naming one names boxes, not points
+
+
+def _header(path: Path) -> tuple[int, list[str]] | None:
+    """``(line number, lower-case names)`` of the header line of ``path`` (a first data line whose first field is no
+    number), else None."""
+    if not path.is_file():
+        return None
+    try:
+        with open_text(path, errors="replace") as fh:
+            lines = ((no, without_comment(line).strip()) for no, line in enumerate(fh, start=1))
+            first = next(((no, text) for no, text in lines if text), None)
+    except DECOMPRESS_ERRORS:
+        return None  # (reading the file again names the problem)
+    if first is None:
+        return None
+    no, fields = first[0], [f.strip() for f in first[1].split(",")]
+    try:
+        float(fields[0])
+        return None
+    except ValueError:
+        return no, [f.strip("\"'").lower() for f in fields]
+
+
+def _columns(path: Path, default: dict[str, int]) -> dict[str, int]:
+    """The column of each role in ``default`` (frame, id, x, y): the one a header names (:data:`COLUMN_NAMES`), else
+    the default one, unless the header leaves that unnamed or names it for another role (a ``ValueError`` naming the
+    header)."""
+    header = _header(path)
+    if header is None:
+        return default
+    no, names = header
+    named = {role: names.index(n) for role, aliases in COLUMN_NAMES.items()
+             for n in reversed(aliases) if n in names}
+    out = {}
+    for role, k in default.items():
+        if role in named:
+            out[role] = named[role]
+        elif k >= len(names) or (names[k] and names[k] not in {a for v in COLUMN_NAMES.values() for a in v}):
+            out[role] = k  # (a column past the header's names, or named otherwise: taken by its place)
+        else:
+            raise ValueError(f"{path}:{no}: the header names no {role} column (one of "
+                             f"{', '.join(COLUMN_NAMES[role])}) in {','.join(names)[:80]!r}")
+    return out
+
+
+def _parse(path: Path, picks: list[int], pixels: int, extra: tuple[int, ...] = ()) -> list[tuple[int, list[float]]]:
+    """``(line number, values)`` of the data lines (blank lines and one leading header skipped): the values of columns
+    ``picks`` (the first one the frame, 1-based; a file whose first frame is 0 is read as 0-based and shifted by 1),
+    then of the columns ``extra`` a line has; values from the ``pixels``-th on are pixels, at most
     :data:`MAX_COORDINATE` in absolute value."""
     if path.is_dir():
         raise ValueError(f"{path}: is a folder; expected a points file (frame,x,y CSV or MOTChallenge rows)")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
+    columns = max(picks) + 1
     out = []
     first = True
+    base: int | None = None  # the first frame's number: 0 for a 0-based file, else 1
     for no, line in enumerate(read_text(path).splitlines(), start=1):
         text = without_comment(line).strip()
         if not text:
@@ -68,16 +124,21 @@ def _parse(path: Path, columns: int, first_coordinate: int = 1,
             raise ValueError(f"{path}:{no}: expected at least {columns} comma-separated columns, got "
                              f"{len(fields)}: {text!r}")
         try:
-            values = [float(f) for f in fields[:keep or columns]]
+            values = [float(fields[k]) for k in (*picks, *(k for k in extra if k < len(fields)))]
         except ValueError:
             raise ValueError(f"{path}:{no}: not a number in {text!r}") from None
         if not all(math.isfinite(v) for v in values):
             raise ValueError(f"{path}:{no}: NaN or infinity in {text!r}")
-        if any(abs(v) > MAX_COORDINATE for v in values[first_coordinate:]):
+        if any(abs(v) > MAX_COORDINATE for v in values[pixels:]):
             raise ValueError(f"{path}:{no}: a coordinate beyond {MAX_COORDINATE:g} px in {text[:80]!r}")
         frame = values[0]
-        if frame < 1 or frame != int(frame):
-            raise ValueError(f"{path}:{no}: frame must be an integer >= 1, got {fields[0]!r}")
+        if base is None:
+            base = 0 if frame == 0 else 1
+        if frame < base or frame != int(frame):
+            why = (" (0-based frames: the first line is frame 0)" if base == 0 else
+                   " (a file is read as 0-based only when its first line is frame 0)" if frame == 0 else "")
+            raise ValueError(f"{path}:{no}: frame must be an integer >= {base}, got {fields[picks[0]]!r}{why}")
+        values[0] = frame + 1 - base
         out.append((no, values))
     problem = frame_problems(np.array([v[0] for _, v in out]))  # a stray huge frame number
     if problem is not None:
@@ -97,61 +158,50 @@ def _group(path: Path, frames: np.ndarray, xy: np.ndarray, n_frames: int | None)
     return PointFrames([xy[bounds[k]:bounds[k + 1]].copy() for k in range(length)], path)
 
 
-def _xy_columns(path: Path, default: tuple[int, int] = (1, 2)) -> tuple[int, int]:
-    """The columns of x and y in a points file: those its header names ``x`` and ``y`` (as ``frame,id,x,y``), else
-    ``default``."""
-    if not path.is_file():
-        return default
-    try:
-        with open_text(path, errors="replace") as fh:
-            text = next((t for t in map(str.strip, fh) if t and not t.startswith("#")), "")
-    except DECOMPRESS_ERRORS:
-        return default  # (reading the file again names the problem)
-    names = [f.strip().strip("\"'").lower() for f in text.split(",")]
-    if "x" in names and "y" in names and min(names.index("x"), names.index("y")) > 0:
-        return names.index("x"), names.index("y")
-    return default
-
-
 def read_points_csv(path: str | os.PathLike[str], n_frames: int | None = None) -> PointFrames:
-    """Points from a ``frame,x,y`` CSV (optional header; a header naming ``x`` and ``y`` elsewhere, as
-    ``frame,id,x,y``, picks those columns; extra columns ignored), padded to ``n_frames``."""
+    """Points from a ``frame,x,y`` CSV (optional header; a header naming the columns, as ``frame,id,x,y`` or
+    ``,t,hexbug,x,y``, picks them: :data:`COLUMN_NAMES`; extra columns ignored; 0-based when the first line is
+    frame 0), padded to ``n_frames``."""
     path = Path(path)
-    x, y = _xy_columns(path)
-    width = max(x, y, 2) + 1
-    parsed = _parse(path, width)
-    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, width)
-    return _group(path, data[:, 0].astype(int), data[:, [x, y]], n_frames)
+    c = _columns(path, {"frame": 0, "x": 1, "y": 2})
+    parsed = _parse(path, [c["frame"], c["x"], c["y"]], pixels=1)
+    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 3)
+    return _group(path, data[:, 0].astype(int), data[:, 1:3], n_frames)
 
 
 def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *,
                     centre: bool = False) -> PointFrames:
-    """Points from rows ``frame, id, x, y, ...`` (a header naming ``x`` and ``y`` elsewhere, as ``frame,x,y,area``,
-    picks those columns), or with ``centre=True`` the centres of MOTChallenge boxes."""
+    """Points from rows ``frame, id, x, y, ...`` (a header naming the columns, as ``frame,x,y,area``, picks them:
+    :data:`COLUMN_NAMES`), or with ``centre=True`` the centres of MOTChallenge boxes."""
     path = Path(path)
-    x, y = (2, 3) if centre else _xy_columns(path, (2, 3))
-    width = 6 if centre else max(x, y, 3) + 1
-    parsed = _parse(path, width, first_coordinate=min(x, y))
-    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, width)
-    if centre:
-        bad = np.flatnonzero((data[:, 4:6] < 0).any(axis=1))
-        if len(bad):
-            no = parsed[int(bad[0])][0]
-            raise ValueError(f"{path}:{no}: negative box size")
-        xy = data[:, 2:4] + data[:, 4:6] / 2
-    else:
-        xy = data[:, [x, y]]
-    return _group(path, data[:, 0].astype(int), xy, n_frames)
+    if not centre:
+        default = {"frame": 0, "x": 2, "y": 3} if _header(path) else {"frame": 0, "id": 1, "x": 2, "y": 3}
+        c = _columns(path, default)  # (an id is read, a number, only without a header, which may name none)
+        parsed = _parse(path, list(c.values()), pixels=len(c) - 2)
+        data = np.array([v for _, v in parsed], dtype=float).reshape(-1, len(c))
+        return _group(path, data[:, 0].astype(int), data[:, -2:], n_frames)
+    parsed = _parse(path, [0, 1, 2, 3, 4, 5], pixels=2)
+    data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 6)
+    bad = np.flatnonzero((data[:, 4:6] < 0).any(axis=1))
+    if len(bad):
+        raise ValueError(f"{path}:{parsed[int(bad[0])][0]}: negative box size")
+    return _group(path, data[:, 0].astype(int), data[:, 2:4] + data[:, 4:6] / 2, n_frames)
 
 
 def read_id_points(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(frame (n,), id (n,), xy (n, 2))`` of a ``frame,id,x,y`` file, or the box centres of MOTChallenge rows (7 or
-    more columns: ``frame,id,left,top,width,height,score,...``); ``ValueError`` naming the file and line of a bad
-    row."""
+    """``(frame (n,), id (n,), xy (n, 2))`` of a ``frame,id,x,y`` file (a header naming the columns, as
+    ``,t,hexbug,x,y``, picks them: :data:`COLUMN_NAMES`; 0-based when the first line is frame 0), or the box centres
+    of MOTChallenge rows (7 or more columns: ``frame,id,left,top,width,height,score,...``); ``ValueError`` naming the
+    file and line of a bad row."""
     path = Path(path)
     if not path.is_file():
         raise not_a_file(path)
-    parsed = _parse(path, 4, first_coordinate=2, keep=7)
+    names = set((_header(path) or (0, []))[1])
+    if {"x", "y"} <= names and not names & _BOX_NAMES:  # (x, y beside a box size: a box's corner, read as below)
+        c = _columns(path, {"frame": 0, "id": 1, "x": 2, "y": 3})
+        parsed = _parse(path, [c["frame"], c["id"], c["x"], c["y"]], pixels=2)
+    else:
+        parsed = _parse(path, [0, 1, 2, 3], pixels=2, extra=(4, 5, 6))
     if not parsed:
         return np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2))
     width = min(len(v) for _, v in parsed)
