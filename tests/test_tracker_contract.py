@@ -271,6 +271,21 @@ def test_a_frame_refused_for_an_unknown_agent_or_missing_columns_leaves_no_trace
     assert [_summary(f) for f in _run(refused, later)] == [_summary(f) for f in _run(untouched, later)]
 
 
+def test_a_frame_too_dense_for_jpda_leaves_no_trace() -> None:
+    """JPDA refuses a cluster beyond its exact methods before it predicts or moves its clock: the next frames give
+    what a tracker that never saw the refused frame gives."""
+    refused, untouched = make_tracker("jpda", max_events=1), make_tracker("jpda", max_events=1)
+    first = [_frame(k, kind=WORLD) for k in range(5)]
+    _run(refused, first)
+    _run(untouched, first)
+    crowd = np.column_stack([2.05 + 0.002 * np.arange(25), np.full(25, -1.2)])  # 25 detections on one track
+    dense = Detections(position=crowd, heading=np.zeros(25), score=np.full(25, 0.9))
+    with pytest.raises(ValueError, match="exceeds the exact methods' limits"):
+        refused.update(dataclasses.replace(_frame(5, kind=WORLD), detections=dense, time=5.5 / FPS))
+    later = [_frame(k, kind=WORLD) for k in range(5, 10)]
+    assert [_summary(f) for f in _run(refused, later)] == [_summary(f) for f in _run(untouched, later)]
+
+
 def _deep_size(root: object) -> int:
     """Bytes of everything reachable from ``root`` through attributes and containers (arrays with their data)."""
     skip = (type, types.ModuleType, types.FunctionType, types.BuiltinFunctionType, types.MethodType)

@@ -6,6 +6,7 @@ labels is found by the Hungarian method on ``1 - β`` (none below ``min_assignme
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from lookalike.trackers.base import COUNT, POSITIVE, UNIT, Range, param
 from lookalike.trackers.parts.world_rules import HeuristicsConfig, WorldRules, positions
 from lookalike.trackers.parts.world_tracker import H, WorldTracker
 from lookalike.trackers.registry import register_tracker
-from lookalike.types import Detections
+from lookalike.types import Detections, Frame, Tracks
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,16 @@ class JpdaConfig(HeuristicsConfig):
     max_events: int = param(5000, "joint events enumerated per cluster before the exact subset DP", range=COUNT)
 
 
+class _Marginals(NamedTuple):
+    """One frame's association: the tracks' projected positions ``z_hat (k, 2)`` and covariances ``S (k, 2, 2)``, the
+    marginals ``beta (k, m)`` and ``beta_miss (k,)``."""
+
+    z_hat: np.ndarray
+    S: np.ndarray
+    beta: np.ndarray
+    beta_miss: np.ndarray
+
+
 @register_tracker("jpda")
 class JpdaTracker(WorldTracker):
     """JPDA track maintenance with Kalman-HA2's lifecycle and the beacon identifier."""
@@ -40,6 +51,40 @@ class JpdaTracker(WorldTracker):
         self.jpda = config or JpdaConfig()
         super().__init__(self.jpda, WorldRules.from_config(self.jpda))
         self._explained = np.zeros(0)
+        self._pending: _Marginals | None = None  # this frame's association, found before anything changed
+
+    def update(self, frame: Frame) -> Tracks:
+        """As :meth:`WorldTracker.update`; a frame whose clusters exceed the exact methods' limits is refused
+        (``ValueError``) before anything changes."""
+        self._pending = self._frame_marginals(frame)
+        try:
+            return super().update(frame)
+        finally:
+            self._pending = None
+
+    def _frame_marginals(self, frame: Frame) -> _Marginals | None:
+        """The association of ``frame``'s detections with the tracks as :meth:`update` will predict them (None where
+        there is nothing to associate, or :meth:`update` refuses the frame for another reason)."""
+        det, t = frame.detections, self._tracks
+        dt = 0.0 if self._time is None else frame.time - self._time
+        if not len(t) or not len(det) or det.position is None or det.heading is None or dt < 0:
+            return None
+        mean, cov = self._predicted(t.mean.copy(), t.cov, dt) if dt != 0 else (t.mean, t.cov)
+        return self._marginals(mean, cov, det)
+
+    def _marginals(self, mean: np.ndarray, cov: np.ndarray, det: Detections) -> _Marginals:
+        """The projected tracks ``z_hat``, ``S`` and the JPDA marginals of tracks ``mean``, ``cov`` and ``det``."""
+        cfg = self.jpda
+        R = self._space.R(mean[:, :2])
+        z_hat, S = kalman.project(mean, cov, H, R)
+        d2 = kalman.gating_distance(mean, cov, positions(det), H, R)
+        d2 = np.where(d2 <= self._gate, d2, np.inf)
+        norm = 1.0 / (2 * np.pi * np.sqrt(np.linalg.det(S)))  # (k,)
+        likelihood = np.where(np.isfinite(d2), cfg.p_detection * norm[:, None] * np.exp(-0.5 * np.where(
+            np.isfinite(d2), d2, 0.0)) / cfg.clutter_density, 0.0)
+        p_gate = 1.0 - np.exp(-0.5 * self._gate)  # chi-square CDF with 2 dof
+        miss = np.full(len(mean), 1.0 - cfg.p_detection * p_gate)
+        return _Marginals(z_hat, S, *jpda_marginals(likelihood, miss, cfg.max_events))
 
     def _associate_and_update(self, det: Detections) -> np.ndarray:
         cfg, t = self.jpda, self._tracks
@@ -48,16 +93,8 @@ class JpdaTracker(WorldTracker):
         self._explained = np.zeros(m)
         if not k or not m:
             return det_of_track
-        R = self._space.R(t.mean[:, :2])
-        z_hat, S = kalman.project(t.mean, t.cov, H, R)
-        d2 = kalman.gating_distance(t.mean, t.cov, positions(det), H, R)
-        d2 = np.where(d2 <= self._gate, d2, np.inf)
-        norm = 1.0 / (2 * np.pi * np.sqrt(np.linalg.det(S)))  # (k,)
-        likelihood = np.where(np.isfinite(d2), cfg.p_detection * norm[:, None] * np.exp(-0.5 * np.where(
-            np.isfinite(d2), d2, 0.0)) / cfg.clutter_density, 0.0)
-        p_gate = 1.0 - np.exp(-0.5 * self._gate)  # chi-square CDF with 2 dof
-        miss = np.full(k, 1.0 - cfg.p_detection * p_gate)
-        beta, beta_miss = jpda_marginals(likelihood, miss, cfg.max_events)
+        pending = self._pending if self._pending is not None else self._marginals(t.mean, t.cov, det)
+        z_hat, S, beta, beta_miss = pending
         self._explained = beta.sum(axis=0)
         # Mixture-reduced update.
         nu = positions(det)[None, :, :] - z_hat[:, None, :]  # (k, m, 2)
