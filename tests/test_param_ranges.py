@@ -94,6 +94,15 @@ def test_make_tracker_names_the_tracker_parameter_and_expectation():
     assert make_tracker("sort", max_age=np.int64(3), iou_threshold=1).config.iou_threshold == 1
 
 
+def test_an_unknown_tracker_name_is_a_value_error_listing_the_known_ones():
+    """A bad name is bad input like a bad parameter: ``ValueError`` (still a ``KeyError``, as it was), its text the
+    plain message."""
+    for build in (make_tracker, tracker_class, tracker_parameters):
+        with pytest.raises(ValueError, match=r"^unknown tracker 'nosuch'; registered: .*\bsort\b") as info:
+            build("nosuch")
+        assert isinstance(info.value, KeyError)
+
+
 def test_parse_parameter_checks_the_range():
     assert parse_parameter("sort", "iou_threshold=0.5") == ("iou_threshold", 0.5)
     for text, message in (("iou_threshold=7", "out of range [0, 1]"), ("iou_threshold=nan", "finite"),

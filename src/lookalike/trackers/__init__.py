@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from lookalike.trackers.parts.health import HealthConfig, HealthMonitor, HealthStatus
     from lookalike.trackers.registry import (
         ParameterInfo,
+        UnknownTrackerError,
         make_tracker,
         register_tracker,
         tracker_class,
@@ -45,6 +46,7 @@ _HOME = {
     "tracker_class": "lookalike.trackers.registry",
     "tracker_names": "lookalike.trackers.registry",
     "tracker_parameters": "lookalike.trackers.registry",
+    "UnknownTrackerError": "lookalike.trackers.registry",
     "Sort": "lookalike.trackers.sort",
     "TrackStatus": "lookalike.types.tracks",
 }
@@ -67,6 +69,7 @@ __all__ = [
     "Sort",
     "TrackStatus",
     "Tracker",
+    "UnknownTrackerError",
     "make_tracker",
     "register_tracker",
     "tracker_class",

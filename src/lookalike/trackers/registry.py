@@ -14,6 +14,14 @@ if TYPE_CHECKING:
 _REGISTRY: dict[str, type] = {}
 
 
+class UnknownTrackerError(KeyError, ValueError):
+    """An unknown tracker name: a ``ValueError`` like every bad input, and still the ``KeyError`` it used to be. Its
+    text is the message itself (a ``KeyError`` alone would print it quoted)."""
+
+    def __str__(self) -> str:
+        return str(self.args[0]) if self.args else ""
+
+
 @dataclass(frozen=True)
 class ParameterInfo:
     """One tracker parameter: name, type name, default value, description and the values it allows
@@ -65,7 +73,8 @@ def tracker_names() -> list[str]:
 
 
 def tracker_class(name: str) -> type:
-    """The class registered under ``name``; unknown names raise ``KeyError`` listing the known ones.
+    """The class registered under ``name``; unknown names raise :class:`UnknownTrackerError` (a ``ValueError``, and a
+    ``KeyError``) listing the known ones.
     Only the module that registers ``name`` is imported (every one for an unknown name)."""
     if name not in _REGISTRY:
         module = BUILTIN_TRACKERS.get(name) or _plugin_entry_points().get(name)
@@ -78,7 +87,7 @@ def tracker_class(name: str) -> type:
     try:
         return _REGISTRY[name]
     except KeyError:
-        raise KeyError(f"unknown tracker {name!r}; registered: {', '.join(sorted(_REGISTRY))}") from None
+        raise UnknownTrackerError(f"unknown tracker {name!r}; registered: {', '.join(sorted(_REGISTRY))}") from None
 
 
 def _config_class(name: str) -> Any:
@@ -86,8 +95,8 @@ def _config_class(name: str) -> Any:
 
 
 def tracker_parameters(name: str) -> list[ParameterInfo]:
-    """The parameters of tracker ``name`` with their defaults and descriptions (``KeyError`` for an unknown
-    ``name``, as :func:`tracker_class`)."""
+    """The parameters of tracker ``name`` with their defaults and descriptions (:class:`UnknownTrackerError` for an
+    unknown ``name``, as :func:`tracker_class`)."""
     from lookalike.trackers.base import field_specs
 
     config_cls = _config_class(name)
@@ -101,7 +110,8 @@ def make_tracker(name: str, **params: Any) -> Any:
     """Build tracker ``name`` with config overrides; an unknown parameter, or a value outside its
     declared type, range or choices (:func:`~lookalike.trackers.base.param`), raises ``ValueError``
     (``TypeError`` for a wrong type) in one line naming the tracker and the parameter. An unknown
-    ``name`` raises ``KeyError`` listing the known ones (:func:`tracker_class`)."""
+    ``name`` raises :class:`UnknownTrackerError`, a ``ValueError`` (and a ``KeyError``), listing the known ones
+    (:func:`tracker_class`)."""
     from lookalike.trackers.base import check_value, field_specs
 
     config_cls = _config_class(name)
