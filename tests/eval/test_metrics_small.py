@@ -172,6 +172,18 @@ def test_similarities_refuse_rows_of_another_width() -> None:
     assert point_similarity(np.zeros(0), np.zeros((1, 2)), 1.0).shape == (0, 1)
 
 
+def test_similarities_refuse_nan_and_infinity_naming_the_row() -> None:
+    """A NaN box gave a NaN IoU (and a NaN point a NaN score) silently; now a ValueError names argument and row."""
+    from lookalike.eval import box_iou, point_similarity
+
+    with pytest.raises(ValueError, match=r"tr_xywh\[1\]: NaN or infinity in \[0.0, nan, 1.0, 1.0\]"):
+        box_iou(np.array([A]), np.array([A, [0, np.nan, 1, 1]]))
+    with pytest.raises(ValueError, match=r"gt_xywh\[0\]: NaN or infinity"):
+        box_iou(np.array([[0, 0, np.inf, 1]]), np.array([A]))
+    with pytest.raises(ValueError, match=r"gt_xy\[0\]: NaN or infinity"):
+        point_similarity(np.array([[np.nan, 0]]), np.zeros((1, 2)), 1.0)
+
+
 def test_points_refuse_frames_and_ids_that_are_not_whole() -> None:
     # frame 1.5 was truncated to frame 1 and id 2.7 to id 2: scored as if they were those
     with pytest.raises(ValueError, match=r"gt_frame\[0\]: 1.5 is not a whole number"):

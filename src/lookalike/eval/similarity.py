@@ -17,10 +17,19 @@ def rows_of(values: np.ndarray, width: int, name: str) -> np.ndarray:
     return a.reshape(-1, width)
 
 
+def _finite_rows(values: np.ndarray, width: int, name: str) -> np.ndarray:
+    """:func:`rows_of`, with a ``ValueError`` naming ``name`` and the first row holding NaN or infinity."""
+    a = rows_of(values, width, name)
+    bad = np.flatnonzero(~np.isfinite(a).all(axis=1))
+    if len(bad):
+        raise ValueError(f"{name}[{bad[0]}]: NaN or infinity in {a[bad[0]].tolist()}")
+    return a
+
+
 def box_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
     """IoU ``(n, m)`` of ``(n, 4)`` and ``(m, 4)`` xywh boxes (px); 0 for zero area or no union; ``ValueError`` naming
-    the argument of another shape."""
-    return _corner_iou(gt_xywh, tr_xywh, outer=True)
+    the argument of another shape, or the argument and row of a box with NaN or infinity."""
+    return _corner_iou(_finite_rows(gt_xywh, 4, "gt_xywh"), _finite_rows(tr_xywh, 4, "tr_xywh"), outer=True)
 
 
 def pair_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray) -> np.ndarray:
@@ -53,11 +62,11 @@ def _corner_iou(gt_xywh: np.ndarray, tr_xywh: np.ndarray, outer: bool) -> np.nda
 
 def point_similarity(gt_xy: np.ndarray, tr_xy: np.ndarray, radius: float) -> np.ndarray:
     """Distance score ``(n, m)`` of ``(n, 2)`` and ``(m, 2)`` points: ``max(0, 1 - d / (2 * radius))``; ``ValueError``
-    naming the argument of another shape."""
+    naming the argument of another shape, or the argument and row of a point with NaN or infinity."""
     if not radius > 0:
         raise ValueError(f"radius must be positive, got {radius}")
-    a = rows_of(gt_xy, 2, "gt_xy")
-    b = rows_of(tr_xy, 2, "tr_xy")
+    a = _finite_rows(gt_xy, 2, "gt_xy")
+    b = _finite_rows(tr_xy, 2, "tr_xy")
     d = np.sqrt(((a[:, None, :] - b[None, :, :]) ** 2).sum(axis=-1))
     result: np.ndarray = np.maximum(0.0, 1.0 - d / (2.0 * radius))
     return result
