@@ -33,7 +33,8 @@ def _pct(scores: dict[str, float]) -> str:
 def tune(
     data: list[str] | None = typer.Argument(
         None, help="Labelled data: MOTChallenge sequence folders (gt/gt.txt, det/det.txt, seqinfo.ini) or a folder "
-        "of them, and/or bench datasets by name (mot15, pigs, hexbug, mot17-synth...)."),
+        "of them, and/or bench datasets by name (mot15, pigs, hexbug, mot17-synth...); each one is a dataset, and "
+        "the criterion is the mean of the datasets' figures."),
     output: Path | None = typer.Option(None, "-o", "--output", help="Parameter file to write (JSON)."),
     tracker: str = typer.Option("boxtrack", "--tracker", "-t", help="Registered tracker name."),
     trials: int = typer.Option(50, "--trials", min=1, help="Trials in the study in all (a resumed study "
