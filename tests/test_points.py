@@ -126,6 +126,22 @@ def test_pandas_csv_with_named_columns_and_0_based_frames(tmp_path: Path) -> Non
         assert f.min() == 1 and len(read_points_csv(real)) == f.max() and set(i.tolist()) <= {0, 1, 2, 3}
 
 
+def test_track_points_says_it_read_a_0_based_file(tmp_path: Path) -> None:
+    """As for a 0-based detection file, `track --points` notes the 0-based frames; the results are 1-based."""
+    from typer.testing import CliRunner
+
+    from lookalike.cli import app
+
+    p, q, out = tmp_path / "p.csv", tmp_path / "q.csv", tmp_path / "out.txt"
+    p.write_text("t,x,y\n0,1,1\n0,50,50\n1,2,1\n1,51,50\n")
+    r = CliRunner().invoke(app, ["track", "--points", str(p), "-t", "boxtrack", "-o", str(out)])
+    assert r.exit_code == 0 and "p.csv: frames start at 0: read as 0-based" in r.output, r.output
+    assert {line.split(",")[0] for line in out.read_text().splitlines()} <= {"1", "2"}
+    q.write_text("t,x,y\n1,1,1\n1,50,50\n2,2,1\n")
+    r = CliRunner().invoke(app, ["track", "--points", str(q), "-t", "boxtrack", "-o", str(out)])
+    assert r.exit_code == 0 and "0-based" not in r.output, r.output
+
+
 def test_read_id_points_centres_boxes(tmp_path: Path) -> None:
     p = tmp_path / "res.txt"
     p.write_text("frame,id,x,y\n1,3,10,20\n")

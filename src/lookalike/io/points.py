@@ -25,10 +25,12 @@ POINT_VEL_NOISE = 0.02
 
 @dataclass(frozen=True, eq=False)
 class PointFrames:
-    """Anonymous points of a sequence: per frame (index = frame − 1) ``(n, 2)`` positions; ``path``: the file."""
+    """Anonymous points of a sequence: per frame (index = frame − 1) ``(n, 2)`` positions; ``path``: the file;
+    ``zero_based``: its frames started at 0 (file frame 0 is frame 1)."""
 
     points: list[np.ndarray]
     path: Path | None = None
+    zero_based: bool = False
 
     def __len__(self) -> int:
         return len(self.points)
@@ -96,11 +98,12 @@ def _columns(path: Path, default: dict[str, int]) -> dict[str, int]:
     return out
 
 
-def _parse(path: Path, picks: list[int], pixels: int, extra: tuple[int, ...] = ()) -> list[tuple[int, list[float]]]:
-    """``(line number, values)`` of the data lines (blank lines and one leading header skipped): the values of columns
-    ``picks`` (the first one the frame, 1-based; a file whose first frame is 0 is read as 0-based and shifted by 1),
-    then of the columns ``extra`` a line has; values from the ``pixels``-th on are pixels, at most
-    :data:`MAX_COORDINATE` in absolute value."""
+def _parse(path: Path, picks: list[int], pixels: int,
+           extra: tuple[int, ...] = ()) -> tuple[list[tuple[int, list[float]]], bool]:
+    """``(line number, values)`` of the data lines (blank lines and one leading header skipped), and whether the file
+    is 0-based: the values of columns ``picks`` (the first one the frame, 1-based; a file whose first frame is 0 is
+    read as 0-based and shifted by 1), then of the columns ``extra`` a line has; values from the ``pixels``-th on are
+    pixels, at most :data:`MAX_COORDINATE` in absolute value."""
     if path.is_dir():
         raise ValueError(f"{path}: is a folder; expected a points file (frame,x,y CSV or MOTChallenge rows)")
     if not path.is_file():
@@ -143,10 +146,10 @@ def _parse(path: Path, picks: list[int], pixels: int, extra: tuple[int, ...] = (
     problem = frame_problems(np.array([v[0] for _, v in out]))  # a stray huge frame number
     if problem is not None:
         raise ValueError(f"{path}:{out[problem[0]][0]}: invalid frame: {problem[1]}")
-    return out
+    return out, base == 0
 
 
-def _group(path: Path, frames: np.ndarray, xy: np.ndarray, n_frames: int | None) -> PointFrames:
+def _group(path: Path, frames: np.ndarray, xy: np.ndarray, n_frames: int | None, zero_based: bool) -> PointFrames:
     length = int(frames.max(initial=0))
     if n_frames is not None:
         if n_frames < length:
@@ -155,7 +158,7 @@ def _group(path: Path, frames: np.ndarray, xy: np.ndarray, n_frames: int | None)
     order = np.argsort(frames, kind="stable")
     frames, xy = frames[order], xy[order]
     bounds = np.searchsorted(frames, np.arange(1, length + 2))
-    return PointFrames([xy[bounds[k]:bounds[k + 1]].copy() for k in range(length)], path)
+    return PointFrames([xy[bounds[k]:bounds[k + 1]].copy() for k in range(length)], path, zero_based)
 
 
 def read_points_csv(path: str | os.PathLike[str], n_frames: int | None = None) -> PointFrames:
@@ -164,9 +167,9 @@ def read_points_csv(path: str | os.PathLike[str], n_frames: int | None = None) -
     frame 0), padded to ``n_frames``."""
     path = Path(path)
     c = _columns(path, {"frame": 0, "x": 1, "y": 2})
-    parsed = _parse(path, [c["frame"], c["x"], c["y"]], pixels=1)
+    parsed, zero = _parse(path, [c["frame"], c["x"], c["y"]], pixels=1)
     data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 3)
-    return _group(path, data[:, 0].astype(int), data[:, 1:3], n_frames)
+    return _group(path, data[:, 0].astype(int), data[:, 1:3], n_frames, zero)
 
 
 def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *,
@@ -177,15 +180,15 @@ def read_points_mot(path: str | os.PathLike[str], n_frames: int | None = None, *
     if not centre:
         default = {"frame": 0, "x": 2, "y": 3} if _header(path) else {"frame": 0, "id": 1, "x": 2, "y": 3}
         c = _columns(path, default)  # (an id is read, a number, only without a header, which may name none)
-        parsed = _parse(path, list(c.values()), pixels=len(c) - 2)
+        parsed, zero = _parse(path, list(c.values()), pixels=len(c) - 2)
         data = np.array([v for _, v in parsed], dtype=float).reshape(-1, len(c))
-        return _group(path, data[:, 0].astype(int), data[:, -2:], n_frames)
-    parsed = _parse(path, [0, 1, 2, 3, 4, 5], pixels=2)
+        return _group(path, data[:, 0].astype(int), data[:, -2:], n_frames, zero)
+    parsed, zero = _parse(path, [0, 1, 2, 3, 4, 5], pixels=2)
     data = np.array([v for _, v in parsed], dtype=float).reshape(-1, 6)
     bad = np.flatnonzero((data[:, 4:6] < 0).any(axis=1))
     if len(bad):
         raise ValueError(f"{path}:{parsed[int(bad[0])][0]}: negative box size")
-    return _group(path, data[:, 0].astype(int), data[:, 2:4] + data[:, 4:6] / 2, n_frames)
+    return _group(path, data[:, 0].astype(int), data[:, 2:4] + data[:, 4:6] / 2, n_frames, zero)
 
 
 def read_id_points(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -199,9 +202,9 @@ def read_id_points(path: str | os.PathLike[str]) -> tuple[np.ndarray, np.ndarray
     names = set((_header(path) or (0, []))[1])
     if {"x", "y"} <= names and not names & _BOX_NAMES:  # (x, y beside a box size: a box's corner, read as below)
         c = _columns(path, {"frame": 0, "id": 1, "x": 2, "y": 3})
-        parsed = _parse(path, [c["frame"], c["id"], c["x"], c["y"]], pixels=2)
+        parsed, _ = _parse(path, [c["frame"], c["id"], c["x"], c["y"]], pixels=2)
     else:
-        parsed = _parse(path, [0, 1, 2, 3], pixels=2, extra=(4, 5, 6))
+        parsed, _ = _parse(path, [0, 1, 2, 3], pixels=2, extra=(4, 5, 6))
     if not parsed:
         return np.zeros(0, int), np.zeros(0, int), np.zeros((0, 2))
     width = min(len(v) for _, v in parsed)

@@ -178,6 +178,7 @@ class PointBoxes:
     count: int
     spacing: float
     side: float
+    zero_based: bool = False
 
 
 def point_boxes(path: Path) -> PointBoxes:
@@ -191,7 +192,8 @@ def point_boxes(path: Path) -> PointBoxes:
                          "a frame are tracked")
     spacing = typical_spacing(points)
     det = points_to_rows(points)
-    return PointBoxes(det, len(points), points.count, spacing, float(det[0, 4]) if len(det) else 1.0)
+    return PointBoxes(det, len(points), points.count, spacing, float(det[0, 4]) if len(det) else 1.0,
+                      points.zero_based)
 
 
 def track_point_boxes(boxes: PointBoxes, output: Path, tracker: Any, frame_rate: float, n_targets: int | None = None,

@@ -225,6 +225,8 @@ def _points(request: TrackRequest, tracker: Any, params: dict[str, Any] | None, 
         raise ValueError(str(exc)) from exc
     why = f"half the typical spacing {boxes.spacing:.3g}" if boxes.spacing > 0 else \
         "one point a frame: twice the typical step"
+    if boxes.zero_based:
+        tell(Event("note", f"{points}: frames start at 0: read as 0-based (file frame 0 is the first frame)"))
     tell(Event("line", f"points: {boxes.count} in {boxes.frames} frames, boxes of {boxes.side:.3g} ({why}), "
                        f"{frame_rate:g} frames/s" + ("" if request.fps else " (--fps to change)")))
     rows = track_point_boxes(boxes, output, tracker, frame_rate, request.targets or None, params,
