@@ -439,7 +439,11 @@ def _run_team_recipe(page: str, tmp_path: Path, node_s: float) -> tuple[list[dic
     node = subprocess.Popen([str(bin_dir / "lookalike"), *args, "--duration", str(node_s)], cwd=tmp_path, env=env,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        script = team.text.replace("127.0.0.1:7700", f"127.0.0.1:{port}") + "\nwait\n"
+        # The start time T 40 s ahead instead of the page's 15-20 s: on a loaded 2-core machine loading the processes
+        # took longer, and a camera that starts late skips the frames before it (camera_frames_sent 57, not 301).
+        script = re.sub(r"\+ \d+ \)\)", "+ 40 ))", team.text.replace("127.0.0.1:7700", f"127.0.0.1:{port}"))
+        assert "+ 40 ))" in script
+        script += "\nwait\n"
         done = subprocess.run(["bash", "-c", script], cwd=tmp_path, env=env, capture_output=True, text=True,
                               timeout=node_s + 30)
     finally:
