@@ -194,9 +194,9 @@ def test_reports_built_outside_decode_are_still_validated():
     from lookalike.node import HeadingReport
 
     node = _node()
-    assert node.add_report(HeadingReport(robot=0, seq=0, t_sent=0.0, heading=math.nan)) == "reports"
-    with pytest.raises(ValueError, match="heading"):
-        node.add_frame(DetectionsMessage(frame=0, time=0.1, position=(), heading=(), score=()))
+    with pytest.raises(ValueError, match="heading"):  # (as it arrives: it never reaches a frame)
+        node.add_report(HeadingReport(robot=0, seq=0, t_sent=0.0, heading=math.nan))
+    assert node.add_frame(DetectionsMessage(frame=0, time=0.1, position=(), heading=(), score=()))[0] == "frames"
 
 
 @pytest.mark.parametrize("seed", range(10))

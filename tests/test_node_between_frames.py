@@ -136,9 +136,9 @@ def test_report_columns_equal_the_queues_also_after_drops() -> None:
 
 def test_reports_that_are_not_finite_still_meet_the_checks() -> None:
     ident = TeamIdentifier(_Recorder(), IdentifierConfig(n_robots=2))
-    assert ident.add_report(HeadingReport(robot=0, seq=1, t_sent=0.0, heading=math.nan)) == "reports"
-    with pytest.raises(ValueError, match="heading"):
-        ident.add_frame(_frame_message(1))
+    with pytest.raises(ValueError, match="heading"):  # (checked as it arrives, before it reaches a frame)
+        ident.add_report(HeadingReport(robot=0, seq=1, t_sent=0.0, heading=math.nan))
+    assert ident.queued == 0 and ident.add_frame(_frame_message(1))[0] == "frames"
 
 
 def test_counters_report_cpu_time_with_the_prepared_next_frame() -> None:

@@ -176,7 +176,16 @@ class NodeCore(abc.ABC):
 
     def handle_message(self, message: HeadingReport | DetectionsMessage, sender: Hashable,
                        t_received: float) -> None:
-        """Process one decoded report or frame of ``sender`` read at ``t_received`` (``time.perf_counter`` s)."""
+        """Process one decoded report or frame of ``sender`` read at ``t_received`` (``time.perf_counter`` s); one
+        outside the wire's bounds (made in Python, or from ROS 2) is counted under ``rejected`` and dropped."""
+        try:
+            self._handle_message(message, sender, t_received)
+        except MessageError as exc:
+            self.counters.reject(exc.reason)
+            log_event(self.log, "rejected", logging.DEBUG, sender=_show(sender), reason=exc.reason, detail=exc.detail)
+
+    def _handle_message(self, message: HeadingReport | DetectionsMessage, sender: Hashable,
+                        t_received: float) -> None:
         if isinstance(message, HeadingReport):
             dropped = self.identifier.queue_dropped
             outcome = self.identifier.add_report(message)
@@ -201,6 +210,8 @@ class NodeCore(abc.ABC):
         restarts, robot_resets = identifier.restarts, identifier.robot_resets
         try:
             outcome, team = identifier.add_frame(message)
+        except MessageError:
+            raise  # (a message outside the bounds: rejected, the camera unchanged)
         except Exception as exc:  # noqa: BLE001 (a tracker bug must not take the node down)
             self._camera, self._last_frame_wall = addr, time.monotonic()
             self.counters.add("tracker_errors")
