@@ -17,6 +17,7 @@ from lookalike.cli.track import build_tracker
 from lookalike.io.outputs import write_atomic
 from lookalike.io.sources import SignalStop
 from lookalike.node import Endpoint, IdentifierConfig, NodeConfig, NodeServer, TeamState, log_event, parse_address
+from lookalike.node.client import resolve_destination
 from lookalike.node.server import check_group, dds_node
 from lookalike.node.teamsim import SimClock, camera_messages, run_camera, run_robot, team_sequence
 from lookalike.sim.presets import PRESET_NAMES, TEAM_HELP, team_size
@@ -41,6 +42,12 @@ def _logger(level: str) -> logging.Logger:
 def _address(text: str, option: str) -> tuple[str, int]:
     with failing(ValueError, prefix=f"{option}: "):
         return parse_address(text)
+
+
+def _destination(text: str, option: str) -> tuple[str, int]:
+    """An address to send to, checked (port 1..65535, a host that resolves) before anything starts."""
+    with failing(ValueError, prefix=f"{option}: "):
+        return resolve_destination(parse_address(text))
 
 
 @app.command()
@@ -80,7 +87,7 @@ def serve(
     listen_address = _address(listen, "--listen")
     check_outputs_or_fail({"--port-file": port_file})
     group_address = _group(group)
-    publish_addresses = tuple(_address(p, "--publish") for p in publish or [])
+    publish_addresses = tuple(_destination(p, "--publish") for p in publish or [])
     settings = list(set_ or [])
     try:
         params = {p.name for p in tracker_parameters(tracker)}
@@ -173,11 +180,11 @@ def robot_sim(
 ) -> None:
     """A simulated robot: send heading reports to the node over a lossy, jittery link, receive
     the team state, and print the error of its identified position against its true one (JSON)."""
+    node_address, bind_address, group_address = _destination(node, "--node"), _address(bind, "--bind"), _group(group)
     sequence = _sequence(preset_name, seed, duration, loss, delay, jitter)
     if not 1 <= robot <= sequence.config.n_agents:
         fail(f"--robot {robot}: team {preset_name} has robots 1..{sequence.config.n_agents}")
     robot -= 1  # the wire protocol's 0-based id
-    node_address, bind_address, group_address = _address(node, "--node"), _address(bind, "--bind"), _group(group)
     with failing(OSError, prefix=f"--bind {bind} / --group {group}: "):
         endpoint = Endpoint(node_address, bind_address, group=group_address)
 
@@ -212,9 +219,10 @@ def camera_sim(
     first_frame: int = typer.Option(0, help="Start at this frame (to resume after a crash)."),
 ) -> None:
     """A simulated camera: send each frame's detections to the node at the camera rate."""
+    node_address = _destination(node, "--node")
     sequence = _sequence(preset_name, seed, duration, loss, delay, jitter)
     messages = camera_messages(sequence)[max(first_frame, 0):]
-    with Endpoint(_address(node, "--node")) as endpoint:
+    with Endpoint(node_address) as endpoint:
         clock = _clock(start_at, speed)
         start_s, late = clock.late_start("the camera") if first_frame <= 0 else (-math.inf, None)
         _warn(late)

@@ -11,14 +11,28 @@ from lookalike.node.messages import Message, MessageError, decode, encode
 Address = tuple[str, int]
 
 
+def resolve_destination(address: Address) -> Address:
+    """``address`` as the numeric IPv4 ``(host, port)`` to send to, looked up once; raises ``ValueError`` naming it for
+    port 0 or a host that does not resolve (sent to as given, a host name would be looked up for every datagram)."""
+    host, port = address
+    if not 0 < port <= 65535:
+        raise ValueError(f"address {host}:{port}: a destination needs a port in 1..65535")
+    try:
+        found = socket.getaddrinfo(host, port, socket.AF_INET, socket.SOCK_DGRAM)
+    except (OSError, UnicodeError) as exc:
+        raise ValueError(f"address {host}:{port}: the host does not resolve to an IPv4 address ({exc})") from None
+    return str(found[0][4][0]), port
+
+
 class Endpoint:
     """A UDP socket bound to ``bind`` (default: an ephemeral loopback port) that sends messages to ``peer`` and
     receives decoded ones; a context manager. With ``group`` (IPv4 multicast ``(address, port)`` joined on
-    ``interface``) a second socket receives the node's batched team states."""
+    ``interface``) a second socket receives the node's batched team states. A ``peer`` that is no destination
+    (:func:`resolve_destination`) raises ``ValueError``."""
 
     def __init__(self, peer: Address, bind: Address = ("127.0.0.1", 0), group: Address | None = None,
                  interface: str = "127.0.0.1") -> None:
-        self.peer = peer
+        self.peer = resolve_destination(peer)
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.group_sock: socket.socket | None = None
         self.selector = selectors.DefaultSelector()

@@ -15,6 +15,7 @@ from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 from typing import TypeVar
 
+from lookalike.node.client import resolve_destination
 from lookalike.node.counters import NodeCounters, log_event
 from lookalike.node.identifier import IdentifierConfig, TeamIdentifier
 from lookalike.node.messages import (
@@ -75,7 +76,7 @@ class NodeConfig:
 
     Attributes:
         listen: address to bind (port 0: an ephemeral port).
-        publish: addresses that receive every team state.
+        publish: addresses that receive every team state (host names are looked up once, when the node starts).
         reply_to_robots: also send each team state to each robot's address (when there is no ``group``).
         group: an IPv4 multicast ``(group, port)`` that receives each team state in place of the per-robot replies.
         group_interface: IPv4 address of the interface multicast leaves from (loopback by default).
@@ -276,6 +277,7 @@ class NodeServer(NodeCore):
                  identifier_config: IdentifierConfig | None = None,
                  logger: logging.Logger | None = None) -> None:
         super().__init__(tracker, config, identifier_config, logger)
+        self._targets = tuple(map(resolve_destination, self.config.publish))  # (ValueError: no destination)
         self.sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, self.config.recv_buffer_bytes)
@@ -351,7 +353,7 @@ class NodeServer(NodeCore):
         except ValueError as exc:
             log_event(self.log, "encode_error", logging.ERROR, frame=team.frame, error=str(exc))
             return
-        targets = list(self.config.publish)
+        targets = list(self._targets)
         if self.config.group is not None:
             targets.append(self.config.group)
         elif self.config.reply_to_robots:
