@@ -108,3 +108,28 @@ def test_a_late_start_is_warned_and_skips_what_was_due(sequence):
     assert log.warning().startswith("warning: robot 1 received no team state")
     log.errors_m.append(0.1)
     assert log.warning() is None
+
+
+class _Unreachable(_Recorder):
+    """An endpoint on a network that is down for every other message (the OS refuses the send)."""
+
+    def send(self, message):
+        if len(self.sent) % 2:
+            self.sent.append(None)
+            raise OSError(101, "Network is unreachable")
+        self.sent.append(message)
+
+
+def test_a_network_that_is_down_loses_messages_but_not_the_process(sequence):
+    """robot-sim and camera-sim go on when a send fails, as on a lossy link, and count what they could not send."""
+    clock = SimClock(epoch=time.time() - 5.5 / 1000.0, speed=1000.0)  # (everything is due: sent at once)
+    camera, failed = _Unreachable(), []
+    messages = camera_messages(sequence)
+    sent = run_camera(camera, messages, clock, on_send_error=failed.append)
+    assert sent + len(failed) == len(messages) and sent == len(messages) - len(messages) // 2
+    assert str(failed[0]) == "[Errno 101] Network is unreachable"
+    robot = _Unreachable()
+    log = run_robot(robot, 0, sequence, clock, linger_s=0.0)
+    assert log.reports_sent + log.send_errors == len(robot_reports(sequence, 0)) and log.send_errors > 0
+    assert log.summary()["send_errors"] == log.send_errors
+    assert "robot 1 could not send" in log.warning() and "Network is unreachable" in log.warning()

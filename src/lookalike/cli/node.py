@@ -226,6 +226,9 @@ def camera_sim(
         clock = _clock(start_at, speed)
         start_s, late = clock.late_start("the camera") if first_frame <= 0 else (-math.inf, None)
         _warn(late)
+        failed: list[OSError] = []
         with SignalStop() as stop:
-            sent = run_camera(endpoint, messages, clock, stop, start_s)
+            sent = run_camera(endpoint, messages, clock, stop, start_s, on_send_error=failed.append)
     print(json.dumps({"camera_frames_sent": sent}), flush=True)
+    if failed:
+        _warn(f"warning: the camera could not send {len(failed)} frames (first: {failed[0]})")

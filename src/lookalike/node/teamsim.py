@@ -90,41 +90,57 @@ def robot_reports(sequence: RobotSequence, robot: int) -> list[tuple[float, Head
 
 
 def run_camera(endpoint: Endpoint, messages: Sequence[DetectionsMessage], clock: SimClock,
-               stop: Callable[[], bool] = lambda: False, start_s: float = -math.inf) -> int:
-    """Send each frame at its simulated time, from simulated time ``start_s`` on; return how many were sent."""
+               stop: Callable[[], bool] = lambda: False, start_s: float = -math.inf,
+               on_send_error: Callable[[OSError], None] | None = None) -> int:
+    """Send each frame at its simulated time, from simulated time ``start_s`` on; return how many were sent. A frame
+    the OS refuses to send (e.g. the network is down) is lost, as on a lossy link, and given to ``on_send_error``."""
     sent = 0
     for message in messages:
         if message.time < start_s:
             continue
         if not clock.wait_until(message.time, stop):
             break
-        endpoint.send(message)
+        try:
+            endpoint.send(message)
+        except OSError as exc:
+            if on_send_error is not None:
+                on_send_error(exc)
+            continue
         sent += 1
     return sent
 
 
 @dataclass
 class RobotLog:
-    """What a simulated robot saw: reports sent, team states received, its position errors (metres)."""
+    """What a simulated robot saw: reports sent, reports the OS refused to send (the first error's text), team states
+    received, its position errors (metres)."""
 
     robot: int
     reports_sent: int = 0
     team_states: int = 0
     errors_m: list[float] = dataclasses.field(default_factory=list)
+    send_errors: int = 0
+    first_send_error: str | None = None
 
     def warning(self) -> str | None:
-        """A warning line when no team state gave this robot's position (its errors are then ``null``)."""
-        if self.errors_m:
-            return None
-        heard = "no team state" if self.team_states == 0 else f"{self.team_states} team states but none with it"
-        return (f"warning: robot {self.robot + 1} received {heard}: is the node running, and did the camera start "
-                f"at the same --start-at?")
+        """A warning line when no team state gave this robot's position (its errors are then ``null``), or when
+        reports could not be sent."""
+        lines = []
+        if self.send_errors:
+            lines.append(f"warning: robot {self.robot + 1} could not send {self.send_errors} reports (first: "
+                         f"{self.first_send_error})")
+        if not self.errors_m:
+            heard = "no team state" if self.team_states == 0 else f"{self.team_states} team states but none with it"
+            lines.append(f"warning: robot {self.robot + 1} received {heard}: is the node running, and did the camera "
+                         f"start at the same --start-at?")
+        return "\n".join(lines) or None
 
     def summary(self) -> dict[str, float | int | None]:
         """JSON-ready figures: counts, median and 95th-percentile position error in metres."""
         err = np.asarray(self.errors_m)
         return {
-            "robot": self.robot, "reports_sent": self.reports_sent, "team_states": self.team_states,
+            "robot": self.robot, "reports_sent": self.reports_sent, "send_errors": self.send_errors,
+            "team_states": self.team_states,
             "positions": int(err.size),
             "median_error_m": round(float(np.median(err)), 4) if err.size else None,
             "p95_error_m": round(float(np.percentile(err, 95)), 4) if err.size else None,
@@ -149,9 +165,14 @@ def run_robot(endpoint: Endpoint, robot: int, sequence: RobotSequence, clock: Si
         if now >= t_next:
             if i >= len(schedule):
                 break
-            endpoint.send(schedule[i][1])
-            log.reports_sent += 1
             i += 1
+            try:
+                endpoint.send(schedule[i - 1][1])
+            except OSError as exc:  # (the network is down: lost, as on a lossy link)
+                log.send_errors += 1
+                log.first_send_error = log.first_send_error or str(exc)
+                continue
+            log.reports_sent += 1
             continue
         message = endpoint.receive(min((t_next - now) / clock.speed, 0.05))
         if isinstance(message, TeamState):
