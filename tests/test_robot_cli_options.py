@@ -77,6 +77,15 @@ def test_serve_refuses_negative_or_nan_times(option):
     assert option[0].lstrip("-").split("-")[0] in result.output and "listening" not in result.output
 
 
+@pytest.mark.parametrize("option", [["--robots", "0"], ["--robots", "300"], ["--max-report-age", "0"],
+                                    ["--rate", "0"], ["--burst", "0.5"], ["--camera-timeout", "nan"],
+                                    ["--transport", "dds", "--domain-id", "999"]])
+def test_serve_names_the_option_of_a_value_out_of_range(option):
+    result = CliRunner().invoke(app, ["serve", "--listen", "127.0.0.1:0", "--duration", "0.1", *option])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert f"{option[-2]})" in result.output or f"{option[-2]}:" in result.output, result.output
+
+
 def test_train_refuses_a_bad_protocol_before_making_its_output_folder(tmp_path):
     pytest.importorskip("torch", reason="train needs the 'train' extra")
     result = CliRunner().invoke(app, ["train", "--steps", "1", "--protocol", "bogus", "-o", str(tmp_path / "run")])

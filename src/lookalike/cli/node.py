@@ -18,6 +18,7 @@ from lookalike.io.outputs import write_atomic
 from lookalike.io.sources import SignalStop
 from lookalike.node import Endpoint, IdentifierConfig, NodeConfig, NodeServer, TeamState, log_event, parse_address
 from lookalike.node.client import resolve_destination
+from lookalike.node.messages import MAX_ROBOTS
 from lookalike.node.server import check_group, dds_node
 from lookalike.node.teamsim import SimClock, camera_messages, run_camera, run_robot, team_sequence
 from lookalike.sim.presets import PRESET_NAMES, TEAM_HELP, team_size
@@ -84,6 +85,8 @@ def serve(
              "topics in --domain-id)")
     if not duration >= 0:
         fail(f"--duration: wall seconds >= 0 (0: until SIGINT/SIGTERM), got {duration}")
+    if not 1 <= robots <= MAX_ROBOTS:  # (before the tracker, which would name its n_agents instead)
+        fail(f"--robots: robots in the team, 1 .. {MAX_ROBOTS}, got {robots}")
     listen_address = _address(listen, "--listen")
     check_outputs_or_fail({"--port-file": port_file})
     group_address = _group(group)

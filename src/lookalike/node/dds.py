@@ -47,7 +47,7 @@ class DdsConfig:
 
     def __post_init__(self) -> None:
         if not 0 <= self.domain_id <= MAX_DOMAIN_ID:
-            raise ValueError(f"DDS domain id must be in 0 .. {MAX_DOMAIN_ID}, got {self.domain_id}")
+            raise ValueError(f"DDS domain id (--domain-id) must be in 0 .. {MAX_DOMAIN_ID}, got {self.domain_id}")
         if self.depth < 1:
             raise ValueError(f"depth must be >= 1, got {self.depth}")
 

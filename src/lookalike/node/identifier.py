@@ -56,10 +56,12 @@ class IdentifierConfig:
 
     def __post_init__(self) -> None:
         if not 1 <= self.n_robots <= MAX_ROBOTS:
-            raise ValueError(f"n_robots must be in 1 .. {MAX_ROBOTS}, got {self.n_robots}")
+            raise ValueError(f"IdentifierConfig.n_robots (--robots) must be in 1 .. {MAX_ROBOTS}, got {self.n_robots}")
         for name in ("max_report_age_s", "max_frame_jump_s", "max_report_ahead_s"):
             if not (getattr(self, name) > 0 and math.isfinite(getattr(self, name))):
-                raise ValueError(f"{name} must be a finite number > 0, got {getattr(self, name)}")
+                option = " (--max-report-age)" if name == "max_report_age_s" else ""
+                raise ValueError(f"IdentifierConfig.{name}{option} must be a finite number > 0, got "
+                                 f"{getattr(self, name)}")
         if self.max_queued_per_robot < 1 or self.max_queued < 1:
             raise ValueError(f"max_queued_per_robot and max_queued must be >= 1, got "
                              f"{self.max_queued_per_robot} and {self.max_queued}")

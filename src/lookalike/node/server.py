@@ -102,9 +102,10 @@ class NodeConfig:
     batch: int = 256
 
     def __post_init__(self) -> None:
-        for name in ("sender_rate", "sender_burst", "camera_timeout_s"):
+        for name, option in (("sender_rate", "--rate"), ("sender_burst", "--burst"),
+                             ("camera_timeout_s", "--camera-timeout")):
             if not getattr(self, name) > 0:
-                raise ValueError(f"NodeConfig.{name} must be > 0, got {getattr(self, name)}")
+                raise ValueError(f"NodeConfig.{name} ({option}) must be > 0, got {getattr(self, name)}")
         if not self.sender_burst >= 1:  # (a sender needs one whole token a packet: below 1 nothing passes)
             raise ValueError(f"NodeConfig.sender_burst (--burst) must be >= 1 packet, got {self.sender_burst:g}")
         if not self.status_interval_s >= 0:
