@@ -60,7 +60,7 @@ def test_track_pipeline_help_names_every_identifier():
 
 
 @pytest.mark.parametrize("option", [["--publish", "127.0.0.1:7800"], ["--group", "239.255.77.1:7701"],
-                                    ["--port-file", "port.txt"]])
+                                    ["--port-file", "port.txt"], ["--listen", "0.0.0.0:9000"], ["--no-reply"]])
 def test_serve_over_dds_refuses_udp_options(tmp_path, option):
     args = [option[0], str(tmp_path / option[1])] if option[0] == "--port-file" else option
     result = CliRunner().invoke(app, ["serve", "--transport", "dds", "--duration", "0.1", *args])

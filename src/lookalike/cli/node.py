@@ -51,13 +51,16 @@ def _destination(text: str, option: str) -> tuple[str, int]:
         return resolve_destination(parse_address(text))
 
 
+_LISTEN = "127.0.0.1:7700"
+
+
 @app.command()
 def serve(
     tracker: str = typer.Option("set", "--tracker", "-t", help="Registered tracker/identifier name (set: any team "
                                 "size; lstm: 2, 3 or 7 robots, or --set weights=PATH --set n_slots=M)."),
     set_: list[str] | None = typer.Option(None, "--set", "-s", help="Tracker parameter KEY=VALUE (repeatable)."),
     robots: int = typer.Option(3, help="Robots in the team (ids 0..N-1); also the tracker's n_agents unless set."),
-    listen: str = typer.Option("127.0.0.1:7700", help="HOST:PORT to receive reports and detections on (port 0: any)."),
+    listen: str = typer.Option(_LISTEN, help="HOST:PORT to receive reports and detections on (port 0: any)."),
     publish: list[str] | None = typer.Option(None, help="HOST:PORT that receives every team state (repeatable)."),
     reply: bool = typer.Option(True, help="Also send each team state to the address every robot reports from."),
     group: str | None = typer.Option(None, help="IPv4 multicast GROUP:PORT that gets each team state once "
@@ -78,8 +81,8 @@ def serve(
     """Run the observer node: receive heading reports and detections over UDP (or DDS), identify the
     robots with a tracker, publish their positions at the camera rate. Logs are JSON Lines on
     stderr; send a status_request message for the counters."""
-    udp_only = [name for name, value in (("--publish", publish), ("--group", group), ("--port-file", port_file))
-                if value]
+    udp_only = [name for name, value in (("--listen", listen != _LISTEN), ("--publish", publish), ("--group", group),
+                                         ("--no-reply", not reply), ("--port-file", port_file)) if value]
     if transport == "dds" and udp_only:
         fail(f"{', '.join(udp_only)}: with --transport udp only (over DDS the node has no addresses: it uses ROS 2 "
              "topics in --domain-id)")
