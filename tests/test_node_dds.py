@@ -147,3 +147,23 @@ def test_detections_and_identity_convert_both_ways():
     assert team.frame == 4 and team.time == 2.5 and team.labels == (-1, 2)
     assert team.robots[0].id == 2 and team.robots[0].position == (1.0, -2.0) and team.robots[0].confidence is None
     assert team.robots[0].heading == pytest.approx(0.5)
+
+
+def test_a_ros_frame_beyond_the_wire_bounds_is_invalid_and_a_peer_refuses_robots_outside_its_team():
+    """A Detection2DArray with a finite but enormous position converts, then is rejected as invalid before the
+    tracker sees it (it would break the set tracker for every later frame); robot -1 is not the last robot's topic."""
+    from lookalike.node import MessageError, TeamIdentifier
+    from lookalike.node import ros_types as t
+
+    pose = t.PoseWithCovariance(pose=t.Pose(t.Point(1e300, 0.0, 0.0), t.Quaternion(*quaternion(0.0))),
+                                covariance=[0.0] * 36)
+    array = t.Detection2DArray(header=t.Header(stamp=t.Time(*stamp(0.5))), detections=[t.Detection2D(
+        results=[t.ObjectHypothesisWithPose(hypothesis=t.ObjectHypothesis(score=0.9), pose=pose)])])
+    identifier = TeamIdentifier(_tracker(), IdentifierConfig(n_robots=3))
+    with pytest.raises(MessageError, match=r"detections.position\[0\]") as caught:
+        identifier.add_frame(detections_message(0, array))
+    assert caught.value.reason == "invalid" and identifier.last_frame is None
+    peer = DdsPeer(n_robots=3, config=DdsConfig(domain_id=_domain_id()))
+    for robot in (-1, 3):
+        with pytest.raises(ValueError, match=f"robot {robot}: this peer publishes robots 0 .. 2"):
+            peer.send(HeadingReport(robot=robot, seq=0, t_sent=0.1, heading=0.0))

@@ -276,9 +276,11 @@ class DdsPeer:
         return True
 
     def send(self, message: HeadingReport | DetectionsMessage) -> None:
-        """Publish a robot's heading or a camera frame."""
+        """Publish a robot's heading or a camera frame; a robot outside ``0 .. n_robots-1`` raises ``ValueError``."""
         types = self.types
         if isinstance(message, HeadingReport):
+            if not 0 <= message.robot < len(self._imu):  # (robot -1 would be the last robot's topic)
+                raise ValueError(f"robot {message.robot}: this peer publishes robots 0 .. {len(self._imu) - 1}")
             x, y, z, w = quaternion(message.heading)
             self._imu[message.robot].write(types.Imu(
                 header=types.Header(stamp=types.Time(*stamp(message.t_sent)), frame_id=f"robot_{message.robot}"),
