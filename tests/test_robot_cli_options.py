@@ -86,6 +86,14 @@ def test_serve_names_the_option_of_a_value_out_of_range(option):
     assert f"{option[-2]})" in result.output or f"{option[-2]}:" in result.output, result.output
 
 
+def test_serve_refuses_a_tracker_with_fewer_agents_than_robots():
+    """Robot 2's reports would make every frame a tracker error: the node would never publish."""
+    result = CliRunner().invoke(app, ["serve", "--listen", "127.0.0.1:0", "--duration", "0.1", "--robots", "3",
+                                      "--set", "n_agents=2"])
+    assert result.exit_code == 2 and isinstance(result.exception, SystemExit), result.output
+    assert "--set n_agents=2: fewer than --robots 3" in result.output and "listening" not in result.output
+
+
 def test_train_refuses_a_bad_protocol_before_making_its_output_folder(tmp_path):
     pytest.importorskip("torch", reason="train needs the 'train' extra")
     result = CliRunner().invoke(app, ["train", "--steps", "1", "--protocol", "bogus", "-o", str(tmp_path / "run")])

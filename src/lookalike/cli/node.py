@@ -99,9 +99,12 @@ def serve(
         params = {p.name for p in tracker_parameters(tracker)}
     except KeyError as exc:
         fail(str(exc.args[0]))
-    given = {s.split("=", 1)[0].strip() for s in settings}
+    given = {s.split("=", 1)[0].strip(): s.split("=", 1)[-1].strip() for s in settings}
     if "n_agents" in params and "n_agents" not in given:
         settings.append(f"n_agents={robots}")
+    elif given.get("n_agents", "").isdigit() and int(given["n_agents"]) < robots:
+        fail(f"--set n_agents={given['n_agents']}: fewer than --robots {robots}; every frame with a report of robot "
+             f"id {given['n_agents']} or more would fail (leave n_agents out: it follows --robots)")
     slots = {n: m for m, n, _ in map(team_size, PRESET_NAMES)}  # the shipped LSTMs' M per team size N
     if tracker == "lstm" and "n_slots" not in given and robots in slots:
         settings.append(f"n_slots={slots[robots]}")
