@@ -7,23 +7,17 @@ import math
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
-from itertools import chain
-from numbers import Integral, Real
 from typing import Any, TypeVar
 
 import numpy as np
 
 from lookalike.node.messages import (
-    INVALID,
-    MAX_ABS_NUMBER,
-    MAX_DETECTIONS,
-    MAX_INT,
     MAX_ROBOTS,
     DetectionsMessage,
     HeadingReport,
-    MessageError,
     RobotEstimate,
     TeamState,
+    check_bounds,
     numbers_of,
 )
 from lookalike.trackers.kernels.world import filled
@@ -94,7 +88,7 @@ class TeamIdentifier:
 
     def add_report(self, report: HeadingReport) -> str:
         """Queue ``report`` for the next frame, or say why it is dropped."""
-        _check_report(report)
+        check_bounds(report)
         j = report.robot
         if j >= self.config.n_robots:
             return "unknown_robot"
@@ -159,7 +153,7 @@ class TeamIdentifier:
     def add_frame(self, message: DetectionsMessage) -> tuple[str, TeamState | None]:
         """Track one camera frame with the reports queued since the previous one."""
         if numbers_of(message) is None:  # (``decode`` checked the others)
-            _check_frame(message)
+            check_bounds(message)
         if self.last_frame is not None:
             if message.frame == self.last_frame or message.time == self.last_time:
                 return "duplicate", None
@@ -311,50 +305,6 @@ def _trusted(cls: type[_T], **fields: Any) -> _T:
             value.flags.writeable = False
     obj.__dict__.update(fields)  # (the fields a frozen dataclass's __init__ sets, in one call)
     return obj
-
-
-def _check_report(report: HeadingReport) -> None:
-    """Raise ``MessageError(INVALID)`` unless ``report`` holds what ``decode`` lets through."""
-    for name in ("robot", "seq"):
-        _check_integer(f"report.{name}", getattr(report, name))
-    _check_number("report.t_sent", report.t_sent)
-    _check_number("report.heading", report.heading)
-
-
-def _check_frame(message: DetectionsMessage) -> None:
-    """Raise ``MessageError(INVALID)`` unless ``message`` (made in Python or from ROS 2) holds what ``decode`` lets
-    through: a tracker fed an enormous or non-finite number can stay broken for every later frame."""
-    _check_integer("detections.frame", message.frame)
-    _check_number("detections.time", message.time)
-    n = len(message.position)
-    if n > MAX_DETECTIONS:
-        raise MessageError(INVALID, f"detections.position has {n} entries, at most {MAX_DETECTIONS} allowed")
-    columns = {"heading": message.heading, "score": message.score}
-    if message.heading_std is not None:
-        columns["heading_std"] = message.heading_std
-    for name, column in columns.items():
-        if len(column) != n:
-            raise MessageError(INVALID, f"detections.{name} has {len(column)} entries, expected {n} (one a position)")
-    for i, pair in enumerate(message.position):
-        if len(pair) != 2:
-            raise MessageError(INVALID, f"detections.position[{i}] must be an (x, y) pair, got {len(pair)} values")
-    for i, value in enumerate(chain.from_iterable(message.position)):
-        _check_number(f"detections.position[{i // 2}]", value)
-    for name, column in columns.items():
-        for i, value in enumerate(column):
-            _check_number(f"detections.{name}[{i}]", value, 0.0 if name == "heading_std" else -MAX_ABS_NUMBER)
-
-
-def _check_integer(name: str, value: object) -> None:
-    if isinstance(value, bool) or not isinstance(value, Integral) or not 0 <= int(value) <= MAX_INT:
-        raise MessageError(INVALID, f"{name} must be an integer in 0 .. {MAX_INT}, got {value!r}")
-
-
-def _check_number(name: str, value: object, minimum: float = -MAX_ABS_NUMBER) -> None:
-    if isinstance(value, bool) or not isinstance(value, Real) or not (
-            minimum <= (int(value) if isinstance(value, Integral) else float(value)) <= MAX_ABS_NUMBER):
-        raise MessageError(INVALID, f"{name} must be a finite number in {minimum:g} .. {MAX_ABS_NUMBER:g}, got "
-                           f"{value!r}")
 
 
 def _plain_report(report: HeadingReport) -> bool:

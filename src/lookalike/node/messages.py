@@ -38,6 +38,7 @@ from lookalike.node.schema import (
 
 # (the messages and bounds are defined in lookalike.node.schema and importable from here too)
 __all__ = [
+    "check_bounds",
     "DetectionsMessage",
     "HeadingReport",
     "INVALID",
@@ -399,6 +400,33 @@ def _check_counters(f: _Fields, obj: dict[str, Any], where: str) -> None:
             _check_counters(f, value, f"{where}.{key}")
         elif value is not None:
             f._finite(f"{where}.{key}", value)
+
+
+
+def check_bounds(message: HeadingReport | DetectionsMessage) -> None:
+    """Raise ``MessageError(INVALID)`` naming the field unless ``message`` (made in Python, or converted from ROS 2)
+    holds what :func:`decode` lets through: its fields are checked by the wire's own parser (numpy numbers taken as
+    the Python numbers they hold)."""
+    kind = "report" if isinstance(message, HeadingReport) else "detections"
+    body = {name: _as_json(value) for name, value in vars(message).items()
+            if not name.startswith("_") and value is not None}
+    for name, value in body.items():  # (JSON has no NaN or infinity, so the parser's fast paths do not look for them)
+        if not _all_finite(value):
+            raise MessageError(INVALID, f"{kind}.{name} must hold finite numbers, got {_quote(value)}")
+    _PARSERS[kind](_Fields(kind, body))
+
+
+def _all_finite(value: Any) -> bool:
+    if isinstance(value, list):
+        return all(map(_all_finite, value))
+    return not isinstance(value, float) or math.isfinite(value)
+
+
+def _as_json(value: Any) -> Any:
+    """A field made in Python as JSON carries it: sequences as lists, numpy numbers as Python numbers."""
+    if isinstance(value, (tuple, list)):
+        return [_as_json(v) for v in value]
+    return value.item() if type(value).__module__ == "numpy" and hasattr(value, "item") else value
 
 
 _PARSERS: dict[str, Callable[[_Fields], Message]] = {
